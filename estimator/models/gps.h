@@ -1,0 +1,43 @@
+// GPS (or any absolute position logical sensor) with lever arm. Seed 000, eq. 9.
+//
+//   z_hat = O^(W) + q_O^W S^(O) + eta,      e = z_hat - z                    e, eta in R^3 [m]
+//
+// Frames: O^(W), q_O^W: pose of the odometric frame in the world W (East-North-Up at the recording's origin).
+// Measurement z: the antenna position in W [m] (latitude/longitude/altitude converted to ENU with
+// GeographicLib::LocalCartesian, see enu.h). Calibration: S^(O) = lever arm of the antenna in O [m] ("lever_arm").
+// Noise: eta ~ N(0, sigma^2 I), sigma [m].
+// Variables: pose at the nearest time stamp (PoseBlock), lever arm (Vector3Block).
+#pragma once
+
+#include <tuple>
+
+#include <Eigen/Core>
+
+#include "estimator/geometry.h"
+#include "estimator/manifold.h"
+
+namespace roamlab::estimator {
+
+class GpsError {
+ public:
+  using Blocks = std::tuple<PoseBlock, Vector3Block>;
+  static constexpr int kResidualDim = 3;
+  static constexpr int kNoiseDim = 3;
+
+  explicit GpsError(const Eigen::Vector3d& z_world) : z_world_(z_world) {}
+
+  template <typename T>
+  bool operator()(const T* const* x, const T* noise, T* error) const {
+    const Pose<T> pose = PoseFromArray(x[0]);
+    const Eigen::Map<const Vector3<T>> p_body_antenna(x[1]);
+    const Eigen::Map<const Vector3<T>> eta(noise);
+    Eigen::Map<Vector3<T>> e(error);
+    e = pose.p_world_body + pose.q_world_body * p_body_antenna + eta - z_world_.cast<T>();
+    return true;
+  }
+
+ private:
+  Eigen::Vector3d z_world_;
+};
+
+}  // namespace roamlab::estimator

@@ -1,0 +1,134 @@
+// The recording directory: one format for simulated and real data (DESIGN.md, "The recording directory").
+//
+//   REC/recording.yaml     format version, platform, origin (when GPS is present), one entry per stream, provenance
+//   REC/<stream>.csv       header row "t,<columns...>", first column time in seconds with nine fractional digits
+//   REC/ground_truth.tum   optional: "t x y z qx qy qz qw" of the odometric frame O in the world frame W
+//   REC/truth.yaml         simulated recordings only: true calibration and hidden effects (see truth.h). The reader in
+//                          this header never opens it; only evaluation does, through ReadTruth.
+//
+// Values are held in the canonical unit of each column (SI: m, rad, s; magnetometer in the unit the stream names).
+// The reader converts declared units (deg, deg/s, g, ticks) to the canonical ones; the writer writes canonical units.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "common/status.h"
+#include "common/time.h"
+#include "recording/trajectory.h"
+
+namespace roamlab::recording {
+
+inline constexpr int kFormatVersion = 1;
+
+// Stream types and their CSV columns (after "t"), in canonical units:
+//   imu              wx wy wz [rad/s] ax ay az [m/s^2]    specific force: at rest the up axis reads +9.81
+//   gyroscope        wx wy wz [rad/s]
+//   accelerometer    ax ay az [m/s^2]
+//   magnetometer     mx my mz [units: normalized | uT | nT | gauss, kept as given]
+//   gps              latitude longitude [deg] altitude [m, above the ellipsoid]
+//   position         x y z [m] absolute position of the sensor in W (SLAM, motion capture)
+//   pose             x y z [m] qx qy qz qw: absolute pose of the sensor in W
+//   wheel_encoders   one column per wheel, named in the stream entry; [rad] cumulative angle, [rad/s] angular speed
+//                    or [m/s] rim speed with the nominal radius (units: rad | rad/s | m/s | ticks, ticks -> rad)
+//   steering         angle [rad]
+//   odometry, visual_odometry, scan_matching
+//                    vx vy vz [m/s] wx wy wz [rad/s]: linear and angular velocity of the sensor, in the sensor frame
+//   camera           frame: image file name relative to the recording directory
+//   inputs           free columns named in the stream entry (control commands)
+enum class StreamType {
+  kImu,
+  kGyroscope,
+  kAccelerometer,
+  kMagnetometer,
+  kGps,
+  kPosition,
+  kPose,
+  kWheelEncoders,
+  kSteering,
+  kOdometry,
+  kVisualOdometry,
+  kScanMatching,
+  kCamera,
+  kInputs,
+};
+
+const char* StreamTypeName(StreamType type);
+std::optional<StreamType> ParseStreamType(const std::string& name);
+
+// Nominal mounting of a sensor frame S in the odometric frame O.
+struct Mounting {
+  Eigen::Vector3d p_body_sensor = Eigen::Vector3d::Zero();                // [m], lever arm S^(O)
+  Eigen::Quaterniond q_body_sensor = Eigen::Quaterniond::Identity();      // rotates S coordinates into O
+};
+
+struct StreamInfo {
+  std::string name;                     // unique; the CSV file is <name>.csv
+  StreamType type = StreamType::kInputs;
+  double rate_hz = 0.0;                 // nominal rate
+  std::vector<std::string> columns;     // after "t"; fixed by the type except wheel_encoders and inputs
+  std::string units;                    // as declared in recording.yaml (see the table above); empty = canonical
+  std::optional<Mounting> mounting;
+  std::map<std::string, double> noise;  // nominal noise, keys carry units, e.g. "sigma_m", "sigma_radps"
+  std::map<std::string, double> attributes;  // type-specific scalars, e.g. "ticks_per_revolution", "fx_px"
+};
+
+struct Stream {
+  StreamInfo info;
+  std::vector<Time> t;                  // strictly increasing
+  Eigen::MatrixXd values;               // rows = samples, columns = info.columns, canonical units
+  std::vector<std::string> text;        // camera only: one file name per row
+};
+
+struct Platform {
+  std::string kind;                          // "ackermann", "differential_drive", "omni3", "mecanum", "skid_steer", ...
+  std::map<std::string, double> geometry;    // nominal geometry, keys with units: "wheelbase_m", "track_m", ...
+};
+
+struct GeodeticOrigin {
+  double latitude_deg = 0.0;
+  double longitude_deg = 0.0;
+  double altitude_m = 0.0;
+};
+
+struct Provenance {
+  std::string source;                   // "simulated" or "imported"
+  std::string scenario;                 // scenario file, when simulated
+  std::optional<std::uint64_t> seed;    // when simulated
+  std::string description;              // free text: importer and original file, ...
+};
+
+struct Recording {
+  int format_version = kFormatVersion;
+  Platform platform;
+  std::optional<GeodeticOrigin> origin;  // required when a gps stream is present
+  std::vector<Stream> streams;
+  Provenance provenance;
+  std::optional<Trajectory> ground_truth;
+
+  const Stream* Find(const std::string& name) const;
+};
+
+struct ReadOptions {
+  // Streams that must be present (by name); a missing one is an error naming the stream.
+  std::vector<std::string> required_streams;
+  // Skip loading ground_truth.tum (the estimator does not need it).
+  bool load_ground_truth = true;
+};
+
+// Reads and validates REC. Errors name the file, the line (and column or key) and the problem: unknown or missing
+// keys, unknown stream type, unknown units, wrong column count or header, non-numeric cells, NaN/Inf, non-monotonic or
+// duplicate timestamps, missing required streams, missing files, a gps stream without origin.
+// Never opens truth.yaml.
+Result<Recording> ReadRecording(const std::string& directory, const ReadOptions& options = {});
+
+// Writes REC (creating the directory). Deterministic: the same Recording gives byte-identical files. Values are
+// printed with 17 significant digits, time with nine fractional digits. Does not write truth.yaml (see truth.h).
+Status WriteRecording(const Recording& recording, const std::string& directory);
+
+}  // namespace roamlab::recording

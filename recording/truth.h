@@ -1,0 +1,33 @@
+// truth.yaml: what only a simulator knows and only evaluation may read. The estimator and the gap diagnosis never call
+// ReadTruth (tests make the file unreadable to prove it).
+//
+//   calibration:            true values of calibration parameters, named "<stream>.<parameter>" as in calibration.json
+//     gps.lever_arm: [0.57, -0.46, 0.32]
+//     imu.misalignment: [w, x, y, z]          # quaternions w first, matrices row-major
+//   effects:                hidden physical effects, each with its parameters
+//     - name: gps_latency
+//       parameters: {latency_s: 0.12}
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "common/status.h"
+
+namespace roamlab::recording {
+
+struct Effect {
+  std::string name;
+  std::map<std::string, double> parameters;
+};
+
+struct Truth {
+  std::map<std::string, std::vector<double>> calibration;
+  std::vector<Effect> effects;
+};
+
+Result<Truth> ReadTruth(const std::string& directory);
+Status WriteTruth(const Truth& truth, const std::string& directory);
+
+}  // namespace roamlab::recording
