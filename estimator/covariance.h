@@ -1,0 +1,56 @@
+// Marginal covariances and observability (seed 000, Section III-D).
+//
+// The marginal information of a set of variables is the Schur complement of the Gauss-Newton Hessian onto them
+// (every other free variable marginalized out), at the graph's current estimate. Its inverse is their marginal
+// covariance, in tangent coordinates (geometry.h): [dp (m), dtheta (rad)] for poses, dtheta for quaternions.
+//
+// Observability of calibration parameters: the information is normalized to unit diagonal (each component's
+// information if all others were known), and eigen-decomposed.
+//  - unobservable: the component loads on a (numerically) null direction: the data cannot tell its value, the
+//    estimate means nothing and no standard deviation is reported;
+//  - weak: its variance is inflated more than `weak_inflation` times by its dependence on other parameters (the
+//    variance inflation factor), or its standard deviation exceeds `weak_std` when one is given;
+//  - observable otherwise.
+// Correlations come from a slightly regularized inverse so that dependent pairs (for example the magnetometer's A
+// against the IMU misalignment, eq. 10) show |rho| near 1 even when exactly dependent.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/status.h"
+#include "estimator/graph.h"
+
+namespace roamlab::estimator {
+
+struct MarginalInformation {
+  std::vector<VariableId> variables;
+  std::vector<int> offsets;       // of each variable in the matrix
+  Eigen::MatrixXd information;    // Schur complement, tangent coordinates
+};
+
+// Requires the listed variables to be free. Fails with a message if the rest of the problem is singular even after a
+// tiny regularization.
+Result<MarginalInformation> ComputeMarginalInformation(const Graph& graph, const std::vector<VariableId>& variables);
+
+enum class Observability { kObservable, kWeak, kUnobservable };
+const char* ObservabilityName(Observability observability);
+
+struct ObservabilityOptions {
+  double null_eigenvalue = 1e-9;     // normalized eigenvalues below this are null directions
+  double null_loading = 1e-2;        // a component whose squared loading on null directions exceeds this is unobservable
+  double weak_inflation = 100.0;     // variance inflation factor above which a component is weak
+};
+
+struct ObservabilityAnalysis {
+  Eigen::MatrixXd covariance;                 // pseudo-inverse of the information on its observable subspace
+  Eigen::VectorXd std;                        // per component; NaN when unobservable
+  Eigen::VectorXd inflation;                  // variance inflation factor per component (inf when unobservable)
+  std::vector<Observability> observability;   // per component
+  Eigen::MatrixXd correlation;                // from the regularized inverse
+};
+
+ObservabilityAnalysis AnalyzeObservability(const Eigen::MatrixXd& information, const ObservabilityOptions& options = {});
+
+}  // namespace roamlab::estimator

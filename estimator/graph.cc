@@ -1,0 +1,102 @@
+#include "estimator/graph.h"
+
+#include <algorithm>
+
+#include <Eigen/Cholesky>
+
+#include "common/check.h"
+
+namespace roamlab::estimator {
+
+VariableId Graph::AddVariable(Variable variable) {
+  ROAMLAB_CHECK(variable.value.size() == variable.manifold.ambient_dim(),
+                "variable '" << variable.name << "' has " << variable.value.size() << " values for manifold "
+                             << variable.manifold.Name());
+  const VariableId id = next_variable_++;
+  variables_.emplace(id, std::move(variable));
+  factors_of_[id];
+  return id;
+}
+
+FactorId Graph::AddFactor(std::unique_ptr<Factor> factor, std::vector<VariableId> variables,
+                          Eigen::MatrixXd noise_covariance, Loss loss, std::string stream, Time stamp) {
+  ROAMLAB_CHECK(factor != nullptr, "null factor");
+  ROAMLAB_CHECK(factor->manifolds().size() == variables.size(),
+                "factor from '" << stream << "' takes " << factor->manifolds().size() << " variables, got "
+                                << variables.size());
+  for (std::size_t i = 0; i < variables.size(); ++i) {
+    const Variable& v = variable(variables[i]);
+    ROAMLAB_CHECK(v.manifold == factor->manifolds()[i], "factor from '" << stream << "': variable " << i << " ('"
+                                                                         << v.name << "') is " << v.manifold.Name()
+                                                                         << ", expected "
+                                                                         << factor->manifolds()[i].Name());
+  }
+  ROAMLAB_CHECK(noise_covariance.rows() == factor->noise_dim() && noise_covariance.cols() == factor->noise_dim(),
+                "factor from '" << stream << "': noise covariance is " << noise_covariance.rows() << "x"
+                                << noise_covariance.cols() << ", expected " << factor->noise_dim());
+  ROAMLAB_CHECK(noise_covariance.isApprox(noise_covariance.transpose()) &&
+                    Eigen::LLT<Eigen::MatrixXd>(noise_covariance).info() == Eigen::Success,
+                "factor from '" << stream << "': noise covariance is not symmetric positive definite");
+  const FactorId id = next_factor_++;
+  for (VariableId v : variables) factors_of_[v].push_back(id);
+  FactorEntry entry;
+  entry.factor = std::move(factor);
+  entry.variables = std::move(variables);
+  entry.noise_covariance = std::move(noise_covariance);
+  entry.loss = loss;
+  entry.stream = std::move(stream);
+  entry.stamp = stamp;
+  factors_.emplace(id, std::move(entry));
+  return id;
+}
+
+void Graph::RemoveFactor(FactorId id) {
+  const auto it = factors_.find(id);
+  ROAMLAB_CHECK(it != factors_.end(), "no factor " << id);
+  for (VariableId v : it->second.variables) {
+    auto& list = factors_of_[v];
+    list.erase(std::remove(list.begin(), list.end(), id), list.end());
+  }
+  factors_.erase(it);
+}
+
+void Graph::RemoveVariable(VariableId id) {
+  const auto it = variables_.find(id);
+  ROAMLAB_CHECK(it != variables_.end(), "no variable " << id);
+  ROAMLAB_CHECK(factors_of_[id].empty(),
+                "variable '" << it->second.name << "' still has " << factors_of_[id].size() << " factors");
+  factors_of_.erase(id);
+  variables_.erase(it);
+}
+
+const Variable& Graph::variable(VariableId id) const {
+  const auto it = variables_.find(id);
+  ROAMLAB_CHECK(it != variables_.end(), "no variable " << id);
+  return it->second;
+}
+
+Variable& Graph::mutable_variable(VariableId id) {
+  const auto it = variables_.find(id);
+  ROAMLAB_CHECK(it != variables_.end(), "no variable " << id);
+  return it->second;
+}
+
+const FactorEntry& Graph::factor(FactorId id) const {
+  const auto it = factors_.find(id);
+  ROAMLAB_CHECK(it != factors_.end(), "no factor " << id);
+  return it->second;
+}
+
+FactorEntry& Graph::mutable_factor(FactorId id) {
+  const auto it = factors_.find(id);
+  ROAMLAB_CHECK(it != factors_.end(), "no factor " << id);
+  return it->second;
+}
+
+std::vector<FactorId> Graph::FactorsOf(VariableId id) const {
+  const auto it = factors_of_.find(id);
+  ROAMLAB_CHECK(it != factors_of_.end(), "no variable " << id);
+  return it->second;
+}
+
+}  // namespace roamlab::estimator

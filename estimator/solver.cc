@@ -1,0 +1,166 @@
+#include "estimator/solver.h"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "estimator/internal/normal_equations.h"
+
+namespace roamlab::estimator {
+
+std::string SolverOptions::Validate() const {
+  if (max_iterations < 0) return "max_iterations must be >= 0";
+  if (!(function_tolerance >= 0.0)) return "function_tolerance must be >= 0";
+  if (!(step_tolerance >= 0.0)) return "step_tolerance must be >= 0";
+  if (!(time_budget_s > 0.0)) return "time_budget_s must be > 0";
+  if (!(initial_lambda > 0.0)) return "initial_lambda must be > 0";
+  return "";
+}
+
+const char* TerminationName(Termination termination) {
+  switch (termination) {
+    case Termination::kFunctionTolerance: return "function_tolerance";
+    case Termination::kStepTolerance: return "step_tolerance";
+    case Termination::kMaxIterations: return "max_iterations";
+    case Termination::kTimeBudget: return "time_budget";
+    case Termination::kNoFreeVariables: return "no_free_variables";
+    case Termination::kFailure: return "failure";
+  }
+  return "unknown";
+}
+
+std::vector<VariableId> FreeVariableOrder(const Graph& graph) {
+  std::vector<VariableId> poses, others;
+  for (const auto& [id, v] : graph.variables()) {
+    if (v.fixed) continue;
+    (v.manifold.kind() == ManifoldKind::kPose ? poses : others).push_back(id);
+  }
+  poses.insert(poses.end(), others.begin(), others.end());
+  return poses;
+}
+
+namespace {
+
+double TangentNorm(const Graph& graph, const std::vector<VariableId>& order) {
+  double sq = 0.0;
+  for (VariableId id : order) {
+    const Variable& v = graph.variable(id);
+    if (v.manifold.kind() == ManifoldKind::kEuclidean) sq += v.value.squaredNorm();
+    if (v.manifold.kind() == ManifoldKind::kPose) sq += v.value.head<3>().squaredNorm();
+  }
+  return std::sqrt(sq);
+}
+
+}  // namespace
+
+SolverSummary Solve(const SolverOptions& options, Graph* graph) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  const auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
+  SolverSummary summary;
+  const std::string invalid = options.Validate();
+  if (!invalid.empty()) {
+    summary.message = "invalid solver options: " + invalid;
+    return summary;
+  }
+
+  const std::vector<VariableId> order = FreeVariableOrder(*graph);
+  internal::NormalEquations system(*graph, order);
+  summary.free_dimension = system.dimension();
+  summary.factors = static_cast<int>(system.factor_ids().size());
+  std::string failed_stream;
+  if (!system.Linearize(*graph, &failed_stream)) {
+    summary.message = "a factor from stream '" + failed_stream + "' could not be evaluated at the initial values";
+    return summary;
+  }
+  summary.initial_cost = summary.final_cost = system.cost();
+  summary.cost_history.push_back(system.cost());
+  if (order.empty()) {
+    summary.termination = Termination::kNoFreeVariables;
+    summary.seconds = elapsed();
+    return summary;
+  }
+
+  const bool lm = options.method == SolverOptions::Method::kLevenbergMarquardt;
+  double lambda = lm ? options.initial_lambda : 0.0;
+  double nu = 2.0;
+  summary.termination = Termination::kMaxIterations;
+  for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
+    if (elapsed() > options.time_budget_s) {
+      summary.termination = Termination::kTimeBudget;
+      break;
+    }
+    // Solve the damped system; raise the damping if the matrix is not positive definite.
+    Eigen::VectorXd dx;
+    bool solved = system.Solve(lambda, &dx);
+    for (int retry = 0; !solved && retry < 10; ++retry) {
+      lambda = std::max(lambda * 10.0, 1e-9);
+      solved = system.Solve(lambda, &dx);
+    }
+    if (!solved) {
+      summary.termination = Termination::kFailure;
+      summary.message = "normal equations are not positive definite even with damping";
+      break;
+    }
+    ++summary.iterations;
+
+    // Try the step on a copy of the free variables.
+    std::vector<Eigen::VectorXd> saved;
+    saved.reserve(order.size());
+    for (VariableId id : order) saved.push_back(graph->variable(id).value);
+    system.Update(dx, graph);
+    double new_cost = 0.0;
+    const bool evaluated = system.CostWithLastWhitening(*graph, &new_cost);
+    const double old_cost = system.cost();
+    const Eigen::VectorXd& g = system.gradient();
+    // Predicted decrease of the quadratic model: -g.dx - dx.H.dx / 2 (H through its upper triangle).
+    const Eigen::VectorXd Hdx = system.hessian_upper().selfadjointView<Eigen::Upper>() * dx;
+    const double predicted = -g.dot(dx) - 0.5 * dx.dot(Hdx);
+    const double actual = old_cost - new_cost;
+    const bool accept = evaluated && (lm ? (predicted > 0.0 && actual / predicted > 1e-3) : true);
+
+    if (!accept) {
+      for (std::size_t i = 0; i < order.size(); ++i) graph->mutable_variable(order[i]).value = saved[i];
+      if (!lm) {
+        summary.termination = Termination::kFailure;
+        summary.message = "Gauss-Newton step could not be evaluated";
+        break;
+      }
+      lambda *= nu;
+      nu *= 2.0;
+      if (lambda > 1e16) {
+        summary.termination = Termination::kFailure;
+        summary.message = "Levenberg-Marquardt damping exceeded 1e16 without a successful step";
+        break;
+      }
+      continue;
+    }
+    if (lm) {
+      const double rho = actual / predicted;
+      lambda *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
+      nu = 2.0;
+    }
+
+    // Relinearize at the new point (this also re-evaluates every error covariance, eq. 1).
+    if (!system.Linearize(*graph, &failed_stream)) {
+      summary.termination = Termination::kFailure;
+      summary.message = "a factor from stream '" + failed_stream + "' could not be evaluated";
+      break;
+    }
+    summary.cost_history.push_back(system.cost());
+    const double step_norm = dx.norm();
+    if (std::abs(actual) <= options.function_tolerance * old_cost) {
+      summary.termination = Termination::kFunctionTolerance;
+      break;
+    }
+    if (step_norm <= options.step_tolerance * (TangentNorm(*graph, order) + options.step_tolerance)) {
+      summary.termination = Termination::kStepTolerance;
+      break;
+    }
+  }
+  summary.final_cost = system.cost();
+  summary.seconds = elapsed();
+  return summary;
+}
+
+}  // namespace roamlab::estimator

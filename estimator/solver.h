@@ -1,0 +1,63 @@
+// Gauss-Newton and Levenberg-Marquardt on the estimation graph (seed 000, Section III-C): the sparse normal equations
+// of the whitened errors are solved by CHOLMOD supernodal Cholesky, the free variables are updated through box-plus
+// only, and the error covariances (eq. 1) are re-evaluated at every linearization.
+#pragma once
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "common/status.h"
+#include "estimator/graph.h"
+
+namespace roamlab::estimator {
+
+struct SolverOptions {
+  enum class Method { kGaussNewton, kLevenbergMarquardt };
+  Method method = Method::kLevenbergMarquardt;
+  int max_iterations = 50;
+  // Stop when an accepted step lowers the cost by less than this fraction.
+  double function_tolerance = 1e-8;
+  // Stop when |dx| < step_tolerance * (|x| + step_tolerance), x and dx in tangent coordinates.
+  double step_tolerance = 1e-10;
+  // Stop before starting an iteration once this much wall time has passed [s].
+  double time_budget_s = std::numeric_limits<double>::infinity();
+  // Initial Levenberg-Marquardt damping, relative to diag(H).
+  double initial_lambda = 1e-4;
+
+  // Empty when valid, otherwise what is wrong.
+  std::string Validate() const;
+};
+
+enum class Termination {
+  kFunctionTolerance,
+  kStepTolerance,
+  kMaxIterations,
+  kTimeBudget,
+  kNoFreeVariables,
+  kFailure,  // a factor could not be evaluated, or the system could not be solved
+};
+const char* TerminationName(Termination termination);
+
+struct SolverSummary {
+  Termination termination = Termination::kFailure;
+  int iterations = 0;                 // linearizations that produced a step
+  double initial_cost = 0.0;          // 1/2 sum of robustified squared whitened errors
+  double final_cost = 0.0;
+  std::vector<double> cost_history;   // cost at each linearization, then the final cost
+  double seconds = 0.0;
+  int free_dimension = 0;
+  int factors = 0;
+  std::string message;                // details on failure
+
+  bool usable() const { return termination != Termination::kFailure; }
+};
+
+// Optimizes the free variables of `graph` in place. Variables are ordered poses first then the others, in id order;
+// CHOLMOD picks its own fill-reducing permutation on top.
+SolverSummary Solve(const SolverOptions& options, Graph* graph);
+
+// The free variables of `graph` in the solver's order.
+std::vector<VariableId> FreeVariableOrder(const Graph& graph);
+
+}  // namespace roamlab::estimator

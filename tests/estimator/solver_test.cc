@@ -1,0 +1,106 @@
+#include "estimator/solver.h"
+
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "estimator/covariance.h"
+#include "estimator/factor.h"
+#include "estimator/models/gps.h"
+#include "tests/estimator/factor_testing.h"
+
+namespace roamlab::estimator {
+namespace {
+
+// One pose seen by four GPS antennas at known, fixed lever arms: position and orientation are observable.
+struct MultiAntennaProblem {
+  Graph graph;
+  VariableId pose;
+  Eigen::VectorXd truth;
+
+  MultiAntennaProblem(double noise_sigma, std::uint32_t seed) {
+    std::mt19937 rng(seed);
+    truth = testing::RandomPoint(Manifold::Pose(), &rng, 5.0);
+    const Pose<double> T = PoseFromArray(truth.data());
+    pose = graph.AddVariable({"pose", Manifold::Pose(), testing::Perturb(Manifold::Pose(), truth, 0.3, &rng), false,
+                              Time::FromSeconds(0.0)});
+    const std::vector<Eigen::Vector3d> levers = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {-1, -1, 0.5}};
+    std::normal_distribution<double> noise(0.0, noise_sigma);
+    for (const Eigen::Vector3d& lever : levers) {
+      const VariableId l = graph.AddVariable({"lever", Manifold::Euclidean(3), lever, true, std::nullopt});
+      for (int k = 0; k < 20; ++k) {
+        const Eigen::Vector3d z = T.p_world_body + T.q_world_body * lever +
+                                  Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+        graph.AddFactor(MakeFactor(GpsError(z)), {pose, l},
+                        Eigen::Matrix3d::Identity() * std::max(noise_sigma * noise_sigma, 1e-6), Loss::Trivial(),
+                        "gps", Time::FromSeconds(0.0));
+      }
+    }
+  }
+
+  Eigen::VectorXd Error() const {
+    Eigen::VectorXd d(6);
+    Manifold::Pose().Minus(graph.variable(pose).value.data(), truth.data(), d.data());
+    return d;
+  }
+};
+
+TEST(SolverTest, LevenbergMarquardtRecoversNoiseFreePose) {
+  MultiAntennaProblem problem(0.0, 3);
+  const SolverSummary summary = Solve(SolverOptions{}, &problem.graph);
+  ASSERT_TRUE(summary.usable()) << summary.message;
+  EXPECT_LT(problem.Error().norm(), 1e-8);
+  EXPECT_LT(summary.final_cost, 1e-12);
+  EXPECT_GT(summary.initial_cost, 1.0);
+  EXPECT_EQ(summary.free_dimension, 6);
+}
+
+TEST(SolverTest, GaussNewtonRecoversNoiseFreePose) {
+  MultiAntennaProblem problem(0.0, 4);
+  SolverOptions options;
+  options.method = SolverOptions::Method::kGaussNewton;
+  const SolverSummary summary = Solve(options, &problem.graph);
+  ASSERT_TRUE(summary.usable()) << summary.message;
+  EXPECT_LT(problem.Error().norm(), 1e-8);
+  for (std::size_t i = 1; i < summary.cost_history.size(); ++i)
+    EXPECT_LE(summary.cost_history[i], summary.cost_history[i - 1] * (1 + 1e-12) + 1e-20);
+}
+
+TEST(SolverTest, NoisyErrorIsConsistentWithMarginalCovariance) {
+  // Over many seeds, the squared Mahalanobis error of the pose against its marginal covariance averages to 6 (the
+  // tangent dimension); with 40 trials the average of chi-square(6) lies in [4.6, 7.6] with probability ~0.999.
+  double sum = 0.0;
+  const int trials = 40;
+  for (int seed = 0; seed < trials; ++seed) {
+    MultiAntennaProblem problem(0.05, 100 + seed);
+    ASSERT_TRUE(Solve(SolverOptions{}, &problem.graph).usable());
+    const auto info = ComputeMarginalInformation(problem.graph, {problem.pose});
+    ASSERT_TRUE(info.ok()) << info.status().message();
+    const Eigen::VectorXd e = problem.Error();
+    sum += e.dot(info.value().information * e);
+  }
+  EXPECT_GT(sum / trials, 4.6);
+  EXPECT_LT(sum / trials, 7.6);
+}
+
+TEST(ObservabilityTest, ClassifiesNullAndWeakDirections) {
+  // Component 0 well determined; components 1 and 2 only through their sum (a null direction); component 3 nearly
+  // collinear with component 0.
+  Eigen::MatrixXd J(4, 4);
+  J << 1, 0, 0, 0,
+       0, 1, 1, 0,
+       0, 2, 2, 0,
+       1, 0, 0, 1.001;
+  Eigen::MatrixXd H = J.transpose() * J;
+  H(0, 0) += 1.0;
+  const ObservabilityAnalysis a = AnalyzeObservability(H);
+  EXPECT_EQ(a.observability[0], Observability::kObservable);
+  EXPECT_EQ(a.observability[1], Observability::kUnobservable);
+  EXPECT_EQ(a.observability[2], Observability::kUnobservable);
+  EXPECT_TRUE(std::isnan(a.std[1]));
+  EXPECT_NEAR(std::abs(a.correlation(1, 2)), 1.0, 1e-3);
+  EXPECT_EQ(a.observability[3], Observability::kObservable);
+}
+
+}  // namespace
+}  // namespace roamlab::estimator
