@@ -58,8 +58,13 @@ enum class StreamType {
   kInputs,
 };
 
+// "imu", "gyroscope", ..., as written in recording.yaml; ParseStreamType is its inverse (nullopt for unknown names).
 const char* StreamTypeName(StreamType type);
 std::optional<StreamType> ParseStreamType(const std::string& name);
+
+// The CSV columns (after "t") that a type fixes, in the table above; empty for wheel_encoders and inputs, whose columns
+// come from the stream entry.
+const std::vector<std::string>& FixedColumns(StreamType type);
 
 // Nominal mounting of a sensor frame S in the odometric frame O.
 struct Mounting {
@@ -72,7 +77,8 @@ struct StreamInfo {
   StreamType type = StreamType::kInputs;
   double rate_hz = 0.0;                 // nominal rate
   std::vector<std::string> columns;     // after "t"; fixed by the type except wheel_encoders and inputs
-  std::string units;                    // as declared in recording.yaml (see the table above); empty = canonical
+  std::string units;                    // after reading: the canonical unit of the type (table above; magnetometer,
+                                        // camera and inputs keep what was declared); empty = canonical
   std::optional<Mounting> mounting;
   std::map<std::string, double> noise;  // nominal noise, keys carry units, e.g. "sigma_m", "sigma_radps"
   std::map<std::string, double> attributes;  // type-specific scalars, e.g. "ticks_per_revolution", "fx_px"

@@ -1,5 +1,7 @@
 #include "recording/truth.h"
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <system_error>
 
@@ -22,7 +24,8 @@ using internal::RequireKey;
 constexpr const char* kTruthFile = "truth.yaml";
 
 // calibration: {name: number | [numbers]}; a single number is read as a vector of size one.
-Status ParseCalibration(const YAML::Node& node, const std::string& path, std::map<std::string, std::vector<double>>* out) {
+Status ParseCalibration(const YAML::Node& node, const std::string& path,
+                        std::map<std::string, std::vector<double>>* out) {
   if (!node.IsMap()) return Status::Error(internal::Where(path, node) + ": calibration must be a mapping");
   for (const auto& item : node) {
     std::string name;
@@ -61,6 +64,56 @@ Status ParseEffects(const YAML::Node& node, const std::string& path, std::vector
   return Status::Ok();
 }
 
+// Refuses what ReadTruth would refuse: empty or non-finite values, effects without a name.
+Status ValidateForWrite(const Truth& truth, const std::string& path) {
+  for (const auto& [name, values] : truth.calibration) {
+    if (values.empty()) return Status::Error(path + ": calibration '" + name + "' is empty");
+    if (!std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); })) {
+      return Status::Error(path + ": calibration '" + name + "' is not finite");
+    }
+  }
+  for (const Effect& effect : truth.effects) {
+    if (effect.name.empty()) return Status::Error(path + ": an effect has no name");
+    for (const auto& [key, value] : effect.parameters) {
+      if (!std::isfinite(value)) {
+        return Status::Error(path + ": effect '" + effect.name + "': " + key + " is not finite");
+      }
+    }
+  }
+  return Status::Ok();
+}
+
+// The text of truth.yaml: keys in a fixed order, numbers as their shortest round-trip text.
+std::string EmitTruth(const Truth& truth) {
+  YAML::Emitter out;
+  out << YAML::BeginMap;
+  // Calibration: one key per parameter, a single value as a number, longer ones as a list.
+  out << YAML::Key << "calibration" << YAML::Value;
+  if (truth.calibration.empty()) out << YAML::Flow;  // "{}" on the same line
+  out << YAML::BeginMap;
+  for (const auto& [name, values] : truth.calibration) {
+    out << YAML::Key << name << YAML::Value;
+    if (values.size() == 1) {
+      internal::EmitNumber(values[0], &out);
+    } else {
+      internal::EmitNumberList(values, &out);
+    }
+  }
+  out << YAML::EndMap;
+  // Effects in the given order.
+  out << YAML::Key << "effects" << YAML::Value;
+  if (truth.effects.empty()) out << YAML::Flow;
+  out << YAML::BeginSeq;
+  for (const Effect& effect : truth.effects) {
+    out << YAML::BeginMap << YAML::Key << "name" << YAML::Value << effect.name;
+    out << YAML::Key << "parameters" << YAML::Value;
+    internal::EmitNumberMap(effect.parameters, &out);
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
 }  // namespace
 
 Result<Truth> ReadTruth(const std::string& directory) {
@@ -82,34 +135,12 @@ Result<Truth> ReadTruth(const std::string& directory) {
 
 Status WriteTruth(const Truth& truth, const std::string& directory) {
   const std::string path = (fs::path(directory) / kTruthFile).string();
-  YAML::Emitter out;
-  out << YAML::BeginMap;
-  // Calibration: one key per parameter, a single value as a number, longer ones as a list.
-  out << YAML::Key << "calibration" << YAML::Value << YAML::BeginMap;
-  for (const auto& [name, values] : truth.calibration) {
-    if (values.empty()) return Status::Error(path + ": calibration '" + name + "' is empty");
-    out << YAML::Key << name << YAML::Value;
-    if (values.size() == 1) {
-      internal::EmitNumber(values[0], &out);
-    } else {
-      internal::EmitNumberList(values, &out);
-    }
-  }
-  out << YAML::EndMap;
-  // Effects in the given order.
-  out << YAML::Key << "effects" << YAML::Value << YAML::BeginSeq;
-  for (const Effect& effect : truth.effects) {
-    out << YAML::BeginMap << YAML::Key << "name" << YAML::Value << effect.name;
-    out << YAML::Key << "parameters" << YAML::Value;
-    internal::EmitNumberMap(effect.parameters, &out);
-    out << YAML::EndMap;
-  }
-  out << YAML::EndSeq << YAML::EndMap;
+  if (Status status = ValidateForWrite(truth, path); !status.ok()) return status;
   // The directory may not exist yet (truth is written beside a fresh recording).
   std::error_code error;
   fs::create_directories(directory, error);
   if (error) return Status::Error(directory + ": cannot create directory: " + error.message());
-  return internal::WriteTextFile(path, std::string(out.c_str()) + "\n");
+  return internal::WriteTextFile(path, EmitTruth(truth));
 }
 
 }  // namespace roamlab::recording

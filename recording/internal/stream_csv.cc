@@ -108,8 +108,8 @@ Status ParseStreamCsv(std::string_view content, const std::string& path, const s
     if (Trim(line).empty()) return LineError(path, n, "blank line");
     SplitCells(line, &cells);
     if (cells.size() != expected_cells) {
-      return LineError(path, n,
-                       "expected " + std::to_string(expected_cells) + " columns, found " + std::to_string(cells.size()));
+      return LineError(
+          path, n, "expected " + std::to_string(expected_cells) + " columns, found " + std::to_string(cells.size()));
     }
     // Time: exact, strictly increasing.
     const std::optional<Time> t = ParseSeconds(Trim(cells[0]));
@@ -134,8 +134,8 @@ Status ParseStreamCsv(std::string_view content, const std::string& path, const s
   // Row-major buffer -> column-major matrix.
   const Eigen::Index rows = static_cast<Eigen::Index>(out->t.size());
   const Eigen::Index cols = static_cast<Eigen::Index>(numeric_columns);
-  out->values = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
-      buffer.data(), rows, cols);
+  out->values = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(buffer.data(),
+                                                                                                         rows, cols);
   return Status::Ok();
 }
 

@@ -4,7 +4,7 @@
 //   12.000000001,0.5,-0.25,...          one row per sample: time in seconds, then one number per column
 //
 // Time is parsed exactly (roamlab::ParseSeconds) and must increase strictly; numbers must be finite. A text stream
-// (camera) has a single text column instead of numbers. Trailing blank lines are allowed, blank lines elsewhere are not.
+// (camera) has a single text column instead of numbers. Trailing blank lines are allowed, others are not.
 #pragma once
 
 #include <string>

@@ -1,5 +1,6 @@
 #include "recording/internal/text_io.h"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -74,9 +75,11 @@ std::string FormatFull(double value) {
 }
 
 void AppendFull(double value, std::string* out) {
+  // std::to_chars in general format with precision 17 is "%.17g" by definition, without printf's locale and parsing.
   char buffer[32];
-  const int n = std::snprintf(buffer, sizeof(buffer), "%.17g", value);
-  out->append(buffer, static_cast<std::size_t>(n));
+  const std::to_chars_result result =
+      std::to_chars(buffer, buffer + sizeof(buffer), value, std::chars_format::general, 17);
+  out->append(buffer, result.ptr);
 }
 
 std::string FormatShortest(double value) {

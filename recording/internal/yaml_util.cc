@@ -84,9 +84,9 @@ Status ReadNumberList(const YAML::Node& node, const std::string& path, const std
                       std::vector<double>* out) {
   if (!node.IsSequence()) return NodeError(path, node, what + " must be a list of numbers");
   if (expected_size >= 0 && node.size() != static_cast<std::size_t>(expected_size)) {
-    return NodeError(path, node,
-                     what + " must have " + std::to_string(expected_size) + " numbers, found " +
-                         std::to_string(node.size()));
+    return NodeError(
+        path, node,
+        what + " must have " + std::to_string(expected_size) + " numbers, found " + std::to_string(node.size()));
   }
   out->clear();
   for (std::size_t i = 0; i < node.size(); ++i) {

@@ -1,0 +1,160 @@
+#include "estimator/calibration.h"
+
+#include <chrono>
+#include <cmath>
+#include <set>
+
+#include "common/chi_square.h"
+#include "estimator/geometry.h"
+#include "estimator/internal/linearization.h"
+
+namespace roamlab::estimator {
+
+int GateOutliers(double probability, ProblemBuilder* builder) {
+  Graph& graph = builder->graph();
+  std::map<int, double> threshold;
+  int rejected = 0;
+  std::vector<FactorId> ids;
+  for (const auto& [id, entry] : graph.factors())
+    if (entry.active && builder->StreamOfFactor(id) >= 0) ids.push_back(id);
+  for (FactorId id : ids) {
+    FactorEntry& entry = graph.mutable_factor(id);
+    const int dim = entry.factor->residual_dim();
+    if (!threshold.count(dim)) threshold[dim] = ChiSquareQuantile(probability, dim);
+    internal::WhitenedFactor wf;
+    const bool ok = internal::LinearizeFactor(graph, entry, std::vector<bool>(entry.variables.size(), false), &wf);
+    if (!ok || wf.squared_norm > threshold[dim]) {
+      entry.active = false;
+      ++builder->mutable_counts(entry.stream).rejected;
+      ++rejected;
+    }
+  }
+  return rejected;
+}
+
+namespace {
+
+void SetFree(const std::set<std::string>& free, ProblemBuilder* builder) {
+  for (const auto& [name, id] : builder->parameters())
+    builder->graph().mutable_variable(id).fixed = free.count(name) == 0;
+}
+
+Trajectory ExtractTrajectory(const ProblemBuilder& builder) {
+  Trajectory out;
+  for (const PoseNode& node : builder.poses()) {
+    const Pose<double> p = PoseFromArray(builder.graph().variable(node.id).value.data());
+    out.push_back({node.t, p.p_world_body, p.q_world_body});
+  }
+  return out;
+}
+
+}  // namespace
+
+Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recording::Recording& recording,
+                                    const CalibrationOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto say = [&](const std::string& line) {
+    if (options.progress) options.progress(line);
+  };
+  auto built = ProblemBuilder::Create(config, recording);
+  if (!built.ok()) return built.status();
+  ProblemBuilder& builder = *built.value();
+
+  // The whole recording in one graph, dead-reckoned from the master stream, then aligned to the absolute fixes.
+  for (const MeasurementRef& m : builder.Measurements()) builder.Add(m);
+  builder.Finish();
+  if (builder.poses().size() < 3) return Status::Error("the recording gives fewer than 3 poses on the master stream");
+  builder.AlignToAbsoluteFixes();
+  say("graph: " + std::to_string(builder.poses().size()) + " poses, " +
+      std::to_string(builder.graph().factors().size()) + " factors");
+
+  // Stages: the configured ones, or all free parameters at once.
+  std::vector<std::vector<std::string>> stages = config.stages;
+  const std::vector<std::string> all_free = builder.FreeParameterNames();
+  if (stages.empty()) stages.push_back(all_free);
+
+  CalibrationResult result;
+  for (std::size_t s = 0; s < stages.size(); ++s) {
+    SetFree({stages[s].begin(), stages[s].end()}, &builder);
+    StageSummary stage;
+    stage.free_parameters = stages[s];
+    stage.solver = Solve(config.solver, &builder.graph());
+    if (!stage.solver.usable()) return Status::Error("stage " + std::to_string(s + 1) + ": " + stage.solver.message);
+    // Gate gross outliers at the converged estimate and re-solve without them.
+    if (config.gate_probability) {
+      stage.rejected = GateOutliers(*config.gate_probability, &builder);
+      if (stage.rejected > 0) {
+        const SolverSummary again = Solve(config.solver, &builder.graph());
+        if (!again.usable()) return Status::Error("stage " + std::to_string(s + 1) + ": " + again.message);
+        stage.solver.iterations += again.iterations;
+        stage.solver.final_cost = again.final_cost;
+        stage.solver.cost_history.insert(stage.solver.cost_history.end(), again.cost_history.begin(),
+                                         again.cost_history.end());
+        stage.solver.termination = again.termination;
+        stage.solver.seconds += again.seconds;
+      }
+    }
+    say("stage " + std::to_string(s + 1) + "/" + std::to_string(stages.size()) + ": cost " +
+        std::to_string(stage.solver.initial_cost) + " -> " + std::to_string(stage.solver.final_cost) + " in " +
+        std::to_string(stage.solver.iterations) + " iterations (" + TerminationName(stage.solver.termination) + ")");
+    result.iterations += stage.solver.iterations;
+    result.termination = TerminationName(stage.solver.termination);
+    result.stages.push_back(std::move(stage));
+  }
+  result.initial_cost = result.stages.front().solver.initial_cost;
+  result.final_cost = result.stages.back().solver.final_cost;
+
+  // Joint marginal information of every parameter free in some stage, at the final estimate.
+  std::set<std::string> ever_free;
+  for (const auto& st : stages) ever_free.insert(st.begin(), st.end());
+  SetFree(ever_free, &builder);
+  std::vector<VariableId> ids;
+  std::vector<std::string> names;
+  for (const auto& [name, id] : builder.parameters()) {
+    if (!ever_free.count(name)) continue;
+    ids.push_back(id);
+    names.push_back(name);
+  }
+  ObservabilityAnalysis analysis;
+  std::vector<int> offsets;
+  if (!ids.empty()) {
+    auto info = ComputeMarginalInformation(builder.graph(), ids);
+    if (!info.ok()) return info.status();
+    analysis = AnalyzeObservability(info.value().information, options.observability);
+    offsets = info.value().offsets;
+  }
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    const Variable& v = builder.graph().variable(ids[i]);
+    ParameterEstimate p;
+    p.name = names[i];
+    p.manifold = v.manifold;
+    p.estimate = v.value;
+    const int dim = v.manifold.tangent_dim();
+    p.std = analysis.std.segment(offsets[i], dim);
+    for (int c = 0; c < dim; ++c) {
+      const Observability o = analysis.observability[offsets[i] + c];
+      p.components.push_back(o);
+      if (static_cast<int>(o) > static_cast<int>(p.observability)) p.observability = o;
+    }
+    result.parameters.push_back(std::move(p));
+  }
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    for (std::size_t j = i + 1; j < ids.size(); ++j) {
+      double best = 0.0;
+      const int di = builder.graph().variable(ids[i]).manifold.tangent_dim();
+      const int dj = builder.graph().variable(ids[j]).manifold.tangent_dim();
+      for (int a = 0; a < di; ++a)
+        for (int b = 0; b < dj; ++b) {
+          const double rho = analysis.correlation(offsets[i] + a, offsets[j] + b);
+          if (std::abs(rho) > std::abs(best)) best = rho;
+        }
+      if (std::abs(best) >= options.correlation_threshold) result.correlations.push_back({names[i], names[j], best});
+    }
+  }
+  result.counts = builder.counts();
+  result.trajectory = ExtractTrajectory(builder);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace roamlab::estimator

@@ -1,0 +1,70 @@
+// Offline self-calibration (seed 000, Sections III-B and V): the whole recording in one graph, the chosen parameters
+// free, optionally in stages (each stage frees its list and holds the other parameters at their current values, as
+// in the seed's two-set procedure), followed by chi-square gating of gross outliers and the observability analysis of
+// every parameter that was free in some stage, on the joint Hessian at the final estimate.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/status.h"
+#include "estimator/config.h"
+#include "estimator/covariance.h"
+#include "estimator/problem.h"
+#include "estimator/solver.h"
+#include "recording/recording.h"
+
+namespace roamlab::estimator {
+
+struct ParameterEstimate {
+  std::string name;
+  Manifold manifold = Manifold::Euclidean(0);
+  Eigen::VectorXd estimate;                  // ambient: quaternions [w, x, y, z], matrices row-major
+  Eigen::VectorXd std;                       // tangent; NaN where unobservable
+  std::vector<Observability> components;     // per tangent component
+  Observability observability = Observability::kObservable;  // the worst component
+};
+
+struct Correlation {
+  std::string a, b;
+  double rho = 0.0;  // the largest |correlation| between any components of a and b, with its sign
+};
+
+struct StageSummary {
+  std::vector<std::string> free_parameters;
+  SolverSummary solver;
+  int rejected = 0;  // measurements gated out after this stage
+};
+
+struct CalibrationResult {
+  std::vector<ParameterEstimate> parameters;
+  std::vector<Correlation> correlations;   // pairs of parameters with |rho| >= correlation_threshold
+  std::vector<StageSummary> stages;
+  std::map<std::string, StreamCounts> counts;
+  Trajectory trajectory;                    // the smoothed trajectory of the final estimate
+  double seconds = 0.0;
+  // Totals over the stages.
+  int iterations = 0;
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  std::string termination;
+};
+
+struct CalibrationOptions {
+  double correlation_threshold = 0.9;
+  ObservabilityOptions observability;
+  std::function<void(const std::string&)> progress;  // optional: one line per step
+};
+
+Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recording::Recording& recording,
+                                    const CalibrationOptions& options = {});
+
+// Switches off active factors whose whitened squared error exceeds the chi-square quantile `probability` of their
+// dimension; counts them per stream. Returns how many were switched off.
+int GateOutliers(double probability, ProblemBuilder* builder);
+
+}  // namespace roamlab::estimator

@@ -1,0 +1,318 @@
+#include "estimator/config.h"
+
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+namespace roamlab::estimator {
+namespace {
+
+Eigen::VectorXd Vec(std::initializer_list<double> v) {
+  Eigen::VectorXd x(static_cast<int>(v.size()));
+  int i = 0;
+  for (double d : v) x[i++] = d;
+  return x;
+}
+
+SlotSpec ScalarSlot(const std::string& name, double value) { return {name, Manifold::Euclidean(1), Vec({value})}; }
+SlotSpec Vector3Slot(const std::string& name, double fill) {
+  return {name, Manifold::Euclidean(3), Eigen::VectorXd::Constant(3, fill)};
+}
+SlotSpec RotationSlot(const std::string& name) { return {name, Manifold::UnitQuaternion(), Vec({1, 0, 0, 0})}; }
+SlotSpec MatrixSlot(const std::string& name) { return {name, Manifold::Euclidean(9), Vec({1, 0, 0, 0, 1, 0, 0, 0, 1})}; }
+
+}  // namespace
+
+const std::vector<ModelSpec>& ModelSpecs() {
+  // kv_over_L defaults to NaN: the builder replaces it with 1 / wheelbase (k_v = 1).
+  static const std::vector<ModelSpec> specs = {
+      {"ackermann",
+       {"speed", "steering"},
+       {"speed_mps", "steering_rad", "lateral_mps", "vertical_mps", "roll_rate_radps", "pitch_rate_radps"},
+       {ScalarSlot("kv_over_L", std::numeric_limits<double>::quiet_NaN()), ScalarSlot("k_theta", 1.0),
+        ScalarSlot("k_gamma", 0.0)},
+       {"wheelbase_m", "speed_column"},
+       true},
+      {"odometer", {""}, {"linear_mps", "angular_radps"}, {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")}, {},
+       true},
+      {"gyroscope", {""}, {"sigma_radps"}, {RotationSlot("misalignment"), Vector3Slot("bias", 0.0), Vector3Slot("scale", 1.0)},
+       {}, false},
+      {"accelerometer",
+       {""},
+       {"sigma_mps2"},
+       {RotationSlot("misalignment"), Vector3Slot("lever_arm", 0.0), Vector3Slot("bias", 0.0), Vector3Slot("scale", 1.0)},
+       {},
+       false},
+      {"magnetometer", {""}, {"sigma"}, {RotationSlot("misalignment"), MatrixSlot("A"), Vector3Slot("b", 0.0)}, {"field_world"},
+       false},
+      {"gps", {""}, {"sigma_m"}, {Vector3Slot("lever_arm", 0.0)}, {}, false},
+      {"absolute_pose", {""}, {"position_m", "orientation_rad"}, {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")},
+       {}, false},
+      {"linear_velocity", {""}, {"sigma_mps"}, {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")}, {}, false},
+  };
+  return specs;
+}
+
+const ModelSpec* FindModelSpec(const std::string& model) {
+  for (const ModelSpec& spec : ModelSpecs())
+    if (spec.name == model) return &spec;
+  return nullptr;
+}
+
+namespace {
+
+// Errors carry "file:line: message".
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class Parser {
+ public:
+  explicit Parser(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void Fail(const YAML::Node& node, const std::string& message) const {
+    std::ostringstream s;
+    s << file_;
+    if (node.Mark().line >= 0) s << ":" << node.Mark().line + 1;
+    s << ": " << message;
+    throw ConfigError(s.str());
+  }
+
+  void CheckKeys(const YAML::Node& map, const std::set<std::string>& allowed, const std::string& where) const {
+    if (!map.IsMap()) Fail(map, where + " must be a mapping");
+    for (const auto& kv : map) {
+      const std::string key = kv.first.as<std::string>();
+      if (allowed.count(key) == 0) Fail(kv.first, "unknown key '" + key + "' in " + where);
+    }
+  }
+
+  double Number(const YAML::Node& node, const std::string& what) const {
+    try {
+      return node.as<double>();
+    } catch (const YAML::Exception&) {
+      Fail(node, what + " must be a number");
+    }
+  }
+
+  std::string String(const YAML::Node& node, const std::string& what) const {
+    if (!node.IsScalar()) Fail(node, what + " must be a string");
+    return node.as<std::string>();
+  }
+
+  std::vector<double> Numbers(const YAML::Node& node, const std::string& what) const {
+    std::vector<double> out;
+    if (node.IsScalar()) return {Number(node, what)};
+    if (!node.IsSequence()) Fail(node, what + " must be a number or a list of numbers");
+    for (const auto& item : node) out.push_back(Number(item, what));
+    return out;
+  }
+
+  bool Bool(const YAML::Node& node, const std::string& what) const {
+    try {
+      return node.as<bool>();
+    } catch (const YAML::Exception&) {
+      Fail(node, what + " must be true or false");
+    }
+  }
+
+  void ParseSolver(const YAML::Node& n, SolverOptions* s) const {
+    CheckKeys(n, {"method", "max_iterations", "function_tolerance", "step_tolerance", "time_budget_s",
+                  "initial_lambda"},
+              "solver");
+    if (n["method"]) {
+      const std::string m = String(n["method"], "solver.method");
+      if (m == "gauss_newton") {
+        s->method = SolverOptions::Method::kGaussNewton;
+      } else if (m == "levenberg_marquardt") {
+        s->method = SolverOptions::Method::kLevenbergMarquardt;
+      } else {
+        Fail(n["method"], "solver.method must be gauss_newton or levenberg_marquardt, not '" + m + "'");
+      }
+    }
+    if (n["max_iterations"]) s->max_iterations = static_cast<int>(Number(n["max_iterations"], "max_iterations"));
+    if (n["function_tolerance"]) s->function_tolerance = Number(n["function_tolerance"], "function_tolerance");
+    if (n["step_tolerance"]) s->step_tolerance = Number(n["step_tolerance"], "step_tolerance");
+    if (n["time_budget_s"]) s->time_budget_s = Number(n["time_budget_s"], "time_budget_s");
+    if (n["initial_lambda"]) s->initial_lambda = Number(n["initial_lambda"], "initial_lambda");
+    const std::string problem = s->Validate();
+    if (!problem.empty()) Fail(n, "solver: " + problem);
+  }
+
+  void ParseTracking(const YAML::Node& n, TrackingConfig* t) const {
+    CheckKeys(n, {"window", "max_iterations", "improvement_threshold", "time_budget_s", "initialization_s"},
+              "tracking");
+    if (n["window"]) t->window = static_cast<int>(Number(n["window"], "tracking.window"));
+    if (n["max_iterations"]) t->max_iterations = static_cast<int>(Number(n["max_iterations"], "max_iterations"));
+    if (n["improvement_threshold"])
+      t->improvement_threshold = Number(n["improvement_threshold"], "improvement_threshold");
+    if (n["time_budget_s"]) t->time_budget_s = Number(n["time_budget_s"], "time_budget_s");
+    if (n["initialization_s"]) t->initialization_s = Number(n["initialization_s"], "initialization_s");
+    if (t->window < 3) Fail(n, "tracking.window must be at least 3 poses");
+    if (t->max_iterations < 1) Fail(n, "tracking.max_iterations must be at least 1");
+    if (!(t->time_budget_s > 0.0)) Fail(n, "tracking.time_budget_s must be positive");
+    if (!(t->initialization_s >= 0.0)) Fail(n, "tracking.initialization_s must be >= 0");
+  }
+
+  ParameterConfig ParseParameter(const std::string& name, const YAML::Node& n) const {
+    CheckKeys(n, {"value", "free", "process"}, "parameter '" + name + "'");
+    ParameterConfig p;
+    if (n["value"]) {
+      const std::vector<double> v = Numbers(n["value"], "parameters." + name + ".value");
+      p.value = Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<int>(v.size()));
+    }
+    if (n["free"]) p.free = Bool(n["free"], "parameters." + name + ".free");
+    if (n["process"]) {
+      const YAML::Node& pr = n["process"];
+      CheckKeys(pr, {"type", "sigma", "tau_s"}, "parameter '" + name + "' process");
+      const std::string type = pr["type"] ? String(pr["type"], "process.type") : "";
+      if (type == "random_walk") {
+        p.process.type = ProcessConfig::Type::kRandomWalk;
+      } else if (type == "gauss_markov") {
+        p.process.type = ProcessConfig::Type::kGaussMarkov;
+        if (!pr["tau_s"]) Fail(pr, "parameter '" + name + "': gauss_markov needs tau_s");
+        p.process.tau_s = Number(pr["tau_s"], "process.tau_s");
+        if (!(p.process.tau_s > 0)) Fail(pr, "parameter '" + name + "': tau_s must be positive");
+      } else if (type != "constant") {
+        Fail(pr, "parameter '" + name + "': process.type must be constant, random_walk or gauss_markov");
+      }
+      if (p.process.type != ProcessConfig::Type::kConstant) {
+        if (!pr["sigma"]) Fail(pr, "parameter '" + name + "': process needs sigma");
+        p.process.sigma = Number(pr["sigma"], "process.sigma");
+        if (!(p.process.sigma > 0)) Fail(pr, "parameter '" + name + "': process sigma must be positive");
+      }
+    }
+    return p;
+  }
+
+  StreamConfig ParseStream(const std::string& name, const YAML::Node& n) const {
+    const std::string where = "stream '" + name + "'";
+    CheckKeys(n, {"model", "source", "noise", "parameters", "options", "loss"}, where);
+    StreamConfig s;
+    if (!n["model"]) Fail(n, where + ": missing key 'model'");
+    s.model = String(n["model"], where + ".model");
+    const ModelSpec* spec = FindModelSpec(s.model);
+    if (spec == nullptr) Fail(n["model"], where + ": unknown model '" + s.model + "'");
+
+    // Sources: a stream name, or a role -> stream mapping.
+    if (!n["source"]) Fail(n, where + ": missing key 'source'");
+    if (spec->source_roles.size() == 1 && spec->source_roles[0].empty()) {
+      s.sources[""] = String(n["source"], where + ".source");
+    } else {
+      std::set<std::string> roles(spec->source_roles.begin(), spec->source_roles.end());
+      CheckKeys(n["source"], roles, where + " source");
+      for (const std::string& role : spec->source_roles) {
+        if (!n["source"][role]) Fail(n["source"], where + ": source needs '" + role + "'");
+        s.sources[role] = String(n["source"][role], where + ".source." + role);
+      }
+    }
+
+    // Noise: every key of the model, positive.
+    if (!n["noise"]) Fail(n, where + ": missing key 'noise'");
+    CheckKeys(n["noise"], {spec->noise_keys.begin(), spec->noise_keys.end()}, where + " noise");
+    for (const std::string& key : spec->noise_keys) {
+      if (!n["noise"][key]) Fail(n["noise"], where + ": noise needs '" + key + "'");
+      const double sigma = Number(n["noise"][key], where + ".noise." + key);
+      if (!(sigma > 0.0)) Fail(n["noise"][key], where + ": noise '" + key + "' must be positive");
+      s.noise[key] = sigma;
+    }
+
+    if (n["parameters"]) {
+      std::set<std::string> slots;
+      for (const SlotSpec& slot : spec->slots) slots.insert(slot.name);
+      CheckKeys(n["parameters"], slots, where + " parameters");
+      for (const auto& kv : n["parameters"])
+        s.parameters[kv.first.as<std::string>()] = String(kv.second, where + " parameter name");
+    }
+    if (n["options"]) {
+      CheckKeys(n["options"], {spec->option_keys.begin(), spec->option_keys.end()}, where + " options");
+      for (const auto& kv : n["options"])
+        s.options[kv.first.as<std::string>()] = Numbers(kv.second, where + " option");
+    }
+    if (n["loss"]) {
+      const YAML::Node& l = n["loss"];
+      CheckKeys(l, {"type", "scale"}, where + " loss");
+      const std::string type = l["type"] ? String(l["type"], "loss.type") : "none";
+      const double scale = l["scale"] ? Number(l["scale"], "loss.scale") : 1.0;
+      if (!(scale > 0.0)) Fail(l, where + ": loss scale must be positive");
+      if (type == "huber") {
+        s.loss = Loss::Huber(scale);
+      } else if (type == "cauchy") {
+        s.loss = Loss::Cauchy(scale);
+      } else if (type != "none") {
+        Fail(l, where + ": loss type must be none, huber or cauchy");
+      }
+    }
+    return s;
+  }
+
+  EstimatorConfig Parse(const YAML::Node& root) const {
+    EstimatorConfig c;
+    c.source_file = file_;
+    CheckKeys(root, {"master", "solver", "gating", "tracking", "streams", "stages"}, "the configuration");
+    if (!root["master"]) Fail(root, "missing key 'master'");
+    if (!root["streams"]) Fail(root, "missing key 'streams'");
+    c.master = String(root["master"], "master");
+    if (root["solver"]) ParseSolver(root["solver"], &c.solver);
+    if (root["tracking"]) ParseTracking(root["tracking"], &c.tracking);
+    if (root["gating"]) {
+      CheckKeys(root["gating"], {"probability"}, "gating");
+      const double p = Number(root["gating"]["probability"], "gating.probability");
+      if (!(p > 0.0 && p < 1.0)) Fail(root["gating"], "gating.probability must be in (0, 1)");
+      c.gate_probability = p;
+    }
+    for (const auto& kv : root["streams"]) c.streams[kv.first.as<std::string>()] = ParseStream(kv.first.as<std::string>(), kv.second);
+    if (c.streams.count(c.master) == 0) Fail(root["master"], "master stream '" + c.master + "' is not in streams");
+    if (!FindModelSpec(c.streams[c.master].model)->odometric)
+      Fail(root["master"], "master stream '" + c.master + "' must use an odometric model (ackermann or odometer)");
+    if (root["stages"]) {
+      for (const auto& stage : root["stages"]) {
+        std::vector<std::string> names;
+        for (const auto& item : stage) names.push_back(String(item, "stage entry"));
+        c.stages.push_back(names);
+      }
+    }
+    return c;
+  }
+
+  void ParseParameters(const YAML::Node& root, EstimatorConfig* c) const {
+    if (!root["parameters"]) return;
+    if (!root["parameters"].IsMap()) Fail(root["parameters"], "parameters must be a mapping");
+    for (const auto& kv : root["parameters"])
+      c->parameters[kv.first.as<std::string>()] = ParseParameter(kv.first.as<std::string>(), kv.second);
+  }
+
+ private:
+  std::string file_;
+};
+
+}  // namespace
+
+Result<EstimatorConfig> ParseEstimatorConfig(const std::string& yaml_text, const std::string& source_name) {
+  try {
+    const YAML::Node root = YAML::Load(yaml_text);
+    Parser parser(source_name);
+    if (!root.IsMap()) return Status::Error(source_name + ": the configuration must be a YAML mapping");
+    YAML::Node copy = YAML::Clone(root);
+    copy.remove("parameters");
+    EstimatorConfig config = parser.Parse(copy);
+    parser.ParseParameters(root, &config);
+    return config;
+  } catch (const ConfigError& e) {
+    return Status::Error(e.what());
+  } catch (const YAML::Exception& e) {
+    return Status::Error(source_name + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+}
+
+Result<EstimatorConfig> LoadEstimatorConfig(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return Status::Error(path + ": cannot open the estimator configuration");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return ParseEstimatorConfig(buffer.str(), path);
+}
+
+}  // namespace roamlab::estimator

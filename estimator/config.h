@@ -1,0 +1,106 @@
+// The estimator configuration (EST.yaml): which recording streams feed which error model, their noise, the
+// calibration parameters (initial value, fixed or free, constant or time-varying), the master stream that creates
+// pose nodes, the solver, outlier gating, the online window and the offline calibration stages.
+//
+//   master: odometer                       # a stream whose model is ackermann or odometer
+//   solver: {method: levenberg_marquardt, max_iterations: 50, function_tolerance: 1.0e-8, step_tolerance: 1.0e-10}
+//   gating: {probability: 0.99999}         # chi-square gate on whitened errors; omit to disable
+//   tracking: {window: 40, max_iterations: 10, improvement_threshold: 1.0e-3, time_budget_s: 0.05,
+//              initialization_s: 2.0}
+//   parameters:                            # any parameter not listed here keeps its model default and is fixed
+//     gps.lever_arm: {value: [0, 0, 0], free: true}
+//     imu.gyro_bias: {value: [0, 0, 0], free: true, process: {type: random_walk, sigma: 1.0e-4}}
+//   streams:
+//     odometer:
+//       model: ackermann
+//       source: {speed: rear_wheel, steering: steering}
+//       noise: {speed_mps: 0.033, steering_rad: 0.014, lateral_mps: 0.05, vertical_mps: 0.05,
+//               roll_rate_radps: 0.3, pitch_rate_radps: 0.3}
+//       parameters: {kv_over_L: odometer.kv_over_L}    # slot -> parameter name; default "<stream>.<slot>"
+//       options: {wheelbase_m: 1.25}
+//       loss: {type: huber, scale: 3.0}
+//     gps: {model: gps, source: gps, noise: {sigma_m: 0.33}}
+//   stages:                                # offline calibration: parameters freed in each stage, in order
+//     - [gps.lever_arm, imu.misalignment]
+//     - [magnetometer.A, magnetometer.b, odometer.kv_over_L, odometer.k_theta, odometer.k_gamma]
+//
+// Models, their noise keys, parameter slots (default value) and options are listed in kModelSpecs (config.cc) and in
+// the README. Unknown keys, unknown models, missing noise keys and malformed values are errors naming the file and key.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/status.h"
+#include "estimator/loss.h"
+#include "estimator/manifold.h"
+#include "estimator/solver.h"
+
+namespace roamlab::estimator {
+
+struct ProcessConfig {
+  enum class Type { kConstant, kRandomWalk, kGaussMarkov };
+  Type type = Type::kConstant;
+  double sigma = 0.0;   // random walk: units/sqrt(s); Gauss-Markov: stationary std in the parameter's units
+  double tau_s = 0.0;   // Gauss-Markov correlation time
+};
+
+struct ParameterConfig {
+  std::optional<Eigen::VectorXd> value;  // ambient; default from the model slot
+  bool free = false;
+  ProcessConfig process;
+};
+
+struct StreamConfig {
+  std::string model;
+  std::map<std::string, std::string> sources;       // role -> recording stream ("" role for single-source models)
+  std::map<std::string, double> noise;
+  std::map<std::string, std::string> parameters;    // slot -> parameter name
+  std::map<std::string, std::vector<double>> options;
+  Loss loss;
+};
+
+struct TrackingConfig {
+  int window = 40;                       // poses kept in the fixed-lag window
+  int max_iterations = 10;               // per update
+  double improvement_threshold = 1e-3;   // stop iterating when the cost drops by less than this fraction
+  double time_budget_s = 0.05;           // per update
+  double initialization_s = 2.0;         // data buffered before the first window is solved
+};
+
+struct EstimatorConfig {
+  std::string source_file;               // for messages
+  std::string master;
+  SolverOptions solver;
+  std::optional<double> gate_probability;
+  TrackingConfig tracking;
+  std::map<std::string, ParameterConfig> parameters;
+  std::map<std::string, StreamConfig> streams;   // by stream name (ordered: deterministic)
+  std::vector<std::vector<std::string>> stages;
+};
+
+// What a model expects: its recording source roles, noise keys, parameter slots.
+struct SlotSpec {
+  std::string name;
+  Manifold manifold;
+  Eigen::VectorXd default_value;
+};
+struct ModelSpec {
+  std::string name;
+  std::vector<std::string> source_roles;  // {""} for one source
+  std::vector<std::string> noise_keys;
+  std::vector<SlotSpec> slots;
+  std::vector<std::string> option_keys;
+  bool odometric = false;                  // can be the master stream
+};
+const ModelSpec* FindModelSpec(const std::string& model);
+const std::vector<ModelSpec>& ModelSpecs();
+
+Result<EstimatorConfig> LoadEstimatorConfig(const std::string& path);
+Result<EstimatorConfig> ParseEstimatorConfig(const std::string& yaml_text, const std::string& source_name);
+
+}  // namespace roamlab::estimator

@@ -1,0 +1,42 @@
+// Marginalization for fixed-lag tracking (seed 000, Section III-B, after Carlevaris-Bianco and Eustice): the factors
+// on the variables leaving the window are linearized at the current estimate, the leaving variables are eliminated by
+// a Schur complement, and what they said about the rest becomes one linear prior on their Markov blanket:
+//
+//   e_prior(x) = r0 + J [x_1 [-] x0_1; ...; x_n [-] x0_n],     J^T J = H_BB - H_Bm H_mm^-1 H_mB,
+//                                                                J^T r0 = g_B - H_Bm H_mm^-1 g_m,
+//
+// with x0 the linearization point, so no information is thrown away (up to linearization).
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "estimator/factor.h"
+#include "estimator/graph.h"
+
+namespace roamlab::estimator {
+
+class LinearPriorFactor final : public Factor {
+ public:
+  LinearPriorFactor(std::vector<Manifold> manifolds, std::vector<Eigen::VectorXd> linearization_point,
+                    Eigen::MatrixXd J, Eigen::VectorXd r0);
+  int residual_dim() const override { return static_cast<int>(r0_.size()); }
+  int noise_dim() const override { return static_cast<int>(r0_.size()); }
+  const std::vector<Manifold>& manifolds() const override { return manifolds_; }
+  bool Evaluate(const double* const* values, double* error, double* const* jacobians,
+                double* noise_jacobian) const override;
+
+ private:
+  std::vector<Manifold> manifolds_;
+  std::vector<Eigen::VectorXd> x0_;
+  std::vector<int> offsets_;
+  Eigen::MatrixXd J_;
+  Eigen::VectorXd r0_;
+};
+
+// Removes `leaving` (and every factor touching them) from the graph, replacing those factors by one linear prior on
+// the free variables they also touched. Returns false (and changes nothing) if a factor cannot be linearized.
+bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph);
+
+}  // namespace roamlab::estimator

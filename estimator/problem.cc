@@ -1,0 +1,528 @@
+#include "estimator/problem.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "estimator/factor.h"
+#include "estimator/geometry.h"
+#include "estimator/models/absolute_pose.h"
+#include "estimator/models/accelerometer.h"
+#include "estimator/models/ackermann_odometer.h"
+#include "estimator/models/enu.h"
+#include "estimator/models/gps.h"
+#include "estimator/models/gyroscope.h"
+#include "estimator/models/linear_velocity.h"
+#include "estimator/models/magnetometer.h"
+#include "estimator/models/odometer.h"
+#include "estimator/models/prior.h"
+#include "estimator/models/process.h"
+
+namespace roamlab::estimator {
+
+using recording::StreamType;
+
+namespace {
+
+enum class Attachment { kMaster, kOnePose, kPair, kTriple };
+
+Attachment AttachmentOf(const std::string& model, bool master) {
+  if (master) return Attachment::kMaster;
+  if (model == "gyroscope" || model == "linear_velocity" || model == "odometer" || model == "ackermann")
+    return Attachment::kPair;
+  if (model == "accelerometer") return Attachment::kTriple;
+  return Attachment::kOnePose;
+}
+
+}  // namespace
+
+// A configured stream bound to its recording data.
+struct StreamBinding {
+  std::string name;
+  StreamConfig config;
+  const ModelSpec* spec = nullptr;
+  Attachment attachment = Attachment::kOnePose;
+  const recording::Stream* primary = nullptr;
+  const recording::Stream* steering = nullptr;  // ackermann
+  int column = 0;                               // first column used in the primary stream
+  std::vector<std::string> slot_parameters;     // parameter name per model slot
+  Eigen::MatrixXd noise_covariance;
+  double wheelbase_m = 0.0;
+  Eigen::Vector3d field_world = Eigen::Vector3d::Zero();
+  std::deque<MeasurementRef> pending;
+};
+
+struct ProblemBuilder::Impl {
+  EstimatorConfig config;
+  std::vector<StreamBinding> streams;
+  int master = -1;
+  std::optional<EnuConverter> enu;
+  std::map<std::string, Manifold> parameter_manifold;
+  std::map<std::string, ParameterConfig> parameter_config;
+  std::map<std::string, Eigen::VectorXd> parameter_initial;
+  std::optional<MeasurementRef> last_master;
+};
+
+ProblemBuilder::ProblemBuilder(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+ProblemBuilder::~ProblemBuilder() = default;
+
+namespace {
+
+Status Error(const EstimatorConfig& c, const std::string& message) {
+  return Status::Error(c.source_file + ": " + message);
+}
+
+bool TypeIn(StreamType t, std::initializer_list<StreamType> allowed) {
+  return std::find(allowed.begin(), allowed.end(), t) != allowed.end();
+}
+
+// Noise covariance of the model's noise input, from the configured standard deviations.
+Eigen::MatrixXd NoiseCovariance(const StreamBinding& s) {
+  const auto& n = s.config.noise;
+  Eigen::VectorXd sigma;
+  const std::string& m = s.config.model;
+  if (m == "ackermann") {
+    sigma.resize(6);
+    sigma << n.at("speed_mps"), n.at("steering_rad"), n.at("lateral_mps"), n.at("vertical_mps"),
+        n.at("roll_rate_radps"), n.at("pitch_rate_radps");
+  } else if (m == "odometer") {
+    sigma.resize(6);
+    sigma << Eigen::Vector3d::Constant(n.at("linear_mps")), Eigen::Vector3d::Constant(n.at("angular_radps"));
+  } else if (m == "absolute_pose") {
+    sigma.resize(6);
+    sigma << Eigen::Vector3d::Constant(n.at("position_m")), Eigen::Vector3d::Constant(n.at("orientation_rad"));
+  } else {
+    sigma = Eigen::Vector3d::Constant(n.begin()->second);
+  }
+  return sigma.cwiseAbs2().asDiagonal();
+}
+
+}  // namespace
+
+Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorConfig& config,
+                                                               const recording::Recording& rec) {
+  auto impl = std::make_unique<Impl>();
+  impl->config = config;
+  if (rec.origin) impl->enu.emplace(*rec.origin);
+
+  // Bind every configured stream to its recording stream(s) and check the types.
+  for (const auto& [name, sc] : config.streams) {
+    StreamBinding b;
+    b.name = name;
+    b.config = sc;
+    b.spec = FindModelSpec(sc.model);
+    b.attachment = AttachmentOf(sc.model, name == config.master);
+    const std::string primary_role = sc.model == "ackermann" ? "speed" : "";
+    const std::string& source = sc.sources.at(primary_role);
+    b.primary = rec.Find(source);
+    if (b.primary == nullptr)
+      return Error(config, "stream '" + name + "' reads recording stream '" + source + "', which the recording lacks");
+    const StreamType type = b.primary->info.type;
+    const std::string bad_type = "stream '" + name + "': recording stream '" + source + "' has type " +
+                                 recording::StreamTypeName(type) + ", which model " + sc.model + " cannot read";
+    const auto& m = sc.model;
+    if (m == "ackermann") {
+      if (type != StreamType::kWheelEncoders) return Error(config, bad_type);
+      if (b.primary->info.units != "m/s")
+        return Error(config, "stream '" + name + "': ackermann speed source '" + source + "' must be in m/s");
+      b.steering = rec.Find(sc.sources.at("steering"));
+      if (b.steering == nullptr || b.steering->info.type != StreamType::kSteering)
+        return Error(config, "stream '" + name + "': steering source '" + sc.sources.at("steering") +
+                                 "' is missing or not a steering stream");
+      if (sc.options.count("speed_column")) b.column = static_cast<int>(sc.options.at("speed_column").at(0));
+      if (b.column < 0 || b.column >= b.primary->values.cols())
+        return Error(config, "stream '" + name + "': speed_column out of range");
+      if (sc.options.count("wheelbase_m")) {
+        b.wheelbase_m = sc.options.at("wheelbase_m").at(0);
+      } else if (rec.platform.geometry.count("wheelbase_m")) {
+        b.wheelbase_m = rec.platform.geometry.at("wheelbase_m");
+      } else {
+        return Error(config, "stream '" + name + "': no wheelbase_m in options or in the recording's platform");
+      }
+      if (!(b.wheelbase_m > 0.0)) return Error(config, "stream '" + name + "': wheelbase_m must be positive");
+    } else if (m == "gyroscope") {
+      if (!TypeIn(type, {StreamType::kImu, StreamType::kGyroscope})) return Error(config, bad_type);
+    } else if (m == "accelerometer") {
+      if (!TypeIn(type, {StreamType::kImu, StreamType::kAccelerometer})) return Error(config, bad_type);
+      if (type == StreamType::kImu) b.column = 3;
+    } else if (m == "magnetometer") {
+      if (type != StreamType::kMagnetometer) return Error(config, bad_type);
+      if (!sc.options.count("field_world") || sc.options.at("field_world").size() != 3)
+        return Error(config, "stream '" + name + "': magnetometer needs options.field_world: [east, north, up]");
+      const auto& f = sc.options.at("field_world");
+      b.field_world = Eigen::Vector3d(f[0], f[1], f[2]);
+    } else if (m == "gps") {
+      if (!TypeIn(type, {StreamType::kGps, StreamType::kPosition})) return Error(config, bad_type);
+      if (type == StreamType::kGps && !impl->enu) return Error(config, "stream '" + name + "': gps without origin");
+    } else if (m == "absolute_pose") {
+      if (type != StreamType::kPose) return Error(config, bad_type);
+    } else if (m == "odometer" || m == "linear_velocity") {
+      if (!TypeIn(type, {StreamType::kOdometry, StreamType::kVisualOdometry, StreamType::kScanMatching}))
+        return Error(config, bad_type);
+    }
+    b.noise_covariance = NoiseCovariance(b);
+
+    // Parameter names per slot, with consistent manifolds across streams.
+    for (const SlotSpec& slot : b.spec->slots) {
+      const auto it = sc.parameters.find(slot.name);
+      const std::string pname = it != sc.parameters.end() ? it->second : name + "." + slot.name;
+      b.slot_parameters.push_back(pname);
+      const auto known = impl->parameter_manifold.find(pname);
+      if (known != impl->parameter_manifold.end() && !(known->second == slot.manifold))
+        return Error(config, "parameter '" + pname + "' is used as " + known->second.Name() + " and as " +
+                                 slot.manifold.Name());
+      impl->parameter_manifold.emplace(pname, slot.manifold);
+      Eigen::VectorXd init = slot.default_value;
+      if (sc.model == "ackermann" && slot.name == "kv_over_L") init[0] = 1.0 / b.wheelbase_m;
+      impl->parameter_initial.emplace(pname, init);
+    }
+    impl->streams.push_back(std::move(b));
+  }
+
+  // Parameter values and flags from the configuration.
+  for (const auto& [pname, pc] : config.parameters) {
+    const auto it = impl->parameter_manifold.find(pname);
+    if (it == impl->parameter_manifold.end())
+      return Error(config, "parameter '" + pname + "' is not used by any stream");
+    if (pc.value) {
+      if (pc.value->size() != it->second.ambient_dim())
+        return Error(config, "parameter '" + pname + "' needs " + std::to_string(it->second.ambient_dim()) +
+                                 " values, got " + std::to_string(pc.value->size()));
+      Eigen::VectorXd v = *pc.value;
+      if (it->second.kind() == ManifoldKind::kQuaternion) {
+        if (std::abs(v.norm() - 1.0) > 1e-3)
+          return Error(config, "parameter '" + pname + "' is a quaternion [w, x, y, z] and must have unit norm");
+        v.normalize();
+      }
+      impl->parameter_initial[pname] = v;
+    }
+    if (pc.process.type != ProcessConfig::Type::kConstant && it->second.kind() != ManifoldKind::kEuclidean)
+      return Error(config, "parameter '" + pname + "': only vector parameters can be time-varying");
+    if (pc.process.type != ProcessConfig::Type::kConstant && it->second.ambient_dim() != 3)
+      return Error(config, "parameter '" + pname + "': time-varying parameters must be 3-vectors");
+    impl->parameter_config[pname] = pc;
+  }
+  for (const auto& stage : config.stages)
+    for (const std::string& pname : stage) {
+      const auto it = impl->parameter_config.find(pname);
+      if (it == impl->parameter_config.end() || !it->second.free)
+        return Error(config, "stage entry '" + pname + "' is not a free parameter");
+    }
+
+  auto builder = std::unique_ptr<ProblemBuilder>(new ProblemBuilder(std::move(impl)));
+  Impl& im = *builder->impl_;
+  for (std::size_t i = 0; i < im.streams.size(); ++i) {
+    builder->stream_names_.push_back(im.streams[i].name);
+    builder->counts_[im.streams[i].name];
+    if (im.streams[i].name == config.master) im.master = static_cast<int>(i);
+    if (im.streams[i].config.model == "gps" || im.streams[i].config.model == "absolute_pose")
+      builder->has_absolute_sensor_ = true;
+  }
+
+  // Constant parameter variables (time-varying ones get instances per pose).
+  for (const auto& [pname, manifold] : im.parameter_manifold) {
+    if (builder->IsTimeVarying(pname)) continue;
+    const auto pc = im.parameter_config.find(pname);
+    const bool free = pc != im.parameter_config.end() && pc->second.free;
+    builder->parameters_[pname] =
+        builder->graph_.AddVariable({pname, manifold, im.parameter_initial.at(pname), !free, std::nullopt});
+  }
+  return builder;
+}
+
+bool ProblemBuilder::IsTimeVarying(const std::string& parameter) const {
+  const auto it = impl_->parameter_config.find(parameter);
+  return it != impl_->parameter_config.end() && it->second.process.type != ProcessConfig::Type::kConstant;
+}
+
+std::vector<std::string> ProblemBuilder::FreeParameterNames() const {
+  std::vector<std::string> names;
+  for (const auto& [pname, pc] : impl_->parameter_config)
+    if (pc.free) names.push_back(pname);
+  return names;
+}
+
+int ProblemBuilder::StreamOfFactor(FactorId id) const {
+  const auto it = stream_of_factor_.find(id);
+  return it == stream_of_factor_.end() ? -1 : it->second;
+}
+
+int ProblemBuilder::ResidualDim(const std::string& stream) const {
+  for (const StreamBinding& s : impl_->streams)
+    if (s.name == stream) {
+      const std::string& m = s.config.model;
+      return (m == "ackermann" || m == "odometer" || m == "absolute_pose") ? 6 : 3;
+    }
+  return 0;
+}
+
+std::vector<MeasurementRef> ProblemBuilder::Measurements() const {
+  std::vector<MeasurementRef> out;
+  for (std::size_t i = 0; i < impl_->streams.size(); ++i) {
+    const recording::Stream& s = *impl_->streams[i].primary;
+    for (std::size_t r = 0; r < s.t.size(); ++r) out.push_back({s.t[r], static_cast<int>(i), static_cast<int>(r)});
+  }
+  const int master = impl_->master;
+  std::stable_sort(out.begin(), out.end(), [master](const MeasurementRef& a, const MeasurementRef& b) {
+    if (a.t != b.t) return a.t < b.t;
+    if ((a.stream == master) != (b.stream == master)) return a.stream == master;
+    return a.stream < b.stream;
+  });
+  return out;
+}
+
+namespace {
+
+// Steering angle at time t, linearly interpolated (exact when the streams share time stamps).
+double SteeringAt(const recording::Stream& s, Time t) {
+  const auto it = std::lower_bound(s.t.begin(), s.t.end(), t);
+  if (it == s.t.end()) return s.values(static_cast<int>(s.t.size()) - 1, 0);
+  const int i = static_cast<int>(it - s.t.begin());
+  if (*it == t || i == 0) return s.values(i, 0);
+  const double w = SecondsBetween(s.t[i - 1], t) / SecondsBetween(s.t[i - 1], s.t[i]);
+  return (1.0 - w) * s.values(i - 1, 0) + w * s.values(i, 0);
+}
+
+}  // namespace
+
+void ProblemBuilder::Add(const MeasurementRef& m) {
+  Impl& im = *impl_;
+  StreamBinding& s = im.streams[m.stream];
+  if (!poses_.empty() && m.t < poses_.front().t && m.stream != im.master) {
+    StreamCounts& c = counts_[s.name];
+    ++(popped_any_ ? c.too_late : c.outside);
+    return;
+  }
+  if (m.stream == im.master) {
+    AddMasterSample(m);
+  } else {
+    s.pending.push_back(m);
+  }
+  AttachPending();
+}
+std::size_t ProblemBuilder::NearestPose(Time t) const {
+  const auto it = std::lower_bound(poses_.begin(), poses_.end(), t,
+                                   [](const PoseNode& p, Time time) { return p.t < time; });
+  if (it == poses_.end()) return poses_.size() - 1;
+  const std::size_t i = static_cast<std::size_t>(it - poses_.begin());
+  if (i == 0) return 0;
+  return (t.nanoseconds() - poses_[i - 1].t.nanoseconds() < it->t.nanoseconds() - t.nanoseconds()) ? i - 1 : i;
+}
+
+VariableId ProblemBuilder::ParameterAt(const std::string& name, std::size_t k) const {
+  const auto it = parameters_.find(name);
+  if (it != parameters_.end()) return it->second;
+  return poses_[k].instances.at(name);
+}
+
+VariableId ProblemBuilder::CreatePose(Time t, const Eigen::VectorXd& value) {
+  Impl& im = *impl_;
+  PoseNode node;
+  node.t = t;
+  node.id = graph_.AddVariable({"pose", Manifold::Pose(), value, false, t});
+  // Time-varying parameter instances, joined to the previous instance by their process.
+  for (const auto& [pname, pc] : im.parameter_config) {
+    if (pc.process.type == ProcessConfig::Type::kConstant) continue;
+    const bool first = poses_.empty();
+    const Eigen::VectorXd init = first ? im.parameter_initial.at(pname)
+                                       : graph_.variable(poses_.back().instances.at(pname)).value;
+    const VariableId id = graph_.AddVariable({pname, Manifold::Euclidean(3), init, !pc.free, t});
+    node.instances[pname] = id;
+    if (first) continue;
+    const double dt = SecondsBetween(poses_.back().t, t);
+    const VariableId prev = poses_.back().instances.at(pname);
+    if (pc.process.type == ProcessConfig::Type::kRandomWalk) {
+      graph_.AddFactor(MakeFactor(RandomWalkError<3>(dt)), {prev, id},
+                       Eigen::Matrix3d::Identity() * pc.process.sigma * pc.process.sigma * dt, Loss::Trivial(),
+                       pname, t);
+    } else {
+      const double var = pc.process.sigma * pc.process.sigma * (1.0 - std::exp(-2.0 * dt / pc.process.tau_s));
+      graph_.AddFactor(MakeFactor(GaussMarkovError<3>(dt, pc.process.tau_s)), {prev, id},
+                       Eigen::Matrix3d::Identity() * var, Loss::Trivial(), pname, t);
+    }
+  }
+  poses_.push_back(node);
+  return node.id;
+}
+
+void ProblemBuilder::AddMasterSample(const MeasurementRef& m) {
+  Impl& im = *impl_;
+  if (poses_.empty()) {
+    CreatePose(m.t, Manifold::Pose().Identity());
+    if (!has_absolute_sensor_) {
+      // No absolute sensor: the first pose defines W (seed, Section III-A); a tight prior removes the gauge freedom.
+      graph_.AddFactor(MakeFactor(PriorError<PoseBlock>(Manifold::Pose().Identity())), {poses_.front().id},
+                       Eigen::MatrixXd::Identity(6, 6) * 1e-12, Loss::Trivial(), "prior", m.t);
+    }
+    im.last_master = m;
+    ++counts_[im.streams[m.stream].name].attached;
+    return;
+  }
+  if (!im.last_master || m.t <= im.last_master->t) {
+    ++counts_[im.streams[m.stream].name].too_late;
+    return;
+  }
+  // The odometric factor of the previous master sample joins the last pose and the new one; its prediction (eq. 7)
+  // is the new pose's initial guess: evaluated with pose1 = pose0, the error is [p_hat - p0; Log(q_hat q0^-1)].
+  const VariableId prev = poses_.back().id;
+  const VariableId next = CreatePose(m.t, graph_.variable(prev).value);
+  const MeasurementRef odo = *im.last_master;
+  im.last_master = m;
+  const bool attached = TryAttach(odo);
+  (void)attached;
+  const FactorId fid = graph_.FactorsOf(next).back();
+  const FactorEntry& entry = graph_.factor(fid);
+  std::vector<const double*> values;
+  for (VariableId v : entry.variables) values.push_back(v == next ? graph_.variable(prev).value.data()
+                                                                  : graph_.variable(v).value.data());
+  Eigen::VectorXd e(6);
+  if (entry.factor->Evaluate(values.data(), e.data(), nullptr, nullptr)) {
+    Pose<double> p0 = PoseFromArray(graph_.variable(prev).value.data());
+    Pose<double> p1{p0.p_world_body + e.head<3>(),
+                    (QuaternionExp<double>(e.tail<3>()) * p0.q_world_body).normalized()};
+    PoseToArray(p1, graph_.mutable_variable(next).value.data());
+  }
+}
+
+bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
+  Impl& im = *impl_;
+  StreamBinding& s = im.streams[m.stream];
+  const recording::Stream& data = *s.primary;
+  const Eigen::RowVectorXd row = data.values.row(m.row);
+  const auto slot = [&](std::size_t i, std::size_t k) { return ParameterAt(s.slot_parameters[i], k); };
+  const auto z3 = [&] { return Eigen::Vector3d(row.segment<3>(s.column).transpose()); };
+
+  // Which poses: bail out (keep waiting) until they exist.
+  std::size_t k = 0;
+  if (poses_.empty() || m.t > poses_.back().t) return false;
+  if (m.t < poses_.front().t) {
+    ++counts_[s.name].outside;
+    return true;
+  }
+  switch (s.attachment) {
+    case Attachment::kMaster:
+    case Attachment::kPair: {
+      if (m.t >= poses_.back().t) return false;
+      const auto it = std::upper_bound(poses_.begin(), poses_.end(), m.t,
+                                       [](Time time, const PoseNode& p) { return time < p.t; });
+      k = static_cast<std::size_t>(it - poses_.begin()) - 1;
+      break;
+    }
+    case Attachment::kTriple:
+      k = NearestPose(m.t);
+      if (k + 1 >= poses_.size()) return false;
+      if (k == 0) {
+        ++counts_[s.name].outside;
+        return true;
+      }
+      break;
+    case Attachment::kOnePose:
+      k = NearestPose(m.t);
+      break;
+  }
+
+  // The factor, by model.
+  const std::string& model = s.config.model;
+  std::unique_ptr<Factor> factor;
+  std::vector<VariableId> vars;
+  const double dt = k + 1 < poses_.size() ? SecondsBetween(poses_[k].t, poses_[k + 1].t) : 0.0;
+  if (model == "ackermann") {
+    const double z_v = row[s.column];
+    const double z_theta = SteeringAt(*s.steering, m.t);
+    factor = MakeFactor(AckermannOdometerError(z_v, z_theta, s.wheelbase_m, dt));
+    vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k)};
+  } else if (model == "odometer") {
+    factor = MakeFactor(OdometerError(row.head<6>().transpose(), dt));
+    vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k)};
+  } else if (model == "gyroscope") {
+    factor = MakeFactor(GyroscopeError(z3(), dt));
+    vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k)};
+  } else if (model == "linear_velocity") {
+    factor = MakeFactor(LinearVelocityError(z3(), dt));
+    vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k)};
+  } else if (model == "accelerometer") {
+    factor = MakeFactor(AccelerometerError(z3(), SecondsBetween(poses_[k - 1].t, poses_[k].t),
+                                           SecondsBetween(poses_[k].t, poses_[k + 1].t)));
+    vars = {poses_[k - 1].id, poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k), slot(3, k)};
+  } else if (model == "magnetometer") {
+    factor = MakeFactor(MagnetometerError(z3(), s.field_world));
+    vars = {poses_[k].id, slot(0, k), slot(1, k), slot(2, k)};
+  } else if (model == "gps") {
+    Eigen::Vector3d z = z3();
+    if (data.info.type == StreamType::kGps) z = im.enu->ToEnu(z[0], z[1], z[2]);
+    factor = MakeFactor(GpsError(z));
+    vars = {poses_[k].id, slot(0, k)};
+    absolute_fixes_.emplace_back(poses_[k].id, z);
+  } else if (model == "absolute_pose") {
+    const Eigen::Quaterniond q(row[6], row[3], row[4], row[5]);
+    factor = MakeFactor(AbsolutePoseError(row.head<3>().transpose(), q.normalized()));
+    vars = {poses_[k].id, slot(0, k), slot(1, k)};
+    absolute_fixes_.emplace_back(poses_[k].id, row.head<3>().transpose());
+  }
+  const FactorId id = graph_.AddFactor(std::move(factor), vars, s.noise_covariance, s.config.loss, s.name, m.t);
+  stream_of_factor_[id] = m.stream;
+  ++counts_[s.name].attached;
+  return true;
+}
+
+void ProblemBuilder::AttachPending() {
+  for (StreamBinding& s : impl_->streams) {
+    for (auto it = s.pending.begin(); it != s.pending.end();) {
+      if (TryAttach(*it)) {
+        it = s.pending.erase(it);
+      } else {
+        ++it;
+      }
+    }
+  }
+}
+
+void ProblemBuilder::Finish() {
+  for (StreamBinding& s : impl_->streams) {
+    counts_[s.name].outside += static_cast<int>(s.pending.size());
+    s.pending.clear();
+  }
+  // The last master sample has no following pose: it is outside the graph.
+  if (impl_->last_master) ++counts_[impl_->streams[impl_->master].name].outside;
+  impl_->last_master.reset();
+}
+
+void ProblemBuilder::PopOldestPose() {
+  poses_.pop_front();
+  popped_any_ = true;
+  absolute_fixes_.erase(std::remove_if(absolute_fixes_.begin(), absolute_fixes_.end(),
+                                       [this](const auto& fix) { return !graph_.HasVariable(fix.first); }),
+                        absolute_fixes_.end());
+}
+
+void ProblemBuilder::AlignToAbsoluteFixes() {
+  if (absolute_fixes_.size() < 2) return;
+  // Centroids of the dead-reckoned positions and of the fixes.
+  Eigen::Vector3d cp = Eigen::Vector3d::Zero(), cz = Eigen::Vector3d::Zero();
+  for (const auto& [id, z] : absolute_fixes_) {
+    cp += graph_.variable(id).value.head<3>();
+    cz += z;
+  }
+  cp /= static_cast<double>(absolute_fixes_.size());
+  cz /= static_cast<double>(absolute_fixes_.size());
+  // Best yaw (2-D Procrustes) when the fixes span at least a metre.
+  double dot = 0.0, cross = 0.0, span = 0.0;
+  for (const auto& [id, z] : absolute_fixes_) {
+    const Eigen::Vector2d a = (graph_.variable(id).value.head<3>() - cp).head<2>();
+    const Eigen::Vector2d b = (z - cz).head<2>();
+    dot += a.dot(b);
+    cross += a.x() * b.y() - a.y() * b.x();
+    span = std::max(span, b.norm());
+  }
+  const double yaw = span >= 1.0 ? std::atan2(cross, dot) : 0.0;
+  const Eigen::Quaterniond q_yaw(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
+  for (const PoseNode& node : poses_) {
+    Eigen::VectorXd& x = graph_.mutable_variable(node.id).value;
+    Pose<double> p = PoseFromArray(x.data());
+    p.p_world_body = q_yaw * (p.p_world_body - cp) + cz;
+    p.q_world_body = (q_yaw * p.q_world_body).normalized();
+    PoseToArray(p, x.data());
+  }
+}
+
+}  // namespace roamlab::estimator

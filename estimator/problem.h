@@ -1,0 +1,122 @@
+// Builds the hyper-graph from a recording and an estimator configuration (seed 000, Section III-B).
+//
+// Each sample of the master stream creates a pose node; its odometric factor joins it to the next pose, and the next
+// pose's initial guess is that factor's prediction (eq. 7) at the current parameter values. Every other measurement
+// attaches to the pose(s) nearest its time stamp as soon as they exist: one pose (GPS, magnetometer, absolute pose),
+// the pair of poses whose interval contains it (gyroscope, velocity sensors), or three poses centred on the nearest
+// (accelerometer). Measurements may arrive out of order; one older than the oldest pose still in the graph is
+// counted as too late, never silently dropped.
+//
+// Parameters are variables named "<stream>.<slot>" unless the configuration maps a slot to another name (shared
+// parameters, e.g. one IMU misalignment for gyroscope, accelerometer and magnetometer). A time-varying parameter
+// (random walk or Gauss-Markov) has one instance per pose, joined by process factors.
+#pragma once
+
+#include <deque>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/status.h"
+#include "common/time.h"
+#include "estimator/config.h"
+#include "estimator/graph.h"
+#include "recording/recording.h"
+
+namespace roamlab::estimator {
+
+// One sample of one configured stream.
+struct MeasurementRef {
+  Time t;
+  int stream = 0;  // index into ProblemBuilder::stream_names()
+  int row = 0;     // row of the stream's primary source
+};
+
+struct PoseNode {
+  Time t;
+  VariableId id = -1;
+  std::map<std::string, VariableId> instances;  // time-varying parameters at this pose
+};
+
+struct StreamCounts {
+  int attached = 0;
+  int rejected = 0;    // switched off by the chi-square gate
+  int too_late = 0;    // older than the oldest pose in the graph
+  int outside = 0;     // no pose around its time stamp (before the first or after the last master sample)
+};
+
+class ProblemBuilder {
+ public:
+  // Validates the configuration against the recording: streams exist with the right types, parameter sizes match
+  // their slots, names are consistent. Errors name the configuration file and the stream or parameter.
+  static Result<std::unique_ptr<ProblemBuilder>> Create(const EstimatorConfig& config,
+                                                        const recording::Recording& recording);
+  ~ProblemBuilder();
+
+  // Every sample of every configured stream, in time order (ties: master first, then stream order).
+  std::vector<MeasurementRef> Measurements() const;
+
+  // Adds one measurement; see the class comment.
+  void Add(const MeasurementRef& measurement);
+  // Counts every measurement still waiting as outside (call when the recording ends).
+  void Finish();
+
+  Graph& graph() { return graph_; }
+  const Graph& graph() const { return graph_; }
+  const std::deque<PoseNode>& poses() const { return poses_; }
+  const std::vector<std::string>& stream_names() const { return stream_names_; }
+  const std::map<std::string, StreamCounts>& counts() const { return counts_; }
+  StreamCounts& mutable_counts(const std::string& stream) { return counts_[stream]; }
+
+  // Constant parameters by name (time-varying ones live in PoseNode::instances).
+  const std::map<std::string, VariableId>& parameters() const { return parameters_; }
+  bool IsTimeVarying(const std::string& parameter) const;
+  // Parameters that the configuration declares free.
+  std::vector<std::string> FreeParameterNames() const;
+
+  // Stream that produced a factor (by factor id); -1 for process and prior factors.
+  int StreamOfFactor(FactorId id) const;
+  // Chi-square dimension of a stream's factors.
+  int ResidualDim(const std::string& stream) const;
+
+  // Absolute position fixes (GPS, absolute pose) as (pose, measured position in W), for initial alignment.
+  const std::vector<std::pair<VariableId, Eigen::Vector3d>>& absolute_fixes() const { return absolute_fixes_; }
+  bool has_absolute_sensor() const { return has_absolute_sensor_; }
+
+  // Removes the oldest pose's bookkeeping after the graph variable has been marginalized by the caller.
+  void PopOldestPose();
+
+  // Rigidly moves every pose (rotation about z and translation, or the identity when the fixes span under 1 m) to best
+  // fit the absolute fixes: the initial guess for a dead-reckoned trajectory.
+  void AlignToAbsoluteFixes();
+
+ private:
+  struct Impl;
+  explicit ProblemBuilder(std::unique_ptr<Impl> impl);
+  void AddMasterSample(const MeasurementRef& m);
+  void AttachPending();
+  // Attaches one measurement if its poses exist; returns false to keep it waiting.
+  bool TryAttach(const MeasurementRef& m);
+  VariableId CreatePose(Time t, const Eigen::VectorXd& value);
+  // The variable of a parameter at pose index k (the instance, when time-varying).
+  VariableId ParameterAt(const std::string& name, std::size_t k) const;
+  // Index of the pose nearest to t.
+  std::size_t NearestPose(Time t) const;
+  std::unique_ptr<Impl> impl_;
+
+  Graph graph_;
+  std::deque<PoseNode> poses_;
+  std::vector<std::string> stream_names_;
+  std::map<std::string, StreamCounts> counts_;
+  std::map<std::string, VariableId> parameters_;
+  std::vector<std::pair<VariableId, Eigen::Vector3d>> absolute_fixes_;
+  bool has_absolute_sensor_ = false;
+  bool popped_any_ = false;
+  std::map<FactorId, int> stream_of_factor_;
+};
+
+}  // namespace roamlab::estimator

@@ -1,0 +1,130 @@
+#include "estimator/tracking.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "estimator/calibration.h"
+#include "estimator/covariance.h"
+#include "estimator/geometry.h"
+#include "estimator/marginalization.h"
+#include "estimator/solver.h"
+
+namespace roamlab::estimator {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The oldest pose's estimate and position covariance (marginal of the whole window).
+Status EmitOldest(ProblemBuilder* builder, TrackingResult* out) {
+  const PoseNode& node = builder->poses().front();
+  const Graph& graph = builder->graph();
+  const Pose<double> p = PoseFromArray(graph.variable(node.id).value.data());
+  auto info = ComputeMarginalInformation(graph, {node.id});
+  if (!info.ok()) return info.status();
+  const Eigen::Matrix<double, 6, 6> cov = info.value().information.inverse();
+  out->trajectory.push_back({node.t, p.p_world_body, p.q_world_body});
+  out->position_covariance.push_back(cov.topLeftCorner<3, 3>());
+  return Status::Ok();
+}
+
+Status EmitAndMarginalizeOldest(ProblemBuilder* builder, TrackingResult* out) {
+  const Status emitted = EmitOldest(builder, out);
+  if (!emitted.ok()) return emitted;
+  const PoseNode& node = builder->poses().front();
+  std::vector<VariableId> leaving = {node.id};
+  for (const auto& [name, id] : node.instances) leaving.push_back(id);
+  if (!Marginalize(leaving, &builder->graph()))
+    return Status::Error("marginalization failed at t = " + FormatSeconds(node.t));
+  builder->PopOldestPose();
+  return Status::Ok();
+}
+
+}  // namespace
+
+Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::Recording& recording,
+                             const std::map<std::string, Eigen::VectorXd>& calibration,
+                             const TrackingOptions& options) {
+  const auto start = Clock::now();
+  // Constant parameters are fixed at their calibrated (or configured) values.
+  EstimatorConfig config = config_in;
+  for (auto& [name, p] : config.parameters)
+    if (p.process.type == ProcessConfig::Type::kConstant) p.free = false;
+  for (const auto& [name, value] : calibration) {
+    ParameterConfig& p = config.parameters[name];
+    p.value = value;
+    if (p.process.type == ProcessConfig::Type::kConstant) p.free = false;
+  }
+  config.stages.clear();
+  auto built = ProblemBuilder::Create(config, recording);
+  if (!built.ok()) return built.status();
+  ProblemBuilder& builder = *built.value();
+
+  SolverOptions update_options = config.solver;
+  update_options.method = SolverOptions::Method::kGaussNewton;
+  update_options.max_iterations = config.tracking.max_iterations;
+  update_options.function_tolerance = config.tracking.improvement_threshold;
+  update_options.time_budget_s = config.tracking.time_budget_s;
+
+  TrackingResult out;
+  const std::vector<MeasurementRef> measurements = builder.Measurements();
+  const std::string& master = config.master;
+  bool initialized = false;
+  std::size_t poses_before = 0;
+  double update_seconds = 0.0;
+  for (std::size_t i = 0; i < measurements.size(); ++i) {
+    const MeasurementRef& m = measurements[i];
+    builder.Add(m);
+    if (builder.stream_names()[m.stream] != master || builder.poses().size() == poses_before) continue;
+    poses_before = builder.poses().size();
+    if (options.progress && i % 1000 == 0) options.progress(static_cast<double>(i) / measurements.size());
+
+    // Initialization: buffer, then align and solve the first stretch in one batch.
+    if (!initialized) {
+      if (builder.poses().size() < 3 ||
+          SecondsBetween(builder.poses().front().t, m.t) < config.tracking.initialization_s)
+        continue;
+      builder.AlignToAbsoluteFixes();
+      const SolverSummary s = Solve(config.solver, &builder.graph());
+      if (!s.usable()) return Status::Error("initialization failed: " + s.message);
+      if (config.gate_probability && GateOutliers(*config.gate_probability, &builder) > 0)
+        Solve(config.solver, &builder.graph());
+      initialized = true;
+    } else {
+      // One update: Gauss-Newton on the window, gating, and a re-solve if anything was gated.
+      const auto t0 = Clock::now();
+      const SolverSummary s = Solve(update_options, &builder.graph());
+      if (!s.usable()) return Status::Error("update at t = " + FormatSeconds(m.t) + " failed: " + s.message);
+      if (config.gate_probability && GateOutliers(*config.gate_probability, &builder) > 0)
+        Solve(update_options, &builder.graph());
+      const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
+      ++out.updates;
+      update_seconds += dt;
+      out.max_update_s = std::max(out.max_update_s, dt);
+    }
+    while (static_cast<int>(builder.poses().size()) > config.tracking.window) {
+      const Status st = EmitAndMarginalizeOldest(&builder, &out);
+      if (!st.ok()) return st;
+    }
+    poses_before = builder.poses().size();
+  }
+  builder.Finish();
+
+  // Whatever is left (short recordings never leave initialization): solve and report the final window.
+  const SolverSummary s = Solve(config.solver, &builder.graph());
+  if (!s.usable()) return Status::Error("final window: " + s.message);
+  while (!builder.poses().empty()) {
+    if (builder.poses().size() == 1) {
+      const Status st = EmitOldest(&builder, &out);
+      if (!st.ok()) return st;
+      break;
+    }
+    const Status st = EmitAndMarginalizeOldest(&builder, &out);
+    if (!st.ok()) return st;
+  }
+  out.mean_update_s = out.updates > 0 ? update_seconds / out.updates : 0.0;
+  out.counts = builder.counts();
+  out.total_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return out;
+}
+
+}  // namespace roamlab::estimator
