@@ -13,23 +13,25 @@ namespace roamlab::estimator {
 int GateOutliers(double probability, ProblemBuilder* builder) {
   Graph& graph = builder->graph();
   std::map<int, double> threshold;
-  int rejected = 0;
+  std::map<std::string, int> rejected_per_stream;
+  int changed = 0;
   std::vector<FactorId> ids;
   for (const auto& [id, entry] : graph.factors())
-    if (entry.active && builder->StreamOfFactor(id) >= 0) ids.push_back(id);
+    if (builder->StreamOfFactor(id) >= 0) ids.push_back(id);
   for (FactorId id : ids) {
     FactorEntry& entry = graph.mutable_factor(id);
     const int dim = entry.factor->residual_dim();
     if (!threshold.count(dim)) threshold[dim] = ChiSquareQuantile(probability, dim);
     internal::WhitenedFactor wf;
     const bool ok = internal::LinearizeFactor(graph, entry, std::vector<bool>(entry.variables.size(), false), &wf);
-    if (!ok || wf.squared_norm > threshold[dim]) {
-      entry.active = false;
-      ++builder->mutable_counts(entry.stream).rejected;
-      ++rejected;
-    }
+    const bool active = ok && wf.squared_norm <= threshold[dim];
+    if (active != entry.active) ++changed;
+    entry.active = active;
+    if (!active) ++rejected_per_stream[entry.stream];
   }
-  return rejected;
+  for (const std::string& stream : builder->stream_names())
+    builder->mutable_counts(stream).rejected = rejected_per_stream[stream];
+  return changed;
 }
 
 namespace {
@@ -81,9 +83,11 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
     stage.solver = Solve(config.solver, &builder.graph());
     if (!stage.solver.usable()) return Status::Error("stage " + std::to_string(s + 1) + ": " + stage.solver.message);
     // Gate gross outliers at the converged estimate and re-solve without them.
-    if (config.gate_probability) {
-      stage.rejected = GateOutliers(*config.gate_probability, &builder);
-      if (stage.rejected > 0) {
+    // Gross outliers bend the estimate and make inliers look bad too: re-test every measurement after each re-solve,
+    // re-admitting those that fit again, until the set is stable.
+    for (int round = 0; config.gate_probability && round < 5; ++round) {
+      if (GateOutliers(*config.gate_probability, &builder) == 0) break;
+      {
         const SolverSummary again = Solve(config.solver, &builder.graph());
         if (!again.usable()) return Status::Error("stage " + std::to_string(s + 1) + ": " + again.message);
         stage.solver.iterations += again.iterations;
@@ -94,6 +98,7 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
         stage.solver.seconds += again.seconds;
       }
     }
+    for (const auto& [stream, c] : builder.counts()) stage.rejected += c.rejected;
     say("stage " + std::to_string(s + 1) + "/" + std::to_string(stages.size()) + ": cost " +
         std::to_string(stage.solver.initial_cost) + " -> " + std::to_string(stage.solver.final_cost) + " in " +
         std::to_string(stage.solver.iterations) + " iterations (" + TerminationName(stage.solver.termination) + ")");

@@ -63,8 +63,9 @@ struct CalibrationOptions {
 Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recording::Recording& recording,
                                     const CalibrationOptions& options = {});
 
-// Switches off active factors whose whitened squared error exceeds the chi-square quantile `probability` of their
-// dimension; counts them per stream. Returns how many were switched off.
+// Re-tests every measurement factor: active exactly when its whitened squared error is within the chi-square quantile
+// `probability` of its dimension. Sets the per-stream rejected counts to the factors now off; returns how many
+// factors changed state.
 int GateOutliers(double probability, ProblemBuilder* builder);
 
 }  // namespace roamlab::estimator

@@ -2,7 +2,7 @@
 // between two consecutive poses. Seed 000, eqs. 5 and 7 (the odometer's velocity relation, inverted).
 //
 //   (v^(O), omega^(O)) = VelocitiesBetween(Gamma_O^W(t_k), Gamma_O^W(t_k+1), dt)                 (eq. 7 inverted)
-//   v_hat^(S) = (q_S^O)^-1 (v^(O) + omega^(O) x S^(O))                                           (eq. 5 solved for v^(S))
+//   v_hat^(S) = (q_S^O)^-1 (v^(O) + omega^(O) x S^(O))                              (eq. 5 solved for v^(S))
 //   e = v_hat^(S) + eta - z                                             e [m/s] in R^3, eta [m/s] in R^3
 //
 // Frames: the two poses of the odometric frame O in the world W, dt = t(k+1) - t(k) [s] apart. v^(O) is the chord

@@ -8,8 +8,8 @@
 // to the field strength (dimensionless); with a field in Tesla, sigma must be scaled by |h| accordingly.
 // Calibration: q_S^O = misalignment q_body_sensor (unit quaternion); A = unconstrained 3x3 matrix (soft iron,
 // non-orthogonality of the axes, per-axis scale; identity nominally), stored row-major; b = hard iron and bias
-// [units of z]. As the seed notes (Sec. III-D), A and q_S^O are not jointly observable (A R^T and A' R'^T can coincide):
-// estimate one with the other fixed.
+// [units of z]. As the seed notes (Sec. III-D), A and q_S^O are not jointly observable (A R^T and A' R'^T can
+// coincide): estimate one with the other fixed.
 // Noise: eta ~ N(0, sigma^2 I); J_e_eta = I.
 // Variables: pose at the nearest time stamp (PoseBlock; only the orientation is used), q_body_sensor
 // (QuaternionBlock), A (Matrix3Block), b (Vector3Block).

@@ -57,8 +57,8 @@ TEST(AccelerometerErrorTest, LevelAtRestReadsPlusGravityOnZ) {
 TEST(AccelerometerErrorTest, RollNinetyDegreesReadsGravityOnY) {
   // q_world_body = 90 deg about x: R = [1 0 0; 0 0 -1; 0 1 0] takes the body's y axis to [0, 0, 1], world up. The
   // reading R^T [0, 0, g] = [0, g, 0]: +9.80665 on the sensor's y axis, nothing on z.
-  const Eigen::VectorXd pose =
-      PoseVector(Eigen::Vector3d(-4.0, 0.5, 1.0), Eigen::Quaterniond(Eigen::AngleAxisd(kPi / 2.0, Eigen::Vector3d::UnitX())));
+  const Eigen::Quaterniond roll_90(Eigen::AngleAxisd(kPi / 2.0, Eigen::Vector3d::UnitX()));
+  const Eigen::VectorXd pose = PoseVector(Eigen::Vector3d(-4.0, 0.5, 1.0), roll_90);
   const Eigen::Vector3d reading = PredictedReading(0.02, 0.02, IdealSensorValues(pose, pose, pose));
   EXPECT_LT((reading - Eigen::Vector3d(0.0, kStandardGravity, 0.0)).norm(), 1e-12);
 }
@@ -168,10 +168,11 @@ TEST(AccelerometerErrorTest, AngularAccelerationTermAppears) {
   const double dt = 0.02;
   auto pose_at = [&](double t) {
     const double theta = 0.3 + w1 * t + 0.5 * alpha * t * t;
-    return PoseVector(Eigen::Vector3d(2.0, -1.0, 0.5), Eigen::Quaterniond(Eigen::AngleAxisd(theta, Eigen::Vector3d::UnitZ())));
+    return PoseVector(Eigen::Vector3d(2.0, -1.0, 0.5),
+                      Eigen::Quaterniond(Eigen::AngleAxisd(theta, Eigen::Vector3d::UnitZ())));
   };
-  const Eigen::Vector3d reading =
-      PredictedReading(dt, dt, IdealSensorValues(pose_at(-dt), pose_at(0.0), pose_at(dt), Eigen::Vector3d(s, 0.0, 0.0)));
+  const Eigen::Vector3d reading = PredictedReading(
+      dt, dt, IdealSensorValues(pose_at(-dt), pose_at(0.0), pose_at(dt), Eigen::Vector3d(s, 0.0, 0.0)));
   EXPECT_LT((reading - Eigen::Vector3d(-w1 * w1 * s, alpha * s, kStandardGravity)).norm(), 1e-9)
       << reading.transpose();
 }

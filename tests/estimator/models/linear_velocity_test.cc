@@ -56,7 +56,8 @@ TEST(LinearVelocityErrorTest, ZeroForStepComposedAsInEq7) {
 
 TEST(LinearVelocityErrorTest, DisplacedMisalignedSensorOnScrewMotion) {
   // O moves with constant body twist (v, omega): q(t) = q0 Exp(omega t), p(t) = p0 + R0 V(t) v with
-  // V(t) = int_0^t Exp(omega s) ds = t I + (1 - cos(w t)) / w^2 [omega]x + (w t - sin(w t)) / w^3 [omega]x^2, w = |omega|.
+  // V(t) = int_0^t Exp(omega s) ds = t I + (1 - cos(w t)) / w^2 [omega]x + (w t - sin(w t)) / w^3 [omega]x^2 with
+  // w = |omega|.
   // The sensor's origin c(t) = p(t) + R(t) S; its velocity at the middle of the interval, by a central difference of
   // c with a small step, expressed in S, is the reading. The model's chord velocity shrinks the part of v normal to
   // omega by sin(w dt / 2) / (w dt / 2) = 1 - (w dt)^2 / 24 + ..., which bounds the error.

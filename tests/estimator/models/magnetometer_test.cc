@@ -66,8 +66,8 @@ TEST(MagnetometerErrorTest, ZeroAtTruth) {
 TEST(MagnetometerErrorTest, YawingNorthPutsTheNorthComponentOnX) {
   // An ideal sensor on a level body yawed +90 deg (body x pointing north, body y pointing west) reads the north
   // component 0.6 on x, nothing on y and the vertical -0.8 on z.
-  const Eigen::VectorXd pose =
-      PoseVector(Eigen::Vector3d(5.0, 1.0, 0.0), Eigen::Quaterniond(Eigen::AngleAxisd(kPi / 2.0, Eigen::Vector3d::UnitZ())));
+  const Eigen::Quaterniond yaw_90(Eigen::AngleAxisd(kPi / 2.0, Eigen::Vector3d::UnitZ()));
+  const Eigen::VectorXd pose = PoseVector(Eigen::Vector3d(5.0, 1.0, 0.0), yaw_90);
   const std::vector<Eigen::VectorXd> values = {pose, QuaternionVector(Eigen::Quaterniond::Identity()),
                                                RowMajor(Eigen::Matrix3d::Identity()), Eigen::Vector3d::Zero()};
   const Eigen::Vector3d z(0.6, 0.0, -0.8);

@@ -1,0 +1,245 @@
+#include "apps/commands.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "common/time.h"
+#include "estimator/calibration.h"
+#include "estimator/config.h"
+#include "estimator/tracking.h"
+#include "recording/recording.h"
+#include "recording/trajectory.h"
+
+namespace roamlab::apps {
+namespace {
+
+using nlohmann::json;
+
+int BadInput(const std::string& command, const std::string& message) {
+  std::cerr << "roamlab " << command << ": " << message << "\n";
+  return 2;
+}
+
+int Failure(const std::string& command, const std::string& message) {
+  std::cerr << "roamlab " << command << ": " << message << "\n";
+  return 1;
+}
+
+json Vector(const Eigen::VectorXd& v) {
+  json a = json::array();
+  for (int i = 0; i < v.size(); ++i) a.push_back(std::isfinite(v[i]) ? json(v[i]) : json(nullptr));
+  return a;
+}
+
+Status WriteJson(const json& j, const std::string& path) {
+  std::ofstream out(path);
+  if (!out) return Status::Error(path + ": cannot write");
+  out << j.dump(2) << "\n";
+  return out ? Status::Ok() : Status::Error(path + ": write failed");
+}
+
+Status MakeOutputDirectory(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return Status::Error(dir + ": cannot create the output directory: " + ec.message());
+  return Status::Ok();
+}
+
+// Loads the configuration and the recording streams it reads.
+struct Inputs {
+  estimator::EstimatorConfig config;
+  recording::Recording recording;
+};
+Result<Inputs> LoadInputs(const std::string& config_path, const std::string& recording_dir) {
+  auto config = estimator::LoadEstimatorConfig(config_path);
+  if (!config.ok()) return config.status();
+  recording::ReadOptions read;
+  read.load_ground_truth = false;
+  for (const auto& [name, stream] : config.value().streams)
+    for (const auto& [role, source] : stream.sources) read.required_streams.push_back(source);
+  auto rec = recording::ReadRecording(recording_dir, read);
+  if (!rec.ok()) return rec.status();
+  return Inputs{std::move(config).value(), std::move(rec).value()};
+}
+
+json CountsJson(const std::map<std::string, estimator::StreamCounts>& counts) {
+  json j = json::object();
+  for (const auto& [name, c] : counts)
+    j[name] = {{"attached", c.attached}, {"rejected", c.rejected}, {"too_late", c.too_late}, {"outside", c.outside}};
+  return j;
+}
+
+// Parameter values from a calibration.json: parameters.NAME.estimate.
+Result<std::map<std::string, Eigen::VectorXd>> ReadCalibration(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return Status::Error(path + ": cannot open");
+  json j;
+  try {
+    in >> j;
+  } catch (const json::exception& e) {
+    return Status::Error(path + ": not valid JSON: " + e.what());
+  }
+  if (!j.contains("parameters") || !j["parameters"].is_object())
+    return Status::Error(path + ": missing object 'parameters'");
+  std::map<std::string, Eigen::VectorXd> out;
+  for (const auto& [name, p] : j["parameters"].items()) {
+    if (!p.contains("estimate") || !p["estimate"].is_array())
+      return Status::Error(path + ": parameter '" + name + "' has no 'estimate' array");
+    Eigen::VectorXd v(static_cast<int>(p["estimate"].size()));
+    for (std::size_t i = 0; i < p["estimate"].size(); ++i) {
+      if (!p["estimate"][i].is_number())
+        return Status::Error(path + ": parameter '" + name + "' estimate has a non-number");
+      v[static_cast<int>(i)] = p["estimate"][i].get<double>();
+    }
+    out[name] = v;
+  }
+  return out;
+}
+
+}  // namespace
+
+int RunCalibrate(const CalibrateArgs& args) {
+  const std::string cmd = "calibrate";
+  auto inputs = LoadInputs(args.config, args.recording);
+  if (!inputs.ok()) return BadInput(cmd, inputs.status().message());
+  const Status dir = MakeOutputDirectory(args.out);
+  if (!dir.ok()) return BadInput(cmd, dir.message());
+
+  estimator::CalibrationOptions options;
+  if (!args.quiet) options.progress = [](const std::string& line) { std::cerr << "calibrate: " << line << "\n"; };
+  auto result = estimator::Calibrate(inputs.value().config, inputs.value().recording, options);
+  if (!result.ok()) return Failure(cmd, result.status().message());
+  const estimator::CalibrationResult& r = result.value();
+
+  // calibration.json
+  json params = json::object();
+  for (const auto& p : r.parameters) {
+    json components = json::array();
+    for (auto o : p.components) components.push_back(estimator::ObservabilityName(o));
+    params[p.name] = {{"estimate", Vector(p.estimate)},
+                      {"std", Vector(p.std)},
+                      {"observability", estimator::ObservabilityName(p.observability)},
+                      {"component_observability", components},
+                      {"manifold", p.manifold.Name()}};
+  }
+  json correlations = json::array();
+  for (const auto& c : r.correlations) correlations.push_back({{"a", c.a}, {"b", c.b}, {"rho", c.rho}});
+  json stages = json::array();
+  for (const auto& s : r.stages)
+    stages.push_back({{"free", s.free_parameters},
+                      {"iterations", s.solver.iterations},
+                      {"initial_cost", s.solver.initial_cost},
+                      {"final_cost", s.solver.final_cost},
+                      {"termination", estimator::TerminationName(s.solver.termination)},
+                      {"cost_history", s.solver.cost_history},
+                      {"rejected", s.rejected},
+                      {"seconds", s.solver.seconds}});
+  const json out = {{"parameters", params},
+                    {"correlations", correlations},
+                    {"solver",
+                     {{"iterations", r.iterations},
+                      {"initial_cost", r.initial_cost},
+                      {"final_cost", r.final_cost},
+                      {"termination", r.termination},
+                      {"seconds", r.seconds},
+                      {"stages", stages}}},
+                    {"measurements", CountsJson(r.counts)},
+                    {"recording", args.recording},
+                    {"config", args.config}};
+  const std::string json_path = args.out + "/calibration.json";
+  Status st = WriteJson(out, json_path);
+  if (!st.ok()) return Failure(cmd, st.message());
+  st = WriteTum(r.trajectory, args.out + "/trajectory.tum");
+  if (!st.ok()) return Failure(cmd, st.message());
+
+  // Human-readable table.
+  std::printf("%-28s %-13s %s\n", "parameter", "observability", "estimate (std)");
+  for (const auto& p : r.parameters) {
+    std::string values;
+    for (int i = 0; i < p.estimate.size(); ++i) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%s%.5g", i ? ", " : "", p.estimate[i]);
+      values += buf;
+    }
+    std::string stds;
+    for (int i = 0; i < p.std.size(); ++i) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%s%.2g", i ? ", " : "", p.std[i]);
+      stds += std::isfinite(p.std[i]) ? buf : (i ? ", -" : "-");
+    }
+    std::printf("%-28s %-13s [%s] (%s)\n", p.name.c_str(), estimator::ObservabilityName(p.observability),
+                values.c_str(), stds.c_str());
+  }
+  for (const auto& c : r.correlations)
+    std::printf("strongly correlated: %s ~ %s (rho %.3f)\n", c.a.c_str(), c.b.c_str(), c.rho);
+  std::printf("cost %.6g -> %.6g in %d iterations, %.2f s; wrote %s\n", r.initial_cost, r.final_cost, r.iterations,
+              r.seconds, json_path.c_str());
+  return 0;
+}
+
+int RunTrack(const TrackArgs& args) {
+  const std::string cmd = "track";
+  auto inputs = LoadInputs(args.config, args.recording);
+  if (!inputs.ok()) return BadInput(cmd, inputs.status().message());
+  std::map<std::string, Eigen::VectorXd> calibration;
+  if (!args.calibration.empty()) {
+    auto cal = ReadCalibration(args.calibration);
+    if (!cal.ok()) return BadInput(cmd, cal.status().message());
+    calibration = std::move(cal).value();
+  }
+  const Status dir = MakeOutputDirectory(args.out);
+  if (!dir.ok()) return BadInput(cmd, dir.message());
+
+  estimator::TrackingOptions options;
+  if (!args.quiet)
+    options.progress = [](double f) { std::cerr << "\rtrack: " << static_cast<int>(100 * f) << "%" << std::flush; };
+  auto result = estimator::Track(inputs.value().config, inputs.value().recording, calibration, options);
+  if (!args.quiet) std::cerr << "\rtrack: 100%\n";
+  if (!result.ok()) return Failure(cmd, result.status().message());
+  const estimator::TrackingResult& r = result.value();
+
+  Status st = WriteTum(r.trajectory, args.out + "/trajectory.tum");
+  if (!st.ok()) return Failure(cmd, st.message());
+  {
+    std::ofstream cov(args.out + "/covariance.csv");
+    cov << "t,xx,xy,xz,yx,yy,yz,zx,zy,zz\n";
+    char buf[64];
+    for (std::size_t i = 0; i < r.trajectory.size(); ++i) {
+      cov << FormatSeconds(r.trajectory[i].t);
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) {
+          std::snprintf(buf, sizeof buf, ",%.17g", r.position_covariance[i](a, b));
+          cov << buf;
+        }
+      cov << "\n";
+    }
+    if (!cov) return Failure(cmd, args.out + "/covariance.csv: write failed");
+  }
+  int rejected = 0;
+  for (const auto& [name, c] : r.counts) rejected += c.rejected;
+  const double duration =
+      r.trajectory.size() > 1 ? SecondsBetween(r.trajectory.front().t, r.trajectory.back().t) : 0.0;
+  const json summary = {{"poses", r.trajectory.size()},
+                        {"updates", r.updates},
+                        {"mean_update_s", r.mean_update_s},
+                        {"max_update_s", r.max_update_s},
+                        {"seconds", r.total_seconds},
+                        {"realtime_factor", r.total_seconds > 0 ? duration / r.total_seconds : 0.0},
+                        {"window", inputs.value().config.tracking.window},
+                        {"rejected_measurements", rejected},
+                        {"measurements", CountsJson(r.counts)}};
+  st = WriteJson(summary, args.out + "/summary.json");
+  if (!st.ok()) return Failure(cmd, st.message());
+  std::printf("tracked %zu poses, %d updates (mean %.2f ms, max %.2f ms), %d rejected, %.1fx real time; wrote %s\n",
+              r.trajectory.size(), r.updates, 1e3 * r.mean_update_s, 1e3 * r.max_update_s, rejected,
+              r.total_seconds > 0 ? duration / r.total_seconds : 0.0, (args.out + "/trajectory.tum").c_str());
+  return 0;
+}
+
+}  // namespace roamlab::apps

@@ -1,0 +1,108 @@
+// The command line end to end: calibrate and track on a synthetic recording, and one clear line with a non-zero
+// exit on bad input.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "recording/recording.h"
+#include "tests/support/synthetic.h"
+
+namespace roamlab {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CommandRun {
+  int exit_code;
+  std::string err;
+};
+
+CommandRun Roamlab(const std::string& args, const fs::path& dir) {
+  const fs::path err = dir / "stderr.txt";
+  const std::string cmd = std::string(ROAMLAB_BINARY) + " " + args + " > " + (dir / "stdout.txt").string() + " 2> " +
+                          err.string();
+  const int status = std::system(cmd.c_str());
+  std::ifstream in(err);
+  std::stringstream s;
+  s << in.rdbuf();
+  return {WEXITSTATUS(status), s.str()};
+}
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("roamlab_cli_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+TEST_F(CliTest, CalibrateAndTrackWriteTheirOutputs) {
+  roamlab::testing::SyntheticOptions options;
+  options.duration_s = 5.0;
+  ASSERT_TRUE(recording::WriteRecording(roamlab::testing::MakeAtvRecording(options).recording,
+                                        (dir_ / "rec").string()).ok());
+  const std::string config = std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/atv_calibration.yaml";
+  CommandRun r = Roamlab("calibrate " + (dir_ / "rec").string() + " --config " + config + " --out " +
+                      (dir_ / "cal").string() + " --quiet",
+                  dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(dir_ / "cal" / "calibration.json");
+  const nlohmann::json cal = nlohmann::json::parse(in);
+  for (const char* name : {"gps.lever_arm", "imu.misalignment", "magnetometer.A", "odometer.kv_over_L"}) {
+    ASSERT_TRUE(cal["parameters"].contains(name)) << name;
+    EXPECT_TRUE(cal["parameters"][name].contains("estimate"));
+    EXPECT_TRUE(cal["parameters"][name].contains("std"));
+    EXPECT_TRUE(cal["parameters"][name].contains("observability"));
+  }
+  EXPECT_EQ(cal["parameters"]["imu.misalignment"]["estimate"].size(), 4u);
+  EXPECT_EQ(cal["parameters"]["magnetometer.A"]["estimate"].size(), 9u);
+  for (const char* key : {"iterations", "initial_cost", "final_cost", "termination", "seconds"})
+    EXPECT_TRUE(cal["solver"].contains(key)) << key;
+  EXPECT_TRUE(cal.contains("correlations"));
+
+  const std::string track_config = std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/atv_tracking.yaml";
+  r = Roamlab("track " + (dir_ / "rec").string() + " --config " + track_config + " --calibration " +
+                  (dir_ / "cal" / "calibration.json").string() + " --out " + (dir_ / "trk").string() + " --quiet",
+              dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "trk" / "trajectory.tum"));
+  EXPECT_TRUE(fs::exists(dir_ / "trk" / "covariance.csv"));
+  std::ifstream sin(dir_ / "trk" / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(sin);
+  for (const char* key : {"updates", "mean_update_s", "max_update_s", "rejected_measurements"})
+    EXPECT_TRUE(summary.contains(key)) << key;
+}
+
+TEST_F(CliTest, BadInputGivesOneLineAndNonZeroExit) {
+  const std::string config = std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/atv_calibration.yaml";
+  for (const std::string& args :
+       {"calibrate /nonexistent/rec --config " + config + " --out " + (dir_ / "o").string(),
+        "calibrate " + dir_.string() + " --config /nonexistent.yaml --out " + (dir_ / "o").string(),
+        std::string("calibrate"), std::string("frobnicate")}) {
+    const CommandRun r = Roamlab(args, dir_);
+    EXPECT_NE(r.exit_code, 0) << args;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": " << r.err;
+  }
+}
+
+TEST_F(CliTest, HelpDescribesEveryCommand) {
+  for (const std::string& cmd : {"--help", "calibrate --help", "track --help"}) {
+    const CommandRun r = Roamlab(cmd, dir_);
+    EXPECT_EQ(r.exit_code, 0) << cmd;
+  }
+}
+
+}  // namespace
+}  // namespace roamlab

@@ -1,0 +1,45 @@
+#include "estimator/config.h"
+
+#include <gtest/gtest.h>
+
+#include "tests/estimator/estimation_testing.h"
+
+namespace roamlab::estimator {
+namespace {
+
+std::string Replace(std::string text, const std::string& from, const std::string& to) {
+  const auto pos = text.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  return text.replace(pos, from.size(), to);
+}
+
+void ExpectError(const std::string& yaml, const std::string& fragment) {
+  const auto config = ParseEstimatorConfig(yaml, "est.yaml");
+  ASSERT_FALSE(config.ok()) << "accepted a configuration that should fail with: " << fragment;
+  EXPECT_NE(config.status().message().find("est.yaml"), std::string::npos) << config.status().message();
+  EXPECT_NE(config.status().message().find(fragment), std::string::npos) << config.status().message();
+}
+
+TEST(ConfigTest, ParsesTheAtvConfiguration) {
+  const auto config = ParseEstimatorConfig(testing::AtvConfigYaml({"gps.lever_arm"}), "est.yaml");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  EXPECT_EQ(config.value().master, "odometer");
+  EXPECT_EQ(config.value().streams.size(), 5u);
+  EXPECT_TRUE(config.value().parameters.at("gps.lever_arm").free);
+  EXPECT_DOUBLE_EQ(config.value().streams.at("gps").noise.at("sigma_m"), 0.33);
+}
+
+TEST(ConfigTest, RejectsUnknownKeysModelsAndMissingNoise) {
+  const std::string good = testing::AtvConfigYaml({});
+  ExpectError(Replace(good, "master: odometer", "master: odometer\nwindow: 3"), "unknown key 'window'");
+  ExpectError(Replace(good, "model: gps", "model: galileo"), "unknown model 'galileo'");
+  ExpectError(Replace(good, "noise: {sigma_m: 0.33}", "noise: {sigma: 0.33}"), "unknown key 'sigma'");
+  ExpectError(Replace(good, "noise: {sigma_m: 0.33}", "noise: {}"), "noise needs 'sigma_m'");
+  ExpectError(Replace(good, "noise: {sigma_m: 0.33}", "noise: {sigma_m: -1}"), "must be positive");
+  ExpectError(Replace(good, "master: odometer", "master: gps"), "must use an odometric model");
+  ExpectError(Replace(good, "free: false}", "free: maybe}"), "must be true or false");
+  ExpectError(Replace(good, "method: levenberg_marquardt", "method: newton"), "solver.method");
+}
+
+}  // namespace
+}  // namespace roamlab::estimator

@@ -1,0 +1,55 @@
+#include "tests/estimator/estimation_testing.h"
+
+#include <algorithm>
+#include <map>
+
+#include <gtest/gtest.h>
+
+namespace roamlab::estimator::testing {
+
+std::string AtvConfigYaml(const std::vector<std::string>& free, int window) {
+  // Nominal (initial) values for free parameters, true values (synthetic defaults) for fixed ones.
+  const std::map<std::string, std::pair<std::string, std::string>> values = {
+      {"gps.lever_arm", {"[0, 0, 0]", "[0.57, -0.46, 0.32]"}},
+      {"imu.misalignment", {"[1, 0, 0, 0]", "[0.9382604033979289, 0.1040288720185337, 0.31308689367116393, "
+                                             "0.1040288720185337]"}},
+      {"magnetometer.A", {"[1, 0, 0, 0, 1, 0, 0, 0, 1]", "[0.87, -0.02, -0.02, 0, 0.88, 0, -0.02, -0.04, 0.85]"}},
+      {"magnetometer.b", {"[0, 0, 0]", "[-0.008, -0.007, -0.04]"}},
+      {"odometer.kv_over_L", {"0.8", "0.8"}},
+      {"odometer.k_theta", {"1.0", "1.0"}},
+      {"odometer.k_gamma", {"0.0", "0.0"}},
+  };
+  std::string yaml = "master: odometer\n"
+                     "solver: {method: levenberg_marquardt, max_iterations: 100, function_tolerance: 1.0e-9}\n"
+                     "tracking: {window: " + std::to_string(window) +
+                     ", max_iterations: 5, improvement_threshold: 1.0e-3, time_budget_s: 1.0, initialization_s: 1.0}\n"
+                     "parameters:\n";
+  for (const auto& [name, v] : values) {
+    const bool is_free = std::find(free.begin(), free.end(), name) != free.end();
+    yaml += "  " + name + ": {value: " + (is_free ? v.first : v.second) + ", free: " + (is_free ? "true" : "false") +
+            "}\n";
+  }
+  yaml += R"(streams:
+  odometer:
+    model: ackermann
+    source: {speed: rear_wheel, steering: steering}
+    noise: {speed_mps: 0.033, steering_rad: 0.014, lateral_mps: 0.02, vertical_mps: 0.02,
+            roll_rate_radps: 0.3, pitch_rate_radps: 0.3}
+  gyroscope: {model: gyroscope, source: imu, noise: {sigma_radps: 0.033}, parameters: {misalignment: imu.misalignment}}
+  accelerometer: {model: accelerometer, source: imu, noise: {sigma_mps2: 0.067},
+                  parameters: {misalignment: imu.misalignment}}
+  magnetometer: {model: magnetometer, source: magnetometer, noise: {sigma: 0.067},
+                 parameters: {misalignment: imu.misalignment},
+                 options: {field_world: [0.0, 0.5, -0.8660254037844386]}}
+  gps: {model: gps, source: gps, noise: {sigma_m: 0.33}}
+)";
+  return yaml;
+}
+
+EstimatorConfig AtvConfig(const std::vector<std::string>& free, int window) {
+  auto config = ParseEstimatorConfig(AtvConfigYaml(free, window), "atv_test.yaml");
+  EXPECT_TRUE(config.ok()) << config.status().message();
+  return config.value();
+}
+
+}  // namespace roamlab::estimator::testing
