@@ -98,7 +98,7 @@ TEST_F(CliTest, BadInputGivesOneLineAndNonZeroExit) {
 }
 
 TEST_F(CliTest, HelpDescribesEveryCommand) {
-  for (const std::string& cmd : {"--help", "calibrate --help", "track --help"}) {
+  for (const char* cmd : {"--help", "calibrate --help", "track --help"}) {
     const CommandRun r = Roamlab(cmd, dir_);
     EXPECT_EQ(r.exit_code, 0) << cmd;
   }
