@@ -354,8 +354,7 @@ void ProblemBuilder::AddMasterSample(const MeasurementRef& m) {
       graph_.AddFactor(MakeFactor(PriorError<PoseBlock>(Manifold::Pose().Identity())), {poses_.front().id},
                        Eigen::MatrixXd::Identity(6, 6) * 1e-12, Loss::Trivial(), "prior", m.t);
     }
-    im.last_master = m;
-    ++counts_[im.streams[m.stream].name].attached;
+    im.last_master = m;  // counted when its odometric factor attaches to the next pose
     return;
   }
   if (!im.last_master || m.t <= im.last_master->t) {
