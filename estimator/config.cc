@@ -35,6 +35,13 @@ const std::vector<ModelSpec>& ModelSpecs() {
         ScalarSlot("k_gamma", 0.0)},
        {"wheelbase_m", "speed_column"},
        true},
+      {"ackermann_seed",
+       {"speed", "steering"},
+       {"speed_mps", "steering_rad", "lateral_mps", "vertical_mps", "roll_rate_radps", "pitch_rate_radps"},
+       {ScalarSlot("kv_over_L", std::numeric_limits<double>::quiet_NaN()), ScalarSlot("k_theta", 1.0),
+        ScalarSlot("k_gamma", 0.0)},
+       {"wheelbase_m", "speed_column"},
+       true},
       {"odometer", {""}, {"linear_mps", "angular_radps"}, {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")}, {},
        true},
       {"gyroscope", {""}, {"sigma_radps"}, {RotationSlot("misalignment"), Vector3Slot("bias", 0.0), Vector3Slot("scale", 1.0)},
@@ -266,7 +273,7 @@ class Parser {
     for (const auto& kv : root["streams"]) c.streams[kv.first.as<std::string>()] = ParseStream(kv.first.as<std::string>(), kv.second);
     if (c.streams.count(c.master) == 0) Fail(root["master"], "master stream '" + c.master + "' is not in streams");
     if (!FindModelSpec(c.streams[c.master].model)->odometric)
-      Fail(root["master"], "master stream '" + c.master + "' must use an odometric model (ackermann or odometer)");
+      Fail(root["master"], "master stream '" + c.master + "' must use an odometric model (ackermann, ackermann_seed or odometer)");
     if (root["stages"]) {
       for (const auto& stage : root["stages"]) {
         std::vector<std::string> names;

@@ -9,6 +9,7 @@
 #include "estimator/models/absolute_pose.h"
 #include "estimator/models/accelerometer.h"
 #include "estimator/models/ackermann_odometer.h"
+#include "estimator/models/ackermann_velocity.h"
 #include "estimator/models/enu.h"
 #include "estimator/models/gps.h"
 #include "estimator/models/gyroscope.h"
@@ -28,7 +29,8 @@ enum class Attachment { kMaster, kOnePose, kPair, kTriple };
 
 Attachment AttachmentOf(const std::string& model, bool master) {
   if (master) return Attachment::kMaster;
-  if (model == "gyroscope" || model == "linear_velocity" || model == "odometer" || model == "ackermann")
+  if (model == "gyroscope" || model == "linear_velocity" || model == "odometer" || model == "ackermann" ||
+      model == "ackermann_seed")
     return Attachment::kPair;
   if (model == "accelerometer") return Attachment::kTriple;
   return Attachment::kOnePose;
@@ -81,7 +83,7 @@ Eigen::MatrixXd NoiseCovariance(const StreamBinding& s) {
   const auto& n = s.config.noise;
   Eigen::VectorXd sigma;
   const std::string& m = s.config.model;
-  if (m == "ackermann") {
+  if (m == "ackermann" || m == "ackermann_seed") {
     sigma.resize(6);
     sigma << n.at("speed_mps"), n.at("steering_rad"), n.at("lateral_mps"), n.at("vertical_mps"),
         n.at("roll_rate_radps"), n.at("pitch_rate_radps");
@@ -112,7 +114,8 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
     b.config = sc;
     b.spec = FindModelSpec(sc.model);
     b.attachment = AttachmentOf(sc.model, name == config.master);
-    const std::string primary_role = sc.model == "ackermann" ? "speed" : "";
+    const bool ackermann = sc.model == "ackermann" || sc.model == "ackermann_seed";
+    const std::string primary_role = ackermann ? "speed" : "";
     const std::string& source = sc.sources.at(primary_role);
     b.primary = rec.Find(source);
     if (b.primary == nullptr)
@@ -121,7 +124,7 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
     const std::string bad_type = "stream '" + name + "': recording stream '" + source + "' has type " +
                                  recording::StreamTypeName(type) + ", which model " + sc.model + " cannot read";
     const auto& m = sc.model;
-    if (m == "ackermann") {
+    if (ackermann) {
       if (type != StreamType::kWheelEncoders) return Error(config, bad_type);
       if (b.primary->info.units != "m/s")
         return Error(config, "stream '" + name + "': ackermann speed source '" + source + "' must be in m/s");
@@ -173,7 +176,7 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
                                  slot.manifold.Name());
       impl->parameter_manifold.emplace(pname, slot.manifold);
       Eigen::VectorXd init = slot.default_value;
-      if (sc.model == "ackermann" && slot.name == "kv_over_L") init[0] = 1.0 / b.wheelbase_m;
+      if (ackermann && slot.name == "kv_over_L") init[0] = 1.0 / b.wheelbase_m;
       impl->parameter_initial.emplace(pname, init);
     }
     impl->streams.push_back(std::move(b));
@@ -251,7 +254,7 @@ int ProblemBuilder::ResidualDim(const std::string& stream) const {
   for (const StreamBinding& s : impl_->streams)
     if (s.name == stream) {
       const std::string& m = s.config.model;
-      return (m == "ackermann" || m == "odometer" || m == "absolute_pose") ? 6 : 3;
+      return (m == "ackermann" || m == "ackermann_seed" || m == "odometer" || m == "absolute_pose") ? 6 : 3;
     }
   return 0;
 }
@@ -361,26 +364,32 @@ void ProblemBuilder::AddMasterSample(const MeasurementRef& m) {
     ++counts_[im.streams[m.stream].name].too_late;
     return;
   }
-  // The odometric factor of the previous master sample joins the last pose and the new one; its prediction (eq. 7)
-  // is the new pose's initial guess: evaluated with pose1 = pose0, the error is [p_hat - p0; Log(q_hat q0^-1)].
+  // The odometric factor of the previous master sample joins the last pose and the new one; the new pose's initial
+  // guess is the seed's eq. 7 prediction from that sample at the current parameter values.
   const VariableId prev = poses_.back().id;
-  const VariableId next = CreatePose(m.t, graph_.variable(prev).value);
   const MeasurementRef odo = *im.last_master;
-  im.last_master = m;
-  const bool attached = TryAttach(odo);
-  (void)attached;
-  const FactorId fid = graph_.FactorsOf(next).back();
-  const FactorEntry& entry = graph_.factor(fid);
-  std::vector<const double*> values;
-  for (VariableId v : entry.variables) values.push_back(v == next ? graph_.variable(prev).value.data()
-                                                                  : graph_.variable(v).value.data());
-  Eigen::VectorXd e(6);
-  if (entry.factor->Evaluate(values.data(), e.data(), nullptr, nullptr)) {
-    Pose<double> p0 = PoseFromArray(graph_.variable(prev).value.data());
-    Pose<double> p1{p0.p_world_body + e.head<3>(),
-                    (QuaternionExp<double>(e.tail<3>()) * p0.q_world_body).normalized()};
-    PoseToArray(p1, graph_.mutable_variable(next).value.data());
+  const double dt = SecondsBetween(odo.t, m.t);
+  const StreamBinding& s = im.streams[odo.stream];
+  const Eigen::RowVectorXd row = s.primary->values.row(odo.row);
+  const auto value = [&](std::size_t slot) { return graph_.variable(ParameterAt(s.slot_parameters[slot], poses_.size() - 1)).value; };
+  Eigen::Vector3d v_body = Eigen::Vector3d::Zero(), omega_body = Eigen::Vector3d::Zero();
+  if (s.config.model == "ackermann" || s.config.model == "ackermann_seed") {
+    const double kv_over_l = value(0)[0], k_theta = value(1)[0], k_gamma = value(2)[0];
+    const double z_v = row[s.column];
+    v_body.x() = kv_over_l * s.wheelbase_m * z_v;
+    omega_body.z() = kv_over_l * z_v * std::tan(k_theta * SteeringAt(*s.steering, odo.t) + k_gamma);
+  } else {
+    const Eigen::VectorXd q = value(1);
+    SensorToBodyVelocity<double>(row.head<3>().transpose(), row.segment<3>(3).transpose(),
+                                 Eigen::Quaterniond(q[0], q[1], q[2], q[3]), value(0), &v_body, &omega_body);
   }
+  const Pose<double> predicted = PredictPose<double>(PoseFromArray(graph_.variable(prev).value.data()), v_body,
+                                                     omega_body, dt);
+  Eigen::VectorXd next_value(7);
+  PoseToArray(predicted, next_value.data());
+  CreatePose(m.t, next_value);
+  im.last_master = m;
+  TryAttach(odo);
 }
 
 bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
@@ -425,10 +434,14 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
   std::unique_ptr<Factor> factor;
   std::vector<VariableId> vars;
   const double dt = k + 1 < poses_.size() ? SecondsBetween(poses_[k].t, poses_[k + 1].t) : 0.0;
-  if (model == "ackermann") {
+  if (model == "ackermann" || model == "ackermann_seed") {
     const double z_v = row[s.column];
     const double z_theta = SteeringAt(*s.steering, m.t);
-    factor = MakeFactor(AckermannOdometerError(z_v, z_theta, s.wheelbase_m, dt));
+    if (model == "ackermann") {
+      factor = MakeFactor(AckermannVelocityError(z_v, z_theta, s.wheelbase_m, dt));
+    } else {
+      factor = MakeFactor(AckermannOdometerError(z_v, z_theta, s.wheelbase_m, dt));
+    }
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k)};
   } else if (model == "odometer") {
     factor = MakeFactor(OdometerError(row.head<6>().transpose(), dt));

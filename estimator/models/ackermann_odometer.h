@@ -1,5 +1,7 @@
-// Ackermann-steering odometer (the ATV of the seed's Section V): rear-wheel speed and handlebar angle feed a
-// first-order kinematic model whose sensor-frame velocities enter the odometer error of eqs. 7-8. Seed 000, eq. 15.
+// Ackermann-steering odometer in the seed's form (model `ackermann_seed`; the ATV of Section V): rear-wheel speed and
+// handlebar angle feed a first-order kinematic model whose sensor-frame velocities enter the odometer error of
+// eqs. 7-8. Seed 000, eq. 15. This form biases the speed gain (errors in variables); the default model `ackermann`
+// is the measurement-space form in ackermann_velocity.h, which explains why.
 //
 //   v_hat^(S)     = [k_v (z_v + eta_v);  eta_vy;  eta_vz]                           k_v = kv_over_L * L
 //   omega_hat^(S) = [eta_wx;  eta_wy;  kv_over_L (z_v + eta_v) tan(k_theta (z_theta + eta_theta) + k_gamma)]

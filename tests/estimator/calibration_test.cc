@@ -53,10 +53,39 @@ TEST(CalibrationTest, RecoversLeverArmAndSteeringGainsWithinReportedUncertainty)
                                            {"gps.lever_arm", "odometer.k_theta", "odometer.k_gamma"});
 }
 
-// Known open problem (issue notes): with sensor noise on, kv_over_L comes out 0.5-0.7% low, 2.7-3.5 reported
-// standard deviations, on two seeds; noise-free it is exact (error 6e-5). Kept here, disabled, until it is explained.
-TEST(CalibrationTest, DISABLED_RecoversSpeedGainWithinReportedUncertainty) {
+TEST(CalibrationTest, RecoversSpeedGainWithinReportedUncertainty) {
   ExpectRecoveredWithinReportedUncertainty(kLeverArmAndGains, {"odometer.kv_over_L"});
+}
+
+// The seed's form of the Ackermann odometer (eqs. 7-8 with the noisy readings as inputs) is biased: averaged over
+// six noise realizations, kv_over_L lies more than 1.5 reported standard deviations below the truth (measured: -3.1),
+// while the measurement-space form used by default (ackermann_velocity.h) is unbiased (measured: -0.02). The test
+// keeps both facts so that a change to either model shows.
+TEST(CalibrationTest, SeedFormOfAckermannOdometerIsBiasedAndMeasurementFormIsNot) {
+  for (const std::string model : {"ackermann_seed", "ackermann"}) {
+    double mean_z = 0.0;
+    const int seeds = 6;
+    for (int seed = 1; seed <= seeds; ++seed) {
+      roamlab::testing::SyntheticOptions options;
+      options.duration_s = 12.0;
+      options.seed = seed;
+      const auto synthetic = roamlab::testing::MakeAtvRecording(options);
+      EstimatorConfig config = testing::AtvConfig({"odometer.kv_over_L"});
+      config.streams["odometer"].model = model;
+      config.parameters["odometer.kv_over_L"].value = Eigen::VectorXd::Constant(1, 0.78);
+      auto result = Calibrate(config, synthetic.recording);
+      ASSERT_TRUE(result.ok()) << result.status().message();
+      const ParameterEstimate& kv = Find(result.value(), "odometer.kv_over_L");
+      mean_z += (kv.estimate[0] - 0.8) / kv.std[0] / seeds;
+    }
+    // The mean of six standard normal z-scores has standard deviation 0.41: |mean| < 1.5 fails by chance with
+    // probability ~2.5e-4 for an unbiased estimator.
+    if (model == "ackermann_seed") {
+      EXPECT_LT(mean_z, -1.5) << model;
+    } else {
+      EXPECT_LT(std::abs(mean_z), 1.5) << model;
+    }
+  }
 }
 
 TEST(CalibrationTest, PlanarDriveLeavesGpsLeverArmHeightUnobservable) {

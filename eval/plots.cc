@@ -1,0 +1,243 @@
+#include "eval/plots.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "common/check.h"
+
+namespace roamlab::eval {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kTerminal = "set terminal pngcairo size %d,%d noenhanced font 'sans,11'\n";
+
+// A number for a data file; gnuplot reads "NaN" as undefined.
+std::string Num(double v) {
+  if (!std::isfinite(v)) return "NaN";
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.10g", v);
+  return buffer;
+}
+
+// A double-quoted gnuplot string.
+std::string Quote(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string Terminal(int width, int height) {
+  char buffer[128];
+  std::snprintf(buffer, sizeof buffer, kTerminal, width, height);
+  return buffer;
+}
+
+Status WriteText(const std::string& directory, const std::string& name, const std::string& text) {
+  const std::string path = (fs::path(directory) / name).string();
+  std::ofstream out(path, std::ios::binary);
+  if (!out) return Status::Error(path + ": cannot write");
+  out << text;
+  out.close();
+  return out ? Status::Ok() : Status::Error(path + ": write failed");
+}
+
+// "t x y z" rows of a trajectory, t in seconds since t_origin.
+std::string TrajectoryData(const std::string& what, Time t_origin, const Trajectory& trajectory) {
+  std::ostringstream s;
+  s << "# " << what << "\n# t_s east_m north_m up_m\n";
+  for (const StampedPose& pose : trajectory)
+    s << Num(SecondsBetween(t_origin, pose.t)) << ' ' << Num(pose.p_world_body.x()) << ' '
+      << Num(pose.p_world_body.y()) << ' ' << Num(pose.p_world_body.z()) << '\n';
+  return s.str();
+}
+
+// A file-name-safe version of a label.
+std::string Slug(const std::string& label) {
+  std::string out;
+  for (char c : label) out += (std::isalnum(static_cast<unsigned char>(c)) ? c : '_');
+  return out;
+}
+
+}  // namespace
+
+Result<PlotFiles> WriteTrajectoryPlot(const std::string& directory, const std::string& title, Time t_origin,
+                                      const Trajectory& truth, const Trajectory& estimate,
+                                      const std::string& estimate_label, const std::vector<PositionFixes>& fixes) {
+  PlotFiles files{"trajectory.gp", "trajectory.png", {"trajectory_truth.dat", "trajectory_estimate.dat"}};
+  // Data: truth, estimate, one file per fix stream.
+  if (Status s = WriteText(directory, files.data[0], TrajectoryData("ground truth", t_origin, truth)); !s.ok()) return s;
+  if (Status s = WriteText(directory, files.data[1], TrajectoryData(estimate_label, t_origin, estimate)); !s.ok())
+    return s;
+  std::ostringstream plot;
+  plot << "plot " << Quote(files.data[0]) << " using 2:3 with lines lw 2.5 lc rgb '#222222' title 'ground truth', \\\n"
+       << "     " << Quote(files.data[1]) << " using 2:3 with lines lw 1.5 lc rgb '#1f77b4' title "
+       << Quote(estimate_label);
+  const char* kFixColors[] = {"#d62728", "#2ca02c", "#9467bd", "#ff7f0e"};
+  for (std::size_t k = 0; k < fixes.size(); ++k) {
+    const PositionFixes& f = fixes[k];
+    ROAMLAB_CHECK(f.t.size() == f.p_world.size(), "fixes '" << f.label << "': times and positions differ in size");
+    const std::string name = "trajectory_fixes_" + Slug(f.label) + ".dat";
+    std::ostringstream s;
+    s << "# " << f.label << "\n# t_s east_m north_m up_m\n";
+    for (std::size_t i = 0; i < f.t.size(); ++i)
+      s << Num(SecondsBetween(t_origin, f.t[i])) << ' ' << Num(f.p_world[i].x()) << ' ' << Num(f.p_world[i].y())
+        << ' ' << Num(f.p_world[i].z()) << '\n';
+    if (Status st = WriteText(directory, name, s.str()); !st.ok()) return st;
+    files.data.push_back(name);
+    plot << ", \\\n     " << Quote(name) << " using 2:3 with points pt 7 ps 0.6 lc rgb '" << kFixColors[k % 4]
+         << "' title " << Quote(f.label);
+  }
+  // Script: equal axis scales so that the shape of the path is true.
+  std::ostringstream gp;
+  gp << "# Redraw: cd into this directory, then: gnuplot " << files.script << "\n"
+     << Terminal(1000, 900) << "set output " << Quote(files.image) << "\n"
+     << "set title " << Quote(title) << "\n"
+     << "set xlabel 'East [m]'\nset ylabel 'North [m]'\n"
+     << "set size ratio -1\nset grid\nset key top left box opaque\n"
+     << plot.str() << "\n";
+  if (Status s = WriteText(directory, files.script, gp.str()); !s.ok()) return s;
+  return files;
+}
+
+Result<PlotFiles> WritePositionErrorPlot(const std::string& directory, const std::string& title, Time t_origin,
+                                         const std::vector<Time>& t, const std::vector<Eigen::Vector3d>& error_world,
+                                         const std::vector<Eigen::Vector3d>& sigma_world) {
+  ROAMLAB_CHECK(t.size() == error_world.size(), "position error: " << t.size() << " stamps, " << error_world.size()
+                                                                    << " errors");
+  const bool envelope = !sigma_world.empty();
+  ROAMLAB_CHECK(!envelope || sigma_world.size() == t.size(), "position error: sigma size " << sigma_world.size());
+  PlotFiles files{"position_error.gp", "position_error.png", {"position_error.dat"}};
+  // Data: t, error E N U, sigma E N U.
+  std::ostringstream s;
+  s << "# position error of the estimate (estimate - truth) [m] and its standard deviation [m]\n"
+    << "# t_s err_east_m err_north_m err_up_m sigma_east_m sigma_north_m sigma_up_m\n";
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    s << Num(SecondsBetween(t_origin, t[i]));
+    for (int a = 0; a < 3; ++a) s << ' ' << Num(error_world[i][a]);
+    for (int a = 0; a < 3; ++a) s << ' ' << (envelope ? Num(sigma_world[i][a]) : "NaN");
+    s << '\n';
+  }
+  if (Status st = WriteText(directory, files.data[0], s.str()); !st.ok()) return st;
+  // Script: one panel per axis, the shaded envelope behind the error line.
+  std::ostringstream gp;
+  gp << "# Redraw: cd into this directory, then: gnuplot " << files.script << "\n"
+     << Terminal(1000, 1000) << "set output " << Quote(files.image) << "\n"
+     << "set multiplot layout 3,1 title " << Quote(title) << "\n"
+     << "set grid\nset key top right box opaque\nset xlabel 'time since start [s]'\n";
+  const char* kAxes[] = {"East", "North", "Up"};
+  for (int a = 0; a < 3; ++a) {
+    gp << "set ylabel '" << kAxes[a] << " error [m]'\n";
+    gp << "plot ";
+    if (envelope)
+      gp << Quote(files.data[0]) << " using 1:(-3*$" << 5 + a << "):(3*$" << 5 + a
+         << ") with filledcurves fc rgb '#1f77b4' fs transparent solid 0.2 noborder title '+-3 sigma (estimated)', \\\n"
+         << "     ";
+    gp << Quote(files.data[0]) << " using 1:" << 2 + a << " with lines lw 1.5 lc rgb '#1f77b4' title '"
+       << kAxes[a] << " error'\n";
+  }
+  gp << "unset multiplot\n";
+  if (Status st = WriteText(directory, files.script, gp.str()); !st.ok()) return st;
+  return files;
+}
+
+Result<PlotFiles> WriteNeesPlot(const std::string& directory, const std::string& title, const MonteCarloNees& nees,
+                                const std::string& name) {
+  ROAMLAB_CHECK(nees.t.size() == nees.mean_nees.size(), "NEES: time and value sizes differ");
+  PlotFiles files{name + ".gp", name + ".png", {name + ".dat"}};
+  const Time t_origin = nees.t.empty() ? Time() : nees.t.front();
+  std::ostringstream s;
+  s << "# average NEES over " << nees.runs << " run(s), dof " << nees.dof << "; band [" << Num(nees.band.lo) << ", "
+    << Num(nees.band.hi) << "]\n# t_s mean_nees\n";
+  for (std::size_t k = 0; k < nees.t.size(); ++k)
+    s << Num(SecondsBetween(t_origin, nees.t[k])) << ' ' << Num(nees.mean_nees[k]) << '\n';
+  if (Status st = WriteText(directory, files.data[0], s.str()); !st.ok()) return st;
+
+  char band_label[160];
+  std::snprintf(band_label, sizeof band_label, "%g%% chi-square band [%.3f, %.3f]", 100.0 * (1.0 - nees.alpha),
+                nees.band.lo, nees.band.hi);
+  std::ostringstream gp;
+  gp << "# Redraw: cd into this directory, then: gnuplot " << files.script << "\n"
+     << Terminal(1000, 600) << "set output " << Quote(files.image) << "\n"
+     << "set title " << Quote(title) << "\n"
+     << "set xlabel 'time since start [s]'\nset ylabel 'average NEES [-]'\n"
+     << "set grid\nset key top right box opaque\n"
+     << "lo = " << Num(nees.band.lo) << "\nhi = " << Num(nees.band.hi) << "\n";
+  if (nees.t0_s > 0.0)
+    gp << "set arrow from " << Num(nees.t0_s) << ", graph 0 to " << Num(nees.t0_s)
+       << ", graph 1 nohead dt 3 lc rgb '#555555'\n"
+       << "set label 'T0' at " << Num(nees.t0_s) << ", graph 0.95 offset 0.5,0\n";
+  gp << "plot " << Quote(files.data[0]) << " using 1:2 with lines lw 1.5 lc rgb '#1f77b4' title 'average NEES', \\\n"
+     << "     lo with lines dt 2 lw 1.5 lc rgb '#d62728' title " << Quote(band_label) << ", \\\n"
+     << "     hi with lines dt 2 lw 1.5 lc rgb '#d62728' notitle\n";
+  if (Status st = WriteText(directory, files.script, gp.str()); !st.ok()) return st;
+  return files;
+}
+
+bool GnuplotAvailable() {
+  const char* path = std::getenv("PATH");
+  if (!path) return false;
+  std::stringstream dirs(path);
+  std::string dir;
+  while (std::getline(dirs, dir, ':')) {
+    if (dir.empty()) continue;
+    const std::string candidate = (fs::path(dir) / "gnuplot").string();
+    struct stat info {};
+    if (::stat(candidate.c_str(), &info) == 0 && S_ISREG(info.st_mode) && ::access(candidate.c_str(), X_OK) == 0)
+      return true;
+  }
+  return false;
+}
+
+Status RunGnuplot(const std::string& directory, const std::string& script) {
+  if (!GnuplotAvailable()) return Status::Error("gnuplot not found on PATH");
+  const std::string stem = fs::path(script).stem().string();
+  const std::string log_path = (fs::path(directory) / (stem + ".log")).string();
+  // Child: into the directory, messages to the log, then gnuplot.
+  const pid_t pid = ::fork();
+  if (pid < 0) return Status::Error("cannot start gnuplot: fork failed");
+  if (pid == 0) {
+    if (::chdir(directory.c_str()) != 0) ::_exit(126);
+    const int log = ::open((stem + ".log").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (log >= 0) {
+      ::dup2(log, STDOUT_FILENO);
+      ::dup2(log, STDERR_FILENO);
+      ::close(log);
+    }
+    ::execlp("gnuplot", "gnuplot", script.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) return Status::Error("gnuplot: waitpid failed");
+  }
+  // The log: first line for the error message, removed when empty.
+  std::string first_line;
+  {
+    std::ifstream log(log_path);
+    std::getline(log, first_line);
+  }
+  std::error_code ec;
+  if (fs::exists(log_path, ec) && fs::file_size(log_path, ec) == 0) fs::remove(log_path, ec);
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return Status::Ok();
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 126) return Status::Error(directory + ": cannot enter directory");
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 127) return Status::Error("cannot run gnuplot");
+  return Status::Error((fs::path(directory) / script).string() + ": gnuplot failed" +
+                       (first_line.empty() ? "" : ": " + first_line) + " (see " + log_path + ")");
+}
+
+}  // namespace roamlab::eval

@@ -1,0 +1,59 @@
+// Figures drawn with gnuplot (Debian package gnuplot-nox, terminal pngcairo). Each Write*Plot writes its data files
+// (whitespace-separated columns with a '#' header) and a gnuplot script into a directory; the script refers to them by
+// relative names, so `cd DIR && gnuplot NAME.gp` redraws NAME.png after editing either. RunGnuplot runs a script.
+//
+//   trajectory       top view (East, North) of the ground truth, the estimate and absolute fixes (the seed's Fig. 3)
+//   position_error   estimate - truth per axis (E, N, U) against time, with the +-3 sigma envelope when known
+//   nees             average NEES against time with the chi-square band lines (the seed's Fig. 4)
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/status.h"
+#include "eval/nees.h"
+#include "recording/trajectory.h"
+
+namespace roamlab::eval {
+
+// What a writer produced, as file names relative to its directory.
+struct PlotFiles {
+  std::string script;             // NAME.gp
+  std::string image;              // NAME.png (written by RunGnuplot)
+  std::vector<std::string> data;  // NAME*.dat
+};
+
+// Positions of an absolute sensor in the reference world frame (GPS converted to ENU, motion capture, ...).
+struct PositionFixes {
+  std::string label;                      // legend text, e.g. "GPS fixes (gps)"
+  std::vector<Time> t;
+  std::vector<Eigen::Vector3d> p_world;   // [m]
+};
+
+// Top view. `estimate` is drawn as given (align it first); `estimate_label` is its legend text. Time columns are
+// seconds since t_origin.
+Result<PlotFiles> WriteTrajectoryPlot(const std::string& directory, const std::string& title, Time t_origin,
+                                      const Trajectory& truth, const Trajectory& estimate,
+                                      const std::string& estimate_label, const std::vector<PositionFixes>& fixes);
+
+// Three stacked panels, East, North, Up. t: one stamp per error; errors [m]; sigma_world: one standard deviation per
+// axis [m] per stamp, or empty for no envelope (sizes CHECKed).
+Result<PlotFiles> WritePositionErrorPlot(const std::string& directory, const std::string& title, Time t_origin,
+                                         const std::vector<Time>& t, const std::vector<Eigen::Vector3d>& error_world,
+                                         const std::vector<Eigen::Vector3d>& sigma_world);
+
+// Average NEES and the band [lo, hi] (dashed), with a dotted line at t0_s when it is positive. Files NAME.gp, NAME.dat,
+// NAME.png with NAME = `name`.
+Result<PlotFiles> WriteNeesPlot(const std::string& directory, const std::string& title, const MonteCarloNees& nees,
+                                const std::string& name = "nees");
+
+// True when an executable named gnuplot is on PATH.
+bool GnuplotAvailable();
+
+// Runs `gnuplot SCRIPT` with `directory` as working directory. Its messages go to SCRIPT-without-.gp.log in the
+// directory (removed when empty). Errors: gnuplot missing, not started, or exiting non-zero (with its first message).
+Status RunGnuplot(const std::string& directory, const std::string& script);
+
+}  // namespace roamlab::eval
