@@ -10,14 +10,13 @@
 
 namespace roamlab::estimator {
 
-int GateOutliers(double probability, ProblemBuilder* builder) {
+int GateOutliers(double probability, ProblemBuilder* builder, FactorId first) {
   Graph& graph = builder->graph();
   std::map<int, double> threshold;
-  std::map<std::string, int> rejected_per_stream;
   int changed = 0;
   std::vector<FactorId> ids;
-  for (const auto& [id, entry] : graph.factors())
-    if (builder->StreamOfFactor(id) >= 0) ids.push_back(id);
+  for (auto it = graph.factors().lower_bound(first); it != graph.factors().end(); ++it)
+    if (builder->StreamOfFactor(it->first) >= 0) ids.push_back(it->first);
   for (FactorId id : ids) {
     FactorEntry& entry = graph.mutable_factor(id);
     const int dim = entry.factor->residual_dim();
@@ -25,12 +24,11 @@ int GateOutliers(double probability, ProblemBuilder* builder) {
     internal::WhitenedFactor wf;
     const bool ok = internal::LinearizeFactor(graph, entry, std::vector<bool>(entry.variables.size(), false), &wf);
     const bool active = ok && wf.squared_norm <= threshold[dim];
-    if (active != entry.active) ++changed;
+    if (active == entry.active) continue;
+    ++changed;
+    builder->mutable_counts(entry.stream).rejected += active ? -1 : 1;
     entry.active = active;
-    if (!active) ++rejected_per_stream[entry.stream];
   }
-  for (const std::string& stream : builder->stream_names())
-    builder->mutable_counts(stream).rejected = rejected_per_stream[stream];
   return changed;
 }
 

@@ -63,9 +63,9 @@ struct CalibrationOptions {
 Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recording::Recording& recording,
                                     const CalibrationOptions& options = {});
 
-// Re-tests every measurement factor: active exactly when its whitened squared error is within the chi-square quantile
-// `probability` of its dimension. Sets the per-stream rejected counts to the factors now off; returns how many
-// factors changed state.
-int GateOutliers(double probability, ProblemBuilder* builder);
+// Re-tests the measurement factors with id >= `first` (factor ids grow as factors are added, so `first` selects the
+// newest ones): active exactly when the whitened squared error is within the chi-square quantile `probability` of its
+// dimension. Keeps the per-stream rejected counts up to date; returns how many factors changed state.
+int GateOutliers(double probability, ProblemBuilder* builder, FactorId first = 0);
 
 }  // namespace roamlab::estimator

@@ -22,6 +22,7 @@
 #include <array>
 #include <memory>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -51,6 +52,7 @@ struct BlockSizes<std::tuple<B...>> {
   static constexpr int kCount = sizeof...(B);
   static constexpr int kTangentSum = (0 + ... + B::kTangent);
   static constexpr int kAmbientMax = std::max({0, B::kAmbient...});
+  static constexpr int kPoseTangentSum = (0 + ... + (std::is_same_v<B, PoseBlock> ? B::kTangent : 0));
 };
 }  // namespace internal
 
@@ -60,7 +62,6 @@ class AutoDiffFactor final : public Factor {
   using Blocks = typename Model::Blocks;
   static constexpr int kBlockCount = internal::BlockSizes<Blocks>::kCount;
   static constexpr int kSlots = internal::BlockSizes<Blocks>::kTangentSum + Model::kNoiseDim;
-  using JetT = Jet<kSlots>;
 
   explicit AutoDiffFactor(Model model) : model_(std::move(model)) {
     FillManifolds(std::make_index_sequence<kBlockCount>());
@@ -77,15 +78,33 @@ class AutoDiffFactor final : public Factor {
       std::array<double, Model::kNoiseDim + 1> zero_noise{};
       return model_(values, zero_noise.data(), error) && AllFinite(error);
     }
-    // Perturb every block by a jet-valued zero tangent vector, and the noise by jet-valued zeros.
-    std::array<std::array<JetT, internal::BlockSizes<Blocks>::kAmbientMax>, kBlockCount> perturbed;
-    std::array<const JetT*, kBlockCount> block_ptrs;
-    PerturbBlocks(values, &perturbed, std::make_index_sequence<kBlockCount>());
-    for (int i = 0; i < kBlockCount; ++i) block_ptrs[i] = perturbed[i].data();
-    std::array<JetT, Model::kNoiseDim + 1> noise;
-    for (int k = 0; k < Model::kNoiseDim; ++k) noise[k] = JetT(0.0, kSlots - Model::kNoiseDim + k);
+    // When no Jacobian of a non-pose block is asked for (parameters held fixed, as in tracking), smaller jets that
+    // carry only the pose and noise slots do the same work.
+    bool parameters_wanted = false;
+    for (int i = 0; i < kBlockCount && jacobians != nullptr; ++i)
+      parameters_wanted |= jacobians[i] != nullptr && manifolds_[i].kind() != ManifoldKind::kPose;
+    if (parameters_wanted) return EvaluateWithJets<kSlots, true>(values, error, jacobians, noise_jacobian);
+    return EvaluateWithJets<kPoseSlots, false>(values, error, jacobians, noise_jacobian);
+  }
 
-    std::array<JetT, Model::kResidualDim> e;
+ private:
+  static constexpr int kPoseSlots = internal::BlockSizes<Blocks>::kPoseTangentSum + Model::kNoiseDim;
+
+  // Every block with a slot range (all blocks, or poses only) is perturbed by a jet-valued zero tangent vector; the
+  // others enter as constants. The noise always has slots, after the blocks'.
+  template <int N, bool kAllBlocks>
+  bool EvaluateWithJets(const double* const* values, double* error, double* const* jacobians,
+                        double* noise_jacobian) const {
+    using J = Jet<N>;
+    std::array<std::array<J, internal::BlockSizes<Blocks>::kAmbientMax>, kBlockCount> perturbed;
+    std::array<const J*, kBlockCount> block_ptrs;
+    std::array<int, kBlockCount> first_slot;
+    PerturbBlocks<J, kAllBlocks>(values, &perturbed, &first_slot, std::make_index_sequence<kBlockCount>());
+    for (int i = 0; i < kBlockCount; ++i) block_ptrs[i] = perturbed[i].data();
+    std::array<J, Model::kNoiseDim + 1> noise;
+    for (int k = 0; k < Model::kNoiseDim; ++k) noise[k] = J(0.0, N - Model::kNoiseDim + k);
+
+    std::array<J, Model::kResidualDim> e;
     if (!model_(block_ptrs.data(), noise.data(), e.data())) return false;
 
     // Scatter values and derivative slots.
@@ -94,25 +113,22 @@ class AutoDiffFactor final : public Factor {
       if (!std::isfinite(e[r].a) || !e[r].v.allFinite()) return false;
     }
     if (jacobians != nullptr) {
-      int slot = 0;
       for (int i = 0; i < kBlockCount; ++i) {
+        if (jacobians[i] == nullptr) continue;
         const int dim = manifolds_[i].tangent_dim();
-        if (jacobians[i] != nullptr) {
-          for (int c = 0; c < dim; ++c)
-            for (int r = 0; r < Model::kResidualDim; ++r) jacobians[i][c * Model::kResidualDim + r] = e[r].v[slot + c];
-        }
-        slot += dim;
+        for (int c = 0; c < dim; ++c)
+          for (int r = 0; r < Model::kResidualDim; ++r)
+            jacobians[i][c * Model::kResidualDim + r] = first_slot[i] >= 0 ? e[r].v[first_slot[i] + c] : 0.0;
       }
     }
     if (noise_jacobian != nullptr) {
-      const int first = kSlots - Model::kNoiseDim;
+      const int first = N - Model::kNoiseDim;
       for (int c = 0; c < Model::kNoiseDim; ++c)
         for (int r = 0; r < Model::kResidualDim; ++r) noise_jacobian[c * Model::kResidualDim + r] = e[r].v[first + c];
     }
     return true;
   }
 
- private:
   static bool AllFinite(const double* e) {
     for (int r = 0; r < Model::kResidualDim; ++r)
       if (!std::isfinite(e[r])) return false;
@@ -124,18 +140,27 @@ class AutoDiffFactor final : public Factor {
     (manifolds_.push_back(std::tuple_element_t<I, Blocks>::manifold()), ...);
   }
 
-  template <std::size_t... I, typename Storage>
-  static void PerturbBlocks(const double* const* values, Storage* out, std::index_sequence<I...>) {
+  template <typename J, bool kAllBlocks, std::size_t... I, typename Storage>
+  static void PerturbBlocks(const double* const* values, Storage* out, std::array<int, kBlockCount>* first_slot,
+                            std::index_sequence<I...>) {
     int slot = 0;
-    (PerturbBlock<std::tuple_element_t<I, Blocks>>(values[I], &slot, (*out)[I].data()), ...);
+    (PerturbBlock<J, kAllBlocks, std::tuple_element_t<I, Blocks>>(values[I], &slot, (*out)[I].data(),
+                                                                   &(*first_slot)[I]),
+     ...);
   }
 
-  template <typename Block>
-  static void PerturbBlock(const double* x, int* slot, JetT* out) {
-    std::array<JetT, Block::kTangent> delta;
-    for (int k = 0; k < Block::kTangent; ++k) delta[k] = JetT(0.0, *slot + k);
-    Block::template Plus<JetT>(x, delta.data(), out);
-    *slot += Block::kTangent;
+  template <typename J, bool kAllBlocks, typename Block>
+  static void PerturbBlock(const double* x, int* slot, J* out, int* first_slot) {
+    std::array<J, Block::kTangent> delta;
+    if (kAllBlocks || std::is_same_v<Block, PoseBlock>) {
+      *first_slot = *slot;
+      for (int k = 0; k < Block::kTangent; ++k) delta[k] = J(0.0, *slot + k);
+      *slot += Block::kTangent;
+    } else {
+      *first_slot = -1;
+      for (int k = 0; k < Block::kTangent; ++k) delta[k] = J(0.0);
+    }
+    Block::template Plus<J>(x, delta.data(), out);
   }
 
   Model model_;

@@ -141,13 +141,10 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph) {
       nu = 2.0;
     }
 
-    // Relinearize at the new point (this also re-evaluates every error covariance, eq. 1).
-    if (!system.Linearize(*graph, &failed_stream)) {
-      summary.termination = Termination::kFailure;
-      summary.message = "a factor from stream '" + failed_stream + "' could not be evaluated";
-      break;
-    }
-    summary.cost_history.push_back(system.cost());
+    // Stop here when converged or out of iterations or time; otherwise relinearize at the new point (which also
+    // re-evaluates every error covariance, eq. 1).
+    summary.cost_history.push_back(new_cost);
+    summary.final_cost = new_cost;
     const double step_norm = dx.norm();
     if (std::abs(actual) <= options.function_tolerance * old_cost) {
       summary.termination = Termination::kFunctionTolerance;
@@ -157,8 +154,17 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph) {
       summary.termination = Termination::kStepTolerance;
       break;
     }
+    if (iteration + 1 == options.max_iterations) break;
+    if (elapsed() > options.time_budget_s) {
+      summary.termination = Termination::kTimeBudget;
+      break;
+    }
+    if (!system.Linearize(*graph, &failed_stream)) {
+      summary.termination = Termination::kFailure;
+      summary.message = "a factor from stream '" + failed_stream + "' could not be evaluated";
+      break;
+    }
   }
-  summary.final_cost = system.cost();
   summary.seconds = elapsed();
   return summary;
 }

@@ -44,7 +44,9 @@ struct SolverSummary {
   int iterations = 0;                 // linearizations that produced a step
   double initial_cost = 0.0;          // 1/2 sum of robustified squared whitened errors
   double final_cost = 0.0;
-  std::vector<double> cost_history;   // cost at each linearization, then the final cost
+  // The initial cost, then after each accepted step the cost at the new point, evaluated with the error covariances
+  // of the linearization that step came from (they are re-evaluated at the next linearization).
+  std::vector<double> cost_history;
   double seconds = 0.0;
   int free_dimension = 0;
   int factors = 0;

@@ -14,6 +14,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+FactorId NextFactorId(const Graph& graph) {
+  return graph.factors().empty() ? 0 : graph.factors().rbegin()->first + 1;
+}
+
 // The oldest pose's estimate and position covariance (marginal of the whole window).
 Status EmitOldest(ProblemBuilder* builder, TrackingResult* out) {
   const PoseNode& node = builder->poses().front();
@@ -71,6 +75,8 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
   bool initialized = false;
   std::size_t poses_before = 0;
   double update_seconds = 0.0;
+  int iterations = 0;
+  FactorId first_new_factor = 0;
   for (std::size_t i = 0; i < measurements.size(); ++i) {
     const MeasurementRef& m = measurements[i];
     builder.Add(m);
@@ -90,17 +96,20 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
         Solve(config.solver, &builder.graph());
       initialized = true;
     } else {
-      // One update: Gauss-Newton on the window, gating, and a re-solve if anything was gated.
+      // One update: Gauss-Newton on the window, gating of the measurements attached since the last update, and a
+      // re-solve if anything was gated.
       const auto t0 = Clock::now();
       const SolverSummary s = Solve(update_options, &builder.graph());
       if (!s.usable()) return Status::Error("update at t = " + FormatSeconds(m.t) + " failed: " + s.message);
-      if (config.gate_probability && GateOutliers(*config.gate_probability, &builder) > 0)
-        Solve(update_options, &builder.graph());
+      iterations += s.iterations;
+      if (config.gate_probability && GateOutliers(*config.gate_probability, &builder, first_new_factor) > 0)
+        iterations += Solve(update_options, &builder.graph()).iterations;
       const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
       ++out.updates;
       update_seconds += dt;
       out.max_update_s = std::max(out.max_update_s, dt);
     }
+    first_new_factor = NextFactorId(builder.graph());
     while (static_cast<int>(builder.poses().size()) > config.tracking.window) {
       const Status st = EmitAndMarginalizeOldest(&builder, &out);
       if (!st.ok()) return st;
@@ -122,6 +131,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
     if (!st.ok()) return st;
   }
   out.mean_update_s = out.updates > 0 ? update_seconds / out.updates : 0.0;
+  out.mean_iterations = out.updates > 0 ? static_cast<double>(iterations) / out.updates : 0.0;
   out.counts = builder.counts();
   out.total_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return out;
