@@ -43,9 +43,19 @@ class Factor {
   // residual_dim x noise_dim. Returns false when the error cannot be evaluated (for example a NaN).
   virtual bool Evaluate(const double* const* values, double* error, double* const* jacobians,
                         double* noise_jacobian) const = 0;
+  // True when e = f(x) + eta exactly: J_e_eta is the identity and the error covariance is the noise covariance, so
+  // it can be whitened once (graph.h) instead of at every linearization.
+  virtual bool additive_noise() const { return false; }
 };
 
 namespace internal {
+// Model::kAdditiveNoise, false when the model does not declare it.
+template <typename Model, typename = void>
+struct AdditiveNoise : std::false_type {};
+template <typename Model>
+struct AdditiveNoise<Model, std::void_t<decltype(Model::kAdditiveNoise)>>
+    : std::integral_constant<bool, Model::kAdditiveNoise> {};
+
 template <typename Tuple> struct BlockSizes;
 template <typename... B>
 struct BlockSizes<std::tuple<B...>> {
@@ -61,7 +71,10 @@ class AutoDiffFactor final : public Factor {
  public:
   using Blocks = typename Model::Blocks;
   static constexpr int kBlockCount = internal::BlockSizes<Blocks>::kCount;
-  static constexpr int kSlots = internal::BlockSizes<Blocks>::kTangentSum + Model::kNoiseDim;
+  static constexpr bool kAdditive = internal::AdditiveNoise<Model>::value;
+  // Derivative slots for the noise; none when the noise is additive (its Jacobian is the identity).
+  static constexpr int kNoiseSlots = kAdditive ? 0 : Model::kNoiseDim;
+  static constexpr int kSlots = internal::BlockSizes<Blocks>::kTangentSum + kNoiseSlots;
 
   explicit AutoDiffFactor(Model model) : model_(std::move(model)) {
     FillManifolds(std::make_index_sequence<kBlockCount>());
@@ -71,6 +84,7 @@ class AutoDiffFactor final : public Factor {
   int residual_dim() const override { return Model::kResidualDim; }
   int noise_dim() const override { return Model::kNoiseDim; }
   const std::vector<Manifold>& manifolds() const override { return manifolds_; }
+  bool additive_noise() const override { return kAdditive; }
 
   bool Evaluate(const double* const* values, double* error, double* const* jacobians,
                 double* noise_jacobian) const override {
@@ -88,7 +102,7 @@ class AutoDiffFactor final : public Factor {
   }
 
  private:
-  static constexpr int kPoseSlots = internal::BlockSizes<Blocks>::kPoseTangentSum + Model::kNoiseDim;
+  static constexpr int kPoseSlots = internal::BlockSizes<Blocks>::kPoseTangentSum + kNoiseSlots;
 
   // Every block with a slot range (all blocks, or poses only) is perturbed by a jet-valued zero tangent vector; the
   // others enter as constants. The noise always has slots, after the blocks'.
@@ -102,7 +116,7 @@ class AutoDiffFactor final : public Factor {
     PerturbBlocks<J, kAllBlocks>(values, &perturbed, &first_slot, std::make_index_sequence<kBlockCount>());
     for (int i = 0; i < kBlockCount; ++i) block_ptrs[i] = perturbed[i].data();
     std::array<J, Model::kNoiseDim + 1> noise;
-    for (int k = 0; k < Model::kNoiseDim; ++k) noise[k] = J(0.0, N - Model::kNoiseDim + k);
+    for (int k = 0; k < Model::kNoiseDim; ++k) noise[k] = kAdditive ? J(0.0) : J(0.0, N - Model::kNoiseDim + k);
 
     std::array<J, Model::kResidualDim> e;
     if (!model_(block_ptrs.data(), noise.data(), e.data())) return false;
@@ -124,7 +138,8 @@ class AutoDiffFactor final : public Factor {
     if (noise_jacobian != nullptr) {
       const int first = N - Model::kNoiseDim;
       for (int c = 0; c < Model::kNoiseDim; ++c)
-        for (int r = 0; r < Model::kResidualDim; ++r) noise_jacobian[c * Model::kResidualDim + r] = e[r].v[first + c];
+        for (int r = 0; r < Model::kResidualDim; ++r)
+          noise_jacobian[c * Model::kResidualDim + r] = kAdditive ? (r == c ? 1.0 : 0.0) : e[r].v[first + c];
     }
     return true;
   }

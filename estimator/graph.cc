@@ -38,10 +38,16 @@ FactorId Graph::AddFactor(std::unique_ptr<Factor> factor, std::vector<VariableId
                     Eigen::LLT<Eigen::MatrixXd>(noise_covariance).info() == Eigen::Success,
                 "factor from '" << stream << "': noise covariance is not symmetric positive definite");
   const FactorId id = next_factor_++;
+  const bool factor_is_additive = factor->additive_noise();
   for (VariableId v : variables) factors_of_[v].push_back(id);
   FactorEntry entry;
   entry.factor = std::move(factor);
   entry.variables = std::move(variables);
+  if (factor_is_additive) {
+    const int n = static_cast<int>(noise_covariance.rows());
+    entry.noise_whitening =
+        Eigen::LLT<Eigen::MatrixXd>(noise_covariance).matrixL().solve(Eigen::MatrixXd::Identity(n, n));
+  }
   entry.noise_covariance = std::move(noise_covariance);
   entry.loss = loss;
   entry.stream = std::move(stream);

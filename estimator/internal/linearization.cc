@@ -32,14 +32,22 @@ bool LinearizeFactor(const Graph& graph, const FactorEntry& entry, const std::ve
       out->jacobians[i].resize(0, 0);
     }
   }
-  Eigen::MatrixXd noise_jacobian(m, factor.noise_dim());
-  if (!factor.Evaluate(values.data(), error.data(), jacobian_ptrs.data(), noise_jacobian.data())) return false;
-
-  // Error covariance (eq. 1) and whitening.
-  const Eigen::MatrixXd sigma_e = noise_jacobian * entry.noise_covariance * noise_jacobian.transpose();
-  const Eigen::LLT<Eigen::MatrixXd> llt(sigma_e);
-  if (llt.info() != Eigen::Success) return false;
-  out->whitening = llt.matrixL().solve(Eigen::MatrixXd::Identity(m, m));
+  bool any_jacobian = false;
+  for (std::size_t i = 0; i < n; ++i) any_jacobian |= want_jacobian[i];
+  if (factor.additive_noise()) {
+    // Error covariance = noise covariance, whitened once when the factor was added.
+    if (!factor.Evaluate(values.data(), error.data(), any_jacobian ? jacobian_ptrs.data() : nullptr, nullptr))
+      return false;
+    out->whitening = entry.noise_whitening;
+  } else {
+    // Error covariance of eq. 1 at the current estimate, and its whitening.
+    Eigen::MatrixXd noise_jacobian(m, factor.noise_dim());
+    if (!factor.Evaluate(values.data(), error.data(), jacobian_ptrs.data(), noise_jacobian.data())) return false;
+    const Eigen::MatrixXd sigma_e = noise_jacobian * entry.noise_covariance * noise_jacobian.transpose();
+    const Eigen::LLT<Eigen::MatrixXd> llt(sigma_e);
+    if (llt.info() != Eigen::Success) return false;
+    out->whitening = llt.matrixL().solve(Eigen::MatrixXd::Identity(m, m));
+  }
   out->residual = out->whitening * error;
   for (std::size_t i = 0; i < n; ++i) {
     if (want_jacobian[i]) out->jacobians[i] = out->whitening * out->jacobians[i];

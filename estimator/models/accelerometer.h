@@ -52,6 +52,7 @@ class AccelerometerError {
       std::tuple<PoseBlock, PoseBlock, PoseBlock, QuaternionBlock, Vector3Block, Vector3Block, Vector3Block>;
   static constexpr int kResidualDim = 3;
   static constexpr int kNoiseDim = 3;
+  static constexpr bool kAdditiveNoise = true;  // e = f(x) + eta
 
   // z_mps2: the reading [m/s^2] in the sensor frame, taken at t1; dt0_s = t1 - t0 and dt1_s = t2 - t1 [s], > 0.
   AccelerometerError(const Eigen::Vector3d& z_mps2, double dt0_s, double dt1_s)

@@ -37,6 +37,7 @@ class AckermannVelocityError {
   using Blocks = std::tuple<PoseBlock, PoseBlock, ScalarBlock, ScalarBlock, ScalarBlock>;
   static constexpr int kResidualDim = 6;
   static constexpr int kNoiseDim = 6;
+  static constexpr bool kAdditiveNoise = true;  // e = f(x) + eta
   static constexpr double kMinSteeringSpeed = 0.2;  // [m/s]
 
   AckermannVelocityError(double z_v_mps, double z_theta_rad, double wheelbase_m, double dt_s)

@@ -23,6 +23,7 @@ class GpsError {
   using Blocks = std::tuple<PoseBlock, Vector3Block>;
   static constexpr int kResidualDim = 3;
   static constexpr int kNoiseDim = 3;
+  static constexpr bool kAdditiveNoise = true;  // e = f(x) + eta
 
   explicit GpsError(const Eigen::Vector3d& z_world) : z_world_(z_world) {}
 

@@ -32,6 +32,7 @@ class LinearVelocityError {
   using Blocks = std::tuple<PoseBlock, PoseBlock, Vector3Block, QuaternionBlock>;
   static constexpr int kResidualDim = 3;
   static constexpr int kNoiseDim = 3;
+  static constexpr bool kAdditiveNoise = true;  // e = f(x) + eta
 
   // z_mps: the sensor's velocity [m/s] in its own frame; dt_s: t(k+1) - t(k) [s], > 0.
   LinearVelocityError(const Eigen::Vector3d& z_mps, double dt_s) : z_mps_(z_mps), dt_s_(dt_s) {}

@@ -29,6 +29,7 @@ class MagnetometerError {
   using Blocks = std::tuple<PoseBlock, QuaternionBlock, Matrix3Block, Vector3Block>;
   static constexpr int kResidualDim = 3;
   static constexpr int kNoiseDim = 3;
+  static constexpr bool kAdditiveNoise = true;  // e = f(x) + eta
 
   // z: the reading in the sensor frame; h_world: the Earth's field in W, in the same units as z.
   MagnetometerError(const Eigen::Vector3d& z, const Eigen::Vector3d& h_world) : z_(z), h_world_(h_world) {}

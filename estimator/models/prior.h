@@ -51,6 +51,7 @@ class PriorError {
   using Blocks = std::tuple<Block>;
   static constexpr int kResidualDim = Block::kTangent;
   static constexpr int kNoiseDim = Block::kTangent;
+  static constexpr bool kAdditiveNoise = true;  // e = f(x) + eta
 
   // x0: the prior value in the block's ambient representation (quaternions [w, x, y, z], unit norm).
   explicit PriorError(const Eigen::VectorXd& x0) : x0_(x0) {

@@ -31,6 +31,7 @@ class RandomWalkError {
   using Blocks = std::tuple<VectorBlock<N>, VectorBlock<N>>;
   static constexpr int kResidualDim = N;
   static constexpr int kNoiseDim = N;
+  static constexpr bool kAdditiveNoise = true;  // e = f(x) + eta
 
   // dt_s = t_k+1 - t_k > 0.
   explicit RandomWalkError(double dt_s) : dt_s_(dt_s) { ROAMLAB_CHECK(dt_s > 0.0, "random walk dt " << dt_s); }
@@ -55,6 +56,7 @@ class GaussMarkovError {
   using Blocks = std::tuple<VectorBlock<N>, VectorBlock<N>>;
   static constexpr int kResidualDim = N;
   static constexpr int kNoiseDim = N;
+  static constexpr bool kAdditiveNoise = true;  // e = f(x) + eta
 
   // dt_s = t_k+1 - t_k > 0, tau_s = correlation time > 0.
   GaussMarkovError(double dt_s, double tau_s) : dt_s_(dt_s), tau_s_(tau_s), decay_(std::exp(-dt_s / tau_s)) {
