@@ -30,7 +30,7 @@ const std::vector<ModelSpec>& ModelSpecs() {
   static const std::vector<ModelSpec> specs = {
       {"ackermann",
        {"speed", "steering"},
-       {"speed_mps", "steering_rad", "lateral_mps", "vertical_mps", "roll_rate_radps", "pitch_rate_radps"},
+       {"speed_mps", "steering_rad", "lateral_mps", "vertical_mps"},
        {ScalarSlot("kv_over_L", std::numeric_limits<double>::quiet_NaN()), ScalarSlot("k_theta", 1.0),
         ScalarSlot("k_gamma", 0.0)},
        {"wheelbase_m", "speed_column"},

@@ -83,7 +83,10 @@ Eigen::MatrixXd NoiseCovariance(const StreamBinding& s) {
   const auto& n = s.config.noise;
   Eigen::VectorXd sigma;
   const std::string& m = s.config.model;
-  if (m == "ackermann" || m == "ackermann_seed") {
+  if (m == "ackermann") {
+    sigma.resize(4);
+    sigma << n.at("speed_mps"), n.at("steering_rad"), n.at("lateral_mps"), n.at("vertical_mps");
+  } else if (m == "ackermann_seed") {
     sigma.resize(6);
     sigma << n.at("speed_mps"), n.at("steering_rad"), n.at("lateral_mps"), n.at("vertical_mps"),
         n.at("roll_rate_radps"), n.at("pitch_rate_radps");
@@ -254,7 +257,8 @@ int ProblemBuilder::ResidualDim(const std::string& stream) const {
   for (const StreamBinding& s : impl_->streams)
     if (s.name == stream) {
       const std::string& m = s.config.model;
-      return (m == "ackermann" || m == "ackermann_seed" || m == "odometer" || m == "absolute_pose") ? 6 : 3;
+      if (m == "ackermann") return 4;
+      return (m == "ackermann_seed" || m == "odometer" || m == "absolute_pose") ? 6 : 3;
     }
   return 0;
 }

@@ -4,7 +4,7 @@
 //   v^(O), omega^(O) = VelocitiesBetween(pose_k, pose_k+1, dt)          (eq. 7 inverted; middle of the interval)
 //   z_v_hat     = v_x / k_v                                              k_v = kv_over_L * L
 //   z_theta_hat = (atan(L omega_z / v_x) - k_gamma) / k_theta           (eq. 15: omega_z = (k_v / L) v tan(delta))
-//   e = [z_v_hat - z_v;  z_theta_hat - z_theta;  v_y;  v_z;  omega_x;  omega_y] + eta                  e in R^6
+//   e = [z_v_hat - z_v;  z_theta_hat - z_theta;  v_y;  v_z] + eta                                      e in R^4
 //
 // Why not the seed's form (ackermann_odometer.h, eqs. 7-8 with the readings as inputs): there the reading noise
 // passes through the nonlinear model, so the error covariance of eq. 1 depends on the parameters, and the
@@ -16,8 +16,11 @@
 // Frames: O is the middle of the rear axle (x forward, z up). Measurements: z_v rear-wheel speed with the nominal
 // wheel radius [m/s], z_theta handlebar angle [rad], both over [t_k, t_k+1]. Calibration: kv_over_L [1/m], k_theta
 // [-], k_gamma [rad]; the wheelbase L [m] is known. Noise eta = [sigma_v (m/s), sigma_theta (rad), lateral (m/s),
-// vertical (m/s), roll rate (rad/s), pitch rate (rad/s)], the last four the uncertainty of eq. 15's non-holonomic
-// assumptions. Below kMinSteeringSpeed the steering angle does not affect the motion, so its error is zero (eta only).
+// vertical (m/s)], the last two the uncertainty of eq. 15's non-holonomic assumptions (no sideways slip, no motion
+// off the ground). Eq. 15 says nothing about roll and pitch rates, and on hills they are not zero (the terrain tilts
+// the vehicle): pretending they are pulls the estimated attitude flat and biases the IMU misalignment, so this form
+// leaves them to the other sensors. Below kMinSteeringSpeed the steering angle does not affect the motion, so its
+// error is zero (eta only).
 // Variables: pose at t_k, pose at t_k+1 (PoseBlock), kv_over_L, k_theta, k_gamma (ScalarBlock each).
 #pragma once
 
@@ -35,8 +38,8 @@ namespace roamlab::estimator {
 class AckermannVelocityError {
  public:
   using Blocks = std::tuple<PoseBlock, PoseBlock, ScalarBlock, ScalarBlock, ScalarBlock>;
-  static constexpr int kResidualDim = 6;
-  static constexpr int kNoiseDim = 6;
+  static constexpr int kResidualDim = 4;
+  static constexpr int kNoiseDim = 4;
   static constexpr bool kAdditiveNoise = true;  // e = f(x) + eta
   static constexpr double kMinSteeringSpeed = 0.2;  // [m/s]
 
@@ -63,8 +66,6 @@ class AckermannVelocityError {
     }
     error[2] = v_body.y() + noise[2];
     error[3] = v_body.z() + noise[3];
-    error[4] = omega_body.x() + noise[4];
-    error[5] = omega_body.y() + noise[5];
     return true;
   }
 

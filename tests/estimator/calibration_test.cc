@@ -72,6 +72,10 @@ TEST(CalibrationTest, SeedFormOfAckermannOdometerIsBiasedAndMeasurementFormIsNot
       const auto synthetic = roamlab::testing::MakeAtvRecording(options);
       EstimatorConfig config = testing::AtvConfig({"odometer.kv_over_L"});
       config.streams["odometer"].model = model;
+      if (model == "ackermann_seed") {
+        config.streams["odometer"].noise["roll_rate_radps"] = 0.3;
+        config.streams["odometer"].noise["pitch_rate_radps"] = 0.3;
+      }
       config.parameters["odometer.kv_over_L"].value = Eigen::VectorXd::Constant(1, 0.78);
       auto result = Calibrate(config, synthetic.recording);
       ASSERT_TRUE(result.ok()) << result.status().message();

@@ -33,8 +33,7 @@ std::string AtvConfigYaml(const std::vector<std::string>& free, int window) {
   odometer:
     model: ackermann
     source: {speed: rear_wheel, steering: steering}
-    noise: {speed_mps: 0.033, steering_rad: 0.014, lateral_mps: 0.02, vertical_mps: 0.02,
-            roll_rate_radps: 0.3, pitch_rate_radps: 0.3}
+    noise: {speed_mps: 0.033, steering_rad: 0.014, lateral_mps: 0.02, vertical_mps: 0.02}
   gyroscope: {model: gyroscope, source: imu, noise: {sigma_radps: 0.033}, parameters: {misalignment: imu.misalignment}}
   accelerometer: {model: accelerometer, source: imu, noise: {sigma_mps2: 0.067},
                   parameters: {misalignment: imu.misalignment}}
