@@ -75,8 +75,10 @@ json CountsJson(const std::map<std::string, estimator::StreamCounts>& counts) {
   return j;
 }
 
+}  // namespace
+
 // Parameter values from a calibration.json: parameters.NAME.estimate.
-Result<std::map<std::string, Eigen::VectorXd>> ReadCalibration(const std::string& path) {
+Result<std::map<std::string, Eigen::VectorXd>> ReadCalibrationValues(const std::string& path) {
   std::ifstream in(path);
   if (!in) return Status::Error(path + ": cannot open");
   json j;
@@ -101,8 +103,6 @@ Result<std::map<std::string, Eigen::VectorXd>> ReadCalibration(const std::string
   }
   return out;
 }
-
-}  // namespace
 
 int RunCalibrate(const CalibrateArgs& args) {
   const std::string cmd = "calibrate";
@@ -189,7 +189,7 @@ int RunTrack(const TrackArgs& args) {
   if (!inputs.ok()) return BadInput(cmd, inputs.status().message());
   std::map<std::string, Eigen::VectorXd> calibration;
   if (!args.calibration.empty()) {
-    auto cal = ReadCalibration(args.calibration);
+    auto cal = ReadCalibrationValues(args.calibration);
     if (!cal.ok()) return BadInput(cmd, cal.status().message());
     calibration = std::move(cal).value();
   }

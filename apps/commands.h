@@ -2,7 +2,12 @@
 // "roamlab <command>: <problem>" and gives exit code 2, a failure at run time exit code 1.
 #pragma once
 
+#include <map>
 #include <string>
+
+#include <Eigen/Core>
+
+#include "common/status.h"
 
 namespace roamlab::apps {
 
@@ -24,5 +29,8 @@ struct TrackArgs {
 };
 // Online fixed-lag tracking: writes OUT/trajectory.tum, OUT/covariance.csv and OUT/summary.json.
 int RunTrack(const TrackArgs& args);
+
+// Parameter values (ambient, by name) from a calibration.json written by `roamlab calibrate`.
+Result<std::map<std::string, Eigen::VectorXd>> ReadCalibrationValues(const std::string& path);
 
 }  // namespace roamlab::apps

@@ -1,14 +1,26 @@
 // roamlab: the command line. `roamlab --help` and `roamlab <command> --help` describe every command.
+#include <cstdint>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
 
 #include "apps/commands.h"
 #include "apps/evaluate.h"
+#include "apps/montecarlo.h"
+#include "apps/simulate.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"roamlab: mobile-robot pose tracking and sensor self-calibration testbed"};
   app.require_subcommand(1);
+
+  roamlab::apps::SimulateArgs simulate;
+  std::uint64_t simulate_seed = 0;
+  CLI::App* sim = app.add_subcommand(
+      "simulate", "Run a scenario in MuJoCo and write its recording with ground truth and true calibration.");
+  sim->add_option("scenario", simulate.scenario, "Scenario file (SCENARIO.yaml)")->required();
+  sim->add_option("--out", simulate.out, "Output recording directory")->required();
+  CLI::Option* seed_option = sim->add_option("--seed", simulate_seed, "Sensor-noise seed (overrides the scenario's)");
+  sim->add_flag("--quiet", simulate.quiet, "No progress and no summary");
 
   roamlab::apps::CalibrateArgs calibrate;
   CLI::App* cal = app.add_subcommand(
@@ -47,6 +59,19 @@ int main(int argc, char** argv) {
   evl->add_flag("--no-plots", evaluate.no_plots, "Write metrics.json only");
   evl->add_flag("--quiet", evaluate.quiet, "No summary on stdout");
 
+  roamlab::apps::MonteCarloArgs montecarlo;
+  CLI::App* mc = app.add_subcommand(
+      "montecarlo", "NEES consistency of online tracking over noise realizations (seed 000, Section V, Fig. 4).");
+  mc->add_option("scenario", montecarlo.scenario, "Scenario file (SCENARIO.yaml)")->required();
+  mc->add_option("--config", montecarlo.config, "Estimator configuration for tracking (EST.yaml)")->required();
+  mc->add_option("--calibration", montecarlo.calibration, "calibration.json whose values tracking uses");
+  mc->add_option("--runs", montecarlo.runs, "Noise realizations (default 50)");
+  mc->add_option("--jobs", montecarlo.jobs, "Parallel runs (default: one per core)");
+  mc->add_option("--seed-base", montecarlo.seed_base, "Run i uses noise seed SEED_BASE + i (default 1000)");
+  mc->add_option("--t0", montecarlo.t0_s, "Leave the first T0 seconds out of fraction_in_band (default 2)");
+  mc->add_option("--out", montecarlo.out, "Output directory: nees.json, runs.json, nees.png")->required();
+  mc->add_flag("--quiet", montecarlo.quiet, "No progress bar");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -58,8 +83,13 @@ int main(int argc, char** argv) {
     std::cerr << "roamlab: " << what << " (see roamlab --help)\n";
     return 2;
   }
+  if (*sim) {
+    if (seed_option->count() > 0) simulate.seed = simulate_seed;
+    return roamlab::apps::RunSimulate(simulate);
+  }
   if (*cal) return roamlab::apps::RunCalibrate(calibrate);
   if (*trk) return roamlab::apps::RunTrack(track);
   if (*evl) return roamlab::apps::RunEvaluate(evaluate);
+  if (*mc) return roamlab::apps::RunMonteCarlo(montecarlo);
   return 2;
 }

@@ -10,8 +10,8 @@
 
 #include <GeographicLib/LocalCartesian.hpp>
 
-#include "recording/truth.h"
 #include "eval/internal/json_util.h"
+#include "recording/truth.h"
 
 namespace roamlab::eval {
 namespace {
@@ -98,6 +98,7 @@ std::vector<PositionFixes> AbsoluteFixes(const recording::Recording& recording) 
   for (const recording::Stream& stream : recording.streams) {
     if (!IsAbsoluteSensor(stream.info.type) || stream.values.rows() == 0) continue;
     PositionFixes f;
+    f.name = stream.info.name;
     f.t = stream.t;
     if (stream.info.type == recording::StreamType::kGps) {
       // latitude, longitude [deg], altitude [m] -> ENU at the origin (the reader guarantees an origin with gps).

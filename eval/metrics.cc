@@ -112,7 +112,8 @@ std::size_t StepForDuration(const Trajectory& trajectory, double seconds) {
   if (trajectory.size() < 2) return 1;
   std::vector<double> periods;
   periods.reserve(trajectory.size() - 1);
-  for (std::size_t i = 1; i < trajectory.size(); ++i) periods.push_back(SecondsBetween(trajectory[i - 1].t, trajectory[i].t));
+  for (std::size_t i = 1; i < trajectory.size(); ++i)
+    periods.push_back(SecondsBetween(trajectory[i - 1].t, trajectory[i].t));
   std::nth_element(periods.begin(), periods.begin() + static_cast<std::ptrdiff_t>(periods.size() / 2), periods.end());
   const double median = periods[periods.size() / 2];
   if (!(median > 0.0)) return 1;

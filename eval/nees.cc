@@ -1,5 +1,6 @@
 #include "eval/nees.h"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -7,8 +8,6 @@
 #include <limits>
 #include <sstream>
 #include <string_view>
-
-#include <Eigen/Cholesky>
 
 #include "common/check.h"
 #include "eval/internal/json_util.h"
@@ -29,7 +28,8 @@ std::vector<std::string_view> SplitCommas(std::string_view line) {
   std::size_t begin = 0;
   while (true) {
     const std::size_t comma = line.find(',', begin);
-    fields.push_back(Trim(line.substr(begin, comma == std::string_view::npos ? std::string_view::npos : comma - begin)));
+    fields.push_back(
+        Trim(line.substr(begin, comma == std::string_view::npos ? std::string_view::npos : comma - begin)));
     if (comma == std::string_view::npos) break;
     begin = comma + 1;
   }
@@ -83,8 +83,8 @@ Result<std::vector<StampedCovariance>> ReadPositionCovariances(const std::string
   std::ifstream in(path);
   if (!in) return Status::Error(path + ": cannot open file");
   std::string line;
-  if (!std::getline(in, line)) return Status::Error(path + ":1: empty file, expected header '" +
-                                                    std::string(kCovarianceHeader) + "'");
+  if (!std::getline(in, line))
+    return Status::Error(path + ":1: empty file, expected header '" + std::string(kCovarianceHeader) + "'");
   if (Trim(line) != kCovarianceHeader)
     return Status::Error(path + ":1: header must be '" + std::string(kCovarianceHeader) + "'");
   std::vector<StampedCovariance> rows;
@@ -102,7 +102,8 @@ Result<std::vector<StampedCovariance>> ReadPositionCovariances(const std::string
 }
 
 double FractionInBand(const std::vector<Time>& t, const std::vector<double>& values, Interval band, double t0_s) {
-  ROAMLAB_CHECK(t.size() == values.size(), "FractionInBand: " << t.size() << " times vs " << values.size() << " values");
+  ROAMLAB_CHECK(t.size() == values.size(),
+                "FractionInBand: " << t.size() << " times vs " << values.size() << " values");
   std::size_t counted = 0;
   std::size_t inside = 0;
   for (std::size_t k = 0; k < t.size(); ++k) {
@@ -138,8 +139,8 @@ MonteCarloNees AggregateNees(const std::vector<Time>& t, const std::vector<std::
     }
   }
   for (double& m : nees.mean_nees) m /= static_cast<double>(runs.size());
-  nees.fraction_in_band = t.empty() ? std::numeric_limits<double>::quiet_NaN()
-                                    : FractionInBand(t, nees.mean_nees, nees.band, t0_s);
+  nees.fraction_in_band =
+      t.empty() ? std::numeric_limits<double>::quiet_NaN() : FractionInBand(t, nees.mean_nees, nees.band, t0_s);
   return nees;
 }
 

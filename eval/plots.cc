@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -61,8 +62,8 @@ std::string TrajectoryData(const std::string& what, Time t_origin, const Traject
   std::ostringstream s;
   s << "# " << what << "\n# t_s east_m north_m up_m\n";
   for (const StampedPose& pose : trajectory)
-    s << Num(SecondsBetween(t_origin, pose.t)) << ' ' << Num(pose.p_world_body.x()) << ' '
-      << Num(pose.p_world_body.y()) << ' ' << Num(pose.p_world_body.z()) << '\n';
+    s << Num(SecondsBetween(t_origin, pose.t)) << ' ' << Num(pose.p_world_body.x()) << ' ' << Num(pose.p_world_body.y())
+      << ' ' << Num(pose.p_world_body.z()) << '\n';
   return s.str();
 }
 
@@ -80,7 +81,8 @@ Result<PlotFiles> WriteTrajectoryPlot(const std::string& directory, const std::s
                                       const std::string& estimate_label, const std::vector<PositionFixes>& fixes) {
   PlotFiles files{"trajectory.gp", "trajectory.png", {"trajectory_truth.dat", "trajectory_estimate.dat"}};
   // Data: truth, estimate, one file per fix stream.
-  if (Status s = WriteText(directory, files.data[0], TrajectoryData("ground truth", t_origin, truth)); !s.ok()) return s;
+  if (Status s = WriteText(directory, files.data[0], TrajectoryData("ground truth", t_origin, truth)); !s.ok())
+    return s;
   if (Status s = WriteText(directory, files.data[1], TrajectoryData(estimate_label, t_origin, estimate)); !s.ok())
     return s;
   std::ostringstream plot;
@@ -91,24 +93,37 @@ Result<PlotFiles> WriteTrajectoryPlot(const std::string& directory, const std::s
   for (std::size_t k = 0; k < fixes.size(); ++k) {
     const PositionFixes& f = fixes[k];
     ROAMLAB_CHECK(f.t.size() == f.p_world.size(), "fixes '" << f.label << "': times and positions differ in size");
-    const std::string name = "trajectory_fixes_" + Slug(f.label) + ".dat";
+    const std::string name = "trajectory_fixes_" + Slug(f.name.empty() ? std::to_string(k) : f.name) + ".dat";
     std::ostringstream s;
     s << "# " << f.label << "\n# t_s east_m north_m up_m\n";
     for (std::size_t i = 0; i < f.t.size(); ++i)
-      s << Num(SecondsBetween(t_origin, f.t[i])) << ' ' << Num(f.p_world[i].x()) << ' ' << Num(f.p_world[i].y())
-        << ' ' << Num(f.p_world[i].z()) << '\n';
+      s << Num(SecondsBetween(t_origin, f.t[i])) << ' ' << Num(f.p_world[i].x()) << ' ' << Num(f.p_world[i].y()) << ' '
+        << Num(f.p_world[i].z()) << '\n';
     if (Status st = WriteText(directory, name, s.str()); !st.ok()) return st;
     files.data.push_back(name);
     plot << ", \\\n     " << Quote(name) << " using 2:3 with points pt 7 ps 0.6 lc rgb '" << kFixColors[k % 4]
          << "' title " << Quote(f.label);
   }
-  // Script: equal axis scales so that the shape of the path is true.
+  // Script: equal axis scales so that the shape of the path is true, on a canvas shaped like the path.
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(0.0);
+  Eigen::Vector2d hi = Eigen::Vector2d::Constant(0.0);
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    const Eigen::Vector2d p = truth[i].p_world_body.head<2>();
+    lo = i == 0 ? p : Eigen::Vector2d(lo.cwiseMin(p));
+    hi = i == 0 ? p : Eigen::Vector2d(hi.cwiseMax(p));
+  }
+  const Eigen::Vector2d extent = (hi - lo).cwiseMax(1e-3);
+  const double aspect = std::clamp(extent.y() / extent.x(), 0.5, 2.0);  // height / width of the plot area
+  const int width = static_cast<int>(std::lround(std::clamp(800.0 / aspect + 200.0, 700.0, 1400.0)));
   std::ostringstream gp;
   gp << "# Redraw: cd into this directory, then: gnuplot " << files.script << "\n"
-     << Terminal(1000, 900) << "set output " << Quote(files.image) << "\n"
+     << Terminal(width, 1000) << "set output " << Quote(files.image) << "\n"
      << "set title " << Quote(title) << "\n"
      << "set xlabel 'East [m]'\nset ylabel 'North [m]'\n"
-     << "set size ratio -1\nset grid\nset key top left box opaque\n"
+     << "set size ratio -1\nset grid\n"
+     // Legend centred under the x label (with an equal-scale plot `set key below` can overlap the label).
+     << "set key at screen 0.5, screen 0.015 center bottom vertical box\n"
+     << "set bmargin " << 4 + 2 * static_cast<int>(2 + fixes.size()) * 4 / 5 << "\n"
      << plot.str() << "\n";
   if (Status s = WriteText(directory, files.script, gp.str()); !s.ok()) return s;
   return files;
@@ -117,8 +132,8 @@ Result<PlotFiles> WriteTrajectoryPlot(const std::string& directory, const std::s
 Result<PlotFiles> WritePositionErrorPlot(const std::string& directory, const std::string& title, Time t_origin,
                                          const std::vector<Time>& t, const std::vector<Eigen::Vector3d>& error_world,
                                          const std::vector<Eigen::Vector3d>& sigma_world) {
-  ROAMLAB_CHECK(t.size() == error_world.size(), "position error: " << t.size() << " stamps, " << error_world.size()
-                                                                    << " errors");
+  ROAMLAB_CHECK(t.size() == error_world.size(),
+                "position error: " << t.size() << " stamps, " << error_world.size() << " errors");
   const bool envelope = !sigma_world.empty();
   ROAMLAB_CHECK(!envelope || sigma_world.size() == t.size(), "position error: sigma size " << sigma_world.size());
   PlotFiles files{"position_error.gp", "position_error.png", {"position_error.dat"}};
@@ -147,8 +162,8 @@ Result<PlotFiles> WritePositionErrorPlot(const std::string& directory, const std
       gp << Quote(files.data[0]) << " using 1:(-3*$" << 5 + a << "):(3*$" << 5 + a
          << ") with filledcurves fc rgb '#1f77b4' fs transparent solid 0.2 noborder title '+-3 sigma (estimated)', \\\n"
          << "     ";
-    gp << Quote(files.data[0]) << " using 1:" << 2 + a << " with lines lw 1.5 lc rgb '#1f77b4' title '"
-       << kAxes[a] << " error'\n";
+    gp << Quote(files.data[0]) << " using 1:" << 2 + a << " with lines lw 1.5 lc rgb '#1f77b4' title '" << kAxes[a]
+       << " error'\n";
   }
   gp << "unset multiplot\n";
   if (Status st = WriteText(directory, files.script, gp.str()); !st.ok()) return st;
@@ -168,20 +183,22 @@ Result<PlotFiles> WriteNeesPlot(const std::string& directory, const std::string&
   if (Status st = WriteText(directory, files.data[0], s.str()); !st.ok()) return st;
 
   char band_label[160];
-  std::snprintf(band_label, sizeof band_label, "%g%% chi-square band [%.3f, %.3f]", 100.0 * (1.0 - nees.alpha),
-                nees.band.lo, nees.band.hi);
+  std::snprintf(band_label, sizeof band_label, "%g%% band of chi-square(%d) / %d: [%.3f, %.3f]",
+                100.0 * (1.0 - nees.alpha), nees.runs * nees.dof, nees.runs, nees.band.lo, nees.band.hi);
   std::ostringstream gp;
   gp << "# Redraw: cd into this directory, then: gnuplot " << files.script << "\n"
      << Terminal(1000, 600) << "set output " << Quote(files.image) << "\n"
      << "set title " << Quote(title) << "\n"
-     << "set xlabel 'time since start [s]'\nset ylabel 'average NEES [-]'\n"
+     << "set xlabel 'time since start [s]'\nset ylabel '" << (nees.runs == 1 ? "NEES" : "average NEES") << " [-]'\n"
      << "set grid\nset key top right box opaque\n"
      << "lo = " << Num(nees.band.lo) << "\nhi = " << Num(nees.band.hi) << "\n";
   if (nees.t0_s > 0.0)
     gp << "set arrow from " << Num(nees.t0_s) << ", graph 0 to " << Num(nees.t0_s)
        << ", graph 1 nohead dt 3 lc rgb '#555555'\n"
        << "set label 'T0' at " << Num(nees.t0_s) << ", graph 0.95 offset 0.5,0\n";
-  gp << "plot " << Quote(files.data[0]) << " using 1:2 with lines lw 1.5 lc rgb '#1f77b4' title 'average NEES', \\\n"
+  const std::string curve = nees.runs == 1 ? "NEES" : "average NEES over " + std::to_string(nees.runs) + " runs";
+  gp << "plot " << Quote(files.data[0]) << " using 1:2 with lines lw 1.5 lc rgb '#1f77b4' title " << Quote(curve)
+     << ", \\\n"
      << "     lo with lines dt 2 lw 1.5 lc rgb '#d62728' title " << Quote(band_label) << ", \\\n"
      << "     hi with lines dt 2 lw 1.5 lc rgb '#d62728' notitle\n";
   if (Status st = WriteText(directory, files.script, gp.str()); !st.ok()) return st;

@@ -27,6 +27,7 @@ struct PlotFiles {
 
 // Positions of an absolute sensor in the reference world frame (GPS converted to ENU, motion capture, ...).
 struct PositionFixes {
+  std::string name;                       // stream name; the data file is trajectory_fixes_<name>.dat
   std::string label;                      // legend text, e.g. "GPS fixes (gps)"
   std::vector<Time> t;
   std::vector<Eigen::Vector3d> p_world;   // [m]

@@ -73,7 +73,6 @@ Result<AckermannVehicle> AckermannVehicle::Bind(const mjModel* model, const std:
   const int root = IdOf(model, mjOBJ_JOINT, "root");
   if (root < 0 || model->jnt_type[root] != mjJNT_FREE) return Missing(what, "a free joint 'root'");
   v.root_qpos_ = model->jnt_qposadr[root];
-  v.root_dof_ = model->jnt_dofadr[root];
   v.root_body_ = model->jnt_bodyid[root];
   v.odom_site_ = IdOf(model, mjOBJ_SITE, "odom");
   if (v.odom_site_ < 0) return Missing(what, "a site 'odom' (the odometric frame O)");

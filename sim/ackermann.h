@@ -79,7 +79,6 @@ class AckermannVehicle {
 
  private:
   int root_qpos_ = -1;          // free joint: x y z qw qx qy qz
-  int root_dof_ = -1;
   int root_body_ = -1;
   int odom_site_ = -1;
   int steer_left_qpos_ = -1, steer_right_qpos_ = -1;

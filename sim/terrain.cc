@@ -102,9 +102,14 @@ double Terrain::HeightAt(double x, double y) const {
   const int r0 = std::min(static_cast<int>(v), rows_ - 2);
   const double fu = u - c0;
   const double fv = v - r0;
-  const auto at = [this](int r, int c) { return static_cast<double>(normalized_[static_cast<std::size_t>(r) * cols_ + c]); };
-  const double h = (1 - fu) * (1 - fv) * at(r0, c0) + fu * (1 - fv) * at(r0, c0 + 1) + (1 - fu) * fv * at(r0 + 1, c0) +
-                   fu * fv * at(r0 + 1, c0 + 1);
+  const auto at = [this](int r, int c) {
+    return static_cast<double>(normalized_[static_cast<std::size_t>(r) * cols_ + c]);
+  };
+  // MuJoCo's two triangles per cell share the diagonal from (r0, c0) to (r0 + 1, c0 + 1).
+  const double h00 = at(r0, c0);
+  const double h11 = at(r0 + 1, c0 + 1);
+  const double h = fu >= fv ? h00 + fu * (at(r0, c0 + 1) - h00) + fv * (h11 - at(r0, c0 + 1))
+                            : h00 + fv * (at(r0 + 1, c0) - h00) + fu * (h11 - at(r0 + 1, c0));
   return h * options_.relief_m + offset_z_m_;
 }
 
@@ -122,7 +127,14 @@ double Terrain::Relief() const {
 std::string Terrain::Mjcf() const {
   std::ostringstream xml;
   xml.precision(17);
-  const double mu = options_.friction;
+  // The robot's MJCF is included in the same document, so its <default> applies here too: every contact attribute
+  // of the ground is explicit. solmix 0 lets the robot's geoms alone set the contact softness (solref, solimp);
+  // MuJoCo takes the larger friction and condim of the pair.
+  std::ostringstream ground_attributes;
+  ground_attributes.precision(17);
+  ground_attributes << "material=\"terrain\" rgba=\"1 1 1 1\" contype=\"1\" conaffinity=\"1\" condim=\"3\" "
+                    << "friction=\"" << options_.friction << " 0.005 0.0001\" solmix=\"0\" margin=\"0\" gap=\"0\"";
+  const std::string ground = ground_attributes.str();
   // A fine checker with random marks: visual texture for cameras; one tile is about 2 m.
   xml << "<asset>\n"
       << "  <texture name=\"terrain\" type=\"2d\" builtin=\"checker\" width=\"512\" height=\"512\""
@@ -131,8 +143,7 @@ std::string Terrain::Mjcf() const {
   if (rows_ == 0) {
     xml << "  <material name=\"terrain\" texture=\"terrain\" texrepeat=\"0.25 0.25\" texuniform=\"true\"/>\n"
         << "</asset>\n<worldbody>\n"
-        << "  <geom name=\"terrain\" type=\"plane\" size=\"0 0 1\" material=\"terrain\" friction=\"" << mu
-        << " 0.005 0.0001\"/>\n";
+        << "  <geom name=\"terrain\" type=\"plane\" size=\"0 0 1\" " << ground << "/>\n";
   } else {
     xml << "  <material name=\"terrain\" texture=\"terrain\" texrepeat=\"" << options_.size_m.x() / 4.0 << " "
         << options_.size_m.y() / 4.0 << "\"/>\n"
@@ -140,8 +151,8 @@ std::string Terrain::Mjcf() const {
         << 0.5 * options_.size_m.x() << " " << 0.5 * options_.size_m.y() << " " << options_.relief_m << " "
         << kBaseThicknessM << "\"/>\n"
         << "</asset>\n<worldbody>\n"
-        << "  <geom name=\"terrain\" type=\"hfield\" hfield=\"terrain\" pos=\"0 0 " << offset_z_m_
-        << "\" material=\"terrain\" friction=\"" << mu << " 0.005 0.0001\"/>\n";
+        << "  <geom name=\"terrain\" type=\"hfield\" hfield=\"terrain\" pos=\"0 0 " << offset_z_m_ << "\" "
+        << ground << "/>\n";
   }
   xml << "  <light name=\"sun\" directional=\"true\" pos=\"0 0 100\" dir=\"0.3 0.2 -1\" castshadow=\"false\"/>\n"
       << "</worldbody>\n";

@@ -10,8 +10,8 @@
 //
 // MuJoCo heightfield layout (verified on 2.2.2): hfield_data[r * ncol + c] is the normalized height at
 // x = -size_x/2 + c * size_x/(ncol - 1), y = -size_y/2 + r * size_y/(nrow - 1); height = data * relief_m + geom z.
-// MuJoCo draws each grid cell as two triangles; HeightAt interpolates bilinearly, which differs from those triangles
-// by O(curvature * resolution^2), millimetres for these hills.
+// MuJoCo's collision surface splits each grid cell into two triangles along the diagonal from (r, c) to
+// (r + 1, c + 1); HeightAt interpolates on the same triangles, so it is the height the tires touch.
 #pragma once
 
 #include <cstdint>
@@ -32,8 +32,8 @@ struct TerrainOptions {
   Eigen::Vector2d size_m{300.0, 300.0};                // extent along x (east) and y (north) [m]
   double resolution_m = 1.0;                           // grid spacing [m]
   double relief_m = 4.0;                               // peak-to-peak height [m]
-  double min_wavelength_m = 25.0;
-  double max_wavelength_m = 80.0;
+  double min_wavelength_m = 20.0;
+  double max_wavelength_m = 60.0;
   int waves = 16;
   double friction = 0.8;                               // sliding friction coefficient of the ground
 

@@ -1,0 +1,26 @@
+// `roamlab montecarlo`: consistency of online tracking over noise realizations (seed 000, Section V, Fig. 4).
+#pragma once
+
+#include <string>
+
+namespace roamlab::apps {
+
+struct MonteCarloArgs {
+  std::string scenario;
+  std::string config;
+  std::string calibration;  // optional calibration.json: tracking uses its values
+  std::string out;
+  int runs = 50;
+  int jobs = 0;             // 0: one per core
+  unsigned long long seed_base = 1000;  // run i simulates with noise seed seed_base + i
+  double t0_s = 2.0;        // fraction_in_band counts time steps from t0_s on
+  bool quiet = false;
+};
+
+// Simulates `runs` noise realizations of the scenario (the terrain and the drive stay the same), tracks each online,
+// computes the position NEES (eq. 16) of every pose against the truth, and writes OUT/nees.json
+// ({"runs", "dof", "band", "t", "mean_nees", "fraction_in_band", ...}), OUT/runs.json (per-run ATE and mean NEES) and
+// OUT/nees.png. Runs are spread over `jobs` threads; results do not depend on the number of jobs.
+int RunMonteCarlo(const MonteCarloArgs& args);
+
+}  // namespace roamlab::apps

@@ -1,0 +1,21 @@
+// `roamlab simulate SCENARIO.yaml --out REC [--seed N]`: runs a scenario in MuJoCo (sim/simulator.h) and writes the
+// recording with its ground_truth.tum and truth.yaml. Returns the process exit code: 0 on success, 2 with one line
+// "roamlab simulate: <file>:<line>: <key>: <problem>" on a bad scenario or model, 1 when the simulation fails (the
+// vehicle leaves the terrain, MuJoCo diverges) or the recording cannot be written.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+namespace roamlab::apps {
+
+struct SimulateArgs {
+  std::string scenario;                 // SCENARIO.yaml
+  std::string out;                      // recording directory
+  std::optional<std::uint64_t> seed;    // overrides the scenario's noise seed
+  bool quiet = false;                   // no progress and no summary
+};
+int RunSimulate(const SimulateArgs& args);
+
+}  // namespace roamlab::apps

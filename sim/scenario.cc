@@ -1,0 +1,406 @@
+#include "sim/scenario.h"
+
+#include <cmath>
+#include <filesystem>
+
+#include "sim/internal/yaml_reader.h"
+
+namespace roamlab::sim {
+namespace {
+
+namespace fs = std::filesystem;
+using internal::YamlReader;
+
+constexpr double kPi = 3.14159265358979323846;
+
+bool Finite(double x) { return std::isfinite(x); }
+bool Positive(double x) { return std::isfinite(x) && x > 0.0; }
+bool NonNegative(double x) { return std::isfinite(x) && x >= 0.0; }
+
+Eigen::Vector3d ToVector3(const std::vector<double>& v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
+
+// One profile term: a mapping with exactly one of the term types (plus an optional window_s).
+void ReadTerm(YamlReader& r, const YAML::Node& node, const std::string& key, ProfileTerm* term) {
+  r.CheckKeys(node, key, {"constant", "sine", "square", "ramp", "piecewise", "window_s"});
+  if (!r.ok()) return;
+  int types = 0;
+  for (const char* type : {"constant", "sine", "square", "ramp", "piecewise"}) types += node[type] ? 1 : 0;
+  if (types != 1) {
+    r.Fail(node, key, "a term needs exactly one of constant, sine, square, ramp, piecewise");
+    return;
+  }
+  if (node["window_s"]) {
+    std::vector<double> window;
+    r.Numbers(node, key, "window_s", 2, &window);
+    if (r.ok()) {
+      term->windowed = true;
+      term->window_begin_s = window[0];
+      term->window_end_s = window[1];
+    }
+  }
+  if (node["constant"]) {
+    term->type = ProfileTerm::Type::kConstant;
+    r.NodeNumber(node["constant"], key + ".constant", &term->value);
+  } else if (node["sine"] || node["square"]) {
+    const bool sine = static_cast<bool>(node["sine"]);
+    term->type = sine ? ProfileTerm::Type::kSine : ProfileTerm::Type::kSquare;
+    const std::string k = key + (sine ? ".sine" : ".square");
+    const YAML::Node spec = node[sine ? "sine" : "square"];
+    r.CheckKeys(spec, k, {"amplitude", "period_s", "phase_rad"});
+    if (r.Require(spec, k, "amplitude") && r.Require(spec, k, "period_s")) {
+      r.Number(spec, k, "amplitude", &term->amplitude);
+      r.Number(spec, k, "period_s", &term->period_s);
+      r.Number(spec, k, "phase_rad", &term->phase_rad);
+    }
+  } else if (node["ramp"]) {
+    term->type = ProfileTerm::Type::kRamp;
+    const std::string k = key + ".ramp";
+    const YAML::Node spec = node["ramp"];
+    r.CheckKeys(spec, k, {"start_s", "end_s", "from", "to"});
+    for (const char* required : {"start_s", "end_s", "from", "to"})
+      if (!r.Require(spec, k, required)) return;
+    r.Number(spec, k, "start_s", &term->start_s);
+    r.Number(spec, k, "end_s", &term->end_s);
+    r.Number(spec, k, "from", &term->from);
+    r.Number(spec, k, "to", &term->to);
+  } else {
+    term->type = ProfileTerm::Type::kPiecewise;
+    const std::string k = key + ".piecewise";
+    const YAML::Node spec = node["piecewise"];
+    r.CheckKeys(spec, k, {"times_s", "values", "interpolation"});
+    if (r.Require(spec, k, "times_s") && r.Require(spec, k, "values")) {
+      r.Numbers(spec, k, "times_s", -1, &term->times_s);
+      r.Numbers(spec, k, "values", -1, &term->values);
+      std::string interpolation = "linear";
+      r.String(spec, k, "interpolation", &interpolation);
+      if (interpolation == "step") {
+        term->interpolation = ProfileTerm::Interpolation::kStep;
+      } else if (interpolation != "linear") {
+        r.Fail(spec["interpolation"], k + ".interpolation", "expected linear or step, got '" + interpolation + "'");
+      }
+    }
+  }
+}
+
+// A profile: a number (constant) or a sequence of terms.
+void ReadProfile(YamlReader& r, const YAML::Node& map, const std::string& parent, const std::string& name,
+                 Profile* profile) {
+  if (!r.ok() || !map[name]) return;
+  const YAML::Node node = map[name];
+  const std::string key = YamlReader::Join(parent, name);
+  r.Remember(key, node);
+  if (node.IsScalar()) {
+    double value = 0.0;
+    r.NodeNumber(node, key, &value);
+    *profile = Profile::Constant(value);
+    return;
+  }
+  if (!node.IsSequence()) {
+    r.Fail(node, key, "expected a number or a list of profile terms (constant, sine, square, ramp, piecewise)");
+    return;
+  }
+  profile->terms.assign(node.size(), ProfileTerm{});
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    ReadTerm(r, node[i], key + "[" + std::to_string(i) + "]", &profile->terms[i]);
+  }
+}
+
+void ReadRobot(YamlReader& r, const YAML::Node& node, const std::string& scenario_dir, Scenario* s) {
+  const std::string key = "robot";
+  r.CheckKeys(node, key, {"kind", "model", "start", "speed_controller"});
+  if (!r.Require(node, key, "kind") || !r.Require(node, key, "model")) return;
+  r.String(node, key, "kind", &s->robot.kind);
+  std::string model;
+  r.String(node, key, "model", &model);
+  if (!r.ok()) return;
+  const fs::path resolved = fs::path(model).is_absolute() ? fs::path(model) : fs::path(scenario_dir) / model;
+  std::error_code error;
+  if (!fs::is_regular_file(resolved, error)) {
+    r.Fail(node["model"], "robot.model", "no such file '" + model + "' (looked for " + resolved.string() + ")");
+    return;
+  }
+  s->robot.model_file = resolved.lexically_normal().string();
+  if (node["start"]) {
+    const YAML::Node start = node["start"];
+    r.CheckKeys(start, "robot.start", {"position_m", "heading_deg"});
+    std::vector<double> position;
+    r.Numbers(start, "robot.start", "position_m", 2, &position);
+    if (r.ok() && !position.empty()) s->robot.start_position_m = Eigen::Vector2d(position[0], position[1]);
+    double heading_deg = s->robot.start_heading_rad * 180.0 / kPi;
+    r.Number(start, "robot.start", "heading_deg", &heading_deg);
+    s->robot.start_heading_rad = heading_deg * kPi / 180.0;
+  }
+  if (node["speed_controller"]) {
+    const YAML::Node c = node["speed_controller"];
+    const std::string k = "robot.speed_controller";
+    r.CheckKeys(c, k, {"kp_nm_per_mps", "ki_nm_per_m", "torque_limit_nm"});
+    r.Number(c, k, "kp_nm_per_mps", &s->robot.speed_controller.kp_nm_per_mps);
+    r.Number(c, k, "ki_nm_per_m", &s->robot.speed_controller.ki_nm_per_m);
+    r.Number(c, k, "torque_limit_nm", &s->robot.speed_controller.torque_limit_nm);
+  }
+}
+
+void ReadWorld(YamlReader& r, const YAML::Node& node, Scenario* s) {
+  r.CheckKeys(node, "world", {"terrain"});
+  if (!r.Require(node, "world", "terrain")) return;
+  const YAML::Node t = node["terrain"];
+  const std::string k = "world.terrain";
+  r.CheckKeys(t, k, {"type", "seed", "size_m", "resolution_m", "relief_m", "wavelength_m", "waves", "friction"});
+  if (!r.Require(t, k, "type")) return;
+  std::string type;
+  r.String(t, k, "type", &type);
+  if (!r.ok()) return;
+  TerrainOptions& terrain = s->terrain;
+  if (type == "flat") {
+    terrain.type = TerrainOptions::Type::kFlat;
+    for (const char* hills_only : {"seed", "size_m", "resolution_m", "relief_m", "wavelength_m", "waves"}) {
+      if (t[hills_only]) r.Fail(t[hills_only], k + "." + hills_only, "only for type hills");
+    }
+  } else if (type == "hills") {
+    terrain.type = TerrainOptions::Type::kHills;
+  } else {
+    r.Fail(t["type"], k + ".type", "expected hills or flat, got '" + type + "'");
+    return;
+  }
+  r.Unsigned(t, k, "seed", &terrain.seed);
+  std::vector<double> size;
+  r.Numbers(t, k, "size_m", 2, &size);
+  if (r.ok() && !size.empty()) terrain.size_m = Eigen::Vector2d(size[0], size[1]);
+  r.Number(t, k, "resolution_m", &terrain.resolution_m);
+  r.Number(t, k, "relief_m", &terrain.relief_m);
+  std::vector<double> wavelength;
+  r.Numbers(t, k, "wavelength_m", 2, &wavelength);
+  if (r.ok() && !wavelength.empty()) {
+    terrain.min_wavelength_m = wavelength[0];
+    terrain.max_wavelength_m = wavelength[1];
+  }
+  std::int64_t waves = terrain.waves;
+  r.Integer(t, k, "waves", &waves);
+  terrain.waves = static_cast<int>(std::max<std::int64_t>(std::min<std::int64_t>(waves, 1 << 20), -1));
+  r.Number(t, k, "friction", &terrain.friction);
+}
+
+void ReadDriver(YamlReader& r, const YAML::Node& node, Scenario* s) {
+  const std::string k = "driver";
+  r.CheckKeys(node, k, {"type", "lead_in_s", "speed_mps", "handlebar_rad"});
+  if (!r.Require(node, k, "type")) return;
+  r.String(node, k, "type", &s->driver.type);
+  r.Number(node, k, "lead_in_s", &s->driver.lead_in_s);
+  if (!r.Require(node, k, "speed_mps") || !r.Require(node, k, "handlebar_rad")) return;
+  ReadProfile(r, node, k, "speed_mps", &s->driver.speed_mps);
+  ReadProfile(r, node, k, "handlebar_rad", &s->driver.handlebar_rad);
+}
+
+void ReadSensors(YamlReader& r, const YAML::Node& node, Scenario* s) {
+  r.CheckKeys(node, "sensors", {"imu", "magnetometer", "gps", "odometer"});
+  if (!r.ok()) return;
+  // A present key with an empty value ("imu:" or "imu: {}") is a sensor with all defaults.
+  const auto section = [&r](const YAML::Node& n, const std::string& k, std::initializer_list<std::string_view> keys) {
+    if (n.IsNull()) return false;
+    r.CheckKeys(n, k, keys);
+    return r.ok();
+  };
+  if (node["imu"]) {
+    ImuOptions& imu = s->sensors.imu.emplace();
+    const YAML::Node n = node["imu"];
+    const std::string k = "sensors.imu";
+    if (section(n, k, {"rate_hz", "gyro_sigma_radps", "accel_sigma_mps2", "misalignment", "lever_arm_m"})) {
+      r.Number(n, k, "rate_hz", &imu.rate_hz);
+      r.Number(n, k, "gyro_sigma_radps", &imu.gyro_sigma_radps);
+      r.Number(n, k, "accel_sigma_mps2", &imu.accel_sigma_mps2);
+      std::vector<double> q, lever;
+      r.Numbers(n, k, "misalignment", 4, &q);
+      if (r.ok() && !q.empty()) imu.misalignment = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
+      r.Numbers(n, k, "lever_arm_m", 3, &lever);
+      if (r.ok() && !lever.empty()) imu.lever_arm_m = ToVector3(lever);
+    }
+  }
+  if (node["magnetometer"]) {
+    MagnetometerOptions& mag = s->sensors.magnetometer.emplace();
+    const YAML::Node n = node["magnetometer"];
+    const std::string k = "sensors.magnetometer";
+    if (section(n, k, {"rate_hz", "sigma", "A", "b", "field_world"})) {
+      r.Number(n, k, "rate_hz", &mag.rate_hz);
+      r.Number(n, k, "sigma", &mag.sigma);
+      std::vector<double> A, b, field;
+      r.Numbers(n, k, "A", 9, &A);
+      if (r.ok() && !A.empty()) mag.A = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(A.data());
+      r.Numbers(n, k, "b", 3, &b);
+      if (r.ok() && !b.empty()) mag.b = ToVector3(b);
+      r.Numbers(n, k, "field_world", 3, &field);
+      if (r.ok() && !field.empty()) mag.field_world = ToVector3(field);
+    }
+  }
+  if (node["gps"]) {
+    GpsOptions& gps = s->sensors.gps.emplace();
+    const YAML::Node n = node["gps"];
+    const std::string k = "sensors.gps";
+    if (section(n, k, {"rate_hz", "sigma_m", "lever_arm_m"})) {
+      r.Number(n, k, "rate_hz", &gps.rate_hz);
+      r.Number(n, k, "sigma_m", &gps.sigma_m);
+      std::vector<double> lever;
+      r.Numbers(n, k, "lever_arm_m", 3, &lever);
+      if (r.ok() && !lever.empty()) gps.lever_arm_m = ToVector3(lever);
+    }
+  }
+  if (node["odometer"]) {
+    OdometerOptions& odo = s->sensors.odometer.emplace();
+    const YAML::Node n = node["odometer"];
+    const std::string k = "sensors.odometer";
+    if (section(n, k, {"rate_hz", "speed_sigma_mps", "steering_sigma_rad", "kv_over_L", "k_theta", "k_gamma"})) {
+      r.Number(n, k, "rate_hz", &odo.rate_hz);
+      r.Number(n, k, "speed_sigma_mps", &odo.speed_sigma_mps);
+      r.Number(n, k, "steering_sigma_rad", &odo.steering_sigma_rad);
+      r.Number(n, k, "kv_over_L", &odo.kv_over_L);
+      r.Number(n, k, "k_theta", &odo.k_theta);
+      r.Number(n, k, "k_gamma", &odo.k_gamma);
+    }
+  }
+}
+
+void ReadEffects(YamlReader& r, const YAML::Node& node, Scenario* s) {
+  r.Remember("effects", node);
+  if (node.IsNull()) return;
+  if (!node.IsSequence()) {
+    r.Fail(node, "effects", "expected a list of effects");
+    return;
+  }
+  for (std::size_t i = 0; i < node.size() && r.ok(); ++i) {
+    const std::string k = "effects[" + std::to_string(i) + "]";
+    EffectOptions effect;
+    r.CheckKeys(node[i], k, {"name", "parameters"});
+    if (!r.Require(node[i], k, "name")) return;
+    r.String(node[i], k, "name", &effect.name);
+    if (node[i]["parameters"]) {
+      const YAML::Node p = node[i]["parameters"];
+      if (!p.IsMap()) {
+        r.Fail(p, k + ".parameters", "expected a mapping of numbers");
+        return;
+      }
+      for (const auto& item : p) {
+        const std::string name = item.first.Scalar();
+        r.NodeNumber(item.second, k + ".parameters." + name, &effect.parameters[name]);
+      }
+    }
+    s->effects.push_back(effect);
+  }
+}
+
+std::optional<Scenario::Problem> ProfileProblem(const Profile& profile, const std::string& key) {
+  for (std::size_t i = 0; i < profile.terms.size(); ++i) {
+    const std::string problem = profile.terms[i].Validate();
+    if (!problem.empty()) return Scenario::Problem{key + "[" + std::to_string(i) + "]", problem};
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<Scenario::Problem> Scenario::Validate() const {
+  using P = Scenario::Problem;
+  if (!Positive(duration_s) || duration_s > 1.0e6) return P{"duration_s", "must be > 0 (and at most 1e6)"};
+  if (!(Finite(origin.latitude_deg) && std::abs(origin.latitude_deg) <= 90.0))
+    return P{"origin.latitude_deg", "must be in [-90, 90]"};
+  if (!(Finite(origin.longitude_deg) && std::abs(origin.longitude_deg) <= 180.0))
+    return P{"origin.longitude_deg", "must be in [-180, 180]"};
+  if (!Finite(origin.altitude_m)) return P{"origin.altitude_m", "must be finite"};
+  if (!Positive(ground_truth_rate_hz)) return P{"ground_truth_rate_hz", "must be > 0"};
+
+  // Robot and driver: only the Ackermann family exists so far.
+  if (robot.kind != "ackermann")
+    return P{"robot.kind", "unsupported kind '" + robot.kind + "' (supported: ackermann)"};
+  if (robot.model_file.empty() && robot.model_xml.empty()) return P{"robot.model", "missing"};
+  if (!robot.start_position_m.allFinite()) return P{"robot.start.position_m", "must be finite"};
+  if (!Finite(robot.start_heading_rad)) return P{"robot.start.heading_deg", "must be finite"};
+  if (const std::string p = robot.speed_controller.Validate(); !p.empty())
+    return P{"robot.speed_controller." + p.substr(0, p.find(':')), p.substr(p.find(':') + 2)};
+  if (const std::string p = terrain.Validate(); !p.empty())
+    return P{"world.terrain." + p.substr(0, p.find(':')), p.substr(p.find(':') + 2)};
+  if (terrain.type == TerrainOptions::Type::kHills &&
+      !(std::abs(robot.start_position_m.x()) < 0.5 * terrain.size_m.x() - 5.0 &&
+        std::abs(robot.start_position_m.y()) < 0.5 * terrain.size_m.y() - 5.0))
+    return P{"robot.start.position_m", "must be on the terrain, at least 5 m from its edge"};
+  if (driver.type != robot.kind)
+    return P{"driver.type", "'" + driver.type + "' does not drive a robot of kind '" + robot.kind +
+                                "' (use " + robot.kind + ")"};
+  if (!NonNegative(driver.lead_in_s) || driver.lead_in_s > 60.0) return P{"driver.lead_in_s", "must be in [0, 60]"};
+  if (auto p = ProfileProblem(driver.speed_mps, "driver.speed_mps")) return p;
+  if (auto p = ProfileProblem(driver.handlebar_rad, "driver.handlebar_rad")) return p;
+
+  // Sensors.
+  if (const auto& imu = sensors.imu) {
+    if (!Positive(imu->rate_hz)) return P{"sensors.imu.rate_hz", "must be > 0"};
+    if (!NonNegative(imu->gyro_sigma_radps)) return P{"sensors.imu.gyro_sigma_radps", "must be >= 0"};
+    if (!NonNegative(imu->accel_sigma_mps2)) return P{"sensors.imu.accel_sigma_mps2", "must be >= 0"};
+    const double norm = imu->misalignment.norm();
+    if (!(imu->misalignment.coeffs().allFinite() && norm > 0.5 && norm < 2.0))
+      return P{"sensors.imu.misalignment", "must be a quaternion [w, x, y, z] near unit norm"};
+    if (!imu->lever_arm_m.allFinite()) return P{"sensors.imu.lever_arm_m", "must be finite"};
+  }
+  if (const auto& mag = sensors.magnetometer) {
+    if (!sensors.imu) return P{"sensors.magnetometer", "needs sensors.imu (it shares the IMU's frame)"};
+    if (!Positive(mag->rate_hz)) return P{"sensors.magnetometer.rate_hz", "must be > 0"};
+    if (!NonNegative(mag->sigma)) return P{"sensors.magnetometer.sigma", "must be >= 0"};
+    if (!mag->A.allFinite()) return P{"sensors.magnetometer.A", "must be finite"};
+    if (!mag->b.allFinite()) return P{"sensors.magnetometer.b", "must be finite"};
+    if (!(mag->field_world.allFinite() && mag->field_world.norm() > 0.0))
+      return P{"sensors.magnetometer.field_world", "must be finite and nonzero"};
+  }
+  if (const auto& gps = sensors.gps) {
+    if (!Positive(gps->rate_hz)) return P{"sensors.gps.rate_hz", "must be > 0"};
+    if (!NonNegative(gps->sigma_m)) return P{"sensors.gps.sigma_m", "must be >= 0"};
+    if (!gps->lever_arm_m.allFinite()) return P{"sensors.gps.lever_arm_m", "must be finite"};
+  }
+  if (const auto& odo = sensors.odometer) {
+    if (!Positive(odo->rate_hz)) return P{"sensors.odometer.rate_hz", "must be > 0"};
+    if (!NonNegative(odo->speed_sigma_mps)) return P{"sensors.odometer.speed_sigma_mps", "must be >= 0"};
+    if (!NonNegative(odo->steering_sigma_rad)) return P{"sensors.odometer.steering_sigma_rad", "must be >= 0"};
+    if (!Positive(odo->kv_over_L)) return P{"sensors.odometer.kv_over_L", "must be > 0"};
+    if (!(Finite(odo->k_theta) && odo->k_theta != 0.0)) return P{"sensors.odometer.k_theta", "must be nonzero"};
+    if (!Finite(odo->k_gamma)) return P{"sensors.odometer.k_gamma", "must be finite"};
+  }
+
+  // Effects: the list exists so that scenarios can name them; none is implemented yet.
+  if (!effects.empty()) {
+    return P{"effects[0].name", "unknown effect '" + effects[0].name + "' (no physical effects are implemented yet)"};
+  }
+  return std::nullopt;
+}
+
+Result<Scenario> LoadScenario(const std::string& path) {
+  YamlReader r(path);
+  if (!r.ok()) return r.status();
+  Scenario s;
+  s.source_file = path;
+  const YAML::Node root = r.root();
+  r.CheckKeys(root, "", {"name", "duration_s", "seed", "origin", "ground_truth_rate_hz", "robot", "world", "driver",
+                         "sensors", "effects"});
+  for (const char* required : {"duration_s", "robot", "world", "driver", "sensors"}) r.Require(root, "", required);
+  r.String(root, "", "name", &s.name);
+  r.Number(root, "", "duration_s", &s.duration_s);
+  r.Unsigned(root, "", "seed", &s.seed);
+  r.Number(root, "", "ground_truth_rate_hz", &s.ground_truth_rate_hz);
+  if (r.ok() && root["origin"]) {
+    const YAML::Node o = root["origin"];
+    r.CheckKeys(o, "origin", {"latitude_deg", "longitude_deg", "altitude_m"});
+    for (const char* required : {"latitude_deg", "longitude_deg", "altitude_m"}) r.Require(o, "origin", required);
+    r.Number(o, "origin", "latitude_deg", &s.origin.latitude_deg);
+    r.Number(o, "origin", "longitude_deg", &s.origin.longitude_deg);
+    r.Number(o, "origin", "altitude_m", &s.origin.altitude_m);
+  }
+  const std::string dir = fs::path(path).parent_path().string();
+  if (r.ok()) ReadRobot(r, root["robot"], dir, &s);
+  if (r.ok()) ReadWorld(r, root["world"], &s);
+  if (r.ok()) ReadDriver(r, root["driver"], &s);
+  if (r.ok()) ReadSensors(r, root["sensors"], &s);
+  if (r.ok() && root["effects"]) ReadEffects(r, root["effects"], &s);
+  if (!r.ok()) return r.status();
+
+  if (const auto problem = s.Validate()) {
+    return Status::Error(r.LineOf(problem->key) + ": " + problem->key + ": " + problem->message);
+  }
+  if (s.sensors.imu) s.sensors.imu->misalignment.normalize();
+  return s;
+}
+
+}  // namespace roamlab::sim

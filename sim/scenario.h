@@ -1,0 +1,165 @@
+// A simulation scenario (SCENARIO.yaml): one robot in one world, driven by control profiles, read by sensors with
+// noise and true calibration, over a given duration. `roamlab simulate` turns it into a recording.
+//
+//   name: atv_hills                         # optional free text
+//   duration_s: 30.0                        # recorded time [s] > 0; recording time starts at 0
+//   seed: 1                                 # sensor-noise seed; `roamlab simulate --seed N` overrides it
+//   origin: {latitude_deg: 45.4642, longitude_deg: 9.19, altitude_m: 120.0}   # geodetic position of W's origin
+//   ground_truth_rate_hz: 100               # poses of O written to ground_truth.tum
+//   robot:
+//     kind: ackermann                       # the vehicle family; decides which model names, driver and odometer apply
+//     model: ../models/atv.xml              # MJCF file, relative to this scenario file (names: see the model's header)
+//     start: {position_m: [0, 0], heading_deg: 0}   # O above (x, y) of W [m], heading from east counter-clockwise
+//     speed_controller: {kp_nm_per_mps: 300, ki_nm_per_m: 150, torque_limit_nm: 400}   # ackermann.h
+//   world:
+//     terrain:
+//       type: hills                         # hills | flat
+//       seed: 7                             # the terrain's own seed, independent of the noise seed
+//       size_m: [300, 300]                  # extent east, north [m], centred on W's origin
+//       resolution_m: 1.0                   # heightfield grid spacing [m]
+//       relief_m: 4.0                       # peak-to-peak height over the field [m]
+//       wavelength_m: [20, 60]              # range of the hills' wavelengths [m]
+//       waves: 16                           # number of plane waves summed
+//       friction: 0.8                       # ground sliding friction (MuJoCo uses the larger of ground and tire)
+//   driver:
+//     type: ackermann                       # set-points: speed_mps (rear-wheel speed) and handlebar_rad
+//     lead_in_s: 4.0                        # unrecorded start before t = 0 (see below)
+//     speed_mps: <profile>                  # sim/profile.h: a number or a list of terms
+//     handlebar_rad: <profile>              # bicycle-equivalent steering angle, positive left
+//   sensors:                                # a sensor is simulated when its key is present; absent fields take the
+//                                           # defaults shown (seed Section V noise, Table I calibration)
+//     imu: {rate_hz: 100, gyro_sigma_radps: 0.033, accel_sigma_mps2: 0.067,
+//           misalignment: [0.938, 0.104, 0.313, 0.104],   # q_body_imu [w, x, y, z], normalized on load
+//           lever_arm_m: [0, 0, 0]}                        # S^(O) of the IMU
+//     magnetometer: {rate_hz: 100, sigma: 0.067,           # in the IMU's frame (needs imu); normalized field units
+//                    A: [0.87, -0.02, -0.02, 0.0, 0.88, 0.0, -0.02, -0.04, 0.85],   # row-major
+//                    b: [-0.008, -0.007, -0.040], field_world: [0.0, 0.5, -0.8660254037844386]}
+//     gps: {rate_hz: 5, sigma_m: 0.33, lever_arm_m: [0.57, -0.46, 0.32]}
+//     odometer: {rate_hz: 100, speed_sigma_mps: 0.033, steering_sigma_rad: 0.014,     # ackermann: eq. 15
+//                kv_over_L: 0.8, k_theta: 1.0, k_gamma: 0.0}
+//   effects: []                             # hidden physical effects, each {name: ..., parameters: {...}}; written
+//                                           # to truth.yaml only. None is implemented yet: any entry is an error.
+//
+// Streams written (names fixed, as tests/support/synthetic.h): imu (wx wy wz ax ay az), magnetometer (mx my mz,
+// normalized), gps (latitude longitude altitude), rear_wheel (wheel_encoders, column rear, m/s) and steering (angle,
+// rad); truth.yaml names gps.lever_arm, imu.misalignment, magnetometer.A, magnetometer.b, odometer.kv_over_L,
+// odometer.k_theta, odometer.k_gamma (and imu.lever_arm when it is not zero).
+//
+// Time. Physics runs at the model's timestep (models/atv.xml: 1 ms). Every rate must give a period that is a whole
+// number of physics steps. Sample k of a stream is at t_k = k * period for 0 <= t_k <= duration_s. The lead-in runs
+// from -lead_in_s to 0 and is not recorded: the vehicle is set on the ground at the start pose, rests for the first
+// quarter of the lead-in, then the set-points ramp linearly from zero to the profiles' values at t = 0, so that the
+// recording starts in motion (the Ackermann odometer, eq. 15, cannot see a turn at standstill).
+//
+// Extension points. Other robot kinds (differential_drive, omni3, mecanum) add their own `driver.type` (wheel speeds,
+// body-velocity set-points with square waves) and sensor sections (wheel encoders per wheel); a flat indoor floor is
+// `terrain: {type: flat}`; physical effects go in `effects`. Each is a new key or value, so existing scenarios keep
+// their meaning.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "common/status.h"
+#include "recording/recording.h"
+#include "sim/ackermann.h"
+#include "sim/profile.h"
+#include "sim/terrain.h"
+
+namespace roamlab::sim {
+
+struct RobotOptions {
+  std::string kind = "ackermann";
+  std::string model_file;         // path as resolved (relative to the scenario file's directory, or absolute)
+  std::string model_xml;          // when non-empty, the MJCF text used instead of model_file (tests, generated models)
+  Eigen::Vector2d start_position_m = Eigen::Vector2d::Zero();
+  double start_heading_rad = 0.0;
+  SpeedControllerOptions speed_controller;
+};
+
+struct DriverOptions {
+  std::string type = "ackermann";
+  double lead_in_s = 4.0;         // >= 0
+  Profile speed_mps = Profile::Constant(0.0);
+  Profile handlebar_rad = Profile::Constant(0.0);
+};
+
+struct ImuOptions {
+  double rate_hz = 100.0;
+  double gyro_sigma_radps = 0.033;
+  double accel_sigma_mps2 = 0.067;
+  Eigen::Quaterniond misalignment{0.938, 0.104, 0.313, 0.104};    // q_body_imu, normalized by the loader
+  Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();
+};
+
+struct MagnetometerOptions {
+  double rate_hz = 100.0;
+  double sigma = 0.067;                                           // normalized field units
+  Eigen::Matrix3d A = (Eigen::Matrix3d() << 0.87, -0.02, -0.02,   //
+                       0.00, 0.88, 0.00,                          //
+                       -0.02, -0.04, 0.85)
+                          .finished();
+  Eigen::Vector3d b{-0.008, -0.007, -0.040};
+  Eigen::Vector3d field_world{0.0, 0.5, -0.8660254037844386};
+};
+
+struct GpsOptions {
+  double rate_hz = 5.0;
+  double sigma_m = 0.33;
+  Eigen::Vector3d lever_arm_m{0.57, -0.46, 0.32};
+};
+
+struct OdometerOptions {
+  double rate_hz = 100.0;
+  double speed_sigma_mps = 0.033;       // on z_v
+  double steering_sigma_rad = 0.014;    // on z_theta
+  double kv_over_L = 0.8;               // 1/m, > 0
+  double k_theta = 1.0;                 // nonzero
+  double k_gamma = 0.0;                 // rad
+};
+
+struct SensorOptions {
+  std::optional<ImuOptions> imu;
+  std::optional<MagnetometerOptions> magnetometer;
+  std::optional<GpsOptions> gps;
+  std::optional<OdometerOptions> odometer;
+};
+
+struct EffectOptions {
+  std::string name;
+  std::map<std::string, double> parameters;
+};
+
+struct Scenario {
+  std::string source_file;              // for messages and provenance; empty when built in code
+  std::string name;
+  double duration_s = 30.0;
+  std::uint64_t seed = 1;
+  recording::GeodeticOrigin origin{45.4642, 9.19, 120.0};
+  double ground_truth_rate_hz = 100.0;
+  RobotOptions robot;
+  TerrainOptions terrain;
+  DriverOptions driver;
+  SensorOptions sensors;
+  std::vector<EffectOptions> effects;
+
+  // The first problem, if any: the key path as written in the YAML (e.g. "sensors.gps.rate_hz") and what is wrong.
+  // Checks values only; files are checked by LoadScenario and the model by the simulator.
+  struct Problem {
+    std::string key;
+    std::string message;
+  };
+  std::optional<Problem> Validate() const;
+};
+
+// Reads and validates a scenario file. Errors are one line naming the file, the line and the key:
+// "scenarios/x.yaml:12: sensors.imu.rate_hz: must be > 0", "...: robot.model: no such file '../models/y.xml'".
+Result<Scenario> LoadScenario(const std::string& path);
+
+}  // namespace roamlab::sim

@@ -1,0 +1,449 @@
+#include "sim/simulator.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <utility>
+
+#include <GeographicLib/LocalCartesian.hpp>
+
+#include "common/check.h"
+#include "sim/ackermann.h"
+#include "sim/mujoco_model.h"
+#include "sim/noise.h"
+#include "sim/sensors.h"
+#include "sim/terrain.h"
+
+namespace roamlab::sim {
+namespace {
+
+using recording::StreamType;
+
+// Fraction of the lead-in spent at rest before the set-points ramp up.
+constexpr double kLeadInRestFraction = 0.25;
+// Drop height of the tires above the ground when the vehicle is placed [m].
+constexpr double kPlacementClearanceM = 0.01;
+// The vehicle must stay this far inside the heightfield [m].
+constexpr double kTerrainMarginM = 2.0;
+// Below this cosine between O's z axis and the world's up the vehicle has rolled over (about 70 deg).
+constexpr double kRolloverCosine = 0.34;
+
+std::string OneLine(std::string text) {
+  for (char& c : text)
+    if (c == '\n' || c == '\r') c = ' ';
+  return text;
+}
+
+std::string FormatTime(std::int64_t t_ns) { return FormatSeconds(Time::FromNanoseconds(t_ns)) + " s"; }
+
+// Nominal geometry is reported to the micrometre: enough, and free of floating-point noise from the model's frames.
+double Micrometres(double x) { return std::round(x * 1e6) / 1e6; }
+
+// A stream's clock: its period and the number of samples in [0, end].
+struct Clock {
+  std::int64_t period_ns = 0;
+  std::size_t samples = 0;
+  bool Due(std::int64_t t_ns) const { return period_ns > 0 && t_ns >= 0 && t_ns % period_ns == 0; }
+  Eigen::Index Row(std::int64_t t_ns) const { return static_cast<Eigen::Index>(t_ns / period_ns); }
+};
+
+recording::Stream MakeStream(const std::string& name, StreamType type, double rate_hz, std::vector<std::string> columns,
+                             const std::string& units, const Clock& clock) {
+  recording::Stream stream;
+  stream.info.name = name;
+  stream.info.type = type;
+  stream.info.rate_hz = rate_hz;
+  stream.info.columns = std::move(columns);
+  stream.info.units = units;
+  stream.t.reserve(clock.samples);
+  for (std::size_t k = 0; k < clock.samples; ++k)
+    stream.t.push_back(Time::FromNanoseconds(static_cast<std::int64_t>(k) * clock.period_ns));
+  stream.values.setZero(static_cast<Eigen::Index>(clock.samples), static_cast<Eigen::Index>(stream.info.columns.size()));
+  return stream;
+}
+
+}  // namespace
+
+// One run of one scenario: Setup() once, then Run() once.
+class Simulator::Impl {
+ public:
+  Impl(const Scenario& scenario, const SimulateOptions& options)
+      : scenario_(scenario),
+        options_(options),
+        seed_(options.seed.value_or(scenario.seed)),
+        where_(scenario.source_file.empty() ? std::string("scenario") : scenario.source_file),
+        model_where_(scenario.robot.model_xml.empty() ? scenario.robot.model_file : std::string("robot.model_xml")) {}
+
+  Result<Simulation> Run() {
+    const auto wall_start = std::chrono::steady_clock::now();
+    TakeMujocoWarnings();
+    try {
+      if (Status s = Loop(); !s.ok()) return s;
+    } catch (const MujocoError& e) {
+      return Status::Error(model_where_ + ": MuJoCo error at t = " + FormatTime(t_ns_) + ": " + OneLine(e.what()));
+    }
+    Finish();
+    out_.stats.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    out_.stats.realtime_factor = out_.stats.wall_s > 0.0 ? out_.stats.simulated_s / out_.stats.wall_s : 0.0;
+    out_.stats.warnings = TakeMujocoWarnings();
+    return std::move(out_);
+  }
+
+  // Compiles the world, binds the vehicle, sets up clocks, streams and noise, and places the vehicle.
+  Status Setup() {
+    // The robot's MJCF text.
+    std::string robot_xml = scenario_.robot.model_xml;
+    if (robot_xml.empty()) {
+      std::ifstream file(scenario_.robot.model_file, std::ios::binary);
+      if (!file) return Status::Error(where_ + ": robot.model: cannot open '" + scenario_.robot.model_file + "'");
+      std::ostringstream content;
+      content << file.rdbuf();
+      robot_xml = content.str();
+    }
+
+    // The world: robot plus terrain, compiled through the VFS; then the heightfield samples.
+    terrain_ = Terrain::Make(scenario_.terrain, scenario_.robot.start_position_m);
+    const std::string world_xml =
+        "<mujoco model=\"roamlab_world\">\n<include file=\"robot.xml\"/>\n" + terrain_.Mjcf() + "</mujoco>\n";
+    auto model = LoadModelFromFiles("world.xml", {{"world.xml", world_xml}, {"robot.xml", robot_xml}}, model_where_);
+    if (!model.ok()) return model.status();
+    model_ = std::move(model).value();
+    if (Status s = terrain_.Fill(model_.get()); !s.ok()) return Status::Error(model_where_ + ": " + s.message());
+    data_ = MakeData(model_.get());
+    auto vehicle = AckermannVehicle::Bind(model_.get(), model_where_);
+    if (!vehicle.ok()) return vehicle.status();
+    vehicle_ = vehicle.value();
+    controller_.emplace(scenario_.robot.speed_controller);
+
+    // Physics step and stream clocks: every period a whole number of steps.
+    step_ns_ = std::llround(model_->opt.timestep * 1e9);
+    if (step_ns_ <= 0) return Status::Error(model_where_ + ": the timestep must be positive");
+    end_ns_ = std::llround(scenario_.duration_s * 1e9);
+    end_ns_ -= end_ns_ % step_ns_;
+    lead_in_ns_ = std::llround(scenario_.driver.lead_in_s * 1e9 / static_cast<double>(step_ns_)) * step_ns_;
+    const auto clock = [this](double rate_hz, const std::string& key, Clock* out) {
+      out->period_ns = std::llround(1e9 / rate_hz);
+      if (out->period_ns % step_ns_ != 0 || out->period_ns == 0) {
+        std::ostringstream message;
+        message << where_ << ": " << key << ": " << rate_hz << " Hz is not a whole number of physics steps of "
+                << static_cast<double>(step_ns_) * 1e-6 << " ms (the model's timestep)";
+        return Status::Error(message.str());
+      }
+      out->samples = static_cast<std::size_t>(end_ns_ / out->period_ns) + 1;
+      return Status::Ok();
+    };
+    const SensorOptions& sensors = scenario_.sensors;
+    if (Status s = clock(scenario_.ground_truth_rate_hz, "ground_truth_rate_hz", &truth_clock_); !s.ok()) return s;
+    if (sensors.imu) {
+      if (Status s = clock(sensors.imu->rate_hz, "sensors.imu.rate_hz", &imu_clock_); !s.ok()) return s;
+      imu_.q_body_imu = sensors.imu->misalignment.normalized();
+      imu_.p_body_imu = sensors.imu->lever_arm_m;
+    }
+    if (sensors.magnetometer) {
+      if (Status s = clock(sensors.magnetometer->rate_hz, "sensors.magnetometer.rate_hz", &mag_clock_); !s.ok())
+        return s;
+      magnetometer_.A = sensors.magnetometer->A;
+      magnetometer_.b = sensors.magnetometer->b;
+      magnetometer_.field_world = sensors.magnetometer->field_world;
+    }
+    if (sensors.gps) {
+      if (Status s = clock(sensors.gps->rate_hz, "sensors.gps.rate_hz", &gps_clock_); !s.ok()) return s;
+    }
+    if (sensors.odometer) {
+      if (Status s = clock(sensors.odometer->rate_hz, "sensors.odometer.rate_hz", &odometer_clock_); !s.ok())
+        return s;
+    }
+    wheelbase_m_ = Micrometres(vehicle_.wheelbase_m());
+
+    // Streams, laid out as tests/support/synthetic.h lays them out.
+    if (sensors.imu) {
+      imu_stream_ = MakeStream("imu", StreamType::kImu, sensors.imu->rate_hz, {"wx", "wy", "wz", "ax", "ay", "az"}, "",
+                               imu_clock_);
+      imu_stream_.info.mounting = recording::Mounting{};
+      imu_stream_.info.noise = {{"gyro_sigma_radps", sensors.imu->gyro_sigma_radps},
+                                {"accel_sigma_mps2", sensors.imu->accel_sigma_mps2}};
+    }
+    if (sensors.magnetometer) {
+      mag_stream_ = MakeStream("magnetometer", StreamType::kMagnetometer, sensors.magnetometer->rate_hz,
+                               {"mx", "my", "mz"}, "normalized", mag_clock_);
+      mag_stream_.info.mounting = recording::Mounting{};
+      mag_stream_.info.noise = {{"sigma_normalized", sensors.magnetometer->sigma}};
+    }
+    if (sensors.gps) {
+      gps_stream_ = MakeStream("gps", StreamType::kGps, sensors.gps->rate_hz, {"latitude", "longitude", "altitude"},
+                               "deg", gps_clock_);
+      gps_stream_.info.mounting = recording::Mounting{};
+      gps_stream_.info.noise = {{"sigma_m", sensors.gps->sigma_m}};
+    }
+    if (sensors.odometer) {
+      wheel_stream_ = MakeStream("rear_wheel", StreamType::kWheelEncoders, sensors.odometer->rate_hz, {"rear"}, "m/s",
+                                 odometer_clock_);
+      wheel_stream_.info.noise = {{"sigma_mps", sensors.odometer->speed_sigma_mps}};
+      steering_stream_ = MakeStream("steering", StreamType::kSteering, sensors.odometer->rate_hz, {"angle"}, "rad",
+                                    odometer_clock_);
+      steering_stream_.info.noise = {{"sigma_rad", sensors.odometer->steering_sigma_rad}};
+    }
+    local_.emplace(scenario_.origin.latitude_deg, scenario_.origin.longitude_deg, scenario_.origin.altitude_m);
+    truth_.reserve(truth_clock_.samples);
+
+    // The vehicle at rest at the start pose.
+    vehicle_.Place(model_.get(), data_.get(), terrain_, scenario_.robot.start_position_m.x(),
+                   scenario_.robot.start_position_m.y(), scenario_.robot.start_heading_rad, kPlacementClearanceM);
+    return Status::Ok();
+  }
+
+ private:
+  // Speed [m/s] and handlebar [rad] set-points at t_ns: the profiles from t = 0, the lead-in's rest and ramp before.
+  std::pair<double, double> SetPoints(std::int64_t t_ns) const {
+    const DriverOptions& driver = scenario_.driver;
+    if (t_ns >= 0) {
+      const double t = static_cast<double>(t_ns) * 1e-9;
+      return {driver.speed_mps.Evaluate(t), driver.handlebar_rad.Evaluate(t)};
+    }
+    const double phase = static_cast<double>(t_ns + lead_in_ns_) / static_cast<double>(lead_in_ns_);
+    const double ramp = std::clamp((phase - kLeadInRestFraction) / (1.0 - kLeadInRestFraction), 0.0, 1.0);
+    return {ramp * driver.speed_mps.Evaluate(0.0), ramp * driver.handlebar_rad.Evaluate(0.0)};
+  }
+
+  Status Loop() {
+    const mjModel* m = model_.get();
+    mjData* d = data_.get();
+    const double dt_s = static_cast<double>(step_ns_) * 1e-9;
+    const long total_steps = static_cast<long>((end_ns_ + lead_in_ns_) / step_ns_);
+    long done = 0;
+    long next_progress = 0;
+    for (t_ns_ = -lead_in_ns_; t_ns_ <= end_ns_; t_ns_ += step_ns_) {
+      // Driver and low-level control.
+      const auto [speed, handlebar] = SetPoints(t_ns_);
+      const double measured = vehicle_.RearWheelRate(d) * vehicle_.wheel_radius_m();
+      vehicle_.Apply(handlebar, controller_->Update(speed, measured, dt_s), d);
+
+      // Sensors due now, on the state at t completed by forward dynamics.
+      if (t_ns_ >= 0 && AnyDue(t_ns_)) {
+        mj_forward(m, d);
+        mj_rnePostConstraint(m, d);
+        if (Status s = Sample(t_ns_); !s.ok()) return s;
+        if (options_.observer) options_.observer(Time::FromNanoseconds(t_ns_), m, d);
+      }
+      if (t_ns_ == end_ns_) break;
+
+      // One physics step.
+      mj_step(m, d);
+      ++done;
+      if (d->warning[mjWARN_BADQACC].number > 0) {
+        return Status::Error(model_where_ + ": the simulation diverged at t = " + FormatTime(t_ns_) +
+                             " (MuJoCo: bad acceleration)");
+      }
+      if (options_.progress && done >= next_progress) {
+        options_.progress(static_cast<double>(done) / static_cast<double>(std::max(total_steps, 1L)));
+        next_progress += std::max(total_steps / 100, 1L);
+      }
+    }
+    out_.stats.physics_steps = done;
+    out_.stats.simulated_s = static_cast<double>(end_ns_ + lead_in_ns_) * 1e-9;
+    if (options_.progress) options_.progress(1.0);
+    return Status::Ok();
+  }
+
+  bool AnyDue(std::int64_t t_ns) const {
+    return truth_clock_.Due(t_ns) || imu_clock_.Due(t_ns) || mag_clock_.Due(t_ns) || gps_clock_.Due(t_ns) ||
+           odometer_clock_.Due(t_ns);
+  }
+
+  // Synthesizes every stream due at t_ns from the current (completed) state.
+  Status Sample(std::int64_t t_ns) {
+    const FrameKinematics body = ReadSiteKinematics(model_.get(), data_.get(), vehicle_.odom_site());
+    const SensorOptions& sensors = scenario_.sensors;
+
+    if (truth_clock_.Due(t_ns)) {
+      if (Status s = CheckVehicle(body, t_ns); !s.ok()) return s;
+      StampedPose pose{Time::FromNanoseconds(t_ns), body.p_world_body, body.q_world_body};
+      // Keep the quaternion sign continuous so that the TUM file has no jumps.
+      if (!truth_.empty() && truth_.back().q_world_body.dot(pose.q_world_body) < 0.0)
+        pose.q_world_body.coeffs() = -pose.q_world_body.coeffs();
+      if (!truth_.empty()) out_.stats.distance_m += (pose.p_world_body - truth_.back().p_world_body).norm();
+      truth_.push_back(pose);
+      UpdateMotionStats(body);
+    }
+    if (imu_clock_.Due(t_ns)) {
+      const Eigen::Vector3d gyro = GyroReading(body, imu_) + gyro_noise_.Draw3(sensors.imu->gyro_sigma_radps);
+      const Eigen::Vector3d accel = AccelReading(body, imu_) + accel_noise_.Draw3(sensors.imu->accel_sigma_mps2);
+      imu_stream_.values.row(imu_clock_.Row(t_ns)) << gyro.transpose(), accel.transpose();
+    }
+    if (mag_clock_.Due(t_ns)) {
+      const Eigen::Vector3d z = MagnetometerReading(body, imu_.q_body_imu, magnetometer_) +
+                                mag_noise_.Draw3(sensors.magnetometer->sigma);
+      mag_stream_.values.row(mag_clock_.Row(t_ns)) = z.transpose();
+    }
+    if (gps_clock_.Due(t_ns)) {
+      const Eigen::Vector3d antenna =
+          GpsAntennaWorld(body, sensors.gps->lever_arm_m) + gps_noise_.Draw3(sensors.gps->sigma_m);
+      double latitude = 0.0, longitude = 0.0, altitude = 0.0;
+      local_->Reverse(antenna.x(), antenna.y(), antenna.z(), latitude, longitude, altitude);
+      gps_stream_.values.row(gps_clock_.Row(t_ns)) << latitude, longitude, altitude;
+    }
+    if (odometer_clock_.Due(t_ns)) {
+      const OdometerOptions& odo = *sensors.odometer;
+      const double z_v =
+          SpeedReading(vehicle_.RearWheelRate(data_.get()), vehicle_.wheel_radius_m(), odo.kv_over_L, wheelbase_m_) +
+          speed_noise_.Draw(odo.speed_sigma_mps);
+      const double z_theta = SteeringReading(vehicle_.SteeringAngle(data_.get()), odo.k_theta, odo.k_gamma) +
+                             steering_noise_.Draw(odo.steering_sigma_rad);
+      wheel_stream_.values(odometer_clock_.Row(t_ns), 0) = z_v;
+      steering_stream_.values(odometer_clock_.Row(t_ns), 0) = z_theta;
+    }
+    return Status::Ok();
+  }
+
+  // The drive must stay on the heightfield and upright.
+  Status CheckVehicle(const FrameKinematics& body, std::int64_t t_ns) const {
+    if (!terrain_.Contains(body.p_world_body.x(), body.p_world_body.y(), kTerrainMarginM)) {
+      return Status::Error(where_ + ": the vehicle left the terrain at t = " + FormatTime(t_ns) +
+                           " (enlarge world.terrain.size_m or change the drive)");
+    }
+    if ((body.q_world_body * Eigen::Vector3d::UnitZ()).z() < kRolloverCosine) {
+      return Status::Error(where_ + ": the vehicle rolled over at t = " + FormatTime(t_ns) +
+                           " (gentler driver profiles or terrain)");
+    }
+    return Status::Ok();
+  }
+
+  void UpdateMotionStats(const FrameKinematics& body) {
+    SimulationStats& st = out_.stats;
+    const Eigen::Matrix3d R = body.q_world_body.toRotationMatrix();
+    st.max_abs_pitch_rad = std::max(st.max_abs_pitch_rad, std::abs(std::asin(std::clamp(-R(2, 0), -1.0, 1.0))));
+    st.max_abs_roll_rad = std::max(st.max_abs_roll_rad, std::abs(std::atan2(R(2, 1), R(2, 2))));
+    st.max_lateral_speed_mps = std::max(st.max_lateral_speed_mps, std::abs(body.v_body.y()));
+    const double rim = vehicle_.RearWheelRate(data_.get()) * vehicle_.wheel_radius_m();
+    st.max_wheel_slip_mps = std::max(st.max_wheel_slip_mps, std::abs(rim - body.v_body.x()));
+    min_height_ = std::min(min_height_, body.p_world_body.z());
+    max_height_ = std::max(max_height_, body.p_world_body.z());
+  }
+
+  // Assembles the recording and the truth.
+  void Finish() {
+    const SensorOptions& sensors = scenario_.sensors;
+    recording::Recording& rec = out_.recording;
+    rec.platform.kind = "ackermann";
+    rec.platform.geometry = {{"wheelbase_m", wheelbase_m_},
+                             {"track_m", Micrometres(vehicle_.rear_track_m())},
+                             {"wheel_radius_m", Micrometres(vehicle_.wheel_radius_m())}};
+    rec.origin = scenario_.origin;
+    rec.provenance.source = "simulated";
+    rec.provenance.scenario = scenario_.source_file;
+    rec.provenance.seed = seed_;
+    std::ostringstream description;
+    if (!scenario_.name.empty()) description << scenario_.name << ": ";
+    description << "MuJoCo " << mj_versionString() << ", model " << model_where_ << ", terrain "
+                << (scenario_.terrain.type == TerrainOptions::Type::kHills
+                        ? "hills (seed " + std::to_string(scenario_.terrain.seed) + ")"
+                        : std::string("flat"))
+                << (options_.noise ? "" : ", noise off");
+    rec.provenance.description = description.str();
+    if (sensors.imu) rec.streams.push_back(std::move(imu_stream_));
+    if (sensors.magnetometer) rec.streams.push_back(std::move(mag_stream_));
+    if (sensors.gps) rec.streams.push_back(std::move(gps_stream_));
+    if (sensors.odometer) {
+      rec.streams.push_back(std::move(wheel_stream_));
+      rec.streams.push_back(std::move(steering_stream_));
+    }
+    rec.ground_truth = std::move(truth_);
+
+    // True calibration, named as calibration.json names the estimated parameters.
+    auto& cal = out_.truth.calibration;
+    if (sensors.gps) {
+      const Eigen::Vector3d& s = sensors.gps->lever_arm_m;
+      cal["gps.lever_arm"] = {s.x(), s.y(), s.z()};
+    }
+    if (sensors.imu) {
+      const Eigen::Quaterniond& q = imu_.q_body_imu;
+      cal["imu.misalignment"] = {q.w(), q.x(), q.y(), q.z()};
+      if (!imu_.p_body_imu.isZero(0.0))
+        cal["imu.lever_arm"] = {imu_.p_body_imu.x(), imu_.p_body_imu.y(), imu_.p_body_imu.z()};
+    }
+    if (sensors.magnetometer) {
+      const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> A = magnetometer_.A;
+      cal["magnetometer.A"] = std::vector<double>(A.data(), A.data() + 9);
+      cal["magnetometer.b"] = {magnetometer_.b.x(), magnetometer_.b.y(), magnetometer_.b.z()};
+    }
+    if (sensors.odometer) {
+      cal["odometer.kv_over_L"] = {sensors.odometer->kv_over_L};
+      cal["odometer.k_theta"] = {sensors.odometer->k_theta};
+      cal["odometer.k_gamma"] = {sensors.odometer->k_gamma};
+    }
+
+    out_.stats.terrain_relief_m = terrain_.Relief();
+    out_.stats.path_height_range_m = max_height_ >= min_height_ ? max_height_ - min_height_ : 0.0;
+  }
+
+  const Scenario scenario_;
+  const SimulateOptions options_;
+  const std::uint64_t seed_;
+  const std::string where_;        // the scenario, for messages
+  const std::string model_where_;  // the robot model, for messages
+
+  Terrain terrain_;
+  ModelPtr model_;
+  DataPtr data_;
+  AckermannVehicle vehicle_;
+  std::optional<SpeedController> controller_;
+  std::optional<GeographicLib::LocalCartesian> local_;
+  ImuCalibration imu_;
+  MagnetometerCalibration magnetometer_;
+  double wheelbase_m_ = 0.0;
+
+  std::int64_t step_ns_ = 0;
+  std::int64_t end_ns_ = 0;
+  std::int64_t lead_in_ns_ = 0;
+  std::int64_t t_ns_ = 0;          // the current time, for messages
+  Clock truth_clock_, imu_clock_, mag_clock_, gps_clock_, odometer_clock_;
+
+  NoiseStream gyro_noise_{seed_, NoiseSource::kGyro, options_.noise};
+  NoiseStream accel_noise_{seed_, NoiseSource::kAccel, options_.noise};
+  NoiseStream mag_noise_{seed_, NoiseSource::kMagnetometer, options_.noise};
+  NoiseStream gps_noise_{seed_, NoiseSource::kGps, options_.noise};
+  NoiseStream speed_noise_{seed_, NoiseSource::kSpeed, options_.noise};
+  NoiseStream steering_noise_{seed_, NoiseSource::kSteering, options_.noise};
+
+  recording::Stream imu_stream_, mag_stream_, gps_stream_, wheel_stream_, steering_stream_;
+  Trajectory truth_;
+  double min_height_ = 1e300;
+  double max_height_ = -1e300;
+  Simulation out_;
+};
+
+Simulator::Simulator(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Simulator::~Simulator() = default;
+
+Result<std::unique_ptr<Simulator>> Simulator::Create(const Scenario& scenario, const SimulateOptions& options) {
+  if (const auto problem = scenario.Validate()) {
+    const std::string where = scenario.source_file.empty() ? std::string("scenario") : scenario.source_file;
+    return Status::Error(where + ": " + problem->key + ": " + problem->message);
+  }
+  InstallMujocoHandlers();
+  auto impl = std::make_unique<Impl>(scenario, options);
+  try {
+    if (Status s = impl->Setup(); !s.ok()) return s;
+  } catch (const MujocoError& e) {
+    return Status::Error((scenario.robot.model_xml.empty() ? scenario.robot.model_file : "robot.model_xml") +
+                         ": MuJoCo error: " + OneLine(e.what()));
+  }
+  return std::unique_ptr<Simulator>(new Simulator(std::move(impl)));
+}
+
+Result<Simulation> Simulator::Run() {
+  ROAMLAB_CHECK(impl_ != nullptr, "Simulator::Run called twice");
+  auto result = impl_->Run();
+  impl_.reset();
+  return result;
+}
+
+Result<Simulation> Simulate(const Scenario& scenario, const SimulateOptions& options) {
+  auto simulator = Simulator::Create(scenario, options);
+  if (!simulator.ok()) return simulator.status();
+  return simulator.value()->Run();
+}
+
+}  // namespace roamlab::sim

@@ -1,0 +1,128 @@
+// Scenario files (sim/scenario.h): the shipped scenario loads with the seed's Section V values, and every kind of bad
+// input gives one line naming the file, the line and the key.
+#include "sim/scenario.h"
+
+#include <algorithm>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "tests/recording/temp_dir.h"
+#include "tests/sim/sim_testing.h"
+
+namespace roamlab::sim {
+namespace {
+
+TEST(ScenarioTest, AtvHillsIsTheSectionVSetup) {
+  auto loaded = LoadScenario(testing::SourcePath("scenarios/atv_hills.yaml"));
+  ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+  const Scenario& s = loaded.value();
+  EXPECT_EQ(s.duration_s, 30.0);
+  EXPECT_EQ(s.seed, 1u);
+  EXPECT_EQ(s.robot.kind, "ackermann");
+  EXPECT_NE(s.robot.model_file.find("models/atv.xml"), std::string::npos);
+  EXPECT_EQ(s.terrain.type, TerrainOptions::Type::kHills);
+  EXPECT_EQ(s.terrain.seed, 7u);
+  ASSERT_TRUE(s.sensors.imu && s.sensors.magnetometer && s.sensors.gps && s.sensors.odometer);
+  EXPECT_EQ(s.sensors.imu->rate_hz, 100.0);
+  EXPECT_EQ(s.sensors.gps->rate_hz, 5.0);
+  EXPECT_EQ(s.sensors.gps->sigma_m, 0.33);
+  EXPECT_EQ(s.sensors.magnetometer->sigma, 0.067);
+  EXPECT_EQ(s.sensors.imu->accel_sigma_mps2, 0.067);
+  EXPECT_EQ(s.sensors.imu->gyro_sigma_radps, 0.033);
+  EXPECT_EQ(s.sensors.odometer->speed_sigma_mps, 0.033);
+  EXPECT_EQ(s.sensors.odometer->steering_sigma_rad, 0.014);
+  EXPECT_NEAR(s.sensors.imu->misalignment.norm(), 1.0, 1e-15);
+  EXPECT_EQ(s.sensors.gps->lever_arm_m, Eigen::Vector3d(0.57, -0.46, 0.32));
+  EXPECT_EQ(s.sensors.magnetometer->A(2, 1), -0.04);
+  EXPECT_EQ(s.sensors.odometer->kv_over_L, 0.8);
+  EXPECT_TRUE(s.effects.empty());
+  // The drive turns both ways.
+  double left = 0.0, right = 0.0;
+  for (double t = 0.0; t <= 30.0; t += 0.01) {
+    left = std::max(left, s.driver.handlebar_rad.Evaluate(t));
+    right = std::min(right, s.driver.handlebar_rad.Evaluate(t));
+  }
+  EXPECT_GT(left, 0.15);
+  EXPECT_LT(right, -0.15);
+}
+
+// Writes atv_hills.yaml with one substitution into a temporary directory, with the model path made absolute.
+class ScenarioErrorTest : public ::testing::Test {
+ protected:
+  // Replaces `from` (which must occur) by `to` and loads; returns the error message ("" if it loaded).
+  std::string LoadWith(const std::string& from, const std::string& to) {
+    std::string text = testing::ReadText(testing::SourcePath("scenarios/atv_hills.yaml"));
+    const std::string model = "model: ../models/atv.xml";
+    text.replace(text.find(model), model.size(), "model: " + testing::SourcePath("models/atv.xml"));
+    const std::size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at == std::string::npos) return "";
+    text.replace(at, from.size(), to);
+    text_ = text;
+    path_ = dir_.File("scenario.yaml");
+    roamlab::testing::WriteFile(path_, text);
+    auto loaded = LoadScenario(path_);
+    return loaded.ok() ? "" : loaded.status().message();
+  }
+  // 1-based line of the first occurrence of `marker` in the last written file.
+  int LineOf(const std::string& marker) const {
+    const std::size_t at = text_.find(marker);
+    EXPECT_NE(at, std::string::npos) << marker;
+    return 1 + static_cast<int>(std::count(text_.begin(), text_.begin() + static_cast<long>(at), '\n'));
+  }
+  // Checks "<file>:<line of marker>: <key>: ..." on a single line.
+  void ExpectError(const std::string& message, const std::string& marker, const std::string& key,
+                   const std::string& problem) {
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    const std::string prefix = path_ + ":" + std::to_string(LineOf(marker)) + ": " + key + ": ";
+    EXPECT_EQ(message.rfind(prefix, 0), 0u) << message << "\nexpected prefix: " << prefix;
+    EXPECT_NE(message.find(problem), std::string::npos) << message;
+  }
+
+  roamlab::testing::TempDir dir_;
+  std::string path_;
+  std::string text_;
+};
+
+TEST_F(ScenarioErrorTest, UnchangedCopyLoads) { EXPECT_EQ(LoadWith("name: atv_hills", "name: copy"), ""); }
+
+TEST_F(ScenarioErrorTest, UnknownKeys) {
+  ExpectError(LoadWith("duration_s: 30.0", "duration_s: 30.0\ncolour: red"), "colour", "colour", "unknown key");
+  ExpectError(LoadWith("sigma_m: 0.33", "sigma_m: 0.33\n    sigma: 1.0"), "sigma: 1.0", "sensors.gps.sigma",
+              "unknown key");
+}
+
+TEST_F(ScenarioErrorTest, BadValues) {
+  ExpectError(LoadWith("rate_hz: 5\n", "rate_hz: fast\n"), "rate_hz: fast", "sensors.gps.rate_hz",
+              "expected a finite number");
+  ExpectError(LoadWith("rate_hz: 5\n", "rate_hz: -5\n"), "rate_hz: -5", "sensors.gps.rate_hz", "must be > 0");
+  ExpectError(LoadWith("lever_arm_m: [0.57, -0.46, 0.32]", "lever_arm_m: [0.57, -0.46]"), "lever_arm_m: [0.57",
+              "sensors.gps.lever_arm_m", "expected 3 numbers");
+  ExpectError(LoadWith("type: hills", "type: mountains"), "type: mountains", "world.terrain.type", "hills or flat");
+  ExpectError(LoadWith("relief_m: 4.0", "relief_m: 0"), "relief_m: 0", "world.terrain.relief_m", "must be > 0");
+  ExpectError(LoadWith("kind: ackermann", "kind: hovercraft"), "kind: hovercraft", "robot.kind", "unsupported");
+  ExpectError(LoadWith("{amplitude: 0.8, period_s: 13.0, phase_rad: 0.0}", "{amplitude: 0.8, period_s: -13.0}"),
+              "period_s: -13.0", "driver.speed_mps[1]", "period_s must be > 0");
+  ExpectError(LoadWith("effects: []", "effects: [{name: gps_latency, parameters: {latency_s: 0.1}}]"), "gps_latency",
+              "effects[0].name", "unknown effect");
+}
+
+TEST_F(ScenarioErrorTest, MissingFilesAndKeys) {
+  ExpectError(LoadWith("model: " + testing::SourcePath("models/atv.xml"), "model: no_such_robot.xml"),
+              "no_such_robot.xml", "robot.model", "no such file 'no_such_robot.xml'");
+  ExpectError(LoadWith("{amplitude: 0.8, period_s: 13.0, phase_rad: 0.0}", "{amplitude: 0.8}"), "{amplitude: 0.8}",
+              "driver.speed_mps[1].sine.period_s", "missing required key");
+  const std::string message = LoadWith("duration_s: 30.0\n", "");
+  EXPECT_NE(message.find("duration_s: missing required key"), std::string::npos) << message;
+  EXPECT_EQ(LoadScenario(dir_.File("absent.yaml")).status().message(), dir_.File("absent.yaml") + ": cannot open file");
+}
+
+TEST_F(ScenarioErrorTest, YamlSyntaxErrorsGiveLineAndColumn) {
+  const std::string message = LoadWith("seed: 1 ", "seed: [1\n");
+  EXPECT_EQ(message.rfind(path_ + ":", 0), 0u) << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+}
+
+}  // namespace
+}  // namespace roamlab::sim
