@@ -154,7 +154,8 @@ int RunMonteCarlo(const MonteCarloArgs& args) {
   if (eval::GnuplotAvailable()) {
     auto plot = eval::WriteNeesPlot(args.out, "Average position NEES over " + std::to_string(args.runs) + " runs",
                                     nees);
-    if (!plot.ok()) plot_note = " (plot failed: " + plot.status().message() + ")";
+    Status drawn = plot.ok() ? eval::RunGnuplot(args.out, plot.value().script) : plot.status();
+    if (!drawn.ok()) plot_note = " (plot failed: " + drawn.message() + ")";
   } else {
     plot_note = " (gnuplot not found: no nees.png)";
   }

@@ -1,16 +1,18 @@
 #!/usr/bin/env bash
-# Sets up (scripts/setup.sh) and runs the main job end to end: a 30 s ATV drive with the seed's Table I calibration
-# and Section V noise, offline self-calibration, online fixed-lag tracking. Output in out/main/ (OUT_DIR overrides).
-# Until the MuJoCo simulator lands (issue 3) the drive comes from the kinematic generator in tests/support.
+# Sets up (scripts/setup.sh) and runs the main job end to end: the ATV on MuJoCo hills (scenarios/atv_hills.yaml, the
+# seed's Section V: Table I calibration, Section V noise), offline self-calibration, online fixed-lag tracking with the
+# calibrated values, and evaluation against the truth. Output in out/main/ (OUT_DIR overrides).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-build_dir=${BUILD_DIR:-build}
+roamlab=${BUILD_DIR:-build}/apps/roamlab
 out=${OUT_DIR:-out/main}
 rm -rf "$out" && mkdir -p "$out"
-"$build_dir/tests/support/make_synthetic_recording" "$out/recording" 30 1
-"$build_dir/apps/roamlab" calibrate "$out/recording" --config scenarios/atv_calibration.yaml --out "$out/calibration"
-"$build_dir/apps/roamlab" track "$out/recording" --config scenarios/atv_tracking.yaml \
+"$roamlab" simulate scenarios/atv_hills.yaml --out "$out/recording"
+"$roamlab" calibrate "$out/recording" --config scenarios/atv_calibration.yaml --out "$out/calibration"
+"$roamlab" track "$out/recording" --config scenarios/atv_tracking.yaml \
   --calibration "$out/calibration/calibration.json" --out "$out/tracking"
-echo "report: $out/calibration/calibration.json, $out/tracking/summary.json, $out/tracking/trajectory.tum"
-echo "truth (for comparison only; the estimator never reads it): $out/recording/truth.yaml"
+"$roamlab" evaluate --estimate "$out/calibration" --recording "$out/recording" --out "$out/report/calibration"
+"$roamlab" evaluate --estimate "$out/tracking" --recording "$out/recording" --out "$out/report/tracking"
+echo "report: $out/report/calibration/metrics.json (parameter table), $out/report/tracking/metrics.json (ATE, RPE,"
+echo "        NEES) and the figures beside them (trajectory.png, position_error.png)"
