@@ -123,7 +123,7 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
   if (!ids.empty()) {
     auto info = ComputeMarginalInformation(builder.graph(), ids);
     if (!info.ok()) return info.status();
-    analysis = AnalyzeObservability(info.value().information, options.observability);
+    analysis = AnalyzeObservability(info.value().information, info.value().conditional, options.observability);
     offsets = info.value().offsets;
   }
   for (std::size_t i = 0; i < ids.size(); ++i) {

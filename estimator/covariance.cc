@@ -45,6 +45,7 @@ Result<MarginalInformation> ComputeMarginalInformation(const Graph& graph, const
   const int nx = n - np;
   const Eigen::SparseMatrix<double> H = system.hessian_upper().selfadjointView<Eigen::Upper>();
   const Eigen::MatrixXd Hpp = Eigen::MatrixXd(H.bottomRightCorner(np, np));
+  result.conditional = Hpp.diagonal();
   if (nx == 0) {
     result.information = Hpp;
     return result;
@@ -69,7 +70,8 @@ Result<MarginalInformation> ComputeMarginalInformation(const Graph& graph, const
   return result;
 }
 
-ObservabilityAnalysis AnalyzeObservability(const Eigen::MatrixXd& information, const ObservabilityOptions& options) {
+ObservabilityAnalysis AnalyzeObservability(const Eigen::MatrixXd& information, const Eigen::VectorXd& conditional,
+                                           const ObservabilityOptions& options) {
   const int n = static_cast<int>(information.rows());
   ObservabilityAnalysis out;
   out.std = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::quiet_NaN());
@@ -103,7 +105,8 @@ ObservabilityAnalysis AnalyzeObservability(const Eigen::MatrixXd& information, c
   out.covariance = scale.asDiagonal() * pseudo * scale.asDiagonal();
   for (int i = 0; i < n; ++i) {
     if (scale[i] == 0.0 || null_loading[i] > options.null_loading) continue;
-    out.inflation[i] = pseudo(i, i);
+    out.inflation[i] = out.covariance(i, i) * conditional[i];
+    if (out.inflation[i] > options.unobservable_inflation) continue;
     out.std[i] = std::sqrt(out.covariance(i, i));
     out.observability[i] =
         out.inflation[i] > options.weak_inflation ? Observability::kWeak : Observability::kObservable;

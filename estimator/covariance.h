@@ -4,12 +4,14 @@
 // (every other free variable marginalized out), at the graph's current estimate. Its inverse is their marginal
 // covariance, in tangent coordinates (geometry.h): [dp (m), dtheta (rad)] for poses, dtheta for quaternions.
 //
-// Observability of calibration parameters: the information is normalized to unit diagonal (each component's
-// information if all others were known), and eigen-decomposed.
-//  - unobservable: the component loads on a (numerically) null direction: the data cannot tell its value, the
-//    estimate means nothing and no standard deviation is reported;
-//  - weak: its variance is inflated more than `weak_inflation` times by its dependence on other parameters (the
-//    variance inflation factor), or its standard deviation exceeds `weak_std` when one is given;
+// Observability of calibration parameters. A component's variance inflation factor is its marginal variance times its
+// conditional information (the diagonal of the Hessian: what the data would say about it if every other variable,
+// poses included, were known). The marginal information is also normalized to unit diagonal and eigen-decomposed.
+//  - unobservable: the component loads on a (numerically) null direction, or its variance is inflated more than
+//    `unobservable_inflation` times (its standard deviation 100 times what the data alone would give: what is left
+//    comes from noise and linearization, as for a GPS lever arm's height on a flat drive). The estimate means
+//    nothing and no standard deviation is reported;
+//  - weak: inflated more than `weak_inflation` times by its dependence on other variables;
 //  - observable otherwise.
 // Correlations come from a slightly regularized inverse so that dependent pairs (for example the magnetometer's A
 // against the IMU misalignment, eq. 10) show |rho| near 1 even when exactly dependent.
@@ -28,6 +30,7 @@ struct MarginalInformation {
   std::vector<VariableId> variables;
   std::vector<int> offsets;       // of each variable in the matrix
   Eigen::MatrixXd information;    // Schur complement, tangent coordinates
+  Eigen::VectorXd conditional;    // diagonal of the Hessian for the same components (every other variable known)
 };
 
 // Requires the listed variables to be free. Fails with a message if the rest of the problem is singular even after a
@@ -40,17 +43,21 @@ const char* ObservabilityName(Observability observability);
 struct ObservabilityOptions {
   double null_eigenvalue = 1e-9;     // normalized eigenvalues below this are null directions
   double null_loading = 1e-2;        // a component whose squared loading on null directions exceeds this is unobservable
-  double weak_inflation = 100.0;     // variance inflation factor above which a component is weak
+  double weak_inflation = 100.0;          // variance inflation factor above which a component is weak
+  double unobservable_inflation = 1.0e4;  // ... and above which it is unobservable
 };
 
 struct ObservabilityAnalysis {
   Eigen::MatrixXd covariance;                 // pseudo-inverse of the information on its observable subspace
   Eigen::VectorXd std;                        // per component; NaN when unobservable
-  Eigen::VectorXd inflation;                  // variance inflation factor per component (inf when unobservable)
+  Eigen::VectorXd inflation;                  // variance inflation factor per component (inf on a null direction)
   std::vector<Observability> observability;   // per component
   Eigen::MatrixXd correlation;                // from the regularized inverse
 };
 
-ObservabilityAnalysis AnalyzeObservability(const Eigen::MatrixXd& information, const ObservabilityOptions& options = {});
+// `conditional`: the Hessian's diagonal for the same components (MarginalInformation::conditional); pass
+// information.diagonal() when the information involves no other variables.
+ObservabilityAnalysis AnalyzeObservability(const Eigen::MatrixXd& information, const Eigen::VectorXd& conditional,
+                                           const ObservabilityOptions& options = {});
 
 }  // namespace roamlab::estimator

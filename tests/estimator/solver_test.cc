@@ -93,13 +93,30 @@ TEST(ObservabilityTest, ClassifiesNullAndWeakDirections) {
        1, 0, 0, 1.001;
   Eigen::MatrixXd H = J.transpose() * J;
   H(0, 0) += 1.0;
-  const ObservabilityAnalysis a = AnalyzeObservability(H);
+  const ObservabilityAnalysis a = AnalyzeObservability(H, H.diagonal());
   EXPECT_EQ(a.observability[0], Observability::kObservable);
   EXPECT_EQ(a.observability[1], Observability::kUnobservable);
   EXPECT_EQ(a.observability[2], Observability::kUnobservable);
   EXPECT_TRUE(std::isnan(a.std[1]));
   EXPECT_NEAR(std::abs(a.correlation(1, 2)), 1.0, 1e-3);
   EXPECT_EQ(a.observability[3], Observability::kObservable);
+}
+
+TEST(ObservabilityTest, ComponentWhoseInformationIsAlmostAllSharedIsUnobservable) {
+  // One component known only 1e-3 as well once the other variables are marginalized as it would be on its own: its
+  // variance is inflated 1e6 times (std 1000 times): unobservable. At 30 times (std ~5.5x) it is weak.
+  Eigen::MatrixXd marginal = Eigen::MatrixXd::Identity(2, 2);
+  marginal(1, 1) = 1e-3 * 1e-3;
+  Eigen::VectorXd conditional(2);
+  conditional << 1.0, 1.0;
+  ObservabilityAnalysis a = AnalyzeObservability(marginal, conditional);
+  EXPECT_EQ(a.observability[0], Observability::kObservable);
+  EXPECT_EQ(a.observability[1], Observability::kUnobservable);
+  EXPECT_TRUE(std::isnan(a.std[1]));
+  marginal(1, 1) = 1.0 / 300.0;
+  a = AnalyzeObservability(marginal, conditional);
+  EXPECT_EQ(a.observability[1], Observability::kWeak);
+  EXPECT_NEAR(a.std[1], std::sqrt(300.0), 1e-9);
 }
 
 }  // namespace

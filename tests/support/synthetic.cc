@@ -231,6 +231,7 @@ std::string SyntheticOptions::Validate() const {
   require(IsFinite(k_theta) && k_theta != 0.0, "k_theta must be nonzero");
   require(IsFinite(k_gamma), "k_gamma must be finite");
   require(IsFinite(wheelbase_m) && wheelbase_m > 0.0, "wheelbase_m must be > 0");
+  require(gyro_bias_radps.allFinite(), "gyro_bias_radps must be finite");
   for (double sigma : {sigma_gps_m, sigma_mag, sigma_acc_mps2, sigma_gyro_radps, sigma_speed_mps, sigma_steering_rad}) {
     require(IsFinite(sigma) && sigma >= 0.0, "noise sigmas must be >= 0");
   }
@@ -272,7 +273,8 @@ SyntheticRecording MakeAtvRecording(const SyntheticOptions& options) {
   ground_truth.reserve(imu.t.size());
   for (std::size_t k = 0; k < imu.t.size(); ++k) {
     const AtvTruth::Kinematics truth = truth_model.At(imu.t[k].nanoseconds());
-    const Eigen::Vector3d gyro = q_body_imu.conjugate() * truth.omega_body + gyro_noise.Draw3(options.sigma_gyro_radps);
+    const Eigen::Vector3d gyro = q_body_imu.conjugate() * truth.omega_body + options.gyro_bias_radps +
+                                 gyro_noise.Draw3(options.sigma_gyro_radps);
     const Eigen::Vector3d accel =
         q_body_imu.conjugate() *
             (truth.q_world_body.conjugate() * (truth.a_world + estimator::kSpecificForceAtRest_world)) +
@@ -343,6 +345,10 @@ SyntheticRecording MakeAtvRecording(const SyntheticOptions& options) {
       {"odometer.k_theta", {options.k_theta}},
       {"odometer.k_gamma", {options.k_gamma}},
   };
+  if (!options.gyro_bias_radps.isZero(0.0)) {
+    const Eigen::Vector3d& b = options.gyro_bias_radps;
+    out.truth.calibration["imu.gyro_bias"] = {b.x(), b.y(), b.z()};
+  }
   return out;
 }
 

@@ -20,7 +20,8 @@
 //     with 1 ms steps; both are within about 1e-6 of the exact derivatives, far below the sensor noise.
 //
 // Sensors (conventions of estimator/geometry.h: Hamilton, q_a_b maps b into a, W = ENU, specific force +9.80665 up):
-//   imu           gyro  = q_body_imu^-1 omega_body + eta_g                                   (seed eq. 11, no bias)
+//   imu           gyro  = q_body_imu^-1 omega_body + b_g + eta_g                             (seed eq. 11, unit scale)
+//                 b_g = gyro_bias_radps, a constant bias in the IMU frame (zero by default).
 //                 accel = q_body_imu^-1 q_world_body^-1 (a_world + [0, 0, g]) + eta_a         (eq. 14 with S^(O) = 0)
 //                 The IMU sits at the origin of O: there is no lever arm in this generator, so the omega x (omega x
 //                 S) and alpha x S terms of eq. 14 vanish.
@@ -73,6 +74,7 @@ struct SyntheticOptions {
   double k_theta = 1.0;                                            // [odometer.k_theta] -, nonzero
   double k_gamma = 0.0;                                            // [odometer.k_gamma] rad
   double wheelbase_m = 1.25;                                       // L, known (platform geometry), > 0
+  Eigen::Vector3d gyro_bias_radps = Eigen::Vector3d::Zero();       // [imu.gyro_bias] in the IMU frame [rad/s]
 
   // Noise standard deviations per sample (seed Section V), each >= 0.
   double sigma_gps_m = 0.33;
@@ -93,7 +95,8 @@ struct SyntheticRecording {
   // IMU sample time; platform ackermann with geometry.wheelbase_m; origin set; provenance "simulated" with the seed.
   recording::Recording recording;
   // calibration: gps.lever_arm [3], imu.misalignment [w, x, y, z] (normalized), magnetometer.A [9, row-major],
-  // magnetometer.b [3], odometer.kv_over_L, odometer.k_theta, odometer.k_gamma [1 each]; no effects.
+  // magnetometer.b [3], odometer.kv_over_L, odometer.k_theta, odometer.k_gamma [1 each], and imu.gyro_bias [3] when
+  // it is not zero (as the simulator records optional effects such as imu.lever_arm); no effects.
   recording::Truth truth;
 };
 

@@ -148,6 +148,33 @@ TEST(SyntheticTest, TruthHoldsTheTrueCalibration) {
   EXPECT_NEAR(table_i[2], 0.313, 1e-3);
 }
 
+// A gyro bias is added to every gyro reading in the IMU's own frame (with the skewed misalignment, a bias added in O
+// would differ by q_body_imu), touches nothing else, and is recorded as imu.gyro_bias; without one there is no entry.
+TEST(SyntheticTest, GyroBiasIsAddedInTheImuFrameAndRecorded) {
+  SyntheticOptions options = SkewedCalibration();
+  options.duration_s = 5.0;
+  const SyntheticRecording unbiased = MakeAtvRecording(options);
+  const Eigen::Vector3d bias(0.02, -0.01, 0.015);
+  options.gyro_bias_radps = bias;
+  const SyntheticRecording biased = MakeAtvRecording(options);
+
+  const recording::Stream& a = Get(unbiased.recording, "imu");
+  const recording::Stream& b = Get(biased.recording, "imu");
+  ASSERT_EQ(a.t.size(), b.t.size());
+  double worst = 0.0;
+  for (std::size_t k = 0; k < a.t.size(); ++k) worst = std::max(worst, (Row3(b, k, 0) - Row3(a, k, 0) - bias).norm());
+  EXPECT_LT(worst, 1e-12);
+  EXPECT_EQ(a.values.rightCols(3), b.values.rightCols(3));  // the accelerometer is untouched
+  EXPECT_EQ(Get(unbiased.recording, "magnetometer").values, Get(biased.recording, "magnetometer").values);
+
+  EXPECT_EQ(biased.truth.calibration.at("imu.gyro_bias"), (std::vector<double>{0.02, -0.01, 0.015}));
+  EXPECT_EQ(biased.truth.calibration.size(), unbiased.truth.calibration.size() + 1);
+  EXPECT_EQ(unbiased.truth.calibration.count("imu.gyro_bias"), 0u);
+
+  options.gyro_bias_radps.x() = std::nan("");
+  EXPECT_NE(options.Validate().find("gyro_bias_radps"), std::string::npos);
+}
+
 // The gyro reads the body rate that the ground-truth poses imply. The central difference over +-10 ms differs from
 // the instantaneous rate by O(dt^2 |d^2 omega/dt^2|), 3e-5 rad/s on this trajectory; the tolerance is sigma_gyro / 33.
 TEST(SyntheticTest, NoiseFreeGyroIsTheBodyRateOfTheGroundTruth) {

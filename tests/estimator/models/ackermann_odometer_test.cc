@@ -14,6 +14,7 @@
 namespace roamlab::estimator {
 namespace {
 
+using testing::PoseVector;
 using testing::RandomPoint;
 
 constexpr double kWheelbase = 1.25;  // [m]
@@ -29,12 +30,6 @@ constexpr Calibration kSkewed{0.8, 1.05, 0.02, "Skewed"};
 
 void PrintTo(const Calibration& c, std::ostream* os) {
   *os << c.name << " {kv_over_L " << c.kv_over_l << ", k_theta " << c.k_theta << ", k_gamma " << c.k_gamma << "}";
-}
-
-Eigen::VectorXd PoseVector(const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
-  Eigen::VectorXd x(7);
-  x << p, q.w(), q.x(), q.y(), q.z();
-  return x;
 }
 
 Eigen::Quaterniond Yaw(double angle) { return Eigen::Quaterniond(Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ())); }
@@ -134,14 +129,7 @@ TEST(AckermannOdometerErrorTest, JacobiansMatchCentralDifferences) {
   for (int trial = 0; trial < 5; ++trial) {
     SCOPED_TRACE(trial);
     const RandomCase c = RandomAckermannCase(&rng);
-    const auto factor = MakeFactor(c.model);
-    testing::ExpectJacobiansMatchNumeric(*factor, c.values);
-
-    const Eigen::MatrixXd numeric = testing::NumericNoiseJacobian(c.model, c.values);
-    const testing::Linearization lin = testing::Evaluate(*factor, c.values);
-    EXPECT_LT((lin.noise_jacobian - numeric).cwiseAbs().maxCoeff(), 1e-8) << "jet\n"
-                                                                         << lin.noise_jacobian << "\nnumeric\n"
-                                                                         << numeric;
+    testing::ExpectModelJacobiansMatchNumeric(c.model, c.values);
   }
 }
 
@@ -203,6 +191,15 @@ TEST(AckermannOdometerErrorTest, StandstillDropsYawUncertainty) {
   EXPECT_GT(svd.singularValues()[4], 1e-3 * svd.singularValues()[0]);
   EXPECT_LT(svd.singularValues()[5], 1e-12 * svd.singularValues()[0]);
 }
+
+TEST(AckermannOdometerErrorTest, SmallSolveRecoversSpeedAndSteeringCalibration) {
+  testing::SmallProblem problem = testing::AckermannProblem<AckermannOdometerError>(false, 25);
+  testing::ExpectSolveRecoversTruth(&problem);
+}
+
+// No noisy case here: this form's reading noise passes through the nonlinear model, which biases the speed gain
+// (errors in variables, see ackermann_velocity.h); the calibration test
+// SeedFormOfAckermannOdometerIsBiasedAndMeasurementFormIsNot measures that bias.
 
 }  // namespace
 }  // namespace roamlab::estimator

@@ -1,6 +1,8 @@
 #include "estimator/models/gps.h"
 
+#include <cstdint>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -32,6 +34,42 @@ TEST(GpsErrorTest, JacobiansMatchCentralDifferences) {
     const Eigen::Vector3d z = RandomPoint(Manifold::Euclidean(3), &rng, 10.0);
     testing::ExpectJacobiansMatchNumeric(*MakeFactor(GpsError(z)), {pose, lever});
   }
+}
+
+// The GPS's small end-to-end problem: an antenna at a lever arm on the smooth 3-D motion, one fix per pose from the
+// motion's own pose, z = p + R S^(O) + eta, with pose priors as the other source of position and orientation. The
+// lever arm starts at zero.
+testing::SmallProblem GpsProblem(bool noisy, std::uint32_t seed) {
+  const double sigma = 0.02;  // [m]
+  const Eigen::Vector3d lever_arm(0.57, -0.46, 0.32);
+  const testing::TwistTrajectory motion = testing::SmoothMotion(40);
+
+  std::mt19937 rng(seed);
+  testing::SmallProblem problem;
+  testing::AddAnchoredPoses(motion.poses, 0.02, 0.002, noisy, &rng, &problem);
+  const VariableId lever_id =
+      testing::AddFreeParameter("lever_arm", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), lever_arm, &problem);
+  for (std::size_t k = 0; k < motion.poses.size(); ++k) {
+    const Pose<double> T = PoseFromArray(motion.poses[k].data());
+    const Eigen::Vector3d z = T.p_world_body + T.q_world_body.toRotationMatrix() * lever_arm +
+                              testing::GaussianNoise(3, testing::NoiseSigma(noisy, sigma), &rng);
+    problem.graph.AddFactor(MakeFactor(GpsError(z)), {problem.poses[k], lever_id},
+                            Eigen::Matrix3d::Identity() * sigma * sigma, Loss::Trivial(), "gps",
+                            Time::FromNanoseconds(static_cast<std::int64_t>(k)));
+  }
+  return problem;
+}
+
+TEST(GpsErrorTest, SmallSolveRecoversLeverArm) {
+  testing::SmallProblem problem = GpsProblem(false, 3);
+  testing::ExpectSolveRecoversTruth(&problem);
+}
+
+TEST(GpsErrorTest, SmallNoisySolveIsWithinFourSigma) {
+  testing::SmallProblem problem = GpsProblem(true, 4);
+  const Eigen::VectorXd sigma = testing::ExpectSolveWithinSigmas(&problem);
+  // The data decide: far below the lever arm's components (0.3 m and more).
+  EXPECT_LT(sigma.maxCoeff(), 0.01) << sigma.transpose();
 }
 
 }  // namespace
