@@ -9,6 +9,13 @@
 // jets: every block is perturbed as x [+] d with d = 0 carrying one derivative slot per tangent coordinate, and the
 // noise carries one slot per component, so one evaluation yields both Jacobians exactly.
 //
+// A model may also provide analytic Jacobians (STYLE.md: analytic where profiling says so, jets as the test oracle):
+//   bool Linearize(const double* const* x, double* error, double* const* jacobians, double* noise_jacobian) const;
+// with Factor::Evaluate's layout and zero noise. AutoDiffFactor then calls it whenever a Jacobian is requested; it
+// must fill exactly the requested blocks (a null jacobians[i] is skipped) and the same error as operator(). Models
+// with kAdditiveNoise may ignore noise_jacobian: AutoDiffFactor fills the identity. EvaluateWithAutoDiff keeps the
+// jet path available to the tests.
+//
 // A model looks like
 //   struct GpsError {
 //     using Blocks = std::tuple<PoseBlock, Vector3Block>;   // variables, in order
@@ -20,6 +27,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <memory>
 #include <tuple>
 #include <type_traits>
@@ -56,6 +64,16 @@ template <typename Model>
 struct AdditiveNoise<Model, std::void_t<decltype(Model::kAdditiveNoise)>>
     : std::integral_constant<bool, Model::kAdditiveNoise> {};
 
+// True when the model has the analytic hook `bool Linearize(x, error, jacobians, noise_jacobian) const`.
+template <typename Model>
+using LinearizeResult = decltype(std::declval<const Model&>().Linearize(
+    std::declval<const double* const*>(), std::declval<double*>(), std::declval<double* const*>(),
+    std::declval<double*>()));
+template <typename Model, typename = void>
+struct HasLinearize : std::false_type {};
+template <typename Model>
+struct HasLinearize<Model, std::void_t<LinearizeResult<Model>>> : std::is_same<LinearizeResult<Model>, bool> {};
+
 template <typename Tuple> struct BlockSizes;
 template <typename... B>
 struct BlockSizes<std::tuple<B...>> {
@@ -75,6 +93,7 @@ class AutoDiffFactor final : public Factor {
   // Derivative slots for the noise; none when the noise is additive (its Jacobian is the identity).
   static constexpr int kNoiseSlots = kAdditive ? 0 : Model::kNoiseDim;
   static constexpr int kSlots = internal::BlockSizes<Blocks>::kTangentSum + kNoiseSlots;
+  static constexpr bool kAnalytic = internal::HasLinearize<Model>::value;
 
   explicit AutoDiffFactor(Model model) : model_(std::move(model)) {
     FillManifolds(std::make_index_sequence<kBlockCount>());
@@ -92,6 +111,16 @@ class AutoDiffFactor final : public Factor {
       std::array<double, Model::kNoiseDim + 1> zero_noise{};
       return model_(values, zero_noise.data(), error) && AllFinite(error);
     }
+    if constexpr (kAnalytic) {
+      return EvaluateAnalytic(values, error, jacobians, noise_jacobian);
+    } else {
+      return EvaluateWithAutoDiff(values, error, jacobians, noise_jacobian);
+    }
+  }
+
+  // Evaluate through the jets, also for models with analytic Jacobians (their oracle in the tests).
+  bool EvaluateWithAutoDiff(const double* const* values, double* error, double* const* jacobians,
+                            double* noise_jacobian) const {
     // When no Jacobian of a non-pose block is asked for (parameters held fixed, as in tracking), smaller jets that
     // carry only the pose and noise slots do the same work.
     bool parameters_wanted = false;
@@ -103,6 +132,23 @@ class AutoDiffFactor final : public Factor {
 
  private:
   static constexpr int kPoseSlots = internal::BlockSizes<Blocks>::kPoseTangentSum + kNoiseSlots;
+
+  // The model's Linearize, the identity noise Jacobian of additive noise, and the finiteness check of the jet path
+  // (on what was requested).
+  bool EvaluateAnalytic(const double* const* values, double* error, double* const* jacobians,
+                        double* noise_jacobian) const {
+    if (!model_.Linearize(values, error, jacobians, noise_jacobian)) return false;
+    if (kAdditive && noise_jacobian != nullptr) {
+      for (int c = 0; c < Model::kNoiseDim; ++c)
+        for (int r = 0; r < Model::kResidualDim; ++r) noise_jacobian[c * Model::kResidualDim + r] = r == c ? 1.0 : 0.0;
+    }
+    if (!AllFinite(error)) return false;
+    for (int i = 0; i < kBlockCount && jacobians != nullptr; ++i) {
+      if (jacobians[i] != nullptr && !AllFinite(jacobians[i], Model::kResidualDim * manifolds_[i].tangent_dim()))
+        return false;
+    }
+    return noise_jacobian == nullptr || AllFinite(noise_jacobian, Model::kResidualDim * Model::kNoiseDim);
+  }
 
   // Every block with a slot range (all blocks, or poses only) is perturbed by a jet-valued zero tangent vector; the
   // others enter as constants. The noise always has slots, after the blocks'.
@@ -144,8 +190,8 @@ class AutoDiffFactor final : public Factor {
     return true;
   }
 
-  static bool AllFinite(const double* e) {
-    for (int r = 0; r < Model::kResidualDim; ++r)
+  static bool AllFinite(const double* e, int n = Model::kResidualDim) {
+    for (int r = 0; r < n; ++r)
       if (!std::isfinite(e[r])) return false;
     return true;
   }

@@ -35,6 +35,18 @@
 // is not part of eta.
 // Variables: poses at t0, t1, t2 (PoseBlock x3), q_body_sensor (QuaternionBlock), S^(O) (Vector3Block), bias
 // (Vector3Block), scale (Vector3Block).
+//
+// Jacobians (Linearize; internal/so3_jacobians.h for Jr^-1, Jl^-1 = (Jr^-1)^T). With f^(O) the specific force in O,
+// D = diag(k_s) R_S^T (so that de = D df^(O)), R1 = R(q1), h = (dt0 + dt1) / 2 and phi_ab = Log(qa^-1 qb):
+//   positions:  df/dp0 = R1^T / (dt0 h),  df/dp1 = -R1^T (1/dt0 + 1/dt1) / h,  df/dp2 = R1^T / (dt1 h)
+//   rotation vectors: dphi_ab/dtheta_a = -Jl^-1(phi_ab)  (Log(Exp(-d) Q)),  dphi_ab/dtheta_b = Jr^-1(phi_ab)
+//   (Log(Q Exp(d))), so with K_alpha = -[S]x / h (alpha x S = -[S]x alpha) and
+//   K_omega = -([omega x S]x + [omega]x [S]x) / (dt0 + dt1) (the differential of omega x (omega x S)):
+//   df/dtheta0 = K_alpha Jl^-1(phi01) / dt0 - K_omega Jl^-1(phi02)
+//   df/dtheta1 = [R1^T (f_rest^(W) + (V1 - V0) / h)]x - K_alpha (Jl^-1(phi12) / dt1 + Jr^-1(phi01) / dt0)
+//                (the first term: (R1 Exp(d))^T v = R1^T v + [R1^T v]x d, for gravity and a^(O))
+//   df/dtheta2 = K_alpha Jr^-1(phi12) / dt1 + K_omega Jr^-1(phi02)
+//   J_e_qS = diag(k_s) [f^(S)]x,  J_e_S = D ([alpha]x + [omega]x^2),  J_e_b = I,  J_e_ks = diag(f^(S)).
 #pragma once
 
 #include <tuple>
@@ -42,6 +54,7 @@
 #include <Eigen/Core>
 
 #include "estimator/geometry.h"
+#include "estimator/internal/so3_jacobians.h"
 #include "estimator/manifold.h"
 
 namespace roamlab::estimator {
@@ -96,6 +109,85 @@ class AccelerometerError {
 
     // Through the sensor model.
     e = scale.cwiseProduct(f_sensor) + bias + eta - z_mps2_.cast<T>();
+    return true;
+  }
+
+  // Analytic Jacobians (header comment), with Factor::Evaluate's layout and zero noise; fills only the requested
+  // blocks. J_e_eta = I is left to AutoDiffFactor.
+  bool Linearize(const double* const* x, double* error, double* const* jacobians, double* /*noise_jacobian*/) const {
+    const Pose<double> pose0 = PoseFromArray(x[0]);
+    const Pose<double> pose1 = PoseFromArray(x[1]);
+    const Pose<double> pose2 = PoseFromArray(x[2]);
+    const Quaternion<double> q_body_sensor = QuaternionFromArray(x[3]);
+    const Eigen::Map<const Eigen::Vector3d> p_body_sensor(x[4]);
+    const Eigen::Map<const Eigen::Vector3d> bias(x[5]);
+    const Eigen::Map<const Eigen::Vector3d> scale(x[6]);
+    Eigen::Map<Eigen::Vector3d> e(error);
+
+    // As operator(), keeping the rotation vectors.
+    const double dt0 = dt0_s_;
+    const double dt1 = dt1_s_;
+    const double half_span = (dt0 + dt1) * 0.5;
+    const Quaternion<double>& q0 = pose0.q_world_body;
+    const Quaternion<double>& q1 = pose1.q_world_body;
+    const Quaternion<double>& q2 = pose2.q_world_body;
+    const Eigen::Vector3d v01_world = (pose1.p_world_body - pose0.p_world_body) / dt0;
+    const Eigen::Vector3d v12_world = (pose2.p_world_body - pose1.p_world_body) / dt1;
+    const Eigen::Vector3d a_body = q1.conjugate() * ((v12_world - v01_world) / half_span);
+    const Eigen::Vector3d phi02 = QuaternionLog<double>(q0.conjugate() * q2);
+    const Eigen::Vector3d phi01 = QuaternionLog<double>(q0.conjugate() * q1);
+    const Eigen::Vector3d phi12 = QuaternionLog<double>(q1.conjugate() * q2);
+    const Eigen::Vector3d omega_body = phi02 / (dt0 + dt1);
+    const Eigen::Vector3d alpha_body = (phi12 / dt1 - phi01 / dt0) / half_span;
+    const Eigen::Vector3d g_body = q1.conjugate() * kSpecificForceAtRest_world;
+    const Eigen::Vector3d f_body = g_body + alpha_body.cross(p_body_sensor) + a_body +
+                                   omega_body.cross(omega_body.cross(p_body_sensor));
+    const Eigen::Vector3d f_sensor = q_body_sensor.conjugate() * f_body;
+    e = scale.cwiseProduct(f_sensor) + bias - z_mps2_;
+    if (jacobians == nullptr) return true;
+
+    const auto wanted = [&](int i) { return jacobians[i] != nullptr; };
+    const Eigen::Matrix3d R_body_sensor = q_body_sensor.toRotationMatrix();
+    const Eigen::Matrix3d D = scale.asDiagonal() * R_body_sensor.transpose();  // de = D df^(O)
+
+    // Poses: de/dp_i = D R1^T c_i, de/dtheta_i = D df/dtheta_i.
+    if (wanted(0) || wanted(1) || wanted(2)) {
+      const Eigen::Matrix3d D_R1T = D * q1.toRotationMatrix().transpose();
+      const Eigen::Matrix3d S_x = Skew<double>(p_body_sensor);
+      const Eigen::Matrix3d omega_x = Skew<double>(omega_body);
+      const Eigen::Matrix3d D_K_alpha = D * S_x * (-1.0 / half_span);
+      const Eigen::Matrix3d D_K_omega =
+          D * (Skew<double>(omega_body.cross(p_body_sensor)) + omega_x * S_x) * (-1.0 / (dt0 + dt1));
+      const auto J_e_pose = [&](int i) { return Eigen::Map<Eigen::Matrix<double, 3, 6>>(jacobians[i]); };
+      // Jr^-1 of the rotation vectors a pose touches (Jl^-1 is its transpose).
+      const bool need01 = wanted(0) || wanted(1), need02 = wanted(0) || wanted(2), need12 = wanted(1) || wanted(2);
+      const Eigen::Matrix3d jr_inv01 = need01 ? internal::InverseRightJacobianSO3(phi01) : Eigen::Matrix3d();
+      const Eigen::Matrix3d jr_inv02 = need02 ? internal::InverseRightJacobianSO3(phi02) : Eigen::Matrix3d();
+      const Eigen::Matrix3d jr_inv12 = need12 ? internal::InverseRightJacobianSO3(phi12) : Eigen::Matrix3d();
+      if (wanted(0)) {
+        J_e_pose(0).leftCols<3>() = D_R1T / (dt0 * half_span);
+        J_e_pose(0).rightCols<3>() =
+            D_K_alpha * jr_inv01.transpose() / dt0 - D_K_omega * jr_inv02.transpose();
+      }
+      if (wanted(1)) {
+        J_e_pose(1).leftCols<3>() = D_R1T * (-(1.0 / dt0 + 1.0 / dt1) / half_span);
+        J_e_pose(1).rightCols<3>() = D * Skew<double>(g_body + a_body) -
+                                     D_K_alpha * (jr_inv12.transpose() / dt1 + jr_inv01 / dt0);
+      }
+      if (wanted(2)) {
+        J_e_pose(2).leftCols<3>() = D_R1T / (dt1 * half_span);
+        J_e_pose(2).rightCols<3>() = D_K_alpha * jr_inv12 / dt1 + D_K_omega * jr_inv02;
+      }
+    }
+
+    // Calibration.
+    if (wanted(3)) Eigen::Map<Eigen::Matrix3d>{jacobians[3]} = scale.asDiagonal() * Skew<double>(f_sensor);
+    if (wanted(4)) {
+      Eigen::Map<Eigen::Matrix3d>{jacobians[4]} =
+          D * (Skew<double>(alpha_body) + Skew<double>(omega_body) * Skew<double>(omega_body));
+    }
+    if (wanted(5)) Eigen::Map<Eigen::Matrix3d>{jacobians[5]}.setIdentity();
+    if (wanted(6)) Eigen::Map<Eigen::Matrix3d>{jacobians[6]} = f_sensor.asDiagonal();
     return true;
   }
 

@@ -22,6 +22,17 @@
 // leaves them to the other sensors. Below kMinSteeringSpeed the steering angle does not affect the motion, so its
 // error is zero (eta only).
 // Variables: pose at t_k, pose at t_k+1 (PoseBlock), kv_over_L, k_theta, k_gamma (ScalarBlock each).
+//
+// Jacobians (Linearize; internal/so3_jacobians.h for Jr, Jr^-1, Jl^-1 = (Jr^-1)^T). VelocitiesBetween computes
+// phi = Log(q_k^-1 q_k+1), omega = phi / dt, q_mid = q_k Exp(phi / 2) and v = R_mid^T (p_k+1 - p_k) / dt, so
+//   dphi/dtheta_k = -Jl^-1(phi),  dphi/dtheta_k+1 = Jr^-1(phi),  dv/dp_k = -R_mid^T / dt = -dv/dp_k+1,
+//   dv/dtheta = [v]x eps/dtheta  ((R_mid Exp(eps))^T u = R_mid^T u + [R_mid^T u]x eps), where eps, the right
+//   perturbation of q_mid, is (q_k Exp(d) Exp(psi + dpsi) = q_mid Exp(R(psi)^T d) Exp(Jr(psi) dpsi), psi = phi / 2)
+//   eps/dtheta_k = R(phi/2)^T - Jr(phi/2) Jl^-1(phi) / 2,   eps/dtheta_k+1 = Jr(phi/2) Jr^-1(phi) / 2.
+// The rows: de_v = dv_x / k_v, de_theta = L (domega_z / v_x - omega_z dv_x / v_x^2) / ((1 + r^2) k_theta) with
+// r = L omega_z / v_x (zero below kMinSteeringSpeed), de_lat = dv_y, de_vert = dv_z; and
+// de_v/dkv_over_L = -v_x / (kv_over_L^2 L), de_theta/dk_theta = -(delta - k_gamma) / k_theta^2,
+// de_theta/dk_gamma = -1 / k_theta.
 #pragma once
 
 #include <cmath>
@@ -31,6 +42,7 @@
 
 #include "common/check.h"
 #include "estimator/geometry.h"
+#include "estimator/internal/so3_jacobians.h"
 #include "estimator/manifold.h"
 
 namespace roamlab::estimator {
@@ -66,6 +78,79 @@ class AckermannVelocityError {
     }
     error[2] = v_body.y() + noise[2];
     error[3] = v_body.z() + noise[3];
+    return true;
+  }
+
+  // Analytic Jacobians (header comment), with Factor::Evaluate's layout and zero noise; fills only the requested
+  // blocks. J_e_eta = I is left to AutoDiffFactor.
+  bool Linearize(const double* const* x, double* error, double* const* jacobians, double* /*noise_jacobian*/) const {
+    const Pose<double> pose_k = PoseFromArray(x[0]);
+    const Pose<double> pose_k1 = PoseFromArray(x[1]);
+    const double kv_over_l = x[2][0];
+    const double k_theta = x[3][0];
+    const double k_gamma = x[4][0];
+
+    // VelocitiesBetween, keeping the rotation vector and q_mid.
+    const Eigen::Vector3d phi = QuaternionLog<double>(pose_k.q_world_body.conjugate() * pose_k1.q_world_body);
+    const Eigen::Vector3d omega_body = phi / dt_s_;
+    const Quaternion<double> q_mid = pose_k.q_world_body * QuaternionExp<double>(phi * 0.5);
+    const Eigen::Vector3d v_body = q_mid.conjugate() * ((pose_k1.p_world_body - pose_k.p_world_body) / dt_s_);
+
+    // As operator().
+    const double k_v = kv_over_l * wheelbase_m_;
+    error[0] = v_body.x() / k_v - z_v_mps_;
+    const bool steering = std::abs(v_body.x()) >= kMinSteeringSpeed;
+    const double delta = steering ? std::atan(wheelbase_m_ * omega_body.z() / v_body.x()) : 0.0;
+    error[1] = steering ? (delta - k_gamma) / k_theta - z_theta_rad_ : 0.0;
+    error[2] = v_body.y();
+    error[3] = v_body.z();
+    if (jacobians == nullptr) return true;
+
+    // Rows of the residual in the motion (v, omega): de/dv (4x3) and de/domega_z (4x1, only the steering row).
+    Eigen::Matrix<double, 4, 3> J_e_v = Eigen::Matrix<double, 4, 3>::Zero();
+    Eigen::Vector4d J_e_omega_z = Eigen::Vector4d::Zero();
+    J_e_v(0, 0) = 1.0 / k_v;
+    J_e_v(2, 1) = 1.0;
+    J_e_v(3, 2) = 1.0;
+    if (steering) {
+      const double r = wheelbase_m_ * omega_body.z() / v_body.x();
+      const double d_e_r = 1.0 / ((1.0 + r * r) * k_theta);
+      J_e_v(1, 0) = -d_e_r * r / v_body.x();
+      J_e_omega_z[1] = d_e_r * wheelbase_m_ / v_body.x();
+    }
+
+    // Poses: [dp, dtheta] through v (R_mid, and q_mid's perturbation eps) and omega (phi / dt).
+    if (jacobians[0] != nullptr || jacobians[1] != nullptr) {
+      const Eigen::Matrix3d R_mid_T = q_mid.toRotationMatrix().transpose();
+      const Eigen::Matrix<double, 4, 3> J_e_eps = J_e_v * Skew<double>(v_body);  // de/deps
+      const Eigen::Matrix3d jr_inv = internal::InverseRightJacobianSO3(phi);
+      const Eigen::Matrix3d half_jr = 0.5 * internal::RightJacobianSO3(phi * 0.5);
+      const Eigen::Matrix<double, 4, 3> J_e_dp1 = J_e_v * R_mid_T / dt_s_;
+      if (jacobians[0] != nullptr) {
+        Eigen::Map<Eigen::Matrix<double, 4, 6>> J_e_pose_k(jacobians[0]);
+        const Eigen::Matrix3d eps_theta = QuaternionExp<double>(phi * -0.5).toRotationMatrix() -
+                                          half_jr * jr_inv.transpose();
+        J_e_pose_k.leftCols<3>() = -J_e_dp1;
+        J_e_pose_k.rightCols<3>() = J_e_eps * eps_theta - J_e_omega_z * (jr_inv.transpose().row(2) / dt_s_);
+      }
+      if (jacobians[1] != nullptr) {
+        Eigen::Map<Eigen::Matrix<double, 4, 6>> J_e_pose_k1(jacobians[1]);
+        J_e_pose_k1.leftCols<3>() = J_e_dp1;
+        J_e_pose_k1.rightCols<3>() = J_e_eps * (half_jr * jr_inv) + J_e_omega_z * (jr_inv.row(2) / dt_s_);
+      }
+    }
+
+    // Calibration scalars.
+    if (jacobians[2] != nullptr) {
+      Eigen::Map<Eigen::Vector4d>{jacobians[2]} << -v_body.x() / (kv_over_l * k_v), 0.0, 0.0, 0.0;
+    }
+    if (jacobians[3] != nullptr) {
+      Eigen::Map<Eigen::Vector4d>{jacobians[3]} << 0.0, steering ? -(delta - k_gamma) / (k_theta * k_theta) : 0.0,
+          0.0, 0.0;
+    }
+    if (jacobians[4] != nullptr) {
+      Eigen::Map<Eigen::Vector4d>{jacobians[4]} << 0.0, steering ? -1.0 / k_theta : 0.0, 0.0, 0.0;
+    }
     return true;
   }
 

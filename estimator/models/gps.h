@@ -7,6 +7,8 @@
 // GeographicLib::LocalCartesian, see enu.h). Calibration: S^(O) = lever arm of the antenna in O [m] ("lever_arm").
 // Noise: eta ~ N(0, sigma^2 I), sigma [m].
 // Variables: pose at the nearest time stamp (PoseBlock), lever arm (Vector3Block).
+// Jacobians (Linearize; R = R(q_O^W), pose tangent [dp (W), dtheta (O)]):
+//   J_e_p = I,   J_e_theta = -R [S^(O)]x   (R Exp(dtheta) S = R S - R [S]x dtheta),   J_e_S = R.
 #pragma once
 
 #include <tuple>
@@ -34,6 +36,25 @@ class GpsError {
     const Eigen::Map<const Vector3<T>> eta(noise);
     Eigen::Map<Vector3<T>> e(error);
     e = pose.p_world_body + pose.q_world_body * p_body_antenna + eta - z_world_.cast<T>();
+    return true;
+  }
+
+  // Analytic Jacobians (header comment), with Factor::Evaluate's layout and zero noise; fills only the requested
+  // blocks. J_e_eta = I is left to AutoDiffFactor.
+  bool Linearize(const double* const* x, double* error, double* const* jacobians, double* /*noise_jacobian*/) const {
+    const Pose<double> pose = PoseFromArray(x[0]);
+    const Eigen::Map<const Eigen::Vector3d> p_body_antenna(x[1]);
+    Eigen::Map<Eigen::Vector3d> e(error);
+    e = pose.p_world_body + pose.q_world_body * p_body_antenna - z_world_;
+    if (jacobians == nullptr) return true;
+
+    const Eigen::Matrix3d R = pose.q_world_body.toRotationMatrix();
+    if (jacobians[0] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, 3, 6>> J_e_pose(jacobians[0]);
+      J_e_pose.leftCols<3>().setIdentity();
+      J_e_pose.rightCols<3>() = -R * Skew<double>(p_body_antenna);
+    }
+    if (jacobians[1] != nullptr) Eigen::Map<Eigen::Matrix3d>{jacobians[1]} = R;
     return true;
   }
 

@@ -16,6 +16,16 @@
 // quaternion multiplies from the left; the seed keeps the vector part, which is half of it near the identity.
 // Variables: pose at t(k) (PoseBlock), pose at t(k+1) (PoseBlock), q_body_sensor (QuaternionBlock), bias
 // (Vector3Block), scale (Vector3Block).
+//
+// Jacobians (Linearize; internal/so3_jacobians.h for Jr, Jl^-1), with phi = omega_hat^(O) dt, R_k, R_k+1, R_hat the
+// rotation matrices of q_O^W(t), q_O^W(t+1), q_hat and E = q_hat (q_O^W(t+1))^-1 = Exp(e):
+//   pose k:    E' = q_k Exp(d) Exp(phi) q_k+1^-1 = Exp(R_k d) E            => J_e_theta_k = Jl^-1(e) R_k
+//   pose k+1:  E' = E q_k+1 Exp(-d) q_k+1^-1 = Exp(-R_hat d) E             => J_e_theta_k+1 = -Jl^-1(e) R_hat
+//   rate:      q_k Exp(phi + d) = q_hat Exp(Jr(phi) d)                     => M = d e / d omega^(O)
+//                                                                             = dt Jl^-1(e) R_hat Jr(phi)
+//   then, with omega^(O) = R_S (z - b - eta) ./ k_s:
+//   J_e_qS = -M R_S [omega^(S)]x,   J_e_b = J_e_eta = -M R_S diag(1 ./ k_s),   J_e_ks = -M R_S diag(omega^(S) ./ k_s),
+// and J_e_p = 0 for both positions.
 #pragma once
 
 #include <tuple>
@@ -23,6 +33,7 @@
 #include <Eigen/Core>
 
 #include "estimator/geometry.h"
+#include "estimator/internal/so3_jacobians.h"
 #include "estimator/manifold.h"
 
 namespace roamlab::estimator {
@@ -53,6 +64,55 @@ class GyroscopeError {
     // Integrate over dt (eq. 11) and compare with the orientation at t(k+1) (eq. 12).
     const Quaternion<T> q_hat = Phi<T>(pose_k.q_world_body, omega_body, T(dt_s_));
     e = QuaternionLog<T>(q_hat * pose_k1.q_world_body.conjugate());
+    return true;
+  }
+
+  // Analytic Jacobians (header comment), with Factor::Evaluate's layout and zero noise; fills only the requested
+  // blocks and, when noise_jacobian is not null, J_e_eta.
+  bool Linearize(const double* const* x, double* error, double* const* jacobians, double* noise_jacobian) const {
+    const Quaternion<double> q_k = QuaternionFromArray(x[0] + 3);
+    const Quaternion<double> q_k1 = QuaternionFromArray(x[1] + 3);
+    const Quaternion<double> q_body_sensor = QuaternionFromArray(x[2]);
+    const Eigen::Map<const Eigen::Vector3d> bias(x[3]);
+    const Eigen::Map<const Eigen::Vector3d> scale(x[4]);
+    Eigen::Map<Eigen::Vector3d> e(error);
+
+    // As operator().
+    const Eigen::Vector3d omega_sensor = (z_radps_ - bias).cwiseQuotient(scale);
+    const Eigen::Vector3d omega_body = q_body_sensor * omega_sensor;
+    const Eigen::Vector3d phi = omega_body * dt_s_;
+    const Quaternion<double> q_hat = q_k * QuaternionExp<double>(phi);
+    e = QuaternionLog<double>(q_hat * q_k1.conjugate());
+
+    const auto wanted = [&](int i) { return jacobians != nullptr && jacobians[i] != nullptr; };
+    const bool calibration_wanted = wanted(2) || wanted(3) || wanted(4) || noise_jacobian != nullptr;
+    if (!wanted(0) && !wanted(1) && !calibration_wanted) return true;
+
+    // Orientation blocks.
+    const Eigen::Matrix3d jl_inv_e = internal::InverseRightJacobianSO3(e).transpose();
+    const Eigen::Matrix3d R_hat = q_hat.toRotationMatrix();
+    if (wanted(0)) {
+      Eigen::Map<Eigen::Matrix<double, 3, 6>> J_e_pose_k(jacobians[0]);
+      J_e_pose_k.leftCols<3>().setZero();
+      J_e_pose_k.rightCols<3>() = jl_inv_e * q_k.toRotationMatrix();
+    }
+    if (wanted(1)) {
+      Eigen::Map<Eigen::Matrix<double, 3, 6>> J_e_pose_k1(jacobians[1]);
+      J_e_pose_k1.leftCols<3>().setZero();
+      J_e_pose_k1.rightCols<3>() = -jl_inv_e * R_hat;
+    }
+    if (!calibration_wanted) return true;
+
+    // Through the rate: J_e_omega_sensor = M R_S; bias and noise enter as -diag(1 ./ k_s), the scale as
+    // -diag(omega^(S) ./ k_s), the misalignment as -[omega^(S)]x.
+    const Eigen::Matrix3d J_e_omega_sensor =
+        (dt_s_ * jl_inv_e * R_hat * internal::RightJacobianSO3(phi)) * q_body_sensor.toRotationMatrix();
+    if (wanted(2)) Eigen::Map<Eigen::Matrix3d>{jacobians[2]} = -J_e_omega_sensor * Skew<double>(omega_sensor);
+    const Eigen::Matrix3d J_e_bias = -J_e_omega_sensor * scale.cwiseInverse().asDiagonal();
+    if (wanted(3)) Eigen::Map<Eigen::Matrix3d>{jacobians[3]} = J_e_bias;
+    if (wanted(4))
+      Eigen::Map<Eigen::Matrix3d>{jacobians[4]} = -J_e_omega_sensor * omega_sensor.cwiseQuotient(scale).asDiagonal();
+    if (noise_jacobian != nullptr) Eigen::Map<Eigen::Matrix3d>{noise_jacobian} = J_e_bias;
     return true;
   }
 

@@ -13,6 +13,10 @@
 // Noise: eta ~ N(0, sigma^2 I); J_e_eta = I.
 // Variables: pose at the nearest time stamp (PoseBlock; only the orientation is used), q_body_sensor
 // (QuaternionBlock), A (Matrix3Block), b (Vector3Block).
+// Jacobians (Linearize), with R = R(q_O^W), R_S = R(q_S^O) and h^(S) = (R R_S)^T h^(W); a right perturbation of
+// either rotation turns the field in S by [h^(S)]x d ((R Exp(d))^T v = R^T v + [R^T v]x d):
+//   J_e_theta = A [h^(S)]x R_S^T   (pose: dtheta in O, moved into S by R_S^T; J_e_p = 0),   J_e_qS = A [h^(S)]x,
+//   J_e_A = [h^(S)T 0 0; 0 h^(S)T 0; 0 0 h^(S)T]   (A row-major),   J_e_b = I.
 #pragma once
 
 #include <tuple>
@@ -47,6 +51,38 @@ class MagnetometerError {
     const Quaternion<T> q_world_sensor = pose.q_world_body * q_body_sensor;
     const Vector3<T> h_sensor = q_world_sensor.conjugate() * h_world_.cast<T>();
     e = A * h_sensor + b + eta - z_.cast<T>();
+    return true;
+  }
+
+  // Analytic Jacobians (header comment), with Factor::Evaluate's layout and zero noise; fills only the requested
+  // blocks. J_e_eta = I is left to AutoDiffFactor.
+  bool Linearize(const double* const* x, double* error, double* const* jacobians, double* /*noise_jacobian*/) const {
+    const Quaternion<double> q_world_body = QuaternionFromArray(x[0] + 3);
+    const Quaternion<double> q_body_sensor = QuaternionFromArray(x[1]);
+    const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> A(x[2]);
+    const Eigen::Map<const Eigen::Vector3d> b(x[3]);
+    Eigen::Map<Eigen::Vector3d> e(error);
+
+    // As operator().
+    const Quaternion<double> q_world_sensor = q_world_body * q_body_sensor;
+    const Eigen::Vector3d h_sensor = q_world_sensor.conjugate() * h_world_;
+    e = A * h_sensor + b - z_;
+    if (jacobians == nullptr) return true;
+
+    // d e / d(right perturbation of q_world_sensor) = A [h^(S)]x; the pose's dtheta enters as R_S^T dtheta.
+    const Eigen::Matrix3d J_e_qS = A * Skew<double>(h_sensor);
+    if (jacobians[0] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, 3, 6>> J_e_pose(jacobians[0]);
+      J_e_pose.leftCols<3>().setZero();
+      J_e_pose.rightCols<3>() = J_e_qS * q_body_sensor.toRotationMatrix().transpose();
+    }
+    if (jacobians[1] != nullptr) Eigen::Map<Eigen::Matrix3d>{jacobians[1]} = J_e_qS;
+    if (jacobians[2] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, 3, 9>> J_e_A(jacobians[2]);
+      J_e_A.setZero();
+      for (int i = 0; i < 3; ++i) J_e_A.block<1, 3>(i, 3 * i) = h_sensor.transpose();
+    }
+    if (jacobians[3] != nullptr) Eigen::Map<Eigen::Matrix3d>{jacobians[3]}.setIdentity();
     return true;
   }
 
