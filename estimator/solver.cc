@@ -53,7 +53,7 @@ double TangentNorm(const Graph& graph, const std::vector<VariableId>& order) {
 
 }  // namespace
 
-SolverSummary Solve(const SolverOptions& options, Graph* graph) {
+SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceRequest* covariance) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   const auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
@@ -165,6 +165,8 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph) {
       break;
     }
   }
+  if (covariance != nullptr && summary.usable())
+    covariance->computed = system.Covariance(covariance->variables, &covariance->covariance);
   summary.seconds = elapsed();
   return summary;
 }

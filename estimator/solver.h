@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "common/status.h"
+#include <Eigen/Core>
+
 #include "estimator/graph.h"
 
 namespace roamlab::estimator {
@@ -55,9 +57,18 @@ struct SolverSummary {
   bool usable() const { return termination != Termination::kFailure; }
 };
 
+// Marginal covariance of some free variables, computed by Solve from its last linearization (the point its last step
+// started from), with the factorization it already has: much cheaper than ComputeMarginalInformation afterwards.
+struct CovarianceRequest {
+  std::vector<VariableId> variables;
+  Eigen::MatrixXd covariance;  // tangent blocks of `variables`, in order
+  bool computed = false;
+};
+
 // Optimizes the free variables of `graph` in place. Variables are ordered poses first then the others, in id order;
-// CHOLMOD picks its own fill-reducing permutation on top.
-SolverSummary Solve(const SolverOptions& options, Graph* graph);
+// CHOLMOD picks its own fill-reducing permutation on top. When `covariance` is given, fills it (computed = false if the
+// Hessian is not positive definite).
+SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceRequest* covariance = nullptr);
 
 // The free variables of `graph` in the solver's order.
 std::vector<VariableId> FreeVariableOrder(const Graph& graph);

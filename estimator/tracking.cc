@@ -18,21 +18,27 @@ FactorId NextFactorId(const Graph& graph) {
   return graph.factors().empty() ? 0 : graph.factors().rbegin()->first + 1;
 }
 
-// The oldest pose's estimate and position covariance (marginal of the whole window).
-Status EmitOldest(ProblemBuilder* builder, TrackingResult* out) {
+// The oldest pose's estimate and position covariance (marginal of the whole window): from the last update's solve
+// when it computed it, otherwise from the window's Hessian now.
+Status EmitOldest(ProblemBuilder* builder, const CovarianceRequest* from_solve, TrackingResult* out) {
   const PoseNode& node = builder->poses().front();
   const Graph& graph = builder->graph();
   const Pose<double> p = PoseFromArray(graph.variable(node.id).value.data());
-  auto info = ComputeMarginalInformation(graph, {node.id});
-  if (!info.ok()) return info.status();
-  const Eigen::Matrix<double, 6, 6> cov = info.value().information.inverse();
+  Eigen::Matrix<double, 6, 6> cov;
+  if (from_solve != nullptr && from_solve->computed && from_solve->variables == std::vector<VariableId>{node.id}) {
+    cov = from_solve->covariance;
+  } else {
+    auto info = ComputeMarginalInformation(graph, {node.id});
+    if (!info.ok()) return info.status();
+    cov = info.value().information.inverse();
+  }
   out->trajectory.push_back({node.t, p.p_world_body, p.q_world_body});
   out->position_covariance.push_back(cov.topLeftCorner<3, 3>());
   return Status::Ok();
 }
 
-Status EmitAndMarginalizeOldest(ProblemBuilder* builder, TrackingResult* out) {
-  const Status emitted = EmitOldest(builder, out);
+Status EmitAndMarginalizeOldest(ProblemBuilder* builder, const CovarianceRequest* from_solve, TrackingResult* out) {
+  const Status emitted = EmitOldest(builder, from_solve, out);
   if (!emitted.ok()) return emitted;
   const PoseNode& node = builder->poses().front();
   std::vector<VariableId> leaving = {node.id};
@@ -77,6 +83,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
   double update_seconds = 0.0;
   int iterations = 0;
   FactorId first_new_factor = 0;
+  CovarianceRequest leaving;
   for (std::size_t i = 0; i < measurements.size(); ++i) {
     const MeasurementRef& m = measurements[i];
     builder.Add(m);
@@ -97,13 +104,17 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
       initialized = true;
     } else {
       // One update: Gauss-Newton on the window, gating of the measurements attached since the last update, and a
-      // re-solve if anything was gated.
+      // re-solve if anything was gated. The solve also gives the covariance of the pose about to leave the window.
       const auto t0 = Clock::now();
-      const SolverSummary s = Solve(update_options, &builder.graph());
+      leaving.variables.assign(1, builder.poses().front().id);
+      leaving.computed = false;
+      CovarianceRequest* request =
+          static_cast<int>(builder.poses().size()) > config.tracking.window ? &leaving : nullptr;
+      const SolverSummary s = Solve(update_options, &builder.graph(), request);
       if (!s.usable()) return Status::Error("update at t = " + FormatSeconds(m.t) + " failed: " + s.message);
       iterations += s.iterations;
       if (config.gate_probability && GateOutliers(*config.gate_probability, &builder, first_new_factor) > 0)
-        iterations += Solve(update_options, &builder.graph()).iterations;
+        iterations += Solve(update_options, &builder.graph(), request).iterations;
       const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
       ++out.updates;
       update_seconds += dt;
@@ -111,7 +122,8 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
     }
     first_new_factor = NextFactorId(builder.graph());
     while (static_cast<int>(builder.poses().size()) > config.tracking.window) {
-      const Status st = EmitAndMarginalizeOldest(&builder, &out);
+      const Status st = EmitAndMarginalizeOldest(&builder, &leaving, &out);
+      leaving.computed = false;
       if (!st.ok()) return st;
     }
     poses_before = builder.poses().size();
@@ -123,11 +135,11 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
   if (!s.usable()) return Status::Error("final window: " + s.message);
   while (!builder.poses().empty()) {
     if (builder.poses().size() == 1) {
-      const Status st = EmitOldest(&builder, &out);
+      const Status st = EmitOldest(&builder, nullptr, &out);
       if (!st.ok()) return st;
       break;
     }
-    const Status st = EmitAndMarginalizeOldest(&builder, &out);
+    const Status st = EmitAndMarginalizeOldest(&builder, nullptr, &out);
     if (!st.ok()) return st;
   }
   out.mean_update_s = out.updates > 0 ? update_seconds / out.updates : 0.0;

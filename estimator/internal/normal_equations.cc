@@ -15,6 +15,7 @@ struct NormalEquations::Cholmod {
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Upper> llt;
   Eigen::SparseMatrix<double> damped;
   bool analyzed = false;
+  bool factored_undamped = false;  // the factorization is of H itself, at the last linearization
 };
 
 NormalEquations::NormalEquations(const Graph& graph, std::vector<VariableId> order)
@@ -181,9 +182,37 @@ bool NormalEquations::Solve(double lambda, Eigen::VectorXd* dx) {
     c.analyzed = true;
   }
   c.llt.factorize(c.damped);
+  c.factored_undamped = lambda <= 0.0 && c.llt.info() == Eigen::Success;
   if (c.llt.info() != Eigen::Success) return false;
   *dx = c.llt.solve(-g_);
   return c.llt.info() == Eigen::Success && dx->allFinite();
+}
+
+bool NormalEquations::Covariance(const std::vector<VariableId>& variables, Eigen::MatrixXd* covariance) {
+  Cholmod& c = *cholmod_;
+  if (!c.factored_undamped) {
+    Eigen::VectorXd unused;
+    if (!Solve(0.0, &unused)) return false;
+  }
+  int cols = 0;
+  for (VariableId id : variables) cols += dims_[std::find(order_.begin(), order_.end(), id) - order_.begin()];
+  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(dimension_, cols);
+  std::vector<int> rows;
+  int col = 0;
+  for (VariableId id : variables) {
+    const int off = OffsetOf(id);
+    ROAMLAB_CHECK(off >= 0, "covariance of variable " << id << ", which is not free in this system");
+    const int dim = dims_[std::find(order_.begin(), order_.end(), id) - order_.begin()];
+    for (int k = 0; k < dim; ++k) {
+      E(off + k, col++) = 1.0;
+      rows.push_back(off + k);
+    }
+  }
+  const Eigen::MatrixXd X = c.llt.solve(E);
+  if (c.llt.info() != Eigen::Success || !X.allFinite()) return false;
+  covariance->resize(cols, cols);
+  for (int i = 0; i < cols; ++i) covariance->row(i) = X.row(rows[i]);
+  return true;
 }
 
 void NormalEquations::Update(const Eigen::VectorXd& dx, Graph* graph) const {

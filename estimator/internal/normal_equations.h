@@ -34,6 +34,11 @@ class NormalEquations {
   // Solves (H + lambda diag(H)) dx = -g. Returns false if the matrix is not positive definite.
   bool Solve(double lambda, Eigen::VectorXd* dx);
 
+  // Marginal covariance of the listed free variables (their tangent blocks, in order) from H of the last Linearize:
+  // solves H X = E for their columns, reusing the last factorization when it was undamped. Returns false when H is
+  // not positive definite.
+  bool Covariance(const std::vector<VariableId>& variables, Eigen::MatrixXd* covariance);
+
   // Applies x [+] dx to the free variables.
   void Update(const Eigen::VectorXd& dx, Graph* graph) const;
 
