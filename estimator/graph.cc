@@ -44,9 +44,7 @@ FactorId Graph::AddFactor(std::unique_ptr<Factor> factor, std::vector<VariableId
   entry.factor = std::move(factor);
   entry.variables = std::move(variables);
   if (factor_is_additive) {
-    const int n = static_cast<int>(noise_covariance.rows());
-    entry.noise_whitening =
-        Eigen::LLT<Eigen::MatrixXd>(noise_covariance).matrixL().solve(Eigen::MatrixXd::Identity(n, n));
+    entry.noise_sqrt_covariance = Eigen::LLT<Eigen::MatrixXd>(noise_covariance).matrixL();
   }
   entry.noise_covariance = std::move(noise_covariance);
   entry.loss = loss;

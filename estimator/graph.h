@@ -38,7 +38,7 @@ struct FactorEntry {
   std::unique_ptr<Factor> factor;
   std::vector<VariableId> variables;
   Eigen::MatrixXd noise_covariance;  // noise_dim x noise_dim, Sigma_eta
-  Eigen::MatrixXd noise_whitening;   // L^-1 with L L^T = Sigma_eta, for factors with additive noise
+  Eigen::MatrixXd noise_sqrt_covariance;  // L (lower) with L L^T = Sigma_eta, for factors with additive noise
   Loss loss;
   std::string stream;
   Time stamp;

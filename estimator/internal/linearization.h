@@ -15,7 +15,7 @@ namespace roamlab::estimator::internal {
 struct WhitenedFactor {
   Eigen::VectorXd residual;               // whitened and loss-weighted
   std::vector<Eigen::MatrixXd> jacobians; // per connected variable (tangent columns); empty matrix when not asked
-  Eigen::MatrixXd whitening;              // L^-1, residual_dim square (kept to evaluate costs at trial points)
+  Eigen::MatrixXd sqrt_covariance;        // L (lower) with L L^T = error covariance (kept to evaluate trial points)
   double squared_norm = 0.0;              // s = |L^-1 e|^2 before the loss
   double cost = 0.0;                      // rho(s) / 2
 };
@@ -25,8 +25,8 @@ struct WhitenedFactor {
 bool LinearizeFactor(const Graph& graph, const FactorEntry& entry, const std::vector<bool>& want_jacobian,
                      WhitenedFactor* out);
 
-// Cost rho(|W e(x)|^2)/2 of `entry` at the graph's current values with a given whitening W (from an earlier
-// linearization). Returns false if the error cannot be evaluated.
-bool FactorCost(const Graph& graph, const FactorEntry& entry, const Eigen::MatrixXd& whitening, double* cost);
+// Cost rho(|L^-1 e(x)|^2)/2 of `entry` at the graph's current values with the Cholesky factor L of an earlier
+// linearization's error covariance. Returns false if the error cannot be evaluated.
+bool FactorCost(const Graph& graph, const FactorEntry& entry, const Eigen::MatrixXd& sqrt_covariance, double* cost);
 
 }  // namespace roamlab::estimator::internal

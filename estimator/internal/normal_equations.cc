@@ -148,12 +148,13 @@ bool NormalEquations::Linearize(const Graph& graph, std::string* failed_stream) 
     for (int va : free_vars) {
       for (int vb : free_vars) {
         if (slots.var_offset[va] > slots.var_offset[vb]) continue;
-        const Eigen::MatrixXd block = wf.jacobians[va].transpose() * wf.jacobians[vb];
+        // The block sits in H's value array with the column length of its block column as outer stride.
         const std::ptrdiff_t start = slots.block[pair++];
         const int col0 = slots.var_offset[vb];
         const std::ptrdiff_t stride = outer[col0 + 1] - outer[col0];
-        for (int j = 0; j < block.cols(); ++j)
-          for (int i = 0; i < block.rows(); ++i) values[start + j * stride + i] += block(i, j);
+        Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> block(values + start, wf.jacobians[va].cols(),
+                                                                   wf.jacobians[vb].cols(), Eigen::OuterStride<>(stride));
+        block.noalias() += wf.jacobians[va].transpose() * wf.jacobians[vb];
       }
     }
   }
@@ -164,7 +165,7 @@ bool NormalEquations::CostWithLastWhitening(const Graph& graph, double* cost) co
   *cost = 0.0;
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
     double c = 0.0;
-    if (!FactorCost(graph, graph.factor(factor_ids_[k]), whitened_[k].whitening, &c)) return false;
+    if (!FactorCost(graph, graph.factor(factor_ids_[k]), whitened_[k].sqrt_covariance, &c)) return false;
     *cost += c;
   }
   return true;
