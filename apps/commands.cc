@@ -229,6 +229,7 @@ int RunTrack(const TrackArgs& args) {
                         {"updates", r.updates},
                         {"mean_update_s", r.mean_update_s},
                         {"max_update_s", r.max_update_s},
+                        {"p99_update_s", r.p99_update_s},
                         {"mean_iterations", r.mean_iterations},
                         {"seconds", r.total_seconds},
                         {"realtime_factor", r.total_seconds > 0 ? duration / r.total_seconds : 0.0},

@@ -84,6 +84,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
   int iterations = 0;
   FactorId first_new_factor = 0;
   CovarianceRequest leaving;
+  std::vector<double> update_times;
   for (std::size_t i = 0; i < measurements.size(); ++i) {
     const MeasurementRef& m = measurements[i];
     builder.Add(m);
@@ -118,6 +119,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
       const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
       ++out.updates;
       update_seconds += dt;
+      update_times.push_back(dt);
       out.max_update_s = std::max(out.max_update_s, dt);
     }
     first_new_factor = NextFactorId(builder.graph());
@@ -143,6 +145,11 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
     if (!st.ok()) return st;
   }
   out.mean_update_s = out.updates > 0 ? update_seconds / out.updates : 0.0;
+  if (!update_times.empty()) {
+    const std::size_t k = std::min(update_times.size() - 1, (update_times.size() * 99) / 100);
+    std::nth_element(update_times.begin(), update_times.begin() + k, update_times.end());
+    out.p99_update_s = update_times[k];
+  }
   out.mean_iterations = out.updates > 0 ? static_cast<double>(iterations) / out.updates : 0.0;
   out.counts = builder.counts();
   out.total_seconds = std::chrono::duration<double>(Clock::now() - start).count();

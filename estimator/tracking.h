@@ -31,6 +31,7 @@ struct TrackingResult {
   int updates = 0;
   double mean_update_s = 0.0;
   double max_update_s = 0.0;
+  double p99_update_s = 0.0;                          // 99th percentile of the update times
   double mean_iterations = 0.0;                      // Gauss-Newton iterations per update
   double total_seconds = 0.0;
   std::map<std::string, StreamCounts> counts;
