@@ -258,7 +258,7 @@ class Parser {
   EstimatorConfig Parse(const YAML::Node& root) const {
     EstimatorConfig c;
     c.source_file = file_;
-    CheckKeys(root, {"master", "solver", "gating", "tracking", "streams", "stages"}, "the configuration");
+    CheckKeys(root, {"master", "solver", "gating", "tracking", "parameters", "streams", "stages"}, "the configuration");
     if (!root["master"]) Fail(root, "missing key 'master'");
     if (!root["streams"]) Fail(root, "missing key 'streams'");
     c.master = String(root["master"], "master");
@@ -270,10 +270,22 @@ class Parser {
       if (!(p > 0.0 && p < 1.0)) Fail(root["gating"], "gating.probability must be in (0, 1)");
       c.gate_probability = p;
     }
-    for (const auto& kv : root["streams"]) c.streams[kv.first.as<std::string>()] = ParseStream(kv.first.as<std::string>(), kv.second);
+    if (!root["streams"].IsMap()) Fail(root["streams"], "streams must be a mapping");
+    for (const auto& kv : root["streams"]) {
+      const std::string name = kv.first.as<std::string>();
+      c.streams[name] = ParseStream(name, kv.second);
+    }
     if (c.streams.count(c.master) == 0) Fail(root["master"], "master stream '" + c.master + "' is not in streams");
     if (!FindModelSpec(c.streams[c.master].model)->odometric)
-      Fail(root["master"], "master stream '" + c.master + "' must use an odometric model (ackermann, ackermann_seed or odometer)");
+      Fail(root["master"], "master stream '" + c.master +
+                               "' must use an odometric model (ackermann, ackermann_seed or odometer)");
+    if (root["parameters"]) {
+      if (!root["parameters"].IsMap()) Fail(root["parameters"], "parameters must be a mapping");
+      for (const auto& kv : root["parameters"]) {
+        const std::string name = kv.first.as<std::string>();
+        c.parameters[name] = ParseParameter(name, kv.second);
+      }
+    }
     if (root["stages"]) {
       for (const auto& stage : root["stages"]) {
         std::vector<std::string> names;
@@ -282,13 +294,6 @@ class Parser {
       }
     }
     return c;
-  }
-
-  void ParseParameters(const YAML::Node& root, EstimatorConfig* c) const {
-    if (!root["parameters"]) return;
-    if (!root["parameters"].IsMap()) Fail(root["parameters"], "parameters must be a mapping");
-    for (const auto& kv : root["parameters"])
-      c->parameters[kv.first.as<std::string>()] = ParseParameter(kv.first.as<std::string>(), kv.second);
   }
 
  private:
@@ -302,11 +307,7 @@ Result<EstimatorConfig> ParseEstimatorConfig(const std::string& yaml_text, const
     const YAML::Node root = YAML::Load(yaml_text);
     Parser parser(source_name);
     if (!root.IsMap()) return Status::Error(source_name + ": the configuration must be a YAML mapping");
-    YAML::Node copy = YAML::Clone(root);
-    copy.remove("parameters");
-    EstimatorConfig config = parser.Parse(copy);
-    parser.ParseParameters(root, &config);
-    return config;
+    return parser.Parse(root);
   } catch (const ConfigError& e) {
     return Status::Error(e.what());
   } catch (const YAML::Exception& e) {

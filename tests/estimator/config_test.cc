@@ -32,6 +32,8 @@ TEST(ConfigTest, ParsesTheAtvConfiguration) {
 TEST(ConfigTest, RejectsUnknownKeysModelsAndMissingNoise) {
   const std::string good = testing::AtvConfigYaml({});
   ExpectError(Replace(good, "master: odometer", "master: odometer\nwindow: 3"), "unknown key 'window'");
+  // Errors carry the line: the stray key is on line 2.
+  ExpectError(Replace(good, "master: odometer", "master: odometer\nwindow: 3"), "est.yaml:2:");
   ExpectError(Replace(good, "model: gps", "model: galileo"), "unknown model 'galileo'");
   ExpectError(Replace(good, "noise: {sigma_m: 0.33}", "noise: {sigma: 0.33}"), "unknown key 'sigma'");
   ExpectError(Replace(good, "noise: {sigma_m: 0.33}", "noise: {}"), "noise needs 'sigma_m'");
