@@ -32,7 +32,7 @@ const std::vector<ModelSpec>& ModelSpecs() {
        {"speed", "steering"},
        {"speed_mps", "steering_rad", "lateral_mps", "vertical_mps"},
        {ScalarSlot("kv_over_L", std::numeric_limits<double>::quiet_NaN()), ScalarSlot("k_theta", 1.0),
-        ScalarSlot("k_gamma", 0.0)},
+        ScalarSlot("k_gamma", 0.0), ScalarSlot("cornering_front", 0.0), ScalarSlot("cornering_rear", 0.0)},
        {"wheelbase_m", "speed_column"},
        true},
       {"ackermann_seed",

@@ -441,12 +441,13 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
   if (model == "ackermann" || model == "ackermann_seed") {
     const double z_v = row[s.column];
     const double z_theta = SteeringAt(*s.steering, m.t);
+    vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k)};
     if (model == "ackermann") {
       factor = MakeFactor(AckermannVelocityError(z_v, z_theta, s.wheelbase_m, dt));
+      vars.insert(vars.end(), {slot(3, k), slot(4, k)});
     } else {
       factor = MakeFactor(AckermannOdometerError(z_v, z_theta, s.wheelbase_m, dt));
     }
-    vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k)};
   } else if (model == "odometer") {
     factor = MakeFactor(OdometerError(row.head<6>().transpose(), dt));
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k)};

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <tuple>
 #include <random>
 #include <string>
 #include <utility>
@@ -206,14 +207,23 @@ SmallProblem AckermannProblem(bool noisy, std::uint32_t seed) {
   AddFreeParameter("kv_over_L", Manifold::Euclidean(1), scalar(1.0 / kWheelbaseM), scalar(kv_over_l), &problem);
   AddFreeParameter("k_theta", Manifold::Euclidean(1), scalar(1.0), scalar(k_theta), &problem);
   AddFreeParameter("k_gamma", Manifold::Euclidean(1), scalar(0.0), scalar(k_gamma), &problem);
+  // The measurement form's cornering compliances, held at zero: the drive does not slip, and at its constant speed
+  // the understeer c_front v^2 tan(delta) / L would be indistinguishable from k_theta.
+  constexpr bool kCornering = std::tuple_size_v<typename Model::Blocks> == 7;
+  std::vector<VariableId> compliances;
+  if constexpr (kCornering) {
+    for (const char* name : {"cornering_front", "cornering_rear"})
+      compliances.push_back(problem.graph.AddVariable({name, Manifold::Euclidean(1), scalar(0.0), true, std::nullopt}));
+  }
   for (std::size_t k = 0; k < drive.speed_mps.size(); ++k) {
     const Eigen::VectorXd noise = GaussianNoise(2, NoiseSigma(noisy, 1.0), &rng).cwiseProduct(sigma.head<2>());
     const double z_v = drive.speed_mps[k] / (kv_over_l * kWheelbaseM) + noise[0];
     const double z_theta = (drive.steering_rad[k] - k_gamma) / k_theta + noise[1];
     const std::vector<VariableId>& p = problem.parameters;
-    problem.graph.AddFactor(MakeFactor(Model(z_v, z_theta, kWheelbaseM, drive.motion.dt_s)),
-                            {problem.poses[k], problem.poses[k + 1], p[0], p[1], p[2]}, covariance, Loss::Trivial(),
-                            "odometer", Time::FromNanoseconds(static_cast<std::int64_t>(k)));
+    std::vector<VariableId> variables = {problem.poses[k], problem.poses[k + 1], p[0], p[1], p[2]};
+    variables.insert(variables.end(), compliances.begin(), compliances.end());
+    problem.graph.AddFactor(MakeFactor(Model(z_v, z_theta, kWheelbaseM, drive.motion.dt_s)), variables, covariance,
+                            Loss::Trivial(), "odometer", Time::FromNanoseconds(static_cast<std::int64_t>(k)));
   }
   return problem;
 }

@@ -13,10 +13,12 @@ namespace {
 
 constexpr double kL = 1.25;
 
-// Pose after dt on a planar arc at speed v and yaw rate omega, from pose0 (eq. 7 is exact for a constant twist only
-// up to the chord; VelocitiesBetween inverts eq. 7 exactly, so build pose1 with PredictPose).
-Eigen::VectorXd Step(const Eigen::VectorXd& pose0, double v, double omega, double dt) {
-  const Pose<double> p1 = PredictPose<double>(PoseFromArray(pose0.data()), Eigen::Vector3d(v, 0, 0),
+Eigen::VectorXd Scalar(double x) { return Eigen::VectorXd::Constant(1, x); }
+
+// Pose after dt on a planar arc at forward speed v, side slip v_y and yaw rate omega, from pose0 (eq. 7 is exact for
+// a constant twist only up to the chord; VelocitiesBetween inverts eq. 7 exactly, so build pose1 with PredictPose).
+Eigen::VectorXd Step(const Eigen::VectorXd& pose0, double v, double omega, double dt, double v_y = 0.0) {
+  const Pose<double> p1 = PredictPose<double>(PoseFromArray(pose0.data()), Eigen::Vector3d(v, v_y, 0),
                                               Eigen::Vector3d(0, 0, omega), dt);
   Eigen::VectorXd out(7);
   PoseToArray(p1, out.data());
@@ -33,9 +35,8 @@ TEST(AckermannVelocityErrorTest, ZeroAtTruthForTableIAndSkewedGains) {
     const double z_v = v / (kv_over_l * kL);
     const double z_theta = (delta - k_gamma) / k_theta;
     const auto factor = MakeFactor(AckermannVelocityError(z_v, z_theta, kL, dt));
-    const auto lin = testing::Evaluate(*factor, {pose0, Step(pose0, v, omega, dt), Eigen::VectorXd::Constant(1, kv_over_l),
-                                                 Eigen::VectorXd::Constant(1, k_theta),
-                                                 Eigen::VectorXd::Constant(1, k_gamma)});
+    const auto lin = testing::Evaluate(*factor, {pose0, Step(pose0, v, omega, dt), Scalar(kv_over_l), Scalar(k_theta),
+                                                 Scalar(k_gamma), Scalar(0.0), Scalar(0.0)});
     EXPECT_LT(lin.error.norm(), 1e-10);
     EXPECT_TRUE(lin.noise_jacobian.isApprox(Eigen::MatrixXd::Identity(4, 4)));
   }
@@ -45,17 +46,36 @@ TEST(AckermannVelocityErrorTest, SpeedErrorScalesWithGain) {
   // 10% too large a gain predicts a reading 1/1.1 of the one taken.
   const Eigen::VectorXd pose0 = Manifold::Pose().Identity();
   const auto factor = MakeFactor(AckermannVelocityError(4.0 / kL / 0.8, 0.0, kL, 0.01));
-  const auto lin = testing::Evaluate(*factor, {pose0, Step(pose0, 4.0, 0.0, 0.01), Eigen::VectorXd::Constant(1, 0.88),
-                                               Eigen::VectorXd::Constant(1, 1.0), Eigen::VectorXd::Constant(1, 0.0)});
+  const auto lin = testing::Evaluate(*factor, {pose0, Step(pose0, 4.0, 0.0, 0.01), Scalar(0.88), Scalar(1.0),
+                                               Scalar(0.0), Scalar(0.0), Scalar(0.0)});
   EXPECT_NEAR(lin.error[0], 4.0 / kL / 0.88 - 4.0 / kL / 0.8, 1e-12);
 }
 
 TEST(AckermannVelocityErrorTest, SteeringIgnoredAtStandstill) {
   const Eigen::VectorXd pose0 = Manifold::Pose().Identity();
   const auto factor = MakeFactor(AckermannVelocityError(0.0, 0.3, kL, 0.01));
-  const auto lin = testing::Evaluate(*factor, {pose0, pose0, Eigen::VectorXd::Constant(1, 0.8),
-                                               Eigen::VectorXd::Constant(1, 1.0), Eigen::VectorXd::Constant(1, 0.0)});
+  const auto lin = testing::Evaluate(*factor, {pose0, pose0, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
+                                               Scalar(0.0)});
   EXPECT_LT(lin.error.norm(), 1e-12);
+}
+
+TEST(AckermannVelocityErrorTest, CorneringComplianceExplainsSideSlipAndUndersteer) {
+  // A left turn at 4 m/s with a_y = 2 m/s^2: the rear axle drifts outwards (v_y = -c_rear a_y) and the front wheels
+  // are steered c_front a_y further than the front axle's velocity direction, atan((L omega + v_y) / v).
+  const double v = 4.0, omega = 0.5, dt = 0.01, c_front = 0.004, c_rear = 0.015;
+  const double a_y = v * omega, v_y = -c_rear * a_y;
+  const double delta = std::atan((kL * omega + v_y) / v) + c_front * a_y;
+  const Eigen::VectorXd pose0 = Manifold::Pose().Identity();
+  const Eigen::VectorXd pose1 = Step(pose0, v, omega, dt, v_y);
+  const auto factor = MakeFactor(AckermannVelocityError(v / kL / 0.8, delta, kL, dt));
+  const auto lin = testing::Evaluate(*factor, {pose0, pose1, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(c_front),
+                                               Scalar(c_rear)});
+  EXPECT_LT(lin.error.norm(), 1e-10) << lin.error.transpose();
+  // Without the compliances the same motion leaves the side slip and the understeer as errors.
+  const auto rigid = testing::Evaluate(*factor, {pose0, pose1, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
+                                                 Scalar(0.0)});
+  EXPECT_NEAR(rigid.error[1], -c_front * a_y, 1e-9);
+  EXPECT_NEAR(rigid.error[2], v_y, 1e-9);
 }
 
 TEST(AckermannVelocityErrorTest, JacobiansMatchCentralDifferences) {
@@ -65,9 +85,7 @@ TEST(AckermannVelocityErrorTest, JacobiansMatchCentralDifferences) {
     const Eigen::VectorXd pose1 = testing::Perturb(Manifold::Pose(), Step(pose0, 3.0 + trial, 0.2, 0.02), 0.002, &rng);
     const auto factor = MakeFactor(AckermannVelocityError(4.0, 0.1, kL, 0.02));
     testing::ExpectJacobiansMatchNumeric(
-        *factor, {pose0, pose1, Eigen::VectorXd::Constant(1, 0.78), Eigen::VectorXd::Constant(1, 1.02),
-                  Eigen::VectorXd::Constant(1, 0.01)},
-        1e-5);
+        *factor, {pose0, pose1, Scalar(0.78), Scalar(1.02), Scalar(0.01), Scalar(0.004), Scalar(-0.015)}, 1e-5);
   }
 }
 
