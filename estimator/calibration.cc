@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <set>
+#include <sstream>
 
 #include "common/chi_square.h"
 #include "estimator/geometry.h"
@@ -65,6 +66,12 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
   builder.Finish();
   if (builder.poses().size() < 3) return Status::Error("the recording gives fewer than 3 poses on the master stream");
   builder.AlignToAbsoluteFixes();
+  if (const auto q = builder.AlignImuToMotion()) {
+    std::ostringstream line;
+    line << "initial IMU misalignment from the motion (Wahba): [" << q->w() << ", " << q->x() << ", " << q->y() << ", "
+         << q->z() << "]";
+    say(line.str());
+  }
   say("graph: " + std::to_string(builder.poses().size()) + " poses, " +
       std::to_string(builder.graph().factors().size()) + " factors");
 

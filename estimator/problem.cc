@@ -542,4 +542,75 @@ void ProblemBuilder::AlignToAbsoluteFixes() {
   }
 }
 
+namespace {
+
+// Row of the sample of `stream` nearest to t (stream.t is strictly increasing and not empty).
+std::size_t NearestRow(const recording::Stream& stream, Time t) {
+  const auto it = std::lower_bound(stream.t.begin(), stream.t.end(), t);
+  if (it == stream.t.begin()) return 0;
+  if (it == stream.t.end()) return stream.t.size() - 1;
+  const std::size_t i = static_cast<std::size_t>(it - stream.t.begin());
+  return SecondsBetween(t, *it) < SecondsBetween(stream.t[i - 1], t) ? i : i - 1;
+}
+
+}  // namespace
+
+// The dead-reckoned poses know the body's motion in the plane: from three consecutive poses, the body-frame angular
+// velocity omega^(O) and specific force f^(O) = R^T (a + g e_z) (eqs. 13-14 without lever arm; the poses are level,
+// so hills show up as unexplained gravity components, averaging out over a drive). The IMU reads the same vectors in
+// its own frame: omega^(S) = R_OS^T omega^(O), f^(S) = R_OS^T f^(O). Wahba's problem, max over R of
+// sum_i w_i u_i^(O) . R u_i^(S), is solved by the SVD of B = sum_i w_i u_i^(O) u_i^(S)T: R = U diag(1, 1, d) V^T.
+// Gravity fixes the body's z axis in the IMU frame; forward acceleration and the centripetal acceleration of turns
+// both ways fix the rotation about it. Each pair is weighted by the inverse of its reading noise variance.
+std::optional<Eigen::Quaterniond> ProblemBuilder::AlignImuToMotion() {
+  Impl& im = *impl_;
+  const StreamBinding* gyro = nullptr;
+  const StreamBinding* accel = nullptr;
+  for (const StreamBinding& s : im.streams) {
+    if (s.config.model == "gyroscope" && gyro == nullptr) gyro = &s;
+    if (s.config.model == "accelerometer" && accel == nullptr) accel = &s;
+  }
+  if (gyro == nullptr || accel == nullptr || gyro->slot_parameters[0] != accel->slot_parameters[0]) return std::nullopt;
+  const std::string& name = gyro->slot_parameters[0];
+  const auto config = im.parameter_config.find(name);
+  if (config == im.parameter_config.end() || !config->second.free || IsTimeVarying(name)) return std::nullopt;
+  if (poses_.size() < 3) return std::nullopt;
+
+  const double gyro_weight = 1.0 / gyro->noise_covariance(0, 0);
+  const double accel_weight = 1.0 / accel->noise_covariance(0, 0);
+  const Eigen::Vector3d g_world(0.0, 0.0, kStandardGravity);
+  Eigen::Matrix3d B = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d horizontal = Eigen::Matrix3d::Zero();  // spread of the body-frame specific force off its mean axis
+  for (std::size_t k = 1; k + 1 < poses_.size(); ++k) {
+    const Pose<double> a = PoseFromArray(graph_.variable(poses_[k - 1].id).value.data());
+    const Pose<double> b = PoseFromArray(graph_.variable(poses_[k].id).value.data());
+    const Pose<double> c = PoseFromArray(graph_.variable(poses_[k + 1].id).value.data());
+    const double dt_ab = SecondsBetween(poses_[k - 1].t, poses_[k].t);
+    const double dt_bc = SecondsBetween(poses_[k].t, poses_[k + 1].t);
+    const Eigen::Vector3d accel_world = 2.0 *
+        ((c.p_world_body - b.p_world_body) / dt_bc - (b.p_world_body - a.p_world_body) / dt_ab) / (dt_ab + dt_bc);
+    const Eigen::Matrix3d R_T = b.q_world_body.toRotationMatrix().transpose();
+    const Eigen::Vector3d f_body = R_T * (accel_world + g_world);
+    const Eigen::Vector3d omega_body =
+        QuaternionLog<double>(a.q_world_body.conjugate() * c.q_world_body) / (dt_ab + dt_bc);
+    const Eigen::RowVectorXd w_row = gyro->primary->values.row(NearestRow(*gyro->primary, poses_[k].t));
+    const Eigen::RowVectorXd f_row = accel->primary->values.row(NearestRow(*accel->primary, poses_[k].t));
+    const Eigen::Vector3d omega_imu = w_row.segment<3>(gyro->column).transpose();
+    const Eigen::Vector3d f_imu = f_row.segment<3>(accel->column).transpose();
+    B += gyro_weight * omega_body * omega_imu.transpose() + accel_weight * f_body * f_imu.transpose();
+    const Eigen::Vector2d f_xy = f_body.head<2>();
+    horizontal.topLeftCorner<2, 2>() += f_xy * f_xy.transpose();
+  }
+  // Two axes are needed: gravity, and some horizontal acceleration (forward or sideways) in the body frame.
+  const double samples = static_cast<double>(poses_.size() - 2);
+  if (horizontal.trace() / samples < 0.05 * 0.05) return std::nullopt;  // under 0.05 m/s^2 rms
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(B, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
+  D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
+  const Eigen::Quaterniond q_body_imu(svd.matrixU() * D * svd.matrixV().transpose());
+  Eigen::VectorXd& value = graph_.mutable_variable(parameters_.at(name)).value;
+  value << q_body_imu.w(), q_body_imu.x(), q_body_imu.y(), q_body_imu.z();
+  return q_body_imu.normalized();
+}
+
 }  // namespace roamlab::estimator

@@ -94,6 +94,12 @@ class ProblemBuilder {
   // fit the absolute fixes: the initial guess for a dead-reckoned trajectory.
   void AlignToAbsoluteFixes();
 
+  // The initial guess of an IMU misalignment q_body_imu that is free and shared by a gyroscope and an accelerometer
+  // stream, from the motion of the (dead-reckoned, aligned) poses: Wahba's problem on body-frame vectors paired with
+  // the IMU's readings. Call after Finish() and AlignToAbsoluteFixes(). Writes the value into the parameter and
+  // returns it; std::nullopt (nothing changed) when no such parameter exists or the motion does not excite two axes.
+  std::optional<Eigen::Quaterniond> AlignImuToMotion();
+
  private:
   struct Impl;
   explicit ProblemBuilder(std::unique_ptr<Impl> impl);
