@@ -228,8 +228,6 @@ class Simulator::Impl {
       scan_stream_.info.rate_hz = sensors.laser->rate_hz;
       scan_stream_.info.columns = recording::FixedColumns(StreamType::kScanMatching);
       scan_stream_.info.units = "m/s,rad/s";
-      laser_mounting_ = SiteInOdom(wheeled_.laser_site());
-      scan_stream_.info.mounting = laser_mounting_;
     }
     if (sensors.odometer) {
       wheel_stream_ = MakeStream("rear_wheel", StreamType::kWheelEncoders, sensors.odometer->rate_hz, {"rear"}, "m/s",
@@ -249,6 +247,10 @@ class Simulator::Impl {
     } else {
       wheeled_.Place(model_.get(), data_.get(), scenario_.robot.start_position_m.x(),
                      scenario_.robot.start_position_m.y(), scenario_.robot.start_heading_rad, kPlacementClearanceM);
+      if (scenario_.sensors.laser) {
+        laser_mounting_ = SiteInOdom(wheeled_.laser_site());
+        scan_stream_.info.mounting = laser_mounting_;
+      }
     }
     return Status::Ok();
   }
