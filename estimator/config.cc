@@ -45,7 +45,7 @@ const std::vector<ModelSpec>& ModelSpecs() {
       // Wheel radii and baseline default to NaN: the builder takes them from the recording's platform geometry.
       {"differential_drive",
        {""},
-       {"wheel_radps", "lateral_mps", "vertical_mps"},
+       {"wheel_radps", "lateral_mps", "vertical_mps", "tilt_radps"},
        {ScalarSlot("radius_left", std::numeric_limits<double>::quiet_NaN()),
         ScalarSlot("radius_right", std::numeric_limits<double>::quiet_NaN()),
         ScalarSlot("baseline", std::numeric_limits<double>::quiet_NaN())},
@@ -287,7 +287,8 @@ class Parser {
     if (c.streams.count(c.master) == 0) Fail(root["master"], "master stream '" + c.master + "' is not in streams");
     if (!FindModelSpec(c.streams[c.master].model)->odometric)
       Fail(root["master"], "master stream '" + c.master +
-                               "' must use an odometric model (ackermann, ackermann_seed, differential_drive or odometer)");
+                               "' must use an odometric model (ackermann, ackermann_seed, differential_drive or "
+                               "odometer)");
     if (root["parameters"]) {
       if (!root["parameters"].IsMap()) Fail(root["parameters"], "parameters must be a mapping");
       for (const auto& kv : root["parameters"]) {

@@ -95,8 +95,9 @@ Eigen::MatrixXd NoiseCovariance(const StreamBinding& s) {
     sigma.resize(6);
     sigma << Eigen::Vector3d::Constant(n.at("linear_mps")), Eigen::Vector3d::Constant(n.at("angular_radps"));
   } else if (m == "differential_drive") {
-    sigma.resize(4);
-    sigma << n.at("wheel_radps"), n.at("wheel_radps"), n.at("lateral_mps"), n.at("vertical_mps");
+    sigma.resize(6);
+    sigma << n.at("wheel_radps"), n.at("wheel_radps"), n.at("lateral_mps"), n.at("vertical_mps"), n.at("tilt_radps"),
+        n.at("tilt_radps");
   } else if (m == "absolute_pose") {
     sigma.resize(6);
     sigma << Eigen::Vector3d::Constant(n.at("position_m")), Eigen::Vector3d::Constant(n.at("orientation_rad"));
@@ -274,8 +275,8 @@ int ProblemBuilder::ResidualDim(const std::string& stream) const {
   for (const StreamBinding& s : impl_->streams)
     if (s.name == stream) {
       const std::string& m = s.config.model;
-      if (m == "ackermann" || m == "differential_drive") return 4;
-      return (m == "ackermann_seed" || m == "odometer" || m == "absolute_pose") ? 6 : 3;
+      if (m == "ackermann") return 4;
+      return (m == "ackermann_seed" || m == "odometer" || m == "absolute_pose" || m == "differential_drive") ? 6 : 3;
     }
   return 0;
 }

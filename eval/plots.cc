@@ -213,7 +213,8 @@ Result<PlotFiles> WriteVelocityPlot(const std::string& directory, const std::str
                 "velocity plot: sizes differ");
   PlotFiles files{"velocity.gp",
                   "velocity.png",
-                  {"velocity_fused.dat", "velocity_encoders.dat", "velocity_rpe_fused.dat", "velocity_rpe_encoders.dat"}};
+                  {"velocity_fused.dat", "velocity_encoders.dat", "velocity_rpe_fused.dat",
+                   "velocity_rpe_encoders.dat"}};
   std::ostringstream fused, encoders, rpe_fused, rpe_encoders;
   fused << "# t_s true_vx_mps true_wz_radps fused_vx_mps fused_wz_radps\n";
   for (std::size_t i = 0; i < d.fused_t_s.size(); ++i)

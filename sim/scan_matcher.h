@@ -46,7 +46,8 @@ struct ScanMatcherOptions {
 
 struct ScanMatch {
   bool ok = false;                                              // converged with enough correspondences
-  Eigen::Vector3d pose = Eigen::Vector3d::Zero();               // (t_x [m], t_y [m], theta [rad]) of current in reference
+  Eigen::Vector3d pose = Eigen::Vector3d::Zero();               // (t_x [m], t_y [m], theta [rad]): current in
+                                                                // the reference frame
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();     // of pose
   int correspondences = 0;
   double rms_m = 0.0;                                           // point-to-line residual at the solution

@@ -420,7 +420,8 @@ std::optional<Scenario::Problem> Scenario::Validate() const {
   if (const auto& laser = sensors.laser) {
     if (!Positive(laser->rate_hz)) return P{"sensors.laser.rate_hz", "must be > 0"};
     if (laser->beams < 10 || laser->beams > 10000) return P{"sensors.laser.beams", "must be in [10, 10000]"};
-    if (!(Positive(laser->fov_deg) && laser->fov_deg <= 360.0)) return P{"sensors.laser.fov_deg", "must be in (0, 360]"};
+    if (!(Positive(laser->fov_deg) && laser->fov_deg <= 360.0))
+      return P{"sensors.laser.fov_deg", "must be in (0, 360]"};
     if (!NonNegative(laser->min_range_m)) return P{"sensors.laser.min_range_m", "must be >= 0"};
     if (!(Positive(laser->max_range_m) && laser->max_range_m > laser->min_range_m))
       return P{"sensors.laser.max_range_m", "must be > min_range_m"};

@@ -42,7 +42,8 @@ Result<WheeledRobot> WheeledRobot::Bind(const mjModel* model, const std::string&
   for (int i = 0; i < n; ++i) {
     const std::string index = std::to_string(i);
     const int joint = IdOf(model, mjOBJ_JOINT, "wheel_" + index);
-    if (joint < 0 || model->jnt_type[joint] != mjJNT_HINGE) return Missing(what, kind, "a hinge joint 'wheel_" + index + "'");
+    if (joint < 0 || model->jnt_type[joint] != mjJNT_HINGE)
+      return Missing(what, kind, "a hinge joint 'wheel_" + index + "'");
     const int actuator = IdOf(model, mjOBJ_ACTUATOR, "drive_" + index);
     if (actuator < 0 || model->actuator_trntype[actuator] != mjTRN_JOINT ||
         model->actuator_trnid[2 * actuator] != joint)

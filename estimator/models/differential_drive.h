@@ -4,7 +4,7 @@
 //
 //   v^(O), omega^(O) = VelocitiesBetween(pose_k, pose_k+1, dt)        (eq. 7 inverted; middle of the interval)
 //   z_L_hat = (v_x - omega_z B / 2) / r_L,   z_R_hat = (v_x + omega_z B / 2) / r_R
-//   e = [z_L_hat - z_L;  z_R_hat - z_R;  v_y;  v_z] + eta                                         e in R^4
+//   e = [z_L_hat - z_L;  z_R_hat - z_R;  v_y;  v_z;  omega_x;  omega_y] + eta                      e in R^6
 //
 // The forward kinematics that the seed's form (eqs. 5-8 with the readings as inputs) would use, and that the graph
 // builder uses for a new pose's initial guess (eq. 7), is the inverse of the first two rows:
@@ -16,8 +16,10 @@
 // Frames: O at the middle of the wheel axle (x forward, z up). Measurements: z_L, z_R mean wheel rates over
 // [t_k, t_k+1] [rad/s], positive rolling forward (the difference of two cumulative encoder angles over dt).
 // Calibration: radius_left r_L [m], radius_right r_R [m], baseline B [m] (distance between the contact points).
-// Noise eta = [sigma_wheel (rad/s), sigma_wheel, lateral (m/s), vertical (m/s)]: encoder quantization and slip on the
-// wheel rows, the slack of the non-holonomic assumptions (no sideways slip, no motion off the floor) on the others.
+// Noise eta = [sigma_wheel (rad/s), sigma_wheel, lateral (m/s), vertical (m/s), tilt (rad/s), tilt]: encoder
+// quantization and slip on the wheel rows, the slack of the planar, non-holonomic assumptions (no sideways slip, no
+// motion off the floor, no roll or pitch rate on a flat floor) on the others. Without the last two rows the pose's
+// roll and pitch would be free between the samples of any other planar sensor (a scan matcher).
 // Slip is not Gaussian: the configuration should give the stream a robust loss (seed Section VI).
 // Variables: pose at t_k, pose at t_k+1 (PoseBlock), r_L, r_R, B (ScalarBlock each).
 #pragma once
@@ -35,8 +37,8 @@ namespace roamlab::estimator {
 class DifferentialDriveError {
  public:
   using Blocks = std::tuple<PoseBlock, PoseBlock, ScalarBlock, ScalarBlock, ScalarBlock>;
-  static constexpr int kResidualDim = 4;
-  static constexpr int kNoiseDim = 4;
+  static constexpr int kResidualDim = 6;
+  static constexpr int kNoiseDim = 6;
   static constexpr bool kAdditiveNoise = true;  // e = f(x) + eta
 
   // z_left_radps, z_right_radps: mean wheel rates over the interval; dt_s = t_k+1 - t_k > 0.
@@ -56,6 +58,8 @@ class DifferentialDriveError {
     error[1] = (v_body.x() + half_turn) / radius_right - T(z_right_radps_) + noise[1];
     error[2] = v_body.y() + noise[2];
     error[3] = v_body.z() + noise[3];
+    error[4] = omega_body.x() + noise[4];
+    error[5] = omega_body.y() + noise[5];
     return true;
   }
 

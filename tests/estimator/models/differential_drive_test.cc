@@ -38,7 +38,7 @@ TEST(DifferentialDriveErrorTest, ZeroAtTruthAndIdentityNoiseJacobian) {
     const auto lin = testing::Evaluate(*factor, {pose0, Step(pose0, v, omega, 0.01), Scalar(kRadiusLeft),
                                                  Scalar(kRadiusRight), Scalar(kBaseline)});
     EXPECT_LT(lin.error.norm(), 1e-9) << v << " " << omega;
-    EXPECT_TRUE(lin.noise_jacobian.isApprox(Eigen::MatrixXd::Identity(4, 4)));
+    EXPECT_TRUE(lin.noise_jacobian.isApprox(Eigen::MatrixXd::Identity(6, 6)));
   }
 }
 
@@ -59,7 +59,7 @@ TEST(DifferentialDriveErrorTest, SidewaysMotionShowsInTheLateralRow) {
   const auto lin = testing::Evaluate(*factor, {pose0, pose1, Scalar(kRadiusLeft), Scalar(kRadiusRight),
                                                Scalar(kBaseline)});
   EXPECT_NEAR(lin.error[2], 0.2, 1e-12);
-  EXPECT_NEAR(lin.error.head<2>().norm() + std::abs(lin.error[3]), 0.0, 1e-12);
+  EXPECT_NEAR(lin.error.head<2>().norm() + lin.error.tail<3>().norm(), 0.0, 1e-12);
 }
 
 TEST(DifferentialDriveErrorTest, JacobiansMatchCentralDifferences) {
@@ -83,7 +83,8 @@ testing::SmallProblem DiffDriveProblem(bool noisy, std::uint32_t seed) {
         *v = Eigen::Vector3d(0.5 + 0.3 * std::sin(0.9 * t), 0.0, 0.0);
         *omega = Eigen::Vector3d(0.0, 0.0, 1.2 * std::sin(0.7 * t + 0.4));
       });
-  const Eigen::Vector4d sigma(0.05, 0.05, 0.01, 0.01);
+  Eigen::Matrix<double, 6, 1> sigma;
+  sigma << 0.05, 0.05, 0.01, 0.01, 0.01, 0.01;
   std::mt19937 rng(seed);
   testing::SmallProblem problem;
   testing::AddAnchoredPoses(motion.poses, 0.002, 0.001, noisy, &rng, &problem);
@@ -96,7 +97,7 @@ testing::SmallProblem DiffDriveProblem(bool noisy, std::uint32_t seed) {
     const std::vector<VariableId>& p = problem.parameters;
     problem.graph.AddFactor(MakeFactor(DifferentialDriveError(z[0], z[1], dt)),
                             {problem.poses[k], problem.poses[k + 1], p[0], p[1], p[2]},
-                            Eigen::Matrix4d(sigma.cwiseAbs2().asDiagonal()), Loss::Trivial(), "odometer",
+                            Eigen::MatrixXd(sigma.cwiseAbs2().asDiagonal()), Loss::Trivial(), "odometer",
                             Time::FromNanoseconds(static_cast<std::int64_t>(k)));
   }
   return problem;
