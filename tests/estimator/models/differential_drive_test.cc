@@ -74,12 +74,12 @@ TEST(DifferentialDriveErrorTest, JacobiansMatchCentralDifferences) {
   }
 }
 
-// Small solve: a drive with both wheels' rates read at every interval, poses held by priors; the radii and the
+// Small solve: a 10 s drive with both wheels' rates read at every interval, poses held by priors; the radii and the
 // baseline start at the nominal 0.075 m and 0.40 m.
 testing::SmallProblem DiffDriveProblem(bool noisy, std::uint32_t seed) {
   const double dt = 0.1;
   const testing::TwistTrajectory motion = testing::IntegrateTwists(
-      Manifold::Pose().Identity(), 40, dt, [](double t, Eigen::Vector3d* v, Eigen::Vector3d* omega) {
+      Manifold::Pose().Identity(), 100, dt, [](double t, Eigen::Vector3d* v, Eigen::Vector3d* omega) {
         *v = Eigen::Vector3d(0.5 + 0.3 * std::sin(0.9 * t), 0.0, 0.0);
         *omega = Eigen::Vector3d(0.0, 0.0, 1.2 * std::sin(0.7 * t + 0.4));
       });
