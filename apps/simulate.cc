@@ -54,6 +54,7 @@ int RunSimulate(const SimulateArgs& args) {
                 "side slip <= %.2f m/s, wheel slip <= %.2f m/s\n",
                 st.distance_m, st.max_abs_pitch_rad * kDegPerRad, st.max_abs_roll_rad * kDegPerRad,
                 st.path_height_range_m, st.terrain_relief_m, st.max_lateral_speed_mps, st.max_wheel_slip_mps);
+    if (st.failed_scan_matches > 0) std::printf("scan matcher: %d scan pairs not matched\n", st.failed_scan_matches);
     std::printf("wrote %s (seed %llu): %zu streams, ground_truth.tum, truth.yaml\n", args.out.c_str(),
                 static_cast<unsigned long long>(*s.recording.provenance.seed), s.recording.streams.size());
   }

@@ -42,6 +42,15 @@ const std::vector<ModelSpec>& ModelSpecs() {
         ScalarSlot("k_gamma", 0.0)},
        {"wheelbase_m", "speed_column"},
        true},
+      // Wheel radii and baseline default to NaN: the builder takes them from the recording's platform geometry.
+      {"differential_drive",
+       {""},
+       {"wheel_radps", "lateral_mps", "vertical_mps", "tilt_radps"},
+       {ScalarSlot("radius_left", std::numeric_limits<double>::quiet_NaN()),
+        ScalarSlot("radius_right", std::numeric_limits<double>::quiet_NaN()),
+        ScalarSlot("baseline", std::numeric_limits<double>::quiet_NaN())},
+       {},
+       true},
       {"odometer", {""}, {"linear_mps", "angular_radps"}, {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")}, {},
        true},
       {"gyroscope", {""}, {"sigma_radps"}, {RotationSlot("misalignment"), Vector3Slot("bias", 0.0), Vector3Slot("scale", 1.0)},
@@ -278,7 +287,8 @@ class Parser {
     if (c.streams.count(c.master) == 0) Fail(root["master"], "master stream '" + c.master + "' is not in streams");
     if (!FindModelSpec(c.streams[c.master].model)->odometric)
       Fail(root["master"], "master stream '" + c.master +
-                               "' must use an odometric model (ackermann, ackermann_seed or odometer)");
+                               "' must use an odometric model (ackermann, ackermann_seed, differential_drive or "
+                               "odometer)");
     if (root["parameters"]) {
       if (!root["parameters"].IsMap()) Fail(root["parameters"], "parameters must be a mapping");
       for (const auto& kv : root["parameters"]) {

@@ -10,6 +10,7 @@
 #include "estimator/models/accelerometer.h"
 #include "estimator/models/ackermann_odometer.h"
 #include "estimator/models/ackermann_velocity.h"
+#include "estimator/models/differential_drive.h"
 #include "estimator/models/enu.h"
 #include "estimator/models/gps.h"
 #include "estimator/models/gyroscope.h"
@@ -30,7 +31,7 @@ enum class Attachment { kMaster, kOnePose, kPair, kTriple };
 Attachment AttachmentOf(const std::string& model, bool master) {
   if (master) return Attachment::kMaster;
   if (model == "gyroscope" || model == "linear_velocity" || model == "odometer" || model == "ackermann" ||
-      model == "ackermann_seed")
+      model == "ackermann_seed" || model == "differential_drive")
     return Attachment::kPair;
   if (model == "accelerometer") return Attachment::kTriple;
   return Attachment::kOnePose;
@@ -93,6 +94,10 @@ Eigen::MatrixXd NoiseCovariance(const StreamBinding& s) {
   } else if (m == "odometer") {
     sigma.resize(6);
     sigma << Eigen::Vector3d::Constant(n.at("linear_mps")), Eigen::Vector3d::Constant(n.at("angular_radps"));
+  } else if (m == "differential_drive") {
+    sigma.resize(6);
+    sigma << n.at("wheel_radps"), n.at("wheel_radps"), n.at("lateral_mps"), n.at("vertical_mps"), n.at("tilt_radps"),
+        n.at("tilt_radps");
   } else if (m == "absolute_pose") {
     sigma.resize(6);
     sigma << Eigen::Vector3d::Constant(n.at("position_m")), Eigen::Vector3d::Constant(n.at("orientation_rad"));
@@ -162,6 +167,11 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
       if (type == StreamType::kGps && !impl->enu) return Error(config, "stream '" + name + "': gps without origin");
     } else if (m == "absolute_pose") {
       if (type != StreamType::kPose) return Error(config, bad_type);
+    } else if (m == "differential_drive") {
+      if (type != StreamType::kWheelEncoders) return Error(config, bad_type);
+      if (b.primary->info.units != "rad" || b.primary->values.cols() != 2)
+        return Error(config, "stream '" + name + "': differential_drive source '" + source +
+                                 "' must hold two cumulative wheel angles (left, right) in rad or ticks");
     } else if (m == "odometer" || m == "linear_velocity") {
       if (!TypeIn(type, {StreamType::kOdometry, StreamType::kVisualOdometry, StreamType::kScanMatching}))
         return Error(config, bad_type);
@@ -180,6 +190,14 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
       impl->parameter_manifold.emplace(pname, slot.manifold);
       Eigen::VectorXd init = slot.default_value;
       if (ackermann && slot.name == "kv_over_L") init[0] = 1.0 / b.wheelbase_m;
+      if (m == "differential_drive") {
+        const std::string key = slot.name == "baseline" ? "baseline_m" : "wheel_radius_m";
+        const auto g = rec.platform.geometry.find(key);
+        if (g == rec.platform.geometry.end() && !(config.parameters.count(pname) && config.parameters.at(pname).value))
+          return Error(config, "stream '" + name + "': no parameters." + pname + ".value and no " + key +
+                                   " in the recording's platform");
+        if (g != rec.platform.geometry.end()) init[0] = g->second;
+      }
       impl->parameter_initial.emplace(pname, init);
     }
     impl->streams.push_back(std::move(b));
@@ -258,7 +276,7 @@ int ProblemBuilder::ResidualDim(const std::string& stream) const {
     if (s.name == stream) {
       const std::string& m = s.config.model;
       if (m == "ackermann") return 4;
-      return (m == "ackermann_seed" || m == "odometer" || m == "absolute_pose") ? 6 : 3;
+      return (m == "ackermann_seed" || m == "odometer" || m == "absolute_pose" || m == "differential_drive") ? 6 : 3;
     }
   return 0;
 }
@@ -288,6 +306,13 @@ double SteeringAt(const recording::Stream& s, Time t) {
   if (*it == t || i == 0) return s.values(i, 0);
   const double w = SecondsBetween(s.t[i - 1], t) / SecondsBetween(s.t[i - 1], s.t[i]);
   return (1.0 - w) * s.values(i - 1, 0) + w * s.values(i, 0);
+}
+
+// Mean wheel rates [rad/s] over [t_row, t_row+1] from cumulative wheel angles; nullopt for the last row.
+std::optional<Eigen::VectorXd> WheelRates(const recording::Stream& s, int row) {
+  if (row + 1 >= static_cast<int>(s.t.size())) return std::nullopt;
+  const double dt = SecondsBetween(s.t[row], s.t[row + 1]);
+  return Eigen::VectorXd((s.values.row(row + 1) - s.values.row(row)).transpose() / dt);
 }
 
 }  // namespace
@@ -382,6 +407,11 @@ void ProblemBuilder::AddMasterSample(const MeasurementRef& m) {
     const double z_v = row[s.column];
     v_body.x() = kv_over_l * s.wheelbase_m * z_v;
     omega_body.z() = kv_over_l * z_v * std::tan(k_theta * SteeringAt(*s.steering, odo.t) + k_gamma);
+  } else if (s.config.model == "differential_drive") {
+    if (const auto rates = WheelRates(*s.primary, odo.row)) {
+      DifferentialDriveError::BodyVelocity((*rates)[0], (*rates)[1], value(0)[0], value(1)[0], value(2)[0], &v_body,
+                                           &omega_body);
+    }
   } else {
     const Eigen::VectorXd q = value(1);
     SensorToBodyVelocity<double>(row.head<3>().transpose(), row.segment<3>(3).transpose(),
@@ -448,6 +478,14 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     } else {
       factor = MakeFactor(AckermannOdometerError(z_v, z_theta, s.wheelbase_m, dt));
     }
+  } else if (model == "differential_drive") {
+    const auto rates = WheelRates(data, m.row);
+    if (!rates) {
+      ++counts_[s.name].outside;
+      return true;
+    }
+    factor = MakeFactor(DifferentialDriveError((*rates)[0], (*rates)[1], dt));
+    vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k)};
   } else if (model == "odometer") {
     factor = MakeFactor(OdometerError(row.head<6>().transpose(), dt));
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k)};

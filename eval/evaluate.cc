@@ -12,6 +12,7 @@
 
 #include "eval/internal/json_util.h"
 #include "recording/truth.h"
+#include "recording/wheel_kinematics.h"
 
 namespace roamlab::eval {
 namespace {
@@ -212,6 +213,36 @@ Result<Evaluation> Evaluate(const EvaluateOptions& options) {
   m["rpe_distance"] = RpeJson(rpe_distance);
   m["rpe_distance"]["distance_m"] = options.rpe_distance_m;
 
+  // Velocities of wheeled robots: the fused estimate and the encoders alone against the truth (seed Fig. 6).
+  if (recording::IsWheeledPlatform(rec.value().platform.kind)) {
+    Result<EncoderOdometry> encoders = EncoderOnlyOdometry(rec.value());
+    if (encoders.ok()) {
+      Evaluation::Velocity v;
+      v.fused = CompareVelocities(TrajectoryVelocities(estimate), truth, options.max_time_difference_s);
+      v.encoders_only = CompareVelocities(encoders.value().twists, truth, options.max_time_difference_s);
+      const Association encoder_association =
+          AssociateByTime(encoders.value().dead_reckoning, truth, association_options);
+      const MatchedTrajectories encoder_matched =
+          SelectMatched(encoders.value().dead_reckoning, truth, encoder_association);
+      const RelativePoseError rpe_encoders =
+          RpeByStep(encoder_matched.estimate, encoder_matched.reference,
+                    StepForDuration(encoder_matched.estimate, options.rpe_delta_s));
+      const auto series = [&truth](const RelativePoseError& rpe, const Trajectory& poses, std::vector<double>* t,
+                                   std::vector<double>* rot) {
+        for (std::size_t n = 0; n < rpe.first.size(); ++n) {
+          t->push_back(SecondsBetween(truth.front().t, poses[rpe.first[n]].t));
+          rot->push_back(rpe.rotation_deg[n]);
+        }
+      };
+      series(rpe_step, matched.estimate, &v.rpe_t_fused_s, &v.rpe_rot_fused_deg);
+      series(rpe_encoders, encoder_matched.estimate, &v.rpe_t_encoders_s, &v.rpe_rot_encoders_deg);
+      m["velocity"] = {{"fused", VelocityJson(v.fused, rpe_step.rotation.rmse)},
+                       {"encoders_only", VelocityJson(v.encoders_only, rpe_encoders.rotation.rmse)},
+                       {"rpe_delta_poses", step}};
+      ev.velocity = std::move(v);
+    }
+  }
+
   // Figures' data: whole trajectories, matched errors.
   ev.t_origin = truth.front().t;
   ev.ground_truth = truth;
@@ -318,6 +349,15 @@ Result<WrittenEvaluation> WriteEvaluation(const Evaluation& evaluation, const st
         out_dir, "Position NEES per pose (eq. 16), " + evaluation.estimate_label + ", single run", *evaluation.nees);
     if (!nees.ok()) return nees.status();
     figures.push_back(nees.value());
+  }
+  if (evaluation.velocity) {
+    const Evaluation::Velocity& v = *evaluation.velocity;
+    Result<PlotFiles> velocity = WriteVelocityPlot(
+        out_dir, "Velocities: ground truth, encoders' forward kinematics, " + evaluation.estimate_label,
+        {v.fused.t_s, v.fused.truth, v.fused.estimate, v.encoders_only.t_s, v.encoders_only.estimate,
+         v.rpe_t_fused_s, v.rpe_rot_fused_deg, v.rpe_t_encoders_s, v.rpe_rot_encoders_deg});
+    if (!velocity.ok()) return velocity.status();
+    figures.push_back(velocity.value());
   }
   if (!GnuplotAvailable()) {
     written.note = "gnuplot not found: wrote the figures' data and scripts (*.gp) but no PNG";

@@ -22,6 +22,9 @@
 //   NEES          eq. 16 per pose with the covariance rotated by the alignment (R Sigma R^T); mean over the poses and
 //                 the fraction of poses inside the single-run 95 % band of chi-square(3)          -> nees_mean, nees
 //   parameters    the table of eval/parameters.h for every estimated parameter with a true value   -> parameters
+//   velocity      wheeled platforms with a wheel_encoders stream (eval/velocity.h): linear and angular velocity
+//                 RMSE and rotational RPE (by step, as rpe_rot_deg) of the fused estimate and of the encoders'
+//                 forward kinematics alone                                  -> velocity.{fused, encoders_only}
 #pragma once
 
 #include <optional>
@@ -38,6 +41,7 @@
 #include "eval/nees.h"
 #include "eval/parameters.h"
 #include "eval/plots.h"
+#include "eval/velocity.h"
 #include "recording/recording.h"
 
 namespace roamlab::eval {
@@ -78,6 +82,13 @@ struct Evaluation {
   std::vector<PositionFixes> fixes;
   std::optional<MonteCarloNees> nees;       // single-run NEES of the poses that have one (runs = 1)
   std::string estimate_label;               // e.g. "estimate (tracking)"
+  // Wheeled platforms with encoders: velocities of the fused estimate and of the encoders against the truth, and the
+  // rotational RPE per pair (stamp of the pair's first pose, seconds since t_origin).
+  struct Velocity {
+    VelocityErrors fused, encoders_only;
+    std::vector<double> rpe_t_fused_s, rpe_rot_fused_deg, rpe_t_encoders_s, rpe_rot_encoders_deg;
+  };
+  std::optional<Velocity> velocity;
 };
 
 // Reads the inputs and computes every metric. Errors are bad input, one line naming the file and the problem: a

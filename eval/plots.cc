@@ -205,6 +205,57 @@ Result<PlotFiles> WriteNeesPlot(const std::string& directory, const std::string&
   return files;
 }
 
+Result<PlotFiles> WriteVelocityPlot(const std::string& directory, const std::string& title,
+                                    const VelocityPlotData& d) {
+  ROAMLAB_CHECK(d.fused_t_s.size() == d.truth.size() && d.fused_t_s.size() == d.fused.size() &&
+                    d.encoders_t_s.size() == d.encoders.size() && d.rpe_fused_t_s.size() == d.rpe_fused_deg.size() &&
+                    d.rpe_encoders_t_s.size() == d.rpe_encoders_deg.size(),
+                "velocity plot: sizes differ");
+  PlotFiles files{"velocity.gp",
+                  "velocity.png",
+                  {"velocity_fused.dat", "velocity_encoders.dat", "velocity_rpe_fused.dat",
+                   "velocity_rpe_encoders.dat"}};
+  std::ostringstream fused, encoders, rpe_fused, rpe_encoders;
+  fused << "# t_s true_vx_mps true_wz_radps fused_vx_mps fused_wz_radps\n";
+  for (std::size_t i = 0; i < d.fused_t_s.size(); ++i)
+    fused << Num(d.fused_t_s[i]) << ' ' << Num(d.truth[i].v_body.x()) << ' ' << Num(d.truth[i].omega_body.z()) << ' '
+          << Num(d.fused[i].v_body.x()) << ' ' << Num(d.fused[i].omega_body.z()) << '\n';
+  encoders << "# t_s encoders_vx_mps encoders_wz_radps\n";
+  for (std::size_t i = 0; i < d.encoders_t_s.size(); ++i)
+    encoders << Num(d.encoders_t_s[i]) << ' ' << Num(d.encoders[i].v_body.x()) << ' '
+             << Num(d.encoders[i].omega_body.z()) << '\n';
+  rpe_fused << "# t_s rpe_rot_deg\n";
+  for (std::size_t i = 0; i < d.rpe_fused_t_s.size(); ++i)
+    rpe_fused << Num(d.rpe_fused_t_s[i]) << ' ' << Num(d.rpe_fused_deg[i]) << '\n';
+  rpe_encoders << "# t_s rpe_rot_deg\n";
+  for (std::size_t i = 0; i < d.rpe_encoders_t_s.size(); ++i)
+    rpe_encoders << Num(d.rpe_encoders_t_s[i]) << ' ' << Num(d.rpe_encoders_deg[i]) << '\n';
+  const std::string texts[4] = {fused.str(), encoders.str(), rpe_fused.str(), rpe_encoders.str()};
+  for (int k = 0; k < 4; ++k)
+    if (Status st = WriteText(directory, files.data[k], texts[k]); !st.ok()) return st;
+
+  const std::string f = Quote(files.data[0]), e = Quote(files.data[1]);
+  std::ostringstream gp;
+  gp << "# Redraw: cd into this directory, then: gnuplot " << files.script << "\n"
+     << Terminal(1100, 1000) << "set output " << Quote(files.image) << "\n"
+     << "set multiplot layout 3,1 title " << Quote(title) << "\n"
+     << "set grid\nset key top right box opaque\nset xlabel 'time since start [s]'\n"
+     << "set ylabel 'forward speed v_x [m/s]'\n"
+     << "plot " << f << " using 1:2 with lines lw 2 lc rgb '#d62728' title 'ground truth', \\\n"
+     << "     " << e << " using 1:2 with lines lw 1 lc rgb '#1f77b4' title 'encoders (forward kinematics)', \\\n"
+     << "     " << f << " using 1:4 with lines lw 1.2 lc rgb '#2ca02c' title 'fused estimate'\n"
+     << "set ylabel 'yaw rate omega_z [rad/s]'\n"
+     << "plot " << f << " using 1:3 with lines lw 2 lc rgb '#d62728' title 'ground truth', \\\n"
+     << "     " << e << " using 1:3 with lines lw 1 lc rgb '#1f77b4' title 'encoders (forward kinematics)', \\\n"
+     << "     " << f << " using 1:5 with lines lw 1.2 lc rgb '#2ca02c' title 'fused estimate'\n"
+     << "set ylabel 'rotational RPE [deg]'\n"
+     << "plot " << Quote(files.data[3]) << " using 1:2 with lines lw 1 lc rgb '#1f77b4' title 'encoders', \\\n"
+     << "     " << Quote(files.data[2]) << " using 1:2 with lines lw 1.2 lc rgb '#2ca02c' title 'fused estimate'\n"
+     << "unset multiplot\n";
+  if (Status st = WriteText(directory, files.script, gp.str()); !st.ok()) return st;
+  return files;
+}
+
 bool GnuplotAvailable() {
   const char* path = std::getenv("PATH");
   if (!path) return false;

@@ -5,6 +5,8 @@
 //   trajectory       top view (East, North) of the ground truth, the estimate and absolute fixes (the seed's Fig. 3)
 //   position_error   estimate - truth per axis (E, N, U) against time, with the +-3 sigma envelope when known
 //   nees             average NEES against time with the chi-square band lines (the seed's Fig. 4)
+//   velocity         forward speed, yaw rate and rotational RPE against time: truth, encoders alone, fused estimate
+//                    (the seed's Fig. 6)
 #pragma once
 
 #include <string>
@@ -14,6 +16,7 @@
 
 #include "common/status.h"
 #include "eval/nees.h"
+#include "eval/velocity.h"
 #include "recording/trajectory.h"
 
 namespace roamlab::eval {
@@ -49,6 +52,20 @@ Result<PlotFiles> WritePositionErrorPlot(const std::string& directory, const std
 // NAME.png with NAME = `name`.
 Result<PlotFiles> WriteNeesPlot(const std::string& directory, const std::string& title, const MonteCarloNees& nees,
                                 const std::string& name = "nees");
+
+// What the velocity figure draws; times in seconds since the truth's first stamp, one per twist or RPE pair.
+struct VelocityPlotData {
+  std::vector<double> fused_t_s;
+  std::vector<StampedTwist> truth;        // at fused_t_s
+  std::vector<StampedTwist> fused;        // at fused_t_s
+  std::vector<double> encoders_t_s;
+  std::vector<StampedTwist> encoders;     // at encoders_t_s
+  std::vector<double> rpe_fused_t_s, rpe_fused_deg, rpe_encoders_t_s, rpe_encoders_deg;
+};
+// Three stacked panels: v_x [m/s], omega_z [rad/s], rotational RPE [deg]. Files velocity.gp, velocity_*.dat,
+// velocity.png. Sizes CHECKed.
+Result<PlotFiles> WriteVelocityPlot(const std::string& directory, const std::string& title,
+                                    const VelocityPlotData& data);
 
 // True when an executable named gnuplot is on PATH.
 bool GnuplotAvailable();

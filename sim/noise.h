@@ -18,6 +18,7 @@ enum class NoiseSource : std::uint32_t {
   kGps = 3,
   kSpeed = 4,
   kSteering = 5,
+  kLaserRange = 6,
 };
 
 class NoiseStream {

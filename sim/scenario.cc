@@ -1,5 +1,6 @@
 #include "sim/scenario.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -140,9 +141,21 @@ void ReadRobot(YamlReader& r, const YAML::Node& node, const std::string& scenari
   }
 }
 
-void ReadWorld(YamlReader& r, const YAML::Node& node, Scenario* s) {
-  r.CheckKeys(node, "world", {"terrain"});
+void ReadWorld(YamlReader& r, const YAML::Node& node, const std::string& scenario_dir, Scenario* s) {
+  r.CheckKeys(node, "world", {"terrain", "model"});
   if (!r.Require(node, "world", "terrain")) return;
+  if (node["model"]) {
+    std::string model;
+    r.String(node, "world", "model", &model);
+    if (!r.ok()) return;
+    const fs::path resolved = fs::path(model).is_absolute() ? fs::path(model) : fs::path(scenario_dir) / model;
+    std::error_code error;
+    if (!fs::is_regular_file(resolved, error)) {
+      r.Fail(node["model"], "world.model", "no such file '" + model + "' (looked for " + resolved.string() + ")");
+      return;
+    }
+    s->world_model_file = resolved.lexically_normal().string();
+  }
   const YAML::Node t = node["terrain"];
   const std::string k = "world.terrain";
   r.CheckKeys(t, k, {"type", "seed", "size_m", "resolution_m", "relief_m", "wavelength_m", "waves", "friction"});
@@ -182,9 +195,18 @@ void ReadWorld(YamlReader& r, const YAML::Node& node, Scenario* s) {
 
 void ReadDriver(YamlReader& r, const YAML::Node& node, Scenario* s) {
   const std::string k = "driver";
-  r.CheckKeys(node, k, {"type", "lead_in_s", "speed_mps", "handlebar_rad"});
   if (!r.Require(node, k, "type")) return;
   r.String(node, k, "type", &s->driver.type);
+  if (!r.ok()) return;
+  if (s->driver.type == "body_velocity") {
+    r.CheckKeys(node, k, {"type", "lead_in_s", "linear_mps", "angular_radps"});
+    r.Number(node, k, "lead_in_s", &s->driver.lead_in_s);
+    if (!r.Require(node, k, "linear_mps") || !r.Require(node, k, "angular_radps")) return;
+    ReadProfile(r, node, k, "linear_mps", &s->driver.linear_mps);
+    ReadProfile(r, node, k, "angular_radps", &s->driver.angular_radps);
+    return;
+  }
+  r.CheckKeys(node, k, {"type", "lead_in_s", "speed_mps", "handlebar_rad"});
   r.Number(node, k, "lead_in_s", &s->driver.lead_in_s);
   if (!r.Require(node, k, "speed_mps") || !r.Require(node, k, "handlebar_rad")) return;
   ReadProfile(r, node, k, "speed_mps", &s->driver.speed_mps);
@@ -192,7 +214,7 @@ void ReadDriver(YamlReader& r, const YAML::Node& node, Scenario* s) {
 }
 
 void ReadSensors(YamlReader& r, const YAML::Node& node, Scenario* s) {
-  r.CheckKeys(node, "sensors", {"imu", "magnetometer", "gps", "odometer"});
+  r.CheckKeys(node, "sensors", {"imu", "magnetometer", "gps", "odometer", "wheel_encoders", "laser"});
   if (!r.ok()) return;
   // A present key with an empty value ("imu:" or "imu: {}") is a sensor with all defaults.
   const auto section = [&r](const YAML::Node& n, const std::string& k, std::initializer_list<std::string_view> keys) {
@@ -258,6 +280,35 @@ void ReadSensors(YamlReader& r, const YAML::Node& node, Scenario* s) {
   }
 }
 
+void ReadIndoorSensors(YamlReader& r, const YAML::Node& node, Scenario* s) {
+  if (node["wheel_encoders"] && !node["wheel_encoders"].IsNull()) {
+    WheelEncoderOptions& enc = s->sensors.wheel_encoders.emplace();
+    const YAML::Node n = node["wheel_encoders"];
+    const std::string k = "sensors.wheel_encoders";
+    r.CheckKeys(n, k, {"rate_hz", "ticks_per_revolution"});
+    r.Number(n, k, "rate_hz", &enc.rate_hz);
+    r.Number(n, k, "ticks_per_revolution", &enc.ticks_per_revolution);
+  } else if (node["wheel_encoders"]) {
+    s->sensors.wheel_encoders.emplace();
+  }
+  if (node["laser"] && !node["laser"].IsNull()) {
+    LaserOptions& laser = s->sensors.laser.emplace();
+    const YAML::Node n = node["laser"];
+    const std::string k = "sensors.laser";
+    r.CheckKeys(n, k, {"rate_hz", "beams", "fov_deg", "min_range_m", "max_range_m", "sigma_m"});
+    r.Number(n, k, "rate_hz", &laser.rate_hz);
+    std::int64_t beams = laser.beams;
+    r.Integer(n, k, "beams", &beams);
+    laser.beams = static_cast<int>(std::clamp<std::int64_t>(beams, -1, 1 << 20));
+    r.Number(n, k, "fov_deg", &laser.fov_deg);
+    r.Number(n, k, "min_range_m", &laser.min_range_m);
+    r.Number(n, k, "max_range_m", &laser.max_range_m);
+    r.Number(n, k, "sigma_m", &laser.sigma_m);
+  } else if (node["laser"]) {
+    s->sensors.laser.emplace();
+  }
+}
+
 void ReadEffects(YamlReader& r, const YAML::Node& node, Scenario* s) {
   r.Remember("effects", node);
   if (node.IsNull()) return;
@@ -306,9 +357,10 @@ std::optional<Scenario::Problem> Scenario::Validate() const {
   if (!Finite(origin.altitude_m)) return P{"origin.altitude_m", "must be finite"};
   if (!Positive(ground_truth_rate_hz)) return P{"ground_truth_rate_hz", "must be > 0"};
 
-  // Robot and driver: only the Ackermann family exists so far.
-  if (robot.kind != "ackermann")
-    return P{"robot.kind", "unsupported kind '" + robot.kind + "' (supported: ackermann)"};
+  // Robot and driver: the Ackermann vehicle, or a wheeled indoor robot driven by body-velocity set-points.
+  const bool ackermann = robot.kind == "ackermann";
+  if (!ackermann && robot.kind != "differential_drive")
+    return P{"robot.kind", "unsupported kind '" + robot.kind + "' (supported: ackermann, differential_drive)"};
   if (robot.model_file.empty() && robot.model_xml.empty()) return P{"robot.model", "missing"};
   if (!robot.start_position_m.allFinite()) return P{"robot.start.position_m", "must be finite"};
   if (!Finite(robot.start_heading_rad)) return P{"robot.start.heading_deg", "must be finite"};
@@ -320,12 +372,17 @@ std::optional<Scenario::Problem> Scenario::Validate() const {
       !(std::abs(robot.start_position_m.x()) < 0.5 * terrain.size_m.x() - 5.0 &&
         std::abs(robot.start_position_m.y()) < 0.5 * terrain.size_m.y() - 5.0))
     return P{"robot.start.position_m", "must be on the terrain, at least 5 m from its edge"};
-  if (driver.type != robot.kind)
+  const std::string driver_type = ackermann ? "ackermann" : "body_velocity";
+  if (driver.type != driver_type)
     return P{"driver.type", "'" + driver.type + "' does not drive a robot of kind '" + robot.kind +
-                                "' (use " + robot.kind + ")"};
+                                "' (use " + driver_type + ")"};
+  if (!ackermann && terrain.type != TerrainOptions::Type::kFlat)
+    return P{"world.terrain.type", "a " + robot.kind + " robot needs a flat floor (type: flat)"};
   if (!NonNegative(driver.lead_in_s) || driver.lead_in_s > 60.0) return P{"driver.lead_in_s", "must be in [0, 60]"};
   if (auto p = ProfileProblem(driver.speed_mps, "driver.speed_mps")) return p;
   if (auto p = ProfileProblem(driver.handlebar_rad, "driver.handlebar_rad")) return p;
+  if (auto p = ProfileProblem(driver.linear_mps, "driver.linear_mps")) return p;
+  if (auto p = ProfileProblem(driver.angular_radps, "driver.angular_radps")) return p;
 
   // Sensors.
   if (const auto& imu = sensors.imu) {
@@ -350,6 +407,25 @@ std::optional<Scenario::Problem> Scenario::Validate() const {
     if (!Positive(gps->rate_hz)) return P{"sensors.gps.rate_hz", "must be > 0"};
     if (!NonNegative(gps->sigma_m)) return P{"sensors.gps.sigma_m", "must be >= 0"};
     if (!gps->lever_arm_m.allFinite()) return P{"sensors.gps.lever_arm_m", "must be finite"};
+  }
+  if (sensors.odometer && !ackermann)
+    return P{"sensors.odometer", "is the Ackermann odometer; a " + robot.kind + " robot has wheel_encoders"};
+  if ((sensors.wheel_encoders || sensors.laser) && ackermann)
+    return P{sensors.laser ? "sensors.laser" : "sensors.wheel_encoders", "only for wheeled indoor robots"};
+  if (const auto& enc = sensors.wheel_encoders) {
+    if (!Positive(enc->rate_hz)) return P{"sensors.wheel_encoders.rate_hz", "must be > 0"};
+    if (!(Positive(enc->ticks_per_revolution) && enc->ticks_per_revolution == std::floor(enc->ticks_per_revolution)))
+      return P{"sensors.wheel_encoders.ticks_per_revolution", "must be a positive whole number"};
+  }
+  if (const auto& laser = sensors.laser) {
+    if (!Positive(laser->rate_hz)) return P{"sensors.laser.rate_hz", "must be > 0"};
+    if (laser->beams < 10 || laser->beams > 10000) return P{"sensors.laser.beams", "must be in [10, 10000]"};
+    if (!(Positive(laser->fov_deg) && laser->fov_deg <= 360.0))
+      return P{"sensors.laser.fov_deg", "must be in (0, 360]"};
+    if (!NonNegative(laser->min_range_m)) return P{"sensors.laser.min_range_m", "must be >= 0"};
+    if (!(Positive(laser->max_range_m) && laser->max_range_m > laser->min_range_m))
+      return P{"sensors.laser.max_range_m", "must be > min_range_m"};
+    if (!NonNegative(laser->sigma_m)) return P{"sensors.laser.sigma_m", "must be >= 0"};
   }
   if (const auto& odo = sensors.odometer) {
     if (!Positive(odo->rate_hz)) return P{"sensors.odometer.rate_hz", "must be > 0"};
@@ -390,9 +466,10 @@ Result<Scenario> LoadScenario(const std::string& path) {
   }
   const std::string dir = fs::path(path).parent_path().string();
   if (r.ok()) ReadRobot(r, root["robot"], dir, &s);
-  if (r.ok()) ReadWorld(r, root["world"], &s);
+  if (r.ok()) ReadWorld(r, root["world"], dir, &s);
   if (r.ok()) ReadDriver(r, root["driver"], &s);
   if (r.ok()) ReadSensors(r, root["sensors"], &s);
+  if (r.ok()) ReadIndoorSensors(r, root["sensors"], &s);
   if (r.ok() && root["effects"]) ReadEffects(r, root["effects"], &s);
   if (!r.ok()) return r.status();
 

@@ -51,10 +51,31 @@
 // quarter of the lead-in, then the set-points ramp linearly from zero to the profiles' values at t = 0, so that the
 // recording starts in motion (the Ackermann odometer, eq. 15, cannot see a turn at standstill).
 //
-// Extension points. Other robot kinds (differential_drive, omni3, mecanum) add their own `driver.type` (wheel speeds,
-// body-velocity set-points with square waves) and sensor sections (wheel encoders per wheel); a flat indoor floor is
-// `terrain: {type: flat}`; physical effects go in `effects`. Each is a new key or value, so existing scenarios keep
-// their meaning.
+// Wheeled indoor robots (seed Section VI; scenarios/indoor_diffdrive_slip.yaml). `robot.kind: differential_drive`
+// with a model that follows models/diffdrive.xml (sim/wheeled_robot.h); no speed_controller (the wheels are velocity
+// servos). The world adds a static MJCF file to the flat floor:
+//   world:
+//     terrain: {type: flat, friction: 0.6}
+//     model: ../models/indoor_room.xml      # optional: walls and clutter (geom group 0, what the laser sees)
+//   driver:
+//     type: body_velocity                   # set-points of O's velocity, turned into wheel speeds by the robot's
+//     lead_in_s: 1.0                        # inverse kinematics
+//     linear_mps: <profile>                 # forward speed v_x [m/s], e.g. a square wave
+//     angular_radps: <profile>              # yaw rate [rad/s]
+//   sensors:
+//     imu: {...}                            # as above (vibration comes from the physics)
+//     wheel_encoders: {rate_hz: 100, ticks_per_revolution: 2048}
+//     laser: {rate_hz: 10, beams: 683, fov_deg: 240, min_range_m: 0.02, max_range_m: 4.0, sigma_m: 0.01}
+// Streams written: imu; wheel_encoders (wheel_encoders: one column per wheel, "left" "right", the cumulative wheel
+// angle quantized to whole ticks and written in rad, attributes.ticks_per_revolution; angle 0 at t = 0);
+// scan_matching (scan_matching: the velocity of the laser frame between consecutive scans, from the project's scan
+// matcher (sim/scan_matcher.h) on the ray-cast scans (sim/laser.h) with Gaussian range noise sigma_m, stamped at the
+// middle of the scan interval, vz = wx = wy = 0; mounting = the laser site in O). The platform geometry
+// (wheel_radius_m, baseline_m) is measured on the model. truth.yaml: imu.misalignment, scan_matching.lever_arm,
+// scan_matching.misalignment, odometer.radius_left, odometer.radius_right, odometer.baseline (the true geometry, the
+// names the differential_drive estimator model uses when its stream is called odometer). A camera for visual
+// odometry is the model's camera "camera" (looking forward); its stream would be of type visual_odometry.
+// Physical effects go in `effects`. Each is a new key or value, so existing scenarios keep their meaning.
 #pragma once
 
 #include <cstdint>
@@ -86,8 +107,10 @@ struct RobotOptions {
 struct DriverOptions {
   std::string type = "ackermann";
   double lead_in_s = 4.0;         // >= 0
-  Profile speed_mps = Profile::Constant(0.0);
-  Profile handlebar_rad = Profile::Constant(0.0);
+  Profile speed_mps = Profile::Constant(0.0);        // ackermann
+  Profile handlebar_rad = Profile::Constant(0.0);    // ackermann
+  Profile linear_mps = Profile::Constant(0.0);       // body_velocity: v_x of O
+  Profile angular_radps = Profile::Constant(0.0);    // body_velocity: omega_z
 };
 
 struct ImuOptions {
@@ -124,11 +147,27 @@ struct OdometerOptions {
   double k_gamma = 0.0;                 // rad
 };
 
+struct WheelEncoderOptions {
+  double rate_hz = 100.0;
+  double ticks_per_revolution = 2048.0;   // > 0, whole number
+};
+
+struct LaserOptions {
+  double rate_hz = 10.0;
+  int beams = 683;
+  double fov_deg = 240.0;                 // centred on the laser's x axis
+  double min_range_m = 0.02;
+  double max_range_m = 4.0;
+  double sigma_m = 0.01;                  // Gaussian range noise
+};
+
 struct SensorOptions {
   std::optional<ImuOptions> imu;
   std::optional<MagnetometerOptions> magnetometer;
   std::optional<GpsOptions> gps;
   std::optional<OdometerOptions> odometer;
+  std::optional<WheelEncoderOptions> wheel_encoders;
+  std::optional<LaserOptions> laser;
 };
 
 struct EffectOptions {
@@ -145,6 +184,7 @@ struct Scenario {
   double ground_truth_rate_hz = 100.0;
   RobotOptions robot;
   TerrainOptions terrain;
+  std::string world_model_file;         // world.model as resolved; empty: none
   DriverOptions driver;
   SensorOptions sensors;
   std::vector<EffectOptions> effects;

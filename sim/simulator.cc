@@ -1,6 +1,7 @@
 #include "sim/simulator.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -11,10 +12,13 @@
 
 #include "common/check.h"
 #include "sim/ackermann.h"
+#include "sim/laser.h"
 #include "sim/mujoco_model.h"
 #include "sim/noise.h"
 #include "sim/sensors.h"
+#include "sim/scan_matcher.h"
 #include "sim/terrain.h"
+#include "sim/wheeled_robot.h"
 
 namespace roamlab::sim {
 namespace {
@@ -29,6 +33,7 @@ constexpr double kPlacementClearanceM = 0.01;
 constexpr double kTerrainMarginM = 2.0;
 // Below this cosine between O's z axis and the world's up the vehicle has rolled over (about 70 deg).
 constexpr double kRolloverCosine = 0.34;
+constexpr double kPi = 3.14159265358979323846;
 
 std::string OneLine(std::string text) {
   for (char& c : text)
@@ -103,19 +108,39 @@ class Simulator::Impl {
       robot_xml = content.str();
     }
 
-    // The world: robot plus terrain, compiled through the VFS; then the heightfield samples.
+    // The world: robot plus terrain (plus the static world model, if any), compiled through the VFS; then the
+    // heightfield samples.
     terrain_ = Terrain::Make(scenario_.terrain, scenario_.robot.start_position_m);
-    const std::string world_xml =
-        "<mujoco model=\"roamlab_world\">\n<include file=\"robot.xml\"/>\n" + terrain_.Mjcf() + "</mujoco>\n";
-    auto model = LoadModelFromFiles("world.xml", {{"world.xml", world_xml}, {"robot.xml", robot_xml}}, model_where_);
+    std::map<std::string, std::string> files{{"robot.xml", robot_xml}};
+    std::string world_xml = "<mujoco model=\"roamlab_world\">\n<include file=\"robot.xml\"/>\n" + terrain_.Mjcf();
+    if (!scenario_.world_model_file.empty()) {
+      std::ifstream file(scenario_.world_model_file, std::ios::binary);
+      if (!file) return Status::Error(where_ + ": world.model: cannot open '" + scenario_.world_model_file + "'");
+      std::ostringstream content;
+      content << file.rdbuf();
+      files["room.xml"] = content.str();
+      world_xml += "<include file=\"room.xml\"/>\n";
+    }
+    files["world.xml"] = world_xml + "</mujoco>\n";
+    auto model = LoadModelFromFiles("world.xml", files, model_where_);
     if (!model.ok()) return model.status();
     model_ = std::move(model).value();
     if (Status s = terrain_.Fill(model_.get()); !s.ok()) return Status::Error(model_where_ + ": " + s.message());
     data_ = MakeData(model_.get());
-    auto vehicle = AckermannVehicle::Bind(model_.get(), model_where_);
-    if (!vehicle.ok()) return vehicle.status();
-    vehicle_ = vehicle.value();
-    controller_.emplace(scenario_.robot.speed_controller);
+    if (ackermann_) {
+      auto vehicle = AckermannVehicle::Bind(model_.get(), model_where_);
+      if (!vehicle.ok()) return vehicle.status();
+      vehicle_ = vehicle.value();
+      controller_.emplace(scenario_.robot.speed_controller);
+      odom_site_ = vehicle_.odom_site();
+    } else {
+      auto robot = WheeledRobot::Bind(model_.get(), scenario_.robot.kind, model_where_);
+      if (!robot.ok()) return robot.status();
+      wheeled_ = robot.value();
+      odom_site_ = wheeled_.odom_site();
+      if (scenario_.sensors.laser && wheeled_.laser_site() < 0)
+        return Status::Error(model_where_ + ": sensors.laser needs a site 'laser' on the robot");
+    }
 
     // Physics step and stream clocks: every period a whole number of steps.
     step_ns_ = std::llround(model_->opt.timestep * 1e9);
@@ -155,7 +180,22 @@ class Simulator::Impl {
       if (Status s = clock(sensors.odometer->rate_hz, "sensors.odometer.rate_hz", &odometer_clock_); !s.ok())
         return s;
     }
-    wheelbase_m_ = Micrometres(vehicle_.wheelbase_m());
+    if (sensors.wheel_encoders) {
+      if (Status s = clock(sensors.wheel_encoders->rate_hz, "sensors.wheel_encoders.rate_hz", &encoder_clock_);
+          !s.ok())
+        return s;
+    }
+    if (sensors.laser) {
+      if (Status s = clock(sensors.laser->rate_hz, "sensors.laser.rate_hz", &laser_clock_); !s.ok()) return s;
+      const LaserOptions& l = *sensors.laser;
+      const double fov = l.fov_deg * kPi / 180.0;
+      scan_geometry_.beams = l.beams;
+      scan_geometry_.first_angle_rad = -0.5 * fov;
+      scan_geometry_.increment_rad = fov / (l.beams - 1);
+      scan_geometry_.min_range_m = l.min_range_m;
+      scan_geometry_.max_range_m = l.max_range_m;
+    }
+    if (ackermann_) wheelbase_m_ = Micrometres(vehicle_.wheelbase_m());
 
     // Streams, laid out as tests/support/synthetic.h lays them out.
     if (sensors.imu) {
@@ -177,6 +217,18 @@ class Simulator::Impl {
       gps_stream_.info.mounting = recording::Mounting{};
       gps_stream_.info.noise = {{"sigma_m", sensors.gps->sigma_m}};
     }
+    if (sensors.wheel_encoders) {
+      encoder_stream_ = MakeStream("wheel_encoders", StreamType::kWheelEncoders, sensors.wheel_encoders->rate_hz,
+                                   {"left", "right"}, "rad", encoder_clock_);
+      encoder_stream_.info.attributes = {{"ticks_per_revolution", sensors.wheel_encoders->ticks_per_revolution}};
+    }
+    if (sensors.laser) {
+      scan_stream_.info.name = "scan_matching";
+      scan_stream_.info.type = StreamType::kScanMatching;
+      scan_stream_.info.rate_hz = sensors.laser->rate_hz;
+      scan_stream_.info.columns = recording::FixedColumns(StreamType::kScanMatching);
+      scan_stream_.info.units = "m/s,rad/s";
+    }
     if (sensors.odometer) {
       wheel_stream_ = MakeStream("rear_wheel", StreamType::kWheelEncoders, sensors.odometer->rate_hz, {"rear"}, "m/s",
                                  odometer_clock_);
@@ -189,22 +241,45 @@ class Simulator::Impl {
     truth_.reserve(truth_clock_.samples);
 
     // The vehicle at rest at the start pose.
-    vehicle_.Place(model_.get(), data_.get(), terrain_, scenario_.robot.start_position_m.x(),
-                   scenario_.robot.start_position_m.y(), scenario_.robot.start_heading_rad, kPlacementClearanceM);
+    if (ackermann_) {
+      vehicle_.Place(model_.get(), data_.get(), terrain_, scenario_.robot.start_position_m.x(),
+                     scenario_.robot.start_position_m.y(), scenario_.robot.start_heading_rad, kPlacementClearanceM);
+    } else {
+      wheeled_.Place(model_.get(), data_.get(), scenario_.robot.start_position_m.x(),
+                     scenario_.robot.start_position_m.y(), scenario_.robot.start_heading_rad, kPlacementClearanceM);
+      if (scenario_.sensors.laser) {
+        laser_mounting_ = SiteInOdom(wheeled_.laser_site());
+        scan_stream_.info.mounting = laser_mounting_;
+      }
+    }
     return Status::Ok();
   }
 
  private:
-  // Speed [m/s] and handlebar [rad] set-points at t_ns: the profiles from t = 0, the lead-in's rest and ramp before.
+  // The two set-points at t_ns (Ackermann: speed [m/s] and handlebar [rad]; body velocity: v_x [m/s] and omega_z
+  // [rad/s]): the profiles from t = 0, the lead-in's rest and ramp before.
   std::pair<double, double> SetPoints(std::int64_t t_ns) const {
     const DriverOptions& driver = scenario_.driver;
+    const Profile& first = ackermann_ ? driver.speed_mps : driver.linear_mps;
+    const Profile& second = ackermann_ ? driver.handlebar_rad : driver.angular_radps;
     if (t_ns >= 0) {
       const double t = static_cast<double>(t_ns) * 1e-9;
-      return {driver.speed_mps.Evaluate(t), driver.handlebar_rad.Evaluate(t)};
+      return {first.Evaluate(t), second.Evaluate(t)};
     }
     const double phase = static_cast<double>(t_ns + lead_in_ns_) / static_cast<double>(lead_in_ns_);
     const double ramp = std::clamp((phase - kLeadInRestFraction) / (1.0 - kLeadInRestFraction), 0.0, 1.0);
-    return {ramp * driver.speed_mps.Evaluate(0.0), ramp * driver.handlebar_rad.Evaluate(0.0)};
+    return {ramp * first.Evaluate(0.0), ramp * second.Evaluate(0.0)};
+  }
+
+  // Pose of a robot site in O, measured at the current state (the robot is rigid between them).
+  recording::Mounting SiteInOdom(int site) const {
+    const FrameKinematics odom = ReadSiteKinematics(model_.get(), data_.get(), odom_site_);
+    const FrameKinematics sensor = ReadSiteKinematics(model_.get(), data_.get(), site);
+    recording::Mounting m;
+    const Eigen::Vector3d p = odom.q_world_body.conjugate() * (sensor.p_world_body - odom.p_world_body);
+    m.p_body_sensor = p.unaryExpr([](double x) { return Micrometres(x); });
+    m.q_body_sensor = (odom.q_world_body.conjugate() * sensor.q_world_body).normalized();
+    return m;
   }
 
   Status Loop() {
@@ -216,9 +291,13 @@ class Simulator::Impl {
     long next_progress = 0;
     for (t_ns_ = -lead_in_ns_; t_ns_ <= end_ns_; t_ns_ += step_ns_) {
       // Driver and low-level control.
-      const auto [speed, handlebar] = SetPoints(t_ns_);
-      const double measured = vehicle_.RearWheelRate(d) * vehicle_.wheel_radius_m();
-      vehicle_.Apply(handlebar, controller_->Update(speed, measured, dt_s), d);
+      const auto [first, second] = SetPoints(t_ns_);
+      if (ackermann_) {
+        const double measured = vehicle_.RearWheelRate(d) * vehicle_.wheel_radius_m();
+        vehicle_.Apply(second, controller_->Update(first, measured, dt_s), d);
+      } else {
+        wheeled_.Apply(first, 0.0, second, d);
+      }
 
       // Sensors due now, on the state at t completed by forward dynamics.
       if (t_ns_ >= 0 && AnyDue(t_ns_)) {
@@ -249,12 +328,12 @@ class Simulator::Impl {
 
   bool AnyDue(std::int64_t t_ns) const {
     return truth_clock_.Due(t_ns) || imu_clock_.Due(t_ns) || mag_clock_.Due(t_ns) || gps_clock_.Due(t_ns) ||
-           odometer_clock_.Due(t_ns);
+           odometer_clock_.Due(t_ns) || encoder_clock_.Due(t_ns) || laser_clock_.Due(t_ns);
   }
 
   // Synthesizes every stream due at t_ns from the current (completed) state.
   Status Sample(std::int64_t t_ns) {
-    const FrameKinematics body = ReadSiteKinematics(model_.get(), data_.get(), vehicle_.odom_site());
+    const FrameKinematics body = ReadSiteKinematics(model_.get(), data_.get(), odom_site_);
     const SensorOptions& sensors = scenario_.sensors;
 
     if (truth_clock_.Due(t_ns)) {
@@ -284,6 +363,17 @@ class Simulator::Impl {
       local_->Reverse(antenna.x(), antenna.y(), antenna.z(), latitude, longitude, altitude);
       gps_stream_.values.row(gps_clock_.Row(t_ns)) << latitude, longitude, altitude;
     }
+    if (encoder_clock_.Due(t_ns)) {
+      // Cumulative angle since t = 0, truncated to whole ticks (an incremental encoder's count).
+      const double tick_rad = 2.0 * kPi / sensors.wheel_encoders->ticks_per_revolution;
+      if (t_ns == 0)
+        for (int i = 0; i < 2; ++i) encoder_zero_rad_[i] = wheeled_.WheelAngle(data_.get(), i);
+      for (int i = 0; i < 2; ++i) {
+        const double angle = wheeled_.WheelAngle(data_.get(), i) - encoder_zero_rad_[i];
+        encoder_stream_.values(encoder_clock_.Row(t_ns), i) = std::floor(angle / tick_rad) * tick_rad;
+      }
+    }
+    if (laser_clock_.Due(t_ns)) SampleLaser(t_ns);
     if (odometer_clock_.Due(t_ns)) {
       const OdometerOptions& odo = *sensors.odometer;
       const double z_v =
@@ -295,6 +385,34 @@ class Simulator::Impl {
       steering_stream_.values(odometer_clock_.Row(t_ns), 0) = z_theta;
     }
     return Status::Ok();
+  }
+
+  // One laser scan: ray casts plus range noise; from the second scan on, the scan matcher's displacement since the
+  // previous scan becomes one scan_matching sample at the middle of the interval. The velocities follow eq. 7's
+  // motion (rotate half, translate, rotate half): omega = theta / dt, v = R(-theta / 2) t / dt.
+  void SampleLaser(std::int64_t t_ns) {
+    const LaserOptions& l = *scenario_.sensors.laser;
+    std::vector<double> ranges = CastScan(model_.get(), data_.get(), wheeled_.laser_site(), scan_geometry_);
+    for (double& r : ranges) {
+      const double noise = laser_noise_.Draw(l.sigma_m);  // drawn for every beam, so returns never shift the stream
+      if (std::isfinite(r)) r += noise;
+    }
+    if (!previous_scan_.empty()) {
+      const double dt = static_cast<double>(laser_clock_.period_ns) * 1e-9;
+      const ScanMatch match = MatchScansFrom(scan_geometry_, previous_scan_, ranges,
+                                             {Eigen::Vector3d::Zero(), previous_scan_velocity_ * dt});
+      if (match.ok) {
+        const double theta = match.pose[2];
+        const Eigen::Vector2d v = Eigen::Rotation2Dd(-0.5 * theta) * match.pose.head<2>() / dt;
+        previous_scan_velocity_ << match.pose.head<2>() / dt, theta / dt;
+        scan_stream_.t.push_back(Time::FromNanoseconds(t_ns - laser_clock_.period_ns / 2));
+        scan_rows_.push_back({v.x(), v.y(), 0.0, 0.0, 0.0, theta / dt});
+        scan_sigma_sum_ += Eigen::Vector2d(std::sqrt(match.covariance(0, 0)), std::sqrt(match.covariance(2, 2))) / dt;
+      } else {
+        ++out_.stats.failed_scan_matches;
+      }
+    }
+    previous_scan_ = std::move(ranges);
   }
 
   // The drive must stay on the heightfield and upright.
@@ -316,8 +434,19 @@ class Simulator::Impl {
     st.max_abs_pitch_rad = std::max(st.max_abs_pitch_rad, std::abs(std::asin(std::clamp(-R(2, 0), -1.0, 1.0))));
     st.max_abs_roll_rad = std::max(st.max_abs_roll_rad, std::abs(std::atan2(R(2, 1), R(2, 2))));
     st.max_lateral_speed_mps = std::max(st.max_lateral_speed_mps, std::abs(body.v_body.y()));
-    const double rim = vehicle_.RearWheelRate(data_.get()) * vehicle_.wheel_radius_m();
-    st.max_wheel_slip_mps = std::max(st.max_wheel_slip_mps, std::abs(rim - body.v_body.x()));
+    if (ackermann_) {
+      const double rim = vehicle_.RearWheelRate(data_.get()) * vehicle_.wheel_radius_m();
+      st.max_wheel_slip_mps = std::max(st.max_wheel_slip_mps, std::abs(rim - body.v_body.x()));
+    } else {
+      // Rim speed against the speed of the ground point below the wheel, along the rolling direction.
+      for (std::size_t i = 0; i < wheeled_.wheels().size(); ++i) {
+        const WheelGeometry& w = wheeled_.wheels()[i];
+        const Eigen::Vector2d v_point =
+            body.v_body.head<2>() + body.omega_body.z() * Eigen::Vector2d(-w.p_body_m.y(), w.p_body_m.x());
+        const double rim = wheeled_.WheelRate(data_.get(), static_cast<int>(i)) * w.radius_m;
+        st.max_wheel_slip_mps = std::max(st.max_wheel_slip_mps, std::abs(rim - w.drive_direction.dot(v_point)));
+      }
+    }
     min_height_ = std::min(min_height_, body.p_world_body.z());
     max_height_ = std::max(max_height_, body.p_world_body.z());
   }
@@ -326,10 +455,15 @@ class Simulator::Impl {
   void Finish() {
     const SensorOptions& sensors = scenario_.sensors;
     recording::Recording& rec = out_.recording;
-    rec.platform.kind = "ackermann";
-    rec.platform.geometry = {{"wheelbase_m", wheelbase_m_},
-                             {"track_m", Micrometres(vehicle_.rear_track_m())},
-                             {"wheel_radius_m", Micrometres(vehicle_.wheel_radius_m())}};
+    rec.platform.kind = scenario_.robot.kind;
+    if (ackermann_) {
+      rec.platform.geometry = {{"wheelbase_m", wheelbase_m_},
+                               {"track_m", Micrometres(vehicle_.rear_track_m())},
+                               {"wheel_radius_m", Micrometres(vehicle_.wheel_radius_m())}};
+    } else {
+      rec.platform.geometry = {{"wheel_radius_m", Micrometres(wheeled_.mean_radius_m())},
+                               {"baseline_m", Micrometres(wheeled_.baseline_m())}};
+    }
     rec.origin = scenario_.origin;
     rec.provenance.source = "simulated";
     rec.provenance.scenario = scenario_.source_file;
@@ -348,6 +482,16 @@ class Simulator::Impl {
     if (sensors.odometer) {
       rec.streams.push_back(std::move(wheel_stream_));
       rec.streams.push_back(std::move(steering_stream_));
+    }
+    if (sensors.wheel_encoders) rec.streams.push_back(std::move(encoder_stream_));
+    if (sensors.laser) {
+      scan_stream_.values.resize(static_cast<Eigen::Index>(scan_rows_.size()), 6);
+      for (std::size_t k = 0; k < scan_rows_.size(); ++k)
+        for (int c = 0; c < 6; ++c) scan_stream_.values(static_cast<Eigen::Index>(k), c) = scan_rows_[k][c];
+      // Nominal noise: the scan matcher's mean standard deviations over the run.
+      const Eigen::Vector2d sigma = scan_sigma_sum_ / std::max<double>(1.0, static_cast<double>(scan_rows_.size()));
+      scan_stream_.info.noise = {{"sigma_mps", sigma.x()}, {"sigma_radps", sigma.y()}};
+      rec.streams.push_back(std::move(scan_stream_));
     }
     rec.ground_truth = std::move(truth_);
 
@@ -368,6 +512,17 @@ class Simulator::Impl {
       cal["magnetometer.A"] = std::vector<double>(A.data(), A.data() + 9);
       cal["magnetometer.b"] = {magnetometer_.b.x(), magnetometer_.b.y(), magnetometer_.b.z()};
     }
+    if (sensors.wheel_encoders) {
+      cal["odometer.radius_left"] = {wheeled_.wheels()[0].radius_m};
+      cal["odometer.radius_right"] = {wheeled_.wheels()[1].radius_m};
+      cal["odometer.baseline"] = {wheeled_.baseline_m()};
+    }
+    if (sensors.laser) {
+      const Eigen::Vector3d& s = laser_mounting_.p_body_sensor;
+      const Eigen::Quaterniond& q = laser_mounting_.q_body_sensor;
+      cal["scan_matching.lever_arm"] = {s.x(), s.y(), s.z()};
+      cal["scan_matching.misalignment"] = {q.w(), q.x(), q.y(), q.z()};
+    }
     if (sensors.odometer) {
       cal["odometer.kv_over_L"] = {sensors.odometer->kv_over_L};
       cal["odometer.k_theta"] = {sensors.odometer->k_theta};
@@ -383,11 +538,21 @@ class Simulator::Impl {
   const std::uint64_t seed_;
   const std::string where_;        // the scenario, for messages
   const std::string model_where_;  // the robot model, for messages
+  const bool ackermann_ = scenario_.robot.kind == "ackermann";
 
   Terrain terrain_;
   ModelPtr model_;
   DataPtr data_;
   AckermannVehicle vehicle_;
+  WheeledRobot wheeled_;
+  int odom_site_ = -1;
+  ScanGeometry scan_geometry_;
+  recording::Mounting laser_mounting_;
+  std::vector<double> previous_scan_;
+  Eigen::Vector3d previous_scan_velocity_ = Eigen::Vector3d::Zero();   // (x, y, theta) rates of the last match
+  std::vector<std::array<double, 6>> scan_rows_;
+  Eigen::Vector2d scan_sigma_sum_ = Eigen::Vector2d::Zero();
+  double encoder_zero_rad_[2] = {0.0, 0.0};
   std::optional<SpeedController> controller_;
   std::optional<GeographicLib::LocalCartesian> local_;
   ImuCalibration imu_;
@@ -398,7 +563,7 @@ class Simulator::Impl {
   std::int64_t end_ns_ = 0;
   std::int64_t lead_in_ns_ = 0;
   std::int64_t t_ns_ = 0;          // the current time, for messages
-  Clock truth_clock_, imu_clock_, mag_clock_, gps_clock_, odometer_clock_;
+  Clock truth_clock_, imu_clock_, mag_clock_, gps_clock_, odometer_clock_, encoder_clock_, laser_clock_;
 
   NoiseStream gyro_noise_{seed_, NoiseSource::kGyro, options_.noise};
   NoiseStream accel_noise_{seed_, NoiseSource::kAccel, options_.noise};
@@ -406,8 +571,10 @@ class Simulator::Impl {
   NoiseStream gps_noise_{seed_, NoiseSource::kGps, options_.noise};
   NoiseStream speed_noise_{seed_, NoiseSource::kSpeed, options_.noise};
   NoiseStream steering_noise_{seed_, NoiseSource::kSteering, options_.noise};
+  NoiseStream laser_noise_{seed_, NoiseSource::kLaserRange, options_.noise};
 
-  recording::Stream imu_stream_, mag_stream_, gps_stream_, wheel_stream_, steering_stream_;
+  recording::Stream imu_stream_, mag_stream_, gps_stream_, wheel_stream_, steering_stream_, encoder_stream_,
+      scan_stream_;
   Trajectory truth_;
   double min_height_ = 1e300;
   double max_height_ = -1e300;

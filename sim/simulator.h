@@ -54,7 +54,9 @@ struct SimulationStats {
   double path_height_range_m = 0.0;     // max - min height of O over the recording
   double terrain_relief_m = 0.0;        // peak-to-peak over the whole heightfield (0 on a flat floor)
   double max_lateral_speed_mps = 0.0;   // max |v_y| of O: side slip, which eq. 15 assumes to be zero
-  double max_wheel_slip_mps = 0.0;      // max |omega_rear r - v_x| of O: longitudinal slip and creep
+  double max_wheel_slip_mps = 0.0;      // max |omega_rear r - v_x| of O (wheeled robots: of every driven wheel's
+                                        // rim against the ground point below it): longitudinal slip and creep
+  int failed_scan_matches = 0;          // scan pairs the scan matcher could not match (no scan_matching sample)
   std::vector<std::string> warnings;    // MuJoCo warnings, if any
 };
 
