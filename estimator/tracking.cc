@@ -73,6 +73,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
   update_options.method = SolverOptions::Method::kGaussNewton;
   update_options.max_iterations = config.tracking.max_iterations;
   update_options.function_tolerance = config.tracking.improvement_threshold;
+  update_options.model_tolerance = config.tracking.improvement_threshold;
   update_options.time_budget_s = config.tracking.time_budget_s;
 
   TrackingResult out;
@@ -85,6 +86,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
   FactorId first_new_factor = 0;
   CovarianceRequest leaving;
   std::vector<double> update_times;
+  SolverWorkspace workspace;  // the window's pattern repeats from one update to the next
   for (std::size_t i = 0; i < measurements.size(); ++i) {
     const MeasurementRef& m = measurements[i];
     builder.Add(m);
@@ -111,11 +113,11 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
       leaving.computed = false;
       CovarianceRequest* request =
           static_cast<int>(builder.poses().size()) > config.tracking.window ? &leaving : nullptr;
-      const SolverSummary s = Solve(update_options, &builder.graph(), request);
+      const SolverSummary s = Solve(update_options, &builder.graph(), request, &workspace);
       if (!s.usable()) return Status::Error("update at t = " + FormatSeconds(m.t) + " failed: " + s.message);
       iterations += s.iterations;
       if (config.gate_probability && GateOutliers(*config.gate_probability, &builder, first_new_factor) > 0)
-        iterations += Solve(update_options, &builder.graph(), request).iterations;
+        iterations += Solve(update_options, &builder.graph(), request, &workspace).iterations;
       const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
       ++out.updates;
       update_seconds += dt;
