@@ -68,7 +68,9 @@ struct StreamConfig {
 struct TrackingConfig {
   int window = 40;                       // poses kept in the fixed-lag window
   int max_iterations = 10;               // per update
-  double improvement_threshold = 1e-3;   // stop iterating when the cost drops by less than this fraction
+  // Stop iterating when the cost drops by less than this fraction, or when the drop matches the Gauss-Newton
+  // model's prediction to within this fraction (SolverOptions::model_tolerance).
+  double improvement_threshold = 1e-3;
   double time_budget_s = 0.05;           // per update
   double initialization_s = 2.0;         // data buffered before the first window is solved
 };

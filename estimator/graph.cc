@@ -45,6 +45,10 @@ FactorId Graph::AddFactor(std::unique_ptr<Factor> factor, std::vector<VariableId
   entry.variables = std::move(variables);
   if (factor_is_additive) {
     entry.noise_sqrt_covariance = Eigen::LLT<Eigen::MatrixXd>(noise_covariance).matrixL();
+    entry.noise_sqrt_diagonal = true;
+    for (int c = 0; c < entry.noise_sqrt_covariance.cols(); ++c)
+      for (int r = c + 1; r < entry.noise_sqrt_covariance.rows(); ++r)
+        entry.noise_sqrt_diagonal &= entry.noise_sqrt_covariance(r, c) == 0.0;
   }
   entry.noise_covariance = std::move(noise_covariance);
   entry.loss = loss;

@@ -39,6 +39,7 @@ struct FactorEntry {
   std::vector<VariableId> variables;
   Eigen::MatrixXd noise_covariance;  // noise_dim x noise_dim, Sigma_eta
   Eigen::MatrixXd noise_sqrt_covariance;  // L (lower) with L L^T = Sigma_eta, for factors with additive noise
+  bool noise_sqrt_diagonal = false;       // L is diagonal (independent noise components): whitening is a division
   Loss loss;
   std::string stream;
   Time stamp;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include "estimator/factor.h"
@@ -545,6 +546,11 @@ void ProblemBuilder::Finish() {
 void ProblemBuilder::PopOldestPose() {
   poses_.pop_front();
   popped_any_ = true;
+  // Forget the streams of factors older than every factor left (their poses have left the graph), so that a long
+  // online run keeps a bounded map.
+  const FactorId oldest = graph_.factors().empty() ? std::numeric_limits<FactorId>::max()
+                                                   : graph_.factors().begin()->first;
+  stream_of_factor_.erase(stream_of_factor_.begin(), stream_of_factor_.lower_bound(oldest));
   absolute_fixes_.erase(std::remove_if(absolute_fixes_.begin(), absolute_fixes_.end(),
                                        [this](const auto& fix) { return !graph_.HasVariable(fix.first); }),
                         absolute_fixes_.end());

@@ -1,6 +1,7 @@
 #include "estimator/solver.h"
 
 #include <chrono>
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -11,6 +12,7 @@ namespace roamlab::estimator {
 std::string SolverOptions::Validate() const {
   if (max_iterations < 0) return "max_iterations must be >= 0";
   if (!(function_tolerance >= 0.0)) return "function_tolerance must be >= 0";
+  if (!(model_tolerance >= 0.0)) return "model_tolerance must be >= 0";
   if (!(step_tolerance >= 0.0)) return "step_tolerance must be >= 0";
   if (!(time_budget_s > 0.0)) return "time_budget_s must be > 0";
   if (!(initial_lambda > 0.0)) return "initial_lambda must be > 0";
@@ -20,6 +22,7 @@ std::string SolverOptions::Validate() const {
 const char* TerminationName(Termination termination) {
   switch (termination) {
     case Termination::kFunctionTolerance: return "function_tolerance";
+    case Termination::kModelTolerance: return "model_tolerance";
     case Termination::kStepTolerance: return "step_tolerance";
     case Termination::kMaxIterations: return "max_iterations";
     case Termination::kTimeBudget: return "time_budget";
@@ -53,7 +56,12 @@ double TangentNorm(const Graph& graph, const std::vector<VariableId>& order) {
 
 }  // namespace
 
-SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceRequest* covariance) {
+SolverWorkspace::SolverWorkspace() : system_(std::make_unique<internal::NormalEquations>()) {}
+SolverWorkspace::~SolverWorkspace() = default;
+int SolverWorkspace::analyses() const { return system_->analyses(); }
+
+SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceRequest* covariance,
+                    SolverWorkspace* workspace) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   const auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
@@ -64,8 +72,11 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
     return summary;
   }
 
-  const std::vector<VariableId> order = FreeVariableOrder(*graph);
-  internal::NormalEquations system(*graph, order);
+  SolverWorkspace local;
+  SolverWorkspace& ws = workspace != nullptr ? *workspace : local;
+  internal::NormalEquations& system = *ws.system_;
+  system.Reset(*graph, FreeVariableOrder(*graph));
+  const std::vector<VariableId>& order = system.order();
   summary.free_dimension = system.dimension();
   summary.factors = static_cast<int>(system.factor_ids().size());
   std::string failed_stream;
@@ -104,10 +115,13 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
     }
     ++summary.iterations;
 
-    // Try the step on a copy of the free variables.
-    std::vector<Eigen::VectorXd> saved;
-    saved.reserve(order.size());
-    for (VariableId id : order) saved.push_back(graph->variable(id).value);
+    // Try the step, keeping a copy of the free variables' values.
+    std::vector<double>& saved = ws.saved_;
+    saved.clear();
+    for (VariableId id : order) {
+      const Eigen::VectorXd& value = graph->variable(id).value;
+      saved.insert(saved.end(), value.data(), value.data() + value.size());
+    }
     system.Update(dx, graph);
     double new_cost = 0.0;
     const bool evaluated = system.CostWithLastWhitening(*graph, &new_cost);
@@ -120,7 +134,12 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
     const bool accept = evaluated && (lm ? (predicted > 0.0 && actual / predicted > 1e-3) : true);
 
     if (!accept) {
-      for (std::size_t i = 0; i < order.size(); ++i) graph->mutable_variable(order[i]).value = saved[i];
+      const double* from = saved.data();
+      for (VariableId id : order) {
+        Eigen::VectorXd& value = graph->mutable_variable(id).value;
+        std::copy(from, from + value.size(), value.data());
+        from += value.size();
+      }
       if (!lm) {
         summary.termination = Termination::kFailure;
         summary.message = "Gauss-Newton step could not be evaluated";
@@ -148,6 +167,10 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
     const double step_norm = dx.norm();
     if (std::abs(actual) <= options.function_tolerance * old_cost) {
       summary.termination = Termination::kFunctionTolerance;
+      break;
+    }
+    if (std::abs(actual - predicted) <= options.model_tolerance * old_cost) {
+      summary.termination = Termination::kModelTolerance;
       break;
     }
     if (step_norm <= options.step_tolerance * (TangentNorm(*graph, order) + options.step_tolerance)) {

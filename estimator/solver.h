@@ -4,6 +4,7 @@
 #pragma once
 
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,10 @@ struct SolverOptions {
   int max_iterations = 50;
   // Stop when an accepted step lowers the cost by less than this fraction.
   double function_tolerance = 1e-8;
+  // Stop when an accepted step's actual decrease matches the decrease predicted by the quadratic model (the one the
+  // step minimized) to within this fraction of the cost: the model is then accurate at the new point, and a
+  // re-linearized step could gain only about that mismatch. 0 turns it off.
+  double model_tolerance = 0.0;
   // Stop when |dx| < step_tolerance * (|x| + step_tolerance), x and dx in tangent coordinates.
   double step_tolerance = 1e-10;
   // Stop before starting an iteration once this much wall time has passed [s].
@@ -33,6 +38,7 @@ struct SolverOptions {
 
 enum class Termination {
   kFunctionTolerance,
+  kModelTolerance,
   kStepTolerance,
   kMaxIterations,
   kTimeBudget,
@@ -65,10 +71,32 @@ struct CovarianceRequest {
   bool computed = false;
 };
 
+namespace internal {
+class NormalEquations;
+}
+
+// State kept between solves of graphs whose structure repeats (fixed-lag tracking: the window slides by one pose and
+// keeps its band): the buffers of the normal equations and CHOLMOD's symbolic analysis, reused while the Hessian's
+// sparsity pattern is unchanged. Results are the same as without it.
+class SolverWorkspace {
+ public:
+  SolverWorkspace();
+  ~SolverWorkspace();
+  // How many solves had to analyse a new sparsity pattern.
+  int analyses() const;
+
+ private:
+  friend SolverSummary Solve(const SolverOptions&, Graph*, CovarianceRequest*, SolverWorkspace*);
+  std::unique_ptr<internal::NormalEquations> system_;
+  std::vector<double> saved_;
+};
+
 // Optimizes the free variables of `graph` in place. Variables are ordered poses first then the others, in id order;
 // CHOLMOD picks its own fill-reducing permutation on top. When `covariance` is given, fills it (computed = false if the
-// Hessian is not positive definite).
-SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceRequest* covariance = nullptr);
+// Hessian is not positive definite). `workspace` (optional) carries buffers and the symbolic factorization over to the
+// next solve.
+SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceRequest* covariance = nullptr,
+                    SolverWorkspace* workspace = nullptr);
 
 // The free variables of `graph` in the solver's order.
 std::vector<VariableId> FreeVariableOrder(const Graph& graph);

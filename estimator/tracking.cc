@@ -20,7 +20,8 @@ FactorId NextFactorId(const Graph& graph) {
 
 // The oldest pose's estimate and position covariance (marginal of the whole window): from the last update's solve
 // when it computed it, otherwise from the window's Hessian now.
-Status EmitOldest(ProblemBuilder* builder, const CovarianceRequest* from_solve, TrackingResult* out) {
+Status EmitOldest(ProblemBuilder* builder, const CovarianceRequest* from_solve, const TrackingOptions& options,
+                  TrackingResult* out) {
   const PoseNode& node = builder->poses().front();
   const Graph& graph = builder->graph();
   const Pose<double> p = PoseFromArray(graph.variable(node.id).value.data());
@@ -32,13 +33,19 @@ Status EmitOldest(ProblemBuilder* builder, const CovarianceRequest* from_solve, 
     if (!info.ok()) return info.status();
     cov = info.value().information.inverse();
   }
-  out->trajectory.push_back({node.t, p.p_world_body, p.q_world_body});
-  out->position_covariance.push_back(cov.topLeftCorner<3, 3>());
+  const StampedPose pose{node.t, p.p_world_body, p.q_world_body};
+  if (options.on_pose) {
+    options.on_pose(pose, cov.topLeftCorner<3, 3>());
+  } else {
+    out->trajectory.push_back(pose);
+    out->position_covariance.push_back(cov.topLeftCorner<3, 3>());
+  }
   return Status::Ok();
 }
 
-Status EmitAndMarginalizeOldest(ProblemBuilder* builder, const CovarianceRequest* from_solve, TrackingResult* out) {
-  const Status emitted = EmitOldest(builder, from_solve, out);
+Status EmitAndMarginalizeOldest(ProblemBuilder* builder, const CovarianceRequest* from_solve,
+                                const TrackingOptions& options, TrackingResult* out) {
+  const Status emitted = EmitOldest(builder, from_solve, options, out);
   if (!emitted.ok()) return emitted;
   const PoseNode& node = builder->poses().front();
   std::vector<VariableId> leaving = {node.id};
@@ -73,6 +80,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
   update_options.method = SolverOptions::Method::kGaussNewton;
   update_options.max_iterations = config.tracking.max_iterations;
   update_options.function_tolerance = config.tracking.improvement_threshold;
+  update_options.model_tolerance = config.tracking.improvement_threshold;
   update_options.time_budget_s = config.tracking.time_budget_s;
 
   TrackingResult out;
@@ -85,6 +93,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
   FactorId first_new_factor = 0;
   CovarianceRequest leaving;
   std::vector<double> update_times;
+  SolverWorkspace workspace;  // the window's pattern repeats from one update to the next
   for (std::size_t i = 0; i < measurements.size(); ++i) {
     const MeasurementRef& m = measurements[i];
     builder.Add(m);
@@ -111,11 +120,11 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
       leaving.computed = false;
       CovarianceRequest* request =
           static_cast<int>(builder.poses().size()) > config.tracking.window ? &leaving : nullptr;
-      const SolverSummary s = Solve(update_options, &builder.graph(), request);
+      const SolverSummary s = Solve(update_options, &builder.graph(), request, &workspace);
       if (!s.usable()) return Status::Error("update at t = " + FormatSeconds(m.t) + " failed: " + s.message);
       iterations += s.iterations;
       if (config.gate_probability && GateOutliers(*config.gate_probability, &builder, first_new_factor) > 0)
-        iterations += Solve(update_options, &builder.graph(), request).iterations;
+        iterations += Solve(update_options, &builder.graph(), request, &workspace).iterations;
       const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
       ++out.updates;
       update_seconds += dt;
@@ -124,7 +133,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
     }
     first_new_factor = NextFactorId(builder.graph());
     while (static_cast<int>(builder.poses().size()) > config.tracking.window) {
-      const Status st = EmitAndMarginalizeOldest(&builder, &leaving, &out);
+      const Status st = EmitAndMarginalizeOldest(&builder, &leaving, options, &out);
       leaving.computed = false;
       if (!st.ok()) return st;
     }
@@ -137,11 +146,11 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
   if (!s.usable()) return Status::Error("final window: " + s.message);
   while (!builder.poses().empty()) {
     if (builder.poses().size() == 1) {
-      const Status st = EmitOldest(&builder, nullptr, &out);
+      const Status st = EmitOldest(&builder, nullptr, options, &out);
       if (!st.ok()) return st;
       break;
     }
-    const Status st = EmitAndMarginalizeOldest(&builder, nullptr, &out);
+    const Status st = EmitAndMarginalizeOldest(&builder, nullptr, options, &out);
     if (!st.ok()) return st;
   }
   out.mean_update_s = out.updates > 0 ? update_seconds / out.updates : 0.0;

@@ -39,6 +39,9 @@ struct TrackingResult {
 
 struct TrackingOptions {
   std::function<void(double fraction_done)> progress;  // optional
+  // Optional: receives each pose and its world-frame position covariance [m^2] as it leaves the window. When set,
+  // TrackingResult::trajectory and position_covariance stay empty (a long online run then keeps bounded memory).
+  std::function<void(const StampedPose& pose, const Eigen::Matrix3d& position_covariance)> on_pose;
 };
 
 // `calibration` overrides parameter values (ambient, by name) and fixes them.

@@ -2,6 +2,8 @@
 
 #include <Eigen/Cholesky>
 
+#include "common/check.h"
+
 namespace roamlab::estimator::internal {
 namespace {
 
@@ -13,14 +15,34 @@ const double* const* GatherValues(const Graph& graph, const FactorEntry& entry) 
   return values.data();
 }
 
+// x <- L^-1 x for the error or a Jacobian: a division per row when L is diagonal (what the triangular solve does
+// then), otherwise a triangular solve.
+template <typename Derived>
+void Whiten(const Eigen::MatrixXd& L, bool diagonal, Eigen::MatrixBase<Derived>* x) {
+  if (diagonal) {
+    for (Eigen::Index r = 0; r < x->rows(); ++r) x->row(r) /= L(r, r);
+  } else {
+    L.triangularView<Eigen::Lower>().solveInPlace(*x);
+  }
+}
+
 }  // namespace
 
 bool LinearizeFactor(const Graph& graph, const FactorEntry& entry, const std::vector<bool>& want_jacobian,
                      WhitenedFactor* out) {
+  ROAMLAB_CHECK(want_jacobian.size() <= 64, "factor from '" << entry.stream << "' has more than 64 variables");
+  std::uint64_t mask = 0;
+  for (std::size_t i = 0; i < want_jacobian.size(); ++i)
+    if (want_jacobian[i]) mask |= std::uint64_t{1} << i;
+  return LinearizeFactorAt(entry, GatherValues(graph, entry), mask, out);
+}
+
+bool LinearizeFactorAt(const FactorEntry& entry, const double* const* values, std::uint64_t want_mask,
+                       WhitenedFactor* out) {
   const Factor& factor = *entry.factor;
   const int m = factor.residual_dim();
   const std::size_t n = entry.variables.size();
-  const double* const* values = GatherValues(graph, entry);
+  const auto wanted = [want_mask](std::size_t i) { return ((want_mask >> i) & 1u) != 0; };
 
   // Raw error (into `residual`, whitened in place below), Jacobians in tangent space, and the noise Jacobian.
   out->residual.resize(m);
@@ -28,33 +50,33 @@ bool LinearizeFactor(const Graph& graph, const FactorEntry& entry, const std::ve
   thread_local std::vector<double*> jacobian_ptrs;
   jacobian_ptrs.assign(n, nullptr);
   for (std::size_t i = 0; i < n; ++i) {
-    if (want_jacobian[i]) {
+    if (wanted(i)) {
       out->jacobians[i].resize(m, factor.manifolds()[i].tangent_dim());
       jacobian_ptrs[i] = out->jacobians[i].data();
     } else {
       out->jacobians[i].resize(0, 0);
     }
   }
-  bool any_jacobian = false;
-  for (std::size_t i = 0; i < n; ++i) any_jacobian |= want_jacobian[i];
+  bool diagonal = false;
   if (factor.additive_noise()) {
     // Error covariance = noise covariance, factored once when the factor was added.
-    if (!factor.Evaluate(values, out->residual.data(), any_jacobian ? jacobian_ptrs.data() : nullptr, nullptr))
+    if (!factor.Evaluate(values, out->residual.data(), want_mask != 0 ? jacobian_ptrs.data() : nullptr, nullptr))
       return false;
-    out->sqrt_covariance = entry.noise_sqrt_covariance;
+    diagonal = entry.noise_sqrt_diagonal;
   } else {
     // Error covariance of eq. 1 at the current estimate, and its Cholesky factor.
-    Eigen::MatrixXd noise_jacobian(m, factor.noise_dim());
+    thread_local Eigen::MatrixXd noise_jacobian;
+    noise_jacobian.resize(m, factor.noise_dim());
     if (!factor.Evaluate(values, out->residual.data(), jacobian_ptrs.data(), noise_jacobian.data())) return false;
     const Eigen::LLT<Eigen::MatrixXd> llt(noise_jacobian * entry.noise_covariance * noise_jacobian.transpose());
     if (llt.info() != Eigen::Success) return false;
     out->sqrt_covariance = llt.matrixL();
   }
-  // Whitening: L^-1 e and L^-1 J, by triangular solves in place.
-  const auto L = out->sqrt_covariance.triangularView<Eigen::Lower>();
-  L.solveInPlace(out->residual);
+  // Whitening: L^-1 e and L^-1 J, in place.
+  const Eigen::MatrixXd& L = SqrtCovariance(entry, *out);
+  Whiten(L, diagonal, &out->residual);
   for (std::size_t i = 0; i < n; ++i) {
-    if (want_jacobian[i]) L.solveInPlace(out->jacobians[i]);
+    if (wanted(i)) Whiten(L, diagonal, &out->jacobians[i]);
   }
 
   // Robust loss as a weight.
@@ -66,17 +88,22 @@ bool LinearizeFactor(const Graph& graph, const FactorEntry& entry, const std::ve
     const double w = std::sqrt(rho_prime);
     out->residual *= w;
     for (std::size_t i = 0; i < n; ++i) {
-      if (want_jacobian[i]) out->jacobians[i] *= w;
+      if (wanted(i)) out->jacobians[i] *= w;
     }
   }
   return true;
 }
 
 bool FactorCost(const Graph& graph, const FactorEntry& entry, const Eigen::MatrixXd& sqrt_covariance, double* cost) {
+  return FactorCostAt(entry, GatherValues(graph, entry), sqrt_covariance, cost);
+}
+
+bool FactorCostAt(const FactorEntry& entry, const double* const* values, const Eigen::MatrixXd& sqrt_covariance,
+                  double* cost) {
   thread_local Eigen::VectorXd error;
   error.resize(entry.factor->residual_dim());
-  if (!entry.factor->Evaluate(GatherValues(graph, entry), error.data(), nullptr, nullptr)) return false;
-  sqrt_covariance.triangularView<Eigen::Lower>().solveInPlace(error);
+  if (!entry.factor->Evaluate(values, error.data(), nullptr, nullptr)) return false;
+  Whiten(sqrt_covariance, &sqrt_covariance == &entry.noise_sqrt_covariance && entry.noise_sqrt_diagonal, &error);
   double rho = 0.0, rho_prime = 1.0;
   entry.loss.Evaluate(error.squaredNorm(), &rho, &rho_prime);
   *cost = 0.5 * rho;

@@ -9,163 +9,237 @@
 
 namespace roamlab::estimator::internal {
 
+namespace {
+
+// Systems up to this dimension (a tracking window) are factored by CHOLMOD's simplicial LLT, larger ones (whole
+// recordings) by its supernodal LLT, whose dense BLAS kernels pay off only on large supernodes.
+constexpr int kMaxSimplicialDimension = 2000;
+
+// dst (A x B block of H's value array, column stride `stride`) += Ja^T Jb, Ja M x A, Jb M x B.
+template <int M, int A, int B>
+void AddProductFixed(const double* ja, const double* jb, double* dst, std::ptrdiff_t stride) {
+  Eigen::Map<Eigen::Matrix<double, A, B>, 0, Eigen::OuterStride<>> block(dst, A, B, Eigen::OuterStride<>(stride));
+  block.noalias() += Eigen::Map<const Eigen::Matrix<double, M, A>>(ja).transpose() *
+                     Eigen::Map<const Eigen::Matrix<double, M, B>>(jb);
+}
+
+void AddProduct(const Eigen::MatrixXd& ja, const Eigen::MatrixXd& jb, double* dst, std::ptrdiff_t stride) {
+  if (ja.cols() == 6 && jb.cols() == 6) {
+    if (ja.rows() == 3) return AddProductFixed<3, 6, 6>(ja.data(), jb.data(), dst, stride);
+    if (ja.rows() == 4) return AddProductFixed<4, 6, 6>(ja.data(), jb.data(), dst, stride);
+    if (ja.rows() == 6) return AddProductFixed<6, 6, 6>(ja.data(), jb.data(), dst, stride);
+  }
+  Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> block(dst, ja.cols(), jb.cols(), Eigen::OuterStride<>(stride));
+  block.noalias() += ja.transpose() * jb;
+}
+
+// g_segment += J^T r.
+void AddGradient(const Eigen::MatrixXd& j, const Eigen::VectorXd& r, double* g) {
+  if (j.cols() == 6 && j.rows() == 3) {
+    Eigen::Map<Eigen::Matrix<double, 6, 1>>(g).noalias() +=
+        Eigen::Map<const Eigen::Matrix<double, 3, 6>>(j.data()).transpose() * Eigen::Map<const Eigen::Vector3d>(r.data());
+    return;
+  }
+  if (j.cols() == 6 && j.rows() == 4) {
+    Eigen::Map<Eigen::Matrix<double, 6, 1>>(g).noalias() +=
+        Eigen::Map<const Eigen::Matrix<double, 4, 6>>(j.data()).transpose() * Eigen::Map<const Eigen::Vector4d>(r.data());
+    return;
+  }
+  Eigen::Map<Eigen::VectorXd>(g, j.cols()).noalias() += j.transpose() * r;
+}
+
+}  // namespace
+
 // H holds the block upper triangle with full diagonal blocks; CHOLMOD (stype = upper) reads only entries on and above
 // the diagonal, and so does selfadjointView<Upper>().
 struct NormalEquations::Cholmod {
-  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Upper> llt;
+  Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Upper> llt;
   Eigen::SparseMatrix<double> damped;
   bool analyzed = false;
   bool factored_undamped = false;  // the factorization is of H itself, at the last linearization
 };
 
-NormalEquations::NormalEquations(const Graph& graph, std::vector<VariableId> order)
-    : order_(std::move(order)), cholmod_(std::make_unique<Cholmod>()) {
-  for (VariableId id : order_) {
-    const Variable& v = graph.variable(id);
-    ROAMLAB_CHECK(!v.fixed, "variable '" << v.name << "' is fixed but was ordered as free");
-    ROAMLAB_CHECK(offset_.emplace(id, dimension_).second, "variable '" << v.name << "' ordered twice");
-    dims_.push_back(v.manifold.tangent_dim());
-    dimension_ += v.manifold.tangent_dim();
-  }
-  BuildPattern(graph);
-  cholmod_->llt.cholmod().print = 0;
+NormalEquations::NormalEquations() : cholmod_(std::make_unique<Cholmod>()) { cholmod_->llt.cholmod().print = 0; }
+
+NormalEquations::NormalEquations(const Graph& graph, std::vector<VariableId> order) : NormalEquations() {
+  Reset(graph, std::move(order));
 }
 
 NormalEquations::~NormalEquations() = default;
 
-int NormalEquations::OffsetOf(VariableId id) const {
-  const auto it = offset_.find(id);
-  return it == offset_.end() ? -1 : it->second;
+int NormalEquations::BlockOf(VariableId id) const {
+  const auto it = std::lower_bound(block_of_id_.begin(), block_of_id_.end(), std::make_pair(id, -1));
+  return it != block_of_id_.end() && it->first == id ? it->second : -1;
 }
 
-void NormalEquations::BuildPattern(const Graph& graph) {
-  // Position of each ordered variable, to find its block column.
-  std::unordered_map<int, int> block_of_offset;
-  std::vector<int> block_offset;
-  for (std::size_t b = 0; b < order_.size(); ++b) {
-    block_of_offset[offset_.at(order_[b])] = static_cast<int>(b);
-    block_offset.push_back(offset_.at(order_[b]));
-  }
+int NormalEquations::OffsetOf(VariableId id) const {
+  const int b = BlockOf(id);
+  return b < 0 ? -1 : block_offset_[b];
+}
 
-  // Which row blocks appear in each block column (upper triangle, diagonal always present).
+void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
+  // Blocks of the free variables.
+  order_ = std::move(order);
   const int nb = static_cast<int>(order_.size());
-  std::vector<std::vector<int>> rows_of(nb);
-  for (int b = 0; b < nb; ++b) rows_of[b].push_back(b);
-  std::vector<std::vector<int>> factor_blocks;
+  block_of_id_.clear();
+  dims_.clear();
+  block_offset_.clear();
+  dimension_ = 0;
+  for (int b = 0; b < nb; ++b) {
+    const Variable& v = graph.variable(order_[b]);
+    ROAMLAB_CHECK(!v.fixed, "variable '" << v.name << "' is fixed but was ordered as free");
+    block_of_id_.emplace_back(order_[b], b);
+    dims_.push_back(v.manifold.tangent_dim());
+    block_offset_.push_back(dimension_);
+    dimension_ += v.manifold.tangent_dim();
+  }
+  std::sort(block_of_id_.begin(), block_of_id_.end());
+  for (std::size_t i = 1; i < block_of_id_.size(); ++i)
+    ROAMLAB_CHECK(block_of_id_[i].first != block_of_id_[i - 1].first, "variable " << block_of_id_[i].first
+                                                                                  << " ordered twice");
+
+  // The included factors, their variables' blocks and values, and which row blocks appear in each block column
+  // (upper triangle, diagonal always present).
+  factor_ids_.clear();
+  entries_.clear();
+  want_.clear();
+  var_begin_.assign(1, 0);
+  var_block_.clear();
+  values_.clear();
+  rows_of_.resize(nb);
+  for (int b = 0; b < nb; ++b) rows_of_[b].assign(1, b);
   for (const auto& [fid, entry] : graph.factors()) {
     if (!entry.active) continue;
-    std::vector<int> blocks;
-    FactorSlots slots;
-    for (VariableId v : entry.variables) {
-      const int off = OffsetOf(v);
-      slots.var_offset.push_back(off);
-      if (off >= 0) blocks.push_back(block_of_offset.at(off));
+    ROAMLAB_CHECK(entry.variables.size() <= 64, "factor from '" << entry.stream << "' has over 64 variables");
+    const std::size_t begin = var_block_.size();
+    std::uint64_t mask = 0;
+    for (std::size_t i = 0; i < entry.variables.size(); ++i) {
+      const int b = BlockOf(entry.variables[i]);
+      var_block_.push_back(b);
+      values_.push_back(graph.variable(entry.variables[i]).value.data());
+      if (b >= 0) mask |= std::uint64_t{1} << i;
     }
-    if (blocks.empty()) continue;
-    for (int a : blocks)
-      for (int b : blocks)
-        if (a < b) rows_of[b].push_back(a);
+    if (mask == 0) {
+      var_block_.resize(begin);
+      values_.resize(begin);
+      continue;
+    }
+    for (std::size_t i = begin; i < var_block_.size(); ++i)
+      for (std::size_t j = begin; j < var_block_.size(); ++j)
+        if (var_block_[i] >= 0 && var_block_[i] < var_block_[j]) rows_of_[var_block_[j]].push_back(var_block_[i]);
     factor_ids_.push_back(fid);
-    slots_.push_back(std::move(slots));
-    factor_blocks.push_back(std::move(blocks));
+    entries_.push_back(&entry);
+    want_.push_back(mask);
+    var_begin_.push_back(static_cast<int>(var_block_.size()));
   }
+  BuildPattern();
+  whitened_.resize(factor_ids_.size());
+  g_.setZero(dimension_);
+  cholmod_->factored_undamped = false;
+}
 
+void NormalEquations::BuildPattern() {
   // Compressed columns: every scalar column of block column b holds the same row blocks.
-  std::vector<std::unordered_map<int, int>> row_offset_in_column(nb);
-  std::vector<int> column_length(nb, 0);
-  std::ptrdiff_t nnz = 0;
+  const int nb = static_cast<int>(order_.size());
+  column_length_.assign(nb, 0);
+  row_offset_.resize(nb);
   for (int b = 0; b < nb; ++b) {
-    auto& rows = rows_of[b];
+    auto& rows = rows_of_[b];
     std::sort(rows.begin(), rows.end());
     rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+    row_offset_[b].clear();
     for (int r : rows) {
-      row_offset_in_column[b][r] = column_length[b];
-      column_length[b] += dims_[r];
+      row_offset_[b].push_back(column_length_[b]);
+      column_length_[b] += dims_[r];
     }
-    nnz += static_cast<std::ptrdiff_t>(column_length[b]) * dims_[b];
   }
-  H_.resize(dimension_, dimension_);
-  H_.resizeNonZeros(nnz);
-  int* outer = H_.outerIndexPtr();
-  int* inner = H_.innerIndexPtr();
-  std::ptrdiff_t pos = 0;
+  outer_.resize(dimension_ + 1);
+  inner_.clear();
   for (int b = 0; b < nb; ++b) {
     for (int j = 0; j < dims_[b]; ++j) {
-      outer[block_offset[b] + j] = static_cast<int>(pos);
-      for (int r : rows_of[b])
-        for (int i = 0; i < dims_[r]; ++i) inner[pos++] = block_offset[r] + i;
+      outer_[block_offset_[b] + j] = static_cast<int>(inner_.size());
+      for (int r : rows_of_[b])
+        for (int i = 0; i < dims_[r]; ++i) inner_.push_back(block_offset_[r] + i);
     }
   }
-  outer[dimension_] = static_cast<int>(pos);
-  std::fill(H_.valuePtr(), H_.valuePtr() + nnz, 0.0);
+  outer_[dimension_] = static_cast<int>(inner_.size());
 
-  // Value index of block (r, b): start of column block_offset[b] plus the row offset; later columns of the block are
-  // found by adding j * column_length[b].
-  for (std::size_t k = 0; k < slots_.size(); ++k) {
-    const auto& blocks = factor_blocks[k];
-    for (std::size_t p = 0; p < blocks.size(); ++p) {
-      for (std::size_t q = 0; q < blocks.size(); ++q) {
-        const int r = blocks[p], b = blocks[q];
-        if (r > b) continue;
-        slots_[k].block.push_back(outer[block_offset[b]] + row_offset_in_column[b].at(r));
+  // A new pattern needs a new symbolic analysis; the same one keeps it.
+  const bool same = H_.rows() == dimension_ && H_.nonZeros() == static_cast<Eigen::Index>(inner_.size()) &&
+                    std::equal(outer_.begin(), outer_.end(), H_.outerIndexPtr()) &&
+                    std::equal(inner_.begin(), inner_.end(), H_.innerIndexPtr());
+  if (!same) {
+    H_.resize(dimension_, dimension_);
+    H_.resizeNonZeros(static_cast<Eigen::Index>(inner_.size()));
+    std::copy(outer_.begin(), outer_.end(), H_.outerIndexPtr());
+    std::copy(inner_.begin(), inner_.end(), H_.innerIndexPtr());
+    std::fill(H_.valuePtr(), H_.valuePtr() + H_.nonZeros(), 0.0);
+    cholmod_->analyzed = false;
+  }
+
+  // Value index of block (r, b): start of column block_offset[b] plus the row offset of r in that column; later
+  // columns of the block are found by adding j * column_length[b].
+  const auto value_index = [&](int r, int b) {
+    const auto it = std::lower_bound(rows_of_[b].begin(), rows_of_[b].end(), r);
+    return static_cast<std::ptrdiff_t>(outer_[block_offset_[b]]) + row_offset_[b][it - rows_of_[b].begin()];
+  };
+  pair_begin_.assign(1, 0);
+  pair_value_.clear();
+  for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
+    for (int p = var_begin_[k]; p < var_begin_[k + 1]; ++p) {
+      for (int q = var_begin_[k]; q < var_begin_[k + 1]; ++q) {
+        const int r = var_block_[p], b = var_block_[q];
+        if (r < 0 || b < 0 || r > b) continue;
+        pair_value_.push_back(value_index(r, b));
       }
     }
+    pair_begin_.push_back(static_cast<int>(pair_value_.size()));
   }
   diagonal_index_.resize(dimension_);
   for (int b = 0; b < nb; ++b)
     for (int j = 0; j < dims_[b]; ++j)
-      diagonal_index_[block_offset[b] + j] = outer[block_offset[b] + j] + row_offset_in_column[b].at(b) + j;
-  whitened_.resize(factor_ids_.size());
-  g_ = Eigen::VectorXd::Zero(dimension_);
+      diagonal_index_[block_offset_[b] + j] = value_index(b, b) + static_cast<std::ptrdiff_t>(j) * column_length_[b] + j;
 }
 
-bool NormalEquations::Linearize(const Graph& graph, std::string* failed_stream) {
+bool NormalEquations::Linearize(const Graph& /*graph*/, std::string* failed_stream) {
   double* values = H_.valuePtr();
   std::fill(values, values + H_.nonZeros(), 0.0);
   g_.setZero();
   cost_ = 0.0;
-  const int* outer = H_.outerIndexPtr();
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
-    const FactorEntry& entry = graph.factor(factor_ids_[k]);
-    const FactorSlots& slots = slots_[k];
-    std::vector<bool> want(slots.var_offset.size());
-    for (std::size_t i = 0; i < want.size(); ++i) want[i] = slots.var_offset[i] >= 0;
+    const FactorEntry& entry = *entries_[k];
+    const int v0 = var_begin_[k];
+    const int n = var_begin_[k + 1] - v0;
     WhitenedFactor& wf = whitened_[k];
-    if (!LinearizeFactor(graph, entry, want, &wf)) {
+    if (!LinearizeFactorAt(entry, &values_[v0], want_[k], &wf)) {
       if (failed_stream != nullptr) *failed_stream = entry.stream;
       return false;
     }
     cost_ += wf.cost;
 
-    // Accumulate J_a^T J_b into the (a <= b) blocks and J_a^T r into g.
-    std::vector<int> free_vars;
-    for (std::size_t i = 0; i < want.size(); ++i)
-      if (want[i]) free_vars.push_back(static_cast<int>(i));
-    std::size_t pair = 0;
-    for (int va : free_vars) {
-      g_.segment(slots.var_offset[va], wf.jacobians[va].cols()) += wf.jacobians[va].transpose() * wf.residual;
-    }
-    for (int va : free_vars) {
-      for (int vb : free_vars) {
-        if (slots.var_offset[va] > slots.var_offset[vb]) continue;
-        // The block sits in H's value array with the column length of its block column as outer stride.
-        const std::ptrdiff_t start = slots.block[pair++];
-        const int col0 = slots.var_offset[vb];
-        const std::ptrdiff_t stride = outer[col0 + 1] - outer[col0];
-        Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> block(values + start, wf.jacobians[va].cols(),
-                                                                   wf.jacobians[vb].cols(), Eigen::OuterStride<>(stride));
-        block.noalias() += wf.jacobians[va].transpose() * wf.jacobians[vb];
+    // Accumulate J_a^T r into g and J_a^T J_b into the (a <= b) blocks, which sit in H's value array with the
+    // column length of their block column as outer stride.
+    const int* block = &var_block_[v0];
+    for (int a = 0; a < n; ++a)
+      if (block[a] >= 0) AddGradient(wf.jacobians[a], wf.residual, g_.data() + block_offset_[block[a]]);
+    int pair = pair_begin_[k];
+    for (int a = 0; a < n; ++a) {
+      if (block[a] < 0) continue;
+      for (int b = 0; b < n; ++b) {
+        if (block[b] < 0 || block[a] > block[b]) continue;
+        AddProduct(wf.jacobians[a], wf.jacobians[b], values + pair_value_[pair++], column_length_[block[b]]);
       }
     }
   }
   return true;
 }
 
-bool NormalEquations::CostWithLastWhitening(const Graph& graph, double* cost) const {
+bool NormalEquations::CostWithLastWhitening(const Graph& /*graph*/, double* cost) const {
   *cost = 0.0;
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
     double c = 0.0;
-    if (!FactorCost(graph, graph.factor(factor_ids_[k]), whitened_[k].sqrt_covariance, &c)) return false;
+    const FactorEntry& entry = *entries_[k];
+    if (!FactorCostAt(entry, &values_[var_begin_[k]], SqrtCovariance(entry, whitened_[k]), &c)) return false;
     *cost += c;
   }
   return true;
@@ -173,16 +247,20 @@ bool NormalEquations::CostWithLastWhitening(const Graph& graph, double* cost) co
 
 bool NormalEquations::Solve(double lambda, Eigen::VectorXd* dx) {
   Cholmod& c = *cholmod_;
-  c.damped = H_;
+  const Eigen::SparseMatrix<double>* A = &H_;
   if (lambda > 0.0) {
+    c.damped = H_;
     double* v = c.damped.valuePtr();
     for (int i = 0; i < dimension_; ++i) v[diagonal_index_[i]] += lambda * std::max(v[diagonal_index_[i]], 1e-12);
+    A = &c.damped;
   }
   if (!c.analyzed) {
-    c.llt.analyzePattern(c.damped);
+    c.llt.setMode(dimension_ <= kMaxSimplicialDimension ? Eigen::CholmodSimplicialLLt : Eigen::CholmodSupernodalLLt);
+    c.llt.analyzePattern(*A);
     c.analyzed = true;
+    ++analyses_;
   }
-  c.llt.factorize(c.damped);
+  c.llt.factorize(*A);
   c.factored_undamped = lambda <= 0.0 && c.llt.info() == Eigen::Success;
   if (c.llt.info() != Eigen::Success) return false;
   *dx = c.llt.solve(-g_);
@@ -196,17 +274,19 @@ bool NormalEquations::Covariance(const std::vector<VariableId>& variables, Eigen
     if (!Solve(0.0, &unused)) return false;
   }
   int cols = 0;
-  for (VariableId id : variables) cols += dims_[std::find(order_.begin(), order_.end(), id) - order_.begin()];
+  for (VariableId id : variables) {
+    const int b = BlockOf(id);
+    ROAMLAB_CHECK(b >= 0, "covariance of variable " << id << ", which is not free in this system");
+    cols += dims_[b];
+  }
   Eigen::MatrixXd E = Eigen::MatrixXd::Zero(dimension_, cols);
   std::vector<int> rows;
   int col = 0;
   for (VariableId id : variables) {
-    const int off = OffsetOf(id);
-    ROAMLAB_CHECK(off >= 0, "covariance of variable " << id << ", which is not free in this system");
-    const int dim = dims_[std::find(order_.begin(), order_.end(), id) - order_.begin()];
-    for (int k = 0; k < dim; ++k) {
-      E(off + k, col++) = 1.0;
-      rows.push_back(off + k);
+    const int b = BlockOf(id);
+    for (int k = 0; k < dims_[b]; ++k) {
+      E(block_offset_[b] + k, col++) = 1.0;
+      rows.push_back(block_offset_[b] + k);
     }
   }
   const Eigen::MatrixXd X = c.llt.solve(E);
@@ -219,8 +299,7 @@ bool NormalEquations::Covariance(const std::vector<VariableId>& variables, Eigen
 void NormalEquations::Update(const Eigen::VectorXd& dx, Graph* graph) const {
   for (std::size_t b = 0; b < order_.size(); ++b) {
     Variable& v = graph->mutable_variable(order_[b]);
-    const int off = offset_.at(order_[b]);
-    v.manifold.Plus(v.value.data(), dx.data() + off, v.value.data());
+    v.manifold.Plus(v.value.data(), dx.data() + block_offset_[b], v.value.data());
   }
 }
 

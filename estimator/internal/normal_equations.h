@@ -1,11 +1,16 @@
 // Sparse normal equations H dx = -g of the whitened, loss-weighted least-squares problem over an ordered list of free
-// variables (seed 000, eqs. 2-3). The block-sparse pattern of H (upper triangle, compressed columns) is built once
-// per graph structure; each Linearize refills the values in place, and CHOLMOD's supernodal Cholesky (with its
-// fill-reducing ordering) analyses the pattern once and refactors the values every iteration.
+// variables (seed 000, eqs. 2-3). The block-sparse pattern of H (upper triangle, compressed columns) is built per
+// graph structure; each Linearize refills the values in place, and CHOLMOD's Cholesky (with its fill-reducing
+// ordering) analyses the pattern once and refactors the values every iteration.
+//
+// An object can be Reset to a changed graph and keeps its buffers; when the new pattern is the same as the old one
+// (a fixed-lag window that slid by one pose has the same band), the symbolic analysis is kept too.
 #pragma once
 
+#include <cstdint>
 #include <memory>
-#include <unordered_map>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -18,10 +23,15 @@ namespace roamlab::estimator::internal {
 
 class NormalEquations {
  public:
-  // `order`: the free variables, in the order of their columns. Active factors that touch at least one of them are
-  // included; the other variables they touch are held constant.
+  NormalEquations();
+  // Reset(graph, order).
   NormalEquations(const Graph& graph, std::vector<VariableId> order);
   ~NormalEquations();
+
+  // Binds to `graph` with the free variables `order`, in the order of their columns. Active factors that touch at
+  // least one of them are included; the other variables they touch are held constant. The graph's structure (its
+  // variables and factors) must not change until the next Reset; values may.
+  void Reset(const Graph& graph, std::vector<VariableId> order);
 
   // Evaluates every included factor at the graph's current values; fills H, g and the per-factor whitening.
   // Returns false if some factor could not be linearized (its stream is named in *failed_stream).
@@ -51,28 +61,45 @@ class NormalEquations {
   // Column offset of a free variable, or -1.
   int OffsetOf(VariableId id) const;
   const std::vector<FactorId>& factor_ids() const { return factor_ids_; }
-  // The whitened factor of the last Linearize, by position in factor_ids().
-  const WhitenedFactor& whitened(std::size_t i) const { return whitened_[i]; }
+  // How many Reset calls had to analyse a new pattern (the others kept the symbolic factorization).
+  int analyses() const { return analyses_; }
 
  private:
-  struct FactorSlots {
-    std::vector<int> var_offset;        // per connected variable: column offset, or -1 when held constant
-    std::vector<std::ptrdiff_t> block;  // per pair (a <= b by offset) of free variables: value index of the block
-  };
-
-  void BuildPattern(const Graph& graph);
+  // Block column of a free variable, or -1.
+  int BlockOf(VariableId id) const;
+  void BuildPattern();
 
   std::vector<VariableId> order_;
-  std::unordered_map<VariableId, int> offset_;
-  std::vector<int> dims_;
+  std::vector<std::pair<VariableId, int>> block_of_id_;  // sorted by id
+  std::vector<int> dims_;                                // per block
+  std::vector<int> block_offset_;                        // per block: first column
   int dimension_ = 0;
+
+  // Included factors, and per factor k the range [var_begin_[k], var_begin_[k + 1]) of its variables in var_block_
+  // (block column or -1 when held constant) and values_ (the variables' ambient values), and the range
+  // [pair_begin_[k], pair_begin_[k + 1]) of its (a <= b) free pairs in pair_value_ (value index of the block in H).
   std::vector<FactorId> factor_ids_;
-  std::vector<FactorSlots> slots_;
+  std::vector<const FactorEntry*> entries_;
+  std::vector<std::uint64_t> want_;
+  std::vector<int> var_begin_;
+  std::vector<int> var_block_;
+  std::vector<const double*> values_;
+  std::vector<int> pair_begin_;
+  std::vector<std::ptrdiff_t> pair_value_;
   std::vector<WhitenedFactor> whitened_;
+
+  // Pattern scratch: row blocks per block column (sorted) with their row offsets in the column, the column lengths,
+  // and the new compressed-column arrays.
+  std::vector<std::vector<int>> rows_of_;
+  std::vector<std::vector<int>> row_offset_;
+  std::vector<int> column_length_;
+  std::vector<int> outer_, inner_;
+
   Eigen::SparseMatrix<double> H_;
   std::vector<std::ptrdiff_t> diagonal_index_;
   Eigen::VectorXd g_;
   double cost_ = 0.0;
+  int analyses_ = 0;
 
   struct Cholmod;
   std::unique_ptr<Cholmod> cholmod_;

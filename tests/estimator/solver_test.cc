@@ -66,6 +66,45 @@ TEST(SolverTest, GaussNewtonRecoversNoiseFreePose) {
     EXPECT_LE(summary.cost_history[i], summary.cost_history[i - 1] * (1 + 1e-12) + 1e-20);
 }
 
+TEST(SolverTest, WorkspaceGivesTheSameSolutionAndKeepsTheAnalysisOfAnUnchangedPattern) {
+  MultiAntennaProblem plain(0.05, 7), reused(0.05, 7);
+  const SolverSummary a = Solve(SolverOptions{}, &plain.graph);
+  SolverWorkspace workspace;
+  const SolverSummary b = Solve(SolverOptions{}, &reused.graph, nullptr, &workspace);
+  ASSERT_TRUE(a.usable() && b.usable());
+  EXPECT_EQ(a.iterations, b.iterations);
+  EXPECT_EQ(a.final_cost, b.final_cost);
+  EXPECT_EQ(plain.graph.variable(plain.pose).value, reused.graph.variable(reused.pose).value);
+  EXPECT_EQ(workspace.analyses(), 1);
+  // A second solve of the same structure keeps the analysis; switching a factor off changes nothing in the pattern
+  // of a single pose, so it is kept too.
+  reused.graph.mutable_variable(reused.pose).value = plain.graph.variable(plain.pose).value;
+  ASSERT_TRUE(Solve(SolverOptions{}, &reused.graph, nullptr, &workspace).usable());
+  reused.graph.mutable_factor(reused.graph.factors().begin()->first).active = false;
+  ASSERT_TRUE(Solve(SolverOptions{}, &reused.graph, nullptr, &workspace).usable());
+  EXPECT_EQ(workspace.analyses(), 1);
+}
+
+TEST(SolverTest, ModelToleranceStopsWhenTheQuadraticModelPredictedTheDecrease) {
+  // GPS errors are linear in the position: after the first Gauss-Newton step from a pose with the right orientation
+  // the model's prediction is exact, so the model tolerance stops there; without it a second step is taken.
+  MultiAntennaProblem problem(0.05, 9);
+  problem.graph.mutable_variable(problem.pose).value.tail<4>() = problem.truth.tail<4>();
+  MultiAntennaProblem again(0.05, 9);
+  again.graph.mutable_variable(again.pose).value = problem.graph.variable(problem.pose).value;
+  SolverOptions options;
+  options.method = SolverOptions::Method::kGaussNewton;
+  options.function_tolerance = 1e-12;
+  const SolverSummary without = Solve(options, &problem.graph);
+  options.model_tolerance = 1e-3;
+  const SolverSummary with = Solve(options, &again.graph);
+  ASSERT_TRUE(without.usable() && with.usable());
+  EXPECT_EQ(with.termination, Termination::kModelTolerance);
+  EXPECT_EQ(with.iterations, 1);
+  EXPECT_GT(without.iterations, 1);
+  EXPECT_NEAR(with.final_cost, without.final_cost, 1e-3 * without.final_cost);
+}
+
 TEST(SolverTest, NoisyErrorIsConsistentWithMarginalCovariance) {
   // Over many seeds, the squared Mahalanobis error of the pose against its marginal covariance averages to 6 (the
   // tangent dimension); with 40 trials the average of chi-square(6) lies in [4.6, 7.6] with probability ~0.999.
