@@ -59,7 +59,7 @@ struct VisualOdometryOptions {
   int grid_rows = 4;
   double feature_quality = 0.01;          // GFTT quality level, relative to the strongest corner
   double min_feature_distance_px = 7.0;
-  int klt_window_px = 21;
+  int klt_window_px = 15;
   int klt_pyramid_levels = 3;
   double max_forward_backward_px = 0.5;
 

@@ -51,8 +51,8 @@ class VisualOdometryStream::Impl {
   std::unique_ptr<CameraRenderer> renderer;
   std::optional<VisualOdometry> vo;
   recording::Mounting mounting;
-  std::int64_t period_ns = 0;
-  std::optional<Time> next_frame;
+  std::optional<Time> t0;              // first call
+  std::int64_t next_frame = 0;         // index of the next frame due
   int frame_index = 0;
   cv::Mat rgb;
   cv::Mat gray;
@@ -101,7 +101,6 @@ Result<std::unique_ptr<VisualOdometryStream>> VisualOdometryStream::Create(
     return Status::Error("visual odometry stream '" + options.stream_name + "': " + problem);
   }
   impl->vo.emplace(impl->renderer->intrinsics(), vo);
-  impl->period_ns = static_cast<std::int64_t>(std::llround(1e9 / options.rate_hz));
 
   // Image directory.
   if (!options.image_directory.empty()) {
@@ -118,11 +117,15 @@ VisualOdometryStream::~VisualOdometryStream() = default;
 
 Result<std::optional<VoEstimate>> VisualOdometryStream::Observe(Time t, mjData* data) {
   Impl& s = *impl_;
-  if (s.next_frame && t < *s.next_frame) return std::optional<VoEstimate>();
-  // Frame k is due at t0 + k period; a late call does not shift the schedule.
-  s.next_frame = s.next_frame ? Time::FromNanoseconds(s.next_frame->nanoseconds() + s.period_ns)
-                              : Time::FromNanoseconds(t.nanoseconds() + s.period_ns);
-  while (*s.next_frame <= t) s.next_frame = Time::FromNanoseconds(s.next_frame->nanoseconds() + s.period_ns);
+  // Frame k is due at t0 + k / rate (rounded to the nanosecond, without accumulating); a late call does not shift
+  // the schedule, a frame whose time has passed entirely is skipped.
+  if (!s.t0) s.t0 = t;
+  const auto due = [&s](std::int64_t k) {
+    return Time::FromNanoseconds(s.t0->nanoseconds() + std::llround(1e9 * static_cast<double>(k) / s.options.rate_hz));
+  };
+  if (t < due(s.next_frame)) return std::optional<VoEstimate>();
+  while (due(s.next_frame + 1) <= t) ++s.next_frame;
+  ++s.next_frame;
   // Render, keep the image when asked, run the VO.
   s.renderer->RenderRgb(data, &s.rgb);
   if (!s.options.image_directory.empty()) {
