@@ -20,6 +20,7 @@
 #include <sys/wait.h>
 #include <time.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -27,6 +28,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <string>
@@ -34,7 +36,9 @@
 #include <vector>
 
 #include <Eigen/CholmodSupport>
+#include <mujoco/mujoco.h>
 #include <nlohmann/json.hpp>
+#include <opencv2/core/utility.hpp>
 
 #include "apps/commands.h"
 #include "apps/montecarlo.h"
@@ -47,8 +51,11 @@
 #include "estimator/solver.h"
 #include "estimator/tracking.h"
 #include "recording/recording.h"
+#include "sim/mujoco_model.h"
+#include "sim/render.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
+#include "sim/visual_odometry.h"
 
 extern char** environ;
 
@@ -82,6 +89,61 @@ long StatusKb(const std::string& key) {
 int Fail(const std::string& message) {
   std::fprintf(stderr, "roamlab_bench: %s\n", message.c_str());
   return 1;
+}
+
+// Rendering + VO at 15 Hz in a 1 kHz loop: the camera rig of models/vo_test_room.xml drives a 0.6 m/s, 0.5 rad/s
+// circle for 10 s (mj_forward every step stands in for the physics, which the robot simulations add at 20-40x real
+// time). Returns {"WxH": {"realtime_factor", "vo_ms_per_pair", "render_ms_per_frame", "failures", "pairs"}}, or
+// null with `error` set.
+nlohmann::json BenchRenderVo(const std::string& root, std::string* error) {
+  namespace sim = roamlab::sim;
+  std::ifstream file(root + "/models/vo_test_room.xml");
+  const std::string xml((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  auto model = sim::LoadModelFromString(xml, "models/vo_test_room.xml");
+  if (!model.ok()) return *error = model.status().message(), nlohmann::json();
+  const mjModel* m = model.value().get();
+  cv::setNumThreads(0);  // one core
+  nlohmann::json out;
+  for (const auto& [width, height] : {std::pair{320, 240}, std::pair{640, 480}}) {
+    sim::DataPtr data = sim::MakeData(m);
+    sim::RenderOptions render;
+    render.width_px = width;
+    render.height_px = height;
+    auto renderer = sim::CameraRenderer::Create(m, "camera", render);
+    if (!renderer.ok()) return *error = renderer.status().message(), nlohmann::json();
+    sim::VisualOdometryOptions options;
+    options.camera_height_m = 0.30;  // the rig's mounting: 0.30 m high, pitched 15 deg down
+    options.floor_normal_camera = Eigen::Vector3d(0.0, std::cos(0.2617993877991494), std::sin(0.2617993877991494));
+    sim::VisualOdometry vo(renderer.value()->intrinsics(), options);
+    cv::Mat gray;
+    double render_s = 0.0;
+    double vo_s = 0.0;
+    const auto t0 = Clock::now();
+    for (int step = 0; step <= 10000; ++step) {
+      const double yaw = 0.5e-3 * step;
+      data->mocap_pos[0] = 1.2 * std::sin(yaw);
+      data->mocap_pos[1] = -1.2 * std::cos(yaw);
+      data->mocap_quat[0] = std::cos(0.5 * yaw);
+      data->mocap_quat[3] = std::sin(0.5 * yaw);
+      mj_forward(m, data.get());
+      if ((step * 15) % 1000 >= 15) continue;  // a frame every 1000 / 15 steps
+      const auto t_render = Clock::now();
+      renderer.value()->RenderGray(data.get(), &gray);
+      const auto t_vo = Clock::now();
+      vo.ProcessFrame(roamlab::Time::FromNanoseconds(1'000'000LL * step), gray);
+      render_s += std::chrono::duration<double>(t_vo - t_render).count();
+      vo_s += Since(t_vo);
+    }
+    const double wall = Since(t0);
+    const auto& counters = vo.counters();
+    out[std::to_string(width) + "x" + std::to_string(height)] = {
+        {"realtime_factor", 10.0 / wall},
+        {"vo_ms_per_pair", 1e3 * vo_s / std::max(1, counters.pairs)},
+        {"render_ms_per_frame", 1e3 * render_s / std::max(1, counters.frames)},
+        {"pairs", counters.pairs},
+        {"failures", counters.failures}};
+  }
+  return out;
 }
 
 // The same drive made longer on a closed route: a constant handlebar offset turns the weaving drive into loops of
@@ -390,6 +452,23 @@ int main(int argc, char** argv) {
     j["indoor_simulation_realtime_factor"] = indoor_factor;
     say("  indoor simulation, no rendering    %8.1fx real time    target >= 10x       ratio %.2f   (CPU time: %.1fx)\n",
         indoor_factor, indoor_factor / 10.0, indoor_cpu_factor);
+  }
+
+  // 1c. The indoor issue's camera yardstick: rendering + visual odometry at 15 Hz (sim/visual_odometry_stream.h) on
+  // the test room of models/vo_test_room.xml, at 320x240 and 640x480, OpenCV on one thread (target >= 1x).
+  {
+    std::string vo_error;
+    const nlohmann::json render_vo = BenchRenderVo(root, &vo_error);
+    if (render_vo.is_null()) return Fail(vo_error);
+    for (const auto& [size, r] : render_vo.items()) {
+      const double factor = r["realtime_factor"].get<double>();
+      j["render_vo_realtime_factor_15hz"][size] = r["realtime_factor"];
+      j["vo_ms_per_pair"][size] = r["vo_ms_per_pair"];
+      say("  render + VO 15 Hz, %-7s          %8.1fx real time    target >= 1x        ratio %.2f   (VO %.1f ms/pair, "
+          "render %.1f ms/frame, %d/%d pairs failed)\n",
+          size.c_str(), factor, factor, r["vo_ms_per_pair"].get<double>(), r["render_ms_per_frame"].get<double>(),
+          r["failures"].get<int>(), r["pairs"].get<int>());
+    }
   }
 
   // 2-3. The Ceres peer and the floor.

@@ -18,12 +18,14 @@
 //       type: gps                                   # required, a StreamTypeName
 //       rate_hz: 5                                  # required, nominal rate, > 0
 //       units: deg                                  # optional, see the table below; absent = canonical
-//       columns: [latitude, longitude, altitude]    # optional for fixed-column types (must then match exactly);
+//       columns: [latitude, longitude, altitude]    # optional for fixed-column types (must then match exactly, or
+//                                                   # for velocity types be followed by the 21 covariance columns);
 //                                                   # required for wheel_encoders and inputs ([A-Za-z0-9_]+, unique)
 //       mounting: {p_body_sensor_m: [0.57, -0.46, 0.32], q_body_sensor_wxyz: [1, 0, 0, 0]}
 //                                                   # optional, each key optional (zero, identity); |q| within 1e-3
 //       noise: {sigma_m: 0.33}                      # optional, name -> number
-//       attributes: {ticks_per_revolution: 2048}    # optional, name -> number
+//       attributes: {ticks_per_revolution: 2048}    # optional, name -> number; camera and visual_odometry: the
+//                                                   # six intrinsics (recording.h), all or none
 //
 // Accepted `units:` per type, and what they become after reading (values are converted, info.units is replaced):
 //   imu              rad/s,m/s^2 (canonical) | deg/s,m/s^2 | rad/s,g | deg/s,g        g = 9.80665 m/s^2
@@ -106,6 +108,67 @@ const TypeRow& RowOf(StreamType type) {
     if (row.type == type) return row;
   }
   ROAMLAB_CHECK(false, "stream type " << static_cast<int>(type) << " missing from the type table");
+}
+
+// The velocity types whose fixed columns may be followed by the covariance columns.
+bool HasCovarianceColumns(StreamType type) {
+  return type == StreamType::kOdometry || type == StreamType::kVisualOdometry || type == StreamType::kScanMatching;
+}
+
+// Fixed columns followed by the covariance columns (velocity types only).
+std::vector<std::string> ColumnsWithCovariance(StreamType type) {
+  std::vector<std::string> columns = FixedColumns(type);
+  const std::vector<std::string>& covariance = CovarianceColumns(type);
+  columns.insert(columns.end(), covariance.begin(), covariance.end());
+  return columns;
+}
+
+bool CarriesCovariance(const StreamInfo& info) {
+  return HasCovarianceColumns(info.type) && info.columns == ColumnsWithCovariance(info.type);
+}
+
+// Camera intrinsics in the attributes of camera and visual_odometry streams: all six or none; "" when fine.
+std::string IntrinsicsProblem(const StreamInfo& info) {
+  if (info.type != StreamType::kCamera && info.type != StreamType::kVisualOdometry) return "";
+  static const char* const kKeys[] = {"width_px", "height_px", "fx_px", "fy_px", "cx_px", "cy_px"};
+  int present = 0;
+  for (const char* key : kKeys) present += static_cast<int>(info.attributes.count(key));
+  if (present == 0) return "";
+  for (const char* key : kKeys) {
+    if (!info.attributes.count(key)) {
+      return std::string("camera intrinsics need all of width_px, height_px, fx_px, fy_px, cx_px, cy_px (") + key +
+             " is missing)";
+    }
+  }
+  const auto& a = info.attributes;
+  const double width = a.at("width_px");
+  const double height = a.at("height_px");
+  if (!(width >= 1.0 && height >= 1.0) || width != std::floor(width) || height != std::floor(height)) {
+    return "camera intrinsics: width_px and height_px must be positive integers";
+  }
+  if (!(a.at("fx_px") > 0.0 && a.at("fy_px") > 0.0)) return "camera intrinsics: fx_px and fy_px must be positive";
+  if (!(a.at("cx_px") >= 0.0 && a.at("cx_px") < width && a.at("cy_px") >= 0.0 && a.at("cy_px") < height)) {
+    return "camera intrinsics: the principal point (cx_px, cy_px) must lie inside the image";
+  }
+  return "";
+}
+
+// Problem with the covariance columns of a stream's values (a negative diagonal entry) as "<line>: <problem>" for the
+// first bad row, or "" when fine. Row i is on line i + 2 of its file (after the header).
+std::string CovarianceProblem(const Stream& stream) {
+  if (!CarriesCovariance(stream.info)) return "";
+  const Eigen::Index fixed = static_cast<Eigen::Index>(FixedColumns(stream.info.type).size());
+  const std::vector<std::string>& names = CovarianceColumns(stream.info.type);
+  for (Eigen::Index row = 0; row < stream.values.rows(); ++row) {
+    // The diagonal of a 6x6 upper triangle stored row by row: entries 0, 6, 11, 15, 18, 20.
+    Eigen::Index index = 0;
+    for (Eigen::Index k = 0; k < 6; index += 6 - k, ++k) {
+      if (stream.values(row, fixed + index) < 0.0) {
+        return std::to_string(row + 2) + ": " + names[static_cast<std::size_t>(index)] + " is negative";
+      }
+    }
+  }
+  return "";
 }
 
 // Types whose `units:` is free text, kept as given.
@@ -304,15 +367,18 @@ Status ParseColumns(const YAML::Node& entry, const std::string& path, const std:
   if (node) {
     if (Status s = ReadStringList(node, path, "columns of " + context, &declared); !s.ok()) return s;
   }
-  // Fixed-column types.
+  // Fixed-column types; the velocity types may add the covariance columns.
   const std::vector<std::string>& fixed = FixedColumns(info->type);
   if (!fixed.empty()) {
-    if (node && declared != fixed) {
+    const bool covariance = HasCovarianceColumns(info->type) && declared == ColumnsWithCovariance(info->type);
+    if (node && declared != fixed && !covariance) {
       return ErrorAt(path, node,
                      "columns " + JoinColumns(declared) + " of " + context + " do not match type " +
-                         StreamTypeName(info->type) + ": expected " + JoinColumns(fixed));
+                         StreamTypeName(info->type) + ": expected " + JoinColumns(fixed) +
+                         (HasCovarianceColumns(info->type) ? " (optionally followed by the 21 covariance columns)"
+                                                           : ""));
     }
-    info->columns = fixed;
+    info->columns = covariance ? declared : fixed;
     return Status::Ok();
   }
   // wheel_encoders and inputs name their own columns.
@@ -407,6 +473,8 @@ Status ParseStreamEntry(const YAML::Node& node, const std::string& path, std::si
   if (node["attributes"]) {
     const YAML::Node attributes = node["attributes"];
     if (Status s = ReadNumberMap(attributes, path, "attributes of " + context, &info.attributes); !s.ok()) return s;
+    const std::string problem = IntrinsicsProblem(info);
+    if (!problem.empty()) return ErrorAt(path, attributes, context + ": " + problem);
   }
   // Units last: ticks need the attributes.
   if (node["units"]) {
@@ -490,7 +558,8 @@ Status ReadStreamFile(const fs::path& directory, const UnitConversion& conversio
   stream->values = std::move(data.values);
   stream->text = std::move(data.text);
   ApplyConversion(conversion, &stream->values);
-  return Status::Ok();
+  const std::string problem = CovarianceProblem(*stream);
+  return problem.empty() ? Status::Ok() : Status::Error(path + ":" + problem);
 }
 
 // Validation before writing: refuse what the reader would refuse, so that every written recording reads back.
@@ -502,10 +571,11 @@ bool WritableUnits(StreamType type, const std::string& units) {
   return row != nullptr && units == row->canonical;
 }
 
-// Columns written for a stream: the fixed ones of its type, or the named ones.
+// Columns written for a stream: the fixed ones of its type (with the covariance columns when it carries them), or
+// the named ones.
 const std::vector<std::string>& WrittenColumns(const StreamInfo& info) {
   const std::vector<std::string>& fixed = FixedColumns(info.type);
-  return fixed.empty() ? info.columns : fixed;
+  return fixed.empty() || CarriesCovariance(info) ? info.columns : fixed;
 }
 
 Status ValidateInfoForWrite(const StreamInfo& info, const std::string& prefix) {
@@ -513,9 +583,10 @@ Status ValidateInfoForWrite(const StreamInfo& info, const std::string& prefix) {
   if (!(info.rate_hz > 0.0) || !std::isfinite(info.rate_hz)) return Status::Error(prefix + "rate_hz must be positive");
   // Columns: as fixed by the type (or left empty), or named validly.
   const std::vector<std::string>& fixed = FixedColumns(info.type);
-  if (!fixed.empty() && !info.columns.empty() && info.columns != fixed) {
+  if (!fixed.empty() && !info.columns.empty() && info.columns != fixed && !CarriesCovariance(info)) {
     return Status::Error(prefix + "columns " + JoinColumns(info.columns) + " do not match type " +
-                         StreamTypeName(info.type) + ": expected " + JoinColumns(fixed));
+                         StreamTypeName(info.type) + ": expected " + JoinColumns(fixed) +
+                         (HasCovarianceColumns(info.type) ? " (optionally followed by the 21 covariance columns)" : ""));
   }
   if (fixed.empty()) {
     const std::string problem = FreeColumnsProblem(info.columns);
@@ -533,7 +604,8 @@ Status ValidateInfoForWrite(const StreamInfo& info, const std::string& prefix) {
   if (!AllFinite(info.noise) || !AllFinite(info.attributes)) {
     return Status::Error(prefix + "noise and attributes must be finite");
   }
-  return Status::Ok();
+  const std::string problem = IntrinsicsProblem(info);
+  return problem.empty() ? Status::Ok() : Status::Error(prefix + problem);
 }
 
 // Camera frame names must survive the CSV: non-empty, no comma or line break, no surrounding blanks.
@@ -567,6 +639,8 @@ Status ValidateDataForWrite(const Stream& stream, const std::string& prefix) {
     }
     if (!stream.text.empty()) return Status::Error(prefix + "text is only for camera streams");
     if (!stream.values.allFinite()) return Status::Error(prefix + "values contain NaN or Inf");
+    const std::string problem = CovarianceProblem(stream);
+    if (!problem.empty()) return Status::Error(prefix + "row " + problem);
   }
   // Time strictly increasing.
   for (std::size_t i = 1; i < n; ++i) {
@@ -698,6 +772,18 @@ std::optional<StreamType> ParseStreamType(const std::string& name) {
 }
 
 const std::vector<std::string>& FixedColumns(StreamType type) { return RowOf(type).columns; }
+
+const std::vector<std::string>& CovarianceColumns(StreamType type) {
+  static const std::vector<std::string> none;
+  static const std::vector<std::string> covariance = [] {
+    const char* const names[] = {"vx", "vy", "vz", "wx", "wy", "wz"};
+    std::vector<std::string> columns;
+    for (int i = 0; i < 6; ++i)
+      for (int j = i; j < 6; ++j) columns.push_back(std::string("cov_") + names[i] + "_" + names[j]);
+    return columns;
+  }();
+  return HasCovarianceColumns(type) ? covariance : none;
+}
 
 const Stream* Recording::Find(const std::string& name) const {
   for (const Stream& stream : streams) {

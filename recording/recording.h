@@ -38,8 +38,15 @@ inline constexpr int kFormatVersion = 1;
 //                    or [m/s] rim speed with the nominal radius (units: rad | rad/s | m/s | ticks, ticks -> rad)
 //   steering         angle [rad]
 //   odometry, visual_odometry, scan_matching
-//                    vx vy vz [m/s] wx wy wz [rad/s]: linear and angular velocity of the sensor, in the sensor frame
+//                    vx vy vz [m/s] wx wy wz [rad/s]: linear and angular velocity of the sensor, in the sensor frame,
+//                    optionally followed by the 21 CovarianceColumns(): the upper triangle of the 6x6 covariance of
+//                    [vx vy vz wx wy wz], row by row (cov_vx_vx, cov_vx_vy, ..., cov_vx_wz, cov_vy_vy, ..., cov_wz_wz)
+//                    [(m/s)^2, m/s rad/s, (rad/s)^2]; the reader refuses a negative diagonal entry
 //   camera           frame: image file name relative to the recording directory
+// Camera intrinsics (camera and visual_odometry streams): the attributes width_px, height_px, fx_px, fy_px, cx_px,
+// cy_px, all six or none: the pinhole model u = fx x / z + cx, v = fy y / z + cy in OpenCV's pixel coordinates (the
+// centre of the top-left pixel is (0, 0)) for a point (x, y, z) in the camera frame (x right, y down, z forward).
+// Sizes are positive integers, focal lengths positive, the principal point inside the image.
 //   inputs           free columns named in the stream entry (control commands)
 enum class StreamType {
   kImu,
@@ -65,6 +72,9 @@ std::optional<StreamType> ParseStreamType(const std::string& name);
 // The CSV columns (after "t") that a type fixes, in the table above; empty for wheel_encoders and inputs, whose columns
 // come from the stream entry.
 const std::vector<std::string>& FixedColumns(StreamType type);
+// The covariance columns that may follow a velocity type's fixed columns (table above); empty for the other types.
+// A stream carries them when its info.columns are FixedColumns() followed by these.
+const std::vector<std::string>& CovarianceColumns(StreamType type);
 
 // Nominal mounting of a sensor frame S in the odometric frame O.
 struct Mounting {
@@ -76,7 +86,8 @@ struct StreamInfo {
   std::string name;                     // unique; the CSV file is <name>.csv
   StreamType type = StreamType::kInputs;
   double rate_hz = 0.0;                 // nominal rate
-  std::vector<std::string> columns;     // after "t"; fixed by the type except wheel_encoders and inputs
+  std::vector<std::string> columns;     // after "t"; fixed by the type except wheel_encoders and inputs (and the
+                                        // optional covariance columns of the velocity types)
   std::string units;                    // after reading: the canonical unit of the type (table above; magnetometer,
                                         // camera and inputs keep what was declared); empty = canonical
   std::optional<Mounting> mounting;

@@ -125,7 +125,8 @@ Recording MakeFullRecording() {
   recording.streams[4].info.noise = {{"sigma_m", 0.33}};
   recording.streams[7].info.units = "rad/s";
   recording.streams[7].info.attributes = {{"ticks_per_revolution", 2048}, {"radius_m", 0.3}};
-  recording.streams[12].info.attributes = {{"fx_px", 525.0}};
+  recording.streams[12].info.attributes = {{"width_px", 640}, {"height_px", 480}, {"fx_px", 525.0}, {"fy_px", 525.0},
+                                           {"cx_px", 319.5},  {"cy_px", 239.5}};
   // Ground truth.
   Trajectory truth;
   for (int i = 0; i < 5; ++i) {
@@ -517,6 +518,90 @@ TEST(RecordingWriteTest, RejectsInvalidRecordings) {
   Recording no_origin = valid;
   no_origin.origin.reset();
   EXPECT_THAT(WriteError(no_origin, dir), HasSubstr("needs an origin"));
+}
+
+
+// Velocity streams may carry their covariance; camera and visual_odometry streams their intrinsics.
+
+// A visual_odometry stream with the covariance columns and the intrinsics: two samples.
+Recording MakeVisualOdometryRecording() {
+  Recording recording;
+  recording.platform.kind = "differential_drive";
+  Stream stream;
+  stream.info.name = "vo";
+  stream.info.type = StreamType::kVisualOdometry;
+  stream.info.rate_hz = 15.0;
+  stream.info.columns = FixedColumns(StreamType::kVisualOdometry);
+  for (const std::string& c : CovarianceColumns(StreamType::kVisualOdometry)) stream.info.columns.push_back(c);
+  stream.info.attributes = {{"width_px", 320}, {"height_px", 240}, {"fx_px", 207.8}, {"fy_px", 207.8},
+                            {"cx_px", 159.5},  {"cy_px", 119.5}};
+  stream.t = {Time::FromSeconds(0.1), Time::FromSeconds(0.2)};
+  stream.values = Eigen::MatrixXd::Constant(2, 27, 1e-4);
+  stream.values.leftCols(6).setConstant(0.5);
+  recording.streams.push_back(stream);
+  return recording;
+}
+
+TEST(RecordingCovarianceTest, ColumnsNameTheUpperTriangle) {
+  const std::vector<std::string>& c = CovarianceColumns(StreamType::kVisualOdometry);
+  ASSERT_EQ(c.size(), 21u);
+  EXPECT_EQ(c[0], "cov_vx_vx");
+  EXPECT_EQ(c[5], "cov_vx_wz");
+  EXPECT_EQ(c[6], "cov_vy_vy");
+  EXPECT_EQ(c[20], "cov_wz_wz");
+  EXPECT_EQ(CovarianceColumns(StreamType::kScanMatching), c);
+  EXPECT_TRUE(CovarianceColumns(StreamType::kImu).empty());
+}
+
+TEST(RecordingCovarianceTest, RoundTripWithIntrinsics) {
+  TempDir dir;
+  const Recording recording = MakeVisualOdometryRecording();
+  ASSERT_TRUE(WriteRecording(recording, dir.path()).ok());
+  const Result<Recording> read = ReadRecording(dir.path());
+  ASSERT_TRUE(read.ok()) << read.status().message();
+  const Stream& stream = read.value().streams.at(0);
+  EXPECT_EQ(stream.info.columns, recording.streams[0].info.columns);
+  EXPECT_EQ(stream.values, recording.streams[0].values);
+  EXPECT_EQ(stream.info.attributes, recording.streams[0].info.attributes);
+  EXPECT_THAT(ReadFile(dir.File("vo.csv")), HasSubstr("t,vx,vy,vz,wx,wy,wz,cov_vx_vx,cov_vx_vy,"));
+}
+
+TEST(RecordingCovarianceTest, NegativeVarianceIsRefusedWithItsLine) {
+  TempDir dir;
+  Recording recording = MakeVisualOdometryRecording();
+  ASSERT_TRUE(WriteRecording(recording, dir.path()).ok());
+  // Second sample (line 3), cov_vy_vy (index 6 + 6).
+  std::string csv = ReadFile(dir.File("vo.csv"));
+  const std::size_t line3 = csv.find('\n', csv.find('\n') + 1) + 1;
+  std::size_t at = line3;
+  for (int comma = 0; comma < 13; ++comma) at = csv.find(',', at) + 1;
+  csv.insert(at, "-");
+  WriteFile(dir.File("vo.csv"), csv);
+  EXPECT_THAT(ReadError(dir), AllOf(HasSubstr("vo.csv:3:"), HasSubstr("cov_vy_vy is negative")));
+  recording.streams[0].values(1, 12) = -1.0;
+  EXPECT_THAT(WriteError(recording, dir), AllOf(HasSubstr("row 3"), HasSubstr("cov_vy_vy is negative")));
+}
+
+TEST(RecordingCovarianceTest, IntrinsicsAreAllOrNoneAndSane) {
+  TempDir dir;
+  Recording partial = MakeVisualOdometryRecording();
+  partial.streams[0].info.attributes.erase("cy_px");
+  EXPECT_THAT(WriteError(partial, dir), HasSubstr("cy_px is missing"));
+  Recording outside = MakeVisualOdometryRecording();
+  outside.streams[0].info.attributes["cx_px"] = 320.0;
+  EXPECT_THAT(WriteError(outside, dir), HasSubstr("principal point"));
+  // The reader says the same, with the line of the attributes.
+  ASSERT_TRUE(WriteRecording(MakeVisualOdometryRecording(), dir.path()).ok());
+  const std::string yaml = ReadFile(dir.File("recording.yaml"));
+  WriteFile(dir.File("recording.yaml"), Replace(yaml, "fy_px: 207.8", "fy_px: 0"));
+  EXPECT_THAT(ReadError(dir), AllOf(HasSubstr("recording.yaml:"), HasSubstr("fx_px and fy_px must be positive")));
+}
+
+TEST(RecordingCovarianceTest, OtherColumnsStillMustMatch) {
+  TempDir dir;
+  Recording recording = MakeVisualOdometryRecording();
+  recording.streams[0].info.columns.pop_back();
+  EXPECT_THAT(WriteError(recording, dir), HasSubstr("optionally followed by the 21 covariance columns"));
 }
 
 }  // namespace
