@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <set>
 
 #include <nlohmann/json.hpp>
@@ -188,6 +189,7 @@ int RunTrack(const TrackArgs& args) {
   const std::string cmd = "track";
   auto inputs = LoadInputs(args.config, args.recording);
   if (!inputs.ok()) return BadInput(args.err, cmd, inputs.status().message());
+  if (args.no_time_budget) inputs.value().config.tracking.time_budget_s = std::numeric_limits<double>::infinity();
   std::map<std::string, Eigen::VectorXd> calibration;
   if (!args.calibration.empty()) {
     auto cal = ReadCalibrationValues(args.calibration);

@@ -27,6 +27,7 @@ struct TrackArgs {
   std::string config;
   std::string calibration;  // optional calibration.json
   std::string out;
+  bool no_time_budget = false;   // ignore tracking.time_budget_s: results that do not depend on the machine's speed
   bool quiet = false;            // no progress and no summary
   std::ostream* err = nullptr;   // receives the one-line error; nullptr: stderr
 };

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -87,6 +88,7 @@ int RunMonteCarlo(const MonteCarloArgs& args) {
   if (!scenario.ok()) return Fail(args.err, scenario.status().message(), 2);
   auto config = estimator::LoadEstimatorConfig(args.config);
   if (!config.ok()) return Fail(args.err, config.status().message(), 2);
+  if (args.no_time_budget) config.value().tracking.time_budget_s = std::numeric_limits<double>::infinity();
   std::map<std::string, Eigen::VectorXd> calibration;
   if (!args.calibration.empty()) {
     auto cal = ReadCalibrationValues(args.calibration);

@@ -15,6 +15,7 @@ struct MonteCarloArgs {
   int jobs = 0;             // 0: one per core
   unsigned long long seed_base = 1000;  // run i simulates with noise seed seed_base + i
   double t0_s = 2.0;        // fraction_in_band counts time steps from t0_s on
+  bool no_time_budget = false;  // ignore tracking.time_budget_s: results that do not depend on the machine's speed
   bool quiet = false;           // no progress bar and no summary
   std::ostream* err = nullptr;  // receives the one-line error; nullptr: stderr
 };

@@ -75,7 +75,7 @@ CaseResult RunCase(const Case& c, const std::string& out_dir, int jobs) {
   if (ec) {
     result.error = dir + ": cannot create the case directory: " + ec.message();
   } else {
-    const Status st = mode.run(regress::CaseContext{c, dir, jobs}, &result.warnings);
+    const Status st = mode.run(regress::CaseContext{c, dir, jobs});
     if (!st.ok()) result.error = st.message();
   }
 

@@ -1,14 +1,11 @@
 #include "apps/regress_modes.h"
 
-#include <filesystem>
-#include <fstream>
 #include <sstream>
 
 #include "apps/commands.h"
 #include "apps/evaluate.h"
 #include "apps/montecarlo.h"
 #include "apps/simulate.h"
-#include "estimator/config.h"
 
 namespace roamlab::apps::regress {
 namespace {
@@ -153,7 +150,7 @@ Status Evaluate(const CaseContext& context, const std::string& estimate, const s
   return Call(RunEvaluate, args, "evaluate");
 }
 
-Status RunCalibrateCase(const CaseContext& context, std::vector<std::string>*) {
+Status RunCalibrateCase(const CaseContext& context) {
   const Result<std::string> recording = Recording(context);
   if (!recording.ok()) return recording.status();
   CalibrateArgs args;
@@ -165,19 +162,9 @@ Status RunCalibrateCase(const CaseContext& context, std::vector<std::string>*) {
   return Evaluate(context, args.out, recording.value());
 }
 
-// The update's time budget makes tracking depend on the machine's speed when an update reaches it: say so.
-void WarnIfTimeBudgetReached(const CaseContext& context, std::vector<std::string>* warnings) {
-  auto config = estimator::LoadEstimatorConfig(context.c.config);
-  std::ifstream in(context.dir + "/tracking/summary.json");
-  const json summary = json::parse(in, nullptr, false);
-  if (!config.ok() || !summary.is_object() || !summary.contains("max_update_s")) return;
-  const double budget_s = config.value().tracking.time_budget_s;
-  if (summary["max_update_s"].is_number() && summary["max_update_s"].get<double>() >= budget_s)
-    warnings->push_back("an update reached tracking.time_budget_s (" + std::to_string(budget_s) +
-                        " s): the values may depend on the machine's speed");
-}
-
-Status RunTrackCase(const CaseContext& context, std::vector<std::string>* warnings) {
+// Tracking runs without its per-update time budget (tracking.time_budget_s): where an update reaches it, the result
+// would depend on the machine's load, and a regression value must not.
+Status RunTrackCase(const CaseContext& context) {
   const Result<std::string> recording = Recording(context);
   if (!recording.ok()) return recording.status();
   const Result<std::string> calibration = CalibrationFile(context, recording.value());
@@ -187,13 +174,13 @@ Status RunTrackCase(const CaseContext& context, std::vector<std::string>* warnin
   args.config = context.c.config;
   args.calibration = calibration.value();
   args.out = context.dir + "/tracking";
+  args.no_time_budget = true;
   const Status st = Call(RunTrack, args, "track");
   if (!st.ok()) return st;
-  WarnIfTimeBudgetReached(context, warnings);
   return Evaluate(context, args.out, recording.value());
 }
 
-Status RunMonteCarloCase(const CaseContext& context, std::vector<std::string>*) {
+Status RunMonteCarloCase(const CaseContext& context) {
   std::string calibration = context.c.calibration;
   if (!context.c.calibrate.empty()) {
     const Result<std::string> recording = Recording(context);
@@ -210,6 +197,7 @@ Status RunMonteCarloCase(const CaseContext& context, std::vector<std::string>*) 
   args.runs = context.c.runs;
   args.jobs = context.jobs;
   args.seed_base = context.c.seed_base;
+  args.no_time_budget = true;
   if (context.c.t0_s) args.t0_s = *context.c.t0_s;
   return Call(RunMonteCarlo, args, "montecarlo");
 }

@@ -34,8 +34,8 @@ struct ModeSpec {
   std::vector<std::string> keys;       // case keys the mode reads besides name, mode, quick and checks
   std::vector<std::string> required;   // of those, the required ones; "a|b" means exactly one of a and b
   std::vector<ModeOutput> outputs;
-  // Runs the case; warnings (e.g. values that may depend on timing) go to `warnings`. nullptr: not available.
-  Status (*run)(const CaseContext& context, std::vector<std::string>* warnings) = nullptr;
+  // Runs the case, writing the outputs above; nullptr: not available in this build.
+  Status (*run)(const CaseContext& context) = nullptr;
 };
 
 // The mode of this name, nullptr when unknown.

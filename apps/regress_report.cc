@@ -70,7 +70,6 @@ std::string ResultsTable(const SuiteResult& result) {
       row(c.name, k.metric, Format(k.value), k.bound, Format(k.baseline), OutcomeName(k.outcome));
   for (const CaseResult& c : result.cases) {
     if (!c.error.empty()) out += "case " + c.name + ": error: " + c.error + "\n";
-    for (const std::string& w : c.warnings) out += "case " + c.name + ": warning: " + w + "\n";
   }
   std::snprintf(line, sizeof line, "%d checks: %d passed, %d failed, %d errors (%zu cases, %.1f s)\n",
                 result.Count(CheckResult::Outcome::kPassed) + result.Count(CheckResult::Outcome::kFailed) +
@@ -96,8 +95,7 @@ json ResultsJson(const SuiteResult& result) {
       if (!k.message.empty()) check["message"] = k.message;
       checks.push_back(check);
     }
-    json entry = {{"name", c.name}, {"mode", c.mode}, {"seconds", c.seconds}, {"checks", checks},
-                  {"warnings", c.warnings}};
+    json entry = {{"name", c.name}, {"mode", c.mode}, {"seconds", c.seconds}, {"checks", checks}};
     if (!c.error.empty()) entry["error"] = c.error;
     cases.push_back(entry);
   }

@@ -25,7 +25,6 @@ struct CaseResult {
   std::string name;
   std::string mode;
   std::string error;                  // empty when the case ran
-  std::vector<std::string> warnings;
   double seconds = 0.0;               // wall time (reported, never checked)
   std::vector<CheckResult> checks;
 };
