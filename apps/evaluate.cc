@@ -84,7 +84,8 @@ int RunEvaluate(const EvaluateArgs& args) {
   Result<eval::WrittenEvaluation> written = eval::WriteEvaluation(evaluation.value(), args.out, !args.no_plots);
   if (!written.ok()) return Fail(args.err, 1, written.status().message());
 
-  if (!written.value().note.empty()) (args.err ? *args.err : std::cerr) << "roamlab evaluate: " << written.value().note << "\n";
+  if (!written.value().note.empty())
+    (args.err ? *args.err : std::cerr) << "roamlab evaluate: " << written.value().note << "\n";
   if (!args.quiet) {
     PrintSummary(evaluation.value().metrics);
     std::printf("wrote %s", written.value().metrics_path.c_str());

@@ -43,7 +43,8 @@ bool SuiteResult::Passed() const {
 
 std::string FailureMessage(const CheckResult& check) {
   std::string message = "value " + Format(check.value) + " violates bound '" + check.bound + "'";
-  if (check.baseline) message += " (threshold " + Format(check.threshold) + ", baseline " + Format(check.baseline) + ")";
+  if (check.baseline)
+    message += " (threshold " + Format(check.threshold) + ", baseline " + Format(check.baseline) + ")";
   return message;
 }
 

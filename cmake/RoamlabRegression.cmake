@@ -18,8 +18,8 @@ function(roamlab_add_regression_suite name suite)
   if(NOT EXISTS "${suite_path}")
     message(FATAL_ERROR "roamlab_add_regression_suite(${name}): no suite file ${suite_path}")
   endif()
-  set(command $<TARGET_FILE:roamlab::roamlab> regress "${suite_path}" --out "${CMAKE_CURRENT_BINARY_DIR}/regress/${name}"
-              --quiet)
+  set(command $<TARGET_FILE:roamlab::roamlab> regress "${suite_path}"
+              --out "${CMAKE_CURRENT_BINARY_DIR}/regress/${name}" --quiet)
   if(ARG_QUICK)
     list(APPEND command --quick)
   endif()
