@@ -18,6 +18,7 @@
 #include "apps/regress_modes.h"
 #include "apps/regress_report.h"
 #include "apps/regress_suite.h"
+#include "common/check.h"
 
 namespace roamlab::apps {
 namespace {
@@ -93,6 +94,7 @@ CaseResult RunCase(const Case& c, const std::string& out_dir, int jobs) {
     }
     const auto o = std::find_if(mode.outputs.begin(), mode.outputs.end(),
                                 [&](const regress::ModeOutput& m) { return m.name == check.metric.output; });
+    ROAMLAB_CHECK(o != mode.outputs.end(), "metric " << r.metric << " was validated against mode " << c.mode);
     const std::string file = dir + "/" + o->file;
     if (!outputs.count(o->name)) {
       std::ifstream in(file);
@@ -214,11 +216,12 @@ int RunRegress(const RegressArgs& args) {
   // Reports.
   std::fputs(regress::ResultsTable(result).c_str(), stdout);
   const std::string results_path = args.out + "/results.json", junit_path = args.out + "/junit.xml";
-  std::ofstream(results_path) << regress::ResultsJson(result).dump(2) << "\n";
+  std::ofstream results(results_path);
+  results << regress::ResultsJson(result).dump(2) << "\n";
   std::ofstream junit(junit_path);
   junit << regress::JunitXml(result);
-  if (!junit) {
-    std::cerr << "roamlab regress: " << junit_path << ": cannot write\n";
+  if (!results || !junit) {
+    std::cerr << "roamlab regress: " << (results ? junit_path : results_path) << ": cannot write\n";
     return 1;
   }
   if (args.update_baseline) std::printf("baseline written to %s\n", baseline_dir.c_str());

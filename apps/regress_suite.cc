@@ -237,7 +237,7 @@ std::string ResolvePath(const std::string& suite_file, const std::string& path) 
   return (fs::path(suite_file).parent_path() / path).lexically_normal().string();
 }
 
-// Loads one case; `names` receives the configuration's names for the metric paths.
+// Loads and validates one case; `seen` holds the names of the cases before it.
 Result<Case> LoadCase(const YAML::Node& node, const Context& suite, std::set<std::string>* seen) {
   Context ctx = suite;
   if (!node.IsMap()) return ctx.Error(node, "a case must be a map");
