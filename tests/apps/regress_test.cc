@@ -3,6 +3,8 @@
 // baseline checks, named in results.json and junit.xml.
 #include "apps/regress.h"
 
+#include <set>
+
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -10,7 +12,11 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "apps/commands.h"
+#include "apps/evaluate.h"
+#include "apps/regress_modes.h"
 #include "recording/recording.h"
+#include "recording/truth.h"
 #include "tests/recording/temp_dir.h"
 #include "tests/support/synthetic.h"
 
@@ -53,7 +59,9 @@ class RegressTest : public ::testing::Test {
     testing::SyntheticOptions options;
     options.duration_s = 8.0;
     options.seed = 11;
-    ASSERT_TRUE(recording::WriteRecording(testing::MakeAtvRecording(options).recording, dir_->File("rec")).ok());
+    const testing::SyntheticRecording synthetic = testing::MakeAtvRecording(options);
+    ASSERT_TRUE(recording::WriteRecording(synthetic.recording, dir_->File("rec")).ok());
+    ASSERT_TRUE(recording::WriteTruth(synthetic.truth, dir_->File("rec")).ok());
     testing::WriteFile(dir_->File("good.yaml"), TrackingConfig("sigma_m: 0.33", "sigma_m: 0.33"));
     // Wrong noise levels: a GPS 10 times noisier than configured is trusted too little, an odometer 10 times less
     // noisy than it is trusted too much.
@@ -142,6 +150,78 @@ TEST_F(RegressTest, MissingBaselineIsAnErrorNotAPass) {
   EXPECT_EQ(results["checks"]["passed"], 1);
   args.filter = "no_such_case";
   EXPECT_EQ(RunRegress(args), 2);
+}
+
+// Keys of a mode output's schema that the output lacks (dotted); placeholders stand for every key the output has.
+void MissingKeys(const json& schema, const json& actual, const std::string& prefix, std::set<std::string>* missing) {
+  if (schema.is_array()) {
+    for (const json& row : actual) MissingKeys(schema[0], row, prefix + "[]", missing);
+    return;
+  }
+  if (!schema.is_object()) return;
+  for (const auto& [key, sub] : schema.items()) {
+    if (key == "<parameter>" || key == "<stream>") {
+      for (const auto& [name, value] : actual.items()) MissingKeys(sub, value, prefix + "." + name, missing);
+    } else if (sub == "relative") {
+      continue;  // derived from error and truth
+    } else if (!actual.contains(key)) {
+      missing->insert(prefix + "." + key);
+    } else {
+      MissingKeys(sub, actual[key], prefix + "." + key, missing);
+    }
+  }
+}
+
+json Output(const std::string& mode, const std::string& name) {
+  for (const regress::ModeOutput& o : regress::FindMode(mode)->outputs)
+    if (o.name == name) return o.schema;
+  ADD_FAILURE() << mode << " has no output " << name;
+  return json::object();
+}
+
+// The schemas that metric paths are validated against are what the commands write: every key is there, except
+// those the commands write only in some cases (a NEES without covariance, rotation errors of vectors).
+TEST_F(RegressTest, OutputSchemasMatchWhatTheCommandsWrite) {
+  CalibrateArgs calibrate;
+  calibrate.recording = dir_->File("rec");
+  calibrate.config = Source("atv_calibration.yaml");
+  calibrate.out = dir_->File("schema_cal");
+  calibrate.quiet = true;
+  ASSERT_EQ(RunCalibrate(calibrate), 0);
+  EvaluateArgs evaluate;
+  evaluate.estimate = calibrate.out;
+  evaluate.recording = calibrate.recording;
+  evaluate.out = dir_->File("schema_eval");
+  evaluate.no_plots = true;
+  evaluate.quiet = true;
+  ASSERT_EQ(RunEvaluate(evaluate), 0);
+
+  std::set<std::string> missing;
+  MissingKeys(Output("calibrate", "calibration"), ReadJson(calibrate.out + "/calibration.json"), "calibration",
+              &missing);
+  EXPECT_TRUE(missing.empty()) << *missing.begin();
+  missing.clear();
+  const json metrics = ReadJson(evaluate.out + "/metrics.json");
+  MissingKeys(Output("calibrate", "metrics"), metrics, "metrics", &missing);
+  for (const std::string& key : missing) {
+    const bool no_covariance = key == "metrics.nees" || key == "metrics.nees_mean";
+    const std::string name = key.substr(key.find('.', 8) + 1, key.rfind('.') - key.find('.', 8) - 1);
+    const bool vector_parameter = key.rfind("metrics.parameters.", 0) == 0 &&
+                                  metrics["parameters"][name]["manifold"] != "S3" &&
+                                  (key.find(".angle_error_deg") != std::string::npos ||
+                                   key.find(".component_error") != std::string::npos);
+    EXPECT_TRUE(no_covariance || vector_parameter) << key;
+  }
+  EXPECT_TRUE(metrics["parameters"].contains("imu.misalignment"));
+
+  // Tracking (the outcome of the checks does not matter here: their baseline may be absent).
+  Run(Suite("good.yaml"), "out_schema", false, 1);
+  const std::string track = dir_->File("out_schema/cases/synthetic_track");
+  ASSERT_TRUE(fs::exists(track + "/tracking/summary.json"));
+  missing.clear();
+  MissingKeys(Output("track", "summary"), ReadJson(track + "/tracking/summary.json"), "summary", &missing);
+  MissingKeys(Output("track", "metrics"), ReadJson(track + "/evaluation/metrics.json"), "metrics", &missing);
+  EXPECT_EQ(missing, std::set<std::string>{"metrics.parameters"});
 }
 
 }  // namespace
