@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <set>
 
 #include <nlohmann/json.hpp>
@@ -21,13 +22,13 @@ namespace {
 
 using nlohmann::json;
 
-int BadInput(const std::string& command, const std::string& message) {
-  std::cerr << "roamlab " << command << ": " << message << "\n";
+int BadInput(std::ostream* err, const std::string& command, const std::string& message) {
+  (err ? *err : std::cerr) << "roamlab " << command << ": " << message << "\n";
   return 2;
 }
 
-int Failure(const std::string& command, const std::string& message) {
-  std::cerr << "roamlab " << command << ": " << message << "\n";
+int Failure(std::ostream* err, const std::string& command, const std::string& message) {
+  (err ? *err : std::cerr) << "roamlab " << command << ": " << message << "\n";
   return 1;
 }
 
@@ -107,14 +108,14 @@ Result<std::map<std::string, Eigen::VectorXd>> ReadCalibrationValues(const std::
 int RunCalibrate(const CalibrateArgs& args) {
   const std::string cmd = "calibrate";
   auto inputs = LoadInputs(args.config, args.recording);
-  if (!inputs.ok()) return BadInput(cmd, inputs.status().message());
+  if (!inputs.ok()) return BadInput(args.err, cmd, inputs.status().message());
   const Status dir = MakeOutputDirectory(args.out);
-  if (!dir.ok()) return BadInput(cmd, dir.message());
+  if (!dir.ok()) return BadInput(args.err, cmd, dir.message());
 
   estimator::CalibrationOptions options;
   if (!args.quiet) options.progress = [](const std::string& line) { std::cerr << "calibrate: " << line << "\n"; };
   auto result = estimator::Calibrate(inputs.value().config, inputs.value().recording, options);
-  if (!result.ok()) return Failure(cmd, result.status().message());
+  if (!result.ok()) return Failure(args.err, cmd, result.status().message());
   const estimator::CalibrationResult& r = result.value();
 
   // calibration.json
@@ -154,11 +155,12 @@ int RunCalibrate(const CalibrateArgs& args) {
                     {"config", args.config}};
   const std::string json_path = args.out + "/calibration.json";
   Status st = WriteJson(out, json_path);
-  if (!st.ok()) return Failure(cmd, st.message());
+  if (!st.ok()) return Failure(args.err, cmd, st.message());
   st = WriteTum(r.trajectory, args.out + "/trajectory.tum");
-  if (!st.ok()) return Failure(cmd, st.message());
+  if (!st.ok()) return Failure(args.err, cmd, st.message());
 
   // Human-readable table.
+  if (args.quiet) return 0;
   std::printf("%-28s %-13s %s\n", "parameter", "observability", "estimate (std)");
   for (const auto& p : r.parameters) {
     std::string values;
@@ -186,26 +188,27 @@ int RunCalibrate(const CalibrateArgs& args) {
 int RunTrack(const TrackArgs& args) {
   const std::string cmd = "track";
   auto inputs = LoadInputs(args.config, args.recording);
-  if (!inputs.ok()) return BadInput(cmd, inputs.status().message());
+  if (!inputs.ok()) return BadInput(args.err, cmd, inputs.status().message());
+  if (args.no_time_budget) inputs.value().config.tracking.time_budget_s = std::numeric_limits<double>::infinity();
   std::map<std::string, Eigen::VectorXd> calibration;
   if (!args.calibration.empty()) {
     auto cal = ReadCalibrationValues(args.calibration);
-    if (!cal.ok()) return BadInput(cmd, cal.status().message());
+    if (!cal.ok()) return BadInput(args.err, cmd, cal.status().message());
     calibration = std::move(cal).value();
   }
   const Status dir = MakeOutputDirectory(args.out);
-  if (!dir.ok()) return BadInput(cmd, dir.message());
+  if (!dir.ok()) return BadInput(args.err, cmd, dir.message());
 
   estimator::TrackingOptions options;
   if (!args.quiet)
     options.progress = [](double f) { std::cerr << "\rtrack: " << static_cast<int>(100 * f) << "%" << std::flush; };
   auto result = estimator::Track(inputs.value().config, inputs.value().recording, calibration, options);
   if (!args.quiet) std::cerr << "\rtrack: 100%\n";
-  if (!result.ok()) return Failure(cmd, result.status().message());
+  if (!result.ok()) return Failure(args.err, cmd, result.status().message());
   const estimator::TrackingResult& r = result.value();
 
   Status st = WriteTum(r.trajectory, args.out + "/trajectory.tum");
-  if (!st.ok()) return Failure(cmd, st.message());
+  if (!st.ok()) return Failure(args.err, cmd, st.message());
   {
     std::ofstream cov(args.out + "/covariance.csv");
     cov << "t,xx,xy,xz,yx,yy,yz,zx,zy,zz\n";
@@ -219,7 +222,7 @@ int RunTrack(const TrackArgs& args) {
         }
       cov << "\n";
     }
-    if (!cov) return Failure(cmd, args.out + "/covariance.csv: write failed");
+    if (!cov) return Failure(args.err, cmd, args.out + "/covariance.csv: write failed");
   }
   int rejected = 0;
   for (const auto& [name, c] : r.counts) rejected += c.rejected;
@@ -237,7 +240,8 @@ int RunTrack(const TrackArgs& args) {
                         {"rejected_measurements", rejected},
                         {"measurements", CountsJson(r.counts)}};
   st = WriteJson(summary, args.out + "/summary.json");
-  if (!st.ok()) return Failure(cmd, st.message());
+  if (!st.ok()) return Failure(args.err, cmd, st.message());
+  if (args.quiet) return 0;
   std::printf("tracked %zu poses, %d updates (mean %.2f ms, max %.2f ms), %d rejected, %.1fx real time; wrote %s\n",
               r.trajectory.size(), r.updates, 1e3 * r.mean_update_s, 1e3 * r.max_update_s, rejected,
               r.total_seconds > 0 ? duration / r.total_seconds : 0.0, (args.out + "/trajectory.tum").c_str());

@@ -2,6 +2,7 @@
 // "roamlab <command>: <problem>" and gives exit code 2, a failure at run time exit code 1.
 #pragma once
 
+#include <iosfwd>
 #include <map>
 #include <string>
 
@@ -15,7 +16,8 @@ struct CalibrateArgs {
   std::string recording;
   std::string config;
   std::string out;
-  bool quiet = false;
+  bool quiet = false;            // no progress and no summary
+  std::ostream* err = nullptr;   // receives the one-line error; nullptr: stderr
 };
 // Offline self-calibration: writes OUT/calibration.json and OUT/trajectory.tum.
 int RunCalibrate(const CalibrateArgs& args);
@@ -25,7 +27,9 @@ struct TrackArgs {
   std::string config;
   std::string calibration;  // optional calibration.json
   std::string out;
-  bool quiet = false;
+  bool no_time_budget = false;   // ignore tracking.time_budget_s: results that do not depend on the machine's speed
+  bool quiet = false;            // no progress and no summary
+  std::ostream* err = nullptr;   // receives the one-line error; nullptr: stderr
 };
 // Online fixed-lag tracking: writes OUT/trajectory.tum, OUT/covariance.csv and OUT/summary.json.
 int RunTrack(const TrackArgs& args);

@@ -12,8 +12,8 @@ namespace {
 
 using nlohmann::json;
 
-int Fail(int code, const std::string& message) {
-  std::cerr << "roamlab evaluate: " << message << "\n";
+int Fail(std::ostream* err, int code, const std::string& message) {
+  (err ? *err : std::cerr) << "roamlab evaluate: " << message << "\n";
   return code;
 }
 
@@ -75,16 +75,17 @@ int RunEvaluate(const EvaluateArgs& args) {
   if (!args.align.empty()) {
     options.alignment = eval::ParseAlignmentKind(args.align);
     if (!options.alignment)
-      return Fail(2, "--align: unknown alignment '" + args.align + "' (none, se3 or yaw_translation)");
+      return Fail(args.err, 2, "--align: unknown alignment '" + args.align + "' (none, se3 or yaw_translation)");
   }
-  if (const std::string problem = options.Validate(); !problem.empty()) return Fail(2, problem);
+  if (const std::string problem = options.Validate(); !problem.empty()) return Fail(args.err, 2, problem);
 
   Result<eval::Evaluation> evaluation = eval::Evaluate(options);
-  if (!evaluation.ok()) return Fail(2, evaluation.status().message());
+  if (!evaluation.ok()) return Fail(args.err, 2, evaluation.status().message());
   Result<eval::WrittenEvaluation> written = eval::WriteEvaluation(evaluation.value(), args.out, !args.no_plots);
-  if (!written.ok()) return Fail(1, written.status().message());
+  if (!written.ok()) return Fail(args.err, 1, written.status().message());
 
-  if (!written.value().note.empty()) std::cerr << "roamlab evaluate: " << written.value().note << "\n";
+  if (!written.value().note.empty())
+    (args.err ? *args.err : std::cerr) << "roamlab evaluate: " << written.value().note << "\n";
   if (!args.quiet) {
     PrintSummary(evaluation.value().metrics);
     std::printf("wrote %s", written.value().metrics_path.c_str());

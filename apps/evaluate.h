@@ -3,6 +3,7 @@
 // line "roamlab evaluate: <file>: <problem>" on bad input, 1 when the output cannot be written or gnuplot fails.
 #pragma once
 
+#include <iosfwd>
 #include <string>
 
 namespace roamlab::apps {
@@ -18,6 +19,7 @@ struct EvaluateArgs {
   double nees_t0_s = 0.0;
   bool no_plots = false;
   bool quiet = false;              // no summary on stdout
+  std::ostream* err = nullptr;     // receives the one-line error and notes; nullptr: stderr
 };
 int RunEvaluate(const EvaluateArgs& args);
 

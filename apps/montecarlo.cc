@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -73,29 +74,30 @@ RunResult OneRun(const sim::Scenario& scenario, const estimator::EstimatorConfig
   return r;
 }
 
-int Fail(const std::string& message, int code) {
-  std::cerr << "roamlab montecarlo: " << message << "\n";
+int Fail(std::ostream* err, const std::string& message, int code) {
+  (err ? *err : std::cerr) << "roamlab montecarlo: " << message << "\n";
   return code;
 }
 
 }  // namespace
 
 int RunMonteCarlo(const MonteCarloArgs& args) {
-  if (args.runs < 1) return Fail("--runs must be at least 1", 2);
-  if (args.jobs < 0) return Fail("--jobs must be >= 0", 2);
+  if (args.runs < 1) return Fail(args.err, "--runs must be at least 1", 2);
+  if (args.jobs < 0) return Fail(args.err, "--jobs must be >= 0", 2);
   auto scenario = sim::LoadScenario(args.scenario);
-  if (!scenario.ok()) return Fail(scenario.status().message(), 2);
+  if (!scenario.ok()) return Fail(args.err, scenario.status().message(), 2);
   auto config = estimator::LoadEstimatorConfig(args.config);
-  if (!config.ok()) return Fail(config.status().message(), 2);
+  if (!config.ok()) return Fail(args.err, config.status().message(), 2);
+  if (args.no_time_budget) config.value().tracking.time_budget_s = std::numeric_limits<double>::infinity();
   std::map<std::string, Eigen::VectorXd> calibration;
   if (!args.calibration.empty()) {
     auto cal = ReadCalibrationValues(args.calibration);
-    if (!cal.ok()) return Fail(cal.status().message(), 2);
+    if (!cal.ok()) return Fail(args.err, cal.status().message(), 2);
     calibration = std::move(cal).value();
   }
   std::error_code ec;
   std::filesystem::create_directories(args.out, ec);
-  if (ec) return Fail(args.out + ": cannot create the output directory: " + ec.message(), 2);
+  if (ec) return Fail(args.err, args.out + ": cannot create the output directory: " + ec.message(), 2);
 
   // Runs spread over worker threads; each writes only its own slot, so the result does not depend on scheduling.
   const int jobs = args.jobs > 0 ? args.jobs : std::max(1u, std::thread::hardware_concurrency());
@@ -119,7 +121,7 @@ int RunMonteCarlo(const MonteCarloArgs& args) {
   for (auto& th : threads) th.join();
   if (!args.quiet) std::cerr << "\n";
   for (const RunResult& r : results)
-    if (!r.error.empty()) return Fail(r.error, 1);
+    if (!r.error.empty()) return Fail(args.err, r.error, 1);
 
   // A common time grid: the stamps every run has (they share the master stream's rate).
   std::vector<Time> grid = results.front().t;
@@ -128,7 +130,7 @@ int RunMonteCarlo(const MonteCarloArgs& args) {
     std::set_intersection(grid.begin(), grid.end(), r.t.begin(), r.t.end(), std::back_inserter(common));
     grid = std::move(common);
   }
-  if (grid.empty()) return Fail("the runs share no time stamp", 1);
+  if (grid.empty()) return Fail(args.err, "the runs share no time stamp", 1);
   std::vector<std::vector<double>> series;
   for (const RunResult& r : results) {
     std::vector<double> s;
@@ -159,6 +161,7 @@ int RunMonteCarlo(const MonteCarloArgs& args) {
   } else {
     plot_note = " (gnuplot not found: no nees.png)";
   }
+  if (args.quiet) return 0;
   std::printf("%d runs: mean NEES in the 95%% band [%.3f, %.3f] for %.1f%% of the time steps after %.1f s; wrote %s%s\n",
               args.runs, nees.band.lo, nees.band.hi, 100.0 * nees.fraction_in_band, args.t0_s,
               (args.out + "/nees.json").c_str(), plot_note.c_str());

@@ -1,6 +1,7 @@
 // `roamlab montecarlo`: consistency of online tracking over noise realizations (seed 000, Section V, Fig. 4).
 #pragma once
 
+#include <iosfwd>
 #include <string>
 
 namespace roamlab::apps {
@@ -14,7 +15,9 @@ struct MonteCarloArgs {
   int jobs = 0;             // 0: one per core
   unsigned long long seed_base = 1000;  // run i simulates with noise seed seed_base + i
   double t0_s = 2.0;        // fraction_in_band counts time steps from t0_s on
-  bool quiet = false;
+  bool no_time_budget = false;  // ignore tracking.time_budget_s: results that do not depend on the machine's speed
+  bool quiet = false;           // no progress bar and no summary
+  std::ostream* err = nullptr;  // receives the one-line error; nullptr: stderr
 };
 
 // Simulates `runs` noise realizations of the scenario (the terrain and the drive stay the same), tracks each online,

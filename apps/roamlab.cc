@@ -7,6 +7,7 @@
 #include "apps/commands.h"
 #include "apps/evaluate.h"
 #include "apps/montecarlo.h"
+#include "apps/regress.h"
 #include "apps/simulate.h"
 
 int main(int argc, char** argv) {
@@ -29,7 +30,7 @@ int main(int argc, char** argv) {
       ->required();
   cal->add_option("--config", calibrate.config, "Estimator configuration (EST.yaml)")->required();
   cal->add_option("--out", calibrate.out, "Output directory: calibration.json, trajectory.tum")->required();
-  cal->add_flag("--quiet", calibrate.quiet, "No progress lines");
+  cal->add_flag("--quiet", calibrate.quiet, "No progress and no summary");
 
   roamlab::apps::TrackArgs track;
   CLI::App* trk = app.add_subcommand(
@@ -38,7 +39,7 @@ int main(int argc, char** argv) {
   trk->add_option("--config", track.config, "Estimator configuration (EST.yaml)")->required();
   trk->add_option("--calibration", track.calibration, "calibration.json from `roamlab calibrate` (fixes parameters)");
   trk->add_option("--out", track.out, "Output directory: trajectory.tum, covariance.csv, summary.json")->required();
-  trk->add_flag("--quiet", track.quiet, "No progress lines");
+  trk->add_flag("--quiet", track.quiet, "No progress and no summary");
 
   roamlab::apps::EvaluateArgs evaluate;
   CLI::App* evl = app.add_subcommand(
@@ -70,7 +71,19 @@ int main(int argc, char** argv) {
   mc->add_option("--seed-base", montecarlo.seed_base, "Run i uses noise seed SEED_BASE + i (default 1000)");
   mc->add_option("--t0", montecarlo.t0_s, "Leave the first T0 seconds out of fraction_in_band (default 2)");
   mc->add_option("--out", montecarlo.out, "Output directory: nees.json, runs.json, nees.png")->required();
-  mc->add_flag("--quiet", montecarlo.quiet, "No progress bar");
+  mc->add_flag("--quiet", montecarlo.quiet, "No progress bar and no summary");
+
+  roamlab::apps::RegressArgs regress;
+  CLI::App* reg = app.add_subcommand(
+      "regress", "Run a regression suite: cases with checks against bounds and baselines; JUnit XML for CI.");
+  reg->add_option("suite", regress.suite, "Suite file (SUITE.yaml)")->required();
+  reg->add_option("--out", regress.out, "Output directory: results.json, junit.xml, cases/NAME/")->required();
+  reg->add_option("--baseline", regress.baseline, "Baseline directory (default: the suite's `baseline`)");
+  reg->add_flag("--update-baseline", regress.update_baseline, "Write the values as the new baseline, one file a case");
+  reg->add_option("--jobs", regress.jobs, "Cases in parallel (default: one per core)");
+  reg->add_option("--filter", regress.filter, "Only the cases whose name matches this glob");
+  reg->add_flag("--quick", regress.quick, "Only the cases marked `quick: true`");
+  reg->add_flag("--quiet", regress.quiet, "No progress lines");
 
   try {
     app.parse(argc, argv);
@@ -91,5 +104,6 @@ int main(int argc, char** argv) {
   if (*trk) return roamlab::apps::RunTrack(track);
   if (*evl) return roamlab::apps::RunEvaluate(evaluate);
   if (*mc) return roamlab::apps::RunMonteCarlo(montecarlo);
+  if (*reg) return roamlab::apps::RunRegress(regress);
   return 2;
 }

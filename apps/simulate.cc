@@ -14,8 +14,8 @@ namespace {
 
 constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
 
-int Fail(int code, const std::string& message) {
-  std::cerr << "roamlab simulate: " << message << "\n";
+int Fail(std::ostream* err, int code, const std::string& message) {
+  (err ? *err : std::cerr) << "roamlab simulate: " << message << "\n";
   return code;
 }
 
@@ -23,7 +23,7 @@ int Fail(int code, const std::string& message) {
 
 int RunSimulate(const SimulateArgs& args) {
   auto scenario = sim::LoadScenario(args.scenario);
-  if (!scenario.ok()) return Fail(2, scenario.status().message());
+  if (!scenario.ok()) return Fail(args.err, 2, scenario.status().message());
 
   // Simulate, with a progress line on stderr.
   sim::SimulateOptions options;
@@ -34,16 +34,16 @@ int RunSimulate(const SimulateArgs& args) {
     };
   }
   auto simulator = sim::Simulator::Create(scenario.value(), options);
-  if (!simulator.ok()) return Fail(2, simulator.status().message());
+  if (!simulator.ok()) return Fail(args.err, 2, simulator.status().message());
   auto simulation = simulator.value()->Run();
   if (!args.quiet) std::cerr << "\n";
-  if (!simulation.ok()) return Fail(1, simulation.status().message());
+  if (!simulation.ok()) return Fail(args.err, 1, simulation.status().message());
 
   // The recording and its truth.
   const sim::Simulation& s = simulation.value();
   Status status = recording::WriteRecording(s.recording, args.out);
   if (status.ok()) status = recording::WriteTruth(s.truth, args.out);
-  if (!status.ok()) return Fail(1, status.message());
+  if (!status.ok()) return Fail(args.err, 1, status.message());
 
   if (!args.quiet) {
     const sim::SimulationStats& st = s.stats;

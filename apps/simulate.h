@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <iosfwd>
 #include <optional>
 #include <string>
 
@@ -15,6 +16,7 @@ struct SimulateArgs {
   std::string out;                      // recording directory
   std::optional<std::uint64_t> seed;    // overrides the scenario's noise seed
   bool quiet = false;                   // no progress and no summary
+  std::ostream* err = nullptr;          // receives the one-line error; nullptr: stderr
 };
 int RunSimulate(const SimulateArgs& args);
 
