@@ -105,6 +105,49 @@ Result<std::map<std::string, Eigen::VectorXd>> ReadCalibrationValues(const std::
   return out;
 }
 
+Result<estimator::CalibrationPrior> ReadCalibrationPrior(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return Status::Error(path + ": cannot open");
+  json j;
+  try {
+    in >> j;
+  } catch (const json::exception& e) {
+    return Status::Error(path + ": not valid JSON: " + e.what());
+  }
+  const json& info = j["information"];
+  if (!info.is_object() || !info["parameters"].is_array() || !info["matrix"].is_array())
+    return Status::Error(path + ": no 'information' with 'parameters' and 'matrix' (calibrate it again)");
+  estimator::CalibrationPrior prior;
+  for (const auto& name : info["parameters"]) {
+    if (!name.is_string()) return Status::Error(path + ": information.parameters must be names");
+    prior.names.push_back(name.get<std::string>());
+  }
+  const json& m = info["matrix"];
+  const int n = static_cast<int>(m.size());
+  prior.information.resize(n, n);
+  for (int r = 0; r < n; ++r) {
+    if (!m[r].is_array() || static_cast<int>(m[r].size()) != n)
+      return Status::Error(path + ": information.matrix must be square");
+    for (int c = 0; c < n; ++c) {
+      if (!m[r][c].is_number()) return Status::Error(path + ": information.matrix has a non-number");
+      prior.information(r, c) = m[r][c].get<double>();
+    }
+  }
+  return prior;
+}
+
+Result<estimator::TrackingOptions> TrackingOptionsFor(const estimator::EstimatorConfig& config,
+                                                      const std::string& calibration_path) {
+  estimator::TrackingOptions options;
+  if (!config.tracking.calibration_prior) return options;
+  if (calibration_path.empty())
+    return Status::Error(config.source_file + ": tracking.calibration_prior needs --calibration calibration.json");
+  auto prior = ReadCalibrationPrior(calibration_path);
+  if (!prior.ok()) return prior.status();
+  options.calibration_prior = std::move(prior).value();
+  return options;
+}
+
 int RunCalibrate(const CalibrateArgs& args) {
   const std::string cmd = "calibrate";
   auto inputs = LoadInputs(args.config, args.recording);
@@ -129,6 +172,9 @@ int RunCalibrate(const CalibrateArgs& args) {
                       {"component_observability", components},
                       {"manifold", p.manifold.Name()}};
   }
+  json names = json::array(), matrix = json::array();
+  for (const auto& p : r.parameters) names.push_back(p.name);
+  for (int row = 0; row < r.information.rows(); ++row) matrix.push_back(Vector(r.information.row(row).transpose()));
   json correlations = json::array();
   for (const auto& c : r.correlations) correlations.push_back({{"a", c.a}, {"b", c.b}, {"rho", c.rho}});
   json stages = json::array();
@@ -142,6 +188,7 @@ int RunCalibrate(const CalibrateArgs& args) {
                       {"rejected", s.rejected},
                       {"seconds", s.solver.seconds}});
   const json out = {{"parameters", params},
+                    {"information", {{"parameters", names}, {"matrix", matrix}}},
                     {"correlations", correlations},
                     {"solver",
                      {{"iterations", r.iterations},
@@ -196,10 +243,12 @@ int RunTrack(const TrackArgs& args) {
     if (!cal.ok()) return BadInput(args.err, cmd, cal.status().message());
     calibration = std::move(cal).value();
   }
+  auto tracking_options = TrackingOptionsFor(inputs.value().config, args.calibration);
+  if (!tracking_options.ok()) return BadInput(args.err, cmd, tracking_options.status().message());
   const Status dir = MakeOutputDirectory(args.out);
   if (!dir.ok()) return BadInput(args.err, cmd, dir.message());
 
-  estimator::TrackingOptions options;
+  estimator::TrackingOptions options = std::move(tracking_options).value();
   if (!args.quiet)
     options.progress = [](double f) { std::cerr << "\rtrack: " << static_cast<int>(100 * f) << "%" << std::flush; };
   auto result = estimator::Track(inputs.value().config, inputs.value().recording, calibration, options);

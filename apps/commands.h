@@ -9,6 +9,8 @@
 #include <Eigen/Core>
 
 #include "common/status.h"
+#include "estimator/config.h"
+#include "estimator/tracking.h"
 
 namespace roamlab::apps {
 
@@ -36,5 +38,14 @@ int RunTrack(const TrackArgs& args);
 
 // Parameter values (ambient, by name) from a calibration.json written by `roamlab calibrate`.
 Result<std::map<std::string, Eigen::VectorXd>> ReadCalibrationValues(const std::string& path);
+
+// The joint marginal information of the calibrated parameters from the same file ("information": {"parameters":
+// [...], "matrix": [[...]]}), for tracking with tracking.calibration_prior.
+Result<estimator::CalibrationPrior> ReadCalibrationPrior(const std::string& path);
+
+// TrackingOptions for `config`: with tracking.calibration_prior, the prior read from `calibration_path` (an error
+// when the configuration asks for it and no calibration file is given).
+Result<estimator::TrackingOptions> TrackingOptionsFor(const estimator::EstimatorConfig& config,
+                                                      const std::string& calibration_path);
 
 }  // namespace roamlab::apps

@@ -35,7 +35,8 @@ struct RunResult {
 
 // One realization: simulate, track, NEES of every tracked pose against the ground truth at the same time stamp.
 RunResult OneRun(const sim::Scenario& scenario, const estimator::EstimatorConfig& config,
-                 const std::map<std::string, Eigen::VectorXd>& calibration, std::uint64_t seed) {
+                 const std::map<std::string, Eigen::VectorXd>& calibration,
+                 const estimator::TrackingOptions& tracking_options, std::uint64_t seed) {
   RunResult r;
   sim::SimulateOptions sim_options;
   sim_options.seed = seed;
@@ -45,7 +46,7 @@ RunResult OneRun(const sim::Scenario& scenario, const estimator::EstimatorConfig
     return r;
   }
   const recording::Recording& rec = simulation.value().recording;
-  auto tracked = estimator::Track(config, rec, calibration);
+  auto tracked = estimator::Track(config, rec, calibration, tracking_options);
   if (!tracked.ok()) {
     r.error = "seed " + std::to_string(seed) + ": " + tracked.status().message();
     return r;
@@ -95,6 +96,8 @@ int RunMonteCarlo(const MonteCarloArgs& args) {
     if (!cal.ok()) return Fail(args.err, cal.status().message(), 2);
     calibration = std::move(cal).value();
   }
+  auto tracking_options = TrackingOptionsFor(config.value(), args.calibration);
+  if (!tracking_options.ok()) return Fail(args.err, tracking_options.status().message(), 2);
   std::error_code ec;
   std::filesystem::create_directories(args.out, ec);
   if (ec) return Fail(args.err, args.out + ": cannot create the output directory: " + ec.message(), 2);
@@ -106,7 +109,7 @@ int RunMonteCarlo(const MonteCarloArgs& args) {
   std::mutex print;
   const auto worker = [&] {
     for (int i = next++; i < args.runs; i = next++) {
-      results[i] = OneRun(scenario.value(), config.value(), calibration, args.seed_base + i);
+      results[i] = OneRun(scenario.value(), config.value(), calibration, tracking_options.value(), args.seed_base + i);
       const int finished = ++done;
       if (!args.quiet) {
         std::lock_guard<std::mutex> lock(print);

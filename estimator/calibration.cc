@@ -132,6 +132,7 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
     if (!info.ok()) return info.status();
     analysis = AnalyzeObservability(info.value().information, info.value().conditional, options.observability);
     offsets = info.value().offsets;
+    result.information = info.value().information;
   }
   for (std::size_t i = 0; i < ids.size(); ++i) {
     const Variable& v = builder.graph().variable(ids[i]);

@@ -43,6 +43,9 @@ struct StageSummary {
 struct CalibrationResult {
   std::vector<ParameterEstimate> parameters;
   std::vector<Correlation> correlations;   // pairs of parameters with |rho| >= correlation_threshold
+  // Joint marginal information of `parameters` (tangent coordinates, stacked in their order) at the final estimate:
+  // what the recording says about them once the poses are eliminated. Zero along unobservable directions.
+  Eigen::MatrixXd information;
   std::vector<StageSummary> stages;
   std::map<std::string, StreamCounts> counts;
   Trajectory trajectory;                    // the smoothed trajectory of the final estimate

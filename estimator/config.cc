@@ -158,8 +158,11 @@ class Parser {
   }
 
   void ParseTracking(const YAML::Node& n, TrackingConfig* t) const {
-    CheckKeys(n, {"window", "max_iterations", "improvement_threshold", "time_budget_s", "initialization_s"},
+    CheckKeys(n,
+              {"window", "max_iterations", "improvement_threshold", "time_budget_s", "initialization_s",
+               "calibration_prior"},
               "tracking");
+    if (n["calibration_prior"]) t->calibration_prior = Bool(n["calibration_prior"], "tracking.calibration_prior");
     if (n["window"]) t->window = static_cast<int>(Number(n["window"], "tracking.window"));
     if (n["max_iterations"]) t->max_iterations = static_cast<int>(Number(n["max_iterations"], "max_iterations"));
     if (n["improvement_threshold"])

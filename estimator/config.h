@@ -73,6 +73,9 @@ struct TrackingConfig {
   double improvement_threshold = 1e-3;
   double time_budget_s = 0.05;           // per update
   double initialization_s = 2.0;         // data buffered before the first window is solved
+  // With a calibration that carries its information matrix (TrackingOptions::calibration_prior), the calibrated
+  // constant parameters stay free in the window under that Gaussian prior instead of being fixed at their values.
+  bool calibration_prior = false;
 };
 
 struct EstimatorConfig {

@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <memory>
+
+#include <Eigen/Eigenvalues>
 
 #include "estimator/calibration.h"
 #include "estimator/covariance.h"
@@ -56,6 +60,43 @@ Status EmitAndMarginalizeOldest(ProblemBuilder* builder, const CovarianceRequest
   return Status::Ok();
 }
 
+// The calibration's Gaussian prior on the parameters as a linear prior factor at the calibrated values: with the
+// information H = V diag(lambda) V^T, e = diag(sqrt(lambda)) V^T [x [-] x_calibrated] (directions the calibration did
+// not observe, lambda ~ 0, carry no information and are left out).
+Status AddCalibrationPrior(const CalibrationPrior& prior, ProblemBuilder* builder) {
+  std::vector<VariableId> ids;
+  std::vector<Manifold> manifolds;
+  std::vector<Eigen::VectorXd> values;
+  int dim = 0;
+  for (const std::string& name : prior.names) {
+    const auto it = builder->parameters().find(name);
+    if (it == builder->parameters().end() || builder->IsTimeVarying(name))
+      return Status::Error("calibration prior: '" + name + "' is not a constant parameter of the configuration");
+    const Variable& v = builder->graph().variable(it->second);
+    ids.push_back(it->second);
+    manifolds.push_back(v.manifold);
+    values.push_back(v.value);
+    dim += v.manifold.tangent_dim();
+  }
+  if (prior.information.rows() != dim || prior.information.cols() != dim)
+    return Status::Error("calibration prior: information is " + std::to_string(prior.information.rows()) + "x" +
+                         std::to_string(prior.information.cols()) + ", the parameters have " + std::to_string(dim) +
+                         " tangent dimensions");
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (prior.information + prior.information.transpose()));
+  const double floor = 1e-12 * std::max(1.0, eig.eigenvalues().cwiseAbs().maxCoeff());
+  std::vector<int> kept;
+  for (int i = 0; i < dim; ++i)
+    if (eig.eigenvalues()[i] > floor) kept.push_back(i);
+  Eigen::MatrixXd J(static_cast<int>(kept.size()), dim);
+  for (std::size_t r = 0; r < kept.size(); ++r)
+    J.row(static_cast<int>(r)) = std::sqrt(eig.eigenvalues()[kept[r]]) * eig.eigenvectors().col(kept[r]).transpose();
+  const int rows = static_cast<int>(J.rows());
+  builder->graph().AddFactor(std::make_unique<LinearPriorFactor>(manifolds, values, J, Eigen::VectorXd::Zero(rows)),
+                             ids, Eigen::MatrixXd::Identity(rows, rows), Loss::Trivial(), "calibration_prior",
+                             Time());
+  return Status::Ok();
+}
+
 }  // namespace
 
 Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::Recording& recording,
@@ -71,10 +112,23 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
     p.value = value;
     if (p.process.type == ProcessConfig::Type::kConstant) p.free = false;
   }
+  const CalibrationPrior* prior =
+      config.tracking.calibration_prior && options.calibration_prior ? &*options.calibration_prior : nullptr;
+  if (prior != nullptr) {
+    for (const std::string& name : prior->names) {
+      if (!calibration.count(name) || !config.parameters.count(name))
+        return Status::Error("calibration prior: parameter '" + name + "' has no calibrated value in the configuration");
+      config.parameters[name].free = true;
+    }
+  }
   config.stages.clear();
   auto built = ProblemBuilder::Create(config, recording);
   if (!built.ok()) return built.status();
   ProblemBuilder& builder = *built.value();
+  if (prior != nullptr) {
+    const Status added = AddCalibrationPrior(*prior, &builder);
+    if (!added.ok()) return added;
+  }
 
   SolverOptions update_options = config.solver;
   update_options.method = SolverOptions::Method::kGaussNewton;

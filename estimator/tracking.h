@@ -12,6 +12,7 @@
 
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,8 +38,19 @@ struct TrackingResult {
   std::map<std::string, StreamCounts> counts;
 };
 
+// What an offline calibration knows about its parameters: their joint marginal information (CalibrationResult::
+// information), tangent coordinates stacked in the order of `names`.
+struct CalibrationPrior {
+  std::vector<std::string> names;
+  Eigen::MatrixXd information;
+};
+
 struct TrackingOptions {
   std::function<void(double fraction_done)> progress;  // optional
+  // When set and the configuration asks for it (tracking.calibration_prior), the parameters it names start at the
+  // values of `calibration` and stay free under this prior: the window then carries the calibration's uncertainty
+  // into the poses' covariance, and marginalization keeps what each update learns about the parameters.
+  std::optional<CalibrationPrior> calibration_prior;
   // Optional: receives each pose and its world-frame position covariance [m^2] as it leaves the window. When set,
   // TrackingResult::trajectory and position_covariance stay empty (a long online run then keeps bounded memory).
   std::function<void(const StampedPose& pose, const Eigen::Matrix3d& position_covariance)> on_pose;

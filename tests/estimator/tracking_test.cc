@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
 #include "common/chi_square.h"
@@ -165,6 +166,81 @@ TEST(TrackingTest, TrackingTheGyroBiasComesCloseToKnowingIt) {
   const double tracked_distance = worst_distance(with_tracked.value());
   const double ignored_distance = worst_distance(with_ignored.value());
   EXPECT_LT(tracked_distance, 0.5 * ignored_distance) << tracked_distance << " vs " << ignored_distance;
+}
+
+}  // namespace
+}  // namespace roamlab::estimator
+
+namespace roamlab::estimator {
+namespace {
+
+// A calibration of the GPS lever arm and the IMU misalignment on one 8 s drive, as tracking of another drive uses it.
+struct CalibratedAtv {
+  std::map<std::string, Eigen::VectorXd> values;
+  CalibrationPrior prior;
+};
+
+CalibratedAtv CalibrateOnOtherDrive() {
+  roamlab::testing::SyntheticOptions options;
+  options.duration_s = 8.0;
+  options.seed = 21;
+  const auto synthetic = roamlab::testing::MakeAtvRecording(options);
+  auto result = Calibrate(testing::AtvConfig({"gps.lever_arm", "imu.misalignment"}), synthetic.recording);
+  EXPECT_TRUE(result.ok()) << result.status().message();
+  CalibratedAtv out;
+  for (const ParameterEstimate& p : result.value().parameters) {
+    out.values[p.name] = p.estimate;
+    out.prior.names.push_back(p.name);
+  }
+  out.prior.information = result.value().information;
+  return out;
+}
+
+TEST(TrackingTest, CalibrationPriorWidensThePositionCovarianceByTheCalibrationUncertainty) {
+  // Fixing a parameter conditions on it; leaving it free under its calibration prior marginalizes it instead, and a
+  // marginal covariance is never smaller than a conditional one: every tracked pose's position covariance must grow
+  // (in the PSD order, checked on the trace and the smallest eigenvalue of the difference).
+  const CalibratedAtv calibrated = CalibrateOnOtherDrive();
+  roamlab::testing::SyntheticOptions options;
+  options.duration_s = 6.0;
+  options.seed = 22;
+  const auto synthetic = roamlab::testing::MakeAtvRecording(options);
+  EstimatorConfig config = testing::AtvConfig({}, 20);
+  config.tracking.time_budget_s = 1e9;
+  auto fixed = Track(config, synthetic.recording, calibrated.values);
+  config.tracking.calibration_prior = true;
+  TrackingOptions with_prior;
+  with_prior.calibration_prior = calibrated.prior;
+  auto marginal = Track(config, synthetic.recording, calibrated.values, with_prior);
+  ASSERT_TRUE(fixed.ok()) << fixed.status().message();
+  ASSERT_TRUE(marginal.ok()) << marginal.status().message();
+  ASSERT_EQ(fixed.value().trajectory.size(), marginal.value().trajectory.size());
+  double growth = 0.0;
+  for (std::size_t i = 0; i < fixed.value().trajectory.size(); ++i) {
+    const Eigen::Matrix3d difference =
+        marginal.value().position_covariance[i] - fixed.value().position_covariance[i];
+    const double scale = fixed.value().position_covariance[i].trace();
+    EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(difference).eigenvalues().minCoeff(), -1e-6 * scale)
+        << "pose " << i;
+    growth = std::max(growth, difference.trace() / scale);
+  }
+  // The lever arm's uncertainty (about 0.05 m horizontally after 8 s) is not negligible against the GPS-held position.
+  EXPECT_GT(growth, 0.05);
+}
+
+TEST(TrackingTest, CalibrationPriorOfTheWrongSizeIsAnError) {
+  CalibratedAtv calibrated = CalibrateOnOtherDrive();
+  calibrated.prior.information = Eigen::MatrixXd::Identity(2, 2);
+  roamlab::testing::SyntheticOptions options;
+  options.duration_s = 3.0;
+  const auto synthetic = roamlab::testing::MakeAtvRecording(options);
+  EstimatorConfig config = testing::AtvConfig({}, 20);
+  config.tracking.calibration_prior = true;
+  TrackingOptions with_prior;
+  with_prior.calibration_prior = calibrated.prior;
+  auto result = Track(config, synthetic.recording, calibrated.values, with_prior);
+  ASSERT_FALSE(result.ok());
+  EXPECT_NE(result.status().message().find("tangent dimensions"), std::string::npos) << result.status().message();
 }
 
 }  // namespace
