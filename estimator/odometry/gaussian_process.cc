@@ -254,6 +254,16 @@ Result<GaussianProcess> GaussianProcess::Train(const Eigen::MatrixXd& X, const E
     if (llt.info() != Eigen::Success) {
       return Status::Error(std::string("GP: K + Sigma is not positive definite for output ") + "xyt"[i]);
     }
+    // With a linear mean and hyper-parameters to optimize, C is re-estimated on all n pairs: at fixed kernel and noise
+    // the log marginal likelihood is maximized in closed form by generalized least squares,
+    // c = (X^T (K + Sigma)^-1 X)^-1 X^T (K + Sigma)^-1 y (the subset's c is only as good as the subset).
+    if (layout.linear_mean && fixed_parameters.empty()) {
+      const Eigen::MatrixXd KiX = llt.solve(X);
+      const Eigen::LDLT<Eigen::MatrixXd> normal(X.transpose() * KiX);
+      if (normal.info() == Eigen::Success && (normal.vectorD().array() > 0.0).all()) {
+        p.segment(layout.c(0), layout.m) = normal.solve(KiX.transpose() * Y.col(i));
+      }
+    }
     gp.alpha_.push_back(llt.solve(Eigen::VectorXd(Y.col(i) - MeanVector(layout, p, X))));
     gp.factor_.push_back(std::move(llt));
     gp.p_.push_back(p);

@@ -19,7 +19,8 @@
 // log-parameters (positive ones) and plain c_i. The exact gradient costs O(n^3) per evaluation (one Cholesky and one
 // inverse per output), so the optimization runs on a seeded random subset of at most `hyperparameter_subset` pairs
 // (the "subset of data" approximation); the trained model then conditions on all n pairs: one Eigen LLT per output,
-// kept for the predictive covariance (Algorithm 1, steps 4-5).
+// kept for the predictive covariance (Algorithm 1, steps 4-5). With a linear mean, C is then re-estimated on all n
+// pairs by generalized least squares, its exact maximum-likelihood value at the subset's kernel hyper-parameters.
 //
 // Prediction (Algorithm 1, steps 8-9): mean mu_i(x) + k_i(x, X) a_i costs O(n m) (O(m) for the linear kernel, whose
 // k(x, X) a = sl^2 x^T (X^T a)); the variance k_i(x, x) - |L_i^-1 k_i(x, X)|^2 costs O(n^2).

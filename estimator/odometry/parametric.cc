@@ -97,7 +97,12 @@ Result<WheelKinematics> NominalKinematics(const recording::Platform& platform,
     for (Eigen::Index i = 0; i < m; ++i) {
       Result<double> angle = GeometryValue(platform, "wheel_angle_" + wheels[i] + "_rad");
       if (!angle.ok()) return angle.status();
-      k.J.row(i) << -std::sin(angle.value()), std::cos(angle.value()), distance.value();
+      // Positive wheel rotation moves the robot counter-clockwise (+1, default) or clockwise (-1).
+      const std::string direction_key = "wheel_direction_" + wheels[i];
+      const auto direction = platform.geometry.find(direction_key);
+      const double sign = direction == platform.geometry.end() ? 1.0 : direction->second;
+      if (sign != 1.0 && sign != -1.0) return Status::Error("platform geometry." + direction_key + " must be 1 or -1");
+      k.J.row(i) << -sign * std::sin(angle.value()), sign * std::cos(angle.value()), sign * distance.value();
     }
   } else if (platform.kind == "mecanum") {
     if (Status s = require_wheels({"front_left", "front_right", "rear_left", "rear_right"}); !s.ok()) return s;

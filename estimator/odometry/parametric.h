@@ -10,7 +10,9 @@
 // Nominal rows from recording.yaml's platform (keys carry units; per-wheel keys use the encoder column names):
 //   differential_drive  wheels `right`, `left`: right [1, 0, b/2], left [1, 0, -b/2]; b = geometry.track_m
 //   omni3               wheel i at angle a_i (geometry.wheel_angle_<name>_rad, from the body x axis, counter-clockwise)
-//                       and distance L (geometry.wheel_distance_m), rolling counter-clockwise: [-sin a_i, cos a_i, L]
+//                       and distance L (geometry.wheel_distance_m): d_i [-sin a_i, cos a_i, L], d_i = +1 when a
+//                       positive wheel rotation drives the robot counter-clockwise, -1 when clockwise
+//                       (geometry.wheel_direction_<name>, default +1)
 //   mecanum             wheels front_left, front_right, rear_left, rear_right, rollers at 45 deg (Taheri et al., the
 //                       seed's [16]): [1, -1, -k], [1, 1, k], [1, 1, -k], [1, -1, k], k = (wheelbase_m + track_m) / 2
 // Radii: geometry.wheel_radius_<name>_m, else geometry.wheel_radius_m. The nominal sensor pose is O itself.

@@ -11,6 +11,8 @@
 // usual meaning (c = 1.345: 95 % efficiency under Gaussian noise).
 #pragma once
 
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "common/status.h"
@@ -33,5 +35,11 @@ struct HuberFit {
 // than unknowns, non-finite data, a singular design.
 Result<HuberFit> FitHuberLinear(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y, const Eigen::MatrixXd& sigma,
                                 const HuberOptions& options = {});
+
+// Rows whose whitened residual |s_i - [W delta]_i| / (sigma_i scale_i) is at most `threshold` in every output: the
+// pairs that lie on the linear surface (the seed's Fig. 3 calls the others outliers). Used to drop gross outliers
+// before fitting models with a Gaussian likelihood (CGP) or least squares (Censi et al.'s second step).
+std::vector<int> InlierRows(const HuberFit& fit, const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y,
+                            const Eigen::MatrixXd& sigma, double threshold);
 
 }  // namespace roamlab::estimator::odometry
