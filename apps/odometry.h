@@ -26,7 +26,7 @@ struct OdometryLearnArgs {
   std::string sensor_stream;       // "" = the only pose stream
   int hyperparameter_subset = 400; // gp: pairs for the hyper-parameter optimization (0 = all)
   double outlier_threshold = 5.0;  // gp, parametric: drop pairs beyond this many robust sigmas of eq. 9's fit (0 = keep)
-  int max_pairs = 2000;            // gp: a seeded random subset of at most this many pairs is conditioned on (0 = all)
+  int max_pairs = 6000;            // gp: condition on a seeded random subset of at most this many pairs (0 = all)
   std::string out;                 // model file (JSON)
   bool quiet = false;
 };

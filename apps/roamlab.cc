@@ -91,9 +91,11 @@ int main(int argc, char** argv) {
   odo_learn->add_option("--hyperparameter-subset", learn.hyperparameter_subset,
                         "GP: pairs used to optimize the hyper-parameters, 0 = all (default 400)");
   odo_learn->add_option("--outlier-threshold", learn.outlier_threshold,
-                        "gp, parametric: drop pairs beyond this many robust sigmas of the eq. 9 fit, 0 = keep (default 5)");
+                        "gp, parametric: drop pairs beyond this many robust sigmas of the eq. 9 fit, 0 = keep "
+                        "(default 5)");
   odo_learn->add_option("--max-pairs", learn.max_pairs,
-                        "GP: condition on a seeded random subset of at most this many pairs, 0 = all (default 2000)");
+                        "GP: condition on a seeded random subset of at most this many pairs, 0 = all "
+                        "(default 6000; memory 3 x 8 n^2 bytes)");
   odo_learn->add_option("--out", learn.out, "Model file (JSON)")->required();
   odo_learn->add_flag("--quiet", learn.quiet, "No progress lines");
   CLI::App* odo_evaluate = odo->add_subcommand(
