@@ -177,9 +177,12 @@ Status WriteTrajectoryFigure(const std::string& dir, const std::string& name, co
      << "set title '" << title << "'\nset xlabel 'x [m]'\nset ylabel 'y [m]'\nset size ratio -1\nset grid\n"
      << "set key outside below\n"
      << "plot '" << name << ".dat' using 1:2 with lines lw 3 lc rgb 'black' title 'reference (motion capture)'";
+  // Distinct colours, none black (the reference).
+  static const char* kColors[] = {"#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd",
+                                  "#8c564b", "#e377c2", "#17becf", "#bcbd22", "#7f7f7f"};
   for (std::size_t i = 0; i < models.size(); ++i) {
-    gp << ", \\\n     '' using " << 3 + 2 * i << ":" << 4 + 2 * i << " with lines lw 1.5 title '" << models[i].label
-       << "'";
+    gp << ", \\\n     '' using " << 3 + 2 * i << ":" << 4 + 2 * i << " with lines lw 1.5 lc rgb '"
+       << kColors[i % 10] << "' title '" << models[i].label << "'";
   }
   gp << "\n";
   for (const auto& [file, text] : {std::pair{name + ".dat", data.str()}, std::pair{name + ".gp", gp.str()}}) {

@@ -301,14 +301,19 @@ Result<GaussianProcess> GaussianProcess::FromParts(GpMean mean, GpKernel kernel,
 void GaussianProcess::Precompute() {
   const GpLayout layout(static_cast<int>(X_.cols()), mean_, kernel_);
   X_scaled_.clear();
+  inverse_length_.clear();
+  scaled_alpha_.clear();
   linear_weights_.clear();
   for (int i = 0; i < 3; ++i) {
     const Eigen::VectorXd& p = p_[static_cast<std::size_t>(i)];
-    Eigen::MatrixXd Xs = X_;
+    Eigen::VectorXd inverse_length = Eigen::VectorXd::Ones(layout.m);
     if (layout.rbf) {
-      for (int d = 0; d < layout.m; ++d) Xs.col(d) *= std::exp(-p[layout.log_length(d)]);
+      for (int d = 0; d < layout.m; ++d) inverse_length[d] = std::exp(-p[layout.log_length(d)]);
     }
-    X_scaled_.push_back(std::move(Xs));
+    X_scaled_.push_back(X_ * inverse_length.asDiagonal());
+    inverse_length_.push_back(inverse_length);
+    scaled_alpha_.push_back(layout.rbf ? Eigen::VectorXd(std::exp(2.0 * p[layout.log_sf()]) * alpha_[i])
+                                       : Eigen::VectorXd());
     Eigen::VectorXd w = Eigen::VectorXd::Zero(layout.m);
     if (layout.linear_mean) w += p.segment(layout.c(0), layout.m);
     if (layout.linear_kernel) w += std::exp(2.0 * p[layout.log_sl()]) * (X_.transpose() * alpha_[i]);
@@ -320,18 +325,17 @@ Eigen::Vector3d GaussianProcess::PredictMean(const Eigen::VectorXd& x) const {
   const GpLayout layout(static_cast<int>(X_.cols()), mean_, kernel_);
   ROAMLAB_CHECK(x.size() == layout.m, "PredictMean: input has " << x.size() << " entries, expected " << layout.m);
   Eigen::Vector3d mean;
+  Eigen::ArrayXd d2(layout.rbf ? X_.rows() : 0);
   for (int i = 0; i < 3; ++i) {
-    const Eigen::VectorXd& p = p_[static_cast<std::size_t>(i)];
     // Linear mean and linear kernel: (c + sl^2 X^T a)^T x, O(m).
     double value = linear_weights_[i].dot(x);
     if (layout.rbf) {
-      // sf^2 sum_n a_n exp(-1/2 |(x_n - x) / l|^2), O(n m).
+      // sum_n (sf^2 a_n) exp(-1/2 |x_n / l - x / l|^2), O(n m), vectorized.
       const Eigen::MatrixXd& Xs = X_scaled_[i];
-      Eigen::ArrayXd d2 = Eigen::ArrayXd::Zero(Xs.rows());
-      for (int d = 0; d < layout.m; ++d) {
-        d2 += (Xs.col(d).array() - x[d] * std::exp(-p[layout.log_length(d)])).square();
-      }
-      value += std::exp(2.0 * p[layout.log_sf()]) * (-0.5 * d2).exp().matrix().dot(alpha_[i]);
+      const Eigen::VectorXd xs = x.cwiseProduct(inverse_length_[i]);
+      d2 = (Xs.col(0).array() - xs[0]).square();
+      for (int d = 1; d < layout.m; ++d) d2 += (Xs.col(d).array() - xs[d]).square();
+      value += (scaled_alpha_[i].array() * (-0.5 * d2).exp()).sum();
     }
     mean[i] = value;
   }

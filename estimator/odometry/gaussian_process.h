@@ -136,6 +136,8 @@ class GaussianProcess {
   std::vector<Eigen::LLT<Eigen::MatrixXd>> factor_;
   // Per output: X_ / l (columns scaled by the inverse length scales), and the linear-part weights.
   std::vector<Eigen::MatrixXd> X_scaled_;
+  std::vector<Eigen::VectorXd> inverse_length_;  // 1 / l per input
+  std::vector<Eigen::VectorXd> scaled_alpha_;    // sf^2 a (rbf only)
   std::vector<Eigen::VectorXd> linear_weights_;  // c_i + sl_i^2 X^T a_i
 };
 
