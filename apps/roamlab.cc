@@ -6,8 +6,10 @@
 
 #include "apps/commands.h"
 #include "apps/evaluate.h"
+#include "apps/import.h"
 #include "apps/montecarlo.h"
 #include "apps/regress.h"
+#include "apps/odometry.h"
 #include "apps/simulate.h"
 
 int main(int argc, char** argv) {
@@ -85,6 +87,48 @@ int main(int argc, char** argv) {
   reg->add_flag("--quick", regress.quick, "Only the cases marked `quick: true`");
   reg->add_flag("--quiet", regress.quiet, "No progress lines");
 
+  roamlab::apps::OdometryLearnArgs learn;
+  roamlab::apps::OdometryEvaluateArgs odo_eval;
+  CLI::App* odo = app.add_subcommand("odometry", "Model-free odometry calibration (seed 001): learn, evaluate.");
+  odo->require_subcommand(1);
+  CLI::App* odo_learn = odo->add_subcommand(
+      "learn", "Learn an odometry model from wheel encoders and an exteroceptive pose stream (CGP, eq. 9, Censi).");
+  odo_learn->add_option("--recording", learn.recordings, "Training recording directories")->required();
+  odo_learn->add_option("--model", learn.model, "gp | linear | parametric (default gp)");
+  odo_learn->add_option("--mean", learn.mean, "GP mean function: zero | linear (default linear)");
+  odo_learn->add_option("--kernel", learn.kernel, "GP kernel: rbf | linear | rbf+linear (default rbf)");
+  odo_learn->add_option("--interval", learn.interval_s, "Key-time interval T [s] (default 0.5)");
+  odo_learn->add_option("--encoders", learn.encoder_stream, "wheel_encoders stream (default: the only one)");
+  odo_learn->add_option("--sensor", learn.sensor_stream,
+                        "pose stream of the exteroceptive sensor (default: the only one)");
+  odo_learn->add_option("--hyperparameter-subset", learn.hyperparameter_subset,
+                        "GP: pairs used to optimize the hyper-parameters, 0 = all (default 400)");
+  odo_learn->add_option("--outlier-threshold", learn.outlier_threshold,
+                        "gp, parametric: drop pairs beyond this many robust sigmas of the eq. 9 fit, 0 = keep "
+                        "(default 5)");
+  odo_learn->add_option("--max-pairs", learn.max_pairs,
+                        "GP: condition on a seeded random subset of at most this many pairs, 0 = all "
+                        "(default 6000; memory 3 x 8 n^2 bytes)");
+  odo_learn->add_option("--out", learn.out, "Model file (JSON)")->required();
+  odo_learn->add_flag("--quiet", learn.quiet, "No progress lines");
+  CLI::App* odo_evaluate = odo->add_subcommand(
+      "evaluate", "Dead-reckon test recordings with models and the nominal model: ATE (eq. 11), RPE (eq. 10), plots.");
+  odo_evaluate->add_option("--model", odo_eval.models, "Model files from `odometry learn`")->required();
+  odo_evaluate->add_option("--recording", odo_eval.recordings, "Test recordings with ground_truth.tum")->required();
+  odo_evaluate->add_option("--encoders", odo_eval.encoder_stream, "wheel_encoders stream (default: the only one)");
+  odo_evaluate->add_option("--out", odo_eval.out, "Output directory: table.json, trajectory_NN.png")->required();
+  odo_evaluate->add_flag("--no-plots", odo_eval.no_plots, "Write table.json only");
+  odo_evaluate->add_flag("--quiet", odo_eval.quiet, "No table on stdout");
+
+  roamlab::apps::ImportOptiOdomArgs import_optiodom;
+  CLI::App* imp = app.add_subcommand("import", "Convert real recordings into the recording format.");
+  imp->require_subcommand(1);
+  CLI::App* imp_optiodom = imp->add_subcommand("optiodom", "An OptiOdom run (encoder ticks + OptiTrack poses).");
+  imp_optiodom->add_option("run", import_optiodom.run_csv, "<set>_run-NN.csv")->required();
+  imp_optiodom->add_option("--metadata", import_optiodom.metadata, "Metadata file (default <set>_metadata.csv)");
+  imp_optiodom->add_option("--out", import_optiodom.out, "Output recording directory")->required();
+  imp_optiodom->add_flag("--quiet", import_optiodom.quiet, "No summary");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -105,5 +149,8 @@ int main(int argc, char** argv) {
   if (*evl) return roamlab::apps::RunEvaluate(evaluate);
   if (*mc) return roamlab::apps::RunMonteCarlo(montecarlo);
   if (*reg) return roamlab::apps::RunRegress(regress);
+  if (*odo_learn) return roamlab::apps::RunOdometryLearn(learn);
+  if (*odo_evaluate) return roamlab::apps::RunOdometryEvaluate(odo_eval);
+  if (*imp_optiodom) return roamlab::apps::RunImportOptiOdom(import_optiodom);
   return 2;
 }

@@ -1,0 +1,72 @@
+// Training data for model-free odometry (seed 001, Sections III and IV-B4): key times T seconds apart, the wheel
+// rotations delta_jk between consecutive key times (m wheels) and the exteroceptive sensor's planar displacement
+// s_jk = (-)s_j (+) s_k with its covariance.
+//
+// Inputs come from a recording (recording/recording.h):
+//   - a wheel_encoders stream, one column per wheel, in rad (cumulative wheel angle: the reader turns ticks into rad
+//     with ticks_per_revolution) or rad/s (integrated here by the trapezoidal rule). delta_jk is the difference of the
+//     cumulative angles, linearly interpolated at the key times. Any linear unit gives the same learned model up to
+//     the scale of C and W; rad keeps encoders of different resolution comparable.
+//   - a pose stream (absolute pose of the exteroceptive sensor: motion capture, or a SLAM/scan-matching trajectory):
+//     its planar part (x, y, yaw) is interpolated at the key times (position linearly, heading along the shorter
+//     arc). Noise from the stream's noise entry: position_m and orientation_rad (the absolute_pose model's keys;
+//     defaults kDefaultPositionSigma_m, kDefaultOrientationSigma_rad). The displacement between two key poses then has
+//     the diagonal covariance diag(2 sp^2, 2 sp^2, 2 so^2) (independent pose errors, first order, cross terms dropped).
+// The learner never reads ground_truth.tum or truth.yaml; evaluation reads the reference separately.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/status.h"
+#include "common/time.h"
+#include "estimator/odometry/se2.h"
+#include "recording/recording.h"
+
+namespace roamlab::estimator::odometry {
+
+inline constexpr double kDefaultPositionSigma_m = 0.001;
+inline constexpr double kDefaultOrientationSigma_rad = 0.002;
+
+struct KeyTimeOptions {
+  double interval_s = 0.5;       // T, the spacing of the key times
+  std::string encoder_stream;    // "" = the only wheel_encoders stream
+  std::string sensor_stream;     // "" = the only pose stream; unused (and not required) by KeyTimes(..., false)
+  std::string Validate() const;  // "" when valid
+};
+
+// One recording cut at key times t_0 < t_1 < ... (T apart, from the first time both streams cover).
+struct KeySequence {
+  std::vector<std::string> wheels;        // encoder column names
+  std::vector<Time> t;                    // key times
+  Eigen::MatrixXd wheel_angle_rad;        // rows = key times, columns = wheels: cumulative angle
+  std::vector<Pose2> sensor_pose;         // planar sensor pose at each key time (empty without a sensor)
+  Eigen::Vector2d sensor_sigma{kDefaultPositionSigma_m, kDefaultOrientationSigma_rad};  // [m], [rad] per pose
+
+  int size() const { return static_cast<int>(t.size()); }
+  // delta_(k-1)k for k = 1..size()-1: (size()-1) x m.
+  Eigen::MatrixXd WheelIncrements() const;
+};
+
+// Cuts `recording` at key times. With with_sensor, also the sensor poses (the key times then lie inside both streams).
+// Errors name the recording and the problem: no or several candidate streams, a named stream missing or of the wrong
+// type, unsupported encoder units, fewer than two key times.
+Result<KeySequence> CutAtKeyTimes(const recording::Recording& recording, const std::string& recording_name,
+                                  const KeyTimeOptions& options, bool with_sensor);
+
+// Training pairs D = (delta_jk, s_jk) stacked over one or more sequences (n rows).
+struct TrainingSet {
+  std::vector<std::string> wheels;
+  Eigen::MatrixXd delta;      // n x m wheel rotations [rad]
+  Eigen::MatrixXd s;          // n x 3 sensor displacements [m, m, rad]
+  Eigen::MatrixXd s_sigma;    // n x 3 standard deviations of s (diagonal of Sigma_jk)
+
+  int size() const { return static_cast<int>(delta.rows()); }
+};
+
+// Consecutive key pairs (k-1, k) of every sequence; all sequences must have the same wheel names and sensor poses.
+Result<TrainingSet> MakeTrainingSet(const std::vector<KeySequence>& sequences);
+
+}  // namespace roamlab::estimator::odometry

@@ -1,0 +1,113 @@
+#include "estimator/odometry/training_data.h"
+
+#include <cmath>
+#include <filesystem>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include "estimator/odometry/odometry_model.h"
+#include "estimator/odometry/parametric.h"
+
+namespace roamlab::estimator::odometry {
+namespace {
+
+// A differential drive with constant wheel speeds, 20 Hz encoders (rad) and a 20 Hz pose stream of the sensor.
+recording::Recording MakeRecording(const WheelKinematics& truth, const Eigen::Vector2d& speed_radps, int samples) {
+  recording::Recording rec;
+  rec.platform.kind = "differential_drive";
+  recording::Stream enc;
+  enc.info.name = "wheel_encoders";
+  enc.info.type = recording::StreamType::kWheelEncoders;
+  enc.info.rate_hz = 20.0;
+  enc.info.columns = {"right", "left"};
+  enc.info.units = "rad";
+  recording::Stream pose;
+  pose.info.name = "mocap";
+  pose.info.type = recording::StreamType::kPose;
+  pose.info.rate_hz = 20.0;
+  pose.info.units = "m";
+  pose.info.noise = {{"position_m", 0.002}, {"orientation_rad", 0.01}};
+  enc.values.resize(samples, 2);
+  pose.values.resize(samples, 7);
+  Pose2 sensor = Pose2(1.0, 2.0, 0.3);
+  for (int k = 0; k < samples; ++k) {
+    const Time t = Time::FromNanoseconds(50'000'000LL * k);
+    enc.t.push_back(t);
+    pose.t.push_back(t);
+    enc.values.row(k) = (0.05 * k * speed_radps).transpose();
+    if (k > 0) sensor = Compose(sensor, truth.Displacement(0.05 * speed_radps));
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(sensor[2], Eigen::Vector3d::UnitZ()));
+    pose.values.row(k) << sensor[0], sensor[1], 0.0, q.x(), q.y(), q.z(), q.w();
+  }
+  rec.streams = {enc, pose};
+  return rec;
+}
+
+TEST(TrainingDataTest, PairsHoldWheelRotationsAndSensorDisplacements) {
+  const WheelKinematics truth = DifferentialDrive({"right", "left"}, 0.042, 0.041, 0.2, Pose2(0.1, 0.02, 0.05));
+  const Eigen::Vector2d speed(6.0, 4.0);
+  const recording::Recording rec = MakeRecording(truth, speed, 101);  // 5 s
+  KeyTimeOptions options;
+  options.interval_s = 0.25;
+  Result<KeySequence> seq = CutAtKeyTimes(rec, "rec", options, true);
+  ASSERT_TRUE(seq.ok()) << seq.status().message();
+  EXPECT_EQ(seq.value().size(), 21);
+  EXPECT_DOUBLE_EQ(seq.value().sensor_sigma[0], 0.002);
+  Result<TrainingSet> set = MakeTrainingSet({seq.value()});
+  ASSERT_TRUE(set.ok()) << set.status().message();
+  ASSERT_EQ(set.value().size(), 20);
+  // Five encoder cycles per pair: delta = 0.25 s x speed; s = five composed cycle displacements.
+  const Pose2 cycle = truth.Displacement(0.05 * speed);
+  Pose2 expected = Pose2::Zero();
+  for (int i = 0; i < 5; ++i) expected = Compose(expected, cycle);
+  for (int k = 0; k < set.value().size(); ++k) {
+    EXPECT_LT((set.value().delta.row(k).transpose() - 0.25 * speed).norm(), 1e-12);
+    EXPECT_LT((set.value().s.row(k).transpose() - expected).norm(), 1e-12);
+    EXPECT_NEAR(set.value().s_sigma(k, 2), std::sqrt(2.0) * 0.01, 1e-15);
+  }
+}
+
+TEST(TrainingDataTest, NamesTheMissingStream) {
+  const WheelKinematics truth = DifferentialDrive({"right", "left"}, 0.042, 0.041, 0.2, Pose2::Zero());
+  recording::Recording rec = MakeRecording(truth, Eigen::Vector2d(1.0, 1.0), 30);
+  rec.streams.pop_back();
+  Result<KeySequence> seq = CutAtKeyTimes(rec, "REC", {}, true);
+  ASSERT_FALSE(seq.ok());
+  EXPECT_EQ(seq.status().message(), "REC: no pose stream");
+  EXPECT_TRUE(CutAtKeyTimes(rec, "REC", {}, false).ok());  // evaluation needs no sensor
+}
+
+// A saved model predicts what the trained one does.
+TEST(OdometryModelTest, SaveAndLoadKeepPredictions) {
+  const WheelKinematics truth = DifferentialDrive({"right", "left"}, 0.042, 0.041, 0.2, Pose2(0.1, 0.0, 0.0));
+  Eigen::MatrixXd X(30, 2), Y(30, 3);
+  for (int k = 0; k < 30; ++k) {
+    X.row(k) << 1.0 + 0.1 * k, 2.0 - 0.07 * k;
+    Y.row(k) = truth.Displacement(X.row(k).transpose()).transpose();
+  }
+  Result<GaussianProcess> gp = GaussianProcess::Train(X, Y, Eigen::MatrixXd::Constant(30, 3, 1e-8), {});
+  ASSERT_TRUE(gp.ok()) << gp.status().message();
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("roamlab_odometry_model_" + std::to_string(::getpid()) + ".json")).string();
+  for (ModelKind kind : {ModelKind::kGp, ModelKind::kLinear, ModelKind::kNominal}) {
+    OdometryModel model;
+    model.kind = kind;
+    model.platform = "differential_drive";
+    model.wheels = {"right", "left"};
+    model.gp = kind == ModelKind::kGp ? std::optional<GaussianProcess>(gp.value()) : std::nullopt;
+    model.W = Eigen::MatrixXd::Random(3, 2);
+    model.kinematics = truth;
+    ASSERT_TRUE(SaveOdometryModel(model, path).ok());
+    Result<OdometryModel> loaded = LoadOdometryModel(path);
+    ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+    EXPECT_EQ(loaded.value().kind, kind);
+    const Eigen::Vector2d delta(1.3, 1.7);
+    EXPECT_LT((loaded.value().Predict(delta) - model.Predict(delta)).norm(), 1e-12) << ModelKindName(kind);
+  }
+  std::filesystem::remove(path);
+  EXPECT_FALSE(LoadOdometryModel(path).ok());
+}
+
+}  // namespace
+}  // namespace roamlab::estimator::odometry
