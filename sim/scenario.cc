@@ -409,10 +409,10 @@ std::optional<Scenario::Problem> Scenario::Validate() const {
   if (auto p = ProfileProblem(driver.linear_mps, "driver.linear_mps")) return p;
   if (auto p = ProfileProblem(driver.angular_radps, "driver.angular_radps")) return p;
   if (auto p = ProfileProblem(driver.lateral_mps, "driver.lateral_mps")) return p;
-  if (!holonomic && !driver.lateral_mps.terms.empty() &&
-      !(driver.lateral_mps.terms.size() == 1 && driver.lateral_mps.Evaluate(0.0) == 0.0 &&
-        driver.lateral_mps.terms[0].type == ProfileTerm::Type::kConstant))
-    return P{"driver.lateral_mps", "only for holonomic robots (omni3, mecanum); a " + robot.kind + " cannot move sideways"};
+  for (const ProfileTerm& term : driver.lateral_mps.terms) {
+    if (!holonomic && !(term.type == ProfileTerm::Type::kConstant && term.value == 0.0))
+      return P{"driver.lateral_mps", "only for holonomic robots (omni3, mecanum); a " + robot.kind + " cannot"};
+  }
   if (ackermann && !robot.wheel_mounting.empty()) return P{"robot.wheel_mounting", "only for wheeled indoor robots"};
   for (std::size_t i = 0; i < robot.wheel_mounting.size(); ++i) {
     const WheelMountingChange& c = robot.wheel_mounting[i];
