@@ -51,6 +51,26 @@ const std::vector<ModelSpec>& ModelSpecs() {
         ScalarSlot("baseline", std::numeric_limits<double>::quiet_NaN())},
        {},
        true},
+      // Omni and mecanum wheel radii and geometry: NaN too, taken from the platform geometry.
+      {"omni3_drive",
+       {""},
+       {"wheel_radps", "vertical_mps", "tilt_radps"},
+       {ScalarSlot("radius_0", std::numeric_limits<double>::quiet_NaN()),
+        ScalarSlot("radius_1", std::numeric_limits<double>::quiet_NaN()),
+        ScalarSlot("radius_2", std::numeric_limits<double>::quiet_NaN()),
+        ScalarSlot("distance", std::numeric_limits<double>::quiet_NaN())},
+       {},
+       true},
+      {"mecanum_drive",
+       {""},
+       {"wheel_radps", "vertical_mps", "tilt_radps"},
+       {ScalarSlot("radius_0", std::numeric_limits<double>::quiet_NaN()),
+        ScalarSlot("radius_1", std::numeric_limits<double>::quiet_NaN()),
+        ScalarSlot("radius_2", std::numeric_limits<double>::quiet_NaN()),
+        ScalarSlot("radius_3", std::numeric_limits<double>::quiet_NaN()),
+        ScalarSlot("lx_plus_ly", std::numeric_limits<double>::quiet_NaN())},
+       {},
+       true},
       {"odometer", {""}, {"linear_mps", "angular_radps"}, {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")}, {},
        true},
       {"gyroscope", {""}, {"sigma_radps"}, {RotationSlot("misalignment"), Vector3Slot("bias", 0.0), Vector3Slot("scale", 1.0)},
@@ -290,8 +310,8 @@ class Parser {
     if (c.streams.count(c.master) == 0) Fail(root["master"], "master stream '" + c.master + "' is not in streams");
     if (!FindModelSpec(c.streams[c.master].model)->odometric)
       Fail(root["master"], "master stream '" + c.master +
-                               "' must use an odometric model (ackermann, ackermann_seed, differential_drive or "
-                               "odometer)");
+                               "' must use an odometric model (ackermann, ackermann_seed, differential_drive, "
+                               "omni3_drive, mecanum_drive or odometer)");
     if (root["parameters"]) {
       if (!root["parameters"].IsMap()) Fail(root["parameters"], "parameters must be a mapping");
       for (const auto& kv : root["parameters"]) {

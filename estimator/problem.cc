@@ -17,7 +17,9 @@
 #include "estimator/models/gyroscope.h"
 #include "estimator/models/linear_velocity.h"
 #include "estimator/models/magnetometer.h"
+#include "estimator/models/mecanum_drive.h"
 #include "estimator/models/odometer.h"
+#include "estimator/models/omni3_drive.h"
 #include "estimator/models/prior.h"
 #include "estimator/models/process.h"
 
@@ -32,7 +34,8 @@ enum class Attachment { kMaster, kOnePose, kPair, kTriple };
 Attachment AttachmentOf(const std::string& model, bool master) {
   if (master) return Attachment::kMaster;
   if (model == "gyroscope" || model == "linear_velocity" || model == "odometer" || model == "ackermann" ||
-      model == "ackermann_seed" || model == "differential_drive")
+      model == "ackermann_seed" || model == "differential_drive" || model == "omni3_drive" ||
+      model == "mecanum_drive")
     return Attachment::kPair;
   if (model == "accelerometer") return Attachment::kTriple;
   return Attachment::kOnePose;
@@ -98,6 +101,11 @@ Eigen::MatrixXd NoiseCovariance(const StreamBinding& s) {
   } else if (m == "differential_drive") {
     sigma.resize(6);
     sigma << n.at("wheel_radps"), n.at("wheel_radps"), n.at("lateral_mps"), n.at("vertical_mps"), n.at("tilt_radps"),
+        n.at("tilt_radps");
+  } else if (m == "omni3_drive" || m == "mecanum_drive") {
+    const int wheels = m == "omni3_drive" ? 3 : 4;
+    sigma.resize(wheels + 3);
+    sigma << Eigen::VectorXd::Constant(wheels, n.at("wheel_radps")), n.at("vertical_mps"), n.at("tilt_radps"),
         n.at("tilt_radps");
   } else if (m == "absolute_pose") {
     sigma.resize(6);
@@ -173,6 +181,12 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
       if (b.primary->info.units != "rad" || b.primary->values.cols() != 2)
         return Error(config, "stream '" + name + "': differential_drive source '" + source +
                                  "' must hold two cumulative wheel angles (left, right) in rad or ticks");
+    } else if (m == "omni3_drive" || m == "mecanum_drive") {
+      const int wheels = m == "omni3_drive" ? 3 : 4;
+      if (type != StreamType::kWheelEncoders) return Error(config, bad_type);
+      if (b.primary->info.units != "rad" || b.primary->values.cols() != wheels)
+        return Error(config, "stream '" + name + "': " + m + " source '" + source + "' must hold " +
+                                 std::to_string(wheels) + " cumulative wheel angles in rad");
     } else if (m == "odometer" || m == "linear_velocity") {
       if (!TypeIn(type, {StreamType::kOdometry, StreamType::kVisualOdometry, StreamType::kScanMatching}))
         return Error(config, bad_type);
@@ -191,13 +205,23 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
       impl->parameter_manifold.emplace(pname, slot.manifold);
       Eigen::VectorXd init = slot.default_value;
       if (ackermann && slot.name == "kv_over_L") init[0] = 1.0 / b.wheelbase_m;
-      if (m == "differential_drive") {
-        const std::string key = slot.name == "baseline" ? "baseline_m" : "wheel_radius_m";
+      if (m == "differential_drive" || m == "omni3_drive" || m == "mecanum_drive") {
+        // Radii from wheel_radius_m; the other slot from its geometry key (lx_plus_ly: the sum of two keys).
+        std::string key = "wheel_radius_m";
+        if (slot.name == "baseline") key = "baseline_m";
+        if (slot.name == "distance") key = "wheel_distance_m";
+        if (slot.name == "lx_plus_ly") key = "half_length_m";
         const auto g = rec.platform.geometry.find(key);
         if (g == rec.platform.geometry.end() && !(config.parameters.count(pname) && config.parameters.at(pname).value))
           return Error(config, "stream '" + name + "': no parameters." + pname + ".value and no " + key +
                                    " in the recording's platform");
         if (g != rec.platform.geometry.end()) init[0] = g->second;
+        if (slot.name == "lx_plus_ly" && g != rec.platform.geometry.end()) {
+          const auto width = rec.platform.geometry.find("half_width_m");
+          if (width == rec.platform.geometry.end())
+            return Error(config, "stream '" + name + "': no half_width_m in the recording's platform");
+          init[0] += width->second;
+        }
       }
       impl->parameter_initial.emplace(pname, init);
     }
@@ -277,7 +301,11 @@ int ProblemBuilder::ResidualDim(const std::string& stream) const {
     if (s.name == stream) {
       const std::string& m = s.config.model;
       if (m == "ackermann") return 4;
-      return (m == "ackermann_seed" || m == "odometer" || m == "absolute_pose" || m == "differential_drive") ? 6 : 3;
+      if (m == "mecanum_drive") return 7;
+      return (m == "ackermann_seed" || m == "odometer" || m == "absolute_pose" || m == "differential_drive" ||
+              m == "omni3_drive")
+                 ? 6
+                 : 3;
     }
   return 0;
 }
@@ -413,6 +441,16 @@ void ProblemBuilder::AddMasterSample(const MeasurementRef& m) {
       DifferentialDriveError::BodyVelocity((*rates)[0], (*rates)[1], value(0)[0], value(1)[0], value(2)[0], &v_body,
                                            &omega_body);
     }
+  } else if (s.config.model == "omni3_drive") {
+    if (const auto rates = WheelRates(*s.primary, odo.row)) {
+      Omni3DriveError::BodyVelocity(*rates, Eigen::Vector3d(value(0)[0], value(1)[0], value(2)[0]), value(3)[0],
+                                    &v_body, &omega_body);
+    }
+  } else if (s.config.model == "mecanum_drive") {
+    if (const auto rates = WheelRates(*s.primary, odo.row)) {
+      MecanumDriveError::BodyVelocity(*rates, Eigen::Vector4d(value(0)[0], value(1)[0], value(2)[0], value(3)[0]),
+                                      value(4)[0], &v_body, &omega_body);
+    }
   } else {
     const Eigen::VectorXd q = value(1);
     SensorToBodyVelocity<double>(row.head<3>().transpose(), row.segment<3>(3).transpose(),
@@ -487,6 +525,19 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     }
     factor = MakeFactor(DifferentialDriveError((*rates)[0], (*rates)[1], dt));
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k)};
+  } else if (model == "omni3_drive" || model == "mecanum_drive") {
+    const auto rates = WheelRates(data, m.row);
+    if (!rates) {
+      ++counts_[s.name].outside;
+      return true;
+    }
+    vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k), slot(3, k)};
+    if (model == "omni3_drive") {
+      factor = MakeFactor(Omni3DriveError(*rates, dt));
+    } else {
+      factor = MakeFactor(MecanumDriveError(*rates, dt));
+      vars.push_back(slot(4, k));
+    }
   } else if (model == "odometer") {
     factor = MakeFactor(OdometerError(row.head<6>().transpose(), dt));
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k)};

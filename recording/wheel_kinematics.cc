@@ -15,7 +15,28 @@ Eigen::Vector3d WheelKinematics::TwistFromRates(const Eigen::VectorXd& rates_rad
   return Eigen::Vector3d(twist[0], 0.0, twist[1]);
 }
 
-bool IsWheeledPlatform(const std::string& kind) { return kind == "differential_drive"; }
+bool IsWheeledPlatform(const std::string& kind) {
+  return kind == "differential_drive" || kind == "omni3" || kind == "mecanum";
+}
+
+Eigen::Matrix3d Omni3RatesFromTwist(const Eigen::Vector3d& radii_m, double distance_m) {
+  constexpr double kPi = 3.14159265358979323846;
+  Eigen::Matrix3d J;
+  for (int i = 0; i < 3; ++i) {
+    const double alpha = (60.0 + 120.0 * i) * kPi / 180.0;
+    J.row(i) << -std::sin(alpha) / radii_m[i], std::cos(alpha) / radii_m[i], distance_m / radii_m[i];
+  }
+  return J;
+}
+
+Eigen::Matrix<double, 4, 3> MecanumRatesFromTwist(const Eigen::Vector4d& radii_m, double lx_plus_ly_m) {
+  // Signs of v_y and of K omega_z per wheel (front left, front right, rear left, rear right).
+  const double s_y[4] = {-1.0, 1.0, 1.0, -1.0};
+  const double s_w[4] = {-1.0, 1.0, -1.0, 1.0};
+  Eigen::Matrix<double, 4, 3> J;
+  for (int i = 0; i < 4; ++i) J.row(i) << 1.0 / radii_m[i], s_y[i] / radii_m[i], s_w[i] * lx_plus_ly_m / radii_m[i];
+  return J;
+}
 
 Result<WheelKinematics> NominalWheelKinematics(const Platform& platform) {
   const auto get = [&platform](const std::string& key, double* out) {
@@ -36,7 +57,25 @@ Result<WheelKinematics> NominalWheelKinematics(const Platform& platform) {
     k.holonomic = false;
     return k;
   }
-  return Status::Error("platform kind '" + platform.kind + "' has no wheel kinematics (supported: differential_drive)");
+  if (platform.kind == "omni3") {
+    double r = 0.0, distance = 0.0;
+    if (Status s = get("wheel_radius_m", &r); !s.ok()) return s;
+    if (Status s = get("wheel_distance_m", &distance); !s.ok()) return s;
+    k.J_rates_twist = Omni3RatesFromTwist(Eigen::Vector3d::Constant(r), distance);
+    k.holonomic = true;
+    return k;
+  }
+  if (platform.kind == "mecanum") {
+    double r = 0.0, lx = 0.0, ly = 0.0;
+    if (Status s = get("wheel_radius_m", &r); !s.ok()) return s;
+    if (Status s = get("half_length_m", &lx); !s.ok()) return s;
+    if (Status s = get("half_width_m", &ly); !s.ok()) return s;
+    k.J_rates_twist = MecanumRatesFromTwist(Eigen::Vector4d::Constant(r), lx + ly);
+    k.holonomic = true;
+    return k;
+  }
+  return Status::Error("platform kind '" + platform.kind +
+                       "' has no wheel kinematics (supported: differential_drive, omni3, mecanum)");
 }
 
 }  // namespace roamlab::recording

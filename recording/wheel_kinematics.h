@@ -11,7 +11,18 @@
 //   differential_drive   geometry: wheel_radius_m, baseline_m (distance between the wheel contact points)
 //                        wheels: 0 = left at (0, +B/2), 1 = right at (0, -B/2), both rolling along +x:
 //                        omega_left = (v_x - omega_z B/2) / r,  omega_right = (v_x + omega_z B/2) / r
+//   omni3                geometry: wheel_radius_m, wheel_distance_m (L, from O to each wheel's contact point)
+//                        wheel i at alpha_i = 60, 180, 300 deg from x, rolling along the counter-clockwise tangent
+//                        d_i = (-sin alpha_i, cos alpha_i) (omni rollers absorb the radial component):
+//                        omega_i = (-sin alpha_i v_x + cos alpha_i v_y + L omega_z) / r
+//   mecanum              geometry: wheel_radius_m, half_length_m (lx), half_width_m (ly); wheels 0-3 front left,
+//                        front right, rear left, rear right at (+-lx, +-ly), rolling along +x, 45 deg rollers in the
+//                        X layout (models/mecanum.xml): with K = lx + ly
+//                        omega_0 = (v_x - v_y - K omega_z) / r,  omega_1 = (v_x + v_y + K omega_z) / r,
+//                        omega_2 = (v_x + v_y - K omega_z) / r,  omega_3 = (v_x - v_y + K omega_z) / r
 #pragma once
+
+#include <string>
 
 #include <Eigen/Core>
 
@@ -33,5 +44,10 @@ struct WheelKinematics {
 bool IsWheeledPlatform(const std::string& kind);
 // The nominal kinematics; errors name the missing or bad geometry key (without a file: the caller adds it).
 Result<WheelKinematics> NominalWheelKinematics(const Platform& platform);
+
+// The rows above for given geometry (n x 3): omni3 with per-wheel radii r_i and distance L; mecanum with per-wheel
+// radii and K = lx + ly. Shared with the estimator's error models, which take the geometry as parameters.
+Eigen::Matrix3d Omni3RatesFromTwist(const Eigen::Vector3d& radii_m, double distance_m);
+Eigen::Matrix<double, 4, 3> MecanumRatesFromTwist(const Eigen::Vector4d& radii_m, double lx_plus_ly_m);
 
 }  // namespace roamlab::recording

@@ -108,7 +108,7 @@ void ReadProfile(YamlReader& r, const YAML::Node& map, const std::string& parent
 
 void ReadRobot(YamlReader& r, const YAML::Node& node, const std::string& scenario_dir, Scenario* s) {
   const std::string key = "robot";
-  r.CheckKeys(node, key, {"kind", "model", "start", "speed_controller"});
+  r.CheckKeys(node, key, {"kind", "model", "start", "speed_controller", "wheel_mounting"});
   if (!r.Require(node, key, "kind") || !r.Require(node, key, "model")) return;
   r.String(node, key, "kind", &s->robot.kind);
   std::string model;
@@ -138,6 +138,28 @@ void ReadRobot(YamlReader& r, const YAML::Node& node, const std::string& scenari
     r.Number(c, k, "kp_nm_per_mps", &s->robot.speed_controller.kp_nm_per_mps);
     r.Number(c, k, "ki_nm_per_m", &s->robot.speed_controller.ki_nm_per_m);
     r.Number(c, k, "torque_limit_nm", &s->robot.speed_controller.torque_limit_nm);
+  }
+  if (node["wheel_mounting"]) {
+    const YAML::Node list = node["wheel_mounting"];
+    const std::string k = "robot.wheel_mounting";
+    r.Remember(k, list);
+    if (!list.IsSequence()) {
+      r.Fail(list, k, "expected a list of {wheel, yaw_deg, tilt_deg}");
+      return;
+    }
+    for (std::size_t i = 0; i < list.size() && r.ok(); ++i) {
+      const YAML::Node item = list[i];
+      const std::string ki = k + "[" + std::to_string(i) + "]";
+      r.CheckKeys(item, ki, {"wheel", "yaw_deg", "tilt_deg"});
+      if (!r.Require(item, ki, "wheel")) return;
+      std::int64_t wheel = 0;
+      double yaw_deg = 0.0, tilt_deg = 0.0;
+      r.Integer(item, ki, "wheel", &wheel);
+      r.Number(item, ki, "yaw_deg", &yaw_deg);
+      r.Number(item, ki, "tilt_deg", &tilt_deg);
+      s->robot.wheel_mounting.push_back(
+          {static_cast<int>(std::clamp<std::int64_t>(wheel, -1, 64)), yaw_deg * kPi / 180.0, tilt_deg * kPi / 180.0});
+    }
   }
 }
 
@@ -199,11 +221,12 @@ void ReadDriver(YamlReader& r, const YAML::Node& node, Scenario* s) {
   r.String(node, k, "type", &s->driver.type);
   if (!r.ok()) return;
   if (s->driver.type == "body_velocity") {
-    r.CheckKeys(node, k, {"type", "lead_in_s", "linear_mps", "angular_radps"});
+    r.CheckKeys(node, k, {"type", "lead_in_s", "linear_mps", "angular_radps", "lateral_mps"});
     r.Number(node, k, "lead_in_s", &s->driver.lead_in_s);
     if (!r.Require(node, k, "linear_mps") || !r.Require(node, k, "angular_radps")) return;
     ReadProfile(r, node, k, "linear_mps", &s->driver.linear_mps);
     ReadProfile(r, node, k, "angular_radps", &s->driver.angular_radps);
+    ReadProfile(r, node, k, "lateral_mps", &s->driver.lateral_mps);
     return;
   }
   r.CheckKeys(node, k, {"type", "lead_in_s", "speed_mps", "handlebar_rad"});
@@ -359,8 +382,10 @@ std::optional<Scenario::Problem> Scenario::Validate() const {
 
   // Robot and driver: the Ackermann vehicle, or a wheeled indoor robot driven by body-velocity set-points.
   const bool ackermann = robot.kind == "ackermann";
-  if (!ackermann && robot.kind != "differential_drive")
-    return P{"robot.kind", "unsupported kind '" + robot.kind + "' (supported: ackermann, differential_drive)"};
+  const bool holonomic = robot.kind == "omni3" || robot.kind == "mecanum";
+  if (!ackermann && !holonomic && robot.kind != "differential_drive")
+    return P{"robot.kind",
+             "unsupported kind '" + robot.kind + "' (supported: ackermann, differential_drive, omni3, mecanum)"};
   if (robot.model_file.empty() && robot.model_xml.empty()) return P{"robot.model", "missing"};
   if (!robot.start_position_m.allFinite()) return P{"robot.start.position_m", "must be finite"};
   if (!Finite(robot.start_heading_rad)) return P{"robot.start.heading_deg", "must be finite"};
@@ -383,6 +408,19 @@ std::optional<Scenario::Problem> Scenario::Validate() const {
   if (auto p = ProfileProblem(driver.handlebar_rad, "driver.handlebar_rad")) return p;
   if (auto p = ProfileProblem(driver.linear_mps, "driver.linear_mps")) return p;
   if (auto p = ProfileProblem(driver.angular_radps, "driver.angular_radps")) return p;
+  if (auto p = ProfileProblem(driver.lateral_mps, "driver.lateral_mps")) return p;
+  for (const ProfileTerm& term : driver.lateral_mps.terms) {
+    if (!holonomic && !(term.type == ProfileTerm::Type::kConstant && term.value == 0.0))
+      return P{"driver.lateral_mps", "only for holonomic robots (omni3, mecanum); a " + robot.kind + " cannot"};
+  }
+  if (ackermann && !robot.wheel_mounting.empty()) return P{"robot.wheel_mounting", "only for wheeled indoor robots"};
+  for (std::size_t i = 0; i < robot.wheel_mounting.size(); ++i) {
+    const WheelMountingChange& c = robot.wheel_mounting[i];
+    const std::string k = "robot.wheel_mounting[" + std::to_string(i) + "]";
+    if (c.wheel < 0) return P{k + ".wheel", "must be >= 0"};
+    if (!(Finite(c.yaw_rad) && std::abs(c.yaw_rad) <= 0.35)) return P{k + ".yaw_deg", "must be within +-20"};
+    if (!(Finite(c.tilt_rad) && std::abs(c.tilt_rad) <= 0.35)) return P{k + ".tilt_deg", "must be within +-20"};
+  }
 
   // Sensors.
   if (const auto& imu = sensors.imu) {

@@ -75,6 +75,20 @@
 // scan_matching.misalignment, odometer.radius_left, odometer.radius_right, odometer.baseline (the true geometry, the
 // names the differential_drive estimator model uses when its stream is called odometer). A camera for visual
 // odometry is the model's camera "camera" (looking forward); its stream would be of type visual_odometry.
+//
+// Holonomic robots: `robot.kind: omni3` (models/omni3.xml, Triskar2-like: three omni wheels at 120 deg) and
+// `robot.kind: mecanum` (models/mecanum.xml: four mecanum wheels, X layout), scenarios/indoor_omni_slip.yaml. As the
+// differential drive, plus:
+//   robot:
+//     wheel_mounting: [{wheel: 1, yaw_deg: 2.0, tilt_deg: 0.0}]   # optional: wheel bodies turned about their centre
+//                                           # (yaw about z: axle misaligned; tilt about the rolling direction: camber)
+//   driver:
+//     lateral_mps: <profile>                # sideways speed v_y [m/s] (default 0; only for omni3 and mecanum)
+// wheel_encoders has one column per wheel: omni3 "wheel_0" "wheel_1" "wheel_2", mecanum "front_left" "front_right"
+// "rear_left" "rear_right". Platform geometry: omni3 wheel_radius_m, wheel_distance_m (L); mecanum wheel_radius_m,
+// half_length_m, half_width_m. truth.yaml: odometer.radius_<i> for every wheel, and odometer.distance (omni3) or
+// odometer.lx_plus_ly (mecanum), the names of the omni3_drive and mecanum_drive estimator models; the radii are the
+// rollers' envelope (the true mean rolling radius is a little smaller: the axle dips between rollers).
 // Physical effects go in `effects`. Each is a new key or value, so existing scenarios keep their meaning.
 #pragma once
 
@@ -92,6 +106,7 @@
 #include "sim/ackermann.h"
 #include "sim/profile.h"
 #include "sim/terrain.h"
+#include "sim/wheeled_robot.h"
 
 namespace roamlab::sim {
 
@@ -102,6 +117,7 @@ struct RobotOptions {
   Eigen::Vector2d start_position_m = Eigen::Vector2d::Zero();
   double start_heading_rad = 0.0;
   SpeedControllerOptions speed_controller;
+  std::vector<WheelMountingChange> wheel_mounting;   // wheeled robots: wheels turned off their nominal mounting
 };
 
 struct DriverOptions {
@@ -111,6 +127,7 @@ struct DriverOptions {
   Profile handlebar_rad = Profile::Constant(0.0);    // ackermann
   Profile linear_mps = Profile::Constant(0.0);       // body_velocity: v_x of O
   Profile angular_radps = Profile::Constant(0.0);    // body_velocity: omega_z
+  Profile lateral_mps = Profile::Constant(0.0);      // body_velocity: v_y of O (omni3, mecanum)
 };
 
 struct ImuOptions {

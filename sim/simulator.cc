@@ -126,6 +126,10 @@ class Simulator::Impl {
     if (!model.ok()) return model.status();
     model_ = std::move(model).value();
     if (Status s = terrain_.Fill(model_.get()); !s.ok()) return Status::Error(model_where_ + ": " + s.message());
+    if (!ackermann_) {
+      if (Status st = WheeledRobot::ChangeMounting(model_.get(), scenario_.robot.wheel_mounting, where_); !st.ok())
+        return st;
+    }
     data_ = MakeData(model_.get());
     if (ackermann_) {
       auto vehicle = AckermannVehicle::Bind(model_.get(), model_where_);
@@ -219,7 +223,7 @@ class Simulator::Impl {
     }
     if (sensors.wheel_encoders) {
       encoder_stream_ = MakeStream("wheel_encoders", StreamType::kWheelEncoders, sensors.wheel_encoders->rate_hz,
-                                   {"left", "right"}, "rad", encoder_clock_);
+                                   wheeled_.EncoderColumns(), "rad", encoder_clock_);
       encoder_stream_.info.attributes = {{"ticks_per_revolution", sensors.wheel_encoders->ticks_per_revolution}};
     }
     if (sensors.laser) {
@@ -256,19 +260,21 @@ class Simulator::Impl {
   }
 
  private:
-  // The two set-points at t_ns (Ackermann: speed [m/s] and handlebar [rad]; body velocity: v_x [m/s] and omega_z
-  // [rad/s]): the profiles from t = 0, the lead-in's rest and ramp before.
-  std::pair<double, double> SetPoints(std::int64_t t_ns) const {
+  // The set-points at t_ns (Ackermann: speed [m/s], handlebar [rad] and 0; body velocity: v_x [m/s], omega_z
+  // [rad/s] and v_y [m/s]): the profiles from t = 0, the lead-in's rest and ramp before.
+  std::array<double, 3> SetPoints(std::int64_t t_ns) const {
     const DriverOptions& driver = scenario_.driver;
     const Profile& first = ackermann_ ? driver.speed_mps : driver.linear_mps;
     const Profile& second = ackermann_ ? driver.handlebar_rad : driver.angular_radps;
+    const Profile none;  // no terms: 0
+    const Profile& third = ackermann_ ? none : driver.lateral_mps;
     if (t_ns >= 0) {
       const double t = static_cast<double>(t_ns) * 1e-9;
-      return {first.Evaluate(t), second.Evaluate(t)};
+      return {first.Evaluate(t), second.Evaluate(t), third.Evaluate(t)};
     }
     const double phase = static_cast<double>(t_ns + lead_in_ns_) / static_cast<double>(lead_in_ns_);
     const double ramp = std::clamp((phase - kLeadInRestFraction) / (1.0 - kLeadInRestFraction), 0.0, 1.0);
-    return {ramp * first.Evaluate(0.0), ramp * second.Evaluate(0.0)};
+    return {ramp * first.Evaluate(0.0), ramp * second.Evaluate(0.0), ramp * third.Evaluate(0.0)};
   }
 
   // Pose of a robot site in O, measured at the current state (the robot is rigid between them).
@@ -291,12 +297,12 @@ class Simulator::Impl {
     long next_progress = 0;
     for (t_ns_ = -lead_in_ns_; t_ns_ <= end_ns_; t_ns_ += step_ns_) {
       // Driver and low-level control.
-      const auto [first, second] = SetPoints(t_ns_);
+      const auto [first, second, third] = SetPoints(t_ns_);
       if (ackermann_) {
         const double measured = vehicle_.RearWheelRate(d) * vehicle_.wheel_radius_m();
         vehicle_.Apply(second, controller_->Update(first, measured, dt_s), d);
       } else {
-        wheeled_.Apply(first, 0.0, second, d);
+        wheeled_.Apply(first, third, second, d);
       }
 
       // Sensors due now, on the state at t completed by forward dynamics.
@@ -366,10 +372,13 @@ class Simulator::Impl {
     if (encoder_clock_.Due(t_ns)) {
       // Cumulative angle since t = 0, truncated to whole ticks (an incremental encoder's count).
       const double tick_rad = 2.0 * kPi / sensors.wheel_encoders->ticks_per_revolution;
-      if (t_ns == 0)
-        for (int i = 0; i < 2; ++i) encoder_zero_rad_[i] = wheeled_.WheelAngle(data_.get(), i);
-      for (int i = 0; i < 2; ++i) {
-        const double angle = wheeled_.WheelAngle(data_.get(), i) - encoder_zero_rad_[i];
+      const int wheels = static_cast<int>(wheeled_.wheels().size());
+      if (t_ns == 0) {
+        encoder_zero_rad_.clear();
+        for (int i = 0; i < wheels; ++i) encoder_zero_rad_.push_back(wheeled_.WheelAngle(data_.get(), i));
+      }
+      for (int i = 0; i < wheels; ++i) {
+        const double angle = wheeled_.WheelAngle(data_.get(), i) - encoder_zero_rad_[static_cast<std::size_t>(i)];
         encoder_stream_.values(encoder_clock_.Row(t_ns), i) = std::floor(angle / tick_rad) * tick_rad;
       }
     }
@@ -438,13 +447,15 @@ class Simulator::Impl {
       const double rim = vehicle_.RearWheelRate(data_.get()) * vehicle_.wheel_radius_m();
       st.max_wheel_slip_mps = std::max(st.max_wheel_slip_mps, std::abs(rim - body.v_body.x()));
     } else {
-      // Rim speed against the speed of the ground point below the wheel, along the rolling direction.
+      // Rim speed against the speed of the ground point below the wheel, along the direction the wheel is locked
+      // in (the rolling direction for a standard or omni wheel), in rim units: r (omega_i - J_i twist).
       for (std::size_t i = 0; i < wheeled_.wheels().size(); ++i) {
         const WheelGeometry& w = wheeled_.wheels()[i];
         const Eigen::Vector2d v_point =
             body.v_body.head<2>() + body.omega_body.z() * Eigen::Vector2d(-w.p_body_m.y(), w.p_body_m.x());
         const double rim = wheeled_.WheelRate(data_.get(), static_cast<int>(i)) * w.radius_m;
-        st.max_wheel_slip_mps = std::max(st.max_wheel_slip_mps, std::abs(rim - w.drive_direction.dot(v_point)));
+        const double ground = w.locked_direction.dot(v_point) / w.locked_direction.dot(w.drive_direction);
+        st.max_wheel_slip_mps = std::max(st.max_wheel_slip_mps, std::abs(rim - ground));
       }
     }
     min_height_ = std::min(min_height_, body.p_world_body.z());
@@ -461,8 +472,7 @@ class Simulator::Impl {
                                {"track_m", Micrometres(vehicle_.rear_track_m())},
                                {"wheel_radius_m", Micrometres(vehicle_.wheel_radius_m())}};
     } else {
-      rec.platform.geometry = {{"wheel_radius_m", Micrometres(wheeled_.mean_radius_m())},
-                               {"baseline_m", Micrometres(wheeled_.baseline_m())}};
+      for (const auto& [key, value] : wheeled_.PlatformGeometry()) rec.platform.geometry[key] = Micrometres(value);
     }
     rec.origin = scenario_.origin;
     rec.provenance.source = "simulated";
@@ -513,9 +523,7 @@ class Simulator::Impl {
       cal["magnetometer.b"] = {magnetometer_.b.x(), magnetometer_.b.y(), magnetometer_.b.z()};
     }
     if (sensors.wheel_encoders) {
-      cal["odometer.radius_left"] = {wheeled_.wheels()[0].radius_m};
-      cal["odometer.radius_right"] = {wheeled_.wheels()[1].radius_m};
-      cal["odometer.baseline"] = {wheeled_.baseline_m()};
+      for (const auto& [name, value] : wheeled_.TrueOdometerCalibration()) cal[name] = value;
     }
     if (sensors.laser) {
       const Eigen::Vector3d& s = laser_mounting_.p_body_sensor;
@@ -552,7 +560,7 @@ class Simulator::Impl {
   Eigen::Vector3d previous_scan_velocity_ = Eigen::Vector3d::Zero();   // (x, y, theta) rates of the last match
   std::vector<std::array<double, 6>> scan_rows_;
   Eigen::Vector2d scan_sigma_sum_ = Eigen::Vector2d::Zero();
-  double encoder_zero_rad_[2] = {0.0, 0.0};
+  std::vector<double> encoder_zero_rad_;
   std::optional<SpeedController> controller_;
   std::optional<GeographicLib::LocalCartesian> local_;
   ImuCalibration imu_;

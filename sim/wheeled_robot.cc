@@ -9,11 +9,63 @@
 namespace roamlab::sim {
 namespace {
 
-Status Missing(const std::string& what, const std::string& kind, const std::string& element) {
-  return Status::Error(what + ": the " + kind + " robot needs " + element + " (see models/diffdrive.xml)");
+std::string ModelOf(const std::string& kind) {
+  if (kind == "omni3") return "models/omni3.xml";
+  if (kind == "mecanum") return "models/mecanum.xml";
+  return "models/diffdrive.xml";
 }
 
-int ExpectedWheels(const std::string& kind) { return kind == "differential_drive" ? 2 : 0; }
+Status Missing(const std::string& what, const std::string& kind, const std::string& element) {
+  return Status::Error(what + ": the " + kind + " robot needs " + element + " (see " + ModelOf(kind) + ")");
+}
+
+int ExpectedWheels(const std::string& kind) {
+  if (kind == "differential_drive") return 2;
+  if (kind == "omni3") return 3;
+  if (kind == "mecanum") return 4;
+  return 0;
+}
+
+bool HasRollers(const std::string& kind) { return kind == "omni3" || kind == "mecanum"; }
+
+// The layout each kind's nominal kinematics assumes (recording/wheel_kinematics.h); empty when the wheels follow it.
+// Tolerances leave room for small mounting changes (WheelMountingChange).
+std::string LayoutProblem(const std::string& kind, const std::vector<WheelGeometry>& w) {
+  constexpr double kPi = 3.14159265358979323846;
+  if (kind == "differential_drive") {
+    if (!(w[0].p_body_m.y() > 0.0 && w[1].p_body_m.y() < 0.0 && std::abs(w[0].p_body_m.x()) < 0.01 &&
+          std::abs(w[1].p_body_m.x()) < 0.01 && w[0].drive_direction.x() > 0.99 && w[1].drive_direction.x() > 0.99))
+      return "differential drive: wheel_0 must be on the left (+y), wheel_1 on the right, both on the y axis of "
+             "'odom' and rolling forward about +y";
+  } else if (kind == "omni3") {
+    const double distance = w[0].p_body_m.norm();
+    for (int i = 0; i < 3; ++i) {
+      const double alpha = (60.0 + 120.0 * i) * kPi / 180.0;
+      const Eigen::Vector2d radial(std::cos(alpha), std::sin(alpha));
+      if ((w[i].p_body_m - distance * radial).norm() > 0.02 || w[i].drive_direction.dot(Eigen::Vector2d(
+                                                                       -radial.y(), radial.x())) < 0.98 ||
+          w[i].locked_direction.dot(w[i].drive_direction) < 0.98)
+        return "omni3: wheel_" + std::to_string(i) + " must be at " + std::to_string(60 + 120 * i) +
+               " deg from x at the same distance as wheel_0, its axle towards 'odom', its bottom roller along the "
+               "rolling direction";
+    }
+  } else if (kind == "mecanum") {
+    const double sx[4] = {1, 1, -1, -1}, sy[4] = {1, -1, 1, -1};
+    for (int i = 0; i < 4; ++i) {
+      const Eigen::Vector2d& p = w[i].p_body_m;
+      // The locked direction must be about 45 deg off the rolling direction and across the diagonal through p (the
+      // "X" layout); along the diagonal the wheel could not turn the body.
+      const Eigen::Vector2d across(-sy[i], sx[i]);
+      if (!(p.x() * sx[i] > 0.0 && p.y() * sy[i] > 0.0 && w[i].drive_direction.x() > 0.98 &&
+            std::abs(std::abs(w[i].locked_direction.dot(w[i].drive_direction)) - std::sqrt(0.5)) < 0.1 &&
+            std::abs(w[i].locked_direction.dot(across.normalized())) > 0.9))
+        return "mecanum: wheel_" + std::to_string(i) + " must be " + (i < 2 ? "front " : "rear ") +
+               (i % 2 == 0 ? "left" : "right") + ", rolling forward, its bottom roller's axis 45 deg off x and "
+               "across the diagonal through the wheel (X layout)";
+    }
+  }
+  return "";
+}
 
 }  // namespace
 
@@ -21,6 +73,7 @@ Result<WheeledRobot> WheeledRobot::Bind(const mjModel* model, const std::string&
   WheeledRobot r;
   const int n = ExpectedWheels(kind);
   if (n == 0) return Status::Error(what + ": unsupported wheeled robot kind '" + kind + "'");
+  r.kind_ = kind;
   const int root = IdOf(model, mjOBJ_JOINT, "root");
   if (root < 0 || model->jnt_type[root] != mjJNT_FREE) return Missing(what, kind, "a free joint 'root'");
   r.root_qpos_ = model->jnt_qposadr[root];
@@ -49,8 +102,10 @@ Result<WheeledRobot> WheeledRobot::Bind(const mjModel* model, const std::string&
         model->actuator_trnid[2 * actuator] != joint)
       return Missing(what, kind, "a velocity actuator 'drive_" + index + "' on joint 'wheel_" + index + "'");
     const int tire = IdOf(model, mjOBJ_GEOM, "tire_" + index);
-    if (tire < 0 || model->geom_type[tire] != mjGEOM_SPHERE)
-      return Missing(what, kind, "a sphere geom 'tire_" + index + "'");
+    if (tire < 0 || !(model->geom_type[tire] == mjGEOM_SPHERE ||
+                      (HasRollers(kind) && model->geom_type[tire] == mjGEOM_CYLINDER)))
+      return Missing(what, kind, std::string("a ") + (HasRollers(kind) ? "sphere or cylinder" : "sphere") +
+                                     " geom 'tire_" + index + "'");
     r.wheel_qpos_.push_back(model->jnt_qposadr[joint]);
     r.wheel_dof_.push_back(model->jnt_dofadr[joint]);
     r.actuators_.push_back(actuator);
@@ -65,25 +120,97 @@ Result<WheeledRobot> WheeledRobot::Bind(const mjModel* model, const std::string&
     WheelGeometry w;
     w.p_body_m = centre.head<2>();
     w.drive_direction = direction.head<2>().normalized();
+    w.locked_direction = w.drive_direction;
     w.radius_m = model->geom_size[3 * tire];
+    if (HasRollers(kind)) {
+      // The roller under the wheel: its hinge axis, seen from above, is the locked direction u.
+      const int roller = IdOf(model, mjOBJ_JOINT, "roller_" + index + "_0");
+      if (roller < 0 || model->jnt_type[roller] != mjJNT_HINGE)
+        return Missing(what, kind, "a hinge joint 'roller_" + index + "_0' (the roller under wheel_" + index + ")");
+      const Eigen::Vector3d roller_axis = R_world_odom.transpose() * Eigen::Vector3d(scratch->xaxis + 3 * roller);
+      if (roller_axis.head<2>().norm() < 0.9)
+        return Status::Error(what + ": roller_" + index + "_0 must turn about a horizontal axis");
+      w.locked_direction = roller_axis.head<2>().normalized();
+      if (w.locked_direction.dot(w.drive_direction) < 0.0) w.locked_direction = -w.locked_direction;
+    }
     height_sum += w.radius_m - centre.z();
-    // omega_i = d . (v + omega_z (-y_i, x_i)) / r.
-    const Eigen::Vector2d& d = w.drive_direction;
-    r.J_rates_twist_.row(i) << d.x() / w.radius_m, d.y() / w.radius_m,
-        (-d.x() * w.p_body_m.y() + d.y() * w.p_body_m.x()) / w.radius_m;
+    // omega_i = u . (v + omega_z (-y_i, x_i)) / (r u . d).
+    const Eigen::Vector2d& u = w.locked_direction;
+    const double scale = w.radius_m * u.dot(w.drive_direction);
+    r.J_rates_twist_.row(i) << u.x() / scale, u.y() / scale, (-u.x() * w.p_body_m.y() + u.y() * w.p_body_m.x()) / scale;
     r.wheels_.push_back(w);
   }
   r.odom_height_m_ = height_sum / n;
-  if (kind == "differential_drive" &&
-      !(r.wheels_[0].p_body_m.y() > 0.0 && r.wheels_[1].p_body_m.y() < 0.0 &&
-        std::abs(r.wheels_[0].p_body_m.x()) < 0.01 && std::abs(r.wheels_[1].p_body_m.x()) < 0.01 &&
-        r.wheels_[0].drive_direction.x() > 0.99 && r.wheels_[1].drive_direction.x() > 0.99))
-    return Status::Error(what + ": differential drive: wheel_0 must be on the left (+y), wheel_1 on the right, both "
-                                "on the y axis of 'odom' and rolling forward about +y");
+  if (const std::string problem = LayoutProblem(kind, r.wheels_); !problem.empty())
+    return Status::Error(what + ": " + problem);
   return r;
 }
 
-double WheeledRobot::baseline_m() const { return (wheels_.front().p_body_m - wheels_.back().p_body_m).norm(); }
+Status WheeledRobot::ChangeMounting(mjModel* model, const std::vector<WheelMountingChange>& changes,
+                                    const std::string& what) {
+  for (const WheelMountingChange& c : changes) {
+    const std::string name = "wheel_" + std::to_string(c.wheel);
+    const int joint = IdOf(model, mjOBJ_JOINT, name);
+    if (joint < 0) return Status::Error(what + ": robot.wheel_mounting: no wheel joint '" + name + "'");
+    // The body turns about its origin (the wheel centre): yaw about z of the parent frame, then tilt about the
+    // rolling direction d = a x e_z (a: the hinge axis in the parent's frame at qpos0).
+    const int body = model->jnt_bodyid[joint];
+    Eigen::Quaterniond q(model->body_quat[4 * body], model->body_quat[4 * body + 1], model->body_quat[4 * body + 2],
+                         model->body_quat[4 * body + 3]);
+    const Eigen::Vector3d axle = q * Eigen::Vector3d(model->jnt_axis + 3 * joint);
+    const Eigen::Vector3d d = axle.cross(Eigen::Vector3d::UnitZ()).normalized();
+    q = Eigen::AngleAxisd(c.yaw_rad, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(c.tilt_rad, d) * q;
+    q.normalize();
+    model->body_quat[4 * body] = q.w();
+    model->body_quat[4 * body + 1] = q.x();
+    model->body_quat[4 * body + 2] = q.y();
+    model->body_quat[4 * body + 3] = q.z();
+  }
+  return Status::Ok();
+}
+
+std::map<std::string, double> WheeledRobot::PlatformGeometry() const {
+  std::map<std::string, double> g{{"wheel_radius_m", mean_radius_m()}};
+  if (kind_ == "differential_drive") {
+    g["baseline_m"] = (wheels_.front().p_body_m - wheels_.back().p_body_m).norm();
+  } else if (kind_ == "omni3") {
+    double sum = 0.0;
+    for (const WheelGeometry& w : wheels_) sum += w.p_body_m.norm();
+    g["wheel_distance_m"] = sum / 3.0;
+  } else {
+    double lx = 0.0, ly = 0.0;
+    for (const WheelGeometry& w : wheels_) {
+      lx += 0.25 * std::abs(w.p_body_m.x());
+      ly += 0.25 * std::abs(w.p_body_m.y());
+    }
+    g["half_length_m"] = lx;
+    g["half_width_m"] = ly;
+  }
+  return g;
+}
+
+std::vector<std::string> WheeledRobot::EncoderColumns() const {
+  if (kind_ == "differential_drive") return {"left", "right"};
+  if (kind_ == "mecanum") return {"front_left", "front_right", "rear_left", "rear_right"};
+  return {"wheel_0", "wheel_1", "wheel_2"};
+}
+
+std::map<std::string, std::vector<double>> WheeledRobot::TrueOdometerCalibration() const {
+  const std::map<std::string, double> g = PlatformGeometry();
+  if (kind_ == "differential_drive")
+    return {{"odometer.radius_left", {wheels_[0].radius_m}},
+            {"odometer.radius_right", {wheels_[1].radius_m}},
+            {"odometer.baseline", {g.at("baseline_m")}}};
+  std::map<std::string, std::vector<double>> cal;
+  for (std::size_t i = 0; i < wheels_.size(); ++i)
+    cal["odometer.radius_" + std::to_string(i)] = {wheels_[i].radius_m};
+  if (kind_ == "omni3") {
+    cal["odometer.distance"] = {g.at("wheel_distance_m")};
+  } else {
+    cal["odometer.lx_plus_ly"] = {g.at("half_length_m") + g.at("half_width_m")};
+  }
+  return cal;
+}
 
 double WheeledRobot::mean_radius_m() const {
   double sum = 0.0;

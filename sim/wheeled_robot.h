@@ -4,11 +4,23 @@
 //
 // Kinematics (recording/wheel_kinematics.h): wheel i at p_i in O with rolling direction d_i = a_i x e_z (a_i its
 // hinge axis in O: turning positive about a_i, the contact point moves along -d_i, so the body moves along +d_i) and
-// true radius r_i turns at omega_i = d_i . (v + omega_z e_z x p_i) / r_i without slip. The driver turns body-velocity
-// set-points (v_x, v_y, omega_z) into wheel-speed commands with these rows; the motors are MuJoCo velocity servos with
-// a torque limit, so a set-point step asks for more torque than the tires can pass and the wheels slip.
+// true radius r_i. The wheel is locked along a direction u_i of the floor plane and free across it: a standard tire
+// and an omni wheel (rollers along the rim) have u_i = d_i, a mecanum wheel has u_i = the axis of the roller at the
+// contact (45 deg off d_i). Without slip u_i . (v + omega_z e_z x p_i) = r_i omega_i (u_i . d_i), so
+//     omega_i = u_i . (v + omega_z e_z x p_i) / (r_i u_i . d_i),
+// which is d_i . (v + omega_z e_z x p_i) / r_i for u_i = d_i. The driver turns body-velocity set-points (v_x, v_y,
+// omega_z) into wheel-speed commands with these rows; the motors are MuJoCo velocity servos with a torque limit, so a
+// set-point step asks for more torque than the tires can pass and the wheels slip.
+//
+// Kinds and the names they need (see the comments at the top of the models):
+//   differential_drive  models/diffdrive.xml: wheel_0 left, wheel_1 right, sphere tires
+//   omni3               models/omni3.xml: wheels 0, 1, 2 at 60, 180, 300 deg from x, equal distance L, axles towards
+//                       O; tire_<i> a sphere or cylinder; roller_<i>_0 the roller under wheel i at qpos0
+//   mecanum             models/mecanum.xml: wheels 0-3 front left, front right, rear left, rear right at (+-lx, +-ly)
+//                       rolling along +x; roller_<i>_0 under wheel i, its axis 45 deg off x and not along p_i
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -22,23 +34,39 @@ namespace roamlab::sim {
 struct WheelGeometry {
   Eigen::Vector2d p_body_m = Eigen::Vector2d::Zero();     // contact point below the wheel centre, in O [m]
   Eigen::Vector2d drive_direction = Eigen::Vector2d::UnitX();
+  Eigen::Vector2d locked_direction = Eigen::Vector2d::UnitX();   // u: unit, the direction the wheel cannot slide in
   double radius_m = 0.0;                                 // true rolling radius
+};
+
+// A change of one wheel's mounting, applied to the compiled model before binding (the wheel turns about its centre):
+// yaw about the body's z axis (its axle out of alignment) and tilt (camber) about its rolling direction.
+struct WheelMountingChange {
+  int wheel = 0;
+  double yaw_rad = 0.0;
+  double tilt_rad = 0.0;
 };
 
 class WheeledRobot {
  public:
-  // Finds the named elements and measures the wheels at qpos0. `kind` is the robot kind (differential_drive); errors
-  // name `what` (the model file) and the missing element.
+  // Finds the named elements and measures the wheels at qpos0. `kind` is the robot kind (differential_drive, omni3,
+  // mecanum); errors name `what` (the model file) and the missing element.
   static Result<WheeledRobot> Bind(const mjModel* model, const std::string& kind, const std::string& what);
+  // Turns wheel bodies of a compiled model (before Bind); errors name `what` and the wheel.
+  static Status ChangeMounting(mjModel* model, const std::vector<WheelMountingChange>& changes,
+                               const std::string& what);
 
   const std::vector<WheelGeometry>& wheels() const { return wheels_; }
   int odom_site() const { return odom_site_; }
   int laser_site() const { return laser_site_; }  // -1 when the model has none
   // Wheel rows of the kinematics: n x 3, rates [rad/s] = J [v_x, v_y, omega_z].
   const Eigen::MatrixXd& J_rates_twist() const { return J_rates_twist_; }
-  // Distance between the two wheels' contact points [m] (differential drive).
-  double baseline_m() const;
   double mean_radius_m() const;
+  // The recording's platform geometry (recording/wheel_kinematics.h keys for the kind), measured on the model.
+  std::map<std::string, double> PlatformGeometry() const;
+  // Encoder column names, one per wheel.
+  std::vector<std::string> EncoderColumns() const;
+  // The true odometer geometry under the names of the kind's estimator model (odometer.<slot>).
+  std::map<std::string, std::vector<double>> TrueOdometerCalibration() const;
 
   // Puts the robot at rest on the flat floor (z = 0) with O above (x, y), heading yaw_rad, the tires clearance_m
   // above the floor. Calls mj_forward.
@@ -52,6 +80,7 @@ class WheeledRobot {
   int root_body() const { return root_body_; }
 
  private:
+  std::string kind_;
   int root_qpos_ = -1;
   int root_body_ = -1;
   int odom_site_ = -1;

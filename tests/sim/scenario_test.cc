@@ -126,3 +126,49 @@ TEST_F(ScenarioErrorTest, YamlSyntaxErrorsGiveLineAndColumn) {
 
 }  // namespace
 }  // namespace roamlab::sim
+
+namespace roamlab::sim {
+namespace {
+
+TEST(ScenarioTest, IndoorOmniDrivesSidewaysAndWheelMountingIsParsedAndChecked) {
+  auto loaded = LoadScenario(testing::SourcePath("scenarios/indoor_omni_slip.yaml"));
+  ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+  Scenario s = loaded.value();
+  EXPECT_EQ(s.robot.kind, "omni3");
+  double left = 0.0, right = 0.0;
+  for (double t = 0.0; t <= 30.0; t += 0.01) {
+    left = std::max(left, s.driver.lateral_mps.Evaluate(t));
+    right = std::min(right, s.driver.lateral_mps.Evaluate(t));
+  }
+  EXPECT_EQ(left, 0.4);
+  EXPECT_EQ(right, -0.4);
+
+  // Wheel mounting from YAML (degrees), then the checks of Validate.
+  std::string text = testing::ReadText(testing::SourcePath("scenarios/indoor_omni_slip.yaml"));
+  for (const std::string model : {"../models/omni3.xml", "../models/indoor_room.xml"})
+    text.replace(text.find(model), model.size(), testing::SourcePath(model.substr(3)));
+  const std::string kind = "kind: omni3\n";
+  text.replace(text.find(kind), kind.size(), kind + "  wheel_mounting: [{wheel: 2, yaw_deg: 2.0, tilt_deg: -3.0}]\n");
+  roamlab::testing::TempDir dir;
+  roamlab::testing::WriteFile(dir.File("omni.yaml"), text);
+  auto mounted = LoadScenario(dir.File("omni.yaml"));
+  ASSERT_TRUE(mounted.ok()) << mounted.status().message();
+  ASSERT_EQ(mounted.value().robot.wheel_mounting.size(), 1u);
+  EXPECT_EQ(mounted.value().robot.wheel_mounting[0].wheel, 2);
+  EXPECT_NEAR(mounted.value().robot.wheel_mounting[0].yaw_rad, 2.0 * M_PI / 180.0, 1e-15);
+  EXPECT_NEAR(mounted.value().robot.wheel_mounting[0].tilt_rad, -3.0 * M_PI / 180.0, 1e-15);
+
+  Scenario bad = s;
+  bad.robot.wheel_mounting = {{0, 0.5, 0.0}};
+  ASSERT_TRUE(bad.Validate().has_value());
+  EXPECT_EQ(bad.Validate()->key, "robot.wheel_mounting[0].yaw_deg");
+  bad = s;
+  bad.robot.kind = "differential_drive";
+  ASSERT_TRUE(bad.Validate().has_value());
+  EXPECT_EQ(bad.Validate()->key, "driver.lateral_mps");
+  bad.driver.lateral_mps = Profile::Constant(0.0);
+  EXPECT_FALSE(bad.Validate().has_value());
+}
+
+}  // namespace
+}  // namespace roamlab::sim
