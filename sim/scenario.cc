@@ -311,6 +311,7 @@ void ReadIndoorSensors(YamlReader& r, const YAML::Node& node, Scenario* s) {
     CameraOptions& camera = s->sensors.camera.emplace();
     const YAML::Node n = node["camera"];
     const std::string k = "sensors.camera";
+    r.Remember(k, n);
     r.CheckKeys(n, k, {"rate_hz", "width_px", "height_px", "store_images"});
     r.Number(n, k, "rate_hz", &camera.rate_hz);
     std::int64_t width = camera.width_px, height = camera.height_px;
@@ -320,6 +321,7 @@ void ReadIndoorSensors(YamlReader& r, const YAML::Node& node, Scenario* s) {
     camera.height_px = static_cast<int>(std::clamp<std::int64_t>(height, -1, 1 << 20));
     r.Bool(n, k, "store_images", &camera.store_images);
   } else if (node["camera"]) {
+    r.Remember("sensors.camera", node["camera"]);
     s->sensors.camera.emplace();
   }
 }
