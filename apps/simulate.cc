@@ -28,6 +28,7 @@ int RunSimulate(const SimulateArgs& args) {
   // Simulate, with a progress line on stderr.
   sim::SimulateOptions options;
   options.seed = args.seed;
+  options.image_directory = args.out;  // sensors.camera.store_images
   if (!args.quiet) {
     options.progress = [](double fraction) {
       std::cerr << "\rsimulate: " << static_cast<int>(100.0 * fraction) << "%" << std::flush;
@@ -55,6 +56,12 @@ int RunSimulate(const SimulateArgs& args) {
                 st.distance_m, st.max_abs_pitch_rad * kDegPerRad, st.max_abs_roll_rad * kDegPerRad,
                 st.path_height_range_m, st.terrain_relief_m, st.max_lateral_speed_mps, st.max_wheel_slip_mps);
     if (st.failed_scan_matches > 0) std::printf("scan matcher: %d scan pairs not matched\n", st.failed_scan_matches);
+    if (const auto& vo = st.visual_odometry) {
+      std::printf("visual odometry: %d frames, %d pairs, %d estimates, %d failures (features %d, tracks %d, inliers "
+                  "%d, scale %d); camera %.4f m above the floor\n",
+                  vo->frames, vo->pairs, vo->estimates, vo->failures, vo->too_few_features, vo->too_few_tracks,
+                  vo->too_few_inliers, vo->no_scale, st.camera_height_m);
+    }
     std::printf("wrote %s (seed %llu): %zu streams, ground_truth.tum, truth.yaml\n", args.out.c_str(),
                 static_cast<unsigned long long>(*s.recording.provenance.seed), s.recording.streams.size());
   }

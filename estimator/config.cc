@@ -71,8 +71,11 @@ const std::vector<ModelSpec>& ModelSpecs() {
         ScalarSlot("lx_plus_ly", std::numeric_limits<double>::quiet_NaN())},
        {},
        true},
-      {"odometer", {""}, {"linear_mps", "angular_radps"}, {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")}, {},
-       true},
+      {"odometer", {""}, {"linear_mps", "angular_radps"}, {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")},
+       {"row_covariance_scale"}, true},
+      // The odometer's eqs. 5-8 over the sample's whole interval: see problem.h (relative motion).
+      {"relative_motion", {""}, {"linear_mps", "angular_radps"},
+       {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")}, {"interval_s", "row_covariance_scale"}, false},
       {"gyroscope", {""}, {"sigma_radps"}, {RotationSlot("misalignment"), Vector3Slot("bias", 0.0), Vector3Slot("scale", 1.0)},
        {}, false},
       {"accelerometer",

@@ -21,12 +21,22 @@
 //       options: {wheelbase_m: 1.25}
 //       loss: {type: huber, scale: 3.0}
 //     gps: {model: gps, source: gps, noise: {sigma_m: 0.33}}
+//     scan_matching:                       # a velocity measured over an interval (scan matcher, visual odometry)
+//       model: relative_motion             # eqs. 5-8 between the poses nearest the interval's ends (problem.h)
+//       source: scan_matching
+//       noise: {linear_mps: 0.03, angular_radps: 0.05}     # of the interval's mean velocity
+//       options: {interval_s: 0.1, row_covariance_scale: 2.0}
 //   stages:                                # offline calibration: parameters freed in each stage, in order
 //     - [gps.lever_arm, imu.misalignment]
 //     - [magnetometer.A, magnetometer.b, odometer.kv_over_L, odometer.k_theta, odometer.k_gamma]
 //
 // Models, their noise keys, parameter slots (default value) and options are listed in kModelSpecs (config.cc) and in
-// the README. Unknown keys, unknown models, missing noise keys and malformed values are errors naming the file and key.
+// the README. `odometer` joins the two master poses around its sample's stamp (one master interval: for sources at the
+// master's rate or faster). `relative_motion` reads the same velocity streams, whose rows hold the mean velocity over
+// [t - T/2, t + T/2] stamped at the middle (scan_matching, visual_odometry), and joins the master poses nearest the
+// two ends, so that a 10 Hz scan matcher constrains the whole 0.1 s displacement instead of one 10 ms interval;
+// options.interval_s gives T (default: 1 / the stream's rate_hz). Both accept options.row_covariance_scale: k > 0
+// adds k times the row's own covariance (the stream's 21 covariance columns) to the configured noise, per sample. Unknown keys, unknown models, missing noise keys and malformed values are errors naming the file and key.
 #pragma once
 
 #include <map>

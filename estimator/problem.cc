@@ -29,10 +29,11 @@ using recording::StreamType;
 
 namespace {
 
-enum class Attachment { kMaster, kOnePose, kPair, kTriple };
+enum class Attachment { kMaster, kOnePose, kPair, kTriple, kInterval };
 
 Attachment AttachmentOf(const std::string& model, bool master) {
   if (master) return Attachment::kMaster;
+  if (model == "relative_motion") return Attachment::kInterval;
   if (model == "gyroscope" || model == "linear_velocity" || model == "odometer" || model == "ackermann" ||
       model == "ackermann_seed" || model == "differential_drive" || model == "omni3_drive" ||
       model == "mecanum_drive")
@@ -54,6 +55,8 @@ struct StreamBinding {
   int column = 0;                               // first column used in the primary stream
   std::vector<std::string> slot_parameters;     // parameter name per model slot
   Eigen::MatrixXd noise_covariance;
+  double row_covariance_scale = 0.0;            // odometer, relative_motion: weight of the rows' own covariance
+  double interval_s = 0.0;                      // relative_motion: T
   double wheelbase_m = 0.0;
   Eigen::Vector3d field_world = Eigen::Vector3d::Zero();
   std::deque<MeasurementRef> pending;
@@ -95,7 +98,7 @@ Eigen::MatrixXd NoiseCovariance(const StreamBinding& s) {
     sigma.resize(6);
     sigma << n.at("speed_mps"), n.at("steering_rad"), n.at("lateral_mps"), n.at("vertical_mps"),
         n.at("roll_rate_radps"), n.at("pitch_rate_radps");
-  } else if (m == "odometer") {
+  } else if (m == "odometer" || m == "relative_motion") {
     sigma.resize(6);
     sigma << Eigen::Vector3d::Constant(n.at("linear_mps")), Eigen::Vector3d::Constant(n.at("angular_radps"));
   } else if (m == "differential_drive") {
@@ -187,9 +190,31 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
       if (b.primary->info.units != "rad" || b.primary->values.cols() != wheels)
         return Error(config, "stream '" + name + "': " + m + " source '" + source + "' must hold " +
                                  std::to_string(wheels) + " cumulative wheel angles in rad");
-    } else if (m == "odometer" || m == "linear_velocity") {
+    } else if (m == "odometer" || m == "linear_velocity" || m == "relative_motion") {
       if (!TypeIn(type, {StreamType::kOdometry, StreamType::kVisualOdometry, StreamType::kScanMatching}))
         return Error(config, bad_type);
+    }
+    if (sc.options.count("row_covariance_scale")) {
+      const std::vector<double>& k = sc.options.at("row_covariance_scale");
+      if (k.size() != 1 || !(k[0] > 0.0))
+        return Error(config, "stream '" + name + "': options.row_covariance_scale must be one positive number");
+      if (b.primary->values.cols() != 27)
+        return Error(config, "stream '" + name + "': options.row_covariance_scale needs the 21 covariance columns, "
+                                 "which recording stream '" + source + "' lacks");
+      b.row_covariance_scale = k[0];
+    }
+    if (m == "relative_motion") {
+      if (sc.options.count("interval_s")) {
+        const std::vector<double>& T = sc.options.at("interval_s");
+        if (T.size() != 1 || !(T[0] > 0.0))
+          return Error(config, "stream '" + name + "': options.interval_s must be one positive number [s]");
+        b.interval_s = T[0];
+      } else if (b.primary->info.rate_hz > 0.0) {
+        b.interval_s = 1.0 / b.primary->info.rate_hz;
+      } else {
+        return Error(config, "stream '" + name + "': recording stream '" + source +
+                                 "' has no rate_hz; give options.interval_s");
+      }
     }
     b.noise_covariance = NoiseCovariance(b);
 
@@ -302,8 +327,8 @@ int ProblemBuilder::ResidualDim(const std::string& stream) const {
       const std::string& m = s.config.model;
       if (m == "ackermann") return 4;
       if (m == "mecanum_drive") return 7;
-      return (m == "ackermann_seed" || m == "odometer" || m == "absolute_pose" || m == "differential_drive" ||
-              m == "omni3_drive")
+      return (m == "ackermann_seed" || m == "odometer" || m == "relative_motion" || m == "absolute_pose" ||
+              m == "differential_drive" || m == "omni3_drive")
                  ? 6
                  : 3;
     }
@@ -475,6 +500,7 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
 
   // Which poses: bail out (keep waiting) until they exist.
   std::size_t k = 0;
+  if (s.attachment == Attachment::kInterval) return TryAttachInterval(m);
   if (poses_.empty() || m.t > poses_.back().t) return false;
   if (m.t < poses_.front().t) {
     ++counts_[s.name].outside;
@@ -499,6 +525,8 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
       break;
     case Attachment::kOnePose:
       k = NearestPose(m.t);
+      break;
+    case Attachment::kInterval:
       break;
   }
 
@@ -541,6 +569,11 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
   } else if (model == "odometer") {
     factor = MakeFactor(OdometerError(row.head<6>().transpose(), dt));
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k)};
+    const FactorId id = graph_.AddFactor(std::move(factor), vars, SampleNoiseCovariance(s, row), s.config.loss, s.name,
+                                         m.t);
+    stream_of_factor_[id] = m.stream;
+    ++counts_[s.name].attached;
+    return true;
   } else if (model == "gyroscope") {
     factor = MakeFactor(GyroscopeError(z3(), dt));
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k)};
@@ -567,6 +600,52 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     absolute_fixes_.emplace_back(poses_[k].id, row.head<3>().transpose());
   }
   const FactorId id = graph_.AddFactor(std::move(factor), vars, s.noise_covariance, s.config.loss, s.name, m.t);
+  stream_of_factor_[id] = m.stream;
+  ++counts_[s.name].attached;
+  return true;
+}
+
+Eigen::MatrixXd ProblemBuilder::SampleNoiseCovariance(const StreamBinding& s, const Eigen::RowVectorXd& row) {
+  if (!(s.row_covariance_scale > 0.0)) return s.noise_covariance;
+  // The row's covariance of [v; omega] from its upper triangle (recording.h), added to the configured noise.
+  Eigen::MatrixXd covariance = s.noise_covariance;
+  int c = 6;
+  for (int i = 0; i < 6; ++i)
+    for (int j = i; j < 6; ++j) {
+      covariance(i, j) += s.row_covariance_scale * row[c];
+      if (j != i) covariance(j, i) += s.row_covariance_scale * row[c];
+      ++c;
+    }
+  return covariance;
+}
+
+bool ProblemBuilder::TryAttachInterval(const MeasurementRef& m) {
+  StreamBinding& s = impl_->streams[m.stream];
+  if (poses_.empty()) return false;
+  const std::int64_t half_ns = std::llround(0.5e9 * s.interval_s);
+  const Time t_a = Time::FromNanoseconds(m.t.nanoseconds() - half_ns);
+  const Time t_b = Time::FromNanoseconds(m.t.nanoseconds() + half_ns);
+  // The pose nearest t_a must still be in the graph: t_a no earlier than half a master period before the oldest pose.
+  if (t_a < poses_.front().t) {
+    const bool near_front = poses_.size() >= 2 && 2 * (poses_.front().t.nanoseconds() - t_a.nanoseconds()) <=
+                                                      poses_[1].t.nanoseconds() - poses_.front().t.nanoseconds();
+    if (!near_front) {
+      ++(popped_any_ ? counts_[s.name].too_late : counts_[s.name].outside);
+      return true;
+    }
+  }
+  // The pose nearest t_b is known once a pose at or after t_b exists.
+  if (poses_.back().t < t_b) return false;
+  const std::size_t a = NearestPose(t_a);
+  std::size_t b = std::max(NearestPose(t_b), a + 1);
+  if (b >= poses_.size()) return false;
+
+  const Eigen::RowVectorXd row = s.primary->values.row(m.row);
+  const double dt = SecondsBetween(poses_[a].t, poses_[b].t);
+  const std::vector<VariableId> vars = {poses_[a].id, poses_[b].id, ParameterAt(s.slot_parameters[0], a),
+                                        ParameterAt(s.slot_parameters[1], a)};
+  const FactorId id = graph_.AddFactor(MakeFactor(OdometerError(row.head<6>().transpose(), dt)), vars,
+                                       SampleNoiseCovariance(s, row), s.config.loss, s.name, m.t);
   stream_of_factor_[id] = m.stream;
   ++counts_[s.name].attached;
   return true;

@@ -7,6 +7,15 @@
 // (accelerometer). Measurements may arrive out of order; one older than the oldest pose still in the graph is
 // counted as too late, never silently dropped.
 //
+// Relative motion (model relative_motion). A sample of a velocity stream stamped at t that stands for the mean
+// velocity over [t_a, t_b] = [t - T/2, t + T/2] (the scan matcher between two scans, the visual odometry between two
+// frames) attaches to the poses k_a and k_b nearest t_a and t_b (k_b > k_a), once a pose at or after t_b exists: the
+// odometer's error (eqs. 5-8) with the velocity held over dt = t(k_b) - t(k_a). Between those poses the master stream
+// still gives the shape of the motion; the sample constrains the displacement and rotation across the whole interval
+// (a relative-pose constraint). With the master poses nearest the ends, the interval differs from [t_a, t_b] by up to
+// half a master period at each end; holding the measured velocity over dt keeps the constraint exact for a constant
+// velocity. A sample whose pose k_a has already left the window is too late (or outside, before the first pose).
+//
 // Parameters are variables named "<stream>.<slot>" unless the configuration maps a slot to another name (shared
 // parameters, e.g. one IMU misalignment for gyroscope, accelerometer and magnetometer). A time-varying parameter
 // (random walk or Gauss-Markov) has one instance per pose, joined by process factors.
@@ -48,6 +57,8 @@ struct StreamCounts {
   int too_late = 0;    // older than the oldest pose in the graph
   int outside = 0;     // no pose around its time stamp (before the first or after the last master sample)
 };
+
+struct StreamBinding;  // a configured stream bound to its recording data (problem.cc)
 
 class ProblemBuilder {
  public:
@@ -107,6 +118,10 @@ class ProblemBuilder {
   void AttachPending();
   // Attaches one measurement if its poses exist; returns false to keep it waiting.
   bool TryAttach(const MeasurementRef& m);
+  // TryAttach for relative_motion (the class comment).
+  bool TryAttachInterval(const MeasurementRef& m);
+  // The noise covariance of one sample: the configured one, plus the row's own when the stream is set to use it.
+  static Eigen::MatrixXd SampleNoiseCovariance(const StreamBinding& s, const Eigen::RowVectorXd& row);
   VariableId CreatePose(Time t, const Eigen::VectorXd& value);
   // The variable of a parameter at pose index k (the instance, when time-varying).
   VariableId ParameterAt(const std::string& name, std::size_t k) const;

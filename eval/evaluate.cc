@@ -11,6 +11,7 @@
 #include <GeographicLib/LocalCartesian.hpp>
 
 #include "eval/internal/json_util.h"
+#include "eval/visual_odometry.h"
 #include "recording/truth.h"
 #include "recording/wheel_kinematics.h"
 
@@ -241,6 +242,12 @@ Result<Evaluation> Evaluate(const EvaluateOptions& options) {
                        {"rpe_delta_poses", step}};
       ev.velocity = std::move(v);
     }
+  }
+
+  // Visual odometry streams against the truth, independently of the estimate (issue 4's per-pair targets).
+  for (const recording::Stream& stream : rec.value().streams) {
+    if (stream.info.type != recording::StreamType::kVisualOdometry) continue;
+    if (const auto vo = CompareVisualOdometry(stream, truth)) m["visual_odometry"][stream.info.name] = VisualOdometryJson(*vo);
   }
 
   // Figures' data: whole trajectories, matched errors.

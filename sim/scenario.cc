@@ -237,7 +237,7 @@ void ReadDriver(YamlReader& r, const YAML::Node& node, Scenario* s) {
 }
 
 void ReadSensors(YamlReader& r, const YAML::Node& node, Scenario* s) {
-  r.CheckKeys(node, "sensors", {"imu", "magnetometer", "gps", "odometer", "wheel_encoders", "laser"});
+  r.CheckKeys(node, "sensors", {"imu", "magnetometer", "gps", "odometer", "wheel_encoders", "laser", "camera"});
   if (!r.ok()) return;
   // A present key with an empty value ("imu:" or "imu: {}") is a sensor with all defaults.
   const auto section = [&r](const YAML::Node& n, const std::string& k, std::initializer_list<std::string_view> keys) {
@@ -329,6 +329,23 @@ void ReadIndoorSensors(YamlReader& r, const YAML::Node& node, Scenario* s) {
     r.Number(n, k, "sigma_m", &laser.sigma_m);
   } else if (node["laser"]) {
     s->sensors.laser.emplace();
+  }
+  if (node["camera"] && !node["camera"].IsNull()) {
+    CameraOptions& camera = s->sensors.camera.emplace();
+    const YAML::Node n = node["camera"];
+    const std::string k = "sensors.camera";
+    r.Remember(k, n);
+    r.CheckKeys(n, k, {"rate_hz", "width_px", "height_px", "store_images"});
+    r.Number(n, k, "rate_hz", &camera.rate_hz);
+    std::int64_t width = camera.width_px, height = camera.height_px;
+    r.Integer(n, k, "width_px", &width);
+    r.Integer(n, k, "height_px", &height);
+    camera.width_px = static_cast<int>(std::clamp<std::int64_t>(width, -1, 1 << 20));
+    camera.height_px = static_cast<int>(std::clamp<std::int64_t>(height, -1, 1 << 20));
+    r.Bool(n, k, "store_images", &camera.store_images);
+  } else if (node["camera"]) {
+    r.Remember("sensors.camera", node["camera"]);
+    s->sensors.camera.emplace();
   }
 }
 
@@ -450,6 +467,17 @@ std::optional<Scenario::Problem> Scenario::Validate() const {
     return P{"sensors.odometer", "is the Ackermann odometer; a " + robot.kind + " robot has wheel_encoders"};
   if ((sensors.wheel_encoders || sensors.laser) && ackermann)
     return P{sensors.laser ? "sensors.laser" : "sensors.wheel_encoders", "only for wheeled indoor robots"};
+  if (sensors.camera && ackermann) return P{"sensors.camera", "only for wheeled indoor robots"};
+  if (const auto& camera = sensors.camera) {
+    if (!(Finite(camera->rate_hz) && camera->rate_hz >= 10.0 && camera->rate_hz <= 30.0))
+      return P{"sensors.camera.rate_hz", "must be in [10, 30]"};
+    const bool small = camera->width_px == 320 && camera->height_px == 240;
+    const bool large = camera->width_px == 640 && camera->height_px == 480;
+    if (!small && !large)
+      return P{camera->width_px != 320 && camera->width_px != 640 ? "sensors.camera.width_px"
+                                                                    : "sensors.camera.height_px",
+               "the image must be 320x240 or 640x480"};
+  }
   if (const auto& enc = sensors.wheel_encoders) {
     if (!Positive(enc->rate_hz)) return P{"sensors.wheel_encoders.rate_hz", "must be > 0"};
     if (!(Positive(enc->ticks_per_revolution) && enc->ticks_per_revolution == std::floor(enc->ticks_per_revolution)))

@@ -66,6 +66,7 @@
 //     imu: {...}                            # as above (vibration comes from the physics)
 //     wheel_encoders: {rate_hz: 100, ticks_per_revolution: 2048}
 //     laser: {rate_hz: 10, beams: 683, fov_deg: 240, min_range_m: 0.02, max_range_m: 4.0, sigma_m: 0.01}
+//     camera: {rate_hz: 15, width_px: 320, height_px: 240, store_images: false}   # rate 10-30 Hz; 320x240 or 640x480
 // Streams written: imu; wheel_encoders (wheel_encoders: one column per wheel, "left" "right", the cumulative wheel
 // angle quantized to whole ticks and written in rad, attributes.ticks_per_revolution; angle 0 at t = 0);
 // scan_matching (scan_matching: the velocity of the laser frame between consecutive scans, from the project's scan
@@ -73,8 +74,16 @@
 // middle of the scan interval, vz = wx = wy = 0; mounting = the laser site in O). The platform geometry
 // (wheel_radius_m, baseline_m) is measured on the model. truth.yaml: imu.misalignment, scan_matching.lever_arm,
 // scan_matching.misalignment, odometer.radius_left, odometer.radius_right, odometer.baseline (the true geometry, the
-// names the differential_drive estimator model uses when its stream is called odometer). A camera for visual
-// odometry is the model's camera "camera" (looking forward); its stream would be of type visual_odometry.
+// names the differential_drive estimator model uses when its stream is called odometer).
+// visual_odometry (sensors.camera; any wheeled kind whose model has a camera named "camera"): the model's camera
+// rendered offscreen (sim/render.h) and fed to the monocular visual odometry (sim/visual_odometry_stream.h, scale
+// from the camera's height over the floor measured at the start pose): the velocity of the camera frame C (OpenCV:
+// x right, y down, z forward) between consecutive frames, stamped at the middle of the frame pair, with the 21
+// covariance columns and the intrinsics; mounting = the camera's pose in O. Frame k is taken at the first physics
+// step at or after k / rate_hz (a 15 Hz camera on a 1 ms step: pairs of 66 or 67 ms); a failed pair writes no row
+// (simulate prints the counts by reason). store_images: true also writes every frame as a PNG into the recording,
+// listed by a camera stream visual_odometry_images (needs the recording directory: SimulateOptions::
+// image_directory). truth.yaml: visual_odometry.lever_arm, visual_odometry.misalignment.
 //
 // Holonomic robots: `robot.kind: omni3` (models/omni3.xml, Triskar2-like: three omni wheels at 120 deg) and
 // `robot.kind: mecanum` (models/mecanum.xml: four mecanum wheels, X layout), scenarios/indoor_omni_slip.yaml. As the
@@ -178,6 +187,13 @@ struct LaserOptions {
   double sigma_m = 0.01;                  // Gaussian range noise
 };
 
+struct CameraOptions {
+  double rate_hz = 15.0;                  // in [10, 30]
+  int width_px = 320;                     // 320x240 or 640x480
+  int height_px = 240;
+  bool store_images = false;              // PNGs in the recording (visual_odometry_images stream)
+};
+
 struct SensorOptions {
   std::optional<ImuOptions> imu;
   std::optional<MagnetometerOptions> magnetometer;
@@ -185,6 +201,7 @@ struct SensorOptions {
   std::optional<OdometerOptions> odometer;
   std::optional<WheelEncoderOptions> wheel_encoders;
   std::optional<LaserOptions> laser;
+  std::optional<CameraOptions> camera;
 };
 
 struct EffectOptions {

@@ -18,6 +18,7 @@
 #include "sim/sensors.h"
 #include "sim/scan_matcher.h"
 #include "sim/terrain.h"
+#include "sim/visual_odometry_stream.h"
 #include "sim/wheeled_robot.h"
 
 namespace roamlab::sim {
@@ -34,6 +35,8 @@ constexpr double kTerrainMarginM = 2.0;
 // Below this cosine between O's z axis and the world's up the vehicle has rolled over (about 70 deg).
 constexpr double kRolloverCosine = 0.34;
 constexpr double kPi = 3.14159265358979323846;
+// The robot's camera for visual odometry (models/diffdrive.xml).
+constexpr const char* kCameraName = "camera";
 
 std::string OneLine(std::string text) {
   for (char& c : text)
@@ -144,6 +147,11 @@ class Simulator::Impl {
       odom_site_ = wheeled_.odom_site();
       if (scenario_.sensors.laser && wheeled_.laser_site() < 0)
         return Status::Error(model_where_ + ": sensors.laser needs a site 'laser' on the robot");
+      if (scenario_.sensors.camera && IdOf(model_.get(), mjOBJ_CAMERA, kCameraName) < 0)
+        return Status::Error(model_where_ + ": sensors.camera needs a camera '" + std::string(kCameraName) +
+                             "' on the robot");
+      if (scenario_.sensors.camera && scenario_.sensors.camera->store_images && options_.image_directory.empty())
+        return Status::Error(where_ + ": sensors.camera.store_images: no recording directory to store images in");
     }
 
     // Physics step and stream clocks: every period a whole number of steps.
@@ -295,6 +303,9 @@ class Simulator::Impl {
     const long total_steps = static_cast<long>((end_ns_ + lead_in_ns_) / step_ns_);
     long done = 0;
     long next_progress = 0;
+    // End of the lead-in's rest (the robot has settled on its wheels).
+    const std::int64_t camera_start_ns =
+        std::min<std::int64_t>(0, -lead_in_ns_ + std::llround(kLeadInRestFraction * static_cast<double>(lead_in_ns_)));
     for (t_ns_ = -lead_in_ns_; t_ns_ <= end_ns_; t_ns_ += step_ns_) {
       // Driver and low-level control.
       const auto [first, second, third] = SetPoints(t_ns_);
@@ -305,11 +316,21 @@ class Simulator::Impl {
         wheeled_.Apply(first, third, second, d);
       }
 
+      if (scenario_.sensors.camera && camera_ == nullptr && t_ns_ >= camera_start_ns) {
+        mj_forward(m, d);
+        if (Status s = StartCamera(); !s.ok()) return s;
+      }
+
       // Sensors due now, on the state at t completed by forward dynamics.
       if (t_ns_ >= 0 && AnyDue(t_ns_)) {
         mj_forward(m, d);
         mj_rnePostConstraint(m, d);
         if (Status s = Sample(t_ns_); !s.ok()) return s;
+        if (CameraDue(t_ns_)) {
+          const auto frame = camera_->Observe(Time::FromNanoseconds(t_ns_), d);
+          if (!frame.ok()) return frame.status();
+          while (CameraFrameNs(next_camera_frame_) <= t_ns_) ++next_camera_frame_;
+        }
         if (options_.observer) options_.observer(Time::FromNanoseconds(t_ns_), m, d);
       }
       if (t_ns_ == end_ns_) break;
@@ -334,7 +355,38 @@ class Simulator::Impl {
 
   bool AnyDue(std::int64_t t_ns) const {
     return truth_clock_.Due(t_ns) || imu_clock_.Due(t_ns) || mag_clock_.Due(t_ns) || gps_clock_.Due(t_ns) ||
-           odometer_clock_.Due(t_ns) || encoder_clock_.Due(t_ns) || laser_clock_.Due(t_ns);
+           odometer_clock_.Due(t_ns) || encoder_clock_.Due(t_ns) || laser_clock_.Due(t_ns) || CameraDue(t_ns);
+  }
+
+  // Camera frame k is due at the first step at or after k / rate_hz (rounded to the nanosecond, not accumulated):
+  // the schedule VisualOdometryStream::Observe keeps when its first call is at t = 0.
+  std::int64_t CameraFrameNs(std::int64_t k) const {
+    return std::llround(1e9 * static_cast<double>(k) / scenario_.sensors.camera->rate_hz);
+  }
+  bool CameraDue(std::int64_t t_ns) const { return camera_ != nullptr && t_ns >= CameraFrameNs(next_camera_frame_); }
+
+  // The camera and its visual odometry, created once the robot rests on the floor (the end of the lead-in's rest), so
+  // that the camera's height over the floor and its mounting are those of the settled robot. Mounting in O (the
+  // stream's own reference is a body).
+  Status StartCamera() {
+    const CameraOptions& c = *scenario_.sensors.camera;
+    VisualOdometryStreamOptions o;
+    o.camera = kCameraName;
+    o.rate_hz = c.rate_hz;
+    o.render.width_px = c.width_px;
+    o.render.height_px = c.height_px;
+    if (c.store_images) o.image_directory = options_.image_directory;
+    auto stream = VisualOdometryStream::Create(model_.get(), data_.get(), o);
+    if (!stream.ok()) return Status::Error(model_where_ + ": sensors.camera: " + stream.status().message());
+    camera_ = std::move(stream).value();
+    const FrameKinematics odom = ReadSiteKinematics(model_.get(), data_.get(), odom_site_);
+    const CameraPose pose = CameraPoseInWorld(model_.get(), data_.get(), camera_->camera_id());
+    const Eigen::Vector3d p = odom.q_world_body.conjugate() * (pose.p_world_camera_m - odom.p_world_body);
+    camera_mounting_.p_body_sensor = p.unaryExpr([](double x) { return Micrometres(x); });
+    camera_mounting_.q_body_sensor =
+        (odom.q_world_body.conjugate() * Eigen::Quaterniond(pose.R_world_camera)).normalized();
+    out_.stats.camera_height_m = camera_->vo_options().camera_height_m;
+    return Status::Ok();
   }
 
   // Synthesizes every stream due at t_ns from the current (completed) state.
@@ -503,6 +555,16 @@ class Simulator::Impl {
       scan_stream_.info.noise = {{"sigma_mps", sigma.x()}, {"sigma_radps", sigma.y()}};
       rec.streams.push_back(std::move(scan_stream_));
     }
+    if (camera_ != nullptr) {
+      recording::Stream vo = camera_->TakeStream();
+      vo.info.mounting = camera_mounting_;
+      rec.streams.push_back(std::move(vo));
+      if (auto images = camera_->TakeCameraStream()) {
+        images->info.mounting = camera_mounting_;
+        rec.streams.push_back(std::move(*images));
+      }
+      out_.stats.visual_odometry = camera_->counters();
+    }
     rec.ground_truth = std::move(truth_);
 
     // True calibration, named as calibration.json names the estimated parameters.
@@ -531,6 +593,12 @@ class Simulator::Impl {
       cal["scan_matching.lever_arm"] = {s.x(), s.y(), s.z()};
       cal["scan_matching.misalignment"] = {q.w(), q.x(), q.y(), q.z()};
     }
+    if (camera_ != nullptr) {
+      const Eigen::Vector3d& s = camera_mounting_.p_body_sensor;
+      const Eigen::Quaterniond& q = camera_mounting_.q_body_sensor;
+      cal["visual_odometry.lever_arm"] = {s.x(), s.y(), s.z()};
+      cal["visual_odometry.misalignment"] = {q.w(), q.x(), q.y(), q.z()};
+    }
     if (sensors.odometer) {
       cal["odometer.kv_over_L"] = {sensors.odometer->kv_over_L};
       cal["odometer.k_theta"] = {sensors.odometer->k_theta};
@@ -557,6 +625,9 @@ class Simulator::Impl {
   ScanGeometry scan_geometry_;
   recording::Mounting laser_mounting_;
   std::vector<double> previous_scan_;
+  std::unique_ptr<VisualOdometryStream> camera_;
+  recording::Mounting camera_mounting_;
+  std::int64_t next_camera_frame_ = 0;
   Eigen::Vector3d previous_scan_velocity_ = Eigen::Vector3d::Zero();   // (x, y, theta) rates of the last match
   std::vector<std::array<double, 6>> scan_rows_;
   Eigen::Vector2d scan_sigma_sum_ = Eigen::Vector2d::Zero();

@@ -30,6 +30,7 @@
 #include "recording/recording.h"
 #include "recording/truth.h"
 #include "sim/scenario.h"
+#include "sim/visual_odometry.h"
 
 namespace roamlab::sim {
 
@@ -41,6 +42,8 @@ struct SimulateOptions {
   // Called at every sample instant of any stream or of the ground truth, with the state at t completed as in step 4
   // above (sensordata included), before the step that leaves t. For tests and tools that compare with MuJoCo.
   std::function<void(Time t, const mjModel* model, const mjData* data)> observer;
+  // The recording directory, where sensors.camera.store_images writes its PNGs (required when it is set).
+  std::string image_directory;
 };
 
 struct SimulationStats {
@@ -57,6 +60,8 @@ struct SimulationStats {
   double max_wheel_slip_mps = 0.0;      // max |omega_rear r - v_x| of O (wheeled robots: of every driven wheel's
                                         // rim against the ground point below it): longitudinal slip and creep
   int failed_scan_matches = 0;          // scan pairs the scan matcher could not match (no scan_matching sample)
+  std::optional<VoCounters> visual_odometry;   // sensors.camera: frames, pairs, estimates, failures by reason
+  double camera_height_m = 0.0;         // sensors.camera: the floor height the VO uses (measured at rest)
   std::vector<std::string> warnings;    // MuJoCo warnings, if any
 };
 

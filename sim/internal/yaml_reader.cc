@@ -194,6 +194,21 @@ void YamlReader::String(const YAML::Node& map, const std::string& parent_key, co
   *out = node.Scalar();
 }
 
+void YamlReader::Bool(const YAML::Node& map, const std::string& parent_key, const std::string& key, bool* out) {
+  if (!ok() || !map[key]) return;
+  const YAML::Node node = map[key];
+  const std::string full = Join(parent_key, key);
+  Remember(full, node);
+  const std::string text = node.IsScalar() ? node.Scalar() : std::string();
+  if (text == "true") {
+    *out = true;
+  } else if (text == "false") {
+    *out = false;
+  } else {
+    Fail(node, full, "expected true or false, got " + Describe(node));
+  }
+}
+
 void YamlReader::Numbers(const YAML::Node& map, const std::string& parent_key, const std::string& key, int size,
                          std::vector<double>* out) {
   if (!ok() || !map[key]) return;

@@ -44,6 +44,8 @@ class YamlReader {
   void Integer(const YAML::Node& map, const std::string& parent_key, const std::string& key, std::int64_t* out);
   void Unsigned(const YAML::Node& map, const std::string& parent_key, const std::string& key, std::uint64_t* out);
   void String(const YAML::Node& map, const std::string& parent_key, const std::string& key, std::string* out);
+  // YAML's true / false.
+  void Bool(const YAML::Node& map, const std::string& parent_key, const std::string& key, bool* out);
   // A sequence of exactly `size` numbers (any length when size < 0).
   void Numbers(const YAML::Node& map, const std::string& parent_key, const std::string& key, int size,
                std::vector<double>* out);

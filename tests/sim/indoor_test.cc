@@ -16,6 +16,7 @@ Scenario IndoorDiffDrive(double duration_s) {
   EXPECT_TRUE(scenario.ok()) << scenario.status().message();
   Scenario s = scenario.value();
   s.duration_s = duration_s;
+  s.sensors.camera.reset();  // rendering: tests/sim/indoor_camera_test.cc
   return s;
 }
 

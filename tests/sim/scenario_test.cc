@@ -65,6 +65,23 @@ class ScenarioErrorTest : public ::testing::Test {
     auto loaded = LoadScenario(path_);
     return loaded.ok() ? "" : loaded.status().message();
   }
+  // The same with scenarios/indoor_diffdrive_slip.yaml.
+  std::string LoadIndoorWith(const std::string& from, const std::string& to) {
+    std::string text = testing::ReadText(testing::SourcePath("scenarios/indoor_diffdrive_slip.yaml"));
+    for (const std::string file : {"diffdrive.xml", "indoor_room.xml"}) {
+      const std::string relative = "../models/" + file;
+      text.replace(text.find(relative), relative.size(), testing::SourcePath("models/" + file));
+    }
+    const std::size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at == std::string::npos) return "";
+    text.replace(at, from.size(), to);
+    text_ = text;
+    path_ = dir_.File("indoor.yaml");
+    roamlab::testing::WriteFile(path_, text);
+    auto loaded = LoadScenario(path_);
+    return loaded.ok() ? "" : loaded.status().message();
+  }
   // 1-based line of the first occurrence of `marker` in the last written file.
   int LineOf(const std::string& marker) const {
     const std::size_t at = text_.find(marker);
@@ -116,6 +133,22 @@ TEST_F(ScenarioErrorTest, MissingFilesAndKeys) {
   const std::string message = LoadWith("duration_s: 30.0\n", "");
   EXPECT_NE(message.find("duration_s: missing required key"), std::string::npos) << message;
   EXPECT_EQ(LoadScenario(dir_.File("absent.yaml")).status().message(), dir_.File("absent.yaml") + ": cannot open file");
+}
+
+TEST_F(ScenarioErrorTest, CameraSection) {
+  EXPECT_EQ(LoadIndoorWith("    rate_hz: 15\n", "    rate_hz: 15\n    store_images: true\n"), "");
+  ExpectError(LoadIndoorWith("    rate_hz: 15\n", "    rate_hz: 40\n"), "rate_hz: 40", "sensors.camera.rate_hz",
+              "must be in [10, 30]");
+  ExpectError(LoadIndoorWith("    width_px: 320\n", "    width_px: 640\n"), "height_px: 240", "sensors.camera.height_px",
+              "320x240 or 640x480");
+  ExpectError(LoadIndoorWith("    width_px: 320\n", "    width_px: 300\n"), "width_px: 300", "sensors.camera.width_px",
+              "320x240 or 640x480");
+  ExpectError(LoadIndoorWith("    rate_hz: 15\n", "    rate_hz: 15\n    store_images: maybe\n"), "store_images",
+              "sensors.camera.store_images", "expected true or false");
+  ExpectError(LoadIndoorWith("    rate_hz: 15\n", "    rate_hz: 15\n    fps: 15\n"), "fps", "sensors.camera.fps",
+              "unknown key");
+  ExpectError(LoadWith("lever_arm_m: [0.57, -0.46, 0.32]", "lever_arm_m: [0.57, -0.46, 0.32]\n  camera: {}"), "camera: {}", "sensors.camera",
+              "only for wheeled indoor robots");
 }
 
 TEST_F(ScenarioErrorTest, YamlSyntaxErrorsGiveLineAndColumn) {
