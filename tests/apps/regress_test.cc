@@ -29,10 +29,12 @@ namespace fs = std::filesystem;
 std::string Source(const std::string& name) { return std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/" + name; }
 
 // The ATV tracking configuration with the synthetic drive's calibration (seed Table I, tests/support/synthetic.h)
-// and a noise value replaced: tracking with known parameters, whose consistency then depends on the noise levels.
+// and a noise value replaced: tracking with known parameters (no calibration prior), whose consistency then depends
+// on the noise levels.
 std::string TrackingConfig(const std::string& from, const std::string& to) {
   std::string text = testing::ReadFile(Source("atv_tracking.yaml"));
   const std::pair<std::string, std::string> replacements[] = {
+      {"calibration_prior: true", "calibration_prior: false"},
       {"gps.lever_arm: {value: [0, 0, 0]}", "gps.lever_arm: {value: [0.57, -0.46, 0.32]}"},
       {"imu.misalignment: {value: [1, 0, 0, 0]}", "imu.misalignment: {value: [0.938, 0.104, 0.313, 0.104]}"},
       {"magnetometer.A: {value: [1, 0, 0, 0, 1, 0, 0, 0, 1]}",
