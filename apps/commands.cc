@@ -76,10 +76,8 @@ json CountsJson(const std::map<std::string, estimator::StreamCounts>& counts) {
   return j;
 }
 
-}  // namespace
-
-// Parameter values from a calibration.json: parameters.NAME.estimate.
-Result<std::map<std::string, Eigen::VectorXd>> ReadCalibrationValues(const std::string& path) {
+// A JSON file, or one line naming it and the problem.
+Result<json> ReadJsonFile(const std::string& path) {
   std::ifstream in(path);
   if (!in) return Status::Error(path + ": cannot open");
   json j;
@@ -88,6 +86,16 @@ Result<std::map<std::string, Eigen::VectorXd>> ReadCalibrationValues(const std::
   } catch (const json::exception& e) {
     return Status::Error(path + ": not valid JSON: " + e.what());
   }
+  return j;
+}
+
+}  // namespace
+
+// Parameter values from a calibration.json: parameters.NAME.estimate.
+Result<std::map<std::string, Eigen::VectorXd>> ReadCalibrationValues(const std::string& path) {
+  auto file = ReadJsonFile(path);
+  if (!file.ok()) return file.status();
+  json j = std::move(file).value();
   if (!j.contains("parameters") || !j["parameters"].is_object())
     return Status::Error(path + ": missing object 'parameters'");
   std::map<std::string, Eigen::VectorXd> out;
@@ -106,14 +114,9 @@ Result<std::map<std::string, Eigen::VectorXd>> ReadCalibrationValues(const std::
 }
 
 Result<estimator::CalibrationPrior> ReadCalibrationPrior(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return Status::Error(path + ": cannot open");
-  json j;
-  try {
-    in >> j;
-  } catch (const json::exception& e) {
-    return Status::Error(path + ": not valid JSON: " + e.what());
-  }
+  auto file = ReadJsonFile(path);
+  if (!file.ok()) return file.status();
+  json j = std::move(file).value();
   const json& info = j["information"];
   if (!info.is_object() || !info["parameters"].is_array() || !info["matrix"].is_array())
     return Status::Error(path + ": no 'information' with 'parameters' and 'matrix' (calibrate it again)");

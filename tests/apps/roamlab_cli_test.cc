@@ -71,6 +71,11 @@ TEST_F(CliTest, CalibrateAndTrackWriteTheirOutputs) {
   for (const char* key : {"iterations", "initial_cost", "final_cost", "termination", "seconds"})
     EXPECT_TRUE(cal["solver"].contains(key)) << key;
   EXPECT_TRUE(cal.contains("correlations"));
+  // The joint information of the calibrated parameters, for tracking.calibration_prior: one row and column per
+  // tangent dimension of the parameters listed (3 + 3 + 9 + 3 + 1 + 1 + 1 for the ATV configuration).
+  ASSERT_TRUE(cal.contains("information"));
+  EXPECT_EQ(cal["information"]["parameters"].size(), cal["parameters"].size());
+  EXPECT_EQ(cal["information"]["matrix"].size(), 21u);
 
   const std::string track_config = std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/atv_tracking.yaml";
   r = Roamlab("track " + (dir_ / "rec").string() + " --config " + track_config + " --calibration " +
@@ -83,6 +88,22 @@ TEST_F(CliTest, CalibrateAndTrackWriteTheirOutputs) {
   const nlohmann::json summary = nlohmann::json::parse(sin);
   for (const char* key : {"updates", "mean_update_s", "max_update_s", "rejected_measurements"})
     EXPECT_TRUE(summary.contains(key)) << key;
+
+  // The tracking configuration tracks under the calibration's uncertainty: without a calibration, or with one that
+  // lacks the information matrix, it refuses with one line.
+  r = Roamlab("track " + (dir_ / "rec").string() + " --config " + track_config + " --out " + (dir_ / "t2").string(),
+              dir_);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("calibration_prior needs --calibration"), std::string::npos) << r.err;
+  nlohmann::json old = cal;
+  old.erase("information");
+  std::ofstream(dir_ / "old.json") << old.dump();
+  r = Roamlab("track " + (dir_ / "rec").string() + " --config " + track_config + " --calibration " +
+                  (dir_ / "old.json").string() + " --out " + (dir_ / "t3").string(),
+              dir_);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("no 'information'"), std::string::npos) << r.err;
 }
 
 TEST_F(CliTest, BadInputGivesOneLineAndNonZeroExit) {
