@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include "apps/commands.h"
+#include "apps/diagnose.h"
 #include "apps/evaluate.h"
 #include "apps/montecarlo.h"
 #include "apps/regress.h"
@@ -73,6 +74,21 @@ int main(int argc, char** argv) {
   mc->add_option("--out", montecarlo.out, "Output directory: nees.json, runs.json, nees.png")->required();
   mc->add_flag("--quiet", montecarlo.quiet, "No progress bar and no summary");
 
+  roamlab::apps::DiagnoseArgs diagnose;
+  CLI::App* dia = app.add_subcommand(
+      "diagnose", "Reality-gap diagnosis: locate where a recording departs from the nominal model, name the physical "
+                  "effect, fit it and show the held-out fit improve (issue 6).");
+  dia->add_option("--real", diagnose.recording, "Recording directory (its truth.yaml is never read)")->required();
+  dia->add_option("--scenario", diagnose.scenario, "The nominal scenario: the robot as believed")->required();
+  dia->add_option("--config", diagnose.config, "Nominal estimator configuration (default: built from the scenario)");
+  dia->add_option("--out", diagnose.out, "Output directory: gap.json, report.md, scenario_patch.yaml, figures")
+      ->required();
+  dia->add_flag("--no-baseline", diagnose.no_baseline,
+                "Do not simulate the nominal scenario to learn its levels (compare with chi2/dof 1)");
+  dia->add_option("--baseline-seed", diagnose.baseline_seed, "Noise seed of the nominal simulation (default 900001)");
+  dia->add_flag("--no-plots", diagnose.no_plots, "No figures");
+  dia->add_flag("--quiet", diagnose.quiet, "No progress and no summary");
+
   roamlab::apps::RegressArgs regress;
   CLI::App* reg = app.add_subcommand(
       "regress", "Run a regression suite: cases with checks against bounds and baselines; JUnit XML for CI.");
@@ -104,6 +120,7 @@ int main(int argc, char** argv) {
   if (*trk) return roamlab::apps::RunTrack(track);
   if (*evl) return roamlab::apps::RunEvaluate(evaluate);
   if (*mc) return roamlab::apps::RunMonteCarlo(montecarlo);
+  if (*dia) return roamlab::apps::RunDiagnose(diagnose);
   if (*reg) return roamlab::apps::RunRegress(regress);
   return 2;
 }
