@@ -181,10 +181,13 @@ std::vector<LocatedComponent> Locate(const std::vector<estimator::MeasurementRes
       const double upper = lc.expected_chi2_per_dof * ChiSquareQuantile(kQuantile, lc.count) / lc.count;
       lc.inconsistent = lc.chi2_per_dof > std::max(upper, options.inconsistency_ratio * lc.expected_chi2_per_dof);
 
-      // When: windows of window_s, half overlapping, whose chi-square exceeds the level's quantile; overlapping
-      // flagged windows merge into intervals.
+      // When: windows of window_s, half overlapping, whose chi-square exceeds the level's quantile (Bonferroni:
+      // 1 - (1 - kQuantile) / windows, so that a consistent component has no interval with probability kQuantile);
+      // overlapping flagged windows merge into intervals.
       const double t_first = s.t.front().seconds();
       const double t_last = s.t.back().seconds();
+      const double windows = std::max(1.0, std::ceil((t_last - t_first) / (0.5 * options.window_s)));
+      const double window_quantile = 1.0 - (1.0 - kQuantile) / windows;
       std::size_t lo = 0;
       for (double w0 = t_first; w0 < t_last; w0 += 0.5 * options.window_s) {
         const double w1 = w0 + options.window_s;
@@ -194,7 +197,7 @@ std::vector<LocatedComponent> Locate(const std::vector<estimator::MeasurementRes
         for (std::size_t i = lo; i < s.t.size() && s.t[i].seconds() < w1; ++i, ++count) sum += s.r[i] * s.r[i];
         if (count < 5) continue;
         const double threshold =
-            std::max(lc.expected_chi2_per_dof * ChiSquareQuantile(kQuantile, count),
+            std::max(lc.expected_chi2_per_dof * ChiSquareQuantile(window_quantile, count),
                      options.inconsistency_ratio * lc.expected_chi2_per_dof * count);
         if (sum <= threshold) continue;
         if (!lc.intervals.empty() && lc.intervals.back().second >= w0)
@@ -212,14 +215,16 @@ std::vector<LocatedComponent> Locate(const std::vector<estimator::MeasurementRes
             cond[i] = conditions.At(c, Time::FromNanoseconds(s.t[i].nanoseconds() + std::llround(lag_s * 1e9)));
           return Pearson(s.r, cond);
         };
-        // The zero lag unless another lag correlates clearly better (by 0.02: noise would pick a lag at random).
+        // The zero lag unless another lag correlates clearly better: by twice the standard deviation of a
+        // correlation estimate, (1 - rho^2) / sqrt(n) (noise would pick a lag at random otherwise).
         Correlate best{conditions.names[c], rho_at(0.0), 0.0};
-        const double zero_lag = std::abs(best.rho);
+        const double zero_lag =
+            std::abs(best.rho) + 2.0 * (1.0 - best.rho * best.rho) / std::sqrt(static_cast<double>(s.r.size()));
         const int lags = static_cast<int>(std::lround(options.max_lag_s / options.lag_step_s));
         for (int l = -lags; l <= lags; ++l) {
           if (l == 0) continue;
           const double rho = rho_at(l * options.lag_step_s);
-          if (std::abs(rho) > std::max(std::abs(best.rho), zero_lag + 0.02)) best = {conditions.names[c], rho,
+          if (std::abs(rho) > std::max(std::abs(best.rho), zero_lag)) best = {conditions.names[c], rho,
                                                                                       l * options.lag_step_s};
         }
         all.push_back(best);
