@@ -33,14 +33,17 @@ json FitsJson(const std::map<std::string, gap::StreamFit>& fits) {
 }
 
 json EffectJson(const gap::EffectEstimate& e) {
-  json p = json::object(), s = json::object();
+  json p = json::object(), s = json::object(), b = json::object();
   for (const auto& [k, v] : e.parameters) p[k] = Number(v);
+  for (const auto& [k, v] : e.baseline_parameters) b[k] = Number(v);
   for (const auto& [k, v] : e.std) s[k] = Number(v);
   return {{"name", e.name},
           {"parameters", p},
           {"std", s},
+          {"baseline_parameters", b},
           {"dof", e.dof},
           {"lr_statistic", Number(e.lr)},
+          {"chi2_drop", Number(e.lr_raw)},
           {"baseline_lr_statistic", Number(e.baseline_lr)},
           {"lr_pvalue", Number(e.lr_pvalue)},
           {"delta_bic", Number(e.delta_bic)},
@@ -173,12 +176,13 @@ std::string Report(const gap::Diagnosis& d, const std::string& recording, const 
     r << " |\n";
   }
   r << "\n## Candidates (fitted on the first part, up to t = " << Fixed(d.train_end_s, 4)
-    << " s)\n\n| effect | parameters | LR | baseline LR | p | Delta BIC | held-out | decision |\n"
+    << " s)\n\n| effect | parameters | LR | chi2 drop / on baseline | p | Delta BIC | held-out | decision |\n"
        "|---|---|---|---|---|---|---|---|\n";
   for (const gap::EffectEstimate& e : d.candidates) {
     r << "| " << e.name << " | ";
     for (const auto& [k, v] : e.parameters) r << k << " = " << Fixed(v, 4) << " ";
-    r << "| " << Fixed(e.lr, 4) << " | " << Fixed(e.baseline_lr, 4) << " | " << Fixed(e.lr_pvalue, 3) << " | "
+    r << "| " << Fixed(e.lr, 4) << " | " << Fixed(e.lr_raw, 4) << " / " << Fixed(e.baseline_lr, 4) << " | "
+      << Fixed(e.lr_pvalue, 3) << " | "
       << Fixed(e.delta_bic, 4) << " | "
       << (e.evaluated_heldout ? Fixed(100.0 * e.heldout_improvement, 3) + " %" : std::string("-")) << " | "
       << e.decision << " |\n";

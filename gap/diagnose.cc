@@ -269,34 +269,42 @@ struct CandidateFit {
 double Neutral(const std::string& parameter) { return parameter.rfind("scale_", 0) == 0 ? 1.0 : 0.0; }
 
 // The likelihood-ratio test and BIC of a fitted candidate, and its parameters relative to the baseline.
-// Without a baseline: LR ~ chi2(k). With one, the nominal model's own structure gives the candidate a drop LR_0 on
-// the nominal simulation; under "no effect" LR and LR_0 are two draws of a non-central chi2(k, lambda) with lambda
-// about LR_0 - k, of variance 2 (k + 2 lambda) each, so the excess LR - LR_0 is compared with its normal
-// approximation. The parameters are reported as departures from the baseline's fit (the value the nominal model
-// reaches on MuJoCo data without any effect, e.g. half an IMU period of timing from eq. 11's zero-order hold) plus the
-// neutral value, their variances added.
+// Without a baseline the null hypothesis is the nominal model (parameters at their neutral values): LR = the chi2 drop
+// ~ chi2(k). With one, the nominal model's own structure already moves the candidate's parameters on MuJoCo data
+// without any effect (e.g. half an IMU period of timing from eq. 11's zero-order hold, a cornering compliance from the
+// tires): the null hypothesis is then "the parameters take the baseline's values theta_0", and LR is its quadratic
+// (Wald) form about the fit, sum ((theta - theta_0)^2 / (sigma^2 + sigma_0^2)) with both fits' standard deviations,
+// ~ chi2(k). A theta_0 within 2 sigma_0 of neutral is taken as neutral (sigma_0 = 0): the baseline shows no
+// structure there, and one noisy draw would only blur the test. The parameters are reported as departures from
+// theta_0 plus the neutral value, variances added.
 void Score(const Baseline* baseline, int measurements, EffectEstimate* e) {
   const double k = e->dof;
-  double excess = e->lr;
-  if (baseline && baseline->candidate_lr.count(e->name)) {
-    e->baseline_lr = baseline->candidate_lr.at(e->name);
-    excess = e->lr - e->baseline_lr;
-    const double lambda = std::max(0.0, e->baseline_lr - k);
-    const double sd = std::sqrt(2.0 * 2.0 * (k + 2.0 * lambda));
-    e->lr_pvalue = 0.5 * std::erfc(excess / sd / std::sqrt(2.0));
-    const auto base = baseline->candidate_parameters.find(e->name);
-    if (base != baseline->candidate_parameters.end()) {
-      for (auto& [name, value] : e->parameters) {
-        if (!base->second.count(name)) continue;
-        e->baseline_parameters[name] = base->second.at(name).first;
-        value = value - base->second.at(name).first + Neutral(name);
-        if (e->std.count(name)) e->std[name] = std::hypot(e->std[name], base->second.at(name).second);
+  e->lr = e->lr_raw;
+  const auto base = baseline ? baseline->candidate_parameters.find(e->name)
+                             : std::map<std::string, std::map<std::string, std::pair<double, double>>>::const_iterator();
+  if (baseline && base != baseline->candidate_parameters.end()) {
+    if (baseline->candidate_lr.count(e->name)) e->baseline_lr = baseline->candidate_lr.at(e->name);
+    double wald = 0.0;
+    bool finite = true;
+    for (auto& [name, value] : e->parameters) {
+      if (!base->second.count(name)) continue;
+      auto [theta0, sigma0] = base->second.at(name);
+      e->baseline_parameters[name] = theta0;
+      // A baseline value within two of its standard deviations of neutral shows no structure: the null is neutral.
+      if (!(std::abs(theta0 - Neutral(name)) > 2.0 * sigma0)) {
+        theta0 = Neutral(name);
+        sigma0 = 0.0;
       }
+      value = value - theta0 + Neutral(name);
+      const double sigma = e->std.count(name) ? std::hypot(e->std.at(name), sigma0) : NAN;
+      e->std[name] = sigma;
+      finite = finite && std::isfinite(sigma) && sigma > 0.0;
+      if (finite) wald += std::pow((value - Neutral(name)) / sigma, 2);
     }
-  } else {
-    e->lr_pvalue = e->lr > 0.0 ? 1.0 - ChiSquareCdf(e->lr, k) : 1.0;
+    e->lr = finite ? wald : 0.0;
   }
-  e->delta_bic = -excess + k * std::log(std::max(2, measurements));
+  e->lr_pvalue = e->lr > 0.0 ? 1.0 - ChiSquareCdf(e->lr, k) : 1.0;
+  e->delta_bic = -e->lr + k * std::log(std::max(2, measurements));
 }
 
 }  // namespace
@@ -404,7 +412,7 @@ Baseline BaselineFrom(const Diagnosis& nominal_simulation) {
   b.component_levels = ComponentLevels(nominal_simulation.residuals);
   b.streams = nominal_simulation.whole_run;
   for (const EffectEstimate& e : nominal_simulation.candidates) {
-    b.candidate_lr[e.name] = e.lr;
+    b.candidate_lr[e.name] = e.lr_raw;
     for (const auto& [name, value] : e.parameters)
       b.candidate_parameters[e.name][name] = {value, e.std.count(name) ? e.std.at(name) : 0.0};
   }
@@ -532,7 +540,7 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
       ++out.fits;
       if (!fit.ok()) return fit.status();
       c.describe(fit.value().values, fit.value().std, &e);
-      e.lr = base.train_chi2 - fit.value().chi2;
+      e.lr_raw = base.train_chi2 - fit.value().chi2;
       cf.next.extra_free = spec.extra_free;
       cf.next.train_values = fit.value().values;
       cf.next.train_trajectory = fit.value().trajectory;
@@ -580,30 +588,48 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
       }
       if (chi2_at[k].chi2 < chi2_at[best].chi2) best = k;
     }
-    for (int k : {best - 1, best + 1}) {
+    // The chi-square on the grid is not smooth: moving a stream by one sample re-pairs its noise with the other
+    // streams', which adds a jitter of tens to the chi-square of a 20 s drive (measured on the ATV's IMU). So a
+    // parabola chi2(k) = a k^2 + b k + c is fitted by least squares to the best point and kHalfWindow points each
+    // side, and the standard deviation of its vertex combines the curvature's (1 / sqrt(a) grid steps: cost = chi2 / 2
+    // has second derivative a) and the vertex's own spread from the jitter (delta method on the fitted a, b).
+    constexpr int kHalfWindow = 3;
+    std::vector<int> ks;
+    for (int k = best - kHalfWindow; k <= best + kHalfWindow; ++k) {
       if (std::abs(k) > k_max) continue;
       if (auto f = at(k); !f.ok()) return f.status();
+      ks.push_back(k);
     }
-    const double f0 = chi2_at[best].chi2;
     double k_hat = best;
-    double chi2_min = f0;
+    double chi2_min = chi2_at[best].chi2;
     double stdev = std::numeric_limits<double>::quiet_NaN();
-    if (chi2_at.count(best - 1) && chi2_at.count(best + 1)) {
-      const double fm = chi2_at[best - 1].chi2, fp = chi2_at[best + 1].chi2;
-      const double curvature = fm + fp - 2.0 * f0;      // chi2'' * period^2
-      if (curvature > 0.0) {
-        const double delta = std::clamp(0.5 * (fm - fp) / curvature, -0.5, 0.5);
-        k_hat = best + delta;
-        chi2_min = f0 - 0.25 * (fm - fp) * delta;
-        // cost = chi2 / 2 has second derivative curvature / (2 period^2) * 2 / 2: the Fisher information of the
-        // shift is chi2'' / 2 = curvature / (2 period^2).
-        stdev = period * std::sqrt(2.0 / curvature);
+    if (ks.size() >= 4) {
+      Eigen::MatrixXd X(static_cast<Eigen::Index>(ks.size()), 3);
+      Eigen::VectorXd y(static_cast<Eigen::Index>(ks.size()));
+      for (std::size_t i = 0; i < ks.size(); ++i) {
+        const double u = ks[i] - best;
+        X.row(static_cast<Eigen::Index>(i)) << u * u, u, 1.0;
+        y[static_cast<Eigen::Index>(i)] = chi2_at[ks[i]].chi2;
+      }
+      const Eigen::Matrix3d XtX_inv = (X.transpose() * X).inverse();
+      const Eigen::Vector3d abc = XtX_inv * X.transpose() * y;
+      const double a = abc[0], b = abc[1], cc = abc[2];
+      if (a > 0.0) {
+        const double u_hat = std::clamp(-b / (2.0 * a), -static_cast<double>(kHalfWindow),
+                                        static_cast<double>(kHalfWindow));
+        k_hat = best + u_hat;
+        chi2_min = a * u_hat * u_hat + b * u_hat + cc;
+        const double dof = static_cast<double>(ks.size()) - 3.0;
+        const double jitter2 = dof > 0.0 ? (y - X * abc).squaredNorm() / dof : 0.0;
+        const Eigen::Vector3d J(b / (2.0 * a * a), -1.0 / (2.0 * a), 0.0);
+        const double vertex_var = jitter2 * J.dot(XtX_inv * J);
+        stdev = period * std::sqrt(1.0 / a + vertex_var);
       }
     }
     const double shift = k_hat * period;
     e.parameters[c.shift_parameter] = shift;
     e.std[c.shift_parameter] = stdev;
-    e.lr = base.train_chi2 - chi2_min;
+    e.lr_raw = base.train_chi2 - chi2_min;
     for (const std::string& s : c.shifted) cf.next.shift_s[s] = shift;
     cf.next.train_values = chi2_at[best].values;
     cf.next.train_trajectory = chi2_at[best].trajectory;

@@ -9,14 +9,14 @@
 //   3. name: every candidate effect of the library is fitted on the first `train_fraction` of the recording with the
 //      full solver (all calibration parameters free, warm-started at the nominal fit): a parameter slot freed in an
 //      error model, or a time shift of a stream found by a 1-D search on the master period's grid with a parabola
-//      through the three best points (its curvature gives the standard deviation). Statistic: the chi-square drop
-//      LR = chi2_nominal - chi2_effect ~ chi2(k) under the nominal model (cost = chi2 / 2, estimator/solver.h). The
-//      nominal model is not exact on MuJoCo data, so the drop a candidate achieves on the nominal simulation
-//      (Baseline::candidate_lr) is subtracted and the excess divided by the dispersion phi (the baseline chi2/dof of
-//      the candidate's stream, at least 1): p = 1 - F_chi2(k)((LR - LR_0) / phi); Delta BIC = -(LR - LR_0) / phi +
-//      k ln n. The best candidate is kept when p < alpha, Delta BIC < 0 and the held-out chi-square (the last part of
-//      the recording, every parameter fixed at the training values) drops. Then the others are scored again on top,
-//      up to max_effects;
+//      through the three best points (its curvature gives the standard deviation). Statistic: without a baseline the
+//      chi-square drop LR = chi2_nominal - chi2_effect ~ chi2(k) (cost = chi2 / 2, estimator/solver.h); with one, the
+//      nominal model is not exact on MuJoCo data and already moves each candidate's parameters on the nominal
+//      simulation, so H0 is "the parameters take the baseline's values" and LR is its Wald form with both fits'
+//      variances (Score in diagnose.cc). p = 1 - F_chi2(k)(LR), Delta BIC = -LR + k ln n. The best candidate (lowest
+//      Delta BIC) is kept when p < alpha, Delta BIC < 0 and the held-out chi-square (the last part of the recording,
+//      every parameter fixed at the training values) drops. Then the others are scored again on top, up to
+//      max_effects;
 //   4. model: the accepted effects' parameters and standard deviations (training fit);
 //   5. show: per-stream whitened RMS and chi2/dof on the held-out part before (nominal) and after (with the effects).
 // Verdict: "named" (some effect kept), "unknown" (no effect kept but some component stays inconsistent: its
@@ -45,8 +45,9 @@ struct EffectEstimate {
   std::map<std::string, double> parameters;     // names as the simulator's effects (sim/scenario.h)
   std::map<std::string, double> std;
   std::map<std::string, double> baseline_parameters;   // the raw fit on the nominal simulation, subtracted
-  double lr = 0.0;                              // chi2 drop on the training part
+  double lr_raw = 0.0;                          // chi2 drop on the training part against the nominal model
   double baseline_lr = 0.0;                     // the same candidate's drop on the nominal simulation
+  double lr = 0.0;                              // the test statistic (Score in diagnose.cc), ~ chi2(dof) under H0
   double lr_pvalue = 1.0;
   double delta_bic = 0.0;                       // < 0 favours the effect
   double heldout_improvement = 0.0;             // relative drop of the held-out chi2 (0.1 = 10 % lower)

@@ -98,12 +98,16 @@ TEST_F(EffectsTest, ImuTimeOffsetStampsReadingsAheadAndTheMagnetometerFollows) {
     ASSERT_EQ(a.values.rows(), b.values.rows());
     ASSERT_EQ(a.values.rows(), c.values.rows());    // samples taken after the end: the physics runs on
     for (Eigen::Index k = 0; k + 3 < a.values.rows(); ++k) {
-      if (k >= 2) EXPECT_NEAR((b.values.row(k) - a.values.row(k - 2)).norm(), 0.0, 1e-9) << name << " " << k;
+      if (k >= 2) {
+        EXPECT_NEAR((b.values.row(k) - a.values.row(k - 2)).norm(), 0.0, 1e-9) << name << " " << k;
+      }
       EXPECT_NEAR((c.values.row(k) - a.values.row(k + 3)).norm(), 0.0, 1e-9) << name << " " << k;
     }
   }
-  // Ground truth and the other streams keep their clock.
-  EXPECT_EQ(StreamOf(late, "rear_wheel").values, StreamOf(*nominal_, "rear_wheel").values);
+  // The other streams keep their clock. (Samples taken during the lead-in add state evaluations, mj_forward, that
+  // can change the physics at round-off level.)
+  EXPECT_LT((StreamOf(late, "rear_wheel").values - StreamOf(*nominal_, "rear_wheel").values).cwiseAbs().maxCoeff(),
+            1e-9);
 }
 
 TEST_F(EffectsTest, MagnetometerInterferenceIsABiasAlongItsDirectionThatFollowsTheTorque) {
