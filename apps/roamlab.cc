@@ -7,6 +7,7 @@
 #include "apps/commands.h"
 #include "apps/diagnose.h"
 #include "apps/evaluate.h"
+#include "apps/gap_benchmark.h"
 #include "apps/montecarlo.h"
 #include "apps/regress.h"
 #include "apps/simulate.h"
@@ -89,6 +90,16 @@ int main(int argc, char** argv) {
   dia->add_flag("--no-plots", diagnose.no_plots, "No figures");
   dia->add_flag("--quiet", diagnose.quiet, "No progress and no summary");
 
+  roamlab::apps::GapBenchmarkArgs benchmark;
+  CLI::App* gbm = app.add_subcommand(
+      "gap-benchmark", "Blind benchmark of the diagnosis: hidden effects (or none, or a decoy) drawn, simulated, "
+                       "diagnosed, then scored against truth.yaml.");
+  gbm->add_option("--cases", benchmark.cases, "Number of cases (default 5)");
+  gbm->add_option("--seed", benchmark.seed, "Seed of the draws; case i uses noise seed SEED * 1000 + i (default 1)");
+  gbm->add_option("--scenario", benchmark.scenario, "The nominal scenario (an Ackermann robot)")->required();
+  gbm->add_option("--out", benchmark.out, "Output directory: score.json, cases/NNN/rec")->required();
+  gbm->add_flag("--quiet", benchmark.quiet, "No progress");
+
   roamlab::apps::RegressArgs regress;
   CLI::App* reg = app.add_subcommand(
       "regress", "Run a regression suite: cases with checks against bounds and baselines; JUnit XML for CI.");
@@ -121,6 +132,7 @@ int main(int argc, char** argv) {
   if (*evl) return roamlab::apps::RunEvaluate(evaluate);
   if (*mc) return roamlab::apps::RunMonteCarlo(montecarlo);
   if (*dia) return roamlab::apps::RunDiagnose(diagnose);
+  if (*gbm) return roamlab::apps::RunGapBenchmark(benchmark);
   if (*reg) return roamlab::apps::RunRegress(regress);
   return 2;
 }

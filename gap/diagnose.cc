@@ -274,9 +274,9 @@ double Neutral(const std::string& parameter) { return parameter.rfind("scale_", 
 // without any effect (e.g. half an IMU period of timing from eq. 11's zero-order hold, a cornering compliance from the
 // tires): the null hypothesis is then "the parameters take the baseline's values theta_0", and LR is its quadratic
 // (Wald) form about the fit, sum ((theta - theta_0)^2 / (sigma^2 + sigma_0^2)) with both fits' standard deviations,
-// ~ chi2(k). A theta_0 within 2 sigma_0 of neutral is taken as neutral (sigma_0 = 0): the baseline shows no
-// structure there, and one noisy draw would only blur the test. The parameters are reported as departures from
-// theta_0 plus the neutral value, variances added.
+// ~ chi2(k); a theta_0 within 2 sigma_0 of neutral shows no structure, and the test is then against neutral with
+// the fit's own variance (one noisy draw of nothing would only blur it). The parameters are always reported as
+// departures from theta_0 plus the neutral value, both variances added (so that the reported std covers the error).
 void Score(const Baseline* baseline, int measurements, EffectEstimate* e) {
   const double k = e->dof;
   e->lr = e->lr_raw;
@@ -288,18 +288,20 @@ void Score(const Baseline* baseline, int measurements, EffectEstimate* e) {
     bool finite = true;
     for (auto& [name, value] : e->parameters) {
       if (!base->second.count(name)) continue;
-      auto [theta0, sigma0] = base->second.at(name);
+      const auto [theta0, sigma0] = base->second.at(name);
       e->baseline_parameters[name] = theta0;
-      // A baseline value within two of its standard deviations of neutral shows no structure: the null is neutral.
-      if (!(std::abs(theta0 - Neutral(name)) > 2.0 * sigma0)) {
-        theta0 = Neutral(name);
-        sigma0 = 0.0;
-      }
-      value = value - theta0 + Neutral(name);
-      const double sigma = e->std.count(name) ? std::hypot(e->std.at(name), sigma0) : NAN;
-      e->std[name] = sigma;
+      const double raw = value;
+      const double raw_sigma = e->std.count(name) ? e->std.at(name) : NAN;
+      // Reported: the departure from the baseline, both variances.
+      value = raw - theta0 + Neutral(name);
+      e->std[name] = std::hypot(raw_sigma, sigma0);
+      // Tested: against theta_0 when the baseline shows structure (beyond 2 sigma_0 from neutral), else against
+      // neutral with the fit's own variance (one noisy draw of nothing would only blur the test).
+      const bool structure = std::abs(theta0 - Neutral(name)) > 2.0 * sigma0;
+      const double null = structure ? theta0 : Neutral(name);
+      const double sigma = structure ? std::hypot(raw_sigma, sigma0) : raw_sigma;
       finite = finite && std::isfinite(sigma) && sigma > 0.0;
-      if (finite) wald += std::pow((value - Neutral(name)) / sigma, 2);
+      if (finite) wald += std::pow((raw - null) / sigma, 2);
     }
     e->lr = finite ? wald : 0.0;
   }
