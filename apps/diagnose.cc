@@ -111,7 +111,7 @@ std::vector<std::string> WritePlots(const gap::Diagnosis& d, const std::string& 
       data << d.conditions.At(ci, t) << " " << r.whitened[lc->component] << "\n";
     }
     std::ofstream gp(dir + "/residual_vs_condition.gp");
-    gp << "set terminal pngcairo size 800,500\nset output 'residual_vs_condition.png'\n"
+    gp << "set terminal pngcairo size 800,500 noenhanced\nset output 'residual_vs_condition.png'\n"
        << "set title \"" << lc->stream << "[" << lc->component << "]: chi2/dof " << Fixed(lc->chi2_per_dof, 3)
        << " (nominal " << Fixed(lc->expected_chi2_per_dof, 3) << "), rho " << Fixed(c.rho, 2) << "\"\n"
        << "set xlabel '" << c.condition << " at t + " << c.lag_s << " s'\nset ylabel 'whitened residual'\n"
@@ -128,9 +128,9 @@ std::vector<std::string> WritePlots(const gap::Diagnosis& d, const std::string& 
            << (after != d.after.end() ? after->second.chi2_per_dof : before.chi2_per_dof) << "\n";
     }
     std::ofstream gp(dir + "/heldout_fit.gp");
-    gp << "set terminal pngcairo size 800,450\nset output 'heldout_fit.png'\n"
+    gp << "set terminal pngcairo size 800,450 noenhanced\nset output 'heldout_fit.png'\n"
        << "set title 'held-out part (after t = " << Fixed(d.train_end_s, 4) << " s): chi2/dof per stream'\n"
-       << "set style data histograms\nset style fill solid 0.8\nset logscale y\nset grid y\nset ylabel 'chi2/dof'\n"
+       << "set style data histograms\nset style fill solid 0.8\nset yrange [0:*]\nset grid y\nset ylabel 'chi2/dof'\n"
        << "plot 'heldout_fit.dat' using 2:xtic(1) title 'nominal', '' using 3 title 'with the accepted effects'\n";
     gp.close();
     if (eval::RunGnuplot(dir, "heldout_fit.gp").ok()) images.push_back("heldout_fit.png");
@@ -259,12 +259,15 @@ int RunDiagnose(const DiagnoseArgs& args) {
   if (recording.platform.kind != scenario.value().robot.kind)
     return bad(args.recording + ": platform kind '" + recording.platform.kind + "' does not match the robot kind '" +
                scenario.value().robot.kind + "' of " + args.scenario);
-  auto config = args.config.empty() ? gap::NominalConfig(scenario.value()) : estimator::LoadEstimatorConfig(args.config);
-  if (!config.ok()) return bad((args.config.empty() ? args.scenario + ": " : std::string()) + config.status().message());
+  auto config =
+      args.config.empty() ? gap::NominalConfig(scenario.value()) : estimator::LoadEstimatorConfig(args.config);
+  if (!config.ok())
+    return bad((args.config.empty() ? args.scenario + ": " : std::string()) + config.status().message());
   for (const auto& [name, stream] : config.value().streams)
     for (const auto& [role, source] : stream.sources)
       if (!recording.Find(source))
-        return bad(args.recording + ": no stream '" + source + "' (the nominal model's stream '" + name + "' reads it)");
+        return bad(args.recording + ": no stream '" + source + "' (the nominal model's stream '" + name +
+                   "' reads it)");
   std::error_code ec;
   std::filesystem::create_directories(args.out, ec);
   if (ec) return bad(args.out + ": cannot create the output directory: " + ec.message());
@@ -332,8 +335,8 @@ int RunDiagnose(const DiagnoseArgs& args) {
   std::string note;
   const std::vector<std::string> images = args.no_plots ? std::vector<std::string>{} : WritePlots(d, args.out, &note);
   if (!note.empty()) say(note);
-  if (Status s = WriteText(args.out + "/report.md", Report(d, args.recording, args.scenario, !args.no_baseline, images));
-      !s.ok())
+  const std::string report = Report(d, args.recording, args.scenario, !args.no_baseline, images);
+  if (Status s = WriteText(args.out + "/report.md", report); !s.ok())
     return fail(s.message());
   std::string summary = "verdict: " + d.verdict;
   for (const gap::EffectEstimate& e : d.effects) {

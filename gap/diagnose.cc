@@ -280,9 +280,8 @@ double Neutral(const std::string& parameter) { return parameter.rfind("scale_", 
 void Score(const Baseline* baseline, int measurements, EffectEstimate* e) {
   const double k = e->dof;
   e->lr = e->lr_raw;
-  const auto base = baseline ? baseline->candidate_parameters.find(e->name)
-                             : std::map<std::string, std::map<std::string, std::pair<double, double>>>::const_iterator();
-  if (baseline && base != baseline->candidate_parameters.end()) {
+  if (baseline && baseline->candidate_parameters.count(e->name)) {
+    const auto base = baseline->candidate_parameters.find(e->name);
     if (baseline->candidate_lr.count(e->name)) e->baseline_lr = baseline->candidate_lr.at(e->name);
     double wald = 0.0;
     bool finite = true;

@@ -486,7 +486,8 @@ std::optional<Scenario::Problem> Scenario::Validate() const {
     if (e.name == "gps_latency" && !sensors.gps) return P{k + ".name", "gps_latency needs sensors.gps"};
     if ((e.name == "imu_time_offset" || e.name == "gyro_scale_error") && !sensors.imu)
       return P{k + ".name", e.name + " needs sensors.imu"};
-    if (e.name == "steering_offset" && !sensors.odometer) return P{k + ".name", "steering_offset needs sensors.odometer"};
+    if (e.name == "steering_offset" && !sensors.odometer)
+      return P{k + ".name", "steering_offset needs sensors.odometer"};
     if (e.name == "magnetometer_motor_interference" && !sensors.magnetometer)
       return P{k + ".name", e.name + " needs sensors.magnetometer"};
   }

@@ -54,8 +54,9 @@ TEST(DiagnoseCliTest, NeverOpensTruthYamlAndWritesGapJson) {
   ASSERT_EQ(Roamlab("simulate " + scenario + " --out " + dir.File("rec") + " --quiet", dir).exit_code, 0);
   // What a reader of truth.yaml would refuse (and what would give the effect away).
   testing::WriteFile(dir.File("rec/truth.yaml"), "{{{ not yaml: [steering_offset");
-  const CommandRun run = Roamlab("diagnose --real " + dir.File("rec") + " --scenario " + Source("scenarios/atv_hills.yaml") +
-                                     " --out " + dir.File("out") + " --no-baseline --no-plots --quiet",
+  const CommandRun run = Roamlab("diagnose --real " + dir.File("rec") + " --scenario " +
+                                     Source("scenarios/atv_hills.yaml") + " --out " + dir.File("out") +
+                                     " --no-baseline --no-plots --quiet",
                                  dir);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   std::ifstream in(dir.File("out/gap.json"));
