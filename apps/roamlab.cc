@@ -5,7 +5,9 @@
 #include <CLI/CLI.hpp>
 
 #include "apps/commands.h"
+#include "apps/diagnose.h"
 #include "apps/evaluate.h"
+#include "apps/gap_benchmark.h"
 #include "apps/import.h"
 #include "apps/montecarlo.h"
 #include "apps/regress.h"
@@ -74,6 +76,31 @@ int main(int argc, char** argv) {
   mc->add_option("--t0", montecarlo.t0_s, "Leave the first T0 seconds out of fraction_in_band (default 2)");
   mc->add_option("--out", montecarlo.out, "Output directory: nees.json, runs.json, nees.png")->required();
   mc->add_flag("--quiet", montecarlo.quiet, "No progress bar and no summary");
+
+  roamlab::apps::DiagnoseArgs diagnose;
+  CLI::App* dia = app.add_subcommand(
+      "diagnose", "Reality-gap diagnosis: locate where a recording departs from the nominal model, name the physical "
+                  "effect, fit it and show the held-out fit improve (issue 6).");
+  dia->add_option("--real", diagnose.recording, "Recording directory (its truth.yaml is never read)")->required();
+  dia->add_option("--scenario", diagnose.scenario, "The nominal scenario: the robot as believed")->required();
+  dia->add_option("--config", diagnose.config, "Nominal estimator configuration (default: built from the scenario)");
+  dia->add_option("--out", diagnose.out, "Output directory: gap.json, report.md, scenario_patch.yaml, figures")
+      ->required();
+  dia->add_flag("--no-baseline", diagnose.no_baseline,
+                "Do not simulate the nominal scenario to learn its levels (compare with chi2/dof 1)");
+  dia->add_option("--baseline-seed", diagnose.baseline_seed, "Noise seed of the nominal simulation (default 900001)");
+  dia->add_flag("--no-plots", diagnose.no_plots, "No figures");
+  dia->add_flag("--quiet", diagnose.quiet, "No progress and no summary");
+
+  roamlab::apps::GapBenchmarkArgs benchmark;
+  CLI::App* gbm = app.add_subcommand(
+      "gap-benchmark", "Blind benchmark of the diagnosis: hidden effects (or none, or a decoy) drawn, simulated, "
+                       "diagnosed, then scored against truth.yaml.");
+  gbm->add_option("--cases", benchmark.cases, "Number of cases (default 5)");
+  gbm->add_option("--seed", benchmark.seed, "Seed of the draws; case i uses noise seed SEED * 1000 + i (default 1)");
+  gbm->add_option("--scenario", benchmark.scenario, "The nominal scenario (an Ackermann robot)")->required();
+  gbm->add_option("--out", benchmark.out, "Output directory: score.json, cases/NNN/rec")->required();
+  gbm->add_flag("--quiet", benchmark.quiet, "No progress");
 
   roamlab::apps::RegressArgs regress;
   CLI::App* reg = app.add_subcommand(
@@ -148,6 +175,8 @@ int main(int argc, char** argv) {
   if (*trk) return roamlab::apps::RunTrack(track);
   if (*evl) return roamlab::apps::RunEvaluate(evaluate);
   if (*mc) return roamlab::apps::RunMonteCarlo(montecarlo);
+  if (*dia) return roamlab::apps::RunDiagnose(diagnose);
+  if (*gbm) return roamlab::apps::RunGapBenchmark(benchmark);
   if (*reg) return roamlab::apps::RunRegress(regress);
   if (*odo_learn) return roamlab::apps::RunOdometryLearn(learn);
   if (*odo_evaluate) return roamlab::apps::RunOdometryEvaluate(odo_eval);

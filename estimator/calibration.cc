@@ -1,7 +1,9 @@
 #include "estimator/calibration.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <sstream>
 
@@ -65,12 +67,27 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
   for (const MeasurementRef& m : builder.Measurements()) builder.Add(m);
   builder.Finish();
   if (builder.poses().size() < 3) return Status::Error("the recording gives fewer than 3 poses on the master stream");
-  builder.AlignToAbsoluteFixes();
-  if (const auto q = builder.AlignImuToMotion()) {
-    std::ostringstream line;
-    line << "initial IMU misalignment from the motion (Wahba): [" << q->w() << ", " << q->x() << ", " << q->y() << ", "
-         << q->z() << "]";
-    say(line.str());
+  if (options.initial_trajectory && !options.initial_trajectory->empty()) {
+    const Trajectory& initial = *options.initial_trajectory;
+    for (const PoseNode& node : builder.poses()) {
+      auto it = std::lower_bound(initial.begin(), initial.end(), node.t,
+                                 [](const StampedPose& p, Time t) { return p.t < t; });
+      if (it == initial.end()) --it;
+      if (it != initial.begin() && node.t.nanoseconds() - std::prev(it)->t.nanoseconds() <
+                                       it->t.nanoseconds() - node.t.nanoseconds())
+        --it;
+      PoseToArray(Pose<double>{it->p_world_body, it->q_world_body},
+                  builder.graph().mutable_variable(node.id).value.data());
+    }
+    say("initial poses from the given trajectory");
+  } else {
+    builder.AlignToAbsoluteFixes();
+    if (const auto q = builder.AlignImuToMotion()) {
+      std::ostringstream line;
+      line << "initial IMU misalignment from the motion (Wahba): [" << q->w() << ", " << q->x() << ", " << q->y()
+           << ", " << q->z() << "]";
+      say(line.str());
+    }
   }
   say("graph: " + std::to_string(builder.poses().size()) + " poses, " +
       std::to_string(builder.graph().factors().size()) + " factors");
@@ -127,7 +144,7 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
   }
   ObservabilityAnalysis analysis;
   std::vector<int> offsets;
-  if (!ids.empty()) {
+  if (!ids.empty() && options.analyze_observability) {
     auto info = ComputeMarginalInformation(builder.graph(), ids);
     if (!info.ok()) return info.status();
     analysis = AnalyzeObservability(info.value().information, info.value().conditional, options.observability);
@@ -141,6 +158,12 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
     p.manifold = v.manifold;
     p.estimate = v.value;
     const int dim = v.manifold.tangent_dim();
+    if (!options.analyze_observability) {
+      p.std = Eigen::VectorXd::Constant(dim, std::numeric_limits<double>::quiet_NaN());
+      p.components.assign(dim, Observability::kObservable);
+      result.parameters.push_back(std::move(p));
+      continue;
+    }
     p.std = analysis.std.segment(offsets[i], dim);
     for (int c = 0; c < dim; ++c) {
       const Observability o = analysis.observability[offsets[i] + c];
@@ -149,7 +172,7 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
     }
     result.parameters.push_back(std::move(p));
   }
-  for (std::size_t i = 0; i < ids.size(); ++i) {
+  for (std::size_t i = 0; i < ids.size() && options.analyze_observability; ++i) {
     for (std::size_t j = i + 1; j < ids.size(); ++j) {
       double best = 0.0;
       const int di = builder.graph().variable(ids[i]).manifold.tangent_dim();
@@ -160,6 +183,19 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
           if (std::abs(rho) > std::abs(best)) best = rho;
         }
       if (std::abs(best) >= options.correlation_threshold) result.correlations.push_back({names[i], names[j], best});
+    }
+  }
+  if (options.keep_residuals) {
+    for (const auto& [id, entry] : builder.graph().factors()) {
+      if (builder.StreamOfFactor(id) < 0) continue;
+      internal::WhitenedFactor wf;
+      const bool ok =
+          internal::LinearizeFactor(builder.graph(), entry, std::vector<bool>(entry.variables.size(), false), &wf);
+      if (!ok) continue;
+      // Undo the loss weighting: sqrt(s) along the weighted residual's direction.
+      Eigen::VectorXd whitened = wf.residual;
+      if (whitened.norm() > 0.0) whitened *= std::sqrt(wf.squared_norm) / whitened.norm();
+      result.residuals.push_back({entry.stream, entry.stamp, whitened, entry.active});
     }
   }
   result.counts = builder.counts();

@@ -40,6 +40,15 @@ struct StageSummary {
   int rejected = 0;  // measurements gated out after this stage
 };
 
+// The whitened error of one measurement at the final estimate (L^-1 e, eq. 1's covariance, before any robust loss):
+// what the reality-gap diagnosis (gap/) takes apart by stream, component and time.
+struct MeasurementResidual {
+  std::string stream;        // the configured stream that produced the factor
+  Time t;                    // the factor's time stamp
+  Eigen::VectorXd whitened;  // residual_dim entries, each ~ N(0, 1) when the model and its noise are right
+  bool active = true;        // false: gated out as an outlier
+};
+
 struct CalibrationResult {
   std::vector<ParameterEstimate> parameters;
   std::vector<Correlation> correlations;   // pairs of parameters with |rho| >= correlation_threshold
@@ -49,6 +58,7 @@ struct CalibrationResult {
   std::vector<StageSummary> stages;
   std::map<std::string, StreamCounts> counts;
   Trajectory trajectory;                    // the smoothed trajectory of the final estimate
+  std::vector<MeasurementResidual> residuals;  // with CalibrationOptions::keep_residuals, in factor id order
   double seconds = 0.0;
   // Totals over the stages.
   int iterations = 0;
@@ -61,6 +71,12 @@ struct CalibrationOptions {
   double correlation_threshold = 0.9;
   ObservabilityOptions observability;
   std::function<void(const std::string&)> progress;  // optional: one line per step
+  bool keep_residuals = false;                       // fill CalibrationResult::residuals
+  // Initial poses (warm start, e.g. from an earlier calibration of the same recording): each pose node takes the
+  // pose of the nearest stamp, and neither the alignment to the absolute fixes nor the IMU misalignment from the
+  // motion replaces the configured values. Null: dead reckoning, then both alignments.
+  const Trajectory* initial_trajectory = nullptr;
+  bool analyze_observability = true;                 // false: no marginal covariance (parameters get NaN std)
 };
 
 Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recording::Recording& recording,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <set>
 
 #include "sim/internal/yaml_reader.h"
 
@@ -387,6 +388,29 @@ std::optional<Scenario::Problem> ProfileProblem(const Profile& profile, const st
 
 }  // namespace
 
+const std::map<std::string, std::map<std::string, double>>& KnownEffects() {
+  static const std::map<std::string, std::map<std::string, double>> known = {
+      {"gps_latency", {{"latency_s", 0.0}}},
+      {"imu_time_offset", {{"offset_s", 0.0}}},
+      {"steering_offset", {{"offset_rad", 0.0}}},
+      {"gyro_scale_error", {{"scale_x", 1.0}, {"scale_y", 1.0}, {"scale_z", 1.0}}},
+      {"magnetometer_motor_interference", {{"b_per_nm_x", 0.0}, {"b_per_nm_y", 0.0}, {"b_per_nm_z", 0.0}}},
+  };
+  return known;
+}
+
+double EffectParameter(const std::vector<EffectOptions>& effects, const std::string& name,
+                       const std::string& parameter, double fallback) {
+  for (const EffectOptions& e : effects) {
+    if (e.name != name) continue;
+    if (const auto it = e.parameters.find(parameter); it != e.parameters.end()) return it->second;
+    const auto known = KnownEffects().find(name);
+    if (known != KnownEffects().end() && known->second.count(parameter)) return known->second.at(parameter);
+    return fallback;
+  }
+  return fallback;
+}
+
 std::optional<Scenario::Problem> Scenario::Validate() const {
   using P = Scenario::Problem;
   if (!Positive(duration_s) || duration_s > 1.0e6) return P{"duration_s", "must be > 0 (and at most 1e6)"};
@@ -502,9 +526,36 @@ std::optional<Scenario::Problem> Scenario::Validate() const {
     if (!Finite(odo->k_gamma)) return P{"sensors.odometer.k_gamma", "must be finite"};
   }
 
-  // Effects: the list exists so that scenarios can name them; none is implemented yet.
-  if (!effects.empty()) {
-    return P{"effects[0].name", "unknown effect '" + effects[0].name + "' (no physical effects are implemented yet)"};
+  // Effects: known names and parameters, each at most once, with values in range.
+  std::set<std::string> seen;
+  for (std::size_t i = 0; i < effects.size(); ++i) {
+    const std::string k = "effects[" + std::to_string(i) + "]";
+    const EffectOptions& e = effects[i];
+    const auto known = KnownEffects().find(e.name);
+    if (known == KnownEffects().end()) {
+      std::string names;
+      for (const auto& [name, unused] : KnownEffects()) names += (names.empty() ? "" : ", ") + name;
+      return P{k + ".name", "unknown effect '" + e.name + "' (known: " + names + ")"};
+    }
+    if (!ackermann) return P{k + ".name", "effects are implemented for ackermann robots only"};
+    if (!seen.insert(e.name).second) return P{k + ".name", "effect '" + e.name + "' appears twice"};
+    for (const auto& [parameter, value] : e.parameters) {
+      if (!known->second.count(parameter))
+        return P{k + ".parameters." + parameter, "unknown parameter of " + e.name};
+      if (!Finite(value)) return P{k + ".parameters." + parameter, "must be finite"};
+    }
+    const double latency = EffectParameter(effects, "gps_latency", "latency_s", 0.0);
+    if (e.name == "gps_latency" && !(latency >= 0.0 && latency <= 1.0))
+      return P{k + ".parameters.latency_s", "must be in [0, 1]"};
+    if (e.name == "imu_time_offset" && !(std::abs(EffectParameter(effects, e.name, "offset_s", 0.0)) <= 0.5))
+      return P{k + ".parameters.offset_s", "must be in [-0.5, 0.5]"};
+    if (e.name == "gps_latency" && !sensors.gps) return P{k + ".name", "gps_latency needs sensors.gps"};
+    if ((e.name == "imu_time_offset" || e.name == "gyro_scale_error") && !sensors.imu)
+      return P{k + ".name", e.name + " needs sensors.imu"};
+    if (e.name == "steering_offset" && !sensors.odometer)
+      return P{k + ".name", "steering_offset needs sensors.odometer"};
+    if (e.name == "magnetometer_motor_interference" && !sensors.magnetometer)
+      return P{k + ".name", e.name + " needs sensors.magnetometer"};
   }
   return std::nullopt;
 }

@@ -38,7 +38,21 @@
 //     odometer: {rate_hz: 100, speed_sigma_mps: 0.033, steering_sigma_rad: 0.014,     # ackermann: eq. 15
 //                kv_over_L: 0.8, k_theta: 1.0, k_gamma: 0.0}
 //   effects: []                             # hidden physical effects, each {name: ..., parameters: {...}}; written
-//                                           # to truth.yaml only. None is implemented yet: any entry is an error.
+//                                           # to truth.yaml only (the recording does not say they are there)
+//
+// Effects (Ackermann robots; issue 6's library). Each lives where it physically belongs; parameters not given take
+// the default shown, unknown names or parameters are errors:
+//   gps_latency {latency_s: 0}             the fix stamped t is the antenna's position at t - latency_s
+//                                          (receiver latency); latency_s in [0, 1], a whole number of physics steps
+//   imu_time_offset {offset_s: 0}          the IMU row stamped t holds the reading taken at t - offset_s (the IMU's
+//                                          clock runs offset_s ahead); |offset_s| <= 0.5, whole physics steps
+//   steering_offset {offset_rad: 0}        the front wheels' angle when the handlebar sensor reads zero: eq. 15's
+//                                          k_gamma becomes k_gamma + offset_rad
+//   gyro_scale_error {scale_x: 1, scale_y: 1, scale_z: 1}   per-axis gain of the gyroscope in its own frame
+//                                          (the estimator's gyroscope.scale, eq. 11 with k_s)
+//   magnetometer_motor_interference {b_per_nm_x: 0, b_per_nm_y: 0, b_per_nm_z: 0}   a magnetometer bias (sensor
+//                                          frame, normalized field units) proportional to the rear drive torque
+//                                          per wheel [N m] applied at the sample instant (motor current)
 //
 // Streams written (names fixed, as tests/support/synthetic.h): imu (wx wy wz ax ay az), magnetometer (mx my mz,
 // normalized), gps (latitude longitude altitude), rear_wheel (wheel_encoders, column rear, m/s) and steering (angle,
@@ -208,6 +222,13 @@ struct EffectOptions {
   std::string name;
   std::map<std::string, double> parameters;
 };
+
+// The effects the simulator implements, with their parameters' defaults (the header comment above).
+const std::map<std::string, std::map<std::string, double>>& KnownEffects();
+// The value of `parameter` of the effect `name` in `effects` (its default when the effect omits it); `fallback` when
+// the effect is absent.
+double EffectParameter(const std::vector<EffectOptions>& effects, const std::string& name,
+                       const std::string& parameter, double fallback);
 
 struct Scenario {
   std::string source_file;              // for messages and provenance; empty when built in code

@@ -49,12 +49,19 @@ std::string FormatTime(std::int64_t t_ns) { return FormatSeconds(Time::FromNanos
 // Nominal geometry is reported to the micrometre: enough, and free of floating-point noise from the model's frames.
 double Micrometres(double x) { return std::round(x * 1e6) / 1e6; }
 
-// A stream's clock: its period and the number of samples in [0, end].
+// A stream's clock: its period and the number of samples in [0, end]. Sample k is stamped k * period and taken at
+// k * period - shift (a time-shift effect: a late GPS fix, an IMU whose clock runs ahead); Due and Row take the time
+// the sample is taken.
 struct Clock {
   std::int64_t period_ns = 0;
   std::size_t samples = 0;
-  bool Due(std::int64_t t_ns) const { return period_ns > 0 && t_ns >= 0 && t_ns % period_ns == 0; }
-  Eigen::Index Row(std::int64_t t_ns) const { return static_cast<Eigen::Index>(t_ns / period_ns); }
+  std::int64_t shift_ns = 0;
+  bool Due(std::int64_t t_ns) const {
+    const std::int64_t stamp_ns = t_ns + shift_ns;
+    return period_ns > 0 && stamp_ns >= 0 && stamp_ns % period_ns == 0 &&
+           stamp_ns / period_ns < static_cast<std::int64_t>(samples);
+  }
+  Eigen::Index Row(std::int64_t t_ns) const { return static_cast<Eigen::Index>((t_ns + shift_ns) / period_ns); }
 };
 
 recording::Stream MakeStream(const std::string& name, StreamType type, double rate_hz, std::vector<std::string> columns,
@@ -208,6 +215,7 @@ class Simulator::Impl {
       scan_geometry_.max_range_m = l.max_range_m;
     }
     if (ackermann_) wheelbase_m_ = Micrometres(vehicle_.wheelbase_m());
+    if (Status s = SetupEffects(); !s.ok()) return s;
 
     // Streams, laid out as tests/support/synthetic.h lays them out.
     if (sensors.imu) {
@@ -296,6 +304,42 @@ class Simulator::Impl {
     return m;
   }
 
+  // Effects (scenario.h): time shifts move the instants at which samples are taken; the others change the synthesis.
+  Status SetupEffects() {
+    const std::vector<EffectOptions>& effects = scenario_.effects;
+    const auto steps = [this](double seconds, const std::string& key, std::int64_t* out) {
+      const std::int64_t ns = std::llround(seconds * 1e9);
+      if (ns % step_ns_ != 0)
+        return Status::Error(where_ + ": " + key + ": " + std::to_string(seconds) +
+                             " s is not a whole number of physics steps");
+      *out = ns;
+      return Status::Ok();
+    };
+    if (Status s = steps(EffectParameter(effects, "gps_latency", "latency_s", 0.0), "gps_latency.latency_s",
+                         &gps_clock_.shift_ns);
+        !s.ok())
+      return s;
+    if (Status s = steps(EffectParameter(effects, "imu_time_offset", "offset_s", 0.0), "imu_time_offset.offset_s",
+                         &imu_clock_.shift_ns);
+        !s.ok())
+      return s;
+    mag_clock_.shift_ns = imu_clock_.shift_ns;  // the magnetometer shares the IMU's clock
+    // A sample taken after the end of the drive (negative shift) extends the physics past it.
+    loop_end_ns_ = end_ns_ + std::max<std::int64_t>(0, -std::min(imu_clock_.shift_ns, gps_clock_.shift_ns));
+    steering_offset_rad_ = EffectParameter(effects, "steering_offset", "offset_rad", 0.0);
+    for (int i = 0; i < 3; ++i) {
+      const std::string axis(1, "xyz"[i]);
+      gyro_scale_[i] = EffectParameter(effects, "gyro_scale_error", "scale_" + axis, 1.0);
+      mag_per_nm_[i] = EffectParameter(effects, "magnetometer_motor_interference", "b_per_nm_" + axis, 0.0);
+    }
+    for (const EffectOptions& e : effects) {
+      recording::Effect truth{e.name, KnownEffects().at(e.name)};
+      for (const auto& [name, value] : e.parameters) truth.parameters[name] = value;
+      out_.truth.effects.push_back(truth);
+    }
+    return Status::Ok();
+  }
+
   Status Loop() {
     const mjModel* m = model_.get();
     mjData* d = data_.get();
@@ -306,12 +350,13 @@ class Simulator::Impl {
     // End of the lead-in's rest (the robot has settled on its wheels).
     const std::int64_t camera_start_ns =
         std::min<std::int64_t>(0, -lead_in_ns_ + std::llround(kLeadInRestFraction * static_cast<double>(lead_in_ns_)));
-    for (t_ns_ = -lead_in_ns_; t_ns_ <= end_ns_; t_ns_ += step_ns_) {
+    for (t_ns_ = -lead_in_ns_; t_ns_ <= loop_end_ns_; t_ns_ += step_ns_) {
       // Driver and low-level control.
       const auto [first, second, third] = SetPoints(t_ns_);
       if (ackermann_) {
         const double measured = vehicle_.RearWheelRate(d) * vehicle_.wheel_radius_m();
-        vehicle_.Apply(second, controller_->Update(first, measured, dt_s), d);
+        drive_torque_nm_ = controller_->Update(first, measured, dt_s);
+        vehicle_.Apply(second, drive_torque_nm_, d);
       } else {
         wheeled_.Apply(first, third, second, d);
       }
@@ -322,7 +367,7 @@ class Simulator::Impl {
       }
 
       // Sensors due now, on the state at t completed by forward dynamics.
-      if (t_ns_ >= 0 && AnyDue(t_ns_)) {
+      if (AnyDue(t_ns_)) {
         mj_forward(m, d);
         mj_rnePostConstraint(m, d);
         if (Status s = Sample(t_ns_); !s.ok()) return s;
@@ -333,7 +378,7 @@ class Simulator::Impl {
         }
         if (options_.observer) options_.observer(Time::FromNanoseconds(t_ns_), m, d);
       }
-      if (t_ns_ == end_ns_) break;
+      if (t_ns_ == loop_end_ns_) break;
 
       // One physics step.
       mj_step(m, d);
@@ -405,13 +450,14 @@ class Simulator::Impl {
       UpdateMotionStats(body);
     }
     if (imu_clock_.Due(t_ns)) {
-      const Eigen::Vector3d gyro = GyroReading(body, imu_) + gyro_noise_.Draw3(sensors.imu->gyro_sigma_radps);
+      const Eigen::Vector3d gyro =
+          gyro_scale_.cwiseProduct(GyroReading(body, imu_)) + gyro_noise_.Draw3(sensors.imu->gyro_sigma_radps);
       const Eigen::Vector3d accel = AccelReading(body, imu_) + accel_noise_.Draw3(sensors.imu->accel_sigma_mps2);
       imu_stream_.values.row(imu_clock_.Row(t_ns)) << gyro.transpose(), accel.transpose();
     }
     if (mag_clock_.Due(t_ns)) {
       const Eigen::Vector3d z = MagnetometerReading(body, imu_.q_body_imu, magnetometer_) +
-                                mag_noise_.Draw3(sensors.magnetometer->sigma);
+                                mag_per_nm_ * drive_torque_nm_ + mag_noise_.Draw3(sensors.magnetometer->sigma);
       mag_stream_.values.row(mag_clock_.Row(t_ns)) = z.transpose();
     }
     if (gps_clock_.Due(t_ns)) {
@@ -440,7 +486,8 @@ class Simulator::Impl {
       const double z_v =
           SpeedReading(vehicle_.RearWheelRate(data_.get()), vehicle_.wheel_radius_m(), odo.kv_over_L, wheelbase_m_) +
           speed_noise_.Draw(odo.speed_sigma_mps);
-      const double z_theta = SteeringReading(vehicle_.SteeringAngle(data_.get()), odo.k_theta, odo.k_gamma) +
+      const double z_theta =
+          SteeringReading(vehicle_.SteeringAngle(data_.get()), odo.k_theta, odo.k_gamma + steering_offset_rad_) +
                              steering_noise_.Draw(odo.steering_sigma_rad);
       wheel_stream_.values(odometer_clock_.Row(t_ns), 0) = z_v;
       steering_stream_.values(odometer_clock_.Row(t_ns), 0) = z_theta;
@@ -637,10 +684,16 @@ class Simulator::Impl {
   ImuCalibration imu_;
   MagnetometerCalibration magnetometer_;
   double wheelbase_m_ = 0.0;
+  double drive_torque_nm_ = 0.0;   // per rear wheel, applied over the current step
+  // Effects (scenario.h); neutral values when absent.
+  double steering_offset_rad_ = 0.0;
+  Eigen::Vector3d gyro_scale_ = Eigen::Vector3d::Ones();
+  Eigen::Vector3d mag_per_nm_ = Eigen::Vector3d::Zero();
 
   std::int64_t step_ns_ = 0;
   std::int64_t end_ns_ = 0;
   std::int64_t lead_in_ns_ = 0;
+  std::int64_t loop_end_ns_ = 0;   // end_ns_, or later when a sample is taken after the recording's end
   std::int64_t t_ns_ = 0;          // the current time, for messages
   Clock truth_clock_, imu_clock_, mag_clock_, gps_clock_, odometer_clock_, encoder_clock_, laser_clock_;
 

@@ -121,8 +121,10 @@ TEST_F(ScenarioErrorTest, BadValues) {
   ExpectError(LoadWith("kind: ackermann", "kind: hovercraft"), "kind: hovercraft", "robot.kind", "unsupported");
   ExpectError(LoadWith("{amplitude: 0.8, period_s: 13.0, phase_rad: 0.0}", "{amplitude: 0.8, period_s: -13.0}"),
               "period_s: -13.0", "driver.speed_mps[1]", "period_s must be > 0");
-  ExpectError(LoadWith("effects: []", "effects: [{name: gps_latency, parameters: {latency_s: 0.1}}]"), "gps_latency",
-              "effects[0].name", "unknown effect");
+  ExpectError(LoadWith("effects: []", "effects: [{name: flux_capacitor, parameters: {gigawatts: 1.21}}]"),
+              "flux_capacitor", "effects[0].name", "unknown effect");
+  ExpectError(LoadWith("effects: []", "effects: [{name: gps_latency, parameters: {latency_s: 2}}]"), "gps_latency",
+              "effects[0].parameters.latency_s", "must be in [0, 1]");
 }
 
 TEST_F(ScenarioErrorTest, MissingFilesAndKeys) {

@@ -1,0 +1,350 @@
+#include "apps/diagnose.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "estimator/config.h"
+#include "eval/plots.h"
+#include "gap/diagnose.h"
+#include "recording/recording.h"
+#include "sim/scenario.h"
+#include "sim/simulator.h"
+
+namespace roamlab::apps {
+namespace {
+
+using nlohmann::json;
+
+json Number(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
+
+json FitsJson(const std::map<std::string, gap::StreamFit>& fits) {
+  json j = json::object();
+  for (const auto& [name, f] : fits)
+    j[name] = {{"rms", Number(f.rms)}, {"chi2_per_dof", Number(f.chi2_per_dof)}, {"dof", f.dof},
+               {"measurements", f.measurements}};
+  return j;
+}
+
+json EffectJson(const gap::EffectEstimate& e) {
+  json p = json::object(), s = json::object(), b = json::object();
+  for (const auto& [k, v] : e.parameters) p[k] = Number(v);
+  for (const auto& [k, v] : e.baseline_parameters) b[k] = Number(v);
+  for (const auto& [k, v] : e.std) s[k] = Number(v);
+  return {{"name", e.name},
+          {"parameters", p},
+          {"std", s},
+          {"baseline_parameters", b},
+          {"dof", e.dof},
+          {"lr_statistic", Number(e.lr)},
+          {"chi2_drop", Number(e.lr_raw)},
+          {"baseline_lr_statistic", Number(e.baseline_lr)},
+          {"lr_pvalue", Number(e.lr_pvalue)},
+          {"delta_bic", Number(e.delta_bic)},
+          {"heldout_improvement", e.evaluated_heldout ? Number(e.heldout_improvement) : json(nullptr)},
+          {"decision", e.decision}};
+}
+
+json LocatedJson(const gap::LocatedComponent& lc) {
+  json intervals = json::array(), correlates = json::array();
+  for (const auto& [a, b] : lc.intervals) intervals.push_back({a, b});
+  for (const gap::Correlate& c : lc.correlates)
+    correlates.push_back({{"condition", c.condition}, {"rho", Number(c.rho)}, {"lag_s", c.lag_s}});
+  return {{"stream", lc.stream},
+          {"component", lc.component},
+          {"chi2_per_dof", Number(lc.chi2_per_dof)},
+          {"expected_chi2_per_dof", Number(lc.expected_chi2_per_dof)},
+          {"inconsistent", lc.inconsistent},
+          {"intervals", intervals},
+          {"correlates", correlates}};
+}
+
+Status WriteText(const std::string& path, const std::string& text) {
+  std::ofstream out(path);
+  if (!out) return Status::Error(path + ": cannot write");
+  out << text;
+  return out ? Status::Ok() : Status::Error(path + ": write failed");
+}
+
+std::string Fixed(double x, int digits) {
+  std::ostringstream s;
+  s << std::setprecision(digits) << x;
+  return s.str();
+}
+
+// The located component most out of its level (inconsistent ones first), or null.
+const gap::LocatedComponent* Worst(const gap::Diagnosis& d) {
+  const gap::LocatedComponent* worst = nullptr;
+  for (const gap::LocatedComponent& lc : d.located) {
+    const double ratio = lc.chi2_per_dof / lc.expected_chi2_per_dof;
+    if (!worst || (lc.inconsistent && !worst->inconsistent) ||
+        (lc.inconsistent == worst->inconsistent && ratio > worst->chi2_per_dof / worst->expected_chi2_per_dof))
+      worst = &lc;
+  }
+  return worst;
+}
+
+// Figures: the worst component's residuals against the condition it correlates with most (at its lag), and the
+// held-out chi2/dof per stream before and after.
+std::vector<std::string> WritePlots(const gap::Diagnosis& d, const std::string& dir, std::string* note) {
+  std::vector<std::string> images;
+  if (!eval::GnuplotAvailable()) {
+    *note = "gnuplot is not installed: no figures";
+    return images;
+  }
+  if (const gap::LocatedComponent* lc = Worst(d); lc && !lc->correlates.empty()) {
+    const gap::Correlate& c = lc->correlates.front();
+    const auto column = std::find(d.conditions.names.begin(), d.conditions.names.end(), c.condition);
+    const int ci = static_cast<int>(column - d.conditions.names.begin());
+    std::ofstream data(dir + "/residual_vs_condition.dat");
+    data << "# " << c.condition << " (at t + " << c.lag_s << " s)  whitened residual of " << lc->stream << "["
+         << lc->component << "]\n";
+    for (const estimator::MeasurementResidual& r : d.residuals) {
+      if (!r.active || r.stream != lc->stream || lc->component >= r.whitened.size()) continue;
+      const Time t = Time::FromNanoseconds(r.t.nanoseconds() + std::llround(c.lag_s * 1e9));
+      data << d.conditions.At(ci, t) << " " << r.whitened[lc->component] << "\n";
+    }
+    std::ofstream gp(dir + "/residual_vs_condition.gp");
+    gp << "set terminal pngcairo size 800,500 noenhanced\nset output 'residual_vs_condition.png'\n"
+       << "set title \"" << lc->stream << "[" << lc->component << "]: chi2/dof " << Fixed(lc->chi2_per_dof, 3)
+       << " (nominal " << Fixed(lc->expected_chi2_per_dof, 3) << "), rho " << Fixed(c.rho, 2) << "\"\n"
+       << "set xlabel '" << c.condition << " at t + " << c.lag_s << " s'\nset ylabel 'whitened residual'\n"
+       << "set grid\nplot 'residual_vs_condition.dat' using 1:2 with dots lc rgb '#1f77b4' notitle\n";
+    gp.close();
+    if (eval::RunGnuplot(dir, "residual_vs_condition.gp").ok()) images.push_back("residual_vs_condition.png");
+  }
+  {
+    std::ofstream data(dir + "/heldout_fit.dat");
+    data << "# stream  chi2_per_dof_before  chi2_per_dof_after (held-out part)\n";
+    for (const auto& [name, before] : d.before) {
+      const auto after = d.after.find(name);
+      data << name << " " << before.chi2_per_dof << " "
+           << (after != d.after.end() ? after->second.chi2_per_dof : before.chi2_per_dof) << "\n";
+    }
+    std::ofstream gp(dir + "/heldout_fit.gp");
+    gp << "set terminal pngcairo size 800,450 noenhanced\nset output 'heldout_fit.png'\n"
+       << "set title 'held-out part (after t = " << Fixed(d.train_end_s, 4) << " s): chi2/dof per stream'\n"
+       << "set style data histograms\nset style fill solid 0.8\nset yrange [0:*]\nset grid y\nset ylabel 'chi2/dof'\n"
+       << "plot 'heldout_fit.dat' using 2:xtic(1) title 'nominal', '' using 3 title 'with the accepted effects'\n";
+    gp.close();
+    if (eval::RunGnuplot(dir, "heldout_fit.gp").ok()) images.push_back("heldout_fit.png");
+  }
+  return images;
+}
+
+std::string Report(const gap::Diagnosis& d, const std::string& recording, const std::string& scenario,
+                   bool baseline, const std::vector<std::string>& images) {
+  std::ostringstream r;
+  r << "# Reality-gap diagnosis\n\nRecording `" << recording << "` against the nominal scenario `" << scenario
+    << "`.\n\n## Verdict: **" << d.verdict << "**\n\n";
+  if (d.verdict == "named") {
+    for (const gap::EffectEstimate& e : d.effects) {
+      r << "- **" << e.name << "**:";
+      for (const auto& [k, v] : e.parameters) {
+        const auto s = e.std.find(k);
+        r << " " << k << " = " << Fixed(v, 4);
+        if (s != e.std.end() && std::isfinite(s->second)) r << " +- " << Fixed(s->second, 2);
+      }
+      r << " (likelihood ratio " << Fixed(e.lr, 4) << ", p = " << Fixed(e.lr_pvalue, 3) << ", Delta BIC "
+        << Fixed(e.delta_bic, 4) << ", held-out chi2 " << Fixed(100.0 * e.heldout_improvement, 3) << " % lower)\n";
+    }
+  } else if (d.verdict == "unknown") {
+    r << "No effect of the library explains it; what stays inconsistent:\n";
+    for (const std::string& u : d.unexplained) r << "- " << u << "\n";
+  } else {
+    r << "Every stream is as consistent as the nominal model is on a nominal simulation"
+      << (baseline ? "" : " (no baseline: levels compared with 1)") << ".\n";
+  }
+  r << "\n## Where (whole run, nominal self-calibration)\n\n| stream[component] | chi2/dof | nominal level | "
+       "inconsistent | intervals [s] | strongest condition (rho, lag) |\n|---|---|---|---|---|---|\n";
+  for (const gap::LocatedComponent& lc : d.located) {
+    r << "| " << lc.stream << "[" << lc.component << "] | " << Fixed(lc.chi2_per_dof, 3) << " | "
+      << Fixed(lc.expected_chi2_per_dof, 3) << " | " << (lc.inconsistent ? "**yes**" : "no") << " | ";
+    for (std::size_t i = 0; i < lc.intervals.size() && i < 3; ++i)
+      r << (i ? ", " : "") << Fixed(lc.intervals[i].first, 3) << "-" << Fixed(lc.intervals[i].second, 3);
+    if (lc.intervals.size() > 3) r << " (+" << lc.intervals.size() - 3 << ")";
+    r << " | ";
+    if (!lc.correlates.empty())
+      r << lc.correlates.front().condition << " (" << Fixed(lc.correlates.front().rho, 2) << ", "
+        << lc.correlates.front().lag_s << " s)";
+    r << " |\n";
+  }
+  r << "\n## Candidates (fitted on the first part, up to t = " << Fixed(d.train_end_s, 4)
+    << " s)\n\n| effect | parameters | LR | chi2 drop / on baseline | p | Delta BIC | held-out | decision |\n"
+       "|---|---|---|---|---|---|---|---|\n";
+  for (const gap::EffectEstimate& e : d.candidates) {
+    r << "| " << e.name << " | ";
+    for (const auto& [k, v] : e.parameters) r << k << " = " << Fixed(v, 4) << " ";
+    r << "| " << Fixed(e.lr, 4) << " | " << Fixed(e.lr_raw, 4) << " / " << Fixed(e.baseline_lr, 4) << " | "
+      << Fixed(e.lr_pvalue, 3) << " | "
+      << Fixed(e.delta_bic, 4) << " | "
+      << (e.evaluated_heldout ? Fixed(100.0 * e.heldout_improvement, 3) + " %" : std::string("-")) << " | "
+      << e.decision << " |\n";
+  }
+  r << "\n## Fit on the held-out part (parameters fixed at the training values)\n\n| stream | RMS before | "
+       "chi2/dof before | RMS after | chi2/dof after |\n|---|---|---|---|---|\n";
+  for (const auto& [name, b] : d.before) {
+    const auto a = d.after.count(name) ? d.after.at(name) : b;
+    r << "| " << name << " | " << Fixed(b.rms, 4) << " | " << Fixed(b.chi2_per_dof, 4) << " | " << Fixed(a.rms, 4)
+      << " | " << Fixed(a.chi2_per_dof, 4) << " |\n";
+  }
+  r << "\n";
+  for (const std::string& image : images) r << "![" << image << "](" << image << ")\n\n";
+  r << d.fits << " calibrations in " << Fixed(d.seconds, 3) << " s.\n";
+  return r.str();
+}
+
+std::string ScenarioPatch(const gap::Diagnosis& d) {
+  std::ostringstream y;
+  y << "# Accepted effects of `roamlab diagnose`, in the form of a scenario's `effects:` section (sim/scenario.h).\n"
+    << "# Standard deviations are comments.\neffects:\n";
+  if (d.effects.empty()) y << "  []\n";
+  for (const gap::EffectEstimate& e : d.effects) {
+    y << "  - name: " << e.name << "\n    parameters:\n";
+    for (const auto& [k, v] : e.parameters) {
+      y << "      " << k << ": " << std::setprecision(10) << v;
+      if (e.std.count(k) && std::isfinite(e.std.at(k))) y << "   # +- " << std::setprecision(3) << e.std.at(k);
+      y << "\n";
+    }
+  }
+  return y.str();
+}
+
+std::string EstimatorPatch(const gap::Diagnosis& d) {
+  std::ostringstream y;
+  y << "# The accepted effects as estimator settings: parameter values to add to the nominal configuration's\n"
+    << "# `parameters`, and time shifts [s] to subtract from the named recording streams' stamps.\nparameters:\n";
+  if (d.effect_parameters.empty()) y << "  {}\n";
+  for (const auto& [name, v] : d.effect_parameters) {
+    y << "  " << name << ": {value: [";
+    for (int i = 0; i < v.size(); ++i) y << (i ? ", " : "") << std::setprecision(10) << v[i];
+    y << "], free: false}\n";
+  }
+  y << "stream_time_shifts_s:\n";
+  if (d.stream_shifts_s.empty()) y << "  {}\n";
+  for (const auto& [name, s] : d.stream_shifts_s) y << "  " << name << ": " << std::setprecision(10) << s << "\n";
+  return y.str();
+}
+
+}  // namespace
+
+int RunDiagnose(const DiagnoseArgs& args) {
+  std::ostream& err = args.err ? *args.err : std::cerr;
+  const auto bad = [&](const std::string& message) {
+    err << "roamlab diagnose: " << message << "\n";
+    return 2;
+  };
+  const auto fail = [&](const std::string& message) {
+    err << "roamlab diagnose: " << message << "\n";
+    return 1;
+  };
+  const auto say = [&](const std::string& line) {
+    if (!args.quiet) std::cout << line << std::endl;
+  };
+
+  // Inputs: the nominal scenario, the recording's streams (never its truth.yaml), the nominal configuration.
+  auto scenario = sim::LoadScenario(args.scenario);
+  if (!scenario.ok()) return bad(scenario.status().message());
+  recording::ReadOptions read;
+  read.load_ground_truth = false;
+  auto rec = recording::ReadRecording(args.recording, read);
+  if (!rec.ok()) return bad(rec.status().message());
+  const recording::Recording& recording = rec.value();
+  if (recording.platform.kind != scenario.value().robot.kind)
+    return bad(args.recording + ": platform kind '" + recording.platform.kind + "' does not match the robot kind '" +
+               scenario.value().robot.kind + "' of " + args.scenario);
+  auto config =
+      args.config.empty() ? gap::NominalConfig(scenario.value()) : estimator::LoadEstimatorConfig(args.config);
+  if (!config.ok())
+    return bad((args.config.empty() ? args.scenario + ": " : std::string()) + config.status().message());
+  for (const auto& [name, stream] : config.value().streams)
+    for (const auto& [role, source] : stream.sources)
+      if (!recording.Find(source))
+        return bad(args.recording + ": no stream '" + source + "' (the nominal model's stream '" + name +
+                   "' reads it)");
+  std::error_code ec;
+  std::filesystem::create_directories(args.out, ec);
+  if (ec) return bad(args.out + ": cannot create the output directory: " + ec.message());
+
+  // The baseline: the nominal scenario simulated over the recording's span and diagnosed without effects.
+  gap::DiagnoseOptions options;
+  options.progress = [&](const std::string& line) { say("  " + line); };
+  gap::Baseline baseline;
+  if (!args.no_baseline) {
+    sim::Scenario nominal = scenario.value();
+    nominal.effects.clear();
+    double span_s = 0.0;
+    for (const recording::Stream& s : recording.streams)
+      if (!s.t.empty()) span_s = std::max(span_s, s.t.back().seconds());
+    nominal.duration_s = std::min(nominal.duration_s, std::max(span_s, 1.0));
+    sim::SimulateOptions sim_options;
+    sim_options.seed = args.baseline_seed;
+    say("baseline: simulating the nominal scenario (" + Fixed(nominal.duration_s, 4) + " s, seed " +
+        std::to_string(args.baseline_seed) + ")");
+    auto simulated = sim::Simulate(nominal, sim_options);
+    if (!simulated.ok()) return fail("nominal simulation: " + simulated.status().message());
+    gap::DiagnoseOptions learn = options;
+    learn.max_effects = 0;
+    say("baseline: diagnosing the nominal simulation");
+    auto learned = gap::Diagnose(config.value(), simulated.value().recording, learn);
+    if (!learned.ok()) return fail("baseline: " + learned.status().message());
+    baseline = gap::BaselineFrom(learned.value());
+    options.baseline = &baseline;
+  }
+
+  say("diagnosing " + args.recording);
+  auto diagnosis = gap::Diagnose(config.value(), recording, options);
+  if (!diagnosis.ok()) return fail(diagnosis.status().message());
+  const gap::Diagnosis& d = diagnosis.value();
+
+  // gap.json, the patches, the figures and the report.
+  json located = json::array(), components = json::array(), effects = json::array(), candidates = json::array();
+  for (const gap::LocatedComponent& lc : d.located) {
+    components.push_back(LocatedJson(lc));
+    if (lc.inconsistent) located.push_back(LocatedJson(lc));
+  }
+  for (const gap::EffectEstimate& e : d.effects) effects.push_back(EffectJson(e));
+  for (const gap::EffectEstimate& e : d.candidates) candidates.push_back(EffectJson(e));
+  json base = json::object();
+  if (!args.no_baseline) {
+    base["seed"] = args.baseline_seed;
+    base["streams"] = FitsJson(baseline.streams);
+    json lr = json::object();
+    for (const auto& [name, v] : baseline.candidate_lr) lr[name] = Number(v);
+    base["candidate_lr_statistic"] = lr;
+  }
+  const json gap_json = {{"verdict", d.verdict},
+                         {"located", located},
+                         {"effects", effects},
+                         {"fit", {{"before", FitsJson(d.before)}, {"after", FitsJson(d.after)},
+                                  {"heldout_start_s", d.train_end_s}, {"whole_run_nominal", FitsJson(d.whole_run)}}},
+                         {"unexplained", d.unexplained},
+                         {"candidates", candidates},
+                         {"components", components},
+                         {"baseline", base},
+                         {"run", {{"fits", d.fits}, {"seconds", d.seconds}}}};
+  if (Status s = WriteText(args.out + "/gap.json", gap_json.dump(2) + "\n"); !s.ok()) return fail(s.message());
+  if (Status s = WriteText(args.out + "/scenario_patch.yaml", ScenarioPatch(d)); !s.ok()) return fail(s.message());
+  if (Status s = WriteText(args.out + "/estimator_patch.yaml", EstimatorPatch(d)); !s.ok()) return fail(s.message());
+  std::string note;
+  const std::vector<std::string> images = args.no_plots ? std::vector<std::string>{} : WritePlots(d, args.out, &note);
+  if (!note.empty()) say(note);
+  const std::string report = Report(d, args.recording, args.scenario, !args.no_baseline, images);
+  if (Status s = WriteText(args.out + "/report.md", report); !s.ok())
+    return fail(s.message());
+  std::string summary = "verdict: " + d.verdict;
+  for (const gap::EffectEstimate& e : d.effects) {
+    summary += "; " + e.name;
+    for (const auto& [k, v] : e.parameters) summary += " " + k + " = " + Fixed(v, 4);
+  }
+  say(summary + " (" + args.out + "/report.md)");
+  return 0;
+}
+
+}  // namespace roamlab::apps

@@ -1,0 +1,30 @@
+// `roamlab diagnose --real REC --scenario SCENARIO.yaml --out DIR`: the reality-gap diagnosis of a recording against
+// the nominal scenario (gap/diagnose.h). Reads REC's streams only (never truth.yaml). Unless --no-baseline, first
+// simulates the nominal scenario (its effects removed, the recording's duration, seed --baseline-seed) and diagnoses
+// that, to learn the levels and candidate gains the nominal model reaches on MuJoCo data without any hidden effect.
+// Writes DIR/gap.json, DIR/report.md, DIR/scenario_patch.yaml (the accepted effects in the scenario's `effects:`
+// form), DIR/estimator_patch.yaml (the same as estimator parameters and stream time shifts) and PNG figures with
+// their gnuplot scripts. Exit codes: 0 done, 2 bad input (one line naming the file), 1 a failure at run time.
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+
+namespace roamlab::apps {
+
+struct DiagnoseArgs {
+  std::string recording;                 // --real REC
+  std::string scenario;                  // --scenario SCENARIO.yaml (the nominal robot)
+  std::string config;                    // --config EST.yaml: nominal estimator configuration (default: from the
+                                         // scenario, gap::NominalConfig)
+  std::string out;
+  bool no_baseline = false;
+  std::uint64_t baseline_seed = 900001;  // noise seed of the nominal simulation
+  bool no_plots = false;
+  bool quiet = false;
+  std::ostream* err = nullptr;           // receives the one-line error; nullptr: stderr
+};
+int RunDiagnose(const DiagnoseArgs& args);
+
+}  // namespace roamlab::apps

@@ -1,0 +1,713 @@
+#include "gap/diagnose.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#include "common/chi_square.h"
+
+namespace roamlab::gap {
+namespace {
+
+using estimator::EstimatorConfig;
+using recording::Recording;
+using recording::StreamType;
+
+// One candidate of the library, as it applies to a configuration.
+struct Candidate {
+  std::string name;
+  std::string stream;                        // configured stream whose dispersion scales its statistic
+  // A parameter-slot effect: estimator parameters freed, and how their values become the effect's parameters.
+  std::vector<std::string> free;
+  std::function<void(const std::map<std::string, Eigen::VectorXd>& value,
+                     const std::map<std::string, Eigen::VectorXd>& std, EffectEstimate* out)>
+      describe;
+  // A time-shift effect: recording streams whose stamps move by the parameter (t' = t - shift).
+  std::vector<std::string> shifted;
+  std::string shift_parameter;
+  double guess_s = 0.0;                      // first guess of the shift
+  int free_dof = 0;                          // tangent dimension of `free`
+};
+
+// How the fit treats the calibration parameters.
+enum class FitMode {
+  kStaged,   // the configuration's stages from its initial values
+  kWarm,     // one stage, every free parameter plus the candidate's, from given values
+  kFixed,    // every parameter fixed at given values; poses only
+};
+
+struct FitSpec {
+  FitMode mode = FitMode::kStaged;
+  std::map<std::string, Eigen::VectorXd> values;   // warm / fixed values (names absent: the configuration's)
+  std::set<std::string> extra_free;                 // freed on top of the configuration's free parameters
+  std::map<std::string, double> shift_s;            // recording stream -> seconds subtracted from its stamps
+  bool keep_residuals = false;
+  bool observability = false;
+  const Trajectory* initial = nullptr;              // warm-start poses (estimator/calibration.h)
+};
+
+struct FitOutcome {
+  double chi2 = 0.0;
+  int measurements = 0;
+  std::map<std::string, Eigen::VectorXd> values;   // every configured parameter (free ones estimated)
+  std::map<std::string, Eigen::VectorXd> std;      // free ones, when observability was asked for
+  std::vector<estimator::MeasurementResidual> residuals;
+  Trajectory trajectory;
+};
+
+// The part of a recording in [t0, t1], cut so that a time shift up to margin_s never changes which measurements
+// attach (a changing count would move the chi-square by whole measurements): the master stream's sources (the poses)
+// lose margin_s at both ends, so that shifted samples of the other streams on the master's grid still find as many
+// poses; streams in `position` (fixes attached to one pose, which constrain no attitude) lose 2 margin_s before any
+// shift, so that they all stay inside the poses' span.
+Recording Slice(const Recording& in, double t0, double t1, const std::set<std::string>& master,
+                const std::set<std::string>& position, double margin_s) {
+  Recording out;
+  out.format_version = in.format_version;
+  out.platform = in.platform;
+  out.origin = in.origin;
+  out.provenance = in.provenance;
+  for (const recording::Stream& s : in.streams) {
+    const double m = master.count(s.info.name) ? margin_s : position.count(s.info.name) ? 2.0 * margin_s : 0.0;
+    recording::Stream c;
+    c.info = s.info;
+    std::vector<Eigen::Index> rows;
+    for (std::size_t i = 0; i < s.t.size(); ++i) {
+      const double t = s.t[i].seconds();
+      if (t >= t0 + m && t <= t1 - m) rows.push_back(static_cast<Eigen::Index>(i));
+    }
+    c.values.resize(static_cast<Eigen::Index>(rows.size()), s.values.cols());
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      c.t.push_back(s.t[static_cast<std::size_t>(rows[k])]);
+      c.values.row(static_cast<Eigen::Index>(k)) = s.values.row(rows[k]);
+      if (!s.text.empty()) c.text.push_back(s.text[static_cast<std::size_t>(rows[k])]);
+    }
+    out.streams.push_back(std::move(c));
+  }
+  return out;
+}
+
+Recording Shifted(const Recording& in, const std::map<std::string, double>& shift_s) {
+  Recording out = in;
+  for (recording::Stream& s : out.streams) {
+    const auto it = shift_s.find(s.info.name);
+    if (it == shift_s.end() || it->second == 0.0) continue;
+    const std::int64_t ns = std::llround(it->second * 1e9);
+    for (Time& t : s.t) t = Time::FromNanoseconds(t.nanoseconds() - ns);
+  }
+  return out;
+}
+
+// The value of parameter `name` in a configuration (its initial value, or the model slot's default).
+std::optional<Eigen::VectorXd> ConfiguredValue(const EstimatorConfig& config, const std::string& name) {
+  const auto it = config.parameters.find(name);
+  if (it != config.parameters.end() && it->second.value) return *it->second.value;
+  for (const auto& [stream, sc] : config.streams) {
+    const estimator::ModelSpec* spec = estimator::FindModelSpec(sc.model);
+    if (!spec) continue;
+    for (const estimator::SlotSpec& slot : spec->slots) {
+      const auto mapped = sc.parameters.find(slot.name);
+      const std::string full = mapped != sc.parameters.end() ? mapped->second : stream + "." + slot.name;
+      if (full == name) return slot.default_value;
+    }
+  }
+  return std::nullopt;
+}
+
+// The parameter a stream's slot maps to.
+std::string SlotParameter(const std::string& stream, const estimator::StreamConfig& sc, const std::string& slot) {
+  const auto mapped = sc.parameters.find(slot);
+  return mapped != sc.parameters.end() ? mapped->second : stream + "." + slot;
+}
+
+Result<FitOutcome> Fit(const EstimatorConfig& nominal, const Recording& recording, const FitSpec& spec) {
+  EstimatorConfig config = nominal;
+  std::vector<std::string> free;
+  for (const auto& [name, p] : config.parameters)
+    if (p.free) free.push_back(name);
+  for (const std::string& name : spec.extra_free) {
+    estimator::ParameterConfig& p = config.parameters[name];
+    if (!p.value) p.value = ConfiguredValue(nominal, name);
+    if (!p.free) free.push_back(name);
+    p.free = true;
+  }
+  for (const auto& [name, value] : spec.values) config.parameters[name].value = value;
+  if (spec.mode != FitMode::kStaged) config.stages.clear();
+  if (spec.mode == FitMode::kWarm) config.stages.push_back(free);
+  if (spec.mode == FitMode::kFixed)
+    for (auto& [name, p] : config.parameters) p.free = false;
+
+  estimator::CalibrationOptions options;
+  options.keep_residuals = spec.keep_residuals;
+  options.analyze_observability = spec.observability;
+  options.initial_trajectory = spec.initial;
+  auto result = estimator::Calibrate(config, Shifted(recording, spec.shift_s), options);
+  if (!result.ok()) return result.status();
+  FitOutcome out;
+  out.chi2 = 2.0 * result.value().final_cost;
+  for (const auto& [name, p] : config.parameters)
+    if (p.value) out.values[name] = *p.value;
+  for (const estimator::ParameterEstimate& p : result.value().parameters) {
+    out.values[p.name] = p.estimate;
+    if (spec.observability) out.std[p.name] = p.std;
+  }
+  for (const auto& [stream, c] : result.value().counts) out.measurements += c.attached - c.rejected;
+  out.residuals = std::move(result.value().residuals);
+  out.trajectory = std::move(result.value().trajectory);
+  return out;
+}
+
+// The candidates that apply to `config` and `recording`.
+std::vector<Candidate> Library(const EstimatorConfig& config) {
+  std::vector<Candidate> out;
+  const auto is_free = [&](const std::string& name) {
+    const auto it = config.parameters.find(name);
+    return it != config.parameters.end() && it->second.free;
+  };
+  std::vector<std::string> gps, imu;
+  std::string gyro, ackermann;
+  for (const auto& [stream, sc] : config.streams) {
+    if (sc.model == "gps") gps.push_back(sc.sources.begin()->second);
+    if (sc.model == "gyroscope" || sc.model == "accelerometer" || sc.model == "magnetometer")
+      imu.push_back(sc.sources.begin()->second);
+    if (sc.model == "gyroscope" && gyro.empty()) gyro = stream;
+    if (sc.model == "ackermann" && ackermann.empty()) ackermann = stream;
+  }
+  std::sort(imu.begin(), imu.end());
+  imu.erase(std::unique(imu.begin(), imu.end()), imu.end());
+
+  for (const std::string& name : CandidateNames()) {
+    Candidate c;
+    c.name = name;
+    if (name == "gps_latency" && !gps.empty()) {
+      c.stream = "gps";
+      for (const auto& [stream, sc] : config.streams)
+        if (sc.model == "gps") c.stream = stream;
+      c.shifted = gps;
+      c.shift_parameter = "latency_s";
+    } else if (name == "imu_time_offset" && !imu.empty() && !gyro.empty()) {
+      c.stream = gyro;
+      c.shifted = imu;
+      c.shift_parameter = "offset_s";
+    } else if (name == "steering_offset" && !ackermann.empty()) {
+      const std::string p = SlotParameter(ackermann, config.streams.at(ackermann), "k_gamma");
+      if (is_free(p)) continue;
+      c.stream = ackermann;
+      c.free = {p};
+      c.free_dof = 1;
+      c.describe = [p, nominal = ConfiguredValue(config, p).value_or(Eigen::VectorXd::Zero(1))](
+                       const auto& value, const auto& std, EffectEstimate* e) {
+        e->parameters["offset_rad"] = value.at(p)[0] - nominal[0];
+        if (std.count(p)) e->std["offset_rad"] = std.at(p)[0];
+      };
+    } else if (name == "gyro_scale_error" && !gyro.empty()) {
+      const std::string p = SlotParameter(gyro, config.streams.at(gyro), "scale");
+      if (is_free(p)) continue;
+      c.stream = gyro;
+      c.free = {p};
+      c.free_dof = 3;
+      c.describe = [p](const auto& value, const auto& std, EffectEstimate* e) {
+        for (int i = 0; i < 3; ++i) {
+          const std::string key = std::string("scale_") + "xyz"[i];
+          e->parameters[key] = value.at(p)[i];
+          if (std.count(p)) e->std[key] = std.at(p)[i];
+        }
+      };
+    } else if (name == "lateral_slip" && !ackermann.empty()) {
+      const std::string front = SlotParameter(ackermann, config.streams.at(ackermann), "cornering_front");
+      const std::string rear = SlotParameter(ackermann, config.streams.at(ackermann), "cornering_rear");
+      if (is_free(front) || is_free(rear)) continue;
+      c.stream = ackermann;
+      c.free = {front, rear};
+      c.free_dof = 2;
+      c.describe = [front, rear](const auto& value, const auto& std, EffectEstimate* e) {
+        e->parameters["cornering_front_rads2pm"] = value.at(front)[0];
+        e->parameters["cornering_rear_s"] = value.at(rear)[0];
+        if (std.count(front)) e->std["cornering_front_rads2pm"] = std.at(front)[0];
+        if (std.count(rear)) e->std["cornering_rear_s"] = std.at(rear)[0];
+      };
+    } else {
+      continue;
+    }
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+// The master stream's sample period [s] (the pose grid).
+double MasterPeriod(const EstimatorConfig& config, const Recording& recording) {
+  const auto it = config.streams.find(config.master);
+  if (it == config.streams.end() || it->second.sources.empty()) return 0.01;
+  const recording::Stream* s = recording.Find(it->second.sources.begin()->second);
+  if (!s || s->t.size() < 2) return 0.01;
+  return SecondsBetween(s->t.front(), s->t.back()) / static_cast<double>(s->t.size() - 1);
+}
+
+// The state the rounds build on: accepted effects and their fits.
+struct State {
+  std::set<std::string> extra_free;
+  std::map<std::string, double> shift_s;
+  std::map<std::string, Eigen::VectorXd> train_values;
+  Trajectory train_trajectory;
+  double train_chi2 = 0.0;
+  int train_measurements = 0;
+  double heldout_chi2 = 0.0;
+  std::map<std::string, StreamFit> heldout;
+};
+
+// A candidate fitted on the training part on top of `state`.
+struct CandidateFit {
+  EffectEstimate estimate;
+  State next;
+};
+
+// Neutral value of an effect parameter (what the nominal model assumes).
+double Neutral(const std::string& parameter) { return parameter.rfind("scale_", 0) == 0 ? 1.0 : 0.0; }
+
+// The likelihood-ratio test and BIC of a fitted candidate, and its parameters relative to the baseline.
+// Without a baseline the null hypothesis is the nominal model (parameters at their neutral values): LR = the chi2 drop
+// ~ chi2(k). With one, the nominal model's own structure already moves the candidate's parameters on MuJoCo data
+// without any effect (e.g. half an IMU period of timing from eq. 11's zero-order hold, a cornering compliance from the
+// tires): the null hypothesis is then "the parameters take the baseline's values theta_0", and LR is its quadratic
+// (Wald) form about the fit, sum ((theta - theta_0)^2 / (sigma^2 + sigma_0^2)) with both fits' standard deviations,
+// ~ chi2(k); a theta_0 within 2 sigma_0 of neutral shows no structure, and the test is then against neutral with
+// the fit's own variance (one noisy draw of nothing would only blur it). The parameters are always reported as
+// departures from theta_0 plus the neutral value, both variances added (so that the reported std covers the error).
+void Score(const Baseline* baseline, int measurements, EffectEstimate* e) {
+  const double k = e->dof;
+  e->lr = e->lr_raw;
+  if (baseline && baseline->candidate_parameters.count(e->name)) {
+    const auto base = baseline->candidate_parameters.find(e->name);
+    if (baseline->candidate_lr.count(e->name)) e->baseline_lr = baseline->candidate_lr.at(e->name);
+    double wald = 0.0;
+    bool finite = true;
+    for (auto& [name, value] : e->parameters) {
+      if (!base->second.count(name)) continue;
+      const auto [theta0, sigma0] = base->second.at(name);
+      e->baseline_parameters[name] = theta0;
+      const double raw = value;
+      const double raw_sigma = e->std.count(name) ? e->std.at(name) : NAN;
+      // Reported: the departure from the baseline, both variances.
+      value = raw - theta0 + Neutral(name);
+      e->std[name] = std::hypot(raw_sigma, sigma0);
+      // Tested: against theta_0 when the baseline shows structure (beyond 2 sigma_0 from neutral), else against
+      // neutral with the fit's own variance (one noisy draw of nothing would only blur the test).
+      const bool structure = std::abs(theta0 - Neutral(name)) > 2.0 * sigma0;
+      const double null = structure ? theta0 : Neutral(name);
+      const double sigma = structure ? std::hypot(raw_sigma, sigma0) : raw_sigma;
+      finite = finite && std::isfinite(sigma) && sigma > 0.0;
+      if (finite) wald += std::pow((raw - null) / sigma, 2);
+    }
+    e->lr = finite ? wald : 0.0;
+  }
+  e->lr_pvalue = e->lr > 0.0 ? 1.0 - ChiSquareCdf(e->lr, k) : 1.0;
+  e->delta_bic = -e->lr + k * std::log(std::max(2, measurements));
+}
+
+}  // namespace
+
+const std::vector<std::string>& CandidateNames() {
+  static const std::vector<std::string> names = {"gps_latency", "imu_time_offset", "steering_offset",
+                                                 "gyro_scale_error", "lateral_slip"};
+  return names;
+}
+
+Result<estimator::EstimatorConfig> NominalConfig(const sim::Scenario& scenario) {
+  if (scenario.robot.kind != "ackermann")
+    return Status::Error("the nominal configuration is implemented for ackermann robots only, not '" +
+                         scenario.robot.kind + "'");
+  const sim::SensorOptions& s = scenario.sensors;
+  if (!s.odometer) return Status::Error("the scenario has no odometer (the master stream)");
+  EstimatorConfig c;
+  c.source_file = scenario.source_file.empty() ? "nominal configuration" : scenario.source_file + " (nominal)";
+  c.master = "odometer";
+  c.solver.max_iterations = 100;
+  c.solver.function_tolerance = 1e-10;
+  const auto vec = [](std::initializer_list<double> v) {
+    Eigen::VectorXd x(static_cast<Eigen::Index>(v.size()));
+    Eigen::Index i = 0;
+    for (double d : v) x[i++] = d;
+    return x;
+  };
+  const auto param = [&](const std::string& name, const Eigen::VectorXd& value, bool free) {
+    c.parameters[name].value = value;
+    c.parameters[name].free = free;
+  };
+  std::vector<std::string> stage1, stage2;
+  {
+    estimator::StreamConfig odo;
+    odo.model = "ackermann";
+    odo.sources = {{"speed", "rear_wheel"}, {"steering", "steering"}};
+    // lateral / vertical: eq. 15's non-holonomic assumptions on a suspended vehicle (scenarios/atv_calibration.yaml).
+    odo.noise = {{"speed_mps", s.odometer->speed_sigma_mps},
+                 {"steering_rad", s.odometer->steering_sigma_rad},
+                 {"lateral_mps", 0.02},
+                 {"vertical_mps", 0.1}};
+    c.streams["odometer"] = odo;
+    param("odometer.kv_over_L", vec({s.odometer->kv_over_L}), true);
+    param("odometer.k_theta", vec({s.odometer->k_theta}), true);
+    param("odometer.k_gamma", vec({s.odometer->k_gamma}), false);
+    stage2.insert(stage2.end(), {"odometer.kv_over_L", "odometer.k_theta"});
+  }
+  if (s.imu) {
+    const Eigen::Quaterniond& q = s.imu->misalignment;
+    param("imu.misalignment", vec({q.w(), q.x(), q.y(), q.z()}), true);
+    stage1.push_back("imu.misalignment");
+    estimator::StreamConfig gyro;
+    gyro.model = "gyroscope";
+    gyro.sources = {{"", "imu"}};
+    gyro.noise = {{"sigma_radps", s.imu->gyro_sigma_radps}};
+    gyro.parameters = {{"misalignment", "imu.misalignment"}};
+    c.streams["gyroscope"] = gyro;
+    estimator::StreamConfig accel;
+    accel.model = "accelerometer";
+    accel.sources = {{"", "imu"}};
+    accel.noise = {{"sigma_mps2", s.imu->accel_sigma_mps2}};
+    accel.parameters = {{"misalignment", "imu.misalignment"}};
+    c.streams["accelerometer"] = accel;
+    if (!s.imu->lever_arm_m.isZero(0.0)) {
+      const Eigen::Vector3d& l = s.imu->lever_arm_m;
+      param("accelerometer.lever_arm", vec({l.x(), l.y(), l.z()}), false);
+    }
+  }
+  if (s.magnetometer && s.imu) {
+    estimator::StreamConfig mag;
+    mag.model = "magnetometer";
+    mag.sources = {{"", "magnetometer"}};
+    mag.noise = {{"sigma", s.magnetometer->sigma}};
+    mag.parameters = {{"misalignment", "imu.misalignment"}};
+    const Eigen::Vector3d& h = s.magnetometer->field_world;
+    mag.options = {{"field_world", {h.x(), h.y(), h.z()}}};
+    c.streams["magnetometer"] = mag;
+    const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> A = s.magnetometer->A;
+    param("magnetometer.A", Eigen::Map<const Eigen::VectorXd>(A.data(), 9), true);
+    const Eigen::Vector3d& b = s.magnetometer->b;
+    param("magnetometer.b", vec({b.x(), b.y(), b.z()}), true);
+    stage2.insert(stage2.end(), {"magnetometer.A", "magnetometer.b"});
+  }
+  if (s.gps) {
+    estimator::StreamConfig gps;
+    gps.model = "gps";
+    gps.sources = {{"", "gps"}};
+    gps.noise = {{"sigma_m", s.gps->sigma_m}};
+    c.streams["gps"] = gps;
+    const Eigen::Vector3d& l = s.gps->lever_arm_m;
+    param("gps.lever_arm", vec({l.x(), l.y(), l.z()}), true);
+    stage1.insert(stage1.begin(), "gps.lever_arm");
+  }
+  // Stages as scenarios/atv_calibration.yaml: attitude and lever arm, then the rest, then all jointly.
+  std::vector<std::string> all = stage1;
+  all.insert(all.end(), stage2.begin(), stage2.end());
+  if (!stage1.empty()) c.stages.push_back(stage1);
+  if (!stage2.empty()) c.stages.push_back(stage2);
+  c.stages.push_back(all);
+  return c;
+}
+
+Baseline BaselineFrom(const Diagnosis& nominal_simulation) {
+  Baseline b;
+  b.component_levels = ComponentLevels(nominal_simulation.residuals);
+  b.streams = nominal_simulation.whole_run;
+  for (const EffectEstimate& e : nominal_simulation.candidates) {
+    b.candidate_lr[e.name] = e.lr_raw;
+    for (const auto& [name, value] : e.parameters)
+      b.candidate_parameters[e.name][name] = {value, e.std.count(name) ? e.std.at(name) : 0.0};
+  }
+  return b;
+}
+
+Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& recording,
+                           const DiagnoseOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto say = [&](const std::string& line) {
+    if (options.progress) options.progress(line);
+  };
+  EstimatorConfig nominal = nominal_in;
+  nominal.gate_probability.reset();   // the same measurements in every fit
+  Diagnosis out;
+
+  // The recording's span (the master stream's) and the split into training and held-out parts.
+  const auto master = nominal.streams.find(nominal.master);
+  if (master == nominal.streams.end() || master->second.sources.empty())
+    return Status::Error(nominal.source_file + ": master stream '" + nominal.master + "' is not configured");
+  const recording::Stream* master_stream = recording.Find(master->second.sources.begin()->second);
+  if (!master_stream || master_stream->t.size() < 10)
+    return Status::Error("the recording has no (or too short a) '" + master->second.sources.begin()->second +
+                         "' stream for the master '" + nominal.master + "'");
+  const double t0 = master_stream->t.front().seconds();
+  const double t1 = master_stream->t.back().seconds();
+  const double t_split = t0 + options.train_fraction * (t1 - t0);
+  out.train_end_s = t_split;
+  const double period = MasterPeriod(nominal, recording);
+  std::vector<Candidate> library = Library(nominal);
+  std::set<std::string> master_sources, position;
+  for (const auto& [role, source] : master->second.sources) master_sources.insert(source);
+  for (const auto& [name, sc] : nominal.streams)
+    if (sc.model == "gps") position.insert(sc.sources.begin()->second);
+  const double margin = options.max_shift_s;
+  const Recording whole = Slice(recording, t0, t1, master_sources, position, margin);
+  const Recording train = Slice(recording, t0, t_split, master_sources, position, margin);
+  const Recording test = Slice(recording, t_split, t1, master_sources, position, margin);
+
+  // 1. Replay: the nominal self-calibration of the whole recording, with its residuals.
+  say("replay: nominal self-calibration of the whole recording");
+  FitSpec whole_spec;
+  whole_spec.keep_residuals = true;
+  auto whole_fit = Fit(nominal, whole, whole_spec);
+  ++out.fits;
+  if (!whole_fit.ok()) return Status::Error("nominal calibration: " + whole_fit.status().message());
+  say("replay: chi2 " + std::to_string(whole_fit.value().chi2) + " over " +
+      std::to_string(whole_fit.value().measurements) + " measurements");
+  out.residuals = whole_fit.value().residuals;
+  out.whole_run = StreamFits(out.residuals);
+  out.nominal_parameters = whole_fit.value().values;
+  out.conditions = ComputeConditions(whole_fit.value().trajectory, recording);
+
+  // First guess of a GPS latency: the fix stamped t is p(t - tau), so e = z_hat - z ~ tau v(t) (eq. 9), and tau is
+  // the least-squares slope of the residuals on the horizontal velocity.
+  for (Candidate& c : library) {
+    if (c.name != "gps_latency") continue;
+    const auto noise = nominal.streams.at(c.stream).noise;
+    const double sigma = noise.count("sigma_m") ? noise.at("sigma_m") : 1.0;
+    const auto east = std::find(out.conditions.names.begin(), out.conditions.names.end(), "v_east_mps");
+    const int ce = static_cast<int>(east - out.conditions.names.begin());
+    double ev = 0.0, vv = 0.0;
+    for (const estimator::MeasurementResidual& r : out.residuals) {
+      if (r.stream != c.stream || !r.active || r.whitened.size() < 2 || out.conditions.t.empty()) continue;
+      const Eigen::Vector2d v(out.conditions.At(ce, r.t), out.conditions.At(ce + 1, r.t));
+      ev += sigma * r.whitened.head<2>().dot(v);
+      vv += v.squaredNorm();
+    }
+    c.guess_s = vv > 0.0 ? ev / vv : 0.0;
+  }
+
+  // 2. Locate.
+  const std::map<std::string, double> levels =
+      options.baseline ? options.baseline->component_levels : std::map<std::string, double>{};
+  out.located = Locate(out.residuals, out.conditions, levels);
+
+  // The training and held-out nominal fits.
+  auto train_fit = Fit(nominal, train, {});
+  ++out.fits;
+  if (!train_fit.ok()) return Status::Error("nominal calibration (training part): " + train_fit.status().message());
+  State state;
+  state.train_values = train_fit.value().values;
+  state.train_trajectory = train_fit.value().trajectory;
+  state.train_chi2 = train_fit.value().chi2;
+  state.train_measurements = train_fit.value().measurements;
+  Trajectory heldout_trajectory;
+  const auto heldout = [&](const State& s) -> Result<std::pair<double, std::map<std::string, StreamFit>>> {
+    FitSpec spec;
+    spec.initial = heldout_trajectory.empty() ? nullptr : &heldout_trajectory;
+    spec.mode = FitMode::kFixed;
+    spec.values = s.train_values;
+    spec.shift_s = s.shift_s;
+    spec.keep_residuals = true;
+    auto fit = Fit(nominal, test, spec);
+    ++out.fits;
+    if (!fit.ok()) return fit.status();
+    if (heldout_trajectory.empty()) heldout_trajectory = fit.value().trajectory;
+    return std::make_pair(fit.value().chi2, StreamFits(fit.value().residuals));
+  };
+  {
+    auto h = heldout(state);
+    if (!h.ok()) return Status::Error("held-out evaluation: " + h.status().message());
+    state.heldout_chi2 = h.value().first;
+    state.heldout = h.value().second;
+    out.before = state.heldout;
+  }
+
+  // 3. Name: score the candidates on top of the accepted ones; keep the best if it passes; repeat.
+  const auto fit_candidate = [&](const Candidate& c, const State& base) -> Result<CandidateFit> {
+    CandidateFit cf;
+    cf.next = base;
+    EffectEstimate& e = cf.estimate;
+    e.name = c.name;
+    if (c.shifted.empty()) {
+      e.dof = c.free_dof;
+      FitSpec spec;
+      spec.mode = FitMode::kWarm;
+      spec.values = base.train_values;
+      spec.extra_free = base.extra_free;
+      spec.extra_free.insert(c.free.begin(), c.free.end());
+      spec.shift_s = base.shift_s;
+      spec.observability = true;
+      spec.initial = &base.train_trajectory;
+      auto fit = Fit(nominal, train, spec);
+      ++out.fits;
+      if (!fit.ok()) return fit.status();
+      c.describe(fit.value().values, fit.value().std, &e);
+      e.lr_raw = base.train_chi2 - fit.value().chi2;
+      cf.next.extra_free = spec.extra_free;
+      cf.next.train_values = fit.value().values;
+      cf.next.train_trajectory = fit.value().trajectory;
+      cf.next.train_chi2 = fit.value().chi2;
+      return cf;
+    }
+    // A time shift: chi2 on the grid k * period (where the shifted stamps fall on poses, so the nominal attachment
+    // is exact), walking downhill from the first guess, then a parabola through the best point and its neighbours.
+    e.dof = 1;
+    struct GridFit {
+      double chi2 = 0.0;
+      std::map<std::string, Eigen::VectorXd> values;
+      Trajectory trajectory;
+    };
+    std::map<int, GridFit> chi2_at;
+    const int k_max = static_cast<int>(std::floor(margin / period));
+    const auto at = [&](int k) -> Result<double> {
+      if (chi2_at.count(k)) return chi2_at[k].chi2;
+      FitSpec spec;
+      spec.mode = FitMode::kWarm;
+      spec.values = base.train_values;
+      spec.extra_free = base.extra_free;
+      spec.shift_s = base.shift_s;
+      spec.initial = &base.train_trajectory;
+      for (const std::string& s : c.shifted) spec.shift_s[s] = k * period;
+      auto fit = Fit(nominal, train, spec);
+      ++out.fits;
+      if (!fit.ok()) return fit.status();
+      chi2_at[k] = {fit.value().chi2, fit.value().values, fit.value().trajectory};
+      return fit.value().chi2;
+    };
+    // The first guess: the linearized effect of the shift on the nominal residuals , on the grid.
+    int best = std::clamp(static_cast<int>(std::lround(c.guess_s / period)), -k_max, k_max);
+    chi2_at[0] = {base.train_chi2, base.train_values, base.train_trajectory};
+    if (auto f = at(best); !f.ok()) return f.status();
+    for (int step : {1, -1}) {
+      int k = best;
+      for (int i = 0; i < 2 * k_max; ++i) {
+        const int next = k + step;
+        if (std::abs(next) > k_max) break;
+        auto f = at(next);
+        if (!f.ok()) return f.status();
+        if (f.value() >= chi2_at[k].chi2) break;
+        k = next;
+      }
+      if (chi2_at[k].chi2 < chi2_at[best].chi2) best = k;
+    }
+    // The chi-square on the grid is not smooth: moving a stream by one sample re-pairs its noise with the other
+    // streams', which adds a jitter of tens to the chi-square of a 20 s drive (measured on the ATV's IMU). So a
+    // parabola chi2(k) = a k^2 + b k + c is fitted by least squares to the best point and kHalfWindow points each
+    // side, and the standard deviation of its vertex combines the curvature's (1 / sqrt(a) grid steps: cost = chi2 / 2
+    // has second derivative a) and the vertex's own spread from the jitter (delta method on the fitted a, b).
+    constexpr int kHalfWindow = 3;
+    std::vector<int> ks;
+    for (int k = best - kHalfWindow; k <= best + kHalfWindow; ++k) {
+      if (std::abs(k) > k_max) continue;
+      if (auto f = at(k); !f.ok()) return f.status();
+      ks.push_back(k);
+    }
+    double k_hat = best;
+    double chi2_min = chi2_at[best].chi2;
+    double stdev = std::numeric_limits<double>::quiet_NaN();
+    if (ks.size() >= 4) {
+      Eigen::MatrixXd X(static_cast<Eigen::Index>(ks.size()), 3);
+      Eigen::VectorXd y(static_cast<Eigen::Index>(ks.size()));
+      for (std::size_t i = 0; i < ks.size(); ++i) {
+        const double u = ks[i] - best;
+        X.row(static_cast<Eigen::Index>(i)) << u * u, u, 1.0;
+        y[static_cast<Eigen::Index>(i)] = chi2_at[ks[i]].chi2;
+      }
+      const Eigen::Matrix3d XtX_inv = (X.transpose() * X).inverse();
+      const Eigen::Vector3d abc = XtX_inv * X.transpose() * y;
+      const double a = abc[0], b = abc[1], cc = abc[2];
+      if (a > 0.0) {
+        const double u_hat = std::clamp(-b / (2.0 * a), -static_cast<double>(kHalfWindow),
+                                        static_cast<double>(kHalfWindow));
+        k_hat = best + u_hat;
+        chi2_min = a * u_hat * u_hat + b * u_hat + cc;
+        const double dof = static_cast<double>(ks.size()) - 3.0;
+        const double jitter2 = dof > 0.0 ? (y - X * abc).squaredNorm() / dof : 0.0;
+        const Eigen::Vector3d J(b / (2.0 * a * a), -1.0 / (2.0 * a), 0.0);
+        const double vertex_var = jitter2 * J.dot(XtX_inv * J);
+        stdev = period * std::sqrt(1.0 / a + vertex_var);
+      }
+    }
+    const double shift = k_hat * period;
+    e.parameters[c.shift_parameter] = shift;
+    e.std[c.shift_parameter] = stdev;
+    e.lr_raw = base.train_chi2 - chi2_min;
+    for (const std::string& s : c.shifted) cf.next.shift_s[s] = shift;
+    cf.next.train_values = chi2_at[best].values;
+    cf.next.train_trajectory = chi2_at[best].trajectory;
+    cf.next.train_chi2 = chi2_min;
+    return cf;
+  };
+
+  std::set<std::string> accepted;
+  for (int round = 0; round < std::max(1, options.max_effects); ++round) {
+    std::vector<CandidateFit> fits;
+    for (const Candidate& c : library) {
+      if (accepted.count(c.name)) continue;
+      say("candidate " + c.name + (round > 0 ? " (on top of the accepted effects)" : ""));
+      auto cf = fit_candidate(c, state);
+      if (!cf.ok()) return Status::Error("candidate " + c.name + ": " + cf.status().message());
+      EffectEstimate& e = cf.value().estimate;
+      Score(options.baseline, state.train_measurements, &e);
+      fits.push_back(std::move(cf).value());
+    }
+    if (fits.empty()) break;
+    std::sort(fits.begin(), fits.end(), [](const CandidateFit& a, const CandidateFit& b) {
+      return a.estimate.delta_bic < b.estimate.delta_bic;
+    });
+    CandidateFit& best = fits.front();
+    bool keep = false;
+    if (options.max_effects > round) {
+      EffectEstimate& e = best.estimate;
+      if (e.lr_pvalue >= options.alpha) {
+        e.decision = "rejected: likelihood-ratio p above alpha";
+      } else if (e.delta_bic >= 0.0) {
+        e.decision = "rejected: BIC does not favour it";
+      } else {
+        auto h = heldout(best.next);
+        if (!h.ok()) return Status::Error("held-out evaluation of " + e.name + ": " + h.status().message());
+        e.evaluated_heldout = true;
+        e.heldout_improvement = state.heldout_chi2 > 0.0 ? 1.0 - h.value().first / state.heldout_chi2 : 0.0;
+        if (e.heldout_improvement <= 0.0) {
+          e.decision = "rejected: no improvement on the held-out part";
+        } else {
+          e.decision = "accepted";
+          e.accepted = true;
+          keep = true;
+          best.next.heldout_chi2 = h.value().first;
+          best.next.heldout = h.value().second;
+        }
+      }
+    }
+    for (CandidateFit& f : fits) {
+      if (f.estimate.decision.empty()) f.estimate.decision = "not the best candidate";
+      if (round == 0) out.candidates.push_back(f.estimate);
+    }
+    if (!keep) break;
+    accepted.insert(best.estimate.name);
+    out.effects.push_back(best.estimate);
+    say("accepted " + best.estimate.name);
+    state = best.next;
+  }
+  out.after = state.heldout;
+  for (const std::string& name : state.extra_free) out.effect_parameters[name] = state.train_values.at(name);
+  out.stream_shifts_s = state.shift_s;
+
+  // Verdict.
+  if (!out.effects.empty()) {
+    out.verdict = "named";
+  } else {
+    for (const LocatedComponent& lc : out.located) {
+      if (!lc.inconsistent) continue;
+      std::ostringstream line;
+      line << ComponentKey(lc.stream, lc.component);
+      if (!lc.correlates.empty())
+        line << " depends on " << lc.correlates.front().condition << " (rho " << lc.correlates.front().rho << ")";
+      out.unexplained.push_back(line.str());
+    }
+    out.verdict = out.unexplained.empty() ? "none" : "unknown";
+  }
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace roamlab::gap

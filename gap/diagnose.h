@@ -1,0 +1,114 @@
+// Reality-gap diagnosis (DESIGN.md, "Reality-gap diagnosis"; issue 6): given a recording and the nominal model of the
+// robot (an estimator configuration whose free parameters are the ordinary calibration), find where the recording
+// departs from the model, name the physical effect from a library, fit it and show the held-out fit improve.
+//
+//   1. replay: self-calibrate the nominal parameters on the whole recording (the estimator's models are the nominal
+//      model) and keep the whitened residuals;
+//   2. locate: per stream and component, chi-square per dof, intervals and correlated conditions (locate.h), against
+//      the levels the nominal model reaches on a nominal simulation (Baseline) when one is given;
+//   3. name: every candidate effect of the library is fitted on the first `train_fraction` of the recording with the
+//      full solver (all calibration parameters free, warm-started at the nominal fit): a parameter slot freed in an
+//      error model, or a time shift of a stream found by a 1-D search on the master period's grid with a parabola
+//      through the three best points (its curvature gives the standard deviation). Statistic: without a baseline the
+//      chi-square drop LR = chi2_nominal - chi2_effect ~ chi2(k) (cost = chi2 / 2, estimator/solver.h); with one, the
+//      nominal model is not exact on MuJoCo data and already moves each candidate's parameters on the nominal
+//      simulation, so H0 is "the parameters take the baseline's values" and LR is its Wald form with both fits'
+//      variances (Score in diagnose.cc). p = 1 - F_chi2(k)(LR), Delta BIC = -LR + k ln n. The best candidate (lowest
+//      Delta BIC) is kept when p < alpha, Delta BIC < 0 and the held-out chi-square (the last part of the recording,
+//      every parameter fixed at the training values) drops. Then the others are scored again on top, up to
+//      max_effects;
+//   4. model: the accepted effects' parameters and standard deviations (training fit);
+//   5. show: per-stream whitened RMS and chi2/dof on the held-out part before (nominal) and after (with the effects).
+// Verdict: "named" (some effect kept), "unknown" (no effect kept but some component stays inconsistent: its
+// conditions say what it depends on) or "none". The diagnosis reads the recording's streams only (never truth.yaml).
+#pragma once
+
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/status.h"
+#include "estimator/calibration.h"
+#include "estimator/config.h"
+#include "gap/locate.h"
+#include "recording/recording.h"
+#include "sim/scenario.h"
+
+namespace roamlab::gap {
+
+struct EffectEstimate {
+  std::string name;
+  int dof = 0;                                  // parameters added
+  std::map<std::string, double> parameters;     // names as the simulator's effects (sim/scenario.h)
+  std::map<std::string, double> std;
+  std::map<std::string, double> baseline_parameters;   // the raw fit on the nominal simulation, subtracted
+  double lr_raw = 0.0;                          // chi2 drop on the training part against the nominal model
+  double baseline_lr = 0.0;                     // the same candidate's drop on the nominal simulation
+  double lr = 0.0;                              // the test statistic (Score in diagnose.cc), ~ chi2(dof) under H0
+  double lr_pvalue = 1.0;
+  double delta_bic = 0.0;                       // < 0 favours the effect
+  double heldout_improvement = 0.0;             // relative drop of the held-out chi2 (0.1 = 10 % lower)
+  bool evaluated_heldout = false;
+  bool accepted = false;
+  std::string decision;                         // why kept or not, one phrase
+};
+
+// What the nominal model gives on a nominal simulation of the same robot and drive.
+struct Baseline {
+  std::map<std::string, double> component_levels;   // ComponentKey -> chi2/dof, whole run
+  std::map<std::string, StreamFit> streams;          // whole run
+  std::map<std::string, double> candidate_lr;        // candidate -> chi2 drop on the training part
+  // candidate -> parameter -> (value, std) fitted on the nominal simulation
+  std::map<std::string, std::map<std::string, std::pair<double, double>>> candidate_parameters;
+};
+
+struct Diagnosis {
+  std::string verdict;                                // named | unknown | none
+  std::vector<LocatedComponent> located;              // every component; inconsistent ones flagged
+  std::vector<EffectEstimate> candidates;             // the first round's scores, best first
+  std::vector<EffectEstimate> effects;                // accepted, in order
+  std::vector<std::string> unexplained;               // for "unknown": "stream/component depends on condition"
+  std::map<std::string, StreamFit> whole_run;         // the nominal fit of the whole recording
+  std::map<std::string, StreamFit> before, after;     // held-out part: nominal, with the accepted effects
+  double train_end_s = 0.0;                           // the held-out part starts here (recording time)
+  std::vector<estimator::MeasurementResidual> residuals;   // whole-run nominal fit
+  Conditions conditions;                              // from the whole-run nominal trajectory
+  std::map<std::string, Eigen::VectorXd> nominal_parameters;   // whole-run nominal calibration
+  // The accepted effects as estimator settings: parameters (name -> value) and stream time shifts [s]
+  // (recording stream -> seconds to subtract from its stamps).
+  std::map<std::string, Eigen::VectorXd> effect_parameters;
+  std::map<std::string, double> stream_shifts_s;
+  int fits = 0;                                       // calibrations run
+  double seconds = 0.0;
+};
+
+struct DiagnoseOptions {
+  const Baseline* baseline = nullptr;   // null: levels 1 and no baseline drops
+  double train_fraction = 2.0 / 3.0;
+  double alpha = 1e-3;                  // likelihood-ratio test level
+  int max_effects = 3;                  // 0: score the candidates only (learning a baseline)
+  double max_shift_s = 0.5;             // time-shift search range and the margin cut from shifted streams
+  std::function<void(const std::string&)> progress;
+};
+
+// The candidate effects the library knows (issue 6), whether or not a configuration supports them.
+const std::vector<std::string>& CandidateNames();
+
+// The nominal estimator configuration of an Ackermann scenario: the streams its sensors produce with the scenario's
+// noise, the Table I calibration free with the scenario's values as the initial guess (staged as
+// scenarios/atv_calibration.yaml), k_gamma fixed at the scenario's value (the handlebar sensor's zero is believed;
+// a steering_offset is a departure from it), gyroscope scale 1 and cornering compliance 0 fixed (eq. 15 as written),
+// no outlier gating (the chi-square comparisons need the same measurements in every fit).
+Result<estimator::EstimatorConfig> NominalConfig(const sim::Scenario& scenario);
+
+// Runs the diagnosis. Errors: the configuration does not fit the recording, or a fit fails.
+Result<Diagnosis> Diagnose(const estimator::EstimatorConfig& nominal, const recording::Recording& recording,
+                           const DiagnoseOptions& options = {});
+
+// The baseline from the diagnosis of a nominal simulation (run with max_effects = 0 and no baseline).
+Baseline BaselineFrom(const Diagnosis& nominal_simulation);
+
+}  // namespace roamlab::gap

@@ -1,0 +1,82 @@
+// Locating a reality gap (DESIGN.md, "Reality-gap diagnosis", step 2): where the whitened residuals of a calibrated
+// estimate stop looking like N(0, 1) noise. Per stream and residual component: the chi-square per degree of freedom
+// against the level expected of the nominal model (1, or what the nominal simulation gives: MuJoCo's suspension and
+// tire compliance already make some streams inconsistent); when: sliding-window statistics flag the intervals whose
+// chi-square exceeds that level beyond its 99.9 % quantile; under which conditions: the correlation of the residual
+// with the motion (speed, accelerations, yaw rate, slope, steering, world-frame velocity), each at the lag within
+// +-kMaxLagS that correlates best (a time offset shows as a lagged copy of the motion).
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/time.h"
+#include "estimator/calibration.h"
+#include "recording/recording.h"
+#include "recording/trajectory.h"
+
+namespace roamlab::gap {
+
+// Motion conditions at the poses of a calibrated trajectory: one column per name, one row per pose.
+struct Conditions {
+  std::vector<std::string> names;
+  std::vector<Time> t;
+  Eigen::MatrixXd values;
+  // The value of condition `c` at time `t` (nearest pose; clamped at the ends).
+  double At(int c, Time t) const;
+};
+
+// Computes, by finite differences over the poses (central, smoothed over about 0.1 s): speed_mps (forward, O),
+// accel_long_mps2, accel_lat_mps2 (v_x omega_z), yaw_rate_radps, yaw_accel_radps2, slope_rad (pitch of O),
+// v_east_mps, v_north_mps, and steering_rad (the recording's steering stream, when there is one).
+Conditions ComputeConditions(const Trajectory& trajectory, const recording::Recording& recording);
+
+// Totals of one stream's whitened residuals (active measurements only).
+struct StreamFit {
+  int measurements = 0;
+  int dof = 0;                 // scalar residuals
+  double chi2 = 0.0;           // sum of squared whitened residuals
+  double chi2_per_dof = 0.0;
+  double rms = 0.0;            // sqrt(chi2_per_dof): whitened RMS
+};
+std::map<std::string, StreamFit> StreamFits(const std::vector<estimator::MeasurementResidual>& residuals);
+
+struct Correlate {
+  std::string condition;
+  double rho = 0.0;            // Pearson correlation of the residual with the condition at t + lag_s
+  double lag_s = 0.0;
+};
+
+struct LocatedComponent {
+  std::string stream;
+  int component = 0;
+  int count = 0;
+  double chi2_per_dof = 0.0;
+  double expected_chi2_per_dof = 1.0;          // the nominal level it was compared with
+  bool inconsistent = false;                   // above the level by more than kInconsistencyRatio and its quantile
+  std::vector<std::pair<double, double>> intervals;   // [t0, t1] in seconds where the windows exceed the level
+  std::vector<Correlate> correlates;                  // the strongest first, at most three
+};
+
+struct LocateOptions {
+  double window_s = 2.0;
+  double max_lag_s = 0.3;
+  double lag_step_s = 0.02;
+  // A component is inconsistent when chi2_per_dof > ratio * expected and above expected's 99.9 % chi-square quantile.
+  double inconsistency_ratio = 1.3;
+};
+
+// expected: per "stream/component" the nominal chi2_per_dof (missing keys: 1).
+std::vector<LocatedComponent> Locate(const std::vector<estimator::MeasurementResidual>& residuals,
+                                     const Conditions& conditions, const std::map<std::string, double>& expected,
+                                     const LocateOptions& options = {});
+
+// "stream/component", the key of `expected`.
+std::string ComponentKey(const std::string& stream, int component);
+// Per component chi2_per_dof, keyed as above.
+std::map<std::string, double> ComponentLevels(const std::vector<estimator::MeasurementResidual>& residuals);
+
+}  // namespace roamlab::gap

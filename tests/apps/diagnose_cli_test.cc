@@ -1,0 +1,93 @@
+// `roamlab diagnose` end to end on short simulated drives: it never opens the recording's truth.yaml (garbage there
+// changes nothing), writes gap.json with the documented keys, and refuses a recording of another robot kind with one
+// line and exit code 2.
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "tests/recording/temp_dir.h"
+
+namespace roamlab {
+namespace {
+
+std::string Source(const std::string& relative) { return std::string(ROAMLAB_SOURCE_DIR) + "/" + relative; }
+
+struct CommandRun {
+  int exit_code;
+  std::string out;
+  std::string err;
+};
+
+CommandRun Roamlab(const std::string& args, const testing::TempDir& dir) {
+  const std::string cmd = std::string(ROAMLAB_BINARY) + " " + args + " > " + dir.File("stdout.txt") + " 2> " +
+                          dir.File("stderr.txt");
+  const int status = std::system(cmd.c_str());
+  return {WEXITSTATUS(status), testing::ReadFile(dir.File("stdout.txt")), testing::ReadFile(dir.File("stderr.txt"))};
+}
+
+// atv_hills.yaml shortened to `duration_s` with `effects` as its effects section, written into dir.
+std::string Scenario(const testing::TempDir& dir, double duration_s, const std::string& effects) {
+  std::string text = testing::ReadFile(Source("scenarios/atv_hills.yaml"));
+  const auto replace = [&text](const std::string& a, const std::string& b) {
+    const std::size_t at = text.find(a);
+    EXPECT_NE(at, std::string::npos) << a;
+    if (at != std::string::npos) text.replace(at, a.size(), b);
+  };
+  replace("model: ../models/atv.xml", "model: " + Source("models/atv.xml"));
+  replace("duration_s: 30.0", "duration_s: " + std::to_string(duration_s));
+  replace("effects: []", "effects: " + effects);
+  const std::string path = dir.File("scenario.yaml");
+  testing::WriteFile(path, text);
+  return path;
+}
+
+TEST(DiagnoseCliTest, NeverOpensTruthYamlAndWritesGapJson) {
+  testing::TempDir dir;
+  const std::string scenario =
+      Scenario(dir, 6.0, "[{name: steering_offset, parameters: {offset_rad: 0.03}}]");
+  ASSERT_EQ(Roamlab("simulate " + scenario + " --out " + dir.File("rec") + " --quiet", dir).exit_code, 0);
+  // What a reader of truth.yaml would refuse (and what would give the effect away).
+  testing::WriteFile(dir.File("rec/truth.yaml"), "{{{ not yaml: [steering_offset");
+  const CommandRun run = Roamlab("diagnose --real " + dir.File("rec") + " --scenario " +
+                                     Source("scenarios/atv_hills.yaml") + " --out " + dir.File("out") +
+                                     " --no-baseline --no-plots --quiet",
+                                 dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  std::ifstream in(dir.File("out/gap.json"));
+  ASSERT_TRUE(in.good());
+  const nlohmann::json gap = nlohmann::json::parse(in);
+  for (const char* key : {"verdict", "located", "effects", "fit", "candidates"}) EXPECT_TRUE(gap.contains(key)) << key;
+  EXPECT_TRUE(gap["fit"].contains("before"));
+  EXPECT_TRUE(gap["fit"].contains("after"));
+  EXPECT_TRUE(gap["fit"]["before"].contains("odometer"));
+  const std::string verdict = gap["verdict"].get<std::string>();
+  EXPECT_TRUE(verdict == "named" || verdict == "unknown" || verdict == "none") << verdict;
+  EXPECT_EQ(gap["candidates"].size(), 5u);
+  EXPECT_TRUE(std::ifstream(dir.File("out/report.md")).good());
+  EXPECT_TRUE(std::ifstream(dir.File("out/scenario_patch.yaml")).good());
+}
+
+TEST(DiagnoseCliTest, RefusesARecordingOfAnotherRobotKind) {
+  testing::TempDir dir;
+  const std::string scenario = Scenario(dir, 1.0, "[]");
+  ASSERT_EQ(Roamlab("simulate " + scenario + " --out " + dir.File("rec") + " --quiet", dir).exit_code, 0);
+  const CommandRun run = Roamlab("diagnose --real " + dir.File("rec") + " --scenario " +
+                                     Source("scenarios/indoor_diffdrive_slip.yaml") + " --out " + dir.File("out"),
+                                 dir);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("roamlab diagnose: " + dir.File("rec") +
+                         ": platform kind 'ackermann' does not match the robot kind 'differential_drive'"),
+            std::string::npos)
+      << run.err;
+  EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1);
+  EXPECT_FALSE(std::ifstream(dir.File("out/gap.json")).good());
+}
+
+}  // namespace
+}  // namespace roamlab

@@ -1,0 +1,157 @@
+// Physical effects of a scenario (sim/scenario.h, issue 6): each changes exactly what it says, against the same drive
+// without it (noise off, so that the difference is the effect alone), and is stated in truth.yaml only.
+#include <cmath>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "recording/recording.h"
+#include "sim/simulator.h"
+#include "tests/sim/sim_testing.h"
+
+namespace roamlab::sim {
+namespace {
+
+constexpr double kDurationS = 2.0;
+
+// The shortened ATV drive, sensors at 100 Hz (GPS too, so that a shift of whole samples can be compared row to row).
+Scenario Drive(const std::vector<EffectOptions>& effects) {
+  Scenario s = testing::AtvHills(kDurationS);
+  s.sensors.gps->rate_hz = 100.0;
+  s.effects = effects;
+  return s;
+}
+
+Simulation Simulated(const Scenario& scenario) {
+  SimulateOptions options;
+  options.noise = false;
+  auto sim = Simulate(scenario, options);
+  EXPECT_TRUE(sim.ok()) << sim.status().message();
+  return std::move(sim).value();
+}
+
+const recording::Stream& StreamOf(const Simulation& sim, const std::string& name) {
+  const recording::Stream* s = sim.recording.Find(name);
+  EXPECT_NE(s, nullptr) << name;
+  return *s;
+}
+
+class EffectsTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { nominal_ = new Simulation(Simulated(Drive({}))); }
+  static void TearDownTestSuite() {
+    delete nominal_;
+    nominal_ = nullptr;
+  }
+  static Simulation* nominal_;
+};
+Simulation* EffectsTest::nominal_ = nullptr;
+
+TEST_F(EffectsTest, GyroScaleMultipliesEachAxisAndNothingElse) {
+  const Simulation sim = Simulated(Drive({{"gyro_scale_error", {{"scale_x", 0.98}, {"scale_z", 1.03}}}}));
+  const recording::Stream& a = StreamOf(*nominal_, "imu");
+  const recording::Stream& b = StreamOf(sim, "imu");
+  ASSERT_EQ(a.values.rows(), b.values.rows());
+  EXPECT_GT(a.values.col(2).cwiseAbs().maxCoeff(), 0.05);  // the drive turns
+  for (Eigen::Index k = 0; k < a.values.rows(); ++k) {
+    EXPECT_NEAR(b.values(k, 0), 0.98 * a.values(k, 0), 1e-12);
+    EXPECT_NEAR(b.values(k, 1), a.values(k, 1), 1e-12);              // default scale 1
+    EXPECT_NEAR(b.values(k, 2), 1.03 * a.values(k, 2), 1e-12);
+    EXPECT_NEAR(b.values(k, 3), a.values(k, 3), 1e-12);              // accelerometer untouched
+  }
+  ASSERT_EQ(sim.truth.effects.size(), 1u);
+  EXPECT_EQ(sim.truth.effects[0].name, "gyro_scale_error");
+  EXPECT_EQ(sim.truth.effects[0].parameters.at("scale_y"), 1.0);     // defaults are written out
+  EXPECT_EQ(sim.truth.effects[0].parameters.at("scale_z"), 1.03);
+  EXPECT_TRUE(nominal_->truth.effects.empty());
+}
+
+TEST_F(EffectsTest, SteeringOffsetShiftsTheHandlebarReadingByOffsetOverKTheta) {
+  const Simulation sim = Simulated(Drive({{"steering_offset", {{"offset_rad", 0.03}}}}));
+  const recording::Stream& a = StreamOf(*nominal_, "steering");
+  const recording::Stream& b = StreamOf(sim, "steering");
+  ASSERT_EQ(a.values.rows(), b.values.rows());
+  // z_theta = (delta - k_gamma - offset) / k_theta with k_theta = 1 in atv_hills.yaml.
+  for (Eigen::Index k = 0; k < a.values.rows(); ++k) EXPECT_NEAR(b.values(k, 0), a.values(k, 0) - 0.03, 1e-12);
+}
+
+TEST_F(EffectsTest, GpsLatencyReportsTheAntennaPositionTauEarlier) {
+  const Simulation sim = Simulated(Drive({{"gps_latency", {{"latency_s", 0.05}}}}));
+  const recording::Stream& a = StreamOf(*nominal_, "gps");
+  const recording::Stream& b = StreamOf(sim, "gps");
+  ASSERT_EQ(a.values.rows(), b.values.rows());
+  EXPECT_EQ(a.t, b.t);                                               // the stamps do not say it
+  // At 100 Hz, 0.05 s is 5 rows: the fix stamped t_k is the nominal fix of t_k - 0.05.
+  for (Eigen::Index k = 5; k < a.values.rows(); ++k)
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(b.values(k, c), a.values(k - 5, c), 1e-9) << k;
+  // Moving at about 4 m/s, that is about 0.2 m: the first rows differ from the nominal ones.
+  EXPECT_GT(std::abs(b.values(10, 1) - a.values(10, 1)) * 111e3 * std::cos(45.46 * M_PI / 180.0), 0.1);
+}
+
+TEST_F(EffectsTest, ImuTimeOffsetStampsReadingsAheadAndTheMagnetometerFollows) {
+  const Simulation late = Simulated(Drive({{"imu_time_offset", {{"offset_s", 0.02}}}}));
+  const Simulation early = Simulated(Drive({{"imu_time_offset", {{"offset_s", -0.03}}}}));
+  for (const std::string name : {"imu", "magnetometer"}) {
+    const recording::Stream& a = StreamOf(*nominal_, name);
+    const recording::Stream& b = StreamOf(late, name);
+    const recording::Stream& c = StreamOf(early, name);
+    ASSERT_EQ(a.values.rows(), b.values.rows());
+    ASSERT_EQ(a.values.rows(), c.values.rows());    // samples taken after the end: the physics runs on
+    for (Eigen::Index k = 0; k + 3 < a.values.rows(); ++k) {
+      if (k >= 2) {
+        EXPECT_NEAR((b.values.row(k) - a.values.row(k - 2)).norm(), 0.0, 1e-9) << name << " " << k;
+      }
+      EXPECT_NEAR((c.values.row(k) - a.values.row(k + 3)).norm(), 0.0, 1e-9) << name << " " << k;
+    }
+  }
+  // The other streams keep their clock. (Samples taken during the lead-in add state evaluations, mj_forward, that
+  // can change the physics at round-off level.)
+  EXPECT_LT((StreamOf(late, "rear_wheel").values - StreamOf(*nominal_, "rear_wheel").values).cwiseAbs().maxCoeff(),
+            1e-9);
+}
+
+TEST_F(EffectsTest, MagnetometerInterferenceIsABiasAlongItsDirectionThatFollowsTheTorque) {
+  const Eigen::Vector3d per_nm(2e-4, -1e-4, 3e-4);
+  const Simulation sim = Simulated(Drive({{"magnetometer_motor_interference",
+                                     {{"b_per_nm_x", per_nm.x()}, {"b_per_nm_y", per_nm.y()},
+                                      {"b_per_nm_z", per_nm.z()}}}}));
+  const recording::Stream& a = StreamOf(*nominal_, "magnetometer");
+  const recording::Stream& b = StreamOf(sim, "magnetometer");
+  ASSERT_EQ(a.values.rows(), b.values.rows());
+  double min_torque = 1e9, max_torque = -1e9;
+  for (Eigen::Index k = 0; k < a.values.rows(); ++k) {
+    const Eigen::Vector3d d = (b.values.row(k) - a.values.row(k)).transpose();
+    const double torque_nm = d.dot(per_nm) / per_nm.squaredNorm();
+    EXPECT_NEAR((d - torque_nm * per_nm).norm(), 0.0, 1e-12) << k;   // along b_per_nm
+    EXPECT_LE(std::abs(torque_nm), 400.0 + 1e-9);                     // within the torque limit
+    min_torque = std::min(min_torque, torque_nm);
+    max_torque = std::max(max_torque, torque_nm);
+  }
+  EXPECT_GT(max_torque - min_torque, 5.0);                            // the speed controller works
+}
+
+TEST(EffectsValidationTest, UnknownNamesParametersAndRangesAreErrors) {
+  const auto problem = [](const std::vector<EffectOptions>& effects) {
+    Scenario s = testing::AtvHills(1.0);
+    s.effects = effects;
+    const auto p = s.Validate();
+    return p ? p->key + ": " + p->message : std::string();
+  };
+  EXPECT_EQ(problem({{"gps_latency", {{"latency_s", 0.1}}}}), "");
+  EXPECT_NE(problem({{"flux_capacitor", {}}}).find("effects[0].name: unknown effect 'flux_capacitor'"),
+            std::string::npos);
+  EXPECT_NE(problem({{"gps_latency", {{"latency", 0.1}}}}).find("effects[0].parameters.latency: unknown parameter"),
+            std::string::npos);
+  EXPECT_NE(problem({{"gps_latency", {{"latency_s", -0.1}}}}).find("must be in [0, 1]"), std::string::npos);
+  EXPECT_NE(problem({{"imu_time_offset", {{"offset_s", 0.7}}}}).find("must be in [-0.5, 0.5]"), std::string::npos);
+  EXPECT_NE(problem({{"steering_offset", {}}, {"steering_offset", {}}}).find("appears twice"), std::string::npos);
+  // Not a whole number of 1 ms physics steps: refused when the simulator is created.
+  Scenario s = testing::AtvHills(1.0);
+  s.effects = {{"gps_latency", {{"latency_s", 0.0105}}}};
+  auto sim = Simulator::Create(s);
+  ASSERT_FALSE(sim.ok());
+  EXPECT_NE(sim.status().message().find("gps_latency.latency_s"), std::string::npos) << sim.status().message();
+}
+
+}  // namespace
+}  // namespace roamlab::sim
