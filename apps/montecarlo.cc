@@ -109,7 +109,8 @@ int RunMonteCarlo(const MonteCarloArgs& args) {
   std::mutex print;
   const auto worker = [&] {
     for (int i = next++; i < args.runs; i = next++) {
-      results[i] = OneRun(scenario.value(), config.value(), calibration, tracking_options.value(), args.seed_base + i);
+      results[i] =
+          OneRun(scenario.value(), config.value(), calibration, tracking_options.value(), args.seed_base + i);
       const int finished = ++done;
       if (!args.quiet) {
         std::lock_guard<std::mutex> lock(print);

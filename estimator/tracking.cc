@@ -117,7 +117,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
   if (prior != nullptr) {
     for (const std::string& name : prior->names) {
       if (!calibration.count(name) || !config.parameters.count(name))
-        return Status::Error("calibration prior: parameter '" + name + "' has no calibrated value in the configuration");
+        return Status::Error("calibration prior: parameter '" + name + "' has no calibrated value");
       config.parameters[name].free = true;
     }
   }
