@@ -18,17 +18,10 @@ namespace {
 
 std::string Source(const std::string& relative) { return std::string(ROAMLAB_SOURCE_DIR) + "/" + relative; }
 
-struct CommandRun {
-  int exit_code;
-  std::string out;
-  std::string err;
-};
+using testing::CommandRun;
 
 CommandRun Roamlab(const std::string& args, const testing::TempDir& dir) {
-  const std::string cmd = std::string(ROAMLAB_BINARY) + " " + args + " > " + dir.File("stdout.txt") + " 2> " +
-                          dir.File("stderr.txt");
-  const int status = std::system(cmd.c_str());
-  return {WEXITSTATUS(status), testing::ReadFile(dir.File("stdout.txt")), testing::ReadFile(dir.File("stderr.txt"))};
+  return testing::RunCommand(std::string(ROAMLAB_BINARY) + " " + args, dir.path());
 }
 
 // atv_hills.yaml shortened to `duration_s` with `effects` as its effects section, written into dir.

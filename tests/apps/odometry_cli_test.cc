@@ -15,25 +15,17 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "tests/recording/temp_dir.h"
+
 namespace roamlab {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CommandRun {
-  int exit_code;
-  std::string err;
-};
+using testing::CommandRun;
 
 CommandRun Roamlab(const std::string& args, const fs::path& dir) {
-  const fs::path err = dir / "stderr.txt";
-  const std::string cmd = std::string(ROAMLAB_BINARY) + " " + args + " > " + (dir / "stdout.txt").string() + " 2> " +
-                          err.string();
-  const int status = std::system(cmd.c_str());
-  std::ifstream in(err);
-  std::stringstream s;
-  s << in.rdbuf();
-  return {WEXITSTATUS(status), s.str()};
+  return testing::RunCommand(std::string(ROAMLAB_BINARY) + " " + args, dir.string());
 }
 
 constexpr double kPi = 3.14159265358979323846;

@@ -1,8 +1,10 @@
 // A fresh directory per test, removed with everything in it when the test ends, and small file helpers.
 #pragma once
 
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -37,6 +39,23 @@ class TempDir {
 
 inline void WriteFile(const std::string& path, const std::string& content) {
   std::ofstream(path, std::ios::binary) << content;
+}
+
+inline std::string ReadFile(const std::string& path);
+
+// A command's exit code, standard output and standard error.
+struct CommandRun {
+  int exit_code;
+  std::string out;
+  std::string err;
+};
+
+// Runs `command` through the shell with its standard output and error captured in files of `directory`.
+inline CommandRun RunCommand(const std::string& command, const std::string& directory) {
+  const std::string out = (std::filesystem::path(directory) / "stdout.txt").string();
+  const std::string err = (std::filesystem::path(directory) / "stderr.txt").string();
+  const int status = std::system((command + " > " + out + " 2> " + err).c_str());
+  return {WEXITSTATUS(status), ReadFile(out), ReadFile(err)};
 }
 
 inline std::string ReadFile(const std::string& path) {

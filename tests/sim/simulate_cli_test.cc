@@ -17,18 +17,10 @@
 namespace roamlab {
 namespace {
 
-struct CommandRun {
-  int exit_code;
-  std::string out;
-  std::string err;
-};
+using roamlab::testing::CommandRun;
 
 CommandRun Roamlab(const std::string& args, const roamlab::testing::TempDir& dir) {
-  const std::string cmd = std::string(ROAMLAB_BINARY) + " " + args + " > " + dir.File("stdout.txt") + " 2> " +
-                          dir.File("stderr.txt");
-  const int status = std::system(cmd.c_str());
-  return {WEXITSTATUS(status), roamlab::testing::ReadFile(dir.File("stdout.txt")),
-          roamlab::testing::ReadFile(dir.File("stderr.txt"))};
+  return roamlab::testing::RunCommand(std::string(ROAMLAB_BINARY) + " " + args, dir.path());
 }
 
 // atv_hills.yaml shortened to 2 s, with `from` replaced by `to`, written into dir as scenario.yaml.
