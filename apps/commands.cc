@@ -144,7 +144,9 @@ Result<estimator::TrackingOptions> TrackingOptionsFor(const estimator::Estimator
   estimator::TrackingOptions options;
   if (!config.tracking.calibration_prior) return options;
   if (calibration_path.empty())
-    return Status::Error(config.source_file + ": tracking.calibration_prior needs --calibration calibration.json");
+    return Status::Error(config.source_file +
+                         ": tracking.calibration_prior needs --calibration calibration.json (montecarlo: or "
+                         "tracking.calibrate)");
   auto prior = ReadCalibrationPrior(calibration_path);
   if (!prior.ok()) return prior.status();
   options.calibration_prior = std::move(prior).value();

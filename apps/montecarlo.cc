@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdint>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
+#include "apps/simulate.h"
 #include "estimator/config.h"
 #include "estimator/tracking.h"
 #include "eval/nees.h"
@@ -80,6 +82,32 @@ int Fail(std::ostream* err, const std::string& message, int code) {
   return code;
 }
 
+// Simulates the scenario with `seed` into OUT/calibration/recording and calibrates it with `calibration_config` into
+// OUT/calibration; `file` receives OUT/calibration/calibration.json. Returns the failing command's exit code.
+int CalibrateOnce(const MonteCarloArgs& args, std::uint64_t seed, const std::string& calibration_config,
+                  std::string* file) {
+  const std::string dir = (std::filesystem::path(args.out) / "calibration").string();
+  if (!args.quiet)
+    std::cerr << "montecarlo: calibrating once with " << calibration_config << " on the scenario's own noise seed "
+              << seed << " (" << dir << ")\n";
+  SimulateArgs simulate;
+  simulate.scenario = args.scenario;
+  simulate.out = dir + "/recording";
+  simulate.seed = seed;
+  simulate.quiet = true;
+  simulate.err = args.err;
+  if (const int code = RunSimulate(simulate); code != 0) return code;
+  CalibrateArgs calibrate;
+  calibrate.recording = simulate.out;
+  calibrate.config = calibration_config;
+  calibrate.out = dir;
+  calibrate.quiet = true;
+  calibrate.err = args.err;
+  if (const int code = RunCalibrate(calibrate); code != 0) return code;
+  *file = dir + "/calibration.json";
+  return 0;
+}
+
 }  // namespace
 
 int RunMonteCarlo(const MonteCarloArgs& args) {
@@ -90,17 +118,25 @@ int RunMonteCarlo(const MonteCarloArgs& args) {
   auto config = estimator::LoadEstimatorConfig(args.config);
   if (!config.ok()) return Fail(args.err, config.status().message(), 2);
   if (args.no_time_budget) config.value().tracking.time_budget_s = std::numeric_limits<double>::infinity();
-  std::map<std::string, Eigen::VectorXd> calibration;
-  if (!args.calibration.empty()) {
-    auto cal = ReadCalibrationValues(args.calibration);
-    if (!cal.ok()) return Fail(args.err, cal.status().message(), 2);
-    calibration = std::move(cal).value();
-  }
-  auto tracking_options = TrackingOptionsFor(config.value(), args.calibration);
-  if (!tracking_options.ok()) return Fail(args.err, tracking_options.status().message(), 2);
   std::error_code ec;
   std::filesystem::create_directories(args.out, ec);
   if (ec) return Fail(args.err, args.out + ": cannot create the output directory: " + ec.message(), 2);
+
+  // The calibration tracking starts from: the given file, or (tracking.calibrate) one offline calibration of the
+  // scenario simulated with its own noise seed, a realization apart from the runs' (seed_base + i).
+  std::string calibration_file = args.calibration;
+  if (calibration_file.empty() && !config.value().tracking.calibrate.empty()) {
+    const int code = CalibrateOnce(args, scenario.value().seed, config.value().tracking.calibrate, &calibration_file);
+    if (code != 0) return code;
+  }
+  std::map<std::string, Eigen::VectorXd> calibration;
+  if (!calibration_file.empty()) {
+    auto cal = ReadCalibrationValues(calibration_file);
+    if (!cal.ok()) return Fail(args.err, cal.status().message(), 2);
+    calibration = std::move(cal).value();
+  }
+  auto tracking_options = TrackingOptionsFor(config.value(), calibration_file);
+  if (!tracking_options.ok()) return Fail(args.err, tracking_options.status().message(), 2);
 
   // Runs spread over worker threads; each writes only its own slot, so the result does not depend on scheduling.
   const int jobs = args.jobs > 0 ? args.jobs : std::max(1u, std::thread::hardware_concurrency());

@@ -69,7 +69,8 @@ int main(int argc, char** argv) {
       "montecarlo", "NEES consistency of online tracking over noise realizations (seed 000, Section V, Fig. 4).");
   mc->add_option("scenario", montecarlo.scenario, "Scenario file (SCENARIO.yaml)")->required();
   mc->add_option("--config", montecarlo.config, "Estimator configuration for tracking (EST.yaml)")->required();
-  mc->add_option("--calibration", montecarlo.calibration, "calibration.json whose values tracking uses");
+  mc->add_option("--calibration", montecarlo.calibration,
+                 "calibration.json whose values tracking uses (default: calibrate once with tracking.calibrate)");
   mc->add_option("--runs", montecarlo.runs, "Noise realizations (default 50)");
   mc->add_option("--jobs", montecarlo.jobs, "Parallel runs (default: one per core)");
   mc->add_option("--seed-base", montecarlo.seed_base, "Run i uses noise seed SEED_BASE + i (default 1000)");

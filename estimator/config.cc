@@ -1,5 +1,6 @@
 #include "estimator/config.h"
 
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -183,9 +184,14 @@ class Parser {
   void ParseTracking(const YAML::Node& n, TrackingConfig* t) const {
     CheckKeys(n,
               {"window", "max_iterations", "improvement_threshold", "time_budget_s", "initialization_s",
-               "calibration_prior"},
+               "calibration_prior", "calibrate"},
               "tracking");
     if (n["calibration_prior"]) t->calibration_prior = Bool(n["calibration_prior"], "tracking.calibration_prior");
+    if (n["calibrate"]) {
+      const std::string path = String(n["calibrate"], "tracking.calibrate");
+      if (path.empty()) Fail(n["calibrate"], "tracking.calibrate must name a configuration file");
+      t->calibrate = (std::filesystem::path(file_).parent_path() / path).lexically_normal().string();
+    }
     if (n["window"]) t->window = static_cast<int>(Number(n["window"], "tracking.window"));
     if (n["max_iterations"]) t->max_iterations = static_cast<int>(Number(n["max_iterations"], "max_iterations"));
     if (n["improvement_threshold"])

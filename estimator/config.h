@@ -86,6 +86,9 @@ struct TrackingConfig {
   // With a calibration that carries its information matrix (TrackingOptions::calibration_prior), the calibrated
   // constant parameters stay free in the window under that Gaussian prior instead of being fixed at their values.
   bool calibration_prior = false;
+  // Offline calibration configuration (absolute path; written relative to this file) that `roamlab montecarlo`
+  // runs once, on the scenario simulated with its own seed, when it is given no calibration. "" = none.
+  std::string calibrate;
 };
 
 struct EstimatorConfig {

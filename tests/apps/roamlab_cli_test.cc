@@ -98,6 +98,37 @@ TEST_F(CliTest, CalibrateAndTrackWriteTheirOutputs) {
   EXPECT_NE(r.err.find("no 'information'"), std::string::npos) << r.err;
 }
 
+// montecarlo without --calibration, with tracking.calibrate (scenarios/atv_tracking.yaml): one offline calibration
+// on the scenario's own noise seed, then the runs track under its prior. A 6 s drive keeps the test short.
+TEST_F(CliTest, MonteCarloCalibratesOnceWhenTheConfigSaysHow) {
+  std::ifstream in(std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/atv_hills.yaml");
+  std::string scenario((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string from = "duration_s: 30.0";
+  ASSERT_NE(scenario.find(from), std::string::npos);
+  scenario.replace(scenario.find(from), from.size(), "duration_s: 6.0");
+  const std::string model = "../models/atv.xml";  // relative to the scenario's file: made absolute for the copy
+  ASSERT_NE(scenario.find(model), std::string::npos);
+  scenario.replace(scenario.find(model), model.size(), std::string(ROAMLAB_SOURCE_DIR) + "/models/atv.xml");
+  const std::string short_scenario = (dir_ / "atv_short.yaml").string();
+  std::ofstream(short_scenario) << scenario;
+  const std::string config = std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/atv_tracking.yaml";
+  const CommandRun r = Roamlab("montecarlo " + short_scenario + " --config " + config + " --runs 2 --jobs 1 --t0 1" +
+                                   " --out " + (dir_ / "mc").string(),
+                               dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("calibrating once with"), std::string::npos) << r.err;
+  std::ifstream cin(dir_ / "mc" / "calibration" / "calibration.json");
+  const nlohmann::json cal = nlohmann::json::parse(cin);
+  EXPECT_TRUE(cal.contains("information"));
+  std::ifstream rin(dir_ / "mc" / "calibration" / "recording" / "recording.yaml");
+  const std::string recording((std::istreambuf_iterator<char>(rin)), std::istreambuf_iterator<char>());
+  EXPECT_NE(recording.find("seed: 1\n"), std::string::npos) << "calibrated on the scenario's own seed";
+  std::ifstream nin(dir_ / "mc" / "nees.json");
+  const nlohmann::json nees = nlohmann::json::parse(nin);
+  EXPECT_EQ(nees["runs"], 2);
+  EXPECT_GT(nees["mean_nees"].size(), 100u);
+}
+
 TEST_F(CliTest, BadInputGivesOneLineAndNonZeroExit) {
   const std::string config = std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/atv_calibration.yaml";
   for (const std::string& args :

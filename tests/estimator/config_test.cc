@@ -43,5 +43,17 @@ TEST(ConfigTest, RejectsUnknownKeysModelsAndMissingNoise) {
   ExpectError(Replace(good, "method: levenberg_marquardt", "method: newton"), "solver.method");
 }
 
+// tracking.calibrate names a calibration configuration relative to the file that names it.
+TEST(ConfigTest, TrackingCalibrateIsRelativeToTheConfigFile) {
+  const std::string good = testing::AtvConfigYaml({});
+  const std::string with = Replace(good, "master: odometer", "master: odometer\ntracking: {calibrate: cal.yaml}");
+  const auto config = ParseEstimatorConfig(with, "configs/est.yaml");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  EXPECT_EQ(config.value().tracking.calibrate, "configs/cal.yaml");
+  EXPECT_EQ(ParseEstimatorConfig(good, "est.yaml").value().tracking.calibrate, "");
+  ExpectError(Replace(good, "master: odometer", "master: odometer\ntracking: {calibrate: ''}"),
+              "tracking.calibrate must name a configuration file");
+}
+
 }  // namespace
 }  // namespace roamlab::estimator
