@@ -17,6 +17,7 @@
 //         - {metric: metrics.ate_m, bound: "<= 1.10 * baseline"}
 //         - {metric: metrics.velocity.fused.linear_rmse, bound: "<= 0.5 * metrics.velocity.encoders_only.linear_rmse"}
 //         - {metric: gap.verdict, equals: named}
+//         - {metric: "gap.effects[name=gps_latency].parameters.latency_s", bound: "<= 0.54"}  # quoted: [ ] , in {}
 //         - {metric: metrics.parameters.imu.misalignment.angle_error_deg, bound: "<= 2", open: "issue 3 target"}
 //
 // A metric is a dotted path into one of the mode's output files (ModeSpec::outputs): the output's name, then keys

@@ -116,9 +116,9 @@ SuiteResult Example() {
   CaseResult a;
   a.name = "atv&calibration";
   a.mode = "calibrate";
-  CheckResult pass{"metrics.ate_m", "<= 0.5", 0.25, std::nullopt, 0.5, CheckResult::Outcome::kPassed, ""};
+  CheckResult pass{"metrics.ate_m", "<= 0.5", 0.25, std::nullopt, 0.5, CheckResult::Outcome::kPassed, "", std::nullopt, ""};
   CheckResult fail{"metrics.nees.fraction_in_band", ">= baseline - 0.03", 0.5, 0.9, 0.87,
-                   CheckResult::Outcome::kFailed, ""};
+                   CheckResult::Outcome::kFailed, "", std::nullopt, ""};
   fail.message = FailureMessage(fail);
   a.checks = {pass, fail};
   CaseResult b;
@@ -126,7 +126,7 @@ SuiteResult Example() {
   b.mode = "track";
   b.error = "roamlab track: rec/<gps>.csv:3: bad \x01 byte & more";
   b.checks = {{"summary.poses", "> 10", std::nullopt, std::nullopt, std::nullopt, CheckResult::Outcome::kError,
-               "case error: " + b.error}};
+               "case error: " + b.error, std::nullopt, ""}};
   r.cases = {a, b};
   return r;
 }
@@ -157,13 +157,13 @@ TEST(JunitTest, OpenTargetsAndSkippedCasesAreSkippedTestcases) {
   CaseResult a;
   a.name = "targets";
   a.mode = "calibrate";
-  CheckResult open{"metrics.ate_m", "<= 0.1", 0.25, std::nullopt, 0.1, CheckResult::Outcome::kOpen, ""};
+  CheckResult open{"metrics.ate_m", "<= 0.1", 0.25, std::nullopt, 0.1, CheckResult::Outcome::kOpen, "", std::nullopt, ""};
   open.open = "issue 3 target, not met yet";
   open.message = "open target not met (" + open.open + "): " + FailureMessage(open);
-  CheckResult met{"metrics.rpe_trans_m", "<= 0.5", 0.25, std::nullopt, 0.5, CheckResult::Outcome::kPassed, ""};
+  CheckResult met{"metrics.rpe_trans_m", "<= 0.5", 0.25, std::nullopt, 0.5, CheckResult::Outcome::kPassed, "", std::nullopt, ""};
   met.open = "issue 3 target";
   CheckResult text{"gap.verdict", "equals named", std::nullopt, std::nullopt, std::nullopt,
-                   CheckResult::Outcome::kFailed, ""};
+                   CheckResult::Outcome::kFailed, "", std::nullopt, ""};
   text.text = "unknown";
   text.message = FailureMessage(text);
   EXPECT_EQ(text.message, "value 'unknown' is not 'named'");
@@ -173,7 +173,7 @@ TEST(JunitTest, OpenTargetsAndSkippedCasesAreSkippedTestcases) {
   b.mode = "odometry";
   b.skipped = "data directory /x is absent";
   b.checks = {{"table.interval_s", "<= 1", std::nullopt, std::nullopt, std::nullopt, CheckResult::Outcome::kSkipped,
-               "case skipped: " + b.skipped}};
+               "case skipped: " + b.skipped, std::nullopt, ""}};
   r.cases = {a, b};
   const std::string xml = JunitXml(r);
   EXPECT_EQ(XmlChecker(xml).Check(), "") << xml;

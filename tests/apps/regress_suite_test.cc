@@ -104,16 +104,16 @@ class SuiteTest : public ::testing::Test {
 // open targets in checks; a case whose data directory is absent loads (it is skipped when run).
 TEST_F(SuiteTest, LoadsOdometryAndDiagnoseCasesWithSelectorsTextsAndOpenTargets) {
   const std::string path = WriteSuite(
-      "  - name: odo\n    mode: odometry\n    data: no_such_data\n    train: [diff/square/*.csv, rec]\n"
-      "    test: [diff/circular/*.csv]\n    interval_s: 0.25\n"
+      "  - name: odo\n    mode: odometry\n    data: no_such_data\n    train: [\"diff/square/*.csv\", rec]\n"
+      "    test: [\"diff/circular/*.csv\"]\n    interval_s: 0.25\n"
       "    models: [{model: linear}, {model: gp, mean: linear, kernel: rbf+linear}]\n    checks:\n"
-      "      - {metric: table.rows[model=gp,mean=linear,kernel=rbf+linear].ate_m,\n"
+      "      - {metric: \"table.rows[model=gp,mean=linear,kernel=rbf+linear].ate_m\",\n"
       "         bound: \"<= 0.5 * table.rows[model=nominal].ate_m\", open: \"issue 5 target\"}\n"
       "      - {metric: table.rows.ate_m.max, bound: \"<= 1\"}\n"
       "  - name: gap\n    mode: diagnose\n    scenario: " + Config("atv_hills.yaml") + "\n    seed: 13\n"
       "    effects: [{name: steering_offset, offset_rad: 0.03}]\n    checks:\n"
       "      - {metric: gap.verdict, equals: named}\n"
-      "      - {metric: gap.effects[name=steering_offset].parameters.offset_rad, bound: \"<= 0.035\"}\n");
+      "      - {metric: \"gap.effects[name=steering_offset].parameters.offset_rad\", bound: \"<= 0.035\"}\n");
   const Result<Suite> suite = LoadSuite(path);
   ASSERT_TRUE(suite.ok()) << suite.status().message();
   const Case& odo = suite.value().cases[0];
@@ -203,9 +203,9 @@ TEST_F(SuiteTest, EachKindOfBadSuiteIsOneLineNamingFileCaseAndProblem) {
        "bad model entry 'model: svm'"},
       {Odometry("      - {metric: table.rows.ate_m, bound: \"<= 1\"}\n", "    models: [{model: linear, mean: zero}]\n"),
        "mean and kernel are options of the gp model only"},
-      {Odometry("      - {metric: table.rows[mdl=gp].ate_m, bound: \"<= 1\"}\n"), "no text field 'mdl'"},
-      {Odometry("      - {metric: table.rows[model].ate_m, bound: \"<= 1\"}\n"), "is not FIELD=VALUE"},
-      {Odometry("      - {metric: table.rows[model=gp].model, bound: \"<= 1\"}\n"), "is a text: check it with"},
+      {Odometry("      - {metric: \"table.rows[mdl=gp].ate_m\", bound: \"<= 1\"}\n"), "no text field 'mdl'"},
+      {Odometry("      - {metric: \"table.rows[model].ate_m\", bound: \"<= 1\"}\n"), "is not FIELD=VALUE"},
+      {Odometry("      - {metric: \"table.rows[model=gp].model\", bound: \"<= 1\"}\n"), "is a text: check it with"},
       {Odometry("      - {metric: table.rows.model, equals: gp}\n"), "column of texts"},
       {Odometry("      - {metric: table.interval_s, equals: gp}\n"), "is a number: give a bound"},
       {Odometry("      - {metric: table.interval_s, bound: \"<= 1\", equals: gp}\n"), "a check is"},
