@@ -70,7 +70,8 @@ bool SuiteResult::Passed() const {
 }
 
 std::string FailureMessage(const CheckResult& check) {
-  if (check.text) return "value " + ValueText(check) + " is not '" + check.bound.substr(check.bound.find(' ') + 1) + "'";
+  if (check.text)
+    return "value " + ValueText(check) + " is not '" + check.bound.substr(check.bound.find(' ') + 1) + "'";
   std::string message = "value " + Format(check.value) + " violates bound '" + check.bound + "'";
   if (check.baseline) {
     message += " (threshold " + Format(check.threshold) + ", baseline " + Format(check.baseline) + ")";

@@ -116,7 +116,8 @@ SuiteResult Example() {
   CaseResult a;
   a.name = "atv&calibration";
   a.mode = "calibrate";
-  CheckResult pass{"metrics.ate_m", "<= 0.5", 0.25, std::nullopt, 0.5, CheckResult::Outcome::kPassed, "", std::nullopt, ""};
+  CheckResult pass{"metrics.ate_m", "<= 0.5", 0.25, std::nullopt, 0.5, CheckResult::Outcome::kPassed, "",
+                   std::nullopt, ""};
   CheckResult fail{"metrics.nees.fraction_in_band", ">= baseline - 0.03", 0.5, 0.9, 0.87,
                    CheckResult::Outcome::kFailed, "", std::nullopt, ""};
   fail.message = FailureMessage(fail);
@@ -157,10 +158,12 @@ TEST(JunitTest, OpenTargetsAndSkippedCasesAreSkippedTestcases) {
   CaseResult a;
   a.name = "targets";
   a.mode = "calibrate";
-  CheckResult open{"metrics.ate_m", "<= 0.1", 0.25, std::nullopt, 0.1, CheckResult::Outcome::kOpen, "", std::nullopt, ""};
+  CheckResult open{"metrics.ate_m", "<= 0.1", 0.25, std::nullopt, 0.1, CheckResult::Outcome::kOpen, "",
+                   std::nullopt, ""};
   open.open = "issue 3 target, not met yet";
   open.message = "open target not met (" + open.open + "): " + FailureMessage(open);
-  CheckResult met{"metrics.rpe_trans_m", "<= 0.5", 0.25, std::nullopt, 0.5, CheckResult::Outcome::kPassed, "", std::nullopt, ""};
+  CheckResult met{"metrics.rpe_trans_m", "<= 0.5", 0.25, std::nullopt, 0.5, CheckResult::Outcome::kPassed, "",
+                  std::nullopt, ""};
   met.open = "issue 3 target";
   CheckResult text{"gap.verdict", "equals named", std::nullopt, std::nullopt, std::nullopt,
                    CheckResult::Outcome::kFailed, "", std::nullopt, ""};

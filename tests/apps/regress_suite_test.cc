@@ -46,7 +46,8 @@ TEST(BoundTest, ParsesNumbersAndBaselineExpressions) {
   }
   EXPECT_EQ(ParseBound("<= 0.5 * metrics.velocity.encoders_only.linear_rmse").value().reference,
             "metrics.velocity.encoders_only.linear_rmse");
-  EXPECT_EQ(ParseBound("<= table.rows[model=nominal].ate_m - 0.5").value().reference, "table.rows[model=nominal].ate_m");
+  EXPECT_EQ(ParseBound("<= table.rows[model=nominal].ate_m - 0.5").value().reference,
+            "table.rows[model=nominal].ate_m");
 }
 
 TEST(BoundTest, ComparesStrictlyOrNotAndRejectsNaN) {

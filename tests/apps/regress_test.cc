@@ -251,7 +251,8 @@ TEST_F(RegressTest, OdometryCaseLearnsAndEvaluatesFromOptiOdomFiles) {
   write_run(data / "test/syn_run-01.csv", 1, 30.0);
   const std::string path = dir_->File("suite_odometry.yaml");
   testing::WriteFile(path, "cases:\n  - name: odometry\n    mode: odometry\n    data: optiodom\n"
-                           "    train: [\"train/*_run-??.csv\"]\n    test: [\"test/*_run-??.csv\"]\n    interval_s: 0.25\n"
+                           "    train: [\"train/*_run-??.csv\"]\n    test: [\"test/*_run-??.csv\"]\n"
+                           "    interval_s: 0.25\n"
                            "    models: [{model: linear}, {model: parametric}]\n    checks:\n"
                            "      - {metric: \"table.rows[model=linear].ate_m\", bound: \"<= 0.2 * "
                            "table.rows[model=nominal].ate_m\"}\n"
