@@ -72,42 +72,77 @@ CaseResult RunCase(const Case& c, const std::string& out_dir, int jobs) {
   const std::string dir = out_dir + "/cases/" + c.name;
   std::error_code ec;
   fs::remove_all(dir, ec);
-  fs::create_directories(dir, ec);
-  if (ec) {
-    result.error = dir + ": cannot create the case directory: " + ec.message();
+  if (!c.data.empty() && !fs::is_directory(c.data)) {
+    result.skipped = "data directory " + c.data + " is absent";
   } else {
-    const Status st = mode.run(regress::CaseContext{c, dir, jobs});
-    if (!st.ok()) result.error = st.message();
+    fs::create_directories(dir, ec);
+    if (ec) {
+      result.error = dir + ": cannot create the case directory: " + ec.message();
+    } else {
+      const Status st = mode.run(regress::CaseContext{c, dir, jobs});
+      if (!st.ok()) result.error = st.message();
+    }
   }
 
   // The values, from the output files the checks name.
   std::map<std::string, json> outputs;
+  const auto output = [&](const std::string& name, std::string* file) -> const json* {
+    const auto o = std::find_if(mode.outputs.begin(), mode.outputs.end(),
+                                [&](const regress::ModeOutput& m) { return m.name == name; });
+    ROAMLAB_CHECK(o != mode.outputs.end(), "output " << name << " was validated against mode " << c.mode);
+    *file = dir + "/" + o->file;
+    if (!outputs.count(name)) {
+      std::ifstream in(*file);
+      outputs[name] = json::parse(in, nullptr, false);
+    }
+    return outputs[name].is_discarded() ? nullptr : &outputs[name];
+  };
   for (const regress::Check& check : c.checks) {
     CheckResult r;
     r.metric = check.metric.text;
-    r.bound = check.bound.text;
+    r.bound = check.equals ? "equals " + *check.equals : check.bound.text;
+    r.open = check.open;
     r.outcome = CheckResult::Outcome::kError;
+    if (!result.skipped.empty()) {
+      r.outcome = CheckResult::Outcome::kSkipped;
+      r.message = "case skipped: " + result.skipped;
+      result.checks.push_back(r);
+      continue;
+    }
     if (!result.error.empty()) {
       r.message = "case error: " + result.error;
       result.checks.push_back(r);
       continue;
     }
-    const auto o = std::find_if(mode.outputs.begin(), mode.outputs.end(),
-                                [&](const regress::ModeOutput& m) { return m.name == check.metric.output; });
-    ROAMLAB_CHECK(o != mode.outputs.end(), "metric " << r.metric << " was validated against mode " << c.mode);
-    const std::string file = dir + "/" + o->file;
-    if (!outputs.count(o->name)) {
-      std::ifstream in(file);
-      outputs[o->name] = json::parse(in, nullptr, false);
-    }
-    if (outputs[o->name].is_discarded()) {
+    std::string file;
+    const json* out = output(check.metric.output, &file);
+    if (!out) {
       r.message = file + ": missing or not valid JSON";
+    } else if (check.metric.is_string) {
+      const Result<std::string> text = regress::ResolveText(*out, check.metric);
+      if (text.ok()) {
+        r.text = text.value();
+      } else {
+        r.message = file + ": " + text.status().message();
+      }
     } else {
-      const Result<double> value = regress::ResolveMetric(outputs[o->name], check.metric);
+      const Result<double> value = regress::ResolveMetric(*out, check.metric);
       if (value.ok()) {
         r.value = value.value();
       } else {
         r.message = file + ": " + value.status().message();
+      }
+    }
+    // The bound's reference metric: its value stands in `baseline`'s place in the threshold.
+    if (check.reference && r.message.empty()) {
+      const json* ref = output(check.reference->output, &file);
+      const Result<double> value = ref ? regress::ResolveMetric(*ref, *check.reference)
+                                       : Result<double>(Status::Error("missing or not valid JSON"));
+      if (value.ok()) {
+        r.threshold = check.bound.Threshold(value.value());
+      } else {
+        r.value.reset();
+        r.message = file + ": bound's reference " + check.reference->text + ": " + value.status().message();
       }
     }
     result.checks.push_back(r);
@@ -116,25 +151,37 @@ CaseResult RunCase(const Case& c, const std::string& out_dir, int jobs) {
   return result;
 }
 
-// Applies each check's bound to its value (and baseline).
+// Applies each check's bound to its value (and baseline); an open target that does not hold becomes kOpen.
 void ApplyBounds(const Case& c, const Baseline& baseline, const std::string& baseline_file, CaseResult* result) {
   for (std::size_t i = 0; i < c.checks.size(); ++i) {
-    const regress::Bound& bound = c.checks[i].bound;
+    const regress::Check& check = c.checks[i];
+    const regress::Bound& bound = check.bound;
     CheckResult& r = result->checks[i];
-    if (!r.value) continue;  // an error already
-    double base = 0.0;
-    if (bound.uses_baseline) {
-      const auto stored = baseline.find(r.metric);
-      if (stored == baseline.end()) {
-        r.message = "no baseline value for " + r.metric + " in " + baseline_file + " (run with --update-baseline)";
-        continue;
+    bool holds = false;
+    if (r.text) {
+      holds = *r.text == *check.equals;
+    } else if (r.value) {
+      double base = 0.0;
+      if (bound.uses_baseline) {
+        const auto stored = baseline.find(r.metric);
+        if (stored == baseline.end()) {
+          r.message = "no baseline value for " + r.metric + " in " + baseline_file + " (run with --update-baseline)";
+          continue;
+        }
+        base = stored->second;
+        r.baseline = base;
       }
-      base = stored->second;
-      r.baseline = base;
+      if (!check.reference) r.threshold = bound.Threshold(base);
+      holds = bound.Holds(*r.value, *r.threshold);
+    } else {
+      continue;  // an error (or a skipped case) already
     }
-    r.threshold = bound.Threshold(base);
-    if (bound.Holds(*r.value, *r.threshold)) {
+    if (holds) {
       r.outcome = CheckResult::Outcome::kPassed;
+      if (!check.open.empty()) r.message = "open target met (" + check.open + "): remove the 'open' marker";
+    } else if (!check.open.empty()) {
+      r.outcome = CheckResult::Outcome::kOpen;
+      r.message = "open target not met (" + check.open + "): " + regress::FailureMessage(r);
     } else {
       r.outcome = CheckResult::Outcome::kFailed;
       r.message = regress::FailureMessage(r);
@@ -191,7 +238,8 @@ int RunRegress(const RegressArgs& args) {
         std::lock_guard<std::mutex> lock(print);
         std::fprintf(stderr, "regress [%zu/%zu] %s (%s): %s in %.1f s\n", finished, cases.size(),
                      cases[i]->name.c_str(), cases[i]->mode.c_str(),
-                     result.cases[i].error.empty() ? "ran" : "error", result.cases[i].seconds);
+                     !result.cases[i].error.empty() ? "error" : !result.cases[i].skipped.empty() ? "skipped" : "ran",
+                     result.cases[i].seconds);
       }
     }
   };
@@ -201,7 +249,7 @@ int RunRegress(const RegressArgs& args) {
 
   // New baselines (cases that ran), then the bounds.
   for (std::size_t i = 0; i < cases.size(); ++i) {
-    if (args.update_baseline && result.cases[i].error.empty()) {
+    if (args.update_baseline && result.cases[i].error.empty() && result.cases[i].skipped.empty()) {
       Baseline values;
       for (const CheckResult& r : result.cases[i].checks)
         if (r.value) values[r.metric] = *r.value;

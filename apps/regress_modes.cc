@@ -1,15 +1,28 @@
 #include "apps/regress_modes.h"
 
+#include <glob.h>
+
+#include <algorithm>
+#include <filesystem>
 #include <sstream>
+#include <type_traits>
+#include <utility>
 
 #include "apps/commands.h"
+#include "apps/diagnose.h"
 #include "apps/evaluate.h"
+#include "apps/import.h"
 #include "apps/montecarlo.h"
+#include "apps/odometry.h"
 #include "apps/simulate.h"
+#include "recording/recording.h"
+#include "recording/truth.h"
+#include "sim/simulator.h"
 
 namespace roamlab::apps::regress {
 namespace {
 
+namespace fs = std::filesystem;
 using nlohmann::json;
 
 // What `roamlab evaluate` writes (apps/evaluate.cc, eval/evaluate.cc, eval/parameters.cc).
@@ -42,6 +55,12 @@ json MetricsSchema() {
             {"band_single_run", "numbers"},
             {"t0_s", "number"},
             {"fraction_in_band", "number"}}},
+          {"velocity",
+           {{"fused", {{"linear_rmse", "number"}, {"angular_rmse", "number"}, {"rpe_rot_deg", "number"},
+                       {"intervals", "number"}}},
+            {"encoders_only", {{"linear_rmse", "number"}, {"angular_rmse", "number"}, {"rpe_rot_deg", "number"},
+                               {"intervals", "number"}}},
+            {"rpe_delta_poses", "number"}}},
           {"parameters",
            {{"<parameter>",
              {{"truth", "numbers"},
@@ -101,12 +120,19 @@ json RunsSchema() {
                                   {"track_seconds", "timing"}}})}};
 }
 
-// Calls a command with its one-line error captured: the error of a failed command becomes the case's error.
+// Whether a command's arguments take an error stream (`err`).
+template <typename Args, typename = void>
+struct HasErr : std::false_type {};
+template <typename Args>
+struct HasErr<Args, std::void_t<decltype(std::declval<Args&>().err)>> : std::true_type {};
+
+// Calls a command with its one-line error captured: the error of a failed command becomes the case's error (commands
+// without an error stream print it to stderr; the case's error then names the command and its exit code).
 template <typename Args>
 Status Call(int (*command)(const Args&), Args args, const std::string& what) {
   std::ostringstream err;
   args.quiet = true;
-  args.err = &err;
+  if constexpr (HasErr<Args>::value) args.err = &err;
   const int code = command(args);
   if (code == 0) return Status::Ok();
   std::string message = err.str();
@@ -202,6 +228,145 @@ Status RunMonteCarloCase(const CaseContext& context) {
   return Call(RunMonteCarlo, args, "montecarlo");
 }
 
+// What `roamlab odometry evaluate` writes (apps/odometry.h).
+json TableSchema() {
+  return {{"rows", json::array({{{"model", "string"}, {"mean", "string"}, {"kernel", "string"}, {"ate_m", "number"},
+                                 {"rpe_mm", "number"}, {"model_file", "string"}}})},
+          {"recordings", json::array({{{"recording", "string"}, {"key_poses", "number"}}})},
+          {"interval_s", "number"}};
+}
+
+// What `roamlab diagnose` writes to gap.json (apps/diagnose.h); effect parameters and stream names vary ("<any>").
+json GapSchema() {
+  const json effect = {{"name", "string"},
+                       {"parameters", {{"<any>", "number"}}},
+                       {"std", {{"<any>", "number"}}},
+                       {"baseline_parameters", {{"<any>", "number"}}},
+                       {"dof", "number"},
+                       {"lr_statistic", "number"},
+                       {"chi2_drop", "number"},
+                       {"baseline_lr_statistic", "number"},
+                       {"lr_pvalue", "number"},
+                       {"delta_bic", "number"},
+                       {"heldout_improvement", "number"},
+                       {"decision", "string"}};
+  const json fits = {{"<any>", {{"rms", "number"}, {"chi2_per_dof", "number"}, {"dof", "number"},
+                                {"measurements", "number"}}}};
+  const json component = {{"stream", "string"}, {"component", "number"}, {"chi2_per_dof", "number"},
+                          {"expected_chi2_per_dof", "number"}};
+  return {{"verdict", "string"},
+          {"located", json::array({component})},
+          {"effects", json::array({effect})},
+          {"candidates", json::array({effect})},
+          {"components", json::array({component})},
+          {"fit", {{"before", fits}, {"after", fits}, {"heldout_start_s", "number"}, {"whole_run_nominal", fits}}},
+          {"run", {{"fits", "number"}, {"seconds", "timing"}}}};
+}
+
+// The files a glob names, sorted; an error when it names none.
+Result<std::vector<std::string>> Glob(const std::string& pattern) {
+  glob_t g{};
+  const int code = ::glob(pattern.c_str(), 0, nullptr, &g);
+  std::vector<std::string> paths;
+  if (code == 0)
+    for (std::size_t i = 0; i < g.gl_pathc; ++i) paths.emplace_back(g.gl_pathv[i]);
+  globfree(&g);
+  if (paths.empty()) return Status::Error(pattern + " matches nothing");
+  std::sort(paths.begin(), paths.end());
+  return paths;
+}
+
+// The recordings of the odometry case's `train` or `test` entries, imported or simulated into DIR/recordings/.
+Result<std::vector<std::string>> OdometryRecordings(const CaseContext& context, const std::vector<std::string>& globs,
+                                                    const std::string& kind) {
+  std::vector<std::string> recordings;
+  for (const std::string& pattern : globs) {
+    const Result<std::vector<std::string>> paths = Glob(pattern);
+    if (!paths.ok()) return Status::Error(kind + ": " + paths.status().message());
+    for (const std::string& path : paths.value()) {
+      const std::string out = context.dir + "/recordings/" + kind + "_" + std::to_string(recordings.size()) + "_" +
+                              fs::path(path).stem().string();
+      if (fs::is_regular_file(fs::path(path) / "recording.yaml")) {
+        recordings.push_back(path);
+      } else if (fs::path(path).extension() == ".csv") {
+        ImportOptiOdomArgs args;
+        args.run_csv = path;
+        args.out = out;
+        const Status st = Call(RunImportOptiOdom, args, "import optiodom " + path);
+        if (!st.ok()) return st;
+        recordings.push_back(out);
+      } else if (fs::path(path).extension() == ".yaml") {
+        SimulateArgs args;
+        args.scenario = path;
+        args.out = out;
+        args.seed = context.c.seed;
+        const Status st = Call(RunSimulate, args, "simulate " + path);
+        if (!st.ok()) return st;
+        recordings.push_back(out);
+      } else {
+        return Status::Error(kind + ": " + path + " is not an OptiOdom run (.csv), a scenario (.yaml) or a recording");
+      }
+    }
+  }
+  return recordings;
+}
+
+// Learns each model on the training recordings and evaluates them all on the test recordings (table.json).
+Status RunOdometryCase(const CaseContext& context) {
+  const Result<std::vector<std::string>> train = OdometryRecordings(context, context.c.train, "train");
+  if (!train.ok()) return train.status();
+  const Result<std::vector<std::string>> test = OdometryRecordings(context, context.c.test, "test");
+  if (!test.ok()) return test.status();
+  OdometryEvaluateArgs evaluate;
+  for (std::size_t i = 0; i < context.c.models.size(); ++i) {
+    const Case::OdometryModel& m = context.c.models[i];
+    OdometryLearnArgs args;
+    args.recordings = train.value();
+    args.model = m.model;
+    if (!m.mean.empty()) args.mean = m.mean;
+    if (!m.kernel.empty()) args.kernel = m.kernel;
+    if (context.c.interval_s) args.interval_s = *context.c.interval_s;
+    args.out = context.dir + "/models/" + std::to_string(i) + "_" + m.model + (m.mean.empty() ? "" : "_" + m.mean) +
+               (m.kernel.empty() ? "" : "_" + m.kernel) + ".json";
+    std::error_code ec;
+    fs::create_directories(context.dir + "/models", ec);
+    const Status st = Call(RunOdometryLearn, args, "odometry learn (" + m.model + ")");
+    if (!st.ok()) return st;
+    evaluate.models.push_back(args.out);
+  }
+  evaluate.recordings = test.value();
+  evaluate.out = context.dir + "/odometry";
+  evaluate.no_plots = true;
+  return Call(RunOdometryEvaluate, evaluate, "odometry evaluate");
+}
+
+// Diagnoses the case's recording, or the scenario simulated with the case's hidden effects, against the scenario.
+Status RunDiagnoseCase(const CaseContext& context) {
+  std::string recording = context.c.recording;
+  if (recording.empty()) {
+    Result<sim::Scenario> scenario = sim::LoadScenario(context.c.scenario);
+    if (!scenario.ok()) return scenario.status();
+    scenario.value().effects.clear();
+    for (const auto& [name, parameters] : context.c.effects) scenario.value().effects.push_back({name, parameters});
+    sim::SimulateOptions options;
+    options.seed = context.c.seed;
+    const auto simulated = sim::Simulate(scenario.value(), options);
+    if (!simulated.ok()) return Status::Error("simulate: " + simulated.status().message());
+    recording = context.dir + "/recording";
+    Status st = recording::WriteRecording(simulated.value().recording, recording);
+    if (st.ok()) st = recording::WriteTruth(simulated.value().truth, recording);  // for people; diagnose never reads it
+    if (!st.ok()) return st;
+  }
+  DiagnoseArgs args;
+  args.recording = recording;
+  args.scenario = context.c.scenario;
+  args.config = context.c.config;
+  args.out = context.dir + "/diagnosis";
+  if (context.c.baseline_seed) args.baseline_seed = *context.c.baseline_seed;
+  args.no_plots = true;
+  return Call(RunDiagnose, args, "diagnose");
+}
+
 const std::vector<ModeSpec>& Modes() {
   static const std::vector<ModeSpec> modes = {
       {"calibrate",
@@ -221,9 +386,16 @@ const std::vector<ModeSpec>& Modes() {
        {"scenario", "config", "runs"},
        {{"nees", "montecarlo/nees.json", NeesSchema()}, {"runs", "montecarlo/runs.json", RunsSchema()}},
        RunMonteCarloCase},
-      // Issues in progress (model-free odometry, reality-gap diagnosis): known names, not available yet.
-      {"odometry", {}, {}, {}, nullptr},
-      {"diagnose", {}, {}, {}, nullptr},
+      {"odometry",
+       {"train", "test", "models", "interval_s", "seed"},
+       {"train", "test", "models"},
+       {{"table", "odometry/table.json", TableSchema()}},
+       RunOdometryCase},
+      {"diagnose",
+       {"scenario", "recording", "seed", "effects", "config", "baseline_seed"},
+       {"scenario"},
+       {{"gap", "diagnosis/gap.json", GapSchema()}},
+       RunDiagnoseCase},
   };
   return modes;
 }

@@ -20,8 +20,36 @@ const char* OutcomeName(CheckResult::Outcome outcome) {
     case CheckResult::Outcome::kPassed: return "pass";
     case CheckResult::Outcome::kFailed: return "FAIL";
     case CheckResult::Outcome::kError: return "ERROR";
+    case CheckResult::Outcome::kOpen: return "open (not met)";
+    case CheckResult::Outcome::kSkipped: return "skipped";
   }
   return "?";
+}
+
+const char* ResultName(const CheckResult& k) {
+  switch (k.outcome) {
+    case CheckResult::Outcome::kPassed: return k.open.empty() ? "passed" : "open met";
+    case CheckResult::Outcome::kFailed: return "failed";
+    case CheckResult::Outcome::kError: return "error";
+    case CheckResult::Outcome::kOpen: return "open";
+    case CheckResult::Outcome::kSkipped: return "skipped";
+  }
+  return "?";
+}
+
+std::string ValueText(const CheckResult& k) { return k.text ? "'" + *k.text + "'" : Format(k.value); }
+
+int OpenMet(const SuiteResult& result) {
+  int n = 0;
+  for (const CaseResult& c : result.cases)
+    for (const CheckResult& k : c.checks) n += k.outcome == CheckResult::Outcome::kPassed && !k.open.empty();
+  return n;
+}
+
+int Total(const SuiteResult& result) {
+  int n = 0;
+  for (const CaseResult& c : result.cases) n += static_cast<int>(c.checks.size());
+  return n;
 }
 
 json Optional(std::optional<double> x) { return x ? json(*x) : json(nullptr); }
@@ -42,9 +70,14 @@ bool SuiteResult::Passed() const {
 }
 
 std::string FailureMessage(const CheckResult& check) {
+  if (check.text)
+    return "value " + ValueText(check) + " is not '" + check.bound.substr(check.bound.find(' ') + 1) + "'";
   std::string message = "value " + Format(check.value) + " violates bound '" + check.bound + "'";
-  if (check.baseline)
+  if (check.baseline) {
     message += " (threshold " + Format(check.threshold) + ", baseline " + Format(check.baseline) + ")";
+  } else if (check.threshold && check.bound.find('*') != std::string::npos) {
+    message += " (threshold " + Format(check.threshold) + ")";
+  }
   return message;
 }
 
@@ -68,15 +101,23 @@ std::string ResultsTable(const SuiteResult& result) {
   row("case", "metric", "value", "bound", "baseline", "result");
   for (const CaseResult& c : result.cases)
     for (const CheckResult& k : c.checks)
-      row(c.name, k.metric, Format(k.value), k.bound, Format(k.baseline), OutcomeName(k.outcome));
+      row(c.name, k.metric, ValueText(k), k.bound, Format(k.baseline),
+          k.outcome == CheckResult::Outcome::kPassed && !k.open.empty() ? "MET (open: remove the marker)"
+                                                                        : OutcomeName(k.outcome));
   for (const CaseResult& c : result.cases) {
     if (!c.error.empty()) out += "case " + c.name + ": error: " + c.error + "\n";
+    if (!c.skipped.empty()) out += "case " + c.name + ": skipped: " + c.skipped + "\n";
   }
-  std::snprintf(line, sizeof line, "%d checks: %d passed, %d failed, %d errors (%zu cases, %.1f s)\n",
-                result.Count(CheckResult::Outcome::kPassed) + result.Count(CheckResult::Outcome::kFailed) +
-                    result.Count(CheckResult::Outcome::kError),
-                result.Count(CheckResult::Outcome::kPassed), result.Count(CheckResult::Outcome::kFailed),
-                result.Count(CheckResult::Outcome::kError), result.cases.size(), result.seconds);
+  for (const CaseResult& c : result.cases)
+    for (const CheckResult& k : c.checks)
+      if (k.outcome == CheckResult::Outcome::kOpen) out += c.name + " " + k.metric + ": " + k.message + "\n";
+  std::snprintf(line, sizeof line,
+                "%d checks: %d passed, %d failed, %d errors, %d open targets not met, %d open targets met, %d skipped "
+                "(%zu cases, %.1f s)\n",
+                Total(result), result.Count(CheckResult::Outcome::kPassed) - OpenMet(result),
+                result.Count(CheckResult::Outcome::kFailed), result.Count(CheckResult::Outcome::kError),
+                result.Count(CheckResult::Outcome::kOpen), OpenMet(result),
+                result.Count(CheckResult::Outcome::kSkipped), result.cases.size(), result.seconds);
   return out + line;
 }
 
@@ -87,17 +128,17 @@ json ResultsJson(const SuiteResult& result) {
     for (const CheckResult& k : c.checks) {
       json check = {{"metric", k.metric},
                     {"bound", k.bound},
-                    {"value", Optional(k.value)},
+                    {"value", k.text ? json(*k.text) : Optional(k.value)},
                     {"baseline", Optional(k.baseline)},
                     {"threshold", Optional(k.threshold)},
-                    {"result", k.outcome == CheckResult::Outcome::kPassed   ? "passed"
-                               : k.outcome == CheckResult::Outcome::kFailed ? "failed"
-                                                                            : "error"}};
+                    {"result", ResultName(k)}};
       if (!k.message.empty()) check["message"] = k.message;
+      if (!k.open.empty()) check["open"] = k.open;
       checks.push_back(check);
     }
     json entry = {{"name", c.name}, {"mode", c.mode}, {"seconds", c.seconds}, {"checks", checks}};
     if (!c.error.empty()) entry["error"] = c.error;
+    if (!c.skipped.empty()) entry["skipped"] = c.skipped;
     cases.push_back(entry);
   }
   return {{"suite", result.name},
@@ -106,7 +147,10 @@ json ResultsJson(const SuiteResult& result) {
           {"checks",
            {{"passed", result.Count(CheckResult::Outcome::kPassed)},
             {"failed", result.Count(CheckResult::Outcome::kFailed)},
-            {"errors", result.Count(CheckResult::Outcome::kError)}}},
+            {"errors", result.Count(CheckResult::Outcome::kError)},
+            {"open_not_met", result.Count(CheckResult::Outcome::kOpen)},
+            {"open_met", OpenMet(result)},
+            {"skipped", result.Count(CheckResult::Outcome::kSkipped)}}},
           {"seconds", result.seconds},
           {"cases", cases}};
 }
@@ -128,12 +172,11 @@ std::string XmlEscape(const std::string& text) {
 }
 
 std::string JunitXml(const SuiteResult& result) {
-  const int tests = static_cast<int>(result.Count(CheckResult::Outcome::kPassed) +
-                                     result.Count(CheckResult::Outcome::kFailed) +
-                                     result.Count(CheckResult::Outcome::kError));
-  const std::string counts = " tests=\"" + std::to_string(tests) + "\" failures=\"" +
+  const int skipped = result.Count(CheckResult::Outcome::kOpen) + result.Count(CheckResult::Outcome::kSkipped);
+  const std::string counts = " tests=\"" + std::to_string(Total(result)) + "\" failures=\"" +
                              std::to_string(result.Count(CheckResult::Outcome::kFailed)) + "\" errors=\"" +
-                             std::to_string(result.Count(CheckResult::Outcome::kError)) + "\"";
+                             std::to_string(result.Count(CheckResult::Outcome::kError)) + "\" skipped=\"" +
+                             std::to_string(skipped) + "\"";
   char seconds[32];
   std::snprintf(seconds, sizeof seconds, "%.3f", result.seconds);
   std::string xml = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
@@ -143,10 +186,15 @@ std::string JunitXml(const SuiteResult& result) {
     for (const CheckResult& k : c.checks) {
       xml += "    <testcase classname=\"" + XmlEscape(c.name) + "\" name=\"" + XmlEscape(k.metric) + "\"";
       const std::string detail = "mode " + c.mode + ", metric " + k.metric + ", bound " + k.bound + ", value " +
-                                 Format(k.value) + ", threshold " + Format(k.threshold) + ", baseline " +
+                                 ValueText(k) + ", threshold " + Format(k.threshold) + ", baseline " +
                                  Format(k.baseline);
-      if (k.outcome == CheckResult::Outcome::kPassed) {
+      if (k.outcome == CheckResult::Outcome::kPassed && k.open.empty()) {
         xml += "/>\n";
+      } else if (k.outcome == CheckResult::Outcome::kPassed) {
+        xml += ">\n      <system-out>" + XmlEscape("open target met (" + k.open + "): remove the 'open' marker; " +
+                                                   detail) + "</system-out>\n    </testcase>\n";
+      } else if (k.outcome == CheckResult::Outcome::kOpen || k.outcome == CheckResult::Outcome::kSkipped) {
+        xml += ">\n      <skipped message=\"" + XmlEscape(k.message) + "\"/>\n    </testcase>\n";
       } else if (k.outcome == CheckResult::Outcome::kFailed) {
         xml += ">\n      <failure message=\"" + XmlEscape(k.message) + "\" type=\"bound\">" + XmlEscape(detail) +
                "</failure>\n    </testcase>\n";

@@ -51,6 +51,24 @@ class Scanner {
     pos_ += static_cast<std::size_t>(end - begin);
     return value;
   }
+  // A metric path: letters, digits, '_' and '.', with selectors in brackets; "" when none starts here.
+  std::string Path() {
+    SkipSpace();
+    const std::size_t start = pos_;
+    if (pos_ == text_.size() || !std::isalpha(static_cast<unsigned char>(text_[pos_]))) return "";
+    while (pos_ < text_.size()) {
+      const char ch = text_[pos_];
+      if (ch == '[') {
+        const std::size_t close = text_.find(']', pos_);
+        pos_ = close == std::string::npos ? text_.size() : close + 1;
+      } else if (std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '.') {
+        ++pos_;
+      } else {
+        break;
+      }
+    }
+    return text_.substr(start, pos_ - start);
+  }
   std::string Rest() const { return text_.substr(pos_); }
 
  private:
@@ -68,13 +86,44 @@ std::string Join(const std::vector<std::string>& parts, std::size_t begin, std::
   return out;
 }
 
+// Splits a metric path at the dots outside row selectors.
 std::vector<std::string> Split(const std::string& text) {
-  std::vector<std::string> parts;
-  std::size_t start = 0;
-  for (std::size_t dot; (dot = text.find('.', start)) != std::string::npos; start = dot + 1)
-    parts.push_back(text.substr(start, dot - start));
-  parts.push_back(text.substr(start));
+  std::vector<std::string> parts(1);
+  int depth = 0;
+  for (const char ch : text) {
+    depth += ch == '[' ? 1 : ch == ']' ? -1 : 0;
+    if (ch == '.' && depth == 0) {
+      parts.emplace_back();
+    } else {
+      parts.back() += ch;
+    }
+  }
   return parts;
+}
+
+// A path component "key[field=value,...]": the key and its selector; an error when the brackets are malformed.
+Result<std::pair<std::string, Selector>> SplitSelector(const std::string& part) {
+  const std::size_t open = part.find('[');
+  if (open == std::string::npos) {
+    if (part.find(']') != std::string::npos) return Status::Error("'" + part + "': ']' without '['");
+    return std::pair<std::string, Selector>{part, {}};
+  }
+  if (open == 0 || part.back() != ']' || part.find('[', open + 1) != std::string::npos)
+    return Status::Error("'" + part + "': a selector is KEY[FIELD=VALUE,...] at the end of a component");
+  Selector selector;
+  const std::string inside = part.substr(open + 1, part.size() - open - 2);
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t comma = inside.find(',', start);
+    const std::string item = inside.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    const std::size_t eq = item.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == item.size())
+      return Status::Error("'" + part + "': selector item '" + item + "' is not FIELD=VALUE");
+    selector.emplace_back(item.substr(0, eq), item.substr(eq + 1));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return std::pair<std::string, Selector>{part.substr(0, open), selector};
 }
 
 std::string KeyList(const json& object) {
@@ -128,9 +177,30 @@ Result<MetricPath> ParseMetricPath(const std::string& text, const ModeSpec& mode
     }
     if (i == parts.size())
       return Status::Error("metric '" + text + "' names an object; continue with one of: " + KeyList(*node));
-    if (node->contains(parts[i])) {
-      path.keys.push_back(parts[i]);
-      node = &(*node)[parts[i]];
+    const auto split = SplitSelector(parts[i]);
+    if (!split.ok()) return Status::Error("metric '" + text + "': " + split.status().message());
+    const auto& [key, selector] = split.value();
+    if (node->contains(key)) {
+      path.keys.push_back(key);
+      node = &(*node)[key];
+      ++i;
+      if (selector.empty()) continue;
+      if (!node->is_array())
+        return Status::Error("metric '" + text + "': '" + key + "' is not an array of objects (no selector)");
+      node = &(*node)[0];
+      for (const auto& [field, value] : selector)
+        if (!node->contains(field) || (*node)[field] != "string")
+          return Status::Error("metric '" + text + "': a row of '" + key + "' has no text field '" + field +
+                               "' to select by");
+      path.select[path.keys.size() - 1] = selector;
+      continue;
+    }
+    if (!selector.empty())
+      return Status::Error("metric '" + text + "': unknown key '" + key + "' after '" + Join(parts, 0, i) +
+                           "' (known: " + KeyList(*node) + ")");
+    if (node->contains("<any>")) {  // any one key (an effect's parameter names): checked when the case has run
+      path.keys.push_back(key);
+      node = &(*node)["<any>"];
       ++i;
       continue;
     }
@@ -162,6 +232,13 @@ Result<MetricPath> ParseMetricPath(const std::string& text, const ModeSpec& mode
   if (leaf == "timing")
     return Status::Error("metric '" + text + "' is a timing value (not deterministic) and cannot be a check");
   const std::size_t rest = parts.size() - i;
+  if (leaf == "string") {
+    if (column) return Status::Error("metric '" + text + "' is a column of texts: select one row with [FIELD=VALUE]");
+    if (rest > 0)
+      return Status::Error("metric '" + text + "': '" + Join(parts, 0, i) + "' is a text; nothing follows it");
+    path.is_string = true;
+    return path;
+  }
   if (leaf == "numbers") {
     const std::string hint = "add .norm, .max_abs, .min, .max, .mean or an index";
     if (rest == 0) return Status::Error("metric '" + text + "' is an array: " + hint);
@@ -263,9 +340,9 @@ Result<Case> LoadCase(const YAML::Node& node, const Context& suite, std::set<std
   // Keys.
   for (const auto& entry : node) {
     const std::string key = entry.first.as<std::string>();
-    const bool common = key == "name" || key == "mode" || key == "quick" || key == "checks";
+    const bool common = key == "name" || key == "mode" || key == "quick" || key == "data" || key == "checks";
     if (!common && std::find(mode->keys.begin(), mode->keys.end(), key) == mode->keys.end()) {
-      std::string allowed = "name, mode, quick, checks";
+      std::string allowed = "name, mode, quick, data, checks";
       for (const std::string& k : mode->keys) allowed += ", " + k;
       return ctx.Error(entry.first, "unknown key '" + key + "' for mode " + c.mode + " (" + allowed + ")");
     }
@@ -290,21 +367,87 @@ Result<Case> LoadCase(const YAML::Node& node, const Context& suite, std::set<std
     if (node["runs"]) c.runs = node["runs"].as<int>();
     if (node["seed_base"]) c.seed_base = node["seed_base"].as<std::uint64_t>();
     if (node["t0_s"]) c.t0_s = node["t0_s"].as<double>();
+    if (node["baseline_seed"]) c.baseline_seed = node["baseline_seed"].as<std::uint64_t>();
+    if (node["interval_s"]) c.interval_s = node["interval_s"].as<double>();
     for (auto [key, field] : {std::pair{"scenario", &c.scenario}, {"recording", &c.recording},
-                              {"config", &c.config}, {"calibration", &c.calibration}, {"calibrate", &c.calibrate}})
+                              {"config", &c.config}, {"calibration", &c.calibration}, {"calibrate", &c.calibrate},
+                              {"data", &c.data}})
       if (node[key]) *field = ResolvePath(suite.file, node[key].as<std::string>());
+    for (auto [key, field] : {std::pair{"train", &c.train}, {"test", &c.test}})
+      if (node[key]) {
+        if (!node[key].IsSequence() || node[key].size() == 0)
+          return ctx.Error(node[key], std::string("'") + key + "' is a non-empty list of paths or globs");
+        for (const YAML::Node& entry : node[key])
+          field->push_back(ResolvePath(c.data.empty() ? suite.file : c.data + "/.", entry.as<std::string>()));
+      }
   } catch (const YAML::Exception& e) {
     return ctx.Error(node, std::string("malformed value: ") + e.msg);
   }
   if (node["runs"] && c.runs < 1) return ctx.Error(node["runs"], "runs must be at least 1");
+  if (c.interval_s && !(*c.interval_s > 0.0)) return ctx.Error(node["interval_s"], "interval_s must be positive");
 
-  // Inputs exist and load.
+  // Effects hidden in a simulated recording (diagnose): names and parameters the simulator knows.
+  if (const YAML::Node effects = node["effects"]) {
+    if (!effects.IsSequence()) return ctx.Error(effects, "'effects' is a list of {name: EFFECT, PARAMETER: value}");
+    for (const YAML::Node& effect : effects) {
+      if (!effect.IsMap() || !effect["name"] || !effect["name"].IsScalar())
+        return ctx.Error(effect, "an effect is {name: EFFECT, PARAMETER: value, ...}");
+      const std::string name = effect["name"].as<std::string>();
+      const auto known = sim::KnownEffects().find(name);
+      if (known == sim::KnownEffects().end()) {
+        std::string list;
+        for (const auto& [n, p] : sim::KnownEffects()) list += (list.empty() ? "" : ", ") + n;
+        return ctx.Error(effect["name"], "unknown effect '" + name + "' (" + list + ")");
+      }
+      std::map<std::string, double> parameters;
+      for (const auto& entry : effect) {
+        const std::string key = entry.first.as<std::string>();
+        if (key == "name") continue;
+        if (!known->second.count(key)) return ctx.Error(entry.first, "effect " + name + " has no parameter " + key);
+        try {
+          parameters[key] = entry.second.as<double>();
+        } catch (const YAML::Exception&) {
+          return ctx.Error(entry.second, "effect parameter " + key + " is not a number");
+        }
+      }
+      c.effects.emplace_back(name, parameters);
+    }
+  }
+
+  // Odometry models (`roamlab odometry learn` options).
+  if (const YAML::Node models = node["models"]) {
+    if (!models.IsSequence() || models.size() == 0)
+      return ctx.Error(models, "'models' is a non-empty list of {model: gp|linear|parametric, mean, kernel}");
+    for (const YAML::Node& m : models) {
+      if (!m.IsMap() || !m["model"]) return ctx.Error(m, "a model is {model: gp|linear|parametric[, mean, kernel]}");
+      Case::OdometryModel model;
+      for (const auto& entry : m) {
+        const std::string key = entry.first.as<std::string>();
+        const std::string value = entry.second.IsScalar() ? entry.second.as<std::string>() : "";
+        const bool ok = key == "model"    ? (value == "gp" || value == "linear" || value == "parametric")
+                        : key == "mean"   ? (value == "zero" || value == "linear")
+                        : key == "kernel" ? (value == "rbf" || value == "linear" || value == "rbf+linear")
+                                          : false;
+        if (!ok)
+          return ctx.Error(entry.first, "bad model entry '" + key + ": " + value +
+                                            "' (model: gp|linear|parametric, mean: zero|linear, kernel: rbf|linear|"
+                                            "rbf+linear)");
+        (key == "model" ? model.model : key == "mean" ? model.mean : model.kernel) = value;
+      }
+      if (model.model != "gp" && (!model.mean.empty() || !model.kernel.empty()))
+        return ctx.Error(m, "mean and kernel are options of the gp model only");
+      c.models.push_back(model);
+    }
+  }
+
+  // Inputs exist and load (a case's `data` may be absent: the case is then skipped, and its inputs are not checked).
+  const bool data_absent = !c.data.empty() && !fs::is_directory(c.data);
   if (!c.scenario.empty()) {
     if (!fs::is_regular_file(c.scenario)) return ctx.Error(node["scenario"], "missing scenario " + c.scenario);
     const auto scenario = sim::LoadScenario(c.scenario);
     if (!scenario.ok()) return ctx.Error(node["scenario"], "bad scenario: " + scenario.status().message());
   }
-  if (!c.recording.empty() && !fs::is_regular_file(fs::path(c.recording) / "recording.yaml"))
+  if (!c.recording.empty() && !data_absent && !fs::is_regular_file(fs::path(c.recording) / "recording.yaml"))
     return ctx.Error(node["recording"], "missing recording " + c.recording + " (no recording.yaml)");
   Names names;
   if (!c.config.empty()) {
@@ -326,16 +469,42 @@ Result<Case> LoadCase(const YAML::Node& node, const Context& suite, std::set<std
   if (!checks || !checks.IsSequence() || checks.size() == 0)
     return ctx.Error(node, "no 'checks' (a list of {metric: PATH, bound: \"<= 0.5\"})");
   for (const YAML::Node& check : checks) {
-    if (!check.IsMap() || !check["metric"] || !check["bound"] || check.size() != 2)
-      return ctx.Error(check, "a check is {metric: PATH, bound: BOUND} and nothing else");
+    const bool is_map = check.IsMap() && check["metric"] && check["metric"].IsScalar();
+    const bool one_test = is_map && (static_cast<bool>(check["bound"]) != static_cast<bool>(check["equals"]));
+    const std::size_t keys = 2 + (is_map && check["open"] ? 1 : 0);
+    if (!is_map || !one_test || check.size() != keys)
+      return ctx.Error(check, "a check is {metric: PATH, bound: BOUND} or {metric: PATH, equals: TEXT}, "
+                              "optionally with open: REASON, and nothing else");
     Check k;
     k.line = check.Mark().line + 1;
     auto metric = ParseMetricPath(check["metric"].as<std::string>(), *mode, names);
     if (!metric.ok()) return ctx.Error(check["metric"], metric.status().message());
     k.metric = std::move(metric).value();
+    if (check["open"]) {
+      k.open = check["open"].IsScalar() ? check["open"].as<std::string>() : "";
+      if (k.open.empty()) return ctx.Error(check["open"], "'open' needs the reason the target is not met yet");
+    }
+    if (check["equals"]) {
+      if (!k.metric.is_string)
+        return ctx.Error(check["equals"], "metric '" + k.metric.text + "' is a number: give a bound, not 'equals'");
+      if (!check["equals"].IsScalar()) return ctx.Error(check["equals"], "'equals' takes one text");
+      k.equals = check["equals"].as<std::string>();
+      c.checks.push_back(std::move(k));
+      continue;
+    }
+    if (k.metric.is_string)
+      return ctx.Error(check["bound"], "metric '" + k.metric.text + "' is a text: check it with 'equals: TEXT'");
     auto bound = ParseBound(check["bound"].as<std::string>());
     if (!bound.ok()) return ctx.Error(check["bound"], bound.status().message());
     k.bound = std::move(bound).value();
+    if (!k.bound.reference.empty()) {
+      auto reference = ParseMetricPath(k.bound.reference, *mode, names);
+      if (!reference.ok()) return ctx.Error(check["bound"], "bound '" + k.bound.text + "': " +
+                                                                reference.status().message());
+      if (reference.value().is_string)
+        return ctx.Error(check["bound"], "bound '" + k.bound.text + "': '" + k.bound.reference + "' is a text");
+      k.reference = std::move(reference).value();
+    }
     c.checks.push_back(std::move(k));
   }
   return c;
@@ -380,14 +549,21 @@ Result<Bound> ParseBound(const std::string& text) {
     if (!s.AtEnd()) return Status::Error(prefix + "unexpected '" + s.Rest() + "' after the number");
     return b;
   }
-  if (!s.Accept("baseline"))
-    return Status::Error(prefix + (first ? "expected 'baseline' after '*'"
-                                         : "expected a number, 'baseline' or 'K * baseline' after the comparator"));
-  b.uses_baseline = true;
+  const std::string reference = s.Path();
+  if (reference.empty() || (reference != "baseline" && reference.find('.') == std::string::npos))
+    return Status::Error(prefix + (first ? "expected 'baseline' or a metric after '*'"
+                                         : "expected a number, 'baseline', a metric or 'K * baseline' after the "
+                                           "comparator"));
+  if (reference == "baseline") {
+    b.uses_baseline = true;
+  } else {
+    b.reference = reference;
+  }
   b.scale = first.value_or(1.0);
   if (s.AtEnd()) return b;
   const bool plus = s.Accept("+");
-  if (!plus && !s.Accept("-")) return Status::Error(prefix + "unexpected '" + s.Rest() + "' after 'baseline'");
+  if (!plus && !s.Accept("-"))
+    return Status::Error(prefix + "unexpected '" + s.Rest() + "' after '" + reference + "'");
   const std::optional<double> d = s.Number();
   if (!d) return Status::Error(prefix + "expected a number after '" + (plus ? "+" : "-") + "'");
   b.offset = plus ? *d : -*d;
@@ -395,50 +571,107 @@ Result<Bound> ParseBound(const std::string& text) {
   return b;
 }
 
-Result<double> ResolveMetric(const json& output, const MetricPath& path) {
-  const json* node = &output;
-  std::string where = path.output;
+namespace {
+
+// Whether `row` matches every FIELD=VALUE of the selector (a null field matches "null").
+bool Matches(const json& row, const Selector& selector) {
+  for (const auto& [field, value] : selector) {
+    if (!row.is_object() || !row.contains(field)) return false;
+    const json& x = row[field];
+    if (!(x.is_string() && x.get<std::string>() == value) && !(x.is_null() && value == "null")) return false;
+  }
+  return true;
+}
+
+// Where a metric path leads in an output: the node, or for the last key of an array of objects that column.
+struct Walked {
+  const json* node = nullptr;
   std::vector<double> column;
   bool is_column = false;
+  bool relative = false;  // the derived relative_error of the parameter row `node`
+  std::string where;
+};
+
+Result<Walked> Walk(const json& output, const MetricPath& path) {
+  Walked w;
+  w.node = &output;
+  w.where = path.output;
   for (std::size_t i = 0; i < path.keys.size(); ++i) {
     const std::string& key = path.keys[i];
-    if (node->is_array() && i + 1 == path.keys.size()) {
+    const json* node = w.node;
+    if (node->is_array() && i + 1 == path.keys.size() && !path.select.count(i)) {
       // The last key of an array of objects: that column, reduced below.
       for (const json& row : *node) {
         if (!row.is_object() || !row.contains(key) || !row[key].is_number())
-          return Status::Error(where + "[]." + key + ": missing or not a number in a row");
-        column.push_back(row[key].get<double>());
+          return Status::Error(w.where + "[]." + key + ": missing or not a number in a row");
+        w.column.push_back(row[key].get<double>());
       }
-      if (column.empty()) return Status::Error(where + " is empty");
-      is_column = true;
-      where += "[]." + key;
-      break;
+      if (w.column.empty()) return Status::Error(w.where + " is empty");
+      w.is_column = true;
+      w.where += "[]." + key;
+      return w;
     }
-    if (key == "relative_error" && i + 1 == path.keys.size() && node->is_object() && !node->contains(key))
-      return RelativeError(*node, where);
-    if (!node->is_object() || !node->contains(key)) return Status::Error(where + " has no key '" + key + "'");
-    node = &(*node)[key];
-    where += "." + key;
+    if (key == "relative_error" && i + 1 == path.keys.size() && node->is_object() && !node->contains(key)) {
+      w.relative = true;
+      return w;
+    }
+    if (!node->is_object() || !node->contains(key)) return Status::Error(w.where + " has no key '" + key + "'");
+    w.node = &(*node)[key];
+    w.where += "." + key;
+    const auto select = path.select.find(i);
+    if (select == path.select.end()) continue;
+    if (!w.node->is_array()) return Status::Error(w.where + " is not an array (no row to select)");
+    std::string selector;
+    for (const auto& [field, value] : select->second) selector += (selector.empty() ? "" : ",") + field + "=" + value;
+    const json* row = nullptr;
+    int matches = 0;
+    for (const json& r : *w.node)
+      if (Matches(r, select->second)) {
+        row = &r;
+        ++matches;
+      }
+    if (matches != 1)
+      return Status::Error(w.where + ": " + std::to_string(matches) + " rows match [" + selector + "] (one needed)");
+    w.node = row;
+    w.where += "[" + selector + "]";
   }
+  return w;
+}
+
+}  // namespace
+
+Result<double> ResolveMetric(const json& output, const MetricPath& path) {
+  Result<Walked> walked = Walk(output, path);
+  if (!walked.ok()) return walked.status();
+  Walked& w = walked.value();
+  if (w.relative) return RelativeError(*w.node, w.where);
   if (path.reduction.empty()) {
-    if (is_column) return Status::Error(where + " is a column: it needs a reduction");
-    if (node->is_null()) return Status::Error(where + " is null (not a number)");
-    if (!node->is_number()) return Status::Error(where + " is not a number");
-    return node->get<double>();
+    if (w.is_column) return Status::Error(w.where + " is a column: it needs a reduction");
+    if (w.node->is_null()) return Status::Error(w.where + " is null (not a number)");
+    if (!w.node->is_number()) return Status::Error(w.where + " is not a number");
+    return w.node->get<double>();
   }
-  if (!is_column) {
-    auto v = Numbers(*node, where);
+  if (!w.is_column) {
+    auto v = Numbers(*w.node, w.where);
     if (!v.ok()) return v.status();
-    column = std::move(v).value();
+    w.column = std::move(v).value();
   }
   if (IsIndex(path.reduction)) {
     const std::size_t index = std::stoul(path.reduction);
-    if (index >= column.size())
-      return Status::Error(where + " has " + std::to_string(column.size()) + " elements, no index " +
+    if (index >= w.column.size())
+      return Status::Error(w.where + " has " + std::to_string(w.column.size()) + " elements, no index " +
                            path.reduction);
-    return column[index];
+    return w.column[index];
   }
-  return Reduce(column, path.reduction);
+  return Reduce(w.column, path.reduction);
+}
+
+Result<std::string> ResolveText(const json& output, const MetricPath& path) {
+  const Result<Walked> w = Walk(output, path);
+  if (!w.ok()) return w.status();
+  if (w.value().is_column || !w.value().node->is_string())
+    return Status::Error(w.value().where + " is not a text");
+  return w.value().node->get<std::string>();
 }
 
 Result<Suite> LoadSuite(const std::string& path) {

@@ -5,25 +5,42 @@
 //   baseline: regression_baseline       # optional baseline directory, relative to the suite file
 //   cases:
 //     - name: atv_calibration           # [A-Za-z0-9_.-]+, unique: names the case's output and baseline files
-//       mode: calibrate                 # one of the modes of apps/regress_modes.h
+//       mode: calibrate                 # one of the modes of apps/regress_modes.h (its keys are listed there)
 //       quick: true                     # in the quick subset (`--quick`); default false
+//       data: ../../shared/data/x       # optional: a directory the case needs (real data); when it is absent the
+//                                       # case is skipped (reported as skipped with this path, never as passed)
 //       scenario: atv_hills.yaml        # simulated with `seed` (default: the scenario's own); or recording: DIR
 //       seed: 1
 //       config: atv_calibration.yaml    # paths are relative to the suite file
 //       checks:
 //         - {metric: metrics.parameters.gps.lever_arm.error.norm, bound: "<= 0.10"}
 //         - {metric: metrics.ate_m, bound: "<= 1.10 * baseline"}
+//         - {metric: metrics.velocity.fused.linear_rmse, bound: "<= 0.5 * metrics.velocity.encoders_only.linear_rmse"}
+//         - {metric: gap.verdict, equals: named}
+//         - {metric: "gap.effects[name=gps_latency].parameters.latency_s", bound: "<= 0.54"}  # quoted: [ ] , in {}
+//         - {metric: metrics.parameters.imu.misalignment.angle_error_deg, bound: "<= 2", open: "issue 3 target"}
 //
 // A metric is a dotted path into one of the mode's output files (ModeSpec::outputs): the output's name, then keys
 // (parameter names keep their dots: metrics.parameters.gps.lever_arm.error), then for an array of numbers one of
-// norm, max_abs, min, max, mean or an index. The path is checked against the output's key schema when the suite is
-// loaded; timing values (not deterministic) are refused.
+// norm, max_abs, min, max, mean or an index. A key naming an array of objects takes either the column of the next
+// key (runs.runs.ate_m.max) or, with a selector KEY[FIELD=VALUE,...], the one row whose string fields equal those
+// values (table.rows[model=gp,mean=linear,kernel=linear].ate_m, gap.effects[name=gps_latency].parameters.latency_s;
+// a null field matches `null`); no row or several rows is an error of the check. The path is checked against the
+// output's key schema when the suite is loaded; timing values (not deterministic) are refused.
 //
-// A bound is a comparator and a threshold:  CMP [-]NUMBER | CMP [K *] baseline [(+|-) D]  with CMP one of <=, <,
-// >=, >; the threshold is K * baseline + D, baseline being the metric's value stored in the baseline directory.
+// A numeric metric takes a bound: a comparator and a threshold:  CMP [-]NUMBER | CMP [K *] REF [(+|-) D]  with CMP
+// one of <=, <, >=, >; REF is `baseline` (the metric's value stored in the baseline directory) or another numeric
+// metric path of the same case (its value in this run); the threshold is K * REF + D. A string metric (gap.verdict,
+// a selected row's name) takes `equals: TEXT` instead (a bound on it, or `equals` on a number, is refused).
+//
+// `open: REASON` marks a target that is known not to be met yet (an issue's target, with the reason): the check is
+// evaluated and reported as usual (table, results.json, and junit.xml as a <skipped> testcase whose message holds
+// the value, the bound and the reason) but does not fail the run; when it holds it is reported as met, so that the
+// marker can be removed. A check without `open` fails the run when it does not hold.
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -38,12 +55,14 @@ struct Bound {
   enum class Comparator { kLess, kLessEqual, kGreater, kGreaterEqual };
   Comparator comparator = Comparator::kLessEqual;
   bool uses_baseline = false;
-  double scale = 0.0;    // threshold = scale * baseline + offset; scale = 0 without baseline
+  std::string reference;  // the other metric the threshold scales (as written); "" = none
+  double scale = 0.0;     // threshold = scale * (baseline or reference) + offset; scale = 0 without either
   double offset = 0.0;
-  std::string text;      // as written
+  std::string text;       // as written
 
-  // The threshold for a baseline value (ignored when !uses_baseline).
-  double Threshold(double baseline) const { return uses_baseline ? scale * baseline + offset : offset; }
+  bool Relative() const { return uses_baseline || !reference.empty(); }
+  // The threshold for the baseline's or the reference metric's value (ignored when !Relative()).
+  double Threshold(double base) const { return Relative() ? scale * base + offset : offset; }
   // Whether `value` satisfies the bound against `threshold`; false for NaN.
   bool Holds(double value, double threshold) const;
 };
@@ -51,20 +70,30 @@ struct Bound {
 // Parses a bound; the error says what is malformed (without file or case).
 Result<Bound> ParseBound(const std::string& text);
 
+// A row selector [FIELD=VALUE,...] on a key that names an array of objects.
+using Selector = std::vector<std::pair<std::string, std::string>>;
+
 struct MetricPath {
   std::string text;                 // as written
   std::string output;               // output name (first component)
   std::vector<std::string> keys;    // JSON keys; a key applied to an array of objects selects that column
+  std::map<std::size_t, Selector> select;  // keys[i] with a row selector (an array of objects: that one row)
   std::string reduction;            // "", norm, max_abs, min, max, mean, or a decimal index
+  bool is_string = false;           // the leaf is a string (checked with `equals`)
 };
 
 // The metric's value in `output` (the parsed output file). Errors: a key absent from the output, a null (a NaN
-// written by the command), an empty array.
+// written by the command), an empty array, a selector matching no row or several.
 Result<double> ResolveMetric(const nlohmann::json& output, const MetricPath& path);
+// The same for a string metric.
+Result<std::string> ResolveText(const nlohmann::json& output, const MetricPath& path);
 
 struct Check {
   MetricPath metric;
-  Bound bound;
+  Bound bound;                      // numeric metrics
+  std::optional<MetricPath> reference;  // the bound's reference metric, when it names one
+  std::optional<std::string> equals;    // string metrics: the expected text
+  std::string open;                 // "" or why the target is open (not met yet): never fails the run
   int line = 0;                     // 1-based line in the suite file
 };
 
@@ -73,6 +102,7 @@ struct Case {
   std::string mode;
   int line = 0;
   bool quick = false;
+  std::string data;                       // a directory the case needs; absent: the case is skipped
   // Inputs (paths resolved against the suite file's directory; empty when not given).
   std::string scenario;
   std::string recording;
@@ -83,6 +113,19 @@ struct Case {
   int runs = 0;                           // montecarlo
   std::uint64_t seed_base = 1000;         // montecarlo: run i uses noise seed seed_base + i
   std::optional<double> t0_s;             // NEES in-band fraction from t0_s on (default: the command's)
+  // diagnose: the effects hidden in the simulated recording ({name, parameters} as a scenario's `effects:`) and the
+  // noise seed of the nominal simulation (default: the command's).
+  std::vector<std::pair<std::string, std::map<std::string, double>>> effects;
+  std::optional<std::uint64_t> baseline_seed;
+  // odometry: training and test inputs (globs relative to `data` when given, else to the suite file: OptiOdom run
+  // CSV files, imported; recording directories; scenario YAML files, simulated with `seed`), the models to learn
+  // ({model, mean, kernel} of `roamlab odometry learn`) and the key interval.
+  std::vector<std::string> train, test;
+  struct OdometryModel {
+    std::string model, mean, kernel;
+  };
+  std::vector<OdometryModel> models;
+  std::optional<double> interval_s;
   std::vector<Check> checks;
 };
 

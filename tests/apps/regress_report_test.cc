@@ -116,9 +116,10 @@ SuiteResult Example() {
   CaseResult a;
   a.name = "atv&calibration";
   a.mode = "calibrate";
-  CheckResult pass{"metrics.ate_m", "<= 0.5", 0.25, std::nullopt, 0.5, CheckResult::Outcome::kPassed, ""};
+  CheckResult pass{"metrics.ate_m", "<= 0.5", 0.25, std::nullopt, 0.5, CheckResult::Outcome::kPassed, "",
+                   std::nullopt, ""};
   CheckResult fail{"metrics.nees.fraction_in_band", ">= baseline - 0.03", 0.5, 0.9, 0.87,
-                   CheckResult::Outcome::kFailed, ""};
+                   CheckResult::Outcome::kFailed, "", std::nullopt, ""};
   fail.message = FailureMessage(fail);
   a.checks = {pass, fail};
   CaseResult b;
@@ -126,7 +127,7 @@ SuiteResult Example() {
   b.mode = "track";
   b.error = "roamlab track: rec/<gps>.csv:3: bad \x01 byte & more";
   b.checks = {{"summary.poses", "> 10", std::nullopt, std::nullopt, std::nullopt, CheckResult::Outcome::kError,
-               "case error: " + b.error}};
+               "case error: " + b.error, std::nullopt, ""}};
   r.cases = {a, b};
   return r;
 }
@@ -147,6 +148,64 @@ TEST(JunitTest, WellFormedWithOneTestcasePerCheck) {
                      "baseline 0.9)\""),
             std::string::npos)
       << xml;
+}
+
+// Open targets and skipped cases: <skipped> testcases (message with value, bound and reason), a met open target a
+// passing testcase that says so; none of them fails the run.
+TEST(JunitTest, OpenTargetsAndSkippedCasesAreSkippedTestcases) {
+  SuiteResult r;
+  r.name = "open";
+  CaseResult a;
+  a.name = "targets";
+  a.mode = "calibrate";
+  CheckResult open{"metrics.ate_m", "<= 0.1", 0.25, std::nullopt, 0.1, CheckResult::Outcome::kOpen, "",
+                   std::nullopt, ""};
+  open.open = "issue 3 target, not met yet";
+  open.message = "open target not met (" + open.open + "): " + FailureMessage(open);
+  CheckResult met{"metrics.rpe_trans_m", "<= 0.5", 0.25, std::nullopt, 0.5, CheckResult::Outcome::kPassed, "",
+                  std::nullopt, ""};
+  met.open = "issue 3 target";
+  CheckResult text{"gap.verdict", "equals named", std::nullopt, std::nullopt, std::nullopt,
+                   CheckResult::Outcome::kFailed, "", std::nullopt, ""};
+  text.text = "unknown";
+  text.message = FailureMessage(text);
+  EXPECT_EQ(text.message, "value 'unknown' is not 'named'");
+  a.checks = {open, met, text};
+  CaseResult b;
+  b.name = "real_data";
+  b.mode = "odometry";
+  b.skipped = "data directory /x is absent";
+  b.checks = {{"table.interval_s", "<= 1", std::nullopt, std::nullopt, std::nullopt, CheckResult::Outcome::kSkipped,
+               "case skipped: " + b.skipped, std::nullopt, ""}};
+  r.cases = {a, b};
+  const std::string xml = JunitXml(r);
+  EXPECT_EQ(XmlChecker(xml).Check(), "") << xml;
+  EXPECT_EQ(Occurrences(xml, "<testcase "), 4u);
+  EXPECT_NE(xml.find("tests=\"4\" failures=\"1\" errors=\"0\" skipped=\"2\""), std::string::npos) << xml;
+  EXPECT_NE(xml.find("<skipped message=\"open target not met (issue 3 target, not met yet): value 0.25 violates "
+                     "bound &apos;&lt;= 0.1&apos;\"/>"),
+            std::string::npos)
+      << xml;
+  EXPECT_NE(xml.find("<system-out>open target met (issue 3 target)"), std::string::npos) << xml;
+  EXPECT_NE(xml.find("<skipped message=\"case skipped: data directory /x is absent\"/>"), std::string::npos) << xml;
+  const nlohmann::json j = ResultsJson(r);
+  EXPECT_EQ(j["cases"][0]["checks"][0]["result"], "open");
+  EXPECT_EQ(j["cases"][0]["checks"][0]["open"], "issue 3 target, not met yet");
+  EXPECT_EQ(j["cases"][0]["checks"][1]["result"], "open met");
+  EXPECT_EQ(j["cases"][0]["checks"][2]["value"], "unknown");
+  EXPECT_EQ(j["cases"][1]["skipped"], b.skipped);
+  EXPECT_EQ(j["checks"]["open_not_met"], 1);
+  EXPECT_EQ(j["checks"]["open_met"], 1);
+  EXPECT_EQ(j["checks"]["skipped"], 1);
+  const std::string table = ResultsTable(r);
+  EXPECT_NE(table.find("MET (open: remove the marker)"), std::string::npos) << table;
+  EXPECT_NE(table.find("4 checks: 0 passed, 1 failed, 0 errors, 1 open targets not met, 1 open targets met, "
+                       "1 skipped"),
+            std::string::npos)
+      << table;
+  EXPECT_FALSE(r.Passed());  // the text check failed
+  r.cases[0].checks.pop_back();
+  EXPECT_TRUE(r.Passed());   // open and skipped alone do not fail
 }
 
 TEST(JunitTest, CheckerCatchesMalformedXml) {

@@ -33,6 +33,8 @@ TEST(BoundTest, ParsesNumbersAndBaselineExpressions) {
       {"<= 1.10 * baseline", Bound::Comparator::kLessEqual, true, 2.2},
       {"<= 1.5*baseline+1", Bound::Comparator::kLessEqual, true, 4.0},
       {"  >   baseline  ", Bound::Comparator::kGreater, true, 2.0},
+      {"<= 0.5 * metrics.velocity.encoders_only.linear_rmse", Bound::Comparator::kLessEqual, false, 1.0},
+      {"<= table.rows[model=nominal].ate_m - 0.5", Bound::Comparator::kLessEqual, false, 1.5},
   };
   for (const Case& c : cases) {
     const Result<Bound> b = ParseBound(c.text);
@@ -42,6 +44,10 @@ TEST(BoundTest, ParsesNumbersAndBaselineExpressions) {
     EXPECT_DOUBLE_EQ(b.value().Threshold(2.0), c.threshold_at_2) << c.text;
     EXPECT_EQ(b.value().text, c.text);
   }
+  EXPECT_EQ(ParseBound("<= 0.5 * metrics.velocity.encoders_only.linear_rmse").value().reference,
+            "metrics.velocity.encoders_only.linear_rmse");
+  EXPECT_EQ(ParseBound("<= table.rows[model=nominal].ate_m - 0.5").value().reference,
+            "table.rows[model=nominal].ate_m");
 }
 
 TEST(BoundTest, ComparesStrictlyOrNotAndRejectsNaN) {
@@ -84,8 +90,57 @@ class SuiteTest : public ::testing::Test {
     return "  - name: cal\n    mode: calibrate\n    scenario: " + Config("atv_hills.yaml") +
            "\n    seed: 3\n    config: " + Config("atv_calibration.yaml") + "\n" + extra + "    checks:\n" + checks;
   }
+  std::string Odometry(const std::string& checks, const std::string& models = "    models: [{model: gp}]\n") {
+    return "  - name: cal\n    mode: odometry\n    train: [a.csv]\n    test: [b.csv]\n" + models + "    checks:\n" +
+           checks;
+  }
+  std::string Diagnose(const std::string& extra) {
+    return "  - name: cal\n    mode: diagnose\n    scenario: " + Config("atv_hills.yaml") + "\n" + extra +
+           "    checks:\n      - {metric: gap.verdict, equals: named}\n";
+  }
   testing::TempDir dir_;
 };
+
+// Odometry and diagnose cases: inputs, models, effects; row selectors, texts, references to other metrics and
+// open targets in checks; a case whose data directory is absent loads (it is skipped when run).
+TEST_F(SuiteTest, LoadsOdometryAndDiagnoseCasesWithSelectorsTextsAndOpenTargets) {
+  const std::string path = WriteSuite(
+      "  - name: odo\n    mode: odometry\n    data: no_such_data\n    train: [\"diff/square/*.csv\", rec]\n"
+      "    test: [\"diff/circular/*.csv\"]\n    interval_s: 0.25\n"
+      "    models: [{model: linear}, {model: gp, mean: linear, kernel: rbf+linear}]\n    checks:\n"
+      "      - {metric: \"table.rows[model=gp,mean=linear,kernel=rbf+linear].ate_m\",\n"
+      "         bound: \"<= 0.5 * table.rows[model=nominal].ate_m\", open: \"issue 5 target\"}\n"
+      "      - {metric: table.rows.ate_m.max, bound: \"<= 1\"}\n"
+      "  - name: gap\n    mode: diagnose\n    scenario: " + Config("atv_hills.yaml") + "\n    seed: 13\n"
+      "    effects: [{name: steering_offset, offset_rad: 0.03}]\n    checks:\n"
+      "      - {metric: gap.verdict, equals: named}\n"
+      "      - {metric: \"gap.effects[name=steering_offset].parameters.offset_rad\", bound: \"<= 0.035\"}\n");
+  const Result<Suite> suite = LoadSuite(path);
+  ASSERT_TRUE(suite.ok()) << suite.status().message();
+  const Case& odo = suite.value().cases[0];
+  EXPECT_EQ(odo.data, dir_.File("no_such_data"));
+  EXPECT_EQ(odo.train, (std::vector<std::string>{dir_.File("no_such_data/diff/square/*.csv"),
+                                                 dir_.File("no_such_data/rec")}));
+  ASSERT_EQ(odo.models.size(), 2u);
+  EXPECT_EQ(odo.models[1].kernel, "rbf+linear");
+  EXPECT_EQ(odo.interval_s, 0.25);
+  const Check& ratio = odo.checks[0];
+  EXPECT_EQ(ratio.metric.keys, (std::vector<std::string>{"rows", "ate_m"}));
+  EXPECT_EQ(ratio.metric.select.at(0),
+            (Selector{{"model", "gp"}, {"mean", "linear"}, {"kernel", "rbf+linear"}}));
+  EXPECT_EQ(ratio.open, "issue 5 target");
+  ASSERT_TRUE(ratio.reference.has_value());
+  EXPECT_EQ(ratio.reference->select.at(0), (Selector{{"model", "nominal"}}));
+  EXPECT_DOUBLE_EQ(ratio.bound.Threshold(0.1), 0.05);
+  EXPECT_TRUE(odo.checks[1].open.empty());
+  const Case& gap = suite.value().cases[1];
+  ASSERT_EQ(gap.effects.size(), 1u);
+  EXPECT_EQ(gap.effects[0].first, "steering_offset");
+  EXPECT_EQ(gap.effects[0].second.at("offset_rad"), 0.03);
+  EXPECT_TRUE(gap.checks[0].metric.is_string);
+  EXPECT_EQ(gap.checks[0].equals, "named");
+  EXPECT_EQ(gap.checks[1].metric.keys, (std::vector<std::string>{"effects", "parameters", "offset_rad"}));
+}
 
 TEST_F(SuiteTest, LoadsCasesWithTheirChecks) {
   const std::string path = WriteSuite(
@@ -143,8 +198,26 @@ TEST_F(SuiteTest, EachKindOfBadSuiteIsOneLineNamingFileCaseAndProblem) {
       {CalibrateCase(check, "    window: 3\n"), "unknown key 'window'"},
       {CalibrateCase(check, "    quick: maybe\n"), "malformed value"},
       {"  - name: cal\n    mode: calbrate\n    checks:\n" + check, "unknown mode 'calbrate'"},
-      {"  - name: cal\n    mode: odometry\n    checks:\n" + check, "mode odometry is not available in this build"},
-      {"  - name: cal\n    mode: diagnose\n    checks:\n" + check, "mode diagnose is not available in this build"},
+      {"  - name: cal\n    mode: odometry\n    checks:\n" + check, "mode odometry needs 'train'"},
+      {"  - name: cal\n    mode: diagnose\n    checks:\n" + check, "mode diagnose needs 'scenario'"},
+      {Odometry("      - {metric: table.rows.ate_m, bound: \"<= 1\"}\n", "    models: [{model: svm}]\n"),
+       "bad model entry 'model: svm'"},
+      {Odometry("      - {metric: table.rows.ate_m, bound: \"<= 1\"}\n", "    models: [{model: linear, mean: zero}]\n"),
+       "mean and kernel are options of the gp model only"},
+      {Odometry("      - {metric: \"table.rows[mdl=gp].ate_m\", bound: \"<= 1\"}\n"), "no text field 'mdl'"},
+      {Odometry("      - {metric: \"table.rows[model].ate_m\", bound: \"<= 1\"}\n"), "is not FIELD=VALUE"},
+      {Odometry("      - {metric: \"table.rows[model=gp].model\", bound: \"<= 1\"}\n"), "is a text: check it with"},
+      {Odometry("      - {metric: table.rows.model, equals: gp}\n"), "column of texts"},
+      {Odometry("      - {metric: table.interval_s, equals: gp}\n"), "is a number: give a bound"},
+      {Odometry("      - {metric: table.interval_s, bound: \"<= 1\", equals: gp}\n"), "a check is"},
+      {Odometry("      - {metric: table.interval_s, bound: \"<= 1\", open: \"\"}\n"), "'open' needs the reason"},
+      {Odometry("      - {metric: table.interval_s, bound: \"<= 1\", opne: x}\n"), "a check is"},
+      {Odometry("      - {metric: table.interval_s, bound: \"<= 2 * table.rows[model=gp].ate\"}\n"),
+       "unknown key 'ate'"},
+      {Odometry("      - {metric: table.interval_s, bound: \"<= 2 * table.rows[model=gp].model\"}\n"), "is a text"},
+      {Diagnose("    effects: [{name: steering_ofset, offset_rad: 0.03}]\n"), "unknown effect 'steering_ofset'"},
+      {Diagnose("    effects: [{name: steering_offset, offset: 0.03}]\n"), "has no parameter offset"},
+      {Diagnose("    effects: [{name: steering_offset, offset_rad: big}]\n"), "is not a number"},
       {"  - name: cal\n    mode: calibrate\n    scenario: nowhere.yaml\n    config: " + cal + "\n    checks:\n" +
            check,
        "missing scenario"},
@@ -210,6 +283,45 @@ TEST(ResolveMetricTest, WalksKeysReducesArraysAndDerivesRelativeErrors) {
   const json runs = json::parse(R"({"runs": [{"ate_m": 0.5}, {"ate_m": 1.5}, {"ate_m": 1.0}]})");
   EXPECT_DOUBLE_EQ(ResolveMetric(runs, path({"runs", "ate_m"}, "max")).value(), 1.5);
   EXPECT_DOUBLE_EQ(ResolveMetric(runs, path({"runs", "ate_m"}, "mean")).value(), 1.0);
+}
+
+TEST(ResolveMetricTest, SelectsOneRowByItsTextFields) {
+  const json table = json::parse(R"({"rows": [
+    {"model": "nominal", "mean": null, "kernel": null, "ate_m": 0.09},
+    {"model": "linear", "mean": null, "kernel": null, "ate_m": 0.02},
+    {"model": "gp", "mean": "linear", "kernel": "rbf", "ate_m": 0.03},
+    {"model": "gp", "mean": "zero", "kernel": "rbf", "ate_m": 0.18}]})");
+  const auto path = [](Selector selector, std::string leaf) {
+    MetricPath p;
+    p.output = "table";
+    p.keys = {"rows", std::move(leaf)};
+    p.select[0] = std::move(selector);
+    return p;
+  };
+  EXPECT_DOUBLE_EQ(ResolveMetric(table, path({{"model", "nominal"}}, "ate_m")).value(), 0.09);
+  EXPECT_DOUBLE_EQ(ResolveMetric(table, path({{"model", "gp"}, {"mean", "zero"}}, "ate_m")).value(), 0.18);
+  EXPECT_DOUBLE_EQ(ResolveMetric(table, path({{"model", "linear"}, {"kernel", "null"}}, "ate_m")).value(), 0.02);
+  const Result<double> two = ResolveMetric(table, path({{"model", "gp"}}, "ate_m"));
+  ASSERT_FALSE(two.ok());
+  EXPECT_NE(two.status().message().find("2 rows match [model=gp]"), std::string::npos) << two.status().message();
+  EXPECT_FALSE(ResolveMetric(table, path({{"model", "parametric"}}, "ate_m")).ok());
+  EXPECT_EQ(ResolveText(table, path({{"model", "gp"}, {"mean", "zero"}}, "kernel")).value(), "rbf");
+  EXPECT_FALSE(ResolveText(table, path({{"model", "nominal"}}, "mean")).ok());  // null: not a text
+  EXPECT_FALSE(ResolveText(table, path({{"model", "nominal"}}, "ate_m")).ok());
+
+  const json gap = json::parse(R"({"verdict": "named", "effects": [{"name": "gps_latency",
+                                   "parameters": {"latency_s": 0.43}}]})");
+  MetricPath verdict;
+  verdict.output = "gap";
+  verdict.keys = {"verdict"};
+  EXPECT_EQ(ResolveText(gap, verdict).value(), "named");
+  MetricPath latency;
+  latency.output = "gap";
+  latency.keys = {"effects", "parameters", "latency_s"};
+  latency.select[0] = {{"name", "gps_latency"}};
+  EXPECT_DOUBLE_EQ(ResolveMetric(gap, latency).value(), 0.43);
+  latency.select[0] = {{"name", "steering_offset"}};
+  EXPECT_FALSE(ResolveMetric(gap, latency).ok());  // not named: an error of the check, never a pass
 }
 
 }  // namespace
