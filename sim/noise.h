@@ -19,6 +19,7 @@ enum class NoiseSource : std::uint32_t {
   kSpeed = 4,
   kSteering = 5,
   kLaserRange = 6,
+  kGyroBiasWalk = 7,   // the gyro_bias_drift effect's random walk
 };
 
 class NoiseStream {

@@ -394,6 +394,7 @@ const std::map<std::string, std::map<std::string, double>>& KnownEffects() {
       {"imu_time_offset", {{"offset_s", 0.0}}},
       {"steering_offset", {{"offset_rad", 0.0}}},
       {"gyro_scale_error", {{"scale_x", 1.0}, {"scale_y", 1.0}, {"scale_z", 1.0}}},
+      {"gyro_bias_drift", {{"initial_x", 0.0}, {"initial_y", 0.0}, {"initial_z", 0.0}, {"random_walk", 0.0}}},
       {"magnetometer_motor_interference", {{"b_per_nm_x", 0.0}, {"b_per_nm_y", 0.0}, {"b_per_nm_z", 0.0}}},
   };
   return known;
@@ -550,7 +551,14 @@ std::optional<Scenario::Problem> Scenario::Validate() const {
     if (e.name == "imu_time_offset" && !(std::abs(EffectParameter(effects, e.name, "offset_s", 0.0)) <= 0.5))
       return P{k + ".parameters.offset_s", "must be in [-0.5, 0.5]"};
     if (e.name == "gps_latency" && !sensors.gps) return P{k + ".name", "gps_latency needs sensors.gps"};
-    if ((e.name == "imu_time_offset" || e.name == "gyro_scale_error") && !sensors.imu)
+    if (e.name == "gyro_bias_drift") {
+      if (!(EffectParameter(effects, e.name, "random_walk", 0.0) >= 0.0))
+        return P{k + ".parameters.random_walk", "must be >= 0"};
+      for (const char* axis : {"initial_x", "initial_y", "initial_z"})
+        if (!(std::abs(EffectParameter(effects, e.name, axis, 0.0)) <= 0.5))
+          return P{k + ".parameters." + axis, "must be in [-0.5, 0.5] rad/s"};
+    }
+    if ((e.name == "imu_time_offset" || e.name == "gyro_scale_error" || e.name == "gyro_bias_drift") && !sensors.imu)
       return P{k + ".name", e.name + " needs sensors.imu"};
     if (e.name == "steering_offset" && !sensors.odometer)
       return P{k + ".name", "steering_offset needs sensors.odometer"};

@@ -50,6 +50,10 @@
 //                                          k_gamma becomes k_gamma + offset_rad
 //   gyro_scale_error {scale_x: 1, scale_y: 1, scale_z: 1}   per-axis gain of the gyroscope in its own frame
 //                                          (the estimator's gyroscope.scale, eq. 11 with k_s)
+//   gyro_bias_drift {initial_x: 0, initial_y: 0, initial_z: 0, random_walk: 0}   a gyroscope bias [rad/s] (sensor
+//                                          frame) that starts at `initial` and walks: b(t_k+1) = b(t_k) +
+//                                          random_walk sqrt(dt) n, n ~ N(0, I), random_walk [rad/s/sqrt(s)] (rate
+//                                          random walk of a warming MEMS gyro); its own seeded generator
 //   magnetometer_motor_interference {b_per_nm_x: 0, b_per_nm_y: 0, b_per_nm_z: 0}   a magnetometer bias (sensor
 //                                          frame, normalized field units) proportional to the rear drive torque
 //                                          per wheel [N m] applied at the sample instant (motor current)

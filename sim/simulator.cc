@@ -331,7 +331,9 @@ class Simulator::Impl {
       const std::string axis(1, "xyz"[i]);
       gyro_scale_[i] = EffectParameter(effects, "gyro_scale_error", "scale_" + axis, 1.0);
       mag_per_nm_[i] = EffectParameter(effects, "magnetometer_motor_interference", "b_per_nm_" + axis, 0.0);
+      gyro_bias_radps_[i] = EffectParameter(effects, "gyro_bias_drift", "initial_" + axis, 0.0);
     }
+    gyro_bias_walk_ = EffectParameter(effects, "gyro_bias_drift", "random_walk", 0.0);
     for (const EffectOptions& e : effects) {
       recording::Effect truth{e.name, KnownEffects().at(e.name)};
       for (const auto& [name, value] : e.parameters) truth.parameters[name] = value;
@@ -450,8 +452,12 @@ class Simulator::Impl {
       UpdateMotionStats(body);
     }
     if (imu_clock_.Due(t_ns)) {
-      const Eigen::Vector3d gyro =
-          gyro_scale_.cwiseProduct(GyroReading(body, imu_)) + gyro_noise_.Draw3(sensors.imu->gyro_sigma_radps);
+      const Eigen::Vector3d gyro = gyro_scale_.cwiseProduct(GyroReading(body, imu_)) + gyro_bias_radps_ +
+                                   gyro_noise_.Draw3(sensors.imu->gyro_sigma_radps);
+      if (gyro_bias_walk_ > 0.0) {
+        const double period_s = 1e-9 * static_cast<double>(imu_clock_.period_ns);
+        gyro_bias_radps_ += gyro_bias_noise_.Draw3(gyro_bias_walk_ * std::sqrt(period_s));
+      }
       const Eigen::Vector3d accel = AccelReading(body, imu_) + accel_noise_.Draw3(sensors.imu->accel_sigma_mps2);
       imu_stream_.values.row(imu_clock_.Row(t_ns)) << gyro.transpose(), accel.transpose();
     }
@@ -688,6 +694,8 @@ class Simulator::Impl {
   // Effects (scenario.h); neutral values when absent.
   double steering_offset_rad_ = 0.0;
   Eigen::Vector3d gyro_scale_ = Eigen::Vector3d::Ones();
+  Eigen::Vector3d gyro_bias_radps_ = Eigen::Vector3d::Zero();   // gyro_bias_drift: the bias at the next sample
+  double gyro_bias_walk_ = 0.0;                                 // [rad/s/sqrt(s)]
   Eigen::Vector3d mag_per_nm_ = Eigen::Vector3d::Zero();
 
   std::int64_t step_ns_ = 0;
@@ -704,6 +712,7 @@ class Simulator::Impl {
   NoiseStream speed_noise_{seed_, NoiseSource::kSpeed, options_.noise};
   NoiseStream steering_noise_{seed_, NoiseSource::kSteering, options_.noise};
   NoiseStream laser_noise_{seed_, NoiseSource::kLaserRange, options_.noise};
+  NoiseStream gyro_bias_noise_{seed_, NoiseSource::kGyroBiasWalk};   // an effect, not sensor noise: always on
 
   recording::Stream imu_stream_, mag_stream_, gps_stream_, wheel_stream_, steering_stream_, encoder_stream_,
       scan_stream_;

@@ -66,6 +66,28 @@ TEST_F(EffectsTest, GyroScaleMultipliesEachAxisAndNothingElse) {
   EXPECT_TRUE(nominal_->truth.effects.empty());
 }
 
+// The bias starts at `initial` and its increments sample by sample are N(0, random_walk^2 dt) per axis; nothing but
+// the gyroscope changes. The variance test uses the chi-square spread of a sample variance: relative std sqrt(2 / n).
+TEST_F(EffectsTest, GyroBiasDriftStartsAtItsInitialValueAndWalks) {
+  const double walk = 0.01;  // rad/s/sqrt(s)
+  const Simulation sim = Simulated(
+      Drive({{"gyro_bias_drift", {{"initial_x", 0.02}, {"initial_z", -0.01}, {"random_walk", walk}}}}));
+  const recording::Stream& a = StreamOf(*nominal_, "imu");
+  const recording::Stream& b = StreamOf(sim, "imu");
+  ASSERT_EQ(a.values.rows(), b.values.rows());
+  const Eigen::MatrixXd bias = b.values.leftCols(3) - a.values.leftCols(3);
+  EXPECT_NEAR(bias(0, 0), 0.02, 1e-12);
+  EXPECT_NEAR(bias(0, 1), 0.0, 1e-12);
+  EXPECT_NEAR(bias(0, 2), -0.01, 1e-12);
+  EXPECT_LT((b.values.rightCols(3) - a.values.rightCols(3)).cwiseAbs().maxCoeff(), 1e-12);  // accelerometer
+  const Eigen::MatrixXd steps = bias.bottomRows(bias.rows() - 1) - bias.topRows(bias.rows() - 1);
+  const double n = static_cast<double>(steps.size());
+  const double dt_s = 0.01;  // the IMU's 100 Hz
+  const double ratio = steps.squaredNorm() / n / (walk * walk * dt_s);
+  EXPECT_NEAR(ratio, 1.0, 4.0 * std::sqrt(2.0 / n));
+  EXPECT_EQ(sim.truth.effects.at(0).parameters.at("initial_y"), 0.0);
+}
+
 TEST_F(EffectsTest, SteeringOffsetShiftsTheHandlebarReadingByOffsetOverKTheta) {
   const Simulation sim = Simulated(Drive({{"steering_offset", {{"offset_rad", 0.03}}}}));
   const recording::Stream& a = StreamOf(*nominal_, "steering");
@@ -145,6 +167,10 @@ TEST(EffectsValidationTest, UnknownNamesParametersAndRangesAreErrors) {
   EXPECT_NE(problem({{"gps_latency", {{"latency_s", -0.1}}}}).find("must be in [0, 1]"), std::string::npos);
   EXPECT_NE(problem({{"imu_time_offset", {{"offset_s", 0.7}}}}).find("must be in [-0.5, 0.5]"), std::string::npos);
   EXPECT_NE(problem({{"steering_offset", {}}, {"steering_offset", {}}}).find("appears twice"), std::string::npos);
+  EXPECT_NE(problem({{"gyro_bias_drift", {{"random_walk", -0.01}}}}).find("random_walk: must be >= 0"),
+            std::string::npos);
+  EXPECT_NE(problem({{"gyro_bias_drift", {{"initial_y", 0.6}}}}).find("initial_y: must be in [-0.5, 0.5]"),
+            std::string::npos);
   // Not a whole number of 1 ms physics steps: refused when the simulator is created.
   Scenario s = testing::AtvHills(1.0);
   s.effects = {{"gps_latency", {{"latency_s", 0.0105}}}};
