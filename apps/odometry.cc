@@ -176,7 +176,7 @@ Status WriteTrajectoryFigure(const std::string& dir, const std::string& name, co
      << "set terminal pngcairo size 900,900 noenhanced font 'sans,11'\nset output '" << name << ".png'\n"
      << "set title '" << title << "'\nset xlabel 'x [m]'\nset ylabel 'y [m]'\nset size ratio -1\nset grid\n"
      << "set key outside below\n"
-     << "plot '" << name << ".dat' using 1:2 with lines lw 3 lc rgb 'black' title 'reference (motion capture)'";
+     << "plot '" << name << ".dat' using 1:2 with lines lw 3 lc rgb 'black' title 'reference (ground_truth.tum)'";
   // Distinct colours, none black (the reference).
   static const char* kColors[] = {"#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd",
                                   "#8c564b", "#e377c2", "#17becf", "#bcbd22", "#7f7f7f"};

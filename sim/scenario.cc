@@ -109,7 +109,7 @@ void ReadProfile(YamlReader& r, const YAML::Node& map, const std::string& parent
 
 void ReadRobot(YamlReader& r, const YAML::Node& node, const std::string& scenario_dir, Scenario* s) {
   const std::string key = "robot";
-  r.CheckKeys(node, key, {"kind", "model", "start", "speed_controller", "wheel_mounting"});
+  r.CheckKeys(node, key, {"kind", "model", "start", "speed_controller", "wheel_mounting", "wheel_deformation"});
   if (!r.Require(node, key, "kind") || !r.Require(node, key, "model")) return;
   r.String(node, key, "kind", &s->robot.kind);
   std::string model;
@@ -160,6 +160,28 @@ void ReadRobot(YamlReader& r, const YAML::Node& node, const std::string& scenari
       r.Number(item, ki, "tilt_deg", &tilt_deg);
       s->robot.wheel_mounting.push_back(
           {static_cast<int>(std::clamp<std::int64_t>(wheel, -1, 64)), yaw_deg * kPi / 180.0, tilt_deg * kPi / 180.0});
+    }
+  }
+  if (node["wheel_deformation"]) {
+    const YAML::Node list = node["wheel_deformation"];
+    const std::string k = "robot.wheel_deformation";
+    r.Remember(k, list);
+    if (!list.IsSequence()) {
+      r.Fail(list, k, "expected a list of {wheel, radius_scale, ovality_m}");
+      return;
+    }
+    for (std::size_t i = 0; i < list.size() && r.ok(); ++i) {
+      const YAML::Node item = list[i];
+      const std::string ki = k + "[" + std::to_string(i) + "]";
+      r.CheckKeys(item, ki, {"wheel", "radius_scale", "ovality_m"});
+      if (!r.Require(item, ki, "wheel")) return;
+      std::int64_t wheel = 0;
+      WheelDeformation d;
+      r.Integer(item, ki, "wheel", &wheel);
+      r.Number(item, ki, "radius_scale", &d.radius_scale);
+      r.Number(item, ki, "ovality_m", &d.ovality_m);
+      d.wheel = static_cast<int>(std::clamp<std::int64_t>(wheel, -1, 64));
+      s->robot.wheel_deformation.push_back(d);
     }
   }
 }
@@ -462,6 +484,17 @@ std::optional<Scenario::Problem> Scenario::Validate() const {
     if (c.wheel < 0) return P{k + ".wheel", "must be >= 0"};
     if (!(Finite(c.yaw_rad) && std::abs(c.yaw_rad) <= 0.35)) return P{k + ".yaw_deg", "must be within +-20"};
     if (!(Finite(c.tilt_rad) && std::abs(c.tilt_rad) <= 0.35)) return P{k + ".tilt_deg", "must be within +-20"};
+  }
+  if (ackermann && !robot.wheel_deformation.empty())
+    return P{"robot.wheel_deformation", "only for wheeled indoor robots"};
+  for (std::size_t i = 0; i < robot.wheel_deformation.size(); ++i) {
+    const WheelDeformation& d = robot.wheel_deformation[i];
+    const std::string k = "robot.wheel_deformation[" + std::to_string(i) + "]";
+    if (d.wheel < 0) return P{k + ".wheel", "must be >= 0"};
+    if (!(Finite(d.radius_scale) && d.radius_scale >= 0.8 && d.radius_scale <= 1.2))
+      return P{k + ".radius_scale", "must be in [0.8, 1.2]"};
+    if (!(Finite(d.ovality_m) && d.ovality_m >= 0.0 && d.ovality_m <= 0.02))
+      return P{k + ".ovality_m", "must be in [0, 0.02]"};
   }
 
   // Sensors.

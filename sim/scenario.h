@@ -109,6 +109,12 @@
 //   robot:
 //     wheel_mounting: [{wheel: 1, yaw_deg: 2.0, tilt_deg: 0.0}]   # optional: wheel bodies turned about their centre
 //                                           # (yaw about z: axle misaligned; tilt about the rolling direction: camber)
+//     wheel_deformation: [{wheel: 0, radius_scale: 1.0, ovality_m: 0.003}]   # optional, any wheeled kind with sphere
+//                                           # tires (differential_drive): the tire radius times radius_scale (in
+//                                           # [0.8, 1.2]), stretched into an oval by ovality_m in [0, 0.02] m (a taped
+//                                           # wheel: the rolling radius varies with the wheel angle; WheelDeformation
+//                                           # in sim/wheeled_robot.h). platform geometry stays nominal; truth.yaml's
+//                                           # odometer radius is the mean rolling radius (perimeter / 2 pi).
 //   driver:
 //     lateral_mps: <profile>                # sideways speed v_y [m/s] (default 0; only for omni3 and mecanum)
 // wheel_encoders has one column per wheel: omni3 "wheel_0" "wheel_1" "wheel_2", mecanum "front_left" "front_right"
@@ -145,6 +151,7 @@ struct RobotOptions {
   double start_heading_rad = 0.0;
   SpeedControllerOptions speed_controller;
   std::vector<WheelMountingChange> wheel_mounting;   // wheeled robots: wheels turned off their nominal mounting
+  std::vector<WheelDeformation> wheel_deformation;   // wheeled robots with sphere tires: deformed tires
 };
 
 struct DriverOptions {

@@ -151,6 +151,7 @@ class Simulator::Impl {
       auto robot = WheeledRobot::Bind(model_.get(), scenario_.robot.kind, model_where_);
       if (!robot.ok()) return robot.status();
       wheeled_ = robot.value();
+      if (Status st = wheeled_.Deform(model_.get(), scenario_.robot.wheel_deformation, where_); !st.ok()) return st;
       odom_site_ = wheeled_.odom_site();
       if (scenario_.sensors.laser && wheeled_.laser_site() < 0)
         return Status::Error(model_where_ + ": sensors.laser needs a site 'laser' on the robot");

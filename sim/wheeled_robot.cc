@@ -109,6 +109,7 @@ Result<WheeledRobot> WheeledRobot::Bind(const mjModel* model, const std::string&
     r.wheel_qpos_.push_back(model->jnt_qposadr[joint]);
     r.wheel_dof_.push_back(model->jnt_dofadr[joint]);
     r.actuators_.push_back(actuator);
+    r.tires_.push_back(tire);
 
     // Geometry in O: centre, axis, rolling direction d = a x e_z.
     const Eigen::Vector3d centre =
@@ -122,6 +123,7 @@ Result<WheeledRobot> WheeledRobot::Bind(const mjModel* model, const std::string&
     w.drive_direction = direction.head<2>().normalized();
     w.locked_direction = w.drive_direction;
     w.radius_m = model->geom_size[3 * tire];
+    w.mean_rolling_radius_m = w.radius_m;
     if (HasRollers(kind)) {
       // The roller under the wheel: its hinge axis, seen from above, is the locked direction u.
       const int roller = IdOf(model, mjOBJ_JOINT, "roller_" + index + "_0");
@@ -169,6 +171,43 @@ Status WheeledRobot::ChangeMounting(mjModel* model, const std::vector<WheelMount
   return Status::Ok();
 }
 
+Status WheeledRobot::Deform(mjModel* model, const std::vector<WheelDeformation>& deformations,
+                            const std::string& what) {
+  constexpr double kPi = 3.14159265358979323846;
+  for (const WheelDeformation& d : deformations) {
+    const std::string name = "robot.wheel_deformation: wheel " + std::to_string(d.wheel);
+    if (d.wheel < 0 || d.wheel >= static_cast<int>(wheels_.size()))
+      return Status::Error(what + ": " + name + ": the " + kind_ + " robot has " + std::to_string(wheels_.size()) +
+                           " wheels");
+    const int tire = tires_[static_cast<std::size_t>(d.wheel)];
+    if (model->geom_type[tire] != mjGEOM_SPHERE)
+      return Status::Error(what + ": " + name + ": only sphere tires can be deformed");
+    const double r = model->geom_size[3 * tire] * d.radius_scale;
+    const double a = r + d.ovality_m;
+    if (!(r > 0.0) || !(d.ovality_m >= 0.0) || d.ovality_m > 0.5 * r)
+      return Status::Error(what + ": " + name + ": needs radius_scale > 0 and 0 <= ovality_m <= half the radius");
+    // Ellipsoid semi-axes (a, r, r) in a geom frame whose y axis is the wheel's hinge axis (in the body frame), so
+    // that x is a direction of the wheel plane.
+    const int joint = IdOf(model, mjOBJ_JOINT, "wheel_" + std::to_string(d.wheel));
+    const Eigen::Vector3d axis = Eigen::Vector3d(model->jnt_axis + 3 * joint).normalized();
+    const Eigen::Quaterniond q = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitY(), axis);
+    model->geom_type[tire] = d.ovality_m > 0.0 ? mjGEOM_ELLIPSOID : mjGEOM_SPHERE;
+    model->geom_size[3 * tire] = a;
+    model->geom_size[3 * tire + 1] = r;
+    model->geom_size[3 * tire + 2] = r;
+    model->geom_rbound[tire] = a;
+    model->geom_quat[4 * tire] = q.w();
+    model->geom_quat[4 * tire + 1] = q.x();
+    model->geom_quat[4 * tire + 2] = q.y();
+    model->geom_quat[4 * tire + 3] = q.z();
+    // Mean rolling radius: the ellipse's perimeter / 2 pi (Ramanujan's second approximation, exact to ~(h^5)).
+    const double h = (a - r) * (a - r) / ((a + r) * (a + r));
+    const double perimeter = kPi * (a + r) * (1.0 + 3.0 * h / (10.0 + std::sqrt(4.0 - 3.0 * h)));
+    wheels_[static_cast<std::size_t>(d.wheel)].mean_rolling_radius_m = perimeter / (2.0 * kPi);
+  }
+  return Status::Ok();
+}
+
 std::map<std::string, double> WheeledRobot::PlatformGeometry() const {
   std::map<std::string, double> g{{"wheel_radius_m", mean_radius_m()}};
   if (kind_ == "differential_drive") {
@@ -198,12 +237,12 @@ std::vector<std::string> WheeledRobot::EncoderColumns() const {
 std::map<std::string, std::vector<double>> WheeledRobot::TrueOdometerCalibration() const {
   const std::map<std::string, double> g = PlatformGeometry();
   if (kind_ == "differential_drive")
-    return {{"odometer.radius_left", {wheels_[0].radius_m}},
-            {"odometer.radius_right", {wheels_[1].radius_m}},
+    return {{"odometer.radius_left", {wheels_[0].mean_rolling_radius_m}},
+            {"odometer.radius_right", {wheels_[1].mean_rolling_radius_m}},
             {"odometer.baseline", {g.at("baseline_m")}}};
   std::map<std::string, std::vector<double>> cal;
   for (std::size_t i = 0; i < wheels_.size(); ++i)
-    cal["odometer.radius_" + std::to_string(i)] = {wheels_[i].radius_m};
+    cal["odometer.radius_" + std::to_string(i)] = {wheels_[i].mean_rolling_radius_m};
   if (kind_ == "omni3") {
     cal["odometer.distance"] = {g.at("wheel_distance_m")};
   } else {

@@ -35,7 +35,8 @@ struct WheelGeometry {
   Eigen::Vector2d p_body_m = Eigen::Vector2d::Zero();     // contact point below the wheel centre, in O [m]
   Eigen::Vector2d drive_direction = Eigen::Vector2d::UnitX();
   Eigen::Vector2d locked_direction = Eigen::Vector2d::UnitX();   // u: unit, the direction the wheel cannot slide in
-  double radius_m = 0.0;                                 // true rolling radius
+  double radius_m = 0.0;                                 // nominal rolling radius (the tire as modelled)
+  double mean_rolling_radius_m = 0.0;                    // travel per revolution / 2 pi (radius_m unless deformed)
 };
 
 // A change of one wheel's mounting, applied to the compiled model before binding (the wheel turns about its centre):
@@ -46,6 +47,18 @@ struct WheelMountingChange {
   double tilt_rad = 0.0;
 };
 
+// A change of one wheel's tire (a sphere in the model), applied to the compiled model after binding, so that the
+// platform geometry and the driver keep the nominal wheel: the tire's radius r becomes r * radius_scale (a worn or
+// over-inflated tire), and ovality_m > 0 stretches it into an ellipsoid whose semi-axis along one direction of the
+// wheel plane is r * radius_scale + ovality_m (a wheel deformed by thick tape, seed 001 Section IV-B5). Rolling on a
+// floor, the axle height h(phi) then varies between r * radius_scale and that semi-axis twice per revolution; the
+// centre advances h(phi) per radian of wheel rotation, so the travel per revolution is the ellipse's perimeter.
+struct WheelDeformation {
+  int wheel = 0;
+  double radius_scale = 1.0;
+  double ovality_m = 0.0;
+};
+
 class WheeledRobot {
  public:
   // Finds the named elements and measures the wheels at qpos0. `kind` is the robot kind (differential_drive, omni3,
@@ -54,6 +67,11 @@ class WheeledRobot {
   // Turns wheel bodies of a compiled model (before Bind); errors name `what` and the wheel.
   static Status ChangeMounting(mjModel* model, const std::vector<WheelMountingChange>& changes,
                                const std::string& what);
+
+  // Deforms tires of the bound model (see WheelDeformation); needs sphere tires. Updates each deformed wheel's
+  // mean_rolling_radius_m (the true odometer radius) but neither the platform geometry nor the driver's kinematics.
+  // Errors name `what` and the wheel.
+  Status Deform(mjModel* model, const std::vector<WheelDeformation>& deformations, const std::string& what);
 
   const std::vector<WheelGeometry>& wheels() const { return wheels_; }
   int odom_site() const { return odom_site_; }
@@ -85,7 +103,7 @@ class WheeledRobot {
   int root_body_ = -1;
   int odom_site_ = -1;
   int laser_site_ = -1;
-  std::vector<int> wheel_qpos_, wheel_dof_, actuators_;
+  std::vector<int> wheel_qpos_, wheel_dof_, actuators_, tires_;
   std::vector<WheelGeometry> wheels_;
   Eigen::MatrixXd J_rates_twist_;
   double odom_height_m_ = 0.0;      // height of O above the tires' lowest points at qpos0

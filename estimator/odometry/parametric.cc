@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 
 #include "estimator/odometry/robust_linear.h"
+#include "recording/wheel_kinematics.h"
 
 namespace roamlab::estimator::odometry {
 namespace {
@@ -30,6 +31,17 @@ Result<double> WheelRadius(const recording::Platform& platform, const std::strin
   const std::string key = "wheel_radius_" + wheel + "_m";
   if (platform.geometry.count(key) > 0) return GeometryValue(platform, key);
   return GeometryValue(platform, "wheel_radius_m");
+}
+
+// Whether the platform uses the simulator's keys (recording/wheel_kinematics.h) rather than the per-wheel keys above:
+// baseline_m, half_length_m, or wheel_distance_m without per-wheel angles.
+bool UsesRecordingKeys(const recording::Platform& platform, const std::vector<std::string>& wheels) {
+  const auto has = [&](const std::string& key) { return platform.geometry.count(key) > 0; };
+  if (!has("wheel_radius_m")) return false;
+  if (platform.kind == "differential_drive") return has("baseline_m") && !has("track_m");
+  if (platform.kind == "mecanum") return has("half_length_m") && has("half_width_m");
+  if (platform.kind == "omni3") return !wheels.empty() && !has("wheel_angle_" + wheels.front() + "_rad");
+  return false;
 }
 
 }  // namespace
@@ -83,6 +95,20 @@ Result<WheelKinematics> NominalKinematics(const recording::Platform& platform,
   k.wheels = wheels;
   k.J = Eigen::MatrixXd::Zero(m, 3);
   k.radius_m.resize(m);
+  // The simulator's geometry keys (recording/wheel_kinematics.h, wheels in index order): its rows, scaled to rim
+  // speeds, J_i = r J_rates_twist_i.
+  if (UsesRecordingKeys(platform, wheels)) {
+    Result<recording::WheelKinematics> rows = recording::NominalWheelKinematics(platform);
+    if (!rows.ok()) return rows.status();
+    if (rows.value().wheels() != m) {
+      return Status::Error("platform '" + platform.kind + "' needs " + std::to_string(rows.value().wheels()) +
+                           " encoder columns");
+    }
+    const double radius = platform.geometry.at("wheel_radius_m");
+    k.J = radius * rows.value().J_rates_twist;
+    k.radius_m.setConstant(radius);
+    return k;
+  }
   if (platform.kind == "differential_drive") {
     if (Status s = require_wheels({"right", "left"}); !s.ok()) return s;
     if (m != 2) return Status::Error("platform differential_drive needs exactly two encoder columns");

@@ -16,6 +16,9 @@
 //   mecanum             wheels front_left, front_right, rear_left, rear_right, rollers at 45 deg (Taheri et al., the
 //                       seed's [16]): [1, -1, -k], [1, 1, k], [1, 1, -k], [1, -1, k], k = (wheelbase_m + track_m) / 2
 // Radii: geometry.wheel_radius_<name>_m, else geometry.wheel_radius_m. The nominal sensor pose is O itself.
+// A simulated recording's platform uses the keys of recording/wheel_kinematics.h instead (differential_drive
+// baseline_m, omni3 wheel_distance_m without per-wheel angles, mecanum half_length_m and half_width_m; wheels in the
+// simulator's column order): then the rows are that header's, J_i = r J_rates_twist_i.
 //
 // Censi et al. (the seed's [10], "CMLE" baseline) calibrate a differential drive from the same training pairs:
 //   1. J21 = -r_L / b and J22 = r_R / b from the sensor rotations, s_theta = J21 delta_L + J22 delta_R (linear, here

@@ -7,11 +7,20 @@
 //     with ticks_per_revolution) or rad/s (integrated here by the trapezoidal rule). delta_jk is the difference of the
 //     cumulative angles, linearly interpolated at the key times. Any linear unit gives the same learned model up to
 //     the scale of C and W; rad keeps encoders of different resolution comparable.
-//   - a pose stream (absolute pose of the exteroceptive sensor: motion capture, or a SLAM/scan-matching trajectory):
-//     its planar part (x, y, yaw) is interpolated at the key times (position linearly, heading along the shorter
-//     arc). Noise from the stream's noise entry: position_m and orientation_rad (the absolute_pose model's keys;
-//     defaults kDefaultPositionSigma_m, kDefaultOrientationSigma_rad). The displacement between two key poses then has
-//     the diagonal covariance diag(2 sp^2, 2 sp^2, 2 so^2) (independent pose errors, first order, cross terms dropped).
+//   - either a pose stream (absolute pose of the exteroceptive sensor: motion capture, or a SLAM trajectory): its
+//     planar part (x, y, yaw) is interpolated at the key times (position linearly, heading along the shorter arc),
+//     s_jk = (-)s_j (+) s_k. Noise from the stream's noise entry: position_m and orientation_rad (the absolute_pose
+//     model's keys; defaults kDefaultPositionSigma_m, kDefaultOrientationSigma_rad); the displacement then has the
+//     covariance diag(2 sp^2, 2 sp^2, 2 so^2) (independent pose errors, first order, cross terms dropped).
+//   - or an interval stream (scan_matching: the sensor's velocity between consecutive scans, a row stamped t covering
+//     [t - dt/2, t + dt/2] with dt = 1 / rate_hz, the rotate-half/translate/rotate-half form of sim/simulator.cc): each
+//     row's displacement d = (R(theta / 2) v dt, theta = omega_z dt) and s_jk = d_1 (+) d_2 (+) ... over the rows that
+//     exactly tile [t_j, t_k]; the key times then lie on the rows' grid (T a whole number of row periods), and a key
+//     interval with a missing row (a failed scan match) gives no pair. Each row has the covariance
+//     diag((sv dt)^2, (sv dt)^2, (sw dt)^2) from the noise entry (sigma_mps, sigma_radps), propagated to first order
+//     through (+) (Jacobians of Table I's operator).
+//   Either displacement is carried from the sensor frame S to O with the stream's mounting l (the hand-measured
+//   extrinsic of the recording metadata; identity when absent): q_jk = l (+) s_jk (+) (-)l, covariance J Sigma J^T.
 // The learner never reads ground_truth.tum or truth.yaml; evaluation reads the reference separately.
 #pragma once
 
@@ -33,7 +42,8 @@ inline constexpr double kDefaultOrientationSigma_rad = 0.002;
 struct KeyTimeOptions {
   double interval_s = 0.5;       // T, the spacing of the key times
   std::string encoder_stream;    // "" = the only wheel_encoders stream
-  std::string sensor_stream;     // "" = the only pose stream; unused (and not required) by KeyTimes(..., false)
+  std::string sensor_stream;     // "" = the only pose stream, else the only scan_matching stream; unused (and not
+                                 // required) by CutAtKeyTimes(..., false)
   std::string Validate() const;  // "" when valid
 };
 
@@ -42,8 +52,11 @@ struct KeySequence {
   std::vector<std::string> wheels;        // encoder column names
   std::vector<Time> t;                    // key times
   Eigen::MatrixXd wheel_angle_rad;        // rows = key times, columns = wheels: cumulative angle
-  std::vector<Pose2> sensor_pose;         // planar sensor pose at each key time (empty without a sensor)
-  Eigen::Vector2d sensor_sigma{kDefaultPositionSigma_m, kDefaultOrientationSigma_rad};  // [m], [rad] per pose
+  // With a sensor, for k = 1..size()-1 (index k-1): the displacement q_(k-1)k in O, its standard deviations
+  // (diagonal of the covariance; [m, m, rad]) and whether the sensor covered the interval.
+  std::vector<Pose2> sensor_step;
+  Eigen::MatrixXd sensor_step_sigma;
+  std::vector<bool> step_valid;
 
   int size() const { return static_cast<int>(t.size()); }
   // delta_(k-1)k for k = 1..size()-1: (size()-1) x m.
@@ -66,7 +79,8 @@ struct TrainingSet {
   int size() const { return static_cast<int>(delta.rows()); }
 };
 
-// Consecutive key pairs (k-1, k) of every sequence; all sequences must have the same wheel names and sensor poses.
+// Consecutive key pairs (k-1, k) of every sequence that the sensor covered; all sequences must have the same wheel
+// names and sensor steps.
 Result<TrainingSet> MakeTrainingSet(const std::vector<KeySequence>& sequences);
 
 }  // namespace roamlab::estimator::odometry

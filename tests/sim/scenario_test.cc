@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -192,6 +193,39 @@ TEST(ScenarioTest, IndoorOmniDrivesSidewaysAndWheelMountingIsParsedAndChecked) {
   EXPECT_EQ(mounted.value().robot.wheel_mounting[0].wheel, 2);
   EXPECT_NEAR(mounted.value().robot.wheel_mounting[0].yaw_rad, 2.0 * M_PI / 180.0, 1e-15);
   EXPECT_NEAR(mounted.value().robot.wheel_mounting[0].tilt_rad, -3.0 * M_PI / 180.0, 1e-15);
+
+  // Wheel deformation from YAML, then the checks of Validate.
+  const std::string deformed_text =
+      std::string(text).replace(text.find(kind), kind.size(),
+                                kind + "  wheel_deformation: [{wheel: 1, radius_scale: 1.01, ovality_m: 0.003}]\n");
+  roamlab::testing::WriteFile(dir.File("deformed.yaml"), deformed_text);
+  auto deformed = LoadScenario(dir.File("deformed.yaml"));
+  ASSERT_TRUE(deformed.ok()) << deformed.status().message();
+  ASSERT_EQ(deformed.value().robot.wheel_deformation.size(), 1u);
+  EXPECT_EQ(deformed.value().robot.wheel_deformation[0].wheel, 1);
+  EXPECT_EQ(deformed.value().robot.wheel_deformation[0].radius_scale, 1.01);
+  EXPECT_EQ(deformed.value().robot.wheel_deformation[0].ovality_m, 0.003);
+  roamlab::testing::WriteFile(dir.File("typo.yaml"), std::string(text).replace(
+      text.find(kind), kind.size(), kind + "  wheel_deformation: [{wheel: 1, ovality: 0.003}]\n"));
+  auto typo = LoadScenario(dir.File("typo.yaml"));
+  ASSERT_FALSE(typo.ok());
+  EXPECT_NE(typo.status().message().find("robot.wheel_deformation[0]"), std::string::npos) << typo.status().message();
+  EXPECT_NE(typo.status().message().find("ovality"), std::string::npos) << typo.status().message();
+  EXPECT_EQ(typo.status().message().find('\n'), std::string::npos);
+  for (const auto& [deformation, key] : std::vector<std::pair<WheelDeformation, std::string>>{
+           {{-1, 1.0, 0.0}, "robot.wheel_deformation[0].wheel"},
+           {{0, 1.5, 0.0}, "robot.wheel_deformation[0].radius_scale"},
+           {{0, 1.0, -0.001}, "robot.wheel_deformation[0].ovality_m"},
+           {{0, 1.0, 0.03}, "robot.wheel_deformation[0].ovality_m"}}) {
+    Scenario wrong = s;
+    wrong.robot.wheel_deformation = {deformation};
+    ASSERT_TRUE(wrong.Validate().has_value()) << key;
+    EXPECT_EQ(wrong.Validate()->key, key);
+  }
+  Scenario atv = testing::AtvHills(1.0);
+  atv.robot.wheel_deformation = {{0, 1.0, 0.001}};
+  ASSERT_TRUE(atv.Validate().has_value());
+  EXPECT_EQ(atv.Validate()->key, "robot.wheel_deformation");
 
   Scenario bad = s;
   bad.robot.wheel_mounting = {{0, 0.5, 0.0}};

@@ -53,7 +53,7 @@ TEST(TrainingDataTest, PairsHoldWheelRotationsAndSensorDisplacements) {
   Result<KeySequence> seq = CutAtKeyTimes(rec, "rec", options, true);
   ASSERT_TRUE(seq.ok()) << seq.status().message();
   EXPECT_EQ(seq.value().size(), 21);
-  EXPECT_DOUBLE_EQ(seq.value().sensor_sigma[0], 0.002);
+  EXPECT_DOUBLE_EQ(seq.value().sensor_step_sigma(0, 0), std::sqrt(2.0) * 0.002);
   Result<TrainingSet> set = MakeTrainingSet({seq.value()});
   ASSERT_TRUE(set.ok()) << set.status().message();
   ASSERT_EQ(set.value().size(), 20);
@@ -76,6 +76,65 @@ TEST(TrainingDataTest, NamesTheMissingStream) {
   ASSERT_FALSE(seq.ok());
   EXPECT_EQ(seq.status().message(), "REC: no pose stream");
   EXPECT_TRUE(CutAtKeyTimes(rec, "REC", {}, false).ok());  // evaluation needs no sensor
+}
+
+// The same drive seen by a 10 Hz scan matcher mounted off O (lever arm and yaw): each row the laser frame's velocity
+// over its scan interval (rotate half, translate, rotate half), stamped at the interval's middle. One row is missing
+// (a failed match). Expected: body displacements q = l (+) s (+) (-)l of the composed rows, the key interval with the
+// gap dropped, covariance grown with the rows composed.
+TEST(TrainingDataTest, ScanMatchingIncrementsAreComposedAndCarriedToTheBody) {
+  const WheelKinematics truth = DifferentialDrive({"right", "left"}, 0.042, 0.041, 0.2, Pose2::Zero());
+  const Eigen::Vector2d speed(6.0, 4.0);
+  recording::Recording rec = MakeRecording(truth, speed, 101);  // 5 s of 20 Hz encoders
+  rec.streams.pop_back();
+  const Pose2 mounting(0.15, -0.05, 0.3);
+  recording::Stream scans;
+  scans.info.name = "scan_matching";
+  scans.info.type = recording::StreamType::kScanMatching;
+  scans.info.rate_hz = 10.0;
+  scans.info.columns = recording::FixedColumns(recording::StreamType::kScanMatching);
+  scans.info.units = "m/s,rad/s";
+  scans.info.noise = {{"sigma_mps", 0.01}, {"sigma_radps", 0.02}};
+  scans.info.mounting = recording::Mounting{};
+  scans.info.mounting->p_body_sensor = Eigen::Vector3d(mounting[0], mounting[1], 0.2);
+  scans.info.mounting->q_body_sensor = Eigen::AngleAxisd(mounting[2], Eigen::Vector3d::UnitZ());
+  const Pose2 body_step = truth.Displacement(0.1 * speed);  // 0.1 s of body motion
+  const Pose2 laser_step = Compose(Compose(Inverse(mounting), body_step), mounting);
+  const double theta = laser_step[2];
+  const Eigen::Vector2d v = Eigen::Rotation2Dd(-0.5 * theta) * laser_step.head<2>() / 0.1;
+  const int rows = 50;
+  const int missing = 17;  // the row covering [1.7, 1.8] s, inside the key interval [1.5, 1.8]
+  scans.values.resize(rows - 1, 6);
+  for (int k = 0, r = 0; k < rows; ++k) {
+    if (k == missing) continue;
+    scans.t.push_back(Time::FromNanoseconds(50'000'000LL + 100'000'000LL * k));
+    scans.values.row(r++) << v.x(), v.y(), 0.0, 0.0, 0.0, theta / 0.1;
+  }
+  rec.streams.push_back(scans);
+
+  KeyTimeOptions options;
+  options.interval_s = 0.3;
+  Result<KeySequence> seq = CutAtKeyTimes(rec, "rec", options, true);
+  ASSERT_TRUE(seq.ok()) << seq.status().message();
+  EXPECT_EQ(seq.value().size(), 17);  // 0 to 4.8 s
+  Result<TrainingSet> set = MakeTrainingSet({seq.value()});
+  ASSERT_TRUE(set.ok()) << set.status().message();
+  ASSERT_EQ(set.value().size(), 15);  // 16 intervals, one with the gap
+  const Pose2 expected = Compose(Compose(body_step, body_step), body_step);
+  for (int k = 0; k < set.value().size(); ++k) {
+    EXPECT_LT((set.value().delta.row(k).transpose() - 0.3 * speed).norm(), 1e-12);
+    EXPECT_LT((set.value().s.row(k).transpose() - expected).norm(), 1e-12) << k;
+  }
+  // Heading variance: three rows of (0.02 rad/s x 0.1 s)^2, unchanged by the mounting; translation grows with the
+  // lever arm's swing.
+  EXPECT_NEAR(set.value().s_sigma(0, 2), std::sqrt(3.0) * 0.002, 1e-12);
+  EXPECT_GT(set.value().s_sigma(0, 1), std::sqrt(3.0) * 0.001);
+
+  // Key times off the rows' grid: no interval is tiled by whole rows.
+  options.interval_s = 0.25;
+  Result<KeySequence> off = CutAtKeyTimes(rec, "rec", options, true);
+  ASSERT_FALSE(off.ok());
+  EXPECT_NE(off.status().message().find("multiple of 1 / rate_hz"), std::string::npos) << off.status().message();
 }
 
 // A saved model predicts what the trained one does.
