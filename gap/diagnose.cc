@@ -169,8 +169,9 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
     return it != config.parameters.end() && it->second.free;
   };
   std::vector<std::string> gps, imu;
-  std::string gyro, ackermann;
+  std::string gyro, ackermann, diff_drive;
   for (const auto& [stream, sc] : config.streams) {
+    if (sc.model == "differential_drive" && diff_drive.empty()) diff_drive = stream;
     if (sc.model == "gps") gps.push_back(sc.sources.begin()->second);
     if (sc.model == "gyroscope" || sc.model == "accelerometer" || sc.model == "magnetometer")
       imu.push_back(sc.sources.begin()->second);
@@ -216,6 +217,33 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
           e->parameters[key] = value.at(p)[i];
           if (std.count(p)) e->std[key] = std.at(p)[i];
         }
+      };
+    } else if (name == "wheel_radius_asymmetry" && !diff_drive.empty()) {
+      // The right/left radius ratio rho (models/differential_drive.h): meaningful when the nominal model believes the
+      // wheels equal, i.e. maps both radius slots to one parameter.
+      const estimator::StreamConfig& sc = config.streams.at(diff_drive);
+      const std::string p = SlotParameter(diff_drive, sc, "right_left_ratio");
+      if (is_free(p) || SlotParameter(diff_drive, sc, "radius_left") != SlotParameter(diff_drive, sc, "radius_right"))
+        continue;
+      c.stream = diff_drive;
+      c.free = {p};
+      c.free_dof = 1;
+      c.describe = [p](const auto& value, const auto& std, EffectEstimate* e) {
+        e->parameters["ratio_right_left"] = value.at(p)[0];
+        if (std.count(p)) e->std["ratio_right_left"] = std.at(p)[0];
+      };
+    } else if (name == "track_width_error" && !diff_drive.empty()) {
+      // The effective track B (for a skid-steer robot, what makes the wheel speeds' difference turn it at the rate it
+      // does), freed from the nominal geometry; reported as the departure from it.
+      const std::string p = SlotParameter(diff_drive, config.streams.at(diff_drive), "baseline");
+      const std::optional<Eigen::VectorXd> nominal = ConfiguredValue(config, p);
+      if (is_free(p) || !nominal || !std::isfinite((*nominal)[0])) continue;
+      c.stream = diff_drive;
+      c.free = {p};
+      c.free_dof = 1;
+      c.describe = [p, b0 = (*nominal)[0]](const auto& value, const auto& std, EffectEstimate* e) {
+        e->parameters["track_error_m"] = value.at(p)[0] - b0;
+        if (std.count(p)) e->std["track_error_m"] = std.at(p)[0];
       };
     } else if (name == "lateral_slip" && !ackermann.empty()) {
       const std::string front = SlotParameter(ackermann, config.streams.at(ackermann), "cornering_front");
@@ -266,7 +294,9 @@ struct CandidateFit {
 };
 
 // Neutral value of an effect parameter (what the nominal model assumes).
-double Neutral(const std::string& parameter) { return parameter.rfind("scale_", 0) == 0 ? 1.0 : 0.0; }
+double Neutral(const std::string& parameter) {
+  return parameter.rfind("scale_", 0) == 0 || parameter.rfind("ratio_", 0) == 0 ? 1.0 : 0.0;
+}
 
 // The likelihood-ratio test and BIC of a fitted candidate, and its parameters relative to the baseline.
 // Without a baseline the null hypothesis is the nominal model (parameters at their neutral values): LR = the chi2 drop
@@ -311,8 +341,9 @@ void Score(const Baseline* baseline, int measurements, EffectEstimate* e) {
 }  // namespace
 
 const std::vector<std::string>& CandidateNames() {
-  static const std::vector<std::string> names = {"gps_latency", "imu_time_offset", "steering_offset",
-                                                 "gyro_scale_error", "lateral_slip"};
+  static const std::vector<std::string> names = {"gps_latency",      "imu_time_offset",        "steering_offset",
+                                                 "gyro_scale_error", "lateral_slip",           "wheel_radius_asymmetry",
+                                                 "track_width_error"};
   return names;
 }
 
