@@ -38,6 +38,7 @@ int RunImportOptiOdom(const ImportOptiOdomArgs& args) {
 int RunImportRosbag(const ImportRosbagArgs& args) {
   recording::RosbagImportOptions options;
   options.platform.kind = args.platform_kind;
+  options.wheels_from_odometry = args.wheels_from_odometry;
   for (const std::string& kv : args.geometry) {
     const std::size_t eq = kv.find('=');
     char* end = nullptr;

@@ -1,6 +1,7 @@
 // `roamlab import optiodom RUN.csv --out REC [--metadata FILE]`: converts a real OptiOdom run (recording/
 // import_optiodom.h) into a recording directory.
-// `roamlab import rosbag BAG --out REC [--imu-mounting W X Y Z] [--platform KIND] [--geometry KEY=VALUE ...]`:
+// `roamlab import rosbag BAG --out REC [--imu-mounting W X Y Z] [--platform KIND] [--geometry KEY=VALUE ...]
+// [--wheels-from-odometry]`:
 // converts the Imu, Odometry and NavSatFix topics of a ROS1 bag (recording/import_rosbag.h); the IMU mounting and the
 // platform's nominal geometry, which a bag does not hold, come from the options and go into recording.yaml.
 // Both return the exit code: 0, 2 with one line "roamlab import: <file>[:<line>]: <problem>" on bad input, 1 when the
@@ -25,7 +26,8 @@ struct ImportRosbagArgs {
   std::string out;
   std::vector<double> imu_mounting_wxyz;   // q_body_imu; empty = identity (no mounting written)
   std::string platform_kind = "unknown";
-  std::vector<std::string> geometry;       // "key=value", e.g. "track_m=0.555"
+  std::vector<std::string> geometry;       // "key=value", e.g. "baseline_m=0.555"
+  bool wheels_from_odometry = false;       // also write the `wheels` stream (recording/import_rosbag.h)
   bool quiet = false;
 };
 int RunImportRosbag(const ImportRosbagArgs& args);

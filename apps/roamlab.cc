@@ -82,7 +82,8 @@ int main(int argc, char** argv) {
       "diagnose", "Reality-gap diagnosis: locate where a recording departs from the nominal model, name the physical "
                   "effect, fit it and show the held-out fit improve (issue 6).");
   dia->add_option("--real", diagnose.recording, "Recording directory (its truth.yaml is never read)")->required();
-  dia->add_option("--scenario", diagnose.scenario, "The nominal scenario: the robot as believed")->required();
+  dia->add_option("--scenario", diagnose.scenario,
+                  "The nominal scenario: the robot as believed (optional with --config and --no-baseline)");
   dia->add_option("--config", diagnose.config, "Nominal estimator configuration (default: built from the scenario)");
   dia->add_option("--out", diagnose.out, "Output directory: gap.json, report.md, scenario_patch.yaml, figures")
       ->required();
@@ -165,6 +166,8 @@ int main(int argc, char** argv) {
       ->expected(4);
   imp_rosbag->add_option("--platform", import_rosbag.platform_kind, "Platform kind (e.g. skid_steer)");
   imp_rosbag->add_option("--geometry", import_rosbag.geometry, "Nominal geometry KEY=VALUE (repeatable)");
+  imp_rosbag->add_flag("--wheels-from-odometry", import_rosbag.wheels_from_odometry,
+                       "Also write wheel angles re-expressed from the odometry (needs wheel_radius_m, baseline_m)");
   imp_rosbag->add_flag("--quiet", import_rosbag.quiet, "No summary");
 
   try {

@@ -348,6 +348,39 @@ Result<Recording> ImportRosbag(const std::string& bag_path, const RosbagImportOp
     }
     rec.streams.push_back(std::move(s));
   }
+  // Wheel angles re-expressed from the odometry (header comment).
+  if (options.wheels_from_odometry) {
+    const auto r = rec.platform.geometry.find("wheel_radius_m");
+    const auto b = rec.platform.geometry.find("baseline_m");
+    if (r == rec.platform.geometry.end() || b == rec.platform.geometry.end() || !(r->second > 0.0) ||
+        !(b->second > 0.0))
+      return fail("wheels from odometry need positive wheel_radius_m and baseline_m in the platform geometry");
+    const Stream* odo = nullptr;
+    for (const Stream& s : rec.streams) {
+      if (s.info.type != StreamType::kOdometry) continue;
+      if (odo) return fail("wheels from odometry need exactly one nav_msgs/Odometry topic");
+      odo = &s;
+    }
+    if (!odo) return fail("wheels from odometry need a nav_msgs/Odometry topic");
+    Stream wheels;
+    wheels.info.name = "wheels";
+    wheels.info.type = StreamType::kWheelEncoders;
+    wheels.info.columns = {"left", "right"};
+    wheels.info.units = "rad";
+    wheels.info.rate_hz = odo->info.rate_hz;
+    wheels.info.attributes["derived_from_odometry"] = 1.0;
+    wheels.t = odo->t;
+    wheels.values = Eigen::MatrixXd::Zero(odo->values.rows(), 2);
+    const auto rates = [&](Eigen::Index k) {
+      const double v = odo->values(k, 0), omega = odo->values(k, 5);
+      return Eigen::Vector2d(v - 0.5 * omega * b->second, v + 0.5 * omega * b->second) / r->second;
+    };
+    for (Eigen::Index k = 1; k < odo->values.rows(); ++k) {
+      const double dt = SecondsBetween(odo->t[static_cast<std::size_t>(k - 1)], odo->t[static_cast<std::size_t>(k)]);
+      wheels.values.row(k) = wheels.values.row(k - 1) + (0.5 * dt * (rates(k - 1) + rates(k))).transpose();
+    }
+    rec.streams.push_back(std::move(wheels));
+  }
   rec.provenance.source = "imported";
   std::ostringstream description;
   description << "ROS1 bag " << std::filesystem::path(bag_path).filename().string() << " (header stamps; topics:";

@@ -19,6 +19,17 @@
 // whose stamp repeats the previous one is skipped and counted (ImportReport). All stamps are kept absolute (Unix
 // time), so the streams of one bag share one clock.
 //
+// Wheels (RosbagImportOptions::wheels_from_odometry, one odometry topic, platform geometry wheel_radius_m and
+// baseline_m): a differential-drive / skid-steer controller (ROS diff_drive_controller, the Husky's) computes its twist
+// from the wheel speeds with its nominal geometry, v = r (w_R + w_L) / 2, omega = r (w_R - w_L) / B, so the wheel
+// speeds are recovered exactly by the inverse w_L = (v - omega B / 2) / r, w_R = (v + omega B / 2) / r with the same
+// r and B. The importer then also writes stream `wheels` (type wheel_encoders, columns left, right, units rad): the
+// cumulative wheel angles, integrated by the trapezoid rule over the odometry stamps, with attribute
+// derived_from_odometry = 1. It is a re-expression of the odometry, not a new measurement; its use is that the
+// estimator's differential_drive model (with its calibration of radii and effective track) can read it. If the
+// controller's geometry differs from the one given, the recovered speeds are scaled, which the radius and track
+// calibration absorbs: ratios against the given geometry are what is meaningful.
+//
 // Mounting: the importer does not know the sensors' mounting (a bag without /tf does not say it), so the mounting is
 // given by the caller (RosbagImportOptions), and written into recording.yaml where the estimator's configuration
 // can read and check it.
@@ -38,6 +49,7 @@ namespace roamlab::recording {
 struct RosbagImportOptions {
   std::optional<Eigen::Quaterniond> q_body_imu;   // IMU mounting (rotates IMU coordinates into the body frame)
   Platform platform;                              // written as is (kind, nominal geometry)
+  bool wheels_from_odometry = false;              // also write `wheels` (header comment)
 };
 
 struct RosbagImportReport {

@@ -124,6 +124,12 @@ std::vector<std::string> ColumnsWithCovariance(StreamType type) {
   return columns;
 }
 
+// " (optionally followed by the N covariance columns)" for the types that may carry them, else "".
+std::string CovarianceNote(StreamType type) {
+  if (!HasCovarianceColumns(type)) return "";
+  return " (optionally followed by the " + std::to_string(CovarianceColumns(type).size()) + " covariance columns)";
+}
+
 bool CarriesCovariance(const StreamInfo& info) {
   return HasCovarianceColumns(info.type) && info.columns == ColumnsWithCovariance(info.type);
 }
@@ -377,8 +383,7 @@ Status ParseColumns(const YAML::Node& entry, const std::string& path, const std:
       return ErrorAt(path, node,
                      "columns " + JoinColumns(declared) + " of " + context + " do not match type " +
                          StreamTypeName(info->type) + ": expected " + JoinColumns(fixed) +
-                         (HasCovarianceColumns(info->type) ? " (optionally followed by its covariance columns)"
-                                                           : ""));
+                         CovarianceNote(info->type));
     }
     info->columns = covariance ? declared : fixed;
     return Status::Ok();
@@ -588,7 +593,7 @@ Status ValidateInfoForWrite(const StreamInfo& info, const std::string& prefix) {
   if (!fixed.empty() && !info.columns.empty() && info.columns != fixed && !CarriesCovariance(info)) {
     return Status::Error(prefix + "columns " + JoinColumns(info.columns) + " do not match type " +
                          StreamTypeName(info.type) + ": expected " + JoinColumns(fixed) +
-                         (HasCovarianceColumns(info.type) ? " (optionally followed by its covariance columns)" : ""));
+                         CovarianceNote(info.type));
   }
   if (fixed.empty()) {
     const std::string problem = FreeColumnsProblem(info.columns);

@@ -199,6 +199,23 @@ TEST_P(ImportRosbagTest, TinyBagRoundTripsThroughTheRecordingFormat) {
   EXPECT_TRUE(back.value().Find("imu")->info.mounting->q_body_sensor.isApprox(*options.q_body_imu, 1e-15));
 }
 
+TEST(ImportRosbagWheelsTest, WheelAnglesInvertTheControllersKinematics) {
+  TempDir dir;
+  RosbagImportOptions options;
+  options.platform.geometry = {{"wheel_radius_m", 0.1}, {"baseline_m", 0.5}};
+  options.wheels_from_odometry = true;
+  Imported in = Import(TinyBag("none"), dir, options);
+  ASSERT_TRUE(in.rec.ok()) << in.rec.status().message();
+  const Stream* wheels = in.rec.value().Find("wheels");
+  ASSERT_NE(wheels, nullptr);
+  EXPECT_EQ(wheels->info.columns, (std::vector<std::string>{"left", "right"}));
+  // Twists (1.0, 0.1) then (1.1, 0.2) 0.1 s apart: wheel rates (9.75, 10.25) and (10.5, 11.5) rad/s, trapezoid.
+  EXPECT_NEAR(wheels->values(1, 0), 0.05 * (9.75 + 10.5), 1e-12);
+  EXPECT_NEAR(wheels->values(1, 1), 0.05 * (10.25 + 11.5), 1e-12);
+  options.platform.geometry.erase("baseline_m");
+  EXPECT_THAT(Import(TinyBag("none"), dir, options).rec.status().message(), HasSubstr("baseline_m"));
+}
+
 INSTANTIATE_TEST_SUITE_P(Compression, ImportRosbagTest, ::testing::Values("none", "bz2"));
 
 TEST(ImportRosbagErrorTest, TruncatedFileNamesTheFileAndTheProblem) {
