@@ -371,13 +371,14 @@ Result<Recording> ImportRosbag(const std::string& bag_path, const RosbagImportOp
     wheels.info.attributes["derived_from_odometry"] = 1.0;
     wheels.t = odo->t;
     wheels.values = Eigen::MatrixXd::Zero(odo->values.rows(), 2);
-    const auto rates = [&](Eigen::Index k) {
-      const double v = odo->values(k, 0), omega = odo->values(k, 5);
-      return Eigen::Vector2d(v - 0.5 * omega * b->second, v + 0.5 * omega * b->second) / r->second;
+    // Wheel rate of side `side` (-1 left, +1 right) at sample k [rad/s].
+    const auto rate = [&](Eigen::Index k, double side) {
+      return (odo->values(k, 0) + side * 0.5 * odo->values(k, 5) * b->second) / r->second;
     };
     for (Eigen::Index k = 1; k < odo->values.rows(); ++k) {
       const double dt = SecondsBetween(odo->t[static_cast<std::size_t>(k - 1)], odo->t[static_cast<std::size_t>(k)]);
-      wheels.values.row(k) = wheels.values.row(k - 1) + (0.5 * dt * (rates(k - 1) + rates(k))).transpose();
+      wheels.values(k, 0) = wheels.values(k - 1, 0) + 0.5 * dt * (rate(k - 1, -1.0) + rate(k, -1.0));
+      wheels.values(k, 1) = wheels.values(k - 1, 1) + 0.5 * dt * (rate(k - 1, 1.0) + rate(k, 1.0));
     }
     rec.streams.push_back(std::move(wheels));
   }
