@@ -608,6 +608,7 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     factor = MakeFactor(AbsolutePoseError(row.head<3>().transpose(), q.normalized()));
     vars = {poses_[k].id, slot(0, k), slot(1, k)};
     absolute_fixes_.emplace_back(poses_[k].id, row.head<3>().transpose());
+    orientation_fixes_.push_back({poses_[k].id, slot(1, k), q.normalized()});
   }
   const FactorId id = graph_.AddFactor(std::move(factor), vars, s.noise_covariance, s.config.loss, s.name, m.t);
   stream_of_factor_[id] = m.stream;
@@ -694,6 +695,9 @@ void ProblemBuilder::PopOldestPose() {
   absolute_fixes_.erase(std::remove_if(absolute_fixes_.begin(), absolute_fixes_.end(),
                                        [this](const auto& fix) { return !graph_.HasVariable(fix.first); }),
                         absolute_fixes_.end());
+  orientation_fixes_.erase(std::remove_if(orientation_fixes_.begin(), orientation_fixes_.end(),
+                                          [this](const OrientationFix& fix) { return !graph_.HasVariable(fix.pose); }),
+                           orientation_fixes_.end());
 }
 
 void ProblemBuilder::AlignToAbsoluteFixes() {
@@ -715,7 +719,23 @@ void ProblemBuilder::AlignToAbsoluteFixes() {
     cross += a.x() * b.y() - a.y() * b.x();
     span = std::max(span, b.norm());
   }
-  const double yaw = span >= 1.0 ? std::atan2(cross, dot) : 0.0;
+  double yaw = span >= 1.0 ? std::atan2(cross, dot) : 0.0;
+  // Measured orientations, when there are any, fix the rotation whatever the span: the body's yaw they imply,
+  // q_world_body = z_q q_body_sensor^-1, less the dead-reckoned yaw, averaged on the circle.
+  double sin_sum = 0.0, cos_sum = 0.0;
+  const auto yaw_of = [](const Eigen::Quaterniond& q) {
+    const Eigen::Vector3d x = q * Eigen::Vector3d::UnitX();
+    return std::atan2(x.y(), x.x());
+  };
+  for (const OrientationFix& fix : orientation_fixes_) {
+    const Eigen::VectorXd& m = graph_.variable(fix.misalignment).value;
+    const Eigen::Quaterniond q_body_sensor(m[0], m[1], m[2], m[3]);
+    const Eigen::Quaterniond q_world_body = fix.q_world_sensor * q_body_sensor.normalized().conjugate();
+    const double d = yaw_of(q_world_body) - yaw_of(PoseFromArray(graph_.variable(fix.pose).value.data()).q_world_body);
+    sin_sum += std::sin(d);
+    cos_sum += std::cos(d);
+  }
+  if (std::hypot(sin_sum, cos_sum) > 0.0) yaw = std::atan2(sin_sum, cos_sum);
   const Eigen::Quaterniond q_yaw(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
   for (const PoseNode& node : poses_) {
     Eigen::VectorXd& x = graph_.mutable_variable(node.id).value;

@@ -168,9 +168,13 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
     const auto it = config.parameters.find(name);
     return it != config.parameters.end() && it->second.free;
   };
-  std::vector<std::string> gps, imu;
-  std::string gyro, ackermann, diff_drive;
+  std::vector<std::string> gps, imu, pose;
+  std::string gyro, ackermann, diff_drive, pose_stream;
   for (const auto& [stream, sc] : config.streams) {
+    if (sc.model == "absolute_pose") {
+      pose.push_back(sc.sources.begin()->second);
+      if (pose_stream.empty()) pose_stream = stream;
+    }
     if (sc.model == "differential_drive" && diff_drive.empty()) diff_drive = stream;
     if (sc.model == "gps") gps.push_back(sc.sources.begin()->second);
     if (sc.model == "gyroscope" || sc.model == "accelerometer" || sc.model == "magnetometer")
@@ -193,6 +197,12 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
     } else if (name == "imu_time_offset" && !imu.empty() && !gyro.empty()) {
       c.stream = gyro;
       c.shifted = imu;
+      c.shift_parameter = "offset_s";
+    } else if (name == "pose_time_offset" && !pose.empty() && config.streams.at(config.master).model != "absolute_pose") {
+      // The absolute pose stream (motion capture, SLAM) stamped late against the master (the wheel encoders): its
+      // pose stamped t is the body's pose at t - offset.
+      c.stream = pose_stream;
+      c.shifted = pose;
       c.shift_parameter = "offset_s";
     } else if (name == "steering_offset" && !ackermann.empty()) {
       const std::string p = SlotParameter(ackermann, config.streams.at(ackermann), "k_gamma");
@@ -341,9 +351,9 @@ void Score(const Baseline* baseline, int measurements, EffectEstimate* e) {
 }  // namespace
 
 const std::vector<std::string>& CandidateNames() {
-  static const std::vector<std::string> names = {"gps_latency",      "imu_time_offset",        "steering_offset",
-                                                 "gyro_scale_error", "lateral_slip",           "wheel_radius_asymmetry",
-                                                 "track_width_error"};
+  static const std::vector<std::string> names = {
+      "gps_latency",  "imu_time_offset",        "pose_time_offset",  "steering_offset",
+      "gyro_scale_error", "lateral_slip", "wheel_radius_asymmetry", "track_width_error"};
   return names;
 }
 
