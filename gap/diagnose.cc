@@ -679,11 +679,11 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
     return cf;
   };
 
-  std::set<std::string> accepted;
+  std::set<std::string> accepted, dropped;
   for (int round = 0; round < std::max(1, options.max_effects); ++round) {
     std::vector<CandidateFit> fits;
     for (const Candidate& c : library) {
-      if (accepted.count(c.name)) continue;
+      if (accepted.count(c.name) || dropped.count(c.name)) continue;
       say("candidate " + c.name + (round > 0 ? " (on top of the accepted effects)" : ""));
       auto cf = fit_candidate(c, state);
       if (!cf.ok()) return Status::Error("candidate " + c.name + ": " + cf.status().message());
@@ -695,39 +695,45 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
     std::sort(fits.begin(), fits.end(), [](const CandidateFit& a, const CandidateFit& b) {
       return a.estimate.delta_bic < b.estimate.delta_bic;
     });
-    CandidateFit& best = fits.front();
-    bool keep = false;
-    if (options.max_effects > round) {
-      EffectEstimate& e = best.estimate;
+    // In order of Delta BIC, the first candidate that passes the likelihood-ratio test, BIC and the held-out test is
+    // kept. One that fails the held-out test (a structure of the training part only, e.g. a clock offset that jumps
+    // within the run) does not hide the next one, and is not tried again in the later rounds.
+    CandidateFit* kept = nullptr;
+    for (CandidateFit& f : fits) {
+      if (options.max_effects <= round || kept) break;
+      EffectEstimate& e = f.estimate;
       if (e.lr_pvalue >= options.alpha) {
         e.decision = "rejected: likelihood-ratio p above alpha";
-      } else if (e.delta_bic >= 0.0) {
-        e.decision = "rejected: BIC does not favour it";
-      } else {
-        auto h = heldout(best.next);
-        if (!h.ok()) return Status::Error("held-out evaluation of " + e.name + ": " + h.status().message());
-        e.evaluated_heldout = true;
-        e.heldout_improvement = state.heldout_chi2 > 0.0 ? 1.0 - h.value().first / state.heldout_chi2 : 0.0;
-        if (e.heldout_improvement <= 0.0) {
-          e.decision = "rejected: no improvement on the held-out part";
-        } else {
-          e.decision = "accepted";
-          e.accepted = true;
-          keep = true;
-          best.next.heldout_chi2 = h.value().first;
-          best.next.heldout = h.value().second;
-        }
+        continue;
       }
+      if (e.delta_bic >= 0.0) {
+        e.decision = "rejected: BIC does not favour it";
+        continue;
+      }
+      auto h = heldout(f.next);
+      if (!h.ok()) return Status::Error("held-out evaluation of " + e.name + ": " + h.status().message());
+      e.evaluated_heldout = true;
+      e.heldout_improvement = state.heldout_chi2 > 0.0 ? 1.0 - h.value().first / state.heldout_chi2 : 0.0;
+      if (e.heldout_improvement <= 0.0) {
+        e.decision = "rejected: no improvement on the held-out part";
+        dropped.insert(e.name);
+        continue;
+      }
+      e.decision = "accepted";
+      e.accepted = true;
+      f.next.heldout_chi2 = h.value().first;
+      f.next.heldout = h.value().second;
+      kept = &f;
     }
     for (CandidateFit& f : fits) {
       if (f.estimate.decision.empty()) f.estimate.decision = "not the best candidate";
       if (round == 0) out.candidates.push_back(f.estimate);
     }
-    if (!keep) break;
-    accepted.insert(best.estimate.name);
-    out.effects.push_back(best.estimate);
-    say("accepted " + best.estimate.name);
-    state = best.next;
+    if (!kept) break;
+    accepted.insert(kept->estimate.name);
+    out.effects.push_back(kept->estimate);
+    say("accepted " + kept->estimate.name);
+    state = kept->next;
   }
   out.after = state.heldout;
   for (const std::string& name : state.extra_free) out.effect_parameters[name] = state.train_values.at(name);
