@@ -673,9 +673,21 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
     e.std[c.shift_parameter] = stdev;
     e.lr_raw = base.train_chi2 - chi2_min;
     for (const std::string& s : c.shifted) cf.next.shift_s[s] = shift;
-    cf.next.train_values = chi2_at[best].values;
-    cf.next.train_trajectory = chi2_at[best].trajectory;
-    cf.next.train_chi2 = chi2_min;
+    // The state the next rounds build on: an actual fit at the chosen shift. The parabola's vertex chi2 is the test
+    // statistic's, but it lies below what any one shift reaches by the jitter, and later candidates compared with it
+    // would lose that much of their own drop.
+    FitSpec spec;
+    spec.mode = FitMode::kWarm;
+    spec.values = chi2_at[best].values;
+    spec.extra_free = base.extra_free;
+    spec.shift_s = cf.next.shift_s;
+    spec.initial = &chi2_at[best].trajectory;
+    auto fit = Fit(nominal, train, spec);
+    ++out.fits;
+    if (!fit.ok()) return fit.status();
+    cf.next.train_values = fit.value().values;
+    cf.next.train_trajectory = fit.value().trajectory;
+    cf.next.train_chi2 = fit.value().chi2;
     return cf;
   };
 
