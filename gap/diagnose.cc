@@ -198,7 +198,8 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
       c.stream = gyro;
       c.shifted = imu;
       c.shift_parameter = "offset_s";
-    } else if (name == "pose_time_offset" && !pose.empty() && config.streams.at(config.master).model != "absolute_pose") {
+    } else if (name == "pose_time_offset" && !pose.empty() && config.streams.count(config.master) &&
+               config.streams.at(config.master).model != "absolute_pose") {
       // The absolute pose stream (motion capture, SLAM) stamped late against the master (the wheel encoders): its
       // pose stamped t is the body's pose at t - offset.
       c.stream = pose_stream;

@@ -119,8 +119,8 @@ TEST(RealDataTest, OptiOdomDifferentialDriveTrackAndWheelRatio) {
   // Other runs of the set: dead reckoning with the patched geometry against the nominal model self-calibrated on the
   // same training run (one radius, track 0.2 m) and against the manufacturer's values.
   const double r0 = diagnosis.nominal_parameters.at("wheels.radius")[0];
-  const double r = diagnosis.effect_parameters.count("wheels.radius") ? diagnosis.effect_parameters.at("wheels.radius")[0]
-                                                                       : r0;
+  const auto radius = diagnosis.effect_parameters.find("wheels.radius");
+  const double r = radius != diagnosis.effect_parameters.end() ? radius->second[0] : r0;
   const double rho_fit = diagnosis.effect_parameters.at("wheels.right_left_ratio")[0];
   const double b = diagnosis.effect_parameters.at("wheels.baseline")[0];
   // Whole runs (the robot's 69 s drives) and 10 s segments (200 samples).
