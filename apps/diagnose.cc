@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -248,19 +249,25 @@ int RunDiagnose(const DiagnoseArgs& args) {
     if (!args.quiet) std::cout << line << std::endl;
   };
 
-  // Inputs: the nominal scenario, the recording's streams (never its truth.yaml), the nominal configuration.
-  auto scenario = sim::LoadScenario(args.scenario);
-  if (!scenario.ok()) return bad(scenario.status().message());
+  // Inputs: the nominal scenario (optional for a robot without a MuJoCo twin: then --config and --no-baseline), the
+  // recording's streams (never its truth.yaml), the nominal configuration.
+  if (args.scenario.empty() && (args.config.empty() || !args.no_baseline))
+    return bad("without --scenario, give the nominal model as --config EST.yaml and --no-baseline");
+  std::optional<sim::Scenario> scenario;
+  if (!args.scenario.empty()) {
+    auto loaded = sim::LoadScenario(args.scenario);
+    if (!loaded.ok()) return bad(loaded.status().message());
+    scenario = std::move(loaded).value();
+  }
   recording::ReadOptions read;
   read.load_ground_truth = false;
   auto rec = recording::ReadRecording(args.recording, read);
   if (!rec.ok()) return bad(rec.status().message());
   const recording::Recording& recording = rec.value();
-  if (recording.platform.kind != scenario.value().robot.kind)
+  if (scenario && recording.platform.kind != scenario->robot.kind)
     return bad(args.recording + ": platform kind '" + recording.platform.kind + "' does not match the robot kind '" +
-               scenario.value().robot.kind + "' of " + args.scenario);
-  auto config =
-      args.config.empty() ? gap::NominalConfig(scenario.value()) : estimator::LoadEstimatorConfig(args.config);
+               scenario->robot.kind + "' of " + args.scenario);
+  auto config = args.config.empty() ? gap::NominalConfig(*scenario) : estimator::LoadEstimatorConfig(args.config);
   if (!config.ok())
     return bad((args.config.empty() ? args.scenario + ": " : std::string()) + config.status().message());
   for (const auto& [name, stream] : config.value().streams)
@@ -277,7 +284,7 @@ int RunDiagnose(const DiagnoseArgs& args) {
   options.progress = [&](const std::string& line) { say("  " + line); };
   gap::Baseline baseline;
   if (!args.no_baseline) {
-    sim::Scenario nominal = scenario.value();
+    sim::Scenario nominal = *scenario;
     nominal.effects.clear();
     double span_s = 0.0;
     for (const recording::Stream& s : recording.streams)
@@ -335,7 +342,8 @@ int RunDiagnose(const DiagnoseArgs& args) {
   std::string note;
   const std::vector<std::string> images = args.no_plots ? std::vector<std::string>{} : WritePlots(d, args.out, &note);
   if (!note.empty()) say(note);
-  const std::string report = Report(d, args.recording, args.scenario, !args.no_baseline, images);
+  const std::string report = Report(d, args.recording, args.scenario.empty() ? args.config : args.scenario,
+                                    !args.no_baseline, images);
   if (Status s = WriteText(args.out + "/report.md", report); !s.ok())
     return fail(s.message());
   std::string summary = "verdict: " + d.verdict;

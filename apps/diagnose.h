@@ -15,7 +15,8 @@ namespace roamlab::apps {
 
 struct DiagnoseArgs {
   std::string recording;                 // --real REC
-  std::string scenario;                  // --scenario SCENARIO.yaml (the nominal robot)
+  std::string scenario;                  // --scenario SCENARIO.yaml (the nominal robot); "" for a robot without a
+                                         // MuJoCo twin: then config and no_baseline are required
   std::string config;                    // --config EST.yaml: nominal estimator configuration (default: from the
                                          // scenario, gap::NominalConfig)
   std::string out;

@@ -1,9 +1,15 @@
 // `roamlab import optiodom RUN.csv --out REC [--metadata FILE]`: converts a real OptiOdom run (recording/
-// import_optiodom.h) into a recording directory. Returns the exit code: 0, 2 with one line
-// "roamlab import: <file>:<line>: <problem>" on bad input, 1 when the recording cannot be written.
+// import_optiodom.h) into a recording directory.
+// `roamlab import rosbag BAG --out REC [--imu-mounting W X Y Z] [--platform KIND] [--geometry KEY=VALUE ...]
+// [--wheels-from-odometry]`:
+// converts the Imu, Odometry and NavSatFix topics of a ROS1 bag (recording/import_rosbag.h); the IMU mounting and the
+// platform's nominal geometry, which a bag does not hold, come from the options and go into recording.yaml.
+// Both return the exit code: 0, 2 with one line "roamlab import: <file>[:<line>]: <problem>" on bad input, 1 when the
+// recording cannot be written.
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace roamlab::apps {
 
@@ -14,5 +20,16 @@ struct ImportOptiOdomArgs {
   bool quiet = false;
 };
 int RunImportOptiOdom(const ImportOptiOdomArgs& args);
+
+struct ImportRosbagArgs {
+  std::string bag;
+  std::string out;
+  std::vector<double> imu_mounting_wxyz;   // q_body_imu; empty = identity (no mounting written)
+  std::string platform_kind = "unknown";
+  std::vector<std::string> geometry;       // "key=value", e.g. "baseline_m=0.555"
+  bool wheels_from_odometry = false;       // also write the `wheels` stream (recording/import_rosbag.h)
+  bool quiet = false;
+};
+int RunImportRosbag(const ImportRosbagArgs& args);
 
 }  // namespace roamlab::apps

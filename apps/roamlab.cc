@@ -83,7 +83,8 @@ int main(int argc, char** argv) {
       "diagnose", "Reality-gap diagnosis: locate where a recording departs from the nominal model, name the physical "
                   "effect, fit it and show the held-out fit improve (issue 6).");
   dia->add_option("--real", diagnose.recording, "Recording directory (its truth.yaml is never read)")->required();
-  dia->add_option("--scenario", diagnose.scenario, "The nominal scenario: the robot as believed")->required();
+  dia->add_option("--scenario", diagnose.scenario,
+                  "The nominal scenario: the robot as believed (optional with --config and --no-baseline)");
   dia->add_option("--config", diagnose.config, "Nominal estimator configuration (default: built from the scenario)");
   dia->add_option("--out", diagnose.out, "Output directory: gap.json, report.md, scenario_patch.yaml, figures")
       ->required();
@@ -156,6 +157,19 @@ int main(int argc, char** argv) {
   imp_optiodom->add_option("--metadata", import_optiodom.metadata, "Metadata file (default <set>_metadata.csv)");
   imp_optiodom->add_option("--out", import_optiodom.out, "Output recording directory")->required();
   imp_optiodom->add_flag("--quiet", import_optiodom.quiet, "No summary");
+  roamlab::apps::ImportRosbagArgs import_rosbag;
+  CLI::App* imp_rosbag = imp->add_subcommand("rosbag", "A ROS1 bag (v2.0): sensor_msgs/Imu, nav_msgs/Odometry, "
+                                                       "sensor_msgs/NavSatFix.");
+  imp_rosbag->add_option("bag", import_rosbag.bag, "BAG.bag")->required();
+  imp_rosbag->add_option("--out", import_rosbag.out, "Output recording directory")->required();
+  imp_rosbag->add_option("--imu-mounting", import_rosbag.imu_mounting_wxyz,
+                         "IMU mounting q_body_imu as W X Y Z (rotates IMU coordinates into the body frame)")
+      ->expected(4);
+  imp_rosbag->add_option("--platform", import_rosbag.platform_kind, "Platform kind (e.g. skid_steer)");
+  imp_rosbag->add_option("--geometry", import_rosbag.geometry, "Nominal geometry KEY=VALUE (repeatable)");
+  imp_rosbag->add_flag("--wheels-from-odometry", import_rosbag.wheels_from_odometry,
+                       "Also write wheel angles re-expressed from the odometry (needs wheel_radius_m, baseline_m)");
+  imp_rosbag->add_flag("--quiet", import_rosbag.quiet, "No summary");
 
   try {
     app.parse(argc, argv);
@@ -182,5 +196,6 @@ int main(int argc, char** argv) {
   if (*odo_learn) return roamlab::apps::RunOdometryLearn(learn);
   if (*odo_evaluate) return roamlab::apps::RunOdometryEvaluate(odo_eval);
   if (*imp_optiodom) return roamlab::apps::RunImportOptiOdom(import_optiodom);
+  if (*imp_rosbag) return roamlab::apps::RunImportRosbag(import_rosbag);
   return 2;
 }

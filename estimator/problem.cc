@@ -53,6 +53,7 @@ struct StreamBinding {
   const recording::Stream* primary = nullptr;
   const recording::Stream* steering = nullptr;  // ackermann
   int column = 0;                               // first column used in the primary stream
+  bool right_then_left = false;                 // differential_drive: columns named [right, left] (else left, right)
   std::vector<std::string> slot_parameters;     // parameter name per model slot
   Eigen::MatrixXd noise_covariance;
   double row_covariance_scale = 0.0;            // odometer, relative_motion: weight of the rows' own covariance
@@ -184,6 +185,7 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
       if (b.primary->info.units != "rad" || b.primary->values.cols() != 2)
         return Error(config, "stream '" + name + "': differential_drive source '" + source +
                                  "' must hold two cumulative wheel angles (left, right) in rad or ticks");
+      b.right_then_left = b.primary->info.columns == std::vector<std::string>{"right", "left"};
     } else if (m == "omni3_drive" || m == "mecanum_drive") {
       const int wheels = m == "omni3_drive" ? 3 : 4;
       if (type != StreamType::kWheelEncoders) return Error(config, bad_type);
@@ -230,7 +232,8 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
       impl->parameter_manifold.emplace(pname, slot.manifold);
       Eigen::VectorXd init = slot.default_value;
       if (ackermann && slot.name == "kv_over_L") init[0] = 1.0 / b.wheelbase_m;
-      if (m == "differential_drive" || m == "omni3_drive" || m == "mecanum_drive") {
+      if ((m == "differential_drive" && slot.name != "right_left_ratio") || m == "omni3_drive" ||
+          m == "mecanum_drive") {
         // Radii from wheel_radius_m; the other slot from its geometry key (lx_plus_ly: the sum of two keys).
         std::string key = "wheel_radius_m";
         if (slot.name == "baseline") key = "baseline_m";
@@ -369,6 +372,13 @@ std::optional<Eigen::VectorXd> WheelRates(const recording::Stream& s, int row) {
   return Eigen::VectorXd((s.values.row(row + 1) - s.values.row(row)).transpose() / dt);
 }
 
+// A differential drive's (left, right) wheel rates, whatever the order of the stream's columns.
+std::optional<Eigen::VectorXd> LeftRightRates(const StreamBinding& s, int row) {
+  std::optional<Eigen::VectorXd> rates = WheelRates(*s.primary, row);
+  if (rates && s.right_then_left) std::swap((*rates)[0], (*rates)[1]);
+  return rates;
+}
+
 }  // namespace
 
 void ProblemBuilder::Add(const MeasurementRef& m) {
@@ -462,9 +472,9 @@ void ProblemBuilder::AddMasterSample(const MeasurementRef& m) {
     v_body.x() = kv_over_l * s.wheelbase_m * z_v;
     omega_body.z() = kv_over_l * z_v * std::tan(k_theta * SteeringAt(*s.steering, odo.t) + k_gamma);
   } else if (s.config.model == "differential_drive") {
-    if (const auto rates = WheelRates(*s.primary, odo.row)) {
-      DifferentialDriveError::BodyVelocity((*rates)[0], (*rates)[1], value(0)[0], value(1)[0], value(2)[0], &v_body,
-                                           &omega_body);
+    if (const auto rates = LeftRightRates(s, odo.row)) {
+      DifferentialDriveError::BodyVelocity((*rates)[0], (*rates)[1], value(0)[0], value(1)[0] * value(3)[0],
+                                           value(2)[0], &v_body, &omega_body);
     }
   } else if (s.config.model == "omni3_drive") {
     if (const auto rates = WheelRates(*s.primary, odo.row)) {
@@ -546,13 +556,13 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
       factor = MakeFactor(AckermannOdometerError(z_v, z_theta, s.wheelbase_m, dt));
     }
   } else if (model == "differential_drive") {
-    const auto rates = WheelRates(data, m.row);
+    const auto rates = LeftRightRates(s, m.row);
     if (!rates) {
       ++counts_[s.name].outside;
       return true;
     }
     factor = MakeFactor(DifferentialDriveError((*rates)[0], (*rates)[1], dt));
-    vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k)};
+    vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k), slot(3, k)};
   } else if (model == "omni3_drive" || model == "mecanum_drive") {
     const auto rates = WheelRates(data, m.row);
     if (!rates) {
@@ -598,6 +608,7 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     factor = MakeFactor(AbsolutePoseError(row.head<3>().transpose(), q.normalized()));
     vars = {poses_[k].id, slot(0, k), slot(1, k)};
     absolute_fixes_.emplace_back(poses_[k].id, row.head<3>().transpose());
+    orientation_fixes_.push_back({poses_[k].id, slot(1, k), q.normalized()});
   }
   const FactorId id = graph_.AddFactor(std::move(factor), vars, s.noise_covariance, s.config.loss, s.name, m.t);
   stream_of_factor_[id] = m.stream;
@@ -684,6 +695,9 @@ void ProblemBuilder::PopOldestPose() {
   absolute_fixes_.erase(std::remove_if(absolute_fixes_.begin(), absolute_fixes_.end(),
                                        [this](const auto& fix) { return !graph_.HasVariable(fix.first); }),
                         absolute_fixes_.end());
+  orientation_fixes_.erase(std::remove_if(orientation_fixes_.begin(), orientation_fixes_.end(),
+                                          [this](const OrientationFix& fix) { return !graph_.HasVariable(fix.pose); }),
+                           orientation_fixes_.end());
 }
 
 void ProblemBuilder::AlignToAbsoluteFixes() {
@@ -705,7 +719,23 @@ void ProblemBuilder::AlignToAbsoluteFixes() {
     cross += a.x() * b.y() - a.y() * b.x();
     span = std::max(span, b.norm());
   }
-  const double yaw = span >= 1.0 ? std::atan2(cross, dot) : 0.0;
+  double yaw = span >= 1.0 ? std::atan2(cross, dot) : 0.0;
+  // Measured orientations, when there are any, fix the rotation whatever the span: the body's yaw they imply,
+  // q_world_body = z_q q_body_sensor^-1, less the dead-reckoned yaw, averaged on the circle.
+  double sin_sum = 0.0, cos_sum = 0.0;
+  const auto yaw_of = [](const Eigen::Quaterniond& q) {
+    const Eigen::Vector3d x = q * Eigen::Vector3d::UnitX();
+    return std::atan2(x.y(), x.x());
+  };
+  for (const OrientationFix& fix : orientation_fixes_) {
+    const Eigen::VectorXd& m = graph_.variable(fix.misalignment).value;
+    const Eigen::Quaterniond q_body_sensor(m[0], m[1], m[2], m[3]);
+    const Eigen::Quaterniond q_world_body = fix.q_world_sensor * q_body_sensor.normalized().conjugate();
+    const double d = yaw_of(q_world_body) - yaw_of(PoseFromArray(graph_.variable(fix.pose).value.data()).q_world_body);
+    sin_sum += std::sin(d);
+    cos_sum += std::cos(d);
+  }
+  if (std::hypot(sin_sum, cos_sum) > 0.0) yaw = std::atan2(sin_sum, cos_sum);
   const Eigen::Quaterniond q_yaw(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
   for (const PoseNode& node : poses_) {
     Eigen::VectorXd& x = graph_.mutable_variable(node.id).value;

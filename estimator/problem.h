@@ -101,8 +101,10 @@ class ProblemBuilder {
   // Removes the oldest pose's bookkeeping after the graph variable has been marginalized by the caller.
   void PopOldestPose();
 
-  // Rigidly moves every pose (rotation about z and translation, or the identity when the fixes span under 1 m) to best
-  // fit the absolute fixes: the initial guess for a dead-reckoned trajectory.
+  // Rigidly moves every pose (rotation about z and translation) to best fit the absolute fixes: the initial guess for a
+  // dead-reckoned trajectory. The rotation: from the measured orientations when an absolute pose stream gives them
+  // (the circular mean of the yaw differences), else from the positions when they span at least 1 m (2-D
+  // Procrustes), else none.
   void AlignToAbsoluteFixes();
 
   // The initial guess of an IMU misalignment q_body_imu that is free and shared by a gyroscope and an accelerometer
@@ -135,6 +137,14 @@ class ProblemBuilder {
   std::map<std::string, StreamCounts> counts_;
   std::map<std::string, VariableId> parameters_;
   std::vector<std::pair<VariableId, Eigen::Vector3d>> absolute_fixes_;
+  // Absolute orientation fixes (absolute pose): the pose, its misalignment q_body_sensor variable, the measured
+  // q_world_sensor.
+  struct OrientationFix {
+    VariableId pose;
+    VariableId misalignment;
+    Eigen::Quaterniond q_world_sensor;
+  };
+  std::vector<OrientationFix> orientation_fixes_;
   bool has_absolute_sensor_ = false;
   bool popped_any_ = false;
   std::map<FactorId, int> stream_of_factor_;

@@ -168,9 +168,14 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
     const auto it = config.parameters.find(name);
     return it != config.parameters.end() && it->second.free;
   };
-  std::vector<std::string> gps, imu;
-  std::string gyro, ackermann;
+  std::vector<std::string> gps, imu, pose;
+  std::string gyro, ackermann, diff_drive, pose_stream;
   for (const auto& [stream, sc] : config.streams) {
+    if (sc.model == "absolute_pose") {
+      pose.push_back(sc.sources.begin()->second);
+      if (pose_stream.empty()) pose_stream = stream;
+    }
+    if (sc.model == "differential_drive" && diff_drive.empty()) diff_drive = stream;
     if (sc.model == "gps") gps.push_back(sc.sources.begin()->second);
     if (sc.model == "gyroscope" || sc.model == "accelerometer" || sc.model == "magnetometer")
       imu.push_back(sc.sources.begin()->second);
@@ -192,6 +197,13 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
     } else if (name == "imu_time_offset" && !imu.empty() && !gyro.empty()) {
       c.stream = gyro;
       c.shifted = imu;
+      c.shift_parameter = "offset_s";
+    } else if (name == "pose_time_offset" && !pose.empty() && config.streams.count(config.master) &&
+               config.streams.at(config.master).model != "absolute_pose") {
+      // The absolute pose stream (motion capture, SLAM) stamped late against the master (the wheel encoders): its
+      // pose stamped t is the body's pose at t - offset.
+      c.stream = pose_stream;
+      c.shifted = pose;
       c.shift_parameter = "offset_s";
     } else if (name == "steering_offset" && !ackermann.empty()) {
       const std::string p = SlotParameter(ackermann, config.streams.at(ackermann), "k_gamma");
@@ -216,6 +228,33 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
           e->parameters[key] = value.at(p)[i];
           if (std.count(p)) e->std[key] = std.at(p)[i];
         }
+      };
+    } else if (name == "wheel_radius_asymmetry" && !diff_drive.empty()) {
+      // The right/left radius ratio rho (models/differential_drive.h): meaningful when the nominal model believes the
+      // wheels equal, i.e. maps both radius slots to one parameter.
+      const estimator::StreamConfig& sc = config.streams.at(diff_drive);
+      const std::string p = SlotParameter(diff_drive, sc, "right_left_ratio");
+      if (is_free(p) || SlotParameter(diff_drive, sc, "radius_left") != SlotParameter(diff_drive, sc, "radius_right"))
+        continue;
+      c.stream = diff_drive;
+      c.free = {p};
+      c.free_dof = 1;
+      c.describe = [p](const auto& value, const auto& std, EffectEstimate* e) {
+        e->parameters["ratio_right_left"] = value.at(p)[0];
+        if (std.count(p)) e->std["ratio_right_left"] = std.at(p)[0];
+      };
+    } else if (name == "track_width_error" && !diff_drive.empty()) {
+      // The effective track B (for a skid-steer robot, what makes the wheel speeds' difference turn it at the rate it
+      // does), freed from the nominal geometry; reported as the departure from it.
+      const std::string p = SlotParameter(diff_drive, config.streams.at(diff_drive), "baseline");
+      const std::optional<Eigen::VectorXd> nominal = ConfiguredValue(config, p);
+      if (is_free(p) || !nominal || !std::isfinite((*nominal)[0])) continue;
+      c.stream = diff_drive;
+      c.free = {p};
+      c.free_dof = 1;
+      c.describe = [p, b0 = (*nominal)[0]](const auto& value, const auto& std, EffectEstimate* e) {
+        e->parameters["track_error_m"] = value.at(p)[0] - b0;
+        if (std.count(p)) e->std["track_error_m"] = std.at(p)[0];
       };
     } else if (name == "lateral_slip" && !ackermann.empty()) {
       const std::string front = SlotParameter(ackermann, config.streams.at(ackermann), "cornering_front");
@@ -266,7 +305,9 @@ struct CandidateFit {
 };
 
 // Neutral value of an effect parameter (what the nominal model assumes).
-double Neutral(const std::string& parameter) { return parameter.rfind("scale_", 0) == 0 ? 1.0 : 0.0; }
+double Neutral(const std::string& parameter) {
+  return parameter.rfind("scale_", 0) == 0 || parameter.rfind("ratio_", 0) == 0 ? 1.0 : 0.0;
+}
 
 // The likelihood-ratio test and BIC of a fitted candidate, and its parameters relative to the baseline.
 // Without a baseline the null hypothesis is the nominal model (parameters at their neutral values): LR = the chi2 drop
@@ -311,8 +352,9 @@ void Score(const Baseline* baseline, int measurements, EffectEstimate* e) {
 }  // namespace
 
 const std::vector<std::string>& CandidateNames() {
-  static const std::vector<std::string> names = {"gps_latency", "imu_time_offset", "steering_offset",
-                                                 "gyro_scale_error", "lateral_slip"};
+  static const std::vector<std::string> names = {
+      "gps_latency",  "imu_time_offset",        "pose_time_offset",  "steering_offset",
+      "gyro_scale_error", "lateral_slip", "wheel_radius_asymmetry", "track_width_error"};
   return names;
 }
 
@@ -632,17 +674,29 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
     e.std[c.shift_parameter] = stdev;
     e.lr_raw = base.train_chi2 - chi2_min;
     for (const std::string& s : c.shifted) cf.next.shift_s[s] = shift;
-    cf.next.train_values = chi2_at[best].values;
-    cf.next.train_trajectory = chi2_at[best].trajectory;
-    cf.next.train_chi2 = chi2_min;
+    // The state the next rounds build on: an actual fit at the chosen shift. The parabola's vertex chi2 is the test
+    // statistic's, but it lies below what any one shift reaches by the jitter, and later candidates compared with it
+    // would lose that much of their own drop.
+    FitSpec spec;
+    spec.mode = FitMode::kWarm;
+    spec.values = chi2_at[best].values;
+    spec.extra_free = base.extra_free;
+    spec.shift_s = cf.next.shift_s;
+    spec.initial = &chi2_at[best].trajectory;
+    auto fit = Fit(nominal, train, spec);
+    ++out.fits;
+    if (!fit.ok()) return fit.status();
+    cf.next.train_values = fit.value().values;
+    cf.next.train_trajectory = fit.value().trajectory;
+    cf.next.train_chi2 = fit.value().chi2;
     return cf;
   };
 
-  std::set<std::string> accepted;
+  std::set<std::string> accepted, dropped;
   for (int round = 0; round < std::max(1, options.max_effects); ++round) {
     std::vector<CandidateFit> fits;
     for (const Candidate& c : library) {
-      if (accepted.count(c.name)) continue;
+      if (accepted.count(c.name) || dropped.count(c.name)) continue;
       say("candidate " + c.name + (round > 0 ? " (on top of the accepted effects)" : ""));
       auto cf = fit_candidate(c, state);
       if (!cf.ok()) return Status::Error("candidate " + c.name + ": " + cf.status().message());
@@ -654,39 +708,45 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
     std::sort(fits.begin(), fits.end(), [](const CandidateFit& a, const CandidateFit& b) {
       return a.estimate.delta_bic < b.estimate.delta_bic;
     });
-    CandidateFit& best = fits.front();
-    bool keep = false;
-    if (options.max_effects > round) {
-      EffectEstimate& e = best.estimate;
+    // In order of Delta BIC, the first candidate that passes the likelihood-ratio test, BIC and the held-out test is
+    // kept. One that fails the held-out test (a structure of the training part only, e.g. a clock offset that jumps
+    // within the run) does not hide the next one, and is not tried again in the later rounds.
+    CandidateFit* kept = nullptr;
+    for (CandidateFit& f : fits) {
+      if (options.max_effects <= round || kept) break;
+      EffectEstimate& e = f.estimate;
       if (e.lr_pvalue >= options.alpha) {
         e.decision = "rejected: likelihood-ratio p above alpha";
-      } else if (e.delta_bic >= 0.0) {
-        e.decision = "rejected: BIC does not favour it";
-      } else {
-        auto h = heldout(best.next);
-        if (!h.ok()) return Status::Error("held-out evaluation of " + e.name + ": " + h.status().message());
-        e.evaluated_heldout = true;
-        e.heldout_improvement = state.heldout_chi2 > 0.0 ? 1.0 - h.value().first / state.heldout_chi2 : 0.0;
-        if (e.heldout_improvement <= 0.0) {
-          e.decision = "rejected: no improvement on the held-out part";
-        } else {
-          e.decision = "accepted";
-          e.accepted = true;
-          keep = true;
-          best.next.heldout_chi2 = h.value().first;
-          best.next.heldout = h.value().second;
-        }
+        continue;
       }
+      if (e.delta_bic >= 0.0) {
+        e.decision = "rejected: BIC does not favour it";
+        continue;
+      }
+      auto h = heldout(f.next);
+      if (!h.ok()) return Status::Error("held-out evaluation of " + e.name + ": " + h.status().message());
+      e.evaluated_heldout = true;
+      e.heldout_improvement = state.heldout_chi2 > 0.0 ? 1.0 - h.value().first / state.heldout_chi2 : 0.0;
+      if (e.heldout_improvement <= 0.0) {
+        e.decision = "rejected: no improvement on the held-out part";
+        dropped.insert(e.name);
+        continue;
+      }
+      e.decision = "accepted";
+      e.accepted = true;
+      f.next.heldout_chi2 = h.value().first;
+      f.next.heldout = h.value().second;
+      kept = &f;
     }
     for (CandidateFit& f : fits) {
       if (f.estimate.decision.empty()) f.estimate.decision = "not the best candidate";
       if (round == 0) out.candidates.push_back(f.estimate);
     }
-    if (!keep) break;
-    accepted.insert(best.estimate.name);
-    out.effects.push_back(best.estimate);
-    say("accepted " + best.estimate.name);
-    state = best.next;
+    if (!kept) break;
+    accepted.insert(kept->estimate.name);
+    out.effects.push_back(kept->estimate);
+    say("accepted " + kept->estimate.name);
+    state = kept->next;
   }
   out.after = state.heldout;
   for (const std::string& name : state.extra_free) out.effect_parameters[name] = state.train_values.at(name);

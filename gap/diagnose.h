@@ -13,10 +13,10 @@
 //      chi-square drop LR = chi2_nominal - chi2_effect ~ chi2(k) (cost = chi2 / 2, estimator/solver.h); with one, the
 //      nominal model is not exact on MuJoCo data and already moves each candidate's parameters on the nominal
 //      simulation, so H0 is "the parameters take the baseline's values" and LR is its Wald form with both fits'
-//      variances (Score in diagnose.cc). p = 1 - F_chi2(k)(LR), Delta BIC = -LR + k ln n. The best candidate (lowest
-//      Delta BIC) is kept when p < alpha, Delta BIC < 0 and the held-out chi-square (the last part of the recording,
-//      every parameter fixed at the training values) drops. Then the others are scored again on top, up to
-//      max_effects;
+//      variances (Score in diagnose.cc). p = 1 - F_chi2(k)(LR), Delta BIC = -LR + k ln n. In order of Delta BIC,
+//      the first candidate with p < alpha, Delta BIC < 0 and a drop of the held-out chi-square (the last part of the
+//      recording, every parameter fixed at the training values) is kept; one that fails the held-out test is dropped.
+//      Then the others are scored again on top, up to max_effects;
 //   4. model: the accepted effects' parameters and standard deviations (training fit);
 //   5. show: per-stream whitened RMS and chi2/dof on the held-out part before (nominal) and after (with the effects).
 // Verdict: "named" (some effect kept), "unknown" (no effect kept but some component stays inconsistent: its

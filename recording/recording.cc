@@ -110,17 +110,24 @@ const TypeRow& RowOf(StreamType type) {
   ROAMLAB_CHECK(false, "stream type " << static_cast<int>(type) << " missing from the type table");
 }
 
-// The velocity types whose fixed columns may be followed by the covariance columns.
+// The types whose fixed columns may be followed by the covariance columns: the velocity types (6x6) and gps (3x3).
 bool HasCovarianceColumns(StreamType type) {
-  return type == StreamType::kOdometry || type == StreamType::kVisualOdometry || type == StreamType::kScanMatching;
+  return type == StreamType::kOdometry || type == StreamType::kVisualOdometry || type == StreamType::kScanMatching ||
+         type == StreamType::kGps;
 }
 
-// Fixed columns followed by the covariance columns (velocity types only).
+// Fixed columns followed by the covariance columns (HasCovarianceColumns types only).
 std::vector<std::string> ColumnsWithCovariance(StreamType type) {
   std::vector<std::string> columns = FixedColumns(type);
   const std::vector<std::string>& covariance = CovarianceColumns(type);
   columns.insert(columns.end(), covariance.begin(), covariance.end());
   return columns;
+}
+
+// " (optionally followed by the N covariance columns)" for the types that may carry them, else "".
+std::string CovarianceNote(StreamType type) {
+  if (!HasCovarianceColumns(type)) return "";
+  return " (optionally followed by the " + std::to_string(CovarianceColumns(type).size()) + " covariance columns)";
 }
 
 bool CarriesCovariance(const StreamInfo& info) {
@@ -160,9 +167,10 @@ std::string CovarianceProblem(const Stream& stream) {
   const Eigen::Index fixed = static_cast<Eigen::Index>(FixedColumns(stream.info.type).size());
   const std::vector<std::string>& names = CovarianceColumns(stream.info.type);
   for (Eigen::Index row = 0; row < stream.values.rows(); ++row) {
-    // The diagonal of a 6x6 upper triangle stored row by row: entries 0, 6, 11, 15, 18, 20.
+    // The diagonal of an n x n upper triangle stored row by row: 6x6 entries 0, 6, 11, 15, 18, 20; 3x3: 0, 3, 5.
+    const Eigen::Index n = stream.info.type == StreamType::kGps ? 3 : 6;
     Eigen::Index index = 0;
-    for (Eigen::Index k = 0; k < 6; index += 6 - k, ++k) {
+    for (Eigen::Index k = 0; k < n; index += n - k, ++k) {
       if (stream.values(row, fixed + index) < 0.0) {
         return std::to_string(row + 2) + ": " + names[static_cast<std::size_t>(index)] + " is negative";
       }
@@ -375,8 +383,7 @@ Status ParseColumns(const YAML::Node& entry, const std::string& path, const std:
       return ErrorAt(path, node,
                      "columns " + JoinColumns(declared) + " of " + context + " do not match type " +
                          StreamTypeName(info->type) + ": expected " + JoinColumns(fixed) +
-                         (HasCovarianceColumns(info->type) ? " (optionally followed by the 21 covariance columns)"
-                                                           : ""));
+                         CovarianceNote(info->type));
     }
     info->columns = covariance ? declared : fixed;
     return Status::Ok();
@@ -586,7 +593,7 @@ Status ValidateInfoForWrite(const StreamInfo& info, const std::string& prefix) {
   if (!fixed.empty() && !info.columns.empty() && info.columns != fixed && !CarriesCovariance(info)) {
     return Status::Error(prefix + "columns " + JoinColumns(info.columns) + " do not match type " +
                          StreamTypeName(info.type) + ": expected " + JoinColumns(fixed) +
-                         (HasCovarianceColumns(info.type) ? " (optionally followed by the 21 covariance columns)" : ""));
+                         CovarianceNote(info.type));
   }
   if (fixed.empty()) {
     const std::string problem = FreeColumnsProblem(info.columns);
@@ -775,6 +782,8 @@ const std::vector<std::string>& FixedColumns(StreamType type) { return RowOf(typ
 
 const std::vector<std::string>& CovarianceColumns(StreamType type) {
   static const std::vector<std::string> none;
+  static const std::vector<std::string> gps = {"cov_e_e", "cov_e_n", "cov_e_u", "cov_n_n", "cov_n_u", "cov_u_u"};
+  if (type == StreamType::kGps) return gps;
   static const std::vector<std::string> covariance = [] {
     const char* const names[] = {"vx", "vy", "vz", "wx", "wy", "wz"};
     std::vector<std::string> columns;

@@ -31,7 +31,9 @@ inline constexpr int kFormatVersion = 1;
 //   gyroscope        wx wy wz [rad/s]
 //   accelerometer    ax ay az [m/s^2]
 //   magnetometer     mx my mz [units: normalized | uT | nT | gauss, kept as given]
-//   gps              latitude longitude [deg] altitude [m, above the ellipsoid]
+//   gps              latitude longitude [deg] altitude [m, above the ellipsoid], optionally followed by the 6
+//                    CovarianceColumns(): the upper triangle of the fix's 3x3 ENU covariance, row by row (cov_e_e,
+//                    cov_e_n, cov_e_u, cov_n_n, cov_n_u, cov_u_u) [m^2] (a ROS NavSatFix's position_covariance)
 //   position         x y z [m] absolute position of the sensor in W (SLAM, motion capture)
 //   pose             x y z [m] qx qy qz qw: absolute pose of the sensor in W
 //   wheel_encoders   one column per wheel, named in the stream entry; [rad] cumulative angle, [rad/s] angular speed
@@ -72,7 +74,8 @@ std::optional<StreamType> ParseStreamType(const std::string& name);
 // The CSV columns (after "t") that a type fixes, in the table above; empty for wheel_encoders and inputs, whose columns
 // come from the stream entry.
 const std::vector<std::string>& FixedColumns(StreamType type);
-// The covariance columns that may follow a velocity type's fixed columns (table above); empty for the other types.
+// The covariance columns that may follow the fixed columns of a velocity type or gps (table above); empty for the other
+// types.
 // A stream carries them when its info.columns are FixedColumns() followed by these.
 const std::vector<std::string>& CovarianceColumns(StreamType type);
 
@@ -87,7 +90,7 @@ struct StreamInfo {
   StreamType type = StreamType::kInputs;
   double rate_hz = 0.0;                 // nominal rate
   std::vector<std::string> columns;     // after "t"; fixed by the type except wheel_encoders and inputs (and the
-                                        // optional covariance columns of the velocity types)
+                                        // optional covariance columns of the velocity types and gps)
   std::string units;                    // after reading: the canonical unit of the type (table above; magnetometer,
                                         // camera and inputs keep what was declared); empty = canonical
   std::optional<Mounting> mounting;

@@ -9,7 +9,7 @@ packages=(
   build-essential cmake pkg-config git
   libeigen3-dev libsuitesparse-dev libgeographiclib-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   libmujoco-dev libqhull-dev libgl-dev libopengl-dev libegl-dev libegl-mesa0 libgl1-mesa-dri
-  libopencv-dev libgtest-dev libgmock-dev gnuplot-nox libceres-dev
+  libopencv-dev libgtest-dev libgmock-dev gnuplot-nox libceres-dev libbz2-dev
 )
 
 missing=()

@@ -3,25 +3,31 @@
 // velocities between two poses predict the two wheel rates, and the error is the difference to the encoder rates.
 //
 //   v^(O), omega^(O) = VelocitiesBetween(pose_k, pose_k+1, dt)        (eq. 7 inverted; middle of the interval)
-//   z_L_hat = (v_x - omega_z B / 2) / r_L,   z_R_hat = (v_x + omega_z B / 2) / r_R
+//   z_L_hat = (v_x - omega_z B / 2) / r_L,   z_R_hat = (v_x + omega_z B / 2) / (rho r_R)
 //   e = [z_L_hat - z_L;  z_R_hat - z_R;  v_y;  v_z;  omega_x;  omega_y] + eta                      e in R^6
 //
 // The forward kinematics that the seed's form (eqs. 5-8 with the readings as inputs) would use, and that the graph
 // builder uses for a new pose's initial guess (eq. 7), is the inverse of the first two rows:
-//   v_x = (r_R z_R + r_L z_L) / 2,   omega_z = (r_R z_R - r_L z_L) / B,   v_y = v_z = 0.
+//   v_x = (rho r_R z_R + r_L z_L) / 2,   omega_z = (rho r_R z_R - r_L z_L) / B,   v_y = v_z = 0.
 // Why measurement space: as for the Ackermann odometer (ackermann_velocity.h), the reading noise then stays additive
 // and its covariance constant, so calibrating r_L, r_R and B is not biased by errors in variables. O is the middle of
 // the wheel axle, so the odometer needs no displacement or misalignment (S = O).
 //
 // Frames: O at the middle of the wheel axle (x forward, z up). Measurements: z_L, z_R mean wheel rates over
 // [t_k, t_k+1] [rad/s], positive rolling forward (the difference of two cumulative encoder angles over dt).
-// Calibration: radius_left r_L [m], radius_right r_R [m], baseline B [m] (distance between the contact points).
+// Calibration: radius_left r_L [m], radius_right r_R [m], baseline B [m] (distance between the contact points; for a
+// skid-steer robot the effective track, wider than the geometric one when the tires scrub in turns), and
+// right_left_ratio rho [-] (default 1), a multiplier of r_R. rho lets a configuration that believes both wheels equal
+// (radius_left and radius_right mapped to one parameter) free their ratio r_R_eff / r_L = rho on its own: the reality-gap
+// diagnosis's wheel_radius_asymmetry candidate (gap/diagnose.h); freeing rho together with two separate radii leaves
+// the product rho r_R unobservable.
 // Noise eta = [sigma_wheel (rad/s), sigma_wheel, lateral (m/s), vertical (m/s), tilt (rad/s), tilt]: encoder
 // quantization and slip on the wheel rows, the slack of the planar, non-holonomic assumptions (no sideways slip, no
 // motion off the floor, no roll or pitch rate on a flat floor) on the others. Without the last two rows the pose's
 // roll and pitch would be free between the samples of any other planar sensor (a scan matcher).
 // Slip is not Gaussian: the configuration should give the stream a robust loss (seed Section VI).
-// Variables: pose at t_k, pose at t_k+1 (PoseBlock), r_L, r_R, B (ScalarBlock each).
+// Variables: pose at t_k, pose at t_k+1 (PoseBlock), r_L, r_R, B, rho (ScalarBlock each). Jacobians by the jets
+// (factor.h); tests/estimator/models/differential_drive_test.cc checks them against central differences.
 #pragma once
 
 #include <tuple>
@@ -36,7 +42,7 @@ namespace roamlab::estimator {
 
 class DifferentialDriveError {
  public:
-  using Blocks = std::tuple<PoseBlock, PoseBlock, ScalarBlock, ScalarBlock, ScalarBlock>;
+  using Blocks = std::tuple<PoseBlock, PoseBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock>;
   static constexpr int kResidualDim = 6;
   static constexpr int kNoiseDim = 6;
   static constexpr bool kAdditiveNoise = true;  // e = f(x) + eta
@@ -52,7 +58,7 @@ class DifferentialDriveError {
     Vector3<T> v_body, omega_body;
     VelocitiesBetween<T>(PoseFromArray(x[0]), PoseFromArray(x[1]), T(dt_s_), &v_body, &omega_body);
     const T& radius_left = x[2][0];
-    const T& radius_right = x[3][0];
+    const T radius_right = x[3][0] * x[5][0];   // rho r_R
     const T half_turn = omega_body.z() * x[4][0] * T(0.5);
     error[0] = (v_body.x() - half_turn) / radius_left - T(z_left_radps_) + noise[0];
     error[1] = (v_body.x() + half_turn) / radius_right - T(z_right_radps_) + noise[1];
@@ -63,7 +69,7 @@ class DifferentialDriveError {
     return true;
   }
 
-  // Forward kinematics: the body velocities of O from the wheel rates (header comment).
+  // Forward kinematics: the body velocities of O from the wheel rates (header comment); radius_right_m is rho r_R.
   static void BodyVelocity(double z_left_radps, double z_right_radps, double radius_left_m, double radius_right_m,
                            double baseline_m, Eigen::Vector3d* v_body, Eigen::Vector3d* omega_body) {
     const double rim_left = radius_left_m * z_left_radps;

@@ -36,7 +36,7 @@ TEST(DifferentialDriveErrorTest, ZeroAtTruthAndIdentityNoiseJacobian) {
     const Eigen::Vector2d z = Rates(v, omega);
     const auto factor = MakeFactor(DifferentialDriveError(z[0], z[1], 0.01));
     const auto lin = testing::Evaluate(*factor, {pose0, Step(pose0, v, omega, 0.01), Scalar(kRadiusLeft),
-                                                 Scalar(kRadiusRight), Scalar(kBaseline)});
+                                                 Scalar(kRadiusRight), Scalar(kBaseline), Scalar(1.0)});
     EXPECT_LT(lin.error.norm(), 1e-9) << v << " " << omega;
     EXPECT_TRUE(lin.noise_jacobian.isApprox(Eigen::MatrixXd::Identity(6, 6)));
   }
@@ -57,7 +57,7 @@ TEST(DifferentialDriveErrorTest, SidewaysMotionShowsInTheLateralRow) {
   pose1[1] = 0.002;  // 2 mm to the left in 10 ms: 0.2 m/s of side slip
   const auto factor = MakeFactor(DifferentialDriveError(0.0, 0.0, 0.01));
   const auto lin = testing::Evaluate(*factor, {pose0, pose1, Scalar(kRadiusLeft), Scalar(kRadiusRight),
-                                               Scalar(kBaseline)});
+                                               Scalar(kBaseline), Scalar(1.0)});
   EXPECT_NEAR(lin.error[2], 0.2, 1e-12);
   EXPECT_NEAR(lin.error.head<2>().norm() + lin.error.tail<3>().norm(), 0.0, 1e-12);
 }
@@ -69,14 +69,16 @@ TEST(DifferentialDriveErrorTest, JacobiansMatchCentralDifferences) {
     const Eigen::VectorXd pose1 =
         testing::Perturb(Manifold::Pose(), Step(pose0, 0.3 + 0.2 * trial, 1.0 - 0.4 * trial, 0.02), 0.002, &rng);
     const auto factor = MakeFactor(DifferentialDriveError(7.0, 9.0, 0.02));
-    testing::ExpectJacobiansMatchNumeric(
-        *factor, {pose0, pose1, Scalar(kRadiusLeft), Scalar(kRadiusRight), Scalar(kBaseline)}, 1e-5);
+    // The ratio slot away from 1, so that its column and its effect on the right wheel's row are both exercised.
+    testing::ExpectJacobiansMatchNumeric(*factor, {pose0, pose1, Scalar(kRadiusLeft), Scalar(kRadiusRight),
+                                                   Scalar(kBaseline), Scalar(0.97 + 0.02 * trial)}, 1e-5);
   }
 }
 
 // Small solve: a 10 s drive with both wheels' rates read at every interval, poses held by priors; the radii and the
-// baseline start at the nominal 0.075 m and 0.40 m.
-testing::SmallProblem DiffDriveProblem(bool noisy, std::uint32_t seed) {
+// baseline start at the nominal 0.075 m and 0.40 m. `shared_radius`: one radius for both slots and the right/left
+// ratio free (from 1), as the reality-gap diagnosis frees it; else two radii and the ratio fixed at 1.
+testing::SmallProblem DiffDriveProblem(bool noisy, std::uint32_t seed, bool shared_radius = false) {
   const double dt = 0.1;
   const testing::TwistTrajectory motion = testing::IntegrateTwists(
       Manifold::Pose().Identity(), 100, dt, [](double t, Eigen::Vector3d* v, Eigen::Vector3d* omega) {
@@ -88,15 +90,29 @@ testing::SmallProblem DiffDriveProblem(bool noisy, std::uint32_t seed) {
   std::mt19937 rng(seed);
   testing::SmallProblem problem;
   testing::AddAnchoredPoses(motion.poses, 0.002, 0.001, noisy, &rng, &problem);
-  testing::AddFreeParameter("radius_left", Manifold::Euclidean(1), Scalar(0.075), Scalar(kRadiusLeft), &problem);
-  testing::AddFreeParameter("radius_right", Manifold::Euclidean(1), Scalar(0.075), Scalar(kRadiusRight), &problem);
-  testing::AddFreeParameter("baseline", Manifold::Euclidean(1), Scalar(0.40), Scalar(kBaseline), &problem);
+  std::vector<VariableId> slots;   // r_L, r_R, B, rho
+  if (shared_radius) {
+    const VariableId r = testing::AddFreeParameter("radius", Manifold::Euclidean(1), Scalar(0.075),
+                                                   Scalar(kRadiusLeft), &problem);
+    const VariableId b = testing::AddFreeParameter("baseline", Manifold::Euclidean(1), Scalar(0.40),
+                                                   Scalar(kBaseline), &problem);
+    const VariableId rho = testing::AddFreeParameter("right_left_ratio", Manifold::Euclidean(1), Scalar(1.0),
+                                                     Scalar(kRadiusRight / kRadiusLeft), &problem);
+    slots = {r, r, b, rho};
+  } else {
+    slots.push_back(testing::AddFreeParameter("radius_left", Manifold::Euclidean(1), Scalar(0.075),
+                                              Scalar(kRadiusLeft), &problem));
+    slots.push_back(testing::AddFreeParameter("radius_right", Manifold::Euclidean(1), Scalar(0.075),
+                                              Scalar(kRadiusRight), &problem));
+    slots.push_back(testing::AddFreeParameter("baseline", Manifold::Euclidean(1), Scalar(0.40), Scalar(kBaseline),
+                                              &problem));
+    slots.push_back(problem.graph.AddVariable({"ratio", Manifold::Euclidean(1), Scalar(1.0), true, std::nullopt}));
+  }
   for (std::size_t k = 0; k + 1 < motion.poses.size(); ++k) {
     const Eigen::Vector2d z = Rates(motion.v_body[k].x(), motion.omega_body[k].z()) +
                               testing::GaussianNoise(2, testing::NoiseSigma(noisy, sigma[0]), &rng);
-    const std::vector<VariableId>& p = problem.parameters;
     problem.graph.AddFactor(MakeFactor(DifferentialDriveError(z[0], z[1], dt)),
-                            {problem.poses[k], problem.poses[k + 1], p[0], p[1], p[2]},
+                            {problem.poses[k], problem.poses[k + 1], slots[0], slots[1], slots[2], slots[3]},
                             Eigen::MatrixXd(sigma.cwiseAbs2().asDiagonal()), Loss::Trivial(), "odometer",
                             Time::FromNanoseconds(static_cast<std::int64_t>(k)));
   }
@@ -116,6 +132,12 @@ TEST(DifferentialDriveErrorTest, SmallNoisySolveIsWithinFourSigma) {
   EXPECT_LT(sigma[0], 0.001 / 3.0);
   EXPECT_LT(sigma[1], 0.0015 / 3.0);
   EXPECT_LT(sigma[2], 0.01 / 3.0);
+}
+
+TEST(DifferentialDriveErrorTest, SmallNoisySolveRecoversTheRatioWithOneRadius) {
+  testing::SmallProblem problem = DiffDriveProblem(true, 25, true);
+  const Eigen::VectorXd sigma = testing::ExpectSolveWithinSigmas(&problem);
+  EXPECT_LT(sigma[2], (kRadiusRight / kRadiusLeft - 1.0) / 3.0);   // the ratio's offset from 1 is resolved
 }
 
 }  // namespace
