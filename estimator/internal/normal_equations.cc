@@ -132,6 +132,17 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
     want_.push_back(mask);
     var_begin_.push_back(static_cast<int>(var_block_.size()));
   }
+  // In a small system (a tracking window), the block column of a free constant parameter (no time stamp) holds every
+  // row block before it, coupled or not: its rows of the Cholesky factor fill in anyway once the band before it is
+  // eliminated, and the pattern no longer depends on which poses happen to carry, say, a GPS fix, so it repeats when
+  // the window slides and CHOLMOD's symbolic analysis is kept.
+  if (dimension_ <= kMaxSimplicialDimension) {
+    for (int b = 0; b < nb; ++b) {
+      if (graph.variable(order_[b]).stamp.has_value()) continue;
+      rows_of_[b].resize(b + 1);
+      for (int r = 0; r <= b; ++r) rows_of_[b][r] = r;
+    }
+  }
   BuildPattern();
   whitened_.resize(factor_ids_.size());
   g_.setZero(dimension_);
