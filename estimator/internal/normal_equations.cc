@@ -57,9 +57,17 @@ struct NormalEquations::Cholmod {
   Eigen::SparseMatrix<double> damped;
   bool analyzed = false;
   bool factored_undamped = false;  // the factorization is of H itself, at the last linearization
+  // CHOLMOD's default choice of ordering (restored after a natural-order analysis).
+  int default_nmethods = 0, default_ordering = 0, default_postorder = 1;
 };
 
-NormalEquations::NormalEquations() : cholmod_(std::make_unique<Cholmod>()) { cholmod_->llt.cholmod().print = 0; }
+NormalEquations::NormalEquations() : cholmod_(std::make_unique<Cholmod>()) {
+  cholmod_common& common = cholmod_->llt.cholmod();
+  common.print = 0;
+  cholmod_->default_nmethods = common.nmethods;
+  cholmod_->default_ordering = common.method[0].ordering;
+  cholmod_->default_postorder = common.postorder;
+}
 
 NormalEquations::NormalEquations(const Graph& graph, std::vector<VariableId> order) : NormalEquations() {
   Reset(graph, std::move(order));
@@ -136,14 +144,27 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   // row block before it, coupled or not: its rows of the Cholesky factor fill in anyway once the band before it is
   // eliminated, and the pattern no longer depends on which poses happen to carry, say, a GPS fix, so it repeats when
   // the window slides and CHOLMOD's symbolic analysis is kept.
+  //
+  // Such a window (poses in time order, then constant parameters) is a band with a dense border: eliminated in its
+  // own order it has no fill beyond the border's, so CHOLMOD then keeps the natural order, which also spares it the
+  // two permuted transposes of H per factorization. With time-varying parameters (instances after the poses) a
+  // fill-reducing ordering is still needed.
+  const bool natural_before = natural_order_;
+  natural_order_ = false;
   if (dimension_ <= kMaxSimplicialDimension) {
+    natural_order_ = true;
     for (int b = 0; b < nb; ++b) {
-      if (graph.variable(order_[b]).stamp.has_value()) continue;
+      const Variable& v = graph.variable(order_[b]);
+      if (v.stamp.has_value()) {
+        natural_order_ &= v.manifold.kind() == ManifoldKind::kPose;
+        continue;
+      }
       rows_of_[b].resize(b + 1);
       for (int r = 0; r <= b; ++r) rows_of_[b][r] = r;
     }
   }
   BuildPattern();
+  if (natural_order_ != natural_before) cholmod_->analyzed = false;
   whitened_.resize(factor_ids_.size());
   g_.setZero(dimension_);
   cholmod_->factored_undamped = false;
@@ -267,6 +288,10 @@ bool NormalEquations::Solve(double lambda, Eigen::VectorXd* dx) {
   }
   if (!c.analyzed) {
     c.llt.setMode(dimension_ <= kMaxSimplicialDimension ? Eigen::CholmodSimplicialLLt : Eigen::CholmodSupernodalLLt);
+    cholmod_common& common = c.llt.cholmod();
+    common.nmethods = natural_order_ ? 1 : c.default_nmethods;
+    common.method[0].ordering = natural_order_ ? CHOLMOD_NATURAL : c.default_ordering;
+    common.postorder = natural_order_ ? 0 : c.default_postorder;
     c.llt.analyzePattern(*A);
     c.analyzed = true;
     ++analyses_;

@@ -100,6 +100,7 @@ class NormalEquations {
   Eigen::VectorXd g_;
   double cost_ = 0.0;
   int analyses_ = 0;
+  bool natural_order_ = false;  // factor in the order of the blocks (Reset)
 
   struct Cholmod;
   std::unique_ptr<Cholmod> cholmod_;
