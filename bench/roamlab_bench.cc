@@ -187,7 +187,8 @@ nlohmann::json BenchRenderVo(const std::string& root, double duration_s, std::st
 }
 
 // The same drive made longer on a closed route: a constant handlebar offset turns the weaving drive into loops of
-// about 36 m radius around a point 36 m north of the start, so that the ATV stays on the 300 m terrain.
+// about 36 m radius around a point 36 m north of the start. The loops drift (about 0.1 m/s: the ATV left the 300 m
+// terrain after 1541 s), so drives over 5 minutes get a 1000 m terrain (the same seed's hills, sampled further out).
 roamlab::sim::Scenario LongerDrive(roamlab::sim::Scenario scenario, double duration_s) {
   scenario.duration_s = duration_s;
   if (duration_s > 30.0) {
@@ -195,6 +196,7 @@ roamlab::sim::Scenario LongerDrive(roamlab::sim::Scenario scenario, double durat
     offset.value = 0.035;  // [rad]: R = L / tan(0.035) = 36 m for L = 1.25 m
     scenario.driver.handlebar_rad.terms.push_back(offset);
   }
+  if (duration_s > 300.0) scenario.terrain.size_m = Eigen::Vector2d(1000.0, 1000.0);
   return scenario;
 }
 

@@ -106,6 +106,22 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
     ROAMLAB_CHECK(block_of_id_[i].first != block_of_id_[i - 1].first, "variable " << block_of_id_[i].first
                                                                                   << " ordered twice");
 
+  // Every variable's value and block (-1 when held constant), by id: one pass over the graph's variables instead of
+  // a map look-up per factor and variable below.
+  variable_table_.clear();
+  auto free_it = block_of_id_.begin();
+  for (const auto& [id, v] : graph.variables()) {
+    while (free_it != block_of_id_.end() && free_it->first < id) ++free_it;
+    const int block = free_it != block_of_id_.end() && free_it->first == id ? free_it->second : -1;
+    variable_table_.push_back({id, v.value.data(), block});
+  }
+  const auto lookup = [this](VariableId id) -> const VariableSlot& {
+    const auto it = std::lower_bound(variable_table_.begin(), variable_table_.end(), id,
+                                     [](const VariableSlot& slot, VariableId key) { return slot.id < key; });
+    ROAMLAB_CHECK(it != variable_table_.end() && it->id == id, "no variable " << id);
+    return *it;
+  };
+
   // The included factors, their variables' blocks and values, and which row blocks appear in each block column
   // (upper triangle, diagonal always present).
   factor_ids_.clear();
@@ -122,9 +138,10 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
     const std::size_t begin = var_block_.size();
     std::uint64_t mask = 0;
     for (std::size_t i = 0; i < entry.variables.size(); ++i) {
-      const int b = BlockOf(entry.variables[i]);
+      const VariableSlot& slot = lookup(entry.variables[i]);
+      const int b = slot.block;
       var_block_.push_back(b);
-      values_.push_back(graph.variable(entry.variables[i]).value.data());
+      values_.push_back(slot.value);
       if (b >= 0) mask |= std::uint64_t{1} << i;
     }
     if (mask == 0) {
