@@ -24,7 +24,8 @@ FactorId NextFactorId(const Graph& graph) {
 }
 
 // The oldest pose's estimate and position covariance (marginal of the whole window): from `known` when it holds that
-// pose (a request of poses only, computed by a solve or by PoseCovariances), otherwise from the window's Hessian now.
+// pose (a request of poses only, computed by a solve or by OldestPoseCovariances), otherwise from the window's
+// Hessian now.
 Status EmitOldest(ProblemBuilder* builder, const CovarianceRequest* known, const TrackingOptions& options,
                   TrackingResult* out) {
   const PoseNode& node = builder->poses().front();
