@@ -24,6 +24,8 @@ class LinearPriorFactor final : public Factor {
   int residual_dim() const override { return static_cast<int>(r0_.size()); }
   int noise_dim() const override { return static_cast<int>(r0_.size()); }
   const std::vector<Manifold>& manifolds() const override { return manifolds_; }
+  // e = r0 + J dx with unit noise: whitened once (by the identity) instead of at every linearization.
+  bool additive_noise() const override { return true; }
   bool Evaluate(const double* const* values, double* error, double* const* jacobians,
                 double* noise_jacobian) const override;
 

@@ -687,11 +687,11 @@ void ProblemBuilder::Finish() {
 void ProblemBuilder::PopOldestPose() {
   poses_.pop_front();
   popped_any_ = true;
-  // Forget the streams of factors older than every factor left (their poses have left the graph), so that a long
-  // online run keeps a bounded map.
-  const FactorId oldest = graph_.factors().empty() ? std::numeric_limits<FactorId>::max()
-                                                   : graph_.factors().begin()->first;
-  stream_of_factor_.erase(stream_of_factor_.begin(), stream_of_factor_.lower_bound(oldest));
+  // Forget the streams of factors that have left the graph, oldest first, so that a long online run keeps a bounded
+  // map. (Not "below the oldest factor in the graph": a factor that never leaves, such as the calibration prior, would
+  // keep every entry.)
+  while (!stream_of_factor_.empty() && graph_.factors().count(stream_of_factor_.begin()->first) == 0)
+    stream_of_factor_.erase(stream_of_factor_.begin());
   absolute_fixes_.erase(std::remove_if(absolute_fixes_.begin(), absolute_fixes_.end(),
                                        [this](const auto& fix) { return !graph_.HasVariable(fix.first); }),
                         absolute_fixes_.end());

@@ -10,6 +10,7 @@
 #include "estimator/calibration.h"
 #include "estimator/covariance.h"
 #include "estimator/geometry.h"
+#include "estimator/internal/normal_equations.h"
 #include "estimator/marginalization.h"
 #include "estimator/solver.h"
 
@@ -22,16 +23,21 @@ FactorId NextFactorId(const Graph& graph) {
   return graph.factors().empty() ? 0 : graph.factors().rbegin()->first + 1;
 }
 
-// The oldest pose's estimate and position covariance (marginal of the whole window): from the last update's solve
-// when it computed it, otherwise from the window's Hessian now.
-Status EmitOldest(ProblemBuilder* builder, const CovarianceRequest* from_solve, const TrackingOptions& options,
+// The oldest pose's estimate and position covariance (marginal of the whole window): from `known` when it holds that
+// pose (a request of poses only, computed by a solve or by OldestPoseCovariances), otherwise from the window's
+// Hessian now.
+Status EmitOldest(ProblemBuilder* builder, const CovarianceRequest* known, const TrackingOptions& options,
                   TrackingResult* out) {
   const PoseNode& node = builder->poses().front();
   const Graph& graph = builder->graph();
   const Pose<double> p = PoseFromArray(graph.variable(node.id).value.data());
   Eigen::Matrix<double, 6, 6> cov;
-  if (from_solve != nullptr && from_solve->computed && from_solve->variables == std::vector<VariableId>{node.id}) {
-    cov = from_solve->covariance;
+  const auto found = known != nullptr && known->computed
+                         ? std::find(known->variables.begin(), known->variables.end(), node.id)
+                         : std::vector<VariableId>::const_iterator();
+  if (known != nullptr && known->computed && found != known->variables.end()) {
+    const int offset = 6 * static_cast<int>(found - known->variables.begin());
+    cov = known->covariance.block<6, 6>(offset, offset);
   } else {
     auto info = ComputeMarginalInformation(graph, {node.id});
     if (!info.ok()) return info.status();
@@ -47,9 +53,25 @@ Status EmitOldest(ProblemBuilder* builder, const CovarianceRequest* from_solve, 
   return Status::Ok();
 }
 
-Status EmitAndMarginalizeOldest(ProblemBuilder* builder, const CovarianceRequest* from_solve,
+// Marginal covariances of the oldest `count` poses of the window, all from one factorization of its Hessian at the
+// current estimate, in blocks of kCovarianceBatch poses (bounded memory). They equal what EmitOldest would compute for
+// each pose in turn after marginalizing the ones before it: the Schur complement at the same linearization point keeps
+// the marginal covariance of the remaining variables. `computed` is false when the Hessian is not positive definite
+// (EmitOldest then falls back to one pose at a time).
+constexpr std::size_t kCovarianceBatch = 64;
+std::vector<CovarianceRequest> OldestPoseCovariances(const ProblemBuilder& builder, std::size_t count) {
+  std::vector<CovarianceRequest> out((count + kCovarianceBatch - 1) / kCovarianceBatch);
+  const Graph& graph = builder.graph();
+  internal::NormalEquations system(graph, FreeVariableOrder(graph));
+  if (!system.Linearize(graph)) return out;
+  for (std::size_t k = 0; k < count; ++k) out[k / kCovarianceBatch].variables.push_back(builder.poses()[k].id);
+  for (CovarianceRequest& request : out) request.computed = system.Covariance(request.variables, &request.covariance);
+  return out;
+}
+
+Status EmitAndMarginalizeOldest(ProblemBuilder* builder, const CovarianceRequest* known,
                                 const TrackingOptions& options, TrackingResult* out) {
-  const Status emitted = EmitOldest(builder, from_solve, options, out);
+  const Status emitted = EmitOldest(builder, known, options, out);
   if (!emitted.ok()) return emitted;
   const PoseNode& node = builder->poses().front();
   std::vector<VariableId> leaving = {node.id};
@@ -186,11 +208,17 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
       out.max_update_s = std::max(out.max_update_s, dt);
     }
     first_new_factor = NextFactorId(builder.graph());
-    while (static_cast<int>(builder.poses().size()) > config.tracking.window) {
-      const Status st = EmitAndMarginalizeOldest(&builder, &leaving, options, &out);
-      leaving.computed = false;
+    // Poses beyond the window leave it: after an update the one whose covariance the solve computed, after the
+    // initial batch every pose beyond the window, their covariances from one factorization.
+    const int excess = static_cast<int>(builder.poses().size()) - config.tracking.window;
+    const std::vector<CovarianceRequest> batch =
+        excess > 1 ? OldestPoseCovariances(builder, excess) : std::vector<CovarianceRequest>();
+    for (int k = 0; k < excess; ++k) {
+      const Status st = EmitAndMarginalizeOldest(&builder, excess > 1 ? &batch[k / kCovarianceBatch] : &leaving,
+                                                 options, &out);
       if (!st.ok()) return st;
     }
+    leaving.computed = false;
     poses_before = builder.poses().size();
   }
   builder.Finish();
@@ -198,13 +226,15 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
   // Whatever is left (short recordings never leave initialization): solve and report the final window.
   const SolverSummary s = Solve(config.solver, &builder.graph());
   if (!s.usable()) return Status::Error("final window: " + s.message);
-  while (!builder.poses().empty()) {
+  const std::vector<CovarianceRequest> last = OldestPoseCovariances(builder, builder.poses().size());
+  for (std::size_t k = 0; !builder.poses().empty(); ++k) {
+    const CovarianceRequest* known = &last[k / kCovarianceBatch];
     if (builder.poses().size() == 1) {
-      const Status st = EmitOldest(&builder, nullptr, options, &out);
+      const Status st = EmitOldest(&builder, known, options, &out);
       if (!st.ok()) return st;
       break;
     }
-    const Status st = EmitAndMarginalizeOldest(&builder, nullptr, options, &out);
+    const Status st = EmitAndMarginalizeOldest(&builder, known, options, &out);
     if (!st.ok()) return st;
   }
   out.mean_update_s = out.updates > 0 ? update_seconds / out.updates : 0.0;

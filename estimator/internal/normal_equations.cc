@@ -57,9 +57,17 @@ struct NormalEquations::Cholmod {
   Eigen::SparseMatrix<double> damped;
   bool analyzed = false;
   bool factored_undamped = false;  // the factorization is of H itself, at the last linearization
+  // CHOLMOD's default choice of ordering (restored after a natural-order analysis).
+  int default_nmethods = 0, default_ordering = 0, default_postorder = 1;
 };
 
-NormalEquations::NormalEquations() : cholmod_(std::make_unique<Cholmod>()) { cholmod_->llt.cholmod().print = 0; }
+NormalEquations::NormalEquations() : cholmod_(std::make_unique<Cholmod>()) {
+  cholmod_common& common = cholmod_->llt.cholmod();
+  common.print = 0;
+  cholmod_->default_nmethods = common.nmethods;
+  cholmod_->default_ordering = common.method[0].ordering;
+  cholmod_->default_postorder = common.postorder;
+}
 
 NormalEquations::NormalEquations(const Graph& graph, std::vector<VariableId> order) : NormalEquations() {
   Reset(graph, std::move(order));
@@ -98,6 +106,22 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
     ROAMLAB_CHECK(block_of_id_[i].first != block_of_id_[i - 1].first, "variable " << block_of_id_[i].first
                                                                                   << " ordered twice");
 
+  // Every variable's value and block (-1 when held constant), by id: one pass over the graph's variables instead of
+  // a map look-up per factor and variable below.
+  variable_table_.clear();
+  auto free_it = block_of_id_.begin();
+  for (const auto& [id, v] : graph.variables()) {
+    while (free_it != block_of_id_.end() && free_it->first < id) ++free_it;
+    const int block = free_it != block_of_id_.end() && free_it->first == id ? free_it->second : -1;
+    variable_table_.push_back({id, v.value.data(), block});
+  }
+  const auto lookup = [this](VariableId id) -> const VariableSlot& {
+    const auto it = std::lower_bound(variable_table_.begin(), variable_table_.end(), id,
+                                     [](const VariableSlot& slot, VariableId key) { return slot.id < key; });
+    ROAMLAB_CHECK(it != variable_table_.end() && it->id == id, "no variable " << id);
+    return *it;
+  };
+
   // The included factors, their variables' blocks and values, and which row blocks appear in each block column
   // (upper triangle, diagonal always present).
   factor_ids_.clear();
@@ -114,9 +138,10 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
     const std::size_t begin = var_block_.size();
     std::uint64_t mask = 0;
     for (std::size_t i = 0; i < entry.variables.size(); ++i) {
-      const int b = BlockOf(entry.variables[i]);
+      const VariableSlot& slot = lookup(entry.variables[i]);
+      const int b = slot.block;
       var_block_.push_back(b);
-      values_.push_back(graph.variable(entry.variables[i]).value.data());
+      values_.push_back(slot.value);
       if (b >= 0) mask |= std::uint64_t{1} << i;
     }
     if (mask == 0) {
@@ -132,7 +157,31 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
     want_.push_back(mask);
     var_begin_.push_back(static_cast<int>(var_block_.size()));
   }
+  // In a small system (a tracking window), the block column of a free constant parameter (no time stamp) holds every
+  // row block before it, coupled or not: its rows of the Cholesky factor fill in anyway once the band before it is
+  // eliminated, and the pattern no longer depends on which poses happen to carry, say, a GPS fix, so it repeats when
+  // the window slides and CHOLMOD's symbolic analysis is kept.
+  //
+  // Such a window (poses in time order, then constant parameters) is a band with a dense border: eliminated in its
+  // own order it has no fill beyond the border's, so CHOLMOD then keeps the natural order, which also spares it the
+  // two permuted transposes of H per factorization. With time-varying parameters (instances after the poses) a
+  // fill-reducing ordering is still needed.
+  const bool natural_before = natural_order_;
+  natural_order_ = false;
+  if (dimension_ <= kMaxSimplicialDimension) {
+    natural_order_ = true;
+    for (int b = 0; b < nb; ++b) {
+      const Variable& v = graph.variable(order_[b]);
+      if (v.stamp.has_value()) {
+        natural_order_ &= v.manifold.kind() == ManifoldKind::kPose;
+        continue;
+      }
+      rows_of_[b].resize(b + 1);
+      for (int r = 0; r <= b; ++r) rows_of_[b][r] = r;
+    }
+  }
   BuildPattern();
+  if (natural_order_ != natural_before) cholmod_->analyzed = false;
   whitened_.resize(factor_ids_.size());
   g_.setZero(dimension_);
   cholmod_->factored_undamped = false;
@@ -256,6 +305,10 @@ bool NormalEquations::Solve(double lambda, Eigen::VectorXd* dx) {
   }
   if (!c.analyzed) {
     c.llt.setMode(dimension_ <= kMaxSimplicialDimension ? Eigen::CholmodSimplicialLLt : Eigen::CholmodSupernodalLLt);
+    cholmod_common& common = c.llt.cholmod();
+    common.nmethods = natural_order_ ? 1 : c.default_nmethods;
+    common.method[0].ordering = natural_order_ ? CHOLMOD_NATURAL : c.default_ordering;
+    common.postorder = natural_order_ ? 0 : c.default_postorder;
     c.llt.analyzePattern(*A);
     c.analyzed = true;
     ++analyses_;

@@ -71,6 +71,12 @@ class NormalEquations {
 
   std::vector<VariableId> order_;
   std::vector<std::pair<VariableId, int>> block_of_id_;  // sorted by id
+  struct VariableSlot {
+    VariableId id;
+    const double* value;
+    int block;  // -1: held constant
+  };
+  std::vector<VariableSlot> variable_table_;  // every variable of the graph, sorted by id
   std::vector<int> dims_;                                // per block
   std::vector<int> block_offset_;                        // per block: first column
   int dimension_ = 0;
@@ -100,6 +106,7 @@ class NormalEquations {
   Eigen::VectorXd g_;
   double cost_ = 0.0;
   int analyses_ = 0;
+  bool natural_order_ = false;  // factor in the order of the blocks (Reset)
 
   struct Cholmod;
   std::unique_ptr<Cholmod> cholmod_;
