@@ -130,6 +130,17 @@ class Simulator::Impl {
     return std::move(out_);
   }
 
+  // The platform geometry the recording states: nominal, measured on the bound model (to the micrometre).
+  std::map<std::string, double> PlatformGeometry() const {
+    if (ackermann_)
+      return {{"wheelbase_m", wheelbase_m_},
+              {"track_m", Micrometres(vehicle_.rear_track_m())},
+              {"wheel_radius_m", Micrometres(vehicle_.wheel_radius_m())}};
+    std::map<std::string, double> geometry;
+    for (const auto& [key, value] : wheeled_.PlatformGeometry()) geometry[key] = Micrometres(value);
+    return geometry;
+  }
+
   // Compiles the world, binds the vehicle, sets up clocks, streams and noise, and places the vehicle.
   Status Setup() {
     // The robot's MJCF text.
@@ -608,13 +619,7 @@ class Simulator::Impl {
     const SensorOptions& sensors = scenario_.sensors;
     recording::Recording& rec = out_.recording;
     rec.platform.kind = scenario_.robot.kind;
-    if (ackermann_) {
-      rec.platform.geometry = {{"wheelbase_m", wheelbase_m_},
-                               {"track_m", Micrometres(vehicle_.rear_track_m())},
-                               {"wheel_radius_m", Micrometres(vehicle_.wheel_radius_m())}};
-    } else {
-      for (const auto& [key, value] : wheeled_.PlatformGeometry()) rec.platform.geometry[key] = Micrometres(value);
-    }
+    rec.platform.geometry = PlatformGeometry();
     rec.origin = scenario_.origin;
     rec.provenance.source = "simulated";
     rec.provenance.scenario = scenario_.source_file;
@@ -775,6 +780,20 @@ Result<std::unique_ptr<Simulator>> Simulator::Create(const Scenario& scenario, c
                          ": MuJoCo error: " + OneLine(e.what()));
   }
   return std::unique_ptr<Simulator>(new Simulator(std::move(impl)));
+}
+
+std::map<std::string, double> Simulator::PlatformGeometry() const {
+  ROAMLAB_CHECK(impl_ != nullptr, "Simulator::PlatformGeometry called after Run");
+  return impl_->PlatformGeometry();
+}
+
+Result<std::map<std::string, double>> NominalPlatformGeometry(const Scenario& scenario) {
+  Scenario nominal = scenario;
+  nominal.effects.clear();
+  nominal.sensors.camera.reset();   // no renderer needed to measure the robot
+  auto simulator = Simulator::Create(nominal);
+  if (!simulator.ok()) return simulator.status();
+  return simulator.value()->PlatformGeometry();
 }
 
 Result<Simulation> Simulator::Run() {
