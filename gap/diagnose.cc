@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "common/chi_square.h"
+#include "sim/simulator.h"
 
 namespace roamlab::gap {
 namespace {
@@ -358,10 +359,56 @@ const std::vector<std::string>& CandidateNames() {
   return names;
 }
 
+namespace {
+
+// The nominal model of a differential-drive scenario: the wheel encoders (master, differential_drive) with the
+// robot's geometry measured on its model (sim::NominalPlatformGeometry): one radius for both wheels, free (the
+// odometry's scale), the baseline fixed (a track_width_error is a departure from it), the right/left ratio at its
+// default 1; the gyroscope (the yaw reference) with the scenario's noise and misalignment free. Encoder noise as
+// scenarios/indoor_diffdrive_tracking.yaml (2048-tick quantization over 10 ms, the casters' slack), no robust loss
+// (the chi-square comparisons need Gaussian costs).
+Result<estimator::EstimatorConfig> NominalDiffDriveConfig(const sim::Scenario& scenario) {
+  const sim::SensorOptions& s = scenario.sensors;
+  if (!s.wheel_encoders) return Status::Error("the scenario has no wheel_encoders (the master stream)");
+  if (!s.imu) return Status::Error("the differential-drive nominal model needs sensors.imu (the yaw reference)");
+  auto geometry = sim::NominalPlatformGeometry(scenario);
+  if (!geometry.ok()) return geometry.status();
+  EstimatorConfig c;
+  c.source_file = scenario.source_file.empty() ? "nominal configuration" : scenario.source_file + " (nominal)";
+  c.master = "odometer";
+  c.solver.max_iterations = 100;
+  c.solver.function_tolerance = 1e-10;
+  const auto param = [&](const std::string& name, const Eigen::VectorXd& value, bool free) {
+    c.parameters[name].value = value;
+    c.parameters[name].free = free;
+  };
+  estimator::StreamConfig odo;
+  odo.model = "differential_drive";
+  odo.sources = {{"", "wheel_encoders"}};
+  odo.noise = {{"wheel_radps", 0.15}, {"lateral_mps", 0.02}, {"vertical_mps", 0.02}, {"tilt_radps", 0.1}};
+  odo.parameters = {{"radius_left", "odometer.radius"}, {"radius_right", "odometer.radius"}};
+  c.streams["odometer"] = odo;
+  param("odometer.radius", Eigen::VectorXd::Constant(1, geometry.value().at("wheel_radius_m")), true);
+  param("odometer.baseline", Eigen::VectorXd::Constant(1, geometry.value().at("baseline_m")), false);
+  const Eigen::Quaterniond& q = s.imu->misalignment;
+  param("imu.misalignment", (Eigen::VectorXd(4) << q.w(), q.x(), q.y(), q.z()).finished(), true);
+  estimator::StreamConfig gyro;
+  gyro.model = "gyroscope";
+  gyro.sources = {{"", "imu"}};
+  gyro.noise = {{"sigma_radps", s.imu->gyro_sigma_radps}};
+  gyro.parameters = {{"misalignment", "imu.misalignment"}};
+  c.streams["gyroscope"] = gyro;
+  c.stages.push_back({"imu.misalignment", "odometer.radius"});
+  return c;
+}
+
+}  // namespace
+
 Result<estimator::EstimatorConfig> NominalConfig(const sim::Scenario& scenario) {
+  if (scenario.robot.kind == "differential_drive") return NominalDiffDriveConfig(scenario);
   if (scenario.robot.kind != "ackermann")
-    return Status::Error("the nominal configuration is implemented for ackermann robots only, not '" +
-                         scenario.robot.kind + "'");
+    return Status::Error("the nominal configuration is implemented for ackermann and differential_drive robots "
+                         "only, not '" + scenario.robot.kind + "'");
   const sim::SensorOptions& s = scenario.sensors;
   if (!s.odometer) return Status::Error("the scenario has no odometer (the master stream)");
   EstimatorConfig c;

@@ -408,6 +408,42 @@ std::optional<Scenario::Problem> ProfileProblem(const Profile& profile, const st
   return std::nullopt;
 }
 
+// The wheeled robots' effects (scenario.h): the kinds they apply to and their parameters' ranges.
+std::optional<Scenario::Problem> WheelEffectProblem(const std::vector<EffectOptions>& effects, const std::string& name,
+                                                    const std::string& kind, const std::string& k) {
+  using P = Scenario::Problem;
+  const bool wheel_effect = name == "wheel_radius_asymmetry" || name == "track_width_error" ||
+                            name == "wheel_deformation" || name == "axle_misalignment";
+  if (!wheel_effect) return std::nullopt;
+  const int wheels = kind == "differential_drive" ? 2 : kind == "omni3" ? 3 : kind == "mecanum" ? 4 : 0;
+  if (wheels == 0) return P{k + ".name", name + " is for wheeled indoor robots, not '" + kind + "'"};
+  if (name == "wheel_radius_asymmetry") {
+    if (kind != "differential_drive") return P{k + ".name", name + " is for differential_drive robots only"};
+    const double ratio = EffectParameter(effects, name, "ratio_right_left", 1.0);
+    if (!(ratio >= 0.8 && ratio <= 1.2)) return P{k + ".parameters.ratio_right_left", "must be in [0.8, 1.2]"};
+  }
+  if (name == "track_width_error") {
+    if (kind != "differential_drive" && kind != "mecanum")
+      return P{k + ".name", name + " is for differential_drive and mecanum robots only"};
+    if (!(std::abs(EffectParameter(effects, name, "track_error_m", 0.0)) <= 0.1))
+      return P{k + ".parameters.track_error_m", "must be in [-0.1, 0.1] m"};
+  }
+  if (name == "wheel_deformation" || name == "axle_misalignment") {
+    const double wheel = EffectParameter(effects, name, "wheel", 0.0);
+    if (!(wheel >= 0.0 && wheel < wheels && wheel == std::floor(wheel)))
+      return P{k + ".parameters.wheel", "no such wheel: the " + kind + " robot has wheels 0 to " +
+                                            std::to_string(wheels - 1)};
+  }
+  if (name == "wheel_deformation") {
+    if (kind != "differential_drive") return P{k + ".name", name + " needs sphere tires (differential_drive)"};
+    const double ovality = EffectParameter(effects, name, "ovality_m", 0.0);
+    if (!(ovality >= 0.0 && ovality <= 0.02)) return P{k + ".parameters.ovality_m", "must be in [0, 0.02] m"};
+  }
+  if (name == "axle_misalignment" && !(std::abs(EffectParameter(effects, name, "yaw_deg", 0.0)) <= 20.0))
+    return P{k + ".parameters.yaw_deg", "must be within +-20"};
+  return std::nullopt;
+}
+
 }  // namespace
 
 const std::map<std::string, std::map<std::string, double>>& KnownEffects() {
@@ -418,6 +454,10 @@ const std::map<std::string, std::map<std::string, double>>& KnownEffects() {
       {"gyro_scale_error", {{"scale_x", 1.0}, {"scale_y", 1.0}, {"scale_z", 1.0}}},
       {"gyro_bias_drift", {{"initial_x", 0.0}, {"initial_y", 0.0}, {"initial_z", 0.0}, {"random_walk", 0.0}}},
       {"magnetometer_motor_interference", {{"b_per_nm_x", 0.0}, {"b_per_nm_y", 0.0}, {"b_per_nm_z", 0.0}}},
+      {"wheel_radius_asymmetry", {{"ratio_right_left", 1.0}}},
+      {"track_width_error", {{"track_error_m", 0.0}}},
+      {"wheel_deformation", {{"wheel", 0.0}, {"ovality_m", 0.0}}},
+      {"axle_misalignment", {{"wheel", 0.0}, {"yaw_deg", 0.0}}},
   };
   return known;
 }
@@ -571,7 +611,6 @@ std::optional<Scenario::Problem> Scenario::Validate() const {
       for (const auto& [name, unused] : KnownEffects()) names += (names.empty() ? "" : ", ") + name;
       return P{k + ".name", "unknown effect '" + e.name + "' (known: " + names + ")"};
     }
-    if (!ackermann) return P{k + ".name", "effects are implemented for ackermann robots only"};
     if (!seen.insert(e.name).second) return P{k + ".name", "effect '" + e.name + "' appears twice"};
     for (const auto& [parameter, value] : e.parameters) {
       if (!known->second.count(parameter))
@@ -597,6 +636,9 @@ std::optional<Scenario::Problem> Scenario::Validate() const {
       return P{k + ".name", "steering_offset needs sensors.odometer"};
     if (e.name == "magnetometer_motor_interference" && !sensors.magnetometer)
       return P{k + ".name", e.name + " needs sensors.magnetometer"};
+    if ((e.name == "steering_offset" || e.name == "magnetometer_motor_interference") && !ackermann)
+      return P{k + ".name", e.name + " is implemented for ackermann robots only"};
+    if (auto p = WheelEffectProblem(effects, e.name, robot.kind, k)) return p;
   }
   return std::nullopt;
 }

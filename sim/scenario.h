@@ -40,8 +40,9 @@
 //   effects: []                             # hidden physical effects, each {name: ..., parameters: {...}}; written
 //                                           # to truth.yaml only (the recording does not say they are there)
 //
-// Effects (Ackermann robots; issue 6's library). Each lives where it physically belongs; parameters not given take
-// the default shown, unknown names or parameters are errors:
+// Effects (issue 6's library). Each lives where it physically belongs; parameters not given take the default shown,
+// unknown names or parameters are errors. The sensor effects apply to any robot with the sensor (the IMU and GPS
+// synthesis is shared); steering_offset and magnetometer_motor_interference to Ackermann robots only:
 //   gps_latency {latency_s: 0}             the fix stamped t is the antenna's position at t - latency_s
 //                                          (receiver latency); latency_s in [0, 1], a whole number of physics steps
 //   imu_time_offset {offset_s: 0}          the IMU row stamped t holds the reading taken at t - offset_s (the IMU's
@@ -57,6 +58,23 @@
 //   magnetometer_motor_interference {b_per_nm_x: 0, b_per_nm_y: 0, b_per_nm_z: 0}   a magnetometer bias (sensor
 //                                          frame, normalized field units) proportional to the rear drive torque
 //                                          per wheel [N m] applied at the sample instant (motor current)
+// Wheeled indoor robots (below); in the compiled MuJoCo model after the robot is bound, so that the recording's
+// platform geometry and the driver's inverse kinematics stay nominal; truth.yaml's odometer geometry is the true one:
+//   wheel_radius_asymmetry {ratio_right_left: 1}   differential_drive: the right tire's radius (wheel_1) times the
+//                                          ratio rho = r_R / r_L in [0.8, 1.2] (WheelDeformation.radius_scale);
+//                                          driving straight at equal wheel rates omega it turns at
+//                                          r_L omega (rho - 1) / B
+//   track_width_error {track_error_m: 0}   differential_drive, mecanum: the wheel bodies moved apart along O's y by
+//                                          track_error_m in [-0.1, 0.1] m, half on each side (a turn at a given wheel-
+//                                          rate difference is B_nom / B_true of the nominal one); truth: baseline +
+//                                          track_error_m (mecanum: lx_plus_ly + track_error_m / 2)
+//   wheel_deformation {wheel: 0, ovality_m: 0}   differential_drive (sphere tires): the tire of wheel `wheel`
+//                                          stretched into an oval by ovality_m in [0, 0.02] m (WheelDeformation: the
+//                                          rolling radius varies twice per revolution); adds to robot.wheel_deformation
+//   axle_misalignment {wheel: 0, yaw_deg: 0}   any wheeled kind: wheel `wheel` turned about z by yaw_deg within
+//                                          +-20 (WheelMountingChange; unlike robot.wheel_mounting, the driver does not
+//                                          know it)
+// `wheel` is a whole wheel index of the kind (differential_drive 0 left, 1 right; omni3 0-2; mecanum 0-3).
 //
 // Streams written (names fixed, as tests/support/synthetic.h): imu (wx wy wz ax ay az), magnetometer (mx my mz,
 // normalized), gps (latitude longitude altitude), rear_wheel (wheel_encoders, column rear, m/s) and steering (angle,

@@ -64,6 +64,30 @@ struct Clock {
   Eigen::Index Row(std::int64_t t_ns) const { return static_cast<Eigen::Index>((t_ns + shift_ns) / period_ns); }
 };
 
+bool HasEffect(const Scenario& s, const std::string& name) {
+  return std::any_of(s.effects.begin(), s.effects.end(), [&](const EffectOptions& e) { return e.name == name; });
+}
+
+// The tires' deformations: robot.wheel_deformation with the tire effects on top, one entry per deformed wheel so that
+// Deform changes each tire once: wheel_radius_asymmetry multiplies the right tire's radius (wheel_1) by the ratio
+// rho = r_R / r_L, wheel_deformation adds its ovality to its wheel's.
+std::vector<WheelDeformation> TireDeformations(const Scenario& s) {
+  std::vector<WheelDeformation> out = s.robot.wheel_deformation;
+  const auto entry = [&out](int wheel) -> WheelDeformation& {
+    for (WheelDeformation& d : out)
+      if (d.wheel == wheel) return d;
+    out.push_back(WheelDeformation{wheel, 1.0, 0.0});
+    return out.back();
+  };
+  if (HasEffect(s, "wheel_radius_asymmetry"))
+    entry(1).radius_scale *= EffectParameter(s.effects, "wheel_radius_asymmetry", "ratio_right_left", 1.0);
+  if (HasEffect(s, "wheel_deformation")) {
+    const int wheel = static_cast<int>(EffectParameter(s.effects, "wheel_deformation", "wheel", 0.0));
+    entry(wheel).ovality_m += EffectParameter(s.effects, "wheel_deformation", "ovality_m", 0.0);
+  }
+  return out;
+}
+
 recording::Stream MakeStream(const std::string& name, StreamType type, double rate_hz, std::vector<std::string> columns,
                              const std::string& units, const Clock& clock) {
   recording::Stream stream;
@@ -104,6 +128,17 @@ class Simulator::Impl {
     out_.stats.realtime_factor = out_.stats.wall_s > 0.0 ? out_.stats.simulated_s / out_.stats.wall_s : 0.0;
     out_.stats.warnings = TakeMujocoWarnings();
     return std::move(out_);
+  }
+
+  // The platform geometry the recording states: nominal, measured on the bound model (to the micrometre).
+  std::map<std::string, double> PlatformGeometry() const {
+    if (ackermann_)
+      return {{"wheelbase_m", wheelbase_m_},
+              {"track_m", Micrometres(vehicle_.rear_track_m())},
+              {"wheel_radius_m", Micrometres(vehicle_.wheel_radius_m())}};
+    std::map<std::string, double> geometry;
+    for (const auto& [key, value] : wheeled_.PlatformGeometry()) geometry[key] = Micrometres(value);
+    return geometry;
   }
 
   // Compiles the world, binds the vehicle, sets up clocks, streams and noise, and places the vehicle.
@@ -151,7 +186,18 @@ class Simulator::Impl {
       auto robot = WheeledRobot::Bind(model_.get(), scenario_.robot.kind, model_where_);
       if (!robot.ok()) return robot.status();
       wheeled_ = robot.value();
-      if (Status st = wheeled_.Deform(model_.get(), scenario_.robot.wheel_deformation, where_); !st.ok()) return st;
+      // The wheel effects change the bound model, so that the platform geometry and the driver stay nominal.
+      if (HasEffect(scenario_, "track_width_error")) {
+        const double error_m = EffectParameter(scenario_.effects, "track_width_error", "track_error_m", 0.0);
+        if (Status st = wheeled_.ChangeTrack(model_.get(), error_m, where_); !st.ok()) return st;
+      }
+      if (HasEffect(scenario_, "axle_misalignment")) {
+        WheelMountingChange change;
+        change.wheel = static_cast<int>(EffectParameter(scenario_.effects, "axle_misalignment", "wheel", 0.0));
+        change.yaw_rad = EffectParameter(scenario_.effects, "axle_misalignment", "yaw_deg", 0.0) * kPi / 180.0;
+        if (Status st = WheeledRobot::ChangeMounting(model_.get(), {change}, where_); !st.ok()) return st;
+      }
+      if (Status st = wheeled_.Deform(model_.get(), TireDeformations(scenario_), where_); !st.ok()) return st;
       odom_site_ = wheeled_.odom_site();
       if (scenario_.sensors.laser && wheeled_.laser_site() < 0)
         return Status::Error(model_where_ + ": sensors.laser needs a site 'laser' on the robot");
@@ -573,13 +619,7 @@ class Simulator::Impl {
     const SensorOptions& sensors = scenario_.sensors;
     recording::Recording& rec = out_.recording;
     rec.platform.kind = scenario_.robot.kind;
-    if (ackermann_) {
-      rec.platform.geometry = {{"wheelbase_m", wheelbase_m_},
-                               {"track_m", Micrometres(vehicle_.rear_track_m())},
-                               {"wheel_radius_m", Micrometres(vehicle_.wheel_radius_m())}};
-    } else {
-      for (const auto& [key, value] : wheeled_.PlatformGeometry()) rec.platform.geometry[key] = Micrometres(value);
-    }
+    rec.platform.geometry = PlatformGeometry();
     rec.origin = scenario_.origin;
     rec.provenance.source = "simulated";
     rec.provenance.scenario = scenario_.source_file;
@@ -740,6 +780,20 @@ Result<std::unique_ptr<Simulator>> Simulator::Create(const Scenario& scenario, c
                          ": MuJoCo error: " + OneLine(e.what()));
   }
   return std::unique_ptr<Simulator>(new Simulator(std::move(impl)));
+}
+
+std::map<std::string, double> Simulator::PlatformGeometry() const {
+  ROAMLAB_CHECK(impl_ != nullptr, "Simulator::PlatformGeometry called after Run");
+  return impl_->PlatformGeometry();
+}
+
+Result<std::map<std::string, double>> NominalPlatformGeometry(const Scenario& scenario) {
+  Scenario nominal = scenario;
+  nominal.effects.clear();
+  nominal.sensors.camera.reset();   // no renderer needed to measure the robot
+  auto simulator = Simulator::Create(nominal);
+  if (!simulator.ok()) return simulator.status();
+  return simulator.value()->PlatformGeometry();
 }
 
 Result<Simulation> Simulator::Run() {

@@ -18,6 +18,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -85,12 +86,19 @@ class Simulator {
   // Runs the lead-in and the recorded drive. Errors (one line, with the time) are run-time failures: the vehicle
   // leaves the terrain or rolls over, MuJoCo reports an error or the simulation diverges. Call once.
   Result<Simulation> Run();
+  // The platform geometry the recording will state (recording/wheel_kinematics.h keys), measured on the bound model
+  // without the effects. Before Run.
+  std::map<std::string, double> PlatformGeometry() const;
 
  private:
   class Impl;
   explicit Simulator(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
+
+// The nominal robot's platform geometry (Simulator::PlatformGeometry of the scenario without its effects and camera):
+// what a user who believes the scenario believes about the wheels.
+Result<std::map<std::string, double>> NominalPlatformGeometry(const Scenario& scenario);
 
 // Create and Run in one call.
 Result<Simulation> Simulate(const Scenario& scenario, const SimulateOptions& options = {});

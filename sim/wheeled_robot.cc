@@ -208,6 +208,24 @@ Status WheeledRobot::Deform(mjModel* model, const std::vector<WheelDeformation>&
   return Status::Ok();
 }
 
+Status WheeledRobot::ChangeTrack(mjModel* model, double track_error_m, const std::string& what) {
+  if (kind_ != "differential_drive" && kind_ != "mecanum")
+    return Status::Error(what + ": a track width error needs a differential_drive or mecanum robot");
+  const Eigen::Quaterniond q_root_odom(odom_in_root_quat_[0], odom_in_root_quat_[1], odom_in_root_quat_[2],
+                                       odom_in_root_quat_[3]);
+  for (std::size_t i = 0; i < wheels_.size(); ++i) {
+    const int body = model->jnt_bodyid[IdOf(model, mjOBJ_JOINT, "wheel_" + std::to_string(i))];
+    if (model->body_parentid[body] != root_body_)
+      return Status::Error(what + ": wheel_" + std::to_string(i) + "'s body must be a child of the root body");
+    // Outwards: the side of O's x axis the wheel is on.
+    const double side = wheels_[i].p_body_m.y() > 0.0 ? 1.0 : -1.0;
+    const Eigen::Vector3d shift_root = q_root_odom * Eigen::Vector3d(0.0, 0.5 * side * track_error_m, 0.0);
+    for (int k = 0; k < 3; ++k) model->body_pos[3 * body + k] += shift_root[k];
+  }
+  track_error_m_ += track_error_m;
+  return Status::Ok();
+}
+
 std::map<std::string, double> WheeledRobot::PlatformGeometry() const {
   std::map<std::string, double> g{{"wheel_radius_m", mean_radius_m()}};
   if (kind_ == "differential_drive") {
@@ -239,14 +257,14 @@ std::map<std::string, std::vector<double>> WheeledRobot::TrueOdometerCalibration
   if (kind_ == "differential_drive")
     return {{"odometer.radius_left", {wheels_[0].mean_rolling_radius_m}},
             {"odometer.radius_right", {wheels_[1].mean_rolling_radius_m}},
-            {"odometer.baseline", {g.at("baseline_m")}}};
+            {"odometer.baseline", {g.at("baseline_m") + track_error_m_}}};
   std::map<std::string, std::vector<double>> cal;
   for (std::size_t i = 0; i < wheels_.size(); ++i)
     cal["odometer.radius_" + std::to_string(i)] = {wheels_[i].mean_rolling_radius_m};
   if (kind_ == "omni3") {
     cal["odometer.distance"] = {g.at("wheel_distance_m")};
   } else {
-    cal["odometer.lx_plus_ly"] = {g.at("half_length_m") + g.at("half_width_m")};
+    cal["odometer.lx_plus_ly"] = {g.at("half_length_m") + g.at("half_width_m") + 0.5 * track_error_m_};
   }
   return cal;
 }

@@ -73,6 +73,12 @@ class WheeledRobot {
   // Errors name `what` and the wheel.
   Status Deform(mjModel* model, const std::vector<WheelDeformation>& deformations, const std::string& what);
 
+  // Moves the wheels of the bound model apart by track_error_m (< 0: together), half on each side, along O's y axis
+  // (a track wider or narrower than designed); differential_drive and mecanum, whose wheel bodies are children of the
+  // root body. As Deform, it keeps the platform geometry and the driver's kinematics nominal; the true odometer
+  // geometry (TrueOdometerCalibration) follows: baseline + track_error_m, lx_plus_ly + track_error_m / 2.
+  Status ChangeTrack(mjModel* model, double track_error_m, const std::string& what);
+
   const std::vector<WheelGeometry>& wheels() const { return wheels_; }
   int odom_site() const { return odom_site_; }
   int laser_site() const { return laser_site_; }  // -1 when the model has none
@@ -106,6 +112,7 @@ class WheeledRobot {
   std::vector<int> wheel_qpos_, wheel_dof_, actuators_, tires_;
   std::vector<WheelGeometry> wheels_;
   Eigen::MatrixXd J_rates_twist_;
+  double track_error_m_ = 0.0;      // ChangeTrack's, for the true geometry
   double odom_height_m_ = 0.0;      // height of O above the tires' lowest points at qpos0
   double odom_in_root_pos_[3] = {};
   double odom_in_root_quat_[4] = {1, 0, 0, 0};

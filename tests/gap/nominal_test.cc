@@ -35,12 +35,30 @@ TEST(NominalConfigTest, TheAtvScenarioGivesTheCalibrationWithKGammaFixedAtTheBel
   EXPECT_EQ(c.stages.back().size(), 6u);
 }
 
+// The differential drive's nominal model: its geometry measured on models/diffdrive.xml (wheel radius 0.075 m at
+// +-0.2 m), one radius free for both wheels, the baseline fixed, the gyroscope as the yaw reference.
+TEST(NominalConfigTest, DifferentialDriveGeometryFromTheModel) {
+  auto scenario = sim::LoadScenario(Source("scenarios/indoor_diffdrive_gap.yaml"));
+  ASSERT_TRUE(scenario.ok()) << scenario.status().message();
+  auto config = NominalConfig(scenario.value());
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  const estimator::EstimatorConfig& c = config.value();
+  EXPECT_EQ(c.master, "odometer");
+  EXPECT_EQ(c.streams.at("odometer").model, "differential_drive");
+  EXPECT_EQ(c.streams.at("odometer").parameters.at("radius_left"), "odometer.radius");
+  EXPECT_EQ(c.streams.at("odometer").parameters.at("radius_right"), "odometer.radius");
+  EXPECT_TRUE(c.parameters.at("odometer.radius").free);
+  EXPECT_FALSE(c.parameters.at("odometer.baseline").free);
+  EXPECT_NEAR((*c.parameters.at("odometer.baseline").value)[0], 0.4, 1e-6);
+  EXPECT_TRUE(c.streams.count("gyroscope"));
+}
+
 TEST(NominalConfigTest, OtherRobotKindsAreRefused) {
-  auto scenario = sim::LoadScenario(Source("scenarios/indoor_diffdrive_slip.yaml"));
+  auto scenario = sim::LoadScenario(Source("scenarios/indoor_omni_slip.yaml"));
   ASSERT_TRUE(scenario.ok()) << scenario.status().message();
   auto config = NominalConfig(scenario.value());
   ASSERT_FALSE(config.ok());
-  EXPECT_NE(config.status().message().find("ackermann robots only"), std::string::npos);
+  EXPECT_NE(config.status().message().find("ackermann and differential_drive robots only"), std::string::npos);
 }
 
 }  // namespace

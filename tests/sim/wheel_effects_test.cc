@@ -1,0 +1,239 @@
+// The wheeled robots' physical effects (sim/scenario.h, issue 6): each changes the physics as it says, against the
+// same drive without it (noise off), keeps the recording's platform geometry nominal and is stated in truth.yaml only;
+// the robot-independent IMU effects apply to wheeled robots too; bad parameters are one-line validation errors.
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "sim/mujoco_model.h"
+#include "sim/simulator.h"
+#include "tests/sim/sim_testing.h"
+
+namespace roamlab::sim {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDurationS = 4.0;
+// The yaw rate and wheel rates are averaged from here on (the set-points' ramp and the servos have settled).
+constexpr double kSettledS = 1.0;
+
+// The differential drive of indoor_diffdrive_slip.yaml on the bare floor (no room, laser or camera: fast), at constant
+// set-points.
+Scenario DiffDrive(double linear_mps, double angular_radps, const std::vector<EffectOptions>& effects) {
+  auto loaded = LoadScenario(testing::SourcePath("scenarios/indoor_diffdrive_slip.yaml"));
+  EXPECT_TRUE(loaded.ok()) << loaded.status().message();
+  Scenario s = loaded.value();
+  s.duration_s = kDurationS;
+  s.world_model_file.clear();
+  s.sensors.laser.reset();
+  s.sensors.camera.reset();
+  s.driver.linear_mps = Profile::Constant(linear_mps);
+  s.driver.angular_radps = Profile::Constant(angular_radps);
+  s.effects = effects;
+  return s;
+}
+
+Simulation Simulated(const Scenario& scenario, const SimulateOptions& base = {}) {
+  SimulateOptions options = base;
+  options.noise = false;
+  auto sim = Simulate(scenario, options);
+  EXPECT_TRUE(sim.ok()) << sim.status().message();
+  return std::move(sim).value();
+}
+
+// Mean yaw rate of O [rad/s] and mean encoder rates [rad/s] (left, right) from kSettledS to the end.
+struct Rates {
+  double yaw_radps = 0.0;
+  double left_radps = 0.0;
+  double right_radps = 0.0;
+};
+Rates MeanRates(const Simulation& sim) {
+  const Trajectory& truth = *sim.recording.ground_truth;
+  const recording::Stream& enc = *sim.recording.Find("wheel_encoders");
+  const auto index = [](const std::vector<Time>& t, double s) {
+    std::size_t k = 0;
+    while (k + 1 < t.size() && t[k].seconds() < s) ++k;
+    return k;
+  };
+  std::vector<Time> truth_t;
+  for (const StampedPose& p : truth) truth_t.push_back(p.t);
+  const std::size_t a = index(truth_t, kSettledS), b = truth.size() - 1;
+  const double dt = SecondsBetween(truth[a].t, truth[b].t);
+  // Unwrapped yaw: sum of the relative turns sample to sample.
+  double yaw = 0.0;
+  for (std::size_t k = a; k < b; ++k) {
+    const Eigen::AngleAxisd turn(truth[k].q_world_body.conjugate() * truth[k + 1].q_world_body);
+    yaw += turn.angle() * turn.axis().z();
+  }
+  const std::size_t ea = index(enc.t, kSettledS), eb = enc.t.size() - 1;
+  const double edt = SecondsBetween(enc.t[ea], enc.t[eb]);
+  return {yaw / dt, (enc.values(static_cast<Eigen::Index>(eb), 0) - enc.values(static_cast<Eigen::Index>(ea), 0)) / edt,
+          (enc.values(static_cast<Eigen::Index>(eb), 1) - enc.values(static_cast<Eigen::Index>(ea), 1)) / edt};
+}
+
+void ExpectNominalPlatform(const Simulation& sim, const Simulation& nominal) {
+  EXPECT_EQ(sim.recording.platform.geometry, nominal.recording.platform.geometry);
+}
+
+class WheelEffectsTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    straight_ = new Simulation(Simulated(DiffDrive(0.3, 0.0, {})));
+    turning_ = new Simulation(Simulated(DiffDrive(0.2, 0.8, {})));
+  }
+  static void TearDownTestSuite() {
+    delete straight_;
+    delete turning_;
+  }
+  static Simulation* straight_;
+  static Simulation* turning_;
+};
+Simulation* WheelEffectsTest::straight_ = nullptr;
+Simulation* WheelEffectsTest::turning_ = nullptr;
+
+// At equal wheel rates omega the right wheel rolls rho r omega, the left r omega: yaw rate r omega (rho - 1) / B. The
+// nominal drive at the same set-points goes straight.
+TEST_F(WheelEffectsTest, RadiusAsymmetryCurvesAStraightDriveAsTheRatioPredicts) {
+  const double rho = 1.02;
+  const Simulation sim = Simulated(DiffDrive(0.3, 0.0, {{"wheel_radius_asymmetry", {{"ratio_right_left", rho}}}}));
+  const auto& g = straight_->recording.platform.geometry;
+  const double r = g.at("wheel_radius_m"), B = g.at("baseline_m");
+  const Rates nominal = MeanRates(*straight_), with = MeanRates(sim);
+  EXPECT_LT(std::abs(nominal.yaw_radps), 1e-3);
+  EXPECT_NEAR(with.left_radps, with.right_radps, 1e-3 * with.left_radps);  // the driver does not know
+  const double predicted = r * (rho * with.right_radps - with.left_radps) / B;
+  EXPECT_GT(predicted, 0.01);
+  EXPECT_NEAR(with.yaw_radps, predicted, 0.05 * predicted) << "predicted " << predicted;
+
+  ExpectNominalPlatform(sim, *straight_);
+  const auto& cal = sim.truth.calibration;
+  EXPECT_NEAR(cal.at("odometer.radius_right")[0] / cal.at("odometer.radius_left")[0], rho, 1e-9);
+  EXPECT_NEAR(cal.at("odometer.radius_left")[0], r, 1e-6);
+  ASSERT_EQ(sim.truth.effects.size(), 1u);
+  EXPECT_EQ(sim.truth.effects[0].name, "wheel_radius_asymmetry");
+  EXPECT_EQ(sim.truth.effects[0].parameters.at("ratio_right_left"), rho);
+}
+
+// The yaw rate per unit of wheel-rate difference is r / B: B_nom / B_true of the nominal one.
+TEST_F(WheelEffectsTest, TrackWidthErrorScalesTheYawRatePerWheelRateDifference) {
+  const double error_m = 0.04;
+  const Simulation sim = Simulated(DiffDrive(0.2, 0.8, {{"track_width_error", {{"track_error_m", error_m}}}}));
+  const double B = turning_->recording.platform.geometry.at("baseline_m");
+  const Rates nominal = MeanRates(*turning_), with = MeanRates(sim);
+  const double k_nominal = nominal.yaw_radps / (nominal.right_radps - nominal.left_radps);
+  const double k_with = with.yaw_radps / (with.right_radps - with.left_radps);
+  EXPECT_GT(nominal.yaw_radps, 0.5);
+  EXPECT_NEAR(k_with / k_nominal, B / (B + error_m), 0.01) << "k " << k_nominal << " -> " << k_with;
+
+  ExpectNominalPlatform(sim, *turning_);
+  EXPECT_NEAR(sim.truth.calibration.at("odometer.baseline")[0], B + error_m, 1e-6);
+  EXPECT_NEAR(turning_->truth.calibration.at("odometer.baseline")[0], B, 1e-6);
+}
+
+// The axle of the chosen wheel, seen from O, is turned by yaw_deg about z; the other stays along y.
+TEST_F(WheelEffectsTest, AxleMisalignmentTurnsTheWheelAxle) {
+  const double yaw_deg = 3.0;
+  Eigen::Vector3d axle_odom[2];
+  bool seen = false;
+  SimulateOptions options;
+  options.observer = [&](Time, const mjModel* m, const mjData* d) {
+    if (seen) return;
+    seen = true;
+    const int odom = IdOf(m, mjOBJ_SITE, "odom");
+    const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> R_world_odom(d->site_xmat + 9 * odom);
+    for (int i = 0; i < 2; ++i) {
+      const int joint = IdOf(m, mjOBJ_JOINT, "wheel_" + std::to_string(i));
+      axle_odom[i] = R_world_odom.transpose() * Eigen::Vector3d(d->xaxis + 3 * joint);
+    }
+  };
+  const Simulation sim =
+      Simulated(DiffDrive(0.3, 0.0, {{"axle_misalignment", {{"wheel", 1}, {"yaw_deg", yaw_deg}}}}), options);
+  ASSERT_TRUE(seen);
+  EXPECT_NEAR(std::atan2(-axle_odom[1].x(), axle_odom[1].y()) * 180.0 / kPi, yaw_deg, 0.05);
+  EXPECT_NEAR(std::atan2(-axle_odom[0].x(), axle_odom[0].y()) * 180.0 / kPi, 0.0, 0.05);
+  // The drive no longer goes straight: the scrubbing wheel turns the robot.
+  EXPECT_GT(std::abs(MeanRates(sim).yaw_radps), 10.0 * std::abs(MeanRates(*straight_).yaw_radps) + 1e-3);
+  ExpectNominalPlatform(sim, *straight_);
+}
+
+// An oval tire lifts its axle between r and r + ovality twice per revolution; its mean rolling radius is the oval's
+// perimeter / 2 pi.
+TEST_F(WheelEffectsTest, WheelDeformationMakesTheAxleHeightPeriodic) {
+  const double ovality_m = 0.01;
+  // The range of wheel_0's centre height after the ramp.
+  const auto height_range = [](double* lo, double* hi) {
+    SimulateOptions options;
+    options.observer = [lo, hi](Time t, const mjModel* m, const mjData* d) {
+      if (t.seconds() < kSettledS) return;
+      const double z = d->xpos[3 * m->jnt_bodyid[IdOf(m, mjOBJ_JOINT, "wheel_0")] + 2];
+      *lo = std::min(*lo, z);
+      *hi = std::max(*hi, z);
+    };
+    return options;
+  };
+  double lo = 1e9, hi = -1e9, lo0 = 1e9, hi0 = -1e9;
+  const Simulation sim = Simulated(
+      DiffDrive(0.3, 0.0, {{"wheel_deformation", {{"wheel", 0}, {"ovality_m", ovality_m}}}}), height_range(&lo, &hi));
+  Simulated(DiffDrive(0.3, 0.0, {}), height_range(&lo0, &hi0));
+  EXPECT_NEAR(hi - lo, ovality_m, 0.2 * ovality_m);
+  EXPECT_LT(hi0 - lo0, 0.1 * ovality_m);
+  const double r = straight_->recording.platform.geometry.at("wheel_radius_m");
+  EXPECT_GT(sim.truth.calibration.at("odometer.radius_left")[0], r + 0.3 * ovality_m);
+  EXPECT_NEAR(sim.truth.calibration.at("odometer.radius_right")[0], r, 1e-6);
+  ExpectNominalPlatform(sim, *straight_);
+}
+
+// The IMU synthesis is shared: a gyroscope scale error scales a wheeled robot's gyroscope too.
+TEST_F(WheelEffectsTest, GyroScaleErrorAppliesToWheeledRobots) {
+  const Simulation sim = Simulated(DiffDrive(0.2, 0.8, {{"gyro_scale_error", {{"scale_z", 1.03}}}}));
+  const recording::Stream& a = *turning_->recording.Find("imu");
+  const recording::Stream& b = *sim.recording.Find("imu");
+  ASSERT_EQ(a.values.rows(), b.values.rows());
+  EXPECT_GT(a.values.col(2).cwiseAbs().maxCoeff(), 0.5);
+  for (Eigen::Index k = 0; k < a.values.rows(); ++k) EXPECT_NEAR(b.values(k, 2), 1.03 * a.values(k, 2), 1e-12);
+}
+
+std::string ProblemOf(Scenario s) {
+  const auto p = s.Validate();
+  return p ? p->key + ": " + p->message : "";
+}
+
+TEST(WheelEffectsValidation, OneLineErrors) {
+  const Scenario drive = DiffDrive(0.3, 0.0, {});
+  Scenario s = drive;
+  s.effects = {{"axle_misalignment", {{"wheel", 2}, {"yaw_deg", 1}}}};
+  EXPECT_EQ(ProblemOf(s), "effects[0].parameters.wheel: no such wheel: the differential_drive robot has wheels 0 to 1");
+  s.effects = {{"wheel_deformation", {{"wheel", 0.5}}}};
+  EXPECT_EQ(ProblemOf(s), "effects[0].parameters.wheel: no such wheel: the differential_drive robot has wheels 0 to 1");
+  s.effects = {{"wheel_radius_asymmetry", {{"ratio_right_left", 1.5}}}};
+  EXPECT_EQ(ProblemOf(s), "effects[0].parameters.ratio_right_left: must be in [0.8, 1.2]");
+  s.effects = {{"track_width_error", {{"track_error_m", -0.2}}}};
+  EXPECT_EQ(ProblemOf(s), "effects[0].parameters.track_error_m: must be in [-0.1, 0.1] m");
+  s.effects = {{"wheel_deformation", {{"ovality_m", 0.05}}}};
+  EXPECT_EQ(ProblemOf(s), "effects[0].parameters.ovality_m: must be in [0, 0.02] m");
+  s.effects = {{"axle_misalignment", {{"yaw_deg", 30}}}};
+  EXPECT_EQ(ProblemOf(s), "effects[0].parameters.yaw_deg: must be within +-20");
+  s.effects = {{"axle_misalignment", {{"roll_deg", 1}}}};
+  EXPECT_EQ(ProblemOf(s), "effects[0].parameters.roll_deg: unknown parameter of axle_misalignment");
+  s.effects = {{"magnetometer_motor_interference", {}}};
+  EXPECT_NE(ProblemOf(s).find("needs sensors.magnetometer"), std::string::npos);
+  s.effects = {{"gyro_bias_drift", {{"initial_z", 0.01}}}, {"imu_time_offset", {{"offset_s", 0.01}}}};
+  EXPECT_EQ(ProblemOf(s), "");
+
+  Scenario omni = s;
+  omni.robot.kind = "omni3";
+  omni.effects = {{"track_width_error", {{"track_error_m", 0.01}}}};
+  EXPECT_EQ(ProblemOf(omni), "effects[0].name: track_width_error is for differential_drive and mecanum robots only");
+  omni.effects = {{"wheel_radius_asymmetry", {}}};
+  EXPECT_EQ(ProblemOf(omni), "effects[0].name: wheel_radius_asymmetry is for differential_drive robots only");
+
+  Scenario atv = testing::AtvHills(2.0);
+  atv.effects = {{"axle_misalignment", {{"yaw_deg", 1}}}};
+  EXPECT_EQ(ProblemOf(atv), "effects[0].name: axle_misalignment is for wheeled indoor robots, not 'ackermann'");
+}
+
+}  // namespace
+}  // namespace roamlab::sim
