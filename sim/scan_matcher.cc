@@ -29,17 +29,18 @@ Points ToPoints(const ScanGeometry& g, const std::vector<double>& ranges) {
 
 // The reference surface around each point: a total-least-squares line through 2w + 1 consecutive reference points
 // on one surface (a chain of neighbours closer than `max_segment_m`) that contain the point, as its centroid c and
-// unit normal n (the eigenvector of the scatter matrix's smaller eigenvalue). Of the windows centred on the point and
-// ending at it on either side, the one with the smallest mean squared distance to its line (lambda_min / (count - 2))
-// is kept, so that next to a corner the line lies on the point's own face, not across the corner. Windows of fewer
-// than three points give no line.
+// unit normal n (the eigenvector of the scatter matrix's smaller eigenvalue). The window centred on the point is kept
+// unless one ending at the point (on either side) has a mean squared distance to its line (lambda_min / (count - 2))
+// kOneSidedPenalty times smaller: next to a corner the line then lies on the point's own face, not across the
+// corner, while on a flat surface the centred window wins (a one-sided window's centroid lies w beams away, and its
+// normal's noise times that offset adds to the residual). Windows of fewer than three points give no line.
 struct Lines {
   std::vector<Eigen::Vector2d> centroid;
   std::vector<Eigen::Vector2d> normal;
   std::vector<bool> valid;
 };
 
-constexpr double kOneSidedPenalty = 4.0;
+constexpr double kOneSidedPenalty = 4.0;  // a corner makes the straddling fit's mse grow far more than 4x
 
 Lines FitLines(const Points& ref, int half_window, double max_segment_m) {
   const int n = static_cast<int>(ref.xy.size());
