@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Dense>
 
@@ -26,6 +27,65 @@ Points ToPoints(const ScanGeometry& g, const std::vector<double>& ranges) {
   return p;
 }
 
+// The reference surface around each point: a total-least-squares line through 2w + 1 consecutive reference points
+// on one surface (a chain of neighbours closer than `max_segment_m`) that contain the point, as its centroid c and
+// unit normal n (the eigenvector of the scatter matrix's smaller eigenvalue). The window centred on the point is kept
+// unless one ending at the point (on either side) has a mean squared distance to its line (lambda_min / (count - 2))
+// kOneSidedPenalty times smaller: next to a corner the line then lies on the point's own face, not across the
+// corner, while on a flat surface the centred window wins (a one-sided window's centroid lies w beams away, and its
+// normal's noise times that offset adds to the residual). Windows of fewer than three points give no line.
+struct Lines {
+  std::vector<Eigen::Vector2d> centroid;
+  std::vector<Eigen::Vector2d> normal;
+  std::vector<bool> valid;
+};
+
+constexpr double kOneSidedPenalty = 4.0;  // a corner makes the straddling fit's mse grow far more than 4x
+
+Lines FitLines(const Points& ref, int half_window, double max_segment_m) {
+  const int n = static_cast<int>(ref.xy.size());
+  // Start and end of each point's surface chain.
+  std::vector<int> chain_begin(ref.xy.size()), chain_end(ref.xy.size());
+  const double max_segment2 = max_segment_m * max_segment_m;
+  for (int j = 0; j < n; ++j) {
+    const bool joined = j > 0 && ref.valid[j] && ref.valid[j - 1] &&
+                        (ref.xy[j] - ref.xy[j - 1]).squaredNorm() <= max_segment2;
+    chain_begin[j] = joined ? chain_begin[j - 1] : j;
+  }
+  for (int j = n - 1; j >= 0; --j) {
+    const bool joined = j < n - 1 && ref.valid[j] && ref.valid[j + 1] &&
+                        (ref.xy[j] - ref.xy[j + 1]).squaredNorm() <= max_segment2;
+    chain_end[j] = joined ? chain_end[j + 1] : j;
+  }
+  Lines lines;
+  lines.centroid.assign(ref.xy.size(), Eigen::Vector2d::Zero());
+  lines.normal.assign(ref.xy.size(), Eigen::Vector2d::Zero());
+  lines.valid.assign(ref.xy.size(), false);
+  for (int j = 0; j < n; ++j) {
+    if (!ref.valid[j]) continue;
+    double best_mse = std::numeric_limits<double>::infinity();
+    for (const int shift : {0, -half_window, half_window}) {
+      const int lo = std::max(chain_begin[j], j + shift - half_window);
+      const int hi = std::min(chain_end[j], j + shift + half_window);
+      const int count = hi - lo + 1;
+      if (count < 3) continue;
+      Eigen::Vector2d c = Eigen::Vector2d::Zero();
+      for (int k = lo; k <= hi; ++k) c += ref.xy[k];
+      c /= count;
+      Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+      for (int k = lo; k <= hi; ++k) scatter += (ref.xy[k] - c) * (ref.xy[k] - c).transpose();
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(scatter);
+      const double mse = eigen.eigenvalues()[0] / (count - 2);  // eigenvalues ascending
+      if (!(eigen.eigenvalues()[1] > 0.0) || !(mse * (shift == 0 ? 1.0 : kOneSidedPenalty) < best_mse)) continue;
+      best_mse = mse * (shift == 0 ? 1.0 : kOneSidedPenalty);
+      lines.centroid[j] = c;
+      lines.normal[j] = eigen.eigenvectors().col(0);
+      lines.valid[j] = true;
+    }
+  }
+  return lines;
+}
+
 Eigen::Matrix2d Rotation(double theta) {
   const double c = std::cos(theta), s = std::sin(theta);
   return (Eigen::Matrix2d() << c, -s, s, c).finished();
@@ -37,6 +97,7 @@ ScanMatch MatchScans(const ScanGeometry& g, const std::vector<double>& reference
                      const Eigen::Vector3d& initial_guess, const ScanMatcherOptions& o) {
   const Points ref = ToPoints(g, reference);
   const Points cur = ToPoints(g, current);
+  const Lines lines = FitLines(ref, o.line_half_window_beams, o.max_segment_m);
   const int n_ref = static_cast<int>(ref.xy.size());
   ScanMatch match;
   Eigen::Vector3d x = initial_guess;
@@ -70,19 +131,9 @@ ScanMatch MatchScans(const ScanGeometry& g, const std::vector<double>& reference
           a = j;
         }
       }
-      if (a < 0) continue;
-      // Its nearer neighbour on the same surface.
-      int b = -1;
-      for (int j : {a - 1, a + 1}) {
-        if (j < 0 || j >= n_ref || !ref.valid[j]) continue;
-        if ((ref.xy[j] - ref.xy[a]).squaredNorm() > o.max_segment_m * o.max_segment_m) continue;
-        if (b < 0 || (ref.xy[j] - p).squaredNorm() < (ref.xy[b] - p).squaredNorm()) b = j;
-      }
-      if (b < 0) continue;
-      const Eigen::Vector2d along = ref.xy[b] - ref.xy[a];
-      if (along.norm() < 1e-9) continue;
-      const Eigen::Vector2d normal = Eigen::Vector2d(-along.y(), along.x()).normalized();
-      const double r = normal.dot(p - ref.xy[a]);
+      if (a < 0 || !lines.valid[a]) continue;
+      const Eigen::Vector2d& normal = lines.normal[a];
+      const double r = normal.dot(p - lines.centroid[a]);
       const Eigen::Vector2d dp_dtheta = R * Eigen::Vector2d(-cur.xy[i].y(), cur.xy[i].x());
       const Eigen::Vector3d J(normal.x(), normal.y(), normal.dot(dp_dtheta));
       JtJ += J * J.transpose();
