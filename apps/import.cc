@@ -9,6 +9,23 @@
 #include "recording/recording.h"
 
 namespace roamlab::apps {
+namespace {
+
+// Writes an imported recording to `out`: 0, or the exit code after one line on stderr (2: the input was bad,
+// 1: the recording could not be written).
+int Written(const Result<recording::Recording>& rec, const std::string& out) {
+  if (!rec.ok()) {
+    std::cerr << "roamlab import: " << rec.status().message() << "\n";
+    return 2;
+  }
+  if (Status s = recording::WriteRecording(rec.value(), out); !s.ok()) {
+    std::cerr << "roamlab import: " << s.message() << "\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace
 
 int RunImportOptiOdom(const ImportOptiOdomArgs& args) {
   std::string metadata = args.metadata;
@@ -18,15 +35,8 @@ int RunImportOptiOdom(const ImportOptiOdomArgs& args) {
               << ": cannot find the metadata file (expected <set>_run-NN.csv; use --metadata)\n";
     return 2;
   }
-  Result<recording::Recording> rec = recording::ImportOptiOdom(args.run_csv, metadata);
-  if (!rec.ok()) {
-    std::cerr << "roamlab import: " << rec.status().message() << "\n";
-    return 2;
-  }
-  if (Status s = recording::WriteRecording(rec.value(), args.out); !s.ok()) {
-    std::cerr << "roamlab import: " << s.message() << "\n";
-    return 1;
-  }
+  const Result<recording::Recording> rec = recording::ImportOptiOdom(args.run_csv, metadata);
+  if (const int code = Written(rec, args.out); code != 0) return code;
   if (!args.quiet) {
     const recording::Stream& enc = rec.value().streams.front();
     std::cout << "imported " << enc.t.size() << " samples (" << rec.value().platform.kind << ", "
@@ -59,15 +69,8 @@ int RunImportRosbag(const ImportRosbagArgs& args) {
     options.q_body_imu = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized();
   }
   recording::RosbagImportReport report;
-  Result<recording::Recording> rec = recording::ImportRosbag(args.bag, options, &report);
-  if (!rec.ok()) {
-    std::cerr << "roamlab import: " << rec.status().message() << "\n";
-    return 2;
-  }
-  if (Status s = recording::WriteRecording(rec.value(), args.out); !s.ok()) {
-    std::cerr << "roamlab import: " << s.message() << "\n";
-    return 1;
-  }
+  const Result<recording::Recording> rec = recording::ImportRosbag(args.bag, options, &report);
+  if (const int code = Written(rec, args.out); code != 0) return code;
   if (!args.quiet) {
     for (const recording::Stream& s : rec.value().streams) {
       std::cout << s.info.name << ": " << s.t.size() << " samples, " << SecondsBetween(s.t.front(), s.t.back())

@@ -361,6 +361,16 @@ const std::vector<std::string>& CandidateNames() {
 
 namespace {
 
+// A stream of the recording's `imu` with its noise and the shared IMU misalignment.
+estimator::StreamConfig ImuStream(const std::string& model, const std::string& noise_key, double sigma) {
+  estimator::StreamConfig stream;
+  stream.model = model;
+  stream.sources = {{"", "imu"}};
+  stream.noise = {{noise_key, sigma}};
+  stream.parameters = {{"misalignment", "imu.misalignment"}};
+  return stream;
+}
+
 // The nominal model of a differential-drive scenario: the wheel encoders (master, differential_drive) with the
 // robot's geometry measured on its model (sim::NominalPlatformGeometry): one radius for both wheels, free (the
 // odometry's scale), the baseline fixed (a track_width_error is a departure from it), the right/left ratio at its
@@ -392,12 +402,7 @@ Result<estimator::EstimatorConfig> NominalDiffDriveConfig(const sim::Scenario& s
   param("odometer.baseline", Eigen::VectorXd::Constant(1, geometry.value().at("baseline_m")), false);
   const Eigen::Quaterniond& q = s.imu->misalignment;
   param("imu.misalignment", (Eigen::VectorXd(4) << q.w(), q.x(), q.y(), q.z()).finished(), true);
-  estimator::StreamConfig gyro;
-  gyro.model = "gyroscope";
-  gyro.sources = {{"", "imu"}};
-  gyro.noise = {{"sigma_radps", s.imu->gyro_sigma_radps}};
-  gyro.parameters = {{"misalignment", "imu.misalignment"}};
-  c.streams["gyroscope"] = gyro;
+  c.streams["gyroscope"] = ImuStream("gyroscope", "sigma_radps", s.imu->gyro_sigma_radps);
   c.stages.push_back({"imu.misalignment", "odometer.radius"});
   return c;
 }
@@ -446,18 +451,8 @@ Result<estimator::EstimatorConfig> NominalConfig(const sim::Scenario& scenario) 
     const Eigen::Quaterniond& q = s.imu->misalignment;
     param("imu.misalignment", vec({q.w(), q.x(), q.y(), q.z()}), true);
     stage1.push_back("imu.misalignment");
-    estimator::StreamConfig gyro;
-    gyro.model = "gyroscope";
-    gyro.sources = {{"", "imu"}};
-    gyro.noise = {{"sigma_radps", s.imu->gyro_sigma_radps}};
-    gyro.parameters = {{"misalignment", "imu.misalignment"}};
-    c.streams["gyroscope"] = gyro;
-    estimator::StreamConfig accel;
-    accel.model = "accelerometer";
-    accel.sources = {{"", "imu"}};
-    accel.noise = {{"sigma_mps2", s.imu->accel_sigma_mps2}};
-    accel.parameters = {{"misalignment", "imu.misalignment"}};
-    c.streams["accelerometer"] = accel;
+    c.streams["gyroscope"] = ImuStream("gyroscope", "sigma_radps", s.imu->gyro_sigma_radps);
+    c.streams["accelerometer"] = ImuStream("accelerometer", "sigma_mps2", s.imu->accel_sigma_mps2);
     if (!s.imu->lever_arm_m.isZero(0.0)) {
       const Eigen::Vector3d& l = s.imu->lever_arm_m;
       param("accelerometer.lever_arm", vec({l.x(), l.y(), l.z()}), false);
