@@ -79,12 +79,8 @@ void WriteRun(const fs::path& path, int pattern, double duration_s) {
 
 class OdometryCliTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("roamlab_odometry_cli_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
+  testing::TempDir temp_;
+  fs::path dir_{temp_.path()};
 };
 
 TEST_F(OdometryCliTest, LearnedModelsBeatTheNominalModelOnAnotherShape) {

@@ -32,12 +32,8 @@ CommandRun Roamlab(const std::string& args, const fs::path& dir) {
 
 class CliTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("roamlab_cli_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
+  testing::TempDir temp_;
+  fs::path dir_{temp_.path()};
 };
 
 TEST_F(CliTest, CalibrateAndTrackWriteTheirOutputs) {

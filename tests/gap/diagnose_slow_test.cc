@@ -10,6 +10,7 @@
 
 #include "gap/diagnose.h"
 #include "sim/simulator.h"
+#include "tests/gap/gap_testing.h"
 
 namespace roamlab::gap {
 namespace {
@@ -22,14 +23,6 @@ sim::Scenario Atv() {
   return s.value();
 }
 
-sim::Simulation Simulate(const sim::Scenario& scenario, std::uint64_t seed) {
-  sim::SimulateOptions options;
-  options.seed = seed;
-  auto sim = sim::Simulate(scenario, options);
-  EXPECT_TRUE(sim.ok()) << sim.status().message();
-  return std::move(sim).value();
-}
-
 class DiagnoseTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -39,7 +32,7 @@ class DiagnoseTest : public ::testing::Test {
     config_ = new estimator::EstimatorConfig(config.value());
     DiagnoseOptions learn;
     learn.max_effects = 0;
-    auto learned = Diagnose(*config_, Simulate(nominal, kBaselineSeed).recording, learn);
+    auto learned = Diagnose(*config_, testing::SimulatedWithSeed(nominal, kBaselineSeed).recording, learn);
     ASSERT_TRUE(learned.ok()) << learned.status().message();
     baseline_ = new Baseline(BaselineFrom(learned.value()));
   }
@@ -52,7 +45,7 @@ class DiagnoseTest : public ::testing::Test {
   static Diagnosis Run(const std::vector<sim::EffectOptions>& effects, std::uint64_t seed, sim::Simulation* sim) {
     sim::Scenario scenario = Atv();
     scenario.effects = effects;
-    *sim = Simulate(scenario, seed);
+    *sim = testing::SimulatedWithSeed(scenario, seed);
     DiagnoseOptions options;
     options.baseline = baseline_;
     auto d = Diagnose(*config_, sim->recording, options);

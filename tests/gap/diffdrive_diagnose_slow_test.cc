@@ -10,17 +10,10 @@
 
 #include "gap/diagnose.h"
 #include "sim/simulator.h"
+#include "tests/gap/gap_testing.h"
 
 namespace roamlab::gap {
 namespace {
-
-sim::Simulation Simulate(const sim::Scenario& scenario, std::uint64_t seed) {
-  sim::SimulateOptions options;
-  options.seed = seed;
-  auto sim = sim::Simulate(scenario, options);
-  EXPECT_TRUE(sim.ok()) << sim.status().message();
-  return std::move(sim).value();
-}
 
 TEST(DiffDriveDiagnoseTest, NamesWheelRadiusAsymmetryAndRecoversTheRatio) {
   auto loaded = sim::LoadScenario(std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/indoor_diffdrive_gap.yaml");
@@ -31,14 +24,14 @@ TEST(DiffDriveDiagnoseTest, NamesWheelRadiusAsymmetryAndRecoversTheRatio) {
 
   DiagnoseOptions learn;
   learn.max_effects = 0;
-  auto learned = Diagnose(config.value(), Simulate(nominal, 900001).recording, learn);
+  auto learned = Diagnose(config.value(), testing::SimulatedWithSeed(nominal, 900001).recording, learn);
   ASSERT_TRUE(learned.ok()) << learned.status().message();
   const Baseline baseline = BaselineFrom(learned.value());
 
   const double rho = 1.02;
   sim::Scenario hidden = nominal;
   hidden.effects = {{"wheel_radius_asymmetry", {{"ratio_right_left", rho}}}};
-  const sim::Simulation real = Simulate(hidden, 7);
+  const sim::Simulation real = testing::SimulatedWithSeed(hidden, 7);
   DiagnoseOptions options;
   options.baseline = &baseline;
   auto d = Diagnose(config.value(), real.recording, options);
