@@ -44,13 +44,16 @@ const std::vector<ModelSpec>& ModelSpecs() {
        {"wheelbase_m", "speed_column"},
        true},
       // Wheel radii and baseline default to NaN: the builder takes them from the recording's platform geometry.
-      // right_left_ratio multiplies radius_right (models/differential_drive.h).
+      // right_left_ratio multiplies radius_right; deformation_left/right are the tires' second harmonic (a, b) [m]
+      // (models/differential_drive.h).
       {"differential_drive",
        {""},
        {"wheel_radps", "lateral_mps", "vertical_mps", "tilt_radps"},
        {ScalarSlot("radius_left", std::numeric_limits<double>::quiet_NaN()),
         ScalarSlot("radius_right", std::numeric_limits<double>::quiet_NaN()),
-        ScalarSlot("baseline", std::numeric_limits<double>::quiet_NaN()), ScalarSlot("right_left_ratio", 1.0)},
+        ScalarSlot("baseline", std::numeric_limits<double>::quiet_NaN()), ScalarSlot("right_left_ratio", 1.0),
+        {"deformation_left", Manifold::Euclidean(2), Vec({0.0, 0.0})},
+        {"deformation_right", Manifold::Euclidean(2), Vec({0.0, 0.0})}},
        {},
        true},
       // Omni and mecanum wheel radii and geometry: NaN too, taken from the platform geometry.

@@ -232,9 +232,9 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
       impl->parameter_manifold.emplace(pname, slot.manifold);
       Eigen::VectorXd init = slot.default_value;
       if (ackermann && slot.name == "kv_over_L") init[0] = 1.0 / b.wheelbase_m;
-      if ((m == "differential_drive" && slot.name != "right_left_ratio") || m == "omni3_drive" ||
-          m == "mecanum_drive") {
-        // Radii from wheel_radius_m; the other slot from its geometry key (lx_plus_ly: the sum of two keys).
+      if ((m == "differential_drive" || m == "omni3_drive" || m == "mecanum_drive") && std::isnan(init[0])) {
+        // The geometry slots (default NaN): radii from wheel_radius_m; the other slot from its geometry key
+        // (lx_plus_ly: the sum of two keys).
         std::string key = "wheel_radius_m";
         if (slot.name == "baseline") key = "baseline_m";
         if (slot.name == "distance") key = "wheel_distance_m";
@@ -377,6 +377,14 @@ std::optional<Eigen::VectorXd> LeftRightRates(const StreamBinding& s, int row) {
   std::optional<Eigen::VectorXd> rates = WheelRates(*s.primary, row);
   if (rates && s.right_then_left) std::swap((*rates)[0], (*rates)[1]);
   return rates;
+}
+
+// The (C, S) deformation harmonics of the left and right wheels over [t_row, t_row+1] (models/differential_drive.h).
+std::pair<Eigen::Vector2d, Eigen::Vector2d> LeftRightHarmonics(const StreamBinding& s, int row) {
+  const Eigen::MatrixXd& angles = s.primary->values;
+  const int left = s.right_then_left ? 1 : 0, right = 1 - left;
+  return {DifferentialDriveError::DeformationHarmonics(angles(row, left), angles(row + 1, left)),
+          DifferentialDriveError::DeformationHarmonics(angles(row, right), angles(row + 1, right))};
 }
 
 }  // namespace
@@ -561,8 +569,9 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
       ++counts_[s.name].outside;
       return true;
     }
-    factor = MakeFactor(DifferentialDriveError((*rates)[0], (*rates)[1], dt));
-    vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k), slot(3, k)};
+    const auto [harmonics_left, harmonics_right] = LeftRightHarmonics(s, m.row);
+    factor = MakeFactor(DifferentialDriveError((*rates)[0], (*rates)[1], dt, harmonics_left, harmonics_right));
+    vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k), slot(3, k), slot(4, k), slot(5, k)};
   } else if (model == "omni3_drive" || model == "mecanum_drive") {
     const auto rates = WheelRates(data, m.row);
     if (!rates) {

@@ -93,7 +93,10 @@ TEST(RealDataTest, OptiOdomDifferentialDriveTrackAndWheelRatio) {
   const Diagnosis& diagnosis = d.value();
   for (const EffectEstimate& e : diagnosis.candidates) {
     std::cout << e.name;
-    for (const auto& [k, v] : e.parameters) std::cout << " " << k << " = " << v << " +- " << e.std.at(k);
+    for (const auto& [k, v] : e.parameters) {
+      std::cout << " " << k << " = " << v;
+      if (e.std.count(k)) std::cout << " +- " << e.std.at(k);
+    }
     std::cout << " LR " << e.lr << " dBIC " << e.delta_bic << " " << e.decision << "\n";
   }
   EXPECT_EQ(diagnosis.verdict, "named");
@@ -189,7 +192,10 @@ TEST(RealDataTest, HuskySkidSteerYawMismatch) {
   ASSERT_TRUE(d.ok()) << d.status().message();
   for (const EffectEstimate& e : d.value().candidates) {
     std::cout << e.name;
-    for (const auto& [k, v] : e.parameters) std::cout << " " << k << " = " << v << " +- " << e.std.at(k);
+    for (const auto& [k, v] : e.parameters) {
+      std::cout << " " << k << " = " << v;
+      if (e.std.count(k)) std::cout << " +- " << e.std.at(k);
+    }
     std::cout << " LR " << e.lr << " dBIC " << e.delta_bic << " " << e.decision << "\n";
   }
   EXPECT_EQ(d.value().verdict, "named");
