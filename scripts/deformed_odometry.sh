@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Model-free odometry on the simulated deformed robots (seed 001, Section IV, Table II): simulates the training and
-# test drives of configurations F1 (taped wheel, differential drive), T1 (misaligned wheel, mecanum) and T2 (tilted
+# test drives of configurations F1 (taped wheel, differential drive), T1 (unaligned wheels, mecanum) and T2 (tilted
 # wheel, mecanum), learns every model from the training drive's scan matcher and evaluates it on the test drive
 # against ground_truth.tum, one table per configuration (the seed's Tables III-IV).
 #   bash scripts/deformed_odometry.sh [OUT_DIR]     (default out/deformed; about 10 minutes of CPU)

@@ -109,7 +109,8 @@ void ReadProfile(YamlReader& r, const YAML::Node& map, const std::string& parent
 
 void ReadRobot(YamlReader& r, const YAML::Node& node, const std::string& scenario_dir, Scenario* s) {
   const std::string key = "robot";
-  r.CheckKeys(node, key, {"kind", "model", "start", "speed_controller", "wheel_mounting", "wheel_deformation"});
+  r.CheckKeys(node, key,
+              {"kind", "model", "start", "speed_controller", "wheel_mounting", "wheel_deformation", "wheel_offset"});
   if (!r.Require(node, key, "kind") || !r.Require(node, key, "model")) return;
   r.String(node, key, "kind", &s->robot.kind);
   std::string model;
@@ -182,6 +183,28 @@ void ReadRobot(YamlReader& r, const YAML::Node& node, const std::string& scenari
       r.Number(item, ki, "ovality_m", &d.ovality_m);
       d.wheel = static_cast<int>(std::clamp<std::int64_t>(wheel, -1, 64));
       s->robot.wheel_deformation.push_back(d);
+    }
+  }
+  if (node["wheel_offset"]) {
+    const YAML::Node list = node["wheel_offset"];
+    const std::string k = "robot.wheel_offset";
+    r.Remember(k, list);
+    if (!list.IsSequence()) {
+      r.Fail(list, k, "expected a list of {wheel, offset_m: [x, y]}");
+      return;
+    }
+    for (std::size_t i = 0; i < list.size() && r.ok(); ++i) {
+      const YAML::Node item = list[i];
+      const std::string ki = k + "[" + std::to_string(i) + "]";
+      r.CheckKeys(item, ki, {"wheel", "offset_m"});
+      if (!r.Require(item, ki, "wheel") || !r.Require(item, ki, "offset_m")) return;
+      std::int64_t wheel = 0;
+      std::vector<double> offset;
+      r.Integer(item, ki, "wheel", &wheel);
+      r.Numbers(item, ki, "offset_m", 2, &offset);
+      if (!r.ok()) return;
+      s->robot.wheel_offset.push_back(
+          {static_cast<int>(std::clamp<std::int64_t>(wheel, -1, 64)), Eigen::Vector2d(offset[0], offset[1])});
     }
   }
 }
@@ -535,6 +558,18 @@ std::optional<Scenario::Problem> Scenario::Validate() const {
       return P{k + ".radius_scale", "must be in [0.8, 1.2]"};
     if (!(Finite(d.ovality_m) && d.ovality_m >= 0.0 && d.ovality_m <= 0.02))
       return P{k + ".ovality_m", "must be in [0, 0.02]"};
+  }
+
+  if (ackermann && !robot.wheel_offset.empty()) return P{"robot.wheel_offset", "only for wheeled indoor robots"};
+  for (std::size_t i = 0; i < robot.wheel_offset.size(); ++i) {
+    const WheelOffset& o = robot.wheel_offset[i];
+    const std::string k = "robot.wheel_offset[" + std::to_string(i) + "]";
+    if (o.wheel < 0) return P{k + ".wheel", "must be >= 0"};
+    for (std::size_t j = 0; j < i; ++j)
+      if (robot.wheel_offset[j].wheel == o.wheel) return P{k + ".wheel", "wheel listed twice"};
+    // An assembly error of a few cm; beyond that a wheel could change sides of O or run into the chassis.
+    if (!(Finite(o.offset_m.x()) && Finite(o.offset_m.y()) && o.offset_m.cwiseAbs().maxCoeff() <= 0.05))
+      return P{k + ".offset_m", "each component must be within +-0.05 m"};
   }
 
   // Sensors.

@@ -133,6 +133,13 @@
 //                                           # wheel: the rolling radius varies with the wheel angle; WheelDeformation
 //                                           # in sim/wheeled_robot.h). platform geometry stays nominal; truth.yaml's
 //                                           # odometer radius is the mean rolling radius (perimeter / 2 pi).
+//     wheel_offset: [{wheel: 1, offset_m: [-0.03, 0.0]}]   # optional, any wheeled kind: the wheel body moved along
+//                                           # O's x and y by offset_m (each component within +-0.05 m; each wheel at
+//                                           # most once): a wheel off its nominal position, an assembly error
+//                                           # (WheelOffset in sim/wheeled_robot.h). Applied after binding, like the
+//                                           # effects: the platform geometry and the driver's inverse kinematics stay
+//                                           # nominal (unlike wheel_mounting, which the driver knows); truth.yaml's
+//                                           # baseline / distance / lx_plus_ly follow the moved wheels' yaw lever arms.
 //   driver:
 //     lateral_mps: <profile>                # sideways speed v_y [m/s] (default 0; only for omni3 and mecanum)
 // wheel_encoders has one column per wheel: omni3 "wheel_0" "wheel_1" "wheel_2", mecanum "front_left" "front_right"
@@ -170,6 +177,7 @@ struct RobotOptions {
   SpeedControllerOptions speed_controller;
   std::vector<WheelMountingChange> wheel_mounting;   // wheeled robots: wheels turned off their nominal mounting
   std::vector<WheelDeformation> wheel_deformation;   // wheeled robots with sphere tires: deformed tires
+  std::vector<WheelOffset> wheel_offset;             // wheeled robots: wheels moved off their nominal positions
 };
 
 struct DriverOptions {

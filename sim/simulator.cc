@@ -197,6 +197,7 @@ class Simulator::Impl {
         change.yaw_rad = EffectParameter(scenario_.effects, "axle_misalignment", "yaw_deg", 0.0) * kPi / 180.0;
         if (Status st = WheeledRobot::ChangeMounting(model_.get(), {change}, where_); !st.ok()) return st;
       }
+      if (Status st = wheeled_.MoveWheels(model_.get(), scenario_.robot.wheel_offset, where_); !st.ok()) return st;
       if (Status st = wheeled_.Deform(model_.get(), TireDeformations(scenario_), where_); !st.ok()) return st;
       odom_site_ = wheeled_.odom_site();
       if (scenario_.sensors.laser && wheeled_.laser_site() < 0)

@@ -143,6 +143,7 @@ Result<WheeledRobot> WheeledRobot::Bind(const mjModel* model, const std::string&
     r.wheels_.push_back(w);
   }
   r.odom_height_m_ = height_sum / n;
+  r.offsets_m_.assign(static_cast<std::size_t>(n), Eigen::Vector2d::Zero());
   if (const std::string problem = LayoutProblem(kind, r.wheels_); !problem.empty())
     return Status::Error(what + ": " + problem);
   return r;
@@ -226,6 +227,24 @@ Status WheeledRobot::ChangeTrack(mjModel* model, double track_error_m, const std
   return Status::Ok();
 }
 
+Status WheeledRobot::MoveWheels(mjModel* model, const std::vector<WheelOffset>& offsets, const std::string& what) {
+  const Eigen::Quaterniond q_root_odom(odom_in_root_quat_[0], odom_in_root_quat_[1], odom_in_root_quat_[2],
+                                       odom_in_root_quat_[3]);
+  for (const WheelOffset& o : offsets) {
+    const std::string name = "robot.wheel_offset: wheel " + std::to_string(o.wheel);
+    if (o.wheel < 0 || o.wheel >= static_cast<int>(wheels_.size()))
+      return Status::Error(what + ": " + name + ": the " + kind_ + " robot has " + std::to_string(wheels_.size()) +
+                           " wheels");
+    const int body = model->jnt_bodyid[IdOf(model, mjOBJ_JOINT, "wheel_" + std::to_string(o.wheel))];
+    if (model->body_parentid[body] != root_body_)
+      return Status::Error(what + ": " + name + ": its body must be a child of the root body");
+    const Eigen::Vector3d shift_root = q_root_odom * Eigen::Vector3d(o.offset_m.x(), o.offset_m.y(), 0.0);
+    for (int k = 0; k < 3; ++k) model->body_pos[3 * body + k] += shift_root[k];
+    offsets_m_[static_cast<std::size_t>(o.wheel)] += o.offset_m;
+  }
+  return Status::Ok();
+}
+
 std::map<std::string, double> WheeledRobot::PlatformGeometry() const {
   std::map<std::string, double> g{{"wheel_radius_m", mean_radius_m()}};
   if (kind_ == "differential_drive") {
@@ -254,17 +273,35 @@ std::vector<std::string> WheeledRobot::EncoderColumns() const {
 
 std::map<std::string, std::vector<double>> WheeledRobot::TrueOdometerCalibration() const {
   const std::map<std::string, double> g = PlatformGeometry();
+  // A moved wheel (MoveWheels) changes its yaw lever arm lambda_i = u_i . (e_z x p_i) / (u_i . d_i), the wheel row's
+  // omega_z coefficient times r (sim/wheeled_robot.h), by u_i . (e_z x offset_i) / (u_i . d_i): the differential
+  // drive's baseline is lambda_1 - lambda_0, omni3's distance and mecanum's lx + ly the mean |lambda_i| (the value
+  // with which the nominal kinematics gives the true yaw rate; a single moved wheel makes the wheels' lever arms
+  // differ, which no single value describes).
+  std::vector<double> lever_change(wheels_.size());
+  double change_of_mean_abs_lever_m = 0.0;
+  for (std::size_t i = 0; i < wheels_.size(); ++i) {
+    const WheelGeometry& w = wheels_[i];
+    const Eigen::Vector2d& o = offsets_m_[i];
+    const auto lever = [&w](const Eigen::Vector2d& p) {
+      return w.locked_direction.dot(Eigen::Vector2d(-p.y(), p.x())) / w.locked_direction.dot(w.drive_direction);
+    };
+    lever_change[i] = lever(o);
+    change_of_mean_abs_lever_m += (lever(w.p_body_m) < 0.0 ? -1.0 : 1.0) * lever_change[i] /
+                             static_cast<double>(wheels_.size());
+  }
   if (kind_ == "differential_drive")
     return {{"odometer.radius_left", {wheels_[0].mean_rolling_radius_m}},
             {"odometer.radius_right", {wheels_[1].mean_rolling_radius_m}},
-            {"odometer.baseline", {g.at("baseline_m") + track_error_m_}}};
+            {"odometer.baseline", {g.at("baseline_m") + track_error_m_ + (lever_change[1] - lever_change[0])}}};
   std::map<std::string, std::vector<double>> cal;
   for (std::size_t i = 0; i < wheels_.size(); ++i)
     cal["odometer.radius_" + std::to_string(i)] = {wheels_[i].mean_rolling_radius_m};
   if (kind_ == "omni3") {
-    cal["odometer.distance"] = {g.at("wheel_distance_m")};
+    cal["odometer.distance"] = {g.at("wheel_distance_m") + change_of_mean_abs_lever_m};
   } else {
-    cal["odometer.lx_plus_ly"] = {g.at("half_length_m") + g.at("half_width_m") + 0.5 * track_error_m_};
+    cal["odometer.lx_plus_ly"] = {g.at("half_length_m") + g.at("half_width_m") + 0.5 * track_error_m_ +
+                                  change_of_mean_abs_lever_m};
   }
   return cal;
 }

@@ -59,6 +59,14 @@ struct WheelDeformation {
   double ovality_m = 0.0;
 };
 
+// A wheel moved from its nominal position (an assembly error: its motor bracket fastened in the wrong holes, a bent
+// bracket), applied to the compiled model after binding, so that the platform geometry and the driver keep the nominal
+// wheel: the wheel body (wheel, rollers, tire) is translated by offset_m along O's x and y axes [m].
+struct WheelOffset {
+  int wheel = 0;
+  Eigen::Vector2d offset_m = Eigen::Vector2d::Zero();
+};
+
 class WheeledRobot {
  public:
   // Finds the named elements and measures the wheels at qpos0. `kind` is the robot kind (differential_drive, omni3,
@@ -78,6 +86,11 @@ class WheeledRobot {
   // root body. As Deform, it keeps the platform geometry and the driver's kinematics nominal; the true odometer
   // geometry (TrueOdometerCalibration) follows: baseline + track_error_m, lx_plus_ly + track_error_m / 2.
   Status ChangeTrack(mjModel* model, double track_error_m, const std::string& what);
+
+  // Moves wheel bodies of the bound model (see WheelOffset); their bodies must be children of the root body. As
+  // Deform, it keeps the platform geometry and the driver's kinematics nominal; the true odometer geometry
+  // (TrueOdometerCalibration) follows the moved wheels' yaw lever arms. Errors name `what` and the wheel.
+  Status MoveWheels(mjModel* model, const std::vector<WheelOffset>& offsets, const std::string& what);
 
   const std::vector<WheelGeometry>& wheels() const { return wheels_; }
   int odom_site() const { return odom_site_; }
@@ -113,6 +126,7 @@ class WheeledRobot {
   std::vector<WheelGeometry> wheels_;
   Eigen::MatrixXd J_rates_twist_;
   double track_error_m_ = 0.0;      // ChangeTrack's, for the true geometry
+  std::vector<Eigen::Vector2d> offsets_m_;   // MoveWheels', per wheel in O, for the true geometry
   double odom_height_m_ = 0.0;      // height of O above the tires' lowest points at qpos0
   double odom_in_root_pos_[3] = {};
   double odom_in_root_quat_[4] = {1, 0, 0, 0};

@@ -86,6 +86,40 @@ TEST(HolonomicRobotTest, ChangedMountingTurnsTheWheelAndBindRefusesAWrongLayout)
   EXPECT_NE(wrong.status().message().find("wheel_0"), std::string::npos) << wrong.status().message();
 }
 
+TEST(HolonomicRobotTest, MovedWheelMovesInThePhysicsOnlyAndTheTrueLeverArmFollows) {
+  const std::string file = "models/mecanum.xml";
+  auto model = LoadModelFromString(testing::ReadText(testing::SourcePath(file)), file);
+  ASSERT_TRUE(model.ok()) << model.status().message();
+  mjModel* m = model.value().get();
+  auto bound = WheeledRobot::Bind(m, "mecanum", file);
+  ASSERT_TRUE(bound.ok()) << bound.status().message();
+  WheeledRobot robot = bound.value();
+  const Eigen::MatrixXd nominal_rows = robot.J_rates_twist();
+  // The front right wheel 3 cm back and 1 cm out, placed in the world turned by 30 deg: its tire centre in O moves
+  // by the offset, the other wheels stay.
+  const Eigen::Vector2d offset_m(-0.03, -0.01);
+  ASSERT_TRUE(robot.MoveWheels(m, {{1, offset_m}}, file).ok());
+  DataPtr data = MakeData(m);
+  robot.Place(m, data.get(), 1.0, 2.0, 30.0 * M_PI / 180.0, 0.01);
+  const int odom = robot.odom_site();
+  const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> R_world_odom(data->site_xmat + 9 * odom);
+  for (int i = 0; i < 4; ++i) {
+    const int tire = IdOf(m, mjOBJ_GEOM, "tire_" + std::to_string(i));
+    const Eigen::Vector3d p_odom_m =
+        R_world_odom.transpose() * (Eigen::Vector3d(data->geom_xpos + 3 * tire) - Eigen::Vector3d(data->site_xpos +
+                                                                                                   3 * odom));
+    const Eigen::Vector2d expected = robot.wheels()[i].p_body_m + (i == 1 ? offset_m : Eigen::Vector2d::Zero());
+    EXPECT_LT((p_odom_m.head<2>() - expected).norm(), 1e-9) << "wheel " << i << ": " << p_odom_m.transpose();
+  }
+  // The driver and the platform geometry keep the nominal robot; the true lx + ly is the mean yaw lever arm: the
+  // front right wheel's |x| + |y| drops from 0.38 to 0.36 m.
+  EXPECT_EQ(robot.J_rates_twist(), nominal_rows);
+  EXPECT_NEAR(robot.PlatformGeometry().at("half_length_m"), 0.2, 1e-5);
+  EXPECT_NEAR(robot.TrueOdometerCalibration().at("odometer.lx_plus_ly")[0], 0.38 - 0.02 / 4.0, 1e-5);
+  const Status missing = robot.MoveWheels(m, {{4, offset_m}}, "F");
+  EXPECT_EQ(missing.message(), "F: robot.wheel_offset: wheel 4: the mecanum robot has 4 wheels");
+}
+
 // 8 s of scenarios/indoor_omni_slip.yaml.
 class OmniSimulationTest : public ::testing::Test {
  protected:

@@ -128,6 +128,35 @@ TEST_F(ScenarioErrorTest, BadValues) {
               "effects[0].parameters.latency_s", "must be in [0, 1]");
 }
 
+TEST_F(ScenarioErrorTest, WheelOffsetIsParsedAndChecked) {
+  const std::string kind = "kind: differential_drive\n";
+  EXPECT_EQ(LoadIndoorWith(kind, kind + "  wheel_offset: [{wheel: 1, offset_m: [-0.03, 0.01]}]\n"), "");
+  auto loaded = LoadScenario(path_);
+  ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+  ASSERT_EQ(loaded.value().robot.wheel_offset.size(), 1u);
+  EXPECT_EQ(loaded.value().robot.wheel_offset[0].wheel, 1);
+  EXPECT_EQ(loaded.value().robot.wheel_offset[0].offset_m, Eigen::Vector2d(-0.03, 0.01));
+  ExpectError(LoadIndoorWith(kind, kind + "  wheel_offset: [{wheel: 1, offset_m: [0.06, 0.0]}]\n"), "wheel_offset",
+              "robot.wheel_offset[0].offset_m", "within +-0.05 m");
+  ExpectError(LoadIndoorWith(kind, kind + "  wheel_offset: [{wheel: 0, offset_m: [0.0, .nan]}]\n"), "wheel_offset",
+              "robot.wheel_offset[0].offset_m[1]", "expected a finite number");
+  ExpectError(LoadIndoorWith(kind, kind + "  wheel_offset: [{wheel: -1, offset_m: [0.0, 0.0]}]\n"), "wheel_offset",
+              "robot.wheel_offset[0].wheel", "must be >= 0");
+  ExpectError(LoadIndoorWith(kind, kind + "  wheel_offset: [{wheel: 1, offset_m: [0.01, 0.0]}, "
+                                          "{wheel: 1, offset_m: [0.0, 0.01]}]\n"),
+              "wheel_offset", "robot.wheel_offset[1].wheel", "wheel listed twice");
+  ExpectError(LoadIndoorWith(kind, kind + "  wheel_offset: [{wheel: 1, offset_m: [0.01]}]\n"), "wheel_offset",
+              "robot.wheel_offset[0].offset_m", "expected 2 numbers");
+  ExpectError(LoadIndoorWith(kind, kind + "  wheel_offset: [{wheel: 1}]\n"), "wheel_offset",
+              "robot.wheel_offset[0].offset_m", "missing required key");
+  ExpectError(LoadIndoorWith(kind, kind + "  wheel_offset: {wheel: 1}\n"), "wheel_offset", "robot.wheel_offset",
+              "expected a list");
+  Scenario atv = testing::AtvHills(1.0);
+  atv.robot.wheel_offset = {{0, Eigen::Vector2d(0.01, 0.0)}};
+  ASSERT_TRUE(atv.Validate().has_value());
+  EXPECT_EQ(atv.Validate()->key, "robot.wheel_offset");
+}
+
 TEST_F(ScenarioErrorTest, MissingFilesAndKeys) {
   ExpectError(LoadWith("model: " + testing::SourcePath("models/atv.xml"), "model: no_such_robot.xml"),
               "no_such_robot.xml", "robot.model", "no such file 'no_such_robot.xml'");
