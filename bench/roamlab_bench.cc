@@ -707,13 +707,17 @@ int main(int argc, char** argv) {
     if (!child.ok()) return Fail(child.status().message());
     std::filesystem::remove_all(dir);
     const Json& c = child.value();
-    const double growth_1h = c["rss_end_kb"].get<double>() / c["rss_after_first_minute_kb"].get<double>() - 1.0;
+    // Growth: the largest resident set seen later in the run (the 10-minute samples, taken while the graph is
+    // live, and the end, after Track has returned and freed its window) over the one after the first minute.
+    double largest_kb = c["rss_end_kb"].get<double>();
+    for (const Json& sample : c["rss_every_10_min"]) largest_kb = std::max(largest_kb, sample["rss_kb"].get<double>());
+    const double growth_1h = largest_kb / c["rss_after_first_minute_kb"].get<double>() - 1.0;
     j["memory_growth_1h"] = growth_1h;  // --quick: over sizes.online_run_s
     j["online_run"] = c;
-    say("  online run of %4.0f s               resident %.1f MB after 1 min, %.1f MB at the end (%+.1f%%), "
-        "%.1fx real time   target within 10%%\n",
-        hour, c["rss_after_first_minute_kb"].get<double>() / 1024.0, c["rss_end_kb"].get<double>() / 1024.0,
-        100.0 * growth_1h, c["realtime_factor"].get<double>());
+    say("  online run of %4.0f s               resident %.1f MB after 1 min, at most %.1f MB later (%+.1f%%), "
+        "%.1f MB at the end, %.1fx real time   target within 10%%\n",
+        hour, c["rss_after_first_minute_kb"].get<double>() / 1024.0, largest_kb / 1024.0, 100.0 * growth_1h,
+        c["rss_end_kb"].get<double>() / 1024.0, c["realtime_factor"].get<double>());
   }
 
   // 7. Monte-Carlo runs per minute with one and two jobs (--quick: the scenario on a shorter drive, its model path made
