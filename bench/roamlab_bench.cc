@@ -258,10 +258,22 @@ int ChildTrack(const std::string& rec_dir, const std::string& config_path, const
   long rss_after_minute = -1;
   std::size_t poses = 0;
   roamlab::Time first, last;
+  // The resident set every 10 minutes of data too, also printed as it comes, so that a long run shows its trend
+  // before it ends.
+  Json rss_samples = Json::array();
+  double next_sample_s = 600.0;
   options.on_pose = [&](const roamlab::StampedPose& pose, const Eigen::Matrix3d&) {
     if (poses++ == 0) first = pose.t;
     last = pose.t;
-    if (rss_after_minute < 0 && roamlab::SecondsBetween(first, pose.t) >= 60.0) rss_after_minute = StatusKb("VmRSS");
+    const double t_s = roamlab::SecondsBetween(first, pose.t);
+    if (rss_after_minute < 0 && t_s >= 60.0) rss_after_minute = StatusKb("VmRSS");
+    if (t_s >= next_sample_s) {
+      const long rss_kb = StatusKb("VmRSS");
+      rss_samples.push_back({{"t_s", t_s}, {"rss_kb", rss_kb}});
+      std::fprintf(stderr, "online run: %.0f s of data, resident %.1f MB (%+.1f%% over the first minute)\n", t_s,
+                   rss_kb / 1024.0, 100.0 * (static_cast<double>(rss_kb) / rss_after_minute - 1.0));
+      next_sample_s += 600.0;
+    }
   };
   const double c0 = ProcessCpu();
   auto tracked = est::Track(config.value(), rec.value(), calibration.value(), options);
@@ -274,6 +286,7 @@ int ChildTrack(const std::string& rec_dir, const std::string& config_path, const
                   {"realtime_factor", duration / tracked.value().total_seconds},
                   {"rss_after_first_minute_kb", rss_after_minute},
                   {"rss_end_kb", StatusKb("VmRSS")},
+                  {"rss_every_10_min", rss_samples},
                   {"peak_rss_kb", StatusKb("VmHWM")}};
   std::ofstream(out_path) << j.dump(2) << "\n";
   return 0;
@@ -656,7 +669,11 @@ int main(int argc, char** argv) {
   std::map<double, double> calibration_seconds, calibration_cpu_seconds;
   for (double size : sizes.calibration_s) {
     const std::string dir = (tmp / ("rec_" + std::to_string(static_cast<int>(size)))).string();
-    const roamlab::Status simulated = SimulateTo(scenario.value(), size, dir);
+    // A drive as long as the scenario's (up to 30 s, which LongerDrive leaves unchanged) is the recording of step 1,
+    // the simulation being deterministic: written out instead of simulated again.
+    const roamlab::Status simulated = size == scenario.value().duration_s && size <= 30.0
+                                          ? roamlab::recording::WriteRecording(rec, dir)
+                                          : SimulateTo(scenario.value(), size, dir);
     if (!simulated.ok()) return Fail(simulated.message());
     const std::string out = (tmp / "calibrate.json").string();
     auto child = RunChild(self, {"--child-calibrate", dir, calibration_path, out}, out);
@@ -690,13 +707,17 @@ int main(int argc, char** argv) {
     if (!child.ok()) return Fail(child.status().message());
     std::filesystem::remove_all(dir);
     const Json& c = child.value();
-    const double growth_1h = c["rss_end_kb"].get<double>() / c["rss_after_first_minute_kb"].get<double>() - 1.0;
+    // Growth: the largest resident set seen later in the run (the 10-minute samples, taken while the graph is
+    // live, and the end, after Track has returned and freed its window) over the one after the first minute.
+    double largest_kb = c["rss_end_kb"].get<double>();
+    for (const Json& sample : c["rss_every_10_min"]) largest_kb = std::max(largest_kb, sample["rss_kb"].get<double>());
+    const double growth_1h = largest_kb / c["rss_after_first_minute_kb"].get<double>() - 1.0;
     j["memory_growth_1h"] = growth_1h;  // --quick: over sizes.online_run_s
     j["online_run"] = c;
-    say("  online run of %4.0f s               resident %.1f MB after 1 min, %.1f MB at the end (%+.1f%%), "
-        "%.1fx real time   target within 10%%\n",
-        hour, c["rss_after_first_minute_kb"].get<double>() / 1024.0, c["rss_end_kb"].get<double>() / 1024.0,
-        100.0 * growth_1h, c["realtime_factor"].get<double>());
+    say("  online run of %4.0f s               resident %.1f MB after 1 min, at most %.1f MB later (%+.1f%%), "
+        "%.1f MB at the end, %.1fx real time   target within 10%%\n",
+        hour, c["rss_after_first_minute_kb"].get<double>() / 1024.0, largest_kb / 1024.0, 100.0 * growth_1h,
+        c["rss_end_kb"].get<double>() / 1024.0, c["realtime_factor"].get<double>());
   }
 
   // 7. Monte-Carlo runs per minute with one and two jobs (--quick: the scenario on a shorter drive, its model path made

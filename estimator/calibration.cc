@@ -108,9 +108,13 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
     // Gross outliers bend the estimate and make inliers look bad too: re-test every measurement after each re-solve,
     // re-admitting those that fit again, until the set is stable.
     for (int round = 0; config.gate_probability && round < 5; ++round) {
-      if (GateOutliers(*config.gate_probability, &builder) == 0) break;
+      const int changed = GateOutliers(*config.gate_probability, &builder);
+      if (changed == 0) break;
       {
         const SolverSummary again = Solve(config.solver, &builder.graph());
+        say("stage " + std::to_string(s + 1) + ": gating round " + std::to_string(round + 1) + ": " +
+            std::to_string(changed) + " measurements switched, re-solved in " + std::to_string(again.iterations) +
+            " iterations, " + std::to_string(again.seconds) + " s");
         if (!again.usable()) return Status::Error("stage " + std::to_string(s + 1) + ": " + again.message);
         stage.solver.iterations += again.iterations;
         stage.solver.final_cost = again.final_cost;
@@ -123,7 +127,8 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
     for (const auto& [stream, c] : builder.counts()) stage.rejected += c.rejected;
     say("stage " + std::to_string(s + 1) + "/" + std::to_string(stages.size()) + ": cost " +
         std::to_string(stage.solver.initial_cost) + " -> " + std::to_string(stage.solver.final_cost) + " in " +
-        std::to_string(stage.solver.iterations) + " iterations (" + TerminationName(stage.solver.termination) + ")");
+        std::to_string(stage.solver.iterations) + " iterations (" + TerminationName(stage.solver.termination) + "), " +
+        std::to_string(stage.solver.seconds) + " s");
     result.iterations += stage.solver.iterations;
     result.termination = TerminationName(stage.solver.termination);
     result.stages.push_back(std::move(stage));
@@ -145,11 +150,15 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
   ObservabilityAnalysis analysis;
   std::vector<int> offsets;
   if (!ids.empty() && options.analyze_observability) {
+    const auto analysis_start = std::chrono::steady_clock::now();
     auto info = ComputeMarginalInformation(builder.graph(), ids);
     if (!info.ok()) return info.status();
     analysis = AnalyzeObservability(info.value().information, info.value().conditional, options.observability);
     offsets = info.value().offsets;
     result.information = info.value().information;
+    say("observability analysis: " +
+        std::to_string(std::chrono::duration<double>(std::chrono::steady_clock::now() - analysis_start).count()) +
+        " s");
   }
   for (std::size_t i = 0; i < ids.size(); ++i) {
     const Variable& v = builder.graph().variable(ids[i]);
