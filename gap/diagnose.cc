@@ -755,13 +755,14 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
     // within the run) does not hide the next one, and is not tried again in the later rounds.
     CandidateFit* kept = nullptr;
     for (CandidateFit& f : fits) {
-      if (options.max_effects <= round || kept) break;
+      const bool extra = kept && options.heldout_all_candidates && round == 0;
+      if (options.max_effects <= round || (kept && !extra)) break;
       EffectEstimate& e = f.estimate;
       if (e.lr_pvalue >= options.alpha) {
         e.decision = "rejected: likelihood-ratio p above alpha";
         continue;
       }
-      if (e.delta_bic >= 0.0) {
+      if (e.delta_bic >= options.max_delta_bic) {
         e.decision = "rejected: BIC does not favour it";
         continue;
       }
@@ -769,7 +770,8 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
       if (!h.ok()) return Status::Error("held-out evaluation of " + e.name + ": " + h.status().message());
       e.evaluated_heldout = true;
       e.heldout_improvement = state.heldout_chi2 > 0.0 ? 1.0 - h.value().first / state.heldout_chi2 : 0.0;
-      if (e.heldout_improvement <= 0.0) {
+      if (extra) continue;   // evaluated for the record only; the decision was taken
+      if (e.heldout_improvement <= options.min_heldout_improvement) {
         e.decision = "rejected: no improvement on the held-out part";
         dropped.insert(e.name);
         continue;
