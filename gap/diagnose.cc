@@ -737,16 +737,31 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
   std::set<std::string> accepted, dropped;
   for (int round = 0; round < std::max(1, options.max_effects); ++round) {
     std::vector<CandidateFit> fits;
+    std::vector<EffectEstimate> failed;
     for (const Candidate& c : library) {
       if (accepted.count(c.name) || dropped.count(c.name)) continue;
       say("candidate " + c.name + (round > 0 ? " (on top of the accepted effects)" : ""));
       auto cf = fit_candidate(c, state);
-      if (!cf.ok()) return Status::Error("candidate " + c.name + ": " + cf.status().message());
+      if (!cf.ok()) {
+        // A candidate whose fit fails (e.g. a gyroscope scale driven to 0 on an axis a short planar drive does not
+        // excite) explains nothing: it is rejected and not tried again, the diagnosis goes on.
+        EffectEstimate e;
+        e.name = c.name;
+        e.dof = c.shifted.empty() ? c.free_dof : 1;
+        e.decision = "rejected: the fit failed (" + cf.status().message() + ")";
+        say("candidate " + c.name + ": " + e.decision);
+        failed.push_back(e);
+        dropped.insert(c.name);
+        continue;
+      }
       EffectEstimate& e = cf.value().estimate;
       Score(options.baseline, state.train_measurements, &e);
       fits.push_back(std::move(cf).value());
     }
-    if (fits.empty()) break;
+    if (fits.empty()) {
+      if (round == 0) out.candidates = failed;
+      break;
+    }
     std::sort(fits.begin(), fits.end(), [](const CandidateFit& a, const CandidateFit& b) {
       return a.estimate.delta_bic < b.estimate.delta_bic;
     });
@@ -786,6 +801,7 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
       if (f.estimate.decision.empty()) f.estimate.decision = "not the best candidate";
       if (round == 0) out.candidates.push_back(f.estimate);
     }
+    if (round == 0) out.candidates.insert(out.candidates.end(), failed.begin(), failed.end());
     if (!kept) break;
     accepted.insert(kept->estimate.name);
     out.effects.push_back(kept->estimate);
