@@ -13,6 +13,7 @@
 #include <random>
 #include <sstream>
 #include <thread>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
@@ -176,7 +177,7 @@ Result<Platform> LoadPlatform(const std::string& name, const std::string& path, 
   return p;
 }
 
-// What the diagnosis is run with, and what a case records beyond the score.
+// The thresholds the diagnosis is run with, and whether it evaluates every passing candidate on the held-out part.
 struct CaseSetup {
   Thresholds thresholds;
   bool heldout_all = false;

@@ -10,7 +10,7 @@
 //      each candidate parameter's noise (the median reported std);
 //   2. scored: N cases (draws seeded S, noise seeds S * 1000 + i) diagnosed with the chosen thresholds.
 // Writes DIR/score.json (figures against the targets, thresholds, per-case table, seconds), the recordings
-// in DIR/calibration/NNN/rec and DIR/cases/NNN/rec, and each diagnosis's gap summary in the case's directory.
+// in DIR/calibration/NNN/rec and DIR/cases/NNN/rec, and each case's row in DIR/.../NNN/case.json.
 #pragma once
 
 #include <cstdint>
