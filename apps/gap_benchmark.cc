@@ -164,7 +164,7 @@ Result<Platform> LoadPlatform(const std::string& name, const std::string& path, 
   auto scenario = sim::LoadScenario(path);
   if (!scenario.ok()) return scenario.status();
   if (scenario.value().robot.kind != kind)
-    return Status::Error(path + ": the " + name + " scenario must describe a " + kind + " robot, not '" +
+    return Status::Error(path + ": the " + name + " scenario must describe a robot of kind '" + kind + "', not '" +
                          scenario.value().robot.kind + "'");
   auto config = gap::NominalConfig(scenario.value());
   if (!config.ok()) return Status::Error(path + ": " + config.status().message());
