@@ -1,16 +1,23 @@
 #include "apps/gap_benchmark.h"
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <iostream>
+#include <mutex>
 #include <random>
 #include <sstream>
+#include <thread>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
+#include "apps/gap_benchmark_score.h"
 #include "gap/diagnose.h"
 #include "recording/recording.h"
 #include "recording/truth.h"
@@ -21,35 +28,76 @@ namespace roamlab::apps {
 namespace {
 
 using nlohmann::json;
+using gapbench::CaseResult;
+using gapbench::Thresholds;
 
 constexpr std::uint64_t kBaselineSeed = 900001;
+constexpr int kMaxCases = 500;                 // per phase: the calibration seeds start 500 after the scored ones
+constexpr double kMaxFalseRate = 0.10;         // the false-discovery target, imposed on the calibration
 
-// One drawn case: the effect hidden in the scenario (empty name: none) and its kind.
-struct Draw {
-  std::string kind;   // none | effect | decoy
-  sim::EffectOptions effect;
+struct Platform {
+  std::string name;                            // atv | diffdrive
+  sim::Scenario scenario;
+  estimator::EstimatorConfig config;
+  gap::Baseline baseline;
 };
 
+// One drawn case: the platform, the kind and the effect hidden in its scenario (empty name: none).
+struct Draw {
+  int platform = 0;                            // index into the platforms
+  std::string kind;                            // none | effect | decoy
+  sim::EffectOptions effect;
+  std::string parameter;                       // the parameter drawn away from neutral
+};
+
+// The stream whose held-out RMS an effect moves (the stream diagnose scales the candidate's statistic by).
+std::string AffectedStream(const std::string& effect) {
+  if (effect == "gps_latency") return "gps";
+  if (effect == "imu_time_offset" || effect == "gyro_scale_error") return "gyroscope";
+  return "odometer";
+}
+
+// Platform 0 is the ATV, 1 the differential drive; each equally likely. Kinds: none 20 %, decoy 15 %, effect 65 %.
+// Magnitudes from about the smallest the diagnosis resolves (its std on a 20 s training part, README) to large.
 Draw DrawCase(std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const auto sign = [&] { return u(rng) < 0.5 ? -1.0 : 1.0; };
   const auto round_to = [](double x, double step) { return std::round(x / step) * step; };
   Draw d;
+  d.platform = u(rng) < 0.5 ? 0 : 1;
   const double kind = u(rng);
+  const double pick = u(rng);
   if (kind < 0.2) {
     d.kind = "none";
     return d;
   }
   if (kind < 0.35) {
     d.kind = "decoy";
-    Eigen::Vector3d direction(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5);
-    direction = direction.normalized() * (3e-4 + 3e-4 * u(rng));
-    d.effect = {"magnetometer_motor_interference",
-                {{"b_per_nm_x", direction.x()}, {"b_per_nm_y", direction.y()}, {"b_per_nm_z", direction.z()}}};
+    if (d.platform == 0) {
+      // A magnetometer bias proportional to the drive torque: the recording has no torque stream, no candidate.
+      Eigen::Vector3d direction(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5);
+      direction = direction.normalized() * (3e-4 + 3e-4 * u(rng));
+      d.effect = {"magnetometer_motor_interference",
+                  {{"b_per_nm_x", direction.x()}, {"b_per_nm_y", direction.y()}, {"b_per_nm_z", direction.z()}}};
+      d.parameter = "b_per_nm_x";
+    } else {
+      // A warming MEMS gyroscope's bias random walk (from zero): the nominal model has no gyro bias and no candidate
+      // frees one; a constant parameter cannot follow a walk, so the held-out part should not improve.
+      d.effect = {"gyro_bias_drift", {{"random_walk", 5e-4 + 1e-3 * u(rng)}}};
+      d.parameter = "random_walk";
+    }
     return d;
   }
   d.kind = "effect";
-  switch (static_cast<int>(4.0 * u(rng))) {
+  if (d.platform == 1) {
+    if (pick < 0.5)
+      d.effect = {"wheel_radius_asymmetry", {{"ratio_right_left", 1.0 + sign() * (0.004 + 0.026 * u(rng))}}};
+    else
+      d.effect = {"track_width_error", {{"track_error_m", sign() * (0.004 + 0.026 * u(rng))}}};
+    d.parameter = d.effect.parameters.begin()->first;
+    return d;
+  }
+  switch (static_cast<int>(4.0 * pick)) {
     case 0:
       d.effect = {"gps_latency", {{"latency_s", round_to(0.2 + 0.2 * u(rng), 0.001)}}};
       break;
@@ -64,178 +112,322 @@ Draw DrawCase(std::mt19937_64& rng) {
       d.effect = {"gyro_scale_error", {{"scale_" + axis, 1.0 + sign() * (0.03 + 0.03 * u(rng))}}};
     }
   }
+  d.parameter = d.effect.parameters.begin()->first;
   return d;
 }
 
-// Scores a diagnosis against the truth (read after the diagnosis): whether it is right, and why not.
-bool Score(const std::string& kind, const recording::Truth& truth, const gap::Diagnosis& d, std::string* why) {
-  if (kind == "none") {
-    *why = d.verdict == "none" ? "" : "expected none, got " + d.verdict;
-    return d.verdict == "none";
+// Runs fn(0..n-1) on `jobs` threads with a progress bar; the first error stops the rest.
+Status RunParallel(int n, int jobs, const std::string& label, bool quiet,
+                   const std::function<Result<std::string>(int)>& fn) {
+  std::atomic<int> next{0};
+  std::mutex mutex;
+  int done = 0;
+  Status first_error = Status::Ok();
+  const auto start = std::chrono::steady_clock::now();
+  const auto bar = [&] {
+    constexpr int kWidth = 30;
+    const int filled = n > 0 ? kWidth * done / n : kWidth;
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::ostringstream s;
+    s << "\r" << label << " [" << std::string(filled, '#') << std::string(kWidth - filled, '.') << "] " << done
+      << "/" << n << "  " << std::fixed << std::setprecision(0) << elapsed << " s";
+    if (done > 0 && done < n) s << ", about " << elapsed / done * (n - done) << " s left";
+    std::cout << s.str() << std::flush;
+  };
+  if (!quiet) bar();
+  const auto worker = [&] {
+    for (int i = next++; i < n; i = next++) {
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!first_error.ok()) return;
+      }
+      Result<std::string> line = fn(i);
+      std::lock_guard<std::mutex> lock(mutex);
+      ++done;
+      if (!line.ok() && first_error.ok()) first_error = line.status();
+      if (!quiet) {
+        std::cout << "\r" << std::string(100, ' ') << "\r" << (line.ok() ? line.value() : line.status().message())
+                  << "\n";
+        bar();
+      }
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int k = 0; k < std::max(1, std::min(jobs, n)); ++k) threads.emplace_back(worker);
+  for (std::thread& t : threads) t.join();
+  if (!quiet) std::cout << "\n";
+  return first_error;
+}
+
+Result<Platform> LoadPlatform(const std::string& name, const std::string& path, const std::string& kind,
+                              double duration_s) {
+  auto scenario = sim::LoadScenario(path);
+  if (!scenario.ok()) return scenario.status();
+  if (scenario.value().robot.kind != kind)
+    return Status::Error(path + ": the " + name + " scenario must describe a robot of kind '" + kind + "', not '" +
+                         scenario.value().robot.kind + "'");
+  auto config = gap::NominalConfig(scenario.value());
+  if (!config.ok()) return Status::Error(path + ": " + config.status().message());
+  Platform p;
+  p.name = name;
+  p.scenario = scenario.value();
+  p.scenario.effects.clear();
+  if (duration_s > 0.0) p.scenario.duration_s = duration_s;
+  p.config = config.value();
+  return p;
+}
+
+// The thresholds the diagnosis is run with, and whether it evaluates every passing candidate on the held-out part.
+struct CaseSetup {
+  Thresholds thresholds;
+  bool heldout_all = false;
+};
+
+// Simulates, writes, diagnoses blind, then reads truth.yaml and fills the case.
+Result<CaseResult> RunCase(const Platform& platform, const Draw& draw, std::uint64_t noise_seed,
+                           const std::string& id, const std::string& dir, const CaseSetup& setup) {
+  const auto start = std::chrono::steady_clock::now();
+  sim::Scenario s = platform.scenario;
+  if (draw.kind != "none") s.effects.push_back(draw.effect);
+  sim::SimulateOptions options;
+  options.seed = noise_seed;
+  auto simulated = sim::Simulate(s, options);
+  if (!simulated.ok()) return Status::Error("simulation: " + simulated.status().message());
+  const std::string rec_dir = dir + "/rec";
+  std::error_code ec;
+  std::filesystem::create_directories(rec_dir, ec);
+  if (ec) return Status::Error(rec_dir + ": cannot create the directory");
+  if (Status st = recording::WriteRecording(simulated.value().recording, rec_dir); !st.ok()) return st;
+  if (Status st = recording::WriteTruth(simulated.value().truth, rec_dir); !st.ok()) return st;
+
+  // Blind: the diagnosis reads the written recording's streams only.
+  recording::ReadOptions read;
+  read.load_ground_truth = false;
+  auto rec = recording::ReadRecording(rec_dir, read);
+  if (!rec.ok()) return rec.status();
+  gap::DiagnoseOptions d_options;
+  d_options.baseline = &platform.baseline;
+  d_options.alpha = setup.thresholds.alpha;
+  d_options.max_delta_bic = setup.thresholds.max_delta_bic;
+  d_options.min_heldout_improvement = setup.thresholds.min_heldout_improvement;
+  d_options.heldout_all_candidates = setup.heldout_all;
+  auto diagnosed = gap::Diagnose(platform.config, rec.value(), d_options);
+  if (!diagnosed.ok()) return Status::Error("diagnosis: " + diagnosed.status().message());
+  const gap::Diagnosis& d = diagnosed.value();
+
+  CaseResult c;
+  c.id = id;
+  c.platform = platform.name;
+  c.kind = draw.kind;
+  c.verdict = d.verdict;
+  for (const gap::EffectEstimate& e : d.effects) c.named.push_back(e.name);
+  c.ranked = c.named;
+  for (const gap::EffectEstimate& e : d.candidates) {   // in order of Delta BIC
+    if (std::find(c.ranked.begin(), c.ranked.end(), e.name) == c.ranked.end()) c.ranked.push_back(e.name);
+    gapbench::CandidateStats stats{e.name, e.lr_pvalue, e.delta_bic, e.evaluated_heldout, e.heldout_improvement,
+                                   e.std};
+    c.candidates.push_back(stats);
   }
-  if (kind == "decoy") {
-    const bool ok = d.verdict != "named";
-    *why = ok ? "" : "a decoy outside the library was named " + d.effects.front().name;
-    return ok;
+
+  // Scoring: now, and only now, the truth.
+  auto truth = recording::ReadTruth(rec_dir);
+  if (!truth.ok()) return truth.status();
+  if (draw.kind != "none") {
+    if (truth.value().effects.empty()) return Status::Error(rec_dir + "/truth.yaml: the hidden effect is missing");
+    const auto& effect = truth.value().effects.front();
+    c.truth_name = effect.name;
+    c.truth_parameter = draw.parameter;
+    const auto value = effect.parameters.find(draw.parameter);
+    c.truth_value = value != effect.parameters.end() ? value->second : 0.0;
   }
-  if (d.verdict != "named" || truth.effects.empty() || d.effects.front().name != truth.effects.front().name) {
-    *why = "expected " + (truth.effects.empty() ? std::string("?") : truth.effects.front().name) + ", got " +
-           (d.effects.empty() ? d.verdict : d.effects.front().name);
-    return false;
-  }
-  const gap::EffectEstimate& e = d.effects.front();
-  for (const auto& [name, value] : truth.effects.front().parameters) {
-    if (!e.parameters.count(name) || !e.std.count(name)) continue;
-    const double error = e.parameters.at(name) - value;
-    if (!(std::abs(error) <= 3.0 * e.std.at(name))) {
-      std::ostringstream s;
-      s << name << " off by " << error << " (" << error / e.std.at(name) << " std)";
-      *why = s.str();
-      return false;
+  if (draw.kind == "effect") {
+    for (const gap::EffectEstimate& e : d.effects) {
+      if (e.name != c.truth_name || !e.parameters.count(c.truth_parameter)) continue;
+      c.estimate = e.parameters.at(c.truth_parameter);
+      c.has_estimate = true;
+      break;
+    }
+    const std::string stream = AffectedStream(c.truth_name);
+    if (d.before.count(stream) && d.after.count(stream)) {
+      c.rms_before = d.before.at(stream).rms;
+      c.rms_after = d.after.at(stream).rms;
+      c.has_rms = true;
     }
   }
-  return true;
+  c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::ofstream(dir + "/case.json") << gapbench::CaseRow(c).dump(2) << "\n";
+  return c;
+}
+
+std::string CaseLine(const CaseResult& c) {
+  std::ostringstream s;
+  s << c.id << " " << c.platform << " " << c.kind;
+  if (!c.truth_name.empty()) s << " " << c.truth_name << " " << c.truth_parameter << "=" << c.truth_value;
+  if (c.noise_ratio >= 0.0) s << std::setprecision(3) << " (" << c.noise_ratio << "x noise)";
+  s << " -> " << c.verdict;
+  if (!c.named.empty()) s << " " << c.named.front();
+  if (c.has_estimate) s << " " << c.estimate;
+  s << std::fixed << std::setprecision(0) << " [" << c.seconds << " s]";
+  return s.str();
+}
+
+// Draws and runs one phase's cases; results in draw order.
+Result<std::vector<CaseResult>> RunPhase(const std::vector<Platform>& platforms, int n, std::uint64_t draw_seed,
+                                         std::uint64_t noise_seed0, const std::string& dir, const CaseSetup& setup,
+                                         const std::string& label, const GapBenchmarkArgs& args) {
+  std::mt19937_64 rng(draw_seed);
+  std::vector<Draw> draws;
+  for (int i = 0; i < n; ++i) draws.push_back(DrawCase(rng));   // all drawn first: independent of scheduling
+  std::vector<CaseResult> results(static_cast<std::size_t>(n));
+  const Status st = RunParallel(n, args.jobs, label, args.quiet, [&](int i) -> Result<std::string> {
+    std::ostringstream id;
+    id << std::setw(3) << std::setfill('0') << i;
+    const Draw& draw = draws[static_cast<std::size_t>(i)];
+    auto c = RunCase(platforms[static_cast<std::size_t>(draw.platform)], draw,
+                     noise_seed0 + static_cast<std::uint64_t>(i), id.str(), dir + "/" + id.str(), setup);
+    if (!c.ok()) return Status::Error(label + " case " + id.str() + ": " + c.status().message());
+    results[static_cast<std::size_t>(i)] = c.value();
+    return CaseLine(c.value());
+  });
+  if (!st.ok()) return st;
+  return results;
+}
+
+double SecondsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
 }  // namespace
 
 int RunGapBenchmark(const GapBenchmarkArgs& args) {
   std::ostream& err = args.err ? *args.err : std::cerr;
-  const auto say = [&](const std::string& line) {
-    if (!args.quiet) std::cout << line << std::endl;
-  };
-  if (args.cases < 1) {
-    err << "roamlab gap-benchmark: --cases must be >= 1\n";
+  if (args.cases < 1 || args.cases > kMaxCases || args.calibration_cases < 1 || args.calibration_cases > kMaxCases) {
+    err << "roamlab gap-benchmark: --cases and --calibration-cases must be in [1, " << kMaxCases << "]\n";
     return 2;
   }
-  auto scenario = sim::LoadScenario(args.scenario);
-  if (!scenario.ok()) {
-    err << "roamlab gap-benchmark: " << scenario.status().message() << "\n";
+  if (args.jobs < 1) {
+    err << "roamlab gap-benchmark: --jobs must be >= 1\n";
     return 2;
   }
-  auto config = gap::NominalConfig(scenario.value());
-  if (!config.ok()) {
-    err << "roamlab gap-benchmark: " << args.scenario << ": " << config.status().message() << "\n";
+  if (args.duration_s < 0.0) {
+    err << "roamlab gap-benchmark: --duration must be positive\n";
     return 2;
+  }
+  std::vector<Platform> platforms;
+  for (const auto& [name, path, kind] : {std::make_tuple("atv", args.atv_scenario, "ackermann"),
+                                         std::make_tuple("diffdrive", args.diffdrive_scenario, "differential_drive")}) {
+    auto p = LoadPlatform(name, path, kind, args.duration_s);
+    if (!p.ok()) {
+      err << "roamlab gap-benchmark: " << p.status().message() << "\n";
+      return 2;
+    }
+    platforms.push_back(std::move(p).value());
   }
   std::error_code ec;
-  std::filesystem::create_directories(args.out + "/cases", ec);
+  std::filesystem::create_directories(args.out, ec);
   if (ec) {
     err << "roamlab gap-benchmark: " << args.out << ": cannot create the output directory\n";
     return 2;
   }
   const auto start = std::chrono::steady_clock::now();
 
-  // The baseline, once.
-  sim::Scenario nominal = scenario.value();
-  nominal.effects.clear();
-  sim::SimulateOptions base_options;
-  base_options.seed = kBaselineSeed;
-  say("baseline: nominal simulation, seed " + std::to_string(kBaselineSeed));
-  auto base_sim = sim::Simulate(nominal, base_options);
-  if (!base_sim.ok()) {
-    err << "roamlab gap-benchmark: nominal simulation: " << base_sim.status().message() << "\n";
-    return 1;
-  }
-  gap::DiagnoseOptions learn;
-  learn.max_effects = 0;
-  auto learned = gap::Diagnose(config.value(), base_sim.value().recording, learn);
-  if (!learned.ok()) {
-    err << "roamlab gap-benchmark: baseline: " << learned.status().message() << "\n";
-    return 1;
-  }
-  const gap::Baseline baseline = gap::BaselineFrom(learned.value());
-
-  std::mt19937_64 rng(args.seed);
-  json cases = json::array();
-  int correct = 0;
-  std::map<std::string, std::pair<int, int>> by_kind;
-  for (int i = 0; i < args.cases; ++i) {
-    std::ostringstream name;
-    name << std::setw(3) << std::setfill('0') << i;
-    const std::string dir = args.out + "/cases/" + name.str() + "/rec";
-    const Draw draw = DrawCase(rng);
-    sim::Scenario s = scenario.value();
-    s.effects.clear();
-    if (draw.kind != "none") s.effects.push_back(draw.effect);
+  // The baselines, once per platform (in parallel).
+  const Status base = RunParallel(static_cast<int>(platforms.size()), args.jobs, "baselines", args.quiet,
+                                  [&](int i) -> Result<std::string> {
+    Platform& p = platforms[static_cast<std::size_t>(i)];
     sim::SimulateOptions options;
-    options.seed = args.seed * 1000 + static_cast<std::uint64_t>(i);
-    say("case " + name.str() + ": simulating (" + draw.kind + ")");
-    auto simulated = sim::Simulate(s, options);
-    if (!simulated.ok()) {
-      err << "roamlab gap-benchmark: case " << name.str() << ": " << simulated.status().message() << "\n";
-      return 1;
-    }
-    std::filesystem::create_directories(dir, ec);
-    if (Status st = recording::WriteRecording(simulated.value().recording, dir); !st.ok()) {
-      err << "roamlab gap-benchmark: " << st.message() << "\n";
-      return 1;
-    }
-    if (Status st = recording::WriteTruth(simulated.value().truth, dir); !st.ok()) {
-      err << "roamlab gap-benchmark: " << st.message() << "\n";
-      return 1;
-    }
-    // Blind: the diagnosis reads the written recording's streams only.
-    recording::ReadOptions read;
-    read.load_ground_truth = false;
-    auto rec = recording::ReadRecording(dir, read);
-    if (!rec.ok()) {
-      err << "roamlab gap-benchmark: " << rec.status().message() << "\n";
-      return 1;
-    }
-    gap::DiagnoseOptions options_d;
-    options_d.baseline = &baseline;
-    auto d = gap::Diagnose(config.value(), rec.value(), options_d);
-    if (!d.ok()) {
-      err << "roamlab gap-benchmark: case " << name.str() << ": " << d.status().message() << "\n";
-      return 1;
-    }
-    // Scoring: now, and only now, the truth.
-    auto truth = recording::ReadTruth(dir);
-    if (!truth.ok()) {
-      err << "roamlab gap-benchmark: " << truth.status().message() << "\n";
-      return 1;
-    }
-    std::string why;
-    const bool ok = Score(draw.kind, truth.value(), d.value(), &why);
-    correct += ok;
-    by_kind[draw.kind].first += ok;
-    ++by_kind[draw.kind].second;
-    json named = json::array(), parameters = json::object(), stds = json::object(), truth_parameters = json::object();
-    for (const gap::EffectEstimate& e : d.value().effects) named.push_back(e.name);
-    if (!d.value().effects.empty()) {
-      for (const auto& [k, v] : d.value().effects.front().parameters) parameters[k] = v;
-      for (const auto& [k, v] : d.value().effects.front().std) stds[k] = std::isfinite(v) ? json(v) : json(nullptr);
-    }
-    for (const auto& [k, v] : draw.effect.parameters) truth_parameters[k] = v;
-    cases.push_back({{"case", name.str()},
-                     {"kind", draw.kind},
-                     {"truth", {{"name", draw.effect.name}, {"parameters", truth_parameters}}},
-                     {"verdict", d.value().verdict},
-                     {"named", named},
-                     {"parameters", parameters},
-                     {"std", stds},
-                     {"correct", ok},
-                     {"why", why}});
-    say("case " + name.str() + ": " + draw.kind + " " + draw.effect.name + " -> " + d.value().verdict +
-        (d.value().effects.empty() ? std::string() : " " + d.value().effects.front().name) +
-        (ok ? ": correct" : ": wrong (" + why + ")"));
+    options.seed = kBaselineSeed;
+    auto simulated = sim::Simulate(p.scenario, options);
+    if (!simulated.ok()) return Status::Error(p.name + " nominal simulation: " + simulated.status().message());
+    gap::DiagnoseOptions learn;
+    learn.max_effects = 0;
+    auto learned = gap::Diagnose(p.config, simulated.value().recording, learn);
+    if (!learned.ok()) return Status::Error(p.name + " baseline: " + learned.status().message());
+    p.baseline = gap::BaselineFrom(learned.value());
+    return p.name + " baseline learned (noise seed " + std::to_string(kBaselineSeed) + ")";
+  });
+  if (!base.ok()) {
+    err << "roamlab gap-benchmark: " << base.message() << "\n";
+    return 1;
   }
-  json kinds = json::object();
-  for (const auto& [kind, c] : by_kind) kinds[kind] = {{"correct", c.first}, {"total", c.second}};
-  const json score = {{"cases", cases},
-                      {"correct", correct},
-                      {"total", args.cases},
-                      {"by_kind", kinds},
-                      {"seed", args.seed},
-                      {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}};
+  const double baseline_s = SecondsSince(start);
+
+  // 1. Calibration: the loosest thresholds, every passing candidate evaluated on the held-out part.
+  const auto calibration_start = std::chrono::steady_clock::now();
+  CaseSetup loose{gapbench::Loosest(), true};
+  const std::uint64_t calibration_seed = args.seed * 1000 + kMaxCases;
+  auto calibration = RunPhase(platforms, args.calibration_cases, calibration_seed, calibration_seed,
+                              args.out + "/calibration", loose, "calibration", args);
+  if (!calibration.ok()) {
+    err << "roamlab gap-benchmark: " << calibration.status().message() << "\n";
+    return 1;
+  }
+  json grid;
+  const Thresholds chosen = gapbench::ChooseThresholds(calibration.value(), kMaxFalseRate, &grid);
+  const auto sigmas = gapbench::CalibrationSigmas(calibration.value());
+  json calibration_rows = json::array();
+  for (CaseResult& c : calibration.value()) {
+    if (c.kind == "effect")
+      c.noise_ratio = gapbench::NoiseRatio(sigmas, c.platform, c.truth_name, c.truth_parameter, c.truth_value);
+    json row = gapbench::CaseRow(c);
+    row["replayed_first_round"] = gapbench::ReplayFirstRound(c.candidates, chosen);
+    calibration_rows.push_back(row);
+  }
+  const double calibration_s = SecondsSince(calibration_start);
+  const json thresholds = {{"alpha", chosen.alpha},
+                           {"max_delta_bic", chosen.max_delta_bic},
+                           {"min_heldout_improvement", chosen.min_heldout_improvement}};
+  if (!args.quiet) std::cout << "thresholds from the calibration cases: " << thresholds.dump() << "\n";
+
+  // 2. The scored cases, diagnosed with the chosen thresholds.
+  const auto scored_start = std::chrono::steady_clock::now();
+  auto scored = RunPhase(platforms, args.cases, args.seed, args.seed * 1000, args.out + "/cases", {chosen, false},
+                         "scored", args);
+  if (!scored.ok()) {
+    err << "roamlab gap-benchmark: " << scored.status().message() << "\n";
+    return 1;
+  }
+  json rows = json::array();
+  for (CaseResult& c : scored.value()) {
+    if (c.kind == "effect")
+      c.noise_ratio = gapbench::NoiseRatio(sigmas, c.platform, c.truth_name, c.truth_parameter, c.truth_value);
+    rows.push_back(gapbench::CaseRow(c));
+  }
+  const double scored_s = SecondsSince(scored_start);
+  const double total_s = SecondsSince(start);
+  json sigma_json = json::object();
+  for (const auto& [platform, by_parameter] : sigmas)
+    for (const auto& [key, sigma] : by_parameter) sigma_json[platform][key] = sigma;
+  const json figures = gapbench::Summarize(scored.value());
+  const json score = {
+      {"seed", args.seed},
+      {"jobs", args.jobs},
+      {"duration_s", {{"atv", platforms[0].scenario.duration_s}, {"diffdrive", platforms[1].scenario.duration_s}}},
+      {"figures", figures},
+      {"thresholds", thresholds},
+      {"calibration",
+       {{"cases", calibration_rows},
+        {"draw_and_noise_seed_base", calibration_seed},
+        {"max_false_rate", kMaxFalseRate},
+        {"grid", grid},
+        {"noise_sigmas", sigma_json}}},
+      {"cases", rows},
+      {"seconds",
+       {{"total", total_s},
+        {"baselines", baseline_s},
+        {"calibration", calibration_s},
+        {"scored", scored_s},
+        {"extrapolated_total_for_60_scored_cases", baseline_s + calibration_s + scored_s / args.cases * 60.0}}}};
   std::ofstream out(args.out + "/score.json");
   out << score.dump(2) << "\n";
   if (!out) {
     err << "roamlab gap-benchmark: " << args.out << "/score.json: cannot write\n";
     return 1;
   }
-  say("score: " + std::to_string(correct) + "/" + std::to_string(args.cases) + " (" + args.out + "/score.json)");
+  if (!args.quiet) {
+    std::cout << "figures: " << figures.dump() << "\n"
+              << "total " << std::fixed << std::setprecision(0) << total_s << " s (" << args.out << "/score.json)\n";
+  }
   return 0;
 }
 

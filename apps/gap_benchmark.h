@@ -1,12 +1,16 @@
-// `roamlab gap-benchmark --cases N --seed S --out DIR [--scenario SCENARIO.yaml]`: the blind benchmark of the
-// reality-gap diagnosis (DESIGN.md). Each case draws, from seed S, one of: no effect, one effect of the diagnosis
-// library with a random parameter (gps_latency, imu_time_offset, steering_offset, gyro_scale_error), or a decoy
-// outside it (magnetometer_motor_interference); simulates the scenario with it (DIR/cases/NNN/rec, truth.yaml
-// included), diagnoses the recording against the nominal scenario (the baseline is learned once, from a seed no case
-// uses), and only then reads truth.yaml to score: none -> verdict none; effect -> named, that effect first, each
-// non-neutral parameter within 3 reported standard deviations; decoy -> not named (unknown or none).
-// Writes DIR/score.json: {"cases": [{"case", "truth": {"name", "parameters"}, "verdict", "named": [...],
-// "parameters": {...}, "std": {...}, "correct", "why"}], "correct", "total", "by_kind": {...}, "seconds"}.
+// `roamlab gap-benchmark --cases N --seed S --out DIR [--calibration-cases C] [--jobs J] [--duration T]
+//  [--atv SCENARIO.yaml] [--diffdrive SCENARIO.yaml] [--quiet]`: the blind benchmark of the reality-gap diagnosis
+// (issue 6, "The proof"). Each case draws a platform (the ATV or the differential drive), a noise seed and a hidden
+// effect: none, a decoy outside the diagnosis's candidates, or one candidate effect with a random magnitude; it
+// simulates the "real" recording (truth.yaml included), diagnoses the written recording against the nominal scenario
+// (baseline learned once per platform from a seed no case uses) and only then reads truth.yaml to score.
+//   1. calibration: C cases from their own seed range (draws seeded S * 1000 + 500, noise seeds S * 1000 + 500 + i)
+//      are diagnosed with the loosest thresholds, the held-out part evaluated for every candidate passing them; the
+//      decision thresholds (alpha, Delta BIC, held-out drop) are chosen on them (gap_benchmark_score.h), and so is
+//      each candidate parameter's noise (the median reported std);
+//   2. scored: N cases (draws seeded S, noise seeds S * 1000 + i) diagnosed with the chosen thresholds.
+// Writes DIR/score.json (figures against the issue's targets, thresholds, per-case table, seconds), the recordings
+// in DIR/calibration/NNN/rec and DIR/cases/NNN/rec, and each case's row in DIR/.../NNN/case.json.
 #pragma once
 
 #include <cstdint>
@@ -16,9 +20,13 @@
 namespace roamlab::apps {
 
 struct GapBenchmarkArgs {
-  int cases = 5;
+  int cases = 16;
+  int calibration_cases = 8;
   std::uint64_t seed = 1;
-  std::string scenario;          // default: the nominal ATV scenario given on the command line
+  int jobs = 2;
+  double duration_s = 0.0;   // 0: the scenarios' own
+  std::string atv_scenario = "scenarios/atv_hills.yaml";
+  std::string diffdrive_scenario = "scenarios/indoor_diffdrive_gap.yaml";
   std::string out;
   bool quiet = false;
   std::ostream* err = nullptr;

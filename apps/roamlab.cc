@@ -98,10 +98,18 @@ int main(int argc, char** argv) {
   CLI::App* gbm = app.add_subcommand(
       "gap-benchmark", "Blind benchmark of the diagnosis: hidden effects (or none, or a decoy) drawn, simulated, "
                        "diagnosed, then scored against truth.yaml.");
-  gbm->add_option("--cases", benchmark.cases, "Number of cases (default 5)");
-  gbm->add_option("--seed", benchmark.seed, "Seed of the draws; case i uses noise seed SEED * 1000 + i (default 1)");
-  gbm->add_option("--scenario", benchmark.scenario, "The nominal scenario (an Ackermann robot)")->required();
-  gbm->add_option("--out", benchmark.out, "Output directory: score.json, cases/NNN/rec")->required();
+  gbm->add_option("--cases", benchmark.cases, "Scored cases (default 16)");
+  gbm->add_option("--calibration-cases", benchmark.calibration_cases,
+                  "Calibration cases, run first, that fix the thresholds (default 8)");
+  gbm->add_option("--seed", benchmark.seed,
+                  "Seed of the draws; scored case i uses noise seed SEED * 1000 + i, calibration case i "
+                  "SEED * 1000 + 500 + i (default 1)");
+  gbm->add_option("--jobs", benchmark.jobs, "Cases in parallel (default 2)");
+  gbm->add_option("--duration", benchmark.duration_s, "Drive duration [s] of every case (default: the scenarios')");
+  gbm->add_option("--atv", benchmark.atv_scenario, "Nominal ATV scenario (default scenarios/atv_hills.yaml)");
+  gbm->add_option("--diffdrive", benchmark.diffdrive_scenario,
+                  "Nominal differential-drive scenario (default scenarios/indoor_diffdrive_gap.yaml)");
+  gbm->add_option("--out", benchmark.out, "Output directory: score.json, calibration/NNN, cases/NNN")->required();
   gbm->add_flag("--quiet", benchmark.quiet, "No progress");
 
   roamlab::apps::RegressArgs regress;

@@ -777,20 +777,21 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
   std::set<std::string> accepted, dropped;
   for (int round = 0; round < std::max(1, options.max_effects); ++round) {
     std::vector<CandidateFit> fits;
+    std::vector<EffectEstimate> failed;
     for (const Candidate& c : library) {
       if (accepted.count(c.name) || dropped.count(c.name)) continue;
       say("candidate " + c.name + (round > 0 ? " (on top of the accepted effects)" : ""));
       auto cf = fit_candidate(c, state);
       if (!cf.ok()) {
-        // A fit that fails (e.g. diverges on a direction the drive does not observe) explains nothing: reported, not
-        // tried again, and the other candidates go on.
-        say("candidate " + c.name + " failed: " + cf.status().message());
-        EffectEstimate failed;
-        failed.name = c.name;
-        failed.dof = c.shifted.empty() ? c.free_dof : 1;
-        failed.delta_bic = std::numeric_limits<double>::infinity();
-        failed.decision = "fit failed: " + cf.status().message();
-        if (round == 0) out.candidates.push_back(failed);
+        // A candidate whose fit fails (e.g. a gyroscope scale driven to 0 on an axis a short planar drive does not
+        // excite) explains nothing: it is rejected and not tried again, the diagnosis goes on.
+        EffectEstimate e;
+        e.name = c.name;
+        e.dof = c.shifted.empty() ? c.free_dof : 1;
+        e.delta_bic = std::numeric_limits<double>::infinity();
+        e.decision = "rejected: the fit failed (" + cf.status().message() + ")";
+        say("candidate " + c.name + ": " + e.decision);
+        failed.push_back(e);
         dropped.insert(c.name);
         continue;
       }
@@ -798,7 +799,10 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
       Score(options.baseline, state.train_measurements, &e);
       fits.push_back(std::move(cf).value());
     }
-    if (fits.empty()) break;
+    if (fits.empty()) {
+      if (round == 0) out.candidates = failed;
+      break;
+    }
     std::sort(fits.begin(), fits.end(), [](const CandidateFit& a, const CandidateFit& b) {
       return a.estimate.delta_bic < b.estimate.delta_bic;
     });
@@ -807,13 +811,14 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
     // within the run) does not hide the next one, and is not tried again in the later rounds.
     CandidateFit* kept = nullptr;
     for (CandidateFit& f : fits) {
-      if (options.max_effects <= round || kept) break;
+      const bool extra = kept && options.heldout_all_candidates && round == 0;
+      if (options.max_effects <= round || (kept && !extra)) break;
       EffectEstimate& e = f.estimate;
       if (e.lr_pvalue >= options.alpha) {
         e.decision = "rejected: likelihood-ratio p above alpha";
         continue;
       }
-      if (e.delta_bic >= 0.0) {
+      if (e.delta_bic >= options.max_delta_bic) {
         e.decision = "rejected: BIC does not favour it";
         continue;
       }
@@ -821,7 +826,8 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
       if (!h.ok()) return Status::Error("held-out evaluation of " + e.name + ": " + h.status().message());
       e.evaluated_heldout = true;
       e.heldout_improvement = state.heldout_chi2 > 0.0 ? 1.0 - h.value().first / state.heldout_chi2 : 0.0;
-      if (e.heldout_improvement <= 0.0) {
+      if (extra) continue;   // evaluated for the record only; the decision was taken
+      if (e.heldout_improvement <= options.min_heldout_improvement) {
         e.decision = "rejected: no improvement on the held-out part";
         dropped.insert(e.name);
         continue;
@@ -836,6 +842,7 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
       if (f.estimate.decision.empty()) f.estimate.decision = "not the best candidate";
       if (round == 0) out.candidates.push_back(f.estimate);
     }
+    if (round == 0) out.candidates.insert(out.candidates.end(), failed.begin(), failed.end());
     if (!kept) break;
     accepted.insert(kept->estimate.name);
     out.effects.push_back(kept->estimate);

@@ -14,7 +14,8 @@
 //      nominal model is not exact on MuJoCo data and already moves each candidate's parameters on the nominal
 //      simulation, so H0 is "the parameters take the baseline's values" and LR is its Wald form with both fits'
 //      variances (Score in diagnose.cc). p = 1 - F_chi2(k)(LR), Delta BIC = -LR + k ln n. In order of Delta BIC,
-//      the first candidate with p < alpha, Delta BIC < 0 and a drop of the held-out chi-square (the last part of the
+//      the first candidate with p < alpha, Delta BIC < max_delta_bic and a held-out chi-square drop above
+//      min_heldout_improvement (defaults 1e-3, 0, 0; gap-benchmark calibrates them) (the last part of the
 //      recording, every parameter fixed at the training values) is kept; one that fails the held-out test is dropped.
 //      Then the others are scored again on top, up to max_effects;
 //   4. model: the accepted effects' parameters and standard deviations (training fit);
@@ -89,6 +90,11 @@ struct DiagnoseOptions {
   const Baseline* baseline = nullptr;   // null: levels 1 and no baseline drops
   double train_fraction = 2.0 / 3.0;
   double alpha = 1e-3;                  // likelihood-ratio test level
+  double max_delta_bic = 0.0;           // kept only with Delta BIC below this
+  double min_heldout_improvement = 0.0; // kept only when the held-out chi2 drops by more than this fraction
+  // First round: also evaluate the held-out part for the candidates after the kept one that pass the p and BIC
+  // tests (decisions unchanged; lets gap-benchmark replay the first round's decision under stricter thresholds).
+  bool heldout_all_candidates = false;
   int max_effects = 3;                  // 0: score the candidates only (learning a baseline)
   double max_shift_s = 0.5;             // time-shift search range and the margin cut from shifted streams
   std::function<void(const std::string&)> progress;

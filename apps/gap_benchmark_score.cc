@@ -1,0 +1,241 @@
+#include "apps/gap_benchmark_score.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <tuple>
+
+namespace roamlab::apps::gapbench {
+namespace {
+
+using nlohmann::json;
+
+constexpr double kAlphas[] = {1e-2, 1e-3, 1e-4, 1e-6};
+constexpr double kDeltaBics[] = {0.0, -10.0, -30.0, -100.0};
+constexpr double kHeldouts[] = {0.0, 0.01, 0.03};
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// A fraction as JSON (null when there is nothing to count).
+json Fraction(int k, int n) { return n > 0 ? json(static_cast<double>(k) / n) : json(nullptr); }
+json Number(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
+
+// Index of x in a grid array (exact values from the same array).
+template <std::size_t N>
+int IndexOf(const double (&grid)[N], double x) {
+  for (std::size_t i = 0; i < N; ++i)
+    if (grid[i] == x) return static_cast<int>(i);
+  return 0;
+}
+
+json Target(const json& value, double target, bool at_least) {
+  json t = {{"value", value}, {"target", target}, {"comparison", at_least ? ">=" : "<="}};
+  t["met"] = value.is_number() && (at_least ? value.get<double>() >= target : value.get<double>() <= target);
+  return t;
+}
+
+}  // namespace
+
+double NeutralValue(const std::string& parameter) {
+  return parameter.rfind("scale_", 0) == 0 || parameter.rfind("ratio_", 0) == 0 ? 1.0 : 0.0;
+}
+
+std::string ReplayFirstRound(std::vector<CandidateStats> candidates, const Thresholds& t) {
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const CandidateStats& a, const CandidateStats& b) { return a.delta_bic < b.delta_bic; });
+  for (const CandidateStats& c : candidates) {
+    if (!(c.lr_pvalue < t.alpha) || !(c.delta_bic < t.max_delta_bic)) continue;
+    if (c.evaluated_heldout && c.heldout_improvement > t.min_heldout_improvement) return c.name;
+  }
+  return "";
+}
+
+bool ReplayCorrect(const CaseResult& c, const std::string& kept) {
+  return c.kind == "effect" ? kept == c.truth_name : kept.empty();
+}
+
+std::vector<Thresholds> ThresholdGrid() {
+  std::vector<Thresholds> grid;
+  for (double a : kAlphas)
+    for (double b : kDeltaBics)
+      for (double h : kHeldouts) grid.push_back({a, b, h});
+  return grid;
+}
+
+Thresholds Loosest() { return {kAlphas[0], kDeltaBics[0], kHeldouts[0]}; }
+
+Thresholds ChooseThresholds(const std::vector<CaseResult>& calibration, double max_false_rate, json* table) {
+  // Distance from diagnose's defaults (1e-3, 0, 0) in grid steps: ties go to the point that departs least from them,
+  // then to the stricter alpha and Delta BIC.
+  const Thresholds defaults;
+  const auto distance = [&](const Thresholds& t) {
+    return std::abs(IndexOf(kAlphas, t.alpha) - IndexOf(kAlphas, defaults.alpha)) +
+           IndexOf(kDeltaBics, t.max_delta_bic) + IndexOf(kHeldouts, t.min_heldout_improvement);
+  };
+  struct Point {
+    Thresholds t;
+    int correct = 0, false_named = 0, effect_free = 0;
+    bool feasible = true;
+  };
+  std::vector<Point> points;
+  for (const Thresholds& t : ThresholdGrid()) {
+    Point p{t};
+    for (const CaseResult& c : calibration) {
+      const std::string kept = ReplayFirstRound(c.candidates, t);
+      p.correct += ReplayCorrect(c, kept);
+      if (c.kind != "effect") {
+        ++p.effect_free;
+        p.false_named += !kept.empty();
+      }
+    }
+    p.feasible = p.effect_free == 0 || p.false_named <= max_false_rate * p.effect_free + 1e-9;
+    points.push_back(p);
+  }
+  const bool any_feasible = std::any_of(points.begin(), points.end(), [](const Point& p) { return p.feasible; });
+  const auto key = [&](const Point& p) {
+    return std::make_tuple(!(p.feasible || !any_feasible), -p.correct, distance(p.t), p.t.alpha, p.t.max_delta_bic);
+  };
+  const Point& best = *std::min_element(points.begin(), points.end(),
+                                        [&](const Point& a, const Point& b) { return key(a) < key(b); });
+  if (table) {
+    *table = json::array();
+    for (const Point& p : points)
+      table->push_back({{"alpha", p.t.alpha},
+                        {"max_delta_bic", p.t.max_delta_bic},
+                        {"min_heldout_improvement", p.t.min_heldout_improvement},
+                        {"correct", p.correct},
+                        {"false_named", p.false_named},
+                        {"effect_free", p.effect_free},
+                        {"feasible", p.feasible}});
+  }
+  return best.t;
+}
+
+std::map<std::string, std::map<std::string, double>> CalibrationSigmas(const std::vector<CaseResult>& calibration) {
+  std::map<std::string, std::map<std::string, std::vector<double>>> samples;
+  for (const CaseResult& c : calibration)
+    for (const CandidateStats& cand : c.candidates)
+      for (const auto& [parameter, sigma] : cand.std)
+        if (std::isfinite(sigma) && sigma > 0.0) samples[c.platform][cand.name + "/" + parameter].push_back(sigma);
+  std::map<std::string, std::map<std::string, double>> out;
+  for (const auto& [platform, by_parameter] : samples)
+    for (const auto& [key, v] : by_parameter) out[platform][key] = Median(v);
+  return out;
+}
+
+double NoiseRatio(const std::map<std::string, std::map<std::string, double>>& sigmas, const std::string& platform,
+                  const std::string& effect, const std::string& parameter, double value) {
+  const auto p = sigmas.find(platform);
+  if (p == sigmas.end()) return -1.0;
+  const auto s = p->second.find(effect + "/" + parameter);
+  if (s == p->second.end() || !(s->second > 0.0)) return -1.0;
+  return std::abs(value - NeutralValue(parameter)) / s->second;
+}
+
+json Summarize(const std::vector<CaseResult>& cases, double min_noise_ratio) {
+  int effects = 0, top1 = 0, top3 = 0, strong = 0, strong_top1 = 0, strong_top3 = 0;
+  int nones = 0, none_named = 0, none_none = 0, decoys = 0, decoy_unknown = 0, decoy_not_named = 0;
+  std::vector<double> relative_error, rms_named, rms_all;
+  std::map<std::string, std::pair<int, int>> by_effect;   // name -> (top-1 correct, cases)
+  for (const CaseResult& c : cases) {
+    if (c.kind == "none") {
+      ++nones;
+      none_named += c.verdict == "named";
+      none_none += c.verdict == "none";
+      continue;
+    }
+    if (c.kind == "decoy") {
+      ++decoys;
+      decoy_unknown += c.verdict == "unknown";
+      decoy_not_named += c.verdict != "named";
+      continue;
+    }
+    ++effects;
+    const bool first = c.verdict == "named" && !c.named.empty() && c.named.front() == c.truth_name;
+    const auto end3 = c.ranked.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(3, c.ranked.size()));
+    const bool in3 = c.verdict == "named" && std::find(c.ranked.begin(), end3, c.truth_name) != end3;
+    top1 += first;
+    top3 += in3;
+    ++by_effect[c.truth_name].second;
+    by_effect[c.truth_name].first += first;
+    if (c.noise_ratio >= min_noise_ratio) {
+      ++strong;
+      strong_top1 += first;
+      strong_top3 += in3;
+    }
+    // Relative to the effect's size (its departure from neutral), so that a scale of 1.03 estimated as 1.02 is a
+    // 33 % error, not 1 %.
+    const double size = std::abs(c.truth_value - NeutralValue(c.truth_parameter));
+    if (first && c.has_estimate && size > 0.0) relative_error.push_back(std::abs(c.estimate - c.truth_value) / size);
+    if (c.has_rms && c.rms_before > 0.0) {
+      const double reduction = 1.0 - c.rms_after / c.rms_before;
+      rms_all.push_back(reduction);
+      if (first) rms_named.push_back(reduction);
+    }
+  }
+  json per_effect = json::object();
+  for (const auto& [name, k] : by_effect) per_effect[name] = {{"top1", k.first}, {"cases", k.second}};
+  const json top1_strong = Fraction(strong_top1, strong);
+  const json false_rate = Fraction(none_named, nones);
+  const json unknown_rate = Fraction(decoy_unknown, decoys);
+  const json rel = Number(Median(relative_error));
+  const json rms = Number(Median(rms_named));
+  return {{"effect_cases", effects},
+          {"top1", Fraction(top1, effects)},
+          {"top3", Fraction(top3, effects)},
+          {"min_noise_ratio", min_noise_ratio},
+          {"strong_effect_cases", strong},
+          {"top1_strong", top1_strong},
+          {"top3_strong", Fraction(strong_top3, strong)},
+          {"by_effect", per_effect},
+          {"none_cases", nones},
+          {"false_discovery_rate", false_rate},
+          {"none_reported_none", Fraction(none_none, nones)},
+          {"decoy_cases", decoys},
+          {"decoys_unknown", unknown_rate},
+          {"decoys_not_named", Fraction(decoy_not_named, decoys)},
+          {"median_parameter_relative_error", rel},
+          {"parameter_errors", relative_error.size()},
+          {"median_heldout_rms_reduction", rms},
+          {"median_heldout_rms_reduction_all_effect_cases", Number(Median(rms_all))},
+          {"targets",
+           {{"top1_strong", Target(top1_strong, 0.85, true)},
+            {"false_discovery_rate", Target(false_rate, 0.10, false)},
+            {"decoys_unknown", Target(unknown_rate, 0.70, true)},
+            {"median_parameter_relative_error", Target(rel, 0.15, false)},
+            {"median_heldout_rms_reduction", Target(rms, 0.30, true)}}}};
+}
+
+json CaseRow(const CaseResult& c) {
+  json candidates = json::array();
+  for (const CandidateStats& s : c.candidates) {
+    json stds = json::object();
+    for (const auto& [k, v] : s.std) stds[k] = Number(v);
+    candidates.push_back({{"name", s.name},
+                          {"lr_pvalue", s.lr_pvalue},
+                          {"delta_bic", s.delta_bic},
+                          {"evaluated_heldout", s.evaluated_heldout},
+                          {"heldout_improvement", s.heldout_improvement},
+                          {"std", stds}});
+  }
+  return {{"case", c.id},
+          {"platform", c.platform},
+          {"kind", c.kind},
+          {"truth", {{"name", c.truth_name}, {"parameter", c.truth_parameter}, {"value", c.truth_value}}},
+          {"noise_ratio", c.noise_ratio >= 0.0 ? json(c.noise_ratio) : json(nullptr)},
+          {"verdict", c.verdict},
+          {"named", c.named},
+          {"ranked", c.ranked},
+          {"estimate", c.has_estimate ? json(c.estimate) : json(nullptr)},
+          {"heldout_rms_before", c.has_rms ? json(c.rms_before) : json(nullptr)},
+          {"heldout_rms_after", c.has_rms ? json(c.rms_after) : json(nullptr)},
+          {"candidates", candidates},
+          {"seconds", c.seconds}};
+}
+
+}  // namespace roamlab::apps::gapbench

@@ -1,0 +1,149 @@
+// The scoring of `roamlab gap-benchmark` on made-up cases (no simulation): replay of the first round's decision,
+// threshold choice on calibration cases, noise ratios and the issue's figures.
+#include "apps/gap_benchmark_score.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+namespace roamlab::apps::gapbench {
+namespace {
+
+CandidateStats Candidate(const std::string& name, double p, double delta_bic, double heldout, bool evaluated = true) {
+  return {name, p, delta_bic, evaluated, heldout, {}};
+}
+
+CaseResult Case(const std::string& kind, const std::string& truth, std::vector<CandidateStats> candidates) {
+  CaseResult c;
+  c.kind = kind;
+  c.truth_name = truth;
+  c.candidates = std::move(candidates);
+  return c;
+}
+
+TEST(GapBenchmarkScore, ReplayTakesTheFirstPassingCandidateInBicOrder) {
+  const std::vector<CandidateStats> candidates = {Candidate("b", 1e-5, -20.0, 0.05),
+                                                  Candidate("a", 1e-9, -50.0, -0.01),   // fails the held-out part
+                                                  Candidate("c", 0.5, 1.0, 0.0, false)};
+  EXPECT_EQ(ReplayFirstRound(candidates, {1e-3, 0.0, 0.0}), "b");
+  EXPECT_EQ(ReplayFirstRound(candidates, {1e-6, 0.0, 0.0}), "");       // a passes p but not the held-out test
+  EXPECT_EQ(ReplayFirstRound(candidates, {1e-3, -30.0, 0.0}), "");     // b's Delta BIC not low enough
+  EXPECT_EQ(ReplayFirstRound(candidates, {1e-3, 0.0, 0.1}), "");       // b's held-out drop too small
+  // Passing p and BIC without a held-out evaluation counts as failing it.
+  EXPECT_EQ(ReplayFirstRound({Candidate("x", 1e-8, -40.0, 0.2, false)}, {1e-3, 0.0, 0.0}), "");
+}
+
+TEST(GapBenchmarkScore, ChoosesTheThresholdsThatKeepFalseDiscoveriesDown) {
+  // Two effect cases (strong and moderate) and two effect-free ones, one of which has a spurious candidate at
+  // p = 1e-5, Delta BIC -15, held-out drop 0.5 %. The defaults (1e-3, 0, 0) name it: 1 of 2 effect-free cases, above
+  // 10 %. Stricter points that still identify both effects: alpha 1e-6 loses the moderate one (p 1e-5), Delta BIC -30
+  // loses it too (-20), a held-out drop above 1 % keeps both effects and rejects the spurious one.
+  std::vector<CaseResult> calibration = {
+      Case("effect", "a", {Candidate("a", 1e-12, -200.0, 0.2), Candidate("b", 0.3, 5.0, 0.0, false)}),
+      Case("effect", "b", {Candidate("b", 1e-5, -20.0, 0.04), Candidate("a", 0.2, 3.0, 0.0, false)}),
+      Case("none", "", {Candidate("a", 1e-5, -15.0, 0.005), Candidate("b", 0.4, 4.0, 0.0, false)}),
+      Case("decoy", "m", {Candidate("a", 0.01, -1.0, -0.02), Candidate("b", 0.6, 6.0, 0.0, false)}),
+  };
+  nlohmann::json table;
+  const Thresholds t = ChooseThresholds(calibration, 0.10, &table);
+  EXPECT_DOUBLE_EQ(t.alpha, 1e-3);
+  EXPECT_DOUBLE_EQ(t.max_delta_bic, 0.0);
+  EXPECT_DOUBLE_EQ(t.min_heldout_improvement, 0.01);
+  EXPECT_EQ(table.size(), ThresholdGrid().size());
+  for (const CaseResult& c : calibration) EXPECT_TRUE(ReplayCorrect(c, ReplayFirstRound(c.candidates, t)));
+  // Without the spurious candidate the defaults are kept (ties go to the point nearest to them).
+  calibration[2].candidates[0].lr_pvalue = 0.5;
+  const Thresholds d = ChooseThresholds(calibration, 0.10);
+  EXPECT_DOUBLE_EQ(d.alpha, 1e-3);
+  EXPECT_DOUBLE_EQ(d.max_delta_bic, 0.0);
+  EXPECT_DOUBLE_EQ(d.min_heldout_improvement, 0.0);
+}
+
+TEST(GapBenchmarkScore, NoiseRatioUsesTheMedianReportedStd) {
+  CaseResult a = Case("none", "", {{"steering_offset", 0.5, 1.0, false, 0.0, {{"offset_rad", 0.001}}}});
+  CaseResult b = Case("effect", "gps_latency", {{"steering_offset", 0.5, 1.0, false, 0.0, {{"offset_rad", 0.003}}}});
+  CaseResult c = Case("none", "", {{"steering_offset", 0.5, 1.0, false, 0.0, {{"offset_rad", 0.002}}},
+                                   {"gps_latency", 0.5, 1.0, false, 0.0, {{"latency_s", std::nan("")}}}});
+  a.platform = b.platform = c.platform = "atv";
+  const auto sigmas = CalibrationSigmas({a, b, c});
+  EXPECT_DOUBLE_EQ(sigmas.at("atv").at("steering_offset/offset_rad"), 0.002);
+  EXPECT_EQ(sigmas.at("atv").count("gps_latency/latency_s"), 0u);   // NaN skipped
+  EXPECT_DOUBLE_EQ(NoiseRatio(sigmas, "atv", "steering_offset", "offset_rad", -0.02), 10.0);
+  EXPECT_DOUBLE_EQ(NoiseRatio(sigmas, "atv", "gps_latency", "latency_s", 0.3), -1.0);
+  EXPECT_DOUBLE_EQ(NeutralValue("scale_z"), 1.0);
+  EXPECT_DOUBLE_EQ(NeutralValue("ratio_right_left"), 1.0);
+  EXPECT_DOUBLE_EQ(NeutralValue("track_error_m"), 0.0);
+}
+
+CaseResult Scored(const std::string& kind, const std::string& truth, const std::string& verdict,
+                  std::vector<std::string> named, double noise_ratio) {
+  CaseResult c;
+  c.kind = kind;
+  c.truth_name = truth;
+  c.verdict = verdict;
+  c.named = named;
+  c.ranked = std::move(named);
+  c.noise_ratio = noise_ratio;
+  return c;
+}
+
+TEST(GapBenchmarkScore, SummarizesTheIssuesFigures) {
+  std::vector<CaseResult> cases;
+  // Strong effect named right, with a 10 % parameter error on a scale (1.05 vs 1.045: error 0.005 of 0.05) and the
+  // affected stream's held-out RMS from 2.0 to 1.0.
+  CaseResult right = Scored("effect", "gyro_scale_error", "named", {"gyro_scale_error"}, 8.0);
+  right.truth_parameter = "scale_z";
+  right.truth_value = 1.05;
+  right.estimate = 1.045;
+  right.has_estimate = true;
+  right.rms_before = 2.0;
+  right.rms_after = 1.0;
+  right.has_rms = true;
+  cases.push_back(right);
+  // Strong effect, second in the ranking: top-3 but not top-1; RMS 1.2 -> 1.14 (5 %).
+  CaseResult second = Scored("effect", "gps_latency", "named", {"imu_time_offset"}, 4.0);
+  second.ranked.push_back("steering_offset");
+  second.ranked.push_back("gps_latency");
+  second.rms_before = 1.2;
+  second.rms_after = 1.14;
+  second.has_rms = true;
+  cases.push_back(second);
+  // Weak effect (below 3 x noise) not found: counts overall only.
+  cases.push_back(Scored("effect", "imu_time_offset", "unknown", {}, 1.5));
+  cases.push_back(Scored("none", "", "none", {}, -1.0));
+  cases.push_back(Scored("none", "", "named", {"lateral_slip"}, -1.0));
+  cases.push_back(Scored("none", "", "unknown", {}, -1.0));
+  cases.push_back(Scored("none", "", "none", {}, -1.0));
+  cases.push_back(Scored("decoy", "magnetometer_motor_interference", "unknown", {}, -1.0));
+  cases.push_back(Scored("decoy", "magnetometer_motor_interference", "none", {}, -1.0));
+  cases.push_back(Scored("decoy", "gyro_bias_drift", "named", {"wheel_radius_asymmetry"}, -1.0));
+
+  const nlohmann::json f = Summarize(cases);
+  EXPECT_EQ(f["effect_cases"], 3);
+  EXPECT_NEAR(f["top1"].get<double>(), 1.0 / 3.0, 1e-12);
+  EXPECT_NEAR(f["top3"].get<double>(), 2.0 / 3.0, 1e-12);
+  EXPECT_EQ(f["strong_effect_cases"], 2);
+  EXPECT_DOUBLE_EQ(f["top1_strong"].get<double>(), 0.5);
+  EXPECT_DOUBLE_EQ(f["top3_strong"].get<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(f["false_discovery_rate"].get<double>(), 0.25);
+  EXPECT_DOUBLE_EQ(f["none_reported_none"].get<double>(), 0.5);
+  EXPECT_NEAR(f["decoys_unknown"].get<double>(), 1.0 / 3.0, 1e-12);
+  EXPECT_NEAR(f["decoys_not_named"].get<double>(), 2.0 / 3.0, 1e-12);
+  EXPECT_NEAR(f["median_parameter_relative_error"].get<double>(), 0.1, 1e-9);
+  EXPECT_DOUBLE_EQ(f["median_heldout_rms_reduction"].get<double>(), 0.5);                  // top-1 cases only
+  EXPECT_NEAR(f["median_heldout_rms_reduction_all_effect_cases"].get<double>(), 0.275, 1e-12);
+  EXPECT_FALSE(f["targets"]["top1_strong"]["met"].get<bool>());
+  EXPECT_FALSE(f["targets"]["false_discovery_rate"]["met"].get<bool>());
+  EXPECT_FALSE(f["targets"]["decoys_unknown"]["met"].get<bool>());
+  EXPECT_TRUE(f["targets"]["median_parameter_relative_error"]["met"].get<bool>());
+  EXPECT_TRUE(f["targets"]["median_heldout_rms_reduction"]["met"].get<bool>());
+  EXPECT_EQ(f["by_effect"]["gyro_scale_error"]["top1"], 1);
+
+  // Nothing to count: fractions are null and the targets not met.
+  const nlohmann::json empty = Summarize({});
+  EXPECT_TRUE(empty["top1_strong"].is_null());
+  EXPECT_FALSE(empty["targets"]["top1_strong"]["met"].get<bool>());
+}
+
+}  // namespace
+}  // namespace roamlab::apps::gapbench
