@@ -183,10 +183,17 @@ Status WheeledRobot::Deform(mjModel* model, const std::vector<WheelDeformation>&
     const int tire = tires_[static_cast<std::size_t>(d.wheel)];
     if (model->geom_type[tire] != mjGEOM_SPHERE)
       return Status::Error(what + ": " + name + ": only sphere tires can be deformed");
-    const double r = model->geom_size[3 * tire] * d.radius_scale;
+    const double r0 = model->geom_size[3 * tire];
+    const double r = r0 * d.radius_scale;
     const double a = r + d.ovality_m;
     if (!(r > 0.0) || !(d.ovality_m >= 0.0) || d.ovality_m > 0.5 * r)
       return Status::Error(what + ": " + name + ": needs radius_scale > 0 and 0 <= ovality_m <= half the radius");
+    // A tire of another size (radius_scale) is mounted with its hub moved along the parent's z by the radius change,
+    // so that it keeps its contact with the floor beside the rigid casters (the chassis stays level, as a sprung
+    // caster would keep it); otherwise a smaller tire hangs on the casters and loses its grip. The oval (ovality_m)
+    // is the deformation itself and lifts its side, as tape around a wheel does.
+    const int wheel_body = model->geom_bodyid[tire];
+    model->body_pos[3 * wheel_body + 2] += r - r0;
     // Ellipsoid semi-axes (a, r, r) in a geom frame whose y axis is the wheel's hinge axis (in the body frame), so
     // that x is a direction of the wheel plane.
     const int joint = IdOf(model, mjOBJ_JOINT, "wheel_" + std::to_string(d.wheel));
