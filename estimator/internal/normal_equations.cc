@@ -205,28 +205,34 @@ void NormalEquations::BuildPattern() {
       column_length_[b] += dims_[r];
     }
   }
-  outer_.resize(dimension_ + 1);
-  inner_.clear();
-  for (int b = 0; b < nb; ++b) {
-    for (int j = 0; j < dims_[b]; ++j) {
-      outer_[block_offset_[b] + j] = static_cast<int>(inner_.size());
-      for (int r : rows_of_[b])
-        for (int i = 0; i < dims_[r]; ++i) inner_.push_back(block_offset_[r] + i);
+  // The same block pattern as at the last call (a window that slid by one pose) keeps outer_ and H's pattern.
+  const bool same_blocks = H_.rows() == dimension_ && pattern_dims_ == dims_ && pattern_rows_of_ == rows_of_;
+  if (!same_blocks) {
+    outer_.resize(dimension_ + 1);
+    inner_.clear();
+    for (int b = 0; b < nb; ++b) {
+      for (int j = 0; j < dims_[b]; ++j) {
+        outer_[block_offset_[b] + j] = static_cast<int>(inner_.size());
+        for (int r : rows_of_[b])
+          for (int i = 0; i < dims_[r]; ++i) inner_.push_back(block_offset_[r] + i);
+      }
     }
-  }
-  outer_[dimension_] = static_cast<int>(inner_.size());
+    outer_[dimension_] = static_cast<int>(inner_.size());
 
-  // A new pattern needs a new symbolic analysis; the same one keeps it.
-  const bool same = H_.rows() == dimension_ && H_.nonZeros() == static_cast<Eigen::Index>(inner_.size()) &&
-                    std::equal(outer_.begin(), outer_.end(), H_.outerIndexPtr()) &&
-                    std::equal(inner_.begin(), inner_.end(), H_.innerIndexPtr());
-  if (!same) {
-    H_.resize(dimension_, dimension_);
-    H_.resizeNonZeros(static_cast<Eigen::Index>(inner_.size()));
-    std::copy(outer_.begin(), outer_.end(), H_.outerIndexPtr());
-    std::copy(inner_.begin(), inner_.end(), H_.innerIndexPtr());
-    std::fill(H_.valuePtr(), H_.valuePtr() + H_.nonZeros(), 0.0);
-    cholmod_->analyzed = false;
+    // A new pattern needs a new symbolic analysis; the same one keeps it.
+    const bool same = H_.rows() == dimension_ && H_.nonZeros() == static_cast<Eigen::Index>(inner_.size()) &&
+                      std::equal(outer_.begin(), outer_.end(), H_.outerIndexPtr()) &&
+                      std::equal(inner_.begin(), inner_.end(), H_.innerIndexPtr());
+    if (!same) {
+      H_.resize(dimension_, dimension_);
+      H_.resizeNonZeros(static_cast<Eigen::Index>(inner_.size()));
+      std::copy(outer_.begin(), outer_.end(), H_.outerIndexPtr());
+      std::copy(inner_.begin(), inner_.end(), H_.innerIndexPtr());
+      std::fill(H_.valuePtr(), H_.valuePtr() + H_.nonZeros(), 0.0);
+      cholmod_->analyzed = false;
+    }
+    pattern_dims_ = dims_;
+    pattern_rows_of_ = rows_of_;
   }
 
   // Value index of block (r, b): start of column block_offset[b] plus the row offset of r in that column; later
@@ -438,11 +444,13 @@ struct Band {
     }
     return true;
   }
-  // x <- Ua^-T x over the band's rows of x, block by block.
+  // x <- Ua^-T x over the band's rows of x, block by block (coefficient-wise products: a block is small, and x has
+  // one column for a step, a few for a covariance, the border's for Ub).
   void Forward(double* x, Eigen::Index ldx, Eigen::Index m) const {
     for (int b = 0; b < blocks; ++b) {
       Rows xb = rows(x, ldx, m, b);
-      for (int k = first_block[b]; k < b; ++k) xb.noalias() -= block(k, b).transpose() * rows(x, ldx, m, k);
+      for (int k = first_block[b]; k < b; ++k)
+        xb.noalias() -= block(k, b).transpose().lazyProduct(rows(x, ldx, m, k));
       SolveUpperTransposed(block(b, b), xb);
     }
   }
@@ -451,7 +459,7 @@ struct Band {
     for (int b = blocks - 1; b >= 0; --b) {
       Rows xb = rows(x, ldx, m, b);
       SolveUpper(block(b, b), xb);
-      for (int k = first_block[b]; k < b; ++k) rows(x, ldx, m, k).noalias() -= block(k, b) * xb;
+      for (int k = first_block[b]; k < b; ++k) rows(x, ldx, m, k).noalias() -= block(k, b).lazyProduct(xb);
     }
   }
 };

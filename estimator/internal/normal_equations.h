@@ -101,6 +101,9 @@ class NormalEquations {
   std::vector<std::vector<int>> row_offset_;
   std::vector<int> column_length_;
   std::vector<int> outer_, inner_;
+  // The block pattern (dims_ and rows_of_) that outer_ and H's pattern were built for.
+  std::vector<int> pattern_dims_;
+  std::vector<std::vector<int>> pattern_rows_of_;
 
   Eigen::SparseMatrix<double> H_;
   std::vector<std::ptrdiff_t> diagonal_index_;
