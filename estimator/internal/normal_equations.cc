@@ -12,8 +12,9 @@ namespace roamlab::estimator::internal {
 
 namespace {
 
-// Systems up to this dimension (a tracking window) are factored by CHOLMOD's simplicial LLT, larger ones (whole
-// recordings) by its supernodal LLT, whose dense BLAS kernels pay off only on large supernodes.
+// Systems up to this dimension (a tracking window) are factored in their envelope when in natural order (Reset),
+// otherwise by CHOLMOD's simplicial LLT; larger ones (whole recordings) by its supernodal LLT, whose dense BLAS kernels
+// pay off only on large supernodes.
 constexpr int kMaxSimplicialDimension = 2000;
 
 // Widest dense border of a natural-order system (NormalEquations::FactorEnvelope); columns beyond it stay in the

@@ -110,7 +110,7 @@ class NormalEquations {
   Eigen::VectorXd g_;
   double cost_ = 0.0;
   int analyses_ = 0;
-  bool natural_order_ = false;  // factor in the order of the blocks (Reset)
+  bool natural_order_ = false;  // factor in the order of the blocks, in the envelope (Reset)
 
   // Cholesky H = U^T U of a natural-order system (a band of poses with a dense border of constant parameters), in
   // blocks H = [A B; B^T C], U = [Ua Ub; 0 Uc]: Ua^T Ua = A in A's block envelope (block column b of Ua holds the row
