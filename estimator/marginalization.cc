@@ -86,21 +86,29 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph) {
   // Dense H and g over [leaving, blanket].
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n, n);
   Eigen::VectorXd g = Eigen::VectorXd::Zero(n);
+  std::vector<bool> want;
+  std::vector<int> var_offset;
+  internal::WhitenedFactor wf;  // reused: its buffers keep their size
   for (FactorId f : factors) {
     const FactorEntry& e = graph->factor(f);
     if (!e.active) continue;
-    std::vector<bool> want;
-    for (VariableId v : e.variables) want.push_back(offset.count(v) > 0);
-    internal::WhitenedFactor wf;
+    want.clear();
+    var_offset.clear();
+    for (VariableId v : e.variables) {
+      const auto it = offset.find(v);
+      want.push_back(it != offset.end());
+      var_offset.push_back(it != offset.end() ? it->second : -1);
+    }
     if (!internal::LinearizeFactor(*graph, e, want, &wf)) return false;
+    // Coefficient-wise products: the blocks are a few rows by at most a few dozen columns.
     for (std::size_t a = 0; a < e.variables.size(); ++a) {
       if (!want[a]) continue;
-      const int oa = offset[e.variables[a]];
-      g.segment(oa, wf.jacobians[a].cols()) += wf.jacobians[a].transpose() * wf.residual;
+      const int oa = var_offset[a];
+      g.segment(oa, wf.jacobians[a].cols()) += wf.jacobians[a].transpose().lazyProduct(wf.residual);
       for (std::size_t b = 0; b < e.variables.size(); ++b) {
         if (!want[b]) continue;
-        H.block(oa, offset[e.variables[b]], wf.jacobians[a].cols(), wf.jacobians[b].cols()) +=
-            wf.jacobians[a].transpose() * wf.jacobians[b];
+        H.block(oa, var_offset[b], wf.jacobians[a].cols(), wf.jacobians[b].cols()) +=
+            wf.jacobians[a].transpose().lazyProduct(wf.jacobians[b]);
       }
     }
   }

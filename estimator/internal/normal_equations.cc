@@ -1,6 +1,7 @@
 #include "estimator/internal/normal_equations.h"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include <Eigen/CholmodSupport>
@@ -11,9 +12,18 @@ namespace roamlab::estimator::internal {
 
 namespace {
 
-// Systems up to this dimension (a tracking window) are factored by CHOLMOD's simplicial LLT, larger ones (whole
-// recordings) by its supernodal LLT, whose dense BLAS kernels pay off only on large supernodes.
+// Systems up to this dimension (a tracking window) are factored in their envelope when in natural order (Reset),
+// otherwise by CHOLMOD's simplicial LLT; larger ones (whole recordings) by its supernodal LLT, whose dense BLAS kernels
+// pay off only on large supernodes.
 constexpr int kMaxSimplicialDimension = 2000;
+
+// Widest dense border of a natural-order system (NormalEquations::FactorEnvelope); columns beyond it stay in the
+// envelope.
+constexpr int kMaxBorder = 128;
+
+// Up to this many columns, a natural-order system's covariance is Y^T Y from the forward substitution alone (the
+// product costs columns^2 x dimension, a back substitution columns x the factor's size).
+constexpr int kMaxForwardCovarianceColumns = 16;
 
 // dst (A x B block of H's value array, column stride `stride`) += Ja^T Jb, Ja M x A, Jb M x B.
 template <int M, int A, int B>
@@ -29,8 +39,9 @@ void AddProduct(const Eigen::MatrixXd& ja, const Eigen::MatrixXd& jb, double* ds
     if (ja.rows() == 4) return AddProductFixed<4, 6, 6>(ja.data(), jb.data(), dst, stride);
     if (ja.rows() == 6) return AddProductFixed<6, 6, 6>(ja.data(), jb.data(), dst, stride);
   }
+  // Coefficient-wise: at these sizes (a few rows, up to a few dozen columns) cheaper than a blocked product.
   Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> block(dst, ja.cols(), jb.cols(), Eigen::OuterStride<>(stride));
-  block.noalias() += ja.transpose() * jb;
+  block.noalias() += ja.transpose().lazyProduct(jb);
 }
 
 // g_segment += J^T r.
@@ -57,17 +68,9 @@ struct NormalEquations::Cholmod {
   Eigen::SparseMatrix<double> damped;
   bool analyzed = false;
   bool factored_undamped = false;  // the factorization is of H itself, at the last linearization
-  // CHOLMOD's default choice of ordering (restored after a natural-order analysis).
-  int default_nmethods = 0, default_ordering = 0, default_postorder = 1;
 };
 
-NormalEquations::NormalEquations() : cholmod_(std::make_unique<Cholmod>()) {
-  cholmod_common& common = cholmod_->llt.cholmod();
-  common.print = 0;
-  cholmod_->default_nmethods = common.nmethods;
-  cholmod_->default_ordering = common.method[0].ordering;
-  cholmod_->default_postorder = common.postorder;
-}
+NormalEquations::NormalEquations() : cholmod_(std::make_unique<Cholmod>()) { cholmod_->llt.cholmod().print = 0; }
 
 NormalEquations::NormalEquations(const Graph& graph, std::vector<VariableId> order) : NormalEquations() {
   Reset(graph, std::move(order));
@@ -160,12 +163,13 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   // In a small system (a tracking window), the block column of a free constant parameter (no time stamp) holds every
   // row block before it, coupled or not: its rows of the Cholesky factor fill in anyway once the band before it is
   // eliminated, and the pattern no longer depends on which poses happen to carry, say, a GPS fix, so it repeats when
-  // the window slides and CHOLMOD's symbolic analysis is kept.
+  // the window slides and the symbolic analysis is kept.
   //
   // Such a window (poses in time order, then constant parameters) is a band with a dense border: eliminated in its
-  // own order it has no fill beyond the border's, so CHOLMOD then keeps the natural order, which also spares it the
-  // two permuted transposes of H per factorization. With time-varying parameters (instances after the poses) a
-  // fill-reducing ordering is still needed.
+  // own order it has no fill outside each column's envelope (its rows from the first coupled one to the diagonal), so
+  // it is factored there directly, densely per column (FactorEnvelope), which spares CHOLMOD's row-by-row sparse
+  // triangular solves on so small a system. With time-varying parameters (instances after the poses) CHOLMOD and a
+  // fill-reducing ordering are still needed.
   const bool natural_before = natural_order_;
   natural_order_ = false;
   if (dimension_ <= kMaxSimplicialDimension) {
@@ -202,28 +206,34 @@ void NormalEquations::BuildPattern() {
       column_length_[b] += dims_[r];
     }
   }
-  outer_.resize(dimension_ + 1);
-  inner_.clear();
-  for (int b = 0; b < nb; ++b) {
-    for (int j = 0; j < dims_[b]; ++j) {
-      outer_[block_offset_[b] + j] = static_cast<int>(inner_.size());
-      for (int r : rows_of_[b])
-        for (int i = 0; i < dims_[r]; ++i) inner_.push_back(block_offset_[r] + i);
+  // The same block pattern as at the last call (a window that slid by one pose) keeps outer_ and H's pattern.
+  const bool same_blocks = H_.rows() == dimension_ && pattern_dims_ == dims_ && pattern_rows_of_ == rows_of_;
+  if (!same_blocks) {
+    outer_.resize(dimension_ + 1);
+    inner_.clear();
+    for (int b = 0; b < nb; ++b) {
+      for (int j = 0; j < dims_[b]; ++j) {
+        outer_[block_offset_[b] + j] = static_cast<int>(inner_.size());
+        for (int r : rows_of_[b])
+          for (int i = 0; i < dims_[r]; ++i) inner_.push_back(block_offset_[r] + i);
+      }
     }
-  }
-  outer_[dimension_] = static_cast<int>(inner_.size());
+    outer_[dimension_] = static_cast<int>(inner_.size());
 
-  // A new pattern needs a new symbolic analysis; the same one keeps it.
-  const bool same = H_.rows() == dimension_ && H_.nonZeros() == static_cast<Eigen::Index>(inner_.size()) &&
-                    std::equal(outer_.begin(), outer_.end(), H_.outerIndexPtr()) &&
-                    std::equal(inner_.begin(), inner_.end(), H_.innerIndexPtr());
-  if (!same) {
-    H_.resize(dimension_, dimension_);
-    H_.resizeNonZeros(static_cast<Eigen::Index>(inner_.size()));
-    std::copy(outer_.begin(), outer_.end(), H_.outerIndexPtr());
-    std::copy(inner_.begin(), inner_.end(), H_.innerIndexPtr());
-    std::fill(H_.valuePtr(), H_.valuePtr() + H_.nonZeros(), 0.0);
-    cholmod_->analyzed = false;
+    // A new pattern needs a new symbolic analysis; the same one keeps it.
+    const bool same = H_.rows() == dimension_ && H_.nonZeros() == static_cast<Eigen::Index>(inner_.size()) &&
+                      std::equal(outer_.begin(), outer_.end(), H_.outerIndexPtr()) &&
+                      std::equal(inner_.begin(), inner_.end(), H_.innerIndexPtr());
+    if (!same) {
+      H_.resize(dimension_, dimension_);
+      H_.resizeNonZeros(static_cast<Eigen::Index>(inner_.size()));
+      std::copy(outer_.begin(), outer_.end(), H_.outerIndexPtr());
+      std::copy(inner_.begin(), inner_.end(), H_.innerIndexPtr());
+      std::fill(H_.valuePtr(), H_.valuePtr() + H_.nonZeros(), 0.0);
+      cholmod_->analyzed = false;
+    }
+    pattern_dims_ = dims_;
+    pattern_rows_of_ = rows_of_;
   }
 
   // Value index of block (r, b): start of column block_offset[b] plus the row offset of r in that column; later
@@ -304,20 +314,232 @@ bool NormalEquations::Solve(double lambda, Eigen::VectorXd* dx) {
     A = &c.damped;
   }
   if (!c.analyzed) {
-    c.llt.setMode(dimension_ <= kMaxSimplicialDimension ? Eigen::CholmodSimplicialLLt : Eigen::CholmodSupernodalLLt);
-    cholmod_common& common = c.llt.cholmod();
-    common.nmethods = natural_order_ ? 1 : c.default_nmethods;
-    common.method[0].ordering = natural_order_ ? CHOLMOD_NATURAL : c.default_ordering;
-    common.postorder = natural_order_ ? 0 : c.default_postorder;
-    c.llt.analyzePattern(*A);
+    if (natural_order_) {
+      // The border: trailing block columns whose first row block is the first; the envelope of each other block
+      // column reaches from its first row block to the diagonal.
+      band_blocks_ = static_cast<int>(order_.size());
+      while (band_blocks_ > 0 && rows_of_[band_blocks_ - 1].front() == 0 &&
+             dimension_ - block_offset_[band_blocks_ - 1] <= kMaxBorder)
+        --band_blocks_;
+      band_dimension_ = band_blocks_ < static_cast<int>(order_.size()) ? block_offset_[band_blocks_] : dimension_;
+      first_block_.resize(band_blocks_);
+      envelope_start_.resize(band_blocks_ + 1);
+      envelope_start_[0] = 0;
+      for (int b = 0; b < band_blocks_; ++b) {
+        first_block_[b] = rows_of_[b].front();
+        const int height = block_offset_[b] + dims_[b] - block_offset_[first_block_[b]];
+        envelope_start_[b + 1] = envelope_start_[b] + static_cast<std::ptrdiff_t>(height) * dims_[b];
+      }
+      envelope_.resize(envelope_start_[band_blocks_]);
+      band_pose_blocks_ = std::all_of(dims_.begin(), dims_.begin() + band_blocks_, [](int d) { return d == 6; });
+      border_.resize(band_dimension_, dimension_ - band_dimension_);
+      corner_.resize(dimension_ - band_dimension_, dimension_ - band_dimension_);
+    } else {
+      c.llt.setMode(dimension_ <= kMaxSimplicialDimension ? Eigen::CholmodSimplicialLLt
+                                                          : Eigen::CholmodSupernodalLLt);
+      c.llt.analyzePattern(*A);
+    }
     c.analyzed = true;
     ++analyses_;
   }
-  c.llt.factorize(*A);
-  c.factored_undamped = lambda <= 0.0 && c.llt.info() == Eigen::Success;
-  if (c.llt.info() != Eigen::Success) return false;
+  bool factored = false;
+  if (natural_order_) {
+    factored = FactorEnvelope(*A);
+  } else {
+    c.llt.factorize(*A);
+    factored = c.llt.info() == Eigen::Success;
+  }
+  c.factored_undamped = lambda <= 0.0 && factored;
+  if (!factored) return false;
+  if (natural_order_) {
+    *dx = -g_;
+    SolveEnvelope(*dx);
+    return dx->allFinite();
+  }
   *dx = c.llt.solve(-g_);
   return c.llt.info() == Eigen::Success && dx->allFinite();
+}
+
+namespace {
+
+// a <- U with U^T U = a (upper triangles; the strict lower triangle is left alone), column by column:
+// U(i, j) = (a(i, j) - sum_{k<i} U(k, i) U(k, j)) / U(i, i), U(j, j) = sqrt(a(j, j) - sum_{k<j} U(k, j)^2).
+// Returns false when a is not positive definite.
+template <typename Matrix>
+bool UpperCholeskyInPlace(Matrix& a) {
+  for (Eigen::Index j = 0; j < a.cols(); ++j) {
+    for (Eigen::Index i = 0; i < j; ++i) {
+      double s = a(i, j);
+      for (Eigen::Index k = 0; k < i; ++k) s -= a(k, i) * a(k, j);
+      a(i, j) = s / a(i, i);
+    }
+    double d = a(j, j);
+    for (Eigen::Index k = 0; k < j; ++k) d -= a(k, j) * a(k, j);
+    if (!(d > 0.0)) return false;
+    a(j, j) = std::sqrt(d);
+  }
+  return true;
+}
+
+// x <- U^-T x (forward substitution) and x <- U^-1 x (back substitution) for a small upper triangular U: plain loops,
+// cheaper than a general triangular solve at the size of a pose block.
+template <typename Upper, typename Rhs>
+void SolveUpperTransposed(const Upper& u, Rhs& x) {
+  for (Eigen::Index c = 0; c < x.cols(); ++c) {
+    for (Eigen::Index i = 0; i < u.rows(); ++i) {
+      double s = x(i, c);
+      for (Eigen::Index k = 0; k < i; ++k) s -= u(k, i) * x(k, c);
+      x(i, c) = s / u(i, i);
+    }
+  }
+}
+template <typename Upper, typename Rhs>
+void SolveUpper(const Upper& u, Rhs& x) {
+  for (Eigen::Index c = 0; c < x.cols(); ++c) {
+    for (Eigen::Index i = u.rows() - 1; i >= 0; --i) {
+      double s = x(i, c);
+      for (Eigen::Index k = i + 1; k < u.rows(); ++k) s -= u(i, k) * x(k, c);
+      x(i, c) = s / u(i, i);
+    }
+  }
+}
+
+// The band part Ua of an envelope factorization (NormalEquations::FactorEnvelope): block column b holds the row blocks
+// first_block[b]..b as one column-major matrix from u + start[b]. Block dimension D: 6 when every block is a pose
+// (fixed-size kernels), otherwise Eigen::Dynamic.
+template <int D>
+struct Band {
+  using Block = Eigen::Map<Eigen::Matrix<double, D, D>, 0, Eigen::OuterStride<>>;
+  using Rows = Eigen::Map<Eigen::Matrix<double, D, Eigen::Dynamic>, 0, Eigen::OuterStride<>>;
+  int blocks;
+  const int* first_block;
+  const int* offset;  // first scalar row of each block
+  const int* dims;
+  const std::ptrdiff_t* start;
+  double* u;
+
+  int height(int b) const { return static_cast<int>((start[b + 1] - start[b]) / dims[b]); }
+  // U(r, b), first_block[b] <= r <= b.
+  Block block(int r, int b) const {
+    return Block(u + start[b] + (offset[r] - offset[first_block[b]]), dims[r], dims[b],
+                 Eigen::OuterStride<>(height(b)));
+  }
+  // Rows of block k of x (column stride ldx, m columns).
+  Rows rows(double* x, Eigen::Index ldx, Eigen::Index m, int k) const {
+    return Rows(x + offset[k], dims[k], m, Eigen::OuterStride<>(ldx));
+  }
+
+  // Block Crout: U(r, b) = U(r, r)^-T (A(r, b) - sum_k U(k, r)^T U(k, b)) for r < b, over the row blocks k both
+  // columns hold, and U(b, b)^T U(b, b) = A(b, b) - sum_k U(k, b)^T U(k, b). u holds A's upper triangle on entry.
+  bool Factor() const {
+    for (int b = 0; b < blocks; ++b) {
+      for (int r = first_block[b]; r < b; ++r) {
+        Block x = block(r, b);
+        for (int k = std::max(first_block[r], first_block[b]); k < r; ++k)
+          x.noalias() -= block(k, r).transpose() * block(k, b);
+        SolveUpperTransposed(block(r, r), x);
+      }
+      Block d = block(b, b);
+      for (int k = first_block[b]; k < b; ++k) d.noalias() -= block(k, b).transpose() * block(k, b);
+      if (!UpperCholeskyInPlace(d)) return false;
+    }
+    return true;
+  }
+  // x <- Ua^-T x over the band's rows of x, block by block (coefficient-wise products: a block is small, and x has
+  // one column for a step, a few for a covariance, the border's for Ub).
+  void Forward(double* x, Eigen::Index ldx, Eigen::Index m) const {
+    for (int b = 0; b < blocks; ++b) {
+      Rows xb = rows(x, ldx, m, b);
+      for (int k = first_block[b]; k < b; ++k)
+        xb.noalias() -= block(k, b).transpose().lazyProduct(rows(x, ldx, m, k));
+      SolveUpperTransposed(block(b, b), xb);
+    }
+  }
+  // x <- Ua^-1 x, block by block from the last.
+  void Backward(double* x, Eigen::Index ldx, Eigen::Index m) const {
+    for (int b = blocks - 1; b >= 0; --b) {
+      Rows xb = rows(x, ldx, m, b);
+      SolveUpper(block(b, b), xb);
+      for (int k = first_block[b]; k < b; ++k) rows(x, ldx, m, k).noalias() -= block(k, b).lazyProduct(xb);
+    }
+  }
+};
+
+}  // namespace
+
+template <typename Function>
+void NormalEquations::WithBand(Function f) {
+  if (band_pose_blocks_) {
+    f(Band<6>{band_blocks_, first_block_.data(), block_offset_.data(), dims_.data(), envelope_start_.data(),
+              envelope_.data()});
+  } else {
+    f(Band<Eigen::Dynamic>{band_blocks_, first_block_.data(), block_offset_.data(), dims_.data(),
+                           envelope_start_.data(), envelope_.data()});
+  }
+}
+
+bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A) {
+  const int na = band_dimension_;
+  // Scatter the upper triangle of A: the band's column j of block b into its column of the block's envelope, rows
+  // from the first of block first_block_[b].
+  std::fill(envelope_.begin(), envelope_.end(), 0.0);
+  border_.setZero();
+  corner_.setZero();
+  const int* outer = A.outerIndexPtr();
+  const int* inner = A.innerIndexPtr();
+  const double* value = A.valuePtr();
+  for (int b = 0; b < band_blocks_; ++b) {
+    const int row0 = block_offset_[first_block_[b]];
+    const std::ptrdiff_t height = (envelope_start_[b + 1] - envelope_start_[b]) / dims_[b];
+    for (int t = 0; t < dims_[b]; ++t) {
+      const int j = block_offset_[b] + t;
+      double* column = envelope_.data() + envelope_start_[b] + t * height - row0;
+      for (int p = outer[j]; p < outer[j + 1]; ++p)
+        if (inner[p] <= j) column[inner[p]] = value[p];
+    }
+  }
+  for (int j = na; j < dimension_; ++j) {
+    for (int p = outer[j]; p < outer[j + 1]; ++p) {
+      const int i = inner[p];
+      if (i < na) {
+        border_(i, j - na) = value[p];
+      } else if (i <= j) {
+        corner_(i - na, j - na) = value[p];
+      }
+    }
+  }
+  // Ua, then Ub = Ua^-T B (forward substitution on B's columns) and Uc^T Uc = C - Ub^T Ub.
+  bool factored = false;
+  WithBand([&](const auto& band) {
+    factored = band.Factor();
+    if (factored && dimension_ > na) band.Forward(border_.data(), border_.rows(), border_.cols());
+  });
+  if (!factored || dimension_ == na) return factored;
+  corner_.selfadjointView<Eigen::Upper>().rankUpdate(border_.transpose(), -1.0);
+  return UpperCholeskyInPlace(corner_);
+}
+
+void NormalEquations::ForwardEnvelope(Eigen::Ref<Eigen::MatrixXd> x) {
+  // U^T y = x: Ua^T ya = xa, then Uc^T yc = xc - Ub^T ya.
+  WithBand([&](const auto& band) { band.Forward(x.data(), x.outerStride(), x.cols()); });
+  const int na = band_dimension_;
+  if (dimension_ > na) {
+    auto xc = x.bottomRows(dimension_ - na);
+    xc.noalias() -= border_.transpose() * x.topRows(na);
+    corner_.triangularView<Eigen::Upper>().transpose().solveInPlace(xc);
+  }
+}
+
+void NormalEquations::SolveEnvelope(Eigen::Ref<Eigen::MatrixXd> x) {
+  // U^T y = x, then U x = y: Uc xc = yc, then Ua xa = ya - Ub xc.
+  ForwardEnvelope(x);
+  const int na = band_dimension_;
+  if (dimension_ > na) {
+    auto xc = x.bottomRows(dimension_ - na);
+    corner_.triangularView<Eigen::Upper>().solveInPlace(xc);
+    x.topRows(na).noalias() -= border_ * xc;
+  }
+  WithBand([&](const auto& band) { band.Backward(x.data(), x.outerStride(), x.cols()); });
 }
 
 bool NormalEquations::Covariance(const std::vector<VariableId>& variables, Eigen::MatrixXd* covariance) {
@@ -342,8 +564,22 @@ bool NormalEquations::Covariance(const std::vector<VariableId>& variables, Eigen
       rows.push_back(block_offset_[b] + k);
     }
   }
-  const Eigen::MatrixXd X = c.llt.solve(E);
-  if (c.llt.info() != Eigen::Success || !X.allFinite()) return false;
+  Eigen::MatrixXd X;
+  if (natural_order_ && cols <= kMaxForwardCovarianceColumns) {
+    // H^-1 = U^-1 U^-T, so the covariance is Y^T Y with U^T Y = E: the forward substitution only.
+    ForwardEnvelope(E);
+    if (!E.allFinite()) return false;
+    *covariance = E.transpose() * E;
+    return true;
+  }
+  if (natural_order_) {
+    X = std::move(E);
+    SolveEnvelope(X);
+  } else {
+    X = c.llt.solve(E);
+    if (c.llt.info() != Eigen::Success) return false;
+  }
+  if (!X.allFinite()) return false;
   covariance->resize(cols, cols);
   for (int i = 0; i < cols; ++i) covariance->row(i) = X.row(rows[i]);
   return true;

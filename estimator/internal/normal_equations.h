@@ -1,7 +1,8 @@
 // Sparse normal equations H dx = -g of the whitened, loss-weighted least-squares problem over an ordered list of free
 // variables (seed 000, eqs. 2-3). The block-sparse pattern of H (upper triangle, compressed columns) is built per
 // graph structure; each Linearize refills the values in place, and CHOLMOD's Cholesky (with its fill-reducing
-// ordering) analyses the pattern once and refactors the values every iteration.
+// ordering) analyses the pattern once and refactors the values every iteration. Small systems in their natural order
+// (a tracking window: a band with a dense border) are factored in their envelope instead (see Reset).
 //
 // An object can be Reset to a changed graph and keeps its buffers; when the new pattern is the same as the old one
 // (a fixed-lag window that slid by one pose has the same band), the symbolic analysis is kept too.
@@ -100,13 +101,37 @@ class NormalEquations {
   std::vector<std::vector<int>> row_offset_;
   std::vector<int> column_length_;
   std::vector<int> outer_, inner_;
+  // The block pattern (dims_ and rows_of_) that outer_ and H's pattern were built for.
+  std::vector<int> pattern_dims_;
+  std::vector<std::vector<int>> pattern_rows_of_;
 
   Eigen::SparseMatrix<double> H_;
   std::vector<std::ptrdiff_t> diagonal_index_;
   Eigen::VectorXd g_;
   double cost_ = 0.0;
   int analyses_ = 0;
-  bool natural_order_ = false;  // factor in the order of the blocks (Reset)
+  bool natural_order_ = false;  // factor in the order of the blocks, in the envelope (Reset)
+
+  // Cholesky H = U^T U of a natural-order system (a band of poses with a dense border of constant parameters), in
+  // blocks H = [A B; B^T C], U = [Ua Ub; 0 Uc]: Ua^T Ua = A in A's block envelope (block column b of Ua holds the row
+  // blocks first_block_[b]..b as one dense column-major matrix from envelope_start_[b] in envelope_; blocks between a
+  // column's first coupled block and the diagonal may fill in, blocks above it cannot), Ub = Ua^-T B and
+  // Uc^T Uc = C - Ub^T Ub (dense). The border is the trailing block columns coupled to the first block, at most
+  // kMaxBorder columns.
+  bool FactorEnvelope(const Eigen::SparseMatrix<double>& A);
+  void ForwardEnvelope(Eigen::Ref<Eigen::MatrixXd> x);  // x <- U^-T x with the last FactorEnvelope
+  void SolveEnvelope(Eigen::Ref<Eigen::MatrixXd> x);    // x <- H^-1 x with the last FactorEnvelope
+  // Calls f with the band (a Band<6> when every block of A is a pose, fixed-size kernels, otherwise Band<Dynamic>).
+  template <typename Function>
+  void WithBand(Function f);
+  int band_blocks_ = 0;                 // block columns of A
+  bool band_pose_blocks_ = false;       // every block column of A has 6 columns
+  int band_dimension_ = 0;              // scalar columns of A
+  std::vector<int> first_block_;
+  std::vector<std::ptrdiff_t> envelope_start_;
+  std::vector<double> envelope_;
+  Eigen::MatrixXd border_;  // Ub
+  Eigen::MatrixXd corner_;  // C, then Uc in its upper triangle
 
   struct Cholmod;
   std::unique_ptr<Cholmod> cholmod_;

@@ -4,8 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
+
 #include "estimator/covariance.h"
 #include "estimator/factor.h"
+#include "estimator/internal/normal_equations.h"
+#include "estimator/marginalization.h"
 #include "estimator/models/gps.h"
 #include "tests/estimator/factor_testing.h"
 
@@ -156,6 +160,79 @@ TEST(ObservabilityTest, ComponentWhoseInformationIsAlmostAllSharedIsUnobservable
   a = AnalyzeObservability(marginal, conditional);
   EXPECT_EQ(a.observability[1], Observability::kWeak);
   EXPECT_NEAR(a.std[1], std::sqrt(300.0), 1e-9);
+}
+
+// A tracking window in the solver's natural order: poses in time order, each tied to the next and to the one after
+// (which skips a pose: fill inside the envelope), and a free constant parameter tied to two poses (the dense border),
+// by linear priors with random Jacobians. The envelope factorization must give the step and the covariances of a dense
+// Cholesky of the same H: a few columns by forward substitution, many by the full solve.
+TEST(NormalEquationsTest, EnvelopeFactorizationOfABandWithABorderMatchesADenseCholesky) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Graph graph;
+  std::vector<VariableId> poses;
+  for (int k = 0; k < 12; ++k)
+    poses.push_back(graph.AddVariable({"pose", Manifold::Pose(), testing::RandomPoint(Manifold::Pose(), &rng, 5.0),
+                                       false, Time::FromSeconds(k)}));
+  const VariableId lever =
+      graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d(0.1, 0.2, 0.3), false, std::nullopt});
+  const auto tie = [&](const std::vector<VariableId>& ids) {
+    std::vector<Manifold> manifolds;
+    std::vector<Eigen::VectorXd> x0;
+    int dim = 0;
+    for (VariableId id : ids) {
+      const Variable& v = graph.variable(id);
+      manifolds.push_back(v.manifold);
+      x0.push_back(testing::Perturb(v.manifold, v.value, 0.1, &rng));
+      dim += v.manifold.tangent_dim();
+    }
+    const Eigen::MatrixXd J = Eigen::MatrixXd::NullaryExpr(dim, dim, [&] { return normal(rng); });
+    const Eigen::VectorXd r0 = Eigen::VectorXd::NullaryExpr(dim, [&] { return normal(rng); });
+    graph.AddFactor(std::make_unique<LinearPriorFactor>(manifolds, x0, J, r0), ids, Eigen::MatrixXd::Identity(dim, dim),
+                    Loss::Trivial(), "test", Time());
+  };
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    tie({poses[k]});
+    if (k + 1 < poses.size()) tie({poses[k], poses[k + 1]});
+    if (k + 2 < poses.size()) tie({poses[k], poses[k + 2]});
+  }
+  tie({poses[0], lever});
+  tie({poses[7], lever});
+
+  internal::NormalEquations system(graph, FreeVariableOrder(graph));
+  ASSERT_TRUE(system.Linearize(graph));
+  const int n = system.dimension();
+  ASSERT_EQ(n, 75);
+  const Eigen::SparseMatrix<double> H_sparse = system.hessian_upper().selfadjointView<Eigen::Upper>();
+  const Eigen::MatrixXd H(H_sparse);
+  const Eigen::LLT<Eigen::MatrixXd> dense(H);
+  ASSERT_EQ(dense.info(), Eigen::Success);
+  const Eigen::MatrixXd H_inv = dense.solve(Eigen::MatrixXd::Identity(n, n));
+
+  Eigen::VectorXd dx;
+  ASSERT_TRUE(system.Solve(0.0, &dx));
+  const Eigen::VectorXd expected = dense.solve(-system.gradient());
+  EXPECT_LT((dx - expected).norm(), 1e-9 * expected.norm());
+
+  // The oldest pose and the parameter (9 columns), then every pose (72).
+  Eigen::MatrixXd few;
+  ASSERT_TRUE(system.Covariance({poses[0], lever}, &few));
+  Eigen::MatrixXd few_expected(9, 9);
+  const std::vector<int> rows = {0, 1, 2, 3, 4, 5, n - 3, n - 2, n - 1};
+  for (int i = 0; i < 9; ++i)
+    for (int j = 0; j < 9; ++j) few_expected(i, j) = H_inv(rows[i], rows[j]);
+  EXPECT_LT((few - few_expected).norm(), 1e-9 * few_expected.norm());
+  Eigen::MatrixXd many;
+  ASSERT_TRUE(system.Covariance(poses, &many));
+  EXPECT_LT((many - H_inv.topLeftCorner(72, 72)).norm(), 1e-9 * H_inv.norm());
+
+  // A damped solve factors H + lambda diag(H).
+  const double lambda = 0.3;
+  Eigen::MatrixXd damped = H;
+  damped.diagonal() += lambda * H.diagonal();
+  ASSERT_TRUE(system.Solve(lambda, &dx));
+  const Eigen::VectorXd damped_expected = damped.llt().solve(-system.gradient());
+  EXPECT_LT((dx - damped_expected).norm(), 1e-9 * damped_expected.norm());
 }
 
 }  // namespace
