@@ -4,8 +4,10 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include "common/chi_square.h"
 #include "estimator/geometry.h"
@@ -15,7 +17,13 @@ namespace roamlab::estimator {
 
 int GateOutliers(double probability, ProblemBuilder* builder, FactorId first) {
   Graph& graph = builder->graph();
-  std::map<int, double> threshold;
+  // Quantiles per (probability, dimension), kept across calls: online tracking gates at every update.
+  thread_local std::map<std::pair<double, int>, double> quantiles;
+  const auto threshold = [&](int dim) {
+    const auto key = std::make_pair(probability, dim);
+    const auto it = quantiles.find(key);
+    return it != quantiles.end() ? it->second : (quantiles[key] = ChiSquareQuantile(probability, dim));
+  };
   int changed = 0;
   std::vector<FactorId> ids;
   for (auto it = graph.factors().lower_bound(first); it != graph.factors().end(); ++it)
@@ -23,10 +31,9 @@ int GateOutliers(double probability, ProblemBuilder* builder, FactorId first) {
   for (FactorId id : ids) {
     FactorEntry& entry = graph.mutable_factor(id);
     const int dim = entry.factor->residual_dim();
-    if (!threshold.count(dim)) threshold[dim] = ChiSquareQuantile(probability, dim);
     internal::WhitenedFactor wf;
     const bool ok = internal::LinearizeFactor(graph, entry, std::vector<bool>(entry.variables.size(), false), &wf);
-    const bool active = ok && wf.squared_norm <= threshold[dim];
+    const bool active = ok && wf.squared_norm <= threshold(dim);
     if (active == entry.active) continue;
     ++changed;
     builder->mutable_counts(entry.stream).rejected += active ? -1 : 1;

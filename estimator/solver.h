@@ -1,6 +1,7 @@
 // Gauss-Newton and Levenberg-Marquardt on the estimation graph (seed 000, Section III-C): the sparse normal equations
-// of the whitened errors are solved by CHOLMOD supernodal Cholesky, the free variables are updated through box-plus
-// only, and the error covariances (eq. 1) are re-evaluated at every linearization.
+// of the whitened errors are solved by Cholesky (CHOLMOD supernodal; a sliding window's band of poses with a border of
+// constant parameters by its own block factorization, internal/normal_equations.h), the free variables are updated
+// through box-plus only, and the error covariances (eq. 1) are re-evaluated at every linearization.
 #pragma once
 
 #include <limits>
