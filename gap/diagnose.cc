@@ -503,6 +503,19 @@ Result<estimator::EstimatorConfig> NominalHolonomicConfig(const sim::Scenario& s
   param("imu.misalignment", (Eigen::VectorXd(4) << q.w(), q.x(), q.y(), q.z()).finished(), true);
   c.streams["gyroscope"] = ImuStream("gyroscope", "sigma_radps", s.imu->gyro_sigma_radps);
   c.stages.push_back({"imu.misalignment", "odometer.radius"});
+  // An absolute position reference (an indoor positioning system, as sensors.gps) when the scenario has one: with
+  // the encoders and the gyroscope alone the translation has no reference, and the wheel rows give only v / r and
+  // K omega_z / r, so the gyroscope fixes K / r and nothing fixes r and K apart; the fixes fix v, hence r. Its lever
+  // arm is fixed at the scenario's value (the antenna's mounting is believed).
+  if (s.gps) {
+    estimator::StreamConfig gps;
+    gps.model = "gps";
+    gps.sources = {{"", "gps"}};
+    gps.noise = {{"sigma_m", s.gps->sigma_m}};
+    c.streams["gps"] = gps;
+    const Eigen::Vector3d& l = s.gps->lever_arm_m;
+    param("gps.lever_arm", (Eigen::VectorXd(3) << l.x(), l.y(), l.z()).finished(), false);
+  }
   return c;
 }
 

@@ -82,14 +82,14 @@ TEST(NominalConfigTest, Omni3GeometryFromTheModel) {
 }
 
 // The mecanum robot's nominal model: models/mecanum.xml's wheels (radius 0.05 m at lx = 0.2 m, ly = 0.18 m), one
-// radius free for the four wheels, lx + ly fixed.
+// radius free for the four wheels, lx + ly fixed, and the scenario's position fixes.
 TEST(NominalConfigTest, MecanumGeometryFromTheModel) {
   auto scenario = sim::LoadScenario(Source("scenarios/indoor_mecanum_gap.yaml"));
   ASSERT_TRUE(scenario.ok()) << scenario.status().message();
   auto config = NominalConfig(scenario.value());
   ASSERT_TRUE(config.ok()) << config.status().message();
   const estimator::EstimatorConfig& c = config.value();
-  ASSERT_EQ(c.streams.size(), 2u);
+  ASSERT_EQ(c.streams.size(), 3u);
   const estimator::StreamConfig& odo = c.streams.at("odometer");
   EXPECT_EQ(odo.model, "mecanum_drive");
   EXPECT_EQ(odo.loss.type, estimator::Loss::Type::kTrivial);
@@ -103,6 +103,11 @@ TEST(NominalConfigTest, MecanumGeometryFromTheModel) {
   EXPECT_FALSE(c.parameters.count("odometer.distance"));
   EXPECT_TRUE(c.streams.count("gyroscope"));
   EXPECT_TRUE(c.parameters.at("imu.misalignment").free);
+  // The scenario's indoor position fixes (the translation's reference) with the believed antenna mounting.
+  EXPECT_EQ(c.streams.at("gps").model, "gps");
+  EXPECT_EQ(c.streams.at("gps").noise.at("sigma_m"), 0.01);
+  EXPECT_FALSE(c.parameters.at("gps.lever_arm").free);
+  EXPECT_EQ((*c.parameters.at("gps.lever_arm").value)[2], 0.1);
 }
 
 TEST(NominalConfigTest, OtherRobotKindsAndMissingYawReferenceAreRefused) {
