@@ -300,7 +300,9 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
       // The mecanum wheels' yaw lever arm K = lx + ly (models/mecanum_drive.h) freed from the nominal geometry. The
       // simulator's effect moves the wheels apart along O's y by track_error_m, half on each side: ly, hence K,
       // grows by track_error_m / 2 (sim/wheeled_robot.h ChangeTrack), so track_error_m = 2 (K - K_nominal) and its
-      // std is 2 std(K). (omni3 has no such effect in the simulator, so no candidate.)
+      // std is 2 std(K). (omni3 has no such effect in the simulator, so no candidate.) K is told from the common
+      // radius only with a translation reference (position fixes): the wheel rows give v / r and K omega_z / r, the
+      // gyroscope K / r; without one the fit leaves K where it is and no std (NominalHolonomicConfig).
       const std::string p = SlotParameter(mecanum, config.streams.at(mecanum), "lx_plus_ly");
       const std::optional<Eigen::VectorXd> nominal = ConfiguredValue(config, p);
       if (is_free(p) || !nominal || !std::isfinite((*nominal)[0])) continue;
@@ -474,7 +476,8 @@ Result<estimator::EstimatorConfig> NominalHolonomicConfig(const sim::Scenario& s
   const sim::SensorOptions& s = scenario.sensors;
   const bool omni3 = scenario.robot.kind == "omni3";
   if (!s.wheel_encoders) return Status::Error("the scenario has no wheel_encoders (the master stream)");
-  if (!s.imu) return Status::Error("the " + scenario.robot.kind + " nominal model needs sensors.imu (the yaw reference)");
+  if (!s.imu)
+    return Status::Error("the " + scenario.robot.kind + " nominal model needs sensors.imu (the yaw reference)");
   auto geometry = sim::NominalPlatformGeometry(scenario);
   if (!geometry.ok()) return geometry.status();
   const std::map<std::string, double>& g = geometry.value();
