@@ -170,13 +170,14 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
     return it != config.parameters.end() && it->second.free;
   };
   std::vector<std::string> gps, imu, pose;
-  std::string gyro, ackermann, diff_drive, pose_stream;
+  std::string gyro, ackermann, diff_drive, mecanum, pose_stream;
   for (const auto& [stream, sc] : config.streams) {
     if (sc.model == "absolute_pose") {
       pose.push_back(sc.sources.begin()->second);
       if (pose_stream.empty()) pose_stream = stream;
     }
     if (sc.model == "differential_drive" && diff_drive.empty()) diff_drive = stream;
+    if (sc.model == "mecanum_drive" && mecanum.empty()) mecanum = stream;
     if (sc.model == "gps") gps.push_back(sc.sources.begin()->second);
     if (sc.model == "gyroscope" || sc.model == "accelerometer" || sc.model == "magnetometer")
       imu.push_back(sc.sources.begin()->second);
@@ -294,6 +295,23 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
       c.describe = [p, b0 = (*nominal)[0]](const auto& value, const auto& std, EffectEstimate* e) {
         e->parameters["track_error_m"] = value.at(p)[0] - b0;
         if (std.count(p)) e->std["track_error_m"] = std.at(p)[0];
+      };
+    } else if (name == "track_width_error" && !mecanum.empty()) {
+      // The mecanum wheels' yaw lever arm K = lx + ly (models/mecanum_drive.h) freed from the nominal geometry. The
+      // simulator's effect moves the wheels apart along O's y by track_error_m, half on each side: ly, hence K,
+      // grows by track_error_m / 2 (sim/wheeled_robot.h ChangeTrack), so track_error_m = 2 (K - K_nominal) and its
+      // std is 2 std(K). (omni3 has no such effect in the simulator, so no candidate.) K is told from the common
+      // radius only with a translation reference (position fixes): the wheel rows give v / r and K omega_z / r, the
+      // gyroscope K / r; without one the fit leaves K where it is and no std (NominalHolonomicConfig).
+      const std::string p = SlotParameter(mecanum, config.streams.at(mecanum), "lx_plus_ly");
+      const std::optional<Eigen::VectorXd> nominal = ConfiguredValue(config, p);
+      if (is_free(p) || !nominal || !std::isfinite((*nominal)[0])) continue;
+      c.stream = mecanum;
+      c.free = {p};
+      c.free_dof = 1;
+      c.describe = [p, k0 = (*nominal)[0]](const auto& value, const auto& std, EffectEstimate* e) {
+        e->parameters["track_error_m"] = 2.0 * (value.at(p)[0] - k0);
+        if (std.count(p)) e->std["track_error_m"] = 2.0 * std.at(p)[0];
       };
     } else if (name == "lateral_slip" && !ackermann.empty()) {
       const std::string front = SlotParameter(ackermann, config.streams.at(ackermann), "cornering_front");
@@ -447,13 +465,71 @@ Result<estimator::EstimatorConfig> NominalDiffDriveConfig(const sim::Scenario& s
   return c;
 }
 
+// The nominal model of an omni3 or mecanum scenario, as NominalDiffDriveConfig: the wheel encoders (master, the
+// omni3_drive or mecanum_drive model) with the platform geometry measured on the robot's model
+// (sim::NominalPlatformGeometry): one radius for all wheels, free (the odometry's scale), the yaw lever arm fixed
+// (omni3 `distance` = wheel_distance_m; mecanum `lx_plus_ly` = half_length_m + half_width_m: a track_width_error is a
+// departure from it); the gyroscope (the yaw reference) with the scenario's noise and misalignment free. Encoder noise
+// as scenarios/indoor_omni_tracking.yaml (quantization plus the rollers' bumps; the rollers rock the chassis), no
+// robust loss (the chi-square comparisons need Gaussian costs).
+Result<estimator::EstimatorConfig> NominalHolonomicConfig(const sim::Scenario& scenario) {
+  const sim::SensorOptions& s = scenario.sensors;
+  const bool omni3 = scenario.robot.kind == "omni3";
+  if (!s.wheel_encoders) return Status::Error("the scenario has no wheel_encoders (the master stream)");
+  if (!s.imu)
+    return Status::Error("the " + scenario.robot.kind + " nominal model needs sensors.imu (the yaw reference)");
+  auto geometry = sim::NominalPlatformGeometry(scenario);
+  if (!geometry.ok()) return geometry.status();
+  const std::map<std::string, double>& g = geometry.value();
+  EstimatorConfig c;
+  c.source_file = scenario.source_file.empty() ? "nominal configuration" : scenario.source_file + " (nominal)";
+  c.master = "odometer";
+  c.solver.max_iterations = 100;
+  c.solver.function_tolerance = 1e-10;
+  const auto param = [&](const std::string& name, const Eigen::VectorXd& value, bool free) {
+    c.parameters[name].value = value;
+    c.parameters[name].free = free;
+  };
+  estimator::StreamConfig odo;
+  odo.model = omni3 ? "omni3_drive" : "mecanum_drive";
+  odo.sources = {{"", "wheel_encoders"}};
+  odo.noise = {{"wheel_radps", 0.3}, {"vertical_mps", 0.02}, {"tilt_radps", 0.1}};
+  for (int i = 0; i < (omni3 ? 3 : 4); ++i) odo.parameters["radius_" + std::to_string(i)] = "odometer.radius";
+  c.streams["odometer"] = odo;
+  param("odometer.radius", Eigen::VectorXd::Constant(1, g.at("wheel_radius_m")), true);
+  if (omni3) {
+    param("odometer.distance", Eigen::VectorXd::Constant(1, g.at("wheel_distance_m")), false);
+  } else {
+    param("odometer.lx_plus_ly", Eigen::VectorXd::Constant(1, g.at("half_length_m") + g.at("half_width_m")), false);
+  }
+  const Eigen::Quaterniond& q = s.imu->misalignment;
+  param("imu.misalignment", (Eigen::VectorXd(4) << q.w(), q.x(), q.y(), q.z()).finished(), true);
+  c.streams["gyroscope"] = ImuStream("gyroscope", "sigma_radps", s.imu->gyro_sigma_radps);
+  c.stages.push_back({"imu.misalignment", "odometer.radius"});
+  // An absolute position reference (an indoor positioning system, as sensors.gps) when the scenario has one: with
+  // the encoders and the gyroscope alone the translation has no reference, and the wheel rows give only v / r and
+  // K omega_z / r, so the gyroscope fixes K / r and nothing fixes r and K apart; the fixes fix v, hence r. Its lever
+  // arm is fixed at the scenario's value (the antenna's mounting is believed).
+  if (s.gps) {
+    estimator::StreamConfig gps;
+    gps.model = "gps";
+    gps.sources = {{"", "gps"}};
+    gps.noise = {{"sigma_m", s.gps->sigma_m}};
+    c.streams["gps"] = gps;
+    const Eigen::Vector3d& l = s.gps->lever_arm_m;
+    param("gps.lever_arm", (Eigen::VectorXd(3) << l.x(), l.y(), l.z()).finished(), false);
+  }
+  return c;
+}
+
 }  // namespace
 
 Result<estimator::EstimatorConfig> NominalConfig(const sim::Scenario& scenario) {
   if (scenario.robot.kind == "differential_drive") return NominalDiffDriveConfig(scenario);
+  if (scenario.robot.kind == "omni3" || scenario.robot.kind == "mecanum") return NominalHolonomicConfig(scenario);
   if (scenario.robot.kind != "ackermann")
-    return Status::Error("the nominal configuration is implemented for ackermann and differential_drive robots "
-                         "only, not '" + scenario.robot.kind + "'");
+    return Status::Error("the nominal configuration is implemented for ackermann, differential_drive, omni3 and "
+                         "mecanum robots only, not '" + scenario.robot.kind + "'");
   const sim::SensorOptions& s = scenario.sensors;
   if (!s.odometer) return Status::Error("the scenario has no odometer (the master stream)");
   EstimatorConfig c;

@@ -53,12 +53,76 @@ TEST(NominalConfigTest, DifferentialDriveGeometryFromTheModel) {
   EXPECT_TRUE(c.streams.count("gyroscope"));
 }
 
-TEST(NominalConfigTest, OtherRobotKindsAreRefused) {
+// The omni3 robot's nominal model: models/omni3.xml's wheels (radius 0.05 m at L = 0.2 m), one radius free for the
+// three wheels, the distance fixed, the gyroscope as the yaw reference.
+TEST(NominalConfigTest, Omni3GeometryFromTheModel) {
   auto scenario = sim::LoadScenario(Source("scenarios/indoor_omni_slip.yaml"));
   ASSERT_TRUE(scenario.ok()) << scenario.status().message();
   auto config = NominalConfig(scenario.value());
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  const estimator::EstimatorConfig& c = config.value();
+  EXPECT_EQ(c.master, "odometer");
+  ASSERT_EQ(c.streams.size(), 2u);
+  const estimator::StreamConfig& odo = c.streams.at("odometer");
+  EXPECT_EQ(odo.model, "omni3_drive");
+  EXPECT_EQ(odo.sources.at(""), "wheel_encoders");
+  EXPECT_EQ(odo.noise.at("wheel_radps"), 0.3);
+  EXPECT_EQ(odo.loss.type, estimator::Loss::Type::kTrivial);
+  ASSERT_EQ(odo.parameters.size(), 3u);
+  for (const char* slot : {"radius_0", "radius_1", "radius_2"}) EXPECT_EQ(odo.parameters.at(slot), "odometer.radius");
+  EXPECT_TRUE(c.parameters.at("odometer.radius").free);
+  EXPECT_NEAR((*c.parameters.at("odometer.radius").value)[0], 0.05, 1e-3);
+  EXPECT_FALSE(c.parameters.at("odometer.distance").free);
+  EXPECT_NEAR((*c.parameters.at("odometer.distance").value)[0], 0.2, 1e-3);
+  EXPECT_FALSE(c.parameters.count("odometer.lx_plus_ly"));
+  EXPECT_EQ(c.streams.at("gyroscope").model, "gyroscope");
+  EXPECT_EQ(c.streams.at("gyroscope").noise.at("sigma_radps"), 0.01);
+  EXPECT_TRUE(c.parameters.at("imu.misalignment").free);
+  ASSERT_EQ(c.stages.size(), 1u);
+}
+
+// The mecanum robot's nominal model: models/mecanum.xml's wheels (radius 0.05 m at lx = 0.2 m, ly = 0.18 m), one
+// radius free for the four wheels, lx + ly fixed, and the scenario's position fixes.
+TEST(NominalConfigTest, MecanumGeometryFromTheModel) {
+  auto scenario = sim::LoadScenario(Source("scenarios/indoor_mecanum_gap.yaml"));
+  ASSERT_TRUE(scenario.ok()) << scenario.status().message();
+  auto config = NominalConfig(scenario.value());
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  const estimator::EstimatorConfig& c = config.value();
+  ASSERT_EQ(c.streams.size(), 3u);
+  const estimator::StreamConfig& odo = c.streams.at("odometer");
+  EXPECT_EQ(odo.model, "mecanum_drive");
+  EXPECT_EQ(odo.loss.type, estimator::Loss::Type::kTrivial);
+  ASSERT_EQ(odo.parameters.size(), 4u);
+  for (const char* slot : {"radius_0", "radius_1", "radius_2", "radius_3"})
+    EXPECT_EQ(odo.parameters.at(slot), "odometer.radius");
+  EXPECT_TRUE(c.parameters.at("odometer.radius").free);
+  EXPECT_NEAR((*c.parameters.at("odometer.radius").value)[0], 0.05, 1e-3);
+  EXPECT_FALSE(c.parameters.at("odometer.lx_plus_ly").free);
+  EXPECT_NEAR((*c.parameters.at("odometer.lx_plus_ly").value)[0], 0.38, 1e-3);
+  EXPECT_FALSE(c.parameters.count("odometer.distance"));
+  EXPECT_TRUE(c.streams.count("gyroscope"));
+  EXPECT_TRUE(c.parameters.at("imu.misalignment").free);
+  // The scenario's indoor position fixes (the translation's reference) with the believed antenna mounting.
+  EXPECT_EQ(c.streams.at("gps").model, "gps");
+  EXPECT_EQ(c.streams.at("gps").noise.at("sigma_m"), 0.01);
+  EXPECT_FALSE(c.parameters.at("gps.lever_arm").free);
+  EXPECT_EQ((*c.parameters.at("gps.lever_arm").value)[2], 0.1);
+}
+
+TEST(NominalConfigTest, OtherRobotKindsAndMissingYawReferenceAreRefused) {
+  auto scenario = sim::LoadScenario(Source("scenarios/indoor_mecanum_gap.yaml"));
+  ASSERT_TRUE(scenario.ok()) << scenario.status().message();
+  sim::Scenario no_imu = scenario.value();
+  no_imu.sensors.imu.reset();
+  auto config = NominalConfig(no_imu);
   ASSERT_FALSE(config.ok());
-  EXPECT_NE(config.status().message().find("ackermann and differential_drive robots only"), std::string::npos);
+  EXPECT_NE(config.status().message().find("needs sensors.imu"), std::string::npos) << config.status().message();
+  sim::Scenario other = scenario.value();
+  other.robot.kind = "tracked";
+  config = NominalConfig(other);
+  ASSERT_FALSE(config.ok());
+  EXPECT_NE(config.status().message().find("mecanum robots only, not 'tracked'"), std::string::npos);
 }
 
 }  // namespace
