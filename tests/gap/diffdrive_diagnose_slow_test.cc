@@ -83,6 +83,19 @@ TEST_F(DiffDriveDiagnoseTest, NamesWheelRadiusAsymmetryAndRecoversTheRatio) {
   EXPECT_NEAR(estimate, rho, 3.0 * std);
 }
 
+// A constant gyroscope bias about z: at a forward speed that never stops it reads like a wheel-radius ratio (a turn
+// rate in proportion to the speed); the drive's reversals tell them apart, and the bias must be named first.
+TEST_F(DiffDriveDiagnoseTest, NamesAGyroBiasApartFromAWheelRatio) {
+  const double bias_radps = 0.006;
+  const EffectEstimate e = NamedEffect({"gyro_bias_drift", {{"initial_z", bias_radps}}}, 10);
+  ASSERT_TRUE(e.parameters.count("initial_z") && e.std.count("initial_z"));
+  const double estimate = e.parameters.at("initial_z"), std = e.std.at("initial_z");
+  std::cout << "gyro bias z " << estimate << " +- " << std << " rad/s (true " << bias_radps << "), held-out chi2 "
+            << 100.0 * e.heldout_improvement << " % lower\n";
+  EXPECT_GT(std, 0.0);
+  EXPECT_NEAR(estimate, bias_radps, 3.0 * std);
+}
+
 // A taped (oval) right tire: 2 mm of ovality on the 75 mm tire, the rolling radius 1 mm either side of its mean twice
 // per revolution. The oval also rolls on a mean radius 1 mm larger (models/differential_drive.h), a right/left ratio
 // of 1.013, so wheel_radius_asymmetry may rightly be named with it, and first.
