@@ -69,8 +69,9 @@
 //                                          rate difference is B_nom / B_true of the nominal one); truth: baseline +
 //                                          track_error_m (mecanum: lx_plus_ly + track_error_m / 2)
 //   wheel_deformation {wheel: 0, ovality_m: 0}   differential_drive (sphere tires): the tire of wheel `wheel`
-//                                          stretched into an oval by ovality_m in [0, 0.02] m (WheelDeformation: the
-//                                          rolling radius varies twice per revolution); adds to robot.wheel_deformation
+//                                          made oval by ovality_m in [0, 0.02] m at the same mean rolling radius
+//                                          (WheelDeformation.keep_mean_radius: the rolling radius varies twice per
+//                                          revolution about its nominal mean); adds to robot.wheel_deformation
 //   axle_misalignment {wheel: 0, yaw_deg: 0}   any wheeled kind: wheel `wheel` turned about z by yaw_deg within
 //                                          +-20 (WheelMountingChange; unlike robot.wheel_mounting, the driver does not
 //                                          know it)

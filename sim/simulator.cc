@@ -70,7 +70,8 @@ bool HasEffect(const Scenario& s, const std::string& name) {
 
 // The tires' deformations: robot.wheel_deformation with the tire effects on top, one entry per deformed wheel so that
 // Deform changes each tire once: wheel_radius_asymmetry multiplies the right tire's radius (wheel_1) by the ratio
-// rho = r_R / r_L, wheel_deformation adds its ovality to its wheel's.
+// rho = r_R / r_L, wheel_deformation adds its ovality to its wheel's and keeps that tire's mean rolling radius (an
+// out-of-round tire: the periodic part of the radius only, not a ratio).
 std::vector<WheelDeformation> TireDeformations(const Scenario& s) {
   std::vector<WheelDeformation> out = s.robot.wheel_deformation;
   const auto entry = [&out](int wheel) -> WheelDeformation& {
@@ -84,6 +85,7 @@ std::vector<WheelDeformation> TireDeformations(const Scenario& s) {
   if (HasEffect(s, "wheel_deformation")) {
     const int wheel = static_cast<int>(EffectParameter(s.effects, "wheel_deformation", "wheel", 0.0));
     entry(wheel).ovality_m += EffectParameter(s.effects, "wheel_deformation", "ovality_m", 0.0);
+    entry(wheel).keep_mean_radius = true;
   }
   return out;
 }

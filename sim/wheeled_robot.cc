@@ -174,7 +174,6 @@ Status WheeledRobot::ChangeMounting(mjModel* model, const std::vector<WheelMount
 
 Status WheeledRobot::Deform(mjModel* model, const std::vector<WheelDeformation>& deformations,
                             const std::string& what) {
-  constexpr double kPi = 3.14159265358979323846;
   for (const WheelDeformation& d : deformations) {
     const std::string name = "robot.wheel_deformation: wheel " + std::to_string(d.wheel);
     if (d.wheel < 0 || d.wheel >= static_cast<int>(wheels_.size()))
@@ -183,11 +182,22 @@ Status WheeledRobot::Deform(mjModel* model, const std::vector<WheelDeformation>&
     const int tire = tires_[static_cast<std::size_t>(d.wheel)];
     if (model->geom_type[tire] != mjGEOM_SPHERE)
       return Status::Error(what + ": " + name + ": only sphere tires can be deformed");
+    // Mean rolling radius of an ellipse of semi-axes a >= b: its perimeter / 2 pi (Ramanujan's second
+    // approximation, exact to ~(h^5)).
+    const auto mean_radius = [](double a, double b) {
+      const double h = (a - b) * (a - b) / ((a + b) * (a + b));
+      return (a + b) / 2.0 * (1.0 + 3.0 * h / (10.0 + std::sqrt(4.0 - 3.0 * h)));
+    };
     const double r0 = model->geom_size[3 * tire];
-    const double r = r0 * d.radius_scale;
-    const double a = r + d.ovality_m;
+    double r = r0 * d.radius_scale;
     if (!(r > 0.0) || !(d.ovality_m >= 0.0) || d.ovality_m > 0.5 * r)
       return Status::Error(what + ": " + name + ": needs radius_scale > 0 and 0 <= ovality_m <= half the radius");
+    if (d.keep_mean_radius) {
+      // The mean grows with r at a rate of about 1: a few fixed-point steps reach the target to rounding.
+      const double target = r;
+      for (int i = 0; i < 30; ++i) r -= mean_radius(r + d.ovality_m, r) - target;
+    }
+    const double a = r + d.ovality_m;
     // A tire of another size (radius_scale) is mounted with its hub moved along the parent's z by the radius change,
     // so that it keeps its contact with the floor beside the rigid casters (the chassis stays level, as a sprung
     // caster would keep it); otherwise a smaller tire hangs on the casters and loses its grip. The oval (ovality_m)
@@ -208,10 +218,7 @@ Status WheeledRobot::Deform(mjModel* model, const std::vector<WheelDeformation>&
     model->geom_quat[4 * tire + 1] = q.x();
     model->geom_quat[4 * tire + 2] = q.y();
     model->geom_quat[4 * tire + 3] = q.z();
-    // Mean rolling radius: the ellipse's perimeter / 2 pi (Ramanujan's second approximation, exact to ~(h^5)).
-    const double h = (a - r) * (a - r) / ((a + r) * (a + r));
-    const double perimeter = kPi * (a + r) * (1.0 + 3.0 * h / (10.0 + std::sqrt(4.0 - 3.0 * h)));
-    wheels_[static_cast<std::size_t>(d.wheel)].mean_rolling_radius_m = perimeter / (2.0 * kPi);
+    wheels_[static_cast<std::size_t>(d.wheel)].mean_rolling_radius_m = mean_radius(a, r);
   }
   return Status::Ok();
 }

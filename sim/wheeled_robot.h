@@ -53,10 +53,13 @@ struct WheelMountingChange {
 // wheel plane is r * radius_scale + ovality_m (a wheel deformed by thick tape, seed 001 Section IV-B5). Rolling on a
 // floor, the axle height h(phi) then varies between r * radius_scale and that semi-axis twice per revolution; the
 // centre advances h(phi) per radian of wheel rotation, so the travel per revolution is the ellipse's perimeter.
+// keep_mean_radius: the short semi-axis is chosen instead so that the mean rolling radius (perimeter / 2 pi) stays
+// r * radius_scale (an out-of-round tire: only the periodic part of the radius, the reality-gap effect).
 struct WheelDeformation {
   int wheel = 0;
   double radius_scale = 1.0;
   double ovality_m = 0.0;
+  bool keep_mean_radius = false;
 };
 
 // A wheel moved from its nominal position (an assembly error: its motor bracket fastened in the wrong holes, a bent
