@@ -38,8 +38,8 @@ class DiffDriveDiagnoseTest : public ::testing::Test {
   }
 
   // The nominal scenario with `effect` hidden, simulated with noise seed `seed` and diagnosed; `effect` must be named
-  // (first, when `first`), with a held-out improvement.
-  static EffectEstimate NamedEffect(const sim::EffectOptions& effect, std::uint64_t seed, bool first = true) {
+  // first, with a held-out improvement.
+  static EffectEstimate NamedEffect(const sim::EffectOptions& effect, std::uint64_t seed) {
     sim::Scenario hidden = *nominal_;
     hidden.effects = {effect};
     const sim::Simulation real = testing::SimulatedWithSeed(hidden, seed);
@@ -52,16 +52,11 @@ class DiffDriveDiagnoseTest : public ::testing::Test {
     std::string names;
     for (const EffectEstimate& e : d.value().effects) names += e.name + " ";
     std::cout << "named: " << names << "\n";
-    for (const EffectEstimate& e : d.value().effects) {
-      if (e.name != effect.name) continue;
-      if (first) {
-        EXPECT_EQ(e.name, d.value().effects.front().name) << names;
-      }
-      EXPECT_GT(e.heldout_improvement, 0.0);
-      return e;
-    }
-    ADD_FAILURE() << effect.name << " not named: " << names;
-    return {};
+    if (d.value().effects.empty()) return {};
+    const EffectEstimate& e = d.value().effects.front();
+    EXPECT_EQ(e.name, effect.name) << names;
+    EXPECT_GT(e.heldout_improvement, 0.0);
+    return e;
   }
 
   static sim::Scenario* nominal_;
@@ -96,12 +91,11 @@ TEST_F(DiffDriveDiagnoseTest, NamesAGyroBiasApartFromAWheelRatio) {
   EXPECT_NEAR(estimate, bias_radps, 3.0 * std);
 }
 
-// A taped (oval) right tire: 2 mm of ovality on the 75 mm tire, the rolling radius 1 mm either side of its mean twice
-// per revolution. The oval also rolls on a mean radius 1 mm larger (models/differential_drive.h), a right/left ratio
-// of 1.013, so wheel_radius_asymmetry may rightly be named with it, and first.
+// An out-of-round right tire: 2 mm of ovality on the 75 mm tire at the nominal mean rolling radius, the rolling
+// radius 1 mm either side of it twice per revolution (models/differential_drive.h).
 TEST_F(DiffDriveDiagnoseTest, NamesWheelDeformationAndRecoversTheOvality) {
   const double ovality_m = 0.002;
-  const EffectEstimate e = NamedEffect({"wheel_deformation", {{"wheel", 1.0}, {"ovality_m", ovality_m}}}, 8, false);
+  const EffectEstimate e = NamedEffect({"wheel_deformation", {{"wheel", 1.0}, {"ovality_m", ovality_m}}}, 8);
   ASSERT_TRUE(e.parameters.count("ovality_m") && e.std.count("ovality_m"));
   const double estimate = e.parameters.at("ovality_m"), std = e.std.at("ovality_m");
   std::cout << "wheel " << e.parameters.at("wheel") << " ovality " << estimate << " +- " << std << " m (true "
