@@ -218,32 +218,22 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
         e->parameters["offset_rad"] = value.at(p)[0] - nominal[0];
         if (std.count(p)) e->std["offset_rad"] = std.at(p)[0];
       };
-    } else if (name == "gyro_scale_error" && !gyro.empty()) {
-      const std::string p = SlotParameter(gyro, config.streams.at(gyro), "scale");
-      if (is_free(p)) continue;
-      c.stream = gyro;
-      c.free = {p};
-      c.free_dof = 3;
-      c.describe = [p](const auto& value, const auto& std, EffectEstimate* e) {
-        for (int i = 0; i < 3; ++i) {
-          const std::string key = std::string("scale_") + "xyz"[i];
-          e->parameters[key] = value.at(p)[i];
-          if (std.count(p)) e->std[key] = std.at(p)[i];
-        }
-      };
-    } else if (name == "gyro_bias_drift" && !gyro.empty()) {
-      // A gyroscope bias b [rad/s] (models/gyroscope.h: z = k_s o omega + b + eta), freed from the nominal model's
-      // zero as one constant over the fitted part: a bias that wanders slowly is seen as its mean there, and the
+    } else if ((name == "gyro_scale_error" || name == "gyro_bias_drift") && !gyro.empty()) {
+      // gyro_scale_error: the per-axis scale k_s (models/gyroscope.h: z = k_s o omega + b + eta) freed from 1,
+      // reported as scale_x/y/z. gyro_bias_drift: the bias b [rad/s] freed from the nominal model's zero as one
+      // constant over the fitted part: a bias that wanders slowly is seen as its mean there, and the
       // held-out test checks that the same value still explains the rest of the run. Reported as the simulator's
       // initial_x/y/z.
-      const std::string p = SlotParameter(gyro, config.streams.at(gyro), "bias");
+      const bool scale = name == "gyro_scale_error";
+      const std::string p = SlotParameter(gyro, config.streams.at(gyro), scale ? "scale" : "bias");
       if (is_free(p)) continue;
       c.stream = gyro;
       c.free = {p};
       c.free_dof = 3;
-      c.describe = [p](const auto& value, const auto& std, EffectEstimate* e) {
+      c.describe = [p, prefix = std::string(scale ? "scale_" : "initial_")](const auto& value, const auto& std,
+                                                                            EffectEstimate* e) {
         for (int i = 0; i < 3; ++i) {
-          const std::string key = std::string("initial_") + "xyz"[i];
+          const std::string key = prefix + "xyz"[i];
           e->parameters[key] = value.at(p)[i];
           if (std.count(p)) e->std[key] = std.at(p)[i];
         }
