@@ -19,33 +19,15 @@ namespace {
 class DiffDriveDiagnoseTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    auto loaded = sim::LoadScenario(std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/indoor_diffdrive_gap.yaml");
-    ASSERT_TRUE(loaded.ok()) << loaded.status().message();
-    nominal_ = new sim::Scenario(loaded.value());
-    auto config = NominalConfig(*nominal_);
-    ASSERT_TRUE(config.ok()) << config.status().message();
-    config_ = new estimator::EstimatorConfig(config.value());
-    DiagnoseOptions learn;
-    learn.max_effects = 0;
-    auto learned = Diagnose(*config_, testing::SimulatedWithSeed(*nominal_, 900001).recording, learn);
-    ASSERT_TRUE(learned.ok()) << learned.status().message();
-    baseline_ = new Baseline(BaselineFrom(learned.value()));
+    nominal_ = testing::LearnNominal("scenarios/indoor_diffdrive_gap.yaml").release();
   }
-  static void TearDownTestSuite() {
-    delete nominal_;
-    delete config_;
-    delete baseline_;
-  }
+  static void TearDownTestSuite() { delete nominal_; }
+  void SetUp() override { ASSERT_NE(nominal_, nullptr); }
 
   // The nominal scenario with `effect` hidden, simulated with noise seed `seed` and diagnosed; `effect` must be named
   // first, with a held-out improvement.
   static EffectEstimate NamedEffect(const sim::EffectOptions& effect, std::uint64_t seed) {
-    sim::Scenario hidden = *nominal_;
-    hidden.effects = {effect};
-    const sim::Simulation real = testing::SimulatedWithSeed(hidden, seed);
-    DiagnoseOptions options;
-    options.baseline = baseline_;
-    auto d = Diagnose(*config_, real.recording, options);
+    auto d = testing::DiagnoseHidden(*nominal_, {effect}, seed);
     EXPECT_TRUE(d.ok()) << d.status().message();
     if (!d.ok()) return {};
     EXPECT_EQ(d.value().verdict, "named");
@@ -59,13 +41,9 @@ class DiffDriveDiagnoseTest : public ::testing::Test {
     return e;
   }
 
-  static sim::Scenario* nominal_;
-  static estimator::EstimatorConfig* config_;
-  static Baseline* baseline_;
+  static testing::LearnedNominal* nominal_;
 };
-sim::Scenario* DiffDriveDiagnoseTest::nominal_ = nullptr;
-estimator::EstimatorConfig* DiffDriveDiagnoseTest::config_ = nullptr;
-Baseline* DiffDriveDiagnoseTest::baseline_ = nullptr;
+testing::LearnedNominal* DiffDriveDiagnoseTest::nominal_ = nullptr;
 
 TEST_F(DiffDriveDiagnoseTest, NamesWheelRadiusAsymmetryAndRecoversTheRatio) {
   const double rho = 1.02;

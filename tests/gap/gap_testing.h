@@ -2,10 +2,14 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
+#include "gap/diagnose.h"
 #include "sim/simulator.h"
 
 namespace roamlab::gap::testing {
@@ -17,6 +21,44 @@ inline sim::Simulation SimulatedWithSeed(const sim::Scenario& scenario, std::uin
   auto simulation = sim::Simulate(scenario, options);
   EXPECT_TRUE(simulation.ok()) << simulation.status().message();
   return std::move(simulation).value();
+}
+
+// A nominal scenario with its nominal model and the baseline learned on its simulation with noise seed 900001 (a seed
+// no test case uses), as `roamlab diagnose` learns it.
+struct LearnedNominal {
+  sim::Scenario scenario;
+  estimator::EstimatorConfig config;
+  Baseline baseline;
+};
+
+// Loads ROAMLAB_SOURCE_DIR/`scenario_path` and learns its baseline; nullptr (with a test failure) when that fails.
+inline std::unique_ptr<LearnedNominal> LearnNominal(const std::string& scenario_path) {
+  auto loaded = sim::LoadScenario(std::string(ROAMLAB_SOURCE_DIR) + "/" + scenario_path);
+  EXPECT_TRUE(loaded.ok()) << loaded.status().message();
+  if (!loaded.ok()) return nullptr;
+  auto out = std::make_unique<LearnedNominal>();
+  out->scenario = loaded.value();
+  auto config = NominalConfig(out->scenario);
+  EXPECT_TRUE(config.ok()) << config.status().message();
+  if (!config.ok()) return nullptr;
+  out->config = config.value();
+  DiagnoseOptions learn;
+  learn.max_effects = 0;
+  auto learned = Diagnose(out->config, SimulatedWithSeed(out->scenario, 900001).recording, learn);
+  EXPECT_TRUE(learned.ok()) << learned.status().message();
+  if (!learned.ok()) return nullptr;
+  out->baseline = BaselineFrom(learned.value());
+  return out;
+}
+
+// The nominal scenario with `effects` hidden, simulated with noise seed `seed` and diagnosed against the baseline.
+inline Result<Diagnosis> DiagnoseHidden(const LearnedNominal& nominal, const std::vector<sim::EffectOptions>& effects,
+                                        std::uint64_t seed) {
+  sim::Scenario hidden = nominal.scenario;
+  hidden.effects = effects;
+  DiagnoseOptions options;
+  options.baseline = &nominal.baseline;
+  return Diagnose(nominal.config, SimulatedWithSeed(hidden, seed).recording, options);
 }
 
 }  // namespace roamlab::gap::testing

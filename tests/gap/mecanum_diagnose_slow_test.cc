@@ -19,32 +19,13 @@ namespace {
 
 class MecanumDiagnoseTest : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
-    auto loaded = sim::LoadScenario(std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/indoor_mecanum_gap.yaml");
-    ASSERT_TRUE(loaded.ok()) << loaded.status().message();
-    nominal_ = new sim::Scenario(loaded.value());
-    auto config = NominalConfig(*nominal_);
-    ASSERT_TRUE(config.ok()) << config.status().message();
-    config_ = new estimator::EstimatorConfig(config.value());
-    DiagnoseOptions learn;
-    learn.max_effects = 0;
-    auto learned = Diagnose(*config_, testing::SimulatedWithSeed(*nominal_, 900001).recording, learn);
-    ASSERT_TRUE(learned.ok()) << learned.status().message();
-    baseline_ = new Baseline(BaselineFrom(learned.value()));
-  }
-  static void TearDownTestSuite() {
-    delete nominal_;
-    delete config_;
-    delete baseline_;
-  }
+  static void SetUpTestSuite() { nominal_ = testing::LearnNominal("scenarios/indoor_mecanum_gap.yaml").release(); }
+  static void TearDownTestSuite() { delete nominal_; }
+  void SetUp() override { ASSERT_NE(nominal_, nullptr); }
 
   // The nominal scenario with `effects` hidden, simulated with noise seed `seed` and diagnosed with the baseline.
   static Diagnosis Diagnosed(const std::vector<sim::EffectOptions>& effects, std::uint64_t seed) {
-    sim::Scenario hidden = *nominal_;
-    hidden.effects = effects;
-    DiagnoseOptions options;
-    options.baseline = baseline_;
-    auto d = Diagnose(*config_, testing::SimulatedWithSeed(hidden, seed).recording, options);
+    auto d = testing::DiagnoseHidden(*nominal_, effects, seed);
     EXPECT_TRUE(d.ok()) << d.status().message();
     if (!d.ok()) return {};
     std::string names;
@@ -59,13 +40,9 @@ class MecanumDiagnoseTest : public ::testing::Test {
     return std::move(d).value();
   }
 
-  static sim::Scenario* nominal_;
-  static estimator::EstimatorConfig* config_;
-  static Baseline* baseline_;
+  static testing::LearnedNominal* nominal_;
 };
-sim::Scenario* MecanumDiagnoseTest::nominal_ = nullptr;
-estimator::EstimatorConfig* MecanumDiagnoseTest::config_ = nullptr;
-Baseline* MecanumDiagnoseTest::baseline_ = nullptr;
+testing::LearnedNominal* MecanumDiagnoseTest::nominal_ = nullptr;
 
 // Wheels 2 cm further apart on each side: lx + ly grows from 0.38 m by 0.02 m.
 TEST_F(MecanumDiagnoseTest, NamesTrackWidthErrorAndRecoversIt) {
