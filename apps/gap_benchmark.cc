@@ -264,6 +264,8 @@ Result<CaseResult> RunCase(const Platform& platform, const Draw& draw, std::uint
     if (d.before.count(stream) && d.after.count(stream)) {
       c.rms_before = d.before.at(stream).rms;
       c.rms_after = d.after.at(stream).rms;
+      c.rms_1s_before = d.before.at(stream).rms_1s;
+      c.rms_1s_after = d.after.at(stream).rms_1s;
       c.has_rms = true;
     }
   }

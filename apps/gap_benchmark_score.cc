@@ -140,7 +140,7 @@ double NoiseRatio(const std::map<std::string, std::map<std::string, double>>& si
 json Summarize(const std::vector<CaseResult>& cases, double min_noise_ratio) {
   int effects = 0, top1 = 0, top3 = 0, strong = 0, strong_top1 = 0, strong_top3 = 0;
   int nones = 0, none_named = 0, none_none = 0, decoys = 0, decoy_unknown = 0, decoy_not_named = 0;
-  std::vector<double> relative_error, rms_named, rms_all;
+  std::vector<double> relative_error, rms_named, rms_all, rms_1s_named, rms_1s_all;
   std::map<std::string, std::pair<int, int>> by_effect;   // name -> (top-1 correct, cases)
   for (const CaseResult& c : cases) {
     if (c.kind == "none") {
@@ -177,6 +177,11 @@ json Summarize(const std::vector<CaseResult>& cases, double min_noise_ratio) {
       rms_all.push_back(reduction);
       if (first) rms_named.push_back(reduction);
     }
+    if (c.has_rms && c.rms_1s_before > 0.0) {
+      const double reduction = 1.0 - c.rms_1s_after / c.rms_1s_before;
+      rms_1s_all.push_back(reduction);
+      if (first) rms_1s_named.push_back(reduction);
+    }
   }
   json per_effect = json::object();
   for (const auto& [name, k] : by_effect) per_effect[name] = {{"top1", k.first}, {"cases", k.second}};
@@ -185,6 +190,7 @@ json Summarize(const std::vector<CaseResult>& cases, double min_noise_ratio) {
   const json unknown_rate = Fraction(decoy_unknown, decoys);
   const json rel = Number(Median(relative_error));
   const json rms = Number(Median(rms_named));
+  const json rms_1s = Number(Median(rms_1s_named));
   return {{"effect_cases", effects},
           {"top1", Fraction(top1, effects)},
           {"top3", Fraction(top3, effects)},
@@ -203,12 +209,15 @@ json Summarize(const std::vector<CaseResult>& cases, double min_noise_ratio) {
           {"parameter_errors", relative_error.size()},
           {"median_heldout_rms_reduction", rms},
           {"median_heldout_rms_reduction_all_effect_cases", Number(Median(rms_all))},
+          {"median_heldout_rms_1s_reduction", rms_1s},
+          {"median_heldout_rms_1s_reduction_all_effect_cases", Number(Median(rms_1s_all))},
           {"targets",
            {{"top1_strong", Target(top1_strong, 0.85, true)},
             {"false_discovery_rate", Target(false_rate, 0.10, false)},
             {"decoys_unknown", Target(unknown_rate, 0.70, true)},
             {"median_parameter_relative_error", Target(rel, 0.15, false)},
-            {"median_heldout_rms_reduction", Target(rms, 0.30, true)}}}};
+            {"median_heldout_rms_reduction", Target(rms, 0.30, true)},
+            {"median_heldout_rms_1s_reduction", Target(rms_1s, 0.30, true)}}}};
 }
 
 json CaseRow(const CaseResult& c) {
@@ -234,6 +243,8 @@ json CaseRow(const CaseResult& c) {
           {"estimate", c.has_estimate ? json(c.estimate) : json(nullptr)},
           {"heldout_rms_before", c.has_rms ? json(c.rms_before) : json(nullptr)},
           {"heldout_rms_after", c.has_rms ? json(c.rms_after) : json(nullptr)},
+          {"heldout_rms_1s_before", c.has_rms ? json(c.rms_1s_before) : json(nullptr)},
+          {"heldout_rms_1s_after", c.has_rms ? json(c.rms_1s_after) : json(nullptr)},
           {"candidates", candidates},
           {"seconds", c.seconds}};
 }

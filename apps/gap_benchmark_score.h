@@ -50,6 +50,7 @@ struct CaseResult {
   double estimate = 0.0;                   // the diagnosis's value of truth_parameter, when the truth was named
   bool has_estimate = false;
   double rms_before = 0.0, rms_after = 0.0;   // held-out whitened RMS of the affected stream
+  double rms_1s_before = 0.0, rms_1s_after = 0.0;   // its systematic part (gap::StreamFit::rms_1s)
   bool has_rms = false;
   std::vector<CandidateStats> candidates;  // first round
   double seconds = 0.0;

@@ -41,7 +41,12 @@ struct StreamFit {
   double chi2 = 0.0;           // sum of squared whitened residuals
   double chi2_per_dof = 0.0;
   double rms = 0.0;            // sqrt(chi2_per_dof): whitened RMS
+  // The systematic part: the RMS over components and 1 s windows (kSystematicWindowS, from the stream's first
+  // residual) of each window's mean whitened residual. White noise averages out of it (by sqrt of the samples in a
+  // window: 10x at 100 Hz), a bias or a slowly varying mismatch does not; it is what a residual plot shows as a trend.
+  double rms_1s = 0.0;
 };
+inline constexpr double kSystematicWindowS = 1.0;
 std::map<std::string, StreamFit> StreamFits(const std::vector<estimator::MeasurementResidual>& residuals);
 
 struct Correlate {

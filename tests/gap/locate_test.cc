@@ -93,5 +93,26 @@ TEST(LocateTest, StreamFitsCountActiveMeasurementsOnly) {
   EXPECT_DOUBLE_EQ(ComponentLevels(r).at("a/0"), 5.0);
 }
 
+// The 1 s RMS keeps a bias and averages white noise out: unit noise at 100 Hz plus a 0.3 bias on one of two
+// components gives a per-sample RMS near sqrt((1 + 0.09 + 1) / 2) = 1.02 but a 1 s RMS near
+// sqrt((0.09 + 2 / 100) / 2) = 0.235 (the noise's window means have variance 1 / 100).
+TEST(LocateTest, SystematicRmsAveragesWhiteNoiseOutAndKeepsABias) {
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::vector<estimator::MeasurementResidual> biased, white;
+  for (int k = 0; k < 20000; ++k) {
+    const Time t = Time::FromSeconds(5.0 + 0.01 * k);
+    const Eigen::Vector2d noise(n(rng), n(rng));
+    white.push_back({"s", t, noise, true});
+    biased.push_back({"s", t, noise + Eigen::Vector2d(0.3, 0.0), true});
+  }
+  const StreamFit w = StreamFits(white).at("s"), b = StreamFits(biased).at("s");
+  EXPECT_NEAR(w.rms, 1.0, 0.02);
+  EXPECT_NEAR(b.rms, std::sqrt(2.09 / 2.0), 0.02);
+  // 200 windows x 2 components: the noise's squared window mean has relative std sqrt(2 / 400) = 7 %.
+  EXPECT_NEAR(w.rms_1s, 0.1, 0.1 * 0.15);
+  EXPECT_NEAR(b.rms_1s, std::sqrt(0.11 / 2.0), 0.235 * 0.1);
+}
+
 }  // namespace
 }  // namespace roamlab::gap
