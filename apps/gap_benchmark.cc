@@ -36,7 +36,7 @@ constexpr int kMaxCases = 500;                 // per phase: the calibration see
 constexpr double kMaxFalseRate = 0.10;         // the false-discovery target, imposed on the calibration
 
 struct Platform {
-  std::string name;                            // atv | diffdrive
+  std::string name;                            // atv | diffdrive | mecanum
   sim::Scenario scenario;
   estimator::EstimatorConfig config;
   gap::Baseline baseline;
@@ -57,20 +57,23 @@ std::string AffectedStream(const std::string& effect) {
   return "odometer";
 }
 
-// Platform 0 is the ATV, 1 the differential drive; each equally likely. Kinds: none 20 %, decoy 15 %, effect 65 %.
+// Platform 0 is the ATV (half of the cases: its library is the largest), 1 the differential drive and 2 the mecanum
+// robot (a quarter each). Kinds: none 20 %, decoy 15 %, effect 65 %.
 // Magnitudes from about the smallest the diagnosis resolves (its std on a 20 s training part, README) to large.
 // Decoys are drawn on the ATV only: a magnetometer bias that follows the drive torque shows in the magnetometer's
 // residuals and no candidate models it; the differential drive's nominal model reads only the encoders and the
 // gyroscope, and the out-of-library effects the simulator has for it either do not show there or look like a library
 // effect (a yawed axle reads as a smaller wheel). Its effects are the ones its sensors can identify:
 // track_width_error is not drawn, because with the wheel radius free and no speed reference only r / B is observable
-// (the gyroscope sees the turn rate r (omega_R - omega_L) / B), so a track error is a radius error.
+// (the gyroscope sees the turn rate r (omega_R - omega_L) / B), so a track error is a radius error. The mecanum robot's
+// position fixes tell its track (README: 0.04 m -> 0.0411 +- 0.0026), so it is drawn there, with a yaw gyro bias.
 Draw DrawCase(std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const auto sign = [&] { return u(rng) < 0.5 ? -1.0 : 1.0; };
   const auto round_to = [](double x, double step) { return std::round(x / step) * step; };
   Draw d;
-  d.platform = u(rng) < 0.5 ? 0 : 1;
+  const double platform = u(rng);
+  d.platform = platform < 0.5 ? 0 : platform < 0.75 ? 1 : 2;
   const double kind = u(rng);
   const double pick = u(rng);
   if (kind < 0.2) {
@@ -93,6 +96,15 @@ Draw DrawCase(std::mt19937_64& rng) {
   const auto gyro_bias = [&](const std::string& axis) {
     d.effect = {"gyro_bias_drift", {{"initial_" + axis, sign() * (0.002 + 0.008 * u(rng))}}};
   };
+  if (d.platform == 2) {
+    if (pick < 0.5) {
+      d.effect = {"track_width_error", {{"track_error_m", sign() * (0.008 + 0.042 * u(rng))}}};
+    } else {
+      gyro_bias("z");
+    }
+    d.parameter = d.effect.parameters.begin()->first;
+    return d;
+  }
   if (d.platform == 1) {
     switch (static_cast<int>(3.0 * pick)) {
       case 0:
@@ -330,7 +342,8 @@ int RunGapBenchmark(const GapBenchmarkArgs& args) {
   }
   std::vector<Platform> platforms;
   for (const auto& [name, path, kind] : {std::make_tuple("atv", args.atv_scenario, "ackermann"),
-                                         std::make_tuple("diffdrive", args.diffdrive_scenario, "differential_drive")}) {
+                                         std::make_tuple("diffdrive", args.diffdrive_scenario, "differential_drive"),
+                                         std::make_tuple("mecanum", args.mecanum_scenario, "mecanum")}) {
     auto p = LoadPlatform(name, path, kind, args.duration_s);
     if (!p.ok()) {
       err << "roamlab gap-benchmark: " << p.status().message() << "\n";
@@ -417,7 +430,10 @@ int RunGapBenchmark(const GapBenchmarkArgs& args) {
   const json score = {
       {"seed", args.seed},
       {"jobs", args.jobs},
-      {"duration_s", {{"atv", platforms[0].scenario.duration_s}, {"diffdrive", platforms[1].scenario.duration_s}}},
+      {"duration_s",
+       {{"atv", platforms[0].scenario.duration_s},
+        {"diffdrive", platforms[1].scenario.duration_s},
+        {"mecanum", platforms[2].scenario.duration_s}}},
       {"figures", figures},
       {"thresholds", thresholds},
       {"calibration",

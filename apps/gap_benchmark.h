@@ -1,6 +1,7 @@
 // `roamlab gap-benchmark --cases N --seed S --out DIR [--calibration-cases C] [--jobs J] [--duration T]
-//  [--atv SCENARIO.yaml] [--diffdrive SCENARIO.yaml] [--quiet]`: the blind benchmark of the reality-gap diagnosis
-// (issue 6, "The proof"). Each case draws a platform (the ATV or the differential drive), a noise seed and a hidden
+//  [--atv SCENARIO.yaml] [--diffdrive SCENARIO.yaml] [--mecanum SCENARIO.yaml] [--quiet]`: the blind benchmark of
+// the reality-gap diagnosis (issue 6, "The proof"). Each case draws a platform (the ATV, the differential drive or
+// the mecanum robot), a noise seed and a hidden
 // effect: none, a decoy outside the diagnosis's candidates, or one candidate effect with a random magnitude; it
 // simulates the "real" recording (truth.yaml included), diagnoses the written recording against the nominal scenario
 // (baseline learned once per platform from a seed no case uses) and only then reads truth.yaml to score.
@@ -27,6 +28,7 @@ struct GapBenchmarkArgs {
   double duration_s = 0.0;   // 0: the scenarios' own
   std::string atv_scenario = "scenarios/atv_hills.yaml";
   std::string diffdrive_scenario = "scenarios/indoor_diffdrive_gap.yaml";
+  std::string mecanum_scenario = "scenarios/indoor_mecanum_gap.yaml";
   std::string out;
   bool quiet = false;
   std::ostream* err = nullptr;

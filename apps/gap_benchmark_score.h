@@ -38,7 +38,7 @@ struct Thresholds {
 // One benchmark case: what was hidden, what the diagnosis said, and the figures scored from truth.yaml.
 struct CaseResult {
   std::string id;
-  std::string platform;                    // atv | diffdrive
+  std::string platform;                    // atv | diffdrive | mecanum
   std::string kind;                        // none | effect | decoy
   std::string truth_name;                  // empty for none
   std::string truth_parameter;             // the parameter drawn away from neutral (effect, decoy)

@@ -16,6 +16,7 @@
 
 #include "apps/commands.h"
 #include "apps/simulate.h"
+#include "estimator/calibration.h"
 #include "estimator/config.h"
 #include "estimator/tracking.h"
 #include "eval/nees.h"
@@ -75,6 +76,49 @@ RunResult OneRun(const sim::Scenario& scenario, const estimator::EstimatorConfig
   r.mean_nees = sum / r.nees.size();
   r.track_seconds = tr.total_seconds;
   return r;
+}
+
+// The calibration a run tracks with: its values and, under tracking.calibration_prior, their prior.
+struct RunCalibration {
+  std::map<std::string, Eigen::VectorXd> values;
+  estimator::TrackingOptions options;
+};
+
+// Run `seed`'s own calibration: the scenario simulated with `seed` (a realization apart from the tracked one) and
+// calibrated with `warm`, the calibration configuration warm-started at the shared calibration (see RunMonteCarlo).
+Result<RunCalibration> CalibrateRun(const sim::Scenario& scenario, const estimator::EstimatorConfig& warm,
+                                    bool prior, std::uint64_t seed) {
+  sim::SimulateOptions sim_options;
+  sim_options.seed = seed;
+  auto simulation = sim::Simulate(scenario, sim_options);
+  if (!simulation.ok()) return Status::Error("calibration seed " + std::to_string(seed) + ": " +
+                                             simulation.status().message());
+  auto calibrated = estimator::Calibrate(warm, simulation.value().recording);
+  if (!calibrated.ok()) return Status::Error("calibration seed " + std::to_string(seed) + ": " +
+                                             calibrated.status().message());
+  RunCalibration out;
+  estimator::CalibrationPrior p;
+  for (const estimator::ParameterEstimate& e : calibrated.value().parameters) {
+    out.values[e.name] = e.estimate;
+    p.names.push_back(e.name);
+  }
+  p.information = calibrated.value().information;
+  if (prior) out.options.calibration_prior = std::move(p);
+  return out;
+}
+
+// The calibration configuration `path` warm-started at `values`: one stage with every free parameter.
+Result<estimator::EstimatorConfig> WarmCalibrationConfig(const std::string& path,
+                                                         const std::map<std::string, Eigen::VectorXd>& values) {
+  auto config = estimator::LoadEstimatorConfig(path);
+  if (!config.ok()) return config.status();
+  std::vector<std::string> free;
+  for (auto& [name, p] : config.value().parameters) {
+    if (values.count(name)) p.value = values.at(name);
+    if (p.free) free.push_back(name);
+  }
+  config.value().stages = {free};
+  return config;
 }
 
 int Fail(std::ostream* err, const std::string& message, int code) {
@@ -137,6 +181,16 @@ int RunMonteCarlo(const MonteCarloArgs& args) {
   }
   auto tracking_options = TrackingOptionsFor(config.value(), calibration_file);
   if (!tracking_options.ok()) return Fail(args.err, tracking_options.status().message(), 2);
+  const bool per_run = args.calibration.empty() && !config.value().tracking.calibrate.empty() && !args.calibrate_once;
+  estimator::EstimatorConfig warm;
+  if (per_run) {
+    auto w = WarmCalibrationConfig(config.value().tracking.calibrate, calibration);
+    if (!w.ok()) return Fail(args.err, w.status().message(), 2);
+    warm = std::move(w).value();
+    if (!args.quiet)
+      std::cerr << "montecarlo: each run also calibrates a drive of its own (noise seed " << args.seed_base
+                << " + " << kCalibrationSeedOffset << " + i), warm-started there\n";
+  }
 
   // Runs spread over worker threads; each writes only its own slot, so the result does not depend on scheduling.
   const int jobs = args.jobs > 0 ? args.jobs : std::max(1u, std::thread::hardware_concurrency());
@@ -145,8 +199,19 @@ int RunMonteCarlo(const MonteCarloArgs& args) {
   std::mutex print;
   const auto worker = [&] {
     for (int i = next++; i < args.runs; i = next++) {
-      results[i] =
-          OneRun(scenario.value(), config.value(), calibration, tracking_options.value(), args.seed_base + i);
+      if (per_run) {
+        auto own = CalibrateRun(scenario.value(), warm, config.value().tracking.calibration_prior,
+                                args.seed_base + kCalibrationSeedOffset + i);
+        if (own.ok()) {
+          results[i] = OneRun(scenario.value(), config.value(), own.value().values, own.value().options,
+                              args.seed_base + i);
+        } else {
+          results[i].error = own.status().message();
+        }
+      } else {
+        results[i] =
+            OneRun(scenario.value(), config.value(), calibration, tracking_options.value(), args.seed_base + i);
+      }
       const int finished = ++done;
       if (!args.quiet) {
         std::lock_guard<std::mutex> lock(print);

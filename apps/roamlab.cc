@@ -75,6 +75,9 @@ int main(int argc, char** argv) {
   mc->add_option("--jobs", montecarlo.jobs, "Parallel runs (default: one per core)");
   mc->add_option("--seed-base", montecarlo.seed_base, "Run i uses noise seed SEED_BASE + i (default 1000)");
   mc->add_option("--t0", montecarlo.t0_s, "Leave the first T0 seconds out of fraction_in_band (default 2)");
+  mc->add_flag("--calibrate-once", montecarlo.calibrate_once,
+               "With tracking.calibrate: one calibration shared by all runs (the seed's protocol) instead of one per "
+               "run on its own calibration drive");
   mc->add_option("--out", montecarlo.out, "Output directory: nees.json, runs.json, nees.png")->required();
   mc->add_flag("--quiet", montecarlo.quiet, "No progress bar and no summary");
 
@@ -109,6 +112,8 @@ int main(int argc, char** argv) {
   gbm->add_option("--atv", benchmark.atv_scenario, "Nominal ATV scenario (default scenarios/atv_hills.yaml)");
   gbm->add_option("--diffdrive", benchmark.diffdrive_scenario,
                   "Nominal differential-drive scenario (default scenarios/indoor_diffdrive_gap.yaml)");
+  gbm->add_option("--mecanum", benchmark.mecanum_scenario,
+                  "Nominal mecanum scenario (default scenarios/indoor_mecanum_gap.yaml)");
   gbm->add_option("--out", benchmark.out, "Output directory: score.json, calibration/NNN, cases/NNN")->required();
   gbm->add_flag("--quiet", benchmark.quiet, "No progress");
 
