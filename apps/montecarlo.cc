@@ -181,7 +181,7 @@ int RunMonteCarlo(const MonteCarloArgs& args) {
   }
   auto tracking_options = TrackingOptionsFor(config.value(), calibration_file);
   if (!tracking_options.ok()) return Fail(args.err, tracking_options.status().message(), 2);
-  const bool per_run = args.calibration.empty() && !config.value().tracking.calibrate.empty() && !args.calibrate_once;
+  const bool per_run = args.calibration.empty() && !config.value().tracking.calibrate.empty() && args.calibrate_each_run;
   estimator::EstimatorConfig warm;
   if (per_run) {
     auto w = WarmCalibrationConfig(config.value().tracking.calibrate, calibration);

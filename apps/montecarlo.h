@@ -19,9 +19,9 @@ struct MonteCarloArgs {
   unsigned long long seed_base = 1000;  // run i simulates with noise seed seed_base + i
   double t0_s = 2.0;        // fraction_in_band counts time steps from t0_s on
   bool no_time_budget = false;  // ignore tracking.time_budget_s: results that do not depend on the machine's speed
-  // With tracking.calibrate and no --calibration: one calibration shared by every run (the seed's protocol) instead
-  // of one per run on its own calibration drive (see RunMonteCarlo).
-  bool calibrate_once = false;
+  // With tracking.calibrate and no --calibration: one calibration per run on its own calibration drive instead of
+  // one shared by every run (the seed's protocol; see RunMonteCarlo).
+  bool calibrate_each_run = false;
   bool quiet = false;           // no progress bar and no summary
   std::ostream* err = nullptr;  // receives the one-line error; nullptr: stderr
 };
@@ -30,12 +30,13 @@ struct MonteCarloArgs {
 // computes the position NEES (eq. 16) of every pose against the truth, and writes OUT/nees.json
 // ({"runs", "dof", "band", "t", "mean_nees", "fraction_in_band", ...}), OUT/runs.json (per-run ATE and mean NEES) and
 // OUT/nees.png. Runs are spread over `jobs` threads; results do not depend on the number of jobs.
-// Calibration (the configuration's tracking.calibrate, when no --calibration file is given): a run's calibration
-// error is part of its realization. Shared by all runs, one draw of it would be common to every run and the average
-// NEES would test that single draw, not the estimator (its band assumes independent runs). So by default run i also
-// simulates a calibration drive of its own (noise seed seed_base + kCalibrationSeedOffset + i), calibrates it
-// (warm-started at the one shared calibration of the scenario's own seed, a single stage with every parameter free:
-// the same minimum, fewer iterations) and tracks with those values under that calibration's prior.
+// Calibration (the configuration's tracking.calibrate, when no --calibration file is given): by default one
+// calibration of the scenario simulated with its own noise seed, shared by every run (the seed's protocol). Its error
+// is then one draw common to all runs, so the average NEES tests that draw as much as the tracker (the band assumes
+// independent runs). With calibrate_each_run, run i also simulates a calibration drive of its own (noise seed
+// seed_base + kCalibrationSeedOffset + i), calibrates it (warm-started at the shared calibration, a single stage with
+// every parameter free: the same minimum, fewer iterations) and tracks with those values under that calibration's
+// prior: every random input of the run is its own.
 int RunMonteCarlo(const MonteCarloArgs& args);
 
 }  // namespace roamlab::apps

@@ -75,9 +75,8 @@ int main(int argc, char** argv) {
   mc->add_option("--jobs", montecarlo.jobs, "Parallel runs (default: one per core)");
   mc->add_option("--seed-base", montecarlo.seed_base, "Run i uses noise seed SEED_BASE + i (default 1000)");
   mc->add_option("--t0", montecarlo.t0_s, "Leave the first T0 seconds out of fraction_in_band (default 2)");
-  mc->add_flag("--calibrate-once", montecarlo.calibrate_once,
-               "With tracking.calibrate: one calibration shared by all runs (the seed's protocol) instead of one per "
-               "run on its own calibration drive");
+  mc->add_flag("--calibrate-each-run", montecarlo.calibrate_each_run,
+               "With tracking.calibrate: each run calibrates a drive of its own instead of sharing one calibration");
   mc->add_option("--out", montecarlo.out, "Output directory: nees.json, runs.json, nees.png")->required();
   mc->add_flag("--quiet", montecarlo.quiet, "No progress bar and no summary");
 
