@@ -222,10 +222,14 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
       // The rear axle's thrust angle alpha (models/ackermann_velocity.h: the rear axle rolls along alpha, so the
       // vehicle crabs by alpha and turns at -v tan(alpha) / L at zero handlebar) freed from the nominal model's zero;
       // reported as the simulator's axle_misalignment on the Ackermann rear axle, yaw_deg = alpha in degrees. Its turn
-      // is a steering offset's to first order; the crab shows against the heading the magnetometer and the gyroscope
-      // give, as far as the IMU's misalignment, free in the nominal model, does not absorb it.
+      // is a steering offset's to first order (k_gamma = -alpha); only the crab tells them apart, and it shows only
+      // against a heading tied to the chassis: the candidate applies when the gyroscope's mounting is believed
+      // (its misalignment fixed). With it free, a rotation of O by alpha absorbs the crab, only alpha sin^2(delta)
+      // on the steering row is left, and on the 30 s ATV drive both candidates fit to within a chi2 of 2
+      // (README, tests/gap/axle_diagnose_slow_test.cc): the candidate would only duplicate steering_offset.
       const std::string p = SlotParameter(ackermann, config.streams.at(ackermann), "thrust_angle");
-      if (is_free(p)) continue;
+      if (is_free(p) || gyro.empty() || is_free(SlotParameter(gyro, config.streams.at(gyro), "misalignment")))
+        continue;
       c.stream = ackermann;
       c.free = {p};
       c.free_dof = 1;

@@ -108,23 +108,15 @@ class NominalAxleTest : public ::testing::Test {
 testing::LearnedNominal* NominalAxleTest::nominal_ = nullptr;
 
 // With the nominal model (IMU misalignment free) the thrust angle and a steering offset of -alpha explain the drive
-// alike (to alpha sin^2(delta)): the diagnosis names one of the two, and the axle candidate recovers the angle.
-TEST_F(NominalAxleTest, ThrustAngleIsRecoveredButNotToldFromASteeringOffset) {
+// alike (to alpha sin^2(delta)): measured with the candidate in the library, both fitted to within a chi2 of 2 (yaw_deg
+// 2.024 +- 0.031 against offset_rad -0.0348; on a hidden steering offset of 0.03 rad, yaw_deg -1.765 +- 0.031 fitted
+// as well as the offset), so the library leaves the candidate out there, and the thrust angle reads as a steering
+// offset of -alpha.
+TEST_F(NominalAxleTest, ThrustAngleReadsAsASteeringOffsetWhenTheImuMountingIsFree) {
   const double yaw_deg = 2.0;
   const Diagnosis d = Diagnosed(*nominal_, {{"axle_misalignment", {{"yaw_deg", yaw_deg}}}}, 18);
-  ASSERT_EQ(d.verdict, "named");
-  ASSERT_FALSE(d.effects.empty());
-  EXPECT_TRUE(d.effects.front().name == "axle_misalignment" || d.effects.front().name == "steering_offset")
-      << d.effects.front().name;
-  const EffectEstimate* axle = CandidateOf(d, "axle_misalignment");
-  const EffectEstimate* steering = CandidateOf(d, "steering_offset");
-  ASSERT_NE(axle, nullptr);
-  ASSERT_NE(steering, nullptr);
-  ASSERT_TRUE(axle->std.count("yaw_deg"));
-  std::cout << "axle yaw_deg " << axle->parameters.at("yaw_deg") << " +- " << axle->std.at("yaw_deg")
-            << ", steering offset_rad " << steering->parameters.at("offset_rad") << " (-alpha "
-            << -yaw_deg * kPi / 180.0 << "); chi2 drops " << axle->lr_raw << " / " << steering->lr_raw << "\n";
-  EXPECT_NEAR(axle->parameters.at("yaw_deg"), yaw_deg, 3.0 * axle->std.at("yaw_deg"));
+  EXPECT_EQ(CandidateOf(d, "axle_misalignment"), nullptr);
+  ExpectNamedFirst(d, "steering_offset", "offset_rad", -yaw_deg * kPi / 180.0);
 }
 
 }  // namespace
