@@ -559,7 +559,7 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k)};
     if (model == "ackermann") {
       factor = MakeFactor(AckermannVelocityError(z_v, z_theta, s.wheelbase_m, dt));
-      vars.insert(vars.end(), {slot(3, k), slot(4, k)});
+      vars.insert(vars.end(), {slot(3, k), slot(4, k), slot(5, k)});
     } else {
       factor = MakeFactor(AckermannOdometerError(z_v, z_theta, s.wheelbase_m, dt));
     }

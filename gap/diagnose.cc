@@ -218,6 +218,26 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
         e->parameters["offset_rad"] = value.at(p)[0] - nominal[0];
         if (std.count(p)) e->std["offset_rad"] = std.at(p)[0];
       };
+    } else if (name == "axle_misalignment" && !ackermann.empty()) {
+      // The rear axle's thrust angle alpha (models/ackermann_velocity.h: the rear axle rolls along alpha, so the
+      // vehicle crabs by alpha and turns at -v tan(alpha) / L at zero handlebar) freed from the nominal model's zero;
+      // reported as the simulator's axle_misalignment on the Ackermann rear axle, yaw_deg = alpha in degrees. Its turn
+      // is a steering offset's to first order (k_gamma = -alpha); only the crab tells them apart, and it shows only
+      // against a heading tied to the chassis: the candidate applies when the gyroscope's mounting is believed
+      // (its misalignment fixed). With it free, a rotation of O by alpha absorbs the crab, only alpha sin^2(delta)
+      // on the steering row is left, and on the 30 s ATV drive both candidates fit to within a chi2 of 2
+      // (README, tests/gap/axle_diagnose_slow_test.cc): the candidate would only duplicate steering_offset.
+      const std::string p = SlotParameter(ackermann, config.streams.at(ackermann), "thrust_angle");
+      if (is_free(p) || gyro.empty() || is_free(SlotParameter(gyro, config.streams.at(gyro), "misalignment")))
+        continue;
+      c.stream = ackermann;
+      c.free = {p};
+      c.free_dof = 1;
+      c.describe = [p](const auto& value, const auto& std, EffectEstimate* e) {
+        constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
+        e->parameters["yaw_deg"] = value.at(p)[0] * kDegPerRad;
+        if (std.count(p)) e->std["yaw_deg"] = std.at(p)[0] * kDegPerRad;
+      };
     } else if ((name == "gyro_scale_error" || name == "gyro_bias_drift") && !gyro.empty()) {
       // gyro_scale_error: the per-axis scale k_s (models/gyroscope.h: z = k_s o omega + b + eta) freed from 1,
       // reported as scale_x/y/z. gyro_bias_drift: the bias b [rad/s] freed from the nominal model's zero as one
@@ -403,7 +423,7 @@ const std::vector<std::string>& CandidateNames() {
   static const std::vector<std::string> names = {
       "gps_latency",  "imu_time_offset",        "pose_time_offset",  "steering_offset",
       "gyro_scale_error", "gyro_bias_drift", "lateral_slip", "wheel_radius_asymmetry", "track_width_error",
-      "wheel_deformation"};
+      "wheel_deformation", "axle_misalignment"};
   return names;
 }
 

@@ -197,6 +197,18 @@ void AckermannVehicle::Place(const mjModel* model, mjData* data, const Terrain& 
   mj_forward(model, data);
 }
 
+void AckermannVehicle::TurnRearAxle(mjModel* model, double yaw_rad) const {
+  const Eigen::Quaterniond turn(Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()));
+  for (int dof : {wheel_left_dof_, wheel_right_dof_}) {
+    mjtNum* q = model->body_quat + 4 * model->dof_bodyid[dof];
+    const Eigen::Quaterniond turned = (turn * Eigen::Quaterniond(q[0], q[1], q[2], q[3])).normalized();
+    q[0] = turned.w();
+    q[1] = turned.x();
+    q[2] = turned.y();
+    q[3] = turned.z();
+  }
+}
+
 void AckermannVehicle::Apply(double handlebar_rad, double torque_per_wheel_nm, mjData* data) const {
   const double delta = std::clamp(handlebar_rad, -max_handlebar_rad_, max_handlebar_rad_);
   double left = 0.0, right = 0.0;

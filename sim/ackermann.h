@@ -70,6 +70,11 @@ class AckermannVehicle {
   // mj_forward.
   void Place(const mjModel* model, mjData* data, const Terrain& terrain, double x, double y, double yaw_rad,
              double clearance_m) const;
+  // A misaligned rear axle (the scenario's axle_misalignment effect): both rear wheel bodies turned about their
+  // parent's z through their centre by yaw_rad (positive counter-clockwise), so that their hinges, hence their rolling
+  // directions, point yaw_rad off O's x (a thrust angle). Changes the compiled model only: the geometry measured by
+  // Bind (tire centres) is unchanged, and the driver's steering stays nominal.
+  void TurnRearAxle(mjModel* model, double yaw_rad) const;
   // Steering servo targets for the handlebar angle (clamped to +-max_handlebar_rad) and the drive torque per rear wheel.
   void Apply(double handlebar_rad, double torque_per_wheel_nm, mjData* data) const;
   // Mean rear-wheel spin rate relative to the chassis [rad/s], positive forward.

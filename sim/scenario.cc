@@ -438,6 +438,17 @@ std::optional<Scenario::Problem> WheelEffectProblem(const std::vector<EffectOpti
   const bool wheel_effect = name == "wheel_radius_asymmetry" || name == "track_width_error" ||
                             name == "wheel_deformation" || name == "axle_misalignment";
   if (!wheel_effect) return std::nullopt;
+  if (kind == "ackermann" && name == "axle_misalignment") {
+    // The Ackermann vehicle's rear axle (both rear wheels: a thrust angle); the front wheels are steered, and their
+    // zero is steering_offset.
+    for (const EffectOptions& e : effects)
+      if (e.name == name && e.parameters.count("wheel"))
+        return P{k + ".parameters.wheel", "ackermann: axle_misalignment turns the rear axle (both rear wheels); "
+                                          "no wheel index"};
+    if (!(std::abs(EffectParameter(effects, name, "yaw_deg", 0.0)) <= 5.0))
+      return P{k + ".parameters.yaw_deg", "must be within +-5 on the ackermann rear axle"};
+    return std::nullopt;
+  }
   const int wheels = kind == "differential_drive" ? 2 : kind == "omni3" ? 3 : kind == "mecanum" ? 4 : 0;
   if (wheels == 0) return P{k + ".name", name + " is for wheeled indoor robots, not '" + kind + "'"};
   if (name == "wheel_radius_asymmetry") {

@@ -74,7 +74,11 @@
 //                                          revolution about its nominal mean); adds to robot.wheel_deformation
 //   axle_misalignment {wheel: 0, yaw_deg: 0}   any wheeled kind: wheel `wheel` turned about z by yaw_deg within
 //                                          +-20 (WheelMountingChange; unlike robot.wheel_mounting, the driver does not
-//                                          know it)
+//                                          know it). ackermann: the rear axle's thrust angle, both rear wheels turned
+//                                          about z by yaw_deg within +-5 (positive counter-clockwise; no `wheel`):
+//                                          the rear axle rolls along yaw_deg, so the vehicle crabs (course = heading
+//                                          + yaw_deg) and at zero handlebar turns at -v tan(yaw) / L
+//                                          (AckermannVehicle::TurnRearAxle; the estimator's odometer.thrust_angle)
 // `wheel` is a whole wheel index of the kind (differential_drive 0 left, 1 right; omni3 0-2; mecanum 0-3).
 //
 // Streams written (names fixed, as tests/support/synthetic.h): imu (wx wy wz ax ay az), magnetometer (mx my mz,

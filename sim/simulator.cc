@@ -182,6 +182,10 @@ class Simulator::Impl {
       auto vehicle = AckermannVehicle::Bind(model_.get(), model_where_);
       if (!vehicle.ok()) return vehicle.status();
       vehicle_ = vehicle.value();
+      // A misaligned rear axle changes the bound model (the driver and the platform geometry stay nominal).
+      if (HasEffect(scenario_, "axle_misalignment"))
+        vehicle_.TurnRearAxle(model_.get(),
+                              EffectParameter(scenario_.effects, "axle_misalignment", "yaw_deg", 0.0) * kPi / 180.0);
       controller_.emplace(scenario_.robot.speed_controller);
       odom_site_ = vehicle_.odom_site();
     } else {
@@ -387,6 +391,7 @@ class Simulator::Impl {
     for (const EffectOptions& e : effects) {
       recording::Effect truth{e.name, KnownEffects().at(e.name)};
       for (const auto& [name, value] : e.parameters) truth.parameters[name] = value;
+      if (ackermann_ && e.name == "axle_misalignment") truth.parameters.erase("wheel");  // the rear axle
       out_.truth.effects.push_back(truth);
     }
     return Status::Ok();

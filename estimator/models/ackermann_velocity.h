@@ -1,13 +1,14 @@
-// Ackermann-steering odometer in measurement space (seed 000, eq. 15 inverted), with the tires' cornering compliance:
-// the body velocities between two poses predict the rear-wheel speed and the handlebar angle, and the error is the
-// difference to the readings.
+// Ackermann-steering odometer in measurement space (seed 000, eq. 15 inverted), with the tires' cornering compliance
+// and the rear axle's thrust angle: the body velocities between two poses predict the rear-wheel speed and the
+// handlebar angle, and the error is the difference to the readings.
 //
 //   v^(O), omega^(O) = VelocitiesBetween(pose_k, pose_k+1, dt)          (eq. 7 inverted; middle of the interval)
 //   a_y         = v_x omega_z                                            lateral (centripetal) acceleration [m/s^2]
-//   z_v_hat     = v_x / k_v                                              k_v = kv_over_L * L
+//   v_roll      = v_x cos(alpha) + v_y sin(alpha)                        rear wheels' rolling speed [m/s]
+//   z_v_hat     = v_roll / k_v                                           k_v = kv_over_L * L
 //   delta       = atan((L omega_z + v_y) / v_x) + c_front a_y            steered angle of the front wheels
 //   z_theta_hat = (delta - k_gamma) / k_theta                           (eq. 15: omega_z = (k_v / L) v tan(delta))
-//   e = [z_v_hat - z_v;  z_theta_hat - z_theta;  v_y + c_rear a_y;  v_z] + eta                       e in R^4
+//   e = [z_v_hat - z_v;  z_theta_hat - z_theta;  v_y - v_x tan(alpha) + c_rear a_y;  v_z] + eta     e in R^4
 //
 // Cornering compliance. Eq. 15 assumes rolling without side slip. Real tires (and MuJoCo's soft contacts) carry the
 // centripetal force by slipping sideways in proportion to it: the rear axle drifts outwards, v_y = -c_rear a_y
@@ -15,6 +16,16 @@
 // less into the turn than they are steered (understeer): the front axle moves along atan((L omega_z + v_y) / v_x).
 // With c_front = c_rear = 0 (their defaults) this is eq. 15 with the non-holonomic constraints. Measured on the MuJoCo
 // ATV (30 s, 4 m hills): v_y regressed on a_y has slope -0.015 s and leaves 0.009 m/s rms of 0.027.
+//
+// Rear-axle thrust angle alpha [rad] (a misaligned rear axle: both rear wheels turned about z by alpha, positive
+// counter-clockwise). The rear wheels roll along d = (cos alpha, sin alpha) in O, so without side slip O's velocity
+// is v_roll d: v_y = v_x tan(alpha) (the vehicle crabs: its course is its heading plus alpha) and the speed sensor
+// reads v_roll = v . d. The front axle, L ahead, moves at (v_x, v_y + L omega_z), so the steering row keeps its form;
+// with v_y = v_x tan(alpha) it says omega_z = v_x (tan(delta) - tan(alpha)) / L: at zero handlebar the vehicle turns
+// at -v_x tan(alpha) / L. To first order that yaw rate is a steering offset (k_gamma = -alpha); what tells them apart
+// is the crab, v_y, seen only against a heading reference that is not itself calibrated to the rear axle (with the
+// IMU's misalignment free, a rotation of O by alpha absorbs the crab, and only alpha sin^2(delta), their difference on
+// the steering row, is left). alpha = 0 (the default) is the model above.
 //
 // Why not the seed's form (ackermann_odometer.h, eqs. 7-8 with the readings as inputs): there the reading noise
 // passes through the nonlinear model, so the error covariance of eq. 1 depends on the parameters, and the
@@ -25,13 +36,14 @@
 //
 // Frames: O is the middle of the rear axle (x forward, z up). Measurements: z_v rear-wheel speed with the nominal
 // wheel radius [m/s], z_theta handlebar angle [rad], both over [t_k, t_k+1]. Calibration: kv_over_L [1/m], k_theta
-// [-], k_gamma [rad], c_front [rad s^2/m], c_rear [s]; the wheelbase L [m] is known. Noise eta = [sigma_v (m/s),
-// sigma_theta (rad), lateral (m/s), vertical (m/s)], the last two the uncertainty of the remaining non-holonomic
+// [-], k_gamma [rad], c_front [rad s^2/m], c_rear [s], alpha [rad]; the wheelbase L [m] is known. Noise eta =
+// [sigma_v (m/s), sigma_theta (rad), lateral (m/s), vertical (m/s)], the last two the uncertainty of the non-holonomic
 // assumptions (no unmodelled sideways slip, no motion off the ground). Eq. 15 says nothing about roll and pitch
 // rates, and on hills they are not zero (the terrain tilts the vehicle): pretending they are pulls the estimated
 // attitude flat and biases the IMU misalignment, so this form leaves them to the other sensors. Below
 // kMinSteeringSpeed the steering angle does not affect the motion, so its error is zero (eta only).
-// Variables: pose at t_k, pose at t_k+1 (PoseBlock), kv_over_L, k_theta, k_gamma, c_front, c_rear (ScalarBlock each).
+// Variables: pose at t_k, pose at t_k+1 (PoseBlock), kv_over_L, k_theta, k_gamma, c_front, c_rear, alpha (ScalarBlock
+// each).
 //
 // Jacobians (Linearize; internal/so3_jacobians.h for Jr, Jr^-1, Jl^-1 = (Jr^-1)^T). VelocitiesBetween computes
 // phi = Log(q_k^-1 q_k+1), omega = phi / dt, q_mid = q_k Exp(phi / 2) and v = R_mid^T (p_k+1 - p_k) / dt, so
@@ -40,10 +52,12 @@
 //   perturbation of q_mid, is (q_k Exp(d) Exp(psi + dpsi) = q_mid Exp(R(psi)^T d) Exp(Jr(psi) dpsi), psi = phi / 2)
 //   eps/dtheta_k = R(phi/2)^T - Jr(phi/2) Jl^-1(phi) / 2,   eps/dtheta_k+1 = Jr(phi/2) Jr^-1(phi) / 2.
 // The rows in (v, omega_z), with r = (L omega_z + v_y) / v_x and s = 1 / (1 + r^2) (steering row zero below
-// kMinSteeringSpeed): de_v = dv_x / k_v;  k_theta de_theta = (c_front omega_z - s r / v_x) dv_x + s / v_x dv_y
-// + (s L / v_x + c_front v_x) domega_z;  de_lat = c_rear omega_z dv_x + dv_y + c_rear v_x domega_z;  de_vert = dv_z.
-// Parameters: de_v/dkv_over_L = -v_x / (kv_over_L^2 L), de_theta/dk_theta = -(delta - k_gamma) / k_theta^2,
-// de_theta/dk_gamma = -1 / k_theta, de_theta/dc_front = a_y / k_theta, de_lat/dc_rear = a_y.
+// kMinSteeringSpeed): de_v = (cos(alpha) dv_x + sin(alpha) dv_y) / k_v;  k_theta de_theta = (c_front omega_z -
+// s r / v_x) dv_x + s / v_x dv_y + (s L / v_x + c_front v_x) domega_z;  de_lat = (c_rear omega_z - tan(alpha)) dv_x
+// + dv_y + c_rear v_x domega_z;  de_vert = dv_z.
+// Parameters: de_v/dkv_over_L = -v_roll / (kv_over_L^2 L), de_theta/dk_theta = -(delta - k_gamma) / k_theta^2,
+// de_theta/dk_gamma = -1 / k_theta, de_theta/dc_front = a_y / k_theta, de_lat/dc_rear = a_y,
+// de_v/dalpha = (v_y cos(alpha) - v_x sin(alpha)) / k_v, de_lat/dalpha = -v_x (1 + tan^2(alpha)).
 #pragma once
 
 #include <cmath>
@@ -60,7 +74,8 @@ namespace roamlab::estimator {
 
 class AckermannVelocityError {
  public:
-  using Blocks = std::tuple<PoseBlock, PoseBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock>;
+  using Blocks =
+      std::tuple<PoseBlock, PoseBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock>;
   static constexpr int kResidualDim = 4;
   static constexpr int kNoiseDim = 4;
   static constexpr bool kAdditiveNoise = true;  // e = f(x) + eta
@@ -75,6 +90,9 @@ class AckermannVelocityError {
   bool operator()(const T* const* x, const T* noise, T* error) const {
     using std::abs;
     using std::atan;
+    using std::cos;
+    using std::sin;
+    using std::tan;
     Vector3<T> v_body, omega_body;
     VelocitiesBetween<T>(PoseFromArray(x[0]), PoseFromArray(x[1]), T(dt_s_), &v_body, &omega_body);
     const T& kv_over_l = x[2][0];
@@ -82,15 +100,17 @@ class AckermannVelocityError {
     const T& k_gamma = x[4][0];
     const T& c_front = x[5][0];
     const T& c_rear = x[6][0];
+    const T& alpha = x[7][0];
     const T a_y = v_body.x() * omega_body.z();
-    error[0] = v_body.x() / (kv_over_l * T(wheelbase_m_)) - T(z_v_mps_) + noise[0];
+    const T v_roll = v_body.x() * cos(alpha) + v_body.y() * sin(alpha);
+    error[0] = v_roll / (kv_over_l * T(wheelbase_m_)) - T(z_v_mps_) + noise[0];
     if (std::abs(ValueOf(v_body.x())) >= kMinSteeringSpeed) {
       const T delta = atan((T(wheelbase_m_) * omega_body.z() + v_body.y()) / v_body.x()) + c_front * a_y;
       error[1] = (delta - k_gamma) / k_theta - T(z_theta_rad_) + noise[1];
     } else {
       error[1] = noise[1];
     }
-    error[2] = v_body.y() + c_rear * a_y + noise[2];
+    error[2] = v_body.y() - v_body.x() * tan(alpha) + c_rear * a_y + noise[2];
     error[3] = v_body.z() + noise[3];
     return true;
   }
@@ -105,6 +125,8 @@ class AckermannVelocityError {
     const double k_gamma = x[4][0];
     const double c_front = x[5][0];
     const double c_rear = x[6][0];
+    const double alpha = x[7][0];
+    const double cos_alpha = std::cos(alpha), sin_alpha = std::sin(alpha), tan_alpha = std::tan(alpha);
 
     // VelocitiesBetween, keeping the rotation vector and q_mid.
     const Eigen::Vector3d phi = QuaternionLog<double>(pose_k.q_world_body.conjugate() * pose_k1.q_world_body);
@@ -115,20 +137,22 @@ class AckermannVelocityError {
     // As operator().
     const double k_v = kv_over_l * wheelbase_m_;
     const double a_y = v_body.x() * omega_body.z();
-    error[0] = v_body.x() / k_v - z_v_mps_;
+    const double v_roll = v_body.x() * cos_alpha + v_body.y() * sin_alpha;
+    error[0] = v_roll / k_v - z_v_mps_;
     const bool steering = std::abs(v_body.x()) >= kMinSteeringSpeed;
     const double r = steering ? (wheelbase_m_ * omega_body.z() + v_body.y()) / v_body.x() : 0.0;
     const double delta = steering ? std::atan(r) + c_front * a_y : 0.0;
     error[1] = steering ? (delta - k_gamma) / k_theta - z_theta_rad_ : 0.0;
-    error[2] = v_body.y() + c_rear * a_y;
+    error[2] = v_body.y() - v_body.x() * tan_alpha + c_rear * a_y;
     error[3] = v_body.z();
     if (jacobians == nullptr) return true;
 
     // Rows of the residual in the motion (v, omega): de/dv (4x3) and de/domega_z (4x1, only the steering row).
     Eigen::Matrix<double, 4, 3> J_e_v = Eigen::Matrix<double, 4, 3>::Zero();
     Eigen::Vector4d J_e_omega_z = Eigen::Vector4d::Zero();
-    J_e_v(0, 0) = 1.0 / k_v;
-    J_e_v(2, 0) = c_rear * omega_body.z();
+    J_e_v(0, 0) = cos_alpha / k_v;
+    J_e_v(0, 1) = sin_alpha / k_v;
+    J_e_v(2, 0) = c_rear * omega_body.z() - tan_alpha;
     J_e_v(2, 1) = 1.0;
     J_e_v(3, 2) = 1.0;
     J_e_omega_z[2] = c_rear * v_body.x();
@@ -162,7 +186,7 @@ class AckermannVelocityError {
 
     // Calibration scalars.
     if (jacobians[2] != nullptr) {
-      Eigen::Map<Eigen::Vector4d>{jacobians[2]} << -v_body.x() / (kv_over_l * k_v), 0.0, 0.0, 0.0;
+      Eigen::Map<Eigen::Vector4d>{jacobians[2]} << -v_roll / (kv_over_l * k_v), 0.0, 0.0, 0.0;
     }
     if (jacobians[3] != nullptr) {
       Eigen::Map<Eigen::Vector4d>{jacobians[3]} << 0.0, steering ? -(delta - k_gamma) / (k_theta * k_theta) : 0.0,
@@ -175,6 +199,10 @@ class AckermannVelocityError {
       Eigen::Map<Eigen::Vector4d>{jacobians[5]} << 0.0, steering ? a_y / k_theta : 0.0, 0.0, 0.0;
     }
     if (jacobians[6] != nullptr) Eigen::Map<Eigen::Vector4d>{jacobians[6]} << 0.0, 0.0, a_y, 0.0;
+    if (jacobians[7] != nullptr) {
+      Eigen::Map<Eigen::Vector4d>{jacobians[7]} << (v_body.y() * cos_alpha - v_body.x() * sin_alpha) / k_v, 0.0,
+          -v_body.x() * (1.0 + tan_alpha * tan_alpha), 0.0;
+    }
     return true;
   }
 

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -32,7 +33,9 @@ struct LearnedNominal {
 };
 
 // Loads ROAMLAB_SOURCE_DIR/`scenario_path` and learns its baseline; nullptr (with a test failure) when that fails.
-inline std::unique_ptr<LearnedNominal> LearnNominal(const std::string& scenario_path) {
+// `adjust`, when given, changes the nominal configuration (what the user believes) before the baseline is learned.
+inline std::unique_ptr<LearnedNominal> LearnNominal(
+    const std::string& scenario_path, const std::function<void(estimator::EstimatorConfig*)>& adjust = {}) {
   auto loaded = sim::LoadScenario(std::string(ROAMLAB_SOURCE_DIR) + "/" + scenario_path);
   EXPECT_TRUE(loaded.ok()) << loaded.status().message();
   if (!loaded.ok()) return nullptr;
@@ -42,6 +45,7 @@ inline std::unique_ptr<LearnedNominal> LearnNominal(const std::string& scenario_
   EXPECT_TRUE(config.ok()) << config.status().message();
   if (!config.ok()) return nullptr;
   out->config = config.value();
+  if (adjust) adjust(&out->config);
   DiagnoseOptions learn;
   learn.max_effects = 0;
   auto learned = Diagnose(out->config, SimulatedWithSeed(out->scenario, 900001).recording, learn);

@@ -1,6 +1,7 @@
 // Physical effects of a scenario (sim/scenario.h, issue 6): each changes exactly what it says, against the same drive
 // without it (noise off, so that the difference is the effect alone), and is stated in truth.yaml only.
 #include <cmath>
+#include <iostream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -13,6 +14,7 @@ namespace roamlab::sim {
 namespace {
 
 constexpr double kDurationS = 2.0;
+constexpr double kPi = 3.14159265358979323846;
 
 // The shortened ATV drive, sensors at 100 Hz (GPS too, so that a shift of whole samples can be compared row to row).
 Scenario Drive(const std::vector<EffectOptions>& effects) {
@@ -152,6 +154,63 @@ TEST_F(EffectsTest, MagnetometerInterferenceIsABiasAlongItsDirectionThatFollowsT
   EXPECT_GT(max_torque - min_torque, 5.0);                            // the speed controller works
 }
 
+// Mean yaw rate [rad/s] and mean crab angle (course minus heading, [rad]) of O over [t0, end] of the ground truth.
+struct Crab {
+  double yaw_rate_radps = 0.0;
+  double crab_rad = 0.0;
+  double speed_mps = 0.0;
+};
+Crab CrabOf(const Trajectory& truth, double t0_s) {
+  Crab out;
+  int n = 0;
+  const auto yaw = [](const StampedPose& p) -> Eigen::Vector2d {
+    return (p.q_world_body * Eigen::Vector3d::UnitX()).head<2>();
+  };
+  for (std::size_t k = 0; k + 1 < truth.size(); ++k) {
+    if (truth[k].t.seconds() < t0_s) continue;
+    const double dt = truth[k + 1].t.seconds() - truth[k].t.seconds();
+    const Eigen::Vector2d h0 = yaw(truth[k]), h1 = yaw(truth[k + 1]);
+    const Eigen::Vector2d v = (truth[k + 1].p_world_body - truth[k].p_world_body).head<2>() / dt;
+    const Eigen::Vector2d h = (h0 + h1).normalized();
+    out.yaw_rate_radps += std::atan2(h0.x() * h1.y() - h0.y() * h1.x(), h0.dot(h1)) / dt;
+    out.crab_rad += std::atan2(h.x() * v.y() - h.y() * v.x(), h.dot(v));
+    out.speed_mps += v.norm();
+    ++n;
+  }
+  out.yaw_rate_radps /= n;
+  out.crab_rad /= n;
+  out.speed_mps /= n;
+  return out;
+}
+
+TEST(AxleMisalignmentTest, AtvRearAxleThrustAngleCrabsAndTurnsAtZeroHandlebar) {
+  // Straight ahead at 4 m/s with the handlebar at zero on flat ground: a rear axle turned by alpha = 2 deg rolls
+  // along alpha, so the vehicle crabs (course = heading + alpha) and turns at -v tan(alpha) / L
+  // (estimator/models/ackermann_velocity.h); without it, it goes straight.
+  const auto drive = [](const std::vector<EffectOptions>& effects) {
+    Scenario s = testing::AtvHills(6.0);
+    s.terrain.type = TerrainOptions::Type::kFlat;
+    s.driver.speed_mps = Profile::Constant(4.0);
+    s.driver.handlebar_rad = Profile::Constant(0.0);
+    s.effects = effects;
+    return CrabOf(*Simulated(s).recording.ground_truth, 2.0);
+  };
+  const double alpha = 2.0 * kPi / 180.0, wheelbase_m = 1.25;
+  const Crab straight = drive({});
+  const Crab crab = drive({{"axle_misalignment", {{"yaw_deg", 2.0}}}});
+  std::cout << "nominal yaw rate " << straight.yaw_rate_radps << " crab " << straight.crab_rad << "; thrust: yaw rate "
+            << crab.yaw_rate_radps << " (kinematic " << -crab.speed_mps * std::tan(alpha) / wheelbase_m << ") crab "
+            << crab.crab_rad << " (" << alpha << ")\n";
+  EXPECT_LT(std::abs(straight.yaw_rate_radps), 0.002);
+  EXPECT_LT(std::abs(straight.crab_rad), 0.002);
+  // Within 10 % of the kinematic values: the tires' cornering compliance (about 0.015 s, slip under the 0.45 m/s^2 of
+  // the turn) is what the rigid kinematics leave out. Measured: yaw rate -0.1123 rad/s (kinematic -0.1124), crab
+  // 0.0372 rad (alpha 0.0349; the outward slip adds about 0.0017).
+  EXPECT_NEAR(crab.yaw_rate_radps, -crab.speed_mps * std::tan(alpha) / wheelbase_m,
+              0.1 * crab.speed_mps * std::tan(alpha) / wheelbase_m);
+  EXPECT_NEAR(crab.crab_rad, alpha, 0.1 * alpha);
+}
+
 TEST(EffectsValidationTest, UnknownNamesParametersAndRangesAreErrors) {
   const auto problem = [](const std::vector<EffectOptions>& effects) {
     Scenario s = testing::AtvHills(1.0);
@@ -171,6 +230,12 @@ TEST(EffectsValidationTest, UnknownNamesParametersAndRangesAreErrors) {
             std::string::npos);
   EXPECT_NE(problem({{"gyro_bias_drift", {{"initial_y", 0.6}}}}).find("initial_y: must be in [-0.5, 0.5]"),
             std::string::npos);
+  EXPECT_EQ(problem({{"axle_misalignment", {{"yaw_deg", 1.5}}}}), "");
+  EXPECT_EQ(problem({{"axle_misalignment", {{"yaw_deg", 6.0}}}}),
+            "effects[0].parameters.yaw_deg: must be within +-5 on the ackermann rear axle");
+  EXPECT_EQ(problem({{"axle_misalignment", {{"wheel", 1}, {"yaw_deg", 1.0}}}}),
+            "effects[0].parameters.wheel: ackermann: axle_misalignment turns the rear axle (both rear wheels); no "
+            "wheel index");
   // Not a whole number of 1 ms physics steps: refused when the simulator is created.
   Scenario s = testing::AtvHills(1.0);
   s.effects = {{"gps_latency", {{"latency_s", 0.0105}}}};

@@ -231,8 +231,8 @@ TEST(WheelEffectsValidation, OneLineErrors) {
   EXPECT_EQ(ProblemOf(omni), "effects[0].name: wheel_radius_asymmetry is for differential_drive robots only");
 
   Scenario atv = testing::AtvHills(2.0);
-  atv.effects = {{"axle_misalignment", {{"yaw_deg", 1}}}};
-  EXPECT_EQ(ProblemOf(atv), "effects[0].name: axle_misalignment is for wheeled indoor robots, not 'ackermann'");
+  atv.effects = {{"wheel_deformation", {{"ovality_m", 0.001}}}};
+  EXPECT_EQ(ProblemOf(atv), "effects[0].name: wheel_deformation is for wheeled indoor robots, not 'ackermann'");
 }
 
 }  // namespace

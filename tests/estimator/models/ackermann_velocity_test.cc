@@ -36,7 +36,7 @@ TEST(AckermannVelocityErrorTest, ZeroAtTruthForTableIAndSkewedGains) {
     const double z_theta = (delta - k_gamma) / k_theta;
     const auto factor = MakeFactor(AckermannVelocityError(z_v, z_theta, kL, dt));
     const auto lin = testing::Evaluate(*factor, {pose0, Step(pose0, v, omega, dt), Scalar(kv_over_l), Scalar(k_theta),
-                                                 Scalar(k_gamma), Scalar(0.0), Scalar(0.0)});
+                                                 Scalar(k_gamma), Scalar(0.0), Scalar(0.0), Scalar(0.0)});
     EXPECT_LT(lin.error.norm(), 1e-10);
     EXPECT_TRUE(lin.noise_jacobian.isApprox(Eigen::MatrixXd::Identity(4, 4)));
   }
@@ -47,7 +47,7 @@ TEST(AckermannVelocityErrorTest, SpeedErrorScalesWithGain) {
   const Eigen::VectorXd pose0 = Manifold::Pose().Identity();
   const auto factor = MakeFactor(AckermannVelocityError(4.0 / kL / 0.8, 0.0, kL, 0.01));
   const auto lin = testing::Evaluate(*factor, {pose0, Step(pose0, 4.0, 0.0, 0.01), Scalar(0.88), Scalar(1.0),
-                                               Scalar(0.0), Scalar(0.0), Scalar(0.0)});
+                                               Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0)});
   EXPECT_NEAR(lin.error[0], 4.0 / kL / 0.88 - 4.0 / kL / 0.8, 1e-12);
 }
 
@@ -55,7 +55,7 @@ TEST(AckermannVelocityErrorTest, SteeringIgnoredAtStandstill) {
   const Eigen::VectorXd pose0 = Manifold::Pose().Identity();
   const auto factor = MakeFactor(AckermannVelocityError(0.0, 0.3, kL, 0.01));
   const auto lin = testing::Evaluate(*factor, {pose0, pose0, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
-                                               Scalar(0.0)});
+                                               Scalar(0.0), Scalar(0.0)});
   EXPECT_LT(lin.error.norm(), 1e-12);
 }
 
@@ -69,13 +69,33 @@ TEST(AckermannVelocityErrorTest, CorneringComplianceExplainsSideSlipAndUnderstee
   const Eigen::VectorXd pose1 = Step(pose0, v, omega, dt, v_y);
   const auto factor = MakeFactor(AckermannVelocityError(v / kL / 0.8, delta, kL, dt));
   const auto lin = testing::Evaluate(*factor, {pose0, pose1, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(c_front),
-                                               Scalar(c_rear)});
+                                               Scalar(c_rear), Scalar(0.0)});
   EXPECT_LT(lin.error.norm(), 1e-10) << lin.error.transpose();
   // Without the compliances the same motion leaves the side slip and the understeer as errors.
   const auto rigid = testing::Evaluate(*factor, {pose0, pose1, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
-                                                 Scalar(0.0)});
+                                                 Scalar(0.0), Scalar(0.0)});
   EXPECT_NEAR(rigid.error[1], -c_front * a_y, 1e-9);
   EXPECT_NEAR(rigid.error[2], v_y, 1e-9);
+}
+
+TEST(AckermannVelocityErrorTest, ThrustAngleExplainsCrabAndTurnAtZeroHandlebar) {
+  // A rear axle turned by alpha = 2 deg: with the handlebar at zero the vehicle turns at -v tan(alpha) / L and crabs,
+  // v_y = v tan(alpha); the rear wheels read the rolling speed v / cos(alpha).
+  const double v = 4.0, dt = 0.01, alpha = 2.0 * 3.14159265358979 / 180.0;
+  const double omega = -v * std::tan(alpha) / kL, v_y = v * std::tan(alpha);
+  const Eigen::VectorXd pose0 = Manifold::Pose().Identity();
+  const Eigen::VectorXd pose1 = Step(pose0, v, omega, dt, v_y);
+  const auto factor = MakeFactor(AckermannVelocityError(v / std::cos(alpha) / kL / 0.8, 0.0, kL, dt));
+  const auto lin = testing::Evaluate(*factor, {pose0, pose1, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
+                                               Scalar(0.0), Scalar(alpha)});
+  EXPECT_LT(lin.error.norm(), 1e-10) << lin.error.transpose();
+  // Without it the crab is a lateral error of v tan(alpha); the front axle still moves straight ahead, so the
+  // steering row holds.
+  const auto aligned = testing::Evaluate(*factor, {pose0, pose1, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
+                                                   Scalar(0.0), Scalar(0.0)});
+  EXPECT_NEAR(aligned.error[2], v_y, 1e-9);
+  EXPECT_LT(std::abs(aligned.error[1]), 1e-9);
+  EXPECT_NEAR(aligned.error[0], v - v / std::cos(alpha), 1e-9);
 }
 
 TEST(AckermannVelocityErrorTest, JacobiansMatchCentralDifferences) {
@@ -85,7 +105,9 @@ TEST(AckermannVelocityErrorTest, JacobiansMatchCentralDifferences) {
     const Eigen::VectorXd pose1 = testing::Perturb(Manifold::Pose(), Step(pose0, 3.0 + trial, 0.2, 0.02), 0.002, &rng);
     const auto factor = MakeFactor(AckermannVelocityError(4.0, 0.1, kL, 0.02));
     testing::ExpectJacobiansMatchNumeric(
-        *factor, {pose0, pose1, Scalar(0.78), Scalar(1.02), Scalar(0.01), Scalar(0.004), Scalar(-0.015)}, 1e-5);
+        *factor, {pose0, pose1, Scalar(0.78), Scalar(1.02), Scalar(0.01), Scalar(0.004), Scalar(-0.015),
+                    Scalar(0.02)},
+        1e-5);
   }
 }
 

@@ -257,11 +257,12 @@ TEST(AnalyticJacobiansTest, AckermannVelocity) {
     const double kv_over_l = 0.8 + 0.02 * normal(rng), k_theta = 1.0 + 0.05 * normal(rng);
     const double k_gamma = 0.02 * normal(rng);
     const double c_front = 0.003 * normal(rng), c_rear = 0.015 * normal(rng);  // [rad s^2/m], [s]
+    const double alpha = 0.03 * normal(rng);                                     // [rad]
     const double z_v = v_body.x() / (kv_over_l * kWheelbase) + 0.03 * normal(rng);
     const double z_theta = 0.2 * normal(rng);
     ExpectAnalyticMatchesJets(AckermannVelocityError(z_v, z_theta, kWheelbase, kDt),
                               {pose_k, pose_k1, Scalar(kv_over_l), Scalar(k_theta), Scalar(k_gamma), Scalar(c_front),
-                               Scalar(c_rear)},
+                               Scalar(c_rear), Scalar(alpha)},
                               "point " + std::to_string(point));
   }
 }
