@@ -4,12 +4,13 @@
 //   z_hat = A (q_O^W q_S^O)^-1 h^(W) + b + k tau_hat + eta,      e = z_hat - z           e, eta in R^3 [units of z]
 //   tau_hat = c e_x^T q_S^O f^(S)                                                         [N m]
 //
-// The added term: the drive motors' current magnetizes the sensor's surroundings, a bias in S along k [units of z per
-// N m] proportional to the drive torque per wheel. The recording carries no torque or current, so tau_hat is a proxy:
-// the vehicle's forward specific force e_x^T q_S^O f^(S) [m/s^2] (f^(S): the accelerometer's reading at the sample's
-// time, in S, i.e. the accelerometer shares the magnetometer's frame, one IMU package), which is the traction force
-// over the mass (the slope's pull included: f_x = a_x + g sin(pitch)), times c = m r / n [N m per m/s^2] (mass m, wheel
-// radius r, n driven wheels). Without the input (f^(S) = 0) or with k = 0 (the default) this is eq. 10 as written.
+// The added term: the drive motors' current magnetizes the sensor's surroundings, a bias in S along k (the slot
+// b_per_drive_nm) [units of z per N m] proportional to the drive torque per wheel. The recording carries no torque
+// or current, so tau_hat is a proxy: the vehicle's forward specific force e_x^T q_S^O f^(S) [m/s^2] (f^(S): the
+// accelerometer's reading at the sample's time, in S, i.e. the accelerometer shares the magnetometer's frame, one IMU
+// package), which is the traction force over the mass (the slope's pull included: f_x = a_x + g sin(pitch)), times
+// c = m r / n [N m per m/s^2] (mass m, wheel radius r, n driven wheels). Without the input (f^(S) = 0) or with k = 0
+// (the default) this is eq. 10 as written.
 //
 // Frames: q_O^W: orientation of the odometric frame O in the world W (East-North-Up); h^(W): the Earth's magnetic
 // field in W, a constant of the measurement. The reading z is the field in the sensor frame S, in the same units as
