@@ -36,14 +36,14 @@ const std::vector<ModelSpec>& ModelSpecs() {
         ScalarSlot("k_gamma", 0.0), ScalarSlot("cornering_front", 0.0), ScalarSlot("cornering_rear", 0.0),
         ScalarSlot("thrust_angle", 0.0)},
        {"wheelbase_m", "speed_column"},
-       true},
+       true, {}},
       {"ackermann_seed",
        {"speed", "steering"},
        {"speed_mps", "steering_rad", "lateral_mps", "vertical_mps", "roll_rate_radps", "pitch_rate_radps"},
        {ScalarSlot("kv_over_L", std::numeric_limits<double>::quiet_NaN()), ScalarSlot("k_theta", 1.0),
         ScalarSlot("k_gamma", 0.0)},
        {"wheelbase_m", "speed_column"},
-       true},
+       true, {}},
       // Wheel radii and baseline default to NaN: the builder takes them from the recording's platform geometry.
       // right_left_ratio multiplies radius_right; deformation_left/right are the tires' second harmonic (a, b) [m]
       // (models/differential_drive.h).
@@ -56,7 +56,7 @@ const std::vector<ModelSpec>& ModelSpecs() {
         {"deformation_left", Manifold::Euclidean(2), Vec({0.0, 0.0})},
         {"deformation_right", Manifold::Euclidean(2), Vec({0.0, 0.0})}},
        {},
-       true},
+       true, {}},
       // Omni and mecanum wheel radii and geometry: NaN too, taken from the platform geometry.
       {"omni3_drive",
        {""},
@@ -66,7 +66,7 @@ const std::vector<ModelSpec>& ModelSpecs() {
         ScalarSlot("radius_2", std::numeric_limits<double>::quiet_NaN()),
         ScalarSlot("distance", std::numeric_limits<double>::quiet_NaN())},
        {},
-       true},
+       true, {}},
       {"mecanum_drive",
        {""},
        {"wheel_radps", "vertical_mps", "tilt_radps"},
@@ -76,26 +76,36 @@ const std::vector<ModelSpec>& ModelSpecs() {
         ScalarSlot("radius_3", std::numeric_limits<double>::quiet_NaN()),
         ScalarSlot("lx_plus_ly", std::numeric_limits<double>::quiet_NaN())},
        {},
-       true},
+       true, {}},
       {"odometer", {""}, {"linear_mps", "angular_radps"}, {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")},
-       {"row_covariance_scale"}, true},
+       {"row_covariance_scale"}, true, {}},
       // The odometer's eqs. 5-8 over the sample's whole interval: see problem.h (relative motion).
       {"relative_motion", {""}, {"linear_mps", "angular_radps"},
-       {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")}, {"interval_s", "row_covariance_scale"}, false},
+       {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")}, {"interval_s", "row_covariance_scale"}, false,
+       {}},
       {"gyroscope", {""}, {"sigma_radps"}, {RotationSlot("misalignment"), Vector3Slot("bias", 0.0), Vector3Slot("scale", 1.0)},
-       {}, false},
+       {}, false, {}},
       {"accelerometer",
        {""},
        {"sigma_mps2"},
        {RotationSlot("misalignment"), Vector3Slot("lever_arm", 0.0), Vector3Slot("bias", 0.0), Vector3Slot("scale", 1.0)},
        {},
-       false},
-      {"magnetometer", {""}, {"sigma"}, {RotationSlot("misalignment"), MatrixSlot("A"), Vector3Slot("b", 0.0)}, {"field_world"},
-       false},
-      {"gps", {""}, {"sigma_m"}, {Vector3Slot("lever_arm", 0.0)}, {}, false},
+       false, {}},
+      // b_per_drive_nm: the motor interference per N m of drive torque, estimated from the forward specific force read
+      // from inputs.specific_force (an imu or accelerometer stream) times options.drive_nm_per_mps2
+      // (models/magnetometer.h).
+      {"magnetometer",
+       {""},
+       {"sigma"},
+       {RotationSlot("misalignment"), MatrixSlot("A"), Vector3Slot("b", 0.0), Vector3Slot("b_per_drive_nm", 0.0)},
+       {"field_world", "drive_nm_per_mps2"},
+       false,
+       {"specific_force"}},
+      {"gps", {""}, {"sigma_m"}, {Vector3Slot("lever_arm", 0.0)}, {}, false, {}},
       {"absolute_pose", {""}, {"position_m", "orientation_rad"}, {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")},
-       {}, false},
-      {"linear_velocity", {""}, {"sigma_mps"}, {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")}, {}, false},
+       {}, false, {}},
+      {"linear_velocity", {""}, {"sigma_mps"}, {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")}, {}, false,
+       {}},
   };
   return specs;
 }
@@ -242,7 +252,7 @@ class Parser {
 
   StreamConfig ParseStream(const std::string& name, const YAML::Node& n) const {
     const std::string where = "stream '" + name + "'";
-    CheckKeys(n, {"model", "source", "noise", "parameters", "options", "loss"}, where);
+    CheckKeys(n, {"model", "source", "noise", "parameters", "options", "inputs", "loss"}, where);
     StreamConfig s;
     if (!n["model"]) Fail(n, where + ": missing key 'model'");
     s.model = String(n["model"], where + ".model");
@@ -283,6 +293,11 @@ class Parser {
       CheckKeys(n["options"], {spec->option_keys.begin(), spec->option_keys.end()}, where + " options");
       for (const auto& kv : n["options"])
         s.options[kv.first.as<std::string>()] = Numbers(kv.second, where + " option");
+    }
+    if (n["inputs"]) {
+      CheckKeys(n["inputs"], {spec->input_roles.begin(), spec->input_roles.end()}, where + " inputs");
+      for (const auto& kv : n["inputs"])
+        s.inputs[kv.first.as<std::string>()] = String(kv.second, where + ".inputs." + kv.first.as<std::string>());
     }
     if (n["loss"]) {
       const YAML::Node& l = n["loss"];

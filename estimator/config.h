@@ -72,6 +72,7 @@ struct StreamConfig {
   std::map<std::string, double> noise;
   std::map<std::string, std::string> parameters;    // slot -> parameter name
   std::map<std::string, std::vector<double>> options;
+  std::map<std::string, std::string> inputs;        // role -> recording stream read as an extra input (optional)
   Loss loss;
 };
 
@@ -115,6 +116,7 @@ struct ModelSpec {
   std::vector<SlotSpec> slots;
   std::vector<std::string> option_keys;
   bool odometric = false;                  // can be the master stream
+  std::vector<std::string> input_roles;    // optional extra inputs (StreamConfig::inputs)
 };
 const ModelSpec* FindModelSpec(const std::string& model);
 const std::vector<ModelSpec>& ModelSpecs();

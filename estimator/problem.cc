@@ -60,6 +60,9 @@ struct StreamBinding {
   double interval_s = 0.0;                      // relative_motion: T
   double wheelbase_m = 0.0;
   Eigen::Vector3d field_world = Eigen::Vector3d::Zero();
+  const recording::Stream* specific_force = nullptr;   // magnetometer: inputs.specific_force
+  int specific_force_column = 0;                       // its first accelerometer column
+  double drive_nm_per_mps2 = 0.0;                      // magnetometer: options.drive_nm_per_mps2
   std::deque<MeasurementRef> pending;
 };
 
@@ -175,6 +178,25 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
         return Error(config, "stream '" + name + "': magnetometer needs options.field_world: [east, north, up]");
       const auto& f = sc.options.at("field_world");
       b.field_world = Eigen::Vector3d(f[0], f[1], f[2]);
+      // The motor interference's proxy (models/magnetometer.h): the accelerometer's specific force, with c.
+      if (sc.inputs.count("specific_force")) {
+        const std::string& input = sc.inputs.at("specific_force");
+        b.specific_force = rec.Find(input);
+        if (b.specific_force == nullptr ||
+            !TypeIn(b.specific_force->info.type, {StreamType::kImu, StreamType::kAccelerometer}))
+          return Error(config, "stream '" + name + "': inputs.specific_force '" + input +
+                                   "' is missing or not an imu or accelerometer stream");
+        if (b.specific_force->t.empty())
+          return Error(config, "stream '" + name + "': inputs.specific_force '" + input + "' is empty");
+        b.specific_force_column = b.specific_force->info.type == StreamType::kImu ? 3 : 0;
+        if (!sc.options.count("drive_nm_per_mps2") || sc.options.at("drive_nm_per_mps2").size() != 1 ||
+            !std::isfinite(sc.options.at("drive_nm_per_mps2")[0]))
+          return Error(config, "stream '" + name + "': inputs.specific_force needs options.drive_nm_per_mps2: [c], "
+                                   "the drive torque per wheel per m/s^2 of forward specific force");
+        b.drive_nm_per_mps2 = sc.options.at("drive_nm_per_mps2")[0];
+      } else if (sc.options.count("drive_nm_per_mps2")) {
+        return Error(config, "stream '" + name + "': options.drive_nm_per_mps2 without inputs.specific_force");
+      }
     } else if (m == "gps") {
       if (!TypeIn(type, {StreamType::kGps, StreamType::kPosition})) return Error(config, bad_type);
       if (type == StreamType::kGps && !impl->enu) return Error(config, "stream '" + name + "': gps without origin");
@@ -385,6 +407,22 @@ std::pair<Eigen::Vector2d, Eigen::Vector2d> LeftRightHarmonics(const StreamBindi
   const int left = s.right_then_left ? 1 : 0, right = 1 - left;
   return {DifferentialDriveError::DeformationHarmonics(angles(row, left), angles(row + 1, left)),
           DifferentialDriveError::DeformationHarmonics(angles(row, right), angles(row + 1, right))};
+}
+
+// The specific force [m/s^2] of a magnetometer's inputs.specific_force at time t: linear interpolation between the
+// rows around t, the first or last row outside the stream's span.
+Eigen::Vector3d SpecificForceAt(const StreamBinding& s, Time t) {
+  const recording::Stream& f = *s.specific_force;
+  const auto row = [&](std::size_t i) {
+    return Eigen::Vector3d(f.values.row(static_cast<Eigen::Index>(i)).segment<3>(s.specific_force_column).transpose());
+  };
+  const auto it = std::lower_bound(f.t.begin(), f.t.end(), t);
+  if (it == f.t.begin()) return row(0);
+  if (it == f.t.end()) return row(f.t.size() - 1);
+  const std::size_t i = static_cast<std::size_t>(it - f.t.begin());
+  const double span = SecondsBetween(f.t[i - 1], f.t[i]);
+  const double w = span > 0.0 ? SecondsBetween(f.t[i - 1], t) / span : 1.0;
+  return (1.0 - w) * row(i - 1) + w * row(i);
 }
 
 }  // namespace
@@ -604,8 +642,9 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
                                            SecondsBetween(poses_[k].t, poses_[k + 1].t)));
     vars = {poses_[k - 1].id, poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k), slot(3, k)};
   } else if (model == "magnetometer") {
-    factor = MakeFactor(MagnetometerError(z3(), s.field_world));
-    vars = {poses_[k].id, slot(0, k), slot(1, k), slot(2, k)};
+    const Eigen::Vector3d f_sensor = s.specific_force ? SpecificForceAt(s, m.t) : Eigen::Vector3d::Zero();
+    factor = MakeFactor(MagnetometerError(z3(), s.field_world, f_sensor, s.drive_nm_per_mps2));
+    vars = {poses_[k].id, slot(0, k), slot(1, k), slot(2, k), slot(3, k)};
   } else if (model == "gps") {
     Eigen::Vector3d z = z3();
     if (data.info.type == StreamType::kGps) z = im.enu->ToEnu(z[0], z[1], z[2]);

@@ -74,6 +74,7 @@ Result<AckermannVehicle> AckermannVehicle::Bind(const mjModel* model, const std:
   if (root < 0 || model->jnt_type[root] != mjJNT_FREE) return Missing(what, "a free joint 'root'");
   v.root_qpos_ = model->jnt_qposadr[root];
   v.root_body_ = model->jnt_bodyid[root];
+  v.mass_kg_ = model->body_subtreemass[v.root_body_];
   v.odom_site_ = IdOf(model, mjOBJ_SITE, "odom");
   if (v.odom_site_ < 0) return Missing(what, "a site 'odom' (the odometric frame O)");
   if (model->site_bodyid[v.odom_site_] != v.root_body_)

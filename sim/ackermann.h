@@ -62,6 +62,7 @@ class AckermannVehicle {
   double front_track_m() const { return front_track_m_; }
   double rear_track_m() const { return rear_track_m_; }
   double wheel_radius_m() const { return wheel_radius_m_; }    // true rolling radius of the rear tires
+  double mass_kg() const { return mass_kg_; }                  // the whole vehicle (the root body's subtree)
   double max_handlebar_rad() const { return max_handlebar_rad_; }  // the inner wheel reaches the servo limit
   int odom_site() const { return odom_site_; }
 
@@ -85,6 +86,7 @@ class AckermannVehicle {
  private:
   int root_qpos_ = -1;          // free joint: x y z qw qx qy qz
   int root_body_ = -1;
+  double mass_kg_ = 0.0;
   int odom_site_ = -1;
   int steer_left_qpos_ = -1, steer_right_qpos_ = -1;
   int wheel_left_dof_ = -1, wheel_right_dof_ = -1;

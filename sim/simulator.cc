@@ -142,6 +142,7 @@ class Simulator::Impl {
     for (const auto& [key, value] : wheeled_.PlatformGeometry()) geometry[key] = Micrometres(value);
     return geometry;
   }
+  double VehicleMassKg() const { return ackermann_ ? vehicle_.mass_kg() : 0.0; }
 
   // Compiles the world, binds the vehicle, sets up clocks, streams and noise, and places the vehicle.
   Status Setup() {
@@ -795,13 +796,33 @@ std::map<std::string, double> Simulator::PlatformGeometry() const {
   return impl_->PlatformGeometry();
 }
 
-Result<std::map<std::string, double>> NominalPlatformGeometry(const Scenario& scenario) {
+double Simulator::VehicleMassKg() const {
+  ROAMLAB_CHECK(impl_ != nullptr, "Simulator::VehicleMassKg called after Run");
+  return impl_->VehicleMassKg();
+}
+
+namespace {
+
+// The scenario's robot bound without its effects and camera (no renderer needed to measure the robot).
+Result<std::unique_ptr<Simulator>> NominalSimulator(const Scenario& scenario) {
   Scenario nominal = scenario;
   nominal.effects.clear();
-  nominal.sensors.camera.reset();   // no renderer needed to measure the robot
-  auto simulator = Simulator::Create(nominal);
+  nominal.sensors.camera.reset();
+  return Simulator::Create(nominal);
+}
+
+}  // namespace
+
+Result<std::map<std::string, double>> NominalPlatformGeometry(const Scenario& scenario) {
+  auto simulator = NominalSimulator(scenario);
   if (!simulator.ok()) return simulator.status();
   return simulator.value()->PlatformGeometry();
+}
+
+Result<double> NominalVehicleMassKg(const Scenario& scenario) {
+  auto simulator = NominalSimulator(scenario);
+  if (!simulator.ok()) return simulator.status();
+  return simulator.value()->VehicleMassKg();
 }
 
 Result<Simulation> Simulator::Run() {

@@ -89,6 +89,8 @@ class Simulator {
   // The platform geometry the recording will state (recording/wheel_kinematics.h keys), measured on the bound model
   // without the effects. Before Run.
   std::map<std::string, double> PlatformGeometry() const;
+  // The Ackermann vehicle's mass [kg] on the bound model (0 for other robots). Before Run.
+  double VehicleMassKg() const;
 
  private:
   class Impl;
@@ -99,6 +101,8 @@ class Simulator {
 // The nominal robot's platform geometry (Simulator::PlatformGeometry of the scenario without its effects and camera):
 // what a user who believes the scenario believes about the wheels.
 Result<std::map<std::string, double>> NominalPlatformGeometry(const Scenario& scenario);
+// The nominal Ackermann vehicle's mass [kg] (Simulator::VehicleMassKg of the scenario without its effects and camera).
+Result<double> NominalVehicleMassKg(const Scenario& scenario);
 
 // Create and Run in one call.
 Result<Simulation> Simulate(const Scenario& scenario, const SimulateOptions& options = {});

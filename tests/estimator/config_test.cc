@@ -43,6 +43,21 @@ TEST(ConfigTest, RejectsUnknownKeysModelsAndMissingNoise) {
   ExpectError(Replace(good, "method: levenberg_marquardt", "method: newton"), "solver.method");
 }
 
+// The magnetometer's motor-interference proxy reads another recording stream through `inputs` (models/magnetometer.h);
+// a model accepts only its own input roles.
+TEST(ConfigTest, MagnetometerTakesTheSpecificForceInput) {
+  const std::string good = testing::AtvConfigYaml({});
+  const std::string mag = "options: {field_world: [0.0, 0.5, -0.8660254037844386]}";
+  const auto config = ParseEstimatorConfig(
+      Replace(good, mag, mag + ",\n                 inputs: {specific_force: imu}"), "est.yaml");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  EXPECT_EQ(config.value().streams.at("magnetometer").inputs.at("specific_force"), "imu");
+  EXPECT_TRUE(config.value().streams.at("gps").inputs.empty());
+  ExpectError(Replace(good, mag, mag + ",\n                 inputs: {torque: imu}"), "unknown key 'torque'");
+  ExpectError(Replace(good, "noise: {sigma_m: 0.33}", "noise: {sigma_m: 0.33}, inputs: {specific_force: imu}"),
+              "unknown key 'specific_force'");
+}
+
 // tracking.calibrate names a calibration configuration relative to the file that names it.
 TEST(ConfigTest, TrackingCalibrateIsRelativeToTheConfigFile) {
   const std::string good = testing::AtvConfigYaml({});

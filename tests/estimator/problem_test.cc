@@ -76,6 +76,29 @@ TEST(ProblemBuilderTest, RejectsConfigurationThatDoesNotFitTheRecording) {
   EXPECT_NE(builder.status().message().find("cannot read"), std::string::npos) << builder.status().message();
 }
 
+// The magnetometer's specific-force input must be an IMU or accelerometer stream of the recording, with the torque
+// factor c; c alone is refused too.
+TEST(ProblemBuilderTest, MagnetometerSpecificForceInputIsChecked) {
+  const auto synthetic = ShortDrive();
+  const auto message = [&](const EstimatorConfig& config) {
+    auto builder = ProblemBuilder::Create(config, synthetic.recording);
+    return builder.ok() ? std::string("accepted") : builder.status().message();
+  };
+  EstimatorConfig config = testing::AtvConfig({});
+  StreamConfig& mag = config.streams["magnetometer"];
+  mag.inputs["specific_force"] = "imu";
+  mag.options["drive_nm_per_mps2"] = {49.6};
+  EXPECT_EQ(message(config), "accepted");
+  mag.inputs["specific_force"] = "gps";
+  EXPECT_NE(message(config).find("not an imu or accelerometer stream"), std::string::npos) << message(config);
+  mag.inputs["specific_force"] = "imu";
+  mag.options.erase("drive_nm_per_mps2");
+  EXPECT_NE(message(config).find("needs options.drive_nm_per_mps2"), std::string::npos) << message(config);
+  mag.inputs.clear();
+  mag.options["drive_nm_per_mps2"] = {49.6};
+  EXPECT_NE(message(config).find("without inputs.specific_force"), std::string::npos) << message(config);
+}
+
 // A differential drive seen by motion capture over a short stretch (the fixes span well under 1 m, too little for a
 // position-only yaw fit) that starts facing backwards: the measured orientations still turn the dead-reckoned
 // trajectory (which starts at yaw 0) onto the fixes.

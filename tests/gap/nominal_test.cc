@@ -31,6 +31,10 @@ TEST(NominalConfigTest, TheAtvScenarioGivesTheCalibrationWithKGammaFixedAtTheBel
   EXPECT_EQ((*c.parameters.at("gps.lever_arm").value)[0], 0.57);
   EXPECT_FALSE(c.parameters.count("gyroscope.scale"));
   EXPECT_FALSE(c.parameters.count("odometer.cornering_rear"));
+  EXPECT_FALSE(c.parameters.count("magnetometer.b_per_drive_nm"));
+  // The motor interference's proxy: the IMU's specific force, c = m r / 2 of models/atv.xml (354 kg, 0.28 m).
+  EXPECT_EQ(c.streams.at("magnetometer").inputs.at("specific_force"), "imu");
+  EXPECT_NEAR(c.streams.at("magnetometer").options.at("drive_nm_per_mps2").at(0), 354.0 * 0.28 / 2.0, 1e-6);
   ASSERT_EQ(c.stages.size(), 3u);
   EXPECT_EQ(c.stages.back().size(), 6u);
 }

@@ -278,8 +278,10 @@ TEST(AnalyticJacobiansTest, Magnetometer) {
     A << 1, 0, 0, 0, 1, 0, 0, 0, 1;
     A += RandomPoint(Manifold::Euclidean(9), &rng, large ? 0.5 : 0.05);
     const Eigen::Vector3d b = Gaussian3(0.05, &rng);
+    const Eigen::Vector3d k = Gaussian3(5e-4, &rng);
+    const Eigen::Vector3d f_sensor = Gaussian3(3.0, &rng);
     const Eigen::Vector3d z = Gaussian3(1.0, &rng).normalized() + Gaussian3(0.067, &rng);
-    ExpectAnalyticMatchesJets(MagnetometerError(z, h_world), {pose, q_body_sensor, A, b},
+    ExpectAnalyticMatchesJets(MagnetometerError(z, h_world, f_sensor, 49.6), {pose, q_body_sensor, A, b, k},
                               "point " + std::to_string(point));
   }
 }
