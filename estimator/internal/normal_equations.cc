@@ -420,11 +420,13 @@ bool UpperCholeskyInPlace(Matrix& a) {
 }
 
 // x <- U^-T x (forward substitution) and x <- U^-1 x (back substitution) for a small upper triangular U: plain loops,
-// cheaper than a general triangular solve at the size of a pose block.
+// cheaper than a general triangular solve at the size of a pose block. The columns of x are independent: looping over
+// them innermost lets their chains of multiply-subtract and division overlap (each entry sees the same operations in
+// the same order as a column at a time).
 template <typename Upper, typename Rhs>
 void SolveUpperTransposed(const Upper& u, Rhs& x) {
-  for (Eigen::Index c = 0; c < x.cols(); ++c) {
-    for (Eigen::Index i = 0; i < u.rows(); ++i) {
+  for (Eigen::Index i = 0; i < u.rows(); ++i) {
+    for (Eigen::Index c = 0; c < x.cols(); ++c) {
       double s = x(i, c);
       for (Eigen::Index k = 0; k < i; ++k) s -= u(k, i) * x(k, c);
       x(i, c) = s / u(i, i);
@@ -433,8 +435,8 @@ void SolveUpperTransposed(const Upper& u, Rhs& x) {
 }
 template <typename Upper, typename Rhs>
 void SolveUpper(const Upper& u, Rhs& x) {
-  for (Eigen::Index c = 0; c < x.cols(); ++c) {
-    for (Eigen::Index i = u.rows() - 1; i >= 0; --i) {
+  for (Eigen::Index i = u.rows() - 1; i >= 0; --i) {
+    for (Eigen::Index c = 0; c < x.cols(); ++c) {
       double s = x(i, c);
       for (Eigen::Index k = i + 1; k < u.rows(); ++k) s -= u(i, k) * x(k, c);
       x(i, c) = s / u(i, i);
