@@ -277,8 +277,12 @@ void NormalEquations::BuildPattern() {
   // Value index of block (r, b): start of column block_offset[b] plus the row offset of r in that column; later
   // columns of the block are found by adding j * column_length[b].
   const auto value_index = [&](int r, int b) {
-    const auto it = std::lower_bound(rows_of_[b].begin(), rows_of_[b].end(), r);
-    return static_cast<std::ptrdiff_t>(outer_[block_offset_[b]]) + row_offset_[b][it - rows_of_[b].begin()];
+    // A column holding every row block up to the diagonal (a constant parameter's, in natural order) has r at r.
+    const auto& rows = rows_of_[b];
+    const std::ptrdiff_t position = static_cast<int>(rows.size()) == b + 1
+                                        ? r
+                                        : std::lower_bound(rows.begin(), rows.end(), r) - rows.begin();
+    return static_cast<std::ptrdiff_t>(outer_[block_offset_[b]]) + row_offset_[b][position];
   };
   pair_begin_.assign(1, 0);
   pair_value_.clear();
