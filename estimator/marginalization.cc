@@ -22,6 +22,77 @@ Eigen::Matrix3d InverseRightJacobian(const Eigen::Vector3d& phi) {
   return Eigen::Matrix3d::Identity() + 0.5 * K + c * K * K;
 }
 
+// J (r x n) and r0 with J^T J = H and J^T r0 = g for a positive semi-definite H (g in its range), keeping the
+// directions of the eigenvalues above 1e-12 of the largest (the others carry no information). Reference: the
+// eigen-decomposition H = V diag(lambda) V^T, J = diag(sqrt(lambda)) V^T, r0 = diag(1/sqrt(lambda)) V^T g over those
+// eigenvalues. Fast path, for a clear gap: a Cholesky factorization with diagonal pivoting, H = P L L^T P^T, the
+// largest remaining diagonal entry eliminated first, stopped at rank r when the remaining Schur complement S has no
+// diagonal entry above 1e-12 / n of H's largest one. Then J = L^T P^T (r rows) and r0 = L11^-1 (P^T g)_1..r give the
+// same prior: |r0 + J dx|^2 depends on them only through J^T J and J^T r0 (up to a constant), the same as the
+// reference when both keep the same directions. They do when
+//  - the dropped eigenvalues are below the floor: lambda_{r+1..n}(H) <= |S|_2 <= n max diag(S) <= 1e-12 max diag(H);
+//  - the kept ones are above it: by interlacing they are at least lambda_min(L11 L11^T) >= 1 / |L11^-1|_F^2, which is
+//    checked against 1e-12 trace(H) >= 1e-12 lambda_max.
+// Otherwise (an eigenvalue near the floor) the eigen-decomposition decides. Returns false when H carries no
+// information at all.
+bool SquareRootInformation(const Eigen::MatrixXd& H_in, const Eigen::VectorXd& g, Eigen::MatrixXd* J,
+                           Eigen::VectorXd* r0) {
+  const int n = static_cast<int>(H_in.rows());
+  Eigen::MatrixXd H = H_in;
+  const double max_diagonal = std::max(H.diagonal().maxCoeff(), 0.0);
+  std::vector<int> perm(n);
+  for (int i = 0; i < n; ++i) perm[i] = i;
+  Eigen::VectorXd gp = g;
+  int rank = 0;
+  // In place: column k of L (rows k..n-1, permuted) in H's column k; the trailing block holds the Schur complement.
+  for (int k = 0; k < n; ++k) {
+    int p = k;
+    for (int i = k + 1; i < n; ++i)
+      if (H(i, i) > H(p, p)) p = i;
+    if (!(H(p, p) > 1e-12 / n * max_diagonal)) break;
+    if (p != k) {
+      H.row(k).swap(H.row(p));
+      H.col(k).swap(H.col(p));
+      std::swap(perm[k], perm[p]);
+      std::swap(gp[k], gp[p]);
+    }
+    const double d = std::sqrt(H(k, k));
+    H(k, k) = d;
+    H.col(k).tail(n - k - 1) /= d;
+    H.bottomRightCorner(n - k - 1, n - k - 1).noalias() -=
+        H.col(k).tail(n - k - 1) * H.col(k).tail(n - k - 1).transpose();
+    rank = k + 1;
+  }
+  bool gap = rank > 0;
+  if (gap) {
+    const Eigen::MatrixXd L11 = H.topLeftCorner(rank, rank).triangularView<Eigen::Lower>();
+    const Eigen::MatrixXd inverse =
+        L11.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(rank, rank));
+    gap = 1.0 / inverse.squaredNorm() > 1e-12 * H_in.trace();
+  }
+  if (gap) {
+    J->setZero(rank, n);
+    for (int i = 0; i < n; ++i) J->col(perm[i]).head(std::min(i + 1, rank)) = H.row(i).head(std::min(i + 1, rank));
+    *r0 = H.topLeftCorner(rank, rank).triangularView<Eigen::Lower>().solve(gp.head(rank));
+    return true;
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H_in);
+  const double max_ev = std::max(eig.eigenvalues().maxCoeff(), 0.0);
+  std::vector<int> keep;
+  for (int k = 0; k < n; ++k)
+    if (eig.eigenvalues()[k] > 1e-12 * max_ev && eig.eigenvalues()[k] > 0.0) keep.push_back(k);
+  if (keep.empty()) return false;
+  J->resize(static_cast<int>(keep.size()), n);
+  r0->resize(static_cast<int>(keep.size()));
+  for (std::size_t i = 0; i < keep.size(); ++i) {
+    const double ev = eig.eigenvalues()[keep[i]];
+    const Eigen::VectorXd u = eig.eigenvectors().col(keep[i]);
+    J->row(static_cast<int>(i)) = std::sqrt(ev) * u.transpose();
+    (*r0)[static_cast<int>(i)] = u.dot(g) / std::sqrt(ev);
+  }
+  return true;
+}
+
 }  // namespace
 
 LinearPriorFactor::LinearPriorFactor(std::vector<Manifold> manifolds, std::vector<Eigen::VectorXd> linearization_point,
@@ -113,7 +184,7 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph) {
     }
   }
 
-  // Schur complement onto the blanket, factored as J^T J by eigen-decomposition (dropping null directions).
+  // Schur complement onto the blanket, factored as J^T J (SquareRootInformation, dropping null directions).
   const int nb = n - nm;
   Eigen::MatrixXd Hbb = H.bottomRightCorner(nb, nb);
   Eigen::VectorXd gb = g.tail(nb);
@@ -136,21 +207,10 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph) {
   for (FactorId f : factors) graph->RemoveFactor(f);
   for (VariableId v : leaving) graph->RemoveVariable(v);
   if (nb == 0) return true;
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (Hbb + Hbb.transpose()));
-  const double max_ev = std::max(eig.eigenvalues().maxCoeff(), 0.0);
-  std::vector<int> keep;
-  for (int k = 0; k < nb; ++k)
-    if (eig.eigenvalues()[k] > 1e-12 * max_ev && eig.eigenvalues()[k] > 0.0) keep.push_back(k);
-  if (keep.empty()) return true;
-  Eigen::MatrixXd J(keep.size(), nb);
-  Eigen::VectorXd r0(keep.size());
-  for (std::size_t i = 0; i < keep.size(); ++i) {
-    const double ev = eig.eigenvalues()[keep[i]];
-    const Eigen::VectorXd u = eig.eigenvectors().col(keep[i]);
-    J.row(static_cast<int>(i)) = std::sqrt(ev) * u.transpose();
-    r0[static_cast<int>(i)] = u.dot(gb) / std::sqrt(ev);
-  }
-  const int dim = static_cast<int>(keep.size());
+  Eigen::MatrixXd J;
+  Eigen::VectorXd r0;
+  if (!SquareRootInformation(0.5 * (Hbb + Hbb.transpose()), gb, &J, &r0)) return true;
+  const int dim = static_cast<int>(J.rows());
   graph->AddFactor(std::make_unique<LinearPriorFactor>(manifolds, x0, J, r0), blanket,
                    Eigen::MatrixXd::Identity(dim, dim), Loss::Trivial(), "marginalization", Time());
   return true;

@@ -33,29 +33,59 @@ void AddProductFixed(const double* ja, const double* jb, double* dst, std::ptrdi
                      Eigen::Map<const Eigen::Matrix<double, M, B>>(jb);
 }
 
-void AddProduct(const Eigen::MatrixXd& ja, const Eigen::MatrixXd& jb, double* dst, std::ptrdiff_t stride) {
-  if (ja.cols() == 6 && jb.cols() == 6) {
-    if (ja.rows() == 3) return AddProductFixed<3, 6, 6>(ja.data(), jb.data(), dst, stride);
-    if (ja.rows() == 4) return AddProductFixed<4, 6, 6>(ja.data(), jb.data(), dst, stride);
-    if (ja.rows() == 6) return AddProductFixed<6, 6, 6>(ja.data(), jb.data(), dst, stride);
+// The same with the column counts as template arguments when they are among the block sizes of the error models
+// (1: scalar, 3: vector or rotation, 6: pose, 9: 3x3 matrix); false for other sizes.
+template <int M, int A>
+bool AddProductColumns(const double* ja, const double* jb, int b, double* dst, std::ptrdiff_t stride) {
+  switch (b) {
+    case 1: AddProductFixed<M, A, 1>(ja, jb, dst, stride); return true;
+    case 3: AddProductFixed<M, A, 3>(ja, jb, dst, stride); return true;
+    case 6: AddProductFixed<M, A, 6>(ja, jb, dst, stride); return true;
+    case 9: AddProductFixed<M, A, 9>(ja, jb, dst, stride); return true;
+    default: return false;
   }
+}
+template <int M>
+bool AddProductRows(const double* ja, int a, const double* jb, int b, double* dst, std::ptrdiff_t stride) {
+  switch (a) {
+    case 1: return AddProductColumns<M, 1>(ja, jb, b, dst, stride);
+    case 3: return AddProductColumns<M, 3>(ja, jb, b, dst, stride);
+    case 6: return AddProductColumns<M, 6>(ja, jb, b, dst, stride);
+    case 9: return AddProductColumns<M, 9>(ja, jb, b, dst, stride);
+    default: return false;
+  }
+}
+
+void AddProduct(const Eigen::MatrixXd& ja, const Eigen::MatrixXd& jb, double* dst, std::ptrdiff_t stride) {
+  const int a = static_cast<int>(ja.cols()), b = static_cast<int>(jb.cols());
+  if (ja.rows() == 3 && AddProductRows<3>(ja.data(), a, jb.data(), b, dst, stride)) return;
+  if (ja.rows() == 4 && AddProductRows<4>(ja.data(), a, jb.data(), b, dst, stride)) return;
+  if (ja.rows() == 6 && AddProductRows<6>(ja.data(), a, jb.data(), b, dst, stride)) return;
   // Coefficient-wise: at these sizes (a few rows, up to a few dozen columns) cheaper than a blocked product.
   Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> block(dst, ja.cols(), jb.cols(), Eigen::OuterStride<>(stride));
   block.noalias() += ja.transpose().lazyProduct(jb);
 }
 
 // g_segment += J^T r.
+template <int M, int A>
+void AddGradientFixed(const double* j, const double* r, double* g) {
+  Eigen::Map<Eigen::Matrix<double, A, 1>>(g).noalias() +=
+      Eigen::Map<const Eigen::Matrix<double, M, A>>(j).transpose() * Eigen::Map<const Eigen::Matrix<double, M, 1>>(r);
+}
+template <int M>
+bool AddGradientRows(const double* j, int a, const double* r, double* g) {
+  switch (a) {
+    case 1: AddGradientFixed<M, 1>(j, r, g); return true;
+    case 3: AddGradientFixed<M, 3>(j, r, g); return true;
+    case 6: AddGradientFixed<M, 6>(j, r, g); return true;
+    case 9: AddGradientFixed<M, 9>(j, r, g); return true;
+    default: return false;
+  }
+}
 void AddGradient(const Eigen::MatrixXd& j, const Eigen::VectorXd& r, double* g) {
-  if (j.cols() == 6 && j.rows() == 3) {
-    Eigen::Map<Eigen::Matrix<double, 6, 1>>(g).noalias() +=
-        Eigen::Map<const Eigen::Matrix<double, 3, 6>>(j.data()).transpose() * Eigen::Map<const Eigen::Vector3d>(r.data());
-    return;
-  }
-  if (j.cols() == 6 && j.rows() == 4) {
-    Eigen::Map<Eigen::Matrix<double, 6, 1>>(g).noalias() +=
-        Eigen::Map<const Eigen::Matrix<double, 4, 6>>(j.data()).transpose() * Eigen::Map<const Eigen::Vector4d>(r.data());
-    return;
-  }
+  const int a = static_cast<int>(j.cols());
+  if (j.rows() == 3 && AddGradientRows<3>(j.data(), a, r.data(), g)) return;
+  if (j.rows() == 4 && AddGradientRows<4>(j.data(), a, r.data(), g)) return;
   Eigen::Map<Eigen::VectorXd>(g, j.cols()).noalias() += j.transpose() * r;
 }
 
@@ -127,6 +157,14 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
 
   // The included factors, their variables' blocks and values, and which row blocks appear in each block column
   // (upper triangle, diagonal always present).
+  // The per-factor buffers follow their factors: a window that slid drops its oldest factors at the front (ids grow
+  // with time), so the buffers are rotated by as many places, and a factor keeps buffers of its own sizes (no
+  // reallocation when it is linearized again).
+  if (!factor_ids_.empty() && !graph.factors().empty()) {
+    const FactorId first = graph.factors().begin()->first;
+    const auto kept = std::lower_bound(factor_ids_.begin(), factor_ids_.end(), first);
+    std::rotate(whitened_.begin(), whitened_.begin() + (kept - factor_ids_.begin()), whitened_.end());
+  }
   factor_ids_.clear();
   entries_.clear();
   want_.clear();
@@ -239,8 +277,12 @@ void NormalEquations::BuildPattern() {
   // Value index of block (r, b): start of column block_offset[b] plus the row offset of r in that column; later
   // columns of the block are found by adding j * column_length[b].
   const auto value_index = [&](int r, int b) {
-    const auto it = std::lower_bound(rows_of_[b].begin(), rows_of_[b].end(), r);
-    return static_cast<std::ptrdiff_t>(outer_[block_offset_[b]]) + row_offset_[b][it - rows_of_[b].begin()];
+    // A column holding every row block up to the diagonal (a constant parameter's, in natural order) has r at r.
+    const auto& rows = rows_of_[b];
+    const std::ptrdiff_t position = static_cast<int>(rows.size()) == b + 1
+                                        ? r
+                                        : std::lower_bound(rows.begin(), rows.end(), r) - rows.begin();
+    return static_cast<std::ptrdiff_t>(outer_[block_offset_[b]]) + row_offset_[b][position];
   };
   pair_begin_.assign(1, 0);
   pair_value_.clear();
@@ -382,11 +424,13 @@ bool UpperCholeskyInPlace(Matrix& a) {
 }
 
 // x <- U^-T x (forward substitution) and x <- U^-1 x (back substitution) for a small upper triangular U: plain loops,
-// cheaper than a general triangular solve at the size of a pose block.
+// cheaper than a general triangular solve at the size of a pose block. The columns of x are independent: looping over
+// them innermost lets their chains of multiply-subtract and division overlap (each entry sees the same operations in
+// the same order as a column at a time).
 template <typename Upper, typename Rhs>
 void SolveUpperTransposed(const Upper& u, Rhs& x) {
-  for (Eigen::Index c = 0; c < x.cols(); ++c) {
-    for (Eigen::Index i = 0; i < u.rows(); ++i) {
+  for (Eigen::Index i = 0; i < u.rows(); ++i) {
+    for (Eigen::Index c = 0; c < x.cols(); ++c) {
       double s = x(i, c);
       for (Eigen::Index k = 0; k < i; ++k) s -= u(k, i) * x(k, c);
       x(i, c) = s / u(i, i);
@@ -395,8 +439,8 @@ void SolveUpperTransposed(const Upper& u, Rhs& x) {
 }
 template <typename Upper, typename Rhs>
 void SolveUpper(const Upper& u, Rhs& x) {
-  for (Eigen::Index c = 0; c < x.cols(); ++c) {
-    for (Eigen::Index i = u.rows() - 1; i >= 0; --i) {
+  for (Eigen::Index i = u.rows() - 1; i >= 0; --i) {
+    for (Eigen::Index c = 0; c < x.cols(); ++c) {
       double s = x(i, c);
       for (Eigen::Index k = i + 1; k < u.rows(); ++k) s -= u(i, k) * x(k, c);
       x(i, c) = s / u(i, i);

@@ -235,5 +235,58 @@ TEST(NormalEquationsTest, EnvelopeFactorizationOfABandWithABorderMatchesADenseCh
   EXPECT_LT((dx - damped_expected).norm(), 1e-9 * damped_expected.norm());
 }
 
+// Marginalizing x out of linear factors on (x, y) leaves a prior on y with J^T J and J^T r0 equal to the Schur
+// complement of the information and the gradient, also when that information is rank-deficient (y's third
+// coordinate is never observed; its second well, or weakly: information 1e-8 of the largest).
+TEST(MarginalizationTest, PriorHoldsTheSchurComplementAlsoWhenRankDeficient) {
+  for (const double weak : {1.0, 1e-4}) {
+    Graph graph;
+    const VariableId x =
+        graph.AddVariable({"x", Manifold::Euclidean(2), Eigen::Vector2d(0.3, -0.2), false, std::nullopt});
+    const VariableId y =
+        graph.AddVariable({"y", Manifold::Euclidean(3), Eigen::Vector3d(1.0, 2.0, -1.0), false, std::nullopt});
+    const std::vector<Manifold> xy = {Manifold::Euclidean(2), Manifold::Euclidean(3)};
+    Eigen::MatrixXd J1(3, 5);  // on (x, y): y's third column zero, its second scaled by `weak`
+    J1 << 1.0, 0.5, -1.0, 0.2 * weak, 0.0,
+          0.0, 2.0, 0.3, -1.0 * weak, 0.0,
+          0.4, 0.0, 0.0, 0.7 * weak, 0.0;
+    const Eigen::Vector3d r1(0.1, -0.4, 0.25);
+    graph.AddFactor(std::make_unique<LinearPriorFactor>(xy, std::vector<Eigen::VectorXd>{Eigen::Vector2d(0.3, -0.2),
+                                                                                      Eigen::Vector3d(1.0, 2.0, -1.0)},
+                                                        J1, r1),
+                    {x, y}, Eigen::Matrix3d::Identity(), Loss::Trivial(), "test", Time());
+    Eigen::MatrixXd J2(2, 2);
+    J2 << 3.0, 0.0, 1.0, 1.0;
+    const Eigen::Vector2d r2(-0.3, 0.2);
+    graph.AddFactor(std::make_unique<LinearPriorFactor>(std::vector<Manifold>{Manifold::Euclidean(2)},
+                                                        std::vector<Eigen::VectorXd>{Eigen::Vector2d(0.3, -0.2)}, J2,
+                                                        r2),
+                    {x}, Eigen::Matrix2d::Identity(), Loss::Trivial(), "test", Time());
+    // Expected: H and g of both factors at the current values, Schur complement onto y.
+    Eigen::MatrixXd H = J1.transpose() * J1;
+    Eigen::VectorXd g = J1.transpose() * r1;
+    H.topLeftCorner(2, 2) += J2.transpose() * J2;
+    g.head(2) += J2.transpose() * r2;
+    const Eigen::MatrixXd Hmm_inv = H.topLeftCorner(2, 2).inverse();
+    const Eigen::MatrixXd expected_H =
+        H.bottomRightCorner(3, 3) - H.bottomLeftCorner(3, 2) * Hmm_inv * H.topRightCorner(2, 3);
+    const Eigen::VectorXd expected_g = g.tail(3) - H.bottomLeftCorner(3, 2) * Hmm_inv * g.head(2);
+
+    ASSERT_TRUE(Marginalize({x}, &graph));
+    ASSERT_EQ(graph.factors().size(), 1u);
+    const FactorEntry& prior = graph.factors().begin()->second;
+    ASSERT_EQ(prior.variables, std::vector<VariableId>{y});
+    const int m = prior.factor->residual_dim();
+    EXPECT_EQ(m, 2);  // the null direction is dropped
+    Eigen::VectorXd r0(m);
+    Eigen::MatrixXd J(m, 3);
+    const double* values[] = {graph.variable(y).value.data()};
+    double* jacobians[] = {J.data()};
+    ASSERT_TRUE(prior.factor->Evaluate(values, r0.data(), jacobians, nullptr));
+    EXPECT_LT((J.transpose() * J - expected_H).norm(), 1e-9 * expected_H.norm()) << "weak = " << weak;
+    EXPECT_LT((J.transpose() * r0 - expected_g).norm(), 1e-9 * expected_g.norm()) << "weak = " << weak;
+  }
+}
+
 }  // namespace
 }  // namespace roamlab::estimator
