@@ -79,4 +79,15 @@ std::string ComponentKey(const std::string& stream, int component);
 // Per component chi2_per_dof, keyed as above.
 std::map<std::string, double> ComponentLevels(const std::vector<estimator::MeasurementResidual>& residuals);
 
+// One component's chi-square per dof over `count` scalar residuals.
+struct ComponentLevel {
+  double chi2_per_dof = 0.0;
+  int count = 0;
+};
+// Per component, keyed as above (active measurements only).
+std::map<std::string, ComponentLevel> ComponentStatistics(const std::vector<estimator::MeasurementResidual>& residuals);
+// Locate's rule: chi2_per_dof above `ratio` times the expected level and above the level's 99.9 % chi-square quantile
+// for `count` residuals.
+bool Inconsistent(const ComponentLevel& level, double expected_chi2_per_dof, double ratio);
+
 }  // namespace roamlab::gap
