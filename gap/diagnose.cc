@@ -934,9 +934,12 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
 
   // Verdict. Without an accepted effect every inconsistent component is unexplained. With accepted effects, an
   // inconsistent component stays unexplained when the held-out part, fitted with the effects, is still inconsistent in
-  // it against the nominal model's held-out level (the baseline's; Locate's rule): structure that the named effects
-  // do not account for (an out-of-library effect can pull a library parameter by a little and pass the tests, as an
-  // accelerometer gain error passes on to the attitude and a gyroscope scale), so the verdict is then "unknown".
+  // it against the nominal model's held-out level (the baseline's; Locate's rule) by an excess the stated noise can
+  // tell from noise (SignificantExcess): structure that the named effects do not account for (an out-of-library
+  // effect can pull a library parameter by a little and pass the tests, as an accelerometer gain error passes on to
+  // the attitude and a gyroscope scale), so the verdict is then "unknown". The excess test keeps components whose
+  // level is far below 1 (an oval tire's roll on a diff drive's gyroscope x: 1e-4 doubled) from overruling an effect
+  // that explains what the likelihood sees.
   const std::map<std::string, double> heldout_levels =
       options.baseline ? options.baseline->heldout_component_levels : std::map<std::string, double>{};
   const LocateOptions locate_options;
@@ -952,7 +955,9 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
       if (after == out.heldout_components_after.end()) continue;
       const auto level = heldout_levels.find(key);
       const double expected = level != heldout_levels.end() ? level->second : 1.0;
-      if (!Inconsistent(after->second, expected, locate_options.inconsistency_ratio)) continue;
+      if (!Inconsistent(after->second, expected, locate_options.inconsistency_ratio) ||
+          !SignificantExcess(after->second, expected))
+        continue;
       line << "; held-out chi2/dof " << after->second.chi2_per_dof << " with the named effects (level " << expected
            << ")";
     }

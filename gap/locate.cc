@@ -161,6 +161,12 @@ bool Inconsistent(const ComponentLevel& level, double expected_chi2_per_dof, dou
   return level.chi2_per_dof > std::max(upper, ratio * expected);
 }
 
+bool SignificantExcess(const ComponentLevel& level, double expected_chi2_per_dof) {
+  if (level.count <= 0) return false;
+  const double n = level.count;
+  return (level.chi2_per_dof - expected_chi2_per_dof) * n > ChiSquareQuantile(kQuantile, level.count) - n;
+}
+
 std::vector<LocatedComponent> Locate(const std::vector<estimator::MeasurementResidual>& residuals,
                                      const Conditions& conditions, const std::map<std::string, double>& expected,
                                      const LocateOptions& options) {
