@@ -54,16 +54,18 @@ struct Draw {
 std::string AffectedStream(const std::string& effect) {
   if (effect == "gps_latency") return "gps";
   if (effect == "imu_time_offset" || effect == "gyro_scale_error" || effect == "gyro_bias_drift") return "gyroscope";
+  if (effect == "magnetometer_motor_interference") return "magnetometer";
   return "odometer";
 }
 
 // Platform 0 is the ATV (half of the cases: its library is the largest), 1 the differential drive and 2 the mecanum
 // robot (a quarter each). Kinds: none 20 %, decoy 15 %, effect 65 %.
 // Magnitudes from about the smallest the diagnosis resolves (its std on a 20 s training part, README) to large.
-// Decoys are drawn on the ATV only: a magnetometer bias that follows the drive torque shows in the magnetometer's
-// residuals and no candidate models it; the differential drive's nominal model reads only the encoders and the
-// gyroscope, and the out-of-library effects the simulator has for it either do not show there or look like a library
-// effect (a yawed axle reads as a smaller wheel). Its effects are the ones its sensors can identify:
+// Decoys are drawn on the ATV only: an accelerometer gain error or GPS multipath shows in the accelerometer's or the
+// GPS's residuals and no candidate models it (tire_growth is not drawn: at 0.003 s^2/m^2, already 2-7 % at the drive's
+// speeds, it left the speed and GPS residuals within their band); the differential drive's nominal model reads only
+// the encoders and the gyroscope, and the out-of-library effects the simulator has for it either do not show there or
+// look like a library effect (a yawed axle reads as a smaller wheel). Its effects are the ones its sensors can identify:
 // track_width_error is not drawn, because with the wheel radius free and no speed reference only r / B is observable
 // (the gyroscope sees the turn rate r (omega_R - omega_L) / B), so a track error is a radius error. The mecanum robot's
 // position fixes tell its track (README: 0.04 m -> 0.0411 +- 0.0026), so it is drawn there, with a yaw gyro bias.
@@ -83,12 +85,16 @@ Draw DrawCase(std::mt19937_64& rng) {
   if (kind < 0.35) {
     d.kind = "decoy";
     d.platform = 0;
-    // A magnetometer bias proportional to the drive torque: the recording has no torque stream, no candidate.
-    Eigen::Vector3d direction(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5);
-    direction = direction.normalized() * (3e-4 + 3e-4 * u(rng));
-    d.effect = {"magnetometer_motor_interference",
-                {{"b_per_nm_x", direction.x()}, {"b_per_nm_y", direction.y()}, {"b_per_nm_z", direction.z()}}};
-    d.parameter = "b_per_nm_x";
+    // Effects no candidate models, each leaving structure in a stream the nominal model reads (sim/scenario.h).
+    if (pick < 0.5) {
+      // An accelerometer gain error on one axis: the accelerometer's components follow gravity and the motion.
+      const std::string axis(1, "xyz"[static_cast<int>(3.0 * u(rng)) % 3]);
+      d.effect = {"accelerometer_scale_error", {{"scale_" + axis, 1.0 + sign() * (0.02 + 0.03 * u(rng))}}};
+    } else {
+      // GPS multipath: a correlated error of the fixes, which follows no motion condition.
+      d.effect = {"gps_multipath", {{"sigma_m", 0.5 + 1.5 * u(rng)}, {"correlation_s", 2.0 + 8.0 * u(rng)}}};
+    }
+    d.parameter = d.effect.name == "gps_multipath" ? "sigma_m" : d.effect.parameters.begin()->first;
     return d;
   }
   d.kind = "effect";
@@ -119,7 +125,7 @@ Draw DrawCase(std::mt19937_64& rng) {
     d.parameter = d.effect.name == "wheel_deformation" ? "ovality_m" : d.effect.parameters.begin()->first;
     return d;
   }
-  switch (static_cast<int>(5.0 * pick)) {
+  switch (static_cast<int>(6.0 * pick)) {
     case 0:
       d.effect = {"gps_latency", {{"latency_s", round_to(0.2 + 0.2 * u(rng), 0.001)}}};
       break;
@@ -133,6 +139,17 @@ Draw DrawCase(std::mt19937_64& rng) {
       const std::string axis(1, "xyz"[static_cast<int>(3.0 * u(rng)) % 3]);
       d.effect = {"gyro_scale_error", {{"scale_" + axis, 1.0 + sign() * (0.03 + 0.03 * u(rng))}}};
       break;
+    }
+    case 4: {
+      // A magnetometer bias following the drive torque, in a random direction with |k| from about 3x its std
+      // (about 1.5e-4 per axis) to large; scored on its largest axis.
+      Eigen::Vector3d k(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5);
+      k = k.normalized() * (5e-4 + 1e-3 * u(rng));
+      Eigen::Index axis = 0;
+      k.cwiseAbs().maxCoeff(&axis);
+      d.effect = {"magnetometer_motor_interference", {{"b_per_nm_x", k.x()}, {"b_per_nm_y", k.y()}, {"b_per_nm_z", k.z()}}};
+      d.parameter = std::string("b_per_nm_") + "xyz"[axis];
+      return d;
     }
     default:
       gyro_bias(std::string(1, "xyz"[static_cast<int>(3.0 * u(rng)) % 3]));

@@ -20,8 +20,10 @@
 //      Then the others are scored again on top, up to max_effects;
 //   4. model: the accepted effects' parameters and standard deviations (training fit);
 //   5. show: per-stream whitened RMS and chi2/dof on the held-out part before (nominal) and after (with the effects).
-// Verdict: "named" (some effect kept), "unknown" (no effect kept but some component stays inconsistent: its
-// conditions say what it depends on) or "none". The diagnosis reads the recording's streams only (never truth.yaml).
+// Verdict: "named" (some effect kept and every inconsistent component explained), "unknown" (some component stays
+// inconsistent: without a kept effect, or on the held-out part with the kept effects against the nominal model's
+// held-out level; its conditions say what it depends on; the kept effects are still listed) or "none". The diagnosis
+// reads the recording's streams only (never truth.yaml).
 #pragma once
 
 #include <functional>
@@ -60,6 +62,7 @@ struct EffectEstimate {
 // What the nominal model gives on a nominal simulation of the same robot and drive.
 struct Baseline {
   std::map<std::string, double> component_levels;   // ComponentKey -> chi2/dof, whole run
+  std::map<std::string, double> heldout_component_levels;   // ComponentKey -> chi2/dof, held-out part (nominal fit)
   std::map<std::string, StreamFit> streams;          // whole run
   std::map<std::string, double> candidate_lr;        // candidate -> chi2 drop on the training part
   // candidate -> parameter -> (value, std) fitted on the nominal simulation
@@ -74,6 +77,7 @@ struct Diagnosis {
   std::vector<std::string> unexplained;               // for "unknown": "stream/component depends on condition"
   std::map<std::string, StreamFit> whole_run;         // the nominal fit of the whole recording
   std::map<std::string, StreamFit> before, after;     // held-out part: nominal, with the accepted effects
+  std::map<std::string, ComponentLevel> heldout_components_before, heldout_components_after;   // per ComponentKey
   double train_end_s = 0.0;                           // the held-out part starts here (recording time)
   std::vector<estimator::MeasurementResidual> residuals;   // whole-run nominal fit
   Conditions conditions;                              // from the whole-run nominal trajectory

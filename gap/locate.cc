@@ -151,7 +151,7 @@ std::string ComponentKey(const std::string& stream, int component) {
   return stream + "/" + std::to_string(component);
 }
 
-std::map<std::string, double> ComponentLevels(const std::vector<estimator::MeasurementResidual>& residuals) {
+std::map<std::string, ComponentLevel> ComponentStatistics(const std::vector<estimator::MeasurementResidual>& residuals) {
   std::map<std::string, std::pair<double, int>> sums;
   for (const estimator::MeasurementResidual& r : residuals) {
     if (!r.active) continue;
@@ -161,9 +161,28 @@ std::map<std::string, double> ComponentLevels(const std::vector<estimator::Measu
       ++s.second;
     }
   }
-  std::map<std::string, double> out;
-  for (const auto& [key, s] : sums) out[key] = s.second > 0 ? s.first / s.second : 0.0;
+  std::map<std::string, ComponentLevel> out;
+  for (const auto& [key, s] : sums) out[key] = {s.second > 0 ? s.first / s.second : 0.0, s.second};
   return out;
+}
+
+std::map<std::string, double> ComponentLevels(const std::vector<estimator::MeasurementResidual>& residuals) {
+  std::map<std::string, double> out;
+  for (const auto& [key, level] : ComponentStatistics(residuals)) out[key] = level.chi2_per_dof;
+  return out;
+}
+
+bool Inconsistent(const ComponentLevel& level, double expected_chi2_per_dof, double ratio) {
+  if (level.count <= 0) return false;
+  const double expected = std::max(expected_chi2_per_dof, 1e-6);
+  const double upper = expected * ChiSquareQuantile(kQuantile, level.count) / level.count;
+  return level.chi2_per_dof > std::max(upper, ratio * expected);
+}
+
+bool SignificantExcess(const ComponentLevel& level, double expected_chi2_per_dof) {
+  if (level.count <= 0) return false;
+  const double n = level.count;
+  return (level.chi2_per_dof - expected_chi2_per_dof) * n > ChiSquareQuantile(kQuantile, level.count) - n;
 }
 
 std::vector<LocatedComponent> Locate(const std::vector<estimator::MeasurementResidual>& residuals,
@@ -196,8 +215,7 @@ std::vector<LocatedComponent> Locate(const std::vector<estimator::MeasurementRes
       lc.chi2_per_dof = chi2 / lc.count;
       const auto level = expected.find(ComponentKey(stream, component));
       lc.expected_chi2_per_dof = level != expected.end() ? std::max(level->second, 1e-6) : 1.0;
-      const double upper = lc.expected_chi2_per_dof * ChiSquareQuantile(kQuantile, lc.count) / lc.count;
-      lc.inconsistent = lc.chi2_per_dof > std::max(upper, options.inconsistency_ratio * lc.expected_chi2_per_dof);
+      lc.inconsistent = Inconsistent({lc.chi2_per_dof, lc.count}, lc.expected_chi2_per_dof, options.inconsistency_ratio);
 
       // When: windows of window_s, half overlapping, whose chi-square exceeds the level's quantile (Bonferroni:
       // 1 - (1 - kQuantile) / windows, so that a consistent component has no interval with probability kQuantile);

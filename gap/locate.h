@@ -84,4 +84,20 @@ std::string ComponentKey(const std::string& stream, int component);
 // Per component chi2_per_dof, keyed as above.
 std::map<std::string, double> ComponentLevels(const std::vector<estimator::MeasurementResidual>& residuals);
 
+// One component's chi-square per dof over `count` scalar residuals.
+struct ComponentLevel {
+  double chi2_per_dof = 0.0;
+  int count = 0;
+};
+// Per component, keyed as above (active measurements only).
+std::map<std::string, ComponentLevel> ComponentStatistics(const std::vector<estimator::MeasurementResidual>& residuals);
+// Locate's rule: chi2_per_dof above `ratio` times the expected level and above the level's 99.9 % chi-square quantile
+// for `count` residuals.
+bool Inconsistent(const ComponentLevel& level, double expected_chi2_per_dof, double ratio);
+// Whether the chi-square above the expected level, (chi2_per_dof - expected) count, exceeds what `count` residuals
+// of the stated noise (chi2(count)) exceed their mean by with 0.1 % probability: an excess the stated noise model can
+// tell from noise, whatever the level (a component far below 1, e.g. a gyroscope axis a planar drive hardly moves,
+// can double its level by a few hundredths of a chi-square unit).
+bool SignificantExcess(const ComponentLevel& level, double expected_chi2_per_dof);
+
 }  // namespace roamlab::gap

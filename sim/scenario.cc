@@ -488,6 +488,9 @@ const std::map<std::string, std::map<std::string, double>>& KnownEffects() {
       {"gyro_scale_error", {{"scale_x", 1.0}, {"scale_y", 1.0}, {"scale_z", 1.0}}},
       {"gyro_bias_drift", {{"initial_x", 0.0}, {"initial_y", 0.0}, {"initial_z", 0.0}, {"random_walk", 0.0}}},
       {"magnetometer_motor_interference", {{"b_per_nm_x", 0.0}, {"b_per_nm_y", 0.0}, {"b_per_nm_z", 0.0}}},
+      {"accelerometer_scale_error", {{"scale_x", 1.0}, {"scale_y", 1.0}, {"scale_z", 1.0}}},
+      {"gps_multipath", {{"sigma_m", 0.0}, {"correlation_s", 5.0}}},
+      {"tire_growth", {{"growth_per_mps2", 0.0}}},
       {"wheel_radius_asymmetry", {{"ratio_right_left", 1.0}}},
       {"track_width_error", {{"track_error_m", 0.0}}},
       {"wheel_deformation", {{"wheel", 0.0}, {"ovality_m", 0.0}}},
@@ -676,8 +679,29 @@ std::optional<Scenario::Problem> Scenario::Validate() const {
         if (!(std::abs(EffectParameter(effects, e.name, axis, 0.0)) <= 0.5))
           return P{k + ".parameters." + axis, "must be in [-0.5, 0.5] rad/s"};
     }
-    if ((e.name == "imu_time_offset" || e.name == "gyro_scale_error" || e.name == "gyro_bias_drift") && !sensors.imu)
+    if ((e.name == "imu_time_offset" || e.name == "gyro_scale_error" || e.name == "gyro_bias_drift" ||
+         e.name == "accelerometer_scale_error") &&
+        !sensors.imu)
       return P{k + ".name", e.name + " needs sensors.imu"};
+    if (e.name == "accelerometer_scale_error") {
+      for (const char* axis : {"scale_x", "scale_y", "scale_z"}) {
+        const double scale = EffectParameter(effects, e.name, axis, 1.0);
+        if (!(scale >= 0.5 && scale <= 1.5)) return P{k + ".parameters." + axis, "must be in [0.5, 1.5]"};
+      }
+    }
+    if (e.name == "gps_multipath") {
+      if (!sensors.gps) return P{k + ".name", "gps_multipath needs sensors.gps"};
+      const double sigma = EffectParameter(effects, e.name, "sigma_m", 0.0);
+      if (!(sigma >= 0.0 && sigma <= 10.0)) return P{k + ".parameters.sigma_m", "must be in [0, 10] m"};
+      const double tau = EffectParameter(effects, e.name, "correlation_s", 5.0);
+      if (!(tau >= 0.1 && tau <= 600.0)) return P{k + ".parameters.correlation_s", "must be in [0.1, 600] s"};
+    }
+    if (e.name == "tire_growth") {
+      if (!ackermann) return P{k + ".name", "tire_growth is implemented for ackermann robots only"};
+      if (!sensors.odometer) return P{k + ".name", "tire_growth needs sensors.odometer"};
+      const double c = EffectParameter(effects, e.name, "growth_per_mps2", 0.0);
+      if (!(c >= 0.0 && c <= 0.01)) return P{k + ".parameters.growth_per_mps2", "must be in [0, 0.01] s^2/m^2"};
+    }
     if (e.name == "steering_offset" && !sensors.odometer)
       return P{k + ".name", "steering_offset needs sensors.odometer"};
     if (e.name == "magnetometer_motor_interference" && !sensors.magnetometer)

@@ -58,6 +58,19 @@
 //   magnetometer_motor_interference {b_per_nm_x: 0, b_per_nm_y: 0, b_per_nm_z: 0}   a magnetometer bias (sensor
 //                                          frame, normalized field units) proportional to the rear drive torque
 //                                          per wheel [N m] applied at the sample instant (motor current)
+// Out-of-library effects (none of the diagnosis's candidates models them; gap-benchmark's decoys):
+//   accelerometer_scale_error {scale_x: 1, scale_y: 1, scale_z: 1}   per-axis gain of the accelerometer in its own
+//                                          frame, each in [0.5, 1.5] (eq. 13's k_s, which the nominal models fix at 1)
+//   gps_multipath {sigma_m: 0, correlation_s: 5}   a slowly varying error of the GPS fix (reflections near the
+//                                          antenna): per ENU axis a first-order Gauss-Markov process, stationary
+//                                          std sigma_m in [0, 10] m, correlation time correlation_s in [0.1, 600]:
+//                                          e(t_k+1) = a e(t_k) + sigma_m sqrt(1 - a^2) n, a = exp(-dt /
+//                                          correlation_s), e(0) ~ N(0, sigma_m^2); its own seeded generator
+//   tire_growth {growth_per_mps2: 0}       ackermann: the rear tires' rolling radius grows with speed (centrifugal
+//                                          growth), r(v) = r0 (1 + c v^2), c in [0, 0.01] s^2/m^2: at ground speed v
+//                                          the wheel turns at v / r(v) and the speed sensor (calibrated for r0)
+//                                          under-reads by the factor 1 / (1 + c v^2). MuJoCo's tire is rigid, so the
+//                                          effect is applied to the rate the sensor reads, v = r0 omega_MuJoCo
 // Wheeled indoor robots (below); in the compiled MuJoCo model after the robot is bound, so that the recording's
 // platform geometry and the driver's inverse kinematics stay nominal; truth.yaml's odometer geometry is the true one:
 //   wheel_radius_asymmetry {ratio_right_left: 1}   differential_drive: the right tire's radius (wheel_1) times the

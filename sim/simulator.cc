@@ -387,8 +387,14 @@ class Simulator::Impl {
       gyro_scale_[i] = EffectParameter(effects, "gyro_scale_error", "scale_" + axis, 1.0);
       mag_per_nm_[i] = EffectParameter(effects, "magnetometer_motor_interference", "b_per_nm_" + axis, 0.0);
       gyro_bias_radps_[i] = EffectParameter(effects, "gyro_bias_drift", "initial_" + axis, 0.0);
+      accel_scale_[i] = EffectParameter(effects, "accelerometer_scale_error", "scale_" + axis, 1.0);
     }
     gyro_bias_walk_ = EffectParameter(effects, "gyro_bias_drift", "random_walk", 0.0);
+    multipath_sigma_m_ = EffectParameter(effects, "gps_multipath", "sigma_m", 0.0);
+    multipath_correlation_s_ = EffectParameter(effects, "gps_multipath", "correlation_s", 5.0);
+    // The Gauss-Markov error starts in its stationary distribution, N(0, sigma^2) per axis.
+    multipath_m_ = multipath_noise_.Draw3(multipath_sigma_m_);
+    tire_growth_per_mps2_ = EffectParameter(effects, "tire_growth", "growth_per_mps2", 0.0);
     for (const EffectOptions& e : effects) {
       recording::Effect truth{e.name, KnownEffects().at(e.name)};
       for (const auto& [name, value] : e.parameters) truth.parameters[name] = value;
@@ -514,7 +520,8 @@ class Simulator::Impl {
         const double period_s = 1e-9 * static_cast<double>(imu_clock_.period_ns);
         gyro_bias_radps_ += gyro_bias_noise_.Draw3(gyro_bias_walk_ * std::sqrt(period_s));
       }
-      const Eigen::Vector3d accel = AccelReading(body, imu_) + accel_noise_.Draw3(sensors.imu->accel_sigma_mps2);
+      const Eigen::Vector3d accel =
+          accel_scale_.cwiseProduct(AccelReading(body, imu_)) + accel_noise_.Draw3(sensors.imu->accel_sigma_mps2);
       imu_stream_.values.row(imu_clock_.Row(t_ns)) << gyro.transpose(), accel.transpose();
     }
     if (mag_clock_.Due(t_ns)) {
@@ -524,7 +531,12 @@ class Simulator::Impl {
     }
     if (gps_clock_.Due(t_ns)) {
       const Eigen::Vector3d antenna =
-          GpsAntennaWorld(body, sensors.gps->lever_arm_m) + gps_noise_.Draw3(sensors.gps->sigma_m);
+          GpsAntennaWorld(body, sensors.gps->lever_arm_m) + multipath_m_ + gps_noise_.Draw3(sensors.gps->sigma_m);
+      if (multipath_sigma_m_ > 0.0) {
+        // gps_multipath: e(t_k+1) = a e(t_k) + sigma sqrt(1 - a^2) n keeps the stationary std sigma (scenario.h).
+        const double a = std::exp(-1e-9 * static_cast<double>(gps_clock_.period_ns) / multipath_correlation_s_);
+        multipath_m_ = a * multipath_m_ + multipath_noise_.Draw3(multipath_sigma_m_ * std::sqrt(1.0 - a * a));
+      }
       double latitude = 0.0, longitude = 0.0, altitude = 0.0;
       local_->Reverse(antenna.x(), antenna.y(), antenna.z(), latitude, longitude, altitude);
       gps_stream_.values.row(gps_clock_.Row(t_ns)) << latitude, longitude, altitude;
@@ -545,9 +557,13 @@ class Simulator::Impl {
     if (laser_clock_.Due(t_ns)) SampleLaser(t_ns);
     if (odometer_clock_.Due(t_ns)) {
       const OdometerOptions& odo = *sensors.odometer;
-      const double z_v =
-          SpeedReading(vehicle_.RearWheelRate(data_.get()), vehicle_.wheel_radius_m(), odo.kv_over_L, wheelbase_m_) +
-          speed_noise_.Draw(odo.speed_sigma_mps);
+      // tire_growth: the rigid MuJoCo tire rolls at omega = v / r0; a tire of radius r0 (1 + c v^2) turns at
+      // omega / (1 + c v^2) at the same ground speed v = r0 omega.
+      const double omega_radps = vehicle_.RearWheelRate(data_.get());
+      const double v_mps = omega_radps * vehicle_.wheel_radius_m();
+      const double z_v = SpeedReading(omega_radps / (1.0 + tire_growth_per_mps2_ * v_mps * v_mps),
+                                      vehicle_.wheel_radius_m(), odo.kv_over_L, wheelbase_m_) +
+                         speed_noise_.Draw(odo.speed_sigma_mps);
       const double z_theta =
           SteeringReading(vehicle_.SteeringAngle(data_.get()), odo.k_theta, odo.k_gamma + steering_offset_rad_) +
                              steering_noise_.Draw(odo.steering_sigma_rad);
@@ -747,6 +763,11 @@ class Simulator::Impl {
   Eigen::Vector3d gyro_bias_radps_ = Eigen::Vector3d::Zero();   // gyro_bias_drift: the bias at the next sample
   double gyro_bias_walk_ = 0.0;                                 // [rad/s/sqrt(s)]
   Eigen::Vector3d mag_per_nm_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_scale_ = Eigen::Vector3d::Ones();
+  double multipath_sigma_m_ = 0.0;                              // gps_multipath: stationary std per axis
+  double multipath_correlation_s_ = 5.0;
+  Eigen::Vector3d multipath_m_ = Eigen::Vector3d::Zero();       // the error of the next fix, ENU [m]
+  double tire_growth_per_mps2_ = 0.0;                           // tire_growth's c [s^2/m^2]
 
   std::int64_t step_ns_ = 0;
   std::int64_t end_ns_ = 0;
@@ -763,6 +784,7 @@ class Simulator::Impl {
   NoiseStream steering_noise_{seed_, NoiseSource::kSteering, options_.noise};
   NoiseStream laser_noise_{seed_, NoiseSource::kLaserRange, options_.noise};
   NoiseStream gyro_bias_noise_{seed_, NoiseSource::kGyroBiasWalk};   // an effect, not sensor noise: always on
+  NoiseStream multipath_noise_{seed_, NoiseSource::kGpsMultipath};   // likewise
 
   recording::Stream imu_stream_, mag_stream_, gps_stream_, wheel_stream_, steering_stream_, encoder_stream_,
       scan_stream_;

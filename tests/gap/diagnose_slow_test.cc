@@ -1,6 +1,7 @@
 // The reality-gap diagnosis of 30 s ATV drives (scenarios/atv_hills.yaml) with one hidden effect, or none: it names the
-// effect and recovers its parameter within three of its reported standard deviations, and stays at "none" without
-// one. The baseline (the nominal model on a nominal simulation) is learned once, from a seed the cases do not use.
+// effect and recovers its parameter within three of its reported standard deviations, stays at "none" without
+// one, and says "unknown" for an effect outside its library. The baseline (the nominal model on a nominal simulation)
+// is learned once, from a seed the cases do not use.
 // The truth is read from the simulation in memory, as evaluation does; the diagnosis sees the recording only.
 #include <cmath>
 #include <iostream>
@@ -119,6 +120,27 @@ TEST_F(DiagnoseTest, GpsLatency) {
   sim::Simulation sim;
   const Diagnosis d = Run({{"gps_latency", {{"latency_s", 0.3}}}}, 16, &sim);
   ExpectNamed(d, sim.truth.effects.at(0), {"latency_s"});
+}
+
+// A decoy (gap-benchmark): an accelerometer gain error, which no candidate models. Its residuals give it away: the
+// accelerometer components are inconsistent and follow the motion (the gain scales gravity and the accelerations, so
+// the residual moves with the slope, the speed or the lateral acceleration), and whatever library parameter it pulls
+// on (through the shared attitude) leaves them inconsistent on the held-out part, so the verdict is "unknown".
+TEST_F(DiagnoseTest, AccelerometerGainDecoyIsUnknown) {
+  sim::Simulation sim;
+  const Diagnosis d = Run({{"accelerometer_scale_error", {{"scale_z", 1.03}}}}, 18, &sim);
+  for (const std::string& u : d.unexplained) std::cout << "unexplained: " << u << "\n";
+  EXPECT_EQ(d.verdict, "unknown");
+  bool accelerometer = false;
+  for (const std::string& u : d.unexplained) accelerometer = accelerometer || u.rfind("accelerometer/", 0) == 0;
+  EXPECT_TRUE(accelerometer);
+  for (const LocatedComponent& lc : d.located) {
+    if (lc.stream != "accelerometer" || lc.component != 2) continue;
+    EXPECT_TRUE(lc.inconsistent);
+    EXPECT_GT(lc.chi2_per_dof, 3.0 * lc.expected_chi2_per_dof);
+    ASSERT_FALSE(lc.correlates.empty());
+    EXPECT_GT(std::abs(lc.correlates.front().rho), 0.3) << lc.correlates.front().condition;
+  }
 }
 
 }  // namespace

@@ -31,6 +31,7 @@ class DiffDriveDiagnoseTest : public ::testing::Test {
     EXPECT_TRUE(d.ok()) << d.status().message();
     if (!d.ok()) return {};
     EXPECT_EQ(d.value().verdict, "named");
+    for (const std::string& u : d.value().unexplained) std::cout << "unexplained: " << u << "\n";
     std::string names;
     for (const EffectEstimate& e : d.value().effects) names += e.name + " ";
     std::cout << "named: " << names << "\n";

@@ -1,9 +1,12 @@
 // Physical effects of a scenario (sim/scenario.h, issue 6): each changes exactly what it says, against the same drive
 // without it (noise off, so that the difference is the effect alone), and is stated in truth.yaml only.
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <string>
+#include <vector>
 
+#include <GeographicLib/LocalCartesian.hpp>
 #include <gtest/gtest.h>
 
 #include "recording/recording.h"
@@ -211,6 +214,68 @@ TEST(AxleMisalignmentTest, AtvRearAxleThrustAngleCrabsAndTurnsAtZeroHandlebar) {
   EXPECT_NEAR(crab.crab_rad, alpha, 0.1 * alpha);
 }
 
+TEST_F(EffectsTest, AccelerometerScaleMultipliesEachAxisAndNothingElse) {
+  const Simulation sim = Simulated(Drive({{"accelerometer_scale_error", {{"scale_y", 0.97}, {"scale_z", 1.04}}}}));
+  const recording::Stream& a = StreamOf(*nominal_, "imu");
+  const recording::Stream& b = StreamOf(sim, "imu");
+  ASSERT_EQ(a.values.rows(), b.values.rows());
+  for (Eigen::Index k = 0; k < a.values.rows(); ++k) {
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(b.values(k, c), a.values(k, c), 1e-12);   // gyroscope untouched
+    EXPECT_NEAR(b.values(k, 3), a.values(k, 3), 1e-12);                             // default scale 1
+    EXPECT_NEAR(b.values(k, 4), 0.97 * a.values(k, 4), 1e-12);
+    EXPECT_NEAR(b.values(k, 5), 1.04 * a.values(k, 5), 1e-12);
+  }
+  EXPECT_EQ(sim.truth.effects.at(0).parameters.at("scale_x"), 1.0);
+}
+
+// The fix error e_k = fix - nominal fix (ENU) obeys e_k+1 = a e_k + sigma sqrt(1 - a^2) n: the innovations have
+// variance sigma^2 (1 - a^2) per axis (chi-square spread sqrt(2 / n) of a sample variance), and the other streams are
+// untouched.
+TEST_F(EffectsTest, GpsMultipathIsAGaussMarkovErrorOfTheFix) {
+  const double sigma_m = 1.5, correlation_s = 0.2;
+  const Simulation sim = Simulated(Drive({{"gps_multipath", {{"sigma_m", sigma_m}, {"correlation_s", correlation_s}}}}));
+  const recording::Stream& a = StreamOf(*nominal_, "gps");
+  const recording::Stream& b = StreamOf(sim, "gps");
+  ASSERT_EQ(a.values.rows(), b.values.rows());
+  const recording::GeodeticOrigin& o = testing::AtvHills(1.0).origin;
+  const GeographicLib::LocalCartesian local(o.latitude_deg, o.longitude_deg, o.altitude_m);
+  std::vector<Eigen::Vector3d> error;
+  for (Eigen::Index k = 0; k < a.values.rows(); ++k) {
+    Eigen::Vector3d pa, pb;
+    local.Forward(a.values(k, 0), a.values(k, 1), a.values(k, 2), pa.x(), pa.y(), pa.z());
+    local.Forward(b.values(k, 0), b.values(k, 1), b.values(k, 2), pb.x(), pb.y(), pb.z());
+    error.push_back(pb - pa);
+  }
+  const double a_k = std::exp(-0.01 / correlation_s);   // the 100 Hz GPS of Drive
+  double sum = 0.0;
+  int n = 0;
+  for (std::size_t k = 0; k + 1 < error.size(); ++k, n += 3) sum += (error[k + 1] - a_k * error[k]).squaredNorm();
+  const double ratio = sum / n / (sigma_m * sigma_m * (1.0 - a_k * a_k));
+  EXPECT_NEAR(ratio, 1.0, 4.0 * std::sqrt(2.0 / n));
+  EXPECT_GT(error.front().norm(), 1e-3);   // starts in the stationary distribution, not at zero
+  EXPECT_LT((StreamOf(sim, "imu").values - StreamOf(*nominal_, "imu").values).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+// At ground speed v = z_v_nominal kv_over_L L the reading is z_v_nominal / (1 + c v^2).
+TEST_F(EffectsTest, TireGrowthMakesTheSpeedSensorUnderReadWithTheSquareOfTheSpeed) {
+  const double c = 0.004;
+  const Simulation sim = Simulated(Drive({{"tire_growth", {{"growth_per_mps2", c}}}}));
+  const recording::Stream& a = StreamOf(*nominal_, "rear_wheel");
+  const recording::Stream& b = StreamOf(sim, "rear_wheel");
+  ASSERT_EQ(a.values.rows(), b.values.rows());
+  auto geometry = NominalPlatformGeometry(Drive({}));
+  ASSERT_TRUE(geometry.ok()) << geometry.status().message();
+  const double kv = Drive({}).sensors.odometer->kv_over_L * geometry.value().at("wheelbase_m");
+  double min_ratio = 1.0;
+  for (Eigen::Index k = 0; k < a.values.rows(); ++k) {
+    const double v_mps = a.values(k, 0) * kv;
+    EXPECT_NEAR(b.values(k, 0), a.values(k, 0) / (1.0 + c * v_mps * v_mps), 1e-9) << k;
+    min_ratio = std::min(min_ratio, b.values(k, 0) / a.values(k, 0));
+  }
+  EXPECT_LT(min_ratio, 0.95);   // about 4 m/s: a 6 % under-reading
+  EXPECT_LT((StreamOf(sim, "steering").values - StreamOf(*nominal_, "steering").values).cwiseAbs().maxCoeff(), 1e-12);
+}
+
 TEST(EffectsValidationTest, UnknownNamesParametersAndRangesAreErrors) {
   const auto problem = [](const std::vector<EffectOptions>& effects) {
     Scenario s = testing::AtvHills(1.0);
@@ -236,6 +301,19 @@ TEST(EffectsValidationTest, UnknownNamesParametersAndRangesAreErrors) {
   EXPECT_EQ(problem({{"axle_misalignment", {{"wheel", 1}, {"yaw_deg", 1.0}}}}),
             "effects[0].parameters.wheel: ackermann: axle_misalignment turns the rear axle (both rear wheels); no "
             "wheel index");
+  EXPECT_NE(problem({{"accelerometer_scale_error", {{"scale_x", 1.6}}}}).find("scale_x: must be in [0.5, 1.5]"),
+            std::string::npos);
+  EXPECT_NE(problem({{"gps_multipath", {{"sigma_m", -1.0}}}}).find("sigma_m: must be in [0, 10] m"),
+            std::string::npos);
+  EXPECT_NE(problem({{"gps_multipath", {{"correlation_s", 0.0}}}}).find("correlation_s: must be in [0.1, 600] s"),
+            std::string::npos);
+  EXPECT_NE(problem({{"tire_growth", {{"growth_per_mps2", 0.02}}}}).find("growth_per_mps2: must be in [0, 0.01]"),
+            std::string::npos);
+  Scenario no_gps = testing::AtvHills(1.0);
+  no_gps.sensors.gps.reset();
+  no_gps.effects = {{"gps_multipath", {{"sigma_m", 1.0}}}};
+  ASSERT_TRUE(no_gps.Validate().has_value());
+  EXPECT_EQ(no_gps.Validate()->message, "gps_multipath needs sensors.gps");
   // Not a whole number of 1 ms physics steps: refused when the simulator is created.
   Scenario s = testing::AtvHills(1.0);
   s.effects = {{"gps_latency", {{"latency_s", 0.0105}}}};
