@@ -28,11 +28,13 @@ int GateOutliers(double probability, ProblemBuilder* builder, FactorId first) {
   std::vector<FactorId> ids;
   for (auto it = graph.factors().lower_bound(first); it != graph.factors().end(); ++it)
     if (builder->StreamOfFactor(it->first) >= 0) ids.push_back(it->first);
+  internal::WhitenedFactor wf;  // reused: its buffers keep their size
+  std::vector<bool> no_jacobians;
   for (FactorId id : ids) {
     FactorEntry& entry = graph.mutable_factor(id);
     const int dim = entry.factor->residual_dim();
-    internal::WhitenedFactor wf;
-    const bool ok = internal::LinearizeFactor(graph, entry, std::vector<bool>(entry.variables.size(), false), &wf);
+    no_jacobians.assign(entry.variables.size(), false);
+    const bool ok = internal::LinearizeFactor(graph, entry, no_jacobians, &wf);
     const bool active = ok && wf.squared_norm <= threshold(dim);
     if (active == entry.active) continue;
     ++changed;

@@ -34,8 +34,11 @@ FactorId Graph::AddFactor(std::unique_ptr<Factor> factor, std::vector<VariableId
   ROAMLAB_CHECK(noise_covariance.rows() == factor->noise_dim() && noise_covariance.cols() == factor->noise_dim(),
                 "factor from '" << stream << "': noise covariance is " << noise_covariance.rows() << "x"
                                 << noise_covariance.cols() << ", expected " << factor->noise_dim());
-  ROAMLAB_CHECK(noise_covariance.isApprox(noise_covariance.transpose()) &&
-                    Eigen::LLT<Eigen::MatrixXd>(noise_covariance).info() == Eigen::Success,
+  // Unit noise (the marginalization's and the calibration's linear priors, added at every step of a window) is
+  // positive definite and its own square root: no factorization needed.
+  const bool identity = noise_covariance.isIdentity(0.0);
+  ROAMLAB_CHECK(identity || (noise_covariance.isApprox(noise_covariance.transpose()) &&
+                             Eigen::LLT<Eigen::MatrixXd>(noise_covariance).info() == Eigen::Success),
                 "factor from '" << stream << "': noise covariance is not symmetric positive definite");
   const FactorId id = next_factor_++;
   const bool factor_is_additive = factor->additive_noise();
@@ -43,7 +46,10 @@ FactorId Graph::AddFactor(std::unique_ptr<Factor> factor, std::vector<VariableId
   FactorEntry entry;
   entry.factor = std::move(factor);
   entry.variables = std::move(variables);
-  if (factor_is_additive) {
+  if (factor_is_additive && identity) {
+    entry.noise_sqrt_covariance = noise_covariance;
+    entry.noise_sqrt_diagonal = true;
+  } else if (factor_is_additive) {
     entry.noise_sqrt_covariance = Eigen::LLT<Eigen::MatrixXd>(noise_covariance).matrixL();
     entry.noise_sqrt_diagonal = true;
     for (int c = 0; c < entry.noise_sqrt_covariance.cols(); ++c)

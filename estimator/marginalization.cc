@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <set>
+#include <vector>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -107,22 +107,31 @@ LinearPriorFactor::LinearPriorFactor(std::vector<Manifold> manifolds, std::vecto
 
 bool LinearPriorFactor::Evaluate(const double* const* values, double* error, double* const* jacobians,
                                  double* noise_jacobian) const {
+  // Evaluated at every linearization and trial point of a window: no allocation once the per-thread buffer has grown.
   const int m = residual_dim();
-  Eigen::VectorXd delta(J_.cols());
+  thread_local Eigen::VectorXd delta;
+  delta.resize(J_.cols());
   for (std::size_t i = 0; i < manifolds_.size(); ++i)
     manifolds_[i].Minus(values[i], x0_[i].data(), delta.data() + offsets_[i]);
-  Eigen::Map<Eigen::VectorXd>(error, m) = r0_ + J_ * delta;
+  Eigen::Map<Eigen::VectorXd> e(error, m);
+  e.noalias() = J_ * delta;
+  e += r0_;
   if (jacobians != nullptr) {
+    // J times the block's d[-] / dx: the identity on Euclidean coordinates and a pose's translation, the inverse right
+    // Jacobian of SO(3) on rotations.
     for (std::size_t i = 0; i < manifolds_.size(); ++i) {
       if (jacobians[i] == nullptr) continue;
       const int d = manifolds_[i].tangent_dim();
-      Eigen::MatrixXd D = Eigen::MatrixXd::Identity(d, d);
+      Eigen::Map<Eigen::MatrixXd> J_i(jacobians[i], m, d);
+      const int o = offsets_[i];
       if (manifolds_[i].kind() == ManifoldKind::kQuaternion) {
-        D = InverseRightJacobian(delta.segment<3>(offsets_[i]));
+        J_i.noalias() = J_.middleCols<3>(o) * InverseRightJacobian(delta.segment<3>(o));
       } else if (manifolds_[i].kind() == ManifoldKind::kPose) {
-        D.bottomRightCorner<3, 3>() = InverseRightJacobian(delta.segment<3>(offsets_[i] + 3));
+        J_i.leftCols<3>() = J_.middleCols<3>(o);
+        J_i.rightCols<3>().noalias() = J_.middleCols<3>(o + 3) * InverseRightJacobian(delta.segment<3>(o + 3));
+      } else {
+        J_i = J_.middleCols(o, d);
       }
-      Eigen::Map<Eigen::MatrixXd>(jacobians[i], m, d) = J_.middleCols(offsets_[i], d) * D;
     }
   }
   if (noise_jacobian != nullptr) Eigen::Map<Eigen::MatrixXd>(noise_jacobian, m, m).setIdentity();
@@ -130,13 +139,15 @@ bool LinearPriorFactor::Evaluate(const double* const* values, double* error, dou
 }
 
 bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph) {
-  // The factors on the leaving variables, and the blanket: the other free variables they touch.
-  const std::set<VariableId> leaving_set(leaving.begin(), leaving.end());
-  std::set<FactorId> factors;
+  // The factors on the leaving variables (sorted, once each), and the blanket: the other free variables they touch.
+  // Small sets (a pose and its blanket of a few dozen coordinates): sorted or searched vectors, no node containers.
+  std::vector<FactorId> factors;
   for (VariableId v : leaving)
-    for (FactorId f : graph->FactorsOf(v)) factors.insert(f);
+    for (FactorId f : graph->FactorsOf(v)) factors.push_back(f);
+  std::sort(factors.begin(), factors.end());
+  factors.erase(std::unique(factors.begin(), factors.end()), factors.end());
+  const auto leaves = [&](VariableId v) { return std::find(leaving.begin(), leaving.end(), v) != leaving.end(); };
   std::vector<VariableId> order;  // leaving first, then blanket
-  std::set<VariableId> blanket_set;
   for (VariableId v : leaving)
     if (!graph->variable(v).fixed) order.push_back(v);
   const std::size_t n_leaving = order.size();
@@ -144,12 +155,13 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph) {
     const FactorEntry& e = graph->factor(f);
     if (!e.active) continue;
     for (VariableId v : e.variables)
-      if (!leaving_set.count(v) && !graph->variable(v).fixed && blanket_set.insert(v).second) order.push_back(v);
+      if (!leaves(v) && !graph->variable(v).fixed && std::find(order.begin(), order.end(), v) == order.end())
+        order.push_back(v);
   }
-  std::map<VariableId, int> offset;
+  std::vector<int> offset(order.size());
   int n = 0, nm = 0;
   for (std::size_t i = 0; i < order.size(); ++i) {
-    offset[order[i]] = n;
+    offset[i] = n;
     n += graph->variable(order[i]).manifold.tangent_dim();
     if (i + 1 == n_leaving) nm = n;
   }
@@ -166,15 +178,16 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph) {
     want.clear();
     var_offset.clear();
     for (VariableId v : e.variables) {
-      const auto it = offset.find(v);
-      want.push_back(it != offset.end());
-      var_offset.push_back(it != offset.end() ? it->second : -1);
+      const auto it = std::find(order.begin(), order.end(), v);
+      want.push_back(it != order.end());
+      var_offset.push_back(it != order.end() ? offset[it - order.begin()] : -1);
     }
     if (!internal::LinearizeFactor(*graph, e, want, &wf)) return false;
-    // Coefficient-wise products: the blocks are a few rows by at most a few dozen columns.
     for (std::size_t a = 0; a < e.variables.size(); ++a) {
       if (!want[a]) continue;
       const int oa = var_offset[a];
+      // Coefficient-wise products in this order: the prior's rank decision (SquareRootInformation) is sensitive to
+      // the rounding of H (see BENCHMARKS.md, fourth tracking pass).
       g.segment(oa, wf.jacobians[a].cols()) += wf.jacobians[a].transpose().lazyProduct(wf.residual);
       for (std::size_t b = 0; b < e.variables.size(); ++b) {
         if (!want[b]) continue;

@@ -7,6 +7,7 @@
 #include <Eigen/CholmodSupport>
 
 #include "common/check.h"
+#include "estimator/internal/jacobian_products.h"
 
 namespace roamlab::estimator::internal {
 
@@ -24,70 +25,6 @@ constexpr int kMaxBorder = 128;
 // Up to this many columns, a natural-order system's covariance is Y^T Y from the forward substitution alone (the
 // product costs columns^2 x dimension, a back substitution columns x the factor's size).
 constexpr int kMaxForwardCovarianceColumns = 16;
-
-// dst (A x B block of H's value array, column stride `stride`) += Ja^T Jb, Ja M x A, Jb M x B.
-template <int M, int A, int B>
-void AddProductFixed(const double* ja, const double* jb, double* dst, std::ptrdiff_t stride) {
-  Eigen::Map<Eigen::Matrix<double, A, B>, 0, Eigen::OuterStride<>> block(dst, A, B, Eigen::OuterStride<>(stride));
-  block.noalias() += Eigen::Map<const Eigen::Matrix<double, M, A>>(ja).transpose() *
-                     Eigen::Map<const Eigen::Matrix<double, M, B>>(jb);
-}
-
-// The same with the column counts as template arguments when they are among the block sizes of the error models
-// (1: scalar, 3: vector or rotation, 6: pose, 9: 3x3 matrix); false for other sizes.
-template <int M, int A>
-bool AddProductColumns(const double* ja, const double* jb, int b, double* dst, std::ptrdiff_t stride) {
-  switch (b) {
-    case 1: AddProductFixed<M, A, 1>(ja, jb, dst, stride); return true;
-    case 3: AddProductFixed<M, A, 3>(ja, jb, dst, stride); return true;
-    case 6: AddProductFixed<M, A, 6>(ja, jb, dst, stride); return true;
-    case 9: AddProductFixed<M, A, 9>(ja, jb, dst, stride); return true;
-    default: return false;
-  }
-}
-template <int M>
-bool AddProductRows(const double* ja, int a, const double* jb, int b, double* dst, std::ptrdiff_t stride) {
-  switch (a) {
-    case 1: return AddProductColumns<M, 1>(ja, jb, b, dst, stride);
-    case 3: return AddProductColumns<M, 3>(ja, jb, b, dst, stride);
-    case 6: return AddProductColumns<M, 6>(ja, jb, b, dst, stride);
-    case 9: return AddProductColumns<M, 9>(ja, jb, b, dst, stride);
-    default: return false;
-  }
-}
-
-void AddProduct(const Eigen::MatrixXd& ja, const Eigen::MatrixXd& jb, double* dst, std::ptrdiff_t stride) {
-  const int a = static_cast<int>(ja.cols()), b = static_cast<int>(jb.cols());
-  if (ja.rows() == 3 && AddProductRows<3>(ja.data(), a, jb.data(), b, dst, stride)) return;
-  if (ja.rows() == 4 && AddProductRows<4>(ja.data(), a, jb.data(), b, dst, stride)) return;
-  if (ja.rows() == 6 && AddProductRows<6>(ja.data(), a, jb.data(), b, dst, stride)) return;
-  // Coefficient-wise: at these sizes (a few rows, up to a few dozen columns) cheaper than a blocked product.
-  Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> block(dst, ja.cols(), jb.cols(), Eigen::OuterStride<>(stride));
-  block.noalias() += ja.transpose().lazyProduct(jb);
-}
-
-// g_segment += J^T r.
-template <int M, int A>
-void AddGradientFixed(const double* j, const double* r, double* g) {
-  Eigen::Map<Eigen::Matrix<double, A, 1>>(g).noalias() +=
-      Eigen::Map<const Eigen::Matrix<double, M, A>>(j).transpose() * Eigen::Map<const Eigen::Matrix<double, M, 1>>(r);
-}
-template <int M>
-bool AddGradientRows(const double* j, int a, const double* r, double* g) {
-  switch (a) {
-    case 1: AddGradientFixed<M, 1>(j, r, g); return true;
-    case 3: AddGradientFixed<M, 3>(j, r, g); return true;
-    case 6: AddGradientFixed<M, 6>(j, r, g); return true;
-    case 9: AddGradientFixed<M, 9>(j, r, g); return true;
-    default: return false;
-  }
-}
-void AddGradient(const Eigen::MatrixXd& j, const Eigen::VectorXd& r, double* g) {
-  const int a = static_cast<int>(j.cols());
-  if (j.rows() == 3 && AddGradientRows<3>(j.data(), a, r.data(), g)) return;
-  if (j.rows() == 4 && AddGradientRows<4>(j.data(), a, r.data(), g)) return;
-  Eigen::Map<Eigen::VectorXd>(g, j.cols()).noalias() += j.transpose() * r;
-}
 
 }  // namespace
 
@@ -322,13 +259,13 @@ bool NormalEquations::Linearize(const Graph& /*graph*/, std::string* failed_stre
     // column length of their block column as outer stride.
     const int* block = &var_block_[v0];
     for (int a = 0; a < n; ++a)
-      if (block[a] >= 0) AddGradient(wf.jacobians[a], wf.residual, g_.data() + block_offset_[block[a]]);
+      if (block[a] >= 0) AddJacobianGradient(wf.jacobians[a], wf.residual, g_.data() + block_offset_[block[a]]);
     int pair = pair_begin_[k];
     for (int a = 0; a < n; ++a) {
       if (block[a] < 0) continue;
       for (int b = 0; b < n; ++b) {
         if (block[b] < 0 || block[a] > block[b]) continue;
-        AddProduct(wf.jacobians[a], wf.jacobians[b], values + pair_value_[pair++], column_length_[block[b]]);
+        AddJacobianProduct(wf.jacobians[a], wf.jacobians[b], values + pair_value_[pair++], column_length_[block[b]]);
       }
     }
   }
