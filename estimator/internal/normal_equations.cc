@@ -56,6 +56,15 @@ int NormalEquations::OffsetOf(VariableId id) const {
 }
 
 void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
+  // The tables of the last Reset, kept for the factors still in the graph (below).
+  prev_order_.swap(order_);
+  prev_block_of_id_.swap(block_of_id_);
+  prev_factor_ids_.swap(factor_ids_);
+  prev_entries_.swap(entries_);
+  prev_var_begin_.swap(var_begin_);
+  prev_var_block_.swap(var_block_);
+  prev_values_.swap(values_);
+
   // Blocks of the free variables.
   order_ = std::move(order);
   const int nb = static_cast<int>(order_.size());
@@ -76,16 +85,35 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
     ROAMLAB_CHECK(block_of_id_[i].first != block_of_id_[i - 1].first, "variable " << block_of_id_[i].first
                                                                                   << " ordered twice");
 
-  // Every variable's value and block (-1 when held constant), by id: one pass over the graph's variables instead of
-  // a map look-up per factor and variable below.
-  variable_table_.clear();
-  auto free_it = block_of_id_.begin();
-  for (const auto& [id, v] : graph.variables()) {
-    while (free_it != block_of_id_.end() && free_it->first < id) ++free_it;
-    const int block = free_it != block_of_id_.end() && free_it->first == id ? free_it->second : -1;
-    variable_table_.push_back({id, v.value.data(), block});
+  // Incremental: the same graph as at the last Reset (a window that slid: factors and variables left at the front,
+  // new ones came at the back, ids are never reused), and no variable that existed then and was held constant is free
+  // now. A factor still in the graph then keeps its variables' values and its blocks, renumbered by old_to_new_; only
+  // the factors that are new (or switched on again by gating) look their variables up.
+  bool incremental = prev_graph_ == &graph && !prev_factor_ids_.empty();
+  const auto prev_block_of = [this](VariableId id) {
+    const auto it = std::lower_bound(prev_block_of_id_.begin(), prev_block_of_id_.end(), std::make_pair(id, -1));
+    return it != prev_block_of_id_.end() && it->first == id ? it->second : -1;
+  };
+  for (int b = 0; incremental && b < nb; ++b)
+    incremental = order_[b] > prev_last_variable_ || prev_block_of(order_[b]) >= 0;
+  prev_graph_ = &graph;
+  prev_last_variable_ = graph.variables().empty() ? -1 : graph.variables().rbegin()->first;
+  if (incremental) {
+    old_to_new_.resize(prev_order_.size());
+    for (std::size_t b = 0; b < prev_order_.size(); ++b) old_to_new_[b] = BlockOf(prev_order_[b]);
+  } else {
+    // Every variable's value and block (-1 when held constant), by id: one pass over the graph's variables instead
+    // of a map look-up per factor and variable below.
+    variable_table_.clear();
+    auto free_it = block_of_id_.begin();
+    for (const auto& [id, v] : graph.variables()) {
+      while (free_it != block_of_id_.end() && free_it->first < id) ++free_it;
+      const int block = free_it != block_of_id_.end() && free_it->first == id ? free_it->second : -1;
+      variable_table_.push_back({id, v.value.data(), block});
+    }
   }
-  const auto lookup = [this](VariableId id) -> const VariableSlot& {
+  const auto lookup = [&](VariableId id) -> VariableSlot {
+    if (incremental) return {id, graph.variable(id).value.data(), BlockOf(id)};
     const auto it = std::lower_bound(variable_table_.begin(), variable_table_.end(), id,
                                      [](const VariableSlot& slot, VariableId key) { return slot.id < key; });
     ROAMLAB_CHECK(it != variable_table_.end() && it->id == id, "no variable " << id);
@@ -97,10 +125,10 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   // The per-factor buffers follow their factors: a window that slid drops its oldest factors at the front (ids grow
   // with time), so the buffers are rotated by as many places, and a factor keeps buffers of its own sizes (no
   // reallocation when it is linearized again).
-  if (!factor_ids_.empty() && !graph.factors().empty()) {
+  if (!prev_factor_ids_.empty() && !graph.factors().empty()) {
     const FactorId first = graph.factors().begin()->first;
-    const auto kept = std::lower_bound(factor_ids_.begin(), factor_ids_.end(), first);
-    std::rotate(whitened_.begin(), whitened_.begin() + (kept - factor_ids_.begin()), whitened_.end());
+    const auto kept = std::lower_bound(prev_factor_ids_.begin(), prev_factor_ids_.end(), first);
+    std::rotate(whitened_.begin(), whitened_.begin() + (kept - prev_factor_ids_.begin()), whitened_.end());
   }
   factor_ids_.clear();
   entries_.clear();
@@ -110,16 +138,28 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   values_.clear();
   rows_of_.resize(nb);
   for (int b = 0; b < nb; ++b) rows_of_[b].assign(1, b);
+  std::size_t prev = 0;  // next factor of the last Reset to compare with (both lists in id order)
   for (const auto& [fid, entry] : graph.factors()) {
     if (!entry.active) continue;
     ROAMLAB_CHECK(entry.variables.size() <= 64, "factor from '" << entry.stream << "' has over 64 variables");
     const std::size_t begin = var_block_.size();
     std::uint64_t mask = 0;
+    while (incremental && prev < prev_factor_ids_.size() && prev_factor_ids_[prev] < fid) ++prev;
+    const bool kept = incremental && prev < prev_factor_ids_.size() && prev_factor_ids_[prev] == fid &&
+                      prev_entries_[prev] == &entry &&
+                      prev_var_begin_[prev + 1] - prev_var_begin_[prev] == static_cast<int>(entry.variables.size());
     for (std::size_t i = 0; i < entry.variables.size(); ++i) {
-      const VariableSlot& slot = lookup(entry.variables[i]);
-      const int b = slot.block;
+      int b = -1;
+      if (kept) {
+        const int p = prev_var_begin_[prev] + static_cast<int>(i);
+        b = prev_var_block_[p] >= 0 ? old_to_new_[prev_var_block_[p]] : -1;
+        values_.push_back(prev_values_[p]);
+      } else {
+        const VariableSlot slot = lookup(entry.variables[i]);
+        b = slot.block;
+        values_.push_back(slot.value);
+      }
       var_block_.push_back(b);
-      values_.push_back(slot.value);
       if (b >= 0) mask |= std::uint64_t{1} << i;
     }
     if (mask == 0) {
@@ -234,9 +274,11 @@ void NormalEquations::BuildPattern() {
     pair_begin_.push_back(static_cast<int>(pair_value_.size()));
   }
   diagonal_index_.resize(dimension_);
-  for (int b = 0; b < nb; ++b)
+  for (int b = 0; b < nb; ++b) {
+    const std::ptrdiff_t diagonal = value_index(b, b);
     for (int j = 0; j < dims_[b]; ++j)
-      diagonal_index_[block_offset_[b] + j] = value_index(b, b) + static_cast<std::ptrdiff_t>(j) * column_length_[b] + j;
+      diagonal_index_[block_offset_[b] + j] = diagonal + static_cast<std::ptrdiff_t>(j) * column_length_[b] + j;
+  }
 }
 
 bool NormalEquations::Linearize(const Graph& /*graph*/, std::string* failed_stream) {

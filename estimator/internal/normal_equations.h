@@ -5,7 +5,9 @@
 // (a tracking window: a band with a dense border) are factored in their envelope instead (see Reset).
 //
 // An object can be Reset to a changed graph and keeps its buffers; when the new pattern is the same as the old one
-// (a fixed-lag window that slid by one pose has the same band), the symbolic analysis is kept too.
+// (a fixed-lag window that slid by one pose has the same band), the symbolic analysis is kept too. Reset to the same
+// graph again is incremental: the factors still in it keep their tables (their variables' values and blocks), only new
+// ones are looked up; the result is the same as from scratch.
 #pragma once
 
 #include <cstdint>
@@ -94,6 +96,19 @@ class NormalEquations {
   std::vector<int> pair_begin_;
   std::vector<std::ptrdiff_t> pair_value_;
   std::vector<WhitenedFactor> whitened_;
+
+  // The tables of the last Reset (swapped out at the next one), for an incremental Reset of a graph that changed at
+  // its ends: old_to_new_ maps the last Reset's blocks to the current ones (-1 when no longer free).
+  const Graph* prev_graph_ = nullptr;
+  VariableId prev_last_variable_ = -1;  // largest variable id in the graph at the last Reset
+  std::vector<VariableId> prev_order_;
+  std::vector<std::pair<VariableId, int>> prev_block_of_id_;
+  std::vector<FactorId> prev_factor_ids_;
+  std::vector<const FactorEntry*> prev_entries_;
+  std::vector<int> prev_var_begin_;
+  std::vector<int> prev_var_block_;
+  std::vector<const double*> prev_values_;
+  std::vector<int> old_to_new_;
 
   // Pattern scratch: row blocks per block column (sorted) with their row offsets in the column, the column lengths,
   // and the new compressed-column arrays.
