@@ -99,6 +99,7 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   prev_graph_ = &graph;
   prev_last_variable_ = graph.variables().empty() ? -1 : graph.variables().rbegin()->first;
   if (incremental) {
+    ++incremental_resets_;
     old_to_new_.resize(prev_order_.size());
     for (std::size_t b = 0; b < prev_order_.size(); ++b) old_to_new_[b] = BlockOf(prev_order_[b]);
   } else {
@@ -167,9 +168,14 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
       values_.resize(begin);
       continue;
     }
-    for (std::size_t i = begin; i < var_block_.size(); ++i)
-      for (std::size_t j = begin; j < var_block_.size(); ++j)
-        if (var_block_[i] >= 0 && var_block_[i] < var_block_[j]) rows_of_[var_block_[j]].push_back(var_block_[i]);
+    // (A row block that its column received last, as from the factors before on the same pair, is not repeated.)
+    for (std::size_t i = begin; i < var_block_.size(); ++i) {
+      for (std::size_t j = begin; j < var_block_.size(); ++j) {
+        if (var_block_[i] < 0 || var_block_[i] >= var_block_[j]) continue;
+        std::vector<int>& rows = rows_of_[var_block_[j]];
+        if (rows.back() != var_block_[i]) rows.push_back(var_block_[i]);
+      }
+    }
     factor_ids_.push_back(fid);
     entries_.push_back(&entry);
     want_.push_back(mask);
@@ -213,7 +219,7 @@ void NormalEquations::BuildPattern() {
   row_offset_.resize(nb);
   for (int b = 0; b < nb; ++b) {
     auto& rows = rows_of_[b];
-    std::sort(rows.begin(), rows.end());
+    if (!std::is_sorted(rows.begin(), rows.end())) std::sort(rows.begin(), rows.end());
     rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
     row_offset_[b].clear();
     for (int r : rows) {

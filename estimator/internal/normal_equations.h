@@ -66,6 +66,8 @@ class NormalEquations {
   const std::vector<FactorId>& factor_ids() const { return factor_ids_; }
   // How many Reset calls had to analyse a new pattern (the others kept the symbolic factorization).
   int analyses() const { return analyses_; }
+  // How many Reset calls kept the tables of the factors still in the graph (incremental).
+  int incremental_resets() const { return incremental_resets_; }
 
  private:
   // Block column of a free variable, or -1.
@@ -125,6 +127,7 @@ class NormalEquations {
   Eigen::VectorXd g_;
   double cost_ = 0.0;
   int analyses_ = 0;
+  int incremental_resets_ = 0;
   bool natural_order_ = false;  // factor in the order of the blocks, in the envelope (Reset)
 
   // Cholesky H = U^T U of a natural-order system (a band of poses with a dense border of constant parameters), in

@@ -1,5 +1,7 @@
 #include "estimator/solver.h"
 
+#include <algorithm>
+#include <deque>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -238,6 +240,85 @@ TEST(NormalEquationsTest, EnvelopeFactorizationOfABandWithABorderMatchesADenseCh
 // Marginalizing x out of linear factors on (x, y) leaves a prior on y with J^T J and J^T r0 equal to the Schur
 // complement of the information and the gradient, also when that information is rank-deficient (y's third
 // coordinate is never observed; its second well, or weakly: information 1e-8 of the largest).
+// Reset of one NormalEquations object to a window that slides (the oldest pose marginalized, a new one added, a
+// factor gated off and on again, a held-constant parameter freed) is incremental; it must give the same system as a
+// fresh object built from scratch: the same factors, H's pattern and values, gradient, cost and step, bit for bit.
+TEST(NormalEquationsTest, IncrementalResetOfASlidingWindowMatchesAFreshBuild) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Graph graph;
+  const VariableId lever =
+      graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d(0.1, 0.2, 0.3), false, std::nullopt});
+  const VariableId held =
+      graph.AddVariable({"held", Manifold::UnitQuaternion(), Eigen::Vector4d(1.0, 0.0, 0.0, 0.0), true, std::nullopt});
+  std::deque<VariableId> poses;
+  const auto tie = [&](const std::vector<VariableId>& ids) {
+    std::vector<Manifold> manifolds;
+    std::vector<Eigen::VectorXd> x0;
+    int dim = 0;
+    for (VariableId id : ids) {
+      const Variable& v = graph.variable(id);
+      manifolds.push_back(v.manifold);
+      x0.push_back(testing::Perturb(v.manifold, v.value, 0.1, &rng));
+      dim += v.manifold.tangent_dim();
+    }
+    const Eigen::MatrixXd J = Eigen::MatrixXd::NullaryExpr(dim, dim, [&] { return normal(rng); });
+    const Eigen::VectorXd r0 = Eigen::VectorXd::NullaryExpr(dim, [&] { return normal(rng); });
+    return graph.AddFactor(std::make_unique<LinearPriorFactor>(manifolds, x0, J, r0), ids,
+                           Eigen::MatrixXd::Identity(dim, dim), Loss::Trivial(), "test", Time());
+  };
+  const auto add_pose = [&] {
+    poses.push_back(graph.AddVariable({"pose", Manifold::Pose(), testing::RandomPoint(Manifold::Pose(), &rng, 5.0),
+                                       false, Time::FromSeconds(static_cast<double>(poses.size()))}));
+    tie({poses.back()});
+    if (poses.size() > 1) tie({poses[poses.size() - 2], poses.back(), lever});
+    if (poses.size() % 3 == 0) tie({poses.back(), held});
+  };
+  tie({held});  // on a held-constant variable only: never in the system
+  for (int k = 0; k < 8; ++k) add_pose();
+
+  internal::NormalEquations incremental;
+  FactorId gated = -1;
+  for (int step = 0; step < 12; ++step) {
+    // Slide: marginalize the oldest pose, add a new one; gate a factor off at step 3, on again at step 5; free the
+    // held parameter at step 8 (a variable that was constant becomes free: the tables are rebuilt).
+    if (step > 0) {
+      ASSERT_TRUE(Marginalize({poses.front()}, &graph));
+      poses.pop_front();
+      add_pose();
+    }
+    if (step == 3) {
+      gated = graph.FactorsOf(poses[4]).back();
+      graph.mutable_factor(gated).active = false;
+    }
+    if (step == 5) graph.mutable_factor(gated).active = true;
+    if (step == 8) graph.mutable_variable(held).fixed = false;
+
+    incremental.Reset(graph, FreeVariableOrder(graph));
+    internal::NormalEquations fresh(graph, FreeVariableOrder(graph));
+    ASSERT_TRUE(incremental.Linearize(graph));
+    ASSERT_TRUE(fresh.Linearize(graph));
+    ASSERT_EQ(incremental.factor_ids(), fresh.factor_ids()) << "step " << step;
+    const Eigen::SparseMatrix<double>& a = incremental.hessian_upper();
+    const Eigen::SparseMatrix<double>& b = fresh.hessian_upper();
+    ASSERT_EQ(a.rows(), b.rows()) << "step " << step;
+    ASSERT_EQ(a.nonZeros(), b.nonZeros()) << "step " << step;
+    EXPECT_TRUE(std::equal(a.outerIndexPtr(), a.outerIndexPtr() + a.outerSize() + 1, b.outerIndexPtr()));
+    EXPECT_TRUE(std::equal(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros(), b.innerIndexPtr()));
+    EXPECT_TRUE(std::equal(a.valuePtr(), a.valuePtr() + a.nonZeros(), b.valuePtr())) << "step " << step;
+    EXPECT_EQ(incremental.gradient(), fresh.gradient()) << "step " << step;
+    EXPECT_EQ(incremental.cost(), fresh.cost()) << "step " << step;
+    Eigen::VectorXd dx_incremental, dx_fresh;
+    ASSERT_TRUE(incremental.Solve(0.0, &dx_incremental));
+    ASSERT_TRUE(fresh.Solve(0.0, &dx_fresh));
+    EXPECT_EQ(dx_incremental, dx_fresh) << "step " << step;
+    // Move the free variables (as a solver step would) so that the next linearization point differs.
+    incremental.Update(0.1 * dx_incremental, &graph);
+  }
+  // Every Reset after the first was incremental but the one after the parameter was freed.
+  EXPECT_EQ(incremental.incremental_resets(), 10);
+}
+
 TEST(MarginalizationTest, PriorHoldsTheSchurComplementAlsoWhenRankDeficient) {
   for (const double weak : {1.0, 1e-4}) {
     Graph graph;
