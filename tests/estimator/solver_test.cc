@@ -168,9 +168,27 @@ TEST(ObservabilityTest, ComponentWhoseInformationIsAlmostAllSharedIsUnobservable
 // (which skips a pose: fill inside the envelope), and a free constant parameter tied to two poses (the dense border),
 // by linear priors with random Jacobians. The envelope factorization must give the step and the covariances of a dense
 // Cholesky of the same H: a few columns by forward substitution, many by the full solve.
+// A linear prior factor with random J and r0 (square, full rank almost surely) on `ids`, linearized at a point near
+// their current values.
+void TieWithRandomPrior(const std::vector<VariableId>& ids, std::mt19937* rng, Graph* graph) {
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::vector<Manifold> manifolds;
+  std::vector<Eigen::VectorXd> x0;
+  int dim = 0;
+  for (VariableId id : ids) {
+    const Variable& v = graph->variable(id);
+    manifolds.push_back(v.manifold);
+    x0.push_back(testing::Perturb(v.manifold, v.value, 0.1, rng));
+    dim += v.manifold.tangent_dim();
+  }
+  const Eigen::MatrixXd J = Eigen::MatrixXd::NullaryExpr(dim, dim, [&] { return normal(*rng); });
+  const Eigen::VectorXd r0 = Eigen::VectorXd::NullaryExpr(dim, [&] { return normal(*rng); });
+  graph->AddFactor(std::make_unique<LinearPriorFactor>(manifolds, x0, J, r0), ids, Eigen::MatrixXd::Identity(dim, dim),
+                   Loss::Trivial(), "test", Time());
+}
+
 TEST(NormalEquationsTest, EnvelopeFactorizationOfABandWithABorderMatchesADenseCholesky) {
   std::mt19937 rng(11);
-  std::normal_distribution<double> normal(0.0, 1.0);
   Graph graph;
   std::vector<VariableId> poses;
   for (int k = 0; k < 12; ++k)
@@ -178,21 +196,7 @@ TEST(NormalEquationsTest, EnvelopeFactorizationOfABandWithABorderMatchesADenseCh
                                        false, Time::FromSeconds(k)}));
   const VariableId lever =
       graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d(0.1, 0.2, 0.3), false, std::nullopt});
-  const auto tie = [&](const std::vector<VariableId>& ids) {
-    std::vector<Manifold> manifolds;
-    std::vector<Eigen::VectorXd> x0;
-    int dim = 0;
-    for (VariableId id : ids) {
-      const Variable& v = graph.variable(id);
-      manifolds.push_back(v.manifold);
-      x0.push_back(testing::Perturb(v.manifold, v.value, 0.1, &rng));
-      dim += v.manifold.tangent_dim();
-    }
-    const Eigen::MatrixXd J = Eigen::MatrixXd::NullaryExpr(dim, dim, [&] { return normal(rng); });
-    const Eigen::VectorXd r0 = Eigen::VectorXd::NullaryExpr(dim, [&] { return normal(rng); });
-    graph.AddFactor(std::make_unique<LinearPriorFactor>(manifolds, x0, J, r0), ids, Eigen::MatrixXd::Identity(dim, dim),
-                    Loss::Trivial(), "test", Time());
-  };
+  const auto tie = [&](const std::vector<VariableId>& ids) { TieWithRandomPrior(ids, &rng, &graph); };
   for (std::size_t k = 0; k < poses.size(); ++k) {
     tie({poses[k]});
     if (k + 1 < poses.size()) tie({poses[k], poses[k + 1]});
@@ -245,28 +249,13 @@ TEST(NormalEquationsTest, EnvelopeFactorizationOfABandWithABorderMatchesADenseCh
 // fresh object built from scratch: the same factors, H's pattern and values, gradient, cost and step, bit for bit.
 TEST(NormalEquationsTest, IncrementalResetOfASlidingWindowMatchesAFreshBuild) {
   std::mt19937 rng(5);
-  std::normal_distribution<double> normal(0.0, 1.0);
   Graph graph;
   const VariableId lever =
       graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d(0.1, 0.2, 0.3), false, std::nullopt});
   const VariableId held =
       graph.AddVariable({"held", Manifold::UnitQuaternion(), Eigen::Vector4d(1.0, 0.0, 0.0, 0.0), true, std::nullopt});
   std::deque<VariableId> poses;
-  const auto tie = [&](const std::vector<VariableId>& ids) {
-    std::vector<Manifold> manifolds;
-    std::vector<Eigen::VectorXd> x0;
-    int dim = 0;
-    for (VariableId id : ids) {
-      const Variable& v = graph.variable(id);
-      manifolds.push_back(v.manifold);
-      x0.push_back(testing::Perturb(v.manifold, v.value, 0.1, &rng));
-      dim += v.manifold.tangent_dim();
-    }
-    const Eigen::MatrixXd J = Eigen::MatrixXd::NullaryExpr(dim, dim, [&] { return normal(rng); });
-    const Eigen::VectorXd r0 = Eigen::VectorXd::NullaryExpr(dim, [&] { return normal(rng); });
-    return graph.AddFactor(std::make_unique<LinearPriorFactor>(manifolds, x0, J, r0), ids,
-                           Eigen::MatrixXd::Identity(dim, dim), Loss::Trivial(), "test", Time());
-  };
+  const auto tie = [&](const std::vector<VariableId>& ids) { TieWithRandomPrior(ids, &rng, &graph); };
   const auto add_pose = [&] {
     poses.push_back(graph.AddVariable({"pose", Manifold::Pose(), testing::RandomPoint(Manifold::Pose(), &rng, 5.0),
                                        false, Time::FromSeconds(static_cast<double>(poses.size()))}));
