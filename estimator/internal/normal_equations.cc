@@ -7,7 +7,6 @@
 #include <Eigen/CholmodSupport>
 
 #include "common/check.h"
-#include "estimator/internal/jacobian_products.h"
 
 namespace roamlab::estimator::internal {
 
@@ -25,6 +24,70 @@ constexpr int kMaxBorder = 128;
 // Up to this many columns, a natural-order system's covariance is Y^T Y from the forward substitution alone (the
 // product costs columns^2 x dimension, a back substitution columns x the factor's size).
 constexpr int kMaxForwardCovarianceColumns = 16;
+
+// dst (A x B block of H's value array, column stride `stride`) += Ja^T Jb, Ja M x A, Jb M x B.
+template <int M, int A, int B>
+void AddProductFixed(const double* ja, const double* jb, double* dst, std::ptrdiff_t stride) {
+  Eigen::Map<Eigen::Matrix<double, A, B>, 0, Eigen::OuterStride<>> block(dst, A, B, Eigen::OuterStride<>(stride));
+  block.noalias() += Eigen::Map<const Eigen::Matrix<double, M, A>>(ja).transpose() *
+                     Eigen::Map<const Eigen::Matrix<double, M, B>>(jb);
+}
+
+// The same with the column counts as template arguments when they are among the block sizes of the error models
+// (1: scalar, 3: vector or rotation, 6: pose, 9: 3x3 matrix); false for other sizes.
+template <int M, int A>
+bool AddProductColumns(const double* ja, const double* jb, int b, double* dst, std::ptrdiff_t stride) {
+  switch (b) {
+    case 1: AddProductFixed<M, A, 1>(ja, jb, dst, stride); return true;
+    case 3: AddProductFixed<M, A, 3>(ja, jb, dst, stride); return true;
+    case 6: AddProductFixed<M, A, 6>(ja, jb, dst, stride); return true;
+    case 9: AddProductFixed<M, A, 9>(ja, jb, dst, stride); return true;
+    default: return false;
+  }
+}
+template <int M>
+bool AddProductRows(const double* ja, int a, const double* jb, int b, double* dst, std::ptrdiff_t stride) {
+  switch (a) {
+    case 1: return AddProductColumns<M, 1>(ja, jb, b, dst, stride);
+    case 3: return AddProductColumns<M, 3>(ja, jb, b, dst, stride);
+    case 6: return AddProductColumns<M, 6>(ja, jb, b, dst, stride);
+    case 9: return AddProductColumns<M, 9>(ja, jb, b, dst, stride);
+    default: return false;
+  }
+}
+
+void AddProduct(const Eigen::MatrixXd& ja, const Eigen::MatrixXd& jb, double* dst, std::ptrdiff_t stride) {
+  const int a = static_cast<int>(ja.cols()), b = static_cast<int>(jb.cols());
+  if (ja.rows() == 3 && AddProductRows<3>(ja.data(), a, jb.data(), b, dst, stride)) return;
+  if (ja.rows() == 4 && AddProductRows<4>(ja.data(), a, jb.data(), b, dst, stride)) return;
+  if (ja.rows() == 6 && AddProductRows<6>(ja.data(), a, jb.data(), b, dst, stride)) return;
+  // Coefficient-wise: at these sizes (a few rows, up to a few dozen columns) cheaper than a blocked product.
+  Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> block(dst, ja.cols(), jb.cols(), Eigen::OuterStride<>(stride));
+  block.noalias() += ja.transpose().lazyProduct(jb);
+}
+
+// g_segment += J^T r.
+template <int M, int A>
+void AddGradientFixed(const double* j, const double* r, double* g) {
+  Eigen::Map<Eigen::Matrix<double, A, 1>>(g).noalias() +=
+      Eigen::Map<const Eigen::Matrix<double, M, A>>(j).transpose() * Eigen::Map<const Eigen::Matrix<double, M, 1>>(r);
+}
+template <int M>
+bool AddGradientRows(const double* j, int a, const double* r, double* g) {
+  switch (a) {
+    case 1: AddGradientFixed<M, 1>(j, r, g); return true;
+    case 3: AddGradientFixed<M, 3>(j, r, g); return true;
+    case 6: AddGradientFixed<M, 6>(j, r, g); return true;
+    case 9: AddGradientFixed<M, 9>(j, r, g); return true;
+    default: return false;
+  }
+}
+void AddGradient(const Eigen::MatrixXd& j, const Eigen::VectorXd& r, double* g) {
+  const int a = static_cast<int>(j.cols());
+  if (j.rows() == 3 && AddGradientRows<3>(j.data(), a, r.data(), g)) return;
+  if (j.rows() == 4 && AddGradientRows<4>(j.data(), a, r.data(), g)) return;
+  Eigen::Map<Eigen::VectorXd>(g, j.cols()).noalias() += j.transpose() * r;
+}
 
 }  // namespace
 
@@ -58,10 +121,10 @@ int NormalEquations::OffsetOf(VariableId id) const {
 void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   // The tables of the last Reset, kept for the factors still in the graph (below).
   prev_order_.swap(order_);
-  prev_block_of_id_.swap(block_of_id_);
   prev_factor_ids_.swap(factor_ids_);
   prev_entries_.swap(entries_);
   prev_var_begin_.swap(var_begin_);
+  prev_var_id_.swap(var_id_);
   prev_var_block_.swap(var_block_);
   prev_values_.swap(values_);
 
@@ -85,41 +148,47 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
     ROAMLAB_CHECK(block_of_id_[i].first != block_of_id_[i - 1].first, "variable " << block_of_id_[i].first
                                                                                   << " ordered twice");
 
-  // Incremental: the same graph as at the last Reset (a window that slid: factors and variables left at the front,
-  // new ones came at the back, ids are never reused), and no variable that existed then and was held constant is free
-  // now. A factor still in the graph then keeps its variables' values and its blocks, renumbered by old_to_new_; only
-  // the factors that are new (or switched on again by gating) look their variables up.
-  bool incremental = prev_graph_ == &graph && !prev_factor_ids_.empty();
-  const auto prev_block_of = [this](VariableId id) {
-    const auto it = std::lower_bound(prev_block_of_id_.begin(), prev_block_of_id_.end(), std::make_pair(id, -1));
-    return it != prev_block_of_id_.end() && it->first == id ? it->second : -1;
-  };
-  for (int b = 0; incremental && b < nb; ++b)
-    incremental = order_[b] > prev_last_variable_ || prev_block_of(order_[b]) >= 0;
-  prev_graph_ = &graph;
-  prev_last_variable_ = graph.variables().empty() ? -1 : graph.variables().rbegin()->first;
-  if (incremental) {
-    ++incremental_resets_;
-    old_to_new_.resize(prev_order_.size());
-    for (std::size_t b = 0; b < prev_order_.size(); ++b) old_to_new_[b] = BlockOf(prev_order_[b]);
-  } else {
-    // Every variable's value and block (-1 when held constant), by id: one pass over the graph's variables instead
-    // of a map look-up per factor and variable below.
-    variable_table_.clear();
-    auto free_it = block_of_id_.begin();
-    for (const auto& [id, v] : graph.variables()) {
-      while (free_it != block_of_id_.end() && free_it->first < id) ++free_it;
-      const int block = free_it != block_of_id_.end() && free_it->first == id ? free_it->second : -1;
-      variable_table_.push_back({id, v.value.data(), block});
-    }
+  // Every variable's value and block (-1 when held constant), by id: one pass over the graph's variables instead of
+  // a map look-up per factor and variable below.
+  prev_variable_table_.swap(variable_table_);
+  variable_table_.clear();
+  auto free_it = block_of_id_.begin();
+  for (const auto& [id, v] : graph.variables()) {
+    while (free_it != block_of_id_.end() && free_it->first < id) ++free_it;
+    const int block = free_it != block_of_id_.end() && free_it->first == id ? free_it->second : -1;
+    variable_table_.push_back({id, v.value.data(), block});
   }
-  const auto lookup = [&](VariableId id) -> VariableSlot {
-    if (incremental) return {id, graph.variable(id).value.data(), BlockOf(id)};
+  const auto lookup = [this](VariableId id) -> const VariableSlot& {
     const auto it = std::lower_bound(variable_table_.begin(), variable_table_.end(), id,
                                      [](const VariableSlot& slot, VariableId key) { return slot.id < key; });
     ROAMLAB_CHECK(it != variable_table_.end() && it->id == id, "no variable " << id);
     return *it;
   };
+
+  // Incremental (a window that slid: factors and variables left at the front, new ones came at the back): every
+  // variable that was in the graph at the last Reset and still is keeps its value buffer, and none that was held
+  // constant then is free now. A factor of the last Reset with the same id, entry and variables then keeps its
+  // variables' values and its blocks, renumbered by old_to_new_; only the other factors (new ones, or ones gating
+  // switched on again) look their variables up. The result is the same as from scratch.
+  bool incremental = !prev_factor_ids_.empty();
+  for (std::size_t i = 0, j = 0; incremental && i < prev_variable_table_.size() && j < variable_table_.size();) {
+    const VariableSlot& before = prev_variable_table_[i];
+    const VariableSlot& now = variable_table_[j];
+    if (before.id < now.id) {
+      ++i;
+    } else if (now.id < before.id) {
+      ++j;
+    } else {
+      incremental = before.value == now.value && (before.block >= 0 || now.block < 0);
+      ++i;
+      ++j;
+    }
+  }
+  if (incremental) {
+    ++incremental_resets_;
+    old_to_new_.resize(prev_order_.size());
+    for (std::size_t b = 0; b < prev_order_.size(); ++b) old_to_new_[b] = BlockOf(prev_order_[b]);
+  }
 
   // The included factors, their variables' blocks and values, and which row blocks appear in each block column
   // (upper triangle, diagonal always present).
@@ -135,6 +204,7 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   entries_.clear();
   want_.clear();
   var_begin_.assign(1, 0);
+  var_id_.clear();
   var_block_.clear();
   values_.clear();
   rows_of_.resize(nb);
@@ -148,7 +218,9 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
     while (incremental && prev < prev_factor_ids_.size() && prev_factor_ids_[prev] < fid) ++prev;
     const bool kept = incremental && prev < prev_factor_ids_.size() && prev_factor_ids_[prev] == fid &&
                       prev_entries_[prev] == &entry &&
-                      prev_var_begin_[prev + 1] - prev_var_begin_[prev] == static_cast<int>(entry.variables.size());
+                      prev_var_begin_[prev + 1] - prev_var_begin_[prev] == static_cast<int>(entry.variables.size()) &&
+                      std::equal(entry.variables.begin(), entry.variables.end(),
+                                 prev_var_id_.begin() + prev_var_begin_[prev]);
     for (std::size_t i = 0; i < entry.variables.size(); ++i) {
       int b = -1;
       if (kept) {
@@ -156,14 +228,16 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
         b = prev_var_block_[p] >= 0 ? old_to_new_[prev_var_block_[p]] : -1;
         values_.push_back(prev_values_[p]);
       } else {
-        const VariableSlot slot = lookup(entry.variables[i]);
+        const VariableSlot& slot = lookup(entry.variables[i]);
         b = slot.block;
         values_.push_back(slot.value);
       }
+      var_id_.push_back(entry.variables[i]);
       var_block_.push_back(b);
       if (b >= 0) mask |= std::uint64_t{1} << i;
     }
     if (mask == 0) {
+      var_id_.resize(begin);
       var_block_.resize(begin);
       values_.resize(begin);
       continue;
@@ -307,13 +381,13 @@ bool NormalEquations::Linearize(const Graph& /*graph*/, std::string* failed_stre
     // column length of their block column as outer stride.
     const int* block = &var_block_[v0];
     for (int a = 0; a < n; ++a)
-      if (block[a] >= 0) AddJacobianGradient(wf.jacobians[a], wf.residual, g_.data() + block_offset_[block[a]]);
+      if (block[a] >= 0) AddGradient(wf.jacobians[a], wf.residual, g_.data() + block_offset_[block[a]]);
     int pair = pair_begin_[k];
     for (int a = 0; a < n; ++a) {
       if (block[a] < 0) continue;
       for (int b = 0; b < n; ++b) {
         if (block[b] < 0 || block[a] > block[b]) continue;
-        AddJacobianProduct(wf.jacobians[a], wf.jacobians[b], values + pair_value_[pair++], column_length_[block[b]]);
+        AddProduct(wf.jacobians[a], wf.jacobians[b], values + pair_value_[pair++], column_length_[block[b]]);
       }
     }
   }

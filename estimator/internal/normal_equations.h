@@ -5,9 +5,10 @@
 // (a tracking window: a band with a dense border) are factored in their envelope instead (see Reset).
 //
 // An object can be Reset to a changed graph and keeps its buffers; when the new pattern is the same as the old one
-// (a fixed-lag window that slid by one pose has the same band), the symbolic analysis is kept too. Reset to the same
-// graph again is incremental: the factors still in it keep their tables (their variables' values and blocks), only new
-// ones are looked up; the result is the same as from scratch.
+// (a fixed-lag window that slid by one pose has the same band), the symbolic analysis is kept too. A Reset after which
+// the graph's factors and variables changed only by some leaving and new ones coming is incremental: the factors
+// still in it keep their tables (their variables' values and blocks), only new ones are looked up; the result is the
+// same as from scratch.
 #pragma once
 
 #include <cstdint>
@@ -99,15 +100,16 @@ class NormalEquations {
   std::vector<std::ptrdiff_t> pair_value_;
   std::vector<WhitenedFactor> whitened_;
 
+  std::vector<VariableId> var_id_;  // per factor variable, as var_block_
+
   // The tables of the last Reset (swapped out at the next one), for an incremental Reset of a graph that changed at
   // its ends: old_to_new_ maps the last Reset's blocks to the current ones (-1 when no longer free).
-  const Graph* prev_graph_ = nullptr;
-  VariableId prev_last_variable_ = -1;  // largest variable id in the graph at the last Reset
+  std::vector<VariableSlot> prev_variable_table_;
   std::vector<VariableId> prev_order_;
-  std::vector<std::pair<VariableId, int>> prev_block_of_id_;
   std::vector<FactorId> prev_factor_ids_;
   std::vector<const FactorEntry*> prev_entries_;
   std::vector<int> prev_var_begin_;
+  std::vector<VariableId> prev_var_id_;
   std::vector<int> prev_var_block_;
   std::vector<const double*> prev_values_;
   std::vector<int> old_to_new_;
