@@ -186,8 +186,8 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph) {
     for (std::size_t a = 0; a < e.variables.size(); ++a) {
       if (!want[a]) continue;
       const int oa = var_offset[a];
-      // Coefficient-wise products in this order: the prior's rank decision (SquareRootInformation) is sensitive to
-      // the rounding of H (see BENCHMARKS.md, fourth tracking pass).
+      // Coefficient-wise products, in this order: tracking under a calibration prior is sensitive to the rounding of
+      // H here (other kernels moved its positions by metres; BENCHMARKS.md, fourth tracking pass).
       g.segment(oa, wf.jacobians[a].cols()) += wf.jacobians[a].transpose().lazyProduct(wf.residual);
       for (std::size_t b = 0; b < e.variables.size(); ++b) {
         if (!want[b]) continue;
