@@ -20,7 +20,8 @@
 // on curved ground a chassis resting on both axles pitches with the chord between the contacts, while the rear
 // contact moves along the ground's tangent: the two differ by half the angle the ground turns over the wheelbase, so
 // the contact moves along O's z at d omega_y with d = L / 2 (crest: nose going down, omega_y > 0, v_z > 0).
-// Measured on the MuJoCo ATV (30 s, 4 m hills, true readings without noise, O at the wheel centres, r = 0.28 m):
+// Measured on the MuJoCo ATV (30 s, 4 m hills, true readings without noise, O at the wheel centres, r = 0.28 m;
+// scripts/atv_odometer_residuals.py):
 // regressed on the rates, O's v_x - speed reading has slope 0.30 m on omega_y, O's v_y -0.25 m on omega_x (besides
 // -0.021 s on a_y, the cornering compliance), O's v_z 0.62 m on omega_y (L / 2 = 0.625).
 //
@@ -29,7 +30,8 @@
 // (c_rear [s], m/s of side slip per m/s^2), and the front wheels' velocity points c_front a_y (c_front [rad s^2/m])
 // less into the turn than they are steered (understeer): the front axle moves along atan((L omega_z + v_y) / v_x).
 // With c_front = c_rear = 0 (their defaults) this is eq. 15 with the non-holonomic constraints. Measured on the MuJoCo
-// ATV (30 s, 4 m hills): v_y regressed on a_y has slope -0.015 s and leaves 0.009 m/s rms of 0.027.
+// ATV (30 s, 4 m hills, scripts/atv_odometer_residuals.py): at the contact v_y has slope -0.0207 s on a_y and leaves
+// 0.0022 m/s rms of 0.035; the steering row -0.0047 rad s^2/m, leaving 0.0025 rad of 0.0083.
 //
 // Rear-axle thrust angle alpha [rad] (a misaligned rear axle: both rear wheels turned about z by alpha, positive
 // counter-clockwise). The rear wheels roll along d = (cos alpha, sin alpha) in O, so without side slip O's velocity
