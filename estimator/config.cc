@@ -35,7 +35,7 @@ const std::vector<ModelSpec>& ModelSpecs() {
        {ScalarSlot("kv_over_L", std::numeric_limits<double>::quiet_NaN()), ScalarSlot("k_theta", 1.0),
         ScalarSlot("k_gamma", 0.0), ScalarSlot("cornering_front", 0.0), ScalarSlot("cornering_rear", 0.0),
         ScalarSlot("thrust_angle", 0.0)},
-       {"wheelbase_m", "speed_column"},
+       {"wheelbase_m", "speed_column", "contact_height_m", "pitch_lever_m"},
        true, {}},
       {"ackermann_seed",
        {"speed", "steering"},

@@ -59,6 +59,7 @@ struct StreamBinding {
   double row_covariance_scale = 0.0;            // odometer, relative_motion: weight of the rows' own covariance
   double interval_s = 0.0;                      // relative_motion: T
   double wheelbase_m = 0.0;
+  AckermannVelocityError::Contact contact;  // ackermann: options contact_height_m, pitch_lever_m
   Eigen::Vector3d field_world = Eigen::Vector3d::Zero();
   const recording::Stream* specific_force = nullptr;   // magnetometer: inputs.specific_force
   int specific_force_column = 0;                       // its first accelerometer column
@@ -167,6 +168,10 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
         return Error(config, "stream '" + name + "': no wheelbase_m in options or in the recording's platform");
       }
       if (!(b.wheelbase_m > 0.0)) return Error(config, "stream '" + name + "': wheelbase_m must be positive");
+      if (sc.options.count("contact_height_m")) b.contact.contact_height_m = sc.options.at("contact_height_m").at(0);
+      if (sc.options.count("pitch_lever_m")) b.contact.pitch_lever_m = sc.options.at("pitch_lever_m").at(0);
+      if (!(std::abs(b.contact.contact_height_m) <= 10.0 && std::abs(b.contact.pitch_lever_m) <= 10.0))
+        return Error(config, "stream '" + name + "': contact_height_m and pitch_lever_m must be within +-10 m");
     } else if (m == "gyroscope") {
       if (!TypeIn(type, {StreamType::kImu, StreamType::kGyroscope})) return Error(config, bad_type);
     } else if (m == "accelerometer") {
@@ -596,7 +601,7 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     const double z_theta = SteeringAt(*s.steering, m.t);
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k)};
     if (model == "ackermann") {
-      factor = MakeFactor(AckermannVelocityError(z_v, z_theta, s.wheelbase_m, dt));
+      factor = MakeFactor(AckermannVelocityError(z_v, z_theta, s.wheelbase_m, dt, s.contact));
       vars.insert(vars.end(), {slot(3, k), slot(4, k), slot(5, k)});
     } else {
       factor = MakeFactor(AckermannOdometerError(z_v, z_theta, s.wheelbase_m, dt));

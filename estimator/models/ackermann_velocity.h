@@ -1,21 +1,37 @@
-// Ackermann-steering odometer in measurement space (seed 000, eq. 15 inverted), with the tires' cornering compliance
-// and the rear axle's thrust angle: the body velocities between two poses predict the rear-wheel speed and the
-// handlebar angle, and the error is the difference to the readings.
+// Ackermann-steering odometer in measurement space (seed 000, eq. 15 inverted), with the tires' cornering compliance,
+// the rear axle's thrust angle and the height of O above the ground contact: the body velocities between two poses
+// predict the rear-wheel speed and the handlebar angle, and the error is the difference to the readings.
 //
 //   v^(O), omega^(O) = VelocitiesBetween(pose_k, pose_k+1, dt)          (eq. 7 inverted; middle of the interval)
+//   v           = v^(O) + omega x (0, 0, -h) = (v^(O)_x - h omega_y, v^(O)_y + h omega_x, v^(O)_z)
+//                                                                        the rear contact's velocity (h below O)
 //   a_y         = v_x omega_z                                            lateral (centripetal) acceleration [m/s^2]
 //   v_roll      = v_x cos(alpha) + v_y sin(alpha)                        rear wheels' rolling speed [m/s]
 //   z_v_hat     = v_roll / k_v                                           k_v = kv_over_L * L
 //   delta       = atan((L omega_z + v_y) / v_x) + c_front a_y            steered angle of the front wheels
 //   z_theta_hat = (delta - k_gamma) / k_theta                           (eq. 15: omega_z = (k_v / L) v tan(delta))
-//   e = [z_v_hat - z_v;  z_theta_hat - z_theta;  v_y - v_x tan(alpha) + c_rear a_y;  v_z] + eta     e in R^4
+//   e = [z_v_hat - z_v;  z_theta_hat - z_theta;  v_y - v_x tan(alpha) + c_rear a_y;  v_z - d omega_y] + eta
+//                                                                        e in R^4
+//
+// Ground contact (h [m], d [m]; both 0 by default, eq. 15 at O). Eq. 15's constraints hold where the rear tires touch
+// the ground, not at O when O is at the wheel centres, h = the wheel radius above the contact: a chassis pitching at
+// omega_y moves O forward by h omega_y over the contact, and the wheel (its hub turns with the chassis) reads the
+// contact's speed v^(O)_x - h omega_y; rolling at omega_x moves O sideways by -h omega_x without any tire slip. And
+// on curved ground a chassis resting on both axles pitches with the chord between the contacts, while the rear
+// contact moves along the ground's tangent: the two differ by half the angle the ground turns over the wheelbase, so
+// the contact moves along O's z at d omega_y with d = L / 2 (crest: nose going down, omega_y > 0, v_z > 0).
+// Measured on the MuJoCo ATV (30 s, 4 m hills, true readings without noise, O at the wheel centres, r = 0.28 m;
+// scripts/atv_odometer_residuals.py):
+// regressed on the rates, O's v_x - speed reading has slope 0.30 m on omega_y, O's v_y -0.25 m on omega_x (besides
+// -0.021 s on a_y, the cornering compliance), O's v_z 0.62 m on omega_y (L / 2 = 0.625).
 //
 // Cornering compliance. Eq. 15 assumes rolling without side slip. Real tires (and MuJoCo's soft contacts) carry the
 // centripetal force by slipping sideways in proportion to it: the rear axle drifts outwards, v_y = -c_rear a_y
 // (c_rear [s], m/s of side slip per m/s^2), and the front wheels' velocity points c_front a_y (c_front [rad s^2/m])
 // less into the turn than they are steered (understeer): the front axle moves along atan((L omega_z + v_y) / v_x).
 // With c_front = c_rear = 0 (their defaults) this is eq. 15 with the non-holonomic constraints. Measured on the MuJoCo
-// ATV (30 s, 4 m hills): v_y regressed on a_y has slope -0.015 s and leaves 0.009 m/s rms of 0.027.
+// ATV (30 s, 4 m hills, scripts/atv_odometer_residuals.py): at the contact v_y has slope -0.0207 s on a_y and leaves
+// 0.0022 m/s rms of 0.035; the steering row -0.0047 rad s^2/m, leaving 0.0025 rad of 0.0083.
 //
 // Rear-axle thrust angle alpha [rad] (a misaligned rear axle: both rear wheels turned about z by alpha, positive
 // counter-clockwise). The rear wheels roll along d = (cos alpha, sin alpha) in O, so without side slip O's velocity
@@ -36,7 +52,7 @@
 //
 // Frames: O is the middle of the rear axle (x forward, z up). Measurements: z_v rear-wheel speed with the nominal
 // wheel radius [m/s], z_theta handlebar angle [rad], both over [t_k, t_k+1]. Calibration: kv_over_L [1/m], k_theta
-// [-], k_gamma [rad], c_front [rad s^2/m], c_rear [s], alpha [rad]; the wheelbase L [m] is known. Noise eta =
+// [-], k_gamma [rad], c_front [rad s^2/m], c_rear [s], alpha [rad]; the wheelbase L [m], h and d [m] are known. Noise eta =
 // [sigma_v (m/s), sigma_theta (rad), lateral (m/s), vertical (m/s)], the last two the uncertainty of the non-holonomic
 // assumptions (no unmodelled sideways slip, no motion off the ground). Eq. 15 says nothing about roll and pitch
 // rates, and on hills they are not zero (the terrain tilts the vehicle): pretending they are pulls the estimated
@@ -51,10 +67,10 @@
 //   dv/dtheta = [v]x eps/dtheta  ((R_mid Exp(eps))^T u = R_mid^T u + [R_mid^T u]x eps), where eps, the right
 //   perturbation of q_mid, is (q_k Exp(d) Exp(psi + dpsi) = q_mid Exp(R(psi)^T d) Exp(Jr(psi) dpsi), psi = phi / 2)
 //   eps/dtheta_k = R(phi/2)^T - Jr(phi/2) Jl^-1(phi) / 2,   eps/dtheta_k+1 = Jr(phi/2) Jr^-1(phi) / 2.
-// The rows in (v, omega_z), with r = (L omega_z + v_y) / v_x and s = 1 / (1 + r^2) (steering row zero below
+// The rows in the contact velocity v and omega_z, with r = (L omega_z + v_y) / v_x and s = 1 / (1 + r^2) (steering row zero below
 // kMinSteeringSpeed): de_v = (cos(alpha) dv_x + sin(alpha) dv_y) / k_v;  k_theta de_theta = (c_front omega_z -
 // s r / v_x) dv_x + s / v_x dv_y + (s L / v_x + c_front v_x) domega_z;  de_lat = (c_rear omega_z - tan(alpha)) dv_x
-// + dv_y + c_rear v_x domega_z;  de_vert = dv_z.
+// + dv_y + c_rear v_x domega_z;  de_vert = dv_z - d domega_y; and dv/domega = [[0, -h, 0], [h, 0, 0], [0, 0, 0]].
 // Parameters: de_v/dkv_over_L = -v_roll / (kv_over_L^2 L), de_theta/dk_theta = -(delta - k_gamma) / k_theta^2,
 // de_theta/dk_gamma = -1 / k_theta, de_theta/dc_front = a_y / k_theta, de_lat/dc_rear = a_y,
 // de_v/dalpha = (v_y cos(alpha) - v_x sin(alpha)) / k_v, de_lat/dalpha = -v_x (1 + tan^2(alpha)).
@@ -72,6 +88,13 @@
 
 namespace roamlab::estimator {
 
+// Where AckermannVelocityError takes its rows (header comment): h = contact_height_m, d = pitch_lever_m; the default
+// 0, 0 is eq. 15 at O.
+struct AckermannContact {
+  double contact_height_m = 0.0;
+  double pitch_lever_m = 0.0;
+};
+
 class AckermannVelocityError {
  public:
   using Blocks =
@@ -81,8 +104,10 @@ class AckermannVelocityError {
   static constexpr bool kAdditiveNoise = true;  // e = f(x) + eta
   static constexpr double kMinSteeringSpeed = 0.2;  // [m/s]
 
-  AckermannVelocityError(double z_v_mps, double z_theta_rad, double wheelbase_m, double dt_s)
-      : z_v_mps_(z_v_mps), z_theta_rad_(z_theta_rad), wheelbase_m_(wheelbase_m), dt_s_(dt_s) {
+  using Contact = AckermannContact;
+
+  AckermannVelocityError(double z_v_mps, double z_theta_rad, double wheelbase_m, double dt_s, Contact contact = {})
+      : z_v_mps_(z_v_mps), z_theta_rad_(z_theta_rad), wheelbase_m_(wheelbase_m), dt_s_(dt_s), contact_(contact) {
     ROAMLAB_CHECK(wheelbase_m > 0.0 && dt_s > 0.0, "Ackermann wheelbase " << wheelbase_m << " dt " << dt_s);
   }
 
@@ -93,8 +118,10 @@ class AckermannVelocityError {
     using std::cos;
     using std::sin;
     using std::tan;
-    Vector3<T> v_body, omega_body;
-    VelocitiesBetween<T>(PoseFromArray(x[0]), PoseFromArray(x[1]), T(dt_s_), &v_body, &omega_body);
+    Vector3<T> v_odom, omega_body;
+    VelocitiesBetween<T>(PoseFromArray(x[0]), PoseFromArray(x[1]), T(dt_s_), &v_odom, &omega_body);
+    const T h(contact_.contact_height_m);
+    const Vector3<T> v_body(v_odom.x() - h * omega_body.y(), v_odom.y() + h * omega_body.x(), v_odom.z());
     const T& kv_over_l = x[2][0];
     const T& k_theta = x[3][0];
     const T& k_gamma = x[4][0];
@@ -111,7 +138,7 @@ class AckermannVelocityError {
       error[1] = noise[1];
     }
     error[2] = v_body.y() - v_body.x() * tan(alpha) + c_rear * a_y + noise[2];
-    error[3] = v_body.z() + noise[3];
+    error[3] = v_body.z() - T(contact_.pitch_lever_m) * omega_body.y() + noise[3];
     return true;
   }
 
@@ -132,7 +159,9 @@ class AckermannVelocityError {
     const Eigen::Vector3d phi = QuaternionLog<double>(pose_k.q_world_body.conjugate() * pose_k1.q_world_body);
     const Eigen::Vector3d omega_body = phi / dt_s_;
     const Quaternion<double> q_mid = pose_k.q_world_body * QuaternionExp<double>(phi * 0.5);
-    const Eigen::Vector3d v_body = q_mid.conjugate() * ((pose_k1.p_world_body - pose_k.p_world_body) / dt_s_);
+    const Eigen::Vector3d v_odom = q_mid.conjugate() * ((pose_k1.p_world_body - pose_k.p_world_body) / dt_s_);
+    const double h = contact_.contact_height_m, d = contact_.pitch_lever_m;
+    const Eigen::Vector3d v_body(v_odom.x() - h * omega_body.y(), v_odom.y() + h * omega_body.x(), v_odom.z());
 
     // As operator().
     const double k_v = kv_over_l * wheelbase_m_;
@@ -144,12 +173,13 @@ class AckermannVelocityError {
     const double delta = steering ? std::atan(r) + c_front * a_y : 0.0;
     error[1] = steering ? (delta - k_gamma) / k_theta - z_theta_rad_ : 0.0;
     error[2] = v_body.y() - v_body.x() * tan_alpha + c_rear * a_y;
-    error[3] = v_body.z();
+    error[3] = v_body.z() - d * omega_body.y();
     if (jacobians == nullptr) return true;
 
-    // Rows of the residual in the motion (v, omega): de/dv (4x3) and de/domega_z (4x1, only the steering row).
+    // Rows of the residual in the motion: de/dv (4x3, v the contact's velocity) and de/domega (4x3) at fixed v.
     Eigen::Matrix<double, 4, 3> J_e_v = Eigen::Matrix<double, 4, 3>::Zero();
-    Eigen::Vector4d J_e_omega_z = Eigen::Vector4d::Zero();
+    Eigen::Matrix<double, 4, 3> J_e_omega = Eigen::Matrix<double, 4, 3>::Zero();
+    auto J_e_omega_z = J_e_omega.col(2);
     J_e_v(0, 0) = cos_alpha / k_v;
     J_e_v(0, 1) = sin_alpha / k_v;
     J_e_v(2, 0) = c_rear * omega_body.z() - tan_alpha;
@@ -162,11 +192,17 @@ class AckermannVelocityError {
       J_e_v(1, 1) = s / (v_body.x() * k_theta);
       J_e_omega_z[1] = (s * wheelbase_m_ / v_body.x() + c_front * v_body.x()) / k_theta;
     }
+    // Through the contact velocity (dv/domega) and the vertical row's chord term; then v is O's velocity below.
+    Eigen::Matrix3d J_v_omega = Eigen::Matrix3d::Zero();
+    J_v_omega(0, 1) = -h;
+    J_v_omega(1, 0) = h;
+    J_e_omega += J_e_v * J_v_omega;
+    J_e_omega(3, 1) -= d;
 
     // Poses: [dp, dtheta] through v (R_mid, and q_mid's perturbation eps) and omega (phi / dt).
     if (jacobians[0] != nullptr || jacobians[1] != nullptr) {
       const Eigen::Matrix3d R_mid_T = q_mid.toRotationMatrix().transpose();
-      const Eigen::Matrix<double, 4, 3> J_e_eps = J_e_v * Skew<double>(v_body);  // de/deps
+      const Eigen::Matrix<double, 4, 3> J_e_eps = J_e_v * Skew<double>(v_odom);  // de/deps
       const Eigen::Matrix3d jr_inv = internal::InverseRightJacobianSO3(phi);
       const Eigen::Matrix3d half_jr = 0.5 * internal::RightJacobianSO3(phi * 0.5);
       const Eigen::Matrix<double, 4, 3> J_e_dp1 = J_e_v * R_mid_T / dt_s_;
@@ -175,12 +211,12 @@ class AckermannVelocityError {
         const Eigen::Matrix3d eps_theta = QuaternionExp<double>(phi * -0.5).toRotationMatrix() -
                                           half_jr * jr_inv.transpose();
         J_e_pose_k.leftCols<3>() = -J_e_dp1;
-        J_e_pose_k.rightCols<3>() = J_e_eps * eps_theta - J_e_omega_z * (jr_inv.transpose().row(2) / dt_s_);
+        J_e_pose_k.rightCols<3>() = J_e_eps * eps_theta - J_e_omega * (jr_inv.transpose() / dt_s_);
       }
       if (jacobians[1] != nullptr) {
         Eigen::Map<Eigen::Matrix<double, 4, 6>> J_e_pose_k1(jacobians[1]);
         J_e_pose_k1.leftCols<3>() = J_e_dp1;
-        J_e_pose_k1.rightCols<3>() = J_e_eps * (half_jr * jr_inv) + J_e_omega_z * (jr_inv.row(2) / dt_s_);
+        J_e_pose_k1.rightCols<3>() = J_e_eps * (half_jr * jr_inv) + J_e_omega * (jr_inv / dt_s_);
       }
     }
 
@@ -211,6 +247,7 @@ class AckermannVelocityError {
   double z_theta_rad_;
   double wheelbase_m_;
   double dt_s_;
+  Contact contact_;
 };
 
 }  // namespace roamlab::estimator

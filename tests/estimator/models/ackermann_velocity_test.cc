@@ -98,16 +98,44 @@ TEST(AckermannVelocityErrorTest, ThrustAngleExplainsCrabAndTurnAtZeroHandlebar) 
   EXPECT_NEAR(aligned.error[0], v - v / std::cos(alpha), 1e-9);
 }
 
+TEST(AckermannVelocityErrorTest, ContactBelowOExplainsPitchAndRollRates) {
+  // O at the wheel centres, h = 0.28 m above the contact, L / 2 = 0.625 m chord lever: a rigid vehicle that rolls
+  // without slip at 4 m/s over a crest (pitch rate 0.3 rad/s) while rolling at 0.2 rad/s and turning at 0.4 rad/s.
+  // O moves at the contact's velocity plus omega x (0, 0, h), and along its z by d omega_y.
+  const double v = 4.0, dt = 0.01, h = 0.28, d = 0.625;
+  const Eigen::Vector3d omega(0.2, 0.3, 0.4);
+  const Eigen::Vector3d v_odom(v + h * omega.y(), -h * omega.x(), d * omega.y());
+  const Eigen::VectorXd pose0 = Manifold::Pose().Identity();
+  Eigen::VectorXd pose1(7);
+  PoseToArray(PredictPose<double>(PoseFromArray(pose0.data()), v_odom, omega, dt), pose1.data());
+  const double delta = std::atan(kL * omega.z() / v);
+  const std::vector<Eigen::VectorXd> values = {pose0,       pose1,       Scalar(0.8), Scalar(1.0),
+                                               Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0)};
+  const auto contact = MakeFactor(AckermannVelocityError(v / kL / 0.8, delta, kL, dt, {h, d}));
+  const auto lin = testing::Evaluate(*contact, values);
+  EXPECT_LT(lin.error.norm(), 1e-9) << lin.error.transpose();
+  // Eq. 15 at O (the default) reads the same motion as a speed error of h omega_y (in the reading's units), a side
+  // slip of -h omega_x and a vertical velocity of d omega_y: what the non-holonomic noise terms would have to absorb.
+  const auto at_o = testing::Evaluate(*MakeFactor(AckermannVelocityError(v / kL / 0.8, delta, kL, dt)), values);
+  EXPECT_NEAR(at_o.error[0], h * omega.y() / (0.8 * kL), 1e-9);
+  EXPECT_NEAR(at_o.error[2], -h * omega.x(), 1e-9);
+  EXPECT_NEAR(at_o.error[3], d * omega.y(), 1e-9);
+}
+
 TEST(AckermannVelocityErrorTest, JacobiansMatchCentralDifferences) {
   std::mt19937 rng(12);
   for (int trial = 0; trial < 5; ++trial) {
     const Eigen::VectorXd pose0 = testing::RandomPoint(Manifold::Pose(), &rng, 10.0);
     const Eigen::VectorXd pose1 = testing::Perturb(Manifold::Pose(), Step(pose0, 3.0 + trial, 0.2, 0.02), 0.002, &rng);
-    const auto factor = MakeFactor(AckermannVelocityError(4.0, 0.1, kL, 0.02));
-    testing::ExpectJacobiansMatchNumeric(
-        *factor, {pose0, pose1, Scalar(0.78), Scalar(1.02), Scalar(0.01), Scalar(0.004), Scalar(-0.015),
-                    Scalar(0.02)},
-        1e-5);
+    // Eq. 15 at O, and with the rows at a contact below O (h, d nonzero: the rates enter every row).
+    for (const AckermannVelocityError::Contact contact : {AckermannVelocityError::Contact{},
+                                                          AckermannVelocityError::Contact{0.28, 0.625}}) {
+      const auto factor = MakeFactor(AckermannVelocityError(4.0, 0.1, kL, 0.02, contact));
+      testing::ExpectJacobiansMatchNumeric(
+          *factor, {pose0, pose1, Scalar(0.78), Scalar(1.02), Scalar(0.01), Scalar(0.004), Scalar(-0.015),
+                      Scalar(0.02)},
+          1e-5);
+    }
   }
 }
 
