@@ -15,7 +15,7 @@ namespace roamlab::estimator {
 namespace {
 
 // Margin of the rank decision over the Schur complement's rounding (n eps max|H|): measured noise eigenvalues were
-// within 0.1 of that bound on the ATV (README, "Marginalization and rounding").
+// within 0.1 of that bound on the ATV (BENCHMARKS.md, "Marginalization and rounding").
 constexpr double kRoundingFloor = 10.0;
 
 // Inverse right Jacobian of SO(3): d Log(Exp(phi) Exp(d)) / dd at d = 0.
