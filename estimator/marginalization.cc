@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <Eigen/Cholesky>
@@ -13,6 +14,10 @@
 namespace roamlab::estimator {
 namespace {
 
+// Margin of the rank decision over the Schur complement's rounding (n eps max|H|): measured noise eigenvalues were
+// within 0.1 of that bound on the ATV (BENCHMARKS.md, "Marginalization and rounding").
+constexpr double kRoundingFloor = 10.0;
+
 // Inverse right Jacobian of SO(3): d Log(Exp(phi) Exp(d)) / dd at d = 0.
 Eigen::Matrix3d InverseRightJacobian(const Eigen::Vector3d& phi) {
   const double theta = phi.norm();
@@ -23,23 +28,22 @@ Eigen::Matrix3d InverseRightJacobian(const Eigen::Vector3d& phi) {
 }
 
 // J (r x n) and r0 with J^T J = H and J^T r0 = g for a positive semi-definite H (g in its range), keeping the
-// directions of the eigenvalues above 1e-12 of the largest (the others carry no information). Reference: the
-// eigen-decomposition H = V diag(lambda) V^T, J = diag(sqrt(lambda)) V^T, r0 = diag(1/sqrt(lambda)) V^T g over those
-// eigenvalues. Fast path, for a clear gap: a Cholesky factorization with diagonal pivoting, H = P L L^T P^T, the
-// largest remaining diagonal entry eliminated first, stopped at rank r when the remaining Schur complement S has no
-// diagonal entry above 1e-12 / n of H's largest one. Then J = L^T P^T (r rows) and r0 = L11^-1 (P^T g)_1..r give the
+// directions of the eigenvalues above `floor` (the others carry no information, or only rounding: see Marginalize).
+// Reference: the eigen-decomposition H = V diag(lambda) V^T, J = diag(sqrt(lambda)) V^T, r0 = diag(1/sqrt(lambda))
+// V^T g over those eigenvalues. Fast path, for a clear gap: a Cholesky factorization with diagonal pivoting,
+// H = P L L^T P^T, the largest remaining diagonal entry eliminated first, stopped at rank r when the remaining Schur
+// complement S has no diagonal entry above floor / n. Then J = L^T P^T (r rows) and r0 = L11^-1 (P^T g)_1..r give the
 // same prior: |r0 + J dx|^2 depends on them only through J^T J and J^T r0 (up to a constant), the same as the
 // reference when both keep the same directions. They do when
-//  - the dropped eigenvalues are below the floor: lambda_{r+1..n}(H) <= |S|_2 <= n max diag(S) <= 1e-12 max diag(H);
+//  - the dropped eigenvalues are below the floor: lambda_{r+1..n}(H) <= |S|_2 <= n max diag(S) <= floor;
 //  - the kept ones are above it: by interlacing they are at least lambda_min(L11 L11^T) >= 1 / |L11^-1|_F^2, which is
-//    checked against 1e-12 trace(H) >= 1e-12 lambda_max.
+//    checked against the floor.
 // Otherwise (an eigenvalue near the floor) the eigen-decomposition decides. Returns false when H carries no
-// information at all.
-bool SquareRootInformation(const Eigen::MatrixXd& H_in, const Eigen::VectorXd& g, Eigen::MatrixXd* J,
+// information above the floor.
+bool SquareRootInformation(const Eigen::MatrixXd& H_in, const Eigen::VectorXd& g, double floor, Eigen::MatrixXd* J,
                            Eigen::VectorXd* r0) {
   const int n = static_cast<int>(H_in.rows());
   Eigen::MatrixXd H = H_in;
-  const double max_diagonal = std::max(H.diagonal().maxCoeff(), 0.0);
   std::vector<int> perm(n);
   for (int i = 0; i < n; ++i) perm[i] = i;
   Eigen::VectorXd gp = g;
@@ -49,7 +53,7 @@ bool SquareRootInformation(const Eigen::MatrixXd& H_in, const Eigen::VectorXd& g
     int p = k;
     for (int i = k + 1; i < n; ++i)
       if (H(i, i) > H(p, p)) p = i;
-    if (!(H(p, p) > 1e-12 / n * max_diagonal)) break;
+    if (!(H(p, p) > floor / n)) break;
     if (p != k) {
       H.row(k).swap(H.row(p));
       H.col(k).swap(H.col(p));
@@ -68,7 +72,7 @@ bool SquareRootInformation(const Eigen::MatrixXd& H_in, const Eigen::VectorXd& g
     const Eigen::MatrixXd L11 = H.topLeftCorner(rank, rank).triangularView<Eigen::Lower>();
     const Eigen::MatrixXd inverse =
         L11.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(rank, rank));
-    gap = 1.0 / inverse.squaredNorm() > 1e-12 * H_in.trace();
+    gap = 1.0 / inverse.squaredNorm() > floor;
   }
   if (gap) {
     J->setZero(rank, n);
@@ -77,10 +81,9 @@ bool SquareRootInformation(const Eigen::MatrixXd& H_in, const Eigen::VectorXd& g
     return true;
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H_in);
-  const double max_ev = std::max(eig.eigenvalues().maxCoeff(), 0.0);
   std::vector<int> keep;
   for (int k = 0; k < n; ++k)
-    if (eig.eigenvalues()[k] > 1e-12 * max_ev && eig.eigenvalues()[k] > 0.0) keep.push_back(k);
+    if (eig.eigenvalues()[k] > floor) keep.push_back(k);
   if (keep.empty()) return false;
   J->resize(static_cast<int>(keep.size()), n);
   r0->resize(static_cast<int>(keep.size()));
@@ -222,7 +225,16 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph) {
   if (nb == 0) return true;
   Eigen::MatrixXd J;
   Eigen::VectorXd r0;
-  if (!SquareRootInformation(0.5 * (Hbb + Hbb.transpose()), gb, &J, &r0)) return true;
+  // The floor: the Schur complement is computed with an absolute error of about n eps max|H| (H over leaving and
+  // blanket; the leaving pose's own information is often 1e2-1e3 times the blanket's), so its eigenvalues below that
+  // are rounding, of either sign. Keeping such a direction (the old floor, 1e-12 of the blanket's largest eigenvalue,
+  // sat within 5x of that noise) turns rounding into information with a mean of noise / lambda, and which side of the
+  // floor it falls on flips with the summation order. 1e-12 of the largest eigenvalue stays a lower bound.
+  const Eigen::MatrixXd S = 0.5 * (Hbb + Hbb.transpose());
+  const double floor =
+      std::max(kRoundingFloor * n * std::numeric_limits<double>::epsilon() * std::max(H.diagonal().maxCoeff(), 0.0),
+               1e-12 * std::max(S.diagonal().maxCoeff(), 0.0));
+  if (!SquareRootInformation(S, gb, floor, &J, &r0)) return true;
   const int dim = static_cast<int>(J.rows());
   graph->AddFactor(std::make_unique<LinearPriorFactor>(manifolds, x0, J, r0), blanket,
                    Eigen::MatrixXd::Identity(dim, dim), Loss::Trivial(), "marginalization", Time());

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
+#include <Eigen/QR>
 
 #include "estimator/covariance.h"
 #include "estimator/factor.h"
@@ -306,6 +307,62 @@ TEST(NormalEquationsTest, IncrementalResetOfASlidingWindowMatchesAFreshBuild) {
   }
   // Every Reset after the first was incremental but the one after the parameter was freed.
   EXPECT_EQ(incremental.incremental_resets(), 10);
+}
+
+// A leaving variable whose own information (1e10) dwarfs the blanket's (1e3), as a pose between 100 Hz odometry and
+// IMU factors does: the stiff factor on (x, y) is absorbed by x entirely, so it must leave no prior on y, whose
+// information stays the weak factor's, rank 2 (y's direction (1, 1, 1) unobserved). The computed Schur complement has an error of about n eps 1e10
+// ~ 1e-5 in that direction (either sign); the old floor (1e-12 of the blanket's largest eigenvalue, 1e-9) kept it when
+// positive, with a mean of rounding / rounding along it. Several stiff couplings (different rounding) must all give
+// the exact rank and the weak factor's minimizer to rounding-level accuracy.
+TEST(MarginalizationTest, StiffLeavingVariableLeavesNoRoundingInThePrior) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> normal;
+  const std::vector<Manifold> xy = {Manifold::Euclidean(3), Manifold::Euclidean(3)};
+  Eigen::MatrixXd J_weak(2, 3);  // information ~1e3, y's direction (1, 1, 1) unobserved
+  J_weak << 30.0, -20.0, -10.0,
+            5.0, 25.0, -30.0;
+  const Eigen::Vector2d r_weak(0.7, -1.1);
+  // The weak factor's minimum-norm step: what the prior must propose for y.
+  const Eigen::Vector3d expected_step = -J_weak.completeOrthogonalDecomposition().solve(r_weak);
+  for (int trial = 0; trial < 20; ++trial) {
+    Graph graph;
+    const VariableId x = graph.AddVariable({"x", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), false, std::nullopt});
+    const VariableId y = graph.AddVariable({"y", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), false, std::nullopt});
+    Eigen::MatrixXd J_stiff(3, 6);
+    J_stiff.leftCols(3) = 1e5 * Eigen::Matrix3d::Identity();
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) J_stiff(i, 3 + j) = 1e5 * normal(rng);
+    const Eigen::Vector3d r_stiff = 1e2 * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    graph.AddFactor(std::make_unique<LinearPriorFactor>(
+                        xy, std::vector<Eigen::VectorXd>{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()}, J_stiff,
+                        r_stiff),
+                    {x, y}, Eigen::Matrix3d::Identity(), Loss::Trivial(), "stiff", Time());
+    graph.AddFactor(std::make_unique<LinearPriorFactor>(std::vector<Manifold>{Manifold::Euclidean(3)},
+                                                        std::vector<Eigen::VectorXd>{Eigen::Vector3d::Zero()},
+                                                        J_weak, r_weak),
+                    {y}, Eigen::Matrix2d::Identity(), Loss::Trivial(), "weak", Time());
+    ASSERT_TRUE(Marginalize({x}, &graph));
+    // What y's factors now say (the weak one, and a prior if any): stacked, their minimum-norm step.
+    Eigen::MatrixXd J(0, 3);
+    Eigen::VectorXd r0(0);
+    for (const auto& [id, entry] : graph.factors()) {
+      const int m = entry.factor->residual_dim();
+      Eigen::VectorXd r(m);
+      Eigen::MatrixXd Jf(m, 3);
+      const double* values[] = {graph.variable(y).value.data()};
+      double* jacobians[] = {Jf.data()};
+      ASSERT_TRUE(entry.factor->Evaluate(values, r.data(), jacobians, nullptr));
+      J.conservativeResize(J.rows() + m, 3);
+      J.bottomRows(m) = Jf;
+      r0.conservativeResize(r0.size() + m);
+      r0.tail(m) = r;
+    }
+    EXPECT_EQ(J.rows(), 2) << "trial " << trial << ": the stiff factor left a prior of rounding";
+    const Eigen::Vector3d step = -J.completeOrthogonalDecomposition().solve(r0);
+    // Tolerance: the Schur complement's rounding (~1e-5 against information ~1e3) relative, with a margin of 10.
+    EXPECT_LT((step - expected_step).norm(), 1e-7 * expected_step.norm()) << "trial " << trial;
+  }
 }
 
 TEST(MarginalizationTest, PriorHoldsTheSchurComplementAlsoWhenRankDeficient) {
