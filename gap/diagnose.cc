@@ -343,8 +343,8 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
       // The driven tires' slip (models/ackermann_velocity.h): the rear-wheel speed over-reads the ground speed by
       // 1 + s_f f_x (longitudinal_slip: f_x the forward specific force read from the IMU, the traction per unit mass)
       // or 1 + s_p g sin(pitch) (slope_slip: the slope alone, from the poses' attitude), the slot freed from zero and
-      // reported as the simulator's slip_per_mps2. MuJoCo's tires slip a little already: the baseline's value is the
-      // null.
+      // reported as the simulator's slip_per_mps2. The null is the baseline's value (what MuJoCo's soft contacts
+      // and the nominal model's other gaps put there without an effect).
       const std::string p = SlotParameter(ackermann, config.streams.at(ackermann),
                                           name == "slope_slip" ? "slope_slip_per_mps2" : "slip_per_mps2");
       if (is_free(p)) continue;

@@ -75,10 +75,9 @@
 //                                          force: the wheel turns faster than the ground passes by the factor
 //                                          1 + s f_x, f_x = a_x + g sin(pitch) O's forward specific force (the
 //                                          traction per unit mass; negative when braking or coasting downhill), s in
-//                                          [0, 0.2] s^2/m. MuJoCo's tires already slip a little (the baseline's
-//                                          value); the effect is applied to the rate the rear-wheel sensor reads,
-//                                          r0 omega_MuJoCo (1 + s f_x) (estimator: the ackermann model's
-//                                          slip_per_mps2)
+//                                          [0, 0.2] s^2/m, on top of whatever MuJoCo's soft contacts slip; applied
+//                                          to the rate the rear-wheel sensor reads, r0 omega_MuJoCo (1 + s f_x)
+//                                          (estimator: the ackermann model's slip_per_mps2)
 //   slope_slip {slip_per_mps2: 0}          ackermann: as longitudinal_slip, but following the slope alone: 1 + s g
 //                                          sin(pitch), pitch O's forward axis above the horizontal, s in [0, 0.2]
 //                                          s^2/m (a soil that gives way under the tires on slopes; estimator:

@@ -44,7 +44,7 @@ class SlipDiagnoseTest : public ::testing::Test {
     const double estimate = e.parameters.at("slip_per_mps2"), std = e.std.at("slip_per_mps2");
     std::cout << effect << ": truth " << s << " estimate " << estimate << " std " << std << " error/std "
               << (estimate - s) / std << ", held-out chi2 drop " << e.heldout_improvement << ", diagnosis "
-              << d.seconds << " s\n";
+              << d.seconds << " s, " << d.fits << " fits\n";
     EXPECT_LT(std::abs(estimate - s), 3.0 * std);
     EXPECT_GT(e.heldout_improvement, 0.0);
     EXPECT_LT(d.after.at("odometer").chi2, d.before.at("odometer").chi2);
