@@ -29,14 +29,17 @@ SlotSpec MatrixSlot(const std::string& name) { return {name, Manifold::Euclidean
 const std::vector<ModelSpec>& ModelSpecs() {
   // kv_over_L defaults to NaN: the builder replaces it with 1 / wheelbase (k_v = 1).
   static const std::vector<ModelSpec> specs = {
+      // slip_per_mps2 and slope_slip_per_mps2: the driven tires' slip per m/s^2 of forward specific force (read from
+      // inputs.specific_force, an imu or accelerometer stream, along options.forward_in_sensor) and of slope g
+      // sin(pitch) (models/ackermann_velocity.h).
       {"ackermann",
        {"speed", "steering"},
        {"speed_mps", "steering_rad", "lateral_mps", "vertical_mps"},
        {ScalarSlot("kv_over_L", std::numeric_limits<double>::quiet_NaN()), ScalarSlot("k_theta", 1.0),
         ScalarSlot("k_gamma", 0.0), ScalarSlot("cornering_front", 0.0), ScalarSlot("cornering_rear", 0.0),
-        ScalarSlot("thrust_angle", 0.0)},
-       {"wheelbase_m", "speed_column", "contact_height_m", "pitch_lever_m"},
-       true, {}},
+        ScalarSlot("thrust_angle", 0.0), ScalarSlot("slip_per_mps2", 0.0), ScalarSlot("slope_slip_per_mps2", 0.0)},
+       {"wheelbase_m", "speed_column", "contact_height_m", "pitch_lever_m", "forward_in_sensor"},
+       true, {"specific_force"}},
       {"ackermann_seed",
        {"speed", "steering"},
        {"speed_mps", "steering_rad", "lateral_mps", "vertical_mps", "roll_rate_radps", "pitch_rate_radps"},

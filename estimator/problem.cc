@@ -61,9 +61,10 @@ struct StreamBinding {
   double wheelbase_m = 0.0;
   AckermannVelocityError::Contact contact;  // ackermann: options contact_height_m, pitch_lever_m
   Eigen::Vector3d field_world = Eigen::Vector3d::Zero();
-  const recording::Stream* specific_force = nullptr;   // magnetometer: inputs.specific_force
+  const recording::Stream* specific_force = nullptr;   // magnetometer, ackermann: inputs.specific_force
   int specific_force_column = 0;                       // its first accelerometer column
   double drive_nm_per_mps2 = 0.0;                      // magnetometer: options.drive_nm_per_mps2
+  Eigen::Vector3d forward_in_sensor = Eigen::Vector3d::UnitX();  // ackermann: options.forward_in_sensor (unit)
   std::deque<MeasurementRef> pending;
 };
 
@@ -89,6 +90,21 @@ Status Error(const EstimatorConfig& c, const std::string& message) {
 
 bool TypeIn(StreamType t, std::initializer_list<StreamType> allowed) {
   return std::find(allowed.begin(), allowed.end(), t) != allowed.end();
+}
+
+// Binds the stream's inputs.specific_force (an imu or accelerometer stream), when configured; false when it is not.
+Result<bool> BindSpecificForce(const EstimatorConfig& config, const recording::Recording& rec, StreamBinding* b) {
+  const auto it = b->config.inputs.find("specific_force");
+  if (it == b->config.inputs.end()) return false;
+  b->specific_force = rec.Find(it->second);
+  if (b->specific_force == nullptr ||
+      !TypeIn(b->specific_force->info.type, {StreamType::kImu, StreamType::kAccelerometer}))
+    return Error(config, "stream '" + b->name + "': inputs.specific_force '" + it->second +
+                             "' is missing or not an imu or accelerometer stream");
+  if (b->specific_force->t.empty())
+    return Error(config, "stream '" + b->name + "': inputs.specific_force '" + it->second + "' is empty");
+  b->specific_force_column = b->specific_force->info.type == StreamType::kImu ? 3 : 0;
+  return true;
 }
 
 // Noise covariance of the model's noise input, from the configured standard deviations.
@@ -172,6 +188,20 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
       if (sc.options.count("pitch_lever_m")) b.contact.pitch_lever_m = sc.options.at("pitch_lever_m").at(0);
       if (!(std::abs(b.contact.contact_height_m) <= 10.0 && std::abs(b.contact.pitch_lever_m) <= 10.0))
         return Error(config, "stream '" + name + "': contact_height_m and pitch_lever_m must be within +-10 m");
+      // The longitudinal slip's input (models/ackermann_velocity.h): the specific force along O's x, which is
+      // options.forward_in_sensor in the accelerometer's frame.
+      const Result<bool> input = BindSpecificForce(config, rec, &b);
+      if (!input.ok()) return input.status();
+      if (input.value()) {
+        const auto f = sc.options.find("forward_in_sensor");
+        if (f == sc.options.end() || f->second.size() != 3 ||
+            !(Eigen::Vector3d(f->second[0], f->second[1], f->second[2]).norm() > 0.5))
+          return Error(config, "stream '" + name + "': inputs.specific_force needs options.forward_in_sensor: "
+                                   "[x, y, z], O's forward axis in the accelerometer's frame (a unit vector)");
+        b.forward_in_sensor = Eigen::Vector3d(f->second[0], f->second[1], f->second[2]).normalized();
+      } else if (sc.options.count("forward_in_sensor")) {
+        return Error(config, "stream '" + name + "': options.forward_in_sensor without inputs.specific_force");
+      }
     } else if (m == "gyroscope") {
       if (!TypeIn(type, {StreamType::kImu, StreamType::kGyroscope})) return Error(config, bad_type);
     } else if (m == "accelerometer") {
@@ -184,16 +214,9 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
       const auto& f = sc.options.at("field_world");
       b.field_world = Eigen::Vector3d(f[0], f[1], f[2]);
       // The motor interference's proxy (models/magnetometer.h): the accelerometer's specific force, with c.
-      if (sc.inputs.count("specific_force")) {
-        const std::string& input = sc.inputs.at("specific_force");
-        b.specific_force = rec.Find(input);
-        if (b.specific_force == nullptr ||
-            !TypeIn(b.specific_force->info.type, {StreamType::kImu, StreamType::kAccelerometer}))
-          return Error(config, "stream '" + name + "': inputs.specific_force '" + input +
-                                   "' is missing or not an imu or accelerometer stream");
-        if (b.specific_force->t.empty())
-          return Error(config, "stream '" + name + "': inputs.specific_force '" + input + "' is empty");
-        b.specific_force_column = b.specific_force->info.type == StreamType::kImu ? 3 : 0;
+      const Result<bool> input = BindSpecificForce(config, rec, &b);
+      if (!input.ok()) return input.status();
+      if (input.value()) {
         if (!sc.options.count("drive_nm_per_mps2") || sc.options.at("drive_nm_per_mps2").size() != 1 ||
             !std::isfinite(sc.options.at("drive_nm_per_mps2")[0]))
           return Error(config, "stream '" + name + "': inputs.specific_force needs options.drive_nm_per_mps2: [c], "
@@ -414,7 +437,7 @@ std::pair<Eigen::Vector2d, Eigen::Vector2d> LeftRightHarmonics(const StreamBindi
           DifferentialDriveError::DeformationHarmonics(angles(row, right), angles(row + 1, right))};
 }
 
-// The specific force [m/s^2] of a magnetometer's inputs.specific_force at time t: linear interpolation between the
+// The specific force [m/s^2] of a stream's inputs.specific_force at time t: linear interpolation between the
 // rows around t, the first or last row outside the stream's span.
 Eigen::Vector3d SpecificForceAt(const StreamBinding& s, Time t) {
   const recording::Stream& f = *s.specific_force;
@@ -601,8 +624,9 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     const double z_theta = SteeringAt(*s.steering, m.t);
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k)};
     if (model == "ackermann") {
-      factor = MakeFactor(AckermannVelocityError(z_v, z_theta, s.wheelbase_m, dt, s.contact));
-      vars.insert(vars.end(), {slot(3, k), slot(4, k), slot(5, k)});
+      const double f_x = s.specific_force ? s.forward_in_sensor.dot(SpecificForceAt(s, m.t)) : 0.0;
+      factor = MakeFactor(AckermannVelocityError(z_v, z_theta, s.wheelbase_m, dt, s.contact, f_x));
+      vars.insert(vars.end(), {slot(3, k), slot(4, k), slot(5, k), slot(6, k), slot(7, k)});
     } else {
       factor = MakeFactor(AckermannOdometerError(z_v, z_theta, s.wheelbase_m, dt));
     }

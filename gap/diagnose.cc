@@ -337,6 +337,24 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
         if (std.count(front)) e->std["cornering_front_rads2pm"] = std.at(front)[0];
         if (std.count(rear)) e->std["cornering_rear_s"] = std.at(rear)[0];
       };
+    } else if ((name == "longitudinal_slip" && !ackermann.empty() &&
+                config.streams.at(ackermann).inputs.count("specific_force")) ||
+               (name == "slope_slip" && !ackermann.empty())) {
+      // The driven tires' slip (models/ackermann_velocity.h): the rear-wheel speed over-reads the ground speed by
+      // 1 + s_f f_x (longitudinal_slip: f_x the forward specific force read from the IMU, the traction per unit mass)
+      // or 1 + s_p g sin(pitch) (slope_slip: the slope alone, from the poses' attitude), the slot freed from zero and
+      // reported as the simulator's slip_per_mps2. The null is the baseline's value (what MuJoCo's soft contacts
+      // and the nominal model's other gaps put there without an effect).
+      const std::string p = SlotParameter(ackermann, config.streams.at(ackermann),
+                                          name == "slope_slip" ? "slope_slip_per_mps2" : "slip_per_mps2");
+      if (is_free(p)) continue;
+      c.stream = ackermann;
+      c.free = {p};
+      c.free_dof = 1;
+      c.describe = [p](const auto& value, const auto& std, EffectEstimate* e) {
+        e->parameters["slip_per_mps2"] = value.at(p)[0];
+        if (std.count(p)) e->std["slip_per_mps2"] = std.at(p)[0];
+      };
     } else if (name == "magnetometer_motor_interference" && !magnetometer.empty()) {
       // The magnetometer's bias per N m of drive torque k (models/magnetometer.h) freed from zero, on the proxy
       // tau_hat = c f_x (forward specific force, c = m r / 2 from the nominal vehicle): reported as the simulator's
@@ -443,7 +461,7 @@ const std::vector<std::string>& CandidateNames() {
   static const std::vector<std::string> names = {
       "gps_latency",  "imu_time_offset",        "pose_time_offset",  "steering_offset",
       "gyro_scale_error", "gyro_bias_drift", "lateral_slip", "wheel_radius_asymmetry", "track_width_error",
-      "wheel_deformation", "axle_misalignment", "magnetometer_motor_interference"};
+      "wheel_deformation", "axle_misalignment", "magnetometer_motor_interference", "longitudinal_slip", "slope_slip"};
   return names;
 }
 
@@ -599,6 +617,11 @@ Result<estimator::EstimatorConfig> NominalConfig(const sim::Scenario& scenario) 
     stage1.push_back("imu.misalignment");
     c.streams["gyroscope"] = ImuStream("gyroscope", "sigma_radps", s.imu->gyro_sigma_radps);
     c.streams["accelerometer"] = ImuStream("accelerometer", "sigma_mps2", s.imu->accel_sigma_mps2);
+    // The longitudinal slip's input (models/ackermann_velocity.h; its slot fixed at zero nominally): the IMU's
+    // specific force along O's forward axis, which the believed mounting puts at R(q)^T e_x in the IMU's frame.
+    const Eigen::Vector3d forward_in_imu = q.conjugate() * Eigen::Vector3d::UnitX();
+    c.streams["odometer"].inputs = {{"specific_force", "imu"}};
+    c.streams["odometer"].options["forward_in_sensor"] = {forward_in_imu.x(), forward_in_imu.y(), forward_in_imu.z()};
     if (!s.imu->lever_arm_m.isZero(0.0)) {
       const Eigen::Vector3d& l = s.imu->lever_arm_m;
       param("accelerometer.lever_arm", vec({l.x(), l.y(), l.z()}), false);

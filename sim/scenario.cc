@@ -491,6 +491,8 @@ const std::map<std::string, std::map<std::string, double>>& KnownEffects() {
       {"accelerometer_scale_error", {{"scale_x", 1.0}, {"scale_y", 1.0}, {"scale_z", 1.0}}},
       {"gps_multipath", {{"sigma_m", 0.0}, {"correlation_s", 5.0}}},
       {"tire_growth", {{"growth_per_mps2", 0.0}}},
+      {"longitudinal_slip", {{"slip_per_mps2", 0.0}}},
+      {"slope_slip", {{"slip_per_mps2", 0.0}}},
       {"wheel_radius_asymmetry", {{"ratio_right_left", 1.0}}},
       {"track_width_error", {{"track_error_m", 0.0}}},
       {"wheel_deformation", {{"wheel", 0.0}, {"ovality_m", 0.0}}},
@@ -701,6 +703,12 @@ std::optional<Scenario::Problem> Scenario::Validate() const {
       if (!sensors.odometer) return P{k + ".name", "tire_growth needs sensors.odometer"};
       const double c = EffectParameter(effects, e.name, "growth_per_mps2", 0.0);
       if (!(c >= 0.0 && c <= 0.01)) return P{k + ".parameters.growth_per_mps2", "must be in [0, 0.01] s^2/m^2"};
+    }
+    if (e.name == "longitudinal_slip" || e.name == "slope_slip") {
+      if (!ackermann) return P{k + ".name", e.name + " is implemented for ackermann robots only"};
+      if (!sensors.odometer) return P{k + ".name", e.name + " needs sensors.odometer"};
+      const double s = EffectParameter(effects, e.name, "slip_per_mps2", 0.0);
+      if (!(s >= 0.0 && s <= 0.2)) return P{k + ".parameters.slip_per_mps2", "must be in [0, 0.2] s^2/m"};
     }
     if (e.name == "steering_offset" && !sensors.odometer)
       return P{k + ".name", "steering_offset needs sensors.odometer"};

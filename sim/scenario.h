@@ -71,6 +71,17 @@
 //                                          the wheel turns at v / r(v) and the speed sensor (calibrated for r0)
 //                                          under-reads by the factor 1 / (1 + c v^2). MuJoCo's tire is rigid, so the
 //                                          effect is applied to the rate the sensor reads, v = r0 omega_MuJoCo
+//   longitudinal_slip {slip_per_mps2: 0}  ackermann: the driven (rear) tires slip in proportion to their traction
+//                                          force: the wheel turns faster than the ground passes by the factor
+//                                          1 + s f_x, f_x = a_x + g sin(pitch) O's forward specific force (the
+//                                          traction per unit mass; negative when braking or coasting downhill), s in
+//                                          [0, 0.2] s^2/m, on top of whatever MuJoCo's soft contacts slip; applied
+//                                          to the rate the rear-wheel sensor reads, r0 omega_MuJoCo (1 + s f_x)
+//                                          (estimator: the ackermann model's slip_per_mps2)
+//   slope_slip {slip_per_mps2: 0}          ackermann: as longitudinal_slip, but following the slope alone: 1 + s g
+//                                          sin(pitch), pitch O's forward axis above the horizontal, s in [0, 0.2]
+//                                          s^2/m (a soil that gives way under the tires on slopes; estimator:
+//                                          slope_slip_per_mps2)
 // Wheeled indoor robots (below); in the compiled MuJoCo model after the robot is bound, so that the recording's
 // platform geometry and the driver's inverse kinematics stay nominal; truth.yaml's odometer geometry is the true one:
 //   wheel_radius_asymmetry {ratio_right_left: 1}   differential_drive: the right tire's radius (wheel_1) times the

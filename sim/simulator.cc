@@ -395,6 +395,8 @@ class Simulator::Impl {
     // The Gauss-Markov error starts in its stationary distribution, N(0, sigma^2) per axis.
     multipath_m_ = multipath_noise_.Draw3(multipath_sigma_m_);
     tire_growth_per_mps2_ = EffectParameter(effects, "tire_growth", "growth_per_mps2", 0.0);
+    slip_per_mps2_ = EffectParameter(effects, "longitudinal_slip", "slip_per_mps2", 0.0);
+    slope_slip_per_mps2_ = EffectParameter(effects, "slope_slip", "slip_per_mps2", 0.0);
     for (const EffectOptions& e : effects) {
       recording::Effect truth{e.name, KnownEffects().at(e.name)};
       for (const auto& [name, value] : e.parameters) truth.parameters[name] = value;
@@ -558,10 +560,15 @@ class Simulator::Impl {
     if (odometer_clock_.Due(t_ns)) {
       const OdometerOptions& odo = *sensors.odometer;
       // tire_growth: the rigid MuJoCo tire rolls at omega = v / r0; a tire of radius r0 (1 + c v^2) turns at
-      // omega / (1 + c v^2) at the same ground speed v = r0 omega.
+      // omega / (1 + c v^2) at the same ground speed v = r0 omega. longitudinal_slip and slope_slip: the driven tire
+      // turns faster than it rolls by 1 + s_f f_x + s_p g sin(pitch) (f_x: O's true forward specific force; pitch:
+      // O's forward axis above the horizontal).
       const double omega_radps = vehicle_.RearWheelRate(data_.get());
       const double v_mps = omega_radps * vehicle_.wheel_radius_m();
-      const double z_v = SpeedReading(omega_radps / (1.0 + tire_growth_per_mps2_ * v_mps * v_mps),
+      const double g_mps2 = Eigen::Map<const Eigen::Vector3d>(model_->opt.gravity).norm();
+      const double slip = 1.0 + slip_per_mps2_ * body.specific_force_body.x() +
+                          slope_slip_per_mps2_ * g_mps2 * (body.q_world_body * Eigen::Vector3d::UnitX()).z();
+      const double z_v = SpeedReading(slip * omega_radps / (1.0 + tire_growth_per_mps2_ * v_mps * v_mps),
                                       vehicle_.wheel_radius_m(), odo.kv_over_L, wheelbase_m_) +
                          speed_noise_.Draw(odo.speed_sigma_mps);
       const double z_theta =
@@ -768,6 +775,8 @@ class Simulator::Impl {
   double multipath_correlation_s_ = 5.0;
   Eigen::Vector3d multipath_m_ = Eigen::Vector3d::Zero();       // the error of the next fix, ENU [m]
   double tire_growth_per_mps2_ = 0.0;                           // tire_growth's c [s^2/m^2]
+  double slip_per_mps2_ = 0.0;                                  // longitudinal_slip's s_f [s^2/m]
+  double slope_slip_per_mps2_ = 0.0;                            // slope_slip's s_p [s^2/m]
 
   std::int64_t step_ns_ = 0;
   std::int64_t end_ns_ = 0;

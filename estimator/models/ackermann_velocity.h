@@ -1,13 +1,15 @@
 // Ackermann-steering odometer in measurement space (seed 000, eq. 15 inverted), with the tires' cornering compliance,
-// the rear axle's thrust angle and the height of O above the ground contact: the body velocities between two poses
-// predict the rear-wheel speed and the handlebar angle, and the error is the difference to the readings.
+// the rear axle's thrust angle, the height of O above the ground contact and the driven tires' longitudinal slip: the
+// body velocities between two poses predict the rear-wheel speed and the handlebar angle, and the error is the
+// difference to the readings.
 //
 //   v^(O), omega^(O) = VelocitiesBetween(pose_k, pose_k+1, dt)          (eq. 7 inverted; middle of the interval)
 //   v           = v^(O) + omega x (0, 0, -h) = (v^(O)_x - h omega_y, v^(O)_y + h omega_x, v^(O)_z)
 //                                                                        the rear contact's velocity (h below O)
 //   a_y         = v_x omega_z                                            lateral (centripetal) acceleration [m/s^2]
 //   v_roll      = v_x cos(alpha) + v_y sin(alpha)                        rear wheels' rolling speed [m/s]
-//   z_v_hat     = v_roll / k_v                                           k_v = kv_over_L * L
+//   sigma       = 1 + s_f f_x + s_p g sin(theta)                         driven wheels' over-reading (slip)
+//   z_v_hat     = v_roll sigma / k_v                                     k_v = kv_over_L * L
 //   delta       = atan((L omega_z + v_y) / v_x) + c_front a_y            steered angle of the front wheels
 //   z_theta_hat = (delta - k_gamma) / k_theta                           (eq. 15: omega_z = (k_v / L) v tan(delta))
 //   e = [z_v_hat - z_v;  z_theta_hat - z_theta;  v_y - v_x tan(alpha) + c_rear a_y;  v_z - d omega_y] + eta
@@ -50,16 +52,28 @@
 // (2-3 reported standard deviations on 12 s drives); here the noise is additive on the readings, the covariance is
 // constant, and the least-squares problem is the likelihood of the readings themselves.
 //
+// Longitudinal slip (issue 6, longitudinal_slip and slope_slip). A driven tire carries its traction force by slipping:
+// the wheel turns faster than the ground passes, v_wheel = v (1 + s) with the slip ratio s growing with the force.
+// The recording has no force: the traction per unit mass is the forward specific force f_x = a_x + g sin(theta)
+// [m/s^2] (aerodynamic drag and rolling resistance aside), read from the IMU (an input of the factor, in O: the
+// accelerometer's reading turned by the believed mounting; 0 without the input), so s = s_f f_x with s_f
+// (slot slip_per_mps2) [s^2/m]. slope_slip: a slip that follows the slope only, s = s_p g sin(theta), theta the pitch
+// of O at the middle of the interval (sin(theta) = e_z^T R_mid e_x, positive nose up; from the poses, so no input),
+// s_p (slot slope_slip_per_mps2) [s^2/m]. The two differ by the acceleration a_x, which only s_f follows. Both 0 (the
+// defaults): the speed row above without slip. A constant error of f_x (the mounting's pitch error times g) only
+// scales the speed row: kv_over_L absorbs it.
+//
 // Frames: O is the middle of the rear axle (x forward, z up). Measurements: z_v rear-wheel speed with the nominal
-// wheel radius [m/s], z_theta handlebar angle [rad], both over [t_k, t_k+1]. Calibration: kv_over_L [1/m], k_theta
-// [-], k_gamma [rad], c_front [rad s^2/m], c_rear [s], alpha [rad]; the wheelbase L [m], h and d [m] are known. Noise eta =
+// wheel radius [m/s], z_theta handlebar angle [rad], both over [t_k, t_k+1]; input f_x [m/s^2]. Calibration:
+// kv_over_L [1/m], k_theta [-], k_gamma [rad], c_front [rad s^2/m], c_rear [s], alpha [rad], s_f [s^2/m], s_p
+// [s^2/m]; the wheelbase L [m], h and d [m] are known. Noise eta =
 // [sigma_v (m/s), sigma_theta (rad), lateral (m/s), vertical (m/s)], the last two the uncertainty of the non-holonomic
 // assumptions (no unmodelled sideways slip, no motion off the ground). Eq. 15 says nothing about roll and pitch
 // rates, and on hills they are not zero (the terrain tilts the vehicle): pretending they are pulls the estimated
 // attitude flat and biases the IMU misalignment, so this form leaves them to the other sensors. Below
 // kMinSteeringSpeed the steering angle does not affect the motion, so its error is zero (eta only).
-// Variables: pose at t_k, pose at t_k+1 (PoseBlock), kv_over_L, k_theta, k_gamma, c_front, c_rear, alpha (ScalarBlock
-// each).
+// Variables: pose at t_k, pose at t_k+1 (PoseBlock), kv_over_L, k_theta, k_gamma, c_front, c_rear, alpha, s_f, s_p
+// (ScalarBlock each).
 //
 // Jacobians (Linearize; internal/so3_jacobians.h for Jr, Jr^-1, Jl^-1 = (Jr^-1)^T). VelocitiesBetween computes
 // phi = Log(q_k^-1 q_k+1), omega = phi / dt, q_mid = q_k Exp(phi / 2) and v = R_mid^T (p_k+1 - p_k) / dt, so
@@ -67,13 +81,15 @@
 //   dv/dtheta = [v]x eps/dtheta  ((R_mid Exp(eps))^T u = R_mid^T u + [R_mid^T u]x eps), where eps, the right
 //   perturbation of q_mid, is (q_k Exp(d) Exp(psi + dpsi) = q_mid Exp(R(psi)^T d) Exp(Jr(psi) dpsi), psi = phi / 2)
 //   eps/dtheta_k = R(phi/2)^T - Jr(phi/2) Jl^-1(phi) / 2,   eps/dtheta_k+1 = Jr(phi/2) Jr^-1(phi) / 2.
-// The rows in the contact velocity v and omega_z, with r = (L omega_z + v_y) / v_x and s = 1 / (1 + r^2) (steering row zero below
-// kMinSteeringSpeed): de_v = (cos(alpha) dv_x + sin(alpha) dv_y) / k_v;  k_theta de_theta = (c_front omega_z -
+// The rows in the contact velocity v and omega_z, with r = (L omega_z + v_y) / v_x and s = 1 / (1 + r^2) (steering
+// row zero below kMinSteeringSpeed): de_v = sigma (cos(alpha) dv_x + sin(alpha) dv_y) / k_v + v_roll s_p g
+// dsin(theta) / k_v with dsin(theta)/deps = -e_z^T R_mid [e_x]x;  k_theta de_theta = (c_front omega_z -
 // s r / v_x) dv_x + s / v_x dv_y + (s L / v_x + c_front v_x) domega_z;  de_lat = (c_rear omega_z - tan(alpha)) dv_x
 // + dv_y + c_rear v_x domega_z;  de_vert = dv_z - d domega_y; and dv/domega = [[0, -h, 0], [h, 0, 0], [0, 0, 0]].
-// Parameters: de_v/dkv_over_L = -v_roll / (kv_over_L^2 L), de_theta/dk_theta = -(delta - k_gamma) / k_theta^2,
+// Parameters: de_v/dkv_over_L = -v_roll sigma / (kv_over_L^2 L), de_theta/dk_theta = -(delta - k_gamma) / k_theta^2,
 // de_theta/dk_gamma = -1 / k_theta, de_theta/dc_front = a_y / k_theta, de_lat/dc_rear = a_y,
-// de_v/dalpha = (v_y cos(alpha) - v_x sin(alpha)) / k_v, de_lat/dalpha = -v_x (1 + tan^2(alpha)).
+// de_v/dalpha = (v_y cos(alpha) - v_x sin(alpha)) sigma / k_v, de_lat/dalpha = -v_x (1 + tan^2(alpha)),
+// de_v/ds_f = v_roll f_x / k_v, de_v/ds_p = v_roll g sin(theta) / k_v.
 #pragma once
 
 #include <cmath>
@@ -98,7 +114,8 @@ struct AckermannContact {
 class AckermannVelocityError {
  public:
   using Blocks =
-      std::tuple<PoseBlock, PoseBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock>;
+      std::tuple<PoseBlock, PoseBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock,
+                 ScalarBlock, ScalarBlock>;
   static constexpr int kResidualDim = 4;
   static constexpr int kNoiseDim = 4;
   static constexpr bool kAdditiveNoise = true;  // e = f(x) + eta
@@ -106,8 +123,15 @@ class AckermannVelocityError {
 
   using Contact = AckermannContact;
 
-  AckermannVelocityError(double z_v_mps, double z_theta_rad, double wheelbase_m, double dt_s, Contact contact = {})
-      : z_v_mps_(z_v_mps), z_theta_rad_(z_theta_rad), wheelbase_m_(wheelbase_m), dt_s_(dt_s), contact_(contact) {
+  // forward_specific_force_mps2: f_x, the IMU's specific force along O's x over the interval (0: no input).
+  AckermannVelocityError(double z_v_mps, double z_theta_rad, double wheelbase_m, double dt_s, Contact contact = {},
+                         double forward_specific_force_mps2 = 0.0)
+      : z_v_mps_(z_v_mps),
+        z_theta_rad_(z_theta_rad),
+        wheelbase_m_(wheelbase_m),
+        dt_s_(dt_s),
+        contact_(contact),
+        forward_specific_force_mps2_(forward_specific_force_mps2) {
     ROAMLAB_CHECK(wheelbase_m > 0.0 && dt_s > 0.0, "Ackermann wheelbase " << wheelbase_m << " dt " << dt_s);
   }
 
@@ -119,7 +143,8 @@ class AckermannVelocityError {
     using std::sin;
     using std::tan;
     Vector3<T> v_odom, omega_body;
-    VelocitiesBetween<T>(PoseFromArray(x[0]), PoseFromArray(x[1]), T(dt_s_), &v_odom, &omega_body);
+    const Pose<T> pose_k = PoseFromArray(x[0]);
+    VelocitiesBetween<T>(pose_k, PoseFromArray(x[1]), T(dt_s_), &v_odom, &omega_body);
     const T h(contact_.contact_height_m);
     const Vector3<T> v_body(v_odom.x() - h * omega_body.y(), v_odom.y() + h * omega_body.x(), v_odom.z());
     const T& kv_over_l = x[2][0];
@@ -128,9 +153,15 @@ class AckermannVelocityError {
     const T& c_front = x[5][0];
     const T& c_rear = x[6][0];
     const T& alpha = x[7][0];
+    const T& slip_f = x[8][0];
+    const T& slip_p = x[9][0];
     const T a_y = v_body.x() * omega_body.z();
     const T v_roll = v_body.x() * cos(alpha) + v_body.y() * sin(alpha);
-    error[0] = v_roll / (kv_over_l * T(wheelbase_m_)) - T(z_v_mps_) + noise[0];
+    // The pitch of O at the middle of the interval, as VelocitiesBetween's q_mid.
+    const Quaternion<T> q_mid = pose_k.q_world_body * QuaternionExp<T>(omega_body * T(0.5 * dt_s_));
+    const T sin_pitch = (q_mid * Vector3<T>::UnitX()).z();
+    const T slip = T(1.0) + slip_f * T(forward_specific_force_mps2_) + slip_p * T(kStandardGravity) * sin_pitch;
+    error[0] = v_roll * slip / (kv_over_l * T(wheelbase_m_)) - T(z_v_mps_) + noise[0];
     if (std::abs(ValueOf(v_body.x())) >= kMinSteeringSpeed) {
       const T delta = atan((T(wheelbase_m_) * omega_body.z() + v_body.y()) / v_body.x()) + c_front * a_y;
       error[1] = (delta - k_gamma) / k_theta - T(z_theta_rad_) + noise[1];
@@ -153,6 +184,8 @@ class AckermannVelocityError {
     const double c_front = x[5][0];
     const double c_rear = x[6][0];
     const double alpha = x[7][0];
+    const double slip_f = x[8][0];
+    const double slip_p = x[9][0];
     const double cos_alpha = std::cos(alpha), sin_alpha = std::sin(alpha), tan_alpha = std::tan(alpha);
 
     // VelocitiesBetween, keeping the rotation vector and q_mid.
@@ -167,7 +200,10 @@ class AckermannVelocityError {
     const double k_v = kv_over_l * wheelbase_m_;
     const double a_y = v_body.x() * omega_body.z();
     const double v_roll = v_body.x() * cos_alpha + v_body.y() * sin_alpha;
-    error[0] = v_roll / k_v - z_v_mps_;
+    const Eigen::Matrix3d R_mid = q_mid.toRotationMatrix();
+    const double sin_pitch = R_mid(2, 0);
+    const double slip = 1.0 + slip_f * forward_specific_force_mps2_ + slip_p * kStandardGravity * sin_pitch;
+    error[0] = v_roll * slip / k_v - z_v_mps_;
     const bool steering = std::abs(v_body.x()) >= kMinSteeringSpeed;
     const double r = steering ? (wheelbase_m_ * omega_body.z() + v_body.y()) / v_body.x() : 0.0;
     const double delta = steering ? std::atan(r) + c_front * a_y : 0.0;
@@ -180,8 +216,8 @@ class AckermannVelocityError {
     Eigen::Matrix<double, 4, 3> J_e_v = Eigen::Matrix<double, 4, 3>::Zero();
     Eigen::Matrix<double, 4, 3> J_e_omega = Eigen::Matrix<double, 4, 3>::Zero();
     auto J_e_omega_z = J_e_omega.col(2);
-    J_e_v(0, 0) = cos_alpha / k_v;
-    J_e_v(0, 1) = sin_alpha / k_v;
+    J_e_v(0, 0) = slip * cos_alpha / k_v;
+    J_e_v(0, 1) = slip * sin_alpha / k_v;
     J_e_v(2, 0) = c_rear * omega_body.z() - tan_alpha;
     J_e_v(2, 1) = 1.0;
     J_e_v(3, 2) = 1.0;
@@ -201,8 +237,11 @@ class AckermannVelocityError {
 
     // Poses: [dp, dtheta] through v (R_mid, and q_mid's perturbation eps) and omega (phi / dt).
     if (jacobians[0] != nullptr || jacobians[1] != nullptr) {
-      const Eigen::Matrix3d R_mid_T = q_mid.toRotationMatrix().transpose();
-      const Eigen::Matrix<double, 4, 3> J_e_eps = J_e_v * Skew<double>(v_odom);  // de/deps
+      const Eigen::Matrix3d R_mid_T = R_mid.transpose();
+      // de/deps: through O's velocity, and through the pitch on the speed row (slope slip).
+      Eigen::Matrix<double, 4, 3> J_e_eps = J_e_v * Skew<double>(v_odom);
+      J_e_eps.row(0) -= (v_roll * slip_p * kStandardGravity / k_v) * R_mid.row(2) *
+                        Skew<double>(Eigen::Vector3d::UnitX());
       const Eigen::Matrix3d jr_inv = internal::InverseRightJacobianSO3(phi);
       const Eigen::Matrix3d half_jr = 0.5 * internal::RightJacobianSO3(phi * 0.5);
       const Eigen::Matrix<double, 4, 3> J_e_dp1 = J_e_v * R_mid_T / dt_s_;
@@ -222,7 +261,7 @@ class AckermannVelocityError {
 
     // Calibration scalars.
     if (jacobians[2] != nullptr) {
-      Eigen::Map<Eigen::Vector4d>{jacobians[2]} << -v_roll / (kv_over_l * k_v), 0.0, 0.0, 0.0;
+      Eigen::Map<Eigen::Vector4d>{jacobians[2]} << -v_roll * slip / (kv_over_l * k_v), 0.0, 0.0, 0.0;
     }
     if (jacobians[3] != nullptr) {
       Eigen::Map<Eigen::Vector4d>{jacobians[3]} << 0.0, steering ? -(delta - k_gamma) / (k_theta * k_theta) : 0.0,
@@ -236,8 +275,14 @@ class AckermannVelocityError {
     }
     if (jacobians[6] != nullptr) Eigen::Map<Eigen::Vector4d>{jacobians[6]} << 0.0, 0.0, a_y, 0.0;
     if (jacobians[7] != nullptr) {
-      Eigen::Map<Eigen::Vector4d>{jacobians[7]} << (v_body.y() * cos_alpha - v_body.x() * sin_alpha) / k_v, 0.0,
-          -v_body.x() * (1.0 + tan_alpha * tan_alpha), 0.0;
+      Eigen::Map<Eigen::Vector4d>{jacobians[7]} << (v_body.y() * cos_alpha - v_body.x() * sin_alpha) * slip / k_v,
+          0.0, -v_body.x() * (1.0 + tan_alpha * tan_alpha), 0.0;
+    }
+    if (jacobians[8] != nullptr) {
+      Eigen::Map<Eigen::Vector4d>{jacobians[8]} << v_roll * forward_specific_force_mps2_ / k_v, 0.0, 0.0, 0.0;
+    }
+    if (jacobians[9] != nullptr) {
+      Eigen::Map<Eigen::Vector4d>{jacobians[9]} << v_roll * kStandardGravity * sin_pitch / k_v, 0.0, 0.0, 0.0;
     }
     return true;
   }
@@ -248,6 +293,7 @@ class AckermannVelocityError {
   double wheelbase_m_;
   double dt_s_;
   Contact contact_;
+  double forward_specific_force_mps2_;
 };
 
 }  // namespace roamlab::estimator

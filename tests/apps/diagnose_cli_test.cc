@@ -62,8 +62,9 @@ TEST(DiagnoseCliTest, NeverOpensTruthYamlAndWritesGapJson) {
   const std::string verdict = gap["verdict"].get<std::string>();
   EXPECT_TRUE(verdict == "named" || verdict == "unknown" || verdict == "none") << verdict;
   // The ATV's: gps_latency, imu_time_offset, steering_offset, gyro_scale_error, gyro_bias_drift, lateral_slip,
-  // magnetometer_motor_interference (not axle_misalignment: the nominal model's IMU misalignment is free).
-  EXPECT_EQ(gap["candidates"].size(), 7u);
+  // magnetometer_motor_interference, longitudinal_slip, slope_slip (not axle_misalignment: the nominal model's IMU
+  // misalignment is free).
+  EXPECT_EQ(gap["candidates"].size(), 9u);
   EXPECT_TRUE(std::ifstream(dir.File("out/report.md")).good());
   EXPECT_TRUE(std::ifstream(dir.File("out/scenario_patch.yaml")).good());
 }

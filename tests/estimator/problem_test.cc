@@ -99,6 +99,33 @@ TEST(ProblemBuilderTest, MagnetometerSpecificForceInputIsChecked) {
   EXPECT_NE(message(config).find("without inputs.specific_force"), std::string::npos) << message(config);
 }
 
+// The Ackermann odometer's specific-force input (the longitudinal slip's proxy) needs O's forward axis in the
+// accelerometer's frame, and that axis needs the input.
+TEST(ProblemBuilderTest, AckermannSpecificForceInputIsChecked) {
+  const auto synthetic = ShortDrive();
+  const auto message = [&](const EstimatorConfig& config) {
+    auto builder = ProblemBuilder::Create(config, synthetic.recording);
+    return builder.ok() ? std::string("accepted") : builder.status().message();
+  };
+  EstimatorConfig config = testing::AtvConfig({});
+  StreamConfig* odo = nullptr;
+  for (auto& [name, sc] : config.streams)
+    if (sc.model == "ackermann") odo = &sc;
+  ASSERT_NE(odo, nullptr);
+  odo->inputs["specific_force"] = "imu";
+  odo->options["forward_in_sensor"] = {1.0, 0.0, 0.0};
+  EXPECT_EQ(message(config), "accepted");
+  odo->inputs["specific_force"] = "gps";
+  EXPECT_NE(message(config).find("not an imu or accelerometer stream"), std::string::npos) << message(config);
+  odo->inputs["specific_force"] = "imu";
+  odo->options["forward_in_sensor"] = {0.0, 0.0, 0.0};
+  EXPECT_NE(message(config).find("needs options.forward_in_sensor"), std::string::npos) << message(config);
+  odo->inputs.clear();
+  odo->options["forward_in_sensor"] = {1.0, 0.0, 0.0};
+  EXPECT_NE(message(config).find("forward_in_sensor without inputs.specific_force"), std::string::npos)
+      << message(config);
+}
+
 // A differential drive seen by motion capture over a short stretch (the fixes span well under 1 m, too little for a
 // position-only yaw fit) that starts facing backwards: the measured orientations still turn the dead-reckoned
 // trajectory (which starts at yaw 0) onto the fixes.

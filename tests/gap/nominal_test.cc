@@ -35,6 +35,15 @@ TEST(NominalConfigTest, TheAtvScenarioGivesTheCalibrationWithKGammaFixedAtTheBel
   // The motor interference's proxy: the IMU's specific force, c = m r / 2 of models/atv.xml (354 kg, 0.28 m).
   EXPECT_EQ(c.streams.at("magnetometer").inputs.at("specific_force"), "imu");
   EXPECT_NEAR(c.streams.at("magnetometer").options.at("drive_nm_per_mps2").at(0), 354.0 * 0.28 / 2.0, 1e-6);
+  // The longitudinal slip's proxy: the IMU's specific force along O's x, R(q_body_imu)^T e_x in the IMU's frame.
+  EXPECT_EQ(c.streams.at("odometer").inputs.at("specific_force"), "imu");
+  const Eigen::Vector3d forward = scenario.value().sensors.imu->misalignment.conjugate() * Eigen::Vector3d::UnitX();
+  const std::vector<double>& f = c.streams.at("odometer").options.at("forward_in_sensor");
+  ASSERT_EQ(f.size(), 3u);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(f[static_cast<std::size_t>(i)], forward[i], 1e-12) << i;
+  EXPECT_GT(std::abs(forward.y()) + std::abs(forward.z()), 0.3);  // Table I's mounting is far from O's axes
+  EXPECT_FALSE(c.parameters.count("odometer.slip_per_mps2"));
+  EXPECT_FALSE(c.parameters.count("odometer.slope_slip_per_mps2"));
   ASSERT_EQ(c.stages.size(), 3u);
   EXPECT_EQ(c.stages.back().size(), 6u);
 }

@@ -276,6 +276,54 @@ TEST_F(EffectsTest, TireGrowthMakesTheSpeedSensorUnderReadWithTheSquareOfTheSpee
   EXPECT_LT((StreamOf(sim, "steering").values - StreamOf(*nominal_, "steering").values).cwiseAbs().maxCoeff(), 1e-12);
 }
 
+// The rear-wheel reading over-reads the nominal one by 1 + s f_x, f_x O's forward specific force: with noise off
+// and the IMU at O (atv_hills: lever arm 0), exactly the IMU's reading turned into O (the estimator's proxy,
+// models/ackermann_velocity.h), sampled at the same instant.
+TEST_F(EffectsTest, LongitudinalSlipOverReadsTheRearWheelWithTheForwardSpecificForce) {
+  const double s = 0.05;  // [s^2/m]
+  const Simulation sim = Simulated(Drive({{"longitudinal_slip", {{"slip_per_mps2", s}}}}));
+  const recording::Stream& a = StreamOf(*nominal_, "rear_wheel");
+  const recording::Stream& b = StreamOf(sim, "rear_wheel");
+  const recording::Stream& imu = StreamOf(sim, "imu");
+  ASSERT_EQ(a.values.rows(), b.values.rows());
+  ASSERT_EQ(imu.values.rows(), a.values.rows());
+  const Eigen::Vector3d forward_in_imu = Drive({}).sensors.imu->misalignment.conjugate() * Eigen::Vector3d::UnitX();
+  double max_abs_f_x = 0.0;
+  for (Eigen::Index k = 0; k < a.values.rows(); ++k) {
+    ASSERT_EQ(imu.t[static_cast<std::size_t>(k)], a.t[static_cast<std::size_t>(k)]);
+    const double f_x = forward_in_imu.dot(imu.values.row(k).segment<3>(3).transpose());
+    EXPECT_NEAR(b.values(k, 0), a.values(k, 0) * (1.0 + s * f_x), 1e-9) << k;
+    max_abs_f_x = std::max(max_abs_f_x, std::abs(f_x));
+  }
+  EXPECT_GT(max_abs_f_x, 0.5);  // the hills and the speed changes pull
+  EXPECT_LT((StreamOf(sim, "steering").values - StreamOf(*nominal_, "steering").values).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((imu.values - StreamOf(*nominal_, "imu").values).cwiseAbs().maxCoeff(), 1e-12);
+  ASSERT_EQ(sim.truth.effects.size(), 1u);
+  EXPECT_EQ(sim.truth.effects[0].parameters.at("slip_per_mps2"), s);
+}
+
+// The slope's part only: the reading over-reads by 1 + s g sin(pitch), pitch that of the true pose (O's x above the
+// horizontal) at the reading's instant.
+TEST_F(EffectsTest, SlopeSlipOverReadsTheRearWheelWithTheSlope) {
+  const double s = 0.05;  // [s^2/m]
+  const Simulation sim = Simulated(Drive({{"slope_slip", {{"slip_per_mps2", s}}}}));
+  const recording::Stream& a = StreamOf(*nominal_, "rear_wheel");
+  const recording::Stream& b = StreamOf(sim, "rear_wheel");
+  ASSERT_TRUE(sim.recording.ground_truth.has_value());
+  const Trajectory& poses = *sim.recording.ground_truth;
+  ASSERT_EQ(a.values.rows(), b.values.rows());
+  ASSERT_EQ(poses.size(), static_cast<std::size_t>(a.values.rows()));
+  double max_abs_sin = 0.0;
+  for (Eigen::Index k = 0; k < a.values.rows(); ++k) {
+    const auto& pose = poses[static_cast<std::size_t>(k)];
+    ASSERT_EQ(pose.t, a.t[static_cast<std::size_t>(k)]);
+    const double sin_pitch = (pose.q_world_body * Eigen::Vector3d::UnitX()).z();
+    EXPECT_NEAR(b.values(k, 0), a.values(k, 0) * (1.0 + s * 9.80665 * sin_pitch), 1e-9) << k;
+    max_abs_sin = std::max(max_abs_sin, std::abs(sin_pitch));
+  }
+  EXPECT_GT(max_abs_sin, 0.03);  // the hills
+}
+
 TEST(EffectsValidationTest, UnknownNamesParametersAndRangesAreErrors) {
   const auto problem = [](const std::vector<EffectOptions>& effects) {
     Scenario s = testing::AtvHills(1.0);
@@ -309,6 +357,11 @@ TEST(EffectsValidationTest, UnknownNamesParametersAndRangesAreErrors) {
             std::string::npos);
   EXPECT_NE(problem({{"tire_growth", {{"growth_per_mps2", 0.02}}}}).find("growth_per_mps2: must be in [0, 0.01]"),
             std::string::npos);
+  EXPECT_EQ(problem({{"longitudinal_slip", {{"slip_per_mps2", -0.01}}}}),
+            "effects[0].parameters.slip_per_mps2: must be in [0, 0.2] s^2/m");
+  EXPECT_EQ(problem({{"slope_slip", {{"slip_per_mps2", 0.3}}}}),
+            "effects[0].parameters.slip_per_mps2: must be in [0, 0.2] s^2/m");
+  EXPECT_EQ(problem({{"slope_slip", {{"slip_per_mps2", 0.05}}}}), "");
   Scenario no_gps = testing::AtvHills(1.0);
   no_gps.sensors.gps.reset();
   no_gps.effects = {{"gps_multipath", {{"sigma_m", 1.0}}}};

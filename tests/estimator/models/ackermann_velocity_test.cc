@@ -36,7 +36,8 @@ TEST(AckermannVelocityErrorTest, ZeroAtTruthForTableIAndSkewedGains) {
     const double z_theta = (delta - k_gamma) / k_theta;
     const auto factor = MakeFactor(AckermannVelocityError(z_v, z_theta, kL, dt));
     const auto lin = testing::Evaluate(*factor, {pose0, Step(pose0, v, omega, dt), Scalar(kv_over_l), Scalar(k_theta),
-                                                 Scalar(k_gamma), Scalar(0.0), Scalar(0.0), Scalar(0.0)});
+                                                 Scalar(k_gamma), Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0),
+                                                 Scalar(0.0)});
     EXPECT_LT(lin.error.norm(), 1e-10);
     EXPECT_TRUE(lin.noise_jacobian.isApprox(Eigen::MatrixXd::Identity(4, 4)));
   }
@@ -47,7 +48,8 @@ TEST(AckermannVelocityErrorTest, SpeedErrorScalesWithGain) {
   const Eigen::VectorXd pose0 = Manifold::Pose().Identity();
   const auto factor = MakeFactor(AckermannVelocityError(4.0 / kL / 0.8, 0.0, kL, 0.01));
   const auto lin = testing::Evaluate(*factor, {pose0, Step(pose0, 4.0, 0.0, 0.01), Scalar(0.88), Scalar(1.0),
-                                               Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0)});
+                                               Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0),
+                                               Scalar(0.0)});
   EXPECT_NEAR(lin.error[0], 4.0 / kL / 0.88 - 4.0 / kL / 0.8, 1e-12);
 }
 
@@ -55,7 +57,7 @@ TEST(AckermannVelocityErrorTest, SteeringIgnoredAtStandstill) {
   const Eigen::VectorXd pose0 = Manifold::Pose().Identity();
   const auto factor = MakeFactor(AckermannVelocityError(0.0, 0.3, kL, 0.01));
   const auto lin = testing::Evaluate(*factor, {pose0, pose0, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
-                                               Scalar(0.0), Scalar(0.0)});
+                                               Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0)});
   EXPECT_LT(lin.error.norm(), 1e-12);
 }
 
@@ -69,11 +71,11 @@ TEST(AckermannVelocityErrorTest, CorneringComplianceExplainsSideSlipAndUnderstee
   const Eigen::VectorXd pose1 = Step(pose0, v, omega, dt, v_y);
   const auto factor = MakeFactor(AckermannVelocityError(v / kL / 0.8, delta, kL, dt));
   const auto lin = testing::Evaluate(*factor, {pose0, pose1, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(c_front),
-                                               Scalar(c_rear), Scalar(0.0)});
+                                               Scalar(c_rear), Scalar(0.0), Scalar(0.0), Scalar(0.0)});
   EXPECT_LT(lin.error.norm(), 1e-10) << lin.error.transpose();
   // Without the compliances the same motion leaves the side slip and the understeer as errors.
   const auto rigid = testing::Evaluate(*factor, {pose0, pose1, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
-                                                 Scalar(0.0), Scalar(0.0)});
+                                                 Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0)});
   EXPECT_NEAR(rigid.error[1], -c_front * a_y, 1e-9);
   EXPECT_NEAR(rigid.error[2], v_y, 1e-9);
 }
@@ -87,12 +89,12 @@ TEST(AckermannVelocityErrorTest, ThrustAngleExplainsCrabAndTurnAtZeroHandlebar) 
   const Eigen::VectorXd pose1 = Step(pose0, v, omega, dt, v_y);
   const auto factor = MakeFactor(AckermannVelocityError(v / std::cos(alpha) / kL / 0.8, 0.0, kL, dt));
   const auto lin = testing::Evaluate(*factor, {pose0, pose1, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
-                                               Scalar(0.0), Scalar(alpha)});
+                                               Scalar(0.0), Scalar(alpha), Scalar(0.0), Scalar(0.0)});
   EXPECT_LT(lin.error.norm(), 1e-10) << lin.error.transpose();
   // Without it the crab is a lateral error of v tan(alpha); the front axle still moves straight ahead, so the
   // steering row holds.
   const auto aligned = testing::Evaluate(*factor, {pose0, pose1, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
-                                                   Scalar(0.0), Scalar(0.0)});
+                                                   Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0)});
   EXPECT_NEAR(aligned.error[2], v_y, 1e-9);
   EXPECT_LT(std::abs(aligned.error[1]), 1e-9);
   EXPECT_NEAR(aligned.error[0], v - v / std::cos(alpha), 1e-9);
@@ -109,8 +111,8 @@ TEST(AckermannVelocityErrorTest, ContactBelowOExplainsPitchAndRollRates) {
   Eigen::VectorXd pose1(7);
   PoseToArray(PredictPose<double>(PoseFromArray(pose0.data()), v_odom, omega, dt), pose1.data());
   const double delta = std::atan(kL * omega.z() / v);
-  const std::vector<Eigen::VectorXd> values = {pose0,       pose1,       Scalar(0.8), Scalar(1.0),
-                                               Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0)};
+  const std::vector<Eigen::VectorXd> values = {pose0,       pose1,       Scalar(0.8), Scalar(1.0), Scalar(0.0),
+                                               Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0)};
   const auto contact = MakeFactor(AckermannVelocityError(v / kL / 0.8, delta, kL, dt, {h, d}));
   const auto lin = testing::Evaluate(*contact, values);
   EXPECT_LT(lin.error.norm(), 1e-9) << lin.error.transpose();
@@ -122,18 +124,44 @@ TEST(AckermannVelocityErrorTest, ContactBelowOExplainsPitchAndRollRates) {
   EXPECT_NEAR(at_o.error[3], d * omega.y(), 1e-9);
 }
 
+TEST(AckermannVelocityErrorTest, LongitudinalSlipFollowsTractionAndSlope) {
+  // Climbing a 10 % grade (pitch atan(0.1), nose up) at 4 m/s while accelerating at 0.5 m/s^2: the forward specific
+  // force is f_x = 0.5 + g sin(pitch); the rear wheel over-reads by 1 + s_f f_x + s_p g sin(pitch).
+  const double v = 4.0, dt = 0.01, pitch = std::atan(0.1), s_f = 0.03, s_p = 0.05;
+  const double g_sin = kStandardGravity * std::sin(pitch), f_x = 0.5 + g_sin;
+  Eigen::VectorXd pose0 = Manifold::Pose().Identity();
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(-pitch, Eigen::Vector3d::UnitY()));  // about y: nose up is negative
+  pose0.segment<4>(3) << q.w(), q.x(), q.y(), q.z();
+  const Eigen::VectorXd pose1 = Step(pose0, v, 0.0, dt);
+  const double z_v = v * (1.0 + s_f * f_x + s_p * g_sin) / kL / 0.8;
+  const auto factor = MakeFactor(AckermannVelocityError(z_v, 0.0, kL, dt, {}, f_x));
+  const auto lin = testing::Evaluate(*factor, {pose0, pose1, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
+                                               Scalar(0.0), Scalar(0.0), Scalar(s_f), Scalar(s_p)});
+  EXPECT_LT(lin.error.norm(), 1e-10) << lin.error.transpose();
+  // Without the slip the reading is too high by v (s_f f_x + s_p g sin(pitch)); on the flat (the same step at zero
+  // pitch) only the traction's part is left for s_f to explain.
+  const auto rigid = testing::Evaluate(*factor, {pose0, pose1, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
+                                                 Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0)});
+  EXPECT_NEAR(rigid.error[0], -v * (s_f * f_x + s_p * g_sin) / kL / 0.8, 1e-9);
+  const Eigen::VectorXd flat0 = Manifold::Pose().Identity();
+  const auto flat = testing::Evaluate(*factor, {flat0, Step(flat0, v, 0.0, dt), Scalar(0.8), Scalar(1.0),
+                                                Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(s_f),
+                                                Scalar(s_p)});
+  EXPECT_NEAR(flat.error[0], -v * s_p * g_sin / kL / 0.8, 1e-9);
+}
+
 TEST(AckermannVelocityErrorTest, JacobiansMatchCentralDifferences) {
   std::mt19937 rng(12);
   for (int trial = 0; trial < 5; ++trial) {
     const Eigen::VectorXd pose0 = testing::RandomPoint(Manifold::Pose(), &rng, 10.0);
     const Eigen::VectorXd pose1 = testing::Perturb(Manifold::Pose(), Step(pose0, 3.0 + trial, 0.2, 0.02), 0.002, &rng);
-    // Eq. 15 at O, and with the rows at a contact below O (h, d nonzero: the rates enter every row).
+    // Eq. 15 at O, and with the rows at a contact below O (h, d nonzero: the rates enter every row); with slip.
     for (const AckermannVelocityError::Contact contact : {AckermannVelocityError::Contact{},
                                                           AckermannVelocityError::Contact{0.28, 0.625}}) {
-      const auto factor = MakeFactor(AckermannVelocityError(4.0, 0.1, kL, 0.02, contact));
+      const auto factor = MakeFactor(AckermannVelocityError(4.0, 0.1, kL, 0.02, contact, 0.7 - 0.4 * trial));
       testing::ExpectJacobiansMatchNumeric(
           *factor, {pose0, pose1, Scalar(0.78), Scalar(1.02), Scalar(0.01), Scalar(0.004), Scalar(-0.015),
-                      Scalar(0.02)},
+                      Scalar(0.02), Scalar(0.03), Scalar(0.05)},
           1e-5);
     }
   }

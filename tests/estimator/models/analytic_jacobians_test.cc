@@ -258,11 +258,16 @@ TEST(AnalyticJacobiansTest, AckermannVelocity) {
     const double k_gamma = 0.02 * normal(rng);
     const double c_front = 0.003 * normal(rng), c_rear = 0.015 * normal(rng);  // [rad s^2/m], [s]
     const double alpha = 0.03 * normal(rng);                                     // [rad]
+    const double s_f = 0.03 * normal(rng), s_p = 0.03 * normal(rng);            // [s^2/m]
+    const double f_x = normal(rng);                                             // [m/s^2]
     const double z_v = v_body.x() / (kv_over_l * kWheelbase) + 0.03 * normal(rng);
     const double z_theta = 0.2 * normal(rng);
-    ExpectAnalyticMatchesJets(AckermannVelocityError(z_v, z_theta, kWheelbase, kDt),
+    // Every other point with the rows at a ground contact below O (options contact_height_m, pitch_lever_m).
+    const AckermannVelocityError::Contact contact =
+        point % 2 ? AckermannVelocityError::Contact{0.28, 0.625} : AckermannVelocityError::Contact{};
+    ExpectAnalyticMatchesJets(AckermannVelocityError(z_v, z_theta, kWheelbase, kDt, contact, f_x),
                               {pose_k, pose_k1, Scalar(kv_over_l), Scalar(k_theta), Scalar(k_gamma), Scalar(c_front),
-                               Scalar(c_rear), Scalar(alpha)},
+                               Scalar(c_rear), Scalar(alpha), Scalar(s_f), Scalar(s_p)},
                               "point " + std::to_string(point));
   }
 }
