@@ -34,6 +34,19 @@ struct Candidate {
   int free_dof = 0;                          // tangent dimension of `free`
 };
 
+// Makes `c` free the one scalar slot `parameter` of `stream`, reported as the simulator's `reported` =
+// scale (value - offset), its std scale std.
+void FreeOneSlot(const std::string& stream, const std::string& parameter, const std::string& reported, double scale,
+                 double offset, Candidate* c) {
+  c->stream = stream;
+  c->free = {parameter};
+  c->free_dof = 1;
+  c->describe = [parameter, reported, scale, offset](const auto& value, const auto& std, EffectEstimate* e) {
+    e->parameters[reported] = scale * (value.at(parameter)[0] - offset);
+    if (std.count(parameter)) e->std[reported] = std::abs(scale) * std.at(parameter)[0];
+  };
+}
+
 // How the fit treats the calibration parameters.
 enum class FitMode {
   kStaged,   // the configuration's stages from its initial values
@@ -211,14 +224,8 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
     } else if (name == "steering_offset" && !ackermann.empty()) {
       const std::string p = SlotParameter(ackermann, config.streams.at(ackermann), "k_gamma");
       if (is_free(p)) continue;
-      c.stream = ackermann;
-      c.free = {p};
-      c.free_dof = 1;
-      c.describe = [p, nominal = ConfiguredValue(config, p).value_or(Eigen::VectorXd::Zero(1))](
-                       const auto& value, const auto& std, EffectEstimate* e) {
-        e->parameters["offset_rad"] = value.at(p)[0] - nominal[0];
-        if (std.count(p)) e->std["offset_rad"] = std.at(p)[0];
-      };
+      FreeOneSlot(ackermann, p, "offset_rad", 1.0, ConfiguredValue(config, p).value_or(Eigen::VectorXd::Zero(1))[0],
+                  &c);
     } else if (name == "axle_misalignment" && !ackermann.empty()) {
       // The rear axle's thrust angle alpha (models/ackermann_velocity.h: the rear axle rolls along alpha, so the
       // vehicle crabs by alpha and turns at -v tan(alpha) / L at zero handlebar) freed from the nominal model's zero;
@@ -231,14 +238,7 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
       const std::string p = SlotParameter(ackermann, config.streams.at(ackermann), "thrust_angle");
       if (is_free(p) || gyro.empty() || is_free(SlotParameter(gyro, config.streams.at(gyro), "misalignment")))
         continue;
-      c.stream = ackermann;
-      c.free = {p};
-      c.free_dof = 1;
-      c.describe = [p](const auto& value, const auto& std, EffectEstimate* e) {
-        constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
-        e->parameters["yaw_deg"] = value.at(p)[0] * kDegPerRad;
-        if (std.count(p)) e->std["yaw_deg"] = std.at(p)[0] * kDegPerRad;
-      };
+      FreeOneSlot(ackermann, p, "yaw_deg", 180.0 / 3.14159265358979323846, 0.0, &c);
     } else if ((name == "gyro_scale_error" || name == "gyro_bias_drift") && !gyro.empty()) {
       // gyro_scale_error: the per-axis scale k_s (models/gyroscope.h: z = k_s o omega + b + eta) freed from 1,
       // reported as scale_x/y/z. gyro_bias_drift: the bias b [rad/s] freed from the nominal model's zero as one
@@ -266,13 +266,7 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
       const std::string p = SlotParameter(diff_drive, sc, "right_left_ratio");
       if (is_free(p) || SlotParameter(diff_drive, sc, "radius_left") != SlotParameter(diff_drive, sc, "radius_right"))
         continue;
-      c.stream = diff_drive;
-      c.free = {p};
-      c.free_dof = 1;
-      c.describe = [p](const auto& value, const auto& std, EffectEstimate* e) {
-        e->parameters["ratio_right_left"] = value.at(p)[0];
-        if (std.count(p)) e->std["ratio_right_left"] = std.at(p)[0];
-      };
+      FreeOneSlot(diff_drive, p, "ratio_right_left", 1.0, 0.0, &c);
     } else if (name == "wheel_deformation" && !diff_drive.empty()) {
       // Tires that are not round: both wheels' second harmonic of the rolling radius (a, b) freed from zero
       // (models/differential_drive.h). Reported as the simulator's effect: the wheel with the larger amplitude
@@ -300,13 +294,7 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
       const std::string p = SlotParameter(diff_drive, config.streams.at(diff_drive), "baseline");
       const std::optional<Eigen::VectorXd> nominal = ConfiguredValue(config, p);
       if (is_free(p) || !nominal || !std::isfinite((*nominal)[0])) continue;
-      c.stream = diff_drive;
-      c.free = {p};
-      c.free_dof = 1;
-      c.describe = [p, b0 = (*nominal)[0]](const auto& value, const auto& std, EffectEstimate* e) {
-        e->parameters["track_error_m"] = value.at(p)[0] - b0;
-        if (std.count(p)) e->std["track_error_m"] = std.at(p)[0];
-      };
+      FreeOneSlot(diff_drive, p, "track_error_m", 1.0, (*nominal)[0], &c);
     } else if (name == "track_width_error" && !mecanum.empty()) {
       // The mecanum wheels' yaw lever arm K = lx + ly (models/mecanum_drive.h) freed from the nominal geometry. The
       // simulator's effect moves the wheels apart along O's y by track_error_m, half on each side: ly, hence K,
@@ -317,13 +305,7 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
       const std::string p = SlotParameter(mecanum, config.streams.at(mecanum), "lx_plus_ly");
       const std::optional<Eigen::VectorXd> nominal = ConfiguredValue(config, p);
       if (is_free(p) || !nominal || !std::isfinite((*nominal)[0])) continue;
-      c.stream = mecanum;
-      c.free = {p};
-      c.free_dof = 1;
-      c.describe = [p, k0 = (*nominal)[0]](const auto& value, const auto& std, EffectEstimate* e) {
-        e->parameters["track_error_m"] = 2.0 * (value.at(p)[0] - k0);
-        if (std.count(p)) e->std["track_error_m"] = 2.0 * std.at(p)[0];
-      };
+      FreeOneSlot(mecanum, p, "track_error_m", 2.0, (*nominal)[0], &c);
     } else if (name == "lateral_slip" && !ackermann.empty()) {
       const std::string front = SlotParameter(ackermann, config.streams.at(ackermann), "cornering_front");
       const std::string rear = SlotParameter(ackermann, config.streams.at(ackermann), "cornering_rear");
@@ -348,13 +330,7 @@ std::vector<Candidate> Library(const EstimatorConfig& config) {
       const std::string p = SlotParameter(ackermann, config.streams.at(ackermann),
                                           name == "slope_slip" ? "slope_slip_per_mps2" : "slip_per_mps2");
       if (is_free(p)) continue;
-      c.stream = ackermann;
-      c.free = {p};
-      c.free_dof = 1;
-      c.describe = [p](const auto& value, const auto& std, EffectEstimate* e) {
-        e->parameters["slip_per_mps2"] = value.at(p)[0];
-        if (std.count(p)) e->std["slip_per_mps2"] = std.at(p)[0];
-      };
+      FreeOneSlot(ackermann, p, "slip_per_mps2", 1.0, 0.0, &c);
     } else if (name == "magnetometer_motor_interference" && !magnetometer.empty()) {
       // The magnetometer's bias per N m of drive torque k (models/magnetometer.h) freed from zero, on the proxy
       // tau_hat = c f_x (forward specific force, c = m r / 2 from the nominal vehicle): reported as the simulator's

@@ -31,7 +31,9 @@ std::string Source(const std::string& name) { return std::string(ROAMLAB_SOURCE_
 
 // The ATV tracking configuration with the synthetic drive's calibration (seed Table I, tests/support/synthetic.h)
 // and a noise value replaced: tracking with known parameters (no calibration prior), whose consistency then depends
-// on the noise levels.
+// on the noise levels. The synthetic drive is eq. 15's rigid vehicle: the MuJoCo ATV's measured physics (rows at the
+// ground contact, cornering compliance, the model residual in the odometer's noise) is replaced by none, and the
+// odometer's noise by the generator's sensor noise.
 std::string TrackingConfig(const std::string& from, const std::string& to) {
   std::string text = testing::ReadFile(Source("atv_tracking.yaml"));
   const std::pair<std::string, std::string> replacements[] = {
@@ -41,6 +43,11 @@ std::string TrackingConfig(const std::string& from, const std::string& to) {
       {"magnetometer.A: {value: [1, 0, 0, 0, 1, 0, 0, 0, 1]}",
        "magnetometer.A: {value: [0.87, -0.02, -0.02, 0.0, 0.88, 0.0, -0.02, -0.04, 0.85]}"},
       {"magnetometer.b: {value: [0, 0, 0]}", "magnetometer.b: {value: [-0.008, -0.007, -0.040]}"},
+      {"odometer.cornering_front: {value: 0.0047}", "odometer.cornering_front: {value: 0.0}"},
+      {"odometer.cornering_rear: {value: 0.0207}", "odometer.cornering_rear: {value: 0.0}"},
+      {"options: {contact_height_m: 0.28, pitch_lever_m: 0.625}", "options: {contact_height_m: 0, pitch_lever_m: 0}"},
+      {"noise: {speed_mps: 0.064, steering_rad: 0.032, lateral_mps: 0.025, vertical_mps: 0.36}",
+       "noise: {speed_mps: 0.033, steering_rad: 0.014, lateral_mps: 0.02, vertical_mps: 0.1}"},
       {from, to}};
   for (const auto& [a, b] : replacements) {
     const std::size_t at = text.find(a);
