@@ -76,14 +76,17 @@ TEST(ProblemBuilderTest, RejectsConfigurationThatDoesNotFitTheRecording) {
   EXPECT_NE(builder.status().message().find("cannot read"), std::string::npos) << builder.status().message();
 }
 
+// "accepted" when the builder takes the configuration, else its error message.
+std::string BuildOutcome(const EstimatorConfig& config, const recording::Recording& recording) {
+  auto builder = ProblemBuilder::Create(config, recording);
+  return builder.ok() ? std::string("accepted") : builder.status().message();
+}
+
 // The magnetometer's specific-force input must be an IMU or accelerometer stream of the recording, with the torque
 // factor c; c alone is refused too.
 TEST(ProblemBuilderTest, MagnetometerSpecificForceInputIsChecked) {
   const auto synthetic = ShortDrive();
-  const auto message = [&](const EstimatorConfig& config) {
-    auto builder = ProblemBuilder::Create(config, synthetic.recording);
-    return builder.ok() ? std::string("accepted") : builder.status().message();
-  };
+  const auto message = [&](const EstimatorConfig& config) { return BuildOutcome(config, synthetic.recording); };
   EstimatorConfig config = testing::AtvConfig({});
   StreamConfig& mag = config.streams["magnetometer"];
   mag.inputs["specific_force"] = "imu";
@@ -103,10 +106,7 @@ TEST(ProblemBuilderTest, MagnetometerSpecificForceInputIsChecked) {
 // accelerometer's frame, and that axis needs the input.
 TEST(ProblemBuilderTest, AckermannSpecificForceInputIsChecked) {
   const auto synthetic = ShortDrive();
-  const auto message = [&](const EstimatorConfig& config) {
-    auto builder = ProblemBuilder::Create(config, synthetic.recording);
-    return builder.ok() ? std::string("accepted") : builder.status().message();
-  };
+  const auto message = [&](const EstimatorConfig& config) { return BuildOutcome(config, synthetic.recording); };
   EstimatorConfig config = testing::AtvConfig({});
   StreamConfig* odo = nullptr;
   for (auto& [name, sc] : config.streams)
