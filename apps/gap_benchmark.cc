@@ -33,7 +33,6 @@ using gapbench::Thresholds;
 
 constexpr std::uint64_t kBaselineSeed = 900001;
 constexpr int kMaxCases = 500;                 // per phase: the calibration seeds start 500 after the scored ones
-constexpr double kMaxFalseRate = 0.10;         // the false-discovery target, imposed on the calibration
 
 struct Platform {
   std::string name;                            // atv | diffdrive | mecanum
@@ -417,7 +416,10 @@ int RunGapBenchmark(const GapBenchmarkArgs& args) {
     return 1;
   }
   json grid;
-  const Thresholds chosen = gapbench::ChooseThresholds(calibration.value(), kMaxFalseRate, &grid);
+  // The targets on the effect-free cases, imposed on the calibration with the score's rule.
+  const double max_decoy_false_rate = 1.0 - gapbench::kMinDecoysUnknown;
+  const Thresholds chosen =
+      gapbench::ChooseThresholds(calibration.value(), gapbench::kMaxNoneFalseRate, max_decoy_false_rate, &grid);
   const auto sigmas = gapbench::CalibrationSigmas(calibration.value());
   json calibration_rows = json::array();
   for (CaseResult& c : calibration.value()) {
@@ -465,7 +467,8 @@ int RunGapBenchmark(const GapBenchmarkArgs& args) {
       {"calibration",
        {{"cases", calibration_rows},
         {"draw_and_noise_seed_base", calibration_seed},
-        {"max_false_rate", kMaxFalseRate},
+        {"max_none_false_rate", gapbench::kMaxNoneFalseRate},
+        {"max_decoy_false_rate", max_decoy_false_rate},
         {"grid", grid},
         {"noise_sigmas", sigma_json}}},
       {"cases", rows},

@@ -2,9 +2,11 @@
 //
 //   - ReplayFirstRound: the diagnosis's first-round decision (gap/diagnose.h, step 3) under other thresholds, from the
 //     candidates' statistics of a run with looser ones (held-out evaluated for every candidate passing them);
+//   - Identified / FalseDiscovery: the one rule that judges a case from the effects kept, used by both the
+//     calibration's replay and the score;
 //   - ChooseThresholds: the thresholds (alpha, Delta BIC, held-out drop) fixed on the calibration cases only: the
-//     grid point that identifies the most calibration cases correctly with false discoveries on the effect-free
-//     cases (none and decoys) at or under the target;
+//     grid point that identifies the most calibration cases correctly with false discoveries on the none cases and
+//     on the decoys at or under the targets;
 //   - CalibrationSigmas / NoiseRatio: the noise of an effect's parameter is the median standard deviation the
 //     diagnosis reports for that candidate's parameter over the calibration cases of the platform (every case fits
 //     every candidate); an effect's magnitude relative to the noise is |theta - neutral| / that sigma;
@@ -56,6 +58,11 @@ struct CaseResult {
   double seconds = 0.0;
 };
 
+// The targets on the effect-free cases: false discoveries on none cases <= 10 %, decoys reported `unknown` (and
+// nothing kept) >= 70 %, i.e. at most 30 % of the decoys with a library effect kept.
+constexpr double kMaxNoneFalseRate = 0.10;
+constexpr double kMinDecoysUnknown = 0.70;
+
 // Neutral value of an effect parameter (what the nominal model assumes).
 double NeutralValue(const std::string& parameter);
 
@@ -63,8 +70,18 @@ double NeutralValue(const std::string& parameter);
 // passes p and BIC but was not evaluated on the held-out part counts as failing it.
 std::string ReplayFirstRound(std::vector<CandidateStats> candidates, const Thresholds& t);
 
-// Whether a case is scored correct under a first-round decision: none and decoy cases name nothing, effect cases
-// name their effect first.
+// The one rule for a case, from the first effect the diagnosis kept (empty: none kept), shared by the calibration's
+// replay and the score. The verdict is not part of it (the replay cannot know it):
+//   - an effect case is identified when its effect is the first kept, also beside a verdict `unknown` (the user gets
+//     the right effect and a warning that more structure remains);
+//   - an effect-free case (none, decoy) is a false discovery when any library effect is kept, also beside a verdict
+//     `unknown`: the user would still apply a scenario patch with a wrong effect.
+bool Identified(const CaseResult& c, const std::string& first_kept);
+bool FalseDiscovery(const CaseResult& c, const std::string& first_kept);
+// The first effect a scored case kept (empty: none).
+std::string FirstKept(const CaseResult& c);
+
+// Whether a case is correct under a first-round decision: effect cases identified, the others no false discovery.
 bool ReplayCorrect(const CaseResult& c, const std::string& kept);
 
 // The grid searched by ChooseThresholds (each point at least as strict as `Loosest()`).
@@ -72,10 +89,11 @@ std::vector<Thresholds> ThresholdGrid();
 Thresholds Loosest();
 
 // Thresholds from calibration cases: the grid point with the most correct replays among those whose false-discovery
-// rate on the effect-free cases (none and decoy: anything named) is <= max_false_rate (all points when none is);
-// ties go to the strictest. `table` (optional) receives every grid point's counts.
-Thresholds ChooseThresholds(const std::vector<CaseResult>& calibration, double max_false_rate,
-                            nlohmann::json* table = nullptr);
+// rate is <= max_none_false_rate on the none cases and <= max_decoy_false_rate on the decoys (all points when none
+// is); ties go to the point nearest diagnose's defaults, then the strictest. `table` (optional) receives every grid
+// point's counts.
+Thresholds ChooseThresholds(const std::vector<CaseResult>& calibration, double max_none_false_rate,
+                            double max_decoy_false_rate, nlohmann::json* table = nullptr);
 
 // platform -> "effect/parameter" -> median reported std over the calibration cases (NaN and non-positive skipped).
 std::map<std::string, std::map<std::string, double>> CalibrationSigmas(const std::vector<CaseResult>& calibration);

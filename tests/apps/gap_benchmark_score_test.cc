@@ -45,7 +45,7 @@ TEST(GapBenchmarkScore, ChoosesTheThresholdsThatKeepFalseDiscoveriesDown) {
       Case("decoy", "m", {Candidate("a", 0.01, -1.0, -0.02), Candidate("b", 0.6, 6.0, 0.0, false)}),
   };
   nlohmann::json table;
-  const Thresholds t = ChooseThresholds(calibration, 0.10, &table);
+  const Thresholds t = ChooseThresholds(calibration, 0.10, 0.30, &table);
   EXPECT_DOUBLE_EQ(t.alpha, 1e-3);
   EXPECT_DOUBLE_EQ(t.max_delta_bic, 0.0);
   EXPECT_DOUBLE_EQ(t.min_heldout_improvement, 0.01);
@@ -53,10 +53,58 @@ TEST(GapBenchmarkScore, ChoosesTheThresholdsThatKeepFalseDiscoveriesDown) {
   for (const CaseResult& c : calibration) EXPECT_TRUE(ReplayCorrect(c, ReplayFirstRound(c.candidates, t)));
   // Without the spurious candidate the defaults are kept (ties go to the point nearest to them).
   calibration[2].candidates[0].lr_pvalue = 0.5;
-  const Thresholds d = ChooseThresholds(calibration, 0.10);
+  const Thresholds d = ChooseThresholds(calibration, 0.10, 0.30);
   EXPECT_DOUBLE_EQ(d.alpha, 1e-3);
   EXPECT_DOUBLE_EQ(d.max_delta_bic, 0.0);
   EXPECT_DOUBLE_EQ(d.min_heldout_improvement, 0.0);
+  // A decoy whose first round keeps a library effect is a false discovery too (the score's rule): with its spurious
+  // candidate passing the defaults but not a 1 % held-out drop, the defaults are infeasible (1 of 1 decoys > 30 %).
+  const auto defaults_feasible = [](const nlohmann::json& grid) {
+    for (const nlohmann::json& p : grid)
+      if (p["alpha"] == 1e-3 && p["max_delta_bic"] == 0.0 && p["min_heldout_improvement"] == 0.0)
+        return p["feasible"].get<bool>();
+    return false;
+  };
+  calibration[3].candidates[0] = Candidate("a", 1e-5, -15.0, 0.005);
+  const Thresholds s = ChooseThresholds(calibration, 0.10, 0.30, &table);
+  EXPECT_DOUBLE_EQ(s.min_heldout_improvement, 0.01);
+  EXPECT_FALSE(defaults_feasible(table));
+  // Within the decoys' allowance (1 of 4 = 25 % <= 30 %) the defaults are feasible (the 1 % point, which names
+  // nothing on any decoy, still identifies more cases).
+  for (int i = 0; i < 3; ++i) calibration.push_back(Case("decoy", "m", {Candidate("b", 0.6, 6.0, 0.0, false)}));
+  ChooseThresholds(calibration, 0.10, 0.30, &table);
+  EXPECT_TRUE(defaults_feasible(table));
+}
+
+TEST(GapBenchmarkScore, CalibrationAndScoreJudgeByOneRule) {
+  // A decoy and a none case reported `unknown` beside a kept library effect are false discoveries; an effect case
+  // whose effect is kept first beside a verdict `unknown` is identified. The replay and the score agree on each.
+  CaseResult decoy = Case("decoy", "accelerometer_scale_error", {});
+  decoy.verdict = "unknown";
+  decoy.named = {"slope_slip"};
+  CaseResult none = Case("none", "", {});
+  none.verdict = "unknown";
+  none.named = {"gyro_bias_drift"};
+  CaseResult effect = Case("effect", "steering_offset", {});
+  effect.verdict = "unknown";
+  effect.named = {"steering_offset"};
+  effect.ranked = effect.named;
+  effect.noise_ratio = 5.0;
+  EXPECT_TRUE(FalseDiscovery(decoy, FirstKept(decoy)));
+  EXPECT_TRUE(FalseDiscovery(none, FirstKept(none)));
+  EXPECT_FALSE(FalseDiscovery(effect, FirstKept(effect)));
+  EXPECT_TRUE(Identified(effect, FirstKept(effect)));
+  EXPECT_FALSE(ReplayCorrect(decoy, FirstKept(decoy)));
+  EXPECT_FALSE(ReplayCorrect(none, FirstKept(none)));
+  EXPECT_TRUE(ReplayCorrect(effect, FirstKept(effect)));
+  EXPECT_TRUE(ReplayCorrect(decoy, ""));
+  const nlohmann::json f = Summarize({decoy, none, effect});
+  EXPECT_DOUBLE_EQ(f["false_discovery_rate"].get<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(f["decoy_false_discovery_rate"].get<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(f["decoys_unknown"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(f["decoys_unknown_effect_kept_or_not"].get<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(f["top1_strong"].get<double>(), 1.0);
+  EXPECT_EQ(f["top1_with_verdict_unknown"], 1);
 }
 
 TEST(GapBenchmarkScore, NoiseRatioUsesTheMedianReportedStd) {
@@ -128,7 +176,7 @@ TEST(GapBenchmarkScore, SummarizesTheIssuesFigures) {
   EXPECT_DOUBLE_EQ(f["false_discovery_rate"].get<double>(), 0.25);
   EXPECT_DOUBLE_EQ(f["none_reported_none"].get<double>(), 0.5);
   EXPECT_NEAR(f["decoys_unknown"].get<double>(), 1.0 / 3.0, 1e-12);
-  EXPECT_NEAR(f["decoys_not_named"].get<double>(), 2.0 / 3.0, 1e-12);
+  EXPECT_NEAR(f["decoy_false_discovery_rate"].get<double>(), 1.0 / 3.0, 1e-12);
   EXPECT_NEAR(f["median_parameter_relative_error"].get<double>(), 0.1, 1e-9);
   EXPECT_DOUBLE_EQ(f["median_heldout_rms_reduction"].get<double>(), 0.5);                  // top-1 cases only
   EXPECT_NEAR(f["median_heldout_rms_reduction_all_effect_cases"].get<double>(), 0.275, 1e-12);
