@@ -108,6 +108,7 @@ Result<AckermannVehicle> AckermannVehicle::Bind(const mjModel* model, const std:
     tires[i] = IdOf(model, mjOBJ_GEOM, kTireGeoms[i]);
     if (tires[i] < 0 || (model->geom_type[tires[i]] != mjGEOM_SPHERE && model->geom_type[tires[i]] != mjGEOM_CYLINDER))
       return Missing(what, std::string("a sphere or cylinder geom '") + kTireGeoms[i] + "'");
+    v.tire_geoms_[i] = tires[i];
   }
   v.wheel_radius_m_ = 0.5 * (model->geom_size[3 * tires[kRearLeft]] + model->geom_size[3 * tires[kRearRight]]);
 
@@ -208,6 +209,17 @@ void AckermannVehicle::TurnRearAxle(mjModel* model, double yaw_rad) const {
     q[2] = turned.y();
     q[3] = turned.z();
   }
+}
+
+Status AckermannVehicle::SoftenTires(mjModel* model, double scale, const std::string& what) const {
+  for (int i = 0; i < 4; ++i) {
+    mjtNum* solref = model->geom_solref + mjNREF * tire_geoms_[i];
+    if (!(solref[0] > 0.0))
+      return Status::Error(what + ": lateral_slip needs the tire '" + kTireGeoms[i] +
+                           "' to give solref as a time constant (solref[0] > 0)");
+    solref[0] *= scale;
+  }
+  return Status::Ok();
 }
 
 void AckermannVehicle::Apply(double handlebar_rad, double torque_per_wheel_nm, mjData* data) const {

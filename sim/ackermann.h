@@ -76,6 +76,12 @@ class AckermannVehicle {
   // directions, point yaw_rad off O's x (a thrust angle). Changes the compiled model only: the geometry measured by
   // Bind (tire centres) is unchanged, and the driver's steering stays nominal.
   void TurnRearAxle(mjModel* model, double yaw_rad) const;
+  // Softer tires (the scenario's lateral_slip effect): the four tires' contact time constant (MuJoCo's solref[0], the
+  // ground geom takes the robot's softness) times `scale`. MuJoCo's soft contact lets a tangential force through by a
+  // slip velocity proportional to it and to the time constant, so the cornering compliance grows with `scale` (on the
+  // ATV about linearly, README); the vertical contact softens too (a lower tire pressure). Changes the compiled model
+  // only. Fails, naming `what`, when a tire's solref is not in the time-constant form (solref[0] <= 0).
+  Status SoftenTires(mjModel* model, double scale, const std::string& what) const;
   // Steering servo targets for the handlebar angle (clamped to +-max_handlebar_rad) and the drive torque per rear wheel.
   void Apply(double handlebar_rad, double torque_per_wheel_nm, mjData* data) const;
   // Mean rear-wheel spin rate relative to the chassis [rad/s], positive forward.
@@ -96,6 +102,7 @@ class AckermannVehicle {
   double max_handlebar_rad_ = 0.0;
   // Tire centres in O at qpos0 (front left, front right, rear left, rear right) and O in the root body's frame.
   double tire_in_odom_[4][3] = {};
+  int tire_geoms_[4] = {-1, -1, -1, -1};   // front left, front right, rear left, rear right
   double odom_in_root_pos_[3] = {};
   double odom_in_root_quat_[4] = {1, 0, 0, 0};
 };

@@ -493,6 +493,7 @@ const std::map<std::string, std::map<std::string, double>>& KnownEffects() {
       {"tire_growth", {{"growth_per_mps2", 0.0}}},
       {"longitudinal_slip", {{"slip_per_mps2", 0.0}}},
       {"slope_slip", {{"slip_per_mps2", 0.0}}},
+      {"lateral_slip", {{"contact_time_scale", 1.0}}},
       {"wheel_radius_asymmetry", {{"ratio_right_left", 1.0}}},
       {"track_width_error", {{"track_error_m", 0.0}}},
       {"wheel_deformation", {{"wheel", 0.0}, {"ovality_m", 0.0}}},
@@ -709,6 +710,11 @@ std::optional<Scenario::Problem> Scenario::Validate() const {
       if (!sensors.odometer) return P{k + ".name", e.name + " needs sensors.odometer"};
       const double s = EffectParameter(effects, e.name, "slip_per_mps2", 0.0);
       if (!(s >= 0.0 && s <= 0.2)) return P{k + ".parameters.slip_per_mps2", "must be in [0, 0.2] s^2/m"};
+    }
+    if (e.name == "lateral_slip") {
+      if (!ackermann) return P{k + ".name", "lateral_slip is implemented for ackermann robots only"};
+      const double scale = EffectParameter(effects, e.name, "contact_time_scale", 1.0);
+      if (!(scale >= 1.0 && scale <= 4.0)) return P{k + ".parameters.contact_time_scale", "must be in [1, 4]"};
     }
     if (e.name == "steering_offset" && !sensors.odometer)
       return P{k + ".name", "steering_offset needs sensors.odometer"};

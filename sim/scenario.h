@@ -82,6 +82,15 @@
 //                                          sin(pitch), pitch O's forward axis above the horizontal, s in [0, 0.2]
 //                                          s^2/m (a soil that gives way under the tires on slopes; estimator:
 //                                          slope_slip_per_mps2)
+//   lateral_slip {contact_time_scale: 1}  ackermann: softer tires, in MuJoCo's contacts: the four tires' contact time
+//                                          constant (solref[0], 0.04 s in models/atv.xml) times contact_time_scale in
+//                                          [1, 4] (AckermannVehicle::SoftenTires). A soft contact carries a sideways
+//                                          force by a slip velocity proportional to it and to the time constant, so
+//                                          the cornering compliance grows about linearly: measured on the truth of
+//                                          atv_hills.yaml (v_y at the rear contact regressed on a_y), c_rear = 0.0207
+//                                          s at 1, 0.0409 at 2, 0.0816 at 4, i.e. +0.0203 (k - 1) s; the steering
+//                                          row's c_front +0.0045 (k - 1) rad s^2/m (README); the tires also sink
+//                                          more (vertical softness); the diagnosis's candidate is lateral_slip
 // Wheeled indoor robots (below); in the compiled MuJoCo model after the robot is bound, so that the recording's
 // platform geometry and the driver's inverse kinematics stay nominal; truth.yaml's odometer geometry is the true one:
 //   wheel_radius_asymmetry {ratio_right_left: 1}   differential_drive: the right tire's radius (wheel_1) times the

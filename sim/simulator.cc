@@ -187,6 +187,11 @@ class Simulator::Impl {
       if (HasEffect(scenario_, "axle_misalignment"))
         vehicle_.TurnRearAxle(model_.get(),
                               EffectParameter(scenario_.effects, "axle_misalignment", "yaw_deg", 0.0) * kPi / 180.0);
+      // Softer tires: the contact time constant, hence the cornering compliance, grows.
+      if (HasEffect(scenario_, "lateral_slip")) {
+        const double scale = EffectParameter(scenario_.effects, "lateral_slip", "contact_time_scale", 1.0);
+        if (Status st = vehicle_.SoftenTires(model_.get(), scale, model_where_); !st.ok()) return st;
+      }
       controller_.emplace(scenario_.robot.speed_controller);
       odom_site_ = vehicle_.odom_site();
     } else {

@@ -214,6 +214,30 @@ TEST(AxleMisalignmentTest, AtvRearAxleThrustAngleCrabsAndTurnsAtZeroHandlebar) {
   EXPECT_NEAR(crab.crab_rad, alpha, 0.1 * alpha);
 }
 
+TEST(LateralSlipTest, SofterTiresRaiseTheCorneringCompliance) {
+  // A steady turn on flat ground (4 m/s, handlebar 0.15 rad): the rear axle drifts outwards, v_y = -c_rear a_y with
+  // a_y = v omega_z (estimator/models/ackermann_velocity.h). Softer tires (contact time constant times k) let the
+  // sideways force through at a proportionally larger slip velocity (MuJoCo's soft contact), so c_rear grows about
+  // as k: measured 0.0202 s at k = 1, 0.0604 s at k = 3 (ratio 2.99; on the hills drive 0.0207 and 0.0614 s, README).
+  // The physics is deterministic (noise plays no part); the bounds check the proportionality, not a tolerance.
+  const auto compliance = [](double scale) {
+    Scenario s = testing::AtvHills(6.0);
+    s.terrain.type = TerrainOptions::Type::kFlat;
+    s.driver.speed_mps = Profile::Constant(4.0);
+    s.driver.handlebar_rad = Profile::Constant(0.15);
+    if (scale != 1.0) s.effects = {{"lateral_slip", {{"contact_time_scale", scale}}}};
+    const Crab turn = CrabOf(*Simulated(s).recording.ground_truth, 3.0);
+    const double a_y = turn.speed_mps * turn.yaw_rate_radps;
+    EXPECT_GT(a_y, 1.0);   // a real turn
+    return -turn.speed_mps * std::sin(turn.crab_rad) / a_y;
+  };
+  const double nominal = compliance(1.0), soft = compliance(3.0);
+  std::cout << "c_rear: nominal " << nominal << " s, contact time x3 " << soft << " s\n";
+  EXPECT_GT(nominal, 0.0);   // outwards
+  EXPECT_GT(soft / nominal, 2.5);
+  EXPECT_LT(soft / nominal, 3.5);
+}
+
 TEST_F(EffectsTest, AccelerometerScaleMultipliesEachAxisAndNothingElse) {
   const Simulation sim = Simulated(Drive({{"accelerometer_scale_error", {{"scale_y", 0.97}, {"scale_z", 1.04}}}}));
   const recording::Stream& a = StreamOf(*nominal_, "imu");
@@ -362,6 +386,9 @@ TEST(EffectsValidationTest, UnknownNamesParametersAndRangesAreErrors) {
   EXPECT_EQ(problem({{"slope_slip", {{"slip_per_mps2", 0.3}}}}),
             "effects[0].parameters.slip_per_mps2: must be in [0, 0.2] s^2/m");
   EXPECT_EQ(problem({{"slope_slip", {{"slip_per_mps2", 0.05}}}}), "");
+  EXPECT_EQ(problem({{"lateral_slip", {{"contact_time_scale", 0.5}}}}),
+            "effects[0].parameters.contact_time_scale: must be in [1, 4]");
+  EXPECT_EQ(problem({{"lateral_slip", {{"contact_time_scale", 2.0}}}}), "");
   Scenario no_gps = testing::AtvHills(1.0);
   no_gps.sensors.gps.reset();
   no_gps.effects = {{"gps_multipath", {{"sigma_m", 1.0}}}};
