@@ -9,14 +9,12 @@
 #include <functional>
 #include <iomanip>
 #include <iostream>
-#include <limits>
 #include <mutex>
 #include <random>
 #include <sstream>
 #include <thread>
 #include <tuple>
 
-#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
 #include "apps/gap_benchmark_score.h"
@@ -58,36 +56,6 @@ std::string AffectedStream(const std::string& effect) {
   if (effect == "imu_time_offset" || effect == "gyro_scale_error" || effect == "gyro_bias_drift") return "gyroscope";
   if (effect == "magnetometer_motor_interference") return "magnetometer";
   return "odometer";
-}
-
-// The rear axle's cornering compliance of a drive, measured on its truth (the size of a lateral_slip effect in the
-// diagnosis candidate's units, as scripts/atv_odometer_residuals.py measures it): O's sideways velocity regressed on
-// the lateral acceleration a_y = v_x omega_z and on the roll rate (which moves O sideways over the ground contact),
-// velocities between consecutive poses, after the first 2 s and above 0.5 m/s; c_rear = -(slope on a_y) [s].
-double RearCorneringCompliance(const Trajectory& truth) {
-  std::vector<Eigen::Vector3d> rows;
-  std::vector<double> v_y;
-  for (std::size_t k = 0; k + 1 < truth.size(); ++k) {
-    const double t0 = SecondsBetween(truth.front().t, truth[k].t);
-    const double dt = SecondsBetween(truth[k].t, truth[k + 1].t);
-    if (t0 < 2.0 || !(dt > 0.0)) continue;
-    const Eigen::AngleAxisd turn(truth[k].q_world_body.conjugate() * truth[k + 1].q_world_body);
-    const Eigen::Vector3d omega = turn.angle() * turn.axis() / dt;
-    const Eigen::Quaterniond q_mid = truth[k].q_world_body * Eigen::Quaterniond(
-                                                                 Eigen::AngleAxisd(0.5 * turn.angle(), turn.axis()));
-    const Eigen::Vector3d v = q_mid.conjugate() * (truth[k + 1].p_world_body - truth[k].p_world_body) / dt;
-    if (v.x() < 0.5) continue;
-    rows.emplace_back(1.0, v.x() * omega.z(), omega.x());
-    v_y.push_back(v.y());
-  }
-  if (rows.size() < 10) return std::numeric_limits<double>::quiet_NaN();
-  Eigen::MatrixXd X(static_cast<Eigen::Index>(rows.size()), 3);
-  Eigen::VectorXd y(static_cast<Eigen::Index>(rows.size()));
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    X.row(static_cast<Eigen::Index>(i)) = rows[i].transpose();
-    y[static_cast<Eigen::Index>(i)] = v_y[i];
-  }
-  return -X.colPivHouseholderQr().solve(y)[1];
 }
 
 // Platform 0 is the ATV (half of the cases: its library is the largest), 1 the differential drive and 2 the mecanum
@@ -195,7 +163,7 @@ Draw DrawCase(std::mt19937_64& rng) {
     case 7:
       // Softer tires: the contact time constant times 3-4, the rear cornering compliance +0.041-0.061 s (std about
       // 0.0036 s; at x2 the diagnosis named gyro_scale_error first, at x1.5 nothing: README). Scored on the
-      // compliance measured on the truth (RearCorneringCompliance), the candidate's cornering_rear_s.
+      // compliance measured on the truth (gapbench::RearCorneringCompliance), the candidate's cornering_rear_s.
       d.effect = {"lateral_slip", {{"contact_time_scale", 3.0 + u(rng)}}};
       d.parameter = "cornering_rear_s";
       return d;
@@ -332,7 +300,8 @@ Result<CaseResult> RunCase(const Platform& platform, const Draw& draw, std::uint
     // Softer tires: their size in the candidate's units, the compliance on this drive's truth minus the nominal's
     // (the physics does not depend on the noise seed).
     if (effect.name == "lateral_slip" && simulated.value().recording.ground_truth)
-      c.truth_value = RearCorneringCompliance(*simulated.value().recording.ground_truth) - platform.rear_compliance_s;
+      c.truth_value =
+          gapbench::RearCorneringCompliance(*simulated.value().recording.ground_truth) - platform.rear_compliance_s;
   }
   if (draw.kind == "effect") {
     for (const gap::EffectEstimate& e : d.effects) {
@@ -442,7 +411,7 @@ int RunGapBenchmark(const GapBenchmarkArgs& args) {
     if (!learned.ok()) return Status::Error(p.name + " baseline: " + learned.status().message());
     p.baseline = gap::BaselineFrom(learned.value());
     if (p.name == "atv" && simulated.value().recording.ground_truth)
-      p.rear_compliance_s = RearCorneringCompliance(*simulated.value().recording.ground_truth);
+      p.rear_compliance_s = gapbench::RearCorneringCompliance(*simulated.value().recording.ground_truth);
     return p.name + " baseline learned (noise seed " + std::to_string(kBaselineSeed) + ")";
   });
   if (!base.ok()) {

@@ -155,6 +155,32 @@ double NoiseRatio(const std::map<std::string, std::map<std::string, double>>& si
   return std::abs(value - NeutralValue(parameter)) / s->second;
 }
 
+double RearCorneringCompliance(const Trajectory& truth) {
+  std::vector<Eigen::Vector3d> rows;
+  std::vector<double> v_y;
+  for (std::size_t k = 0; k + 1 < truth.size(); ++k) {
+    const double t0 = SecondsBetween(truth.front().t, truth[k].t);
+    const double dt = SecondsBetween(truth[k].t, truth[k + 1].t);
+    if (t0 < 2.0 || !(dt > 0.0)) continue;
+    const Eigen::AngleAxisd turn(truth[k].q_world_body.conjugate() * truth[k + 1].q_world_body);
+    const Eigen::Vector3d omega = turn.angle() * turn.axis() / dt;
+    const Eigen::Quaterniond q_mid = truth[k].q_world_body * Eigen::Quaterniond(
+                                                                 Eigen::AngleAxisd(0.5 * turn.angle(), turn.axis()));
+    const Eigen::Vector3d v = q_mid.conjugate() * (truth[k + 1].p_world_body - truth[k].p_world_body) / dt;
+    if (v.x() < 0.5) continue;
+    rows.emplace_back(1.0, v.x() * omega.z(), omega.x());
+    v_y.push_back(v.y());
+  }
+  if (rows.size() < 10) return std::numeric_limits<double>::quiet_NaN();
+  Eigen::MatrixXd X(static_cast<Eigen::Index>(rows.size()), 3);
+  Eigen::VectorXd y(static_cast<Eigen::Index>(rows.size()));
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    X.row(static_cast<Eigen::Index>(i)) = rows[i].transpose();
+    y[static_cast<Eigen::Index>(i)] = v_y[i];
+  }
+  return -X.colPivHouseholderQr().solve(y)[1];
+}
+
 json Summarize(const std::vector<CaseResult>& cases, double min_noise_ratio) {
   int effects = 0, top1 = 0, top3 = 0, strong = 0, strong_top1 = 0, strong_top3 = 0;
   int nones = 0, none_false = 0, none_none = 0, decoys = 0, decoy_false = 0, decoy_unknown = 0, decoy_unknown_any = 0;

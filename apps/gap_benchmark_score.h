@@ -10,6 +10,7 @@
 //   - CalibrationSigmas / NoiseRatio: the noise of an effect's parameter is the median standard deviation the
 //     diagnosis reports for that candidate's parameter over the calibration cases of the platform (every case fits
 //     every candidate); an effect's magnitude relative to the noise is |theta - neutral| / that sigma;
+//   - RearCorneringCompliance: a lateral_slip effect's size in the candidate's units, measured on a drive's truth;
 //   - Summarize: the figures and targets.
 #pragma once
 
@@ -18,6 +19,8 @@
 #include <vector>
 
 #include <nlohmann/json.hpp>
+
+#include "recording/trajectory.h"
 
 namespace roamlab::apps::gapbench {
 
@@ -101,6 +104,13 @@ std::map<std::string, std::map<std::string, double>> CalibrationSigmas(const std
 // |value - neutral| / sigma of platform's effect parameter; -1 when there is no sigma.
 double NoiseRatio(const std::map<std::string, std::map<std::string, double>>& sigmas, const std::string& platform,
                   const std::string& effect, const std::string& parameter, double value);
+
+// The rear axle's cornering compliance c_rear [s] of a drive, measured on its truth (how the diagnosis's lateral_slip
+// candidate states a tire's sideways slip, as scripts/atv_odometer_residuals.py measures it): O's sideways velocity
+// regressed on the lateral acceleration a_y = v_x omega_z and on the roll rate (which moves O sideways over the ground
+// contact), velocities between consecutive poses, after the first 2 s and above 0.5 m/s forward; c_rear = -(slope on
+// a_y). NaN with fewer than 10 such pose pairs.
+double RearCorneringCompliance(const Trajectory& truth);
 
 // The figures over the scored cases, with the targets and whether each is met.
 nlohmann::json Summarize(const std::vector<CaseResult>& cases, double min_noise_ratio = 3.0);

@@ -123,6 +123,29 @@ TEST(GapBenchmarkScore, NoiseRatioUsesTheMedianReportedStd) {
   EXPECT_DOUBLE_EQ(NeutralValue("track_error_m"), 0.0);
 }
 
+TEST(GapBenchmarkScore, RearCorneringComplianceIsTheSideSlipPerLateralAcceleration) {
+  // A drive whose body velocity drifts outwards by c a_y and sideways with the roll rate (O above the contact): the
+  // poses integrated step by step with the body rates and velocities at the middle of each step, as the measurement
+  // reads them back. The first 2 s and a slow part are skipped.
+  const double c = 0.03, lever = 0.25;
+  Trajectory truth;
+  StampedPose pose;
+  const double dt = 0.01;
+  for (int k = 0; k <= 2000; ++k) {
+    pose.t = Time::FromNanoseconds(static_cast<std::int64_t>(k) * 10000000);
+    truth.push_back(pose);
+    const double t = (k + 0.5) * dt;
+    const double v_x = t < 5.0 ? 0.3 : 4.0 + 0.5 * std::sin(0.7 * t);
+    const Eigen::Vector3d omega(0.05 * std::cos(1.3 * t), 0.02 * std::sin(0.9 * t), 0.3 * std::sin(0.5 * t));
+    const Eigen::Vector3d v(v_x, -c * v_x * omega.z() - lever * omega.x() + 0.001, 0.0);
+    const Eigen::Quaterniond half(Eigen::AngleAxisd(0.5 * omega.norm() * dt, omega.normalized()));
+    pose.p_world_body += (pose.q_world_body * half) * v * dt;
+    pose.q_world_body = (pose.q_world_body * half * half).normalized();
+  }
+  EXPECT_NEAR(RearCorneringCompliance(truth), c, 1e-9);
+  EXPECT_TRUE(std::isnan(RearCorneringCompliance(Trajectory(truth.begin(), truth.begin() + 300))));   // all in 2 s
+}
+
 CaseResult Scored(const std::string& kind, const std::string& truth, const std::string& verdict,
                   std::vector<std::string> named, double noise_ratio) {
   CaseResult c;
