@@ -10,6 +10,8 @@
 //      decision thresholds (alpha, Delta BIC, held-out drop) are chosen on them (gap_benchmark_score.h), and so is
 //      each candidate parameter's noise (the median reported std);
 //   2. scored: N cases (draws seeded S, noise seeds S * 1000 + i) diagnosed with the chosen thresholds.
+// Both phases judge a case by one rule (gapbench::Identified / FalseDiscovery): a none or decoy case that keeps any
+// library effect is a false discovery, whatever the verdict.
 // Writes DIR/score.json (figures against the targets, thresholds, per-case table, seconds), the recordings
 // in DIR/calibration/NNN/rec and DIR/cases/NNN/rec, and each case's row in DIR/.../NNN/case.json.
 #pragma once
