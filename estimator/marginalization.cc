@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -9,6 +10,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "estimator/geometry.h"
+#include "estimator/solver.h"
 #include "estimator/internal/linearization.h"
 
 namespace roamlab::estimator {
@@ -141,7 +143,7 @@ bool LinearPriorFactor::Evaluate(const double* const* values, double* error, dou
   return error != nullptr && r0_.allFinite();
 }
 
-bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph) {
+bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const SolverWorkspace* last_solve) {
   // The factors on the leaving variables (sorted, once each), and the blanket: the other free variables they touch.
   // Small sets (a pose and its blanket of a few dozen coordinates): sorted or searched vectors, no node containers.
   std::vector<FactorId> factors;
@@ -180,22 +182,29 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph) {
     if (!e.active) continue;
     want.clear();
     var_offset.clear();
+    std::uint64_t mask = 0;
     for (VariableId v : e.variables) {
       const auto it = std::find(order.begin(), order.end(), v);
+      if (it != order.end()) mask |= std::uint64_t{1} << want.size();
       want.push_back(it != order.end());
       var_offset.push_back(it != order.end() ? offset[it - order.begin()] : -1);
     }
-    if (!internal::LinearizeFactor(*graph, e, want, &wf)) return false;
+    const internal::WhitenedFactor* linearized = last_solve != nullptr ? last_solve->Linearization(f, mask) : nullptr;
+    if (linearized == nullptr) {
+      if (!internal::LinearizeFactor(*graph, e, want, &wf)) return false;
+      linearized = &wf;
+    }
+    const internal::WhitenedFactor& lf = *linearized;
     for (std::size_t a = 0; a < e.variables.size(); ++a) {
       if (!want[a]) continue;
       const int oa = var_offset[a];
       // Coefficient-wise products, in this order: tracking under a calibration prior is sensitive to the rounding of
       // H here (other kernels moved its positions by metres; BENCHMARKS.md, fourth tracking pass).
-      g.segment(oa, wf.jacobians[a].cols()) += wf.jacobians[a].transpose().lazyProduct(wf.residual);
+      g.segment(oa, lf.jacobians[a].cols()) += lf.jacobians[a].transpose().lazyProduct(lf.residual);
       for (std::size_t b = 0; b < e.variables.size(); ++b) {
         if (!want[b]) continue;
-        H.block(oa, var_offset[b], wf.jacobians[a].cols(), wf.jacobians[b].cols()) +=
-            wf.jacobians[a].transpose().lazyProduct(wf.jacobians[b]);
+        H.block(oa, var_offset[b], lf.jacobians[a].cols(), lf.jacobians[b].cols()) +=
+            lf.jacobians[a].transpose().lazyProduct(lf.jacobians[b]);
       }
     }
   }

@@ -26,6 +26,16 @@ void Whiten(const Eigen::MatrixXd& L, bool diagonal, Eigen::MatrixBase<Derived>*
   }
 }
 
+// rho(|L^-1 e|^2) / 2 for an un-whitened error e.
+double WhitenedCost(const FactorEntry& entry, const Eigen::MatrixXd& sqrt_covariance, const Eigen::VectorXd& error) {
+  thread_local Eigen::VectorXd whitened;
+  whitened = error;
+  Whiten(sqrt_covariance, &sqrt_covariance == &entry.noise_sqrt_covariance && entry.noise_sqrt_diagonal, &whitened);
+  double rho = 0.0, rho_prime = 1.0;
+  entry.loss.Evaluate(whitened.squaredNorm(), &rho, &rho_prime);
+  return 0.5 * rho;
+}
+
 }  // namespace
 
 bool LinearizeFactor(const Graph& graph, const FactorEntry& entry, const std::vector<bool>& want_jacobian,
@@ -38,7 +48,7 @@ bool LinearizeFactor(const Graph& graph, const FactorEntry& entry, const std::ve
 }
 
 bool LinearizeFactorAt(const FactorEntry& entry, const double* const* values, std::uint64_t want_mask,
-                       WhitenedFactor* out) {
+                       WhitenedFactor* out, double* previous_cost) {
   const Factor& factor = *entry.factor;
   const int m = factor.residual_dim();
   const std::size_t n = entry.variables.size();
@@ -68,6 +78,8 @@ bool LinearizeFactorAt(const FactorEntry& entry, const double* const* values, st
     thread_local Eigen::MatrixXd noise_jacobian;
     noise_jacobian.resize(m, factor.noise_dim());
     if (!factor.Evaluate(values, out->residual.data(), jacobian_ptrs.data(), noise_jacobian.data())) return false;
+    // The earlier whitening is overwritten below: the cost with it first.
+    if (previous_cost != nullptr) *previous_cost = WhitenedCost(entry, out->sqrt_covariance, out->residual);
     const Eigen::LLT<Eigen::MatrixXd> llt(noise_jacobian * entry.noise_covariance * noise_jacobian.transpose());
     if (llt.info() != Eigen::Success) return false;
     out->sqrt_covariance = llt.matrixL();
@@ -84,6 +96,8 @@ bool LinearizeFactorAt(const FactorEntry& entry, const double* const* values, st
   double rho = 0.0, rho_prime = 1.0;
   entry.loss.Evaluate(out->squared_norm, &rho, &rho_prime);
   out->cost = 0.5 * rho;
+  // An additive-noise factor's whitening does not change: the earlier one gives the same cost.
+  if (previous_cost != nullptr && factor.additive_noise()) *previous_cost = out->cost;
   if (rho_prime != 1.0) {
     const double w = std::sqrt(rho_prime);
     out->residual *= w;
@@ -103,10 +117,7 @@ bool FactorCostAt(const FactorEntry& entry, const double* const* values, const E
   thread_local Eigen::VectorXd error;
   error.resize(entry.factor->residual_dim());
   if (!entry.factor->Evaluate(values, error.data(), nullptr, nullptr)) return false;
-  Whiten(sqrt_covariance, &sqrt_covariance == &entry.noise_sqrt_covariance && entry.noise_sqrt_diagonal, &error);
-  double rho = 0.0, rho_prime = 1.0;
-  entry.loss.Evaluate(error.squaredNorm(), &rho, &rho_prime);
-  *cost = 0.5 * rho;
+  *cost = WhitenedCost(entry, sqrt_covariance, error);
   return true;
 }
 

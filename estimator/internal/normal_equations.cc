@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include <Eigen/CholmodSupport>
@@ -192,14 +193,6 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
 
   // The included factors, their variables' blocks and values, and which row blocks appear in each block column
   // (upper triangle, diagonal always present).
-  // The per-factor buffers follow their factors: a window that slid drops its oldest factors at the front (ids grow
-  // with time), so the buffers are rotated by as many places, and a factor keeps buffers of its own sizes (no
-  // reallocation when it is linearized again).
-  if (!prev_factor_ids_.empty() && !graph.factors().empty()) {
-    const FactorId first = graph.factors().begin()->first;
-    const auto kept = std::lower_bound(prev_factor_ids_.begin(), prev_factor_ids_.end(), first);
-    std::rotate(whitened_.begin(), whitened_.begin() + (kept - prev_factor_ids_.begin()), whitened_.end());
-  }
   factor_ids_.clear();
   entries_.clear();
   want_.clear();
@@ -281,7 +274,29 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   }
   BuildPattern();
   if (natural_order_ != natural_before) cholmod_->analyzed = false;
-  whitened_.resize(factor_ids_.size());
+
+  // The per-factor linearizations follow their factors (by id). A new factor takes the buffers of one that left, in
+  // order: a window that slid drops its oldest factors and gains new ones of the same kinds, so a factor's buffers
+  // mostly have its own sizes already (no reallocation).
+  prev_linearized_.swap(linearized_);
+  prev_linearized_.resize(prev_factor_ids_.size());
+  linearized_.resize(factor_ids_.size());
+  std::vector<bool>& taken = taken_scratch_;
+  taken.assign(prev_linearized_.size(), false);
+  std::vector<std::size_t>& fresh = fresh_scratch_;
+  fresh.clear();
+  for (std::size_t k = 0, p = 0; k < factor_ids_.size(); ++k) {
+    while (p < prev_factor_ids_.size() && prev_factor_ids_[p] < factor_ids_[k]) ++p;
+    if (p < prev_factor_ids_.size() && prev_factor_ids_[p] == factor_ids_[k]) {
+      std::swap(linearized_[k], prev_linearized_[p]);
+      taken[p] = true;
+    } else {
+      fresh.push_back(k);
+    }
+  }
+  for (std::size_t p = 0, i = 0; p < prev_linearized_.size() && i < fresh.size(); ++p)
+    if (!taken[p]) std::swap(linearized_[fresh[i++]], prev_linearized_[p]);
+  for (std::size_t k : fresh) linearized_[k].id = -1;
   g_.setZero(dimension_);
   cholmod_->factored_undamped = false;
 }
@@ -370,11 +385,11 @@ bool NormalEquations::Linearize(const Graph& /*graph*/, std::string* failed_stre
     const FactorEntry& entry = *entries_[k];
     const int v0 = var_begin_[k];
     const int n = var_begin_[k + 1] - v0;
-    WhitenedFactor& wf = whitened_[k];
-    if (!LinearizeFactorAt(entry, &values_[v0], want_[k], &wf)) {
+    if (!Current(k) && !LinearizeAndRecord(k, nullptr)) {
       if (failed_stream != nullptr) *failed_stream = entry.stream;
       return false;
     }
+    const WhitenedFactor& wf = linearized_[k].whitened;
     cost_ += wf.cost;
 
     // Accumulate J_a^T r into g and J_a^T J_b into the (a <= b) blocks, which sit in H's value array with the
@@ -399,10 +414,59 @@ bool NormalEquations::CostWithLastWhitening(const Graph& /*graph*/, double* cost
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
     double c = 0.0;
     const FactorEntry& entry = *entries_[k];
-    if (!FactorCostAt(entry, &values_[var_begin_[k]], SqrtCovariance(entry, whitened_[k]), &c)) return false;
+    if (!FactorCostAt(entry, &values_[var_begin_[k]], SqrtCovariance(entry, linearized_[k].whitened), &c))
+      return false;
     *cost += c;
   }
   return true;
+}
+
+bool NormalEquations::LinearizeForCost(double* cost) {
+  *cost = 0.0;
+  for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
+    double c = 0.0;
+    if (!LinearizeAndRecord(k, &c)) return false;
+    *cost += c;
+  }
+  return true;
+}
+
+bool NormalEquations::Current(std::size_t k) const {
+  const FactorLinearization& l = linearized_[k];
+  if (l.id != factor_ids_[k] || l.entry != entries_[k] || l.mask != want_[k]) return false;
+  const std::vector<Manifold>& manifolds = entries_[k]->factor->manifolds();
+  const double* at = l.at.data();
+  for (int v = var_begin_[k]; v < var_begin_[k + 1]; ++v) {
+    const int n = manifolds[v - var_begin_[k]].ambient_dim();
+    if (std::memcmp(at, values_[v], n * sizeof(double)) != 0) return false;
+    at += n;
+  }
+  return true;
+}
+
+bool NormalEquations::LinearizeAndRecord(std::size_t k, double* previous_cost) {
+  FactorLinearization& l = linearized_[k];
+  const int v0 = var_begin_[k];
+  if (!LinearizeFactorAt(*entries_[k], &values_[v0], want_[k], &l.whitened, previous_cost)) {
+    l.id = -1;
+    return false;
+  }
+  l.id = factor_ids_[k];
+  l.entry = entries_[k];
+  l.mask = want_[k];
+  l.at.clear();
+  const std::vector<Manifold>& manifolds = entries_[k]->factor->manifolds();
+  for (int v = v0; v < var_begin_[k + 1]; ++v)
+    l.at.insert(l.at.end(), values_[v], values_[v] + manifolds[v - v0].ambient_dim());
+  return true;
+}
+
+const WhitenedFactor* NormalEquations::LinearizationAt(FactorId id, std::uint64_t want_mask) const {
+  const auto it = std::lower_bound(factor_ids_.begin(), factor_ids_.end(), id);
+  if (it == factor_ids_.end() || *it != id) return nullptr;
+  const std::size_t k = static_cast<std::size_t>(it - factor_ids_.begin());
+  if (want_[k] != want_mask || !Current(k)) return nullptr;
+  return &linearized_[k].whitened;
 }
 
 bool NormalEquations::Solve(double lambda, Eigen::VectorXd* dx) {
