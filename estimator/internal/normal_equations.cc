@@ -376,7 +376,9 @@ void NormalEquations::BuildPattern() {
   }
 }
 
-bool NormalEquations::Linearize(const Graph& /*graph*/, std::string* failed_stream) {
+// flatten: the small fixed-size J^T J kernels are inlined here whatever the compiler's size heuristics decide (once
+// left out of line, they cost a third more).
+__attribute__((flatten)) bool NormalEquations::Linearize(const Graph& /*graph*/, std::string* failed_stream) {
   double* values = H_.valuePtr();
   std::fill(values, values + H_.nonZeros(), 0.0);
   g_.setZero();
