@@ -93,7 +93,13 @@ bool LinearizeFactorAt(const FactorEntry& entry, const double* const* values, st
     if (!factor.Evaluate(values, out->residual.data(), jacobian_ptrs.data(), noise_jacobian.data())) return false;
     // The earlier whitening is overwritten below: the cost with it first.
     if (previous_cost != nullptr) *previous_cost = WhitenedCost(entry, out->sqrt_covariance, out->residual);
-    const Eigen::LLT<Eigen::MatrixXd> llt(noise_jacobian * entry.noise_covariance * noise_jacobian.transpose());
+    // The products and the factorization in per-thread buffers (no allocation once they have grown), as the
+    // expression J Sigma J^T would evaluate them.
+    thread_local Eigen::MatrixXd half, covariance;
+    thread_local Eigen::LLT<Eigen::MatrixXd> llt;
+    half.noalias() = noise_jacobian * entry.noise_covariance;
+    covariance.noalias() = half * noise_jacobian.transpose();
+    llt.compute(covariance);
     if (llt.info() != Eigen::Success) return false;
     out->sqrt_covariance = llt.matrixL();
   }
