@@ -135,10 +135,14 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   block_of_id_.clear();
   dims_.clear();
   block_offset_.clear();
+  full_column_.assign(nb, 0);
   dimension_ = 0;
+  bool stamped_poses_only = true;  // every time-stamped variable is a pose (natural order, below)
   for (int b = 0; b < nb; ++b) {
     const Variable& v = graph.variable(order_[b]);
     ROAMLAB_CHECK(!v.fixed, "variable '" << v.name << "' is fixed but was ordered as free");
+    full_column_[b] = !v.stamp.has_value();
+    if (v.stamp.has_value()) stamped_poses_only &= v.manifold.kind() == ManifoldKind::kPose;
     block_of_id_.emplace_back(order_[b], b);
     dims_.push_back(v.manifold.tangent_dim());
     block_offset_.push_back(dimension_);
@@ -200,6 +204,9 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   var_id_.clear();
   var_block_.clear();
   values_.clear();
+  // In a small system the block column of a constant parameter holds every row block (below); only the others
+  // collect their rows from the factors.
+  if (dimension_ > kMaxSimplicialDimension) std::fill(full_column_.begin(), full_column_.end(), 0);
   rows_of_.resize(nb);
   for (int b = 0; b < nb; ++b) rows_of_[b].assign(1, b);
   std::size_t prev = 0;  // next factor of the last Reset to compare with (both lists in id order)
@@ -236,10 +243,12 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
       continue;
     }
     // (A row block that its column received last, as from the factors before on the same pair, is not repeated.)
-    for (std::size_t i = begin; i < var_block_.size(); ++i) {
-      for (std::size_t j = begin; j < var_block_.size(); ++j) {
-        if (var_block_[i] < 0 || var_block_[i] >= var_block_[j]) continue;
-        std::vector<int>& rows = rows_of_[var_block_[j]];
+    for (std::size_t j = begin; j < var_block_.size(); ++j) {
+      const int column = var_block_[j];
+      if (column < 0 || full_column_[column]) continue;
+      std::vector<int>& rows = rows_of_[column];
+      for (std::size_t i = begin; i < var_block_.size(); ++i) {
+        if (var_block_[i] < 0 || var_block_[i] >= column) continue;
         if (rows.back() != var_block_[i]) rows.push_back(var_block_[i]);
       }
     }
@@ -259,18 +268,11 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   // triangular solves on so small a system. With time-varying parameters (instances after the poses) CHOLMOD and a
   // fill-reducing ordering are still needed.
   const bool natural_before = natural_order_;
-  natural_order_ = false;
-  if (dimension_ <= kMaxSimplicialDimension) {
-    natural_order_ = true;
-    for (int b = 0; b < nb; ++b) {
-      const Variable& v = graph.variable(order_[b]);
-      if (v.stamp.has_value()) {
-        natural_order_ &= v.manifold.kind() == ManifoldKind::kPose;
-        continue;
-      }
-      rows_of_[b].resize(b + 1);
-      for (int r = 0; r <= b; ++r) rows_of_[b][r] = r;
-    }
+  natural_order_ = dimension_ <= kMaxSimplicialDimension && stamped_poses_only;
+  for (int b = 0; b < nb; ++b) {
+    if (!full_column_[b]) continue;
+    rows_of_[b].resize(b + 1);
+    for (int r = 0; r <= b; ++r) rows_of_[b][r] = r;
   }
   BuildPattern();
   if (natural_order_ != natural_before) cholmod_->analyzed = false;

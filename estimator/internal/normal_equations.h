@@ -94,6 +94,7 @@ class NormalEquations {
   };
   std::vector<VariableSlot> variable_table_;  // every variable of the graph, sorted by id
   std::vector<int> dims_;                                // per block
+  std::vector<char> full_column_;                        // per block: its column holds every row block before it
   std::vector<int> block_offset_;                        // per block: first column
   int dimension_ = 0;
 
