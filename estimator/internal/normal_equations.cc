@@ -90,6 +90,15 @@ void AddGradient(const Eigen::MatrixXd& j, const Eigen::VectorXd& r, double* g) 
   Eigen::Map<Eigen::VectorXd>(g, j.cols()).noalias() += j.transpose() * r;
 }
 
+// The positions i < n with block[i] >= 0 (a factor's free variables), in order, into free; returns their count. The
+// normal equations visit a factor's (a, b) pairs of free variables in this order, a outer, b inner.
+int FreePositions(const int* block, int n, int* free) {
+  int count = 0;
+  for (int i = 0; i < n; ++i)
+    if (block[i] >= 0) free[count++] = i;
+  return count;
+}
+
 }  // namespace
 
 // H holds the block upper triangle with full diagonal blocks; CHOLMOD (stype = upper) reads only entries on and above
@@ -360,12 +369,14 @@ void NormalEquations::BuildPattern() {
   };
   pair_begin_.assign(1, 0);
   pair_value_.clear();
+  int free[64];
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
-    for (int p = var_begin_[k]; p < var_begin_[k + 1]; ++p) {
-      for (int q = var_begin_[k]; q < var_begin_[k + 1]; ++q) {
-        const int r = var_block_[p], b = var_block_[q];
-        if (r < 0 || b < 0 || r > b) continue;
-        pair_value_.push_back(value_index(r, b));
+    const int* block = &var_block_[var_begin_[k]];
+    const int nf = FreePositions(block, var_begin_[k + 1] - var_begin_[k], free);
+    for (int i = 0; i < nf; ++i) {
+      for (int j = 0; j < nf; ++j) {
+        const int r = block[free[i]], b = block[free[j]];
+        if (r <= b) pair_value_.push_back(value_index(r, b));
       }
     }
     pair_begin_.push_back(static_cast<int>(pair_value_.size()));
@@ -399,13 +410,16 @@ __attribute__((flatten)) bool NormalEquations::Linearize(const Graph& /*graph*/,
     // Accumulate J_a^T r into g and J_a^T J_b into the (a <= b) blocks, which sit in H's value array with the
     // column length of their block column as outer stride.
     const int* block = &var_block_[v0];
-    for (int a = 0; a < n; ++a)
-      if (block[a] >= 0) AddGradient(wf.jacobians[a], wf.residual, g_.data() + block_offset_[block[a]]);
+    int free[64];  // positions of the factor's free variables
+    const int nf = FreePositions(block, n, free);
+    for (int i = 0; i < nf; ++i)
+      AddGradient(wf.jacobians[free[i]], wf.residual, g_.data() + block_offset_[block[free[i]]]);
     int pair = pair_begin_[k];
-    for (int a = 0; a < n; ++a) {
-      if (block[a] < 0) continue;
-      for (int b = 0; b < n; ++b) {
-        if (block[b] < 0 || block[a] > block[b]) continue;
+    for (int i = 0; i < nf; ++i) {
+      const int a = free[i];
+      for (int j = 0; j < nf; ++j) {
+        const int b = free[j];
+        if (block[a] > block[b]) continue;
         AddProduct(wf.jacobians[a], wf.jacobians[b], values + pair_value_[pair++], column_length_[block[b]]);
       }
     }
