@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <map>
 #include <set>
@@ -15,7 +16,7 @@
 
 namespace roamlab::estimator {
 
-int GateOutliers(double probability, ProblemBuilder* builder, FactorId first) {
+int GateOutliers(double probability, ProblemBuilder* builder, FactorId first, const SolverWorkspace* last_solve) {
   Graph& graph = builder->graph();
   // Quantiles per (probability, dimension), kept across calls: online tracking gates at every update.
   thread_local std::map<std::pair<double, int>, double> quantiles;
@@ -33,9 +34,21 @@ int GateOutliers(double probability, ProblemBuilder* builder, FactorId first) {
   for (FactorId id : ids) {
     FactorEntry& entry = graph.mutable_factor(id);
     const int dim = entry.factor->residual_dim();
-    no_jacobians.assign(entry.variables.size(), false);
-    const bool ok = internal::LinearizeFactor(graph, entry, no_jacobians, &wf);
-    const bool active = ok && wf.squared_norm <= threshold(dim);
+    // The solve's linearization (of an active factor, with the Jacobians of its free variables), else the error.
+    const internal::WhitenedFactor* linearized = nullptr;
+    if (last_solve != nullptr && entry.active) {
+      std::uint64_t free_mask = 0;
+      for (std::size_t i = 0; i < entry.variables.size() && i < 64; ++i)
+        if (!graph.variable(entry.variables[i]).fixed) free_mask |= std::uint64_t{1} << i;
+      linearized = last_solve->Linearization(id, free_mask);
+    }
+    bool ok = linearized != nullptr;
+    if (!ok) {
+      no_jacobians.assign(entry.variables.size(), false);
+      ok = internal::LinearizeFactor(graph, entry, no_jacobians, &wf);
+      linearized = &wf;
+    }
+    const bool active = ok && linearized->squared_norm <= threshold(dim);
     if (active == entry.active) continue;
     ++changed;
     builder->mutable_counts(entry.stream).rejected += active ? -1 : 1;

@@ -84,7 +84,10 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
 
 // Re-tests the measurement factors with id >= `first` (factor ids grow as factors are added, so `first` selects the
 // newest ones): active exactly when the whitened squared error is within the chi-square quantile `probability` of its
-// dimension. Keeps the per-stream rejected counts up to date; returns how many factors changed state.
-int GateOutliers(double probability, ProblemBuilder* builder, FactorId first = 0);
+// dimension. Keeps the per-stream rejected counts up to date; returns how many factors changed state. `last_solve`
+// (optional): the workspace of the solve that left the graph at its current values; a factor it linearized at exactly
+// these values is tested on that linearization's error instead of being evaluated again.
+int GateOutliers(double probability, ProblemBuilder* builder, FactorId first = 0,
+                 const SolverWorkspace* last_solve = nullptr);
 
 }  // namespace roamlab::estimator

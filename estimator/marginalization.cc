@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -9,6 +10,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "estimator/geometry.h"
+#include "estimator/solver.h"
 #include "estimator/internal/linearization.h"
 
 namespace roamlab::estimator {
@@ -48,31 +50,45 @@ bool SquareRootInformation(const Eigen::MatrixXd& H_in, const Eigen::VectorXd& g
   for (int i = 0; i < n; ++i) perm[i] = i;
   Eigen::VectorXd gp = g;
   int rank = 0;
-  // In place: column k of L (rows k..n-1, permuted) in H's column k; the trailing block holds the Schur complement.
+  // In place, on the lower triangle only: column k of L (rows k..n-1, permuted) in H's column k; the trailing block
+  // holds the lower triangle of the Schur complement. (The same operations on those entries as on a full symmetric
+  // copy: the symmetric swap moves the same values, and the update of entry (i, j) is H(i, j) - H(i, k) H(j, k).)
   for (int k = 0; k < n; ++k) {
     int p = k;
     for (int i = k + 1; i < n; ++i)
       if (H(i, i) > H(p, p)) p = i;
     if (!(H(p, p) > floor / n)) break;
     if (p != k) {
-      H.row(k).swap(H.row(p));
-      H.col(k).swap(H.col(p));
+      for (int j = 0; j < k; ++j) std::swap(H(k, j), H(p, j));
+      std::swap(H(k, k), H(p, p));
+      for (int i = k + 1; i < p; ++i) std::swap(H(i, k), H(p, i));
+      for (int i = p + 1; i < n; ++i) std::swap(H(i, k), H(i, p));
       std::swap(perm[k], perm[p]);
       std::swap(gp[k], gp[p]);
     }
     const double d = std::sqrt(H(k, k));
     H(k, k) = d;
     H.col(k).tail(n - k - 1) /= d;
-    H.bottomRightCorner(n - k - 1, n - k - 1).noalias() -=
-        H.col(k).tail(n - k - 1) * H.col(k).tail(n - k - 1).transpose();
+    for (int j = k + 1; j < n; ++j) {
+      const double hjk = H(j, k);
+      for (int i = j; i < n; ++i) H(i, j) -= hjk * H(i, k);
+    }
     rank = k + 1;
   }
+  // The kept eigenvalues' bound 1 / |L11^-1|_F^2, column by column of L11^-1 (forward substitution on e_j).
   bool gap = rank > 0;
   if (gap) {
-    const Eigen::MatrixXd L11 = H.topLeftCorner(rank, rank).triangularView<Eigen::Lower>();
-    const Eigen::MatrixXd inverse =
-        L11.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(rank, rank));
-    gap = 1.0 / inverse.squaredNorm() > floor;
+    double inverse_squared_norm = 0.0;
+    Eigen::VectorXd y(rank);
+    for (int j = 0; j < rank; ++j) {
+      for (int i = j; i < rank; ++i) {
+        double s = i == j ? 1.0 : 0.0;
+        for (int k = j; k < i; ++k) s -= H(i, k) * y[k];
+        y[i] = s / H(i, i);
+        inverse_squared_norm += y[i] * y[i];
+      }
+    }
+    gap = 1.0 / inverse_squared_norm > floor;
   }
   if (gap) {
     J->setZero(rank, n);
@@ -141,7 +157,7 @@ bool LinearPriorFactor::Evaluate(const double* const* values, double* error, dou
   return error != nullptr && r0_.allFinite();
 }
 
-bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph) {
+bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const SolverWorkspace* last_solve) {
   // The factors on the leaving variables (sorted, once each), and the blanket: the other free variables they touch.
   // Small sets (a pose and its blanket of a few dozen coordinates): sorted or searched vectors, no node containers.
   std::vector<FactorId> factors;
@@ -180,22 +196,29 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph) {
     if (!e.active) continue;
     want.clear();
     var_offset.clear();
+    std::uint64_t mask = 0;
     for (VariableId v : e.variables) {
       const auto it = std::find(order.begin(), order.end(), v);
+      if (it != order.end()) mask |= std::uint64_t{1} << want.size();
       want.push_back(it != order.end());
       var_offset.push_back(it != order.end() ? offset[it - order.begin()] : -1);
     }
-    if (!internal::LinearizeFactor(*graph, e, want, &wf)) return false;
+    const internal::WhitenedFactor* linearized = last_solve != nullptr ? last_solve->Linearization(f, mask) : nullptr;
+    if (linearized == nullptr) {
+      if (!internal::LinearizeFactor(*graph, e, want, &wf)) return false;
+      linearized = &wf;
+    }
+    const internal::WhitenedFactor& lf = *linearized;
     for (std::size_t a = 0; a < e.variables.size(); ++a) {
       if (!want[a]) continue;
       const int oa = var_offset[a];
       // Coefficient-wise products, in this order: tracking under a calibration prior is sensitive to the rounding of
       // H here (other kernels moved its positions by metres; BENCHMARKS.md, fourth tracking pass).
-      g.segment(oa, wf.jacobians[a].cols()) += wf.jacobians[a].transpose().lazyProduct(wf.residual);
+      g.segment(oa, lf.jacobians[a].cols()) += lf.jacobians[a].transpose().lazyProduct(lf.residual);
       for (std::size_t b = 0; b < e.variables.size(); ++b) {
         if (!want[b]) continue;
-        H.block(oa, var_offset[b], wf.jacobians[a].cols(), wf.jacobians[b].cols()) +=
-            wf.jacobians[a].transpose().lazyProduct(wf.jacobians[b]);
+        H.block(oa, var_offset[b], lf.jacobians[a].cols(), lf.jacobians[b].cols()) +=
+            lf.jacobians[a].transpose().lazyProduct(lf.jacobians[b]);
       }
     }
   }

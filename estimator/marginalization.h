@@ -37,8 +37,12 @@ class LinearPriorFactor final : public Factor {
   Eigen::VectorXd r0_;
 };
 
+class SolverWorkspace;
+
 // Removes `leaving` (and every factor touching them) from the graph, replacing those factors by one linear prior on
 // the free variables they also touched. Returns false (and changes nothing) if a factor cannot be linearized.
-bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph);
+// `last_solve` (optional): the workspace of the solve that left the graph at its current values; the factors it
+// linearized at exactly these values are taken from it instead of being linearized again (the same numbers).
+bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const SolverWorkspace* last_solve = nullptr);
 
 }  // namespace roamlab::estimator

@@ -59,6 +59,9 @@ double TangentNorm(const Graph& graph, const std::vector<VariableId>& order) {
 SolverWorkspace::SolverWorkspace() : system_(std::make_unique<internal::NormalEquations>()) {}
 SolverWorkspace::~SolverWorkspace() = default;
 int SolverWorkspace::analyses() const { return system_->analyses(); }
+const internal::WhitenedFactor* SolverWorkspace::Linearization(FactorId id, std::uint64_t want_mask) const {
+  return system_->LinearizationAt(id, want_mask);
+}
 
 SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceRequest* covariance,
                     SolverWorkspace* workspace) {
@@ -123,8 +126,12 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
       saved.insert(saved.end(), value.data(), value.data() + value.size());
     }
     system.Update(dx, graph);
+    // Gauss-Newton takes every step it can evaluate: its trial point is linearized at once (the next iteration, or
+    // the next solve of a workspace, starts there), Levenberg-Marquardt only evaluates the cost of a trial that may
+    // be rejected.
     double new_cost = 0.0;
-    const bool evaluated = system.CostWithLastWhitening(*graph, &new_cost);
+    const bool evaluated =
+        lm ? system.CostWithLastWhitening(*graph, &new_cost) : system.LinearizeForCost(&new_cost);
     const double old_cost = system.cost();
     const Eigen::VectorXd& g = system.gradient();
     // Predicted decrease of the quadratic model: -g.dx - dx.H.dx / 2 (H through its upper triangle).

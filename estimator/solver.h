@@ -4,6 +4,7 @@
 // through box-plus only, and the error covariances (eq. 1) are re-evaluated at every linearization.
 #pragma once
 
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <string>
@@ -74,17 +75,23 @@ struct CovarianceRequest {
 
 namespace internal {
 class NormalEquations;
+struct WhitenedFactor;
 }
 
 // State kept between solves of graphs whose structure repeats (fixed-lag tracking: the window slides by one pose and
-// keeps its band): the buffers of the normal equations and CHOLMOD's symbolic analysis, reused while the Hessian's
-// sparsity pattern is unchanged. Results are the same as without it.
+// keeps its band): the buffers of the normal equations, CHOLMOD's symbolic analysis, reused while the Hessian's
+// sparsity pattern is unchanged, and the factors' last linearizations, reused while their variables keep their
+// values. Results are the same as without it.
 class SolverWorkspace {
  public:
   SolverWorkspace();
   ~SolverWorkspace();
   // How many solves had to analyse a new sparsity pattern.
   int analyses() const;
+  // The last solve's linearization of factor `id` (still in the graph) when it was computed at the graph's current
+  // values with the Jacobians of exactly the variables in want_mask (bit i: variable i), otherwise null. A
+  // Gauss-Newton solve ends with every factor linearized at its final point.
+  const internal::WhitenedFactor* Linearization(FactorId id, std::uint64_t want_mask) const;
 
  private:
   friend SolverSummary Solve(const SolverOptions&, Graph*, CovarianceRequest*, SolverWorkspace*);

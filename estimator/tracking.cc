@@ -70,13 +70,14 @@ std::vector<CovarianceRequest> OldestPoseCovariances(const ProblemBuilder& build
 }
 
 Status EmitAndMarginalizeOldest(ProblemBuilder* builder, const CovarianceRequest* known,
-                                const TrackingOptions& options, TrackingResult* out) {
+                                const SolverWorkspace* last_solve, const TrackingOptions& options,
+                                TrackingResult* out) {
   const Status emitted = EmitOldest(builder, known, options, out);
   if (!emitted.ok()) return emitted;
   const PoseNode& node = builder->poses().front();
   std::vector<VariableId> leaving = {node.id};
   for (const auto& [name, id] : node.instances) leaving.push_back(id);
-  if (!Marginalize(leaving, &builder->graph()))
+  if (!Marginalize(leaving, &builder->graph(), last_solve))
     return Status::Error("marginalization failed at t = " + FormatSeconds(node.t));
   builder->PopOldestPose();
   return Status::Ok();
@@ -199,7 +200,8 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
       const SolverSummary s = Solve(update_options, &builder.graph(), request, &workspace);
       if (!s.usable()) return Status::Error("update at t = " + FormatSeconds(m.t) + " failed: " + s.message);
       iterations += s.iterations;
-      if (config.gate_probability && GateOutliers(*config.gate_probability, &builder, first_new_factor) > 0)
+      if (config.gate_probability &&
+          GateOutliers(*config.gate_probability, &builder, first_new_factor, &workspace) > 0)
         iterations += Solve(update_options, &builder.graph(), request, &workspace).iterations;
       const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
       ++out.updates;
@@ -214,8 +216,9 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
     const std::vector<CovarianceRequest> batch =
         excess > 1 ? OldestPoseCovariances(builder, excess) : std::vector<CovarianceRequest>();
     for (int k = 0; k < excess; ++k) {
+      // After an update, the leaving pose's factors were linearized at the solve's final point (Gauss-Newton).
       const Status st = EmitAndMarginalizeOldest(&builder, excess > 1 ? &batch[k / kCovarianceBatch] : &leaving,
-                                                 options, &out);
+                                                 excess > 1 ? nullptr : &workspace, options, &out);
       if (!st.ok()) return st;
     }
     leaving.computed = false;
@@ -234,7 +237,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
       if (!st.ok()) return st;
       break;
     }
-    const Status st = EmitAndMarginalizeOldest(&builder, known, options, &out);
+    const Status st = EmitAndMarginalizeOldest(&builder, known, nullptr, options, &out);
     if (!st.ok()) return st;
   }
   out.mean_update_s = out.updates > 0 ? update_seconds / out.updates : 0.0;

@@ -37,9 +37,11 @@ bool LinearizeFactor(const Graph& graph, const FactorEntry& entry, const std::ve
                      WhitenedFactor* out);
 
 // The same at given variable values (values[i]: ambient values of variable i), with bit i of want_mask asking for the
-// Jacobian of variable i (factors with up to 64 variables).
+// Jacobian of variable i (factors with up to 64 variables). When previous_cost is given, `out` must hold an earlier
+// linearization of the same factor: it also receives the cost at these values with that linearization's whitening
+// (what FactorCostAt gives with its L), computed from the same error before `out` is overwritten.
 bool LinearizeFactorAt(const FactorEntry& entry, const double* const* values, std::uint64_t want_mask,
-                       WhitenedFactor* out);
+                       WhitenedFactor* out, double* previous_cost = nullptr);
 
 // Cost rho(|L^-1 e(x)|^2)/2 of `entry` at the graph's current values with the Cholesky factor L of an earlier
 // linearization's error covariance. Returns false if the error cannot be evaluated.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include <Eigen/CholmodSupport>
@@ -89,6 +90,15 @@ void AddGradient(const Eigen::MatrixXd& j, const Eigen::VectorXd& r, double* g) 
   Eigen::Map<Eigen::VectorXd>(g, j.cols()).noalias() += j.transpose() * r;
 }
 
+// The positions i < n with block[i] >= 0 (a factor's free variables), in order, into free; returns their count. The
+// normal equations visit a factor's (a, b) pairs of free variables in this order, a outer, b inner.
+int FreePositions(const int* block, int n, int* free) {
+  int count = 0;
+  for (int i = 0; i < n; ++i)
+    if (block[i] >= 0) free[count++] = i;
+  return count;
+}
+
 }  // namespace
 
 // H holds the block upper triangle with full diagonal blocks; CHOLMOD (stype = upper) reads only entries on and above
@@ -134,10 +144,14 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   block_of_id_.clear();
   dims_.clear();
   block_offset_.clear();
+  full_column_.assign(nb, 0);
   dimension_ = 0;
+  bool stamped_poses_only = true;  // every time-stamped variable is a pose (natural order, below)
   for (int b = 0; b < nb; ++b) {
     const Variable& v = graph.variable(order_[b]);
     ROAMLAB_CHECK(!v.fixed, "variable '" << v.name << "' is fixed but was ordered as free");
+    full_column_[b] = !v.stamp.has_value();
+    if (v.stamp.has_value()) stamped_poses_only &= v.manifold.kind() == ManifoldKind::kPose;
     block_of_id_.emplace_back(order_[b], b);
     dims_.push_back(v.manifold.tangent_dim());
     block_offset_.push_back(dimension_);
@@ -192,14 +206,6 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
 
   // The included factors, their variables' blocks and values, and which row blocks appear in each block column
   // (upper triangle, diagonal always present).
-  // The per-factor buffers follow their factors: a window that slid drops its oldest factors at the front (ids grow
-  // with time), so the buffers are rotated by as many places, and a factor keeps buffers of its own sizes (no
-  // reallocation when it is linearized again).
-  if (!prev_factor_ids_.empty() && !graph.factors().empty()) {
-    const FactorId first = graph.factors().begin()->first;
-    const auto kept = std::lower_bound(prev_factor_ids_.begin(), prev_factor_ids_.end(), first);
-    std::rotate(whitened_.begin(), whitened_.begin() + (kept - prev_factor_ids_.begin()), whitened_.end());
-  }
   factor_ids_.clear();
   entries_.clear();
   want_.clear();
@@ -207,6 +213,9 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   var_id_.clear();
   var_block_.clear();
   values_.clear();
+  // In a small system the block column of a constant parameter holds every row block (below); only the others
+  // collect their rows from the factors.
+  if (dimension_ > kMaxSimplicialDimension) std::fill(full_column_.begin(), full_column_.end(), 0);
   rows_of_.resize(nb);
   for (int b = 0; b < nb; ++b) rows_of_[b].assign(1, b);
   std::size_t prev = 0;  // next factor of the last Reset to compare with (both lists in id order)
@@ -243,10 +252,12 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
       continue;
     }
     // (A row block that its column received last, as from the factors before on the same pair, is not repeated.)
-    for (std::size_t i = begin; i < var_block_.size(); ++i) {
-      for (std::size_t j = begin; j < var_block_.size(); ++j) {
-        if (var_block_[i] < 0 || var_block_[i] >= var_block_[j]) continue;
-        std::vector<int>& rows = rows_of_[var_block_[j]];
+    for (std::size_t j = begin; j < var_block_.size(); ++j) {
+      const int column = var_block_[j];
+      if (column < 0 || full_column_[column]) continue;
+      std::vector<int>& rows = rows_of_[column];
+      for (std::size_t i = begin; i < var_block_.size(); ++i) {
+        if (var_block_[i] < 0 || var_block_[i] >= column) continue;
         if (rows.back() != var_block_[i]) rows.push_back(var_block_[i]);
       }
     }
@@ -266,22 +277,37 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   // triangular solves on so small a system. With time-varying parameters (instances after the poses) CHOLMOD and a
   // fill-reducing ordering are still needed.
   const bool natural_before = natural_order_;
-  natural_order_ = false;
-  if (dimension_ <= kMaxSimplicialDimension) {
-    natural_order_ = true;
-    for (int b = 0; b < nb; ++b) {
-      const Variable& v = graph.variable(order_[b]);
-      if (v.stamp.has_value()) {
-        natural_order_ &= v.manifold.kind() == ManifoldKind::kPose;
-        continue;
-      }
-      rows_of_[b].resize(b + 1);
-      for (int r = 0; r <= b; ++r) rows_of_[b][r] = r;
-    }
+  natural_order_ = dimension_ <= kMaxSimplicialDimension && stamped_poses_only;
+  for (int b = 0; b < nb; ++b) {
+    if (!full_column_[b]) continue;
+    rows_of_[b].resize(b + 1);
+    for (int r = 0; r <= b; ++r) rows_of_[b][r] = r;
   }
   BuildPattern();
   if (natural_order_ != natural_before) cholmod_->analyzed = false;
-  whitened_.resize(factor_ids_.size());
+
+  // The per-factor linearizations follow their factors (by id). A new factor takes the buffers of one that left, in
+  // order: a window that slid drops its oldest factors and gains new ones of the same kinds, so a factor's buffers
+  // mostly have its own sizes already (no reallocation).
+  prev_linearized_.swap(linearized_);
+  prev_linearized_.resize(prev_factor_ids_.size());
+  linearized_.resize(factor_ids_.size());
+  std::vector<bool>& taken = taken_scratch_;
+  taken.assign(prev_linearized_.size(), false);
+  std::vector<std::size_t>& fresh = fresh_scratch_;
+  fresh.clear();
+  for (std::size_t k = 0, p = 0; k < factor_ids_.size(); ++k) {
+    while (p < prev_factor_ids_.size() && prev_factor_ids_[p] < factor_ids_[k]) ++p;
+    if (p < prev_factor_ids_.size() && prev_factor_ids_[p] == factor_ids_[k]) {
+      std::swap(linearized_[k], prev_linearized_[p]);
+      taken[p] = true;
+    } else {
+      fresh.push_back(k);
+    }
+  }
+  for (std::size_t p = 0, i = 0; p < prev_linearized_.size() && i < fresh.size(); ++p)
+    if (!taken[p]) std::swap(linearized_[fresh[i++]], prev_linearized_[p]);
+  for (std::size_t k : fresh) linearized_[k].id = -1;
   g_.setZero(dimension_);
   cholmod_->factored_undamped = false;
 }
@@ -343,12 +369,14 @@ void NormalEquations::BuildPattern() {
   };
   pair_begin_.assign(1, 0);
   pair_value_.clear();
+  int free[64];
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
-    for (int p = var_begin_[k]; p < var_begin_[k + 1]; ++p) {
-      for (int q = var_begin_[k]; q < var_begin_[k + 1]; ++q) {
-        const int r = var_block_[p], b = var_block_[q];
-        if (r < 0 || b < 0 || r > b) continue;
-        pair_value_.push_back(value_index(r, b));
+    const int* block = &var_block_[var_begin_[k]];
+    const int nf = FreePositions(block, var_begin_[k + 1] - var_begin_[k], free);
+    for (int i = 0; i < nf; ++i) {
+      for (int j = 0; j < nf; ++j) {
+        const int r = block[free[i]], b = block[free[j]];
+        if (r <= b) pair_value_.push_back(value_index(r, b));
       }
     }
     pair_begin_.push_back(static_cast<int>(pair_value_.size()));
@@ -361,7 +389,9 @@ void NormalEquations::BuildPattern() {
   }
 }
 
-bool NormalEquations::Linearize(const Graph& /*graph*/, std::string* failed_stream) {
+// flatten: the small fixed-size J^T J kernels are inlined here whatever the compiler's size heuristics decide (once
+// left out of line, they cost a third more).
+__attribute__((flatten)) bool NormalEquations::Linearize(const Graph& /*graph*/, std::string* failed_stream) {
   double* values = H_.valuePtr();
   std::fill(values, values + H_.nonZeros(), 0.0);
   g_.setZero();
@@ -370,23 +400,26 @@ bool NormalEquations::Linearize(const Graph& /*graph*/, std::string* failed_stre
     const FactorEntry& entry = *entries_[k];
     const int v0 = var_begin_[k];
     const int n = var_begin_[k + 1] - v0;
-    WhitenedFactor& wf = whitened_[k];
-    if (!LinearizeFactorAt(entry, &values_[v0], want_[k], &wf)) {
+    if (!Current(k) && !LinearizeAndRecord(k, nullptr)) {
       if (failed_stream != nullptr) *failed_stream = entry.stream;
       return false;
     }
+    const WhitenedFactor& wf = linearized_[k].whitened;
     cost_ += wf.cost;
 
     // Accumulate J_a^T r into g and J_a^T J_b into the (a <= b) blocks, which sit in H's value array with the
     // column length of their block column as outer stride.
     const int* block = &var_block_[v0];
-    for (int a = 0; a < n; ++a)
-      if (block[a] >= 0) AddGradient(wf.jacobians[a], wf.residual, g_.data() + block_offset_[block[a]]);
+    int free[64];  // positions of the factor's free variables
+    const int nf = FreePositions(block, n, free);
+    for (int i = 0; i < nf; ++i)
+      AddGradient(wf.jacobians[free[i]], wf.residual, g_.data() + block_offset_[block[free[i]]]);
     int pair = pair_begin_[k];
-    for (int a = 0; a < n; ++a) {
-      if (block[a] < 0) continue;
-      for (int b = 0; b < n; ++b) {
-        if (block[b] < 0 || block[a] > block[b]) continue;
+    for (int i = 0; i < nf; ++i) {
+      const int a = free[i];
+      for (int j = 0; j < nf; ++j) {
+        const int b = free[j];
+        if (block[a] > block[b]) continue;
         AddProduct(wf.jacobians[a], wf.jacobians[b], values + pair_value_[pair++], column_length_[block[b]]);
       }
     }
@@ -399,10 +432,59 @@ bool NormalEquations::CostWithLastWhitening(const Graph& /*graph*/, double* cost
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
     double c = 0.0;
     const FactorEntry& entry = *entries_[k];
-    if (!FactorCostAt(entry, &values_[var_begin_[k]], SqrtCovariance(entry, whitened_[k]), &c)) return false;
+    if (!FactorCostAt(entry, &values_[var_begin_[k]], SqrtCovariance(entry, linearized_[k].whitened), &c))
+      return false;
     *cost += c;
   }
   return true;
+}
+
+bool NormalEquations::LinearizeForCost(double* cost) {
+  *cost = 0.0;
+  for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
+    double c = 0.0;
+    if (!LinearizeAndRecord(k, &c)) return false;
+    *cost += c;
+  }
+  return true;
+}
+
+bool NormalEquations::Current(std::size_t k) const {
+  const FactorLinearization& l = linearized_[k];
+  if (l.id != factor_ids_[k] || l.entry != entries_[k] || l.mask != want_[k]) return false;
+  const std::vector<Manifold>& manifolds = entries_[k]->factor->manifolds();
+  const double* at = l.at.data();
+  for (int v = var_begin_[k]; v < var_begin_[k + 1]; ++v) {
+    const int n = manifolds[v - var_begin_[k]].ambient_dim();
+    if (std::memcmp(at, values_[v], n * sizeof(double)) != 0) return false;
+    at += n;
+  }
+  return true;
+}
+
+bool NormalEquations::LinearizeAndRecord(std::size_t k, double* previous_cost) {
+  FactorLinearization& l = linearized_[k];
+  const int v0 = var_begin_[k];
+  if (!LinearizeFactorAt(*entries_[k], &values_[v0], want_[k], &l.whitened, previous_cost)) {
+    l.id = -1;
+    return false;
+  }
+  l.id = factor_ids_[k];
+  l.entry = entries_[k];
+  l.mask = want_[k];
+  l.at.clear();
+  const std::vector<Manifold>& manifolds = entries_[k]->factor->manifolds();
+  for (int v = v0; v < var_begin_[k + 1]; ++v)
+    l.at.insert(l.at.end(), values_[v], values_[v] + manifolds[v - v0].ambient_dim());
+  return true;
+}
+
+const WhitenedFactor* NormalEquations::LinearizationAt(FactorId id, std::uint64_t want_mask) const {
+  const auto it = std::lower_bound(factor_ids_.begin(), factor_ids_.end(), id);
+  if (it == factor_ids_.end() || *it != id) return nullptr;
+  const std::size_t k = static_cast<std::size_t>(it - factor_ids_.begin());
+  if (want_[k] != want_mask || !Current(k)) return nullptr;
+  return &linearized_[k].whitened;
 }
 
 bool NormalEquations::Solve(double lambda, Eigen::VectorXd* dx) {

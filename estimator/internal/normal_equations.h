@@ -45,6 +45,16 @@ class NormalEquations {
   // the same objective it was computed for).
   bool CostWithLastWhitening(const Graph& graph, double* cost) const;
 
+  // The same cost, from a linearization of every factor at the current values, which is kept: the next Linearize at
+  // these values (the next iteration once the step is taken, or the next solve of a window that slid) only adds it
+  // up, and LinearizationAt hands it out. For a step that is always taken (Gauss-Newton), where the trial point is
+  // the next linearization point.
+  bool LinearizeForCost(double* cost);
+
+  // The kept linearization of factor `id` when it was computed at the graph's current values with the Jacobians of
+  // exactly the variables in want_mask (bit i: variable i), otherwise null. The factor must still be in the graph.
+  const WhitenedFactor* LinearizationAt(FactorId id, std::uint64_t want_mask) const;
+
   // Solves (H + lambda diag(H)) dx = -g. Returns false if the matrix is not positive definite.
   bool Solve(double lambda, Eigen::VectorXd* dx);
 
@@ -84,6 +94,7 @@ class NormalEquations {
   };
   std::vector<VariableSlot> variable_table_;  // every variable of the graph, sorted by id
   std::vector<int> dims_;                                // per block
+  std::vector<char> full_column_;                        // per block: its column holds every row block before it
   std::vector<int> block_offset_;                        // per block: first column
   int dimension_ = 0;
 
@@ -98,7 +109,21 @@ class NormalEquations {
   std::vector<const double*> values_;
   std::vector<int> pair_begin_;
   std::vector<std::ptrdiff_t> pair_value_;
-  std::vector<WhitenedFactor> whitened_;
+  // Per included factor, its last linearization and the point it was computed at: Linearize evaluates a factor again
+  // only when its variables' values (bit for bit), its entry or its Jacobians' mask changed since.
+  struct FactorLinearization {
+    WhitenedFactor whitened;
+    FactorId id = -1;  // the factor it belongs to, -1: none yet
+    const FactorEntry* entry = nullptr;
+    std::uint64_t mask = 0;
+    std::vector<double> at;  // the factor's variables' ambient values, concatenated
+  };
+  std::vector<FactorLinearization> linearized_;
+  std::vector<FactorLinearization> prev_linearized_;
+  std::vector<bool> taken_scratch_;          // Reset: which of prev_linearized_ found their factor
+  std::vector<std::size_t> fresh_scratch_;   // Reset: factors new since the last Reset
+  bool Current(std::size_t k) const;  // linearized_[k] holds factor k at the current values
+  bool LinearizeAndRecord(std::size_t k, double* previous_cost);
 
   std::vector<VariableId> var_id_;  // per factor variable, as var_block_
 
