@@ -202,8 +202,14 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
       const SolverSummary s = Solve(update_options, &builder.graph(), request, &workspace);
       if (!s.usable()) return Status::Error("update at t = " + FormatSeconds(m.t) + " failed: " + s.message);
       iterations += s.iterations;
-      if (config.gate_probability && GateOutliers(*config.gate_probability, &builder, first_new_factor) > 0)
+      if (config.gate_probability && GateOutliers(*config.gate_probability, &builder, first_new_factor) > 0) {
+        // Without a gated measurement the window may not factor (a gated odometer factor leaves the newest pose's
+        // position free until the next samples attach), and the Schur complement EmitOldest would fall back to runs
+        // through that singular block: keep the leaving pose's covariance from before the gate then.
+        const CovarianceRequest before_gate = leaving;
         iterations += Solve(update_options, &builder.graph(), request, &workspace).iterations;
+        if (request != nullptr && !leaving.computed && before_gate.computed) leaving = before_gate;
+      }
       const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
       ++out.updates;
       update_seconds += dt;
