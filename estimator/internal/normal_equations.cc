@@ -263,18 +263,20 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   // Such a window (poses in time order, then constant parameters) is a band with a dense border: eliminated in its
   // own order it has no fill outside each column's envelope (its rows from the first coupled one to the diagonal), so
   // it is factored there directly, densely per column (FactorEnvelope), which spares CHOLMOD's row-by-row sparse
-  // triangular solves on so small a system. With time-varying parameters (instances after the poses) CHOLMOD and a
-  // fill-reducing ordering are still needed.
+  // triangular solves on so small a system. Time-varying parameters' instances, stamped with their pose and created
+  // with it, sit next to it in that order (FreeVariableOrder) and only widen the band.
   const bool natural_before = natural_order_;
   natural_order_ = false;
   if (dimension_ <= kMaxSimplicialDimension) {
     natural_order_ = true;
+    bool constants = false;  // the stamped variables must all come first
     for (int b = 0; b < nb; ++b) {
       const Variable& v = graph.variable(order_[b]);
       if (v.stamp.has_value()) {
-        natural_order_ &= v.manifold.kind() == ManifoldKind::kPose;
+        natural_order_ &= !constants;
         continue;
       }
+      constants = true;
       rows_of_[b].resize(b + 1);
       for (int r = 0; r <= b; ++r) rows_of_[b][r] = r;
     }
