@@ -31,13 +31,15 @@ const std::vector<ModelSpec>& ModelSpecs() {
   static const std::vector<ModelSpec> specs = {
       // slip_per_mps2 and slope_slip_per_mps2: the driven tires' slip per m/s^2 of forward specific force (read from
       // inputs.specific_force, an imu or accelerometer stream, along options.forward_in_sensor) and of slope g
-      // sin(pitch) (models/ackermann_velocity.h).
+      // sin(pitch); disturbance: the speed, lateral and vertical rows' coloured disturbance [m/s], meant to be
+      // time-varying (models/ackermann_velocity.h).
       {"ackermann",
        {"speed", "steering"},
        {"speed_mps", "steering_rad", "lateral_mps", "vertical_mps"},
        {ScalarSlot("kv_over_L", std::numeric_limits<double>::quiet_NaN()), ScalarSlot("k_theta", 1.0),
         ScalarSlot("k_gamma", 0.0), ScalarSlot("cornering_front", 0.0), ScalarSlot("cornering_rear", 0.0),
-        ScalarSlot("thrust_angle", 0.0), ScalarSlot("slip_per_mps2", 0.0), ScalarSlot("slope_slip_per_mps2", 0.0)},
+        ScalarSlot("thrust_angle", 0.0), ScalarSlot("slip_per_mps2", 0.0), ScalarSlot("slope_slip_per_mps2", 0.0),
+        Vector3Slot("disturbance", 0.0)},
        {"wheelbase_m", "speed_column", "contact_height_m", "pitch_lever_m", "forward_in_sensor"},
        true, {"specific_force"}},
       {"ackermann_seed",
@@ -168,6 +170,14 @@ class Parser {
     return out;
   }
 
+  // A process setting of a 3-vector parameter: one number for every component, or a list of three.
+  Eigen::Vector3d PerComponent(const YAML::Node& node, const std::string& what) const {
+    const std::vector<double> v = Numbers(node, what);
+    if (v.size() == 1) return Eigen::Vector3d::Constant(v[0]);
+    if (v.size() != 3) Fail(node, what + " must be a number or a list of 3 numbers (one per component)");
+    return Eigen::Vector3d(v[0], v[1], v[2]);
+  }
+
   bool Bool(const YAML::Node& node, const std::string& what) const {
     try {
       return node.as<bool>();
@@ -239,15 +249,16 @@ class Parser {
       } else if (type == "gauss_markov") {
         p.process.type = ProcessConfig::Type::kGaussMarkov;
         if (!pr["tau_s"]) Fail(pr, "parameter '" + name + "': gauss_markov needs tau_s");
-        p.process.tau_s = Number(pr["tau_s"], "process.tau_s");
-        if (!(p.process.tau_s > 0)) Fail(pr, "parameter '" + name + "': tau_s must be positive");
+        p.process.tau_s = PerComponent(pr["tau_s"], "parameters." + name + ".process.tau_s");
+        if (!(p.process.tau_s.array() > 0).all()) Fail(pr, "parameter '" + name + "': tau_s must be positive");
       } else if (type != "constant") {
         Fail(pr, "parameter '" + name + "': process.type must be constant, random_walk or gauss_markov");
       }
       if (p.process.type != ProcessConfig::Type::kConstant) {
         if (!pr["sigma"]) Fail(pr, "parameter '" + name + "': process needs sigma");
-        p.process.sigma = Number(pr["sigma"], "process.sigma");
-        if (!(p.process.sigma > 0)) Fail(pr, "parameter '" + name + "': process sigma must be positive");
+        p.process.sigma = PerComponent(pr["sigma"], "parameters." + name + ".process.sigma");
+        if (!(p.process.sigma.array() > 0).all())
+          Fail(pr, "parameter '" + name + "': process sigma must be positive");
       }
     }
     return p;

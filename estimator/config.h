@@ -11,6 +11,9 @@
 //   parameters:                            # any parameter not listed here keeps its model default and is fixed
 //     gps.lever_arm: {value: [0, 0, 0], free: true}
 //     imu.gyro_bias: {value: [0, 0, 0], free: true, process: {type: random_walk, sigma: 1.0e-4}}
+//     odometer.disturbance: {value: [0, 0, 0], free: true,   # per component: a list of three (Gauss-Markov:
+//                            process: {type: gauss_markov, sigma: [0.01, 0.002, 0.03], tau_s: [0.5, 1.2, 1.8]}}
+//                                          # a stationary prior N(0, sigma^2) on the first instance)
 //   streams:
 //     odometer:
 //       model: ackermann
@@ -56,8 +59,10 @@ namespace roamlab::estimator {
 struct ProcessConfig {
   enum class Type { kConstant, kRandomWalk, kGaussMarkov };
   Type type = Type::kConstant;
-  double sigma = 0.0;   // random walk: units/sqrt(s); Gauss-Markov: stationary std in the parameter's units
-  double tau_s = 0.0;   // Gauss-Markov correlation time
+  // Per component of the (3-vector) parameter; EST.yaml gives one number for all three or a list of three.
+  Eigen::Vector3d sigma = Eigen::Vector3d::Zero();  // random walk: units/sqrt(s); Gauss-Markov: stationary std in
+                                                    // the parameter's units
+  Eigen::Vector3d tau_s = Eigen::Vector3d::Zero();  // Gauss-Markov correlation time [s]
 };
 
 struct ParameterConfig {

@@ -498,17 +498,27 @@ VariableId ProblemBuilder::CreatePose(Time t, const Eigen::VectorXd& value) {
                                        : graph_.variable(poses_.back().instances.at(pname)).value;
     const VariableId id = graph_.AddVariable({pname, Manifold::Euclidean(3), init, !pc.free, t});
     node.instances[pname] = id;
-    if (first) continue;
+    const Eigen::Vector3d& sigma = pc.process.sigma;
+    if (first) {
+      // A Gauss-Markov process starts from its stationary distribution, N(0, sigma^2) (a random walk from anywhere).
+      if (pc.process.type == ProcessConfig::Type::kGaussMarkov && pc.free) {
+        graph_.AddFactor(MakeFactor(PriorError<Vector3Block>(Eigen::Vector3d::Zero())), {id},
+                         Eigen::Matrix3d(sigma.array().square().matrix().asDiagonal()), Loss::Trivial(), pname, t);
+      }
+      continue;
+    }
     const double dt = SecondsBetween(poses_.back().t, t);
     const VariableId prev = poses_.back().instances.at(pname);
     if (pc.process.type == ProcessConfig::Type::kRandomWalk) {
-      graph_.AddFactor(MakeFactor(RandomWalkError<3>(dt)), {prev, id},
-                       Eigen::Matrix3d::Identity() * pc.process.sigma * pc.process.sigma * dt, Loss::Trivial(),
-                       pname, t);
+      const RandomWalkError<3> process(dt);
+      Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+      for (int i = 0; i < 3; ++i) covariance(i, i) = process.NoiseVariance(sigma[i]);
+      graph_.AddFactor(MakeFactor(process), {prev, id}, covariance, Loss::Trivial(), pname, t);
     } else {
-      const double var = pc.process.sigma * pc.process.sigma * (1.0 - std::exp(-2.0 * dt / pc.process.tau_s));
-      graph_.AddFactor(MakeFactor(GaussMarkovError<3>(dt, pc.process.tau_s)), {prev, id},
-                       Eigen::Matrix3d::Identity() * var, Loss::Trivial(), pname, t);
+      const GaussMarkovError<3> process(dt, pc.process.tau_s);
+      Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+      for (int i = 0; i < 3; ++i) covariance(i, i) = process.NoiseVariance(sigma[i], i);
+      graph_.AddFactor(MakeFactor(process), {prev, id}, covariance, Loss::Trivial(), pname, t);
     }
   }
   poses_.push_back(node);
@@ -626,7 +636,7 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     if (model == "ackermann") {
       const double f_x = s.specific_force ? s.forward_in_sensor.dot(SpecificForceAt(s, m.t)) : 0.0;
       factor = MakeFactor(AckermannVelocityError(z_v, z_theta, s.wheelbase_m, dt, s.contact, f_x));
-      vars.insert(vars.end(), {slot(3, k), slot(4, k), slot(5, k), slot(6, k), slot(7, k)});
+      vars.insert(vars.end(), {slot(3, k), slot(4, k), slot(5, k), slot(6, k), slot(7, k), slot(8, k)});
     } else {
       factor = MakeFactor(AckermannOdometerError(z_v, z_theta, s.wheelbase_m, dt));
     }

@@ -33,13 +33,13 @@ const char* TerminationName(Termination termination) {
 }
 
 std::vector<VariableId> FreeVariableOrder(const Graph& graph) {
-  std::vector<VariableId> poses, others;
+  std::vector<VariableId> stamped, others;
   for (const auto& [id, v] : graph.variables()) {
     if (v.fixed) continue;
-    (v.manifold.kind() == ManifoldKind::kPose ? poses : others).push_back(id);
+    (v.stamp.has_value() ? stamped : others).push_back(id);
   }
-  poses.insert(poses.end(), others.begin(), others.end());
-  return poses;
+  stamped.insert(stamped.end(), others.begin(), others.end());
+  return stamped;
 }
 
 namespace {

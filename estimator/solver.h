@@ -99,7 +99,8 @@ class SolverWorkspace {
   std::vector<double> saved_;
 };
 
-// Optimizes the free variables of `graph` in place. Variables are ordered poses first then the others, in id order;
+// Optimizes the free variables of `graph` in place. Variables are ordered in id order, the stamped ones first (poses
+// and time-varying parameters' instances, each created after its pose), then the others;
 // CHOLMOD picks its own fill-reducing permutation on top. When `covariance` is given, fills it (computed = false if the
 // Hessian is not positive definite). `workspace` (optional) carries buffers and the symbolic factorization over to the
 // next solve.

@@ -43,6 +43,9 @@ Status EmitOldest(ProblemBuilder* builder, const CovarianceRequest* known, const
     if (!info.ok()) return info.status();
     cov = info.value().information.inverse();
   }
+  // The marginal covariance is symmetric; the solves and the inverse above are so only to rounding, which on a badly
+  // conditioned window exceeds what a consumer's symmetry check (eval::PositionNees: 1e-9) allows.
+  cov = (0.5 * (cov + cov.transpose())).eval();
   const StampedPose pose{node.t, p.p_world_body, p.q_world_body};
   if (options.on_pose) {
     options.on_pose(pose, cov.topLeftCorner<3, 3>());
@@ -201,8 +204,14 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
       if (!s.usable()) return Status::Error("update at t = " + FormatSeconds(m.t) + " failed: " + s.message);
       iterations += s.iterations;
       if (config.gate_probability &&
-          GateOutliers(*config.gate_probability, &builder, first_new_factor, &workspace) > 0)
+          GateOutliers(*config.gate_probability, &builder, first_new_factor, &workspace) > 0) {
+        // Without a gated measurement the window may not factor (a gated odometer factor leaves the newest pose's
+        // position free until the next samples attach), and the Schur complement EmitOldest would fall back to runs
+        // through that singular block: keep the leaving pose's covariance from before the gate then.
+        const CovarianceRequest before_gate = leaving;
         iterations += Solve(update_options, &builder.graph(), request, &workspace).iterations;
+        if (request != nullptr && !leaving.computed && before_gate.computed) leaving = before_gate;
+      }
       const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
       ++out.updates;
       update_seconds += dt;

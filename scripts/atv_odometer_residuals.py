@@ -9,7 +9,11 @@ poses of O (eq. 7 inverted, as the estimator does) and the true calibration, and
 estimator/models/ackermann_velocity.h: their RMS, 1/e correlation time and white-noise equivalent (the per-sample
 sigma of white noise with the same low-frequency power, sqrt of the summed autocovariance over +-3 s), at O and at the
 rear ground contact (--height below O, vertical chord lever --lever), and least-squares slopes on the body rates and
-the lateral acceleration. Standard library only.
+the lateral acceleration, and each row's split into a first-order Gauss-Markov part (stationary sigma, correlation
+time tau) and a white part, with the fit's white equivalent (the Bartlett-weighted sum above, over +-3 s, falls short
+of it for correlation times of a second or more). Last, the IMU's rows against the same poses: their model error
+(the readings are instantaneous samples, the estimator's rates and accelerations come from the poses). Standard
+library only.
 """
 import argparse
 import csv
@@ -78,6 +82,25 @@ def white_equivalent(a, lags):
     return math.sqrt(max(s, 0.0))
 
 
+def gauss_markov_fit(a, dt):
+    """First-order Gauss-Markov part plus white noise: (sigma, tau, white) with the autocovariance sigma^2
+    exp(-|lag| dt / tau) + white^2 [lag = 0]. tau from the lags >= 1 (the 1/e point of c(lag) / c(1), one lag added
+    back), sigma^2 = c(1) exp(dt / tau) (c extrapolated to lag 0), white^2 = c(0) - sigma^2."""
+    a = centred(a)
+    n = len(a)
+
+    def c(lag):
+        return sum(a[i] * a[i + lag] for i in range(n - lag)) / n
+    c0, c1 = c(0), c(1)
+    tau = float("nan")
+    for lag in range(2, n // 2):
+        if c(lag) < c1 * math.exp(-1):
+            tau = (lag - 1) * dt
+            break
+    sigma2 = min(c1 * math.exp(dt / tau), c0)
+    return math.sqrt(sigma2), tau, math.sqrt(max(c0 - sigma2, 0.0))
+
+
 def least_squares(y, columns):
     """Slopes of y on [1, columns...] and the residual RMS (normal equations, Gauss-Jordan)."""
     X = [[1.0] + [c[i] for c in columns] for i in range(len(y))]
@@ -134,6 +157,10 @@ def main():
             rows = list(csv.reader(open(os.path.join(rec, name))))[1:]
             return {round(float(r[0]) * 1e3): float(r[1]) for r in rows}
         speed, steering = column("rear_wheel.csv"), column("steering.csv")
+        misalignment = [float(x) for x in
+                        re.search(r"imu.misalignment: *\[([^\]]*)\]", truth).group(1).split(",")]
+        imu = {round(float(r[0]) * 1e3): [float(x) for x in r[1:7]]
+               for r in list(csv.reader(open(os.path.join(rec, "imu.csv"))))[1:]}
     samples = []
     for (t0, p0, q0), (t1, p1, q1) in zip(poses, poses[1:]):
         key = round(t0 * 1e3)
@@ -185,6 +212,49 @@ def main():
             for name, a in (("lateral v_y [m/s]", lat_left), ("steering [rad]", str_left)):
                 print("  %-32s %+8.4f %8.4f %8.2f %10.4f" % (name, sum(a) / len(a), rms(a), correlation_time(a, dt),
                                                            white_equivalent(a, lags)))
+            print("  Gauss-Markov part + white part at the contact (after cornering):")
+            print("  %-32s %8s %8s %8s %10s" % ("", "GM sigma", "GM tau", "white", "white-eq"))
+            for name, a in (("speed [m/s]", rows["speed [m/s]"]), ("lateral v_y [m/s]", lat_left),
+                            ("vertical v_z [m/s]", rows["vertical v_z [m/s]"]), ("steering [rad]", str_left)):
+                sigma, tau, white = gauss_markov_fit(a, dt)
+                # The fitted process's power at zero frequency as white noise per sample: the Gauss-Markov part's
+                # autocovariance summed over all lags, sigma^2 (1 + rho) / (1 - rho) with rho = exp(-dt / tau).
+                rho = math.exp(-dt / tau)
+                print("  %-32s %8.4f %8.2f %8.4f %10.4f" % (name, sigma, tau, white,
+                                                           math.sqrt(sigma ** 2 * (1 + rho) / (1 - rho) + white ** 2)))
+
+    imu_rows(poses, imu, misalignment, args.t0)
+
+
+def block_equivalent(a, n):
+    """Per-sample sigma of white noise whose sums over n samples spread as a's do (a's mean removed)."""
+    a = centred(a)
+    sums = [sum(a[i:i + n]) for i in range(0, len(a) - n + 1, n)]
+    return math.sqrt(sum(x * x for x in sums) / len(sums) / n)
+
+
+def imu_rows(poses, imu, misalignment, t0_s):
+    """The IMU's rows against the true poses of O (IMU at O, true misalignment): the gyroscope's reading against the
+    rate over the interval that starts at it (Log(q_k^-1 q_k+1) / dt), the accelerometer's against the specific
+    force from the second difference of the positions at the middle pose (estimator/models/gyroscope.h,
+    accelerometer.h). Per body axis: rms, and the per-sample sigma of white noise whose sums over 0.2 s and 1 s
+    spread alike (a white error keeps it; a slow one grows)."""
+    gyro, accel = [], []
+    for (_, p0, _), (t1, p1, q1), (t2, p2, q2) in zip(poses, poses[1:], poses[2:]):
+        key = round(t1 * 1e3)
+        if t1 < t0_s or key not in imu:
+            continue
+        dt = t2 - t1
+        gyro.append([r - w / dt for r, w in zip(rotate(misalignment, imu[key][:3]), qlog(qmul(qconj(q1), q2)))])
+        a_world = [(c - 2 * b + a) / (dt * dt) for a, b, c in zip(p0, p1, p2)]
+        a_world[2] += 9.80665
+        accel.append([r - f for r, f in zip(rotate(misalignment, imu[key][3:]), rotate(qconj(q1), a_world))])
+    n = round(0.2 / dt), round(1.0 / dt)
+    print("IMU rows against the true poses (body axes x, y, z): rms; white equivalent over 0.2 s and 1 s")
+    for name, rows in (("gyroscope [rad/s]", gyro), ("accelerometer [m/s^2]", accel)):
+        print("  %-22s %s" % (name, "   ".join(
+            "%s %.4f; %.4f %.4f" % ("xyz"[i], rms([r[i] for r in rows]), block_equivalent([r[i] for r in rows], n[0]),
+                                   block_equivalent([r[i] for r in rows], n[1])) for i in range(3))))
 
 
 if __name__ == "__main__":

@@ -146,12 +146,16 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   block_offset_.clear();
   full_column_.assign(nb, 0);
   dimension_ = 0;
-  bool stamped_poses_only = true;  // every time-stamped variable is a pose (natural order, below)
+  bool stamped_first = true;  // every time-stamped variable comes before the constant ones (natural order, below)
+  bool constants_seen = false;
   for (int b = 0; b < nb; ++b) {
     const Variable& v = graph.variable(order_[b]);
     ROAMLAB_CHECK(!v.fixed, "variable '" << v.name << "' is fixed but was ordered as free");
     full_column_[b] = !v.stamp.has_value();
-    if (v.stamp.has_value()) stamped_poses_only &= v.manifold.kind() == ManifoldKind::kPose;
+    if (v.stamp.has_value())
+      stamped_first &= !constants_seen;
+    else
+      constants_seen = true;
     block_of_id_.emplace_back(order_[b], b);
     dims_.push_back(v.manifold.tangent_dim());
     block_offset_.push_back(dimension_);
@@ -274,10 +278,10 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   // Such a window (poses in time order, then constant parameters) is a band with a dense border: eliminated in its
   // own order it has no fill outside each column's envelope (its rows from the first coupled one to the diagonal), so
   // it is factored there directly, densely per column (FactorEnvelope), which spares CHOLMOD's row-by-row sparse
-  // triangular solves on so small a system. With time-varying parameters (instances after the poses) CHOLMOD and a
-  // fill-reducing ordering are still needed.
+  // triangular solves on so small a system. Time-varying parameters' instances, stamped with their pose and created
+  // with it, sit next to it in that order (FreeVariableOrder) and only widen the band.
   const bool natural_before = natural_order_;
-  natural_order_ = dimension_ <= kMaxSimplicialDimension && stamped_poses_only;
+  natural_order_ = dimension_ <= kMaxSimplicialDimension && stamped_first;
   for (int b = 0; b < nb; ++b) {
     if (!full_column_[b]) continue;
     rows_of_[b].resize(b + 1);

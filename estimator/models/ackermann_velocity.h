@@ -12,8 +12,8 @@
 //   z_v_hat     = v_roll sigma / k_v                                     k_v = kv_over_L * L
 //   delta       = atan((L omega_z + v_y) / v_x) + c_front a_y            steered angle of the front wheels
 //   z_theta_hat = (delta - k_gamma) / k_theta                           (eq. 15: omega_z = (k_v / L) v tan(delta))
-//   e = [z_v_hat - z_v;  z_theta_hat - z_theta;  v_y - v_x tan(alpha) + c_rear a_y;  v_z - d omega_y] + eta
-//                                                                        e in R^4
+//   e = [z_v_hat - z_v + w_v;  z_theta_hat - z_theta;  v_y - v_x tan(alpha) + c_rear a_y + w_lat;
+//        v_z - d omega_y + w_vert] + eta                                 e in R^4
 //
 // Ground contact (h [m], d [m]; both 0 by default, eq. 15 at O). Eq. 15's constraints hold where the rear tires touch
 // the ground, not at O when O is at the wheel centres, h = the wheel radius above the contact: a chassis pitching at
@@ -45,6 +45,13 @@
 // IMU's misalignment free, a rotation of O by alpha absorbs the crab, and only alpha sin^2(delta), their difference on
 // the steering row, is left). alpha = 0 (the default) is the model above.
 //
+// Coloured disturbance w = (w_v, w_lat, w_vert) [m/s] (slot disturbance, default 0 and constant): what the speed,
+// lateral and vertical rows still see once the terms above are modelled is not white (suspension and terrain: on the
+// MuJoCo ATV 1/e correlation times of 0.5-1.8 s, scripts/atv_odometer_residuals.py). Declared time-varying with a
+// first-order Gauss-Markov process per component (EST.yaml: process {type: gauss_markov, sigma: [...], tau_s: [...]}),
+// w is one more state per pose that the IMU and the GPS can observe, instead of white noise that claims to average
+// out over a second; eta keeps the white part.
+//
 // Why not the seed's form (ackermann_odometer.h, eqs. 7-8 with the readings as inputs): there the reading noise
 // passes through the nonlinear model, so the error covariance of eq. 1 depends on the parameters, and the
 // Gauss-Newton fixed point (which holds the covariance constant within an iteration) regresses the precise motion on
@@ -66,14 +73,14 @@
 // Frames: O is the middle of the rear axle (x forward, z up). Measurements: z_v rear-wheel speed with the nominal
 // wheel radius [m/s], z_theta handlebar angle [rad], both over [t_k, t_k+1]; input f_x [m/s^2]. Calibration:
 // kv_over_L [1/m], k_theta [-], k_gamma [rad], c_front [rad s^2/m], c_rear [s], alpha [rad], s_f [s^2/m], s_p
-// [s^2/m]; the wheelbase L [m], h and d [m] are known. Noise eta =
+// [s^2/m], w [m/s]; the wheelbase L [m], h and d [m] are known. Noise eta =
 // [sigma_v (m/s), sigma_theta (rad), lateral (m/s), vertical (m/s)], the last two the uncertainty of the non-holonomic
 // assumptions (no unmodelled sideways slip, no motion off the ground). Eq. 15 says nothing about roll and pitch
 // rates, and on hills they are not zero (the terrain tilts the vehicle): pretending they are pulls the estimated
 // attitude flat and biases the IMU misalignment, so this form leaves them to the other sensors. Below
 // kMinSteeringSpeed the steering angle does not affect the motion, so its error is zero (eta only).
 // Variables: pose at t_k, pose at t_k+1 (PoseBlock), kv_over_L, k_theta, k_gamma, c_front, c_rear, alpha, s_f, s_p
-// (ScalarBlock each).
+// (ScalarBlock each), w (Vector3Block).
 //
 // Jacobians (Linearize; internal/so3_jacobians.h for Jr, Jr^-1, Jl^-1 = (Jr^-1)^T). VelocitiesBetween computes
 // phi = Log(q_k^-1 q_k+1), omega = phi / dt, q_mid = q_k Exp(phi / 2) and v = R_mid^T (p_k+1 - p_k) / dt, so
@@ -89,7 +96,8 @@
 // Parameters: de_v/dkv_over_L = -v_roll sigma / (kv_over_L^2 L), de_theta/dk_theta = -(delta - k_gamma) / k_theta^2,
 // de_theta/dk_gamma = -1 / k_theta, de_theta/dc_front = a_y / k_theta, de_lat/dc_rear = a_y,
 // de_v/dalpha = (v_y cos(alpha) - v_x sin(alpha)) sigma / k_v, de_lat/dalpha = -v_x (1 + tan^2(alpha)),
-// de_v/ds_f = v_roll f_x / k_v, de_v/ds_p = v_roll g sin(theta) / k_v.
+// de_v/ds_f = v_roll f_x / k_v, de_v/ds_p = v_roll g sin(theta) / k_v; de/dw: ones at (speed, w_v), (lateral, w_lat),
+// (vertical, w_vert).
 #pragma once
 
 #include <cmath>
@@ -115,7 +123,7 @@ class AckermannVelocityError {
  public:
   using Blocks =
       std::tuple<PoseBlock, PoseBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock,
-                 ScalarBlock, ScalarBlock>;
+                 ScalarBlock, ScalarBlock, Vector3Block>;
   static constexpr int kResidualDim = 4;
   static constexpr int kNoiseDim = 4;
   static constexpr bool kAdditiveNoise = true;  // e = f(x) + eta
@@ -155,21 +163,22 @@ class AckermannVelocityError {
     const T& alpha = x[7][0];
     const T& slip_f = x[8][0];
     const T& slip_p = x[9][0];
+    const T* const w = x[10];
     const T a_y = v_body.x() * omega_body.z();
     const T v_roll = v_body.x() * cos(alpha) + v_body.y() * sin(alpha);
     // The pitch of O at the middle of the interval, as VelocitiesBetween's q_mid.
     const Quaternion<T> q_mid = pose_k.q_world_body * QuaternionExp<T>(omega_body * T(0.5 * dt_s_));
     const T sin_pitch = (q_mid * Vector3<T>::UnitX()).z();
     const T slip = T(1.0) + slip_f * T(forward_specific_force_mps2_) + slip_p * T(kStandardGravity) * sin_pitch;
-    error[0] = v_roll * slip / (kv_over_l * T(wheelbase_m_)) - T(z_v_mps_) + noise[0];
+    error[0] = v_roll * slip / (kv_over_l * T(wheelbase_m_)) - T(z_v_mps_) + w[0] + noise[0];
     if (std::abs(ValueOf(v_body.x())) >= kMinSteeringSpeed) {
       const T delta = atan((T(wheelbase_m_) * omega_body.z() + v_body.y()) / v_body.x()) + c_front * a_y;
       error[1] = (delta - k_gamma) / k_theta - T(z_theta_rad_) + noise[1];
     } else {
       error[1] = noise[1];
     }
-    error[2] = v_body.y() - v_body.x() * tan(alpha) + c_rear * a_y + noise[2];
-    error[3] = v_body.z() - T(contact_.pitch_lever_m) * omega_body.y() + noise[3];
+    error[2] = v_body.y() - v_body.x() * tan(alpha) + c_rear * a_y + w[1] + noise[2];
+    error[3] = v_body.z() - T(contact_.pitch_lever_m) * omega_body.y() + w[2] + noise[3];
     return true;
   }
 
@@ -186,6 +195,7 @@ class AckermannVelocityError {
     const double alpha = x[7][0];
     const double slip_f = x[8][0];
     const double slip_p = x[9][0];
+    const double* const w = x[10];
     const double cos_alpha = std::cos(alpha), sin_alpha = std::sin(alpha), tan_alpha = std::tan(alpha);
 
     // VelocitiesBetween, keeping the rotation vector and q_mid.
@@ -203,13 +213,13 @@ class AckermannVelocityError {
     const Eigen::Matrix3d R_mid = q_mid.toRotationMatrix();
     const double sin_pitch = R_mid(2, 0);
     const double slip = 1.0 + slip_f * forward_specific_force_mps2_ + slip_p * kStandardGravity * sin_pitch;
-    error[0] = v_roll * slip / k_v - z_v_mps_;
+    error[0] = v_roll * slip / k_v - z_v_mps_ + w[0];
     const bool steering = std::abs(v_body.x()) >= kMinSteeringSpeed;
     const double r = steering ? (wheelbase_m_ * omega_body.z() + v_body.y()) / v_body.x() : 0.0;
     const double delta = steering ? std::atan(r) + c_front * a_y : 0.0;
     error[1] = steering ? (delta - k_gamma) / k_theta - z_theta_rad_ : 0.0;
-    error[2] = v_body.y() - v_body.x() * tan_alpha + c_rear * a_y;
-    error[3] = v_body.z() - d * omega_body.y();
+    error[2] = v_body.y() - v_body.x() * tan_alpha + c_rear * a_y + w[1];
+    error[3] = v_body.z() - d * omega_body.y() + w[2];
     if (jacobians == nullptr) return true;
 
     // Rows of the residual in the motion: de/dv (4x3, v the contact's velocity) and de/domega (4x3) at fixed v.
@@ -283,6 +293,11 @@ class AckermannVelocityError {
     }
     if (jacobians[9] != nullptr) {
       Eigen::Map<Eigen::Vector4d>{jacobians[9]} << v_roll * kStandardGravity * sin_pitch / k_v, 0.0, 0.0, 0.0;
+    }
+    if (jacobians[10] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, 4, 3>> J_e_w(jacobians[10]);
+      J_e_w.setZero();
+      J_e_w(0, 0) = J_e_w(2, 1) = J_e_w(3, 2) = 1.0;
     }
     return true;
   }

@@ -6,6 +6,8 @@
 //   e = x(t_k+1) - x(t_k) + eta,                         eta ~ N(0, sigma^2 dt I)                 e, eta in R^N
 // First-order Gauss-Markov process (dx/dt = -x / tau + w), exact discretization:
 //   e = x(t_k+1) - exp(-dt / tau) x(t_k) + eta,          eta ~ N(0, sigma^2 (1 - exp(-2 dt / tau)) I)
+// per component i with its own tau_i and sigma_i when the components are independent processes of different
+// correlation times (eta's covariance then diagonal).
 //
 // Units: x in the parameter's own units [u]. dt = t_k+1 - t_k [s], tau = correlation time [s]. For the random walk,
 // sigma is the random-walk density [u/sqrt(s)]; for the Gauss-Markov process, sigma is the stationary standard
@@ -54,32 +56,36 @@ template <int N>
 class GaussMarkovError {
  public:
   using Blocks = std::tuple<VectorBlock<N>, VectorBlock<N>>;
+  using Vector = Eigen::Matrix<double, N, 1>;
   static constexpr int kResidualDim = N;
   static constexpr int kNoiseDim = N;
   static constexpr bool kAdditiveNoise = true;  // e = f(x) + eta
 
-  // dt_s = t_k+1 - t_k > 0, tau_s = correlation time > 0.
-  GaussMarkovError(double dt_s, double tau_s) : dt_s_(dt_s), tau_s_(tau_s), decay_(std::exp(-dt_s / tau_s)) {
-    ROAMLAB_CHECK(dt_s > 0.0 && tau_s > 0.0, "Gauss-Markov dt " << dt_s << " tau " << tau_s);
+  // dt_s = t_k+1 - t_k > 0, tau_s = correlation time > 0 (of every component, or of each).
+  GaussMarkovError(double dt_s, double tau_s) : GaussMarkovError(dt_s, Vector::Constant(tau_s)) {}
+  GaussMarkovError(double dt_s, const Vector& tau_s)
+      : dt_s_(dt_s), tau_s_(tau_s), decay_((-dt_s / tau_s.array()).exp().matrix()) {
+    ROAMLAB_CHECK(dt_s > 0.0 && (tau_s.array() > 0.0).all(),
+                  "Gauss-Markov dt " << dt_s << " tau " << tau_s.transpose());
   }
 
   template <typename T>
   bool operator()(const T* const* x, const T* noise, T* error) const {
-    for (int i = 0; i < N; ++i) error[i] = x[1][i] - T(decay_) * x[0][i] + noise[i];
+    for (int i = 0; i < N; ++i) error[i] = x[1][i] - T(decay_[i]) * x[0][i] + noise[i];
     return true;
   }
 
-  // Variance of each noise component for a stationary standard deviation sigma [u]: sigma^2 (1 - exp(-2 dt / tau)).
-  double NoiseVariance(double sigma) const { return sigma * sigma * -std::expm1(-2.0 * dt_s_ / tau_s_); }
+  // Variance of component i's noise for a stationary standard deviation sigma [u]: sigma^2 (1 - exp(-2 dt / tau_i)).
+  double NoiseVariance(double sigma, int i = 0) const { return sigma * sigma * -std::expm1(-2.0 * dt_s_ / tau_s_[i]); }
   double dt_s() const { return dt_s_; }
-  double tau_s() const { return tau_s_; }
-  // exp(-dt / tau), the factor applied to the value at t_k.
-  double decay() const { return decay_; }
+  double tau_s(int i = 0) const { return tau_s_[i]; }
+  // exp(-dt / tau_i), the factor applied to component i of the value at t_k.
+  double decay(int i = 0) const { return decay_[i]; }
 
  private:
   double dt_s_;
-  double tau_s_;
-  double decay_;
+  Vector tau_s_;
+  Vector decay_;
 };
 
 }  // namespace roamlab::estimator

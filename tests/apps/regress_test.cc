@@ -32,8 +32,8 @@ std::string Source(const std::string& name) { return std::string(ROAMLAB_SOURCE_
 // The ATV tracking configuration with the synthetic drive's calibration (seed Table I, tests/support/synthetic.h)
 // and a noise value replaced: tracking with known parameters (no calibration prior), whose consistency then depends
 // on the noise levels. The synthetic drive is eq. 15's rigid vehicle: the MuJoCo ATV's measured physics (rows at the
-// ground contact, cornering compliance, the model residual in the odometer's noise) is replaced by none, and the
-// odometer's noise by the generator's sensor noise.
+// ground contact, cornering compliance, the odometer's coloured disturbance (held at zero) and the model residual in
+// the odometer's and the IMU's noise) is replaced by none, and the noise by the generator's sensor noise.
 std::string TrackingConfig(const std::string& from, const std::string& to) {
   std::string text = testing::ReadFile(Source("atv_tracking.yaml"));
   const std::pair<std::string, std::string> replacements[] = {
@@ -46,8 +46,11 @@ std::string TrackingConfig(const std::string& from, const std::string& to) {
       {"odometer.cornering_front: {value: 0.0047}", "odometer.cornering_front: {value: 0.0}"},
       {"odometer.cornering_rear: {value: 0.0207}", "odometer.cornering_rear: {value: 0.0}"},
       {"options: {contact_height_m: 0.28, pitch_lever_m: 0.625}", "options: {contact_height_m: 0, pitch_lever_m: 0}"},
-      {"noise: {speed_mps: 0.064, steering_rad: 0.032, lateral_mps: 0.025, vertical_mps: 0.36}",
+      {"odometer.disturbance: {value: [0, 0, 0], free: true,", "odometer.disturbance: {value: [0, 0, 0], free: false,"},
+      {"noise: {speed_mps: 0.033, steering_rad: 0.039, lateral_mps: 0.02, vertical_mps: 0.05}",
        "noise: {speed_mps: 0.033, steering_rad: 0.014, lateral_mps: 0.02, vertical_mps: 0.1}"},
+      {"noise: {sigma_radps: 0.037}", "noise: {sigma_radps: 0.033}"},
+      {"noise: {sigma_mps2: 0.087}", "noise: {sigma_mps2: 0.067}"},
       {from, to}};
   for (const auto& [a, b] : replacements) {
     const std::size_t at = text.find(a);

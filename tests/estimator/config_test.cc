@@ -43,6 +43,30 @@ TEST(ConfigTest, RejectsUnknownKeysModelsAndMissingNoise) {
   ExpectError(Replace(good, "method: levenberg_marquardt", "method: newton"), "solver.method");
 }
 
+// A time-varying parameter's process: one sigma and tau for all three components, or one per component.
+TEST(ConfigTest, ProcessSigmaAndTauAreOneNumberOrOnePerComponent) {
+  const std::string good = testing::AtvConfigYaml({});
+  // The parameter list precedes `streams:`.
+  const auto parameter = [&](const std::string& process) {
+    return Replace(good, "streams:\n",
+                   "  odometer.disturbance: {value: [0, 0, 0], free: true, process: " + process + "}\nstreams:\n");
+  };
+  auto config = ParseEstimatorConfig(
+      parameter("{type: gauss_markov, sigma: [0.006, 0.002, 0.025], tau_s: [0.7, 1.2, 1.8]}"), "est.yaml");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  const ProcessConfig& gm = config.value().parameters.at("odometer.disturbance").process;
+  EXPECT_EQ(gm.type, ProcessConfig::Type::kGaussMarkov);
+  EXPECT_TRUE(gm.sigma.isApprox(Eigen::Vector3d(0.006, 0.002, 0.025)));
+  EXPECT_TRUE(gm.tau_s.isApprox(Eigen::Vector3d(0.7, 1.2, 1.8)));
+  config = ParseEstimatorConfig(parameter("{type: random_walk, sigma: 1.0e-4}"), "est.yaml");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  EXPECT_TRUE(config.value().parameters.at("odometer.disturbance").process.sigma.isApprox(
+      Eigen::Vector3d::Constant(1.0e-4)));
+  ExpectError(parameter("{type: gauss_markov, sigma: [0.006, 0.002], tau_s: 1.0}"), "a list of 3 numbers");
+  ExpectError(parameter("{type: gauss_markov, sigma: 0.01, tau_s: [0.7, -1.2, 1.8]}"), "tau_s must be positive");
+  ExpectError(parameter("{type: gauss_markov, sigma: [0.01, 0, 0.01], tau_s: 1.0}"), "sigma must be positive");
+}
+
 // The magnetometer's motor-interference proxy reads another recording stream through `inputs` (models/magnetometer.h);
 // a model accepts only its own input roles.
 TEST(ConfigTest, MagnetometerTakesTheSpecificForceInput) {

@@ -207,14 +207,16 @@ SmallProblem AckermannProblem(bool noisy, std::uint32_t seed) {
   AddFreeParameter("kv_over_L", Manifold::Euclidean(1), scalar(1.0 / kWheelbaseM), scalar(kv_over_l), &problem);
   AddFreeParameter("k_theta", Manifold::Euclidean(1), scalar(1.0), scalar(k_theta), &problem);
   AddFreeParameter("k_gamma", Manifold::Euclidean(1), scalar(0.0), scalar(k_gamma), &problem);
-  // The measurement form's cornering compliances, thrust angle and slips, held at zero: the drive does not slip, and at
-  // its constant speed the understeer c_front v^2 tan(delta) / L would be indistinguishable from k_theta.
-  constexpr bool kCornering = std::tuple_size_v<typename Model::Blocks> == 10;
+  // The measurement form's cornering compliances, thrust angle, slips and disturbance, held at zero: the drive does not
+  // slip, and at its constant speed the understeer c_front v^2 tan(delta) / L would be indistinguishable from k_theta.
+  constexpr bool kCornering = std::tuple_size_v<typename Model::Blocks> == 11;
   std::vector<VariableId> compliances;
   if constexpr (kCornering) {
     for (const char* name : {"cornering_front", "cornering_rear", "thrust_angle", "slip_per_mps2",
                              "slope_slip_per_mps2"})
       compliances.push_back(problem.graph.AddVariable({name, Manifold::Euclidean(1), scalar(0.0), true, std::nullopt}));
+    compliances.push_back(problem.graph.AddVariable(
+        {"disturbance", Manifold::Euclidean(3), Eigen::VectorXd::Zero(3), true, std::nullopt}));
   }
   for (std::size_t k = 0; k < drive.speed_mps.size(); ++k) {
     const Eigen::VectorXd noise = GaussianNoise(2, NoiseSigma(noisy, 1.0), &rng).cwiseProduct(sigma.head<2>());

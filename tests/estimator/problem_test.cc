@@ -37,6 +37,55 @@ TEST(ProblemBuilderTest, OnePosePerMasterSampleAndEveryMeasurementAccountedFor) 
   }
 }
 
+// The odometer's disturbance as a Gauss-Markov process with its own sigma and tau per row: one instance per pose,
+// joined by process factors whose noise is sigma_i^2 (1 - exp(-2 dt / tau_i)) per component, and a stationary prior
+// N(0, sigma^2) on the first instance; the odometer's factors read the instance at their interval's start.
+TEST(ProblemBuilderTest, GaussMarkovDisturbanceHasAProcessPerComponentAndAStationaryStart) {
+  const auto synthetic = ShortDrive();
+  EstimatorConfig config = testing::AtvConfig({});
+  ParameterConfig disturbance;
+  disturbance.value = Eigen::VectorXd(Eigen::Vector3d::Zero());
+  disturbance.free = true;
+  disturbance.process.type = ProcessConfig::Type::kGaussMarkov;
+  disturbance.process.sigma = Eigen::Vector3d(0.006, 0.002, 0.025);
+  disturbance.process.tau_s = Eigen::Vector3d(0.7, 1.2, 1.8);
+  config.parameters["odometer.disturbance"] = disturbance;
+  auto built = ProblemBuilder::Create(config, synthetic.recording);
+  ASSERT_TRUE(built.ok()) << built.status().message();
+  ProblemBuilder& builder = *built.value();
+  for (const MeasurementRef& m : builder.Measurements()) builder.Add(m);
+  builder.Finish();
+  ASSERT_TRUE(builder.IsTimeVarying("odometer.disturbance"));
+  const Graph& graph = builder.graph();
+  int process = 0, prior = 0, odometer = 0;
+  for (const auto& [id, f] : graph.factors()) {
+    if (f.stream == "odometer.disturbance" && f.variables.size() == 2) {
+      ++process;
+      const double dt = SecondsBetween(*graph.variable(f.variables[0]).stamp, *graph.variable(f.variables[1]).stamp);
+      for (int i = 0; i < 3; ++i) {
+        const double expected = std::pow(disturbance.process.sigma[i], 2) *
+                                (1.0 - std::exp(-2.0 * dt / disturbance.process.tau_s[i]));
+        EXPECT_NEAR(f.noise_covariance(i, i), expected, 1e-12 * expected) << i;
+      }
+      EXPECT_DOUBLE_EQ(f.noise_covariance(0, 1), 0.0);
+    } else if (f.stream == "odometer.disturbance") {
+      ++prior;
+      EXPECT_EQ(f.variables[0], builder.poses().front().instances.at("odometer.disturbance"));
+      EXPECT_TRUE(f.noise_covariance.diagonal().isApprox(disturbance.process.sigma.array().square().matrix()));
+    } else if (f.stream == "odometer") {
+      ++odometer;
+      // Poses k and k+1, the eight scalars, then the disturbance at pose k.
+      ASSERT_EQ(f.variables.size(), 11u);
+      const Variable& instance = graph.variable(f.variables[10]);
+      EXPECT_EQ(instance.name, "odometer.disturbance");
+      EXPECT_EQ(*instance.stamp, *graph.variable(f.variables[0]).stamp);
+    }
+  }
+  EXPECT_EQ(process, static_cast<int>(builder.poses().size()) - 1);
+  EXPECT_EQ(prior, 1);
+  EXPECT_GT(odometer, 0);
+}
+
 TEST(ProblemBuilderTest, AcceptsOutOfOrderMeasurements) {
   // All odometry first, then the GPS fixes newest first: every fix still lands on the pose nearest its time.
   const auto synthetic = ShortDrive();

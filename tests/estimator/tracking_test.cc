@@ -93,7 +93,7 @@ EstimatorConfig WithRandomWalkGyroBias(EstimatorConfig config) {
   bias.value = Eigen::VectorXd(Eigen::Vector3d::Zero());
   bias.free = true;
   bias.process.type = ProcessConfig::Type::kRandomWalk;
-  bias.process.sigma = 1.0e-3;
+  bias.process.sigma = Eigen::Vector3d::Constant(1.0e-3);
   config.parameters["imu.gyro_bias"] = bias;
   return config;
 }

@@ -14,6 +14,10 @@ namespace {
 constexpr double kL = 1.25;
 
 Eigen::VectorXd Scalar(double x) { return Eigen::VectorXd::Constant(1, x); }
+// The rows' coloured disturbance (w_v, w_lat, w_vert) [m/s].
+Eigen::VectorXd Disturbance(double w_v = 0.0, double w_lat = 0.0, double w_vert = 0.0) {
+  return Eigen::Vector3d(w_v, w_lat, w_vert);
+}
 
 // Pose after dt on a planar arc at forward speed v, side slip v_y and yaw rate omega, from pose0 (eq. 7 is exact for
 // a constant twist only up to the chord; VelocitiesBetween inverts eq. 7 exactly, so build pose1 with PredictPose).
@@ -37,7 +41,7 @@ TEST(AckermannVelocityErrorTest, ZeroAtTruthForTableIAndSkewedGains) {
     const auto factor = MakeFactor(AckermannVelocityError(z_v, z_theta, kL, dt));
     const auto lin = testing::Evaluate(*factor, {pose0, Step(pose0, v, omega, dt), Scalar(kv_over_l), Scalar(k_theta),
                                                  Scalar(k_gamma), Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0),
-                                                 Scalar(0.0)});
+                                                 Scalar(0.0), Disturbance()});
     EXPECT_LT(lin.error.norm(), 1e-10);
     EXPECT_TRUE(lin.noise_jacobian.isApprox(Eigen::MatrixXd::Identity(4, 4)));
   }
@@ -49,7 +53,7 @@ TEST(AckermannVelocityErrorTest, SpeedErrorScalesWithGain) {
   const auto factor = MakeFactor(AckermannVelocityError(4.0 / kL / 0.8, 0.0, kL, 0.01));
   const auto lin = testing::Evaluate(*factor, {pose0, Step(pose0, 4.0, 0.0, 0.01), Scalar(0.88), Scalar(1.0),
                                                Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0),
-                                               Scalar(0.0)});
+                                               Scalar(0.0), Disturbance()});
   EXPECT_NEAR(lin.error[0], 4.0 / kL / 0.88 - 4.0 / kL / 0.8, 1e-12);
 }
 
@@ -57,7 +61,7 @@ TEST(AckermannVelocityErrorTest, SteeringIgnoredAtStandstill) {
   const Eigen::VectorXd pose0 = Manifold::Pose().Identity();
   const auto factor = MakeFactor(AckermannVelocityError(0.0, 0.3, kL, 0.01));
   const auto lin = testing::Evaluate(*factor, {pose0, pose0, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
-                                               Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0)});
+                                               Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0), Disturbance()});
   EXPECT_LT(lin.error.norm(), 1e-12);
 }
 
@@ -71,11 +75,11 @@ TEST(AckermannVelocityErrorTest, CorneringComplianceExplainsSideSlipAndUnderstee
   const Eigen::VectorXd pose1 = Step(pose0, v, omega, dt, v_y);
   const auto factor = MakeFactor(AckermannVelocityError(v / kL / 0.8, delta, kL, dt));
   const auto lin = testing::Evaluate(*factor, {pose0, pose1, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(c_front),
-                                               Scalar(c_rear), Scalar(0.0), Scalar(0.0), Scalar(0.0)});
+                                               Scalar(c_rear), Scalar(0.0), Scalar(0.0), Scalar(0.0), Disturbance()});
   EXPECT_LT(lin.error.norm(), 1e-10) << lin.error.transpose();
   // Without the compliances the same motion leaves the side slip and the understeer as errors.
   const auto rigid = testing::Evaluate(*factor, {pose0, pose1, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
-                                                 Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0)});
+                                                 Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0), Disturbance()});
   EXPECT_NEAR(rigid.error[1], -c_front * a_y, 1e-9);
   EXPECT_NEAR(rigid.error[2], v_y, 1e-9);
 }
@@ -89,12 +93,12 @@ TEST(AckermannVelocityErrorTest, ThrustAngleExplainsCrabAndTurnAtZeroHandlebar) 
   const Eigen::VectorXd pose1 = Step(pose0, v, omega, dt, v_y);
   const auto factor = MakeFactor(AckermannVelocityError(v / std::cos(alpha) / kL / 0.8, 0.0, kL, dt));
   const auto lin = testing::Evaluate(*factor, {pose0, pose1, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
-                                               Scalar(0.0), Scalar(alpha), Scalar(0.0), Scalar(0.0)});
+                                               Scalar(0.0), Scalar(alpha), Scalar(0.0), Scalar(0.0), Disturbance()});
   EXPECT_LT(lin.error.norm(), 1e-10) << lin.error.transpose();
   // Without it the crab is a lateral error of v tan(alpha); the front axle still moves straight ahead, so the
   // steering row holds.
   const auto aligned = testing::Evaluate(*factor, {pose0, pose1, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
-                                                   Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0)});
+                                                   Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0), Disturbance()});
   EXPECT_NEAR(aligned.error[2], v_y, 1e-9);
   EXPECT_LT(std::abs(aligned.error[1]), 1e-9);
   EXPECT_NEAR(aligned.error[0], v - v / std::cos(alpha), 1e-9);
@@ -112,7 +116,8 @@ TEST(AckermannVelocityErrorTest, ContactBelowOExplainsPitchAndRollRates) {
   PoseToArray(PredictPose<double>(PoseFromArray(pose0.data()), v_odom, omega, dt), pose1.data());
   const double delta = std::atan(kL * omega.z() / v);
   const std::vector<Eigen::VectorXd> values = {pose0,       pose1,       Scalar(0.8), Scalar(1.0), Scalar(0.0),
-                                               Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0)};
+                                               Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0),
+                                               Disturbance()};
   const auto contact = MakeFactor(AckermannVelocityError(v / kL / 0.8, delta, kL, dt, {h, d}));
   const auto lin = testing::Evaluate(*contact, values);
   EXPECT_LT(lin.error.norm(), 1e-9) << lin.error.transpose();
@@ -136,18 +141,41 @@ TEST(AckermannVelocityErrorTest, LongitudinalSlipFollowsTractionAndSlope) {
   const double z_v = v * (1.0 + s_f * f_x + s_p * g_sin) / kL / 0.8;
   const auto factor = MakeFactor(AckermannVelocityError(z_v, 0.0, kL, dt, {}, f_x));
   const auto lin = testing::Evaluate(*factor, {pose0, pose1, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
-                                               Scalar(0.0), Scalar(0.0), Scalar(s_f), Scalar(s_p)});
+                                               Scalar(0.0), Scalar(0.0), Scalar(s_f), Scalar(s_p), Disturbance()});
   EXPECT_LT(lin.error.norm(), 1e-10) << lin.error.transpose();
   // Without the slip the reading is too high by v (s_f f_x + s_p g sin(pitch)); on the flat (the same step at zero
   // pitch) only the traction's part is left for s_f to explain.
   const auto rigid = testing::Evaluate(*factor, {pose0, pose1, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
-                                                 Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0)});
+                                                 Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0), Disturbance()});
   EXPECT_NEAR(rigid.error[0], -v * (s_f * f_x + s_p * g_sin) / kL / 0.8, 1e-9);
   const Eigen::VectorXd flat0 = Manifold::Pose().Identity();
   const auto flat = testing::Evaluate(*factor, {flat0, Step(flat0, v, 0.0, dt), Scalar(0.8), Scalar(1.0),
                                                 Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(s_f),
-                                                Scalar(s_p)});
+                                                Scalar(s_p), Disturbance()});
   EXPECT_NEAR(flat.error[0], -v * s_p * g_sin / kL / 0.8, 1e-9);
+}
+
+TEST(AckermannVelocityErrorTest, DisturbanceAddsToTheSpeedLateralAndVerticalRows) {
+  // A straight run at 4 m/s whose wheel reads 0.05 m/s fast while O slides 0.02 m/s to the left and rises at 0.1 m/s:
+  // a disturbance w = (0.05 / k_v, -0.02, -0.1) of the speed, lateral and vertical rows explains it; the steering row
+  // (which sees the side slip at the front axle) does not see w.
+  const double v = 4.0, dt = 0.01, w_v = 0.05, v_y = 0.02, v_z = 0.1;
+  const Eigen::VectorXd pose0 = Manifold::Pose().Identity();
+  Eigen::VectorXd pose1(7);
+  PoseToArray(PredictPose<double>(PoseFromArray(pose0.data()), Eigen::Vector3d(v, v_y, v_z), Eigen::Vector3d::Zero(),
+                                  dt),
+              pose1.data());
+  const auto factor = MakeFactor(AckermannVelocityError((v + w_v) / kL / 0.8, 0.0, kL, dt));
+  std::vector<Eigen::VectorXd> values = {pose0,       pose1,       Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
+                                         Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0), Disturbance()};
+  const auto rigid = testing::Evaluate(*factor, values);
+  EXPECT_NEAR(rigid.error[0], -w_v / (0.8 * kL), 1e-9);
+  EXPECT_NEAR(rigid.error[2], v_y, 1e-9);
+  EXPECT_NEAR(rigid.error[3], v_z, 1e-9);
+  values.back() = Disturbance(w_v / (0.8 * kL), -v_y, -v_z);
+  const auto disturbed = testing::Evaluate(*factor, values);
+  for (const int row : {0, 2, 3}) EXPECT_NEAR(disturbed.error[row], 0.0, 1e-9) << row;
+  EXPECT_NEAR(disturbed.error[1], rigid.error[1], 1e-15);
 }
 
 TEST(AckermannVelocityErrorTest, JacobiansMatchCentralDifferences) {
@@ -161,7 +189,7 @@ TEST(AckermannVelocityErrorTest, JacobiansMatchCentralDifferences) {
       const auto factor = MakeFactor(AckermannVelocityError(4.0, 0.1, kL, 0.02, contact, 0.7 - 0.4 * trial));
       testing::ExpectJacobiansMatchNumeric(
           *factor, {pose0, pose1, Scalar(0.78), Scalar(1.02), Scalar(0.01), Scalar(0.004), Scalar(-0.015),
-                      Scalar(0.02), Scalar(0.03), Scalar(0.05)},
+                      Scalar(0.02), Scalar(0.03), Scalar(0.05), Disturbance(0.01, -0.004, 0.02)},
           1e-5);
     }
   }

@@ -260,6 +260,7 @@ TEST(AnalyticJacobiansTest, AckermannVelocity) {
     const double alpha = 0.03 * normal(rng);                                     // [rad]
     const double s_f = 0.03 * normal(rng), s_p = 0.03 * normal(rng);            // [s^2/m]
     const double f_x = normal(rng);                                             // [m/s^2]
+    const Eigen::VectorXd w = Eigen::Vector3d(0.01 * normal(rng), 0.005 * normal(rng), 0.03 * normal(rng));  // [m/s]
     const double z_v = v_body.x() / (kv_over_l * kWheelbase) + 0.03 * normal(rng);
     const double z_theta = 0.2 * normal(rng);
     // Every other point with the rows at a ground contact below O (options contact_height_m, pitch_lever_m).
@@ -267,7 +268,7 @@ TEST(AnalyticJacobiansTest, AckermannVelocity) {
         point % 2 ? AckermannVelocityError::Contact{0.28, 0.625} : AckermannVelocityError::Contact{};
     ExpectAnalyticMatchesJets(AckermannVelocityError(z_v, z_theta, kWheelbase, kDt, contact, f_x),
                               {pose_k, pose_k1, Scalar(kv_over_l), Scalar(k_theta), Scalar(k_gamma), Scalar(c_front),
-                               Scalar(c_rear), Scalar(alpha), Scalar(s_f), Scalar(s_p)},
+                               Scalar(c_rear), Scalar(alpha), Scalar(s_f), Scalar(s_p), w},
                               "point " + std::to_string(point));
   }
 }

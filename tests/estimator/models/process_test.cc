@@ -97,6 +97,26 @@ TEST(GaussMarkovErrorTest, JacobiansMatchCentralDifferences) {
   }
 }
 
+// Components with their own correlation times (the odometer's speed, lateral and vertical disturbance): each decays
+// by its own exp(-dt / tau_i) and keeps its own stationary spread.
+TEST(GaussMarkovErrorTest, PerComponentCorrelationTimes) {
+  std::mt19937 rng(36);
+  const double dt = 0.01;
+  const Eigen::Vector3d tau(0.68, 1.18, 1.82), sigma(0.0061, 0.0020, 0.0253);
+  const GaussMarkovError<3> model(dt, tau);
+  const Eigen::VectorXd x0 = RandomPoint(Manifold::Euclidean(3), &rng);
+  const Eigen::Vector3d decay = (-dt / tau.array()).exp();
+  const testing::Linearization lin = testing::Evaluate(*MakeFactor(model), {x0, x0});
+  EXPECT_LT((lin.error - (Eigen::Vector3d::Ones() - decay).cwiseProduct(x0)).norm(), 1e-15);
+  EXPECT_TRUE(lin.jacobians[0].isApprox(-Eigen::Matrix3d(decay.asDiagonal())));
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_DOUBLE_EQ(model.decay(i), decay[i]);
+    EXPECT_NEAR(decay[i] * decay[i] * sigma[i] * sigma[i] + model.NoiseVariance(sigma[i], i), sigma[i] * sigma[i],
+                1e-18);
+  }
+  testing::ExpectModelJacobiansMatchNumeric(model, {x0, RandomPoint(Manifold::Euclidean(3), &rng)});
+}
+
 TEST(ProcessErrorDeathTest, RejectsNonPositiveTimes) {
   EXPECT_DEATH(RandomWalkError<1>(0.0), "dt");
   EXPECT_DEATH(GaussMarkovError<1>(0.01, -1.0), "tau");
