@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -138,6 +140,8 @@ std::string SlotParameter(const std::string& stream, const estimator::StreamConf
   return mapped != sc.parameters.end() ? mapped->second : stream + "." + slot;
 }
 
+constexpr double kWarmInitialLambda = 1e-11;
+
 Result<FitOutcome> Fit(const EstimatorConfig& nominal, const Recording& recording, const FitSpec& spec) {
   EstimatorConfig config = nominal;
   std::vector<std::string> free;
@@ -155,12 +159,31 @@ Result<FitOutcome> Fit(const EstimatorConfig& nominal, const Recording& recordin
   if (spec.mode == FitMode::kFixed)
     for (auto& [name, p] : config.parameters) p.free = false;
 
+  // A warm or fixed fit starts next to its minimum: the staged fits' initial damping (relative to diag(H)) would
+  // dominate the weakly determined directions (a few calibration parameters that trade against each other) and
+  // Levenberg-Marquardt would spend a dozen iterations cutting it by 3 per step while the cost barely moves, or stop
+  // there on the function tolerance before the minimum. A damping that small still rises if a step is rejected.
+  if (spec.mode != FitMode::kStaged) config.solver.initial_lambda = kWarmInitialLambda;
   estimator::CalibrationOptions options;
   options.keep_residuals = spec.keep_residuals;
   options.analyze_observability = spec.observability;
   options.initial_trajectory = spec.initial;
+  const auto fit_start = std::chrono::steady_clock::now();
   auto result = estimator::Calibrate(config, Shifted(recording, spec.shift_s), options);
   if (!result.ok()) return result.status();
+  if (std::getenv("ROAMLAB_FIT_TRACE")) {
+    std::fprintf(stderr, "FIT mode=%d obs=%d iters=%d term=%s stages=%zu sec=%.3f chi2=%.4f\n", static_cast<int>(spec.mode),
+                 spec.observability ? 1 : 0, result.value().iterations, result.value().termination.c_str(),
+                 result.value().stages.size(),
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - fit_start).count(),
+                 2.0 * result.value().final_cost);
+    if (std::getenv("ROAMLAB_FIT_TRACE")[0] == '2')
+      for (const auto& st : result.value().stages) {
+        std::fprintf(stderr, "  HIST");
+        for (double c : st.solver.cost_history) std::fprintf(stderr, " %.6f", 2.0 * c);
+        std::fprintf(stderr, "\n");
+      }
+  }
   FitOutcome out;
   out.chi2 = 2.0 * result.value().final_cost;
   for (const auto& [name, p] : config.parameters)
@@ -808,12 +831,18 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
     const int k_max = static_cast<int>(std::floor(margin / period));
     const auto at = [&](int k) -> Result<double> {
       if (chi2_at.count(k)) return chi2_at[k].chi2;
+      // Warm-started from the nearest shift fitted so far (the poses follow the shifted stream, so the unshifted
+      // fit is a poor start far from 0).
+      int nearest = 0;
+      for (const auto& [j, g] : chi2_at)
+        if (std::abs(j - k) < std::abs(nearest - k)) nearest = j;
+      const GridFit* from = &chi2_at.at(nearest);
       FitSpec spec;
       spec.mode = FitMode::kWarm;
-      spec.values = base.train_values;
+      spec.values = from->values;
       spec.extra_free = base.extra_free;
       spec.shift_s = base.shift_s;
-      spec.initial = &base.train_trajectory;
+      spec.initial = &from->trajectory;
       for (const std::string& s : c.shifted) spec.shift_s[s] = k * period;
       auto fit = Fit(nominal, train, spec);
       ++out.fits;
