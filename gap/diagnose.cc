@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -168,22 +166,8 @@ Result<FitOutcome> Fit(const EstimatorConfig& nominal, const Recording& recordin
   options.keep_residuals = spec.keep_residuals;
   options.analyze_observability = spec.observability;
   options.initial_trajectory = spec.initial;
-  const auto fit_start = std::chrono::steady_clock::now();
   auto result = estimator::Calibrate(config, Shifted(recording, spec.shift_s), options);
   if (!result.ok()) return result.status();
-  if (std::getenv("ROAMLAB_FIT_TRACE")) {
-    std::fprintf(stderr, "FIT mode=%d obs=%d iters=%d term=%s stages=%zu sec=%.3f chi2=%.4f\n", static_cast<int>(spec.mode),
-                 spec.observability ? 1 : 0, result.value().iterations, result.value().termination.c_str(),
-                 result.value().stages.size(),
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - fit_start).count(),
-                 2.0 * result.value().final_cost);
-    if (std::getenv("ROAMLAB_FIT_TRACE")[0] == '2')
-      for (const auto& st : result.value().stages) {
-        std::fprintf(stderr, "  HIST");
-        for (double c : st.solver.cost_history) std::fprintf(stderr, " %.6f", 2.0 * c);
-        std::fprintf(stderr, "\n");
-      }
-  }
   FitOutcome out;
   out.chi2 = 2.0 * result.value().final_cost;
   for (const auto& [name, p] : config.parameters)
