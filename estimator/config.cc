@@ -1,5 +1,6 @@
 #include "estimator/config.h"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -242,7 +243,7 @@ class Parser {
     if (n["free"]) p.free = Bool(n["free"], "parameters." + name + ".free");
     if (n["process"]) {
       const YAML::Node& pr = n["process"];
-      CheckKeys(pr, {"type", "sigma", "tau_s"}, "parameter '" + name + "' process");
+      CheckKeys(pr, {"type", "sigma", "tau_s", "interval_s"}, "parameter '" + name + "' process");
       const std::string type = pr["type"] ? String(pr["type"], "process.type") : "";
       if (type == "random_walk") {
         p.process.type = ProcessConfig::Type::kRandomWalk;
@@ -259,6 +260,14 @@ class Parser {
         p.process.sigma = PerComponent(pr["sigma"], "parameters." + name + ".process.sigma");
         if (!(p.process.sigma.array() > 0).all())
           Fail(pr, "parameter '" + name + "': process sigma must be positive");
+      }
+      if (pr["interval_s"]) {
+        if (p.process.type == ProcessConfig::Type::kConstant)
+          Fail(pr["interval_s"], "parameter '" + name + "': process.interval_s needs a random_walk or gauss_markov "
+                                 "process");
+        p.process.interval_s = Number(pr["interval_s"], "parameters." + name + ".process.interval_s");
+        if (!(p.process.interval_s > 0.0) || !std::isfinite(p.process.interval_s))
+          Fail(pr["interval_s"], "parameter '" + name + "': process.interval_s must be a positive number of seconds");
       }
     }
     return p;

@@ -14,6 +14,8 @@
 //     odometer.disturbance: {value: [0, 0, 0], free: true,   # per component: a list of three (Gauss-Markov:
 //                            process: {type: gauss_markov, sigma: [0.01, 0.002, 0.03], tau_s: [0.5, 1.2, 1.8]}}
 //                                          # a stationary prior N(0, sigma^2) on the first instance)
+//                            # optional in process: interval_s: 0.1, one instance per 0.1 s shared by its poses
+//                            # instead of one per pose (positive; for processes much slower than the master rate)
 //   streams:
 //     odometer:
 //       model: ackermann
@@ -63,6 +65,9 @@ struct ProcessConfig {
   Eigen::Vector3d sigma = Eigen::Vector3d::Zero();  // random walk: units/sqrt(s); Gauss-Markov: stationary std in
                                                     // the parameter's units
   Eigen::Vector3d tau_s = Eigen::Vector3d::Zero();  // Gauss-Markov correlation time [s]
+  // Spacing of the instances [s]; 0: one per pose. With a spacing, the poses within interval_s of an instance's first
+  // pose share it (problem.h), and the process joins consecutive instances over their actual time difference.
+  double interval_s = 0.0;
 };
 
 struct ParameterConfig {

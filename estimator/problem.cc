@@ -490,10 +490,19 @@ VariableId ProblemBuilder::CreatePose(Time t, const Eigen::VectorXd& value) {
   PoseNode node;
   node.t = t;
   node.id = graph_.AddVariable({"pose", Manifold::Pose(), value, false, t});
-  // Time-varying parameter instances, joined to the previous instance by their process.
+  // Time-varying parameter instances, joined to the previous instance by their process. With a spacing, a pose less
+  // than interval_s after the current instance's first pose shares that instance (1 us of slack for stamps rounded
+  // to the master period).
   for (const auto& [pname, pc] : im.parameter_config) {
     if (pc.process.type == ProcessConfig::Type::kConstant) continue;
     const bool first = poses_.empty();
+    if (!first && pc.process.interval_s > 0.0) {
+      const VariableId current = poses_.back().instances.at(pname);
+      if (SecondsBetween(*graph_.variable(current).stamp, t) < pc.process.interval_s - 1e-6) {
+        node.instances[pname] = current;
+        continue;
+      }
+    }
     const Eigen::VectorXd init = first ? im.parameter_initial.at(pname)
                                        : graph_.variable(poses_.back().instances.at(pname)).value;
     const VariableId id = graph_.AddVariable({pname, Manifold::Euclidean(3), init, !pc.free, t});
@@ -507,8 +516,8 @@ VariableId ProblemBuilder::CreatePose(Time t, const Eigen::VectorXd& value) {
       }
       continue;
     }
-    const double dt = SecondsBetween(poses_.back().t, t);
     const VariableId prev = poses_.back().instances.at(pname);
+    const double dt = SecondsBetween(*graph_.variable(prev).stamp, t);
     if (pc.process.type == ProcessConfig::Type::kRandomWalk) {
       const RandomWalkError<3> process(dt);
       Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();

@@ -18,7 +18,10 @@
 //
 // Parameters are variables named "<stream>.<slot>" unless the configuration maps a slot to another name (shared
 // parameters, e.g. one IMU misalignment for gyroscope, accelerometer and magnetometer). A time-varying parameter
-// (random walk or Gauss-Markov) has one instance per pose, joined by process factors.
+// (random walk or Gauss-Markov) has one instance per pose, joined by process factors; with process.interval_s, one
+// instance per interval instead: a pose starts a new instance (stamped with its time) when it comes at least
+// interval_s after the current instance's stamp, and otherwise shares the current one (PoseNode::instances then holds
+// the same variable for consecutive poses). The process factor joining two instances spans their stamps' difference.
 #pragma once
 
 #include <deque>
@@ -48,7 +51,8 @@ struct MeasurementRef {
 struct PoseNode {
   Time t;
   VariableId id = -1;
-  std::map<std::string, VariableId> instances;  // time-varying parameters at this pose
+  std::map<std::string, VariableId> instances;  // time-varying parameters at this pose (under a process.interval_s
+                                                // shared by the consecutive poses of one interval)
 };
 
 struct StreamCounts {

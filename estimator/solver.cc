@@ -1,8 +1,14 @@
 #include "estimator/solver.h"
 
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
 #include <sstream>
 
 #include "estimator/internal/normal_equations.h"
@@ -33,13 +39,46 @@ const char* TerminationName(Termination termination) {
 }
 
 std::vector<VariableId> FreeVariableOrder(const Graph& graph) {
-  std::vector<VariableId> stamped, others;
+  // Stamped variables by (key, rank, id): a pose at its stamp (rank 1); an instance at the stamp of the next instance
+  // of its parameter (rank 0: before the pose that starts it), the newest at the end. Instances of one parameter are
+  // created in time order, so the next one is the next of that name in id order. (With one instance per pose this is
+  // each pose followed by its instances, their id order.)
+  struct Stamped {
+    std::int64_t key;
+    int rank;
+    VariableId id;
+    bool fixed;
+  };
+  std::vector<Stamped> stamped;
+  std::vector<VariableId> others;
+  std::vector<std::pair<const std::string*, std::size_t>> newest;  // per parameter: its last instance so far
   for (const auto& [id, v] : graph.variables()) {
-    if (v.fixed) continue;
-    (v.stamp.has_value() ? stamped : others).push_back(id);
+    if (!v.stamp.has_value()) {
+      if (!v.fixed) others.push_back(id);
+      continue;
+    }
+    if (v.name == "pose") {
+      stamped.push_back({v.stamp->nanoseconds(), 1, id, v.fixed});
+      continue;
+    }
+    const auto same = std::find_if(newest.begin(), newest.end(), [&](const auto& n) { return *n.first == v.name; });
+    if (same != newest.end()) {
+      stamped[same->second].key = v.stamp->nanoseconds();
+      same->second = stamped.size();
+    } else {
+      newest.emplace_back(&v.name, stamped.size());
+    }
+    stamped.push_back({std::numeric_limits<std::int64_t>::max(), 0, id, v.fixed});
   }
-  stamped.insert(stamped.end(), others.begin(), others.end());
-  return stamped;
+  std::sort(stamped.begin(), stamped.end(), [](const Stamped& a, const Stamped& b) {
+    return std::tie(a.key, a.rank, a.id) < std::tie(b.key, b.rank, b.id);
+  });
+  std::vector<VariableId> order;
+  order.reserve(stamped.size() + others.size());
+  for (const Stamped& s : stamped)
+    if (!s.fixed) order.push_back(s.id);
+  order.insert(order.end(), others.begin(), others.end());
+  return order;
 }
 
 namespace {

@@ -99,8 +99,9 @@ class SolverWorkspace {
   std::vector<double> saved_;
 };
 
-// Optimizes the free variables of `graph` in place. Variables are ordered in id order, the stamped ones first (poses
-// and time-varying parameters' instances, each created after its pose), then the others;
+// Optimizes the free variables of `graph` in place. Variables are ordered in time, the stamped ones first (poses and
+// time-varying parameters' instances; each instance after the last pose it serves, just before the pose that starts
+// the next instance of the same parameter, the newest after every pose: a band), then the others in id order;
 // CHOLMOD picks its own fill-reducing permutation on top. When `covariance` is given, fills it (computed = false if the
 // Hessian is not positive definite). `workspace` (optional) carries buffers and the symbolic factorization over to the
 // next solve.

@@ -79,7 +79,10 @@ Status EmitAndMarginalizeOldest(ProblemBuilder* builder, const CovarianceRequest
   if (!emitted.ok()) return emitted;
   const PoseNode& node = builder->poses().front();
   std::vector<VariableId> leaving = {node.id};
-  for (const auto& [name, id] : node.instances) leaving.push_back(id);
+  // A time-varying parameter's instance leaves with the last pose that uses it (process.interval_s: poses share one).
+  const PoseNode* next = builder->poses().size() > 1 ? &builder->poses()[1] : nullptr;
+  for (const auto& [name, id] : node.instances)
+    if (next == nullptr || next->instances.at(name) != id) leaving.push_back(id);
   if (!Marginalize(leaving, &builder->graph(), last_solve))
     return Status::Error("marginalization failed at t = " + FormatSeconds(node.t));
   builder->PopOldestPose();

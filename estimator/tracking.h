@@ -2,7 +2,8 @@
 // a pose, the window is re-optimized by Gauss-Newton until the improvement drops under a threshold, an iteration cap
 // or a time budget, gross outliers are gated, and poses beyond the window length are marginalized into a linear prior
 // on their Markov blanket (marginalization.h). Calibration parameters are fixed at their calibrated values;
-// time-varying ones declared free (for example a random-walk gyro bias) are tracked with the poses.
+// time-varying ones declared free (for example a random-walk gyro bias) are tracked with the poses; an instance shared
+// by several poses (process.interval_s) leaves the window with the last of them.
 //
 // Output: each pose's estimate and position covariance at the moment it leaves the window (a fixed-lag smoother with a
 // lag of `window` master samples); poses still in the window at the end are reported from the final window.

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <type_traits>
 
 #include <Eigen/CholmodSupport>
 
@@ -278,8 +279,9 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   // Such a window (poses in time order, then constant parameters) is a band with a dense border: eliminated in its
   // own order it has no fill outside each column's envelope (its rows from the first coupled one to the diagonal), so
   // it is factored there directly, densely per column (FactorEnvelope), which spares CHOLMOD's row-by-row sparse
-  // triangular solves on so small a system. Time-varying parameters' instances, stamped with their pose and created
-  // with it, sit next to it in that order (FreeVariableOrder) and only widen the band.
+  // triangular solves on so small a system. Time-varying parameters' instances sit in that order after the last pose
+  // they serve (FreeVariableOrder) and only widen the band: an instance shared by the poses of an interval
+  // (process.interval_s) has a tall column (those poses), the poses' columns stay short.
   const bool natural_before = natural_order_;
   natural_order_ = dimension_ <= kMaxSimplicialDimension && stamped_first;
   for (int b = 0; b < nb; ++b) {
@@ -334,16 +336,23 @@ void NormalEquations::BuildPattern() {
   // The same block pattern as at the last call (a window that slid by one pose) keeps outer_ and H's pattern.
   const bool same_blocks = H_.rows() == dimension_ && pattern_dims_ == dims_ && pattern_rows_of_ == rows_of_;
   if (!same_blocks) {
+    // Sized once, each block column's first scalar column written and copied to the others.
+    std::size_t nonzeros = 0;
+    for (int b = 0; b < nb; ++b) nonzeros += static_cast<std::size_t>(column_length_[b]) * dims_[b];
     outer_.resize(dimension_ + 1);
-    inner_.clear();
+    inner_.resize(nonzeros);
+    int* out = inner_.data();
     for (int b = 0; b < nb; ++b) {
-      for (int j = 0; j < dims_[b]; ++j) {
-        outer_[block_offset_[b] + j] = static_cast<int>(inner_.size());
-        for (int r : rows_of_[b])
-          for (int i = 0; i < dims_[r]; ++i) inner_.push_back(block_offset_[r] + i);
+      const int* first = out;
+      for (int r : rows_of_[b])
+        for (int i = 0; i < dims_[r]; ++i) *out++ = block_offset_[r] + i;
+      outer_[block_offset_[b]] = static_cast<int>(first - inner_.data());
+      for (int j = 1; j < dims_[b]; ++j) {
+        outer_[block_offset_[b] + j] = static_cast<int>(out - inner_.data());
+        out = std::copy(first, first + column_length_[b], out);
       }
     }
-    outer_[dimension_] = static_cast<int>(inner_.size());
+    outer_[dimension_] = static_cast<int>(out - inner_.data());
 
     // A new pattern needs a new symbolic analysis; the same one keeps it.
     const bool same = H_.rows() == dimension_ && H_.nonZeros() == static_cast<Eigen::Index>(inner_.size()) &&
@@ -593,13 +602,28 @@ void SolveUpper(const Upper& u, Rhs& x) {
   }
 }
 
+// Calls f(std::integral_constant<int, N>{}) with N = d for the block sizes of the band's variables that have
+// fixed-size kernels (6: a pose, 3: a vector such as a time-varying parameter's instance), else N = Eigen::Dynamic.
+template <typename Function>
+void WithBlockSize(int d, Function&& f) {
+  if (d == 6) {
+    f(std::integral_constant<int, 6>{});
+  } else if (d == 3) {
+    f(std::integral_constant<int, 3>{});
+  } else {
+    f(std::integral_constant<int, Eigen::Dynamic>{});
+  }
+}
+
 // The band part Ua of an envelope factorization (NormalEquations::FactorEnvelope): block column b holds the row blocks
-// first_block[b]..b as one column-major matrix from u + start[b]. Block dimension D: 6 when every block is a pose
-// (fixed-size kernels), otherwise Eigen::Dynamic.
+// first_block[b]..b as one column-major matrix from u + start[b]. Block dimension D: 6 when every block is a pose,
+// otherwise Eigen::Dynamic, and then each block's kernels are picked by its size (WithBlockSize).
 template <int D>
 struct Band {
-  using Block = Eigen::Map<Eigen::Matrix<double, D, D>, 0, Eigen::OuterStride<>>;
-  using Rows = Eigen::Map<Eigen::Matrix<double, D, Eigen::Dynamic>, 0, Eigen::OuterStride<>>;
+  template <int R, int C>
+  using Block = Eigen::Map<Eigen::Matrix<double, R, C>, 0, Eigen::OuterStride<>>;
+  template <int R>
+  using Rows = Eigen::Map<Eigen::Matrix<double, R, Eigen::Dynamic>, 0, Eigen::OuterStride<>>;
   int blocks;
   const int* first_block;
   const int* offset;  // first scalar row of each block
@@ -607,49 +631,91 @@ struct Band {
   const std::ptrdiff_t* start;
   double* u;
 
+  // f(std::integral_constant<int, N>{}) with N the compile-time size of block k (D, or by WithBlockSize).
+  template <typename Function>
+  void Sized(int k, Function&& f) const {
+    if constexpr (D == Eigen::Dynamic) {
+      WithBlockSize(dims[k], f);
+    } else {
+      f(std::integral_constant<int, D>{});
+    }
+  }
   int height(int b) const { return static_cast<int>((start[b + 1] - start[b]) / dims[b]); }
-  // U(r, b), first_block[b] <= r <= b.
-  Block block(int r, int b) const {
-    return Block(u + start[b] + (offset[r] - offset[first_block[b]]), dims[r], dims[b],
-                 Eigen::OuterStride<>(height(b)));
+  // U(r, b), first_block[b] <= r <= b, as an R x C map (R, C: dims[r], dims[b] or Dynamic).
+  template <int R, int C>
+  Block<R, C> block(int r, int b) const {
+    return Block<R, C>(u + start[b] + (offset[r] - offset[first_block[b]]), dims[r], dims[b],
+                       Eigen::OuterStride<>(height(b)));
   }
   // Rows of block k of x (column stride ldx, m columns).
-  Rows rows(double* x, Eigen::Index ldx, Eigen::Index m, int k) const {
-    return Rows(x + offset[k], dims[k], m, Eigen::OuterStride<>(ldx));
+  template <int R>
+  Rows<R> rows(double* x, Eigen::Index ldx, Eigen::Index m, int k) const {
+    return Rows<R>(x + offset[k], dims[k], m, Eigen::OuterStride<>(ldx));
   }
 
   // Block Crout: U(r, b) = U(r, r)^-T (A(r, b) - sum_k U(k, r)^T U(k, b)) for r < b, over the row blocks k both
   // columns hold, and U(b, b)^T U(b, b) = A(b, b) - sum_k U(k, b)^T U(k, b). u holds A's upper triangle on entry.
   bool Factor() const {
-    for (int b = 0; b < blocks; ++b) {
-      for (int r = first_block[b]; r < b; ++r) {
-        Block x = block(r, b);
-        for (int k = std::max(first_block[r], first_block[b]); k < r; ++k)
-          x.noalias() -= block(k, r).transpose() * block(k, b);
-        SolveUpperTransposed(block(r, r), x);
-      }
-      Block d = block(b, b);
-      for (int k = first_block[b]; k < b; ++k) d.noalias() -= block(k, b).transpose() * block(k, b);
-      if (!UpperCholeskyInPlace(d)) return false;
+    bool ok = true;
+    for (int b = 0; b < blocks && ok; ++b) {
+      Sized(b, [&](auto nb) {
+        constexpr int B = decltype(nb)::value;
+        for (int r = first_block[b]; r < b; ++r) {
+          Sized(r, [&](auto nr) {
+            constexpr int R = decltype(nr)::value;
+            Block<R, B> x = block<R, B>(r, b);
+            for (int k = std::max(first_block[r], first_block[b]); k < r; ++k) {
+              Sized(k, [&](auto nk) {
+                constexpr int K = decltype(nk)::value;
+                x.noalias() -= block<K, R>(k, r).transpose() * block<K, B>(k, b);
+              });
+            }
+            SolveUpperTransposed(block<R, R>(r, r), x);
+          });
+        }
+        Block<B, B> d = block<B, B>(b, b);
+        for (int k = first_block[b]; k < b; ++k) {
+          Sized(k, [&](auto nk) {
+            constexpr int K = decltype(nk)::value;
+            d.noalias() -= block<K, B>(k, b).transpose() * block<K, B>(k, b);
+          });
+        }
+        ok = UpperCholeskyInPlace(d);
+      });
     }
-    return true;
+    return ok;
   }
   // x <- Ua^-T x over the band's rows of x, block by block (coefficient-wise products: a block is small, and x has
   // one column for a step, a few for a covariance, the border's for Ub).
   void Forward(double* x, Eigen::Index ldx, Eigen::Index m) const {
     for (int b = 0; b < blocks; ++b) {
-      Rows xb = rows(x, ldx, m, b);
-      for (int k = first_block[b]; k < b; ++k)
-        xb.noalias() -= block(k, b).transpose().lazyProduct(rows(x, ldx, m, k));
-      SolveUpperTransposed(block(b, b), xb);
+      Sized(b, [&](auto nb) {
+        constexpr int B = decltype(nb)::value;
+        Rows<B> xb = rows<B>(x, ldx, m, b);
+        for (int k = first_block[b]; k < b; ++k) {
+          Sized(k, [&](auto nk) {
+            constexpr int K = decltype(nk)::value;
+            xb.noalias() -= block<K, B>(k, b).transpose().lazyProduct(rows<K>(x, ldx, m, k));
+          });
+        }
+        SolveUpperTransposed(block<B, B>(b, b), xb);
+      });
     }
   }
   // x <- Ua^-1 x, block by block from the last.
   void Backward(double* x, Eigen::Index ldx, Eigen::Index m) const {
     for (int b = blocks - 1; b >= 0; --b) {
-      Rows xb = rows(x, ldx, m, b);
-      SolveUpper(block(b, b), xb);
-      for (int k = first_block[b]; k < b; ++k) rows(x, ldx, m, k).noalias() -= block(k, b).lazyProduct(xb);
+      Sized(b, [&](auto nb) {
+        constexpr int B = decltype(nb)::value;
+        Rows<B> xb = rows<B>(x, ldx, m, b);
+        SolveUpper(block<B, B>(b, b), xb);
+        for (int k = first_block[b]; k < b; ++k) {
+          Sized(k, [&](auto nk) {
+            constexpr int K = decltype(nk)::value;
+            rows<K>(x, ldx, m, k).noalias() -= block<K, B>(k, b).lazyProduct(xb);
+          });
+        }
+      });
     }
   }
 };

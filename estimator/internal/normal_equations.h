@@ -166,7 +166,8 @@ class NormalEquations {
   bool FactorEnvelope(const Eigen::SparseMatrix<double>& A);
   void ForwardEnvelope(Eigen::Ref<Eigen::MatrixXd> x);  // x <- U^-T x with the last FactorEnvelope
   void SolveEnvelope(Eigen::Ref<Eigen::MatrixXd> x);    // x <- H^-1 x with the last FactorEnvelope
-  // Calls f with the band (a Band<6> when every block of A is a pose, fixed-size kernels, otherwise Band<Dynamic>).
+  // Calls f with the band (a Band<6> when every block of A is a pose, otherwise a Band<Dynamic>, whose kernels are
+  // picked per block size).
   template <typename Function>
   void WithBand(Function f);
   int band_blocks_ = 0;                 // block columns of A

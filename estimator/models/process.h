@@ -1,6 +1,7 @@
 // Process models for time-varying calibration parameters (seed 000, Section III-B: "tracking online a limited set of
 // time-varying calibration parameters ... such as gyroscope biases or slippage coefficients"). One instance of the
-// parameter exists per time step; these errors link the instances at t_k and t_k+1.
+// parameter exists per time step (per pose, or per process.interval_s); these errors link the instances at t_k and
+// t_k+1, however far apart.
 //
 // Random walk (Wiener process, dx/dt = w, w white with density sigma):
 //   e = x(t_k+1) - x(t_k) + eta,                         eta ~ N(0, sigma^2 dt I)                 e, eta in R^N

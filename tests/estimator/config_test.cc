@@ -67,6 +67,32 @@ TEST(ConfigTest, ProcessSigmaAndTauAreOneNumberOrOnePerComponent) {
   ExpectError(parameter("{type: gauss_markov, sigma: [0.01, 0, 0.01], tau_s: 1.0}"), "sigma must be positive");
 }
 
+// The spacing of a process's instances: absent means one per pose; given, a positive number of seconds, and only for a
+// time-varying process.
+TEST(ConfigTest, ProcessIntervalIsAPositiveNumberOfSeconds) {
+  const std::string good = testing::AtvConfigYaml({});
+  const auto parameter = [&](const std::string& process) {
+    return Replace(good, "streams:\n",
+                   "  odometer.disturbance: {value: [0, 0, 0], free: true, process: " + process + "}\nstreams:\n");
+  };
+  auto config = ParseEstimatorConfig(parameter("{type: gauss_markov, sigma: 0.01, tau_s: 1.0}"), "est.yaml");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  EXPECT_EQ(config.value().parameters.at("odometer.disturbance").process.interval_s, 0.0);
+  config = ParseEstimatorConfig(parameter("{type: gauss_markov, sigma: 0.01, tau_s: 1.0, interval_s: 0.1}"),
+                                "est.yaml");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  EXPECT_DOUBLE_EQ(config.value().parameters.at("odometer.disturbance").process.interval_s, 0.1);
+  config = ParseEstimatorConfig(parameter("{type: random_walk, sigma: 1.0e-4, interval_s: 0.5}"), "est.yaml");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  EXPECT_DOUBLE_EQ(config.value().parameters.at("odometer.disturbance").process.interval_s, 0.5);
+  const std::string positive = "process.interval_s must be a positive number of seconds";
+  ExpectError(parameter("{type: gauss_markov, sigma: 0.01, tau_s: 1.0, interval_s: 0}"), positive);
+  ExpectError(parameter("{type: gauss_markov, sigma: 0.01, tau_s: 1.0, interval_s: -0.1}"), positive);
+  ExpectError(parameter("{type: gauss_markov, sigma: 0.01, tau_s: 1.0, interval_s: .nan}"), positive);
+  ExpectError(parameter("{type: gauss_markov, sigma: 0.01, tau_s: 1.0, interval_s: soon}"), "must be a number");
+  ExpectError(parameter("{type: constant, interval_s: 0.1}"), "interval_s needs a random_walk or gauss_markov");
+}
+
 // The magnetometer's motor-interference proxy reads another recording stream through `inputs` (models/magnetometer.h);
 // a model accepts only its own input roles.
 TEST(ConfigTest, MagnetometerTakesTheSpecificForceInput) {

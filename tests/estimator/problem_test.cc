@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 #include <gtest/gtest.h>
 
@@ -83,6 +84,100 @@ TEST(ProblemBuilderTest, GaussMarkovDisturbanceHasAProcessPerComponentAndAStatio
   }
   EXPECT_EQ(process, static_cast<int>(builder.poses().size()) - 1);
   EXPECT_EQ(prior, 1);
+  EXPECT_GT(odometer, 0);
+}
+
+// process.interval_s: the poses within the interval of an instance's first pose share it, and the Gauss-Markov
+// factor between two instances spans their actual time difference. The odometer (master, 100 Hz) misses the samples
+// at 0.09-0.11 s, so the second instance starts at the first pose after the gap, 0.12 s after the first.
+TEST(ProblemBuilderTest, ProcessIntervalSharesOneInstanceAmongItsPoses) {
+  auto synthetic = ShortDrive();
+  for (recording::Stream& s : synthetic.recording.streams) {
+    if (s.info.name != "rear_wheel") continue;
+    std::vector<Time> t;
+    std::vector<int> kept;
+    for (std::size_t r = 0; r < s.t.size(); ++r) {
+      const double since_start = SecondsBetween(s.t.front(), s.t[r]);
+      if (since_start > 0.085 && since_start < 0.115) continue;
+      t.push_back(s.t[r]);
+      kept.push_back(static_cast<int>(r));
+    }
+    s.values = Eigen::MatrixXd(s.values(kept, Eigen::all));
+    s.t = t;
+  }
+  EstimatorConfig config = testing::AtvConfig({});
+  ParameterConfig disturbance;
+  disturbance.value = Eigen::VectorXd(Eigen::Vector3d::Zero());
+  disturbance.free = true;
+  disturbance.process.type = ProcessConfig::Type::kGaussMarkov;
+  disturbance.process.sigma = Eigen::Vector3d(0.006, 0.002, 0.025);
+  disturbance.process.tau_s = Eigen::Vector3d(0.7, 1.2, 1.8);
+  disturbance.process.interval_s = 0.1;
+  config.parameters["odometer.disturbance"] = disturbance;
+  auto built = ProblemBuilder::Create(config, synthetic.recording);
+  ASSERT_TRUE(built.ok()) << built.status().message();
+  ProblemBuilder& builder = *built.value();
+  for (const MeasurementRef& m : builder.Measurements()) builder.Add(m);
+  builder.Finish();
+  const Graph& graph = builder.graph();
+  const auto& poses = builder.poses();
+  const auto instance = [&](std::size_t k) { return poses[k].instances.at("odometer.disturbance"); };
+  const Time t0 = poses.front().t;
+
+  // Every pose uses the instance started by the latest pose at most 0.1 s before it; that instance is stamped with
+  // that pose's time.
+  std::vector<VariableId> instances;
+  std::vector<Time> starts;
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    const bool starts_one = k == 0 || SecondsBetween(starts.back(), poses[k].t) >= 0.1 - 1e-6;
+    if (starts_one) {
+      instances.push_back(instance(k));
+      starts.push_back(poses[k].t);
+      EXPECT_EQ(*graph.variable(instance(k)).stamp, poses[k].t) << k;
+    }
+    EXPECT_EQ(instance(k), instances.back()) << "pose " << k;
+  }
+  EXPECT_EQ(instance(0), instance(1));
+  EXPECT_EQ(instance(0), instance(8));  // 0.08 s, the last pose before the gap
+  EXPECT_NE(instance(8), instance(9));  // 0.12 s
+  EXPECT_NEAR(SecondsBetween(t0, poses[9].t), 0.12, 1e-9);
+  EXPECT_EQ(std::set<VariableId>(instances.begin(), instances.end()).size(), instances.size());
+  ASSERT_GE(instances.size(), 15u);  // 2 s of poses
+
+  // One process factor per pair of consecutive instances, over their stamps' difference (0.12 s first, 0.1 s after):
+  // noise sigma_i^2 (1 - exp(-2 dt / tau_i)), and x_1 - exp(-dt / tau_i) x_0 (evaluated at x_0 = 1, x_1 = 0).
+  int process = 0;
+  for (const auto& [id, f] : graph.factors()) {
+    if (f.stream != "odometer.disturbance" || f.variables.size() != 2) continue;
+    const auto it = std::find(instances.begin(), instances.end(), f.variables[0]);
+    ASSERT_NE(it, instances.end());
+    ASSERT_NE(it + 1, instances.end());
+    EXPECT_EQ(f.variables[1], *(it + 1));
+    const double dt = SecondsBetween(starts[it - instances.begin()], starts[it - instances.begin() + 1]);
+    EXPECT_NEAR(dt, it == instances.begin() ? 0.12 : 0.1, 1e-6);
+    const double x0[3] = {1.0, 1.0, 1.0}, x1[3] = {0.0, 0.0, 0.0};
+    const double* values[2] = {x0, x1};
+    double error[3], noise_jacobian[9];
+    ASSERT_TRUE(f.factor->Evaluate(values, error, nullptr, noise_jacobian));
+    for (int i = 0; i < 3; ++i) {
+      const double tau = disturbance.process.tau_s[i];
+      EXPECT_NEAR(error[i], -std::exp(-dt / tau), 1e-12) << i;
+      const double expected = std::pow(disturbance.process.sigma[i], 2) * -std::expm1(-2.0 * dt / tau);
+      EXPECT_NEAR(f.noise_covariance(i, i), expected, 1e-12 * expected) << i;
+    }
+    ++process;
+  }
+  EXPECT_EQ(process, static_cast<int>(instances.size()) - 1);
+
+  // The odometer's factor of the interval [k, k+1] reads the instance of pose k.
+  int odometer = 0;
+  for (const auto& [id, f] : graph.factors()) {
+    if (f.stream != "odometer") continue;
+    const auto k = std::find_if(poses.begin(), poses.end(), [&](const PoseNode& p) { return p.id == f.variables[0]; });
+    ASSERT_NE(k, poses.end());
+    EXPECT_EQ(f.variables[10], k->instances.at("odometer.disturbance"));
+    ++odometer;
+  }
   EXPECT_GT(odometer, 0);
 }
 

@@ -191,6 +191,27 @@ void TieWithRandomPrior(const std::vector<VariableId>& ids, std::mt19937* rng, G
                    Loss::Trivial(), "test", Time());
 }
 
+// The solver's order: poses in time; each time-varying instance after the last pose it serves (just before the pose
+// that starts the next instance of its parameter), the newest after every pose; fixed variables left out; constant
+// parameters last. Here instance "a" every 3 poses (one fixed), "b" per pose, created out of id order with the poses.
+TEST(SolverTest, FreeVariableOrderPutsEachInstanceAfterTheLastPoseItServes) {
+  Graph graph;
+  const VariableId lever =
+      graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), false, std::nullopt});
+  std::vector<VariableId> poses, a, b;
+  for (int k = 0; k < 8; ++k) {
+    const Time t = Time::FromSeconds(0.1 * k);
+    poses.push_back(graph.AddVariable({"pose", Manifold::Pose(), Manifold::Pose().Identity(), false, t}));
+    if (k % 3 == 0)
+      a.push_back(graph.AddVariable({"a", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), k == 3, t}));
+    b.push_back(graph.AddVariable({"b", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), false, t}));
+  }
+  const std::vector<VariableId> expected = {poses[0], b[0], poses[1], b[1], poses[2], a[0], b[2],
+                                            poses[3], b[3], poses[4], b[4], poses[5], b[5], /* a[1] fixed */
+                                            poses[6], b[6], poses[7], a[2], b[7], lever};
+  EXPECT_EQ(FreeVariableOrder(graph), expected);
+}
+
 TEST(NormalEquationsTest, EnvelopeFactorizationOfABandWithABorderMatchesADenseCholesky) {
   std::mt19937 rng(11);
   Graph graph;

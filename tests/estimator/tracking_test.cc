@@ -136,6 +136,34 @@ TEST(TrackingTest, RandomWalkGyroBiasIsRecoveredWithinFourSigma) {
   EXPECT_NEAR(calibrated.value().final_cost, summary.final_cost, 1e-6 * summary.final_cost);
 }
 
+TEST(TrackingTest, MarginalizationKeepsTheInformationWithSharedInstances) {
+  // As MarginalizationKeepsTheInformationOfTheWindow, with a random-walk gyro bias whose instances are 0.1 s apart,
+  // each shared by 10 poses: an instance leaves the 15-pose window with the last pose that uses it, and the end of the
+  // track matches the window holding everything.
+  roamlab::testing::SyntheticOptions options;
+  options.duration_s = 3.0;
+  options.seed = 5;
+  options.gyro_bias_radps = Eigen::Vector3d(0.02, -0.01, 0.015);
+  const auto synthetic = roamlab::testing::MakeAtvRecording(options);
+  EstimatorConfig sliding_config = WithRandomWalkGyroBias(testing::AtvConfig({}, 15));
+  sliding_config.parameters["imu.gyro_bias"].process.interval_s = 0.1;
+  EstimatorConfig whole_config = sliding_config;
+  whole_config.tracking.window = 100000;
+  auto sliding = Track(sliding_config, synthetic.recording, {});
+  auto whole = Track(whole_config, synthetic.recording, {});
+  ASSERT_TRUE(sliding.ok()) << sliding.status().message();
+  ASSERT_TRUE(whole.ok()) << whole.status().message();
+  ASSERT_EQ(sliding.value().trajectory.size(), whole.value().trajectory.size());
+  const StampedPose& a = sliding.value().trajectory.back();
+  const StampedPose& b = whole.value().trajectory.back();
+  ASSERT_EQ(a.t, b.t);
+  const Eigen::Matrix3d& cov = whole.value().position_covariance.back();
+  const Eigen::Vector3d d = a.p_world_body - b.p_world_body;
+  EXPECT_LT(std::sqrt(d.dot(cov.ldlt().solve(d))), 0.2);
+  EXPECT_NEAR(std::sqrt(sliding.value().position_covariance.back().trace()), std::sqrt(cov.trace()),
+              0.1 * std::sqrt(cov.trace()));
+}
+
 TEST(TrackingTest, TrackingTheGyroBiasComesCloseToKnowingIt) {
   // Tracking with the bias free as a random walk, against tracking with the bias fixed at its true value (the oracle)
   // and with it fixed at zero (ignored). The position error against the truth cannot show the difference: it is
