@@ -646,6 +646,24 @@ Result<estimator::EstimatorConfig> NominalConfig(const sim::Scenario& scenario) 
   return c;
 }
 
+double HeldoutExcess(const std::map<std::string, ComponentLevel>& components, const std::vector<std::string>& keys,
+                     const std::map<std::string, double>& expected) {
+  double excess = 0.0;
+  for (const std::string& key : keys) {
+    const auto c = components.find(key);
+    if (c == components.end()) continue;
+    const auto level = expected.find(key);
+    const double nominal = level != expected.end() ? level->second : 1.0;
+    excess += std::max(0.0, (c->second.chi2_per_dof - nominal) * c->second.count);
+  }
+  return excess;
+}
+
+double ExplainedShare(double excess_before, double excess_after) {
+  if (!(excess_before > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  return (excess_before - excess_after) / excess_before;
+}
+
 Baseline BaselineFrom(const Diagnosis& nominal_simulation) {
   Baseline b;
   b.component_levels = ComponentLevels(nominal_simulation.residuals);
@@ -898,6 +916,14 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
     return cf;
   };
 
+  // The located mismatch: the components found inconsistent over the whole run, measured on the held-out part
+  // against the nominal model's held-out level (the baseline's).
+  const std::map<std::string, double> heldout_levels =
+      options.baseline ? options.baseline->heldout_component_levels : std::map<std::string, double>{};
+  std::vector<std::string> located_keys;
+  for (const LocatedComponent& lc : out.located)
+    if (lc.inconsistent) located_keys.push_back(ComponentKey(lc.stream, lc.component));
+
   std::set<std::string> accepted, dropped;
   for (int round = 0; round < std::max(1, options.max_effects); ++round) {
     std::vector<CandidateFit> fits;
@@ -950,9 +976,19 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
       if (!h.ok()) return Status::Error("held-out evaluation of " + e.name + ": " + h.status().message());
       e.evaluated_heldout = true;
       e.heldout_improvement = state.heldout_chi2 > 0.0 ? 1.0 - h.value().chi2 / state.heldout_chi2 : 0.0;
+      e.heldout_excess_before = HeldoutExcess(state.heldout_components, located_keys, heldout_levels);
+      e.heldout_excess_after = HeldoutExcess(h.value().components, located_keys, heldout_levels);
+      e.explained_share = ExplainedShare(e.heldout_excess_before, e.heldout_excess_after);
       if (extra) continue;   // evaluated for the record only; the decision was taken
       if (e.heldout_improvement <= options.min_heldout_improvement) {
         e.decision = "rejected: no improvement on the held-out part";
+        dropped.insert(e.name);
+        continue;
+      }
+      // A decoy's stream stays as inconsistent as before: the effect explains too small a share of the located
+      // mismatch (a candidate the same structure pulls in would not explain more in a later round either).
+      if (std::isfinite(e.explained_share) && e.explained_share < options.min_explained_share) {
+        e.decision = "rejected: explains too small a share of the located mismatch on the held-out part";
         dropped.insert(e.name);
         continue;
       }
@@ -987,8 +1023,6 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
   // the attitude and a gyroscope scale), so the verdict is then "unknown". The excess test keeps components whose
   // level is far below 1 (an oval tire's roll on a diff drive's gyroscope x: 1e-4 doubled) from overruling an effect
   // that explains what the likelihood sees.
-  const std::map<std::string, double> heldout_levels =
-      options.baseline ? options.baseline->heldout_component_levels : std::map<std::string, double>{};
   const LocateOptions locate_options;
   for (const LocatedComponent& lc : out.located) {
     if (!lc.inconsistent) continue;
