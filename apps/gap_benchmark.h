@@ -8,7 +8,7 @@
 //   1. calibration: C cases from their own seed range (draws seeded S * 1000 + 500, noise seeds S * 1000 + 500 + i),
 //      stratified (a quarter none, a quarter decoys, the rest effects: gapbench::CalibrationKind), are diagnosed with
 //      the loosest thresholds, the held-out part evaluated for every candidate passing them; the decision thresholds
-//      (alpha, Delta BIC, held-out drop, share of the located mismatch explained) are chosen on them
+//      (alpha, Delta BIC, held-out drop, share of the held-out mismatch explained) are chosen on them
 //      (gap_benchmark_score.h), and so is each candidate parameter's noise (the median reported std);
 //   2. scored: N cases (draws seeded S, noise seeds S * 1000 + i) diagnosed with the chosen thresholds.
 // Both phases judge a case by one rule (gapbench::Identified / FalseDiscovery): a none or decoy case that keeps any

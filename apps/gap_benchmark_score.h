@@ -4,7 +4,7 @@
 //     candidates' statistics of a run with looser ones (held-out evaluated for every candidate passing them);
 //   - Identified / FalseDiscovery: the one rule that judges a case from the effects kept, used by both the
 //     calibration's replay and the score;
-//   - ChooseThresholds: the thresholds (alpha, Delta BIC, held-out drop, share of the located mismatch explained)
+//   - ChooseThresholds: the thresholds (alpha, Delta BIC, held-out drop, share of the held-out mismatch explained)
 //     fixed on the calibration cases only (drawn stratified, CalibrationKind): the
 //     grid point that identifies the most calibration cases correctly with false discoveries on the none cases and
 //     on the decoys at or under the targets;
@@ -35,7 +35,7 @@ struct CandidateStats {
   bool evaluated_heldout = false;
   double heldout_improvement = 0.0;
   std::map<std::string, double> std;      // reported standard deviations (NaN when unknown)
-  // The share of the located held-out mismatch it explains (gap::ExplainedShare; NaN: nothing located to explain).
+  // The share of the held-out mismatch it explains (gap::ExplainedShare; NaN: not evaluated).
   double explained_share = std::numeric_limits<double>::quiet_NaN();
 };
 
@@ -77,7 +77,7 @@ double NeutralValue(const std::string& parameter);
 
 // The first candidate the first round keeps under `t` (empty: none kept). Candidates in order of Delta BIC; one that
 // passes p and BIC but was not evaluated on the held-out part counts as failing it; one evaluated passes the share
-// test when it explains at least t.min_explained_share of the located mismatch or nothing was located (NaN).
+// test when it explains at least t.min_explained_share of the held-out mismatch (a NaN share, not recorded, passes).
 std::string ReplayFirstRound(std::vector<CandidateStats> candidates, const Thresholds& t);
 
 // The one rule for a case, from the first effect the diagnosis kept (empty: none kept), shared by the calibration's

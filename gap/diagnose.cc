@@ -659,9 +659,9 @@ double HeldoutExcess(const std::map<std::string, ComponentLevel>& components, co
   return excess;
 }
 
-double ExplainedShare(double excess_before, double excess_after) {
-  if (!(excess_before > 0.0)) return std::numeric_limits<double>::quiet_NaN();
-  return (excess_before - excess_after) / excess_before;
+double ExplainedShare(double heldout_drop, double remaining_excess) {
+  if (!(heldout_drop > 0.0)) return 0.0;
+  return heldout_drop / (heldout_drop + std::max(0.0, remaining_excess));
 }
 
 Baseline BaselineFrom(const Diagnosis& nominal_simulation) {
@@ -978,17 +978,17 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
       e.heldout_improvement = state.heldout_chi2 > 0.0 ? 1.0 - h.value().chi2 / state.heldout_chi2 : 0.0;
       e.heldout_excess_before = HeldoutExcess(state.heldout_components, located_keys, heldout_levels);
       e.heldout_excess_after = HeldoutExcess(h.value().components, located_keys, heldout_levels);
-      e.explained_share = ExplainedShare(e.heldout_excess_before, e.heldout_excess_after);
+      e.explained_share = ExplainedShare(state.heldout_chi2 - h.value().chi2, e.heldout_excess_after);
       if (extra) continue;   // evaluated for the record only; the decision was taken
       if (e.heldout_improvement <= options.min_heldout_improvement) {
         e.decision = "rejected: no improvement on the held-out part";
         dropped.insert(e.name);
         continue;
       }
-      // A decoy's stream stays as inconsistent as before: the effect explains too small a share of the located
+      // A decoy's stream stays about as inconsistent as before: the effect explains too small a share of the
       // mismatch (a candidate the same structure pulls in would not explain more in a later round either).
-      if (std::isfinite(e.explained_share) && e.explained_share < options.min_explained_share) {
-        e.decision = "rejected: explains too small a share of the located mismatch on the held-out part";
+      if (e.explained_share < options.min_explained_share) {
+        e.decision = "rejected: explains too small a share of the held-out mismatch";
         dropped.insert(e.name);
         continue;
       }

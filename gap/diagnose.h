@@ -17,9 +17,9 @@
 //      the first candidate with p < alpha, Delta BIC < max_delta_bic and a held-out chi-square drop above
 //      min_heldout_improvement (defaults 1e-3, 0, 0; gap-benchmark calibrates them) (the last part of the
 //      recording, every parameter fixed at the training values) and that explains at least min_explained_share of
-//      the located mismatch there (ExplainedShare: the drop of the held-out chi-square above the nominal level,
-//      summed over the components Locate found inconsistent; default 0.25) is kept; one that fails a held-out test is
-//      dropped.
+//      the mismatch there (ExplainedShare: its held-out chi-square drop over that drop plus the chi-square left above
+//      the nominal level in the components Locate found inconsistent; default 0.25) is kept; one that fails a held-out
+//      test is dropped.
 //      Then the others are scored again on top, up to max_effects;
 //   4. model: the accepted effects' parameters and standard deviations (training fit);
 //   5. show: per-stream whitened RMS and chi2/dof on the held-out part before (nominal) and after (with the effects).
@@ -59,8 +59,8 @@ struct EffectEstimate {
   double delta_bic = 0.0;                       // < 0 favours the effect
   double heldout_improvement = 0.0;             // relative drop of the held-out chi2 (0.1 = 10 % lower)
   // The located mismatch on the held-out part (HeldoutExcess over the components Locate found inconsistent) before
-  // the candidate (the nominal model with the effects kept so far) and with it, and the share of it the candidate
-  // explains (ExplainedShare; NaN when there is no located excess to explain).
+  // the candidate (the nominal model with the effects kept so far) and with it, and the share of the mismatch the
+  // candidate explains (ExplainedShare of its held-out chi2 drop and the excess left; NaN until evaluated).
   double heldout_excess_before = 0.0;
   double heldout_excess_after = 0.0;
   double explained_share = std::numeric_limits<double>::quiet_NaN();
@@ -108,10 +108,9 @@ struct DiagnoseOptions {
   double alpha = 1e-3;                  // likelihood-ratio test level
   double max_delta_bic = 0.0;           // kept only with Delta BIC below this
   double min_heldout_improvement = 0.0; // kept only when the held-out chi2 drops by more than this fraction
-  // Kept only when it explains at least this share of the located mismatch on the held-out part (ExplainedShare;
-  // not applied when nothing located shows an excess there). An effect outside the library can pull a library
-  // parameter by a little through the shared attitude or trajectory and pass the tests above, but leaves its own
-  // stream as inconsistent as before: the share it explains is small.
+  // Kept only when it explains at least this share of the mismatch on the held-out part (ExplainedShare). An effect
+  // outside the library can pull a library parameter through the shared attitude or trajectory and pass the tests
+  // above, but leaves its own stream about as inconsistent as before: the share it explains is small.
   double min_explained_share = kDefaultMinExplainedShare;
   // First round: also evaluate the held-out part for the candidates after the kept one that pass the p and BIC
   // tests (decisions unchanged; lets gap-benchmark replay the first round's decision under stricter thresholds).
@@ -145,9 +144,12 @@ Result<Diagnosis> Diagnose(const estimator::EstimatorConfig& nominal, const reco
 // add nothing).
 double HeldoutExcess(const std::map<std::string, ComponentLevel>& components, const std::vector<std::string>& keys,
                      const std::map<std::string, double>& expected);
-// The share of the excess `before` that a candidate removes, (before - after) / before (negative when it adds to
-// it); NaN when before <= 0 (nothing to explain).
-double ExplainedShare(double excess_before, double excess_after);
+// The share of the held-out mismatch a candidate explains: its held-out chi-square drop D over D plus the located
+// excess R that remains with it (HeldoutExcess), D / (D + R): 1 when nothing located stays above its level, small
+// when a large excess stays (a decoy's stream), 0 when D <= 0. The drop counts wherever it is (an effect's own
+// components need not be among the located ones, e.g. an oval tire's wheel rows), the remainder only where Locate
+// found the run inconsistent (the rest carries the noise's excess).
+double ExplainedShare(double heldout_drop, double remaining_excess);
 
 // The baseline from the diagnosis of a nominal simulation (run with max_effects = 0 and no baseline).
 Baseline BaselineFrom(const Diagnosis& nominal_simulation);

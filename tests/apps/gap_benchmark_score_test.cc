@@ -83,8 +83,8 @@ CandidateStats Explaining(const std::string& name, double p, double delta_bic, d
 }
 
 TEST(GapBenchmarkScore, ReplayRejectsACandidateThatExplainsTooLittleOfTheLocatedMismatch) {
-  // A decoy's pull: the best candidate passes p, BIC and the held-out drop but removes 2 % of the located excess; the
-  // next one explains 60 %. Nothing located (NaN): the share test does not apply.
+  // A decoy's pull: the best candidate passes p, BIC and the held-out drop but explains 2 % of the held-out mismatch;
+  // the next one explains 60 %. A share not recorded (NaN): the share test does not apply.
   const std::vector<CandidateStats> candidates = {Explaining("pulled", 1e-12, -300.0, 0.012, 0.02),
                                                   Explaining("next", 1e-6, -40.0, 0.01, 0.6)};
   EXPECT_EQ(ReplayFirstRound(candidates, {1e-3, 0.0, 0.0, 0.0}), "pulled");
@@ -95,7 +95,7 @@ TEST(GapBenchmarkScore, ReplayRejectsACandidateThatExplainsTooLittleOfTheLocated
 
 TEST(GapBenchmarkScore, ChoosesTheShareThatTurnsDecoysAwayAndKeepsSmallEffects) {
   // Two decoys pull a library effect in with a large Delta BIC (-500, -200) and a held-out drop, but explain 1-5 %
-  // of the located mismatch; the small effects pass at Delta BIC -20 to -40 and explain 40-90 % of it. No Delta BIC
+  // of the held-out mismatch; the small effects pass at Delta BIC -20 to -40 and explain 40-90 % of it. No Delta BIC
   // or held-out point turns the decoys away without losing the small effects; a share of 0.25 or 0.1 does it; ties go
   // to the default share.
   std::vector<CaseResult> calibration = {
@@ -112,8 +112,9 @@ TEST(GapBenchmarkScore, ChoosesTheShareThatTurnsDecoysAwayAndKeepsSmallEffects) 
   EXPECT_DOUBLE_EQ(t.min_heldout_improvement, 0.0);
   EXPECT_DOUBLE_EQ(t.min_explained_share, 0.25);
   for (const CaseResult& c : calibration) EXPECT_TRUE(ReplayCorrect(c, ReplayFirstRound(c.candidates, t)));
-  for (const nlohmann::json& p : table)
+  for (const nlohmann::json& p : table) {
     if (p["min_explained_share"] == 0.0) EXPECT_FALSE(p["feasible"].get<bool>());
+  }
   // The default share is one of the grid's, and the loosest point applies none.
   EXPECT_DOUBLE_EQ(Loosest().min_explained_share, 0.0);
   EXPECT_DOUBLE_EQ(Thresholds{}.min_explained_share, gap::kDefaultMinExplainedShare);

@@ -1,9 +1,7 @@
 // The diagnosis's share rule (gap/diagnose.h: HeldoutExcess, ExplainedShare) on made-up held-out statistics: a
-// candidate that removes the located mismatch explains most of it; one that leaves another stream's large excess in
-// place (an out-of-library effect pulling a library parameter) explains little.
+// candidate that removes the mismatch explains most of it; one that leaves another stream's large excess in place (an
+// out-of-library effect pulling a library parameter) explains little.
 #include "gap/diagnose.h"
-
-#include <cmath>
 
 #include <gtest/gtest.h>
 
@@ -25,24 +23,24 @@ TEST(DecisionTest, HeldoutExcessSumsTheChiSquareAboveTheNominalLevel) {
 TEST(DecisionTest, ExplainedShareTellsAnEffectFromADecoysPull) {
   const std::map<std::string, double> expected = {{"gyroscope/2", 1.0}, {"accelerometer/0", 1.0}};
   const std::vector<std::string> keys = {"gyroscope/2", "accelerometer/0"};
-  // A gyroscope bias: its axis 3x its level, the accelerometer a little above; the bias brings the gyroscope back.
-  const std::map<std::string, ComponentLevel> before = {{"gyroscope/2", {3.0, 1000}}, {"accelerometer/0", {1.1, 1000}}};
+  // A gyroscope bias: its axis 3x its level, the accelerometer a little above; the bias brings the gyroscope back
+  // (held-out chi2 drop 1950) and leaves the accelerometer's 100 above its level.
   const std::map<std::string, ComponentLevel> with_bias = {{"gyroscope/2", {1.05, 1000}},
                                                            {"accelerometer/0", {1.1, 1000}}};
-  const double e0 = HeldoutExcess(before, keys, expected);
-  EXPECT_NEAR(ExplainedShare(e0, HeldoutExcess(with_bias, keys, expected)), (2100.0 - 150.0) / 2100.0, 1e-12);
+  EXPECT_NEAR(ExplainedShare(1950.0, HeldoutExcess(with_bias, keys, expected)), 1950.0 / (1950.0 + 150.0), 1e-12);
   // An accelerometer gain error (40x its level) that pulls the gyroscope's scale: the scale lowers the gyroscope a
-  // little and leaves the accelerometer as it was.
-  const std::map<std::string, ComponentLevel> decoy = {{"gyroscope/2", {1.2, 1000}}, {"accelerometer/0", {40.0, 1000}}};
+  // little (drop 300) and leaves the accelerometer as it was.
   const std::map<std::string, ComponentLevel> with_scale = {{"gyroscope/2", {1.0, 1000}},
                                                             {"accelerometer/0", {39.9, 1000}}};
-  const double d0 = HeldoutExcess(decoy, keys, expected);
-  const double share = ExplainedShare(d0, HeldoutExcess(with_scale, keys, expected));
-  EXPECT_NEAR(share, 300.0 / 39200.0, 1e-12);
+  const double share = ExplainedShare(300.0, HeldoutExcess(with_scale, keys, expected));
+  EXPECT_NEAR(share, 300.0 / (300.0 + 38900.0), 1e-12);
   EXPECT_LT(share, kDefaultMinExplainedShare);
-  // A candidate that makes it worse has a negative share; nothing located: no share (the rule does not apply).
-  EXPECT_LT(ExplainedShare(100.0, 150.0), 0.0);
-  EXPECT_TRUE(std::isnan(ExplainedShare(0.0, 0.0)));
+  // An effect whose own components were not located (an oval tire's wheel rows) still explains its drop against what
+  // stays located; nothing left located: all of it; no drop: nothing.
+  EXPECT_NEAR(ExplainedShare(30.0, 60.0), 1.0 / 3.0, 1e-12);
+  EXPECT_DOUBLE_EQ(ExplainedShare(30.0, 0.0), 1.0);
+  EXPECT_DOUBLE_EQ(ExplainedShare(-5.0, 100.0), 0.0);
+  EXPECT_DOUBLE_EQ(ExplainedShare(0.0, 0.0), 0.0);
 }
 
 }  // namespace
