@@ -181,8 +181,8 @@ std::string Report(const gap::Diagnosis& d, const std::string& recording, const 
     r << " |\n";
   }
   r << "\n## Candidates (fitted on the first part, up to t = " << Fixed(d.train_end_s, 4)
-    << " s)\n\n| effect | parameters | LR | chi2 drop / on baseline | p | Delta BIC | held-out | decision |\n"
-       "|---|---|---|---|---|---|---|---|\n";
+    << " s)\n\n| effect | parameters | LR | chi2 drop / on baseline | p | Delta BIC | held-out | share of the held-out "
+       "mismatch | decision |\n|---|---|---|---|---|---|---|---|---|\n";
   for (const gap::EffectEstimate& e : d.candidates) {
     r << "| " << e.name << " | ";
     for (const auto& [k, v] : e.parameters) r << k << " = " << Fixed(v, 4) << " ";
@@ -190,7 +190,7 @@ std::string Report(const gap::Diagnosis& d, const std::string& recording, const 
       << Fixed(e.lr_pvalue, 3) << " | "
       << Fixed(e.delta_bic, 4) << " | "
       << (e.evaluated_heldout ? Fixed(100.0 * e.heldout_improvement, 3) + " %" : std::string("-")) << " | "
-      << e.decision << " |\n";
+      << (e.evaluated_heldout ? Fixed(e.explained_share, 3) : std::string("-")) << " | " << e.decision << " |\n";
   }
   r << "\n## Fit on the held-out part (parameters fixed at the training values)\n\nWhitened residuals: RMS per "
        "sample, RMS of their 1 s means (the systematic part) and chi2/dof.\n\n| stream | RMS before | RMS after | "
