@@ -18,8 +18,8 @@
 //      min_heldout_improvement (defaults 1e-3, 0, 0; gap-benchmark calibrates them) (the last part of the
 //      recording, every parameter fixed at the training values) and that explains at least min_explained_share of
 //      the mismatch there (ExplainedShare: its held-out chi-square drop over that drop plus the chi-square left above
-//      the nominal level in the components Locate found inconsistent that stay so; default 0.25) is kept; one that
-//      fails a held-out test is dropped.
+//      the nominal level in the components Locate found inconsistent that stay so; with effects kept, the drop is
+//      theirs and its together; default 0.25) is kept; one that fails a held-out test is dropped.
 //      Then the others are scored again on top, up to max_effects;
 //   4. model: the accepted effects' parameters and standard deviations (training fit);
 //   5. show: per-stream whitened RMS and chi2/dof on the held-out part before (nominal) and after (with the effects).
@@ -60,7 +60,8 @@ struct EffectEstimate {
   double heldout_improvement = 0.0;             // relative drop of the held-out chi2 (0.1 = 10 % lower)
   // The located mismatch on the held-out part (HeldoutExcess over the components Locate found inconsistent) before
   // the candidate (the nominal model with the effects kept so far) and with it, and the share of the mismatch the
-  // candidate explains (ExplainedShare of its held-out chi2 drop and the excess left; NaN until evaluated).
+  // effects kept so far and the candidate explain together (ExplainedShare of their held-out chi2 drop from the
+  // nominal model and the excess left; NaN until evaluated).
   double heldout_excess_before = 0.0;
   double heldout_excess_after = 0.0;
   double explained_share = std::numeric_limits<double>::quiet_NaN();
