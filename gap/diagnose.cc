@@ -648,16 +648,13 @@ Result<estimator::EstimatorConfig> NominalConfig(const sim::Scenario& scenario) 
 
 double HeldoutExcess(const std::map<std::string, ComponentLevel>& components, const std::vector<std::string>& keys,
                      const std::map<std::string, double>& expected) {
-  const LocateOptions locate_options;
   double excess = 0.0;
   for (const std::string& key : keys) {
     const auto c = components.find(key);
     if (c == components.end()) continue;
     const auto level = expected.find(key);
     const double nominal = level != expected.end() ? level->second : 1.0;
-    if (!Inconsistent(c->second, nominal, locate_options.inconsistency_ratio) || !SignificantExcess(c->second, nominal))
-      continue;
-    excess += (c->second.chi2_per_dof - nominal) * c->second.count;
+    excess += std::max(0.0, (c->second.chi2_per_dof - nominal) * c->second.count);
   }
   return excess;
 }
