@@ -50,6 +50,9 @@ json EffectJson(const gap::EffectEstimate& e) {
           {"lr_pvalue", Number(e.lr_pvalue)},
           {"delta_bic", Number(e.delta_bic)},
           {"heldout_improvement", e.evaluated_heldout ? Number(e.heldout_improvement) : json(nullptr)},
+          {"heldout_excess_before", e.evaluated_heldout ? Number(e.heldout_excess_before) : json(nullptr)},
+          {"heldout_excess_after", e.evaluated_heldout ? Number(e.heldout_excess_after) : json(nullptr)},
+          {"explained_share", e.evaluated_heldout ? Number(e.explained_share) : json(nullptr)},
           {"decision", e.decision}};
 }
 
@@ -178,8 +181,8 @@ std::string Report(const gap::Diagnosis& d, const std::string& recording, const 
     r << " |\n";
   }
   r << "\n## Candidates (fitted on the first part, up to t = " << Fixed(d.train_end_s, 4)
-    << " s)\n\n| effect | parameters | LR | chi2 drop / on baseline | p | Delta BIC | held-out | decision |\n"
-       "|---|---|---|---|---|---|---|---|\n";
+    << " s)\n\n| effect | parameters | LR | chi2 drop / on baseline | p | Delta BIC | held-out | share of the held-out "
+       "mismatch | decision |\n|---|---|---|---|---|---|---|---|---|\n";
   for (const gap::EffectEstimate& e : d.candidates) {
     r << "| " << e.name << " | ";
     for (const auto& [k, v] : e.parameters) r << k << " = " << Fixed(v, 4) << " ";
@@ -187,7 +190,7 @@ std::string Report(const gap::Diagnosis& d, const std::string& recording, const 
       << Fixed(e.lr_pvalue, 3) << " | "
       << Fixed(e.delta_bic, 4) << " | "
       << (e.evaluated_heldout ? Fixed(100.0 * e.heldout_improvement, 3) + " %" : std::string("-")) << " | "
-      << e.decision << " |\n";
+      << (e.evaluated_heldout ? Fixed(e.explained_share, 3) : std::string("-")) << " | " << e.decision << " |\n";
   }
   r << "\n## Fit on the held-out part (parameters fixed at the training values)\n\nWhitened residuals: RMS per "
        "sample, RMS of their 1 s means (the systematic part) and chi2/dof.\n\n| stream | RMS before | RMS after | "
@@ -236,6 +239,34 @@ std::string EstimatorPatch(const gap::Diagnosis& d) {
 }
 
 }  // namespace
+
+json DiagnosisJson(const gap::Diagnosis& d, const gap::Baseline* baseline, std::uint64_t baseline_seed) {
+  json located = json::array(), components = json::array(), effects = json::array(), candidates = json::array();
+  for (const gap::LocatedComponent& lc : d.located) {
+    components.push_back(LocatedJson(lc));
+    if (lc.inconsistent) located.push_back(LocatedJson(lc));
+  }
+  for (const gap::EffectEstimate& e : d.effects) effects.push_back(EffectJson(e));
+  for (const gap::EffectEstimate& e : d.candidates) candidates.push_back(EffectJson(e));
+  json base = json::object();
+  if (baseline) {
+    base["seed"] = baseline_seed;
+    base["streams"] = FitsJson(baseline->streams);
+    json lr = json::object();
+    for (const auto& [name, v] : baseline->candidate_lr) lr[name] = Number(v);
+    base["candidate_lr_statistic"] = lr;
+  }
+  return {{"verdict", d.verdict},
+          {"located", located},
+          {"effects", effects},
+          {"fit", {{"before", FitsJson(d.before)}, {"after", FitsJson(d.after)},
+                   {"heldout_start_s", d.train_end_s}, {"whole_run_nominal", FitsJson(d.whole_run)}}},
+          {"unexplained", d.unexplained},
+          {"candidates", candidates},
+          {"components", components},
+          {"baseline", base},
+          {"run", {{"fits", d.fits}, {"seconds", d.seconds}}}};
+}
 
 int RunDiagnose(const DiagnoseArgs& args) {
   std::ostream& err = args.err ? *args.err : std::cerr;
@@ -313,31 +344,7 @@ int RunDiagnose(const DiagnoseArgs& args) {
   const gap::Diagnosis& d = diagnosis.value();
 
   // gap.json, the patches, the figures and the report.
-  json located = json::array(), components = json::array(), effects = json::array(), candidates = json::array();
-  for (const gap::LocatedComponent& lc : d.located) {
-    components.push_back(LocatedJson(lc));
-    if (lc.inconsistent) located.push_back(LocatedJson(lc));
-  }
-  for (const gap::EffectEstimate& e : d.effects) effects.push_back(EffectJson(e));
-  for (const gap::EffectEstimate& e : d.candidates) candidates.push_back(EffectJson(e));
-  json base = json::object();
-  if (!args.no_baseline) {
-    base["seed"] = args.baseline_seed;
-    base["streams"] = FitsJson(baseline.streams);
-    json lr = json::object();
-    for (const auto& [name, v] : baseline.candidate_lr) lr[name] = Number(v);
-    base["candidate_lr_statistic"] = lr;
-  }
-  const json gap_json = {{"verdict", d.verdict},
-                         {"located", located},
-                         {"effects", effects},
-                         {"fit", {{"before", FitsJson(d.before)}, {"after", FitsJson(d.after)},
-                                  {"heldout_start_s", d.train_end_s}, {"whole_run_nominal", FitsJson(d.whole_run)}}},
-                         {"unexplained", d.unexplained},
-                         {"candidates", candidates},
-                         {"components", components},
-                         {"baseline", base},
-                         {"run", {{"fits", d.fits}, {"seconds", d.seconds}}}};
+  const json gap_json = DiagnosisJson(d, args.no_baseline ? nullptr : &baseline, args.baseline_seed);
   if (Status s = WriteText(args.out + "/gap.json", gap_json.dump(2) + "\n"); !s.ok()) return fail(s.message());
   if (Status s = WriteText(args.out + "/scenario_patch.yaml", ScenarioPatch(d)); !s.ok()) return fail(s.message());
   if (Status s = WriteText(args.out + "/estimator_patch.yaml", EstimatorPatch(d)); !s.ok()) return fail(s.message());

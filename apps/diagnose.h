@@ -11,6 +11,10 @@
 #include <iosfwd>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
+#include "gap/diagnose.h"
+
 namespace roamlab::apps {
 
 struct DiagnoseArgs {
@@ -27,5 +31,8 @@ struct DiagnoseArgs {
   std::ostream* err = nullptr;           // receives the one-line error; nullptr: stderr
 };
 int RunDiagnose(const DiagnoseArgs& args);
+
+// A diagnosis as DIR/gap.json (README, `roamlab diagnose`); `baseline` null: diagnosed without one.
+nlohmann::json DiagnosisJson(const gap::Diagnosis& d, const gap::Baseline* baseline, std::uint64_t baseline_seed);
 
 }  // namespace roamlab::apps

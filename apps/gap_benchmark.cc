@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "apps/diagnose.h"
 #include "apps/gap_benchmark_score.h"
 #include "gap/diagnose.h"
 #include "recording/recording.h"
@@ -59,7 +60,8 @@ std::string AffectedStream(const std::string& effect) {
 }
 
 // Platform 0 is the ATV (half of the cases: its library is the largest), 1 the differential drive and 2 the mecanum
-// robot (a quarter each). Kinds: none 20 %, decoy 15 %, effect 65 %.
+// robot (a quarter each). Kinds: none 20 %, decoy 15 %, effect 65 %; or `stratum` (none, decoy or effect) when given
+// (the calibration's stratified draws: the same random numbers are drawn, the kind's is overruled).
 // Magnitudes from about the smallest the diagnosis resolves (its std on a 20 s training part, README) to large.
 // Decoys are drawn on the ATV only: an accelerometer gain error or GPS multipath shows in the accelerometer's or the
 // GPS's residuals and no candidate models it (tire_growth is not drawn: at 0.003 s^2/m^2, already 2-7 % at the drive's
@@ -69,20 +71,21 @@ std::string AffectedStream(const std::string& effect) {
 // track_width_error is not drawn, because with the wheel radius free and no speed reference only r / B is observable
 // (the gyroscope sees the turn rate r (omega_R - omega_L) / B), so a track error is a radius error. The mecanum robot's
 // position fixes tell its track (README: 0.04 m -> 0.0411 +- 0.0026), so it is drawn there, with a yaw gyro bias.
-Draw DrawCase(std::mt19937_64& rng) {
+Draw DrawCase(std::mt19937_64& rng, const std::string& stratum) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const auto sign = [&] { return u(rng) < 0.5 ? -1.0 : 1.0; };
   const auto round_to = [](double x, double step) { return std::round(x / step) * step; };
   Draw d;
   const double platform = u(rng);
   d.platform = platform < 0.5 ? 0 : platform < 0.75 ? 1 : 2;
-  const double kind = u(rng);
+  const double u_kind = u(rng);
   const double pick = u(rng);
-  if (kind < 0.2) {
+  const std::string kind = !stratum.empty() ? stratum : u_kind < 0.2 ? "none" : u_kind < 0.35 ? "decoy" : "effect";
+  if (kind == "none") {
     d.kind = "none";
     return d;
   }
-  if (kind < 0.35) {
+  if (kind == "decoy") {
     d.kind = "decoy";
     d.platform = 0;
     // Effects no candidate models, each leaving structure in a stream the nominal model reads (sim/scenario.h).
@@ -268,10 +271,14 @@ Result<CaseResult> RunCase(const Platform& platform, const Draw& draw, std::uint
   d_options.alpha = setup.thresholds.alpha;
   d_options.max_delta_bic = setup.thresholds.max_delta_bic;
   d_options.min_heldout_improvement = setup.thresholds.min_heldout_improvement;
+  d_options.min_explained_share = setup.thresholds.min_explained_share;
   d_options.heldout_all_candidates = setup.heldout_all;
   auto diagnosed = gap::Diagnose(platform.config, rec.value(), d_options);
   if (!diagnosed.ok()) return Status::Error("diagnosis: " + diagnosed.status().message());
   const gap::Diagnosis& d = diagnosed.value();
+  // The diagnosis as `roamlab diagnose` writes it (located components, candidates, held-out fit before and after),
+  // for the study of a case.
+  std::ofstream(dir + "/gap.json") << DiagnosisJson(d, &platform.baseline, kBaselineSeed).dump(2) << "\n";
 
   CaseResult c;
   c.id = id;
@@ -283,7 +290,7 @@ Result<CaseResult> RunCase(const Platform& platform, const Draw& draw, std::uint
   for (const gap::EffectEstimate& e : d.candidates) {   // in order of Delta BIC
     if (std::find(c.ranked.begin(), c.ranked.end(), e.name) == c.ranked.end()) c.ranked.push_back(e.name);
     gapbench::CandidateStats stats{e.name, e.lr_pvalue, e.delta_bic, e.evaluated_heldout, e.heldout_improvement,
-                                   e.std};
+                                   e.std, e.explained_share};
     c.candidates.push_back(stats);
   }
 
@@ -336,13 +343,16 @@ std::string CaseLine(const CaseResult& c) {
   return s.str();
 }
 
-// Draws and runs one phase's cases; results in draw order.
+// Draws and runs one phase's cases (stratified: kinds by gapbench::CalibrationKind; else blind); results in draw
+// order.
 Result<std::vector<CaseResult>> RunPhase(const std::vector<Platform>& platforms, int n, std::uint64_t draw_seed,
-                                         std::uint64_t noise_seed0, const std::string& dir, const CaseSetup& setup,
-                                         const std::string& label, const GapBenchmarkArgs& args) {
+                                         std::uint64_t noise_seed0, bool stratified, const std::string& dir,
+                                         const CaseSetup& setup, const std::string& label,
+                                         const GapBenchmarkArgs& args) {
   std::mt19937_64 rng(draw_seed);
   std::vector<Draw> draws;
-  for (int i = 0; i < n; ++i) draws.push_back(DrawCase(rng));   // all drawn first: independent of scheduling
+  for (int i = 0; i < n; ++i)   // all drawn first: independent of scheduling
+    draws.push_back(DrawCase(rng, stratified ? gapbench::CalibrationKind(i) : std::string()));
   std::vector<CaseResult> results(static_cast<std::size_t>(n));
   const Status st = RunParallel(n, args.jobs, label, args.quiet, [&](int i) -> Result<std::string> {
     std::ostringstream id;
@@ -424,7 +434,7 @@ int RunGapBenchmark(const GapBenchmarkArgs& args) {
   const auto calibration_start = std::chrono::steady_clock::now();
   CaseSetup loose{gapbench::Loosest(), true};
   const std::uint64_t calibration_seed = args.seed * 1000 + kMaxCases;
-  auto calibration = RunPhase(platforms, args.calibration_cases, calibration_seed, calibration_seed,
+  auto calibration = RunPhase(platforms, args.calibration_cases, calibration_seed, calibration_seed, true,
                               args.out + "/calibration", loose, "calibration", args);
   if (!calibration.ok()) {
     err << "roamlab gap-benchmark: " << calibration.status().message() << "\n";
@@ -447,13 +457,14 @@ int RunGapBenchmark(const GapBenchmarkArgs& args) {
   const double calibration_s = SecondsSince(calibration_start);
   const json thresholds = {{"alpha", chosen.alpha},
                            {"max_delta_bic", chosen.max_delta_bic},
-                           {"min_heldout_improvement", chosen.min_heldout_improvement}};
+                           {"min_heldout_improvement", chosen.min_heldout_improvement},
+                           {"min_explained_share", chosen.min_explained_share}};
   if (!args.quiet) std::cout << "thresholds from the calibration cases: " << thresholds.dump() << "\n";
 
   // 2. The scored cases, diagnosed with the chosen thresholds.
   const auto scored_start = std::chrono::steady_clock::now();
-  auto scored = RunPhase(platforms, args.cases, args.seed, args.seed * 1000, args.out + "/cases", {chosen, false},
-                         "scored", args);
+  auto scored = RunPhase(platforms, args.cases, args.seed, args.seed * 1000, false, args.out + "/cases",
+                         {chosen, false}, "scored", args);
   if (!scored.ok()) {
     err << "roamlab gap-benchmark: " << scored.status().message() << "\n";
     return 1;

@@ -13,6 +13,7 @@ using nlohmann::json;
 constexpr double kAlphas[] = {1e-2, 1e-3, 1e-4, 1e-6};
 constexpr double kDeltaBics[] = {0.0, -10.0, -30.0, -100.0};
 constexpr double kHeldouts[] = {0.0, 0.01, 0.03};
+constexpr double kShares[] = {0.0, 0.1, gap::kDefaultMinExplainedShare, 0.5};
 
 double Median(std::vector<double> v) {
   if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
@@ -50,7 +51,8 @@ std::string ReplayFirstRound(std::vector<CandidateStats> candidates, const Thres
                    [](const CandidateStats& a, const CandidateStats& b) { return a.delta_bic < b.delta_bic; });
   for (const CandidateStats& c : candidates) {
     if (!(c.lr_pvalue < t.alpha) || !(c.delta_bic < t.max_delta_bic)) continue;
-    if (c.evaluated_heldout && c.heldout_improvement > t.min_heldout_improvement) return c.name;
+    if (!c.evaluated_heldout || !(c.heldout_improvement > t.min_heldout_improvement)) continue;
+    if (!std::isfinite(c.explained_share) || c.explained_share >= t.min_explained_share) return c.name;
   }
   return "";
 }
@@ -69,24 +71,31 @@ bool ReplayCorrect(const CaseResult& c, const std::string& kept) {
   return c.kind == "effect" ? Identified(c, kept) : !FalseDiscovery(c, kept);
 }
 
+std::string CalibrationKind(int index) {
+  const int stratum = index % 4;
+  return stratum == 0 ? "none" : stratum == 1 ? "decoy" : "effect";
+}
+
 std::vector<Thresholds> ThresholdGrid() {
   std::vector<Thresholds> grid;
   for (double a : kAlphas)
     for (double b : kDeltaBics)
-      for (double h : kHeldouts) grid.push_back({a, b, h});
+      for (double h : kHeldouts)
+        for (double f : kShares) grid.push_back({a, b, h, f});
   return grid;
 }
 
-Thresholds Loosest() { return {kAlphas[0], kDeltaBics[0], kHeldouts[0]}; }
+Thresholds Loosest() { return {kAlphas[0], kDeltaBics[0], kHeldouts[0], kShares[0]}; }
 
 Thresholds ChooseThresholds(const std::vector<CaseResult>& calibration, double max_none_false_rate,
                             double max_decoy_false_rate, json* table) {
-  // Distance from diagnose's defaults (1e-3, 0, 0) in grid steps: ties go to the point that departs least from them,
-  // then to the stricter alpha and Delta BIC.
+  // Distance from diagnose's defaults (1e-3, 0, 0, the default share) in grid steps: ties go to the point that
+  // departs least from them, then to the stricter alpha and Delta BIC.
   const Thresholds defaults;
   const auto distance = [&](const Thresholds& t) {
     return std::abs(IndexOf(kAlphas, t.alpha) - IndexOf(kAlphas, defaults.alpha)) +
-           IndexOf(kDeltaBics, t.max_delta_bic) + IndexOf(kHeldouts, t.min_heldout_improvement);
+           IndexOf(kDeltaBics, t.max_delta_bic) + IndexOf(kHeldouts, t.min_heldout_improvement) +
+           std::abs(IndexOf(kShares, t.min_explained_share) - IndexOf(kShares, defaults.min_explained_share));
   };
   struct Point {
     Thresholds t;
@@ -124,6 +133,7 @@ Thresholds ChooseThresholds(const std::vector<CaseResult>& calibration, double m
       table->push_back({{"alpha", p.t.alpha},
                         {"max_delta_bic", p.t.max_delta_bic},
                         {"min_heldout_improvement", p.t.min_heldout_improvement},
+                        {"min_explained_share", p.t.min_explained_share},
                         {"correct", p.correct},
                         {"none_false_discoveries", p.none_false},
                         {"none_cases", p.nones},
@@ -280,6 +290,7 @@ json CaseRow(const CaseResult& c) {
                           {"delta_bic", s.delta_bic},
                           {"evaluated_heldout", s.evaluated_heldout},
                           {"heldout_improvement", s.heldout_improvement},
+                          {"explained_share", Number(s.explained_share)},
                           {"std", stds}});
   }
   return {{"case", c.id},

@@ -4,7 +4,8 @@
 //     candidates' statistics of a run with looser ones (held-out evaluated for every candidate passing them);
 //   - Identified / FalseDiscovery: the one rule that judges a case from the effects kept, used by both the
 //     calibration's replay and the score;
-//   - ChooseThresholds: the thresholds (alpha, Delta BIC, held-out drop) fixed on the calibration cases only: the
+//   - ChooseThresholds: the thresholds (alpha, Delta BIC, held-out drop, share of the held-out mismatch explained)
+//     fixed on the calibration cases only (drawn stratified, CalibrationKind): the
 //     grid point that identifies the most calibration cases correctly with false discoveries on the none cases and
 //     on the decoys at or under the targets;
 //   - CalibrationSigmas / NoiseRatio: the noise of an effect's parameter is the median standard deviation the
@@ -14,12 +15,14 @@
 //   - Summarize: the figures and targets.
 #pragma once
 
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "gap/diagnose.h"
 #include "recording/trajectory.h"
 
 namespace roamlab::apps::gapbench {
@@ -32,12 +35,15 @@ struct CandidateStats {
   bool evaluated_heldout = false;
   double heldout_improvement = 0.0;
   std::map<std::string, double> std;      // reported standard deviations (NaN when unknown)
+  // The share of the held-out mismatch it explains (gap::ExplainedShare; NaN: not evaluated).
+  double explained_share = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct Thresholds {
   double alpha = 1e-3;
   double max_delta_bic = 0.0;
   double min_heldout_improvement = 0.0;
+  double min_explained_share = gap::kDefaultMinExplainedShare;
 };
 
 // One benchmark case: what was hidden, what the diagnosis said, and the figures scored from truth.yaml.
@@ -70,7 +76,8 @@ constexpr double kMinDecoysUnknown = 0.70;
 double NeutralValue(const std::string& parameter);
 
 // The first candidate the first round keeps under `t` (empty: none kept). Candidates in order of Delta BIC; one that
-// passes p and BIC but was not evaluated on the held-out part counts as failing it.
+// passes p and BIC but was not evaluated on the held-out part counts as failing it; one evaluated passes the share
+// test when it explains at least t.min_explained_share of the held-out mismatch (a NaN share, not recorded, passes).
 std::string ReplayFirstRound(std::vector<CandidateStats> candidates, const Thresholds& t);
 
 // The one rule for a case, from the first effect the diagnosis kept (empty: none kept), shared by the calibration's
@@ -87,13 +94,19 @@ std::string FirstKept(const CaseResult& c);
 // Whether a case is correct under a first-round decision: effect cases identified, the others no false discovery.
 bool ReplayCorrect(const CaseResult& c, const std::string& kept);
 
+// The kind of calibration case `index` (stratified: the threshold's false-discovery rates are judged on enough
+// effect-free cases): none when index % 4 == 0, decoy when index % 4 == 1, else effect, so that any first n cases
+// hold about a quarter none and a quarter decoys. The scored cases are drawn blind (kinds at random).
+std::string CalibrationKind(int index);
+
 // The grid searched by ChooseThresholds (each point at least as strict as `Loosest()`).
 std::vector<Thresholds> ThresholdGrid();
 Thresholds Loosest();
 
 // Thresholds from calibration cases: the grid point with the most correct replays among those whose false-discovery
 // rate is <= max_none_false_rate on the none cases and <= max_decoy_false_rate on the decoys (all points when none
-// is); ties go to the point nearest diagnose's defaults, then the strictest. `table` (optional) receives every grid
+// is); ties go to the point nearest diagnose's defaults (alpha 1e-3, Delta BIC 0, held-out drop 0, explained share
+// gap::kDefaultMinExplainedShare), then the strictest. `table` (optional) receives every grid
 // point's counts.
 Thresholds ChooseThresholds(const std::vector<CaseResult>& calibration, double max_none_false_rate,
                             double max_decoy_false_rate, nlohmann::json* table = nullptr);

@@ -653,6 +653,24 @@ Result<estimator::EstimatorConfig> NominalConfig(const sim::Scenario& scenario) 
   return c;
 }
 
+double HeldoutExcess(const std::map<std::string, ComponentLevel>& components, const std::vector<std::string>& keys,
+                     const std::map<std::string, double>& expected) {
+  double excess = 0.0;
+  for (const std::string& key : keys) {
+    const auto c = components.find(key);
+    if (c == components.end()) continue;
+    const auto level = expected.find(key);
+    const double nominal = level != expected.end() ? level->second : 1.0;
+    excess += std::max(0.0, (c->second.chi2_per_dof - nominal) * c->second.count);
+  }
+  return excess;
+}
+
+double ExplainedShare(double heldout_drop, double remaining_excess) {
+  if (!(heldout_drop > 0.0)) return 0.0;
+  return heldout_drop / (heldout_drop + std::max(0.0, remaining_excess));
+}
+
 Baseline BaselineFrom(const Diagnosis& nominal_simulation) {
   Baseline b;
   b.component_levels = ComponentLevels(nominal_simulation.residuals);
@@ -911,6 +929,18 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
     return cf;
   };
 
+  // The located mismatch: the components found inconsistent over the whole run, measured on the held-out part
+  // against the nominal model's held-out level (the baseline's).
+  const std::map<std::string, double> heldout_levels =
+      options.baseline ? options.baseline->heldout_component_levels : std::map<std::string, double>{};
+  std::vector<std::string> located_keys;
+  for (const LocatedComponent& lc : out.located)
+    if (lc.inconsistent) located_keys.push_back(ComponentKey(lc.stream, lc.component));
+  // The share is of the effects kept so far and the candidate together (their held-out drop from the nominal model):
+  // a later effect that refines an explained mismatch (OptiOdom's wheel ratio after the track, the Husky's track after
+  // the IMU's time offset, beside GPS structure no candidate models) is not judged against the whole remainder alone.
+  const double nominal_heldout_chi2 = state.heldout_chi2;
+
   std::set<std::string> accepted, dropped;
   for (int round = 0; round < std::max(1, options.max_effects); ++round) {
     std::vector<CandidateFit> fits;
@@ -963,9 +993,19 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
       if (!h.ok()) return Status::Error("held-out evaluation of " + e.name + ": " + h.status().message());
       e.evaluated_heldout = true;
       e.heldout_improvement = state.heldout_chi2 > 0.0 ? 1.0 - h.value().chi2 / state.heldout_chi2 : 0.0;
+      e.heldout_excess_before = HeldoutExcess(state.heldout_components, located_keys, heldout_levels);
+      e.heldout_excess_after = HeldoutExcess(h.value().components, located_keys, heldout_levels);
+      e.explained_share = ExplainedShare(nominal_heldout_chi2 - h.value().chi2, e.heldout_excess_after);
       if (extra) continue;   // evaluated for the record only; the decision was taken
       if (e.heldout_improvement <= options.min_heldout_improvement) {
         e.decision = "rejected: no improvement on the held-out part";
+        dropped.insert(e.name);
+        continue;
+      }
+      // A decoy's stream stays about as inconsistent as before: the effect explains too small a share of the
+      // mismatch (a candidate the same structure pulls in would not explain more in a later round either).
+      if (e.explained_share < options.min_explained_share) {
+        e.decision = "rejected: explains too small a share of the held-out mismatch";
         dropped.insert(e.name);
         continue;
       }
@@ -977,6 +1017,10 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
       kept = &f;
     }
     for (CandidateFit& f : fits) {
+      if (f.estimate.evaluated_heldout)
+        say("candidate " + f.estimate.name + ": held-out chi2 " + std::to_string(100.0 * f.estimate.heldout_improvement) +
+            " % lower, share of the held-out mismatch " + std::to_string(f.estimate.explained_share) + ": " +
+            (f.estimate.decision.empty() ? "evaluated" : f.estimate.decision));
       if (f.estimate.decision.empty()) f.estimate.decision = "not the best candidate";
       if (round == 0) out.candidates.push_back(f.estimate);
     }
@@ -1000,8 +1044,6 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
   // the attitude and a gyroscope scale), so the verdict is then "unknown". The excess test keeps components whose
   // level is far below 1 (an oval tire's roll on a diff drive's gyroscope x: 1e-4 doubled) from overruling an effect
   // that explains what the likelihood sees.
-  const std::map<std::string, double> heldout_levels =
-      options.baseline ? options.baseline->heldout_component_levels : std::map<std::string, double>{};
   const LocateOptions locate_options;
   for (const LocatedComponent& lc : out.located) {
     if (!lc.inconsistent) continue;

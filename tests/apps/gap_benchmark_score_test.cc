@@ -76,6 +76,69 @@ TEST(GapBenchmarkScore, ChoosesTheThresholdsThatKeepFalseDiscoveriesDown) {
   EXPECT_TRUE(defaults_feasible(table));
 }
 
+CandidateStats Explaining(const std::string& name, double p, double delta_bic, double heldout, double share) {
+  CandidateStats c = Candidate(name, p, delta_bic, heldout);
+  c.explained_share = share;
+  return c;
+}
+
+TEST(GapBenchmarkScore, ReplayRejectsACandidateThatExplainsTooLittleOfTheLocatedMismatch) {
+  // A decoy's pull: the best candidate passes p, BIC and the held-out drop but explains 2 % of the held-out mismatch;
+  // the next one explains 60 %. A share not recorded (NaN): the share test does not apply.
+  const std::vector<CandidateStats> candidates = {Explaining("pulled", 1e-12, -300.0, 0.012, 0.02),
+                                                  Explaining("next", 1e-6, -40.0, 0.01, 0.6)};
+  EXPECT_EQ(ReplayFirstRound(candidates, {1e-3, 0.0, 0.0, 0.0}), "pulled");
+  EXPECT_EQ(ReplayFirstRound(candidates, {1e-3, 0.0, 0.0, 0.25}), "next");
+  EXPECT_EQ(ReplayFirstRound(candidates, {1e-3, 0.0, 0.0, 0.75}), "");
+  EXPECT_EQ(ReplayFirstRound({Explaining("x", 1e-8, -40.0, 0.02, std::nan(""))}, {1e-3, 0.0, 0.0, 0.5}), "x");
+}
+
+TEST(GapBenchmarkScore, ChoosesTheShareThatTurnsDecoysAwayAndKeepsSmallEffects) {
+  // Two decoys pull a library effect in with a large Delta BIC (-500, -200) and a held-out drop, but explain 1-5 %
+  // of the held-out mismatch; the small effects pass at Delta BIC -20 to -40 and explain 40-90 % of it. No Delta BIC
+  // or held-out point turns the decoys away without losing the small effects; a share of 0.25 or 0.1 does it; ties go
+  // to the default share.
+  std::vector<CaseResult> calibration = {
+      Case("effect", "a", {Explaining("a", 1e-9, -40.0, 0.01, 0.9)}),
+      Case("effect", "b", {Explaining("b", 1e-6, -20.0, 0.004, 0.4)}),
+      Case("none", "", {Candidate("a", 0.2, 3.0, 0.0, false)}),
+      Case("decoy", "m", {Explaining("a", 1e-30, -500.0, 0.012, 0.01)}),
+      Case("decoy", "m", {Explaining("b", 1e-20, -200.0, 0.05, 0.05)}),
+  };
+  nlohmann::json table;
+  const Thresholds t = ChooseThresholds(calibration, 0.10, 0.30, &table);
+  EXPECT_DOUBLE_EQ(t.alpha, 1e-3);
+  EXPECT_DOUBLE_EQ(t.max_delta_bic, 0.0);
+  EXPECT_DOUBLE_EQ(t.min_heldout_improvement, 0.0);
+  EXPECT_DOUBLE_EQ(t.min_explained_share, 0.25);
+  for (const CaseResult& c : calibration) EXPECT_TRUE(ReplayCorrect(c, ReplayFirstRound(c.candidates, t)));
+  for (const nlohmann::json& p : table)
+    EXPECT_TRUE(p["min_explained_share"] != 0.0 || !p["feasible"].get<bool>());
+  // The default share is one of the grid's, and the loosest point applies none.
+  EXPECT_DOUBLE_EQ(Loosest().min_explained_share, 0.0);
+  EXPECT_DOUBLE_EQ(Thresholds{}.min_explained_share, gap::kDefaultMinExplainedShare);
+}
+
+TEST(GapBenchmarkScore, CalibrationDrawsAreStratified) {
+  // Any first n calibration cases hold a quarter none and a quarter decoys (rounded up), the rest effects.
+  for (int n : {1, 4, 8, 16, 17, 60}) {
+    int none = 0, decoy = 0, effect = 0;
+    for (int i = 0; i < n; ++i) {
+      const std::string kind = CalibrationKind(i);
+      none += kind == "none";
+      decoy += kind == "decoy";
+      effect += kind == "effect";
+    }
+    EXPECT_EQ(none, (n + 3) / 4) << n;
+    EXPECT_EQ(decoy, (n + 2) / 4) << n;
+    EXPECT_EQ(none + decoy + effect, n) << n;
+  }
+  EXPECT_EQ(CalibrationKind(0), "none");
+  EXPECT_EQ(CalibrationKind(1), "decoy");
+  EXPECT_EQ(CalibrationKind(2), "effect");
+  EXPECT_EQ(CalibrationKind(3), "effect");
+}
+
 TEST(GapBenchmarkScore, CalibrationAndScoreJudgeByOneRule) {
   // A decoy and a none case reported `unknown` beside a kept library effect are false discoveries; an effect case
   // whose effect is kept first beside a verdict `unknown` is identified. The replay and the score agree on each.
