@@ -38,18 +38,26 @@ TEST(ProblemBuilderTest, OnePosePerMasterSampleAndEveryMeasurementAccountedFor) 
   }
 }
 
-// The odometer's disturbance as a Gauss-Markov process with its own sigma and tau per row: one instance per pose,
-// joined by process factors whose noise is sigma_i^2 (1 - exp(-2 dt / tau_i)) per component, and a stationary prior
-// N(0, sigma^2) on the first instance; the odometer's factors read the instance at their interval's start.
-TEST(ProblemBuilderTest, GaussMarkovDisturbanceHasAProcessPerComponentAndAStationaryStart) {
-  const auto synthetic = ShortDrive();
-  EstimatorConfig config = testing::AtvConfig({});
+// The odometer's disturbance slot, free, as a Gauss-Markov process with its own sigma and tau per row (about the ATV
+// configuration's); interval_s 0: one instance per pose.
+ParameterConfig GaussMarkovDisturbance(double interval_s) {
   ParameterConfig disturbance;
   disturbance.value = Eigen::VectorXd(Eigen::Vector3d::Zero());
   disturbance.free = true;
   disturbance.process.type = ProcessConfig::Type::kGaussMarkov;
   disturbance.process.sigma = Eigen::Vector3d(0.006, 0.002, 0.025);
   disturbance.process.tau_s = Eigen::Vector3d(0.7, 1.2, 1.8);
+  disturbance.process.interval_s = interval_s;
+  return disturbance;
+}
+
+// The odometer's disturbance as a Gauss-Markov process with its own sigma and tau per row: one instance per pose,
+// joined by process factors whose noise is sigma_i^2 (1 - exp(-2 dt / tau_i)) per component, and a stationary prior
+// N(0, sigma^2) on the first instance; the odometer's factors read the instance at their interval's start.
+TEST(ProblemBuilderTest, GaussMarkovDisturbanceHasAProcessPerComponentAndAStationaryStart) {
+  const auto synthetic = ShortDrive();
+  EstimatorConfig config = testing::AtvConfig({});
+  const ParameterConfig disturbance = GaussMarkovDisturbance(0.0);
   config.parameters["odometer.disturbance"] = disturbance;
   auto built = ProblemBuilder::Create(config, synthetic.recording);
   ASSERT_TRUE(built.ok()) << built.status().message();
@@ -106,13 +114,7 @@ TEST(ProblemBuilderTest, ProcessIntervalSharesOneInstanceAmongItsPoses) {
     s.t = t;
   }
   EstimatorConfig config = testing::AtvConfig({});
-  ParameterConfig disturbance;
-  disturbance.value = Eigen::VectorXd(Eigen::Vector3d::Zero());
-  disturbance.free = true;
-  disturbance.process.type = ProcessConfig::Type::kGaussMarkov;
-  disturbance.process.sigma = Eigen::Vector3d(0.006, 0.002, 0.025);
-  disturbance.process.tau_s = Eigen::Vector3d(0.7, 1.2, 1.8);
-  disturbance.process.interval_s = 0.1;
+  const ParameterConfig disturbance = GaussMarkovDisturbance(0.1);
   config.parameters["odometer.disturbance"] = disturbance;
   auto built = ProblemBuilder::Create(config, synthetic.recording);
   ASSERT_TRUE(built.ok()) << built.status().message();

@@ -30,6 +30,19 @@ std::vector<Eigen::Vector3d> PositionErrors(const TrackingResult& r, const Traje
   return errors;
 }
 
+// A sliding window's last pose against the whole track's (no marginalization): within 0.2 of the whole track's
+// position std (Mahalanobis), and its position std within 10 % of the whole track's.
+void ExpectEndsLikeTheWholeTrack(const TrackingResult& sliding, const TrackingResult& whole) {
+  const StampedPose& a = sliding.trajectory.back();
+  const StampedPose& b = whole.trajectory.back();
+  ASSERT_EQ(a.t, b.t);
+  const Eigen::Matrix3d& cov = whole.position_covariance.back();
+  const Eigen::Vector3d d = a.p_world_body - b.p_world_body;
+  EXPECT_LT(std::sqrt(d.dot(cov.ldlt().solve(d))), 0.2);
+  EXPECT_NEAR(std::sqrt(sliding.position_covariance.back().trace()), std::sqrt(cov.trace()),
+              0.1 * std::sqrt(cov.trace()));
+}
+
 TEST(TrackingTest, NoiseFreeTrackingFollowsTheTruth) {
   roamlab::testing::SyntheticOptions options;
   options.duration_s = 4.0;
@@ -75,14 +88,7 @@ TEST(TrackingTest, MarginalizationKeepsTheInformationOfTheWindow) {
   auto sliding = Track(testing::AtvConfig({}, 10), synthetic.recording, {});
   auto whole = Track(testing::AtvConfig({}, 100000), synthetic.recording, {});
   ASSERT_TRUE(sliding.ok() && whole.ok());
-  const StampedPose& a = sliding.value().trajectory.back();
-  const StampedPose& b = whole.value().trajectory.back();
-  ASSERT_EQ(a.t, b.t);
-  const Eigen::Matrix3d& cov = whole.value().position_covariance.back();
-  const Eigen::Vector3d d = a.p_world_body - b.p_world_body;
-  EXPECT_LT(std::sqrt(d.dot(cov.ldlt().solve(d))), 0.2);
-  EXPECT_NEAR(std::sqrt(sliding.value().position_covariance.back().trace()), std::sqrt(cov.trace()),
-              0.1 * std::sqrt(cov.trace()));
+  ExpectEndsLikeTheWholeTrack(sliding.value(), whole.value());
 }
 
 // The ATV configuration with the gyroscope's bias slot mapped to imu.gyro_bias, declared free and time-varying: a
@@ -154,14 +160,7 @@ TEST(TrackingTest, MarginalizationKeepsTheInformationWithSharedInstances) {
   ASSERT_TRUE(sliding.ok()) << sliding.status().message();
   ASSERT_TRUE(whole.ok()) << whole.status().message();
   ASSERT_EQ(sliding.value().trajectory.size(), whole.value().trajectory.size());
-  const StampedPose& a = sliding.value().trajectory.back();
-  const StampedPose& b = whole.value().trajectory.back();
-  ASSERT_EQ(a.t, b.t);
-  const Eigen::Matrix3d& cov = whole.value().position_covariance.back();
-  const Eigen::Vector3d d = a.p_world_body - b.p_world_body;
-  EXPECT_LT(std::sqrt(d.dot(cov.ldlt().solve(d))), 0.2);
-  EXPECT_NEAR(std::sqrt(sliding.value().position_covariance.back().trace()), std::sqrt(cov.trace()),
-              0.1 * std::sqrt(cov.trace()));
+  ExpectEndsLikeTheWholeTrack(sliding.value(), whole.value());
 }
 
 TEST(TrackingTest, TrackingTheGyroBiasComesCloseToKnowingIt) {
