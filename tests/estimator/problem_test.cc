@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -51,19 +52,30 @@ ParameterConfig GaussMarkovDisturbance(double interval_s) {
   return disturbance;
 }
 
+// The ATV configuration with `disturbance` as its odometer.disturbance, every measurement of `recording` added and
+// the graph finished; null (and a failed expectation) when the configuration is refused.
+std::unique_ptr<ProblemBuilder> BuildWithDisturbance(const recording::Recording& recording,
+                                                     const ParameterConfig& disturbance) {
+  EstimatorConfig config = testing::AtvConfig({});
+  config.parameters["odometer.disturbance"] = disturbance;
+  auto built = ProblemBuilder::Create(config, recording);
+  EXPECT_TRUE(built.ok()) << built.status().message();
+  if (!built.ok()) return nullptr;
+  std::unique_ptr<ProblemBuilder> builder = std::move(built.value());
+  for (const MeasurementRef& m : builder->Measurements()) builder->Add(m);
+  builder->Finish();
+  return builder;
+}
+
 // The odometer's disturbance as a Gauss-Markov process with its own sigma and tau per row: one instance per pose,
 // joined by process factors whose noise is sigma_i^2 (1 - exp(-2 dt / tau_i)) per component, and a stationary prior
 // N(0, sigma^2) on the first instance; the odometer's factors read the instance at their interval's start.
 TEST(ProblemBuilderTest, GaussMarkovDisturbanceHasAProcessPerComponentAndAStationaryStart) {
   const auto synthetic = ShortDrive();
-  EstimatorConfig config = testing::AtvConfig({});
   const ParameterConfig disturbance = GaussMarkovDisturbance(0.0);
-  config.parameters["odometer.disturbance"] = disturbance;
-  auto built = ProblemBuilder::Create(config, synthetic.recording);
-  ASSERT_TRUE(built.ok()) << built.status().message();
-  ProblemBuilder& builder = *built.value();
-  for (const MeasurementRef& m : builder.Measurements()) builder.Add(m);
-  builder.Finish();
+  const std::unique_ptr<ProblemBuilder> built = BuildWithDisturbance(synthetic.recording, disturbance);
+  ASSERT_NE(built, nullptr);
+  ProblemBuilder& builder = *built;
   ASSERT_TRUE(builder.IsTimeVarying("odometer.disturbance"));
   const Graph& graph = builder.graph();
   int process = 0, prior = 0, odometer = 0;
@@ -113,14 +125,10 @@ TEST(ProblemBuilderTest, ProcessIntervalSharesOneInstanceAmongItsPoses) {
     s.values = Eigen::MatrixXd(s.values(kept, Eigen::all));
     s.t = t;
   }
-  EstimatorConfig config = testing::AtvConfig({});
   const ParameterConfig disturbance = GaussMarkovDisturbance(0.1);
-  config.parameters["odometer.disturbance"] = disturbance;
-  auto built = ProblemBuilder::Create(config, synthetic.recording);
-  ASSERT_TRUE(built.ok()) << built.status().message();
-  ProblemBuilder& builder = *built.value();
-  for (const MeasurementRef& m : builder.Measurements()) builder.Add(m);
-  builder.Finish();
+  const std::unique_ptr<ProblemBuilder> built = BuildWithDisturbance(synthetic.recording, disturbance);
+  ASSERT_NE(built, nullptr);
+  ProblemBuilder& builder = *built;
   const Graph& graph = builder.graph();
   const auto& poses = builder.poses();
   const auto instance = [&](std::size_t k) { return poses[k].instances.at("odometer.disturbance"); };
