@@ -33,7 +33,8 @@ const std::vector<ModelSpec>& ModelSpecs() {
       // slip_per_mps2 and slope_slip_per_mps2: the driven tires' slip per m/s^2 of forward specific force (read from
       // inputs.specific_force, an imu or accelerometer stream, along options.forward_in_sensor) and of slope g
       // sin(pitch); disturbance: the speed, lateral and vertical rows' coloured disturbance [m/s], meant to be
-      // time-varying (models/ackermann_velocity.h).
+      // time-varying; option front_slip_velocity 1: cornering_front is the front axle's side slip velocity per a_y
+      // [s] instead of an angle (models/ackermann_velocity.h).
       {"ackermann",
        {"speed", "steering"},
        {"speed_mps", "steering_rad", "lateral_mps", "vertical_mps"},
@@ -41,7 +42,7 @@ const std::vector<ModelSpec>& ModelSpecs() {
         ScalarSlot("k_gamma", 0.0), ScalarSlot("cornering_front", 0.0), ScalarSlot("cornering_rear", 0.0),
         ScalarSlot("thrust_angle", 0.0), ScalarSlot("slip_per_mps2", 0.0), ScalarSlot("slope_slip_per_mps2", 0.0),
         Vector3Slot("disturbance", 0.0)},
-       {"wheelbase_m", "speed_column", "contact_height_m", "pitch_lever_m", "forward_in_sensor"},
+       {"wheelbase_m", "speed_column", "contact_height_m", "pitch_lever_m", "forward_in_sensor", "front_slip_velocity"},
        true, {"specific_force"}},
       {"ackermann_seed",
        {"speed", "steering"},

@@ -59,7 +59,7 @@ struct StreamBinding {
   double row_covariance_scale = 0.0;            // odometer, relative_motion: weight of the rows' own covariance
   double interval_s = 0.0;                      // relative_motion: T
   double wheelbase_m = 0.0;
-  AckermannVelocityError::Contact contact;  // ackermann: options contact_height_m, pitch_lever_m
+  AckermannVelocityError::Options ackermann;  // ackermann: options contact_height_m, pitch_lever_m, front_slip_velocity
   Eigen::Vector3d field_world = Eigen::Vector3d::Zero();
   const recording::Stream* specific_force = nullptr;   // magnetometer, ackermann: inputs.specific_force
   int specific_force_column = 0;                       // its first accelerometer column
@@ -184,10 +184,15 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
         return Error(config, "stream '" + name + "': no wheelbase_m in options or in the recording's platform");
       }
       if (!(b.wheelbase_m > 0.0)) return Error(config, "stream '" + name + "': wheelbase_m must be positive");
-      if (sc.options.count("contact_height_m")) b.contact.contact_height_m = sc.options.at("contact_height_m").at(0);
-      if (sc.options.count("pitch_lever_m")) b.contact.pitch_lever_m = sc.options.at("pitch_lever_m").at(0);
-      if (!(std::abs(b.contact.contact_height_m) <= 10.0 && std::abs(b.contact.pitch_lever_m) <= 10.0))
+      if (sc.options.count("contact_height_m")) b.ackermann.contact_height_m = sc.options.at("contact_height_m").at(0);
+      if (sc.options.count("pitch_lever_m")) b.ackermann.pitch_lever_m = sc.options.at("pitch_lever_m").at(0);
+      if (!(std::abs(b.ackermann.contact_height_m) <= 10.0 && std::abs(b.ackermann.pitch_lever_m) <= 10.0))
         return Error(config, "stream '" + name + "': contact_height_m and pitch_lever_m must be within +-10 m");
+      if (const auto f = sc.options.find("front_slip_velocity"); f != sc.options.end()) {
+        if (f->second.size() != 1 || !(f->second[0] == 0.0 || f->second[0] == 1.0))
+          return Error(config, "stream '" + name + "': front_slip_velocity must be 0 or 1");
+        b.ackermann.front_slip_velocity = f->second[0] == 1.0;
+      }
       // The longitudinal slip's input (models/ackermann_velocity.h): the specific force along O's x, which is
       // options.forward_in_sensor in the accelerometer's frame.
       const Result<bool> input = BindSpecificForce(config, rec, &b);
@@ -644,7 +649,7 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k)};
     if (model == "ackermann") {
       const double f_x = s.specific_force ? s.forward_in_sensor.dot(SpecificForceAt(s, m.t)) : 0.0;
-      factor = MakeFactor(AckermannVelocityError(z_v, z_theta, s.wheelbase_m, dt, s.contact, f_x));
+      factor = MakeFactor(AckermannVelocityError(z_v, z_theta, s.wheelbase_m, dt, s.ackermann, f_x));
       vars.insert(vars.end(), {slot(3, k), slot(4, k), slot(5, k), slot(6, k), slot(7, k), slot(8, k)});
     } else {
       factor = MakeFactor(AckermannOdometerError(z_v, z_theta, s.wheelbase_m, dt));

@@ -35,6 +35,15 @@
 // ATV (30 s, 4 m hills, scripts/atv_odometer_residuals.py): at the contact v_y has slope -0.0207 s on a_y and leaves
 // 0.0022 m/s rms of 0.035; the steering row -0.0047 rad s^2/m, leaving 0.0025 rad of 0.0083.
 //
+// Understeer as a slip velocity (option front_slip_velocity, default off). MuJoCo's soft contacts let a tire slip at a
+// velocity proportional to the force it carries (as the rear axle's v_y = -c_rear a_y above), not at an angle: the
+// front axle drifts outwards at c_front a_y [m/s] (c_front [s]), so it moves along atan((L omega_z + v_y) / v_x) while
+// steered at
+//   delta = atan((L omega_z + v_y + c_front a_y) / v_x),
+// an angle c_front a_y / v_x = c_front omega_z to first order: the angle form's coefficient is this one over the speed
+// at which the drive corners. Measured on the MuJoCo ATV (scripts/atv_understeer_fit.py, noise-free, at the contact):
+// 0.0209 s on the default drive and on a steering-rich weave alike (the angle form: 0.0047 and 0.0059 rad s^2/m).
+//
 // Rear-axle thrust angle alpha [rad] (a misaligned rear axle: both rear wheels turned about z by alpha, positive
 // counter-clockwise). The rear wheels roll along d = (cos alpha, sin alpha) in O, so without side slip O's velocity
 // is v_roll d: v_y = v_x tan(alpha) (the vehicle crabs: its course is its heading plus alpha) and the speed sensor
@@ -72,8 +81,8 @@
 //
 // Frames: O is the middle of the rear axle (x forward, z up). Measurements: z_v rear-wheel speed with the nominal
 // wheel radius [m/s], z_theta handlebar angle [rad], both over [t_k, t_k+1]; input f_x [m/s^2]. Calibration:
-// kv_over_L [1/m], k_theta [-], k_gamma [rad], c_front [rad s^2/m], c_rear [s], alpha [rad], s_f [s^2/m], s_p
-// [s^2/m], w [m/s]; the wheelbase L [m], h and d [m] are known. Noise eta =
+// kv_over_L [1/m], k_theta [-], k_gamma [rad], c_front [rad s^2/m; s with front_slip_velocity], c_rear [s], alpha
+// [rad], s_f [s^2/m], s_p [s^2/m], w [m/s]; the wheelbase L [m], h and d [m] are known. Noise eta =
 // [sigma_v (m/s), sigma_theta (rad), lateral (m/s), vertical (m/s)], the last two the uncertainty of the non-holonomic
 // assumptions (no unmodelled sideways slip, no motion off the ground). Eq. 15 says nothing about roll and pitch
 // rates, and on hills they are not zero (the terrain tilts the vehicle): pretending they are pulls the estimated
@@ -88,13 +97,15 @@
 //   dv/dtheta = [v]x eps/dtheta  ((R_mid Exp(eps))^T u = R_mid^T u + [R_mid^T u]x eps), where eps, the right
 //   perturbation of q_mid, is (q_k Exp(d) Exp(psi + dpsi) = q_mid Exp(R(psi)^T d) Exp(Jr(psi) dpsi), psi = phi / 2)
 //   eps/dtheta_k = R(phi/2)^T - Jr(phi/2) Jl^-1(phi) / 2,   eps/dtheta_k+1 = Jr(phi/2) Jr^-1(phi) / 2.
-// The rows in the contact velocity v and omega_z, with r = (L omega_z + v_y) / v_x and s = 1 / (1 + r^2) (steering
+// The rows in the contact velocity v and omega_z, with delta = atan(r) + c_a a_y, r = (L omega_z + v_y + c_s a_y) /
+// v_x (c_a = c_front, c_s = 0; with front_slip_velocity c_a = 0, c_s = c_front) and s = 1 / (1 + r^2) (steering
 // row zero below kMinSteeringSpeed): de_v = sigma (cos(alpha) dv_x + sin(alpha) dv_y) / k_v + v_roll s_p g
-// dsin(theta) / k_v with dsin(theta)/deps = -e_z^T R_mid [e_x]x;  k_theta de_theta = (c_front omega_z -
-// s r / v_x) dv_x + s / v_x dv_y + (s L / v_x + c_front v_x) domega_z;  de_lat = (c_rear omega_z - tan(alpha)) dv_x
-// + dv_y + c_rear v_x domega_z;  de_vert = dv_z - d domega_y; and dv/domega = [[0, -h, 0], [h, 0, 0], [0, 0, 0]].
-// Parameters: de_v/dkv_over_L = -v_roll sigma / (kv_over_L^2 L), de_theta/dk_theta = -(delta - k_gamma) / k_theta^2,
-// de_theta/dk_gamma = -1 / k_theta, de_theta/dc_front = a_y / k_theta, de_lat/dc_rear = a_y,
+// dsin(theta) / k_v with dsin(theta)/deps = -e_z^T R_mid [e_x]x;  k_theta de_theta = (c_a omega_z - s (r - c_s
+// omega_z) / v_x) dv_x + s / v_x dv_y + (s (L / v_x + c_s) + c_a v_x) domega_z;  de_lat = (c_rear omega_z -
+// tan(alpha)) dv_x + dv_y + c_rear v_x domega_z;  de_vert = dv_z - d domega_y; and dv/domega = [[0, -h, 0], [h, 0, 0],
+// [0, 0, 0]]. Parameters: de_v/dkv_over_L = -v_roll sigma / (kv_over_L^2 L), de_theta/dk_theta = -(delta - k_gamma) /
+// k_theta^2, de_theta/dk_gamma = -1 / k_theta, de_theta/dc_front = a_y / k_theta (s omega_z / k_theta with
+// front_slip_velocity), de_lat/dc_rear = a_y,
 // de_v/dalpha = (v_y cos(alpha) - v_x sin(alpha)) sigma / k_v, de_lat/dalpha = -v_x (1 + tan^2(alpha)),
 // de_v/ds_f = v_roll f_x / k_v, de_v/ds_p = v_roll g sin(theta) / k_v; de/dw: ones at (speed, w_v), (lateral, w_lat),
 // (vertical, w_vert).
@@ -112,11 +123,13 @@
 
 namespace roamlab::estimator {
 
-// Where AckermannVelocityError takes its rows (header comment): h = contact_height_m, d = pitch_lever_m; the default
-// 0, 0 is eq. 15 at O.
-struct AckermannContact {
+// AckermannVelocityError's options (header comment): where it takes its rows, h = contact_height_m and d =
+// pitch_lever_m (the default 0, 0 is eq. 15 at O), and the form of the understeer: front_slip_velocity false (the
+// default) c_front [rad s^2/m] an angle, true c_front [s] the front axle's side slip velocity per a_y.
+struct AckermannOptions {
   double contact_height_m = 0.0;
   double pitch_lever_m = 0.0;
+  bool front_slip_velocity = false;
 };
 
 class AckermannVelocityError {
@@ -129,16 +142,16 @@ class AckermannVelocityError {
   static constexpr bool kAdditiveNoise = true;  // e = f(x) + eta
   static constexpr double kMinSteeringSpeed = 0.2;  // [m/s]
 
-  using Contact = AckermannContact;
+  using Options = AckermannOptions;
 
   // forward_specific_force_mps2: f_x, the IMU's specific force along O's x over the interval (0: no input).
-  AckermannVelocityError(double z_v_mps, double z_theta_rad, double wheelbase_m, double dt_s, Contact contact = {},
+  AckermannVelocityError(double z_v_mps, double z_theta_rad, double wheelbase_m, double dt_s, Options options = {},
                          double forward_specific_force_mps2 = 0.0)
       : z_v_mps_(z_v_mps),
         z_theta_rad_(z_theta_rad),
         wheelbase_m_(wheelbase_m),
         dt_s_(dt_s),
-        contact_(contact),
+        options_(options),
         forward_specific_force_mps2_(forward_specific_force_mps2) {
     ROAMLAB_CHECK(wheelbase_m > 0.0 && dt_s > 0.0, "Ackermann wheelbase " << wheelbase_m << " dt " << dt_s);
   }
@@ -153,7 +166,7 @@ class AckermannVelocityError {
     Vector3<T> v_odom, omega_body;
     const Pose<T> pose_k = PoseFromArray(x[0]);
     VelocitiesBetween<T>(pose_k, PoseFromArray(x[1]), T(dt_s_), &v_odom, &omega_body);
-    const T h(contact_.contact_height_m);
+    const T h(options_.contact_height_m);
     const Vector3<T> v_body(v_odom.x() - h * omega_body.y(), v_odom.y() + h * omega_body.x(), v_odom.z());
     const T& kv_over_l = x[2][0];
     const T& k_theta = x[3][0];
@@ -172,13 +185,16 @@ class AckermannVelocityError {
     const T slip = T(1.0) + slip_f * T(forward_specific_force_mps2_) + slip_p * T(kStandardGravity) * sin_pitch;
     error[0] = v_roll * slip / (kv_over_l * T(wheelbase_m_)) - T(z_v_mps_) + w[0] + noise[0];
     if (std::abs(ValueOf(v_body.x())) >= kMinSteeringSpeed) {
-      const T delta = atan((T(wheelbase_m_) * omega_body.z() + v_body.y()) / v_body.x()) + c_front * a_y;
+      // The understeer as an angle (c_angle = c_front) or as the front axle's side slip velocity (c_slip = c_front).
+      const T c_angle = options_.front_slip_velocity ? T(0.0) : c_front;
+      const T c_slip = options_.front_slip_velocity ? c_front : T(0.0);
+      const T delta = atan((T(wheelbase_m_) * omega_body.z() + v_body.y() + c_slip * a_y) / v_body.x()) + c_angle * a_y;
       error[1] = (delta - k_gamma) / k_theta - T(z_theta_rad_) + noise[1];
     } else {
       error[1] = noise[1];
     }
     error[2] = v_body.y() - v_body.x() * tan(alpha) + c_rear * a_y + w[1] + noise[2];
-    error[3] = v_body.z() - T(contact_.pitch_lever_m) * omega_body.y() + w[2] + noise[3];
+    error[3] = v_body.z() - T(options_.pitch_lever_m) * omega_body.y() + w[2] + noise[3];
     return true;
   }
 
@@ -203,7 +219,7 @@ class AckermannVelocityError {
     const Eigen::Vector3d omega_body = phi / dt_s_;
     const Quaternion<double> q_mid = pose_k.q_world_body * QuaternionExp<double>(phi * 0.5);
     const Eigen::Vector3d v_odom = q_mid.conjugate() * ((pose_k1.p_world_body - pose_k.p_world_body) / dt_s_);
-    const double h = contact_.contact_height_m, d = contact_.pitch_lever_m;
+    const double h = options_.contact_height_m, d = options_.pitch_lever_m;
     const Eigen::Vector3d v_body(v_odom.x() - h * omega_body.y(), v_odom.y() + h * omega_body.x(), v_odom.z());
 
     // As operator().
@@ -215,8 +231,11 @@ class AckermannVelocityError {
     const double slip = 1.0 + slip_f * forward_specific_force_mps2_ + slip_p * kStandardGravity * sin_pitch;
     error[0] = v_roll * slip / k_v - z_v_mps_ + w[0];
     const bool steering = std::abs(v_body.x()) >= kMinSteeringSpeed;
-    const double r = steering ? (wheelbase_m_ * omega_body.z() + v_body.y()) / v_body.x() : 0.0;
-    const double delta = steering ? std::atan(r) + c_front * a_y : 0.0;
+    // The understeer as an angle (c_angle = c_front) or as the front axle's side slip velocity (c_slip = c_front).
+    const double c_angle = options_.front_slip_velocity ? 0.0 : c_front;
+    const double c_slip = options_.front_slip_velocity ? c_front : 0.0;
+    const double r = steering ? (wheelbase_m_ * omega_body.z() + v_body.y() + c_slip * a_y) / v_body.x() : 0.0;
+    const double delta = steering ? std::atan(r) + c_angle * a_y : 0.0;
     error[1] = steering ? (delta - k_gamma) / k_theta - z_theta_rad_ : 0.0;
     error[2] = v_body.y() - v_body.x() * tan_alpha + c_rear * a_y + w[1];
     error[3] = v_body.z() - d * omega_body.y() + w[2];
@@ -234,9 +253,9 @@ class AckermannVelocityError {
     J_e_omega_z[2] = c_rear * v_body.x();
     if (steering) {
       const double s = 1.0 / (1.0 + r * r);
-      J_e_v(1, 0) = (c_front * omega_body.z() - s * r / v_body.x()) / k_theta;
+      J_e_v(1, 0) = (c_angle * omega_body.z() - s * (r - c_slip * omega_body.z()) / v_body.x()) / k_theta;
       J_e_v(1, 1) = s / (v_body.x() * k_theta);
-      J_e_omega_z[1] = (s * wheelbase_m_ / v_body.x() + c_front * v_body.x()) / k_theta;
+      J_e_omega_z[1] = (s * (wheelbase_m_ / v_body.x() + c_slip) + c_angle * v_body.x()) / k_theta;
     }
     // Through the contact velocity (dv/domega) and the vertical row's chord term; then v is O's velocity below.
     Eigen::Matrix3d J_v_omega = Eigen::Matrix3d::Zero();
@@ -281,7 +300,8 @@ class AckermannVelocityError {
       Eigen::Map<Eigen::Vector4d>{jacobians[4]} << 0.0, steering ? -1.0 / k_theta : 0.0, 0.0, 0.0;
     }
     if (jacobians[5] != nullptr) {
-      Eigen::Map<Eigen::Vector4d>{jacobians[5]} << 0.0, steering ? a_y / k_theta : 0.0, 0.0, 0.0;
+      const double d_delta = options_.front_slip_velocity ? omega_body.z() / (1.0 + r * r) : a_y;
+      Eigen::Map<Eigen::Vector4d>{jacobians[5]} << 0.0, steering ? d_delta / k_theta : 0.0, 0.0, 0.0;
     }
     if (jacobians[6] != nullptr) Eigen::Map<Eigen::Vector4d>{jacobians[6]} << 0.0, 0.0, a_y, 0.0;
     if (jacobians[7] != nullptr) {
@@ -307,7 +327,7 @@ class AckermannVelocityError {
   double z_theta_rad_;
   double wheelbase_m_;
   double dt_s_;
-  Contact contact_;
+  Options options_;
   double forward_specific_force_mps2_;
 };
 

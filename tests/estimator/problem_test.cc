@@ -280,6 +280,21 @@ TEST(ProblemBuilderTest, AckermannSpecificForceInputIsChecked) {
       << message(config);
 }
 
+// The Ackermann odometer's understeer form: option front_slip_velocity is 0 or 1.
+TEST(ProblemBuilderTest, AckermannFrontSlipVelocityIsChecked) {
+  const auto synthetic = ShortDrive();
+  const auto message = [&](const EstimatorConfig& config) { return BuildOutcome(config, synthetic.recording); };
+  EstimatorConfig config = testing::AtvConfig({});
+  StreamConfig* odo = nullptr;
+  for (auto& [name, sc] : config.streams)
+    if (sc.model == "ackermann") odo = &sc;
+  ASSERT_NE(odo, nullptr);
+  odo->options["front_slip_velocity"] = {1.0};
+  EXPECT_EQ(message(config), "accepted");
+  odo->options["front_slip_velocity"] = {0.5};
+  EXPECT_NE(message(config).find("front_slip_velocity must be 0 or 1"), std::string::npos) << message(config);
+}
+
 // A differential drive seen by motion capture over a short stretch (the fixes span well under 1 m, too little for a
 // position-only yaw fit) that starts facing backwards: the measured orientations still turn the dead-reckoned
 // trajectory (which starts at yaw 0) onto the fixes.

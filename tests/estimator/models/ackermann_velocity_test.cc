@@ -84,6 +84,34 @@ TEST(AckermannVelocityErrorTest, CorneringComplianceExplainsSideSlipAndUnderstee
   EXPECT_NEAR(rigid.error[2], v_y, 1e-9);
 }
 
+TEST(AckermannVelocityErrorTest, FrontSlipVelocityExplainsUndersteerAtEverySpeed) {
+  // Option front_slip_velocity: the front axle drifts outwards at c_front a_y [m/s], so the front wheels are steered
+  // at atan((L omega + v_y + c_front a_y) / v): an understeer angle of about c_front omega, the same c_front at 2 and
+  // 5 m/s. The angle form would need c_front / (v (1 + r^2)), a different coefficient per speed.
+  const double a_y = 1.0, dt = 0.01, c_front = 0.02, c_rear = 0.015;
+  const AckermannVelocityError::Options slip_velocity{0.0, 0.0, true};
+  double angle_per_a_y[2];
+  for (int i = 0; i < 2; ++i) {
+    const double v = i == 0 ? 2.0 : 5.0, omega = a_y / v, v_y = -c_rear * a_y;
+    const double delta = std::atan((kL * omega + v_y + c_front * a_y) / v);
+    const Eigen::VectorXd pose0 = Manifold::Pose().Identity();
+    const Eigen::VectorXd pose1 = Step(pose0, v, omega, dt, v_y);
+    const auto factor = MakeFactor(AckermannVelocityError(v / kL / 0.8, delta, kL, dt, slip_velocity));
+    const auto lin = testing::Evaluate(*factor, {pose0, pose1, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(c_front),
+                                                 Scalar(c_rear), Scalar(0.0), Scalar(0.0), Scalar(0.0), Disturbance()});
+    EXPECT_LT(lin.error.norm(), 1e-10) << lin.error.transpose();
+    // The angle form (default options) leaves delta - atan((L omega + v_y) / v) as the steering error without
+    // c_front; that understeer angle per a_y falls with the speed.
+    const auto angle = testing::Evaluate(*MakeFactor(AckermannVelocityError(v / kL / 0.8, delta, kL, dt)),
+                                         {pose0, pose1, Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
+                                          Scalar(c_rear), Scalar(0.0), Scalar(0.0), Scalar(0.0), Disturbance()});
+    angle_per_a_y[i] = -angle.error[1] / a_y;
+    const double r = (kL * omega + v_y) / v;
+    EXPECT_NEAR(angle_per_a_y[i], c_front / (v * (1.0 + r * r)), 0.05 * c_front / v);
+  }
+  EXPECT_GT(angle_per_a_y[0], 2.0 * angle_per_a_y[1]);
+}
+
 TEST(AckermannVelocityErrorTest, ThrustAngleExplainsCrabAndTurnAtZeroHandlebar) {
   // A rear axle turned by alpha = 2 deg: with the handlebar at zero the vehicle turns at -v tan(alpha) / L and crabs,
   // v_y = v tan(alpha); the rear wheels read the rolling speed v / cos(alpha).
@@ -184,8 +212,8 @@ TEST(AckermannVelocityErrorTest, JacobiansMatchCentralDifferences) {
     const Eigen::VectorXd pose0 = testing::RandomPoint(Manifold::Pose(), &rng, 10.0);
     const Eigen::VectorXd pose1 = testing::Perturb(Manifold::Pose(), Step(pose0, 3.0 + trial, 0.2, 0.02), 0.002, &rng);
     // Eq. 15 at O, and with the rows at a contact below O (h, d nonzero: the rates enter every row); with slip.
-    for (const AckermannVelocityError::Contact contact : {AckermannVelocityError::Contact{},
-                                                          AckermannVelocityError::Contact{0.28, 0.625}}) {
+    for (const AckermannVelocityError::Options contact : {AckermannVelocityError::Options{},
+                                                          AckermannVelocityError::Options{0.28, 0.625}}) {
       const auto factor = MakeFactor(AckermannVelocityError(4.0, 0.1, kL, 0.02, contact, 0.7 - 0.4 * trial));
       testing::ExpectJacobiansMatchNumeric(
           *factor, {pose0, pose1, Scalar(0.78), Scalar(1.02), Scalar(0.01), Scalar(0.004), Scalar(-0.015),

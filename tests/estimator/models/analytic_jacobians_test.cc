@@ -245,6 +245,8 @@ TEST(AnalyticJacobiansTest, AckermannVelocity) {
     const bool large = LargeRotation(point);
     // Every fifth point below kMinSteeringSpeed, where the steering row is zero.
     const bool slow = point % 5 == 4;
+    // Every third with the understeer as the front axle's slip velocity (option front_slip_velocity, c_front in s).
+    const bool slip_velocity = point % 3 == 1;
     const Eigen::Vector3d v_body(slow ? 0.05 * normal(rng) : 3.0 + 1.5 * normal(rng), 0.05 * normal(rng),
                                  0.05 * normal(rng));
     const Eigen::Vector3d omega_body = large ? RandomRotationVector(1.0, 2.5, &rng) / kDt
@@ -256,16 +258,16 @@ TEST(AnalyticJacobiansTest, AckermannVelocity) {
     const Eigen::VectorXd pose_k1 = PlusPose(pose_k, q_mid * (v_body * kDt), omega_body * kDt);
     const double kv_over_l = 0.8 + 0.02 * normal(rng), k_theta = 1.0 + 0.05 * normal(rng);
     const double k_gamma = 0.02 * normal(rng);
-    const double c_front = 0.003 * normal(rng), c_rear = 0.015 * normal(rng);  // [rad s^2/m], [s]
-    const double alpha = 0.03 * normal(rng);                                     // [rad]
-    const double s_f = 0.03 * normal(rng), s_p = 0.03 * normal(rng);            // [s^2/m]
-    const double f_x = normal(rng);                                             // [m/s^2]
+    const double c_front = (slip_velocity ? 0.02 : 0.003) * normal(rng);  // [s] or [rad s^2/m]
+    const double c_rear = 0.015 * normal(rng);                              // [s]
+    const double alpha = 0.03 * normal(rng);                                // [rad]
+    const double s_f = 0.03 * normal(rng), s_p = 0.03 * normal(rng);       // [s^2/m]
+    const double f_x = normal(rng);                                        // [m/s^2]
     const Eigen::VectorXd w = Eigen::Vector3d(0.01 * normal(rng), 0.005 * normal(rng), 0.03 * normal(rng));  // [m/s]
     const double z_v = v_body.x() / (kv_over_l * kWheelbase) + 0.03 * normal(rng);
     const double z_theta = 0.2 * normal(rng);
     // Every other point with the rows at a ground contact below O (options contact_height_m, pitch_lever_m).
-    const AckermannVelocityError::Contact contact =
-        point % 2 ? AckermannVelocityError::Contact{0.28, 0.625} : AckermannVelocityError::Contact{};
+    const AckermannVelocityError::Options contact{point % 2 ? 0.28 : 0.0, point % 2 ? 0.625 : 0.0, slip_velocity};
     ExpectAnalyticMatchesJets(AckermannVelocityError(z_v, z_theta, kWheelbase, kDt, contact, f_x),
                               {pose_k, pose_k1, Scalar(kv_over_l), Scalar(k_theta), Scalar(k_gamma), Scalar(c_front),
                                Scalar(c_rear), Scalar(alpha), Scalar(s_f), Scalar(s_p), w},
