@@ -10,8 +10,10 @@ velocities between consecutive ground-truth poses of O at the rear ground contac
 estimator/models/ackermann_velocity.h with contact_height_m) and the true steered angle delta = k_theta z + k_gamma,
 and fits the understeer u = delta - atan((L omega_z + v_y) / v_x) with candidate terms (least squares with an offset,
 which k_gamma absorbs): per drive, and jointly on all drives. For the joint coefficients it prints each drive's
-residual RMS and k_theta's relative error: a calibration that fixes the candidate's coefficients predicts delta minus
-the residual, so k_theta absorbs the residual's slope on delta, negated. Standard library only.
+residual RMS, its white equivalent (a first-order Gauss-Markov fit's power at zero frequency as white noise per
+sample, as scripts/atv_odometer_residuals.py: the steering row's noise term) and k_theta's relative error: a
+calibration that fixes the candidate's coefficients predicts delta minus the residual, so k_theta absorbs the
+residual's slope on delta, negated. Standard library only.
 """
 import argparse
 import math
@@ -98,13 +100,16 @@ def main():
             open(path, "w").write(information.variant(args.scenario, information.DRIVES[d][1], noise=False))
             rec = residuals.simulate_noiseless(args.roamlab, path, args.seed, os.path.join(tmp, d))
             data[d] = samples_of(rec, args.height, args.t0)
+            poses = information.read_poses(rec)
+            dt = poses[1][0] - poses[0][0]
     for d in drives:
         s = data[d]
-        print("%-8s %d samples: |a_y| max %.2f m/s^2, v_x %.1f-%.1f m/s, |delta| max %.3f rad, understeer rms %.4f rad"
+        print("%-13s %d samples: |a_y| max %.2f m/s^2, v_x %.1f-%.1f m/s, |delta| max %.3f rad, understeer rms %.4f rad"
               % (d, len(s), max(abs(x["a_y"]) for x in s), min(x["v_x"] for x in s), max(x["v_x"] for x in s),
                  max(abs(x["delta"]) for x in s), residuals.rms(centred_u(s))))
     everything = [x for d in drives for x in data[d]]
-    print("per candidate: joint coefficients; per drive the residual rms [rad] and k_theta's error [%] with them (own fit)")
+    print("per candidate: joint coefficients; per drive with them the residual's rms and white equivalent [rad] and "
+          "k_theta's error [%] (own fit: coefficients, rms)")
     for name, (description, regressors) in CANDIDATES.items():
         b = fit(everything, regressors)
         print("%-21s %s" % (name, description))
@@ -113,8 +118,11 @@ def main():
             r = left_over(data[d], regressors, b)
             slope, _ = residuals.least_squares(r, [[x["delta"] for x in data[d]]])
             own = fit(data[d], regressors)
-            print("  %-8s rms %.4f, k_theta %+.2f %%   (own: %s, rms %.4f)" %
-                  (d, residuals.rms(residuals.centred(r)), -100 * slope[1], ", ".join("%+.5g" % x for x in own[1:]),
+            sigma, tau, white = residuals.gauss_markov_fit(r, dt)
+            rho = math.exp(-dt / tau)
+            print("  %-13s rms %.4f, white-eq %.4f, k_theta %+.2f %%   (own: %s, rms %.4f)" %
+                  (d, residuals.rms(residuals.centred(r)), math.sqrt(sigma ** 2 * (1 + rho) / (1 - rho) + white ** 2),
+                   -100 * slope[1], ", ".join("%+.5g" % x for x in own[1:]),
                    residuals.rms(left_over(data[d], regressors, own))))
 
 
