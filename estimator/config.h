@@ -93,6 +93,10 @@ struct TrackingConfig {
   // model's prediction to within this fraction (SolverOptions::model_tolerance).
   double improvement_threshold = 1e-3;
   double time_budget_s = 0.05;           // per update
+  // Relinearization threshold of the updates (SolverOptions::relinearize_threshold, iSAM2's): a factor whose
+  // variables all moved by at most this much in every tangent component [m, rad, parameter units] since it was last
+  // linearized keeps its Jacobians, its error carried to first order. 0: every factor is relinearized at every step.
+  double relinearize_threshold = 0.0;
   double initialization_s = 2.0;         // data buffered before the first window is solved
   // With a calibration that carries its information matrix (TrackingOptions::calibration_prior), the calibrated
   // constant parameters stay free in the window under that Gaussian prior instead of being fixed at their values.
