@@ -7,7 +7,7 @@
 //   solver: {method: levenberg_marquardt, max_iterations: 50, function_tolerance: 1.0e-8, step_tolerance: 1.0e-10}
 //   gating: {probability: 0.99999}         # chi-square gate on whitened errors; omit to disable
 //   tracking: {window: 40, max_iterations: 10, improvement_threshold: 1.0e-3, time_budget_s: 0.05,
-//              initialization_s: 2.0}
+//              initialization_s: 2.0, relinearize_threshold: 0.0}
 //   parameters:                            # any parameter not listed here keeps its model default and is fixed
 //     gps.lever_arm: {value: [0, 0, 0], free: true}
 //     imu.gyro_bias: {value: [0, 0, 0], free: true, process: {type: random_walk, sigma: 1.0e-4}}

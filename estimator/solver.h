@@ -98,7 +98,8 @@ class SolverWorkspace {
   long carries() const;
   // The last solve's linearization of factor `id` (still in the graph) when it was computed at the graph's current
   // values with the Jacobians of exactly the variables in want_mask (bit i: variable i), otherwise null. A
-  // Gauss-Newton solve ends with every factor linearized at its final point.
+  // Gauss-Newton solve ends with every factor linearized at its final point (under relinearize_threshold, possibly
+  // carried there to first order from an earlier point, with that point's Jacobians).
   const internal::WhitenedFactor* Linearization(FactorId id, std::uint64_t want_mask) const;
 
  private:
