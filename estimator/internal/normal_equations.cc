@@ -593,6 +593,8 @@ bool NormalEquations::LinearizeAndRecord(std::size_t k, double* previous_cost) {
   if (relinearize_threshold_ > 0.0) {
     l.lin_at = l.at;
     l.lin_residual = l.whitened.residual;
+  } else {
+    l.lin_at.clear();  // not a point to carry from, should a later solve of this object set a threshold
   }
   return true;
 }
