@@ -288,6 +288,8 @@ int RunTrack(const TrackArgs& args) {
                         {"max_update_s", r.max_update_s},
                         {"p99_update_s", r.p99_update_s},
                         {"mean_iterations", r.mean_iterations},
+                        {"factor_evaluations", r.factor_evaluations},
+                        {"factor_carries", r.factor_carries},
                         {"seconds", r.total_seconds},
                         {"realtime_factor", r.total_seconds > 0 ? duration / r.total_seconds : 0.0},
                         {"window", inputs.value().config.tracking.window},

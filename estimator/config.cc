@@ -214,7 +214,7 @@ class Parser {
   void ParseTracking(const YAML::Node& n, TrackingConfig* t) const {
     CheckKeys(n,
               {"window", "max_iterations", "improvement_threshold", "time_budget_s", "initialization_s",
-               "calibration_prior", "calibrate"},
+               "calibration_prior", "calibrate", "relinearize_threshold"},
               "tracking");
     if (n["calibration_prior"]) t->calibration_prior = Bool(n["calibration_prior"], "tracking.calibration_prior");
     if (n["calibrate"]) {
@@ -228,10 +228,13 @@ class Parser {
       t->improvement_threshold = Number(n["improvement_threshold"], "improvement_threshold");
     if (n["time_budget_s"]) t->time_budget_s = Number(n["time_budget_s"], "time_budget_s");
     if (n["initialization_s"]) t->initialization_s = Number(n["initialization_s"], "initialization_s");
+    if (n["relinearize_threshold"])
+      t->relinearize_threshold = Number(n["relinearize_threshold"], "tracking.relinearize_threshold");
     if (t->window < 3) Fail(n, "tracking.window must be at least 3 poses");
     if (t->max_iterations < 1) Fail(n, "tracking.max_iterations must be at least 1");
     if (!(t->time_budget_s > 0.0)) Fail(n, "tracking.time_budget_s must be positive");
     if (!(t->initialization_s >= 0.0)) Fail(n, "tracking.initialization_s must be >= 0");
+    if (!(t->relinearize_threshold >= 0.0)) Fail(n, "tracking.relinearize_threshold must be >= 0");
   }
 
   ParameterConfig ParseParameter(const std::string& name, const YAML::Node& n) const {

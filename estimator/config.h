@@ -7,7 +7,7 @@
 //   solver: {method: levenberg_marquardt, max_iterations: 50, function_tolerance: 1.0e-8, step_tolerance: 1.0e-10}
 //   gating: {probability: 0.99999}         # chi-square gate on whitened errors; omit to disable
 //   tracking: {window: 40, max_iterations: 10, improvement_threshold: 1.0e-3, time_budget_s: 0.05,
-//              initialization_s: 2.0}
+//              initialization_s: 2.0, relinearize_threshold: 0.0}
 //   parameters:                            # any parameter not listed here keeps its model default and is fixed
 //     gps.lever_arm: {value: [0, 0, 0], free: true}
 //     imu.gyro_bias: {value: [0, 0, 0], free: true, process: {type: random_walk, sigma: 1.0e-4}}
@@ -93,6 +93,10 @@ struct TrackingConfig {
   // model's prediction to within this fraction (SolverOptions::model_tolerance).
   double improvement_threshold = 1e-3;
   double time_budget_s = 0.05;           // per update
+  // Relinearization threshold of the updates (SolverOptions::relinearize_threshold, iSAM2's): a factor whose
+  // variables all moved by at most this much in every tangent component [m, rad, parameter units] since it was last
+  // linearized keeps its Jacobians, its error carried to first order. 0: every factor is relinearized at every step.
+  double relinearize_threshold = 0.0;
   double initialization_s = 2.0;         // data buffered before the first window is solved
   // With a calibration that carries its information matrix (TrackingOptions::calibration_prior), the calibrated
   // constant parameters stay free in the window under that Gaussian prior instead of being fixed at their values.

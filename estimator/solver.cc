@@ -22,6 +22,9 @@ std::string SolverOptions::Validate() const {
   if (!(step_tolerance >= 0.0)) return "step_tolerance must be >= 0";
   if (!(time_budget_s > 0.0)) return "time_budget_s must be > 0";
   if (!(initial_lambda > 0.0)) return "initial_lambda must be > 0";
+  if (!(relinearize_threshold >= 0.0)) return "relinearize_threshold must be >= 0";
+  if (relinearize_threshold > 0.0 && method != Method::kGaussNewton)
+    return "relinearize_threshold needs method gauss_newton";
   return "";
 }
 
@@ -98,6 +101,8 @@ double TangentNorm(const Graph& graph, const std::vector<VariableId>& order) {
 SolverWorkspace::SolverWorkspace() : system_(std::make_unique<internal::NormalEquations>()) {}
 SolverWorkspace::~SolverWorkspace() = default;
 int SolverWorkspace::analyses() const { return system_->analyses(); }
+long SolverWorkspace::evaluations() const { return system_->evaluations(); }
+long SolverWorkspace::carries() const { return system_->carries(); }
 const internal::WhitenedFactor* SolverWorkspace::Linearization(FactorId id, std::uint64_t want_mask) const {
   return system_->LinearizationAt(id, want_mask);
 }
@@ -117,6 +122,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
   SolverWorkspace local;
   SolverWorkspace& ws = workspace != nullptr ? *workspace : local;
   internal::NormalEquations& system = *ws.system_;
+  system.set_relinearize_threshold(options.relinearize_threshold);
   system.Reset(*graph, FreeVariableOrder(*graph));
   const std::vector<VariableId>& order = system.order();
   summary.free_dimension = system.dimension();

@@ -33,6 +33,11 @@ struct SolverOptions {
   double time_budget_s = std::numeric_limits<double>::infinity();
   // Initial Levenberg-Marquardt damping, relative to diag(H).
   double initial_lambda = 1e-4;
+  // Gauss-Newton only: relinearization threshold (iSAM2's; internal::NormalEquations::set_relinearize_threshold). A
+  // factor (trivial loss) whose free variables all moved by at most this much in every tangent component since its
+  // Jacobians were computed keeps them, and its error is carried to the new values to first order; its part of the
+  // cost is then that of the linearized error. 0: every factor is evaluated again at every new point.
+  double relinearize_threshold = 0.0;
 
   // Empty when valid, otherwise what is wrong.
   std::string Validate() const;
@@ -88,9 +93,13 @@ class SolverWorkspace {
   ~SolverWorkspace();
   // How many solves had to analyse a new sparsity pattern.
   int analyses() const;
+  // Factor evaluations with Jacobians, and linearizations carried to first order (relinearize_threshold), so far.
+  long evaluations() const;
+  long carries() const;
   // The last solve's linearization of factor `id` (still in the graph) when it was computed at the graph's current
   // values with the Jacobians of exactly the variables in want_mask (bit i: variable i), otherwise null. A
-  // Gauss-Newton solve ends with every factor linearized at its final point.
+  // Gauss-Newton solve ends with every factor linearized at its final point (under relinearize_threshold, possibly
+  // carried there to first order from an earlier point, with that point's Jacobians).
   const internal::WhitenedFactor* Linearization(FactorId id, std::uint64_t want_mask) const;
 
  private:

@@ -165,6 +165,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
   update_options.function_tolerance = config.tracking.improvement_threshold;
   update_options.model_tolerance = config.tracking.improvement_threshold;
   update_options.time_budget_s = config.tracking.time_budget_s;
+  update_options.relinearize_threshold = config.tracking.relinearize_threshold;
 
   TrackingResult out;
   const std::vector<MeasurementRef> measurements = builder.Measurements();
@@ -259,6 +260,8 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
     out.p99_update_s = update_times[k];
   }
   out.mean_iterations = out.updates > 0 ? static_cast<double>(iterations) / out.updates : 0.0;
+  out.factor_evaluations = workspace.evaluations();
+  out.factor_carries = workspace.carries();
   out.counts = builder.counts();
   out.total_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return out;

@@ -35,6 +35,10 @@ struct TrackingResult {
   double max_update_s = 0.0;
   double p99_update_s = 0.0;                          // 99th percentile of the update times
   double mean_iterations = 0.0;                      // Gauss-Newton iterations per update
+  // Factor linearizations of the updates: evaluated with Jacobians, and carried to first order under
+  // tracking.relinearize_threshold.
+  long factor_evaluations = 0;
+  long factor_carries = 0;
   double total_seconds = 0.0;
   std::map<std::string, StreamCounts> counts;
 };

@@ -68,6 +68,62 @@ void AddProduct(const Eigen::MatrixXd& ja, const Eigen::MatrixXd& jb, double* ds
   block.noalias() += ja.transpose().lazyProduct(jb);
 }
 
+// dst (rows x cols block of H's value array, column stride `stride`) += src (rows x cols, column-major), or += src^T
+// (src cols x rows) when `transposed`.
+template <int A, int B>
+void AddBlockFixed(const double* src, bool transposed, double* dst, std::ptrdiff_t stride) {
+  Eigen::Map<Eigen::Matrix<double, A, B>, 0, Eigen::OuterStride<>> block(dst, A, B, Eigen::OuterStride<>(stride));
+  if (transposed)
+    block += Eigen::Map<const Eigen::Matrix<double, B, A>>(src).transpose();
+  else
+    block += Eigen::Map<const Eigen::Matrix<double, A, B>>(src);
+}
+template <int A>
+bool AddBlockColumns(const double* src, int cols, bool transposed, double* dst, std::ptrdiff_t stride) {
+  switch (cols) {
+    case 1: AddBlockFixed<A, 1>(src, transposed, dst, stride); return true;
+    case 3: AddBlockFixed<A, 3>(src, transposed, dst, stride); return true;
+    case 6: AddBlockFixed<A, 6>(src, transposed, dst, stride); return true;
+    case 9: AddBlockFixed<A, 9>(src, transposed, dst, stride); return true;
+    default: return false;
+  }
+}
+void AddBlock(const double* src, int rows, int cols, bool transposed, double* dst, std::ptrdiff_t stride) {
+  bool done = false;
+  switch (rows) {
+    case 1: done = AddBlockColumns<1>(src, cols, transposed, dst, stride); break;
+    case 3: done = AddBlockColumns<3>(src, cols, transposed, dst, stride); break;
+    case 6: done = AddBlockColumns<6>(src, cols, transposed, dst, stride); break;
+    case 9: done = AddBlockColumns<9>(src, cols, transposed, dst, stride); break;
+    default: break;
+  }
+  if (done) return;
+  Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> block(dst, rows, cols, Eigen::OuterStride<>(stride));
+  if (transposed)
+    block += Eigen::Map<const Eigen::MatrixXd>(src, cols, rows).transpose();
+  else
+    block += Eigen::Map<const Eigen::MatrixXd>(src, rows, cols);
+}
+
+// r += J d (d: J.cols() entries), with fixed-size kernels for 3-row errors and the models' block sizes.
+template <int M, int A>
+void AddJacobianTimesFixed(const double* j, const double* d, double* r) {
+  Eigen::Map<Eigen::Matrix<double, M, 1>>(r).noalias() +=
+      Eigen::Map<const Eigen::Matrix<double, M, A>>(j) * Eigen::Map<const Eigen::Matrix<double, A, 1>>(d);
+}
+void AddJacobianTimes(const Eigen::MatrixXd& j, const double* d, Eigen::VectorXd* r) {
+  if (j.rows() == 3) {
+    switch (j.cols()) {
+      case 1: AddJacobianTimesFixed<3, 1>(j.data(), d, r->data()); return;
+      case 3: AddJacobianTimesFixed<3, 3>(j.data(), d, r->data()); return;
+      case 6: AddJacobianTimesFixed<3, 6>(j.data(), d, r->data()); return;
+      case 9: AddJacobianTimesFixed<3, 9>(j.data(), d, r->data()); return;
+      default: break;
+    }
+  }
+  r->noalias() += j * Eigen::Map<const Eigen::VectorXd>(d, j.cols());
+}
+
 // g_segment += J^T r.
 template <int M, int A>
 void AddGradientFixed(const double* j, const double* r, double* g) {
@@ -413,7 +469,7 @@ __attribute__((flatten)) bool NormalEquations::Linearize(const Graph& /*graph*/,
     const FactorEntry& entry = *entries_[k];
     const int v0 = var_begin_[k];
     const int n = var_begin_[k + 1] - v0;
-    if (!Current(k) && !LinearizeAndRecord(k, nullptr)) {
+    if (!Current(k) && !CarryToFirstOrder(k) && !LinearizeAndRecord(k, nullptr)) {
       if (failed_stream != nullptr) *failed_stream = entry.stream;
       return false;
     }
@@ -428,6 +484,46 @@ __attribute__((flatten)) bool NormalEquations::Linearize(const Graph& /*graph*/,
     for (int i = 0; i < nf; ++i)
       AddGradient(wf.jacobians[free[i]], wf.residual, g_.data() + block_offset_[block[free[i]]]);
     int pair = pair_begin_[k];
+    if (relinearize_threshold_ > 0.0) {
+      // The products J_a^T J_b of a linearization whose Jacobians are kept (relinearization threshold) are kept
+      // with it: a carried factor only adds them again. Kept per pair of free positions i <= j (the block order of
+      // two variables may change between Resets: then the transpose is added).
+      FactorLinearization& l = linearized_[k];
+      int offset[64 * 64 / 2 + 64];
+      std::ptrdiff_t size = 0;
+      for (int i = 0, p = 0; i < nf; ++i)
+        for (int j = i; j < nf; ++j, ++p) {
+          offset[p] = static_cast<int>(size);
+          size += wf.jacobians[free[i]].cols() * wf.jacobians[free[j]].cols();
+        }
+      if (!l.products_valid) {
+        l.products.resize(size);
+        for (int i = 0, p = 0; i < nf; ++i)
+          for (int j = i; j < nf; ++j, ++p) {
+            const Eigen::MatrixXd& ja = wf.jacobians[free[i]];
+            const Eigen::MatrixXd& jb = wf.jacobians[free[j]];
+            std::fill_n(l.products.data() + offset[p], ja.cols() * jb.cols(), 0.0);
+            AddProduct(ja, jb, l.products.data() + offset[p], ja.cols());
+          }
+        l.products_valid = true;
+      }
+      const auto index = [nf](int i, int j) { return i * nf - i * (i - 1) / 2 + (j - i); };  // i <= j
+      for (int i = 0; i < nf; ++i) {
+        const int a = free[i];
+        for (int j = 0; j < nf; ++j) {
+          const int b = free[j];
+          if (block[a] > block[b]) continue;
+          double* dst = values + pair_value_[pair++];
+          const std::ptrdiff_t stride = column_length_[block[b]];
+          const int rows = static_cast<int>(wf.jacobians[a].cols()), cols = static_cast<int>(wf.jacobians[b].cols());
+          if (i <= j)
+            AddBlock(l.products.data() + offset[index(i, j)], rows, cols, false, dst, stride);
+          else
+            AddBlock(l.products.data() + offset[index(j, i)], rows, cols, true, dst, stride);
+        }
+      }
+      continue;
+    }
     for (int i = 0; i < nf; ++i) {
       const int a = free[i];
       for (int j = 0; j < nf; ++j) {
@@ -456,7 +552,10 @@ bool NormalEquations::LinearizeForCost(double* cost) {
   *cost = 0.0;
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
     double c = 0.0;
-    if (!LinearizeAndRecord(k, &c)) return false;
+    if (CarryToFirstOrder(k))
+      c = linearized_[k].whitened.cost;
+    else if (!LinearizeAndRecord(k, &c))
+      return false;
     *cost += c;
   }
   return true;
@@ -485,10 +584,69 @@ bool NormalEquations::LinearizeAndRecord(std::size_t k, double* previous_cost) {
   l.id = factor_ids_[k];
   l.entry = entries_[k];
   l.mask = want_[k];
+  l.products_valid = false;
   l.at.clear();
   const std::vector<Manifold>& manifolds = entries_[k]->factor->manifolds();
   for (int v = v0; v < var_begin_[k + 1]; ++v)
     l.at.insert(l.at.end(), values_[v], values_[v] + manifolds[v - v0].ambient_dim());
+  ++evaluations_;
+  if (relinearize_threshold_ > 0.0) {
+    l.lin_at = l.at;
+    l.lin_residual = l.whitened.residual;
+  } else {
+    l.lin_at.clear();  // not a point to carry from, should a later solve of this object set a threshold
+  }
+  return true;
+}
+
+bool NormalEquations::CarryToFirstOrder(std::size_t k) {
+  FactorLinearization& l = linearized_[k];
+  const FactorEntry& entry = *entries_[k];
+  if (relinearize_threshold_ <= 0.0 || l.id != factor_ids_[k] || l.entry != &entry || l.mask != want_[k] ||
+      entry.loss.type != Loss::Type::kTrivial || l.lin_at.size() != l.at.size())
+    return false;
+  // The tangent offsets x [-] x_lin of the free variables (a held-constant one must not have moved at all).
+  const std::vector<Manifold>& manifolds = entry.factor->manifolds();
+  const int v0 = var_begin_[k];
+  const int n = var_begin_[k + 1] - v0;
+  std::vector<double>& delta_values = carry_delta_;
+  int total = 0;
+  for (int i = 0; i < n; ++i) total += manifolds[i].tangent_dim();
+  delta_values.resize(total);
+  double* delta = delta_values.data();
+  int offset = 0, tangent = 0;
+  for (int i = 0; i < n; ++i) {
+    const Manifold& manifold = manifolds[i];
+    const int ambient = manifold.ambient_dim();
+    if (((want_[k] >> i) & 1u) == 0) {
+      if (std::memcmp(&l.lin_at[offset], values_[v0 + i], ambient * sizeof(double)) != 0) return false;
+    } else {
+      double* d = delta + tangent;
+      manifold.Minus(values_[v0 + i], &l.lin_at[offset], d);
+      for (int j = 0; j < manifold.tangent_dim(); ++j)
+        if (!(std::abs(d[j]) <= relinearize_threshold_)) return false;
+      tangent += manifold.tangent_dim();
+    }
+    offset += ambient;
+  }
+  WhitenedFactor& wf = l.whitened;
+  wf.residual = l.lin_residual;
+  tangent = 0;
+  for (int i = 0; i < n; ++i) {
+    if (((want_[k] >> i) & 1u) == 0) continue;
+    const Eigen::MatrixXd& J = wf.jacobians[i];
+    AddJacobianTimes(J, delta + tangent, &wf.residual);
+    tangent += static_cast<int>(J.cols());
+  }
+  wf.squared_norm = wf.residual.squaredNorm();
+  wf.cost = 0.5 * wf.squared_norm;
+  offset = 0;
+  for (int i = 0; i < n; ++i) {
+    const int ambient = manifolds[i].ambient_dim();
+    std::copy(values_[v0 + i], values_[v0 + i] + ambient, l.at.begin() + offset);
+    offset += ambient;
+  }
+  ++carries_;
   return true;
 }
 

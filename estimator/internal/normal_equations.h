@@ -53,7 +53,18 @@ class NormalEquations {
 
   // The kept linearization of factor `id` when it was computed at the graph's current values with the Jacobians of
   // exactly the variables in want_mask (bit i: variable i), otherwise null. The factor must still be in the graph.
+  // With a relinearization threshold its error may be carried to these values to first order (below).
   const WhitenedFactor* LinearizationAt(FactorId id, std::uint64_t want_mask) const;
+
+  // Relinearization threshold (iSAM2's): when > 0, Linearize and LinearizeForCost do not evaluate again a factor with
+  // a trivial loss whose free variables all moved by at most this much (every tangent component of x [-] x_lin) since
+  // the point its Jacobians and whitening were computed at, x_lin; its whitened error is carried to the current values
+  // to first order, r(x_lin) + sum_i J_i (x_i [-] x_lin_i), with the same Jacobians. 0 (the default): a factor is
+  // evaluated again whenever one of its values changed.
+  void set_relinearize_threshold(double threshold) { relinearize_threshold_ = threshold; }
+  // Factor evaluations (with Jacobians) and first-order carries since construction.
+  long evaluations() const { return evaluations_; }
+  long carries() const { return carries_; }
 
   // Solves (H + lambda diag(H)) dx = -g. Returns false if the matrix is not positive definite.
   bool Solve(double lambda, Eigen::VectorXd* dx);
@@ -117,6 +128,13 @@ class NormalEquations {
     const FactorEntry* entry = nullptr;
     std::uint64_t mask = 0;
     std::vector<double> at;  // the factor's variables' ambient values, concatenated
+    // The point the Jacobians and the whitening were computed at (ambient values, as `at`) and the whitened error
+    // there; `at` and whitened.residual differ from them after a first-order carry (CarryToFirstOrder).
+    std::vector<double> lin_at;
+    Eigen::VectorXd lin_residual;
+    // With a relinearization threshold: the J_i^T J_j of the Jacobians, per pair of free positions i <= j.
+    std::vector<double> products;
+    bool products_valid = false;
   };
   std::vector<FactorLinearization> linearized_;
   std::vector<FactorLinearization> prev_linearized_;
@@ -124,6 +142,13 @@ class NormalEquations {
   std::vector<std::size_t> fresh_scratch_;   // Reset: factors new since the last Reset
   bool Current(std::size_t k) const;  // linearized_[k] holds factor k at the current values
   bool LinearizeAndRecord(std::size_t k, double* previous_cost);
+  // Carries factor k's kept linearization to the current values to first order when the relinearization threshold
+  // allows it (see set_relinearize_threshold); false when it must be evaluated again.
+  bool CarryToFirstOrder(std::size_t k);
+  double relinearize_threshold_ = 0.0;
+  std::vector<double> carry_delta_;  // CarryToFirstOrder: the tangent offsets
+  long evaluations_ = 0;
+  long carries_ = 0;
 
   std::vector<VariableId> var_id_;  // per factor variable, as var_block_
 

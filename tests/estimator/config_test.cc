@@ -120,5 +120,17 @@ TEST(ConfigTest, TrackingCalibrateIsRelativeToTheConfigFile) {
               "tracking.calibrate must name a configuration file");
 }
 
+// tracking.relinearize_threshold: 0 by default, a non-negative number.
+TEST(ConfigTest, TrackingRelinearizeThreshold) {
+  const std::string good = testing::AtvConfigYaml({});
+  EXPECT_EQ(ParseEstimatorConfig(good, "est.yaml").value().tracking.relinearize_threshold, 0.0);
+  const auto config = ParseEstimatorConfig(
+      Replace(good, "initialization_s: 1.0}", "initialization_s: 1.0, relinearize_threshold: 0.01}"), "est.yaml");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  EXPECT_EQ(config.value().tracking.relinearize_threshold, 0.01);
+  ExpectError(Replace(good, "initialization_s: 1.0}", "initialization_s: 1.0, relinearize_threshold: -0.1}"),
+              "tracking.relinearize_threshold must be >= 0");
+}
+
 }  // namespace
 }  // namespace roamlab::estimator

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <deque>
+#include <map>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -331,6 +332,102 @@ TEST(NormalEquationsTest, IncrementalResetOfASlidingWindowMatchesAFreshBuild) {
   }
   // Every Reset after the first was incremental but the one after the parameter was freed.
   EXPECT_EQ(incremental.incremental_resets(), 10);
+}
+
+// Relinearization threshold (iSAM2's): a factor whose variables all moved by at most the threshold since its
+// linearization keeps its Jacobians (H is the same, bit for bit) and its whitened error is carried to first order,
+// r_lin + sum_i J_i (x_i [-] x_lin_i), which differs from a fresh evaluation by second order only. Once a variable has
+// moved beyond it, its factors are evaluated again and the system equals a fresh one's; with threshold 0 every move
+// re-evaluates.
+TEST(NormalEquationsTest, RelinearizationThresholdCarriesTheErrorToFirstOrderAndRelinearizesBeyondIt) {
+  std::mt19937 rng(23);
+  Graph graph;
+  std::vector<VariableId> poses;
+  for (int k = 0; k < 5; ++k)
+    poses.push_back(graph.AddVariable({"pose", Manifold::Pose(), testing::RandomPoint(Manifold::Pose(), &rng, 5.0),
+                                       false, Time::FromSeconds(k)}));
+  const VariableId lever =
+      graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d(0.1, 0.2, 0.3), false, std::nullopt});
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    TieWithRandomPrior({poses[k]}, &rng, &graph);
+    if (k + 1 < poses.size()) TieWithRandomPrior({poses[k], poses[k + 1], lever}, &rng, &graph);
+  }
+  const double threshold = 1e-3;
+  internal::NormalEquations system(graph, FreeVariableOrder(graph));
+  system.set_relinearize_threshold(threshold);
+  ASSERT_TRUE(system.Linearize(graph));
+  const long factors = static_cast<long>(system.factor_ids().size());
+  EXPECT_EQ(system.evaluations(), factors);
+  const Eigen::SparseMatrix<double> H0 = system.hessian_upper();
+  std::map<FactorId, internal::WhitenedFactor> at_start;
+  const auto full_mask = [&](FactorId id) {
+    return (std::uint64_t{1} << graph.factor(id).variables.size()) - 1;  // every variable is free
+  };
+  for (FactorId id : system.factor_ids()) at_start[id] = *system.LinearizationAt(id, full_mask(id));
+  std::map<VariableId, Eigen::VectorXd> start;
+  for (const auto& [id, v] : graph.variables()) start[id] = v.value;
+
+  // Every tangent component moved by up to 0.8 of the threshold: carried, the same H.
+  std::uniform_real_distribution<double> within(-0.8 * threshold, 0.8 * threshold);
+  const Eigen::VectorXd small = Eigen::VectorXd::NullaryExpr(system.dimension(), [&] { return within(rng); });
+  system.Update(small, &graph);
+  ASSERT_TRUE(system.Linearize(graph));
+  EXPECT_EQ(system.evaluations(), factors);
+  EXPECT_EQ(system.carries(), factors);
+  EXPECT_TRUE(std::equal(H0.valuePtr(), H0.valuePtr() + H0.nonZeros(), system.hessian_upper().valuePtr()));
+  double cost = 0.0;
+  for (FactorId id : system.factor_ids()) {
+    const FactorEntry& entry = graph.factor(id);
+    const internal::WhitenedFactor* kept = system.LinearizationAt(id, full_mask(id));
+    ASSERT_NE(kept, nullptr);
+    const internal::WhitenedFactor& lin = at_start[id];
+    Eigen::VectorXd expected = lin.residual;
+    for (std::size_t i = 0; i < entry.variables.size(); ++i) {
+      const Manifold& m = graph.variable(entry.variables[i]).manifold;
+      Eigen::VectorXd d(m.tangent_dim());
+      m.Minus(graph.variable(entry.variables[i]).value.data(), start.at(entry.variables[i]).data(),
+              d.data());
+      expected += lin.jacobians[i] * d;
+      EXPECT_EQ(kept->jacobians[i], lin.jacobians[i]);
+    }
+    EXPECT_LT((kept->residual - expected).norm(), 1e-12 * (1.0 + expected.norm())) << "factor " << id;
+    internal::WhitenedFactor fresh;
+    ASSERT_TRUE(internal::LinearizeFactor(graph, entry, std::vector<bool>(entry.variables.size(), true), &fresh));
+    // Second order against the first-order change.
+    EXPECT_LT((kept->residual - fresh.residual).norm(), 0.01 * (fresh.residual - lin.residual).norm())
+        << "factor " << id;
+    cost += 0.5 * kept->residual.squaredNorm();
+  }
+  EXPECT_NEAR(system.cost(), cost, 1e-12 * cost);
+
+  // Then every component moved by 2 thresholds more: beyond it from the start, every factor is evaluated again.
+  system.Update(Eigen::VectorXd::Constant(system.dimension(), 2.0 * threshold), &graph);
+  ASSERT_TRUE(system.Linearize(graph));
+  EXPECT_EQ(system.evaluations(), 2 * factors);
+  EXPECT_EQ(system.carries(), factors);
+  internal::NormalEquations fresh(graph, FreeVariableOrder(graph));
+  ASSERT_TRUE(fresh.Linearize(graph));
+  const Eigen::SparseMatrix<double>& a = system.hessian_upper();
+  const Eigen::SparseMatrix<double>& b = fresh.hessian_upper();
+  ASSERT_EQ(a.nonZeros(), b.nonZeros());
+  EXPECT_TRUE(std::equal(a.valuePtr(), a.valuePtr() + a.nonZeros(), b.valuePtr()));
+  EXPECT_EQ(system.gradient(), fresh.gradient());
+
+  // Threshold 0: the smallest move re-evaluates every factor.
+  fresh.Update(Eigen::VectorXd::Constant(fresh.dimension(), 1e-9), &graph);
+  ASSERT_TRUE(fresh.Linearize(graph));
+  EXPECT_EQ(fresh.evaluations(), 2 * factors);
+  EXPECT_EQ(fresh.carries(), 0);
+}
+
+TEST(SolverTest, RelinearizationThresholdNeedsGaussNewton) {
+  SolverOptions options;
+  options.relinearize_threshold = 0.01;
+  EXPECT_EQ(options.Validate(), "relinearize_threshold needs method gauss_newton");
+  options.method = SolverOptions::Method::kGaussNewton;
+  EXPECT_EQ(options.Validate(), "");
+  options.relinearize_threshold = -1.0;
+  EXPECT_EQ(options.Validate(), "relinearize_threshold must be >= 0");
 }
 
 // A Gauss-Newton solve with a workspace ends with every factor linearized at its final point (its trial point), and

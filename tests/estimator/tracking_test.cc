@@ -255,6 +255,37 @@ TEST(TrackingTest, CalibrationPriorWidensThePositionCovarianceByTheCalibrationUn
   EXPECT_GT(growth, 0.05);
 }
 
+// With a relinearization threshold of 0.01 (iSAM2's) most factors of an update keep their Jacobians and carry their
+// error to first order. Under the calibration prior on a noisy drive, the tracked poses must stay within a small part
+// of their own position std of the fully relinearized ones (0.25 sigma, Mahalanobis), their covariances within 10 %,
+// and most linearizations must be carries.
+TEST(TrackingTest, RelinearizationThresholdStaysCloseToRelinearizingEveryFactor) {
+  const CalibratedAtv calibrated = CalibrateOnOtherDrive();
+  roamlab::testing::SyntheticOptions options;
+  options.duration_s = 6.0;
+  options.seed = 23;
+  const auto synthetic = roamlab::testing::MakeAtvRecording(options);
+  EstimatorConfig config = testing::AtvConfig({}, 20);
+  config.tracking.time_budget_s = 1e9;
+  config.tracking.calibration_prior = true;
+  TrackingOptions with_prior;
+  with_prior.calibration_prior = calibrated.prior;
+  auto every = Track(config, synthetic.recording, calibrated.values, with_prior);
+  config.tracking.relinearize_threshold = 0.01;
+  auto carried = Track(config, synthetic.recording, calibrated.values, with_prior);
+  ASSERT_TRUE(every.ok()) << every.status().message();
+  ASSERT_TRUE(carried.ok()) << carried.status().message();
+  EXPECT_EQ(every.value().factor_carries, 0);
+  EXPECT_GT(carried.value().factor_carries, 2 * carried.value().factor_evaluations);
+  ASSERT_EQ(every.value().trajectory.size(), carried.value().trajectory.size());
+  for (std::size_t i = 0; i < every.value().trajectory.size(); ++i) {
+    const Eigen::Matrix3d& cov = every.value().position_covariance[i];
+    const Eigen::Vector3d d = carried.value().trajectory[i].p_world_body - every.value().trajectory[i].p_world_body;
+    EXPECT_LT(std::sqrt(d.dot(cov.ldlt().solve(d))), 0.25) << "pose " << i;
+    EXPECT_NEAR(carried.value().position_covariance[i].trace(), cov.trace(), 0.1 * cov.trace()) << "pose " << i;
+  }
+}
+
 TEST(TrackingTest, CalibrationPriorOfTheWrongSizeIsAnError) {
   CalibratedAtv calibrated = CalibrateOnOtherDrive();
   calibrated.prior.information = Eigen::MatrixXd::Identity(2, 2);
