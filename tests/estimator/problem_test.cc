@@ -20,6 +20,13 @@ roamlab::testing::SyntheticRecording ShortDrive() {
   return roamlab::testing::MakeAtvRecording(options);
 }
 
+// The configuration's Ackermann odometer stream, or null.
+StreamConfig* AckermannStream(EstimatorConfig& config) {
+  for (auto& [name, sc] : config.streams)
+    if (sc.model == "ackermann") return &sc;
+  return nullptr;
+}
+
 TEST(ProblemBuilderTest, OnePosePerMasterSampleAndEveryMeasurementAccountedFor) {
   const auto synthetic = ShortDrive();
   auto builder = ProblemBuilder::Create(testing::AtvConfig({}), synthetic.recording);
@@ -262,9 +269,7 @@ TEST(ProblemBuilderTest, AckermannSpecificForceInputIsChecked) {
   const auto synthetic = ShortDrive();
   const auto message = [&](const EstimatorConfig& config) { return BuildOutcome(config, synthetic.recording); };
   EstimatorConfig config = testing::AtvConfig({});
-  StreamConfig* odo = nullptr;
-  for (auto& [name, sc] : config.streams)
-    if (sc.model == "ackermann") odo = &sc;
+  StreamConfig* odo = AckermannStream(config);
   ASSERT_NE(odo, nullptr);
   odo->inputs["specific_force"] = "imu";
   odo->options["forward_in_sensor"] = {1.0, 0.0, 0.0};
@@ -285,9 +290,7 @@ TEST(ProblemBuilderTest, AckermannFrontSlipVelocityIsChecked) {
   const auto synthetic = ShortDrive();
   const auto message = [&](const EstimatorConfig& config) { return BuildOutcome(config, synthetic.recording); };
   EstimatorConfig config = testing::AtvConfig({});
-  StreamConfig* odo = nullptr;
-  for (auto& [name, sc] : config.streams)
-    if (sc.model == "ackermann") odo = &sc;
+  StreamConfig* odo = AckermannStream(config);
   ASSERT_NE(odo, nullptr);
   odo->options["front_slip_velocity"] = {1.0};
   EXPECT_EQ(message(config), "accepted");

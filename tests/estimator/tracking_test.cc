@@ -223,17 +223,28 @@ CalibratedAtv CalibrateOnOtherDrive() {
   return out;
 }
 
+// A noisy 6 s synthetic ATV drive.
+roamlab::testing::SyntheticRecording SixSecondDrive(std::uint32_t seed) {
+  roamlab::testing::SyntheticOptions options;
+  options.duration_s = 6.0;
+  options.seed = seed;
+  return roamlab::testing::MakeAtvRecording(options);
+}
+
+// The ATV configuration with a 20-pose window and no time budget (every update solved as far as it goes).
+EstimatorConfig UnbudgetedConfig() {
+  EstimatorConfig config = testing::AtvConfig({}, 20);
+  config.tracking.time_budget_s = 1e9;
+  return config;
+}
+
 TEST(TrackingTest, CalibrationPriorWidensThePositionCovarianceByTheCalibrationUncertainty) {
   // Fixing a parameter conditions on it; leaving it free under its calibration prior marginalizes it instead, and a
   // marginal covariance is never smaller than a conditional one: every tracked pose's position covariance must grow
   // (in the PSD order, checked on the trace and the smallest eigenvalue of the difference).
   const CalibratedAtv calibrated = CalibrateOnOtherDrive();
-  roamlab::testing::SyntheticOptions options;
-  options.duration_s = 6.0;
-  options.seed = 22;
-  const auto synthetic = roamlab::testing::MakeAtvRecording(options);
-  EstimatorConfig config = testing::AtvConfig({}, 20);
-  config.tracking.time_budget_s = 1e9;
+  const auto synthetic = SixSecondDrive(22);
+  EstimatorConfig config = UnbudgetedConfig();
   auto fixed = Track(config, synthetic.recording, calibrated.values);
   config.tracking.calibration_prior = true;
   TrackingOptions with_prior;
@@ -261,12 +272,8 @@ TEST(TrackingTest, CalibrationPriorWidensThePositionCovarianceByTheCalibrationUn
 // and most linearizations must be carries.
 TEST(TrackingTest, RelinearizationThresholdStaysCloseToRelinearizingEveryFactor) {
   const CalibratedAtv calibrated = CalibrateOnOtherDrive();
-  roamlab::testing::SyntheticOptions options;
-  options.duration_s = 6.0;
-  options.seed = 23;
-  const auto synthetic = roamlab::testing::MakeAtvRecording(options);
-  EstimatorConfig config = testing::AtvConfig({}, 20);
-  config.tracking.time_budget_s = 1e9;
+  const auto synthetic = SixSecondDrive(23);
+  EstimatorConfig config = UnbudgetedConfig();
   config.tracking.calibration_prior = true;
   TrackingOptions with_prior;
   with_prior.calibration_prior = calibrated.prior;
