@@ -15,6 +15,7 @@
 #include "estimator/models/enu.h"
 #include "estimator/models/gps.h"
 #include "estimator/models/gyroscope.h"
+#include "estimator/models/imu_time_offset.h"
 #include "estimator/models/linear_velocity.h"
 #include "estimator/models/magnetometer.h"
 #include "estimator/models/mecanum_drive.h"
@@ -30,6 +31,13 @@ using recording::StreamType;
 namespace {
 
 enum class Attachment { kMaster, kOnePose, kPair, kTriple, kInterval };
+
+// The IMU's time-offset models (models/imu_time_offset.h) take the time derivative of the predicted reading as a
+// central difference over this many master intervals on each side (at least 2: the accelerometer's model needs its
+// poses distinct). Over one interval the poses' rates carry the readings' own noise, which the offset multiplies by
+// about delta / dt; over m intervals that noise is m^1.5 times smaller, while the difference's own error grows as
+// (m dt)^2 times the third derivative.
+constexpr std::size_t kTimeOffsetSpan = 2;
 
 Attachment AttachmentOf(const std::string& model, bool master) {
   if (master) return Attachment::kMaster;
@@ -65,6 +73,10 @@ struct StreamBinding {
   int specific_force_column = 0;                       // its first accelerometer column
   double drive_nm_per_mps2 = 0.0;                      // magnetometer: options.drive_nm_per_mps2
   Eigen::Vector3d forward_in_sensor = Eigen::Vector3d::UnitX();  // ackermann: options.forward_in_sensor (unit)
+  // gyroscope, accelerometer, magnetometer: the slot time_offset_s (its index), and whether the samples take the
+  // time-offset model (models/imu_time_offset.h): when the parameter is free or not zero.
+  int time_offset_slot = -1;
+  bool time_offset = false;
   std::deque<MeasurementRef> pending;
 };
 
@@ -77,6 +89,7 @@ struct ProblemBuilder::Impl {
   std::map<std::string, ParameterConfig> parameter_config;
   std::map<std::string, Eigen::VectorXd> parameter_initial;
   std::optional<MeasurementRef> last_master;
+  bool finishing = false;   // Finish(): attach what waits for poses that will not come with the plain models
 };
 
 ProblemBuilder::ProblemBuilder(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -328,6 +341,15 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
     if (pc.process.type != ProcessConfig::Type::kConstant && it->second.ambient_dim() != 3)
       return Error(config, "parameter '" + pname + "': time-varying parameters must be 3-vectors");
     impl->parameter_config[pname] = pc;
+  }
+  // The IMU's time offset: the time-offset models, which need a pose more on each side, only where it can matter.
+  for (StreamBinding& b : impl->streams) {
+    for (std::size_t i = 0; i < b.spec->slots.size(); ++i)
+      if (b.spec->slots[i].name == "time_offset_s") b.time_offset_slot = static_cast<int>(i);
+    if (b.time_offset_slot < 0) continue;
+    const std::string& pname = b.slot_parameters[static_cast<std::size_t>(b.time_offset_slot)];
+    const auto pc = impl->parameter_config.find(pname);
+    b.time_offset = (pc != impl->parameter_config.end() && pc->second.free) || impl->parameter_initial.at(pname)[0] != 0.0;
   }
   for (const auto& stage : config.stages)
     for (const std::string& pname : stage) {
@@ -632,6 +654,23 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     case Attachment::kInterval:
       break;
   }
+  // The time-offset models (models/imu_time_offset.h) also read the poses of their derivative, kTimeOffsetSpan
+  // master intervals on each side: the sample waits for the last; where the first is not there (the window's first
+  // poses), or the last will not come (Finish), it takes the plain model, so that every sample attaches as it would
+  // without the offset.
+  constexpr std::size_t span = kTimeOffsetSpan;
+  const std::size_t before = s.config.model == "accelerometer" ? 2 * span : span;
+  const std::size_t after =
+      s.config.model == "accelerometer" ? 2 * span : s.config.model == "gyroscope" ? span + 1 : span;
+  const bool time_offset = s.time_offset && k >= before;
+  if (time_offset && k + after >= poses_.size() && !im.finishing) return false;
+  const bool offset_model = time_offset && k + after < poses_.size();
+  const auto ids = [&](std::initializer_list<std::size_t> indices) {
+    std::vector<VariableId> out;
+    for (std::size_t i : indices) out.push_back(poses_[i].id);
+    return out;
+  };
+  const auto between = [&](std::size_t a, std::size_t b) { return SecondsBetween(poses_[a].t, poses_[b].t); };
 
   // The factor, by model.
   const std::string& model = s.config.model;
@@ -679,20 +718,38 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     stream_of_factor_[id] = m.stream;
     ++counts_[s.name].attached;
     return true;
+  } else if (model == "gyroscope" && offset_model) {
+    factor = MakeFactor(GyroscopeTimeOffsetError(z3(), between(k - span, k), dt, between(k + 1, k + 1 + span)));
+    vars = ids({k - span, k, k + 1, k + 1 + span});
+    vars.insert(vars.end(), {slot(0, k), slot(1, k), slot(2, k), slot(3, k)});
   } else if (model == "gyroscope") {
     factor = MakeFactor(GyroscopeError(z3(), dt));
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k)};
   } else if (model == "linear_velocity") {
     factor = MakeFactor(LinearVelocityError(z3(), dt));
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k)};
+  } else if (model == "accelerometer" && offset_model) {
+    factor = MakeFactor(AccelerometerTimeOffsetError(
+        z3(), between(k - 1, k), between(k, k + 1),
+        Eigen::Vector4d(between(k - 2 * span, k - span), between(k - span, k), between(k, k + span),
+                        between(k + span, k + 2 * span))));
+    vars = ids({k - 2 * span, k - span, k - 1, k, k + 1, k + span, k + 2 * span});
+    vars.insert(vars.end(), {slot(0, k), slot(1, k), slot(2, k), slot(3, k), slot(4, k)});
   } else if (model == "accelerometer") {
     factor = MakeFactor(AccelerometerError(z3(), SecondsBetween(poses_[k - 1].t, poses_[k].t),
                                            SecondsBetween(poses_[k].t, poses_[k + 1].t)));
     vars = {poses_[k - 1].id, poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k), slot(3, k)};
   } else if (model == "magnetometer") {
     const Eigen::Vector3d f_sensor = s.specific_force ? SpecificForceAt(s, m.t) : Eigen::Vector3d::Zero();
-    factor = MakeFactor(MagnetometerError(z3(), s.field_world, f_sensor, s.drive_nm_per_mps2));
-    vars = {poses_[k].id, slot(0, k), slot(1, k), slot(2, k), slot(3, k)};
+    if (offset_model) {
+      factor = MakeFactor(MagnetometerTimeOffsetError(z3(), s.field_world, f_sensor, s.drive_nm_per_mps2,
+                                                      between(k - span, k), between(k, k + span)));
+      vars = ids({k - span, k, k + span});
+      vars.insert(vars.end(), {slot(0, k), slot(1, k), slot(2, k), slot(3, k), slot(4, k)});
+    } else {
+      factor = MakeFactor(MagnetometerError(z3(), s.field_world, f_sensor, s.drive_nm_per_mps2));
+      vars = {poses_[k].id, slot(0, k), slot(1, k), slot(2, k), slot(3, k)};
+    }
   } else if (model == "gps") {
     Eigen::Vector3d z = z3();
     if (data.info.type == StreamType::kGps) z = im.enu->ToEnu(z[0], z[1], z[2]);
@@ -771,6 +828,9 @@ void ProblemBuilder::AttachPending() {
 }
 
 void ProblemBuilder::Finish() {
+  impl_->finishing = true;
+  AttachPending();
+  impl_->finishing = false;
   for (StreamBinding& s : impl_->streams) {
     counts_[s.name].outside += static_cast<int>(s.pending.size());
     s.pending.clear();
