@@ -142,9 +142,11 @@ std::string SlotParameter(const std::string& stream, const estimator::StreamConf
 
 constexpr double kWarmInitialLambda = 1e-11;
 
-// A clock offset fitted as a parameter (imu_time_offset): the largest the first-order model is trusted with, beyond
-// the imu_time_offset draws (0.02-0.05 s) with their uncertainty.
-constexpr double kFirstOrderOffsetS = 0.06;
+// A clock offset fitted as a parameter (imu_time_offset): the largest the first-order model is trusted with. The fit
+// is of the streams' timing conventions too (on the nominal ATV simulation about +0.04 s: the estimator holds a
+// gyroscope reading over the interval after its stamp, the simulator reads the rate at it), so it holds those plus
+// the imu_time_offset draws (0.02-0.05 s); at 0.06 s the 30 ms test case and the baseline fell to the grid.
+constexpr double kFirstOrderOffsetS = 0.1;
 constexpr double kProfileStepS = 0.01;   // the profile's step: a master period of the 100 Hz drives
 
 Result<FitOutcome> Fit(const EstimatorConfig& nominal, const Recording& recording, const FitSpec& spec) {
