@@ -32,12 +32,11 @@ namespace {
 
 enum class Attachment { kMaster, kOnePose, kPair, kTriple, kInterval };
 
-// The IMU's time-offset models (models/imu_time_offset.h) take the time derivative of the predicted reading as a
-// central difference over this many master intervals on each side (at least 2: the accelerometer's model needs its
-// poses distinct). Over one interval the poses' rates carry the readings' own noise, which the offset multiplies by
-// about delta / dt; over m intervals that noise is m^1.5 times smaller, while the difference's own error grows as
-// (m dt)^2 times the third derivative.
-constexpr std::size_t kTimeOffsetSpan = 2;
+// The IMU's time-offset models (models/imu_time_offset.h) move each reading by the slope of its stream's readings
+// within this many seconds on each side (at least the neighbouring sample on each side): over 2n + 1 samples the
+// slope's noise, which biases the offset towards zero, falls as n^-1.5, while the line smooths the motion's content
+// above about 0.5 Hz (the header's numbers).
+constexpr double kReadingRateHalfWindow = 0.3;
 
 Attachment AttachmentOf(const std::string& model, bool master) {
   if (master) return Attachment::kMaster;
@@ -89,7 +88,6 @@ struct ProblemBuilder::Impl {
   std::map<std::string, ParameterConfig> parameter_config;
   std::map<std::string, Eigen::VectorXd> parameter_initial;
   std::optional<MeasurementRef> last_master;
-  bool finishing = false;   // Finish(): attach what waits for poses that will not come with the plain models
 };
 
 ProblemBuilder::ProblemBuilder(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -342,7 +340,7 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
       return Error(config, "parameter '" + pname + "': time-varying parameters must be 3-vectors");
     impl->parameter_config[pname] = pc;
   }
-  // The IMU's time offset: the time-offset models, which need a pose more on each side, only where it can matter.
+  // The IMU's time offset: the time-offset models only where it can matter.
   for (StreamBinding& b : impl->streams) {
     for (std::size_t i = 0; i < b.spec->slots.size(); ++i)
       if (b.spec->slots[i].name == "time_offset_s") b.time_offset_slot = static_cast<int>(i);
@@ -473,6 +471,35 @@ Eigen::Vector3d SpecificForceAt(const StreamBinding& s, Time t) {
   const double span = SecondsBetween(f.t[i - 1], f.t[i]);
   const double w = span > 0.0 ? SecondsBetween(f.t[i - 1], t) / span : 1.0;
   return (1.0 - w) * row(i - 1) + w * row(i);
+}
+
+// The rate [units / s] of a stream's three columns from `column` at row `row`: the slope of the least-squares line
+// through the rows within kReadingRateHalfWindow of it, and at least the neighbouring row on each side that exists
+// (models/imu_time_offset.h); zero for a single row.
+Eigen::Vector3d ReadingRate(const recording::Stream& data, int column, int row) {
+  const Time t = data.t[static_cast<std::size_t>(row)];
+  const std::int64_t half_ns = std::llround(kReadingRateHalfWindow * 1e9);
+  const auto first = std::lower_bound(data.t.begin(), data.t.end(), Time::FromNanoseconds(t.nanoseconds() - half_ns));
+  const auto last = std::upper_bound(data.t.begin(), data.t.end(), Time::FromNanoseconds(t.nanoseconds() + half_ns));
+  const int lo = std::min(static_cast<int>(first - data.t.begin()), std::max(row - 1, 0));
+  const int hi = std::max(static_cast<int>(last - data.t.begin()) - 1,
+                          std::min(row + 1, static_cast<int>(data.t.size()) - 1));
+  double mean_t = 0.0;
+  Eigen::Vector3d mean_z = Eigen::Vector3d::Zero();
+  for (int i = lo; i <= hi; ++i) {
+    mean_t += SecondsBetween(t, data.t[static_cast<std::size_t>(i)]);
+    mean_z += data.values.row(i).segment<3>(column).transpose();
+  }
+  mean_t /= hi - lo + 1;
+  mean_z /= hi - lo + 1;
+  double stt = 0.0;
+  Eigen::Vector3d stz = Eigen::Vector3d::Zero();
+  for (int i = lo; i <= hi; ++i) {
+    const double dt = SecondsBetween(t, data.t[static_cast<std::size_t>(i)]) - mean_t;
+    stt += dt * dt;
+    stz += dt * (data.values.row(i).segment<3>(column).transpose() - mean_z);
+  }
+  return stt > 0.0 ? Eigen::Vector3d(stz / stt) : Eigen::Vector3d::Zero();
 }
 
 }  // namespace
@@ -622,6 +649,7 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
   const Eigen::RowVectorXd row = data.values.row(m.row);
   const auto slot = [&](std::size_t i, std::size_t k) { return ParameterAt(s.slot_parameters[i], k); };
   const auto z3 = [&] { return Eigen::Vector3d(row.segment<3>(s.column).transpose()); };
+  const auto reading_rate = [&] { return ReadingRate(data, s.column, m.row); };
 
   // Which poses: bail out (keep waiting) until they exist.
   std::size_t k = 0;
@@ -654,23 +682,6 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     case Attachment::kInterval:
       break;
   }
-  // The time-offset models (models/imu_time_offset.h) also read the poses of their derivative, kTimeOffsetSpan
-  // master intervals on each side: the sample waits for the last; where the first is not there (the window's first
-  // poses), or the last will not come (Finish), it takes the plain model, so that every sample attaches as it would
-  // without the offset.
-  constexpr std::size_t span = kTimeOffsetSpan;
-  const std::size_t before = s.config.model == "accelerometer" ? 2 * span : span;
-  const std::size_t after =
-      s.config.model == "accelerometer" ? 2 * span : s.config.model == "gyroscope" ? span + 1 : span;
-  const bool time_offset = s.time_offset && k >= before;
-  if (time_offset && k + after >= poses_.size() && !im.finishing) return false;
-  const bool offset_model = time_offset && k + after < poses_.size();
-  const auto ids = [&](std::initializer_list<std::size_t> indices) {
-    std::vector<VariableId> out;
-    for (std::size_t i : indices) out.push_back(poses_[i].id);
-    return out;
-  };
-  const auto between = [&](std::size_t a, std::size_t b) { return SecondsBetween(poses_[a].t, poses_[b].t); };
 
   // The factor, by model.
   const std::string& model = s.config.model;
@@ -718,38 +729,34 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     stream_of_factor_[id] = m.stream;
     ++counts_[s.name].attached;
     return true;
-  } else if (model == "gyroscope" && offset_model) {
-    factor = MakeFactor(GyroscopeTimeOffsetError(z3(), between(k - span, k), dt, between(k + 1, k + 1 + span)));
-    vars = ids({k - span, k, k + 1, k + 1 + span});
-    vars.insert(vars.end(), {slot(0, k), slot(1, k), slot(2, k), slot(3, k)});
   } else if (model == "gyroscope") {
-    factor = MakeFactor(GyroscopeError(z3(), dt));
+    if (s.time_offset) {
+      factor = MakeFactor(GyroscopeTimeOffsetError(GyroscopeError(z3(), dt), reading_rate()));
+    } else {
+      factor = MakeFactor(GyroscopeError(z3(), dt));
+    }
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k)};
   } else if (model == "linear_velocity") {
     factor = MakeFactor(LinearVelocityError(z3(), dt));
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k)};
-  } else if (model == "accelerometer" && offset_model) {
-    factor = MakeFactor(AccelerometerTimeOffsetError(
-        z3(), between(k - 1, k), between(k, k + 1),
-        Eigen::Vector4d(between(k - 2 * span, k - span), between(k - span, k), between(k, k + span),
-                        between(k + span, k + 2 * span))));
-    vars = ids({k - 2 * span, k - span, k - 1, k, k + 1, k + span, k + 2 * span});
-    vars.insert(vars.end(), {slot(0, k), slot(1, k), slot(2, k), slot(3, k), slot(4, k)});
   } else if (model == "accelerometer") {
-    factor = MakeFactor(AccelerometerError(z3(), SecondsBetween(poses_[k - 1].t, poses_[k].t),
-                                           SecondsBetween(poses_[k].t, poses_[k + 1].t)));
+    AccelerometerError plain(z3(), SecondsBetween(poses_[k - 1].t, poses_[k].t),
+                             SecondsBetween(poses_[k].t, poses_[k + 1].t));
+    if (s.time_offset) {
+      factor = MakeFactor(AccelerometerTimeOffsetError(std::move(plain), reading_rate()));
+    } else {
+      factor = MakeFactor(std::move(plain));
+    }
     vars = {poses_[k - 1].id, poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k), slot(3, k)};
   } else if (model == "magnetometer") {
     const Eigen::Vector3d f_sensor = s.specific_force ? SpecificForceAt(s, m.t) : Eigen::Vector3d::Zero();
-    if (offset_model) {
-      factor = MakeFactor(MagnetometerTimeOffsetError(z3(), s.field_world, f_sensor, s.drive_nm_per_mps2,
-                                                      between(k - span, k), between(k, k + span)));
-      vars = ids({k - span, k, k + span});
-      vars.insert(vars.end(), {slot(0, k), slot(1, k), slot(2, k), slot(3, k), slot(4, k)});
+    MagnetometerError plain(z3(), s.field_world, f_sensor, s.drive_nm_per_mps2);
+    if (s.time_offset) {
+      factor = MakeFactor(MagnetometerTimeOffsetError(std::move(plain), reading_rate()));
     } else {
-      factor = MakeFactor(MagnetometerError(z3(), s.field_world, f_sensor, s.drive_nm_per_mps2));
-      vars = {poses_[k].id, slot(0, k), slot(1, k), slot(2, k), slot(3, k)};
+      factor = MakeFactor(std::move(plain));
     }
+    vars = {poses_[k].id, slot(0, k), slot(1, k), slot(2, k), slot(3, k)};
   } else if (model == "gps") {
     Eigen::Vector3d z = z3();
     if (data.info.type == StreamType::kGps) z = im.enu->ToEnu(z[0], z[1], z[2]);
@@ -763,6 +770,7 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     absolute_fixes_.emplace_back(poses_[k].id, row.head<3>().transpose());
     orientation_fixes_.push_back({poses_[k].id, slot(1, k), q.normalized()});
   }
+  if (s.time_offset) vars.push_back(slot(static_cast<std::size_t>(s.time_offset_slot), k));
   const FactorId id = graph_.AddFactor(std::move(factor), vars, s.noise_covariance, s.config.loss, s.name, m.t);
   stream_of_factor_[id] = m.stream;
   ++counts_[s.name].attached;
@@ -828,9 +836,6 @@ void ProblemBuilder::AttachPending() {
 }
 
 void ProblemBuilder::Finish() {
-  impl_->finishing = true;
-  AttachPending();
-  impl_->finishing = false;
   for (StreamBinding& s : impl_->streams) {
     counts_[s.name].outside += static_cast<int>(s.pending.size());
     s.pending.clear();

@@ -49,7 +49,6 @@
 //   J_e_qS = diag(k_s) [f^(S)]x,  J_e_S = D ([alpha]x + [omega]x^2),  J_e_b = I,  J_e_ks = diag(f^(S)).
 #pragma once
 
-#include <array>
 #include <tuple>
 
 #include <Eigen/Core>
@@ -72,11 +71,20 @@ class AccelerometerError {
   AccelerometerError(const Eigen::Vector3d& z_mps2, double dt0_s, double dt1_s)
       : z_mps2_(z_mps2), dt0_s_(dt0_s), dt1_s_(dt1_s) {}
 
-  // The specific force at the sensor in O at t1 (eq. 14) from the poses at t0 < t1 < t2 (dt0 = t1 - t0,
-  // dt1 = t2 - t1) and the sensor's position S^(O) (header comment).
   template <typename T>
-  static Vector3<T> SpecificForceBody(const Pose<T>& pose0, const Pose<T>& pose1, const Pose<T>& pose2, const T& dt0,
-                                      const T& dt1, const Vector3<T>& p_body_sensor) {
+  bool operator()(const T* const* x, const T* noise, T* error) const {
+    const Pose<T> pose0 = PoseFromArray(x[0]);
+    const Pose<T> pose1 = PoseFromArray(x[1]);
+    const Pose<T> pose2 = PoseFromArray(x[2]);
+    const Quaternion<T> q_body_sensor = QuaternionFromArray(x[3]);
+    const Eigen::Map<const Vector3<T>> p_body_sensor(x[4]);
+    const Eigen::Map<const Vector3<T>> bias(x[5]);
+    const Eigen::Map<const Vector3<T>> scale(x[6]);
+    const Eigen::Map<const Vector3<T>> eta(noise);
+    Eigen::Map<Vector3<T>> e(error);
+
+    const T dt0(dt0_s_);
+    const T dt1(dt1_s_);
     const T half_span = (dt0 + dt1) * T(0.5);
     const Quaternion<T>& q0 = pose0.q_world_body;
     const Quaternion<T>& q1 = pose1.q_world_body;
@@ -93,43 +101,32 @@ class AccelerometerError {
     const Vector3<T> omega12_body = QuaternionLog<T>(q1.conjugate() * q2) / dt1;
     const Vector3<T> alpha_body = (omega12_body - omega01_body) / half_span;
 
-    // Specific force at the sensor, in O (eq. 14).
-    return q1.conjugate() * kSpecificForceAtRest_world.cast<T>() + alpha_body.cross(p_body_sensor) + a_body +
-           omega_body.cross(omega_body.cross(p_body_sensor));
-  }
-
-  template <typename T>
-  bool operator()(const T* const* x, const T* noise, T* error) const {
-    const Pose<T> pose0 = PoseFromArray(x[0]);
-    const Pose<T> pose1 = PoseFromArray(x[1]);
-    const Pose<T> pose2 = PoseFromArray(x[2]);
-    const Quaternion<T> q_body_sensor = QuaternionFromArray(x[3]);
-    const Eigen::Map<const Vector3<T>> p_body_sensor(x[4]);
-    const Eigen::Map<const Vector3<T>> bias(x[5]);
-    const Eigen::Map<const Vector3<T>> scale(x[6]);
-    const Eigen::Map<const Vector3<T>> eta(noise);
-    Eigen::Map<Vector3<T>> e(error);
-
-    const Vector3<T> f_sensor =
-        q_body_sensor.conjugate() * SpecificForceBody<T>(pose0, pose1, pose2, T(dt0_s_), T(dt1_s_), p_body_sensor);
+    // Specific force at the sensor, in O (eq. 14), then in S.
+    const Vector3<T> f_body = q1.conjugate() * kSpecificForceAtRest_world.cast<T>() +
+                              alpha_body.cross(p_body_sensor) + a_body +
+                              omega_body.cross(omega_body.cross(p_body_sensor));
+    const Vector3<T> f_sensor = q_body_sensor.conjugate() * f_body;
 
     // Through the sensor model.
     e = scale.cwiseProduct(f_sensor) + bias + eta - z_mps2_.cast<T>();
     return true;
   }
 
-  // SpecificForceBody with its Jacobians (header comment, without D): f^(O) w.r.t. the three poses' tangents (3 x 6,
-  // computed when wanted[i]) and S^(O) (when wanted[3]).
-  struct SpecificForceLinearization {
-    Eigen::Vector3d f_body;
-    Eigen::Matrix<double, 3, 6> J_pose[3];
-    Eigen::Matrix3d J_lever;
-  };
-  static SpecificForceLinearization LinearizeSpecificForce(const Pose<double>& pose0, const Pose<double>& pose1,
-                                                          const Pose<double>& pose2, double dt0, double dt1,
-                                                          const Eigen::Vector3d& p_body_sensor,
-                                                          const std::array<bool, 4>& wanted) {
-    // As SpecificForceBody, keeping the rotation vectors.
+  // Analytic Jacobians (header comment), with Factor::Evaluate's layout and zero noise; fills only the requested
+  // blocks. J_e_eta = I is left to AutoDiffFactor.
+  bool Linearize(const double* const* x, double* error, double* const* jacobians, double* /*noise_jacobian*/) const {
+    const Pose<double> pose0 = PoseFromArray(x[0]);
+    const Pose<double> pose1 = PoseFromArray(x[1]);
+    const Pose<double> pose2 = PoseFromArray(x[2]);
+    const Quaternion<double> q_body_sensor = QuaternionFromArray(x[3]);
+    const Eigen::Map<const Eigen::Vector3d> p_body_sensor(x[4]);
+    const Eigen::Map<const Eigen::Vector3d> bias(x[5]);
+    const Eigen::Map<const Eigen::Vector3d> scale(x[6]);
+    Eigen::Map<Eigen::Vector3d> e(error);
+
+    // As operator(), keeping the rotation vectors.
+    const double dt0 = dt0_s_;
+    const double dt1 = dt1_s_;
     const double half_span = (dt0 + dt1) * 0.5;
     const Quaternion<double>& q0 = pose0.q_world_body;
     const Quaternion<double>& q1 = pose1.q_world_body;
@@ -143,61 +140,52 @@ class AccelerometerError {
     const Eigen::Vector3d omega_body = phi02 / (dt0 + dt1);
     const Eigen::Vector3d alpha_body = (phi12 / dt1 - phi01 / dt0) / half_span;
     const Eigen::Vector3d g_body = q1.conjugate() * kSpecificForceAtRest_world;
-    SpecificForceLinearization out;
-    out.f_body = g_body + alpha_body.cross(p_body_sensor) + a_body + omega_body.cross(omega_body.cross(p_body_sensor));
-
-    // Poses: df/dp_i = R1^T c_i, df/dtheta_i as in the header comment.
-    if (wanted[0] || wanted[1] || wanted[2]) {
-      const Eigen::Matrix3d R1T = q1.toRotationMatrix().transpose();
-      const Eigen::Matrix3d S_x = Skew<double>(p_body_sensor);
-      const Eigen::Matrix3d K_alpha = S_x * (-1.0 / half_span);
-      const Eigen::Matrix3d K_omega =
-          (Skew<double>(omega_body.cross(p_body_sensor)) + Skew<double>(omega_body) * S_x) * (-1.0 / (dt0 + dt1));
-      // Jr^-1 of the rotation vectors a pose touches (Jl^-1 is its transpose).
-      const bool need01 = wanted[0] || wanted[1], need02 = wanted[0] || wanted[2], need12 = wanted[1] || wanted[2];
-      const Eigen::Matrix3d jr_inv01 = need01 ? internal::InverseRightJacobianSO3(phi01) : Eigen::Matrix3d();
-      const Eigen::Matrix3d jr_inv02 = need02 ? internal::InverseRightJacobianSO3(phi02) : Eigen::Matrix3d();
-      const Eigen::Matrix3d jr_inv12 = need12 ? internal::InverseRightJacobianSO3(phi12) : Eigen::Matrix3d();
-      if (wanted[0]) {
-        out.J_pose[0].leftCols<3>() = R1T / (dt0 * half_span);
-        out.J_pose[0].rightCols<3>() = K_alpha * jr_inv01.transpose() / dt0 - K_omega * jr_inv02.transpose();
-      }
-      if (wanted[1]) {
-        out.J_pose[1].leftCols<3>() = R1T * (-(1.0 / dt0 + 1.0 / dt1) / half_span);
-        out.J_pose[1].rightCols<3>() =
-            Skew<double>(g_body + a_body) - K_alpha * (jr_inv12.transpose() / dt1 + jr_inv01 / dt0);
-      }
-      if (wanted[2]) {
-        out.J_pose[2].leftCols<3>() = R1T / (dt1 * half_span);
-        out.J_pose[2].rightCols<3>() = K_alpha * jr_inv12 / dt1 + K_omega * jr_inv02;
-      }
-    }
-    if (wanted[3]) out.J_lever = Skew<double>(alpha_body) + Skew<double>(omega_body) * Skew<double>(omega_body);
-    return out;
-  }
-
-  // Analytic Jacobians (header comment), with Factor::Evaluate's layout and zero noise; fills only the requested
-  // blocks. J_e_eta = I is left to AutoDiffFactor.
-  bool Linearize(const double* const* x, double* error, double* const* jacobians, double* /*noise_jacobian*/) const {
-    const Quaternion<double> q_body_sensor = QuaternionFromArray(x[3]);
-    const Eigen::Map<const Eigen::Vector3d> p_body_sensor(x[4]);
-    const Eigen::Map<const Eigen::Vector3d> bias(x[5]);
-    const Eigen::Map<const Eigen::Vector3d> scale(x[6]);
-    Eigen::Map<Eigen::Vector3d> e(error);
-
-    const auto wanted = [&](int i) { return jacobians != nullptr && jacobians[i] != nullptr; };
-    const SpecificForceLinearization f = LinearizeSpecificForce(
-        PoseFromArray(x[0]), PoseFromArray(x[1]), PoseFromArray(x[2]), dt0_s_, dt1_s_, p_body_sensor,
-        {wanted(0), wanted(1), wanted(2), wanted(4)});
-    const Eigen::Vector3d f_sensor = q_body_sensor.conjugate() * f.f_body;
+    const Eigen::Vector3d f_body = g_body + alpha_body.cross(p_body_sensor) + a_body +
+                                   omega_body.cross(omega_body.cross(p_body_sensor));
+    const Eigen::Vector3d f_sensor = q_body_sensor.conjugate() * f_body;
     e = scale.cwiseProduct(f_sensor) + bias - z_mps2_;
     if (jacobians == nullptr) return true;
 
-    const Eigen::Matrix3d D = scale.asDiagonal() * q_body_sensor.toRotationMatrix().transpose();  // de = D df^(O)
-    for (int i = 0; i < 3; ++i)
-      if (wanted(i)) Eigen::Map<Eigen::Matrix<double, 3, 6>>{jacobians[i]} = D * f.J_pose[i];
+    const auto wanted = [&](int i) { return jacobians[i] != nullptr; };
+    const Eigen::Matrix3d R_body_sensor = q_body_sensor.toRotationMatrix();
+    const Eigen::Matrix3d D = scale.asDiagonal() * R_body_sensor.transpose();  // de = D df^(O)
+
+    // Poses: de/dp_i = D R1^T c_i, de/dtheta_i = D df/dtheta_i.
+    if (wanted(0) || wanted(1) || wanted(2)) {
+      const Eigen::Matrix3d D_R1T = D * q1.toRotationMatrix().transpose();
+      const Eigen::Matrix3d S_x = Skew<double>(p_body_sensor);
+      const Eigen::Matrix3d omega_x = Skew<double>(omega_body);
+      const Eigen::Matrix3d D_K_alpha = D * S_x * (-1.0 / half_span);
+      const Eigen::Matrix3d D_K_omega =
+          D * (Skew<double>(omega_body.cross(p_body_sensor)) + omega_x * S_x) * (-1.0 / (dt0 + dt1));
+      const auto J_e_pose = [&](int i) { return Eigen::Map<Eigen::Matrix<double, 3, 6>>(jacobians[i]); };
+      // Jr^-1 of the rotation vectors a pose touches (Jl^-1 is its transpose).
+      const bool need01 = wanted(0) || wanted(1), need02 = wanted(0) || wanted(2), need12 = wanted(1) || wanted(2);
+      const Eigen::Matrix3d jr_inv01 = need01 ? internal::InverseRightJacobianSO3(phi01) : Eigen::Matrix3d();
+      const Eigen::Matrix3d jr_inv02 = need02 ? internal::InverseRightJacobianSO3(phi02) : Eigen::Matrix3d();
+      const Eigen::Matrix3d jr_inv12 = need12 ? internal::InverseRightJacobianSO3(phi12) : Eigen::Matrix3d();
+      if (wanted(0)) {
+        J_e_pose(0).leftCols<3>() = D_R1T / (dt0 * half_span);
+        J_e_pose(0).rightCols<3>() =
+            D_K_alpha * jr_inv01.transpose() / dt0 - D_K_omega * jr_inv02.transpose();
+      }
+      if (wanted(1)) {
+        J_e_pose(1).leftCols<3>() = D_R1T * (-(1.0 / dt0 + 1.0 / dt1) / half_span);
+        J_e_pose(1).rightCols<3>() = D * Skew<double>(g_body + a_body) -
+                                     D_K_alpha * (jr_inv12.transpose() / dt1 + jr_inv01 / dt0);
+      }
+      if (wanted(2)) {
+        J_e_pose(2).leftCols<3>() = D_R1T / (dt1 * half_span);
+        J_e_pose(2).rightCols<3>() = D_K_alpha * jr_inv12 / dt1 + D_K_omega * jr_inv02;
+      }
+    }
+
+    // Calibration.
     if (wanted(3)) Eigen::Map<Eigen::Matrix3d>{jacobians[3]} = scale.asDiagonal() * Skew<double>(f_sensor);
-    if (wanted(4)) Eigen::Map<Eigen::Matrix3d>{jacobians[4]} = D * f.J_lever;
+    if (wanted(4)) {
+      Eigen::Map<Eigen::Matrix3d>{jacobians[4]} =
+          D * (Skew<double>(alpha_body) + Skew<double>(omega_body) * Skew<double>(omega_body));
+    }
     if (wanted(5)) Eigen::Map<Eigen::Matrix3d>{jacobians[5]}.setIdentity();
     if (wanted(6)) Eigen::Map<Eigen::Matrix3d>{jacobians[6]} = f_sensor.asDiagonal();
     return true;

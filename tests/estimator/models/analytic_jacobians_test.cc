@@ -238,48 +238,39 @@ TEST(AnalyticJacobiansTest, Accelerometer) {
   }
 }
 
-// The IMU's time-offset models (imu_time_offset.h): poses m = 3 intervals apart around the plain ones, an offset of a
-// few master periods either sign.
-TEST(AnalyticJacobiansTest, GyroscopeTimeOffset) {
+// The IMU's time-offset models (imu_time_offset.h): the plain models' points, a reading rate of a few units per
+// second and an offset of a few master periods either sign.
+TEST(AnalyticJacobiansTest, ImuTimeOffset) {
+  const Eigen::Vector3d h_world(0.0, 0.5, -0.8660254037844386);
   std::mt19937 rng(21);
   for (int point = 0; point < kPoints; ++point) {
+    const std::string where = "point " + std::to_string(point);
+    const Eigen::VectorXd delta = Eigen::VectorXd::Constant(1, 0.05 * (2.0 * (point % 2) - 1.0) + 0.01 * point / kPoints);
+    const Eigen::Vector3d rate = Gaussian3(3.0, &rng);
     const Eigen::VectorXd q_body_sensor = Misalignment(false, &rng);
     const Eigen::Vector3d bias = Gaussian3(0.01, &rng), scale = Eigen::Vector3d::Ones() + Gaussian3(0.02, &rng);
     const Eigen::Vector3d omega_body = Gaussian3(1.0, &rng);
-    const Eigen::Vector3d z =
-        scale.cwiseProduct(QuaternionFromArray(q_body_sensor.data()).conjugate() * omega_body) + bias;
-    const Eigen::VectorXd before = RandomPoint(Manifold::Pose(), &rng, 10.0);
-    const auto next = [&](const Eigen::VectorXd& pose, double dt) {
-      return PlusPose(pose, Gaussian3(0.05, &rng), (omega_body + Gaussian3(0.3, &rng)) * dt);
-    };
-    const Eigen::VectorXd pose_k = next(before, 3 * kDt), pose_k1 = next(pose_k, kDt);
-    const Eigen::VectorXd after = next(pose_k1, 3.3 * kDt);
-    const Eigen::VectorXd delta = Eigen::VectorXd::Constant(1, 0.05 * (2.0 * (point % 2) - 1.0) + 0.01 * point / kPoints);
-    ExpectAnalyticMatchesJets(GyroscopeTimeOffsetError(z, 3 * kDt, kDt, 3.3 * kDt),
-                              {before, pose_k, pose_k1, after, q_body_sensor, bias, scale, delta},
-                              "point " + std::to_string(point));
-  }
-}
-
-TEST(AnalyticJacobiansTest, AccelerometerTimeOffset) {
-  std::mt19937 rng(22);
-  for (int point = 0; point < kPoints; ++point) {
-    // Seven poses at t(k) + {-6, -3, -1, 0, 1, 3, 6} dt, about 3 m/s and 1 rad/s apart.
-    const std::vector<double> steps = {3, 2, 1, 1, 2, 3};
-    std::vector<Eigen::VectorXd> poses = {RandomPoint(Manifold::Pose(), &rng, 10.0)};
+    const Eigen::VectorXd pose0 = RandomPoint(Manifold::Pose(), &rng, 10.0);
     const Eigen::Vector3d v_world = Gaussian3(3.0, &rng);
-    for (double n : steps)
-      poses.push_back(PlusPose(poses.back(), (v_world + Gaussian3(0.1, &rng)) * n * kDt, Gaussian3(1.0, &rng) * n * kDt));
-    const Eigen::VectorXd q_body_sensor = Misalignment(false, &rng);
-    const Eigen::Vector3d p_body_sensor = Gaussian3(0.5, &rng), bias = Gaussian3(0.05, &rng);
-    const Eigen::Vector3d scale = Eigen::Vector3d::Ones() + Gaussian3(0.02, &rng);
-    const Eigen::Vector3d z = kSpecificForceAtRest_world + Gaussian3(1.0, &rng);
-    const Eigen::VectorXd delta = Eigen::VectorXd::Constant(1, 0.05 * (2.0 * (point % 2) - 1.0) + 0.01 * point / kPoints);
-    std::vector<Eigen::VectorXd> values = poses;
-    values.insert(values.end(), {q_body_sensor, p_body_sensor, bias, scale, delta});
+    const Eigen::VectorXd pose1 = PlusPose(pose0, v_world * kDt, omega_body * kDt + Gaussian3(0.003, &rng));
+    const Eigen::VectorXd pose2 = PlusPose(pose1, v_world * kDt, omega_body * kDt + Gaussian3(0.003, &rng));
+
+    const Eigen::Vector3d gyro_z =
+        scale.cwiseProduct(QuaternionFromArray(q_body_sensor.data()).conjugate() * omega_body) + bias;
+    ExpectAnalyticMatchesJets(GyroscopeTimeOffsetError(GyroscopeError(gyro_z, kDt), rate),
+                              {pose0, pose1, q_body_sensor, bias, scale, delta}, "gyroscope " + where);
+    const Eigen::Vector3d lever = Gaussian3(0.5, &rng);
     ExpectAnalyticMatchesJets(
-        AccelerometerTimeOffsetError(z, kDt, kDt, Eigen::Vector4d(3 * kDt, 3 * kDt, 3 * kDt, 3 * kDt)), values,
-        "point " + std::to_string(point));
+        AccelerometerTimeOffsetError(AccelerometerError(kSpecificForceAtRest_world + Gaussian3(1.0, &rng), kDt, kDt),
+                                     rate),
+        {pose0, pose1, pose2, q_body_sensor, lever, bias, scale, delta}, "accelerometer " + where);
+    Eigen::VectorXd A(9);
+    A << 1, 0, 0, 0, 1, 0, 0, 0, 1;
+    A += RandomPoint(Manifold::Euclidean(9), &rng, 0.05);
+    const Eigen::Vector3d mag_z = Gaussian3(1.0, &rng).normalized();
+    ExpectAnalyticMatchesJets(
+        MagnetometerTimeOffsetError(MagnetometerError(mag_z, h_world, Gaussian3(3.0, &rng), 49.6), rate),
+        {pose1, q_body_sensor, A, bias, Gaussian3(5e-4, &rng), delta}, "magnetometer " + where);
   }
 }
 
