@@ -48,7 +48,8 @@ namespace roamlab::estimator {
 template <typename Plain, int kBiasBlock>
 class ReadingTimeOffsetError {
  public:
-  using Blocks = decltype(std::tuple_cat(std::declval<typename Plain::Blocks>(), std::declval<std::tuple<ScalarBlock>>()));
+  using Blocks =
+      decltype(std::tuple_cat(std::declval<typename Plain::Blocks>(), std::declval<std::tuple<ScalarBlock>>()));
   static constexpr int kResidualDim = Plain::kResidualDim;
   static constexpr int kNoiseDim = Plain::kNoiseDim;
   static constexpr bool kAdditiveNoise = internal::AdditiveNoise<Plain>::value;

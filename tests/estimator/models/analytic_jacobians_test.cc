@@ -245,7 +245,8 @@ TEST(AnalyticJacobiansTest, ImuTimeOffset) {
   std::mt19937 rng(21);
   for (int point = 0; point < kPoints; ++point) {
     const std::string where = "point " + std::to_string(point);
-    const Eigen::VectorXd delta = Eigen::VectorXd::Constant(1, 0.05 * (2.0 * (point % 2) - 1.0) + 0.01 * point / kPoints);
+    const Eigen::VectorXd delta =
+        Eigen::VectorXd::Constant(1, 0.05 * (2.0 * (point % 2) - 1.0) + 0.01 * point / kPoints);
     const Eigen::Vector3d rate = Gaussian3(3.0, &rng);
     const Eigen::VectorXd q_body_sensor = Misalignment(false, &rng);
     const Eigen::Vector3d bias = Gaussian3(0.01, &rng), scale = Eigen::Vector3d::Ones() + Gaussian3(0.02, &rng);
