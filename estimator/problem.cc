@@ -347,7 +347,8 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
     if (b.time_offset_slot < 0) continue;
     const std::string& pname = b.slot_parameters[static_cast<std::size_t>(b.time_offset_slot)];
     const auto pc = impl->parameter_config.find(pname);
-    b.time_offset = (pc != impl->parameter_config.end() && pc->second.free) || impl->parameter_initial.at(pname)[0] != 0.0;
+    b.time_offset =
+        (pc != impl->parameter_config.end() && pc->second.free) || impl->parameter_initial.at(pname)[0] != 0.0;
   }
   for (const auto& stage : config.stages)
     for (const std::string& pname : stage) {
