@@ -15,6 +15,7 @@
 #include "estimator/models/enu.h"
 #include "estimator/models/gps.h"
 #include "estimator/models/gyroscope.h"
+#include "estimator/models/imu_time_offset.h"
 #include "estimator/models/linear_velocity.h"
 #include "estimator/models/magnetometer.h"
 #include "estimator/models/mecanum_drive.h"
@@ -30,6 +31,12 @@ using recording::StreamType;
 namespace {
 
 enum class Attachment { kMaster, kOnePose, kPair, kTriple, kInterval };
+
+// The IMU's time-offset models (models/imu_time_offset.h) move each reading by the slope of its stream's readings
+// within this many seconds on each side (at least the neighbouring sample on each side): over 2n + 1 samples the
+// slope's noise, which biases the offset towards zero, falls as n^-1.5, while the line smooths the motion's content
+// above about 0.5 Hz (the header's numbers).
+constexpr double kReadingRateHalfWindow = 0.3;
 
 Attachment AttachmentOf(const std::string& model, bool master) {
   if (master) return Attachment::kMaster;
@@ -65,6 +72,10 @@ struct StreamBinding {
   int specific_force_column = 0;                       // its first accelerometer column
   double drive_nm_per_mps2 = 0.0;                      // magnetometer: options.drive_nm_per_mps2
   Eigen::Vector3d forward_in_sensor = Eigen::Vector3d::UnitX();  // ackermann: options.forward_in_sensor (unit)
+  // gyroscope, accelerometer, magnetometer: the slot time_offset_s (its index), and whether the samples take the
+  // time-offset model (models/imu_time_offset.h): when the parameter is free or not zero.
+  int time_offset_slot = -1;
+  bool time_offset = false;
   std::deque<MeasurementRef> pending;
 };
 
@@ -334,6 +345,16 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
       return Error(config, "parameter '" + pname + "': time-varying parameters must be 3-vectors");
     impl->parameter_config[pname] = pc;
   }
+  // The IMU's time offset: the time-offset models only where it can matter.
+  for (StreamBinding& b : impl->streams) {
+    for (std::size_t i = 0; i < b.spec->slots.size(); ++i)
+      if (b.spec->slots[i].name == "time_offset_s") b.time_offset_slot = static_cast<int>(i);
+    if (b.time_offset_slot < 0) continue;
+    const std::string& pname = b.slot_parameters[static_cast<std::size_t>(b.time_offset_slot)];
+    const auto pc = impl->parameter_config.find(pname);
+    b.time_offset =
+        (pc != impl->parameter_config.end() && pc->second.free) || impl->parameter_initial.at(pname)[0] != 0.0;
+  }
   for (const auto& stage : config.stages)
     for (const std::string& pname : stage) {
       const auto it = impl->parameter_config.find(pname);
@@ -456,6 +477,35 @@ Eigen::Vector3d SpecificForceAt(const StreamBinding& s, Time t) {
   const double span = SecondsBetween(f.t[i - 1], f.t[i]);
   const double w = span > 0.0 ? SecondsBetween(f.t[i - 1], t) / span : 1.0;
   return (1.0 - w) * row(i - 1) + w * row(i);
+}
+
+// The rate [units / s] of a stream's three columns from `column` at row `row`: the slope of the least-squares line
+// through the rows within kReadingRateHalfWindow of it, and at least the neighbouring row on each side that exists
+// (models/imu_time_offset.h); zero for a single row.
+Eigen::Vector3d ReadingRate(const recording::Stream& data, int column, int row) {
+  const Time t = data.t[static_cast<std::size_t>(row)];
+  const std::int64_t half_ns = std::llround(kReadingRateHalfWindow * 1e9);
+  const auto first = std::lower_bound(data.t.begin(), data.t.end(), Time::FromNanoseconds(t.nanoseconds() - half_ns));
+  const auto last = std::upper_bound(data.t.begin(), data.t.end(), Time::FromNanoseconds(t.nanoseconds() + half_ns));
+  const int lo = std::min(static_cast<int>(first - data.t.begin()), std::max(row - 1, 0));
+  const int hi = std::max(static_cast<int>(last - data.t.begin()) - 1,
+                          std::min(row + 1, static_cast<int>(data.t.size()) - 1));
+  double mean_t = 0.0;
+  Eigen::Vector3d mean_z = Eigen::Vector3d::Zero();
+  for (int i = lo; i <= hi; ++i) {
+    mean_t += SecondsBetween(t, data.t[static_cast<std::size_t>(i)]);
+    mean_z += data.values.row(i).segment<3>(column).transpose();
+  }
+  mean_t /= hi - lo + 1;
+  mean_z /= hi - lo + 1;
+  double stt = 0.0;
+  Eigen::Vector3d stz = Eigen::Vector3d::Zero();
+  for (int i = lo; i <= hi; ++i) {
+    const double dt = SecondsBetween(t, data.t[static_cast<std::size_t>(i)]) - mean_t;
+    stt += dt * dt;
+    stz += dt * (data.values.row(i).segment<3>(column).transpose() - mean_z);
+  }
+  return stt > 0.0 ? Eigen::Vector3d(stz / stt) : Eigen::Vector3d::Zero();
 }
 
 }  // namespace
@@ -605,6 +655,7 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
   const Eigen::RowVectorXd row = data.values.row(m.row);
   const auto slot = [&](std::size_t i, std::size_t k) { return ParameterAt(s.slot_parameters[i], k); };
   const auto z3 = [&] { return Eigen::Vector3d(row.segment<3>(s.column).transpose()); };
+  const auto reading_rate = [&] { return ReadingRate(data, s.column, m.row); };
 
   // Which poses: bail out (keep waiting) until they exist.
   std::size_t k = 0;
@@ -685,18 +736,32 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     ++counts_[s.name].attached;
     return true;
   } else if (model == "gyroscope") {
-    factor = MakeFactor(GyroscopeError(z3(), dt));
+    if (s.time_offset) {
+      factor = MakeFactor(GyroscopeTimeOffsetError(GyroscopeError(z3(), dt), reading_rate()));
+    } else {
+      factor = MakeFactor(GyroscopeError(z3(), dt));
+    }
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k)};
   } else if (model == "linear_velocity") {
     factor = MakeFactor(LinearVelocityError(z3(), dt));
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k)};
   } else if (model == "accelerometer") {
-    factor = MakeFactor(AccelerometerError(z3(), SecondsBetween(poses_[k - 1].t, poses_[k].t),
-                                           SecondsBetween(poses_[k].t, poses_[k + 1].t)));
+    AccelerometerError plain(z3(), SecondsBetween(poses_[k - 1].t, poses_[k].t),
+                             SecondsBetween(poses_[k].t, poses_[k + 1].t));
+    if (s.time_offset) {
+      factor = MakeFactor(AccelerometerTimeOffsetError(std::move(plain), reading_rate()));
+    } else {
+      factor = MakeFactor(std::move(plain));
+    }
     vars = {poses_[k - 1].id, poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k), slot(3, k)};
   } else if (model == "magnetometer") {
     const Eigen::Vector3d f_sensor = s.specific_force ? SpecificForceAt(s, m.t) : Eigen::Vector3d::Zero();
-    factor = MakeFactor(MagnetometerError(z3(), s.field_world, f_sensor, s.drive_nm_per_mps2));
+    MagnetometerError plain(z3(), s.field_world, f_sensor, s.drive_nm_per_mps2);
+    if (s.time_offset) {
+      factor = MakeFactor(MagnetometerTimeOffsetError(std::move(plain), reading_rate()));
+    } else {
+      factor = MakeFactor(std::move(plain));
+    }
     vars = {poses_[k].id, slot(0, k), slot(1, k), slot(2, k), slot(3, k)};
   } else if (model == "gps") {
     Eigen::Vector3d z = z3();
@@ -711,6 +776,7 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     absolute_fixes_.emplace_back(poses_[k].id, row.head<3>().transpose());
     orientation_fixes_.push_back({poses_[k].id, slot(1, k), q.normalized()});
   }
+  if (s.time_offset) vars.push_back(slot(static_cast<std::size_t>(s.time_offset_slot), k));
   const FactorId id = graph_.AddFactor(std::move(factor), vars, s.noise_covariance, s.config.loss, s.name, m.t);
   stream_of_factor_[id] = m.stream;
   ++counts_[s.name].attached;

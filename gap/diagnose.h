@@ -8,8 +8,10 @@
 //      the levels the nominal model reaches on a nominal simulation (Baseline) when one is given;
 //   3. name: every candidate effect of the library is fitted on the first `train_fraction` of the recording with the
 //      full solver (all calibration parameters free, warm-started at the nominal fit): a parameter slot freed in an
-//      error model, or a time shift of a stream found by a 1-D search on the master period's grid with a parabola
-//      through the three best points (its curvature gives the standard deviation). Statistic: without a baseline the
+//      error model (also the IMU's clock offset, the time_offset_s the gyroscope and accelerometer share, started from
+//      a profile over it), or a time shift of a stream found by a 1-D search on the master period's grid with a
+//      parabola through the best points (its curvature gives the standard deviation; GPS latency, an absolute pose
+//      stream's offset, and an IMU offset beyond the first-order model's range). Statistic: without a baseline the
 //      chi-square drop LR = chi2_nominal - chi2_effect ~ chi2(k) (cost = chi2 / 2, estimator/solver.h); with one, the
 //      nominal model is not exact on MuJoCo data and already moves each candidate's parameters on the nominal
 //      simulation, so H0 is "the parameters take the baseline's values" and LR is its Wald form with both fits'

@@ -18,6 +18,7 @@ std::string AtvConfigYaml(const std::vector<std::string>& free, int window) {
       {"odometer.kv_over_L", {"0.8", "0.8"}},
       {"odometer.k_theta", {"1.0", "1.0"}},
       {"odometer.k_gamma", {"0.0", "0.0"}},
+      {"imu.time_offset_s", {"0.0", "0.0"}},
   };
   std::string yaml = "master: odometer\n"
                      "solver: {method: levenberg_marquardt, max_iterations: 100, function_tolerance: 1.0e-9}\n"
@@ -34,11 +35,12 @@ std::string AtvConfigYaml(const std::vector<std::string>& free, int window) {
     model: ackermann
     source: {speed: rear_wheel, steering: steering}
     noise: {speed_mps: 0.033, steering_rad: 0.014, lateral_mps: 0.02, vertical_mps: 0.02}
-  gyroscope: {model: gyroscope, source: imu, noise: {sigma_radps: 0.033}, parameters: {misalignment: imu.misalignment}}
+  gyroscope: {model: gyroscope, source: imu, noise: {sigma_radps: 0.033},
+              parameters: {misalignment: imu.misalignment, time_offset_s: imu.time_offset_s}}
   accelerometer: {model: accelerometer, source: imu, noise: {sigma_mps2: 0.067},
-                  parameters: {misalignment: imu.misalignment}}
+                  parameters: {misalignment: imu.misalignment, time_offset_s: imu.time_offset_s}}
   magnetometer: {model: magnetometer, source: magnetometer, noise: {sigma: 0.067},
-                 parameters: {misalignment: imu.misalignment},
+                 parameters: {misalignment: imu.misalignment, time_offset_s: imu.time_offset_s},
                  options: {field_world: [0.0, 0.5, -0.8660254037844386]}}
   gps: {model: gps, source: gps, noise: {sigma_m: 0.33}}
 )";

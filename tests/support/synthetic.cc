@@ -1,5 +1,6 @@
 #include "tests/support/synthetic.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -66,13 +67,16 @@ class AtvTruth {
     double speed_mps;            // |v_body|
   };
 
-  AtvTruth(bool hilly, double wheelbase_m, std::int64_t end_ns) : hilly_(hilly), wheelbase_m_(wheelbase_m) {
+  // Queried for t in [start_ns, end_ns] (start_ns <= 0).
+  AtvTruth(bool hilly, double wheelbase_m, std::int64_t start_ns, std::int64_t end_ns)
+      : hilly_(hilly), wheelbase_m_(wheelbase_m), first_node_(start_ns / kGridStepNs - 2) {
     if (hilly_) height_offset_ = SumWaves(0.0, 0.0).h;
-    // Grid nodes from -2 to last (inclusive), so that every t +- 1 ms with t in [0, end] has a node at or before it.
+    // Grid nodes from first to last (inclusive), so that every t +- 1 ms with t in [start, end] has a node at or before
+    // it.
     const std::int64_t last = end_ns / kGridStepNs + 2;
-    nodes_.resize(static_cast<std::size_t>(last - kFirstNode + 1));
+    nodes_.resize(static_cast<std::size_t>(last - first_node_ + 1));
     Node(0) = Eigen::Vector3d::Zero();
-    for (std::int64_t j = 0; j > kFirstNode; --j) Node(j - 1) = Rk4(j * kGridStepS, Node(j), -kGridStepS);
+    for (std::int64_t j = 0; j > first_node_; --j) Node(j - 1) = Rk4(j * kGridStepS, Node(j), -kGridStepS);
     for (std::int64_t j = 0; j < last; ++j) Node(j + 1) = Rk4(j * kGridStepS, Node(j), kGridStepS);
   }
 
@@ -93,10 +97,8 @@ class AtvTruth {
   }
 
  private:
-  static constexpr std::int64_t kFirstNode = -2;
-
-  Eigen::Vector3d& Node(std::int64_t j) { return nodes_[static_cast<std::size_t>(j - kFirstNode)]; }
-  const Eigen::Vector3d& Node(std::int64_t j) const { return nodes_[static_cast<std::size_t>(j - kFirstNode)]; }
+  Eigen::Vector3d& Node(std::int64_t j) { return nodes_[static_cast<std::size_t>(j - first_node_)]; }
+  const Eigen::Vector3d& Node(std::int64_t j) const { return nodes_[static_cast<std::size_t>(j - first_node_)]; }
 
   static TerrainSample SumWaves(double x, double y) {
     TerrainSample sample;
@@ -139,7 +141,7 @@ class AtvTruth {
   Eigen::Vector3d StateAt(std::int64_t t_ns) const {
     std::int64_t j = t_ns / kGridStepNs;
     if (j * kGridStepNs > t_ns) --j;  // floor for negative times
-    ROAMLAB_CHECK(j >= kFirstNode && j - kFirstNode < static_cast<std::int64_t>(nodes_.size()),
+    ROAMLAB_CHECK(j >= first_node_ && j - first_node_ < static_cast<std::int64_t>(nodes_.size()),
                   "synthetic truth queried outside its grid at " << t_ns << " ns");
     const std::int64_t rest_ns = t_ns - j * kGridStepNs;
     if (rest_ns == 0) return Node(j);
@@ -163,7 +165,8 @@ class AtvTruth {
   bool hilly_;
   double wheelbase_m_;
   double height_offset_ = 0.0;
-  std::vector<Eigen::Vector3d> nodes_;  // planar state at node j * 1 ms, j from kFirstNode
+  std::int64_t first_node_;
+  std::vector<Eigen::Vector3d> nodes_;  // planar state at node j * 1 ms, j from first_node_
 };
 
 // Zero-mean Gaussian noise of one source; all zeros when disabled.
@@ -232,6 +235,7 @@ std::string SyntheticOptions::Validate() const {
   require(IsFinite(k_gamma), "k_gamma must be finite");
   require(IsFinite(wheelbase_m) && wheelbase_m > 0.0, "wheelbase_m must be > 0");
   require(gyro_bias_radps.allFinite(), "gyro_bias_radps must be finite");
+  require(IsFinite(imu_time_offset_s) && std::abs(imu_time_offset_s) <= 1.0, "imu_time_offset_s must be in [-1, 1]");
   for (double sigma : {sigma_gps_m, sigma_mag, sigma_acc_mps2, sigma_gyro_radps, sigma_speed_mps, sigma_steering_rad}) {
     require(IsFinite(sigma) && sigma >= 0.0, "noise sigmas must be >= 0");
   }
@@ -244,7 +248,10 @@ SyntheticRecording MakeAtvRecording(const SyntheticOptions& options) {
   ROAMLAB_CHECK(problem.empty(), "invalid SyntheticOptions: " << problem);
 
   const std::int64_t end_ns = std::llround(options.duration_s * 1e9);
-  const AtvTruth truth_model(options.hilly, options.wheelbase_m, end_ns);
+  // The IMU's and magnetometer's rows stamped t are read at t - imu_time_offset_s.
+  const std::int64_t imu_offset_ns = std::llround(options.imu_time_offset_s * 1e9);
+  const AtvTruth truth_model(options.hilly, options.wheelbase_m, std::min<std::int64_t>(0, -imu_offset_ns),
+                             end_ns + std::max<std::int64_t>(0, -imu_offset_ns));
   const Eigen::Quaterniond q_body_imu = options.q_body_imu.normalized();
   const double k_v = options.kv_over_L * options.wheelbase_m;
 
@@ -273,11 +280,12 @@ SyntheticRecording MakeAtvRecording(const SyntheticOptions& options) {
   ground_truth.reserve(imu.t.size());
   for (std::size_t k = 0; k < imu.t.size(); ++k) {
     const AtvTruth::Kinematics truth = truth_model.At(imu.t[k].nanoseconds());
-    const Eigen::Vector3d gyro = q_body_imu.conjugate() * truth.omega_body + options.gyro_bias_radps +
+    const AtvTruth::Kinematics read = truth_model.At(imu.t[k].nanoseconds() - imu_offset_ns);
+    const Eigen::Vector3d gyro = q_body_imu.conjugate() * read.omega_body + options.gyro_bias_radps +
                                  gyro_noise.Draw3(options.sigma_gyro_radps);
     const Eigen::Vector3d accel =
         q_body_imu.conjugate() *
-            (truth.q_world_body.conjugate() * (truth.a_world + estimator::kSpecificForceAtRest_world)) +
+            (read.q_world_body.conjugate() * (read.a_world + estimator::kSpecificForceAtRest_world)) +
         accel_noise.Draw3(options.sigma_acc_mps2);
     imu.values.row(static_cast<Eigen::Index>(k)) << gyro.transpose(), accel.transpose();
 
@@ -295,7 +303,7 @@ SyntheticRecording MakeAtvRecording(const SyntheticOptions& options) {
   mag.info.mounting = recording::Mounting{};
   mag.info.noise = {{"sigma_normalized", options.sigma_mag}};
   for (std::size_t k = 0; k < mag.t.size(); ++k) {
-    const AtvTruth::Kinematics truth = truth_model.At(mag.t[k].nanoseconds());
+    const AtvTruth::Kinematics truth = truth_model.At(mag.t[k].nanoseconds() - imu_offset_ns);
     const Eigen::Vector3d z = options.mag_A * ((truth.q_world_body * q_body_imu).conjugate() * options.field_world) +
                               options.mag_b + mag_noise.Draw3(options.sigma_mag);
     mag.values.row(static_cast<Eigen::Index>(k)) = z.transpose();
@@ -349,6 +357,7 @@ SyntheticRecording MakeAtvRecording(const SyntheticOptions& options) {
     const Eigen::Vector3d& b = options.gyro_bias_radps;
     out.truth.calibration["imu.gyro_bias"] = {b.x(), b.y(), b.z()};
   }
+  if (options.imu_time_offset_s != 0.0) out.truth.calibration["imu.time_offset_s"] = {options.imu_time_offset_s};
   return out;
 }
 

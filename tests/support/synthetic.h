@@ -75,6 +75,9 @@ struct SyntheticOptions {
   double k_gamma = 0.0;                                            // [odometer.k_gamma] rad
   double wheelbase_m = 1.25;                                       // L, known (platform geometry), > 0
   Eigen::Vector3d gyro_bias_radps = Eigen::Vector3d::Zero();       // [imu.gyro_bias] in the IMU frame [rad/s]
+  // [imu.time_offset_s] the IMU's clock offset [s], |offset| <= 1: the imu and magnetometer rows stamped t hold the
+  // readings taken at t - offset (ground_truth stays at the stamps).
+  double imu_time_offset_s = 0.0;
 
   // Noise standard deviations per sample (seed Section V), each >= 0.
   double sigma_gps_m = 0.33;
@@ -95,8 +98,8 @@ struct SyntheticRecording {
   // IMU sample time; platform ackermann with geometry.wheelbase_m; origin set; provenance "simulated" with the seed.
   recording::Recording recording;
   // calibration: gps.lever_arm [3], imu.misalignment [w, x, y, z] (normalized), magnetometer.A [9, row-major],
-  // magnetometer.b [3], odometer.kv_over_L, odometer.k_theta, odometer.k_gamma [1 each], and imu.gyro_bias [3] when
-  // it is not zero (as the simulator records optional effects such as imu.lever_arm); no effects.
+  // magnetometer.b [3], odometer.kv_over_L, odometer.k_theta, odometer.k_gamma [1 each], and imu.gyro_bias [3] and
+  // imu.time_offset_s [1] when not zero (as the simulator records optional effects such as imu.lever_arm); no effects.
   recording::Truth truth;
 };
 

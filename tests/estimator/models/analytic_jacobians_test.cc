@@ -19,6 +19,7 @@
 #include "estimator/models/ackermann_velocity.h"
 #include "estimator/models/gps.h"
 #include "estimator/models/gyroscope.h"
+#include "estimator/models/imu_time_offset.h"
 #include "estimator/models/magnetometer.h"
 #include "estimator/models/odometer.h"
 #include "tests/estimator/factor_testing.h"
@@ -234,6 +235,43 @@ TEST(AnalyticJacobiansTest, Accelerometer) {
     ExpectAnalyticMatchesJets(AccelerometerError(z, dt0, dt1),
                               {pose0, pose1, pose2, q_body_sensor, p_body_sensor, bias, scale},
                               "point " + std::to_string(point));
+  }
+}
+
+// The IMU's time-offset models (imu_time_offset.h): the plain models' points, a reading rate of a few units per
+// second and an offset of a few master periods either sign.
+TEST(AnalyticJacobiansTest, ImuTimeOffset) {
+  const Eigen::Vector3d h_world(0.0, 0.5, -0.8660254037844386);
+  std::mt19937 rng(21);
+  for (int point = 0; point < kPoints; ++point) {
+    const std::string where = "point " + std::to_string(point);
+    const Eigen::VectorXd delta =
+        Eigen::VectorXd::Constant(1, 0.05 * (2.0 * (point % 2) - 1.0) + 0.01 * point / kPoints);
+    const Eigen::Vector3d rate = Gaussian3(3.0, &rng);
+    const Eigen::VectorXd q_body_sensor = Misalignment(false, &rng);
+    const Eigen::Vector3d bias = Gaussian3(0.01, &rng), scale = Eigen::Vector3d::Ones() + Gaussian3(0.02, &rng);
+    const Eigen::Vector3d omega_body = Gaussian3(1.0, &rng);
+    const Eigen::VectorXd pose0 = RandomPoint(Manifold::Pose(), &rng, 10.0);
+    const Eigen::Vector3d v_world = Gaussian3(3.0, &rng);
+    const Eigen::VectorXd pose1 = PlusPose(pose0, v_world * kDt, omega_body * kDt + Gaussian3(0.003, &rng));
+    const Eigen::VectorXd pose2 = PlusPose(pose1, v_world * kDt, omega_body * kDt + Gaussian3(0.003, &rng));
+
+    const Eigen::Vector3d gyro_z =
+        scale.cwiseProduct(QuaternionFromArray(q_body_sensor.data()).conjugate() * omega_body) + bias;
+    ExpectAnalyticMatchesJets(GyroscopeTimeOffsetError(GyroscopeError(gyro_z, kDt), rate),
+                              {pose0, pose1, q_body_sensor, bias, scale, delta}, "gyroscope " + where);
+    const Eigen::Vector3d lever = Gaussian3(0.5, &rng);
+    ExpectAnalyticMatchesJets(
+        AccelerometerTimeOffsetError(AccelerometerError(kSpecificForceAtRest_world + Gaussian3(1.0, &rng), kDt, kDt),
+                                     rate),
+        {pose0, pose1, pose2, q_body_sensor, lever, bias, scale, delta}, "accelerometer " + where);
+    Eigen::VectorXd A(9);
+    A << 1, 0, 0, 0, 1, 0, 0, 0, 1;
+    A += RandomPoint(Manifold::Euclidean(9), &rng, 0.05);
+    const Eigen::Vector3d mag_z = Gaussian3(1.0, &rng).normalized();
+    ExpectAnalyticMatchesJets(
+        MagnetometerTimeOffsetError(MagnetometerError(mag_z, h_world, Gaussian3(3.0, &rng), 49.6), rate),
+        {pose1, q_body_sensor, A, bias, Gaussian3(5e-4, &rng), delta}, "magnetometer " + where);
   }
 }
 
