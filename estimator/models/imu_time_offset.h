@@ -17,8 +17,8 @@
 // the chi-square is smooth in delta. Errors: the second-order remainder delta^2 z'' / 2 (a few master periods at the
 // motion's bandwidth; beyond 0.1 s the diagnosis searches the offset on a grid of whole-master-period stamp
 // shifts instead, gap/diagnose.cc), the slope's smoothing (a line over +-W passes a sine of angular frequency w
-// at about 1 - (w W)^2 / 10), and the slope's noise. A symmetric line fit over 2n + 1 samples at rate f (n = W f) leaves the
-// middle sample's own noise out and has
+// at about 1 - (w W)^2 / 10), and the slope's noise. A symmetric line fit over 2n + 1 samples at rate f (n = W f)
+// leaves the middle sample's own noise out and has
 //   var(z') = 3 f^2 sigma^2 / (n (n + 1) (2n + 1)),
 // so the moved reading carries an extra delta^2 var(z'), correlated between neighbouring samples; at 100 Hz and
 // W = 0.3 s (n = 30) std(z') = 0.73 sigma / s: 0.022 sigma at |delta| = 30 ms (+0.05 % of the variance), 0.07 sigma
