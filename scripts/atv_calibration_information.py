@@ -37,6 +37,7 @@ TARGETS = {"lever_norm": 0.10, "misalignment_deg": 2.0, "A": 0.02, "b": 0.01, "k
            "kgamma": 0.005}
 
 # Handlebar and speed coupled: slow where the handlebar is turned most, so that v^2 tan(delta) / L stays < 0.45 g.
+# atv_hills.yaml's drive since 2026-11-26.
 WEAVE = """driver:
   type: ackermann
   lead_in_s: 4.0
@@ -45,6 +46,18 @@ WEAVE = """driver:
     - sine: {amplitude: 1.2, period_s: 5.5, phase_rad: 1.5708}
   handlebar_rad:
     - sine: {amplitude: 0.40, period_s: 11.0, phase_rad: 0.0}
+"""
+# atv_hills.yaml's drive before 2026-11-26: turns both ways (handlebar +-0.22 rad), speed 2.9-5.1 m/s.
+SINES = """driver:
+  type: ackermann
+  lead_in_s: 4.0
+  speed_mps:
+    - constant: 4.0
+    - sine: {amplitude: 0.8, period_s: 13.0, phase_rad: 0.0}
+    - sine: {amplitude: 0.3, period_s: 4.7, phase_rad: 0.6}
+  handlebar_rad:
+    - sine: {amplitude: 0.15, period_s: 11.0, phase_rad: 0.3}
+    - sine: {amplitude: 0.07, period_s: 3.7, phase_rad: 1.1}
 """
 # Loops both ways (a figure eight every 17 s): the heading sweeps all directions, so every slope is crossed up and
 # down and sideways.
@@ -60,11 +73,12 @@ LOOPS = """driver:
 
 # name: (description, substitutions): terrain_seed, relief_m, driver (a whole driver block).
 DRIVES = {
-    "default": ("atv_hills.yaml as it is (terrain seed 7, 4 m relief)", {}),
-    "terrain9": ("default drive, terrain seed 9", {"terrain_seed": 9}),
-    "terrain11": ("default drive, terrain seed 11", {"terrain_seed": 11}),
-    "relief5": ("default drive, 5 m relief", {"relief_m": 5.0}),
-    "relief6": ("default drive, 6 m relief", {"relief_m": 6.0}),
+    "default": ("atv_hills.yaml as it is (terrain seed 7, 4 m relief; the weave since 2026-11-26)", {}),
+    "sines": ("the former default: terrain 7, 4 m; handlebar +-0.22 rad, speed 2.9-5.1 m/s", {"driver": SINES}),
+    "terrain9": ("sines, terrain seed 9", {"driver": SINES, "terrain_seed": 9}),
+    "terrain11": ("sines, terrain seed 11", {"driver": SINES, "terrain_seed": 11}),
+    "relief5": ("sines, 5 m relief", {"driver": SINES, "relief_m": 5.0}),
+    "relief6": ("sines, 6 m relief", {"driver": SINES, "relief_m": 6.0}),
     "weave": ("terrain 7, 4 m; handlebar +-0.40 rad, speed 2.3-4.7 m/s", {"driver": WEAVE}),
     "loops": ("terrain 7, 4 m; figure eights, handlebar +-0.45 rad", {"driver": LOOPS}),
     "weave_relief5": ("weave, 5 m relief", {"driver": WEAVE, "relief_m": 5.0}),

@@ -208,14 +208,23 @@ def main():
             b_str, _ = least_squares(rows["steering [rad]"], [a_y])
             lat_left = [y - b_lat[1] * a for y, a in zip(lat, a_y)]
             str_left = [y - b_str[1] * a for y, a in zip(rows["steering [rad]"], a_y)]
-            print("    cornering: lateral %+.4f s on a_y, steering %+.4f rad s^2/m; after them:" % (b_lat[1], b_str[1]))
-            for name, a in (("lateral v_y [m/s]", lat_left), ("steering [rad]", str_left)):
+            # The understeer as the front axle's side slip velocity c a_y (option front_slip_velocity): to first order
+            # the row moves by c a_y cos^2(kin) / v_x, kin = atan((L omega_z + v_y) / v_x) at the contact.
+            slip_regressor = [a * math.cos(math.atan((wheelbase * w[2] + v[1] + h * w[0]) / (v[0] - h * w[1]))) ** 2 /
+                              (v[0] - h * w[1]) for a, (v, w, _, _) in zip(a_y, samples)]
+            b_slip, _ = least_squares(rows["steering [rad]"], [slip_regressor])
+            slip_left = [y - b_slip[1] * a for y, a in zip(rows["steering [rad]"], slip_regressor)]
+            print("    cornering: lateral %+.4f s on a_y, steering %+.4f rad s^2/m (as the front axle's slip velocity "
+                  "%+.4f s); after them:" % (b_lat[1], b_str[1], b_slip[1]))
+            for name, a in (("lateral v_y [m/s]", lat_left), ("steering [rad]", str_left),
+                            ("steering, slip velocity [rad]", slip_left)):
                 print("  %-32s %+8.4f %8.4f %8.2f %10.4f" % (name, sum(a) / len(a), rms(a), correlation_time(a, dt),
                                                            white_equivalent(a, lags)))
             print("  Gauss-Markov part + white part at the contact (after cornering):")
             print("  %-32s %8s %8s %8s %10s" % ("", "GM sigma", "GM tau", "white", "white-eq"))
             for name, a in (("speed [m/s]", rows["speed [m/s]"]), ("lateral v_y [m/s]", lat_left),
-                            ("vertical v_z [m/s]", rows["vertical v_z [m/s]"]), ("steering [rad]", str_left)):
+                            ("vertical v_z [m/s]", rows["vertical v_z [m/s]"]), ("steering [rad]", str_left),
+                            ("steering, slip velocity [rad]", slip_left)):
                 sigma, tau, white = gauss_markov_fit(a, dt)
                 # The fitted process's power at zero frequency as white noise per sample: the Gauss-Markov part's
                 # autocovariance summed over all lags, sigma^2 (1 + rho) / (1 - rho) with rho = exp(-dt / tau).
