@@ -43,14 +43,15 @@ std::string TrackingConfig(const std::string& from, const std::string& to) {
       {"magnetometer.A: {value: [1, 0, 0, 0, 1, 0, 0, 0, 1]}",
        "magnetometer.A: {value: [0.87, -0.02, -0.02, 0.0, 0.88, 0.0, -0.02, -0.04, 0.85]}"},
       {"magnetometer.b: {value: [0, 0, 0]}", "magnetometer.b: {value: [-0.008, -0.007, -0.040]}"},
-      {"odometer.cornering_front: {value: 0.0047}", "odometer.cornering_front: {value: 0.0}"},
-      {"odometer.cornering_rear: {value: 0.0207}", "odometer.cornering_rear: {value: 0.0}"},
-      {"options: {contact_height_m: 0.28, pitch_lever_m: 0.625}", "options: {contact_height_m: 0, pitch_lever_m: 0}"},
+      {"odometer.cornering_front: {value: 0.0208}", "odometer.cornering_front: {value: 0.0}"},
+      {"odometer.cornering_rear: {value: 0.0208}", "odometer.cornering_rear: {value: 0.0}"},
+      {"options: {contact_height_m: 0.28, pitch_lever_m: 0.625, front_slip_velocity: 1}",
+       "options: {contact_height_m: 0, pitch_lever_m: 0}"},
       {"odometer.disturbance: {value: [0, 0, 0], free: true,", "odometer.disturbance: {value: [0, 0, 0], free: false,"},
-      {"noise: {speed_mps: 0.033, steering_rad: 0.039, lateral_mps: 0.02, vertical_mps: 0.05}",
+      {"noise: {speed_mps: 0.033, steering_rad: 0.053, lateral_mps: 0.02, vertical_mps: 0.05}",
        "noise: {speed_mps: 0.033, steering_rad: 0.014, lateral_mps: 0.02, vertical_mps: 0.1}"},
-      {"noise: {sigma_radps: 0.037}", "noise: {sigma_radps: 0.033}"},
-      {"noise: {sigma_mps2: 0.087}", "noise: {sigma_mps2: 0.067}"},
+      {"noise: {sigma_radps: 0.040}", "noise: {sigma_radps: 0.033}"},
+      {"noise: {sigma_mps2: 0.084}", "noise: {sigma_mps2: 0.067}"},
       {from, to}};
   for (const auto& [a, b] : replacements) {
     const std::size_t at = text.find(a);

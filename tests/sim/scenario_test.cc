@@ -120,8 +120,8 @@ TEST_F(ScenarioErrorTest, BadValues) {
   ExpectError(LoadWith("type: hills", "type: mountains"), "type: mountains", "world.terrain.type", "hills or flat");
   ExpectError(LoadWith("relief_m: 4.0", "relief_m: 0"), "relief_m: 0", "world.terrain.relief_m", "must be > 0");
   ExpectError(LoadWith("kind: ackermann", "kind: hovercraft"), "kind: hovercraft", "robot.kind", "unsupported");
-  ExpectError(LoadWith("{amplitude: 0.8, period_s: 13.0, phase_rad: 0.0}", "{amplitude: 0.8, period_s: -13.0}"),
-              "period_s: -13.0", "driver.speed_mps[1]", "period_s must be > 0");
+  ExpectError(LoadWith("{amplitude: 1.2, period_s: 5.5, phase_rad: 1.5708}", "{amplitude: 1.2, period_s: -5.5}"),
+              "period_s: -5.5", "driver.speed_mps[1]", "period_s must be > 0");
   ExpectError(LoadWith("effects: []", "effects: [{name: flux_capacitor, parameters: {gigawatts: 1.21}}]"),
               "flux_capacitor", "effects[0].name", "unknown effect");
   ExpectError(LoadWith("effects: []", "effects: [{name: gps_latency, parameters: {latency_s: 2}}]"), "gps_latency",
@@ -160,7 +160,7 @@ TEST_F(ScenarioErrorTest, WheelOffsetIsParsedAndChecked) {
 TEST_F(ScenarioErrorTest, MissingFilesAndKeys) {
   ExpectError(LoadWith("model: " + testing::SourcePath("models/atv.xml"), "model: no_such_robot.xml"),
               "no_such_robot.xml", "robot.model", "no such file 'no_such_robot.xml'");
-  ExpectError(LoadWith("{amplitude: 0.8, period_s: 13.0, phase_rad: 0.0}", "{amplitude: 0.8}"), "{amplitude: 0.8}",
+  ExpectError(LoadWith("{amplitude: 1.2, period_s: 5.5, phase_rad: 1.5708}", "{amplitude: 1.2}"), "{amplitude: 1.2}",
               "driver.speed_mps[1].sine.period_s", "missing required key");
   const std::string message = LoadWith("duration_s: 30.0\n", "");
   EXPECT_NE(message.find("duration_s: missing required key"), std::string::npos) << message;
