@@ -108,7 +108,7 @@ int main(int argc, char** argv) {
                   "SEED * 1000 + 500 + i (default 1)");
   gbm->add_option("--jobs", benchmark.jobs, "Cases in parallel (default 2)");
   gbm->add_option("--duration", benchmark.duration_s, "Drive duration [s] of every case (default: the scenarios')");
-  gbm->add_option("--atv", benchmark.atv_scenario, "Nominal ATV scenario (default scenarios/atv_hills.yaml)");
+  gbm->add_option("--atv", benchmark.atv_scenario, "Nominal ATV scenario (default scenarios/atv_hills_sines.yaml)");
   gbm->add_option("--diffdrive", benchmark.diffdrive_scenario,
                   "Nominal differential-drive scenario (default scenarios/indoor_diffdrive_gap.yaml)");
   gbm->add_option("--mecanum", benchmark.mecanum_scenario,

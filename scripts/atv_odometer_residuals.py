@@ -2,10 +2,12 @@
 """What eq. 15's rows see on the nominal MuJoCo ATV: an analysis tool (it reads the truth; the estimator never does).
 
     python3 scripts/atv_odometer_residuals.py [--roamlab build/apps/roamlab] [--scenario scenarios/atv_hills.yaml]
+                                              [--drive NAME]
                                               [--seed 1] [--height 0.28] [--lever 0.625]
 
-Simulates the scenario with every sensor noise set to zero, then takes the velocities between consecutive ground-truth
-poses of O (eq. 7 inverted, as the estimator does) and the true calibration, and prints, for the rows of
+Simulates the scenario (with --drive, its variant of scripts/atv_calibration_information.py's DRIVES, e.g. `sines`,
+the default drive before 2026-11-26) with every sensor noise set to zero, then takes the velocities between consecutive
+ground-truth poses of O (eq. 7 inverted, as the estimator does) and the true calibration, and prints, for the rows of
 estimator/models/ackermann_velocity.h: their RMS, 1/e correlation time and white-noise equivalent (the per-sample
 sigma of white noise with the same low-frequency power, sqrt of the summed autocovariance over +-3 s), at O and at the
 rear ground contact (--height below O, vertical chord lever --lever), and least-squares slopes on the body rates and
@@ -134,13 +136,22 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--roamlab", default="build/apps/roamlab")
     ap.add_argument("--scenario", default="scenarios/atv_hills.yaml")
+    ap.add_argument("--drive", help="a drive of atv_calibration_information.py's DRIVES instead of the scenario's")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--height", type=float, default=0.28, help="contact below O [m]")
     ap.add_argument("--lever", type=float, default=0.625, help="vertical row's pitch-rate lever [m]")
     ap.add_argument("--t0", type=float, default=2.0, help="skip the first seconds [s]")
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
-        rec = simulate_noiseless(args.roamlab, args.scenario, args.seed, tmp)
+        scenario = args.scenario
+        if args.drive:
+            import atv_calibration_information as information
+            if args.drive not in information.DRIVES:
+                raise SystemExit("atv_odometer_residuals: unknown drive '%s' (known: %s)" %
+                                 (args.drive, ", ".join(information.DRIVES)))
+            scenario = os.path.join(tmp, "drive.yaml")
+            open(scenario, "w").write(information.variant(args.scenario, information.DRIVES[args.drive][1], True))
+        rec = simulate_noiseless(args.roamlab, scenario, args.seed, tmp)
         truth = open(os.path.join(rec, "truth.yaml")).read()
         kv_over_l = float(re.search(r"odometer.kv_over_L: *([0-9.eE+-]+)", truth).group(1))
         k_theta = float(re.search(r"odometer.k_theta: *([0-9.eE+-]+)", truth).group(1))

@@ -1,5 +1,6 @@
-// The reality-gap diagnosis of a misaligned rear axle on 30 s ATV drives (scenarios/atv_hills.yaml): a thrust angle
-// (sim axle_misalignment on the ackermann rear axle, estimator odometer.thrust_angle) against a steering offset.
+// The reality-gap diagnosis of a misaligned rear axle on 30 s ATV drives (scenarios/atv_hills_sines.yaml, the drive
+// these diagnose tests were measured on): a thrust angle (sim axle_misalignment on the ackermann rear axle, estimator
+// odometer.thrust_angle) against a steering offset.
 // Kinematics (estimator/models/ackermann_velocity.h): the thrust angle alpha turns the vehicle at -v tan(alpha) / L at
 // zero handlebar, as a steering offset of -alpha does, and makes it crab by alpha. The crab is seen only against a
 // heading reference tied to the chassis: with the IMU's misalignment free (the nominal model), a rotation of O by
@@ -78,7 +79,7 @@ void ExpectNamedFirst(const Diagnosis& d, const std::string& name, const std::st
 class KnownMountingAxleTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    nominal_ = testing::LearnNominal("scenarios/atv_hills.yaml", KnownImuMounting).release();
+    nominal_ = testing::LearnNominal("scenarios/atv_hills_sines.yaml", KnownImuMounting).release();
   }
   static void TearDownTestSuite() { delete nominal_; }
   void SetUp() override { ASSERT_NE(nominal_, nullptr); }
@@ -100,7 +101,7 @@ TEST_F(KnownMountingAxleTest, SteeringOffsetIsNotNamedAxleMisalignment) {
 
 class NominalAxleTest : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() { nominal_ = testing::LearnNominal("scenarios/atv_hills.yaml").release(); }
+  static void SetUpTestSuite() { nominal_ = testing::LearnNominal("scenarios/atv_hills_sines.yaml").release(); }
   static void TearDownTestSuite() { delete nominal_; }
   void SetUp() override { ASSERT_NE(nominal_, nullptr); }
   static testing::LearnedNominal* nominal_;

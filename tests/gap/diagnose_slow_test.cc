@@ -1,7 +1,8 @@
-// The reality-gap diagnosis of 30 s ATV drives (scenarios/atv_hills.yaml) with one hidden effect, or none: it names the
-// effect and recovers its parameter within three of its reported standard deviations, stays at "none" without
-// one, and says "unknown" for an effect outside its library. The baseline (the nominal model on a nominal simulation)
-// is learned once, from a seed the cases do not use.
+// The reality-gap diagnosis of 30 s ATV drives (scenarios/atv_hills_sines.yaml: the ATV's former default drive, on
+// which these cases were measured; see that file) with one hidden effect, or none: it names the effect and recovers
+// its parameter within three of its reported standard deviations, stays at "none" without one, and says "unknown"
+// for an effect outside its library. The baseline (the nominal model on a nominal simulation) is learned once, from
+// a seed the cases do not use.
 // The truth is read from the simulation in memory, as evaluation does; the diagnosis sees the recording only.
 #include <cmath>
 #include <iostream>
@@ -19,7 +20,7 @@ namespace {
 constexpr std::uint64_t kBaselineSeed = 900001;
 
 sim::Scenario Atv() {
-  auto s = sim::LoadScenario(std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/atv_hills.yaml");
+  auto s = sim::LoadScenario(std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/atv_hills_sines.yaml");
   EXPECT_TRUE(s.ok()) << s.status().message();
   return s.value();
 }

@@ -1,4 +1,4 @@
-// The reality-gap diagnosis of a 30 s ATV drive (scenarios/atv_hills.yaml, baseline seed 900001) with a hidden
+// The reality-gap diagnosis of a 30 s ATV drive (scenarios/atv_hills_sines.yaml, baseline seed 900001) with a hidden
 // magnetometer interference proportional to the rear drive torque (sim/scenario.h magnetometer_motor_interference).
 // The recording has no torque stream: the candidate reads the forward specific force as the torque's proxy
 // (models/magnetometer.h, c = m r / 2). The ATV without an effect stays "none" with this candidate in the library:
@@ -19,7 +19,7 @@ namespace {
 
 class MagnetometerDiagnoseTest : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() { nominal_ = testing::LearnNominal("scenarios/atv_hills.yaml").release(); }
+  static void SetUpTestSuite() { nominal_ = testing::LearnNominal("scenarios/atv_hills_sines.yaml").release(); }
   static void TearDownTestSuite() { delete nominal_; }
   static testing::LearnedNominal* nominal_;
 };

@@ -1,4 +1,4 @@
-// The reality-gap diagnosis of a 30 s ATV drive (scenarios/atv_hills.yaml, baseline seed 900001) with a hidden
+// The reality-gap diagnosis of a 30 s ATV drive (scenarios/atv_hills_sines.yaml, baseline seed 900001) with a hidden
 // longitudinal slip of the driven tires (sim/scenario.h longitudinal_slip: the rear wheel over-reads the ground speed by
 // 1 + s f_x, f_x the forward specific force) or a slip that follows the slope alone (slope_slip: 1 + s g sin(pitch)).
 // The candidates free the ackermann model's slip_per_mps2 (on the IMU's forward specific force) and
@@ -22,7 +22,7 @@ namespace {
 
 class SlipDiagnoseTest : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() { nominal_ = testing::LearnNominal("scenarios/atv_hills.yaml").release(); }
+  static void SetUpTestSuite() { nominal_ = testing::LearnNominal("scenarios/atv_hills_sines.yaml").release(); }
   static void TearDownTestSuite() { delete nominal_; }
 
   // Hides `effect` with slip_per_mps2 = s, diagnoses, and checks that it is named first with s within 3 reported std
