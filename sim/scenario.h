@@ -87,7 +87,7 @@
 //                                          [1, 4] (AckermannVehicle::SoftenTires). A soft contact carries a sideways
 //                                          force by a slip velocity proportional to it and to the time constant, so
 //                                          the cornering compliance grows about linearly: measured on the truth of
-//                                          atv_hills.yaml (v_y at the rear contact regressed on a_y), c_rear = 0.0207
+//                                          atv_hills_sines.yaml (v_y at the rear contact on a_y), c_rear = 0.0207
 //                                          s at 1, 0.0409 at 2, 0.0816 at 4, i.e. +0.0203 (k - 1) s; the steering
 //                                          row's c_front +0.0045 (k - 1) rad s^2/m (README); the tires also sink
 //                                          more (vertical softness); the diagnosis's candidate is lateral_slip

@@ -32,8 +32,9 @@
 // (c_rear [s], m/s of side slip per m/s^2), and the front wheels' velocity points c_front a_y (c_front [rad s^2/m])
 // less into the turn than they are steered (understeer): the front axle moves along atan((L omega_z + v_y) / v_x).
 // With c_front = c_rear = 0 (their defaults) this is eq. 15 with the non-holonomic constraints. Measured on the MuJoCo
-// ATV (30 s, 4 m hills, scripts/atv_odometer_residuals.py): at the contact v_y has slope -0.0207 s on a_y and leaves
-// 0.0022 m/s rms of 0.035; the steering row -0.0047 rad s^2/m, leaving 0.0025 rad of 0.0083.
+// ATV (30 s, 4 m hills, scripts/atv_odometer_residuals.py; the former drive, scenarios/atv_hills_sines.yaml): at the
+// contact v_y has slope -0.0207 s on a_y and leaves 0.0022 m/s rms of 0.035; the steering row -0.0047 rad s^2/m,
+// leaving 0.0025 rad of 0.0083 (on the weave, atv_hills.yaml's drive now: -0.0208 s and -0.0058 rad s^2/m).
 //
 // Understeer as a slip velocity (option front_slip_velocity, default off). MuJoCo's soft contacts let a tire slip at a
 // velocity proportional to the force it carries (as the rear axle's v_y = -c_rear a_y above), not at an angle: the
@@ -42,7 +43,8 @@
 //   delta = atan((L omega_z + v_y + c_front a_y) / v_x),
 // an angle c_front a_y / v_x = c_front omega_z to first order: the angle form's coefficient is this one over the speed
 // at which the drive corners. Measured on the MuJoCo ATV (scripts/atv_understeer_fit.py, noise-free, at the contact):
-// 0.0209 s on the default drive and on a steering-rich weave alike (the angle form: 0.0047 and 0.0059 rad s^2/m).
+// 0.0209 s on the former drive (atv_hills_sines.yaml) and 0.0208 s on the steering-rich weave (atv_hills.yaml) alike
+// (the angle form: 0.0047 and 0.0058 rad s^2/m).
 //
 // Rear-axle thrust angle alpha [rad] (a misaligned rear axle: both rear wheels turned about z by alpha, positive
 // counter-clockwise). The rear wheels roll along d = (cos alpha, sin alpha) in O, so without side slip O's velocity
