@@ -437,7 +437,6 @@ void NormalEquations::BuildPattern() {
       H_.resizeNonZeros(static_cast<Eigen::Index>(inner_.size()));
       std::copy(outer_.begin(), outer_.end(), H_.outerIndexPtr());
       std::copy(inner_.begin(), inner_.end(), H_.innerIndexPtr());
-      std::fill(H_.valuePtr(), H_.valuePtr() + H_.nonZeros(), 0.0);
       cholmod_->analyzed = false;
     }
     pattern_dims_ = dims_;
