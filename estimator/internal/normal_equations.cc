@@ -964,7 +964,8 @@ bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, bool 
       const int kb = b + shift;
       const std::ptrdiff_t kept_height = (kept_envelope_start_[kb + 1] - kept_envelope_start_[kb]) / dims_[b];
       const std::ptrdiff_t height = (envelope_start_[b + 1] - envelope_start_[b]) / dims_[b];
-      const std::ptrdiff_t skip = kept_block_offset_[first_block_[b] + shift] - kept_block_offset_[kept_first_block_[kb]];
+      const std::ptrdiff_t skip =
+          kept_block_offset_[first_block_[b] + shift] - kept_block_offset_[kept_first_block_[kb]];
       for (int t = 0; t < dims_[b]; ++t)
         std::copy_n(kept_envelope_.data() + kept_envelope_start_[kb] + t * kept_height + skip, height,
                     envelope_.data() + envelope_start_[b] + t * height);
@@ -972,7 +973,6 @@ bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, bool 
     border_.topRows(reused_rows) = kept_border_.middleRows(row_shift, reused_rows);
   }
   reused_blocks_ += reused;
-  factored_blocks_ += band_blocks_ - reused;
 
   // Scatter the upper triangle of A: the band's column j of block b into its column of the block's envelope, rows
   // from the first of block first_block_[b] (the columns not taken over).

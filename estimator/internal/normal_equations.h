@@ -8,7 +8,8 @@
 // (a fixed-lag window that slid by one pose has the same band), the symbolic analysis is kept too. A Reset after which
 // the graph's factors and variables changed only by some leaving and new ones coming is incremental: the factors
 // still in it keep their tables (their variables' values and blocks), only new ones are looked up; the result is the
-// same as from scratch.
+// same as from scratch. Under a relinearization threshold the envelope factorization is incremental too: the leading
+// block columns of the last factor whose rows of H did not change are taken over (FactorEnvelope).
 #pragma once
 
 #include <cstdint>
@@ -65,10 +66,9 @@ class NormalEquations {
   // Factor evaluations (with Jacobians) and first-order carries since construction.
   long evaluations() const { return evaluations_; }
   long carries() const { return carries_; }
-  // Band block columns of the factor taken over from the last factorization, and factored anew, since construction
-  // (incremental factorization: see FactorEnvelope).
+  // Band block columns of the factor taken over from the last factorization since construction (incremental
+  // factorization under a relinearization threshold: see FactorEnvelope).
   long reused_blocks() const { return reused_blocks_; }
-  long factored_blocks() const { return factored_blocks_; }
 
   // Solves (H + lambda diag(H)) dx = -g. Returns false if the matrix is not positive definite.
   bool Solve(double lambda, Eigen::VectorXd* dx);
@@ -231,7 +231,6 @@ class NormalEquations {
   Eigen::MatrixXd kept_border_;
   std::vector<VariableId> dirty_;
   long reused_blocks_ = 0;
-  long factored_blocks_ = 0;
 
   struct Cholmod;
   std::unique_ptr<Cholmod> cholmod_;
