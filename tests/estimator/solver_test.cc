@@ -410,7 +410,9 @@ TEST(NormalEquationsTest, IncrementalFactorizationOfASlidingWindowMatchesAFreshO
     const long reused = incremental.reused_blocks() - reused_before;
     reused_before = incremental.reused_blocks();
     EXPECT_LE(reused, reusable) << "step " << step;
-    if (step > 0) EXPECT_GT(reused + (step == 12 ? 1 : 0), 0) << "step " << step;
+    if (step > 0 && step != 12) {
+      EXPECT_GT(reused, 0) << "step " << step;
+    }
     Eigen::MatrixXd cov_incremental, cov_fresh;
     ASSERT_TRUE(incremental.Covariance({poses.front()}, &cov_incremental));
     ASSERT_TRUE(fresh.Covariance({poses.front()}, &cov_fresh));
