@@ -216,12 +216,13 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const Sol
       // H here (other kernels moved its positions by metres; BENCHMARKS.md, fourth tracking pass).
       g.segment(oa, lf.jacobians[a].cols()) += lf.jacobians[a].transpose().lazyProduct(lf.residual);
       for (std::size_t b = 0; b < e.variables.size(); ++b) {
-        if (!want[b]) continue;
+        if (!want[b] || var_offset[b] < oa) continue;  // the lower triangle is mirrored below
         H.block(oa, var_offset[b], lf.jacobians[a].cols(), lf.jacobians[b].cols()) +=
             lf.jacobians[a].transpose().lazyProduct(lf.jacobians[b]);
       }
     }
   }
+  H.triangularView<Eigen::StrictlyLower>() = H.transpose();
 
   // Schur complement onto the blanket, factored as J^T J (SquareRootInformation, dropping null directions).
   const int nb = n - nm;

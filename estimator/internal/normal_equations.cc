@@ -259,6 +259,10 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
       ++j;
     }
   }
+  if (!incremental || relinearize_threshold_ <= 0.0) {
+    factor_kept_ = false;
+    dirty_.clear();
+  }
   if (incremental) {
     ++incremental_resets_;
     old_to_new_.resize(prev_order_.size());
@@ -367,6 +371,20 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
       fresh.push_back(k);
     }
   }
+  // A factor that left while all its variables stayed (gated off) changed H where they are free.
+  if (factor_kept_) {
+    for (std::size_t p = 0; p < prev_factor_ids_.size(); ++p) {
+      if (taken[p]) continue;
+      bool stayed = true;
+      for (int v = prev_var_begin_[p]; v < prev_var_begin_[p + 1] && stayed; ++v) {
+        const auto it = std::lower_bound(variable_table_.begin(), variable_table_.end(), prev_var_id_[v],
+                                         [](const VariableSlot& slot, VariableId key) { return slot.id < key; });
+        stayed = it != variable_table_.end() && it->id == prev_var_id_[v];
+      }
+      for (int v = prev_var_begin_[p]; v < prev_var_begin_[p + 1] && stayed; ++v)
+        if (prev_var_block_[v] >= 0) dirty_.push_back(prev_var_id_[v]);
+    }
+  }
   for (std::size_t p = 0, i = 0; p < prev_linearized_.size() && i < fresh.size(); ++p)
     if (!taken[p]) std::swap(linearized_[fresh[i++]], prev_linearized_[p]);
   for (std::size_t k : fresh) linearized_[k].id = -1;
@@ -419,7 +437,6 @@ void NormalEquations::BuildPattern() {
       H_.resizeNonZeros(static_cast<Eigen::Index>(inner_.size()));
       std::copy(outer_.begin(), outer_.end(), H_.outerIndexPtr());
       std::copy(inner_.begin(), inner_.end(), H_.innerIndexPtr());
-      std::fill(H_.valuePtr(), H_.valuePtr() + H_.nonZeros(), 0.0);
       cholmod_->analyzed = false;
     }
     pattern_dims_ = dims_;
@@ -577,6 +594,12 @@ bool NormalEquations::Current(std::size_t k) const {
 bool NormalEquations::LinearizeAndRecord(std::size_t k, double* previous_cost) {
   FactorLinearization& l = linearized_[k];
   const int v0 = var_begin_[k];
+  // A new marginalization prior stands for the Schur complement that the kept factorization already holds (see
+  // FactorEnvelope); any other evaluation changes H where the factor's variables are free.
+  const bool new_prior = l.id != factor_ids_[k] && entries_[k]->stream == "marginalization";
+  if (factor_kept_ && !new_prior)
+    for (int v = v0; v < var_begin_[k + 1]; ++v)
+      if (var_block_[v] >= 0) dirty_.push_back(var_id_[v]);
   if (!LinearizeFactorAt(*entries_[k], &values_[v0], want_[k], &l.whitened, previous_cost)) {
     l.id = -1;
     return false;
@@ -667,6 +690,12 @@ bool NormalEquations::Solve(double lambda, Eigen::VectorXd* dx) {
     for (int i = 0; i < dimension_; ++i) v[diagonal_index_[i]] += lambda * std::max(v[diagonal_index_[i]], 1e-12);
     A = &c.damped;
   }
+  if (natural_order_ && factor_kept_) {
+    // The last factorization (still in envelope_ and border_, for the solves after it) becomes the kept one
+    // (FactorEnvelope); the buffers of the one before take the new factor.
+    kept_envelope_.swap(envelope_);
+    kept_border_.swap(border_);
+  }
   if (!c.analyzed) {
     if (natural_order_) {
       // The border: trailing block columns whose first row block is the first; the envelope of each other block
@@ -698,7 +727,7 @@ bool NormalEquations::Solve(double lambda, Eigen::VectorXd* dx) {
   }
   bool factored = false;
   if (natural_order_) {
-    factored = FactorEnvelope(*A);
+    factored = FactorEnvelope(*A, lambda <= 0.0);
   } else {
     c.llt.factorize(*A);
     factored = c.llt.info() == Eigen::Success;
@@ -813,9 +842,10 @@ struct Band {
 
   // Block Crout: U(r, b) = U(r, r)^-T (A(r, b) - sum_k U(k, r)^T U(k, b)) for r < b, over the row blocks k both
   // columns hold, and U(b, b)^T U(b, b) = A(b, b) - sum_k U(k, b)^T U(k, b). u holds A's upper triangle on entry.
-  bool Factor() const {
+  // Block columns from..blocks-1; the ones before hold U already.
+  bool Factor(int from = 0) const {
     bool ok = true;
-    for (int b = 0; b < blocks && ok; ++b) {
+    for (int b = from; b < blocks && ok; ++b) {
       Sized(b, [&](auto nb) {
         constexpr int B = decltype(nb)::value;
         for (int r = first_block[b]; r < b; ++r) {
@@ -845,8 +875,9 @@ struct Band {
   }
   // x <- Ua^-T x over the band's rows of x, block by block (coefficient-wise products: a block is small, and x has
   // one column for a step, a few for a covariance, the border's for Ub).
-  void Forward(double* x, Eigen::Index ldx, Eigen::Index m) const {
-    for (int b = 0; b < blocks; ++b) {
+  // Rows of blocks from..blocks-1; the ones before hold their result already.
+  void Forward(double* x, Eigen::Index ldx, Eigen::Index m, int from = 0) const {
+    for (int b = from; b < blocks; ++b) {
       Sized(b, [&](auto nb) {
         constexpr int B = decltype(nb)::value;
         Rows<B> xb = rows<B>(x, ldx, m, b);
@@ -891,17 +922,67 @@ void NormalEquations::WithBand(Function f) {
   }
 }
 
-bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A) {
+int NormalEquations::ReusableBlocks() const {
+  if (!factor_kept_ || order_.empty() || kept_band_blocks_ == 0) return 0;
+  // The kept order without the blocks that left at its front (shift), and the same border.
+  const auto first = std::find(kept_order_.begin(), kept_order_.begin() + kept_band_blocks_, order_.front());
+  if (first == kept_order_.begin() + kept_band_blocks_) return 0;
+  const int shift = static_cast<int>(first - kept_order_.begin());
+  const int border_blocks = static_cast<int>(order_.size()) - band_blocks_;
+  if (static_cast<int>(kept_order_.size()) - kept_band_blocks_ != border_blocks ||
+      !std::equal(order_.begin() + band_blocks_, order_.end(), kept_order_.begin() + kept_band_blocks_))
+    return 0;
+  int reusable = 0;
+  while (reusable < band_blocks_ && reusable + shift < kept_band_blocks_ &&
+         order_[reusable] == kept_order_[reusable + shift] &&
+         first_block_[reusable] == std::max(kept_first_block_[reusable + shift] - shift, 0))
+    ++reusable;
+  for (VariableId id : dirty_) {
+    const int b = BlockOf(id);
+    if (b >= 0) {
+      if (b < band_blocks_) reusable = std::min(reusable, b);
+    } else if (std::find(kept_order_.begin(), kept_order_.end(), id) != kept_order_.end()) {
+      return 0;  // a factor on a variable that left (or is no longer free) changed: the Schur complement did too
+    }
+  }
+  return reusable;
+}
+
+bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, bool undamped) {
   const int na = band_dimension_;
+  const int reused = undamped && relinearize_threshold_ > 0.0 ? ReusableBlocks() : 0;
+  const int reused_rows = reused > 0 ? block_offset_[reused] : 0;
+  envelope_.resize(envelope_start_[band_blocks_]);
+  border_.resize(na, dimension_ - na);
+  if (reused > 0) {
+    // Columns 0..reused-1 of Ua from the kept ones shifted by the blocks that left (their rows above the first
+    // block now are dropped), and the rows of Ub before row block `reused`.
+    const int shift = static_cast<int>(std::find(kept_order_.begin(), kept_order_.end(), order_.front()) -
+                                       kept_order_.begin());
+    const int row_shift = kept_block_offset_[shift];
+    for (int b = 0; b < reused; ++b) {
+      const int kb = b + shift;
+      const std::ptrdiff_t kept_height = (kept_envelope_start_[kb + 1] - kept_envelope_start_[kb]) / dims_[b];
+      const std::ptrdiff_t height = (envelope_start_[b + 1] - envelope_start_[b]) / dims_[b];
+      const std::ptrdiff_t skip =
+          kept_block_offset_[first_block_[b] + shift] - kept_block_offset_[kept_first_block_[kb]];
+      for (int t = 0; t < dims_[b]; ++t)
+        std::copy_n(kept_envelope_.data() + kept_envelope_start_[kb] + t * kept_height + skip, height,
+                    envelope_.data() + envelope_start_[b] + t * height);
+    }
+    border_.topRows(reused_rows) = kept_border_.middleRows(row_shift, reused_rows);
+  }
+  reused_blocks_ += reused;
+
   // Scatter the upper triangle of A: the band's column j of block b into its column of the block's envelope, rows
-  // from the first of block first_block_[b].
-  std::fill(envelope_.begin(), envelope_.end(), 0.0);
-  border_.setZero();
+  // from the first of block first_block_[b] (the columns not taken over).
+  std::fill(envelope_.begin() + envelope_start_[reused], envelope_.end(), 0.0);
+  border_.bottomRows(na - reused_rows).setZero();
   corner_.setZero();
   const int* outer = A.outerIndexPtr();
   const int* inner = A.innerIndexPtr();
   const double* value = A.valuePtr();
-  for (int b = 0; b < band_blocks_; ++b) {
+  for (int b = reused; b < band_blocks_; ++b) {
     const int row0 = block_offset_[first_block_[b]];
     const std::ptrdiff_t height = (envelope_start_[b + 1] - envelope_start_[b]) / dims_[b];
     for (int t = 0; t < dims_[b]; ++t) {
@@ -915,7 +996,7 @@ bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A) {
     for (int p = outer[j]; p < outer[j + 1]; ++p) {
       const int i = inner[p];
       if (i < na) {
-        border_(i, j - na) = value[p];
+        if (i >= reused_rows) border_(i, j - na) = value[p];
       } else if (i <= j) {
         corner_(i - na, j - na) = value[p];
       }
@@ -924,12 +1005,24 @@ bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A) {
   // Ua, then Ub = Ua^-T B (forward substitution on B's columns) and Uc^T Uc = C - Ub^T Ub.
   bool factored = false;
   WithBand([&](const auto& band) {
-    factored = band.Factor();
-    if (factored && dimension_ > na) band.Forward(border_.data(), border_.rows(), border_.cols());
+    factored = band.Factor(reused);
+    if (factored && dimension_ > na) band.Forward(border_.data(), border_.rows(), border_.cols(), reused);
   });
-  if (!factored || dimension_ == na) return factored;
-  corner_.selfadjointView<Eigen::Upper>().rankUpdate(border_.transpose(), -1.0);
-  return UpperCholeskyInPlace(corner_);
+  if (factored && dimension_ > na) {
+    corner_.selfadjointView<Eigen::Upper>().rankUpdate(border_.transpose(), -1.0);
+    factored = UpperCholeskyInPlace(corner_);
+  }
+  // Kept for the next factorization (with a relinearization threshold, undamped).
+  factor_kept_ = factored && undamped && relinearize_threshold_ > 0.0;
+  dirty_.clear();
+  if (factor_kept_) {
+    kept_order_ = order_;
+    kept_band_blocks_ = band_blocks_;
+    kept_first_block_ = first_block_;
+    kept_block_offset_ = block_offset_;
+    kept_envelope_start_ = envelope_start_;
+  }
+  return factored;
 }
 
 void NormalEquations::ForwardEnvelope(Eigen::Ref<Eigen::MatrixXd> x) {

@@ -8,7 +8,8 @@
 // (a fixed-lag window that slid by one pose has the same band), the symbolic analysis is kept too. A Reset after which
 // the graph's factors and variables changed only by some leaving and new ones coming is incremental: the factors
 // still in it keep their tables (their variables' values and blocks), only new ones are looked up; the result is the
-// same as from scratch.
+// same as from scratch. Under a relinearization threshold the envelope factorization is incremental too: the leading
+// block columns of the last factor whose rows of H did not change are taken over (FactorEnvelope).
 #pragma once
 
 #include <cstdint>
@@ -65,6 +66,9 @@ class NormalEquations {
   // Factor evaluations (with Jacobians) and first-order carries since construction.
   long evaluations() const { return evaluations_; }
   long carries() const { return carries_; }
+  // Band block columns of the factor taken over from the last factorization since construction (incremental
+  // factorization under a relinearization threshold: see FactorEnvelope).
+  long reused_blocks() const { return reused_blocks_; }
 
   // Solves (H + lambda diag(H)) dx = -g. Returns false if the matrix is not positive definite.
   bool Solve(double lambda, Eigen::VectorXd* dx);
@@ -188,7 +192,17 @@ class NormalEquations {
   // column's first coupled block and the diagonal may fill in, blocks above it cannot), Ub = Ua^-T B and
   // Uc^T Uc = C - Ub^T Ub (dense). The border is the trailing block columns coupled to the first block, at most
   // kMaxBorder columns.
-  bool FactorEnvelope(const Eigen::SparseMatrix<double>& A);
+  //
+  // Incremental (with a relinearization threshold, undamped): the leading block columns of U depend only on H's
+  // leading principal block, so the columns of the last factorization whose rows of H did not change are taken over.
+  // A window that slid drops its oldest pose, which takes its block row of U with it: the rest of U is the factor of
+  // the Schur complement, which is what the marginalization prior that replaces the pose's factors adds to H again
+  // (to rounding, and to the directions its rank floor drops, below 10 n eps of H's scale). So a column is taken
+  // over while its variable is the same as the kept column's and no factor on it or a variable before it changed
+  // its Jacobians or left since (dirty_), except the new marginalization prior. The border's rows Ub follow the
+  // same rule (a row of Ua^-T B depends on B's rows above it); C - Ub^T Ub and Uc are always computed.
+  bool FactorEnvelope(const Eigen::SparseMatrix<double>& A, bool undamped);
+  int ReusableBlocks() const;  // leading band blocks of the kept factorization that hold for this one
   void ForwardEnvelope(Eigen::Ref<Eigen::MatrixXd> x);  // x <- U^-T x with the last FactorEnvelope
   void SolveEnvelope(Eigen::Ref<Eigen::MatrixXd> x);    // x <- H^-1 x with the last FactorEnvelope
   // Calls f with the band (a Band<6> when every block of A is a pose, otherwise a Band<Dynamic>, whose kernels are
@@ -203,6 +217,20 @@ class NormalEquations {
   std::vector<double> envelope_;
   Eigen::MatrixXd border_;  // Ub
   Eigen::MatrixXd corner_;  // C, then Uc in its upper triangle
+
+  // The last undamped factorization with a relinearization threshold (its order and band layout; its Ua and Ub stay
+  // in envelope_ and border_ until the next factorization swaps them here), and the free variables of factors whose
+  // Jacobians changed or that left the system since (FactorEnvelope).
+  bool factor_kept_ = false;
+  std::vector<VariableId> kept_order_;
+  int kept_band_blocks_ = 0;
+  std::vector<int> kept_first_block_;
+  std::vector<int> kept_block_offset_;
+  std::vector<std::ptrdiff_t> kept_envelope_start_;
+  std::vector<double> kept_envelope_;
+  Eigen::MatrixXd kept_border_;
+  std::vector<VariableId> dirty_;
+  long reused_blocks_ = 0;
 
   struct Cholmod;
   std::unique_ptr<Cholmod> cholmod_;

@@ -334,6 +334,106 @@ TEST(NormalEquationsTest, IncrementalResetOfASlidingWindowMatchesAFreshBuild) {
   EXPECT_EQ(incremental.incremental_resets(), 10);
 }
 
+// Incremental factorization (with a relinearization threshold): the leading block columns of the factor whose rows of
+// H did not change since the last factorization are taken over. Against a fresh object on the same graph at every
+// slide (the same H bit for bit: variables either stay or move beyond the threshold, so every factor is evaluated at
+// the same values in both): before the first marginalization the step and the oldest pose's covariance are the same
+// bit for bit; after it (the prior stands for the Schur complement that the kept rows hold) to 1e-12 relative. A
+// moved pose, a factor gated off or on again, and a leaving pose whose factors were evaluated again after the last
+// factorization limit what is taken over.
+TEST(NormalEquationsTest, IncrementalFactorizationOfASlidingWindowMatchesAFreshOne) {
+  std::mt19937 rng(17);
+  Graph graph;
+  const VariableId lever =
+      graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d(0.1, 0.2, 0.3), false, std::nullopt});
+  std::deque<VariableId> poses;
+  int stamp = 0;
+  const auto tie = [&](const std::vector<VariableId>& ids) { TieWithRandomPrior(ids, &rng, &graph); };
+  const auto add_pose = [&] {
+    poses.push_back(graph.AddVariable({"pose", Manifold::Pose(), testing::RandomPoint(Manifold::Pose(), &rng, 5.0),
+                                       false, Time::FromSeconds(static_cast<double>(stamp++))}));
+    tie({poses.back()});
+    if (poses.size() > 1) tie({poses[poses.size() - 2], poses.back(), lever});
+  };
+  for (int k = 0; k < 10; ++k) add_pose();
+  const double threshold = 1e-3;
+  const auto move = [&](VariableId id) {  // beyond the threshold
+    Variable& v = graph.mutable_variable(id);
+    const Eigen::VectorXd d = Eigen::VectorXd::Constant(v.manifold.tangent_dim(), 10.0 * threshold);
+    v.manifold.Plus(v.value.data(), d.data(), v.value.data());
+  };
+
+  internal::NormalEquations incremental;
+  incremental.set_relinearize_threshold(threshold);
+  FactorId gated = -1;
+  long reused_before = 0;
+  bool marginalized = false;
+  for (int step = 0; step < 14; ++step) {
+    int reusable = 1 << 20;  // bound on the columns taken over at this step
+    if (step > 0 && step % 2 == 0) {
+      ASSERT_TRUE(Marginalize({poses.front()}, &graph));
+      poses.pop_front();
+      marginalized = true;
+    }
+    if (step > 0) {
+      add_pose();
+      reusable = static_cast<int>(poses.size()) - 2;  // the pose before the new one has a new factor
+    }
+    if (step == 5) {
+      move(poses[4]);  // its factors are evaluated again from pose 3 on
+      reusable = 3;
+    }
+    if (step == 7) {
+      gated = graph.FactorsOf(poses[6]).back();  // (pose 6, pose 7, lever)
+      graph.mutable_factor(gated).active = false;
+      reusable = 6;
+    }
+    if (step == 9) {
+      graph.mutable_factor(gated).active = true;
+      reusable = 5;  // pose 6 of step 7, one pose marginalized since
+    }
+    if (step == 12) reusable = 0;  // the leaving pose's factors were evaluated again after the last factorization
+
+    incremental.Reset(graph, FreeVariableOrder(graph));
+    internal::NormalEquations fresh(graph, FreeVariableOrder(graph));
+    fresh.set_relinearize_threshold(threshold);
+    ASSERT_TRUE(incremental.Linearize(graph));
+    ASSERT_TRUE(fresh.Linearize(graph));
+    const Eigen::SparseMatrix<double>& a = incremental.hessian_upper();
+    const Eigen::SparseMatrix<double>& b = fresh.hessian_upper();
+    ASSERT_EQ(a.nonZeros(), b.nonZeros()) << "step " << step;
+    ASSERT_TRUE(std::equal(a.valuePtr(), a.valuePtr() + a.nonZeros(), b.valuePtr())) << "step " << step;
+    Eigen::VectorXd dx_incremental, dx_fresh;
+    ASSERT_TRUE(incremental.Solve(0.0, &dx_incremental));
+    ASSERT_TRUE(fresh.Solve(0.0, &dx_fresh));
+    EXPECT_EQ(fresh.reused_blocks(), 0);
+    const long reused = incremental.reused_blocks() - reused_before;
+    reused_before = incremental.reused_blocks();
+    EXPECT_LE(reused, reusable) << "step " << step;
+    if (step > 0 && step != 12) {
+      EXPECT_GT(reused, 0) << "step " << step;
+    }
+    Eigen::MatrixXd cov_incremental, cov_fresh;
+    ASSERT_TRUE(incremental.Covariance({poses.front()}, &cov_incremental));
+    ASSERT_TRUE(fresh.Covariance({poses.front()}, &cov_fresh));
+    if (marginalized) {
+      EXPECT_LT((dx_incremental - dx_fresh).norm(), 1e-12 * dx_fresh.norm()) << "step " << step;
+      EXPECT_LT((cov_incremental - cov_fresh).norm(), 1e-12 * cov_fresh.norm()) << "step " << step;
+    } else {
+      EXPECT_EQ(dx_incremental, dx_fresh) << "step " << step;
+      EXPECT_EQ(cov_incremental, cov_fresh) << "step " << step;
+    }
+    if (step == 11) {
+      // After the factorization the oldest pose moves and its factors are evaluated again (a Gauss-Newton trial point
+      // beyond the threshold): the prior that replaces them is not the Schur complement of the kept rows.
+      move(poses.front());
+      double cost = 0.0;
+      ASSERT_TRUE(incremental.LinearizeForCost(&cost));
+    }
+  }
+  EXPECT_GT(incremental.reused_blocks(), 40);
+}
+
 // Relinearization threshold (iSAM2's): a factor whose variables all moved by at most the threshold since its
 // linearization keeps its Jacobians (H is the same, bit for bit) and its whitened error is carried to first order,
 // r_lin + sum_i J_i (x_i [-] x_lin_i), which differs from a fresh evaluation by second order only. Once a variable has
