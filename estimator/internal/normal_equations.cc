@@ -809,8 +809,8 @@ template <int D>
 struct Band {
   template <int R, int C>
   using Block = Eigen::Map<Eigen::Matrix<double, R, C>, 0, Eigen::OuterStride<>>;
-  template <int R>
-  using Rows = Eigen::Map<Eigen::Matrix<double, R, Eigen::Dynamic>, 0, Eigen::OuterStride<>>;
+  template <int R, int M = Eigen::Dynamic>
+  using Rows = Eigen::Map<Eigen::Matrix<double, R, M>, 0, Eigen::OuterStride<>>;
   int blocks;
   const int* first_block;
   const int* offset;  // first scalar row of each block
@@ -834,10 +834,10 @@ struct Band {
     return Block<R, C>(u + start[b] + (offset[r] - offset[first_block[b]]), dims[r], dims[b],
                        Eigen::OuterStride<>(height(b)));
   }
-  // Rows of block k of x (column stride ldx, m columns).
-  template <int R>
-  Rows<R> rows(double* x, Eigen::Index ldx, Eigen::Index m, int k) const {
-    return Rows<R>(x + offset[k], dims[k], m, Eigen::OuterStride<>(ldx));
+  // Rows of block k of x (column stride ldx, m columns; M: m at compile time, or Dynamic).
+  template <int R, int M = Eigen::Dynamic>
+  Rows<R, M> rows(double* x, Eigen::Index ldx, Eigen::Index m, int k) const {
+    return Rows<R, M>(x + offset[k], dims[k], m, Eigen::OuterStride<>(ldx));
   }
 
   // Block Crout: U(r, b) = U(r, r)^-T (A(r, b) - sum_k U(k, r)^T U(k, b)) for r < b, over the row blocks k both
@@ -875,16 +875,18 @@ struct Band {
   }
   // x <- Ua^-T x over the band's rows of x, block by block (coefficient-wise products: a block is small, and x has
   // one column for a step, a few for a covariance, the border's for Ub).
-  // Rows of blocks from..blocks-1; the ones before hold their result already.
+  // Rows of blocks from..blocks-1; the ones before hold their result already. M: the column count m at compile time
+  // (a pose's covariance: 6), or Dynamic.
+  template <int M = Eigen::Dynamic>
   void Forward(double* x, Eigen::Index ldx, Eigen::Index m, int from = 0) const {
     for (int b = from; b < blocks; ++b) {
       Sized(b, [&](auto nb) {
         constexpr int B = decltype(nb)::value;
-        Rows<B> xb = rows<B>(x, ldx, m, b);
+        Rows<B, M> xb = rows<B, M>(x, ldx, m, b);
         for (int k = first_block[b]; k < b; ++k) {
           Sized(k, [&](auto nk) {
             constexpr int K = decltype(nk)::value;
-            xb.noalias() -= block<K, B>(k, b).transpose().lazyProduct(rows<K>(x, ldx, m, k));
+            xb.noalias() -= block<K, B>(k, b).transpose().lazyProduct(rows<K, M>(x, ldx, m, k));
           });
         }
         SolveUpperTransposed(block<B, B>(b, b), xb);
@@ -1072,10 +1074,23 @@ bool NormalEquations::Covariance(const std::vector<VariableId>& variables, Eigen
   }
   Eigen::MatrixXd X;
   if (natural_order_ && cols <= kMaxForwardCovarianceColumns) {
-    // H^-1 = U^-1 U^-T, so the covariance is Y^T Y with U^T Y = E: the forward substitution only.
-    ForwardEnvelope(E);
+    // H^-1 = U^-1 U^-T, so the covariance is Y^T Y with U^T Y = E: the forward substitution only. As
+    // ForwardEnvelope, with kernels for so few columns: a pose's six at compile time in the band, and the border's
+    // and the Gram matrix's products coefficient-wise (a blocked product packs the whole of Ub for six columns).
+    const int na = band_dimension_;
+    WithBand([&](const auto& band) {
+      if (cols == 6)
+        band.template Forward<6>(E.data(), E.outerStride(), cols);
+      else
+        band.Forward(E.data(), E.outerStride(), cols);
+    });
+    if (dimension_ > na) {
+      auto yc = E.bottomRows(dimension_ - na);
+      yc.noalias() -= border_.transpose().lazyProduct(E.topRows(na));
+      SolveUpperTransposed(corner_, yc);
+    }
     if (!E.allFinite()) return false;
-    *covariance = E.transpose() * E;
+    *covariance = E.transpose().lazyProduct(E);
     return true;
   }
   if (natural_order_) {
