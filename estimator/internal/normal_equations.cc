@@ -27,6 +27,10 @@ constexpr int kMaxBorder = 128;
 // product costs columns^2 x dimension, a back substitution columns x the factor's size).
 constexpr int kMaxForwardCovarianceColumns = 16;
 
+// Block patterns of H kept for a small system whose pattern comes back as it slides (NormalEquations::BuildPattern):
+// a window's instances of a parameter per 0.1 s repeat every ten poses.
+constexpr std::size_t kPatternCache = 16;
+
 // dst (A x B block of H's value array, column stride `stride`) += Ja^T Jb, Ja M x A, Jb M x B.
 template <int M, int A, int B>
 void AddProductFixed(const double* ja, const double* jb, double* dst, std::ptrdiff_t stride) {
@@ -407,9 +411,22 @@ void NormalEquations::BuildPattern() {
       column_length_[b] += dims_[r];
     }
   }
-  // The same block pattern as at the last call (a window that slid by one pose) keeps outer_ and H's pattern.
+  // The same block pattern as at the last call (a window that slid by one pose) keeps H's pattern. A window's
+  // pattern also changes as it slides (where a time-varying parameter's instance sits in the band) and comes back
+  // with that period: the last few patterns of a small system are kept with their H, and one that comes back is
+  // swapped in instead of built again (the same arrays as a new build).
   const bool same_blocks = H_.rows() == dimension_ && pattern_dims_ == dims_ && pattern_rows_of_ == rows_of_;
-  if (!same_blocks) {
+  const auto cached = same_blocks ? pattern_cache_.end()
+                                  : std::find_if(pattern_cache_.begin(), pattern_cache_.end(), [&](const auto& c) {
+                                      return c.dims == dims_ && c.rows_of == rows_of_;
+                                    });
+  if (cached != pattern_cache_.end()) {
+    // The cache entry takes the current pattern in exchange.
+    H_.swap(cached->H);
+    pattern_dims_.swap(cached->dims);
+    pattern_rows_of_.swap(cached->rows_of);
+    cholmod_->analyzed = false;
+  } else if (!same_blocks) {
     // Sized once, each block column's first scalar column written and copied to the others.
     std::size_t nonzeros = 0;
     for (int b = 0; b < nb; ++b) nonzeros += static_cast<std::size_t>(column_length_[b]) * dims_[b];
@@ -433,11 +450,24 @@ void NormalEquations::BuildPattern() {
                       std::equal(outer_.begin(), outer_.end(), H_.outerIndexPtr()) &&
                       std::equal(inner_.begin(), inner_.end(), H_.innerIndexPtr());
     if (!same) {
+      if (dimension_ <= kMaxSimplicialDimension && H_.rows() > 0) {
+        // The current pattern goes to the cache (in the place of the oldest entry once it is full).
+        if (pattern_cache_.size() < kPatternCache) {
+          pattern_cache_.push_back({});
+        } else {
+          std::rotate(pattern_cache_.begin(), pattern_cache_.begin() + 1, pattern_cache_.end());
+        }
+        PatternCacheEntry& entry = pattern_cache_.back();
+        entry.H.swap(H_);
+        entry.dims.swap(pattern_dims_);
+        entry.rows_of.swap(pattern_rows_of_);
+      }
       H_.resize(dimension_, dimension_);
       H_.resizeNonZeros(static_cast<Eigen::Index>(inner_.size()));
       std::copy(outer_.begin(), outer_.end(), H_.outerIndexPtr());
       std::copy(inner_.begin(), inner_.end(), H_.innerIndexPtr());
       cholmod_->analyzed = false;
+      ++patterns_built_;
     }
     pattern_dims_ = dims_;
     pattern_rows_of_ = rows_of_;
@@ -445,13 +475,14 @@ void NormalEquations::BuildPattern() {
 
   // Value index of block (r, b): start of column block_offset[b] plus the row offset of r in that column; later
   // columns of the block are found by adding j * column_length[b].
+  const int* outer = H_.outerIndexPtr();
   const auto value_index = [&](int r, int b) {
     // A column holding every row block up to the diagonal (a constant parameter's, in natural order) has r at r.
     const auto& rows = rows_of_[b];
     const std::ptrdiff_t position = static_cast<int>(rows.size()) == b + 1
                                         ? r
                                         : std::lower_bound(rows.begin(), rows.end(), r) - rows.begin();
-    return static_cast<std::ptrdiff_t>(outer_[block_offset_[b]]) + row_offset_[b][position];
+    return static_cast<std::ptrdiff_t>(outer[block_offset_[b]]) + row_offset_[b][position];
   };
   pair_begin_.assign(1, 0);
   pair_value_.clear();

@@ -92,6 +92,8 @@ class NormalEquations {
   const std::vector<FactorId>& factor_ids() const { return factor_ids_; }
   // How many Reset calls had to analyse a new pattern (the others kept the symbolic factorization).
   int analyses() const { return analyses_; }
+  // How many Reset calls built H's pattern anew (the others kept it, or took it from the few last ones).
+  int patterns_built() const { return patterns_built_; }
   // How many Reset calls kept the tables of the factors still in the graph (incremental).
   int incremental_resets() const { return incremental_resets_; }
 
@@ -174,9 +176,17 @@ class NormalEquations {
   std::vector<std::vector<int>> row_offset_;
   std::vector<int> column_length_;
   std::vector<int> outer_, inner_;
-  // The block pattern (dims_ and rows_of_) that outer_ and H's pattern were built for.
+  // The block pattern (dims_ and rows_of_) that H's pattern was built for, and the last few other patterns of a small
+  // system with their H (BuildPattern), oldest first.
   std::vector<int> pattern_dims_;
   std::vector<std::vector<int>> pattern_rows_of_;
+  struct PatternCacheEntry {
+    std::vector<int> dims;
+    std::vector<std::vector<int>> rows_of;
+    Eigen::SparseMatrix<double> H;
+  };
+  std::vector<PatternCacheEntry> pattern_cache_;
+  int patterns_built_ = 0;
 
   Eigen::SparseMatrix<double> H_;
   std::vector<std::ptrdiff_t> diagonal_index_;
