@@ -393,6 +393,7 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
     if (!taken[p]) std::swap(linearized_[fresh[i++]], prev_linearized_[p]);
   for (std::size_t k : fresh) linearized_[k].id = -1;
   g_.setZero(dimension_);
+  minus_memo_.assign(nb, MinusMemo());
   cholmod_->factored_undamped = false;
 }
 
@@ -676,7 +677,25 @@ bool NormalEquations::CarryToFirstOrder(std::size_t k) {
       if (std::memcmp(&l.lin_at[offset], values_[v0 + i], ambient * sizeof(double)) != 0) return false;
     } else {
       double* d = delta + tangent;
-      manifold.Minus(values_[v0 + i], &l.lin_at[offset], d);
+      const int block = var_block_[v0 + i];
+      if (manifold.kind() == ManifoldKind::kEuclidean || ambient > kMinusMemoAmbient) {
+        manifold.Minus(values_[v0 + i], &l.lin_at[offset], d);
+      } else {
+        // A pose's offset from the point its factors were linearized at recurs in each of them (a box-minus with a
+        // logarithm): the last one per block is kept, by the bytes of both points.
+        MinusMemo& memo = minus_memo_[block];
+        const std::size_t bytes = ambient * sizeof(double);
+        if (memo.ambient == ambient && std::memcmp(memo.value, values_[v0 + i], bytes) == 0 &&
+            std::memcmp(memo.from, &l.lin_at[offset], bytes) == 0) {
+          std::copy_n(memo.delta, manifold.tangent_dim(), d);
+        } else {
+          manifold.Minus(values_[v0 + i], &l.lin_at[offset], d);
+          memo.ambient = ambient;
+          std::memcpy(memo.value, values_[v0 + i], bytes);
+          std::memcpy(memo.from, &l.lin_at[offset], bytes);
+          std::copy_n(d, manifold.tangent_dim(), memo.delta);
+        }
+      }
       for (int j = 0; j < manifold.tangent_dim(); ++j)
         if (!(std::abs(d[j]) <= relinearize_threshold_)) return false;
       tangent += manifold.tangent_dim();

@@ -153,6 +153,15 @@ class NormalEquations {
   bool CarryToFirstOrder(std::size_t k);
   double relinearize_threshold_ = 0.0;
   std::vector<double> carry_delta_;  // CarryToFirstOrder: the tangent offsets
+  // CarryToFirstOrder: per block, the last box-minus of a pose or rotation (x [-] from) and its two points.
+  static constexpr int kMinusMemoAmbient = 7;
+  struct MinusMemo {
+    int ambient = 0;  // 0: none
+    double value[kMinusMemoAmbient];
+    double from[kMinusMemoAmbient];
+    double delta[kMinusMemoAmbient];
+  };
+  std::vector<MinusMemo> minus_memo_;
   long evaluations_ = 0;
   long carries_ = 0;
 

@@ -592,6 +592,56 @@ TEST(NormalEquationsTest, RelinearizationThresholdCarriesTheErrorToFirstOrderAnd
   EXPECT_EQ(fresh.carries(), 0);
 }
 
+// Two factors on one pose, linearized at different points of it (the second one evaluated again after its other pose
+// moved beyond the threshold): carried to the same values, each takes the pose's offset from its own point (the
+// box-minus of a pose is kept per block for the factors that share both points).
+TEST(NormalEquationsTest, CarriesOfFactorsLinearizedAtDifferentPointsOfAPoseUseTheirOwnPoint) {
+  std::mt19937 rng(31);
+  Graph graph;
+  const VariableId p = graph.AddVariable(
+      {"pose", Manifold::Pose(), testing::RandomPoint(Manifold::Pose(), &rng, 5.0), false, Time::FromSeconds(0)});
+  const VariableId q = graph.AddVariable(
+      {"pose", Manifold::Pose(), testing::RandomPoint(Manifold::Pose(), &rng, 5.0), false, Time::FromSeconds(1)});
+  TieWithRandomPrior({p}, &rng, &graph);
+  TieWithRandomPrior({p, q}, &rng, &graph);
+  const double threshold = 1e-2;
+  internal::NormalEquations system(graph, FreeVariableOrder(graph));
+  system.set_relinearize_threshold(threshold);
+  const auto move = [&](VariableId id, double by) {
+    Variable& v = graph.mutable_variable(id);
+    Eigen::VectorXd d(6);
+    d << by, -by, 0.5 * by, -0.7 * by, by, 0.3 * by;
+    v.manifold.Plus(v.value.data(), d.data(), v.value.data());
+  };
+  const std::vector<FactorId> ids = system.factor_ids();
+  ASSERT_EQ(ids.size(), 2u);
+  ASSERT_TRUE(system.Linearize(graph));
+  const internal::WhitenedFactor prior_lin = *system.LinearizationAt(ids[0], 1);
+  const Eigen::VectorXd p0 = graph.variable(p).value;
+  // p within the threshold, q beyond it: the prior on p is carried from p0, the tie evaluated again at p1.
+  move(p, 0.3 * threshold);
+  move(q, 3.0 * threshold);
+  ASSERT_TRUE(system.Linearize(graph));
+  EXPECT_EQ(system.evaluations(), 3);
+  const internal::WhitenedFactor tie_lin = *system.LinearizationAt(ids[1], 3);
+  const Eigen::VectorXd p1 = graph.variable(p).value, q1 = graph.variable(q).value;
+  // Both within the threshold of their points: both carried to p2.
+  move(p, 0.3 * threshold);
+  move(q, 0.1 * threshold);
+  ASSERT_TRUE(system.Linearize(graph));
+  EXPECT_EQ(system.evaluations(), 3);
+  const auto minus = [&](VariableId id, const Eigen::VectorXd& from) {
+    Eigen::VectorXd d(6);
+    Manifold::Pose().Minus(graph.variable(id).value.data(), from.data(), d.data());
+    return d;
+  };
+  const Eigen::VectorXd prior_expected = prior_lin.residual + prior_lin.jacobians[0] * minus(p, p0);
+  const Eigen::VectorXd tie_expected =
+      tie_lin.residual + tie_lin.jacobians[0] * minus(p, p1) + tie_lin.jacobians[1] * minus(q, q1);
+  EXPECT_LT((system.LinearizationAt(ids[0], 1)->residual - prior_expected).norm(), 1e-12 * prior_expected.norm());
+  EXPECT_LT((system.LinearizationAt(ids[1], 3)->residual - tie_expected).norm(), 1e-12 * tie_expected.norm());
+}
+
 TEST(SolverTest, RelinearizationThresholdNeedsGaussNewton) {
   SolverOptions options;
   options.relinearize_threshold = 0.01;
