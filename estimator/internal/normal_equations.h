@@ -5,7 +5,8 @@
 // (a tracking window: a band with a dense border) are factored in their envelope instead (see Reset).
 //
 // An object can be Reset to a changed graph and keeps its buffers; when the new pattern is the same as the old one
-// (a fixed-lag window that slid by one pose has the same band), the symbolic analysis is kept too. A Reset after which
+// (a fixed-lag window that slid by one pose has the same band), the symbolic analysis is kept too, and a small
+// system's last few patterns are kept so that one which comes back is not built again. A Reset after which
 // the graph's factors and variables changed only by some leaving and new ones coming is incremental: the factors
 // still in it keep their tables (their variables' values and blocks), only new ones are looked up; the result is the
 // same as from scratch. Under a relinearization threshold the envelope factorization is incremental too: the leading
