@@ -172,10 +172,16 @@ std::map<std::string, double> ComponentLevels(const std::vector<estimator::Measu
   return out;
 }
 
+double LevelQuantile(double p, double expected_chi2_per_dof, int count) {
+  const double expected = std::max(expected_chi2_per_dof, 1e-6);
+  const double dof = std::max(1.0, count * std::min(1.0, expected));
+  return expected * count * ChiSquareQuantile(p, dof) / dof;
+}
+
 bool Inconsistent(const ComponentLevel& level, double expected_chi2_per_dof, double ratio) {
   if (level.count <= 0) return false;
   const double expected = std::max(expected_chi2_per_dof, 1e-6);
-  const double upper = expected * ChiSquareQuantile(kQuantile, level.count) / level.count;
+  const double upper = LevelQuantile(kQuantile, expected, level.count) / level.count;
   return level.chi2_per_dof > std::max(upper, ratio * expected);
 }
 
@@ -233,7 +239,7 @@ std::vector<LocatedComponent> Locate(const std::vector<estimator::MeasurementRes
         for (std::size_t i = lo; i < s.t.size() && s.t[i].seconds() < w1; ++i, ++count) sum += s.r[i] * s.r[i];
         if (count < 5) continue;
         const double threshold =
-            std::max(lc.expected_chi2_per_dof * ChiSquareQuantile(window_quantile, count),
+            std::max(LevelQuantile(window_quantile, lc.expected_chi2_per_dof, count),
                      options.inconsistency_ratio * lc.expected_chi2_per_dof * count);
         if (sum <= threshold) continue;
         if (!lc.intervals.empty() && lc.intervals.back().second >= w0)

@@ -114,5 +114,26 @@ TEST(LocateTest, SystematicRmsAveragesWhiteNoiseOutAndKeepsABias) {
   EXPECT_NEAR(b.rms_1s, std::sqrt(0.11 / 2.0), 0.235 * 0.1);
 }
 
+// A component whose level is far below 1 (the fit absorbs most of the noise, as the poses absorb the IMU's) spreads
+// as the few dimensions of noise the fit leaves: at level 0.03 over 2900 residuals, with the projection's eigenvalues 0
+// or 1, its chi-square is chi2(87), whose 99.9 % quantile is 1.54 times its mean (chi2(2900) scaled: 1.08).
+TEST(LocateTest, ALevelBelowOneSpreadsAsTheNoiseTheFitLeaves) {
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> n(0.0, 1.0);
+  int flagged = 0;
+  for (int r = 0; r < 400; ++r) {
+    double chi2 = 0.0;
+    for (int i = 0; i < 87; ++i) chi2 += std::pow(n(rng), 2);
+    flagged += Inconsistent({chi2 / 2900.0, 2900}, 0.03, 1.3) ? 1 : 0;
+  }
+  EXPECT_LE(flagged, 3);   // 0.4 expected of 400
+  EXPECT_FALSE(Inconsistent({0.0435, 2900}, 0.03, 1.3));
+  EXPECT_TRUE(Inconsistent({0.06, 2900}, 0.03, 1.3));
+  // At level 1 and above: the level times chi2(count), as before.
+  EXPECT_TRUE(Inconsistent({1.2, 2900}, 1.0, 1.1));
+  EXPECT_FALSE(Inconsistent({1.07, 2900}, 1.0, 1.0));
+  EXPECT_TRUE(Inconsistent({2.2, 2900}, 2.0, 1.0));
+}
+
 }  // namespace
 }  // namespace roamlab::gap
