@@ -40,7 +40,11 @@ class NormalEquations {
   void Reset(const Graph& graph, std::vector<VariableId> order);
 
   // Evaluates every included factor at the graph's current values; fills H, g and the per-factor whitening.
-  // Returns false if some factor could not be linearized (its stream is named in *failed_stream).
+  // Returns false if some factor could not be linearized (its stream is named in *failed_stream). Under a
+  // relinearization threshold, the blocks of H that the next undamped factorization takes over from the kept one
+  // (FactorEnvelope) are left out: it does not read them. They are added from the factors' kept J^T J products when
+  // something needs the whole of H (hessian_upper, a damped Solve), which must then come before a factor is evaluated
+  // again (LinearizeForCost).
   bool Linearize(const Graph& graph, std::string* failed_stream = nullptr);
 
   // Cost at the graph's current values with the whitening of the last Linearize (so that a trial step is judged on
@@ -74,6 +78,11 @@ class NormalEquations {
   // Solves (H + lambda diag(H)) dx = -g. Returns false if the matrix is not positive definite.
   bool Solve(double lambda, Eigen::VectorXd* dx);
 
+  // The decrease of the quadratic model of the last Linearize along dx, -g.dx - dx.H.dx / 2. When H lacks the blocks
+  // that the factorization took over (Linearize), dx must be the step of the last Solve, which was undamped: then
+  // H dx = -g (to the solve's rounding) and the decrease is -g.dx / 2.
+  double ModelDecrease(const Eigen::VectorXd& dx) const;
+
   // Marginal covariance of the listed free variables (their tangent blocks, in order) from H of the last Linearize:
   // solves H X = E for their columns, reusing the last factorization when it was undamped. Returns false when H is
   // not positive definite.
@@ -85,8 +94,8 @@ class NormalEquations {
   int dimension() const { return dimension_; }
   double cost() const { return cost_; }
   const Eigen::VectorXd& gradient() const { return g_; }
-  // Upper triangle of H.
-  const Eigen::SparseMatrix<double>& hessian_upper() const { return H_; }
+  // Upper triangle of H (the blocks Linearize left out are added first).
+  const Eigen::SparseMatrix<double>& hessian_upper();
   const std::vector<VariableId>& order() const { return order_; }
   // Column offset of a free variable, or -1.
   int OffsetOf(VariableId id) const;
@@ -102,6 +111,8 @@ class NormalEquations {
   // Block column of a free variable, or -1.
   int BlockOf(VariableId id) const;
   void BuildPattern();
+  // The symbolic analysis of a new pattern: a natural-order system's band and border layout, or CHOLMOD's.
+  void Analyze();
 
   std::vector<VariableId> order_;
   std::vector<std::pair<VariableId, int>> block_of_id_;  // sorted by id
@@ -148,6 +159,11 @@ class NormalEquations {
   std::vector<bool> taken_scratch_;          // Reset: which of prev_linearized_ found their factor
   std::vector<std::size_t> fresh_scratch_;   // Reset: factors new since the last Reset
   bool Current(std::size_t k) const;  // linearized_[k] holds factor k at the current values
+  // Adds factor k's kept J_a^T J_b into the blocks of H that Linearize sums (`left_out` false) or into those it left
+  // out (true); computes the products first when they are not kept yet.
+  void AddKeptProducts(std::size_t k, bool left_out);
+  // Adds the blocks Linearize left out (see left_out_blocks_).
+  void CompleteHessian();
   bool LinearizeAndRecord(std::size_t k, double* previous_cost);
   // Carries factor k's kept linearization to the current values to first order when the relinearization threshold
   // allows it (see set_relinearize_threshold); false when it must be evaluated again.
@@ -199,6 +215,13 @@ class NormalEquations {
   int patterns_built_ = 0;
 
   Eigen::SparseMatrix<double> H_;
+  // With a kept factorization whose leading left_out_blocks_ band columns the next one takes over, H lacks the
+  // blocks (r, c), r <= c, with r < left_out_blocks_ and c either before it or in the border (until CompleteHessian);
+  // those values are stale. left_out_evaluations_: evaluations_ when Linearize left them out (the products it would
+  // add are those of the factors' current Jacobians only until one is evaluated again).
+  int left_out_blocks_ = 0;
+  long left_out_evaluations_ = 0;
+  bool undamped_step_ = false;  // the last Solve since Linearize was undamped and succeeded
   std::vector<std::ptrdiff_t> diagonal_index_;
   Eigen::VectorXd g_;
   double cost_ = 0.0;

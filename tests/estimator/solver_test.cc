@@ -506,6 +506,108 @@ TEST(NormalEquationsTest, IncrementalFactorizationOfASlidingWindowMatchesAFreshO
   EXPECT_GT(incremental.reused_blocks(), 40);
 }
 
+// Under a relinearization threshold Linearize leaves out the blocks of H that the kept factorization takes over. A
+// window that slides (with a border parameter, an instance per two poses and a pose moved beyond the threshold) is
+// solved by two objects with the same history: one completes H after every Linearize (hessian_upper), the other does
+// not. Their steps must be the same bit for bit (the factorization reads only blocks that were summed), H completed
+// after the solve the same as the other's bit for bit, a damped solve after a fresh Linearize the same (it completes H
+// first), and the model decrease from -g.dx / 2 that from H to rounding. Reading H once a factor was evaluated again
+// since (a trial point beyond the threshold) is refused.
+TEST(NormalEquationsTest, LinearizationWithoutTheTakenOverBlocksSolvesLikeAComplete) {
+  std::mt19937 rng(31);
+  Graph graph;
+  const VariableId lever =
+      graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d(0.1, 0.2, 0.3), false, std::nullopt});
+  struct Node {
+    VariableId pose;
+    VariableId instance;
+  };
+  std::deque<Node> nodes;
+  int stamp = 0;
+  const auto tie = [&](const std::vector<VariableId>& ids) { TieWithRandomPrior(ids, &rng, &graph); };
+  const auto add_pose = [&] {
+    const Time t = Time::FromSeconds(static_cast<double>(stamp));
+    const VariableId pose =
+        graph.AddVariable({"pose", Manifold::Pose(), testing::RandomPoint(Manifold::Pose(), &rng, 5.0), false, t});
+    VariableId instance = nodes.empty() ? -1 : nodes.back().instance;
+    if (stamp % 2 == 0) {
+      instance = graph.AddVariable({"drift", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), false, t});
+      if (!nodes.empty()) tie({nodes.back().instance, instance});
+    }
+    ++stamp;
+    tie({pose, instance, lever});
+    if (!nodes.empty()) tie({nodes.back().pose, pose, lever});
+    nodes.push_back({pose, instance});
+  };
+  for (int k = 0; k < 10; ++k) add_pose();
+  const double threshold = 1e-3;
+
+  internal::NormalEquations partial, complete;
+  int steps_with_reuse = 0;
+  partial.set_relinearize_threshold(threshold);
+  complete.set_relinearize_threshold(threshold);
+  for (int step = 0; step < 12; ++step) {
+    if (step > 0) {
+      std::vector<VariableId> leaving = {nodes.front().pose};
+      if (nodes[1].instance != nodes.front().instance) leaving.push_back(nodes.front().instance);
+      ASSERT_TRUE(Marginalize(leaving, &graph));
+      nodes.pop_front();
+      add_pose();
+    }
+    if (step == 6) {  // beyond the threshold: its factors are evaluated again
+      Variable& v = graph.mutable_variable(nodes[5].pose);
+      const Eigen::VectorXd d = Eigen::VectorXd::Constant(6, 10.0 * threshold);
+      v.manifold.Plus(v.value.data(), d.data(), v.value.data());
+    }
+    const long reused_before = partial.reused_blocks();
+    partial.Reset(graph, FreeVariableOrder(graph));
+    complete.Reset(graph, FreeVariableOrder(graph));
+    ASSERT_TRUE(partial.Linearize(graph));
+    ASSERT_TRUE(complete.Linearize(graph));
+    complete.hessian_upper();
+    Eigen::VectorXd dx_partial, dx_complete;
+    ASSERT_TRUE(partial.Solve(0.0, &dx_partial));
+    ASSERT_TRUE(complete.Solve(0.0, &dx_complete));
+    if (partial.reused_blocks() > reused_before) ++steps_with_reuse;
+    EXPECT_EQ(partial.reused_blocks(), complete.reused_blocks()) << "step " << step;
+    EXPECT_EQ(dx_partial, dx_complete) << "step " << step;
+    // -g.dx - dx.H.dx / 2 and -g.dx / 2 differ by dx.(H dx + g) / 2: the solve's residual (the kept rows are the
+    // factor of the exact Schur complement, the prior in H is that complement to rounding).
+    const double decrease = complete.ModelDecrease(dx_complete);
+    const Eigen::VectorXd residual =
+        complete.hessian_upper().selfadjointView<Eigen::Upper>() * dx_complete + complete.gradient();
+    EXPECT_NEAR(partial.ModelDecrease(dx_partial), decrease,
+                0.5 * dx_complete.norm() * residual.norm() + 1e-12 * std::abs(decrease))
+        << "step " << step;
+    const Eigen::SparseMatrix<double>& a = partial.hessian_upper();
+    const Eigen::SparseMatrix<double>& b = complete.hessian_upper();
+    ASSERT_EQ(a.nonZeros(), b.nonZeros()) << "step " << step;
+    EXPECT_TRUE(std::equal(a.valuePtr(), a.valuePtr() + a.nonZeros(), b.valuePtr())) << "step " << step;
+    // Both take the step, as a Gauss-Newton iteration would (within the threshold: the factors are carried).
+    partial.Update(dx_partial.normalized() * 0.1 * threshold, &graph);
+    ASSERT_TRUE(partial.Linearize(graph));
+    ASSERT_TRUE(complete.Linearize(graph));
+    if (step % 3 == 1) {
+      ASSERT_TRUE(partial.Solve(0.3, &dx_partial));
+      ASSERT_TRUE(complete.Solve(0.3, &dx_complete));
+      EXPECT_EQ(dx_partial, dx_complete) << "step " << step;
+    } else {
+      ASSERT_TRUE(partial.Solve(0.0, &dx_partial));
+      ASSERT_TRUE(complete.Solve(0.0, &dx_complete));
+      EXPECT_EQ(dx_partial, dx_complete) << "step " << step;
+    }
+  }
+  EXPECT_GE(steps_with_reuse, 6);
+  EXPECT_DEATH(
+      {
+        partial.Update(Eigen::VectorXd::Constant(partial.dimension(), 10.0 * threshold), &graph);
+        double cost = 0.0;
+        partial.LinearizeForCost(&cost);
+        partial.hessian_upper();
+      },
+      "evaluated again");
+}
+
 // Relinearization threshold (iSAM2's): a factor whose variables all moved by at most the threshold since its
 // linearization keeps its Jacobians (H is the same, bit for bit) and its whitened error is carried to first order,
 // r_lin + sum_i J_i (x_i [-] x_lin_i), which differs from a fresh evaluation by second order only. Once a variable has
