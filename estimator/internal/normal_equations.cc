@@ -488,18 +488,20 @@ void NormalEquations::BuildPattern() {
     return static_cast<std::ptrdiff_t>(outer[block_offset_[b]]) + row_offset_[b][position];
   };
   pair_begin_.assign(1, 0);
-  pair_value_.clear();
+  pairs_.clear();
   int free[64];
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
     const int* block = &var_block_[var_begin_[k]];
     const int nf = FreePositions(block, var_begin_[k + 1] - var_begin_[k], free);
-    for (int i = 0; i < nf; ++i) {
-      for (int j = 0; j < nf; ++j) {
-        const int r = block[free[i]], b = block[free[j]];
-        if (r <= b) pair_value_.push_back(value_index(r, b));
+    for (int i = 0, product = 0; i < nf; ++i) {
+      for (int j = i; j < nf; ++j) {
+        const int a = block[free[i]], b = block[free[j]];
+        ROAMLAB_CHECK(i == j || a != b, "factor from '" << entries_[k]->stream << "' takes a variable twice");
+        pairs_.push_back({value_index(std::min(a, b), std::max(a, b)), std::min(a, b), std::max(a, b), product, a > b});
+        product += dims_[a] * dims_[b];
       }
     }
-    pair_begin_.push_back(static_cast<int>(pair_value_.size()));
+    pair_begin_.push_back(static_cast<int>(pairs_.size()));
   }
   diagonal_index_.resize(dimension_);
   for (int b = 0; b < nb; ++b) {
@@ -551,13 +553,11 @@ __attribute__((flatten)) bool NormalEquations::Linearize(const Graph& /*graph*/,
     const WhitenedFactor& wf = linearized_[k].whitened;
     const int* block = &var_block_[var_begin_[k]];
     const int nf = FreePositions(block, var_begin_[k + 1] - var_begin_[k], free);
-    int pair = pair_begin_[k];
+    const PairSlot* pair = &pairs_[pair_begin_[k]];
     for (int i = 0; i < nf; ++i) {
-      const int a = free[i];
-      for (int j = 0; j < nf; ++j) {
-        const int b = free[j];
-        if (block[a] > block[b]) continue;
-        AddProduct(wf.jacobians[a], wf.jacobians[b], values + pair_value_[pair++], column_length_[block[b]]);
+      for (int j = i; j < nf; ++j, ++pair) {
+        const int a = pair->transposed ? free[j] : free[i], b = pair->transposed ? free[i] : free[j];
+        AddProduct(wf.jacobians[a], wf.jacobians[b], values + pair->value, column_length_[pair->column]);
       }
     }
   }
@@ -567,48 +567,35 @@ __attribute__((flatten)) bool NormalEquations::Linearize(const Graph& /*graph*/,
 __attribute__((flatten)) void NormalEquations::AddKeptProducts(std::size_t k, bool left_out) {
   // The products J_a^T J_b of a linearization whose Jacobians are kept (relinearization threshold) are kept with it:
   // a carried factor only adds them again. Kept per pair of free positions i <= j (the block order of two variables
-  // may change between Resets: then the transpose is added).
+  // may change between Resets: then the transpose is added; BuildPattern's pairs_ say where each goes).
   FactorLinearization& l = linearized_[k];
-  const WhitenedFactor& wf = l.whitened;
-  const int* block = &var_block_[var_begin_[k]];
-  int free[64];
-  const int nf = FreePositions(block, var_begin_[k + 1] - var_begin_[k], free);
-  int offset[64 * 64 / 2 + 64];
-  std::ptrdiff_t size = 0;
-  for (int i = 0, p = 0; i < nf; ++i)
-    for (int j = i; j < nf; ++j, ++p) {
-      offset[p] = static_cast<int>(size);
-      size += wf.jacobians[free[i]].cols() * wf.jacobians[free[j]].cols();
-    }
   if (!l.products_valid) {
+    const WhitenedFactor& wf = l.whitened;
+    const int* block = &var_block_[var_begin_[k]];
+    int free[64];
+    const int nf = FreePositions(block, var_begin_[k + 1] - var_begin_[k], free);
+    std::ptrdiff_t size = 0;
+    for (int i = 0; i < nf; ++i)
+      for (int j = i; j < nf; ++j) size += wf.jacobians[free[i]].cols() * wf.jacobians[free[j]].cols();
     l.products.resize(size);
-    for (int i = 0, p = 0; i < nf; ++i)
-      for (int j = i; j < nf; ++j, ++p) {
+    double* product = l.products.data();
+    for (int i = 0; i < nf; ++i)
+      for (int j = i; j < nf; ++j) {
         const Eigen::MatrixXd& ja = wf.jacobians[free[i]];
         const Eigen::MatrixXd& jb = wf.jacobians[free[j]];
-        std::fill_n(l.products.data() + offset[p], ja.cols() * jb.cols(), 0.0);
-        AddProduct(ja, jb, l.products.data() + offset[p], ja.cols());
+        std::fill_n(product, ja.cols() * jb.cols(), 0.0);
+        AddProduct(ja, jb, product, ja.cols());
+        product += ja.cols() * jb.cols();
       }
     l.products_valid = true;
   }
-  const auto index = [nf](int i, int j) { return i * nf - i * (i - 1) / 2 + (j - i); };  // i <= j
   double* values = H_.valuePtr();
   const int first_summed = left_out_blocks_;
-  int pair = pair_begin_[k];
-  for (int i = 0; i < nf; ++i) {
-    const int a = free[i];
-    for (int j = 0; j < nf; ++j) {
-      const int b = free[j];
-      const int r = block[a], c = block[b];
-      if (r > c) continue;
-      double* dst = values + pair_value_[pair++];
-      if ((r < first_summed && (c < first_summed || c >= band_blocks_)) != left_out) continue;
-      const int rows = static_cast<int>(wf.jacobians[a].cols()), cols = static_cast<int>(wf.jacobians[b].cols());
-      if (i <= j)
-        AddBlock(l.products.data() + offset[index(i, j)], rows, cols, false, dst, column_length_[c]);
-      else
-        AddBlock(l.products.data() + offset[index(j, i)], rows, cols, true, dst, column_length_[c]);
-    }
+  for (int p = pair_begin_[k]; p < pair_begin_[k + 1]; ++p) {
+    const PairSlot& pair = pairs_[p];
+    if ((pair.row < first_summed && (pair.column < first_summed || pair.column >= band_blocks_)) != left_out) continue;
+    AddBlock(l.products.data() + pair.product, dims_[pair.row], dims_[pair.column], pair.transposed,
+             values + pair.value, column_length_[pair.column]);
   }
 }
 

@@ -129,7 +129,9 @@ class NormalEquations {
 
   // Included factors, and per factor k the range [var_begin_[k], var_begin_[k + 1]) of its variables in var_block_
   // (block column or -1 when held constant) and values_ (the variables' ambient values), and the range
-  // [pair_begin_[k], pair_begin_[k + 1]) of its (a <= b) free pairs in pair_value_ (value index of the block in H).
+  // [pair_begin_[k], pair_begin_[k + 1]) of its pairs of free positions i <= j (i outer) in pairs_: the block of H
+  // that J_i^T J_j goes to, or its transpose when i's block comes after j's. (Each block of H receives at most one
+  // product per factor, so the order of a factor's pairs does not change the sums.)
   std::vector<FactorId> factor_ids_;
   std::vector<const FactorEntry*> entries_;
   std::vector<std::uint64_t> want_;
@@ -137,7 +139,13 @@ class NormalEquations {
   std::vector<int> var_block_;
   std::vector<const double*> values_;
   std::vector<int> pair_begin_;
-  std::vector<std::ptrdiff_t> pair_value_;
+  struct PairSlot {
+    std::ptrdiff_t value;  // index of the block in H's value array
+    int row, column;       // its blocks, row <= column
+    int product;           // offset of the kept product J_i^T J_j (FactorLinearization::products)
+    bool transposed;       // the block is J_j^T J_i (i's block comes after j's)
+  };
+  std::vector<PairSlot> pairs_;
   // Per included factor, its last linearization and the point it was computed at: Linearize evaluates a factor again
   // only when its variables' values (bit for bit), its entry or its Jacobians' mask changed since.
   struct FactorLinearization {
@@ -150,7 +158,8 @@ class NormalEquations {
     // there; `at` and whitened.residual differ from them after a first-order carry (CarryToFirstOrder).
     std::vector<double> lin_at;
     Eigen::VectorXd lin_residual;
-    // With a relinearization threshold: the J_i^T J_j of the Jacobians, per pair of free positions i <= j.
+    // With a relinearization threshold: the J_i^T J_j of the Jacobians, per pair of free positions i <= j in order
+    // (i outer), each column-major.
     std::vector<double> products;
     bool products_valid = false;
   };
