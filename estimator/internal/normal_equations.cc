@@ -496,8 +496,10 @@ void NormalEquations::BuildPattern() {
     for (int i = 0, product = 0; i < nf; ++i) {
       for (int j = i; j < nf; ++j) {
         const int a = block[free[i]], b = block[free[j]];
-        ROAMLAB_CHECK(i == j || a != b, "factor from '" << entries_[k]->stream << "' takes a variable twice");
-        pairs_.push_back({value_index(std::min(a, b), std::max(a, b)), std::min(a, b), std::max(a, b), product, a > b});
+        const std::ptrdiff_t value = value_index(std::min(a, b), std::max(a, b));
+        if (a <= b) pairs_.push_back({value, a, b, free[i], free[j], product, false});
+        // (A variable the factor takes twice gets both products in its diagonal block.)
+        if (a > b || (a == b && i != j)) pairs_.push_back({value, b, a, free[j], free[i], product, true});
         product += dims_[a] * dims_[b];
       }
     }
@@ -548,17 +550,12 @@ __attribute__((flatten)) bool NormalEquations::Linearize(const Graph& /*graph*/,
     return true;
   }
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
-    // J_a^T J_b into the (a <= b) blocks, which sit in H's value array with the column length of their block column
-    // as outer stride.
+    // J_a^T J_b into the blocks of the upper triangle, which sit in H's value array with the column length of their
+    // block column as outer stride.
     const WhitenedFactor& wf = linearized_[k].whitened;
-    const int* block = &var_block_[var_begin_[k]];
-    const int nf = FreePositions(block, var_begin_[k + 1] - var_begin_[k], free);
-    const PairSlot* pair = &pairs_[pair_begin_[k]];
-    for (int i = 0; i < nf; ++i) {
-      for (int j = i; j < nf; ++j, ++pair) {
-        const int a = pair->transposed ? free[j] : free[i], b = pair->transposed ? free[i] : free[j];
-        AddProduct(wf.jacobians[a], wf.jacobians[b], values + pair->value, column_length_[pair->column]);
-      }
+    for (int p = pair_begin_[k]; p < pair_begin_[k + 1]; ++p) {
+      const PairSlot& pair = pairs_[p];
+      AddProduct(wf.jacobians[pair.a], wf.jacobians[pair.b], values + pair.value, column_length_[pair.column]);
     }
   }
   return true;

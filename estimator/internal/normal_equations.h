@@ -130,8 +130,9 @@ class NormalEquations {
   // Included factors, and per factor k the range [var_begin_[k], var_begin_[k + 1]) of its variables in var_block_
   // (block column or -1 when held constant) and values_ (the variables' ambient values), and the range
   // [pair_begin_[k], pair_begin_[k + 1]) of its pairs of free positions i <= j (i outer) in pairs_: the block of H
-  // that J_i^T J_j goes to, or its transpose when i's block comes after j's. (Each block of H receives at most one
-  // product per factor, so the order of a factor's pairs does not change the sums.)
+  // that J_i^T J_j goes to, or its transpose when i's block comes after j's. (A block of H receives one product per
+  // factor, so the order of a factor's pairs does not change the sums; a variable the factor takes twice, at i and
+  // j, receives J_i^T J_j and then J_j^T J_i in its diagonal block, between J_i^T J_i and J_j^T J_j, as before.)
   std::vector<FactorId> factor_ids_;
   std::vector<const FactorEntry*> entries_;
   std::vector<std::uint64_t> want_;
@@ -142,8 +143,9 @@ class NormalEquations {
   struct PairSlot {
     std::ptrdiff_t value;  // index of the block in H's value array
     int row, column;       // its blocks, row <= column
-    int product;           // offset of the kept product J_i^T J_j (FactorLinearization::products)
-    bool transposed;       // the block is J_j^T J_i (i's block comes after j's)
+    int a, b;              // the factor's variables (positions) whose J_a^T J_b the block receives
+    int product;           // offset of the kept product J_i^T J_j, i <= j (FactorLinearization::products)
+    bool transposed;       // the block receives that product's transpose
   };
   std::vector<PairSlot> pairs_;
   // Per included factor, its last linearization and the point it was computed at: Linearize evaluates a factor again
