@@ -107,6 +107,10 @@ const internal::WhitenedFactor* SolverWorkspace::Linearization(FactorId id, std:
   return system_->LinearizationAt(id, want_mask);
 }
 
+const std::vector<double>* SolverWorkspace::Products(FactorId id, std::uint64_t want_mask) const {
+  return system_->KeptProductsAt(id, want_mask);
+}
+
 SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceRequest* covariance,
                     SolverWorkspace* workspace) {
   using Clock = std::chrono::steady_clock;

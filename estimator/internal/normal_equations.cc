@@ -750,6 +750,13 @@ bool NormalEquations::CarryToFirstOrder(std::size_t k) {
   return true;
 }
 
+const std::vector<double>* NormalEquations::KeptProductsAt(FactorId id, std::uint64_t want_mask) const {
+  if (LinearizationAt(id, want_mask) == nullptr) return nullptr;
+  const FactorLinearization& l = linearized_[std::lower_bound(factor_ids_.begin(), factor_ids_.end(), id) -
+                                             factor_ids_.begin()];
+  return l.products_valid ? &l.products : nullptr;
+}
+
 const WhitenedFactor* NormalEquations::LinearizationAt(FactorId id, std::uint64_t want_mask) const {
   const auto it = std::lower_bound(factor_ids_.begin(), factor_ids_.end(), id);
   if (it == factor_ids_.end() || *it != id) return nullptr;

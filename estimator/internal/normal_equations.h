@@ -61,6 +61,10 @@ class NormalEquations {
   // exactly the variables in want_mask (bit i: variable i), otherwise null. The factor must still be in the graph.
   // With a relinearization threshold its error may be carried to these values to first order (below).
   const WhitenedFactor* LinearizationAt(FactorId id, std::uint64_t want_mask) const;
+  // The J_i^T J_j products of that linearization's Jacobians when they are kept (relinearization threshold, computed
+  // by Linearize since the factor was last evaluated), otherwise null: per pair of its free positions i <= j in order
+  // (i outer), each column-major.
+  const std::vector<double>* KeptProductsAt(FactorId id, std::uint64_t want_mask) const;
 
   // Relinearization threshold (iSAM2's): when > 0, Linearize and LinearizeForCost do not evaluate again a factor with
   // a trivial loss whose free variables all moved by at most this much (every tangent component of x [-] x_lin) since

@@ -923,5 +923,71 @@ TEST(MarginalizationTest, PriorHoldsTheSchurComplementAlsoWhenRankDeficient) {
   }
 }
 
+// Marginalize after a Gauss-Newton solve under a relinearization threshold adds the solve's kept J_a^T J_b products
+// instead of computing them again (one factor takes its variables in the opposite order to the blanket's: its
+// products go in transposed). The prior must hold the Schur complement of the information of those Jacobians.
+TEST(MarginalizationTest, PriorFromTheSolvesKeptProductsHoldsTheSchurComplement) {
+  std::mt19937 rng(37);
+  Graph graph;
+  const VariableId lever =
+      graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d(0.1, 0.2, 0.3), false, std::nullopt});
+  std::vector<VariableId> x;
+  for (int k = 0; k < 4; ++k)
+    x.push_back(graph.AddVariable({"x", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), false, Time::FromSeconds(k)}));
+  const auto tie = [&](const std::vector<VariableId>& ids) { TieWithRandomPrior(ids, &rng, &graph); };
+  tie({x[0]});
+  tie({x[1], x[0], lever});
+  tie({x[0], x[2]});
+  for (int k = 1; k < 4; ++k) tie({x[k]});
+  tie({x[2], x[3], lever});
+  SolverOptions options;
+  options.method = SolverOptions::Method::kGaussNewton;
+  options.relinearize_threshold = 1e-3;
+  SolverWorkspace workspace;
+  // The first solve's trial point is evaluated again (it moved beyond the threshold); the second keeps the products of
+  // its linearization (its step is within the threshold: carried).
+  ASSERT_TRUE(Solve(options, &graph, nullptr, &workspace).usable());
+  ASSERT_TRUE(Solve(options, &graph, nullptr, &workspace).usable());
+
+  // Expected: the information of the kept Jacobians over [x0, x1, x2, lever], Schur complement onto the blanket.
+  const std::vector<VariableId> order = {x[0], x[1], x[2], lever};
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(12, 12);
+  int with_products = 0;
+  for (FactorId f : graph.FactorsOf(x[0])) {
+    const FactorEntry& e = graph.factor(f);
+    const std::uint64_t mask = (std::uint64_t{1} << e.variables.size()) - 1;
+    const internal::WhitenedFactor* lf = workspace.Linearization(f, mask);
+    ASSERT_NE(lf, nullptr);
+    if (workspace.Products(f, mask) != nullptr) ++with_products;
+    for (std::size_t a = 0; a < e.variables.size(); ++a)
+      for (std::size_t b = 0; b < e.variables.size(); ++b) {
+        const int oa = 3 * static_cast<int>(std::find(order.begin(), order.end(), e.variables[a]) - order.begin());
+        const int ob = 3 * static_cast<int>(std::find(order.begin(), order.end(), e.variables[b]) - order.begin());
+        H.block(oa, ob, 3, 3) += lf->jacobians[a].transpose() * lf->jacobians[b];
+      }
+  }
+  EXPECT_EQ(with_products, 3);
+  const Eigen::MatrixXd expected =
+      H.bottomRightCorner(9, 9) - H.bottomLeftCorner(9, 3) * H.topLeftCorner(3, 3).inverse() * H.topRightCorner(3, 9);
+
+  ASSERT_TRUE(Marginalize({x[0]}, &graph, &workspace));
+  const FactorEntry& prior = graph.factor(graph.FactorsOf(x[1]).back());
+  ASSERT_EQ(prior.stream, "marginalization");
+  ASSERT_EQ(prior.variables, (std::vector<VariableId>{x[1], lever, x[2]}));
+  const int m = prior.factor->residual_dim();
+  Eigen::VectorXd r0(m);
+  Eigen::MatrixXd J(m, 9);
+  const double* values[] = {graph.variable(x[1]).value.data(), graph.variable(lever).value.data(),
+                            graph.variable(x[2]).value.data()};
+  double* jacobians[] = {J.data(), J.data() + 3 * m, J.data() + 6 * m};
+  ASSERT_TRUE(prior.factor->Evaluate(values, r0.data(), jacobians, nullptr));
+  // The prior's variables are in the blanket's order (x1, lever, x2): the expected one's rows and columns permuted.
+  Eigen::MatrixXd permuted(9, 9);
+  const int from[] = {0, 6, 3};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) permuted.block(3 * i, 3 * j, 3, 3) = expected.block(from[i], from[j], 3, 3);
+  EXPECT_LT((J.transpose() * J - permuted).norm(), 1e-9 * permuted.norm());
+}
+
 }  // namespace
 }  // namespace roamlab::estimator
