@@ -191,6 +191,7 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const Sol
   std::vector<bool> want;
   std::vector<int> var_offset;
   internal::WhitenedFactor wf;  // reused: its buffers keep their size
+  std::vector<int> product_offset;
   for (FactorId f : factors) {
     const FactorEntry& e = graph->factor(f);
     if (!e.active) continue;
@@ -209,16 +210,35 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const Sol
       linearized = &wf;
     }
     const internal::WhitenedFactor& lf = *linearized;
-    for (std::size_t a = 0; a < e.variables.size(); ++a) {
+    // The solve's own products J_a^T J_b of these Jacobians when it kept them (relinearization threshold): the same
+    // coefficient-wise sums as the products below, bit for bit (measured over the ATV run), without computing them
+    // again. Kept per pair of wanted positions i <= j (i outer); product_offset at i * nv + j.
+    const std::vector<double>* products = linearized != &wf ? last_solve->Products(f, mask) : nullptr;
+    const std::size_t nv = e.variables.size();
+    if (products != nullptr) {
+      product_offset.resize(nv * nv);
+      for (std::size_t i = 0, size = 0; i < nv; ++i)
+        for (std::size_t j = i; j < nv; ++j) {
+          product_offset[i * nv + j] = static_cast<int>(size);
+          if (want[i] && want[j]) size += lf.jacobians[i].cols() * lf.jacobians[j].cols();
+        }
+    }
+    for (std::size_t a = 0; a < nv; ++a) {
       if (!want[a]) continue;
       const int oa = var_offset[a];
       // Coefficient-wise products, in this order: tracking under a calibration prior is sensitive to the rounding of
       // H here (other kernels moved its positions by metres; BENCHMARKS.md, fourth tracking pass).
       g.segment(oa, lf.jacobians[a].cols()) += lf.jacobians[a].transpose().lazyProduct(lf.residual);
-      for (std::size_t b = 0; b < e.variables.size(); ++b) {
+      for (std::size_t b = 0; b < nv; ++b) {
         if (!want[b] || var_offset[b] < oa) continue;  // the lower triangle is mirrored below
-        H.block(oa, var_offset[b], lf.jacobians[a].cols(), lf.jacobians[b].cols()) +=
-            lf.jacobians[a].transpose().lazyProduct(lf.jacobians[b]);
+        const Eigen::Index ca = lf.jacobians[a].cols(), cb = lf.jacobians[b].cols();
+        auto block = H.block(oa, var_offset[b], ca, cb);
+        if (products == nullptr)
+          block += lf.jacobians[a].transpose().lazyProduct(lf.jacobians[b]);
+        else if (a <= b)
+          block += Eigen::Map<const Eigen::MatrixXd>(products->data() + product_offset[a * nv + b], ca, cb);
+        else
+          block += Eigen::Map<const Eigen::MatrixXd>(products->data() + product_offset[b * nv + a], cb, ca).transpose();
       }
     }
   }

@@ -107,6 +107,10 @@ const internal::WhitenedFactor* SolverWorkspace::Linearization(FactorId id, std:
   return system_->LinearizationAt(id, want_mask);
 }
 
+const std::vector<double>* SolverWorkspace::Products(FactorId id, std::uint64_t want_mask) const {
+  return system_->KeptProductsAt(id, want_mask);
+}
+
 SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceRequest* covariance,
                     SolverWorkspace* workspace) {
   using Clock = std::chrono::steady_clock;
@@ -178,10 +182,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
     const bool evaluated =
         lm ? system.CostWithLastWhitening(*graph, &new_cost) : system.LinearizeForCost(&new_cost);
     const double old_cost = system.cost();
-    const Eigen::VectorXd& g = system.gradient();
-    // Predicted decrease of the quadratic model: -g.dx - dx.H.dx / 2 (H through its upper triangle).
-    const Eigen::VectorXd Hdx = system.hessian_upper().selfadjointView<Eigen::Upper>() * dx;
-    const double predicted = -g.dot(dx) - 0.5 * dx.dot(Hdx);
+    const double predicted = system.ModelDecrease(dx);
     const double actual = old_cost - new_cost;
     const bool accept = evaluated && (lm ? (predicted > 0.0 && actual / predicted > 1e-3) : true);
 

@@ -101,6 +101,8 @@ class SolverWorkspace {
   // Gauss-Newton solve ends with every factor linearized at its final point (under relinearize_threshold, possibly
   // carried there to first order from an earlier point, with that point's Jacobians).
   const internal::WhitenedFactor* Linearization(FactorId id, std::uint64_t want_mask) const;
+  // Its Jacobians' products J_i^T J_j when the solve kept them (internal::NormalEquations::KeptProductsAt), else null.
+  const std::vector<double>* Products(FactorId id, std::uint64_t want_mask) const;
 
  private:
   friend SolverSummary Solve(const SolverOptions&, Graph*, CovarianceRequest*, SolverWorkspace*);

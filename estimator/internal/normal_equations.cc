@@ -395,6 +395,8 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   g_.setZero(dimension_);
   minus_memo_.assign(nb, MinusMemo());
   cholmod_->factored_undamped = false;
+  left_out_blocks_ = 0;
+  undamped_step_ = false;
 }
 
 void NormalEquations::BuildPattern() {
@@ -486,18 +488,22 @@ void NormalEquations::BuildPattern() {
     return static_cast<std::ptrdiff_t>(outer[block_offset_[b]]) + row_offset_[b][position];
   };
   pair_begin_.assign(1, 0);
-  pair_value_.clear();
+  pairs_.clear();
   int free[64];
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
     const int* block = &var_block_[var_begin_[k]];
     const int nf = FreePositions(block, var_begin_[k + 1] - var_begin_[k], free);
-    for (int i = 0; i < nf; ++i) {
-      for (int j = 0; j < nf; ++j) {
-        const int r = block[free[i]], b = block[free[j]];
-        if (r <= b) pair_value_.push_back(value_index(r, b));
+    for (int i = 0, product = 0; i < nf; ++i) {
+      for (int j = i; j < nf; ++j) {
+        const int a = block[free[i]], b = block[free[j]];
+        const std::ptrdiff_t value = value_index(std::min(a, b), std::max(a, b));
+        if (a <= b) pairs_.push_back({value, a, b, free[i], free[j], product, false});
+        // (A variable the factor takes twice gets both products in its diagonal block.)
+        if (a > b || (a == b && i != j)) pairs_.push_back({value, b, a, free[j], free[i], product, true});
+        product += dims_[a] * dims_[b];
       }
     }
-    pair_begin_.push_back(static_cast<int>(pair_value_.size()));
+    pair_begin_.push_back(static_cast<int>(pairs_.size()));
   }
   diagonal_index_.resize(dimension_);
   for (int b = 0; b < nb; ++b) {
@@ -510,79 +516,100 @@ void NormalEquations::BuildPattern() {
 // flatten: the small fixed-size J^T J kernels are inlined here whatever the compiler's size heuristics decide (once
 // left out of line, they cost a third more).
 __attribute__((flatten)) bool NormalEquations::Linearize(const Graph& /*graph*/, std::string* failed_stream) {
-  double* values = H_.valuePtr();
-  std::fill(values, values + H_.nonZeros(), 0.0);
   g_.setZero();
   cost_ = 0.0;
+  undamped_step_ = false;
+  // Every factor at the current values (kept, carried or evaluated), its cost and J_a^T r into g.
+  int free[64];  // positions of a factor's free variables
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
-    const FactorEntry& entry = *entries_[k];
-    const int v0 = var_begin_[k];
-    const int n = var_begin_[k + 1] - v0;
     if (!Current(k) && !CarryToFirstOrder(k) && !LinearizeAndRecord(k, nullptr)) {
-      if (failed_stream != nullptr) *failed_stream = entry.stream;
+      if (failed_stream != nullptr) *failed_stream = entries_[k]->stream;
       return false;
     }
     const WhitenedFactor& wf = linearized_[k].whitened;
     cost_ += wf.cost;
-
-    // Accumulate J_a^T r into g and J_a^T J_b into the (a <= b) blocks, which sit in H's value array with the
-    // column length of their block column as outer stride.
-    const int* block = &var_block_[v0];
-    int free[64];  // positions of the factor's free variables
-    const int nf = FreePositions(block, n, free);
+    const int* block = &var_block_[var_begin_[k]];
+    const int nf = FreePositions(block, var_begin_[k + 1] - var_begin_[k], free);
     for (int i = 0; i < nf; ++i)
       AddGradient(wf.jacobians[free[i]], wf.residual, g_.data() + block_offset_[block[free[i]]]);
-    int pair = pair_begin_[k];
-    if (relinearize_threshold_ > 0.0) {
-      // The products J_a^T J_b of a linearization whose Jacobians are kept (relinearization threshold) are kept
-      // with it: a carried factor only adds them again. Kept per pair of free positions i <= j (the block order of
-      // two variables may change between Resets: then the transpose is added).
-      FactorLinearization& l = linearized_[k];
-      int offset[64 * 64 / 2 + 64];
-      std::ptrdiff_t size = 0;
-      for (int i = 0, p = 0; i < nf; ++i)
-        for (int j = i; j < nf; ++j, ++p) {
-          offset[p] = static_cast<int>(size);
-          size += wf.jacobians[free[i]].cols() * wf.jacobians[free[j]].cols();
-        }
-      if (!l.products_valid) {
-        l.products.resize(size);
-        for (int i = 0, p = 0; i < nf; ++i)
-          for (int j = i; j < nf; ++j, ++p) {
-            const Eigen::MatrixXd& ja = wf.jacobians[free[i]];
-            const Eigen::MatrixXd& jb = wf.jacobians[free[j]];
-            std::fill_n(l.products.data() + offset[p], ja.cols() * jb.cols(), 0.0);
-            AddProduct(ja, jb, l.products.data() + offset[p], ja.cols());
-          }
-        l.products_valid = true;
-      }
-      const auto index = [nf](int i, int j) { return i * nf - i * (i - 1) / 2 + (j - i); };  // i <= j
-      for (int i = 0; i < nf; ++i) {
-        const int a = free[i];
-        for (int j = 0; j < nf; ++j) {
-          const int b = free[j];
-          if (block[a] > block[b]) continue;
-          double* dst = values + pair_value_[pair++];
-          const std::ptrdiff_t stride = column_length_[block[b]];
-          const int rows = static_cast<int>(wf.jacobians[a].cols()), cols = static_cast<int>(wf.jacobians[b].cols());
-          if (i <= j)
-            AddBlock(l.products.data() + offset[index(i, j)], rows, cols, false, dst, stride);
-          else
-            AddBlock(l.products.data() + offset[index(j, i)], rows, cols, true, dst, stride);
-        }
-      }
-      continue;
-    }
-    for (int i = 0; i < nf; ++i) {
-      const int a = free[i];
-      for (int j = 0; j < nf; ++j) {
-        const int b = free[j];
-        if (block[a] > block[b]) continue;
-        AddProduct(wf.jacobians[a], wf.jacobians[b], values + pair_value_[pair++], column_length_[block[b]]);
-      }
+  }
+
+  // H. The blocks the next factorization takes over from the kept one (every factor evaluated since is known now:
+  // ReusableBlocks) are left out; their band columns come first in H's values and stay as they are.
+  double* values = H_.valuePtr();
+  left_out_blocks_ = 0;
+  if (relinearize_threshold_ > 0.0 && natural_order_ && factor_kept_) {
+    Analyze();
+    left_out_blocks_ = ReusableBlocks();
+    left_out_evaluations_ = evaluations_;
+  }
+  const std::ptrdiff_t summed_from = left_out_blocks_ > 0 ? H_.outerIndexPtr()[block_offset_[left_out_blocks_]] : 0;
+  std::fill(values + summed_from, values + H_.nonZeros(), 0.0);
+  if (relinearize_threshold_ > 0.0) {
+    for (std::size_t k = 0; k < factor_ids_.size(); ++k) AddKeptProducts(k, false);
+    return true;
+  }
+  for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
+    // J_a^T J_b into the blocks of the upper triangle, which sit in H's value array with the column length of their
+    // block column as outer stride.
+    const WhitenedFactor& wf = linearized_[k].whitened;
+    for (int p = pair_begin_[k]; p < pair_begin_[k + 1]; ++p) {
+      const PairSlot& pair = pairs_[p];
+      AddProduct(wf.jacobians[pair.a], wf.jacobians[pair.b], values + pair.value, column_length_[pair.column]);
     }
   }
   return true;
+}
+
+__attribute__((flatten)) void NormalEquations::AddKeptProducts(std::size_t k, bool left_out) {
+  // The products J_a^T J_b of a linearization whose Jacobians are kept (relinearization threshold) are kept with it:
+  // a carried factor only adds them again. Kept per pair of free positions i <= j (the block order of two variables
+  // may change between Resets: then the transpose is added; BuildPattern's pairs_ say where each goes).
+  FactorLinearization& l = linearized_[k];
+  if (!l.products_valid) {
+    const WhitenedFactor& wf = l.whitened;
+    const int* block = &var_block_[var_begin_[k]];
+    int free[64];
+    const int nf = FreePositions(block, var_begin_[k + 1] - var_begin_[k], free);
+    std::ptrdiff_t size = 0;
+    for (int i = 0; i < nf; ++i)
+      for (int j = i; j < nf; ++j) size += wf.jacobians[free[i]].cols() * wf.jacobians[free[j]].cols();
+    l.products.resize(size);
+    double* product = l.products.data();
+    for (int i = 0; i < nf; ++i)
+      for (int j = i; j < nf; ++j) {
+        const Eigen::MatrixXd& ja = wf.jacobians[free[i]];
+        const Eigen::MatrixXd& jb = wf.jacobians[free[j]];
+        std::fill_n(product, ja.cols() * jb.cols(), 0.0);
+        AddProduct(ja, jb, product, ja.cols());
+        product += ja.cols() * jb.cols();
+      }
+    l.products_valid = true;
+  }
+  double* values = H_.valuePtr();
+  const int first_summed = left_out_blocks_;
+  for (int p = pair_begin_[k]; p < pair_begin_[k + 1]; ++p) {
+    const PairSlot& pair = pairs_[p];
+    if ((pair.row < first_summed && (pair.column < first_summed || pair.column >= band_blocks_)) != left_out) continue;
+    AddBlock(l.products.data() + pair.product, dims_[pair.row], dims_[pair.column], pair.transposed,
+             values + pair.value, column_length_[pair.column]);
+  }
+}
+
+void NormalEquations::CompleteHessian() {
+  if (left_out_blocks_ == 0) return;
+  ROAMLAB_CHECK(evaluations_ == left_out_evaluations_,
+                "the normal equations' H is incomplete and a factor was evaluated again since Linearize");
+  // The left-out band columns (the first values) were not zeroed; the border's left-out rows were.
+  double* values = H_.valuePtr();
+  std::fill(values, values + H_.outerIndexPtr()[block_offset_[left_out_blocks_]], 0.0);
+  for (std::size_t k = 0; k < factor_ids_.size(); ++k) AddKeptProducts(k, true);
+  left_out_blocks_ = 0;
+}
+
+const Eigen::SparseMatrix<double>& NormalEquations::hessian_upper() {
+  CompleteHessian();
+  return H_;
 }
 
 bool NormalEquations::CostWithLastWhitening(const Graph& /*graph*/, double* cost) const {
@@ -723,6 +750,13 @@ bool NormalEquations::CarryToFirstOrder(std::size_t k) {
   return true;
 }
 
+const std::vector<double>* NormalEquations::KeptProductsAt(FactorId id, std::uint64_t want_mask) const {
+  if (LinearizationAt(id, want_mask) == nullptr) return nullptr;
+  const FactorLinearization& l = linearized_[std::lower_bound(factor_ids_.begin(), factor_ids_.end(), id) -
+                                             factor_ids_.begin()];
+  return l.products_valid ? &l.products : nullptr;
+}
+
 const WhitenedFactor* NormalEquations::LinearizationAt(FactorId id, std::uint64_t want_mask) const {
   const auto it = std::lower_bound(factor_ids_.begin(), factor_ids_.end(), id);
   if (it == factor_ids_.end() || *it != id) return nullptr;
@@ -731,10 +765,41 @@ const WhitenedFactor* NormalEquations::LinearizationAt(FactorId id, std::uint64_
   return &linearized_[k].whitened;
 }
 
+void NormalEquations::Analyze() {
+  Cholmod& c = *cholmod_;
+  if (c.analyzed) return;
+  if (natural_order_) {
+    // The border: trailing block columns whose first row block is the first; the envelope of each other block column
+    // reaches from its first row block to the diagonal. (The buffers are sized by FactorEnvelope: until then they
+    // hold the last factorization, which it may take over.)
+    band_blocks_ = static_cast<int>(order_.size());
+    while (band_blocks_ > 0 && rows_of_[band_blocks_ - 1].front() == 0 &&
+           dimension_ - block_offset_[band_blocks_ - 1] <= kMaxBorder)
+      --band_blocks_;
+    band_dimension_ = band_blocks_ < static_cast<int>(order_.size()) ? block_offset_[band_blocks_] : dimension_;
+    first_block_.resize(band_blocks_);
+    envelope_start_.resize(band_blocks_ + 1);
+    envelope_start_[0] = 0;
+    for (int b = 0; b < band_blocks_; ++b) {
+      first_block_[b] = rows_of_[b].front();
+      const int height = block_offset_[b] + dims_[b] - block_offset_[first_block_[b]];
+      envelope_start_[b + 1] = envelope_start_[b] + static_cast<std::ptrdiff_t>(height) * dims_[b];
+    }
+    band_pose_blocks_ = std::all_of(dims_.begin(), dims_.begin() + band_blocks_, [](int d) { return d == 6; });
+  } else {
+    c.llt.setMode(dimension_ <= kMaxSimplicialDimension ? Eigen::CholmodSimplicialLLt : Eigen::CholmodSupernodalLLt);
+    c.llt.analyzePattern(H_);
+  }
+  c.analyzed = true;
+  ++analyses_;
+}
+
 bool NormalEquations::Solve(double lambda, Eigen::VectorXd* dx) {
   Cholmod& c = *cholmod_;
+  undamped_step_ = false;
   const Eigen::SparseMatrix<double>* A = &H_;
   if (lambda > 0.0) {
+    CompleteHessian();
     c.damped = H_;
     double* v = c.damped.valuePtr();
     for (int i = 0; i < dimension_; ++i) v[diagonal_index_[i]] += lambda * std::max(v[diagonal_index_[i]], 1e-12);
@@ -746,35 +811,7 @@ bool NormalEquations::Solve(double lambda, Eigen::VectorXd* dx) {
     kept_envelope_.swap(envelope_);
     kept_border_.swap(border_);
   }
-  if (!c.analyzed) {
-    if (natural_order_) {
-      // The border: trailing block columns whose first row block is the first; the envelope of each other block
-      // column reaches from its first row block to the diagonal.
-      band_blocks_ = static_cast<int>(order_.size());
-      while (band_blocks_ > 0 && rows_of_[band_blocks_ - 1].front() == 0 &&
-             dimension_ - block_offset_[band_blocks_ - 1] <= kMaxBorder)
-        --band_blocks_;
-      band_dimension_ = band_blocks_ < static_cast<int>(order_.size()) ? block_offset_[band_blocks_] : dimension_;
-      first_block_.resize(band_blocks_);
-      envelope_start_.resize(band_blocks_ + 1);
-      envelope_start_[0] = 0;
-      for (int b = 0; b < band_blocks_; ++b) {
-        first_block_[b] = rows_of_[b].front();
-        const int height = block_offset_[b] + dims_[b] - block_offset_[first_block_[b]];
-        envelope_start_[b + 1] = envelope_start_[b] + static_cast<std::ptrdiff_t>(height) * dims_[b];
-      }
-      envelope_.resize(envelope_start_[band_blocks_]);
-      band_pose_blocks_ = std::all_of(dims_.begin(), dims_.begin() + band_blocks_, [](int d) { return d == 6; });
-      border_.resize(band_dimension_, dimension_ - band_dimension_);
-      corner_.resize(dimension_ - band_dimension_, dimension_ - band_dimension_);
-    } else {
-      c.llt.setMode(dimension_ <= kMaxSimplicialDimension ? Eigen::CholmodSimplicialLLt
-                                                          : Eigen::CholmodSupernodalLLt);
-      c.llt.analyzePattern(*A);
-    }
-    c.analyzed = true;
-    ++analyses_;
-  }
+  Analyze();
   bool factored = false;
   if (natural_order_) {
     factored = FactorEnvelope(*A, lambda <= 0.0);
@@ -784,6 +821,7 @@ bool NormalEquations::Solve(double lambda, Eigen::VectorXd* dx) {
   }
   c.factored_undamped = lambda <= 0.0 && factored;
   if (!factored) return false;
+  undamped_step_ = c.factored_undamped;
   if (natural_order_) {
     *dx = -g_;
     SolveEnvelope(*dx);
@@ -791,6 +829,15 @@ bool NormalEquations::Solve(double lambda, Eigen::VectorXd* dx) {
   }
   *dx = c.llt.solve(-g_);
   return c.llt.info() == Eigen::Success && dx->allFinite();
+}
+
+double NormalEquations::ModelDecrease(const Eigen::VectorXd& dx) const {
+  if (left_out_blocks_ > 0) {
+    ROAMLAB_CHECK(undamped_step_, "model decrease with an incomplete H but no undamped step since Linearize");
+    return -0.5 * g_.dot(dx);
+  }
+  const Eigen::VectorXd Hdx = H_.selfadjointView<Eigen::Upper>() * dx;
+  return -g_.dot(dx) - 0.5 * dx.dot(Hdx);
 }
 
 namespace {
@@ -1003,6 +1050,7 @@ int NormalEquations::ReusableBlocks() const {
 bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, bool undamped) {
   const int na = band_dimension_;
   const int reused = undamped && relinearize_threshold_ > 0.0 ? ReusableBlocks() : 0;
+  if (reused < left_out_blocks_) CompleteHessian();  // (A is H_: undamped)
   const int reused_rows = reused > 0 ? block_offset_[reused] : 0;
   envelope_.resize(envelope_start_[band_blocks_]);
   border_.resize(na, dimension_ - na);
@@ -1030,7 +1078,7 @@ bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, bool 
   // from the first of block first_block_[b] (the columns not taken over).
   std::fill(envelope_.begin() + envelope_start_[reused], envelope_.end(), 0.0);
   border_.bottomRows(na - reused_rows).setZero();
-  corner_.setZero();
+  corner_.setZero(dimension_ - na, dimension_ - na);
   const int* outer = A.outerIndexPtr();
   const int* inner = A.innerIndexPtr();
   const double* value = A.valuePtr();

@@ -40,7 +40,11 @@ class NormalEquations {
   void Reset(const Graph& graph, std::vector<VariableId> order);
 
   // Evaluates every included factor at the graph's current values; fills H, g and the per-factor whitening.
-  // Returns false if some factor could not be linearized (its stream is named in *failed_stream).
+  // Returns false if some factor could not be linearized (its stream is named in *failed_stream). Under a
+  // relinearization threshold, the blocks of H that the next undamped factorization takes over from the kept one
+  // (FactorEnvelope) are left out: it does not read them. They are added from the factors' kept J^T J products when
+  // something needs the whole of H (hessian_upper, a damped Solve), which must then come before a factor is evaluated
+  // again (LinearizeForCost).
   bool Linearize(const Graph& graph, std::string* failed_stream = nullptr);
 
   // Cost at the graph's current values with the whitening of the last Linearize (so that a trial step is judged on
@@ -57,6 +61,10 @@ class NormalEquations {
   // exactly the variables in want_mask (bit i: variable i), otherwise null. The factor must still be in the graph.
   // With a relinearization threshold its error may be carried to these values to first order (below).
   const WhitenedFactor* LinearizationAt(FactorId id, std::uint64_t want_mask) const;
+  // The J_i^T J_j products of that linearization's Jacobians when they are kept (relinearization threshold, computed
+  // by Linearize since the factor was last evaluated), otherwise null: per pair of its free positions i <= j in order
+  // (i outer), each column-major.
+  const std::vector<double>* KeptProductsAt(FactorId id, std::uint64_t want_mask) const;
 
   // Relinearization threshold (iSAM2's): when > 0, Linearize and LinearizeForCost do not evaluate again a factor with
   // a trivial loss whose free variables all moved by at most this much (every tangent component of x [-] x_lin) since
@@ -74,6 +82,11 @@ class NormalEquations {
   // Solves (H + lambda diag(H)) dx = -g. Returns false if the matrix is not positive definite.
   bool Solve(double lambda, Eigen::VectorXd* dx);
 
+  // The decrease of the quadratic model of the last Linearize along dx, -g.dx - dx.H.dx / 2. When H lacks the blocks
+  // that the factorization took over (Linearize), dx must be the step of the last Solve, which was undamped: then
+  // H dx = -g (to the solve's rounding) and the decrease is -g.dx / 2.
+  double ModelDecrease(const Eigen::VectorXd& dx) const;
+
   // Marginal covariance of the listed free variables (their tangent blocks, in order) from H of the last Linearize:
   // solves H X = E for their columns, reusing the last factorization when it was undamped. Returns false when H is
   // not positive definite.
@@ -85,8 +98,8 @@ class NormalEquations {
   int dimension() const { return dimension_; }
   double cost() const { return cost_; }
   const Eigen::VectorXd& gradient() const { return g_; }
-  // Upper triangle of H.
-  const Eigen::SparseMatrix<double>& hessian_upper() const { return H_; }
+  // Upper triangle of H (the blocks Linearize left out are added first).
+  const Eigen::SparseMatrix<double>& hessian_upper();
   const std::vector<VariableId>& order() const { return order_; }
   // Column offset of a free variable, or -1.
   int OffsetOf(VariableId id) const;
@@ -102,6 +115,8 @@ class NormalEquations {
   // Block column of a free variable, or -1.
   int BlockOf(VariableId id) const;
   void BuildPattern();
+  // The symbolic analysis of a new pattern: a natural-order system's band and border layout, or CHOLMOD's.
+  void Analyze();
 
   std::vector<VariableId> order_;
   std::vector<std::pair<VariableId, int>> block_of_id_;  // sorted by id
@@ -118,7 +133,10 @@ class NormalEquations {
 
   // Included factors, and per factor k the range [var_begin_[k], var_begin_[k + 1]) of its variables in var_block_
   // (block column or -1 when held constant) and values_ (the variables' ambient values), and the range
-  // [pair_begin_[k], pair_begin_[k + 1]) of its (a <= b) free pairs in pair_value_ (value index of the block in H).
+  // [pair_begin_[k], pair_begin_[k + 1]) of its pairs of free positions i <= j (i outer) in pairs_: the block of H
+  // that J_i^T J_j goes to, or its transpose when i's block comes after j's. (A block of H receives one product per
+  // factor, so the order of a factor's pairs does not change the sums; a variable the factor takes twice, at i and
+  // j, receives J_i^T J_j and then J_j^T J_i in its diagonal block, between J_i^T J_i and J_j^T J_j, as before.)
   std::vector<FactorId> factor_ids_;
   std::vector<const FactorEntry*> entries_;
   std::vector<std::uint64_t> want_;
@@ -126,7 +144,14 @@ class NormalEquations {
   std::vector<int> var_block_;
   std::vector<const double*> values_;
   std::vector<int> pair_begin_;
-  std::vector<std::ptrdiff_t> pair_value_;
+  struct PairSlot {
+    std::ptrdiff_t value;  // index of the block in H's value array
+    int row, column;       // its blocks, row <= column
+    int a, b;              // the factor's variables (positions) whose J_a^T J_b the block receives
+    int product;           // offset of the kept product J_i^T J_j, i <= j (FactorLinearization::products)
+    bool transposed;       // the block receives that product's transpose
+  };
+  std::vector<PairSlot> pairs_;
   // Per included factor, its last linearization and the point it was computed at: Linearize evaluates a factor again
   // only when its variables' values (bit for bit), its entry or its Jacobians' mask changed since.
   struct FactorLinearization {
@@ -139,7 +164,8 @@ class NormalEquations {
     // there; `at` and whitened.residual differ from them after a first-order carry (CarryToFirstOrder).
     std::vector<double> lin_at;
     Eigen::VectorXd lin_residual;
-    // With a relinearization threshold: the J_i^T J_j of the Jacobians, per pair of free positions i <= j.
+    // With a relinearization threshold: the J_i^T J_j of the Jacobians, per pair of free positions i <= j in order
+    // (i outer), each column-major.
     std::vector<double> products;
     bool products_valid = false;
   };
@@ -148,6 +174,11 @@ class NormalEquations {
   std::vector<bool> taken_scratch_;          // Reset: which of prev_linearized_ found their factor
   std::vector<std::size_t> fresh_scratch_;   // Reset: factors new since the last Reset
   bool Current(std::size_t k) const;  // linearized_[k] holds factor k at the current values
+  // Adds factor k's kept J_a^T J_b into the blocks of H that Linearize sums (`left_out` false) or into those it left
+  // out (true); computes the products first when they are not kept yet.
+  void AddKeptProducts(std::size_t k, bool left_out);
+  // Adds the blocks Linearize left out (see left_out_blocks_).
+  void CompleteHessian();
   bool LinearizeAndRecord(std::size_t k, double* previous_cost);
   // Carries factor k's kept linearization to the current values to first order when the relinearization threshold
   // allows it (see set_relinearize_threshold); false when it must be evaluated again.
@@ -199,6 +230,13 @@ class NormalEquations {
   int patterns_built_ = 0;
 
   Eigen::SparseMatrix<double> H_;
+  // With a kept factorization whose leading left_out_blocks_ band columns the next one takes over, H lacks the
+  // blocks (r, c), r <= c, with r < left_out_blocks_ and c either before it or in the border (until CompleteHessian);
+  // those values are stale. left_out_evaluations_: evaluations_ when Linearize left them out (the products it would
+  // add are those of the factors' current Jacobians only until one is evaluated again).
+  int left_out_blocks_ = 0;
+  long left_out_evaluations_ = 0;
+  bool undamped_step_ = false;  // the last Solve since Linearize was undamped and succeeded
   std::vector<std::ptrdiff_t> diagonal_index_;
   Eigen::VectorXd g_;
   double cost_ = 0.0;

@@ -506,6 +506,108 @@ TEST(NormalEquationsTest, IncrementalFactorizationOfASlidingWindowMatchesAFreshO
   EXPECT_GT(incremental.reused_blocks(), 40);
 }
 
+// Under a relinearization threshold Linearize leaves out the blocks of H that the kept factorization takes over. A
+// window that slides (with a border parameter, an instance per two poses and a pose moved beyond the threshold) is
+// solved by two objects with the same history: one completes H after every Linearize (hessian_upper), the other does
+// not. Their steps must be the same bit for bit (the factorization reads only blocks that were summed), H completed
+// after the solve the same as the other's bit for bit, a damped solve after a fresh Linearize the same (it completes H
+// first), and the model decrease from -g.dx / 2 that from H to rounding. Reading H once a factor was evaluated again
+// since (a trial point beyond the threshold) is refused.
+TEST(NormalEquationsTest, LinearizationWithoutTheTakenOverBlocksSolvesLikeAComplete) {
+  std::mt19937 rng(31);
+  Graph graph;
+  const VariableId lever =
+      graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d(0.1, 0.2, 0.3), false, std::nullopt});
+  struct Node {
+    VariableId pose;
+    VariableId instance;
+  };
+  std::deque<Node> nodes;
+  int stamp = 0;
+  const auto tie = [&](const std::vector<VariableId>& ids) { TieWithRandomPrior(ids, &rng, &graph); };
+  const auto add_pose = [&] {
+    const Time t = Time::FromSeconds(static_cast<double>(stamp));
+    const VariableId pose =
+        graph.AddVariable({"pose", Manifold::Pose(), testing::RandomPoint(Manifold::Pose(), &rng, 5.0), false, t});
+    VariableId instance = nodes.empty() ? -1 : nodes.back().instance;
+    if (stamp % 2 == 0) {
+      instance = graph.AddVariable({"drift", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), false, t});
+      if (!nodes.empty()) tie({nodes.back().instance, instance});
+    }
+    ++stamp;
+    tie({pose, instance, lever});
+    if (!nodes.empty()) tie({nodes.back().pose, pose, lever});
+    nodes.push_back({pose, instance});
+  };
+  for (int k = 0; k < 10; ++k) add_pose();
+  const double threshold = 1e-3;
+
+  internal::NormalEquations partial, complete;
+  int steps_with_reuse = 0;
+  partial.set_relinearize_threshold(threshold);
+  complete.set_relinearize_threshold(threshold);
+  for (int step = 0; step < 12; ++step) {
+    if (step > 0) {
+      std::vector<VariableId> leaving = {nodes.front().pose};
+      if (nodes[1].instance != nodes.front().instance) leaving.push_back(nodes.front().instance);
+      ASSERT_TRUE(Marginalize(leaving, &graph));
+      nodes.pop_front();
+      add_pose();
+    }
+    if (step == 6) {  // beyond the threshold: its factors are evaluated again
+      Variable& v = graph.mutable_variable(nodes[5].pose);
+      const Eigen::VectorXd d = Eigen::VectorXd::Constant(6, 10.0 * threshold);
+      v.manifold.Plus(v.value.data(), d.data(), v.value.data());
+    }
+    const long reused_before = partial.reused_blocks();
+    partial.Reset(graph, FreeVariableOrder(graph));
+    complete.Reset(graph, FreeVariableOrder(graph));
+    ASSERT_TRUE(partial.Linearize(graph));
+    ASSERT_TRUE(complete.Linearize(graph));
+    complete.hessian_upper();
+    Eigen::VectorXd dx_partial, dx_complete;
+    ASSERT_TRUE(partial.Solve(0.0, &dx_partial));
+    ASSERT_TRUE(complete.Solve(0.0, &dx_complete));
+    if (partial.reused_blocks() > reused_before) ++steps_with_reuse;
+    EXPECT_EQ(partial.reused_blocks(), complete.reused_blocks()) << "step " << step;
+    EXPECT_EQ(dx_partial, dx_complete) << "step " << step;
+    // -g.dx - dx.H.dx / 2 and -g.dx / 2 differ by dx.(H dx + g) / 2: the solve's residual (the kept rows are the
+    // factor of the exact Schur complement, the prior in H is that complement to rounding).
+    const double decrease = complete.ModelDecrease(dx_complete);
+    const Eigen::VectorXd residual =
+        complete.hessian_upper().selfadjointView<Eigen::Upper>() * dx_complete + complete.gradient();
+    EXPECT_NEAR(partial.ModelDecrease(dx_partial), decrease,
+                0.5 * dx_complete.norm() * residual.norm() + 1e-12 * std::abs(decrease))
+        << "step " << step;
+    const Eigen::SparseMatrix<double>& a = partial.hessian_upper();
+    const Eigen::SparseMatrix<double>& b = complete.hessian_upper();
+    ASSERT_EQ(a.nonZeros(), b.nonZeros()) << "step " << step;
+    EXPECT_TRUE(std::equal(a.valuePtr(), a.valuePtr() + a.nonZeros(), b.valuePtr())) << "step " << step;
+    // Both take the step, as a Gauss-Newton iteration would (within the threshold: the factors are carried).
+    partial.Update(dx_partial.normalized() * 0.1 * threshold, &graph);
+    ASSERT_TRUE(partial.Linearize(graph));
+    ASSERT_TRUE(complete.Linearize(graph));
+    if (step % 3 == 1) {
+      ASSERT_TRUE(partial.Solve(0.3, &dx_partial));
+      ASSERT_TRUE(complete.Solve(0.3, &dx_complete));
+      EXPECT_EQ(dx_partial, dx_complete) << "step " << step;
+    } else {
+      ASSERT_TRUE(partial.Solve(0.0, &dx_partial));
+      ASSERT_TRUE(complete.Solve(0.0, &dx_complete));
+      EXPECT_EQ(dx_partial, dx_complete) << "step " << step;
+    }
+  }
+  EXPECT_GE(steps_with_reuse, 6);
+  EXPECT_DEATH(
+      {
+        partial.Update(Eigen::VectorXd::Constant(partial.dimension(), 10.0 * threshold), &graph);
+        double cost = 0.0;
+        partial.LinearizeForCost(&cost);
+        partial.hessian_upper();
+      },
+      "evaluated again");
+}
+
 // Relinearization threshold (iSAM2's): a factor whose variables all moved by at most the threshold since its
 // linearization keeps its Jacobians (H is the same, bit for bit) and its whitened error is carried to first order,
 // r_lin + sum_i J_i (x_i [-] x_lin_i), which differs from a fresh evaluation by second order only. Once a variable has
@@ -819,6 +921,72 @@ TEST(MarginalizationTest, PriorHoldsTheSchurComplementAlsoWhenRankDeficient) {
     EXPECT_LT((J.transpose() * J - expected_H).norm(), 1e-9 * expected_H.norm()) << "weak = " << weak;
     EXPECT_LT((J.transpose() * r0 - expected_g).norm(), 1e-9 * expected_g.norm()) << "weak = " << weak;
   }
+}
+
+// Marginalize after a Gauss-Newton solve under a relinearization threshold adds the solve's kept J_a^T J_b products
+// instead of computing them again (one factor takes its variables in the opposite order to the blanket's: its
+// products go in transposed). The prior must hold the Schur complement of the information of those Jacobians.
+TEST(MarginalizationTest, PriorFromTheSolvesKeptProductsHoldsTheSchurComplement) {
+  std::mt19937 rng(37);
+  Graph graph;
+  const VariableId lever =
+      graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d(0.1, 0.2, 0.3), false, std::nullopt});
+  std::vector<VariableId> x;
+  for (int k = 0; k < 4; ++k)
+    x.push_back(graph.AddVariable({"x", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), false, Time::FromSeconds(k)}));
+  const auto tie = [&](const std::vector<VariableId>& ids) { TieWithRandomPrior(ids, &rng, &graph); };
+  tie({x[0]});
+  tie({x[1], x[0], lever});
+  tie({x[0], x[2]});
+  for (int k = 1; k < 4; ++k) tie({x[k]});
+  tie({x[2], x[3], lever});
+  SolverOptions options;
+  options.method = SolverOptions::Method::kGaussNewton;
+  options.relinearize_threshold = 1e-3;
+  SolverWorkspace workspace;
+  // The first solve's trial point is evaluated again (it moved beyond the threshold); the second keeps the products of
+  // its linearization (its step is within the threshold: carried).
+  ASSERT_TRUE(Solve(options, &graph, nullptr, &workspace).usable());
+  ASSERT_TRUE(Solve(options, &graph, nullptr, &workspace).usable());
+
+  // Expected: the information of the kept Jacobians over [x0, x1, x2, lever], Schur complement onto the blanket.
+  const std::vector<VariableId> order = {x[0], x[1], x[2], lever};
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(12, 12);
+  int with_products = 0;
+  for (FactorId f : graph.FactorsOf(x[0])) {
+    const FactorEntry& e = graph.factor(f);
+    const std::uint64_t mask = (std::uint64_t{1} << e.variables.size()) - 1;
+    const internal::WhitenedFactor* lf = workspace.Linearization(f, mask);
+    ASSERT_NE(lf, nullptr);
+    if (workspace.Products(f, mask) != nullptr) ++with_products;
+    for (std::size_t a = 0; a < e.variables.size(); ++a)
+      for (std::size_t b = 0; b < e.variables.size(); ++b) {
+        const int oa = 3 * static_cast<int>(std::find(order.begin(), order.end(), e.variables[a]) - order.begin());
+        const int ob = 3 * static_cast<int>(std::find(order.begin(), order.end(), e.variables[b]) - order.begin());
+        H.block(oa, ob, 3, 3) += lf->jacobians[a].transpose() * lf->jacobians[b];
+      }
+  }
+  EXPECT_EQ(with_products, 3);
+  const Eigen::MatrixXd expected =
+      H.bottomRightCorner(9, 9) - H.bottomLeftCorner(9, 3) * H.topLeftCorner(3, 3).inverse() * H.topRightCorner(3, 9);
+
+  ASSERT_TRUE(Marginalize({x[0]}, &graph, &workspace));
+  const FactorEntry& prior = graph.factor(graph.FactorsOf(x[1]).back());
+  ASSERT_EQ(prior.stream, "marginalization");
+  ASSERT_EQ(prior.variables, (std::vector<VariableId>{x[1], lever, x[2]}));
+  const int m = prior.factor->residual_dim();
+  Eigen::VectorXd r0(m);
+  Eigen::MatrixXd J(m, 9);
+  const double* values[] = {graph.variable(x[1]).value.data(), graph.variable(lever).value.data(),
+                            graph.variable(x[2]).value.data()};
+  double* jacobians[] = {J.data(), J.data() + 3 * m, J.data() + 6 * m};
+  ASSERT_TRUE(prior.factor->Evaluate(values, r0.data(), jacobians, nullptr));
+  // The prior's variables are in the blanket's order (x1, lever, x2): the expected one's rows and columns permuted.
+  Eigen::MatrixXd permuted(9, 9);
+  const int from[] = {0, 6, 3};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) permuted.block(3 * i, 3 * j, 3, 3) = expected.block(from[i], from[j], 3, 3);
+  EXPECT_LT((J.transpose() * J - permuted).norm(), 1e-9 * permuted.norm());
 }
 
 }  // namespace
