@@ -169,10 +169,6 @@ TEST(ObservabilityTest, ComponentWhoseInformationIsAlmostAllSharedIsUnobservable
   EXPECT_NEAR(a.std[1], std::sqrt(300.0), 1e-9);
 }
 
-// A tracking window in the solver's natural order: poses in time order, each tied to the next and to the one after
-// (which skips a pose: fill inside the envelope), and a free constant parameter tied to two poses (the dense border),
-// by linear priors with random Jacobians. The envelope factorization must give the step and the covariances of a dense
-// Cholesky of the same H: a few columns by forward substitution, many by the full solve.
 // A linear prior factor with random J and r0 (square, full rank almost surely) on `ids`, linearized at a point near
 // their current values.
 void TieWithRandomPrior(const std::vector<VariableId>& ids, std::mt19937* rng, Graph* graph) {
@@ -191,6 +187,63 @@ void TieWithRandomPrior(const std::vector<VariableId>& ids, std::mt19937* rng, G
   graph->AddFactor(std::make_unique<LinearPriorFactor>(manifolds, x0, J, r0), ids, Eigen::MatrixXd::Identity(dim, dim),
                    Loss::Trivial(), "test", Time());
 }
+
+// A sliding window of poses with a constant parameter ("lever") and a time-varying one whose instance changes every
+// `instance_period` poses, tied by linear priors with random Jacobians: instance to instance, pose to its instance
+// (and to the lever when `pose_with_lever`), pose to pose with the lever.
+class SlidingWindowWithInstances {
+ public:
+  SlidingWindowWithInstances(unsigned seed, int instance_period, bool pose_with_lever)
+      : rng_(seed), instance_period_(instance_period), pose_with_lever_(pose_with_lever) {
+    lever_ = graph_.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d(0.1, 0.2, 0.3), false, std::nullopt});
+  }
+  Graph& graph() { return graph_; }
+  VariableId oldest_pose() const { return nodes_.front().pose; }
+  VariableId pose(int k) const { return nodes_[static_cast<std::size_t>(k)].pose; }
+
+  void AddPose() {
+    const Time t = Time::FromSeconds(static_cast<double>(stamp_));
+    const VariableId pose =
+        graph_.AddVariable({"pose", Manifold::Pose(), testing::RandomPoint(Manifold::Pose(), &rng_, 5.0), false, t});
+    VariableId instance = nodes_.empty() ? -1 : nodes_.back().instance;
+    if (stamp_ % instance_period_ == 0) {
+      instance = graph_.AddVariable({"drift", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), false, t});
+      if (!nodes_.empty()) Tie({nodes_.back().instance, instance});
+    }
+    ++stamp_;
+    if (pose_with_lever_) {
+      Tie({pose, instance, lever_});
+    } else {
+      Tie({pose, instance});
+    }
+    if (!nodes_.empty()) Tie({nodes_.back().pose, pose, lever_});
+    nodes_.push_back({pose, instance});
+  }
+  // The oldest pose leaves (marginalized), with its instance when the next pose has another one; a new pose comes.
+  bool Slide() {
+    std::vector<VariableId> leaving = {nodes_.front().pose};
+    if (nodes_[1].instance != nodes_.front().instance) leaving.push_back(nodes_.front().instance);
+    if (!Marginalize(leaving, &graph_)) return false;
+    nodes_.pop_front();
+    AddPose();
+    return true;
+  }
+
+ private:
+  struct Node {
+    VariableId pose;
+    VariableId instance;
+  };
+  void Tie(const std::vector<VariableId>& ids) { TieWithRandomPrior(ids, &rng_, &graph_); }
+
+  std::mt19937 rng_;
+  int instance_period_;
+  bool pose_with_lever_;
+  Graph graph_;
+  VariableId lever_ = -1;
+  std::deque<Node> nodes_;
+  int stamp_ = 0;
+};
 
 // The solver's order: poses in time; each time-varying instance after the last pose it serves (just before the pose
 // that starts the next instance of its parameter), the newest after every pose; fixed variables left out; constant
@@ -213,6 +266,10 @@ TEST(SolverTest, FreeVariableOrderPutsEachInstanceAfterTheLastPoseItServes) {
   EXPECT_EQ(FreeVariableOrder(graph), expected);
 }
 
+// A tracking window in the solver's natural order: poses in time order, each tied to the next and to the one after
+// (which skips a pose: fill inside the envelope), and a free constant parameter tied to two poses (the dense border),
+// by linear priors with random Jacobians. The envelope factorization must give the step and the covariances of a dense
+// Cholesky of the same H: a few columns by forward substitution, many by the full solve.
 TEST(NormalEquationsTest, EnvelopeFactorizationOfABandWithABorderMatchesADenseCholesky) {
   std::mt19937 rng(11);
   Graph graph;
@@ -339,43 +396,15 @@ TEST(NormalEquationsTest, IncrementalResetOfASlidingWindowMatchesAFreshBuild) {
 // same system as a fresh object built from scratch, bit for bit (H's pattern and values, gradient, step, the oldest
 // pose's covariance); fewer patterns are built than there are slides.
 TEST(NormalEquationsTest, PatternsThatComeBackAsTheWindowSlidesMatchAFreshBuild) {
-  std::mt19937 rng(29);
-  Graph graph;
-  const VariableId lever =
-      graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d(0.1, 0.2, 0.3), false, std::nullopt});
-  struct Node {
-    VariableId pose;
-    VariableId instance;
-  };
-  std::deque<Node> nodes;
-  int stamp = 0;
-  const auto tie = [&](const std::vector<VariableId>& ids) { TieWithRandomPrior(ids, &rng, &graph); };
-  const auto add_pose = [&] {
-    const Time t = Time::FromSeconds(static_cast<double>(stamp));
-    const VariableId pose =
-        graph.AddVariable({"pose", Manifold::Pose(), testing::RandomPoint(Manifold::Pose(), &rng, 5.0), false, t});
-    VariableId instance = nodes.empty() ? -1 : nodes.back().instance;
-    if (stamp % 3 == 0) {
-      instance = graph.AddVariable({"drift", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), false, t});
-      if (!nodes.empty()) tie({nodes.back().instance, instance});
-    }
-    ++stamp;
-    tie({pose, instance});
-    if (!nodes.empty()) tie({nodes.back().pose, pose, lever});
-    nodes.push_back({pose, instance});
-  };
-  for (int k = 0; k < 8; ++k) add_pose();
+  SlidingWindowWithInstances window(29, 3, false);
+  Graph& graph = window.graph();
+  for (int k = 0; k < 8; ++k) window.AddPose();
 
   internal::NormalEquations incremental;
   const int slides = 15;
   for (int step = 0; step <= slides; ++step) {
     if (step > 0) {
-      // The oldest pose leaves, with its instance when the next pose has another one.
-      std::vector<VariableId> leaving = {nodes.front().pose};
-      if (nodes[1].instance != nodes.front().instance) leaving.push_back(nodes.front().instance);
-      ASSERT_TRUE(Marginalize(leaving, &graph));
-      nodes.pop_front();
-      add_pose();
+      ASSERT_TRUE(window.Slide());
     }
     incremental.Reset(graph, FreeVariableOrder(graph));
     internal::NormalEquations fresh(graph, FreeVariableOrder(graph));
@@ -396,8 +425,8 @@ TEST(NormalEquationsTest, PatternsThatComeBackAsTheWindowSlidesMatchAFreshBuild)
     ASSERT_TRUE(fresh.Solve(0.0, &dx_fresh));
     EXPECT_EQ(dx_incremental, dx_fresh) << "step " << step;
     Eigen::MatrixXd cov_incremental, cov_fresh;
-    ASSERT_TRUE(incremental.Covariance({nodes.front().pose}, &cov_incremental));
-    ASSERT_TRUE(fresh.Covariance({nodes.front().pose}, &cov_fresh));
+    ASSERT_TRUE(incremental.Covariance({window.oldest_pose()}, &cov_incremental));
+    ASSERT_TRUE(fresh.Covariance({window.oldest_pose()}, &cov_fresh));
     EXPECT_EQ(cov_incremental, cov_fresh) << "step " << step;
   }
   // The first patterns are built; from then on most come back from the kept ones (the marginalization prior on the
@@ -514,32 +543,9 @@ TEST(NormalEquationsTest, IncrementalFactorizationOfASlidingWindowMatchesAFreshO
 // first), and the model decrease from -g.dx / 2 that from H to rounding. Reading H once a factor was evaluated again
 // since (a trial point beyond the threshold) is refused.
 TEST(NormalEquationsTest, LinearizationWithoutTheTakenOverBlocksSolvesLikeAComplete) {
-  std::mt19937 rng(31);
-  Graph graph;
-  const VariableId lever =
-      graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d(0.1, 0.2, 0.3), false, std::nullopt});
-  struct Node {
-    VariableId pose;
-    VariableId instance;
-  };
-  std::deque<Node> nodes;
-  int stamp = 0;
-  const auto tie = [&](const std::vector<VariableId>& ids) { TieWithRandomPrior(ids, &rng, &graph); };
-  const auto add_pose = [&] {
-    const Time t = Time::FromSeconds(static_cast<double>(stamp));
-    const VariableId pose =
-        graph.AddVariable({"pose", Manifold::Pose(), testing::RandomPoint(Manifold::Pose(), &rng, 5.0), false, t});
-    VariableId instance = nodes.empty() ? -1 : nodes.back().instance;
-    if (stamp % 2 == 0) {
-      instance = graph.AddVariable({"drift", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), false, t});
-      if (!nodes.empty()) tie({nodes.back().instance, instance});
-    }
-    ++stamp;
-    tie({pose, instance, lever});
-    if (!nodes.empty()) tie({nodes.back().pose, pose, lever});
-    nodes.push_back({pose, instance});
-  };
-  for (int k = 0; k < 10; ++k) add_pose();
+  SlidingWindowWithInstances window(31, 2, true);
+  Graph& graph = window.graph();
+  for (int k = 0; k < 10; ++k) window.AddPose();
   const double threshold = 1e-3;
 
   internal::NormalEquations partial, complete;
@@ -548,14 +554,10 @@ TEST(NormalEquationsTest, LinearizationWithoutTheTakenOverBlocksSolvesLikeACompl
   complete.set_relinearize_threshold(threshold);
   for (int step = 0; step < 12; ++step) {
     if (step > 0) {
-      std::vector<VariableId> leaving = {nodes.front().pose};
-      if (nodes[1].instance != nodes.front().instance) leaving.push_back(nodes.front().instance);
-      ASSERT_TRUE(Marginalize(leaving, &graph));
-      nodes.pop_front();
-      add_pose();
+      ASSERT_TRUE(window.Slide());
     }
     if (step == 6) {  // beyond the threshold: its factors are evaluated again
-      Variable& v = graph.mutable_variable(nodes[5].pose);
+      Variable& v = graph.mutable_variable(window.pose(5));
       const Eigen::VectorXd d = Eigen::VectorXd::Constant(6, 10.0 * threshold);
       v.manifold.Plus(v.value.data(), d.data(), v.value.data());
     }
@@ -817,12 +819,12 @@ TEST(SolverTest, GaussNewtonWorkspaceKeepsTheFinalLinearizationForMarginalizeAnd
   for (const auto& [id, v] : reused.graph.variables()) EXPECT_EQ(v.value, plain.graph.variable(id).value);
 }
 
-// A leaving variable whose own information (1e10) dwarfs the blanket's (1e3), as a pose between 100 Hz odometry and
-// IMU factors does: the stiff factor on (x, y) is absorbed by x entirely, so it must leave no prior on y, whose
-// information stays the weak factor's, rank 2 (y's direction (1, 1, 1) unobserved). The computed Schur complement has an error of about n eps 1e10
-// ~ 1e-5 in that direction (either sign); the old floor (1e-12 of the blanket's largest eigenvalue, 1e-9) kept it when
-// positive, with a mean of rounding / rounding along it. Several stiff couplings (different rounding) must all give
-// the exact rank and the weak factor's minimizer to rounding-level accuracy.
+// A leaving variable whose own information (1e10) dwarfs the blanket's (1e3), as a pose between 100 Hz odometry and IMU
+// factors does: the stiff factor on (x, y) is absorbed by x entirely, so it must leave no prior on y, whose information
+// stays the weak factor's, rank 2 (y's direction (1, 1, 1) unobserved). The computed Schur complement has an error of
+// about n eps 1e10 ~ 1e-5 in that direction (either sign); the old floor (1e-12 of the blanket's largest eigenvalue,
+// 1e-9) kept it when positive, with a mean of rounding / rounding along it. Several stiff couplings (different
+// rounding) must all give the exact rank and the weak factor's minimizer to rounding-level accuracy.
 TEST(MarginalizationTest, StiffLeavingVariableLeavesNoRoundingInThePrior) {
   std::mt19937 rng(11);
   std::normal_distribution<double> normal;
