@@ -7,7 +7,8 @@
 // 1. Simulation of scenarios/atv_hills.yaml with every sensor (multiple of real time).
 // 2. Offline calibration of that recording by roamlab and by the Ceres peer (bench/ceres_peer.h) on the same graph:
 //    one stage with every parameter of scenarios/atv_calibration.yaml free, from the same aligned initial values,
-//    no gating; final costs (both evaluated by roamlab's objective) and parameters compared; time ratio.
+//    no gating; final costs (both evaluated by roamlab's objective) and parameters compared; time ratio (each solver's
+//    least time of three runs).
 // 3. The floor: one CHOLMOD factorization of the final Hessian, against roamlab's time per iteration.
 // 4. Online tracking (scenarios/atv_tracking.yaml, calibrated values of step 2) with windows of 10, 40 and 160 poses,
 //    parameters fixed and under the calibration prior (the configuration's default): multiple of real time by wall
@@ -357,19 +358,34 @@ roamlab::Result<PeerComparison> CompareWithCeres(est::EstimatorConfig config, co
   peer_options.function_tolerance = config.solver.function_tolerance;
   peer_options.parameter_tolerance = config.solver.step_tolerance;
   peer_options.initial_lambda = config.solver.initial_lambda;
-  const roamlab::bench::CeresPeerResult ceres = roamlab::bench::SolveWithCeres(graph, peer_options);
+  // Each solver runs kSolveRuns times from the same values and its least time is kept, as the floor's factorization
+  // (best of 5): other work on the machine only ever slows a run down.
+  constexpr int kSolveRuns = 3;
+  roamlab::bench::CeresPeerResult ceres = roamlab::bench::SolveWithCeres(graph, peer_options);
+  for (int run = 1; run < kSolveRuns && ceres.usable; ++run) {
+    const double fastest = ceres.seconds;
+    ceres = roamlab::bench::SolveWithCeres(graph, peer_options);
+    ceres.seconds = std::min(ceres.seconds, fastest);
+  }
   if (!ceres.usable) return roamlab::Status::Error("Ceres: " + ceres.termination);
   out.ceres_seconds = ceres.seconds;
   out.ceres_iterations = ceres.iterations;
   out.ceres_reported_cost = ceres.final_cost;
   out.ceres_termination = ceres.termination;
 
-  // roamlab from the same values.
-  const double c0 = ProcessCpu();
-  const est::SolverSummary summary = est::Solve(config.solver, &graph);
-  out.roamlab_cpu_seconds = ProcessCpu() - c0;
-  if (!summary.usable()) return roamlab::Status::Error("roamlab: " + summary.message);
-  out.roamlab_seconds = summary.seconds;
+  // roamlab from the same values (restored before each run).
+  std::map<est::VariableId, Eigen::VectorXd> initial_values;
+  for (const auto& [id, v] : graph.variables()) initial_values[id] = v.value;
+  est::SolverSummary summary;
+  out.roamlab_seconds = out.roamlab_cpu_seconds = 1e9;
+  for (int run = 0; run < kSolveRuns; ++run) {
+    for (const auto& [id, value] : initial_values) graph.mutable_variable(id).value = value;
+    const double c0 = ProcessCpu();
+    summary = est::Solve(config.solver, &graph);
+    out.roamlab_cpu_seconds = std::min(out.roamlab_cpu_seconds, ProcessCpu() - c0);
+    if (!summary.usable()) return roamlab::Status::Error("roamlab: " + summary.message);
+    out.roamlab_seconds = std::min(out.roamlab_seconds, summary.seconds);
+  }
   out.roamlab_iterations = summary.iterations;
   out.roamlab_reported_cost = summary.final_cost;
   out.roamlab_termination = est::TerminationName(summary.termination);
