@@ -1,0 +1,53 @@
+// The diagnosis's last step on the simulator's side (issue 6, "Shows": "re-simulates ... with the patch and compares
+// before/after on held-out data"): the nominal scenario is simulated again without sensor noise over the recording's
+// span, once as believed and once with the accepted effects applied as the simulator applies them, and each of the
+// recording's streams is compared sample by sample with both simulations on the held-out part.
+//
+// The simulation is driven by the scenario's own driver, so the comparison means something only for a recording of the
+// scenario's drive (a simulated recording with hidden effects, or a real robot driven by the same command schedule):
+// a recording of another drive differs everywhere, before and after. Streams are matched by name and sample time; a
+// residual is recorded minus simulated, in units of the stream's stated noise (recording.yaml `noise`: the imu's
+// gyro_sigma_radps and accel_sigma_mps2, sigma_m of a GPS fix per ENU axis, sigma_mps, sigma_rad, ...; a wheel
+// encoder's tick / sqrt(12)); streams with no stated noise are left out. With the drive reproduced, what is left
+// before is the recording's noise plus the effect's signature, after the noise plus what the fitted effect misses.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "common/status.h"
+#include "gap/diagnose.h"
+#include "recording/recording.h"
+#include "sim/scenario.h"
+
+namespace roamlab::gap {
+
+// An accepted effect as the simulator's scenario effect (sim/scenario.h): the parameters the simulator knows, and
+// lateral_slip's rear cornering compliance as the tires' contact time scale (+0.0203 s per unit above 1, measured on
+// atv_hills_sines.yaml, sim/scenario.h), within the simulator's [1, 4]. `std` gets the parameters' standard deviations
+// in the same units (may be null).
+sim::EffectOptions SimulatorEffect(const EffectEstimate& effect, std::map<std::string, double>* std = nullptr);
+
+struct SimulatedStreamFit {
+  double rms = 0.0;                    // over the compared samples and components, in units of the stated noise
+  std::vector<double> component_rms;   // per component (a GPS stream's East, North, Up)
+  int samples = 0;                     // samples matched in time
+};
+
+struct SimulationComparison {
+  double from_s = 0.0;                                        // compared from here to the end of the recording
+  double duration_s = 0.0;                                    // of the simulations
+  std::map<std::string, SimulatedStreamFit> before, after;    // as believed; with the effects. The imu's columns as
+                                                              // "gyroscope" and "accelerometer"
+  std::vector<std::string> left_out;                          // streams not compared, with the reason
+  std::string not_simulated;   // why the simulation with the effects failed (then `after` is empty)
+};
+
+// Simulates `nominal` (its effects replaced) without noise, without and with `effects`, and compares them with
+// `recording` from `from_s` on. Errors: a recording of another robot kind, a failed nominal simulation.
+Result<SimulationComparison> CompareWithSimulation(const sim::Scenario& nominal,
+                                                   const std::vector<EffectEstimate>& effects,
+                                                   const recording::Recording& recording, double from_s);
+
+}  // namespace roamlab::gap
