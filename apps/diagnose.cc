@@ -14,6 +14,7 @@
 #include "estimator/config.h"
 #include "eval/plots.h"
 #include "gap/diagnose.h"
+#include "gap/resimulate.h"
 #include "recording/recording.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
@@ -144,7 +145,8 @@ std::vector<std::string> WritePlots(const gap::Diagnosis& d, const std::string& 
 }
 
 std::string Report(const gap::Diagnosis& d, const std::string& recording, const std::string& scenario,
-                   bool baseline, const std::vector<std::string>& images) {
+                   bool baseline, const gap::SimulationComparison* simulation,
+                   const std::vector<std::string>& images) {
   std::ostringstream r;
   r << "# Reality-gap diagnosis\n\nRecording `" << recording << "` against the nominal scenario `" << scenario
     << "`.\n\n## Verdict: **" << d.verdict << "**\n\n";
@@ -200,6 +202,27 @@ std::string Report(const gap::Diagnosis& d, const std::string& recording, const 
     r << "| " << name << " | " << Fixed(b.rms, 4) << " | " << Fixed(a.rms, 4) << " | " << Fixed(b.rms_1s, 4) << " | "
       << Fixed(a.rms_1s, 4) << " | " << Fixed(b.chi2_per_dof, 4) << " | " << Fixed(a.chi2_per_dof, 4) << " |\n";
   }
+  if (simulation) {
+    r << "\n## The simulation against the recording (held-out part, after t = " << Fixed(simulation->from_s, 4)
+      << " s)\n\nThe nominal scenario simulated again without noise, as believed and with the accepted effects "
+         "applied (scenario_patch.yaml), compared sample by sample with the recording: RMS of recorded minus "
+         "simulated in units of each stream's stated noise (1 = noise only; meaningful for a recording of the "
+         "scenario's drive).\n\n| stream | RMS as believed | RMS with the effects | change |\n|---|---|---|---|\n";
+    for (const auto& [name, b] : simulation->before) {
+      const auto a = simulation->after.find(name);
+      r << "| " << name << " | " << Fixed(b.rms, 4) << " | ";
+      if (a == simulation->after.end()) {
+        r << "- | - |\n";
+        continue;
+      }
+      r << Fixed(a->second.rms, 4) << " | "
+        << (b.rms > 0.0 ? Fixed(100.0 * (a->second.rms / b.rms - 1.0), 3) + " %" : std::string("-")) << " |\n";
+    }
+    for (const std::string& l : simulation->left_out) r << "\nNot compared: " << l << ".";
+    if (!simulation->not_simulated.empty())
+      r << "\nThe effects could not be simulated: " << simulation->not_simulated << ".";
+    r << "\n";
+  }
   r << "\n";
   for (const std::string& image : images) r << "![" << image << "](" << image << ")\n\n";
   r << d.fits << " calibrations in " << Fixed(d.seconds, 3) << " s.\n";
@@ -212,10 +235,20 @@ std::string ScenarioPatch(const gap::Diagnosis& d) {
     << "# Standard deviations are comments.\neffects:\n";
   if (d.effects.empty()) y << "  []\n";
   for (const gap::EffectEstimate& e : d.effects) {
-    y << "  - name: " << e.name << "\n    parameters:\n";
-    for (const auto& [k, v] : e.parameters) {
+    std::map<std::string, double> std;
+    const sim::EffectOptions effect = gap::SimulatorEffect(e, &std);
+    y << "  - name: " << e.name << "\n";
+    bool same = effect.parameters.size() == e.parameters.size();
+    for (const auto& [k, v] : effect.parameters) same = same && e.parameters.count(k);
+    if (!same) {   // parameters the simulator takes in another form (lateral_slip): the diagnosed ones as comments
+      y << "    # diagnosed:";
+      for (const auto& [k, v] : e.parameters) y << " " << k << " = " << std::setprecision(6) << v;
+      y << "\n";
+    }
+    y << "    parameters:\n";
+    for (const auto& [k, v] : effect.parameters) {
       y << "      " << k << ": " << std::setprecision(10) << v;
-      if (e.std.count(k) && std::isfinite(e.std.at(k))) y << "   # +- " << std::setprecision(3) << e.std.at(k);
+      if (std.count(k) && std::isfinite(std.at(k))) y << "   # +- " << std::setprecision(3) << std.at(k);
       y << "\n";
     }
   }
@@ -240,7 +273,20 @@ std::string EstimatorPatch(const gap::Diagnosis& d) {
 
 }  // namespace
 
-json DiagnosisJson(const gap::Diagnosis& d, const gap::Baseline* baseline, std::uint64_t baseline_seed) {
+json SimulationJson(const gap::SimulationComparison& c) {
+  const auto fits = [](const std::map<std::string, gap::SimulatedStreamFit>& m) {
+    json j = json::object();
+    for (const auto& [name, f] : m)
+      j[name] = {{"rms", Number(f.rms)}, {"component_rms", f.component_rms}, {"samples", f.samples}};
+    return j;
+  };
+  return {{"from_s", c.from_s},         {"duration_s", c.duration_s}, {"before", fits(c.before)},
+          {"after", fits(c.after)},     {"left_out", c.left_out},
+          {"not_simulated", c.not_simulated.empty() ? json(nullptr) : json(c.not_simulated)}};
+}
+
+json DiagnosisJson(const gap::Diagnosis& d, const gap::Baseline* baseline, std::uint64_t baseline_seed,
+                   const gap::SimulationComparison* simulation) {
   json located = json::array(), components = json::array(), effects = json::array(), candidates = json::array();
   for (const gap::LocatedComponent& lc : d.located) {
     components.push_back(LocatedJson(lc));
@@ -265,6 +311,7 @@ json DiagnosisJson(const gap::Diagnosis& d, const gap::Baseline* baseline, std::
           {"candidates", candidates},
           {"components", components},
           {"baseline", base},
+          {"simulation", simulation ? SimulationJson(*simulation) : json(nullptr)},
           {"run", {{"fits", d.fits}, {"seconds", d.seconds}}}};
 }
 
@@ -343,8 +390,18 @@ int RunDiagnose(const DiagnoseArgs& args) {
   if (!diagnosis.ok()) return fail(diagnosis.status().message());
   const gap::Diagnosis& d = diagnosis.value();
 
+  // The simulation again, as believed and with the accepted effects, against the recording's held-out part.
+  std::optional<gap::SimulationComparison> simulation;
+  if (scenario) {
+    say("re-simulating the nominal scenario without noise, as believed and with the accepted effects");
+    auto compared = gap::CompareWithSimulation(*scenario, d.effects, recording, d.train_end_s);
+    if (!compared.ok()) return fail("re-simulation: " + compared.status().message());
+    simulation = std::move(compared).value();
+  }
+
   // gap.json, the patches, the figures and the report.
-  const json gap_json = DiagnosisJson(d, args.no_baseline ? nullptr : &baseline, args.baseline_seed);
+  const json gap_json = DiagnosisJson(d, args.no_baseline ? nullptr : &baseline, args.baseline_seed,
+                                      simulation ? &*simulation : nullptr);
   if (Status s = WriteText(args.out + "/gap.json", gap_json.dump(2) + "\n"); !s.ok()) return fail(s.message());
   if (Status s = WriteText(args.out + "/scenario_patch.yaml", ScenarioPatch(d)); !s.ok()) return fail(s.message());
   if (Status s = WriteText(args.out + "/estimator_patch.yaml", EstimatorPatch(d)); !s.ok()) return fail(s.message());
@@ -352,7 +409,7 @@ int RunDiagnose(const DiagnoseArgs& args) {
   const std::vector<std::string> images = args.no_plots ? std::vector<std::string>{} : WritePlots(d, args.out, &note);
   if (!note.empty()) say(note);
   const std::string report = Report(d, args.recording, args.scenario.empty() ? args.config : args.scenario,
-                                    !args.no_baseline, images);
+                                    !args.no_baseline, simulation ? &*simulation : nullptr, images);
   if (Status s = WriteText(args.out + "/report.md", report); !s.ok())
     return fail(s.message());
   std::string summary = "verdict: " + d.verdict;

@@ -4,7 +4,9 @@
 // that, to learn the levels and candidate gains the nominal model reaches on MuJoCo data without any hidden effect.
 // Writes DIR/gap.json, DIR/report.md, DIR/scenario_patch.yaml (the accepted effects in the scenario's `effects:`
 // form), DIR/estimator_patch.yaml (the same as estimator parameters and stream time shifts) and PNG figures with
-// their gnuplot scripts. Exit codes: 0 done, 2 bad input (one line naming the file), 1 a failure at run time.
+// their gnuplot scripts. With a scenario, the nominal scenario is simulated again without noise, as believed and with
+// the accepted effects, and compared with the recording's held-out part (gap/resimulate.h; gap.json "simulation").
+// Exit codes: 0 done, 2 bad input (one line naming the file), 1 a failure at run time.
 #pragma once
 
 #include <cstdint>
@@ -14,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gap/diagnose.h"
+#include "gap/resimulate.h"
 
 namespace roamlab::apps {
 
@@ -32,7 +35,9 @@ struct DiagnoseArgs {
 };
 int RunDiagnose(const DiagnoseArgs& args);
 
-// A diagnosis as DIR/gap.json (README, `roamlab diagnose`); `baseline` null: diagnosed without one.
-nlohmann::json DiagnosisJson(const gap::Diagnosis& d, const gap::Baseline* baseline, std::uint64_t baseline_seed);
+// A diagnosis as DIR/gap.json (README, `roamlab diagnose`); `baseline` null: diagnosed without one; `simulation` null:
+// no re-simulation (a robot without a MuJoCo twin).
+nlohmann::json DiagnosisJson(const gap::Diagnosis& d, const gap::Baseline* baseline, std::uint64_t baseline_seed,
+                             const gap::SimulationComparison* simulation);
 
 }  // namespace roamlab::apps

@@ -20,6 +20,7 @@
 #include "apps/diagnose.h"
 #include "apps/gap_benchmark_score.h"
 #include "gap/diagnose.h"
+#include "gap/resimulate.h"
 #include "recording/recording.h"
 #include "recording/truth.h"
 #include "sim/scenario.h"
@@ -57,6 +58,17 @@ std::string AffectedStream(const std::string& effect) {
   if (effect == "imu_time_offset" || effect == "gyro_scale_error" || effect == "gyro_bias_drift") return "gyroscope";
   if (effect == "magnetometer_motor_interference") return "magnetometer";
   return "odometer";
+}
+
+// The recording's stream in which the effect shows when the scenario is simulated again (gap/resimulate.h): sensor
+// effects in their sensor; physical ones (the drive is open-loop: the same commands) where the changed motion shows,
+// the ATV's path in its GPS fixes, an indoor robot's turn rate in its gyroscope.
+std::string SimulatedStream(const std::string& effect) {
+  if (effect == "gps_latency" || effect == "lateral_slip" || effect == "axle_misalignment") return "gps";
+  if (effect == "magnetometer_motor_interference") return "magnetometer";
+  if (effect == "steering_offset") return "steering";
+  if (effect == "longitudinal_slip" || effect == "slope_slip") return "rear_wheel";
+  return "gyroscope";
 }
 
 // Platform 0 is the ATV (half of the cases: its library is the largest), 1 the differential drive and 2 the mecanum
@@ -278,7 +290,11 @@ Result<CaseResult> RunCase(const Platform& platform, const Draw& draw, std::uint
   const gap::Diagnosis& d = diagnosed.value();
   // The diagnosis as `roamlab diagnose` writes it (located components, candidates, held-out fit before and after),
   // for the study of a case.
-  std::ofstream(dir + "/gap.json") << DiagnosisJson(d, &platform.baseline, kBaselineSeed).dump(2) << "\n";
+  // The nominal scenario simulated again, as believed and with the accepted effects, against the held-out part.
+  auto simulation = gap::CompareWithSimulation(platform.scenario, d.effects, rec.value(), d.train_end_s);
+  if (!simulation.ok()) return Status::Error("re-simulation: " + simulation.status().message());
+  std::ofstream(dir + "/gap.json") << DiagnosisJson(d, &platform.baseline, kBaselineSeed, &simulation.value()).dump(2)
+                                   << "\n";
 
   CaseResult c;
   c.id = id;
@@ -324,6 +340,14 @@ Result<CaseResult> RunCase(const Platform& platform, const Draw& draw, std::uint
       c.rms_1s_before = d.before.at(stream).rms_1s;
       c.rms_1s_after = d.after.at(stream).rms_1s;
       c.has_rms = true;
+    }
+    c.sim_stream = SimulatedStream(c.truth_name);
+    const auto before = simulation.value().before.find(c.sim_stream);
+    const auto after = simulation.value().after.find(c.sim_stream);
+    if (before != simulation.value().before.end() && after != simulation.value().after.end()) {
+      c.sim_rms_before = before->second.rms;
+      c.sim_rms_after = after->second.rms;
+      c.has_sim_rms = true;
     }
   }
   c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

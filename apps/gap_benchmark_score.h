@@ -63,6 +63,11 @@ struct CaseResult {
   double rms_before = 0.0, rms_after = 0.0;   // held-out whitened RMS of the affected stream
   double rms_1s_before = 0.0, rms_1s_after = 0.0;   // its systematic part (gap::StreamFit::rms_1s)
   bool has_rms = false;
+  // The re-simulation's (gap/resimulate.h): RMS of recorded minus simulated in the stream the effect shows in
+  // (SimulatedStream), in units of its stated noise, on the held-out part, as believed and with the accepted effects.
+  std::string sim_stream;
+  double sim_rms_before = 0.0, sim_rms_after = 0.0;
+  bool has_sim_rms = false;
   std::vector<CandidateStats> candidates;  // first round
   double seconds = 0.0;
 };

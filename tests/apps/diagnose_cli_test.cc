@@ -67,6 +67,12 @@ TEST(DiagnoseCliTest, NeverOpensTruthYamlAndWritesGapJson) {
   EXPECT_EQ(gap["candidates"].size(), 9u);
   EXPECT_TRUE(std::ifstream(dir.File("out/report.md")).good());
   EXPECT_TRUE(std::ifstream(dir.File("out/scenario_patch.yaml")).good());
+  // The re-simulation as believed sees the hidden offset in the steering stream: 0.03 rad on a sensor of 0.014 rad
+  // noise is a whitened RMS of sqrt(1 + (0.03 / 0.014)^2) = 2.36 (over 200 samples: +-0.05).
+  ASSERT_TRUE(gap.contains("simulation") && gap["simulation"].contains("before")) << gap.dump();
+  const nlohmann::json& steering = gap["simulation"]["before"]["steering"];
+  EXPECT_NEAR(steering["rms"].get<double>(), 2.36, 0.2) << steering.dump();
+  EXPECT_GT(steering["samples"].get<int>(), 100);
 }
 
 TEST(DiagnoseCliTest, RefusesARecordingOfAnotherRobotKind) {
