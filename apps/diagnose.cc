@@ -229,14 +229,18 @@ std::string Report(const gap::Diagnosis& d, const std::string& recording, const 
   return r.str();
 }
 
-std::string ScenarioPatch(const gap::Diagnosis& d) {
+// The accepted effects as the simulator takes them: as simulated when the scenario was simulated again (time shifts
+// in whole physics steps), otherwise converted without the step.
+std::string ScenarioPatch(const gap::Diagnosis& d, const gap::SimulationComparison* simulation) {
   std::ostringstream y;
   y << "# Accepted effects of `roamlab diagnose`, in the form of a scenario's `effects:` section (sim/scenario.h).\n"
     << "# Standard deviations are comments.\neffects:\n";
   if (d.effects.empty()) y << "  []\n";
-  for (const gap::EffectEstimate& e : d.effects) {
+  for (std::size_t i = 0; i < d.effects.size(); ++i) {
+    const gap::EffectEstimate& e = d.effects[i];
     std::map<std::string, double> std;
-    const sim::EffectOptions effect = gap::SimulatorEffect(e, &std);
+    sim::EffectOptions effect = gap::SimulatorEffect(e, &std);
+    if (simulation && simulation->effects.size() == d.effects.size()) effect = simulation->effects[i];
     y << "  - name: " << e.name << "\n";
     bool same = effect.parameters.size() == e.parameters.size();
     for (const auto& [k, v] : effect.parameters) same = same && e.parameters.count(k);
@@ -280,8 +284,10 @@ json SimulationJson(const gap::SimulationComparison& c) {
       j[name] = {{"rms", Number(f.rms)}, {"component_rms", f.component_rms}, {"samples", f.samples}};
     return j;
   };
-  return {{"from_s", c.from_s},         {"duration_s", c.duration_s}, {"before", fits(c.before)},
-          {"after", fits(c.after)},     {"left_out", c.left_out},
+  json effects = json::array();
+  for (const sim::EffectOptions& e : c.effects) effects.push_back({{"name", e.name}, {"parameters", e.parameters}});
+  return {{"from_s", c.from_s},         {"duration_s", c.duration_s}, {"effects", effects},
+          {"before", fits(c.before)},   {"after", fits(c.after)},     {"left_out", c.left_out},
           {"not_simulated", c.not_simulated.empty() ? json(nullptr) : json(c.not_simulated)}};
 }
 
@@ -403,7 +409,8 @@ int RunDiagnose(const DiagnoseArgs& args) {
   const json gap_json = DiagnosisJson(d, args.no_baseline ? nullptr : &baseline, args.baseline_seed,
                                       simulation ? &*simulation : nullptr);
   if (Status s = WriteText(args.out + "/gap.json", gap_json.dump(2) + "\n"); !s.ok()) return fail(s.message());
-  if (Status s = WriteText(args.out + "/scenario_patch.yaml", ScenarioPatch(d)); !s.ok()) return fail(s.message());
+  const std::string patch = ScenarioPatch(d, simulation ? &*simulation : nullptr);
+  if (Status s = WriteText(args.out + "/scenario_patch.yaml", patch); !s.ok()) return fail(s.message());
   if (Status s = WriteText(args.out + "/estimator_patch.yaml", EstimatorPatch(d)); !s.ok()) return fail(s.message());
   std::string note;
   const std::vector<std::string> images = args.no_plots ? std::vector<std::string>{} : WritePlots(d, args.out, &note);

@@ -143,7 +143,8 @@ std::map<std::string, SimulatedStreamFit> Compare(const recording::Recording& re
 
 }  // namespace
 
-sim::EffectOptions SimulatorEffect(const EffectEstimate& effect, std::map<std::string, double>* std) {
+sim::EffectOptions SimulatorEffect(const EffectEstimate& effect, std::map<std::string, double>* std,
+                                   double physics_step_s) {
   sim::EffectOptions e;
   e.name = effect.name;
   if (effect.name == "lateral_slip") {
@@ -156,9 +157,10 @@ sim::EffectOptions SimulatorEffect(const EffectEstimate& effect, std::map<std::s
   }
   const auto known = sim::KnownEffects().find(effect.name);
   if (known == sim::KnownEffects().end()) return e;
+  const bool shift = effect.name == "gps_latency" || effect.name == "imu_time_offset";
   for (const auto& [name, value] : effect.parameters) {
     if (!known->second.count(name)) continue;
-    e.parameters[name] = value;
+    e.parameters[name] = shift && physics_step_s > 0.0 ? std::round(value / physics_step_s) * physics_step_s : value;
     if (std && effect.std.count(name)) (*std)[name] = effect.std.at(name);
   }
   return e;
@@ -182,10 +184,15 @@ Result<SimulationComparison> CompareWithSimulation(const sim::Scenario& nominal,
   sim::SimulateOptions options;
   options.noise = false;
   const Time from = Time::FromSeconds(from_s);
+  double step_s = 0.0;
   for (const bool patched : {false, true}) {
-    if (patched)
-      for (const EffectEstimate& e : effects) scenario.effects.push_back(SimulatorEffect(e));
-    auto simulated = sim::Simulate(scenario, options);
+    if (patched) {
+      for (const EffectEstimate& e : effects) scenario.effects.push_back(SimulatorEffect(e, nullptr, step_s));
+      out.effects = scenario.effects;
+    }
+    auto simulator = sim::Simulator::Create(scenario, options);
+    if (!patched && simulator.ok()) step_s = simulator.value()->PhysicsStepS();
+    auto simulated = simulator.ok() ? simulator.value()->Run() : Result<sim::Simulation>(simulator.status());
     if (!simulated.ok() && !patched) return Status::Error("the nominal simulation: " + simulated.status().message());
     if (!simulated.ok()) {
       out.not_simulated = simulated.status().message();

@@ -143,6 +143,7 @@ class Simulator::Impl {
     return geometry;
   }
   double VehicleMassKg() const { return ackermann_ ? vehicle_.mass_kg() : 0.0; }
+  double PhysicsStepS() const { return static_cast<double>(step_ns_) * 1e-9; }
 
   // Compiles the world, binds the vehicle, sets up clocks, streams and noise, and places the vehicle.
   Status Setup() {
@@ -835,6 +836,11 @@ std::map<std::string, double> Simulator::PlatformGeometry() const {
 double Simulator::VehicleMassKg() const {
   ROAMLAB_CHECK(impl_ != nullptr, "Simulator::VehicleMassKg called after Run");
   return impl_->VehicleMassKg();
+}
+
+double Simulator::PhysicsStepS() const {
+  ROAMLAB_CHECK(impl_ != nullptr, "Simulator::PhysicsStepS called after Run");
+  return impl_->PhysicsStepS();
 }
 
 namespace {

@@ -91,6 +91,8 @@ class Simulator {
   std::map<std::string, double> PlatformGeometry() const;
   // The Ackermann vehicle's mass [kg] on the bound model (0 for other robots). Before Run.
   double VehicleMassKg() const;
+  // The compiled model's physics step [s] (time shifts of effects are whole numbers of it). Before Run.
+  double PhysicsStepS() const;
 
  private:
   class Impl;
