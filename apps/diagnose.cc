@@ -207,16 +207,18 @@ std::string Report(const gap::Diagnosis& d, const std::string& recording, const 
       << " s)\n\nThe nominal scenario simulated again without noise, as believed and with the accepted effects "
          "applied (scenario_patch.yaml), compared sample by sample with the recording: RMS of recorded minus "
          "simulated in units of each stream's stated noise (1 = noise only; meaningful for a recording of the "
-         "scenario's drive).\n\n| stream | RMS as believed | RMS with the effects | change |\n|---|---|---|---|\n";
+         "scenario's drive), and of its 1 s means (the systematic part).\n\n| stream | RMS as believed | RMS with the "
+         "effects | change | 1 s RMS as believed | 1 s RMS with the effects |\n|---|---|---|---|---|---|\n";
     for (const auto& [name, b] : simulation->before) {
       const auto a = simulation->after.find(name);
       r << "| " << name << " | " << Fixed(b.rms, 4) << " | ";
       if (a == simulation->after.end()) {
-        r << "- | - |\n";
+        r << "- | - | " << Fixed(b.rms_1s, 4) << " | - |\n";
         continue;
       }
       r << Fixed(a->second.rms, 4) << " | "
-        << (b.rms > 0.0 ? Fixed(100.0 * (a->second.rms / b.rms - 1.0), 3) + " %" : std::string("-")) << " |\n";
+        << (b.rms > 0.0 ? Fixed(100.0 * (a->second.rms / b.rms - 1.0), 3) + " %" : std::string("-")) << " | "
+        << Fixed(b.rms_1s, 4) << " | " << Fixed(a->second.rms_1s, 4) << " |\n";
     }
     for (const std::string& l : simulation->left_out) r << "\nNot compared: " << l << ".";
     if (!simulation->not_simulated.empty())
@@ -281,7 +283,8 @@ json SimulationJson(const gap::SimulationComparison& c) {
   const auto fits = [](const std::map<std::string, gap::SimulatedStreamFit>& m) {
     json j = json::object();
     for (const auto& [name, f] : m)
-      j[name] = {{"rms", Number(f.rms)}, {"component_rms", f.component_rms}, {"samples", f.samples}};
+      j[name] = {{"rms", Number(f.rms)}, {"rms_1s", Number(f.rms_1s)}, {"component_rms", f.component_rms},
+                 {"samples", f.samples}};
     return j;
   };
   json effects = json::array();

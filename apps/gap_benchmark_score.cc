@@ -195,7 +195,8 @@ json Summarize(const std::vector<CaseResult>& cases, double min_noise_ratio) {
   int effects = 0, top1 = 0, top3 = 0, strong = 0, strong_top1 = 0, strong_top3 = 0;
   int nones = 0, none_false = 0, none_none = 0, decoys = 0, decoy_false = 0, decoy_unknown = 0, decoy_unknown_any = 0;
   int top1_unknown = 0;
-  std::vector<double> relative_error, rms_named, rms_all, rms_1s_named, rms_1s_all, sim_named, sim_all;
+  std::vector<double> relative_error, rms_named, rms_all, rms_1s_named, rms_1s_all, sim_named, sim_all, sim_1s_named,
+      sim_1s_all;
   std::map<std::string, std::pair<int, int>> by_effect;   // name -> (top-1 correct, cases)
   for (const CaseResult& c : cases) {
     const std::string kept = FirstKept(c);
@@ -240,6 +241,11 @@ json Summarize(const std::vector<CaseResult>& cases, double min_noise_ratio) {
       sim_all.push_back(reduction);
       if (first) sim_named.push_back(reduction);
     }
+    if (c.has_sim_rms && c.sim_rms_1s_before > 0.0) {
+      const double reduction = 1.0 - c.sim_rms_1s_after / c.sim_rms_1s_before;
+      sim_1s_all.push_back(reduction);
+      if (first) sim_1s_named.push_back(reduction);
+    }
     if (c.has_rms && c.rms_1s_before > 0.0) {
       const double reduction = 1.0 - c.rms_1s_after / c.rms_1s_before;
       rms_1s_all.push_back(reduction);
@@ -255,6 +261,7 @@ json Summarize(const std::vector<CaseResult>& cases, double min_noise_ratio) {
   const json rms = Number(Median(rms_named));
   const json rms_1s = Number(Median(rms_1s_named));
   const json sim = Number(Median(sim_named));
+  const json sim_1s = Number(Median(sim_1s_named));
   return {{"effect_cases", effects},
           {"top1", Fraction(top1, effects)},
           {"top3", Fraction(top3, effects)},
@@ -279,6 +286,8 @@ json Summarize(const std::vector<CaseResult>& cases, double min_noise_ratio) {
           {"median_heldout_rms_1s_reduction_all_effect_cases", Number(Median(rms_1s_all))},
           {"median_resimulated_rms_reduction", sim},
           {"median_resimulated_rms_reduction_all_effect_cases", Number(Median(sim_all))},
+          {"median_resimulated_rms_1s_reduction", sim_1s},
+          {"median_resimulated_rms_1s_reduction_all_effect_cases", Number(Median(sim_1s_all))},
           {"targets",
            {{"top1_strong", Target(top1_strong, 0.85, true)},
             {"false_discovery_rate", Target(false_rate, kMaxNoneFalseRate, false)},
@@ -286,7 +295,8 @@ json Summarize(const std::vector<CaseResult>& cases, double min_noise_ratio) {
             {"median_parameter_relative_error", Target(rel, 0.15, false)},
             {"median_heldout_rms_reduction", Target(rms, 0.30, true)},
             {"median_heldout_rms_1s_reduction", Target(rms_1s, 0.30, true)},
-            {"median_resimulated_rms_reduction", Target(sim, 0.30, true)}}}};
+            {"median_resimulated_rms_reduction", Target(sim, 0.30, true)},
+            {"median_resimulated_rms_1s_reduction", Target(sim_1s, 0.30, true)}}}};
 }
 
 json CaseRow(const CaseResult& c) {
@@ -318,6 +328,8 @@ json CaseRow(const CaseResult& c) {
           {"resimulated_stream", c.has_sim_rms ? json(c.sim_stream) : json(nullptr)},
           {"resimulated_rms_before", c.has_sim_rms ? json(c.sim_rms_before) : json(nullptr)},
           {"resimulated_rms_after", c.has_sim_rms ? json(c.sim_rms_after) : json(nullptr)},
+          {"resimulated_rms_1s_before", c.has_sim_rms ? json(c.sim_rms_1s_before) : json(nullptr)},
+          {"resimulated_rms_1s_after", c.has_sim_rms ? json(c.sim_rms_1s_after) : json(nullptr)},
           {"candidates", candidates},
           {"seconds", c.seconds}};
 }

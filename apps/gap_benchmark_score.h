@@ -67,6 +67,7 @@ struct CaseResult {
   // (SimulatedStream), in units of its stated noise, on the held-out part, as believed and with the accepted effects.
   std::string sim_stream;
   double sim_rms_before = 0.0, sim_rms_after = 0.0;
+  double sim_rms_1s_before = 0.0, sim_rms_1s_after = 0.0;   // of its 1 s means
   bool has_sim_rms = false;
   std::vector<CandidateStats> candidates;  // first round
   double seconds = 0.0;

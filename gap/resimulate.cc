@@ -63,10 +63,18 @@ std::vector<double> ColumnSigmas(const recording::StreamInfo& info) {
   }
 }
 
-// Sums of squared whitened residuals per component, accumulated over matched samples.
+// Whitened residuals of one stream (or the imu's gyroscope or accelerometer columns): sums of squares per component,
+// and per 1 s window from the first compared sample (gap::kSystematicWindowS, as StreamFits) their sums.
 struct Accumulator {
-  std::vector<double> sum_squares;
-  int samples = 0;
+  explicit Accumulator(int components) : sum_squares(static_cast<std::size_t>(components), 0.0) {}
+
+  void Add(Time t, const Eigen::VectorXd& whitened) {
+    for (int k = 0; k < whitened.size(); ++k) sum_squares[static_cast<std::size_t>(k)] += whitened[k] * whitened[k];
+    if (samples++ == 0) first = t;
+    auto& [sum, count] = windows[static_cast<long>(std::floor(SecondsBetween(first, t) / kSystematicWindowS))];
+    if (count++ == 0) sum = Eigen::VectorXd::Zero(whitened.size());
+    sum += whitened;
+  }
 
   SimulatedStreamFit Fit() const {
     SimulatedStreamFit f;
@@ -78,8 +86,17 @@ struct Accumulator {
     }
     const double count = static_cast<double>(samples) * static_cast<double>(sum_squares.size());
     f.rms = count > 0.0 ? std::sqrt(total / count) : 0.0;
+    double window_squares = 0.0;
+    for (const auto& [w, window] : windows) window_squares += (window.first / window.second).squaredNorm();
+    const double terms = static_cast<double>(windows.size()) * static_cast<double>(sum_squares.size());
+    f.rms_1s = terms > 0.0 ? std::sqrt(window_squares / terms) : 0.0;
     return f;
   }
+
+  std::vector<double> sum_squares;
+  int samples = 0;
+  Time first;
+  std::map<long, std::pair<Eigen::VectorXd, int>> windows;
 };
 
 // Compares every stream of `recorded` with the same-named stream of `simulated`, from `from` on.
@@ -111,25 +128,21 @@ std::map<std::string, SimulatedStreamFit> Compare(const recording::Recording& re
       return v;
     };
     const bool imu = rec.info.type == StreamType::kImu;
-    Accumulator gyro, accel, whole;
-    for (Accumulator* a : {&gyro, &accel}) a->sum_squares.assign(3, 0.0);
-    whole.sum_squares.assign(static_cast<std::size_t>(n), 0.0);
+    Accumulator gyro(3), accel(3), whole(n);
     std::size_t j = 0;
     for (std::size_t i = 0; i < rec.t.size(); ++i) {
       if (rec.t[i] < from) continue;
       while (j < sim->t.size() && sim->t[j] < rec.t[i]) ++j;
       if (j == sim->t.size()) break;
       if (sim->t[j] != rec.t[i]) continue;
-      const Eigen::VectorXd r = value(rec, i) - value(*sim, j);
-      for (int k = 0; k < n; ++k) {
-        const double w = r[k] / sigma[static_cast<std::size_t>(k)];
-        if (imu)
-          (k < 3 ? gyro : accel).sum_squares[static_cast<std::size_t>(k % 3)] += w * w;
-        else
-          whole.sum_squares[static_cast<std::size_t>(k)] += w * w;
+      Eigen::VectorXd w = value(rec, i) - value(*sim, j);
+      for (int k = 0; k < n; ++k) w[k] /= sigma[static_cast<std::size_t>(k)];
+      if (imu) {
+        gyro.Add(rec.t[i], w.head(3));
+        accel.Add(rec.t[i], w.tail(3));
+      } else {
+        whole.Add(rec.t[i], w);
       }
-      ++(imu ? gyro.samples : whole.samples);
-      if (imu) ++accel.samples;
     }
     if (imu) {
       out["gyroscope"] = gyro.Fit();

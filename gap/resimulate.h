@@ -33,6 +33,7 @@ sim::EffectOptions SimulatorEffect(const EffectEstimate& effect, std::map<std::s
 
 struct SimulatedStreamFit {
   double rms = 0.0;                    // over the compared samples and components, in units of the stated noise
+  double rms_1s = 0.0;                 // of the 1 s means per component (the systematic part, as StreamFit::rms_1s)
   std::vector<double> component_rms;   // per component (a GPS stream's East, North, Up)
   int samples = 0;                     // samples matched in time
 };

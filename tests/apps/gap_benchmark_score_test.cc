@@ -233,6 +233,13 @@ TEST(GapBenchmarkScore, SummarizesTheIssuesFigures) {
   right.rms_before = 2.0;
   right.rms_after = 1.0;
   right.has_rms = true;
+  // The re-simulation: 1.5 -> 1.2 per sample (20 %), 0.4 -> 0.1 in the 1 s means (75 %).
+  right.sim_stream = "gyroscope";
+  right.sim_rms_before = 1.5;
+  right.sim_rms_after = 1.2;
+  right.sim_rms_1s_before = 0.4;
+  right.sim_rms_1s_after = 0.1;
+  right.has_sim_rms = true;
   cases.push_back(right);
   // Strong effect, second in the ranking: top-3 but not top-1; RMS 1.2 -> 1.14 (5 %).
   CaseResult second = Scored("effect", "gps_latency", "named", {"imu_time_offset"}, 4.0);
@@ -241,6 +248,11 @@ TEST(GapBenchmarkScore, SummarizesTheIssuesFigures) {
   second.rms_before = 1.2;
   second.rms_after = 1.14;
   second.has_rms = true;
+  second.sim_rms_before = 2.0;
+  second.sim_rms_after = 1.0;
+  second.sim_rms_1s_before = 1.0;
+  second.sim_rms_1s_after = 0.5;
+  second.has_sim_rms = true;
   cases.push_back(second);
   // Weak effect (below 3 x noise) not found: counts overall only.
   cases.push_back(Scored("effect", "imu_time_offset", "unknown", {}, 1.5));
@@ -266,6 +278,12 @@ TEST(GapBenchmarkScore, SummarizesTheIssuesFigures) {
   EXPECT_NEAR(f["median_parameter_relative_error"].get<double>(), 0.1, 1e-9);
   EXPECT_DOUBLE_EQ(f["median_heldout_rms_reduction"].get<double>(), 0.5);                  // top-1 cases only
   EXPECT_NEAR(f["median_heldout_rms_reduction_all_effect_cases"].get<double>(), 0.275, 1e-12);
+  EXPECT_NEAR(f["median_resimulated_rms_reduction"].get<double>(), 0.2, 1e-12);         // top-1 cases only
+  EXPECT_NEAR(f["median_resimulated_rms_reduction_all_effect_cases"].get<double>(), 0.35, 1e-12);
+  EXPECT_NEAR(f["median_resimulated_rms_1s_reduction"].get<double>(), 0.75, 1e-12);
+  EXPECT_NEAR(f["median_resimulated_rms_1s_reduction_all_effect_cases"].get<double>(), 0.625, 1e-12);
+  EXPECT_FALSE(f["targets"]["median_resimulated_rms_reduction"]["met"].get<bool>());
+  EXPECT_TRUE(f["targets"]["median_resimulated_rms_1s_reduction"]["met"].get<bool>());
   EXPECT_FALSE(f["targets"]["top1_strong"]["met"].get<bool>());
   EXPECT_FALSE(f["targets"]["false_discovery_rate"]["met"].get<bool>());
   EXPECT_FALSE(f["targets"]["decoys_unknown"]["met"].get<bool>());
