@@ -116,6 +116,7 @@ std::vector<std::string> WritePlots(const gap::Diagnosis& d, const std::string& 
       const Time t = Time::FromNanoseconds(r.t.nanoseconds() + std::llround(c.lag_s * 1e9));
       data << d.conditions.At(ci, t) << " " << r.whitened[lc->component] << "\n";
     }
+    data.close();   // gnuplot reads it below: every line on disk first
     std::ofstream gp(dir + "/residual_vs_condition.gp");
     gp << "set terminal pngcairo size 800,500 noenhanced\nset output 'residual_vs_condition.png'\n"
        << "set title \"" << lc->stream << "[" << lc->component << "]: chi2/dof " << Fixed(lc->chi2_per_dof, 3)
@@ -133,6 +134,7 @@ std::vector<std::string> WritePlots(const gap::Diagnosis& d, const std::string& 
       data << name << " " << before.chi2_per_dof << " "
            << (after != d.after.end() ? after->second.chi2_per_dof : before.chi2_per_dof) << "\n";
     }
+    data.close();
     std::ofstream gp(dir + "/heldout_fit.gp");
     gp << "set terminal pngcairo size 800,450 noenhanced\nset output 'heldout_fit.png'\n"
        << "set title 'held-out part (after t = " << Fixed(d.train_end_s, 4) << " s): chi2/dof per stream'\n"

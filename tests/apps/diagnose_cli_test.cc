@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -11,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "eval/plots.h"
 #include "tests/recording/temp_dir.h"
 
 namespace roamlab {
@@ -49,7 +51,7 @@ TEST(DiagnoseCliTest, NeverOpensTruthYamlAndWritesGapJson) {
   testing::WriteFile(dir.File("rec/truth.yaml"), "{{{ not yaml: [steering_offset");
   const CommandRun run = Roamlab("diagnose --real " + dir.File("rec") + " --scenario " +
                                      Source("scenarios/atv_hills.yaml") + " --out " + dir.File("out") +
-                                     " --no-baseline --no-plots --quiet",
+                                     " --no-baseline --quiet",
                                  dir);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   std::ifstream in(dir.File("out/gap.json"));
@@ -67,6 +69,12 @@ TEST(DiagnoseCliTest, NeverOpensTruthYamlAndWritesGapJson) {
   EXPECT_EQ(gap["candidates"].size(), 9u);
   EXPECT_TRUE(std::ifstream(dir.File("out/report.md")).good());
   EXPECT_TRUE(std::ifstream(dir.File("out/scenario_patch.yaml")).good());
+  // The figures are drawn from complete data files (the held-out bars were once plotted from an unflushed, empty one).
+  if (eval::GnuplotAvailable()) {
+    const std::string report = testing::ReadFile(dir.File("out/report.md"));
+    EXPECT_NE(report.find("![heldout_fit.png]"), std::string::npos) << report;
+    EXPECT_GT(std::filesystem::file_size(dir.File("out/heldout_fit.png")), 0u);
+  }
   // The re-simulation as believed sees the hidden offset in the steering stream: 0.03 rad on a sensor of 0.014 rad
   // noise is a whitened RMS of sqrt(1 + (0.03 / 0.014)^2) = 2.36 (over 200 samples: +-0.05).
   ASSERT_TRUE(gap.contains("simulation") && gap["simulation"].contains("before")) << gap.dump();
