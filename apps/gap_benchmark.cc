@@ -65,8 +65,8 @@ std::string AffectedStream(const std::string& effect) {
 // the ATV's path and the mecanum robot's (track_width_error, drawn on it only) in their GPS fixes, the differential
 // drive's turn rate in its gyroscope (it has no GPS). Not the mecanum robot's IMU: its rollers shake the body, and
 // any change of the physics draws another shaking (the first run with the gyroscope for the track: accelerometer 15-20
-// and gyroscope 2-2.9 times the noise as believed, still 13-20 and 1.6-2.5 with the track fitted within 2-13 %,
-// while the GPS fell from 4.4-8.2 to 1.0-1.1).
+// and gyroscope 2-2.9 times the noise as believed, still 13-20 and 1.6-2.5 with the track fitted within 3-13 %,
+// while the GPS fell from 4.4-8.2 to 1.03-1.14).
 std::string SimulatedStream(const std::string& effect) {
   if (effect == "gps_latency" || effect == "lateral_slip" || effect == "axle_misalignment" ||
       effect == "track_width_error")
