@@ -279,8 +279,6 @@ std::string EstimatorPatch(const gap::Diagnosis& d) {
   return y.str();
 }
 
-}  // namespace
-
 json SimulationJson(const gap::SimulationComparison& c) {
   const auto fits = [](const std::map<std::string, gap::SimulatedStreamFit>& m) {
     json j = json::object();
@@ -295,6 +293,8 @@ json SimulationJson(const gap::SimulationComparison& c) {
           {"before", fits(c.before)},   {"after", fits(c.after)},     {"left_out", c.left_out},
           {"not_simulated", c.not_simulated.empty() ? json(nullptr) : json(c.not_simulated)}};
 }
+
+}  // namespace
 
 json DiagnosisJson(const gap::Diagnosis& d, const gap::Baseline* baseline, std::uint64_t baseline_seed,
                    const gap::SimulationComparison* simulation) {
