@@ -242,7 +242,8 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
     }
   }
   if (covariance != nullptr && summary.usable())
-    covariance->computed = system.Covariance(covariance->variables, &covariance->covariance);
+    covariance->computed =
+        system.Covariance(covariance->variables, &covariance->covariance, covariance->leading_dims);
   summary.seconds = elapsed();
   return summary;
 }

@@ -72,9 +72,12 @@ struct SolverSummary {
 
 // Marginal covariance of some free variables, computed by Solve from its last linearization (the point its last step
 // started from), with the factorization it already has: much cheaper than ComputeMarginalInformation afterwards.
+// leading_dims > 0 asks for each variable's first leading_dims tangent components only (a pose's position: 3), at
+// that share of the cost.
 struct CovarianceRequest {
   std::vector<VariableId> variables;
-  Eigen::MatrixXd covariance;  // tangent blocks of `variables`, in order
+  int leading_dims = 0;
+  Eigen::MatrixXd covariance;  // tangent blocks of `variables` (or their leading parts), in order
   bool computed = false;
 };
 

@@ -7,6 +7,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "common/check.h"
 #include "estimator/calibration.h"
 #include "estimator/covariance.h"
 #include "estimator/geometry.h"
@@ -19,39 +20,43 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// A pose's tangent starts with its position (manifold.h); the output is the position's covariance.
+constexpr int kPositionDims = 3;
+
 FactorId NextFactorId(const Graph& graph) {
   return graph.factors().empty() ? 0 : graph.factors().rbegin()->first + 1;
 }
 
 // The oldest pose's estimate and position covariance (marginal of the whole window): from `known` when it holds that
-// pose (a request of poses only, computed by a solve or by OldestPoseCovariances), otherwise from the window's
-// Hessian now.
+// pose (a request of poses' positions only, kPositionDims each, computed by a solve or by OldestPoseCovariances),
+// otherwise from the window's Hessian now.
 Status EmitOldest(ProblemBuilder* builder, const CovarianceRequest* known, const TrackingOptions& options,
                   TrackingResult* out) {
   const PoseNode& node = builder->poses().front();
   const Graph& graph = builder->graph();
   const Pose<double> p = PoseFromArray(graph.variable(node.id).value.data());
-  Eigen::Matrix<double, 6, 6> cov;
+  Eigen::Matrix3d cov;
   const auto found = known != nullptr && known->computed
                          ? std::find(known->variables.begin(), known->variables.end(), node.id)
                          : std::vector<VariableId>::const_iterator();
   if (known != nullptr && known->computed && found != known->variables.end()) {
-    const int offset = 6 * static_cast<int>(found - known->variables.begin());
-    cov = known->covariance.block<6, 6>(offset, offset);
+    ROAMLAB_CHECK(known->leading_dims == kPositionDims, "a pose covariance request of positions only");
+    const int offset = kPositionDims * static_cast<int>(found - known->variables.begin());
+    cov = known->covariance.block<3, 3>(offset, offset);
   } else {
     auto info = ComputeMarginalInformation(graph, {node.id});
     if (!info.ok()) return info.status();
-    cov = info.value().information.inverse();
+    cov = info.value().information.inverse().topLeftCorner<3, 3>();
   }
   // The marginal covariance is symmetric; the solves and the inverse above are so only to rounding, which on a badly
   // conditioned window exceeds what a consumer's symmetry check (eval::PositionNees: 1e-9) allows.
   cov = (0.5 * (cov + cov.transpose())).eval();
   const StampedPose pose{node.t, p.p_world_body, p.q_world_body};
   if (options.on_pose) {
-    options.on_pose(pose, cov.topLeftCorner<3, 3>());
+    options.on_pose(pose, cov);
   } else {
     out->trajectory.push_back(pose);
-    out->position_covariance.push_back(cov.topLeftCorner<3, 3>());
+    out->position_covariance.push_back(cov);
   }
   return Status::Ok();
 }
@@ -68,7 +73,10 @@ std::vector<CovarianceRequest> OldestPoseCovariances(const ProblemBuilder& build
   internal::NormalEquations system(graph, FreeVariableOrder(graph));
   if (!system.Linearize(graph)) return out;
   for (std::size_t k = 0; k < count; ++k) out[k / kCovarianceBatch].variables.push_back(builder.poses()[k].id);
-  for (CovarianceRequest& request : out) request.computed = system.Covariance(request.variables, &request.covariance);
+  for (CovarianceRequest& request : out) {
+    request.leading_dims = kPositionDims;
+    request.computed = system.Covariance(request.variables, &request.covariance, kPositionDims);
+  }
   return out;
 }
 
@@ -176,6 +184,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
   int iterations = 0;
   FactorId first_new_factor = 0;
   CovarianceRequest leaving;
+  leaving.leading_dims = kPositionDims;
   std::vector<double> update_times;
   SolverWorkspace workspace;  // the window's pattern repeats from one update to the next
   for (std::size_t i = 0; i < measurements.size(); ++i) {

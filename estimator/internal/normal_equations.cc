@@ -1148,24 +1148,26 @@ void NormalEquations::SolveEnvelope(Eigen::Ref<Eigen::MatrixXd> x) {
   WithBand([&](const auto& band) { band.Backward(x.data(), x.outerStride(), x.cols()); });
 }
 
-bool NormalEquations::Covariance(const std::vector<VariableId>& variables, Eigen::MatrixXd* covariance) {
+bool NormalEquations::Covariance(const std::vector<VariableId>& variables, Eigen::MatrixXd* covariance,
+                                 int leading_dims) {
   Cholmod& c = *cholmod_;
   if (!c.factored_undamped) {
     Eigen::VectorXd unused;
     if (!Solve(0.0, &unused)) return false;
   }
+  const auto used = [&](int b) { return leading_dims > 0 ? std::min(leading_dims, dims_[b]) : dims_[b]; };
   int cols = 0;
   for (VariableId id : variables) {
     const int b = BlockOf(id);
     ROAMLAB_CHECK(b >= 0, "covariance of variable " << id << ", which is not free in this system");
-    cols += dims_[b];
+    cols += used(b);
   }
   Eigen::MatrixXd E = Eigen::MatrixXd::Zero(dimension_, cols);
   std::vector<int> rows;
   int col = 0;
   for (VariableId id : variables) {
     const int b = BlockOf(id);
-    for (int k = 0; k < dims_[b]; ++k) {
+    for (int k = 0; k < used(b); ++k) {
       E(block_offset_[b] + k, col++) = 1.0;
       rows.push_back(block_offset_[b] + k);
     }
@@ -1173,12 +1175,15 @@ bool NormalEquations::Covariance(const std::vector<VariableId>& variables, Eigen
   Eigen::MatrixXd X;
   if (natural_order_ && cols <= kMaxForwardCovarianceColumns) {
     // H^-1 = U^-1 U^-T, so the covariance is Y^T Y with U^T Y = E: the forward substitution only. As
-    // ForwardEnvelope, with kernels for so few columns: a pose's six at compile time in the band, and the border's
-    // and the Gram matrix's products coefficient-wise (a blocked product packs the whole of Ub for six columns).
+    // ForwardEnvelope, with kernels for so few columns: a pose's six (or its position's three) at compile time in the
+    // band, and the border's and the Gram matrix's products coefficient-wise (a blocked product packs the whole of Ub
+    // for six columns).
     const int na = band_dimension_;
     WithBand([&](const auto& band) {
       if (cols == 6)
         band.template Forward<6>(E.data(), E.outerStride(), cols);
+      else if (cols == 3)
+        band.template Forward<3>(E.data(), E.outerStride(), cols);
       else
         band.Forward(E.data(), E.outerStride(), cols);
     });

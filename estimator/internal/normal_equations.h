@@ -87,10 +87,10 @@ class NormalEquations {
   // H dx = -g (to the solve's rounding) and the decrease is -g.dx / 2.
   double ModelDecrease(const Eigen::VectorXd& dx) const;
 
-  // Marginal covariance of the listed free variables (their tangent blocks, in order) from H of the last Linearize:
-  // solves H X = E for their columns, reusing the last factorization when it was undamped. Returns false when H is
-  // not positive definite.
-  bool Covariance(const std::vector<VariableId>& variables, Eigen::MatrixXd* covariance);
+  // Marginal covariance of the listed free variables (their tangent blocks, in order; with leading_dims > 0 only
+  // each one's first leading_dims tangent components) from H of the last Linearize: solves H X = E for their columns,
+  // reusing the last factorization when it was undamped. Returns false when H is not positive definite.
+  bool Covariance(const std::vector<VariableId>& variables, Eigen::MatrixXd* covariance, int leading_dims = 0);
 
   // Applies x [+] dx to the free variables.
   void Update(const Eigen::VectorXd& dx, Graph* graph) const;

@@ -314,6 +314,18 @@ TEST(NormalEquationsTest, EnvelopeFactorizationOfABandWithABorderMatchesADenseCh
   Eigen::MatrixXd many;
   ASSERT_TRUE(system.Covariance(poses, &many));
   EXPECT_LT((many - H_inv.topLeftCorner(72, 72)).norm(), 1e-9 * H_inv.norm());
+  // Positions only (a pose's first three tangent components; tracking's output): the oldest pose, then two poses and
+  // the parameter (its three components are all it has).
+  Eigen::MatrixXd position;
+  ASSERT_TRUE(system.Covariance({poses[0]}, &position, 3));
+  EXPECT_LT((position - H_inv.topLeftCorner(3, 3)).norm(), 1e-9 * H_inv.topLeftCorner(3, 3).norm());
+  Eigen::MatrixXd leading;
+  ASSERT_TRUE(system.Covariance({poses[0], poses[5], lever}, &leading, 3));
+  const std::vector<int> leading_rows = {0, 1, 2, 30, 31, 32, n - 3, n - 2, n - 1};
+  ASSERT_EQ(leading.rows(), 9);
+  for (int i = 0; i < 9; ++i)
+    for (int j = 0; j < 9; ++j)
+      EXPECT_NEAR(leading(i, j), H_inv(leading_rows[i], leading_rows[j]), 1e-9 * H_inv.norm()) << i << ", " << j;
 
   // A damped solve factors H + lambda diag(H).
   const double lambda = 0.3;
