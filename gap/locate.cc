@@ -113,36 +113,41 @@ Conditions ComputeConditions(const Trajectory& trajectory, const recording::Reco
   return out;
 }
 
+void WindowMeans::Add(Time t, const Eigen::VectorXd& whitened) {
+  if (!first_) first_ = t;
+  const long w = static_cast<long>(std::floor(SecondsBetween(*first_, t) / kSystematicWindowS));
+  auto& [sum, count] = windows_[w];
+  if (count == 0) sum = Eigen::VectorXd::Zero(whitened.size());
+  if (sum.size() != whitened.size()) return;
+  sum += whitened;
+  ++count;
+}
+
+double WindowMeans::Rms() const {
+  double sum_squares = 0.0;
+  int terms = 0;
+  for (const auto& [w, window] : windows_) {
+    sum_squares += (window.first / window.second).squaredNorm();
+    terms += static_cast<int>(window.first.size());
+  }
+  return terms > 0 ? std::sqrt(sum_squares / terms) : 0.0;
+}
+
 std::map<std::string, StreamFit> StreamFits(const std::vector<estimator::MeasurementResidual>& residuals) {
   std::map<std::string, StreamFit> out;
-  // stream -> window index -> (sum of whitened residuals, count)
-  std::map<std::string, std::map<long, std::pair<Eigen::VectorXd, int>>> windows;
-  std::map<std::string, Time> first;
+  std::map<std::string, WindowMeans> windows;
   for (const estimator::MeasurementResidual& r : residuals) {
     if (!r.active) continue;
     StreamFit& f = out[r.stream];
     ++f.measurements;
     f.dof += static_cast<int>(r.whitened.size());
     f.chi2 += r.whitened.squaredNorm();
-    const Time t0 = first.emplace(r.stream, r.t).first->second;
-    const long w = static_cast<long>(std::floor(SecondsBetween(t0, r.t) / kSystematicWindowS));
-    auto& [sum, count] = windows[r.stream][w];
-    if (count == 0) sum = Eigen::VectorXd::Zero(r.whitened.size());
-    if (sum.size() == r.whitened.size()) {
-      sum += r.whitened;
-      ++count;
-    }
+    windows[r.stream].Add(r.t, r.whitened);
   }
   for (auto& [name, f] : out) {
     f.chi2_per_dof = f.dof > 0 ? f.chi2 / f.dof : 0.0;
     f.rms = std::sqrt(f.chi2_per_dof);
-    double sum_squares = 0.0;
-    int terms = 0;
-    for (const auto& [w, window] : windows[name]) {
-      sum_squares += (window.first / window.second).squaredNorm();
-      terms += static_cast<int>(window.first.size());
-    }
-    f.rms_1s = terms > 0 ? std::sqrt(sum_squares / terms) : 0.0;
+    f.rms_1s = windows[name].Rms();
   }
   return out;
 }

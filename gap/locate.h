@@ -8,6 +8,7 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,20 @@ struct StreamFit {
 };
 inline constexpr double kSystematicWindowS = 1.0;
 std::map<std::string, StreamFit> StreamFits(const std::vector<estimator::MeasurementResidual>& residuals);
+
+// The systematic part of one stream's whitened residuals (StreamFit::rms_1s): each residual added to the mean of its
+// kSystematicWindowS window, counted from the first one added; a residual of another size than its window's first is
+// left out.
+class WindowMeans {
+ public:
+  void Add(Time t, const Eigen::VectorXd& whitened);
+  // RMS over windows and components of the windows' means (0 before anything was added).
+  double Rms() const;
+
+ private:
+  std::optional<Time> first_;
+  std::map<long, std::pair<Eigen::VectorXd, int>> windows_;   // window index -> (sum, count)
+};
 
 struct Correlate {
   std::string condition;

@@ -64,16 +64,14 @@ std::vector<double> ColumnSigmas(const recording::StreamInfo& info) {
 }
 
 // Whitened residuals of one stream (or the imu's gyroscope or accelerometer columns): sums of squares per component,
-// and per 1 s window from the first compared sample (gap::kSystematicWindowS, as StreamFits) their sums.
+// and their 1 s means (WindowMeans, as StreamFits).
 struct Accumulator {
   explicit Accumulator(int components) : sum_squares(static_cast<std::size_t>(components), 0.0) {}
 
   void Add(Time t, const Eigen::VectorXd& whitened) {
     for (int k = 0; k < whitened.size(); ++k) sum_squares[static_cast<std::size_t>(k)] += whitened[k] * whitened[k];
-    if (samples++ == 0) first = t;
-    auto& [sum, count] = windows[static_cast<long>(std::floor(SecondsBetween(first, t) / kSystematicWindowS))];
-    if (count++ == 0) sum = Eigen::VectorXd::Zero(whitened.size());
-    sum += whitened;
+    ++samples;
+    windows.Add(t, whitened);
   }
 
   SimulatedStreamFit Fit() const {
@@ -86,17 +84,13 @@ struct Accumulator {
     }
     const double count = static_cast<double>(samples) * static_cast<double>(sum_squares.size());
     f.rms = count > 0.0 ? std::sqrt(total / count) : 0.0;
-    double window_squares = 0.0;
-    for (const auto& [w, window] : windows) window_squares += (window.first / window.second).squaredNorm();
-    const double terms = static_cast<double>(windows.size()) * static_cast<double>(sum_squares.size());
-    f.rms_1s = terms > 0.0 ? std::sqrt(window_squares / terms) : 0.0;
+    f.rms_1s = windows.Rms();
     return f;
   }
 
   std::vector<double> sum_squares;
   int samples = 0;
-  Time first;
-  std::map<long, std::pair<Eigen::VectorXd, int>> windows;
+  WindowMeans windows;
 };
 
 // Compares every stream of `recorded` with the same-named stream of `simulated`, from `from` on.
