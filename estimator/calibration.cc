@@ -129,11 +129,19 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
     // Gate gross outliers at the converged estimate and re-solve without them.
     // Gross outliers bend the estimate and make inliers look bad too: re-test every measurement after each re-solve,
     // re-admitting those that fit again, until the set is stable.
+    // Each re-solve starts from the last one's damping: the problem changed by a few measurements, and restarting
+    // Levenberg-Marquardt from SolverOptions::initial_lambda would crawl again through the weakly observed directions
+    // (lever arm and trajectory height) it had already damped down to Gauss-Newton steps for.
+    double lambda = stage.solver.final_lambda;
     for (int round = 0; config.gate_probability && round < 5; ++round) {
       const int changed = GateOutliers(*config.gate_probability, &builder);
       if (changed == 0) break;
       {
-        const SolverSummary again = Solve(config.solver, &builder.graph());
+        SolverOptions warm = config.solver;
+        if (warm.method == SolverOptions::Method::kLevenbergMarquardt)
+          warm.initial_lambda = std::max(lambda, std::numeric_limits<double>::epsilon());
+        const SolverSummary again = Solve(warm, &builder.graph());
+        lambda = again.final_lambda;
         say("stage " + std::to_string(s + 1) + ": gating round " + std::to_string(round + 1) + ": " +
             std::to_string(changed) + " measurements switched, re-solved in " + std::to_string(again.iterations) +
             " iterations, " + std::to_string(again.seconds) + " s");

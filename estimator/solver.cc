@@ -86,10 +86,10 @@ std::vector<VariableId> FreeVariableOrder(const Graph& graph) {
 
 namespace {
 
-double TangentNorm(const Graph& graph, const std::vector<VariableId>& order) {
+double TangentNorm(const std::vector<Variable*>& variables) {
   double sq = 0.0;
-  for (VariableId id : order) {
-    const Variable& v = graph.variable(id);
+  for (const Variable* variable : variables) {
+    const Variable& v = *variable;
     if (v.manifold.kind() == ManifoldKind::kEuclidean) sq += v.value.squaredNorm();
     if (v.manifold.kind() == ManifoldKind::kPose) sq += v.value.head<3>().squaredNorm();
   }
@@ -144,6 +144,11 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
     return summary;
   }
 
+  // The free variables in the system's order, looked up once (a whole recording's graph holds hundreds of thousands).
+  std::vector<Variable*>& free_variables = ws.free_variables_;
+  free_variables.clear();
+  for (VariableId id : order) free_variables.push_back(&graph->mutable_variable(id));
+
   const bool lm = options.method == SolverOptions::Method::kLevenbergMarquardt;
   double lambda = lm ? options.initial_lambda : 0.0;
   double nu = 2.0;
@@ -170,11 +175,8 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
     // Try the step, keeping a copy of the free variables' values.
     std::vector<double>& saved = ws.saved_;
     saved.clear();
-    for (VariableId id : order) {
-      const Eigen::VectorXd& value = graph->variable(id).value;
-      saved.insert(saved.end(), value.data(), value.data() + value.size());
-    }
-    system.Update(dx, graph);
+    for (const Variable* v : free_variables) saved.insert(saved.end(), v->value.data(), v->value.data() + v->value.size());
+    system.Update(dx, free_variables);
     // Gauss-Newton takes every step it can evaluate: its trial point is linearized at once (the next iteration, or
     // the next solve of a workspace, starts there), Levenberg-Marquardt only evaluates the cost of a trial that may
     // be rejected.
@@ -188,10 +190,9 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
 
     if (!accept) {
       const double* from = saved.data();
-      for (VariableId id : order) {
-        Eigen::VectorXd& value = graph->mutable_variable(id).value;
-        std::copy(from, from + value.size(), value.data());
-        from += value.size();
+      for (Variable* v : free_variables) {
+        std::copy(from, from + v->value.size(), v->value.data());
+        from += v->value.size();
       }
       if (!lm) {
         summary.termination = Termination::kFailure;
@@ -226,7 +227,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
       summary.termination = Termination::kModelTolerance;
       break;
     }
-    if (step_norm <= options.step_tolerance * (TangentNorm(*graph, order) + options.step_tolerance)) {
+    if (step_norm <= options.step_tolerance * (TangentNorm(free_variables) + options.step_tolerance)) {
       summary.termination = Termination::kStepTolerance;
       break;
     }
@@ -241,6 +242,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
       break;
     }
   }
+  summary.final_lambda = lambda;
   if (covariance != nullptr && summary.usable())
     covariance->computed =
         system.Covariance(covariance->variables, &covariance->covariance, covariance->leading_dims);

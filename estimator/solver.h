@@ -63,6 +63,9 @@ struct SolverSummary {
   // of the linearization that step came from (they are re-evaluated at the next linearization).
   std::vector<double> cost_history;
   double seconds = 0.0;
+  // Levenberg-Marquardt's damping (relative to diag(H)) for the step after the last: a re-solve of the same problem
+  // changed a little (a few measurements gated) can start from it instead of SolverOptions::initial_lambda.
+  double final_lambda = 0.0;
   int free_dimension = 0;
   int factors = 0;
   std::string message;                // details on failure
@@ -111,6 +114,7 @@ class SolverWorkspace {
   friend SolverSummary Solve(const SolverOptions&, Graph*, CovarianceRequest*, SolverWorkspace*);
   std::unique_ptr<internal::NormalEquations> system_;
   std::vector<double> saved_;
+  std::vector<Variable*> free_variables_;
 };
 
 // Optimizes the free variables of `graph` in place. Variables are ordered in time, the stamped ones first (poses and

@@ -15,9 +15,13 @@ namespace roamlab::estimator::internal {
 namespace {
 
 // Systems up to this dimension (a tracking window) are factored in their envelope when in natural order (Reset),
-// otherwise by CHOLMOD's simplicial LLT; larger ones (whole recordings) by its supernodal LLT, whose dense BLAS kernels
-// pay off only on large supernodes.
+// otherwise by CHOLMOD's simplicial LLT; larger ones (whole recordings) in their envelope when it is narrow, otherwise
+// by CHOLMOD's supernodal LLT, whose dense BLAS kernels pay off only on large supernodes.
 constexpr int kMaxSimplicialDimension = 2000;
+
+// A large system in natural order is factored in its envelope when the envelope has at most this many times the
+// entries of H's upper triangle (NormalEquations::EnvelopeIsNarrow).
+constexpr std::size_t kMaxEnvelopeOverPattern = 2;
 
 // Widest dense border of a natural-order system (NormalEquations::FactorEnvelope); columns beyond it stay in the
 // envelope.
@@ -282,9 +286,9 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   var_id_.clear();
   var_block_.clear();
   values_.clear();
-  // In a small system the block column of a constant parameter holds every row block (below); only the others
-  // collect their rows from the factors.
-  if (dimension_ > kMaxSimplicialDimension) std::fill(full_column_.begin(), full_column_.end(), 0);
+  // In a system in natural order the block column of a constant parameter holds every row block (below); only the
+  // others collect their rows from the factors.
+  if (!stamped_first) std::fill(full_column_.begin(), full_column_.end(), 0);
   rows_of_.resize(nb);
   for (int b = 0; b < nb; ++b) rows_of_[b].assign(1, b);
   std::size_t prev = 0;  // next factor of the last Reset to compare with (both lists in id order)
@@ -346,14 +350,19 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   // triangular solves on so small a system. Time-varying parameters' instances sit in that order after the last pose
   // they serve (FreeVariableOrder) and only widen the band: an instance shared by the poses of an interval
   // (process.interval_s) has a tall column (those poses), the poses' columns stay short.
+  //
+  // A large system (a whole recording) in that order is factored in its envelope too when the envelope holds little
+  // more than H's own pattern (poses coupled to their neighbours in time only): its cost is then linear in the drive's
+  // length, where CHOLMOD's supernodal factorization spends much of its time permuting and transposing H's pattern.
+  // Factors that tie poses far apart in time (an envelope many times the pattern) leave it to CHOLMOD.
   const bool natural_before = natural_order_;
-  natural_order_ = dimension_ <= kMaxSimplicialDimension && stamped_first;
   for (int b = 0; b < nb; ++b) {
     if (!full_column_[b]) continue;
     rows_of_[b].resize(b + 1);
     for (int r = 0; r <= b; ++r) rows_of_[b][r] = r;
   }
   BuildPattern();
+  natural_order_ = stamped_first && (dimension_ <= kMaxSimplicialDimension || EnvelopeIsNarrow());
   if (natural_order_ != natural_before) cholmod_->analyzed = false;
 
   // The per-factor linearizations follow their factors (by id). A new factor takes the buffers of one that left, in
@@ -397,6 +406,16 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   cholmod_->factored_undamped = false;
   left_out_blocks_ = 0;
   undamped_step_ = false;
+}
+
+bool NormalEquations::EnvelopeIsNarrow() const {
+  // Entries of the blocks' envelopes (rows_of_ sorted by BuildPattern) against those of H's upper triangle.
+  std::size_t pattern = 0, envelope = 0;
+  for (std::size_t b = 0; b < order_.size(); ++b) {
+    pattern += static_cast<std::size_t>(column_length_[b]) * dims_[b];
+    envelope += static_cast<std::size_t>(block_offset_[b] + dims_[b] - block_offset_[rows_of_[b].front()]) * dims_[b];
+  }
+  return envelope <= kMaxEnvelopeOverPattern * pattern;
 }
 
 void NormalEquations::BuildPattern() {
@@ -798,7 +817,7 @@ bool NormalEquations::Solve(double lambda, Eigen::VectorXd* dx) {
   Cholmod& c = *cholmod_;
   undamped_step_ = false;
   const Eigen::SparseMatrix<double>* A = &H_;
-  if (lambda > 0.0) {
+  if (lambda > 0.0 && !natural_order_) {  // (the envelope takes H_ and adds the damping as it copies it)
     CompleteHessian();
     c.damped = H_;
     double* v = c.damped.valuePtr();
@@ -814,7 +833,7 @@ bool NormalEquations::Solve(double lambda, Eigen::VectorXd* dx) {
   Analyze();
   bool factored = false;
   if (natural_order_) {
-    factored = FactorEnvelope(*A, lambda <= 0.0);
+    factored = FactorEnvelope(*A, lambda);
   } else {
     c.llt.factorize(*A);
     factored = c.llt.info() == Eigen::Success;
@@ -1047,7 +1066,8 @@ int NormalEquations::ReusableBlocks() const {
   return reusable;
 }
 
-bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, bool undamped) {
+bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, double lambda) {
+  const bool undamped = lambda <= 0.0;
   const int na = band_dimension_;
   const int reused = undamped && relinearize_threshold_ > 0.0 ? ReusableBlocks() : 0;
   if (reused < left_out_blocks_) CompleteHessian();  // (A is H_: undamped)
@@ -1075,7 +1095,8 @@ bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, bool 
   reused_blocks_ += reused;
 
   // Scatter the upper triangle of A: the band's column j of block b into its column of the block's envelope, rows
-  // from the first of block first_block_[b] (the columns not taken over).
+  // from the first of block first_block_[b] (the columns not taken over), with the damping on the diagonal:
+  // A(j, j) + lambda max(A(j, j), 1e-12).
   std::fill(envelope_.begin() + envelope_start_[reused], envelope_.end(), 0.0);
   border_.bottomRows(na - reused_rows).setZero();
   corner_.setZero(dimension_ - na, dimension_ - na);
@@ -1090,6 +1111,7 @@ bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, bool 
       double* column = envelope_.data() + envelope_start_[b] + t * height - row0;
       for (int p = outer[j]; p < outer[j + 1]; ++p)
         if (inner[p] <= j) column[inner[p]] = value[p];
+      if (!undamped) column[j] += lambda * std::max(column[j], 1e-12);
     }
   }
   for (int j = na; j < dimension_; ++j) {
@@ -1101,6 +1123,8 @@ bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, bool 
         corner_(i - na, j - na) = value[p];
       }
     }
+    double& diagonal = corner_(j - na, j - na);
+    if (!undamped) diagonal += lambda * std::max(diagonal, 1e-12);
   }
   // Ua, then Ub = Ua^-T B (forward substitution on B's columns) and Uc^T Uc = C - Ub^T Ub.
   bool factored = false;
@@ -1210,8 +1234,17 @@ bool NormalEquations::Covariance(const std::vector<VariableId>& variables, Eigen
 }
 
 void NormalEquations::Update(const Eigen::VectorXd& dx, Graph* graph) const {
+  std::vector<Variable*> free_variables;
+  free_variables.reserve(order_.size());
+  for (VariableId id : order_) free_variables.push_back(&graph->mutable_variable(id));
+  Update(dx, free_variables);
+}
+
+void NormalEquations::Update(const Eigen::VectorXd& dx, const std::vector<Variable*>& free_variables) const {
+  ROAMLAB_CHECK(free_variables.size() == order_.size(), "Update with " << free_variables.size() << " variables for "
+                                                                        << order_.size() << " blocks");
   for (std::size_t b = 0; b < order_.size(); ++b) {
-    Variable& v = graph->mutable_variable(order_[b]);
+    Variable& v = *free_variables[b];
     v.manifold.Plus(v.value.data(), dx.data() + block_offset_[b], v.value.data());
   }
 }

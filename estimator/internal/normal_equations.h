@@ -92,8 +92,10 @@ class NormalEquations {
   // reusing the last factorization when it was undamped. Returns false when H is not positive definite.
   bool Covariance(const std::vector<VariableId>& variables, Eigen::MatrixXd* covariance, int leading_dims = 0);
 
-  // Applies x [+] dx to the free variables.
+  // Applies x [+] dx to the free variables, found in the graph by id, or given in the order of the blocks (a solve's
+  // loop looks them up once instead of at every step).
   void Update(const Eigen::VectorXd& dx, Graph* graph) const;
+  void Update(const Eigen::VectorXd& dx, const std::vector<Variable*>& free_variables) const;
 
   int dimension() const { return dimension_; }
   double cost() const { return cost_; }
@@ -115,6 +117,7 @@ class NormalEquations {
   // Block column of a free variable, or -1.
   int BlockOf(VariableId id) const;
   void BuildPattern();
+  bool EnvelopeIsNarrow() const;  // the envelopes hold little more than H's pattern (Reset)
   // The symbolic analysis of a new pattern: a natural-order system's band and border layout, or CHOLMOD's.
   void Analyze();
 
@@ -244,7 +247,7 @@ class NormalEquations {
   int incremental_resets_ = 0;
   bool natural_order_ = false;  // factor in the order of the blocks, in the envelope (Reset)
 
-  // Cholesky H = U^T U of a natural-order system (a band of poses with a dense border of constant parameters), in
+  // Cholesky H + lambda diag(H) = U^T U (lambda 0: undamped) of a natural-order system (a band of poses with a dense border of constant parameters), in
   // blocks H = [A B; B^T C], U = [Ua Ub; 0 Uc]: Ua^T Ua = A in A's block envelope (block column b of Ua holds the row
   // blocks first_block_[b]..b as one dense column-major matrix from envelope_start_[b] in envelope_; blocks between a
   // column's first coupled block and the diagonal may fill in, blocks above it cannot), Ub = Ua^-T B and
@@ -259,7 +262,7 @@ class NormalEquations {
   // over while its variable is the same as the kept column's and no factor on it or a variable before it changed
   // its Jacobians or left since (dirty_), except the new marginalization prior. The border's rows Ub follow the
   // same rule (a row of Ua^-T B depends on B's rows above it); C - Ub^T Ub and Uc are always computed.
-  bool FactorEnvelope(const Eigen::SparseMatrix<double>& A, bool undamped);
+  bool FactorEnvelope(const Eigen::SparseMatrix<double>& A, double lambda);
   int ReusableBlocks() const;  // leading band blocks of the kept factorization that hold for this one
   void ForwardEnvelope(Eigen::Ref<Eigen::MatrixXd> x);  // x <- U^-T x with the last FactorEnvelope
   void SolveEnvelope(Eigen::Ref<Eigen::MatrixXd> x);    // x <- H^-1 x with the last FactorEnvelope
