@@ -1,6 +1,7 @@
 // Gauss-Newton and Levenberg-Marquardt on the estimation graph (seed 000, Section III-C): the sparse normal equations
-// of the whitened errors are solved by Cholesky (CHOLMOD supernodal; a sliding window's band of poses with a border of
-// constant parameters by its own block factorization, internal/normal_equations.h), the free variables are updated
+// of the whitened errors are solved by Cholesky (a band of poses with a border of constant parameters, a sliding
+// window's or a whole recording's, by its own block factorization in the band's envelope, internal/normal_equations.h;
+// anything else, such as poses tied far apart in time, by CHOLMOD supernodal), the free variables are updated
 // through box-plus only, and the error covariances (eq. 1) are re-evaluated at every linearization.
 #pragma once
 
@@ -120,7 +121,8 @@ class SolverWorkspace {
 // Optimizes the free variables of `graph` in place. Variables are ordered in time, the stamped ones first (poses and
 // time-varying parameters' instances; each instance after the last pose it serves, just before the pose that starts
 // the next instance of the same parameter, the newest after every pose: a band), then the others in id order;
-// CHOLMOD picks its own fill-reducing permutation on top. When `covariance` is given, fills it (computed = false if the
+// in that order a band's envelope is factored as it is, otherwise CHOLMOD picks its own fill-reducing permutation
+// on top. When `covariance` is given, fills it (computed = false if the
 // Hessian is not positive definite). `workspace` (optional) carries buffers and the symbolic factorization over to the
 // next solve.
 SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceRequest* covariance = nullptr,

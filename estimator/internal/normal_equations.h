@@ -1,8 +1,9 @@
 // Sparse normal equations H dx = -g of the whitened, loss-weighted least-squares problem over an ordered list of free
 // variables (seed 000, eqs. 2-3). The block-sparse pattern of H (upper triangle, compressed columns) is built per
 // graph structure; each Linearize refills the values in place, and CHOLMOD's Cholesky (with its fill-reducing
-// ordering) analyses the pattern once and refactors the values every iteration. Small systems in their natural order
-// (a tracking window: a band with a dense border) are factored in their envelope instead (see Reset).
+// ordering) analyses the pattern once and refactors the values every iteration. Systems in their natural order (a
+// band of poses with a dense border: a tracking window, or a whole recording whose factors tie poses to their
+// neighbours in time only) are factored in their envelope instead (see Reset).
 //
 // An object can be Reset to a changed graph and keeps its buffers; when the new pattern is the same as the old one
 // (a fixed-lag window that slid by one pose has the same band), the symbolic analysis is kept too, and a small
@@ -98,6 +99,8 @@ class NormalEquations {
   void Update(const Eigen::VectorXd& dx, const std::vector<Variable*>& free_variables) const;
 
   int dimension() const { return dimension_; }
+  // Factored in the band's envelope (natural order), not by CHOLMOD (Reset).
+  bool factored_in_envelope() const { return natural_order_; }
   double cost() const { return cost_; }
   const Eigen::VectorXd& gradient() const { return g_; }
   // Upper triangle of H (the blocks Linearize left out are added first).

@@ -11,6 +11,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
+#include <Eigen/SparseCholesky>
 
 #include "estimator/covariance.h"
 #include "estimator/factor.h"
@@ -334,6 +335,49 @@ TEST(NormalEquationsTest, EnvelopeFactorizationOfABandWithABorderMatchesADenseCh
   ASSERT_TRUE(system.Solve(lambda, &dx));
   const Eigen::VectorXd damped_expected = damped.llt().solve(-system.gradient());
   EXPECT_LT((dx - damped_expected).norm(), 1e-9 * damped_expected.norm());
+}
+
+// A whole recording's system (beyond the size of a tracking window) in natural order: 400 poses tied to their next
+// and to the one after, and a constant parameter tied to a few poses (none of them the first). It is factored in its
+// envelope while the poses are tied to their neighbours in time only, by CHOLMOD once every pose is also tied to the
+// one 100 poses later (a route driven twice: each block column's envelope would reach 100 poses back, 25 times H's
+// pattern); either way the undamped and the damped steps must be those of a sparse Cholesky of the same H.
+TEST(NormalEquationsTest, LargeBandIsFactoredInItsEnvelopeUnlessManyPosesFarApartAreTied) {
+  for (const bool loop : {false, true}) {
+    SCOPED_TRACE(loop ? "each pose tied to the one 100 poses later" : "neighbours only");
+    std::mt19937 rng(17);
+    Graph graph;
+    std::vector<VariableId> poses;
+    for (int k = 0; k < 400; ++k)
+      poses.push_back(graph.AddVariable({"pose", Manifold::Pose(), testing::RandomPoint(Manifold::Pose(), &rng, 5.0),
+                                         false, Time::FromSeconds(k)}));
+    const VariableId lever =
+        graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d(0.1, 0.2, 0.3), false, std::nullopt});
+    const auto tie = [&](const std::vector<VariableId>& ids) { TieWithRandomPrior(ids, &rng, &graph); };
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+      if (k + 1 < poses.size()) tie({poses[k], poses[k + 1]});
+      if (k + 2 < poses.size()) tie({poses[k], poses[k + 2]});
+      if (k % 50 == 7) tie({poses[k], lever});
+      if (loop && k + 100 < poses.size()) tie({poses[k], poses[k + 100]});
+    }
+    tie({poses[0]});
+
+    internal::NormalEquations system(graph, FreeVariableOrder(graph));
+    ASSERT_TRUE(system.Linearize(graph));
+    ASSERT_EQ(system.dimension(), 2403);
+    EXPECT_EQ(system.factored_in_envelope(), !loop);
+    const Eigen::SparseMatrix<double> H = system.hessian_upper().selfadjointView<Eigen::Upper>();
+    for (const double lambda : {0.0, 0.3}) {
+      Eigen::SparseMatrix<double> A = H;
+      for (int i = 0; i < A.rows(); ++i) A.coeffRef(i, i) += lambda * std::max(H.coeff(i, i), 1e-12);
+      const Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> reference(A);
+      ASSERT_EQ(reference.info(), Eigen::Success);
+      const Eigen::VectorXd expected = reference.solve(-system.gradient());
+      Eigen::VectorXd dx;
+      ASSERT_TRUE(system.Solve(lambda, &dx));
+      EXPECT_LT((dx - expected).norm(), 1e-9 * expected.norm()) << "lambda " << lambda;
+    }
+  }
 }
 
 // Marginalizing x out of linear factors on (x, y) leaves a prior on y with J^T J and J^T r0 equal to the Schur
