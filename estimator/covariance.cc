@@ -43,15 +43,21 @@ Result<MarginalInformation> ComputeMarginalInformation(const Graph& graph, const
   if (!system.Linearize(graph, &failed)) return Status::Error("a factor from '" + failed + "' cannot be evaluated");
   const int n = system.dimension();
   const int nx = n - np;
+  {
+    const Eigen::SparseMatrix<double>& upper = system.hessian_upper();
+    result.conditional.resize(np);
+    for (int i = 0; i < np; ++i) result.conditional[i] = upper.coeff(nx + i, nx + i);
+  }
+  // Schur complement S = Hpp - Hxp^T Hxx^-1 Hxp: from the envelope factorization when the other variables are a band
+  // of poses with the requested ones as its border (a calibration), else with CHOLMOD on the (large, sparse) Hxx.
+  if (nx > 0 && system.BorderInformation(np, &result.information)) return result;
   const Eigen::SparseMatrix<double> H = system.hessian_upper().selfadjointView<Eigen::Upper>();
   const Eigen::MatrixXd Hpp = Eigen::MatrixXd(H.bottomRightCorner(np, np));
-  result.conditional = Hpp.diagonal();
   if (nx == 0) {
     result.information = Hpp;
     return result;
   }
 
-  // Schur complement S = Hpp - Hxp^T Hxx^-1 Hxp, with CHOLMOD on the (large, sparse) Hxx.
   Eigen::SparseMatrix<double> Hxx = H.topLeftCorner(nx, nx);
   const Eigen::MatrixXd Hxp = Eigen::MatrixXd(H.topRightCorner(nx, np));
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;

@@ -175,7 +175,8 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
     // Try the step, keeping a copy of the free variables' values.
     std::vector<double>& saved = ws.saved_;
     saved.clear();
-    for (const Variable* v : free_variables) saved.insert(saved.end(), v->value.data(), v->value.data() + v->value.size());
+    for (const Variable* v : free_variables)
+      saved.insert(saved.end(), v->value.data(), v->value.data() + v->value.size());
     system.Update(dx, free_variables);
     // Gauss-Newton takes every step it can evaluate: its trial point is linearized at once (the next iteration, or
     // the next solve of a workspace, starts there), Levenberg-Marquardt only evaluates the cost of a trial that may

@@ -1066,7 +1066,7 @@ int NormalEquations::ReusableBlocks() const {
   return reusable;
 }
 
-bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, double lambda) {
+bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, double lambda, bool factor_corner) {
   const bool undamped = lambda <= 0.0;
   const int na = band_dimension_;
   const int reused = undamped && relinearize_threshold_ > 0.0 ? ReusableBlocks() : 0;
@@ -1134,10 +1134,10 @@ bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, doubl
   });
   if (factored && dimension_ > na) {
     corner_.selfadjointView<Eigen::Upper>().rankUpdate(border_.transpose(), -1.0);
-    factored = UpperCholeskyInPlace(corner_);
+    if (factor_corner) factored = UpperCholeskyInPlace(corner_);
   }
   // Kept for the next factorization (with a relinearization threshold, undamped).
-  factor_kept_ = factored && undamped && relinearize_threshold_ > 0.0;
+  factor_kept_ = factored && factor_corner && undamped && relinearize_threshold_ > 0.0;
   dirty_.clear();
   if (factor_kept_) {
     kept_order_ = order_;
@@ -1147,6 +1147,18 @@ bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, doubl
     kept_envelope_start_ = envelope_start_;
   }
   return factored;
+}
+
+bool NormalEquations::BorderInformation(int border_dimension, Eigen::MatrixXd* information) {
+  if (!natural_order_ || border_dimension <= 0) return false;
+  Analyze();
+  if (dimension_ - band_dimension_ != border_dimension) return false;
+  // The factorization without Uc: corner_ keeps C - Ub^T Ub (upper triangle), which need not be positive definite.
+  cholmod_->factored_undamped = false;
+  const bool factored = FactorEnvelope(hessian_upper(), 0.0, /*factor_corner=*/false);
+  if (!factored) return false;
+  *information = corner_.selfadjointView<Eigen::Upper>();
+  return true;
 }
 
 void NormalEquations::ForwardEnvelope(Eigen::Ref<Eigen::MatrixXd> x) {

@@ -93,6 +93,13 @@ class NormalEquations {
   // reusing the last factorization when it was undamped. Returns false when H is not positive definite.
   bool Covariance(const std::vector<VariableId>& variables, Eigen::MatrixXd* covariance, int leading_dims = 0);
 
+  // The information of the border (the trailing constant parameters of a system factored in its envelope, when they
+  // span exactly border_dimension) with every other free variable marginalized out: the Schur complement
+  // C - B^T A^-1 B of H = [A B; B^T C], from the envelope factorization of A (Ua^T Ua = A, Ub = Ua^-T B, S = C - Ub^T Ub).
+  // False when the system has no such border or A is not positive definite. The next Solve or Covariance factors
+  // again.
+  bool BorderInformation(int border_dimension, Eigen::MatrixXd* information);
+
   // Applies x [+] dx to the free variables, found in the graph by id, or given in the order of the blocks (a solve's
   // loop looks them up once instead of at every step).
   void Update(const Eigen::VectorXd& dx, Graph* graph) const;
@@ -250,12 +257,12 @@ class NormalEquations {
   int incremental_resets_ = 0;
   bool natural_order_ = false;  // factor in the order of the blocks, in the envelope (Reset)
 
-  // Cholesky H + lambda diag(H) = U^T U (lambda 0: undamped) of a natural-order system (a band of poses with a dense border of constant parameters), in
-  // blocks H = [A B; B^T C], U = [Ua Ub; 0 Uc]: Ua^T Ua = A in A's block envelope (block column b of Ua holds the row
-  // blocks first_block_[b]..b as one dense column-major matrix from envelope_start_[b] in envelope_; blocks between a
-  // column's first coupled block and the diagonal may fill in, blocks above it cannot), Ub = Ua^-T B and
-  // Uc^T Uc = C - Ub^T Ub (dense). The border is the trailing block columns coupled to the first block, at most
-  // kMaxBorder columns.
+  // Cholesky H + lambda diag(H) = U^T U (lambda 0: undamped) of a natural-order system (a band of poses with a dense
+  // border of constant parameters), in blocks H = [A B; B^T C], U = [Ua Ub; 0 Uc]: Ua^T Ua = A in A's block envelope
+  // (block column b of Ua holds the row blocks first_block_[b]..b as one dense column-major matrix from
+  // envelope_start_[b] in envelope_; blocks between a column's first coupled block and the diagonal may fill in, blocks
+  // above it cannot), Ub = Ua^-T B and Uc^T Uc = C - Ub^T Ub (dense). The border is the trailing block columns coupled
+  // to the first block, at most kMaxBorder columns.
   //
   // Incremental (with a relinearization threshold, undamped): the leading block columns of U depend only on H's
   // leading principal block, so the columns of the last factorization whose rows of H did not change are taken over.
@@ -265,7 +272,8 @@ class NormalEquations {
   // over while its variable is the same as the kept column's and no factor on it or a variable before it changed
   // its Jacobians or left since (dirty_), except the new marginalization prior. The border's rows Ub follow the
   // same rule (a row of Ua^-T B depends on B's rows above it); C - Ub^T Ub and Uc are always computed.
-  bool FactorEnvelope(const Eigen::SparseMatrix<double>& A, double lambda);
+  // factor_corner false: Ua and Ub only, corner_ left holding C - Ub^T Ub (BorderInformation).
+  bool FactorEnvelope(const Eigen::SparseMatrix<double>& A, double lambda, bool factor_corner = true);
   int ReusableBlocks() const;  // leading band blocks of the kept factorization that hold for this one
   void ForwardEnvelope(Eigen::Ref<Eigen::MatrixXd> x);  // x <- U^-T x with the last FactorEnvelope
   void SolveEnvelope(Eigen::Ref<Eigen::MatrixXd> x);    // x <- H^-1 x with the last FactorEnvelope

@@ -341,7 +341,8 @@ TEST(NormalEquationsTest, EnvelopeFactorizationOfABandWithABorderMatchesADenseCh
 // and to the one after, and a constant parameter tied to a few poses (none of them the first). It is factored in its
 // envelope while the poses are tied to their neighbours in time only, by CHOLMOD once every pose is also tied to the
 // one 100 poses later (a route driven twice: each block column's envelope would reach 100 poses back, 25 times H's
-// pattern); either way the undamped and the damped steps must be those of a sparse Cholesky of the same H.
+// pattern); either way the undamped and the damped steps must be those of a sparse Cholesky of the same H, and the
+// parameter's marginal information the Schur complement of H onto it.
 TEST(NormalEquationsTest, LargeBandIsFactoredInItsEnvelopeUnlessManyPosesFarApartAreTied) {
   for (const bool loop : {false, true}) {
     SCOPED_TRACE(loop ? "each pose tied to the one 100 poses later" : "neighbours only");
@@ -377,6 +378,23 @@ TEST(NormalEquationsTest, LargeBandIsFactoredInItsEnvelopeUnlessManyPosesFarApar
       ASSERT_TRUE(system.Solve(lambda, &dx));
       EXPECT_LT((dx - expected).norm(), 1e-9 * expected.norm()) << "lambda " << lambda;
     }
+
+    // The parameter's information with the poses marginalized out, Hpp - Hxp^T Hxx^-1 Hxp: from the envelope
+    // factorization (its border), or from CHOLMOD on Hxx.
+    const int nx = system.dimension() - 3;
+    const Eigen::SparseMatrix<double> Hxx = H.topLeftCorner(nx, nx);
+    const Eigen::MatrixXd Hxp = Eigen::MatrixXd(H.topRightCorner(nx, 3));
+    const Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> xx(Hxx);
+    ASSERT_EQ(xx.info(), Eigen::Success);
+    const Eigen::MatrixXd schur = Eigen::MatrixXd(H.bottomRightCorner(3, 3)) - Hxp.transpose() * xx.solve(Hxp);
+    Eigen::MatrixXd border;
+    ASSERT_EQ(system.BorderInformation(3, &border), !loop);
+    if (!loop) {
+      EXPECT_LT((border - schur).norm(), 1e-9 * schur.norm());
+    }
+    const auto marginal = ComputeMarginalInformation(graph, {lever});
+    ASSERT_TRUE(marginal.ok()) << marginal.status().message();
+    EXPECT_LT((marginal.value().information - schur).norm(), 1e-9 * schur.norm());
   }
 }
 
