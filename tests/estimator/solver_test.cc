@@ -6,6 +6,7 @@
 #include <deque>
 #include <map>
 #include <random>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -267,6 +268,17 @@ TEST(SolverTest, FreeVariableOrderPutsEachInstanceAfterTheLastPoseItServes) {
   EXPECT_EQ(FreeVariableOrder(graph), expected);
 }
 
+// `count` poses one second apart at random points, then a free constant parameter ("lever", 3 components).
+std::pair<std::vector<VariableId>, VariableId> AddPosesAndLever(int count, std::mt19937* rng, Graph* graph) {
+  std::vector<VariableId> poses;
+  for (int k = 0; k < count; ++k)
+    poses.push_back(graph->AddVariable({"pose", Manifold::Pose(), testing::RandomPoint(Manifold::Pose(), rng, 5.0),
+                                        false, Time::FromSeconds(k)}));
+  const VariableId lever =
+      graph->AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d(0.1, 0.2, 0.3), false, std::nullopt});
+  return {poses, lever};
+}
+
 // A tracking window in the solver's natural order: poses in time order, each tied to the next and to the one after
 // (which skips a pose: fill inside the envelope), and a free constant parameter tied to two poses (the dense border),
 // by linear priors with random Jacobians. The envelope factorization must give the step and the covariances of a dense
@@ -274,12 +286,7 @@ TEST(SolverTest, FreeVariableOrderPutsEachInstanceAfterTheLastPoseItServes) {
 TEST(NormalEquationsTest, EnvelopeFactorizationOfABandWithABorderMatchesADenseCholesky) {
   std::mt19937 rng(11);
   Graph graph;
-  std::vector<VariableId> poses;
-  for (int k = 0; k < 12; ++k)
-    poses.push_back(graph.AddVariable({"pose", Manifold::Pose(), testing::RandomPoint(Manifold::Pose(), &rng, 5.0),
-                                       false, Time::FromSeconds(k)}));
-  const VariableId lever =
-      graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d(0.1, 0.2, 0.3), false, std::nullopt});
+  const auto [poses, lever] = AddPosesAndLever(12, &rng, &graph);
   const auto tie = [&](const std::vector<VariableId>& ids) { TieWithRandomPrior(ids, &rng, &graph); };
   for (std::size_t k = 0; k < poses.size(); ++k) {
     tie({poses[k]});
@@ -348,12 +355,7 @@ TEST(NormalEquationsTest, LargeBandIsFactoredInItsEnvelopeUnlessManyPosesFarApar
     SCOPED_TRACE(loop ? "each pose tied to the one 100 poses later" : "neighbours only");
     std::mt19937 rng(17);
     Graph graph;
-    std::vector<VariableId> poses;
-    for (int k = 0; k < 400; ++k)
-      poses.push_back(graph.AddVariable({"pose", Manifold::Pose(), testing::RandomPoint(Manifold::Pose(), &rng, 5.0),
-                                         false, Time::FromSeconds(k)}));
-    const VariableId lever =
-        graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d(0.1, 0.2, 0.3), false, std::nullopt});
+    const auto [poses, lever] = AddPosesAndLever(400, &rng, &graph);
     const auto tie = [&](const std::vector<VariableId>& ids) { TieWithRandomPrior(ids, &rng, &graph); };
     for (std::size_t k = 0; k < poses.size(); ++k) {
       if (k + 1 < poses.size()) tie({poses[k], poses[k + 1]});
