@@ -396,8 +396,9 @@ roamlab::Result<PeerComparison> CompareWithCeres(est::EstimatorConfig config, co
   out.roamlab_termination = est::TerminationName(summary.termination);
   out.calibration = ParameterValues(builder);
 
-  // The floor: CHOLMOD's numeric factorization of the final Hessian (the pattern analysed beforehand, as in the
-  // solver's iterations), with the factorization roamlab uses at this size.
+  // The floor: CHOLMOD's numeric factorization of the final Hessian (the pattern analysed beforehand, as a sparse
+  // solver's iterations would), the general sparse Cholesky the issue measures against; roamlab's own iterations
+  // factor this band in its envelope instead.
   {
     est::internal::NormalEquations system(graph, est::FreeVariableOrder(graph));
     if (!system.Linearize(graph)) return roamlab::Status::Error("final Hessian cannot be evaluated");
