@@ -122,9 +122,8 @@ class SolverWorkspace {
 // time-varying parameters' instances; each instance after the last pose it serves, just before the pose that starts
 // the next instance of the same parameter, the newest after every pose: a band), then the others in id order;
 // in that order a band's envelope is factored as it is, otherwise CHOLMOD picks its own fill-reducing permutation
-// on top. When `covariance` is given, fills it (computed = false if the
-// Hessian is not positive definite). `workspace` (optional) carries buffers and the symbolic factorization over to the
-// next solve.
+// on top. When `covariance` is given, fills it (computed = false if the Hessian is not positive definite).
+// `workspace` (optional) carries buffers and the symbolic factorization over to the next solve.
 SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceRequest* covariance = nullptr,
                     SolverWorkspace* workspace = nullptr);
 
