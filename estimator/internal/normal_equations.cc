@@ -1153,8 +1153,10 @@ bool NormalEquations::BorderInformation(int border_dimension, Eigen::MatrixXd* i
   if (!natural_order_ || border_dimension <= 0) return false;
   Analyze();
   if (dimension_ - band_dimension_ != border_dimension) return false;
-  // The factorization without Uc: corner_ keeps C - Ub^T Ub (upper triangle), which need not be positive definite.
+  // The factorization without Uc, from scratch (no kept columns): corner_ keeps C - Ub^T Ub (upper triangle), which
+  // need not be positive definite.
   cholmod_->factored_undamped = false;
+  factor_kept_ = false;
   const bool factored = FactorEnvelope(hessian_upper(), 0.0, /*factor_corner=*/false);
   if (!factored) return false;
   *information = corner_.selfadjointView<Eigen::Upper>();
