@@ -1070,7 +1070,7 @@ bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, doubl
   const bool undamped = lambda <= 0.0;
   const int na = band_dimension_;
   const int reused = undamped && relinearize_threshold_ > 0.0 ? ReusableBlocks() : 0;
-  if (reused < left_out_blocks_) CompleteHessian();  // (A is H_: undamped)
+  if (reused < left_out_blocks_) CompleteHessian();  // (A is H_, the damping added below)
   const int reused_rows = reused > 0 ? block_offset_[reused] : 0;
   envelope_.resize(envelope_start_[band_blocks_]);
   border_.resize(na, dimension_ - na);
