@@ -69,26 +69,15 @@ bool SquareRootInformation(const Eigen::MatrixXd& H_in, const Eigen::VectorXd& g
     const double d = std::sqrt(H(k, k));
     H(k, k) = d;
     H.col(k).tail(n - k - 1) /= d;
-    for (int j = k + 1; j < n; ++j) {
-      const double hjk = H(j, k);
-      for (int i = j; i < n; ++i) H(i, j) -= hjk * H(i, k);
-    }
+    for (int j = k + 1; j < n; ++j) H.col(j).segment(j, n - j) -= H(j, k) * H.col(k).segment(j, n - j);
     rank = k + 1;
   }
-  // The kept eigenvalues' bound 1 / |L11^-1|_F^2, column by column of L11^-1 (forward substitution on e_j).
+  // The kept eigenvalues' bound 1 / |L11^-1|_F^2.
   bool gap = rank > 0;
   if (gap) {
-    double inverse_squared_norm = 0.0;
-    Eigen::VectorXd y(rank);
-    for (int j = 0; j < rank; ++j) {
-      for (int i = j; i < rank; ++i) {
-        double s = i == j ? 1.0 : 0.0;
-        for (int k = j; k < i; ++k) s -= H(i, k) * y[k];
-        y[i] = s / H(i, i);
-        inverse_squared_norm += y[i] * y[i];
-      }
-    }
-    gap = 1.0 / inverse_squared_norm > floor;
+    const Eigen::MatrixXd inverse = H.topLeftCorner(rank, rank).triangularView<Eigen::Lower>().solve(
+        Eigen::MatrixXd::Identity(rank, rank));
+    gap = 1.0 / inverse.squaredNorm() > floor;
   }
   if (gap) {
     J->setZero(rank, n);

@@ -506,8 +506,27 @@ void NormalEquations::BuildPattern() {
                                         : std::lower_bound(rows.begin(), rows.end(), r) - rows.begin();
     return static_cast<std::ptrdiff_t>(outer[block_offset_[b]]) + row_offset_[b][position];
   };
+  // Sized for the most pairs (two per pair of positions; never shrunk, pair_begin_ says which are used) and written
+  // in place: a PairSlot assembled on the stack and copied in stalls on the store forwarding of its mixed-width fields.
+  std::size_t most_pairs = 0;
+  for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
+    const std::size_t n = static_cast<std::size_t>(var_begin_[k + 1] - var_begin_[k]);
+    most_pairs += n * (n + 1);
+  }
+  if (pairs_.size() < most_pairs) pairs_.resize(most_pairs);
   pair_begin_.assign(1, 0);
-  pairs_.clear();
+  PairSlot* pair = pairs_.data();
+  const auto add_pair = [&pair](std::ptrdiff_t value, int row, int column, int a, int b, int product,
+                                bool transposed) {
+    pair->value = value;
+    pair->row = row;
+    pair->column = column;
+    pair->a = a;
+    pair->b = b;
+    pair->product = product;
+    pair->transposed = transposed;
+    ++pair;
+  };
   int free[64];
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
     const int* block = &var_block_[var_begin_[k]];
@@ -516,13 +535,13 @@ void NormalEquations::BuildPattern() {
       for (int j = i; j < nf; ++j) {
         const int a = block[free[i]], b = block[free[j]];
         const std::ptrdiff_t value = value_index(std::min(a, b), std::max(a, b));
-        if (a <= b) pairs_.push_back({value, a, b, free[i], free[j], product, false});
+        if (a <= b) add_pair(value, a, b, free[i], free[j], product, false);
         // (A variable the factor takes twice gets both products in its diagonal block.)
-        if (a > b || (a == b && i != j)) pairs_.push_back({value, b, a, free[j], free[i], product, true});
+        if (a > b || (a == b && i != j)) add_pair(value, b, a, free[j], free[i], product, true);
         product += dims_[a] * dims_[b];
       }
     }
-    pair_begin_.push_back(static_cast<int>(pairs_.size()));
+    pair_begin_.push_back(static_cast<int>(pair - pairs_.data()));
   }
   diagonal_index_.resize(dimension_);
   for (int b = 0; b < nb; ++b) {
@@ -1115,10 +1134,12 @@ bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, doubl
     }
   }
   for (int j = na; j < dimension_; ++j) {
-    for (int p = outer[j]; p < outer[j + 1]; ++p) {
+    // (Rows sorted: the ones taken over are skipped at once.)
+    const int from = static_cast<int>(std::lower_bound(inner + outer[j], inner + outer[j + 1], reused_rows) - inner);
+    for (int p = from; p < outer[j + 1]; ++p) {
       const int i = inner[p];
       if (i < na) {
-        if (i >= reused_rows) border_(i, j - na) = value[p];
+        border_(i, j - na) = value[p];
       } else if (i <= j) {
         corner_(i - na, j - na) = value[p];
       }
