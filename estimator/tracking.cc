@@ -61,19 +61,20 @@ Status EmitOldest(ProblemBuilder* builder, const CovarianceRequest* known, const
   return Status::Ok();
 }
 
-// Marginal covariances of the oldest `count` poses of the window, all from one factorization of its Hessian at the
-// current estimate, in blocks of kCovarianceBatch poses (bounded memory). They equal what EmitOldest would compute for
-// each pose in turn after marginalizing the ones before it: the Schur complement at the same linearization point keeps
-// the marginal covariance of the remaining variables. `computed` is false when the Hessian is not positive definite
-// (EmitOldest then falls back to one pose at a time).
-constexpr std::size_t kCovarianceBatch = 64;
+// Marginal position covariances of the oldest `count` poses of the window, one request per pose, all from one
+// factorization of its Hessian at the current estimate (each a forward substitution from the pose's block on: only
+// the diagonal blocks are emitted). They equal what EmitOldest would compute for each pose in turn after marginalizing
+// the ones before it: the Schur complement at the same linearization point keeps the marginal covariance of the
+// remaining variables. `computed` is false when the Hessian is not positive definite (EmitOldest then falls back to
+// one pose at a time).
 std::vector<CovarianceRequest> OldestPoseCovariances(const ProblemBuilder& builder, std::size_t count) {
-  std::vector<CovarianceRequest> out((count + kCovarianceBatch - 1) / kCovarianceBatch);
+  std::vector<CovarianceRequest> out(count);
   const Graph& graph = builder.graph();
   internal::NormalEquations system(graph, FreeVariableOrder(graph));
   if (!system.Linearize(graph)) return out;
-  for (std::size_t k = 0; k < count; ++k) out[k / kCovarianceBatch].variables.push_back(builder.poses()[k].id);
-  for (CovarianceRequest& request : out) {
+  for (std::size_t k = 0; k < count; ++k) {
+    CovarianceRequest& request = out[k];
+    request.variables.assign(1, builder.poses()[k].id);
     request.leading_dims = kPositionDims;
     request.computed = system.Covariance(request.variables, &request.covariance, kPositionDims);
   }
@@ -239,7 +240,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
         excess > 1 ? OldestPoseCovariances(builder, excess) : std::vector<CovarianceRequest>();
     for (int k = 0; k < excess; ++k) {
       // After an update, the leaving pose's factors were linearized at the solve's final point (Gauss-Newton).
-      const Status st = EmitAndMarginalizeOldest(&builder, excess > 1 ? &batch[k / kCovarianceBatch] : &leaving,
+      const Status st = EmitAndMarginalizeOldest(&builder, excess > 1 ? &batch[k] : &leaving,
                                                  excess > 1 ? nullptr : &workspace, options, &out);
       if (!st.ok()) return st;
     }
@@ -253,7 +254,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
   if (!s.usable()) return Status::Error("final window: " + s.message);
   const std::vector<CovarianceRequest> last = OldestPoseCovariances(builder, builder.poses().size());
   for (std::size_t k = 0; !builder.poses().empty(); ++k) {
-    const CovarianceRequest* known = &last[k / kCovarianceBatch];
+    const CovarianceRequest* known = &last[k];
     if (builder.poses().size() == 1) {
       const Status st = EmitOldest(&builder, known, options, &out);
       if (!st.ok()) return st;

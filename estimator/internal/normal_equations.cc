@@ -1236,23 +1236,29 @@ bool NormalEquations::Covariance(const std::vector<VariableId>& variables, Eigen
     // H^-1 = U^-1 U^-T, so the covariance is Y^T Y with U^T Y = E: the forward substitution only. As
     // ForwardEnvelope, with kernels for so few columns: a pose's six (or its position's three) at compile time in the
     // band, and the border's and the Gram matrix's products coefficient-wise (a blocked product packs the whole of Ub
-    // for six columns).
+    // for six columns). Y's rows above the first requested block stay zero: the substitution and the products start
+    // there (a window's leaving pose is its first block; an initial batch's poses leave from the front one by one).
     const int na = band_dimension_;
+    int first = static_cast<int>(order_.size());
+    for (VariableId id : variables) first = std::min(first, BlockOf(id));
+    const int from = std::min(first, band_blocks_);
+    const int row0 = from < band_blocks_ ? block_offset_[from] : na;
     WithBand([&](const auto& band) {
       if (cols == 6)
-        band.template Forward<6>(E.data(), E.outerStride(), cols);
+        band.template Forward<6>(E.data(), E.outerStride(), cols, from);
       else if (cols == 3)
-        band.template Forward<3>(E.data(), E.outerStride(), cols);
+        band.template Forward<3>(E.data(), E.outerStride(), cols, from);
       else
-        band.Forward(E.data(), E.outerStride(), cols);
+        band.Forward(E.data(), E.outerStride(), cols, from);
     });
     if (dimension_ > na) {
       auto yc = E.bottomRows(dimension_ - na);
-      yc.noalias() -= border_.transpose().lazyProduct(E.topRows(na));
+      yc.noalias() -= border_.bottomRows(na - row0).transpose().lazyProduct(E.middleRows(row0, na - row0));
       SolveUpperTransposed(corner_, yc);
     }
-    if (!E.allFinite()) return false;
-    *covariance = E.transpose().lazyProduct(E);
+    const auto y = E.bottomRows(dimension_ - row0);
+    if (!y.allFinite()) return false;
+    *covariance = y.transpose().lazyProduct(y);
     return true;
   }
   if (natural_order_) {

@@ -334,6 +334,18 @@ TEST(NormalEquationsTest, EnvelopeFactorizationOfABandWithABorderMatchesADenseCh
   for (int i = 0; i < 9; ++i)
     for (int j = 0; j < 9; ++j)
       EXPECT_NEAR(leading(i, j), H_inv(leading_rows[i], leading_rows[j]), 1e-9 * H_inv.norm()) << i << ", " << j;
+  // Requests whose first block lies further down the band (the forward substitution starts there), or in the border.
+  const auto expect_covariance = [&](const std::vector<VariableId>& ids, const std::vector<int>& expected_rows) {
+    Eigen::MatrixXd covariance;
+    ASSERT_TRUE(system.Covariance(ids, &covariance, 3));
+    ASSERT_EQ(covariance.rows(), static_cast<int>(expected_rows.size()));
+    for (std::size_t i = 0; i < expected_rows.size(); ++i)
+      for (std::size_t j = 0; j < expected_rows.size(); ++j)
+        EXPECT_NEAR(covariance(i, j), H_inv(expected_rows[i], expected_rows[j]), 1e-9 * H_inv.norm()) << i << ", " << j;
+  };
+  expect_covariance({poses[7]}, {42, 43, 44});
+  expect_covariance({poses[11], poses[4], lever}, {66, 67, 68, 24, 25, 26, n - 3, n - 2, n - 1});
+  expect_covariance({lever}, {n - 3, n - 2, n - 1});
 
   // A damped solve factors H + lambda diag(H).
   const double lambda = 0.3;
