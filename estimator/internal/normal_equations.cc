@@ -506,14 +506,19 @@ void NormalEquations::BuildPattern() {
                                         : std::lower_bound(rows.begin(), rows.end(), r) - rows.begin();
     return static_cast<std::ptrdiff_t>(outer[block_offset_[b]]) + row_offset_[b][position];
   };
-  // Sized for the most pairs (two per pair of positions; never shrunk, pair_begin_ says which are used) and written
-  // in place: a PairSlot assembled on the stack and copied in stalls on the store forwarding of its mixed-width fields.
-  std::size_t most_pairs = 0;
+  // Counted first (a pair of free positions i <= j gives one slot, two when i < j take the same variable), then
+  // written in place: a PairSlot assembled on the stack and copied in stalls on the store forwarding of its
+  // mixed-width fields.
+  int free[64];
+  std::size_t pair_count = 0;
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
-    const std::size_t n = static_cast<std::size_t>(var_begin_[k + 1] - var_begin_[k]);
-    most_pairs += n * (n + 1);
+    const int* block = &var_block_[var_begin_[k]];
+    const int nf = FreePositions(block, var_begin_[k + 1] - var_begin_[k], free);
+    pair_count += static_cast<std::size_t>(nf) * (nf + 1) / 2;
+    for (int i = 0; i < nf; ++i)
+      for (int j = i + 1; j < nf; ++j) pair_count += block[free[i]] == block[free[j]];
   }
-  if (pairs_.size() < most_pairs) pairs_.resize(most_pairs);
+  pairs_.resize(pair_count);
   pair_begin_.assign(1, 0);
   PairSlot* pair = pairs_.data();
   const auto add_pair = [&pair](std::ptrdiff_t value, int row, int column, int a, int b, int product,
@@ -527,7 +532,6 @@ void NormalEquations::BuildPattern() {
     pair->transposed = transposed;
     ++pair;
   };
-  int free[64];
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
     const int* block = &var_block_[var_begin_[k]];
     const int nf = FreePositions(block, var_begin_[k + 1] - var_begin_[k], free);
@@ -543,6 +547,8 @@ void NormalEquations::BuildPattern() {
     }
     pair_begin_.push_back(static_cast<int>(pair - pairs_.data()));
   }
+  ROAMLAB_CHECK(pair == pairs_.data() + pairs_.size(), "pair count " << pairs_.size() << ", written "
+                                                                     << pair - pairs_.data());
   diagonal_index_.resize(dimension_);
   for (int b = 0; b < nb; ++b) {
     const std::ptrdiff_t diagonal = value_index(b, b);
