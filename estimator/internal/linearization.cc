@@ -15,6 +15,10 @@ const double* const* GatherValues(const Graph& graph, const FactorEntry& entry) 
   return values.data();
 }
 
+// Rows of Eigen's triangular vector solve's first panel (EIGEN_TUNE_TRIANGULAR_PANEL_WIDTH): up to this size its
+// result is the plain substitution below.
+constexpr Eigen::Index kTriangularPanel = EIGEN_TUNE_TRIANGULAR_PANEL_WIDTH;
+
 // x <- L^-1 x for the error or a Jacobian: a division per row when L is diagonal (what the triangular solve does
 // then), otherwise a triangular solve. A Jacobian of up to 4 rows (an error covariance of eq. 1 is 3 x 3) is solved
 // by plain loops instead of Eigen's blocked matrix solve, whose set-up costs several times the arithmetic at this
@@ -33,6 +37,16 @@ void Whiten(const Eigen::MatrixXd& L, bool diagonal, Eigen::MatrixBase<Derived>*
         const double b = m(i, j);
         for (Eigen::Index r = i + 1; r < m.rows(); ++r) m(r, j) -= b * L(r, i);
       }
+    }
+  } else if (Derived::ColsAtCompileTime == 1 && x->rows() <= kTriangularPanel) {
+    // An error vector: what Eigen's vector solve does within its first panel of rows, entry by entry (a nonzero
+    // x(i) is divided by L(i, i), then x(r) -= x(i) L(r, i) for the rows below), without its call and set-up.
+    Eigen::MatrixBase<Derived>& v = *x;
+    for (Eigen::Index i = 0; i < v.rows(); ++i) {
+      if (v(i) == 0.0) continue;
+      v(i) /= L(i, i);
+      const double b = v(i);
+      for (Eigen::Index r = i + 1; r < v.rows(); ++r) v(r) -= b * L(r, i);
     }
   } else {
     L.triangularView<Eigen::Lower>().solveInPlace(*x);
