@@ -29,6 +29,11 @@ Eigen::Matrix3d InverseRightJacobian(const Eigen::Vector3d& phi) {
   return Eigen::Matrix3d::Identity() + 0.5 * K + c * K * K;
 }
 
+std::vector<double>& InverseColumnScratch() {
+  thread_local std::vector<double> scratch;
+  return scratch;
+}
+
 // J (r x n) and r0 with J^T J = H and J^T r0 = g for a positive semi-definite H (g in its range), keeping the
 // directions of the eigenvalues above `floor` (the others carry no information, or only rounding: see Marginalize).
 // Reference: the eigen-decomposition H = V diag(lambda) V^T, J = diag(sqrt(lambda)) V^T, r0 = diag(1/sqrt(lambda))
@@ -66,18 +71,38 @@ bool SquareRootInformation(const Eigen::MatrixXd& H_in, const Eigen::VectorXd& g
       std::swap(perm[k], perm[p]);
       std::swap(gp[k], gp[p]);
     }
-    const double d = std::sqrt(H(k, k));
-    H(k, k) = d;
-    H.col(k).tail(n - k - 1) /= d;
-    for (int j = k + 1; j < n; ++j) H.col(j).segment(j, n - j) -= H(j, k) * H.col(k).segment(j, n - j);
+    // Plain loops over the columns (column-major, n rows): the same operations as Eigen's segment expressions, whose
+    // per-segment set-up cost more than the arithmetic on a blanket of a few dozen coordinates.
+    double* column_k = H.data() + static_cast<std::ptrdiff_t>(k) * n;
+    const double d = std::sqrt(column_k[k]);
+    column_k[k] = d;
+    for (int i = k + 1; i < n; ++i) column_k[i] /= d;
+    for (int j = k + 1; j < n; ++j) {
+      const double a = column_k[j];
+      double* column_j = H.data() + static_cast<std::ptrdiff_t>(j) * n;
+      for (int i = j; i < n; ++i) column_j[i] -= a * column_k[i];
+    }
     rank = k + 1;
   }
-  // The kept eigenvalues' bound 1 / |L11^-1|_F^2.
+  // The kept eigenvalues' bound 1 / |L11^-1|_F^2: each column of L11^-1 by a forward substitution from its diagonal
+  // on (the rows above are zero).
   bool gap = rank > 0;
   if (gap) {
-    const Eigen::MatrixXd inverse = H.topLeftCorner(rank, rank).triangularView<Eigen::Lower>().solve(
-        Eigen::MatrixXd::Identity(rank, rank));
-    gap = 1.0 / inverse.squaredNorm() > floor;
+    std::vector<double>& x = InverseColumnScratch();
+    x.resize(rank);
+    double squared_norm = 0.0;
+    for (int c = 0; c < rank; ++c) {
+      std::fill(x.begin() + c, x.end(), 0.0);
+      x[c] = 1.0;
+      for (int j = c; j < rank; ++j) {
+        const double* column_j = H.data() + static_cast<std::ptrdiff_t>(j) * n;
+        const double xj = x[j] / column_j[j];
+        x[j] = xj;
+        squared_norm += xj * xj;
+        for (int i = j + 1; i < rank; ++i) x[i] -= xj * column_j[i];
+      }
+    }
+    gap = 1.0 / squared_norm > floor;
   }
   if (gap) {
     J->setZero(rank, n);
