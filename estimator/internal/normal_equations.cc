@@ -499,10 +499,11 @@ void NormalEquations::BuildPattern() {
   // columns of the block are found by adding j * column_length[b].
   const int* outer = H_.outerIndexPtr();
   const auto value_index = [&](int r, int b) {
-    // A column holding every row block up to the diagonal (a constant parameter's, in natural order) has r at r.
+    // A column whose row blocks are consecutive (a constant parameter's in natural order: all up to the diagonal; most
+    // of a band's) has r at r - rows.front().
     const auto& rows = rows_of_[b];
-    const std::ptrdiff_t position = static_cast<int>(rows.size()) == b + 1
-                                        ? r
+    const std::ptrdiff_t position = rows.back() - rows.front() + 1 == static_cast<int>(rows.size())
+                                        ? r - rows.front()
                                         : std::lower_bound(rows.begin(), rows.end(), r) - rows.begin();
     return static_cast<std::ptrdiff_t>(outer[block_offset_[b]]) + row_offset_[b][position];
   };
