@@ -29,11 +29,6 @@ Eigen::Matrix3d InverseRightJacobian(const Eigen::Vector3d& phi) {
   return Eigen::Matrix3d::Identity() + 0.5 * K + c * K * K;
 }
 
-std::vector<double>& InverseColumnScratch() {
-  thread_local std::vector<double> scratch;
-  return scratch;
-}
-
 // J (r x n) and r0 with J^T J = H and J^T r0 = g for a positive semi-definite H (g in its range), keeping the
 // directions of the eigenvalues above `floor` (the others carry no information, or only rounding: see Marginalize).
 // Reference: the eigen-decomposition H = V diag(lambda) V^T, J = diag(sqrt(lambda)) V^T, r0 = diag(1/sqrt(lambda))
@@ -88,8 +83,7 @@ bool SquareRootInformation(const Eigen::MatrixXd& H_in, const Eigen::VectorXd& g
   // on (the rows above are zero).
   bool gap = rank > 0;
   if (gap) {
-    std::vector<double>& x = InverseColumnScratch();
-    x.resize(rank);
+    std::vector<double> x(rank);
     double squared_norm = 0.0;
     for (int c = 0; c < rank; ++c) {
       std::fill(x.begin() + c, x.end(), 0.0);
