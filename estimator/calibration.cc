@@ -120,26 +120,34 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
   if (stages.empty()) stages.push_back(all_free);
 
   CalibrationResult result;
+  // Levenberg-Marquardt's damping, carried from one solve to the next. The first stage starts from the configured one:
+  // its parameters and the dead-reckoned poses may be far from the minimum (from an identity IMU misalignment 40
+  // degrees off, a first damping of 1e-12 led Levenberg-Marquardt and Ceres alike to a minimum 9 times costlier).
+  // Every later solve starts where the last one ended: restarted from the configured 1e-4, every step was accepted with
+  // a gain ratio of 0.95-1.00 while the damping, cut by at most 3 per step, held the steps back along the weakly
+  // observed directions (lever arm against height, magnetometer b against A) for a dozen or more iterations until it
+  // had come down to about 1e-13, whatever the stage freed (BENCHMARKS.md, thirteenth tracking pass).
+  double lambda = config.solver.initial_lambda;
+  const bool lm = config.solver.method == SolverOptions::Method::kLevenbergMarquardt;
   for (std::size_t s = 0; s < stages.size(); ++s) {
     SetFree({stages[s].begin(), stages[s].end()}, &builder);
     StageSummary stage;
     stage.free_parameters = stages[s];
-    stage.solver = Solve(config.solver, &builder.graph());
+    SolverOptions stage_options = config.solver;
+    if (lm) stage_options.initial_lambda = std::max(lambda, std::numeric_limits<double>::epsilon());
+    stage.solver = Solve(stage_options, &builder.graph());
     if (!stage.solver.usable()) return Status::Error("stage " + std::to_string(s + 1) + ": " + stage.solver.message);
     // Gate gross outliers at the converged estimate and re-solve without them.
     // Gross outliers bend the estimate and make inliers look bad too: re-test every measurement after each re-solve,
     // re-admitting those that fit again, until the set is stable.
-    // Each re-solve starts from the last one's damping: the problem changed by a few measurements, and restarting
-    // Levenberg-Marquardt from SolverOptions::initial_lambda would crawl again through the weakly observed directions
-    // (lever arm and trajectory height) it had already damped down to Gauss-Newton steps for.
-    double lambda = stage.solver.final_lambda;
+    // Each re-solve starts from the last one's damping too (the problem changed by a few measurements).
+    lambda = stage.solver.final_lambda;
     for (int round = 0; config.gate_probability && round < 5; ++round) {
       const int changed = GateOutliers(*config.gate_probability, &builder);
       if (changed == 0) break;
       {
         SolverOptions warm = config.solver;
-        if (warm.method == SolverOptions::Method::kLevenbergMarquardt)
-          warm.initial_lambda = std::max(lambda, std::numeric_limits<double>::epsilon());
+        if (lm) warm.initial_lambda = std::max(lambda, std::numeric_limits<double>::epsilon());
         const SolverSummary again = Solve(warm, &builder.graph());
         lambda = again.final_lambda;
         say("stage " + std::to_string(s + 1) + ": gating round " + std::to_string(round + 1) + ": " +
