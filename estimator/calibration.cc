@@ -129,38 +129,58 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
   // had come down to about 1e-13, whatever the stage freed (BENCHMARKS.md, thirteenth tracking pass).
   double lambda = config.solver.initial_lambda;
   const bool lm = config.solver.method == SolverOptions::Method::kLevenbergMarquardt;
+  // The solves' buffers, carried from one solve to the next: a gating round's one-step solve on the 30 min drive took
+  // 1.5-2.0 s with them against 2.1-2.9 s (its pattern and envelope allocated and paged in again); peak memory +6 %.
+  // Released before the observability analysis, which builds its own system.
+  auto workspace = std::make_unique<SolverWorkspace>();
   for (std::size_t s = 0; s < stages.size(); ++s) {
     SetFree({stages[s].begin(), stages[s].end()}, &builder);
     StageSummary stage;
     stage.free_parameters = stages[s];
     SolverOptions stage_options = config.solver;
     if (lm) stage_options.initial_lambda = std::max(lambda, std::numeric_limits<double>::epsilon());
-    stage.solver = Solve(stage_options, &builder.graph());
+    stage.solver = Solve(stage_options, &builder.graph(), nullptr, workspace.get());
     if (!stage.solver.usable()) return Status::Error("stage " + std::to_string(s + 1) + ": " + stage.solver.message);
     // Gate gross outliers at the converged estimate and re-solve without them.
     // Gross outliers bend the estimate and make inliers look bad too: re-test every measurement after each re-solve,
-    // re-admitting those that fit again, until the set is stable.
+    // re-admitting those that fit again, until the set is stable (at most 5 rounds).
+    // A round's re-solve is one step (the damping is down to about 1e-13 there: a Gauss-Newton step): from a converged
+    // point with a few measurements switched the problem is all but quadratic, and that step leaves less than a
+    // thousandth of its decrease to the next ones (30 min drive: 310, then 0.23, 3e-4, 2e-6), which do not move the
+    // next round's test. Once the set is stable the solve runs to convergence: the same rejected set and final cost
+    // as re-solving to convergence in every round, in 46 iterations instead of 62 on the long weave, whose gate takes
+    // 5 + 3 rounds against 1 + 1 on 30 s (BENCHMARKS.md, fourteenth pass).
     // Each re-solve starts from the last one's damping too (the problem changed by a few measurements).
     lambda = stage.solver.final_lambda;
+    const auto resolve = [&](int max_iterations, const std::string& what) -> Status {
+      SolverOptions warm = config.solver;
+      warm.max_iterations = max_iterations;
+      if (lm) warm.initial_lambda = std::max(lambda, std::numeric_limits<double>::epsilon());
+      const SolverSummary again = Solve(warm, &builder.graph(), nullptr, workspace.get());
+      lambda = again.final_lambda;
+      say("stage " + std::to_string(s + 1) + ": " + what + " in " + std::to_string(again.iterations) +
+          " iterations, " + std::to_string(again.seconds) + " s");
+      if (!again.usable()) return Status::Error("stage " + std::to_string(s + 1) + ": " + again.message);
+      stage.solver.iterations += again.iterations;
+      stage.solver.final_cost = again.final_cost;
+      stage.solver.cost_history.insert(stage.solver.cost_history.end(), again.cost_history.begin(),
+                                       again.cost_history.end());
+      stage.solver.termination = again.termination;
+      stage.solver.seconds += again.seconds;
+      return Status::Ok();
+    };
+    bool gated = false;
     for (int round = 0; config.gate_probability && round < 5; ++round) {
-      const int changed = GateOutliers(*config.gate_probability, &builder);
+      const int changed = GateOutliers(*config.gate_probability, &builder, 0, workspace.get());
       if (changed == 0) break;
-      {
-        SolverOptions warm = config.solver;
-        if (lm) warm.initial_lambda = std::max(lambda, std::numeric_limits<double>::epsilon());
-        const SolverSummary again = Solve(warm, &builder.graph());
-        lambda = again.final_lambda;
-        say("stage " + std::to_string(s + 1) + ": gating round " + std::to_string(round + 1) + ": " +
-            std::to_string(changed) + " measurements switched, re-solved in " + std::to_string(again.iterations) +
-            " iterations, " + std::to_string(again.seconds) + " s");
-        if (!again.usable()) return Status::Error("stage " + std::to_string(s + 1) + ": " + again.message);
-        stage.solver.iterations += again.iterations;
-        stage.solver.final_cost = again.final_cost;
-        stage.solver.cost_history.insert(stage.solver.cost_history.end(), again.cost_history.begin(),
-                                         again.cost_history.end());
-        stage.solver.termination = again.termination;
-        stage.solver.seconds += again.seconds;
-      }
+      gated = true;
+      const Status stepped = resolve(1, "gating round " + std::to_string(round + 1) + ": " + std::to_string(changed) +
+                                            " measurements switched, one step");
+      if (!stepped.ok()) return stepped;
+    }
+    if (gated) {
+      const Status converged = resolve(config.solver.max_iterations, "gated set re-solved");
+      if (!converged.ok()) return converged;
     }
     for (const auto& [stream, c] : builder.counts()) stage.rejected += c.rejected;
     say("stage " + std::to_string(s + 1) + "/" + std::to_string(stages.size()) + ": cost " +
@@ -171,6 +191,7 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
     result.termination = TerminationName(stage.solver.termination);
     result.stages.push_back(std::move(stage));
   }
+  workspace.reset();
   result.initial_cost = result.stages.front().solver.initial_cost;
   result.final_cost = result.stages.back().solver.final_cost;
 
