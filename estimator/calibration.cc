@@ -171,7 +171,8 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
     };
     bool gated = false;
     for (int round = 0; config.gate_probability && round < 5; ++round) {
-      const int changed = GateOutliers(*config.gate_probability, &builder, 0, workspace.get());
+      // (Not handed the workspace: Levenberg-Marquardt's last point had its cost evaluated, not its linearization.)
+      const int changed = GateOutliers(*config.gate_probability, &builder);
       if (changed == 0) break;
       gated = true;
       const Status stepped = resolve(1, "gating round " + std::to_string(round + 1) + ": " + std::to_string(changed) +
