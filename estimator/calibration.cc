@@ -144,10 +144,10 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
     // Gate gross outliers at the converged estimate and re-solve without them.
     // Gross outliers bend the estimate and make inliers look bad too: re-test every measurement after each re-solve,
     // re-admitting those that fit again, until the set is stable (at most 5 rounds).
-    // A round's re-solve is one step (the damping is down to about 1e-13 there: a Gauss-Newton step): from a converged
-    // point with a few measurements switched the problem is all but quadratic, and that step leaves less than a
-    // thousandth of its decrease to the next ones (30 min drive: 310, then 0.23, 3e-4, 2e-6), which do not move the
-    // next round's test. Once the set is stable the solve runs to convergence: the same rejected set and final cost
+    // A round's re-solve is one step (the damping has come down to 1e-16-1e-18 by then: a Gauss-Newton step): from a
+    // converged point with a few measurements switched the problem is all but quadratic, and that step leaves less
+    // than a thousandth of its decrease to the next ones (30 min drive: 310, then 0.23, 3e-4, 2e-6), which do not move
+    // the next round's test. Once the set is stable the solve runs to convergence: the same rejected set and final cost
     // as re-solving to convergence in every round, in 46 iterations instead of 62 on the long weave, whose gate takes
     // 5 + 3 rounds against 1 + 1 on 30 s (BENCHMARKS.md, fourteenth pass).
     // Each re-solve starts from the last one's damping too (the problem changed by a few measurements).
