@@ -564,6 +564,13 @@ __attribute__((flatten)) bool NormalEquations::Linearize(const Graph& /*graph*/,
   g_.setZero();
   cost_ = 0.0;
   undamped_step_ = false;
+  double* values = H_.valuePtr();
+  left_out_blocks_ = 0;
+  // Without a relinearization threshold every block of H is summed, and each factor's J_a^T J_b go into it right after
+  // its gradient, while its Jacobians are still in the cache: a whole recording's linearizations do not fit there,
+  // and a second pass would stream them from memory again.
+  const bool summed_in_pass = relinearize_threshold_ <= 0.0;
+  if (summed_in_pass) std::fill(values, values + H_.nonZeros(), 0.0);
   // Every factor at the current values (kept, carried or evaluated), its cost and J_a^T r into g.
   int free[64];  // positions of a factor's free variables
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
@@ -577,32 +584,26 @@ __attribute__((flatten)) bool NormalEquations::Linearize(const Graph& /*graph*/,
     const int nf = FreePositions(block, var_begin_[k + 1] - var_begin_[k], free);
     for (int i = 0; i < nf; ++i)
       AddGradient(wf.jacobians[free[i]], wf.residual, g_.data() + block_offset_[block[free[i]]]);
+    if (!summed_in_pass) continue;
+    // J_a^T J_b into the blocks of the upper triangle, which sit in H's value array with the column length of their
+    // block column as outer stride.
+    for (int p = pair_begin_[k]; p < pair_begin_[k + 1]; ++p) {
+      const PairSlot& pair = pairs_[p];
+      AddProduct(wf.jacobians[pair.a], wf.jacobians[pair.b], values + pair.value, column_length_[pair.column]);
+    }
   }
+  if (summed_in_pass) return true;
 
-  // H. The blocks the next factorization takes over from the kept one (every factor evaluated since is known now:
-  // ReusableBlocks) are left out; their band columns come first in H's values and stay as they are.
-  double* values = H_.valuePtr();
-  left_out_blocks_ = 0;
-  if (relinearize_threshold_ > 0.0 && natural_order_ && factor_kept_) {
+  // H from the kept products. The blocks the next factorization takes over from the kept one (every factor evaluated
+  // since is known now: ReusableBlocks) are left out; their band columns come first in H's values and stay as they are.
+  if (natural_order_ && factor_kept_) {
     Analyze();
     left_out_blocks_ = ReusableBlocks();
     left_out_evaluations_ = evaluations_;
   }
   const std::ptrdiff_t summed_from = left_out_blocks_ > 0 ? H_.outerIndexPtr()[block_offset_[left_out_blocks_]] : 0;
   std::fill(values + summed_from, values + H_.nonZeros(), 0.0);
-  if (relinearize_threshold_ > 0.0) {
-    for (std::size_t k = 0; k < factor_ids_.size(); ++k) AddKeptProducts(k, false);
-    return true;
-  }
-  for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
-    // J_a^T J_b into the blocks of the upper triangle, which sit in H's value array with the column length of their
-    // block column as outer stride.
-    const WhitenedFactor& wf = linearized_[k].whitened;
-    for (int p = pair_begin_[k]; p < pair_begin_[k + 1]; ++p) {
-      const PairSlot& pair = pairs_[p];
-      AddProduct(wf.jacobians[pair.a], wf.jacobians[pair.b], values + pair.value, column_length_[pair.column]);
-    }
-  }
+  for (std::size_t k = 0; k < factor_ids_.size(); ++k) AddKeptProducts(k, false);
   return true;
 }
 
