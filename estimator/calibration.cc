@@ -25,36 +25,54 @@ int GateOutliers(double probability, ProblemBuilder* builder, FactorId first, co
     const auto it = quantiles.find(key);
     return it != quantiles.end() ? it->second : (quantiles[key] = ChiSquareQuantile(probability, dim));
   };
-  int changed = 0;
-  std::vector<FactorId> ids;
-  for (auto it = graph.factors().lower_bound(first); it != graph.factors().end(); ++it)
-    if (builder->StreamOfFactor(it->first) >= 0) ids.push_back(it->first);
+  // One walk over the measurement factors and the graph's factors in id order, and the variables' values from a table
+  // sorted by id: a whole recording's 10^5-10^6 factors are not looked up in the graph's maps one by one (each look-up
+  // a chain of cache misses).
+  std::vector<std::pair<VariableId, const Variable*>> variables;
+  variables.reserve(graph.variables().size());
+  for (const auto& [id, v] : graph.variables()) variables.emplace_back(id, &v);
+  const auto variable = [&variables](VariableId id) -> const Variable& {
+    const auto it = std::lower_bound(variables.begin(), variables.end(), id,
+                                     [](const auto& slot, VariableId key) { return slot.first < key; });
+    ROAMLAB_CHECK(it != variables.end() && it->first == id, "no variable " << id);
+    return *it->second;
+  };
+  std::vector<FactorId> switched;
+  std::vector<const double*> values;
   internal::WhitenedFactor wf;  // reused: its buffers keep their size
-  std::vector<bool> no_jacobians;
-  for (FactorId id : ids) {
-    FactorEntry& entry = graph.mutable_factor(id);
+  auto factor = graph.factors().lower_bound(first);
+  for (auto stream = builder->factor_streams().lower_bound(first); stream != builder->factor_streams().end();
+       ++stream) {
+    const FactorId id = stream->first;
+    while (factor != graph.factors().end() && factor->first < id) ++factor;
+    if (factor == graph.factors().end()) break;
+    if (factor->first != id) continue;  // (no longer in the graph)
+    const FactorEntry& entry = factor->second;
     const int dim = entry.factor->residual_dim();
     // The solve's linearization (of an active factor, with the Jacobians of its free variables), else the error.
     const internal::WhitenedFactor* linearized = nullptr;
     if (last_solve != nullptr && entry.active) {
       std::uint64_t free_mask = 0;
       for (std::size_t i = 0; i < entry.variables.size() && i < 64; ++i)
-        if (!graph.variable(entry.variables[i]).fixed) free_mask |= std::uint64_t{1} << i;
+        if (!variable(entry.variables[i]).fixed) free_mask |= std::uint64_t{1} << i;
       linearized = last_solve->Linearization(id, free_mask);
     }
     bool ok = linearized != nullptr;
     if (!ok) {
-      no_jacobians.assign(entry.variables.size(), false);
-      ok = internal::LinearizeFactor(graph, entry, no_jacobians, &wf);
+      values.clear();
+      for (VariableId v : entry.variables) values.push_back(variable(v).value.data());
+      ok = internal::LinearizeFactorAt(entry, values.data(), 0, &wf);
       linearized = &wf;
     }
     const bool active = ok && linearized->squared_norm <= threshold(dim);
-    if (active == entry.active) continue;
-    ++changed;
-    builder->mutable_counts(entry.stream).rejected += active ? -1 : 1;
-    entry.active = active;
+    if (active != entry.active) switched.push_back(id);
   }
-  return changed;
+  for (FactorId id : switched) {
+    FactorEntry& entry = graph.mutable_factor(id);
+    entry.active = !entry.active;
+    builder->mutable_counts(entry.stream).rejected += entry.active ? -1 : 1;
+  }
+  return static_cast<int>(switched.size());
 }
 
 namespace {

@@ -95,6 +95,8 @@ class ProblemBuilder {
 
   // Stream that produced a factor (by factor id); -1 for process and prior factors.
   int StreamOfFactor(FactorId id) const;
+  // The same for every measurement factor added, by id.
+  const std::map<FactorId, int>& factor_streams() const { return stream_of_factor_; }
   // Chi-square dimension of a stream's factors.
   int ResidualDim(const std::string& stream) const;
 
