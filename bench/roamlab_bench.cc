@@ -750,16 +750,15 @@ int main(int argc, char** argv) {
     auto child = RunChild(self, {"--child-calibrate", dir, calibration_path, out}, out);
     if (!child.ok()) return Fail(child.status().message());
     std::filesystem::remove_all(dir);
-    const Json& c = child.value();
+    Json c = child.value();
     calibration_seconds[size] = c["seconds"].get<double>();
     calibration_cpu_seconds[size] = c["cpu_seconds"].get<double>();
-    j["calibration_scaling"][std::to_string(static_cast<int>(size)) + "s"] = c;
     // CPU time per pose and iteration (set-up, gate passes and the observability analysis spread over them): flat
     // when the calibration's cost grows with the data alone.
     const double us_per_pose_iteration =
         1e6 * c["cpu_seconds"].get<double>() / (c["poses"].get<double>() * std::max(1, c["iterations"].get<int>()));
-    j["calibration_scaling"][std::to_string(static_cast<int>(size)) + "s"]["cpu_us_per_pose_iteration"] =
-        us_per_pose_iteration;
+    c["cpu_us_per_pose_iteration"] = us_per_pose_iteration;
+    j["calibration_scaling"][std::to_string(static_cast<int>(size)) + "s"] = c;
     say("  calibration of a %5.0f s drive    %8.2f s wall, %.2f s CPU, %d iterations (%.1f us CPU per pose and "
         "iteration), peak memory %.0f MB\n",
         size, c["seconds"].get<double>(), c["cpu_seconds"].get<double>(), c["iterations"].get<int>(),
