@@ -149,8 +149,10 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
   const bool lm = config.solver.method == SolverOptions::Method::kLevenbergMarquardt;
   // The solves' buffers, carried from one solve to the next: a gating round's one-step solve on the 30 min drive took
   // 1.5-2.0 s with them against 2.1-2.9 s (its pattern and envelope allocated and paged in again); peak memory +6 %.
-  // Released before the observability analysis, which builds its own system.
+  // Released before the observability analysis, which builds its own system. The factors' linearizations are not kept
+  // (the gate evaluates the errors at the converged point, where no solve linearized them).
   auto workspace = std::make_unique<SolverWorkspace>();
+  workspace->set_keep_linearizations(false);
   for (std::size_t s = 0; s < stages.size(); ++s) {
     SetFree({stages[s].begin(), stages[s].end()}, &builder);
     StageSummary stage;

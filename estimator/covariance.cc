@@ -39,6 +39,7 @@ Result<MarginalInformation> ComputeMarginalInformation(const Graph& graph, const
   }
 
   internal::NormalEquations system(graph, order);
+  system.set_keep_linearizations(false);  // (one linearization, H alone read)
   std::string failed;
   if (!system.Linearize(graph, &failed)) return Status::Error("a factor from '" + failed + "' cannot be evaluated");
   const int n = system.dimension();

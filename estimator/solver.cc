@@ -124,9 +124,11 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
   }
 
   SolverWorkspace local;
+  local.set_keep_linearizations(false);  // (nobody can read them)
   SolverWorkspace& ws = workspace != nullptr ? *workspace : local;
   internal::NormalEquations& system = *ws.system_;
   system.set_relinearize_threshold(options.relinearize_threshold);
+  system.set_keep_linearizations(ws.keep_linearizations_);
   system.Reset(*graph, FreeVariableOrder(*graph));
   const std::vector<VariableId>& order = system.order();
   summary.free_dimension = system.dimension();

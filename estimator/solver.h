@@ -110,9 +110,16 @@ class SolverWorkspace {
   const internal::WhitenedFactor* Linearization(FactorId id, std::uint64_t want_mask) const;
   // Its Jacobians' products J_i^T J_j when the solve kept them (internal::NormalEquations::KeptProductsAt), else null.
   const std::vector<double>* Products(FactorId id, std::uint64_t want_mask) const;
+  // Whether the solves keep each factor's last linearization for Linearization and Products (default true). A caller
+  // that does not read them (a whole recording's calibration) sets false: a solve without a relinearization threshold
+  // then uses each factor's Jacobians as they are computed and keeps only its whitening and cost, instead of writing
+  // about 1 KB per factor and iteration to memory that nothing reads again (a 30 min drive has 729 001 factors).
+  // Results are the same.
+  void set_keep_linearizations(bool keep) { keep_linearizations_ = keep; }
 
  private:
   friend SolverSummary Solve(const SolverOptions&, Graph*, CovarianceRequest*, SolverWorkspace*);
+  bool keep_linearizations_ = true;
   std::unique_ptr<internal::NormalEquations> system_;
   std::vector<double> saved_;
   std::vector<Variable*> free_variables_;

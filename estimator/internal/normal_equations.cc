@@ -558,6 +558,40 @@ void NormalEquations::BuildPattern() {
   }
 }
 
+namespace {
+constexpr std::size_t kPrefetchAhead = 8;  // factors or variables
+}  // namespace
+
+void NormalEquations::PrefetchAhead(std::size_t k) const {
+  const std::size_t n = factor_ids_.size();
+  if (k + 2 * kPrefetchAhead < n) {
+    const char* entry = reinterpret_cast<const char*>(entries_[k + 2 * kPrefetchAhead]);
+    for (std::size_t line = 0; line < sizeof(FactorEntry); line += 64) __builtin_prefetch(entry + line);
+  }
+  if (k + kPrefetchAhead >= n) return;
+  const std::size_t j = k + kPrefetchAhead;
+  const FactorEntry& entry = *entries_[j];
+  const char* factor = reinterpret_cast<const char*>(entry.factor.get());
+  __builtin_prefetch(factor);
+  __builtin_prefetch(factor + 64);
+  __builtin_prefetch(entry.noise_sqrt_covariance.data());
+  __builtin_prefetch(linearized_[j].whitened.sqrt_covariance.data());
+  for (int v = var_begin_[j]; v < var_begin_[j + 1]; ++v) __builtin_prefetch(values_[v]);
+}
+
+WhitenedFactor& NormalEquations::BufferFor(std::size_t k) {
+  const FactorEntry& entry = *entries_[k];
+  const std::vector<Manifold>& manifolds = entry.factor->manifolds();
+  std::vector<int>& shape = shape_scratch_;
+  shape.assign(1, entry.factor->residual_dim());
+  for (std::size_t i = 0; i < manifolds.size(); ++i)
+    shape.push_back(((want_[k] >> i) & 1u) != 0 ? manifolds[i].tangent_dim() : 0);
+  for (ShapedBuffer& buffer : shaped_buffers_)
+    if (buffer.shape == shape) return buffer.whitened;
+  shaped_buffers_.push_back({shape, {}});
+  return shaped_buffers_.back().whitened;
+}
+
 // flatten: the small fixed-size J^T J kernels are inlined here whatever the compiler's size heuristics decide (once
 // left out of line, they cost a third more).
 __attribute__((flatten)) bool NormalEquations::Linearize(const Graph& /*graph*/, std::string* failed_stream) {
@@ -573,12 +607,30 @@ __attribute__((flatten)) bool NormalEquations::Linearize(const Graph& /*graph*/,
   if (summed_in_pass) std::fill(values, values + H_.nonZeros(), 0.0);
   // Every factor at the current values (kept, carried or evaluated), its cost and J_a^T r into g.
   int free[64];  // positions of a factor's free variables
+  const bool keep = keep_linearizations_ || !summed_in_pass;
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
-    if (!Current(k) && !CarryToFirstOrder(k) && !LinearizeAndRecord(k, nullptr)) {
+    PrefetchAhead(k);
+    const WhitenedFactor* linearized = &linearized_[k].whitened;
+    if (!keep && !Current(k)) {
+      // Into the buffer of the factor's shape; the factor keeps what CostWithLastWhitening and the gate read. (A
+      // Gauss-Newton trial point's linearization, which LinearizeForCost keeps, is current.)
+      WhitenedFactor& buffer = BufferFor(k);
+      if (!LinearizeFactorAt(*entries_[k], &values_[var_begin_[k]], want_[k], &buffer)) {
+        if (failed_stream != nullptr) *failed_stream = entries_[k]->stream;
+        return false;
+      }
+      ++evaluations_;
+      FactorLinearization& l = linearized_[k];
+      l.id = -1;  // not a kept linearization
+      if (!entries_[k]->factor->additive_noise()) l.whitened.sqrt_covariance = buffer.sqrt_covariance;
+      l.whitened.squared_norm = buffer.squared_norm;
+      l.whitened.cost = buffer.cost;
+      linearized = &buffer;
+    } else if (!Current(k) && !CarryToFirstOrder(k) && !LinearizeAndRecord(k, nullptr)) {
       if (failed_stream != nullptr) *failed_stream = entries_[k]->stream;
       return false;
     }
-    const WhitenedFactor& wf = linearized_[k].whitened;
+    const WhitenedFactor& wf = *linearized;
     cost_ += wf.cost;
     const int* block = &var_block_[var_begin_[k]];
     const int nf = FreePositions(block, var_begin_[k + 1] - var_begin_[k], free);
@@ -661,6 +713,7 @@ const Eigen::SparseMatrix<double>& NormalEquations::hessian_upper() {
 bool NormalEquations::CostWithLastWhitening(const Graph& /*graph*/, double* cost) const {
   *cost = 0.0;
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
+    PrefetchAhead(k);
     double c = 0.0;
     const FactorEntry& entry = *entries_[k];
     if (!FactorCostAt(entry, &values_[var_begin_[k]], SqrtCovariance(entry, linearized_[k].whitened), &c))
@@ -1292,7 +1345,11 @@ void NormalEquations::Update(const Eigen::VectorXd& dx, Graph* graph) const {
 void NormalEquations::Update(const Eigen::VectorXd& dx, const std::vector<Variable*>& free_variables) const {
   ROAMLAB_CHECK(free_variables.size() == order_.size(), "Update with " << free_variables.size() << " variables for "
                                                                         << order_.size() << " blocks");
-  for (std::size_t b = 0; b < order_.size(); ++b) {
+  // (The variables lie in separate heap blocks, their values in others: both prefetched ahead.)
+  const std::size_t n = order_.size();
+  for (std::size_t b = 0; b < n; ++b) {
+    if (b + 2 * kPrefetchAhead < n) __builtin_prefetch(free_variables[b + 2 * kPrefetchAhead]);
+    if (b + kPrefetchAhead < n) __builtin_prefetch(free_variables[b + kPrefetchAhead]->value.data());
     Variable& v = *free_variables[b];
     v.manifold.Plus(v.value.data(), dx.data() + block_offset_[b], v.value.data());
   }

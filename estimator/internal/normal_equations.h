@@ -73,6 +73,15 @@ class NormalEquations {
   // to first order, r(x_lin) + sum_i J_i (x_i [-] x_lin_i), with the same Jacobians. 0 (the default): a factor is
   // evaluated again whenever one of its values changed.
   void set_relinearize_threshold(double threshold) { relinearize_threshold_ = threshold; }
+  // Whether Linearize keeps every factor's linearization (its Jacobians, whitened error, point) for LinearizationAt
+  // and KeptProductsAt (default true). Without a relinearization threshold and with keep false, each factor is
+  // linearized into a buffer of its shape that the next one of that shape reuses, and only what the trial points'
+  // costs and the outlier gate need stays with the factor (its error covariance's factor when that depends on the
+  // estimate, its cost and squared norm): the same H, g and cost, without streaming a whole recording's
+  // linearizations to memory that nothing reads again. LinearizationAt is then null after Linearize. (With a
+  // threshold they are kept whatever this says: the carries need them; LinearizeForCost keeps its linearization of
+  // a Gauss-Newton trial point, which the next Linearize takes.)
+  void set_keep_linearizations(bool keep) { keep_linearizations_ = keep; }
   // Factor evaluations (with Jacobians) and first-order carries since construction.
   long evaluations() const { return evaluations_; }
   long carries() const { return carries_; }
@@ -183,6 +192,20 @@ class NormalEquations {
     bool products_valid = false;
   };
   std::vector<FactorLinearization> linearized_;
+  bool keep_linearizations_ = true;
+  // Linearize without keeping: one buffer per factor shape (residual size and Jacobian columns, in that order), so
+  // that a factor's Jacobians are written where the last factor of its kind left buffers of the right size.
+  struct ShapedBuffer {
+    std::vector<int> shape;
+    WhitenedFactor whitened;
+  };
+  std::vector<ShapedBuffer> shaped_buffers_;
+  std::vector<int> shape_scratch_;
+  WhitenedFactor& BufferFor(std::size_t k);
+  // Prefetches what linearizing or costing factor k + kPrefetchAhead will read (its entry further ahead, since the
+  // others are found through it): a whole recording's factors, variables and noise matrices lie in separate heap
+  // blocks far out of the cache, a chain of misses that the hardware's prefetcher cannot follow.
+  void PrefetchAhead(std::size_t k) const;
   std::vector<FactorLinearization> prev_linearized_;
   std::vector<bool> taken_scratch_;          // Reset: which of prev_linearized_ found their factor
   std::vector<std::size_t> fresh_scratch_;   // Reset: factors new since the last Reset

@@ -19,6 +19,7 @@
 #include "estimator/internal/linearization.h"
 #include "estimator/internal/normal_equations.h"
 #include "estimator/marginalization.h"
+#include "estimator/models/ackermann_odometer.h"
 #include "estimator/models/gps.h"
 #include "tests/estimator/factor_testing.h"
 
@@ -96,6 +97,49 @@ TEST(SolverTest, WorkspaceGivesTheSameSolutionAndKeepsTheAnalysisOfAnUnchangedPa
   reused.graph.mutable_factor(reused.graph.factors().begin()->first).active = false;
   ASSERT_TRUE(Solve(SolverOptions{}, &reused.graph, nullptr, &workspace).usable());
   EXPECT_EQ(workspace.analyses(), 1);
+}
+
+TEST(SolverTest, WorkspaceThatKeepsNoLinearizationsSolvesTheSame) {
+  // Factors of several shapes (pose priors, Ackermann rows with two poses and three parameters) and an error
+  // covariance that depends on the estimate (the odometer's noise through eq. 15): Levenberg-Marquardt judges its
+  // trial points with the last whitening, which a factor linearized without keeping must still keep.
+  testing::SmallProblem kept = testing::AckermannProblem<AckermannOdometerError>(true, 41);
+  testing::SmallProblem lean = testing::AckermannProblem<AckermannOdometerError>(true, 41);
+  for (testing::SmallProblem* problem : {&kept, &lean}) {  // (far from the minimum: several iterations)
+    std::mt19937 rng(5);
+    for (VariableId pose : problem->poses) {
+      Eigen::VectorXd& x = problem->graph.mutable_variable(pose).value;
+      x = testing::Perturb(Manifold::Pose(), x, 0.7, &rng);
+    }
+  }
+  SolverWorkspace keeping, not_keeping;
+  not_keeping.set_keep_linearizations(false);
+  const SolverOptions options;
+  for (int solve = 0; solve < 2; ++solve) {
+    const SolverSummary a = Solve(options, &kept.graph, nullptr, &keeping);
+    const SolverSummary b = Solve(options, &lean.graph, nullptr, &not_keeping);
+    ASSERT_TRUE(a.usable() && b.usable()) << a.message << b.message;
+    EXPECT_EQ(a.iterations, b.iterations);
+    EXPECT_EQ(a.cost_history, b.cost_history);
+    for (const auto& [id, v] : kept.graph.variables()) ASSERT_EQ(v.value, lean.graph.variable(id).value) << id;
+    // A solve that only linearizes (no iteration) leaves a linearization at the current values with the keeping
+    // workspace only.
+    SolverOptions none = options;
+    none.max_iterations = 0;
+    ASSERT_TRUE(Solve(none, &kept.graph, nullptr, &keeping).usable());
+    ASSERT_TRUE(Solve(none, &lean.graph, nullptr, &not_keeping).usable());
+    const auto& [id, entry] = *kept.graph.factors().rbegin();
+    std::uint64_t free_mask = 0;
+    for (std::size_t i = 0; i < entry.variables.size(); ++i)
+      if (!kept.graph.variable(entry.variables[i]).fixed) free_mask |= std::uint64_t{1} << i;
+    EXPECT_NE(keeping.Linearization(id, free_mask), nullptr);
+    EXPECT_EQ(not_keeping.Linearization(id, free_mask), nullptr);
+    // The next solve starts elsewhere, with one factor switched off.
+    for (testing::SmallProblem* problem : {&kept, &lean}) {
+      problem->graph.mutable_factor(problem->graph.factors().begin()->first).active = false;
+      problem->graph.mutable_variable(problem->parameters[0]).value *= 1.1;
+    }
+  }
 }
 
 TEST(SolverTest, ModelToleranceStopsWhenTheQuadraticModelPredictedTheDecrease) {
