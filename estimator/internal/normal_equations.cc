@@ -913,7 +913,8 @@ bool NormalEquations::Solve(double lambda, Eigen::VectorXd* dx) {
   Analyze();
   bool factored = false;
   if (natural_order_) {
-    factored = FactorEnvelope(*A, lambda);
+    *dx = -g_;  // (its band rows substituted forward in the factorization's sweep)
+    factored = FactorEnvelope(*A, lambda, /*factor_corner=*/true, dx->data());
   } else {
     c.llt.factorize(*A);
     factored = c.llt.info() == Eigen::Success;
@@ -922,8 +923,7 @@ bool NormalEquations::Solve(double lambda, Eigen::VectorXd* dx) {
   if (!factored) return false;
   undamped_step_ = c.factored_undamped;
   if (natural_order_) {
-    *dx = -g_;
-    SolveEnvelope(*dx);
+    SolveEnvelope(*dx, /*band_forwarded=*/true);
     return dx->allFinite();
   }
   *dx = c.llt.solve(-g_);
@@ -1041,32 +1041,36 @@ struct Band {
   // Block columns from..blocks-1; the ones before hold U already.
   bool Factor(int from = 0) const {
     bool ok = true;
-    for (int b = from; b < blocks && ok; ++b) {
-      Sized(b, [&](auto nb) {
-        constexpr int B = decltype(nb)::value;
-        for (int r = first_block[b]; r < b; ++r) {
-          Sized(r, [&](auto nr) {
-            constexpr int R = decltype(nr)::value;
-            Block<R, B> x = block<R, B>(r, b);
-            for (int k = std::max(first_block[r], first_block[b]); k < r; ++k) {
-              Sized(k, [&](auto nk) {
-                constexpr int K = decltype(nk)::value;
-                x.noalias() -= block<K, R>(k, r).transpose() * block<K, B>(k, b);
-              });
-            }
-            SolveUpperTransposed(block<R, R>(r, r), x);
-          });
-        }
-        Block<B, B> d = block<B, B>(b, b);
-        for (int k = first_block[b]; k < b; ++k) {
-          Sized(k, [&](auto nk) {
-            constexpr int K = decltype(nk)::value;
-            d.noalias() -= block<K, B>(k, b).transpose() * block<K, B>(k, b);
-          });
-        }
-        ok = UpperCholeskyInPlace(d);
-      });
-    }
+    for (int b = from; b < blocks && ok; ++b) ok = FactorColumn(b);
+    return ok;
+  }
+  // Block column b of U, from its column of A and the columns before it.
+  bool FactorColumn(int b) const {
+    bool ok = true;
+    Sized(b, [&](auto nb) {
+      constexpr int B = decltype(nb)::value;
+      for (int r = first_block[b]; r < b; ++r) {
+        Sized(r, [&](auto nr) {
+          constexpr int R = decltype(nr)::value;
+          Block<R, B> x = block<R, B>(r, b);
+          for (int k = std::max(first_block[r], first_block[b]); k < r; ++k) {
+            Sized(k, [&](auto nk) {
+              constexpr int K = decltype(nk)::value;
+              x.noalias() -= block<K, R>(k, r).transpose() * block<K, B>(k, b);
+            });
+          }
+          SolveUpperTransposed(block<R, R>(r, r), x);
+        });
+      }
+      Block<B, B> d = block<B, B>(b, b);
+      for (int k = first_block[b]; k < b; ++k) {
+        Sized(k, [&](auto nk) {
+          constexpr int K = decltype(nk)::value;
+          d.noalias() -= block<K, B>(k, b).transpose() * block<K, B>(k, b);
+        });
+      }
+      ok = UpperCholeskyInPlace(d);
+    });
     return ok;
   }
   // x <- Ua^-T x over the band's rows of x, block by block (coefficient-wise products: a block is small, and x has
@@ -1075,19 +1079,22 @@ struct Band {
   // (a pose's covariance: 6), or Dynamic.
   template <int M = Eigen::Dynamic>
   void Forward(double* x, Eigen::Index ldx, Eigen::Index m, int from = 0) const {
-    for (int b = from; b < blocks; ++b) {
-      Sized(b, [&](auto nb) {
-        constexpr int B = decltype(nb)::value;
-        Rows<B, M> xb = rows<B, M>(x, ldx, m, b);
-        for (int k = first_block[b]; k < b; ++k) {
-          Sized(k, [&](auto nk) {
-            constexpr int K = decltype(nk)::value;
-            xb.noalias() -= block<K, B>(k, b).transpose().lazyProduct(rows<K, M>(x, ldx, m, k));
-          });
-        }
-        SolveUpperTransposed(block<B, B>(b, b), xb);
-      });
-    }
+    for (int b = from; b < blocks; ++b) ForwardRows<M>(b, x, ldx, m);
+  }
+  // Row block b of that substitution (the row blocks before it hold their result).
+  template <int M = Eigen::Dynamic>
+  void ForwardRows(int b, double* x, Eigen::Index ldx, Eigen::Index m) const {
+    Sized(b, [&](auto nb) {
+      constexpr int B = decltype(nb)::value;
+      Rows<B, M> xb = rows<B, M>(x, ldx, m, b);
+      for (int k = first_block[b]; k < b; ++k) {
+        Sized(k, [&](auto nk) {
+          constexpr int K = decltype(nk)::value;
+          xb.noalias() -= block<K, B>(k, b).transpose().lazyProduct(rows<K, M>(x, ldx, m, k));
+        });
+      }
+      SolveUpperTransposed(block<B, B>(b, b), xb);
+    });
   }
   // x <- Ua^-1 x, block by block from the last.
   void Backward(double* x, Eigen::Index ldx, Eigen::Index m) const {
@@ -1146,7 +1153,8 @@ int NormalEquations::ReusableBlocks() const {
   return reusable;
 }
 
-bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, double lambda, bool factor_corner) {
+bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, double lambda, bool factor_corner,
+                                     double* rhs) {
   const bool undamped = lambda <= 0.0;
   const int na = band_dimension_;
   const int reused = undamped && relinearize_threshold_ > 0.0 ? ReusableBlocks() : 0;
@@ -1176,16 +1184,25 @@ bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, doubl
 
   // Scatter the upper triangle of A: the band's column j of block b into its column of the block's envelope, rows
   // from the first of block first_block_[b] (the columns not taken over), with the damping on the diagonal:
-  // A(j, j) + lambda max(A(j, j), 1e-12).
-  std::fill(envelope_.begin() + envelope_start_[reused], envelope_.end(), 0.0);
-  border_.bottomRows(na - reused_rows).setZero();
+  // A(j, j) + lambda max(A(j, j), 1e-12); the border's columns into B's rows (Ub's place) and C (corner_).
+  // Ua and Ub = Ua^-T B (forward substitution on B's columns) are computed block by block in the same sweep, each
+  // block column scattered just before it is factored and its rows of B substituted just after: a whole recording's
+  // envelope and border (hundreds of MB) are then streamed from memory once, not once per pass over them, and the
+  // arithmetic is that of the passes one after the other.
   corner_.setZero(dimension_ - na, dimension_ - na);
   const int* outer = A.outerIndexPtr();
   const int* inner = A.innerIndexPtr();
   const double* value = A.valuePtr();
-  for (int b = reused; b < band_blocks_; ++b) {
+  const int border_columns = dimension_ - na;
+  // Per border column, its next entry (rows sorted: the ones taken over are skipped at once).
+  std::vector<int>& next = border_cursor_;
+  next.resize(border_columns);
+  for (int c = 0; c < border_columns; ++c)
+    next[c] = static_cast<int>(std::lower_bound(inner + outer[na + c], inner + outer[na + c + 1], reused_rows) - inner);
+  const auto scatter = [&](int b) {
     const int row0 = block_offset_[first_block_[b]];
     const std::ptrdiff_t height = (envelope_start_[b + 1] - envelope_start_[b]) / dims_[b];
+    std::fill(envelope_.begin() + envelope_start_[b], envelope_.begin() + envelope_start_[b + 1], 0.0);
     for (int t = 0; t < dims_[b]; ++t) {
       const int j = block_offset_[b] + t;
       double* column = envelope_.data() + envelope_start_[b] + t * height - row0;
@@ -1193,27 +1210,34 @@ bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, doubl
         if (inner[p] <= j) column[inner[p]] = value[p];
       if (!undamped) column[j] += lambda * std::max(column[j], 1e-12);
     }
-  }
-  for (int j = na; j < dimension_; ++j) {
-    // (Rows sorted: the ones taken over are skipped at once.)
-    const int from = static_cast<int>(std::lower_bound(inner + outer[j], inner + outer[j + 1], reused_rows) - inner);
-    for (int p = from; p < outer[j + 1]; ++p) {
-      const int i = inner[p];
-      if (i < na) {
-        border_(i, j - na) = value[p];
-      } else if (i <= j) {
-        corner_(i - na, j - na) = value[p];
-      }
+    const int end_row = block_offset_[b] + dims_[b];
+    for (int c = 0; c < border_columns; ++c) {
+      double* column = border_.data() + static_cast<std::ptrdiff_t>(c) * na;
+      std::fill(column + block_offset_[b], column + end_row, 0.0);
+      int p = next[c];
+      for (; p < outer[na + c + 1] && inner[p] < end_row; ++p) column[inner[p]] = value[p];
+      next[c] = p;
     }
-    double& diagonal = corner_(j - na, j - na);
+  };
+  bool factored = true;
+  WithBand([&](const auto& band) {
+    if (rhs != nullptr)
+      for (int b = 0; b < reused; ++b) band.ForwardRows(b, rhs, dimension_, 1);
+    for (int b = reused; b < band_blocks_ && factored; ++b) {
+      scatter(b);
+      factored = band.FactorColumn(b);
+      if (factored && border_columns > 0) band.ForwardRows(b, border_.data(), border_.rows(), border_.cols());
+      if (factored && rhs != nullptr) band.ForwardRows(b, rhs, dimension_, 1);
+    }
+  });
+  // (The cursors are past the band's rows once every block column is factored.)
+  for (int c = 0; c < border_columns && factored; ++c) {
+    const int j = na + c;
+    for (int p = next[c]; p < outer[j + 1]; ++p)
+      if (inner[p] <= j) corner_(inner[p] - na, c) = value[p];
+    double& diagonal = corner_(c, c);
     if (!undamped) diagonal += lambda * std::max(diagonal, 1e-12);
   }
-  // Ua, then Ub = Ua^-T B (forward substitution on B's columns) and Uc^T Uc = C - Ub^T Ub.
-  bool factored = false;
-  WithBand([&](const auto& band) {
-    factored = band.Factor(reused);
-    if (factored && dimension_ > na) band.Forward(border_.data(), border_.rows(), border_.cols(), reused);
-  });
   if (factored && dimension_ > na) {
     corner_.selfadjointView<Eigen::Upper>().rankUpdate(border_.transpose(), -1.0);
     if (factor_corner) factored = UpperCholeskyInPlace(corner_);
@@ -1245,9 +1269,9 @@ bool NormalEquations::BorderInformation(int border_dimension, Eigen::MatrixXd* i
   return true;
 }
 
-void NormalEquations::ForwardEnvelope(Eigen::Ref<Eigen::MatrixXd> x) {
+void NormalEquations::ForwardEnvelope(Eigen::Ref<Eigen::MatrixXd> x, bool band_forwarded) {
   // U^T y = x: Ua^T ya = xa, then Uc^T yc = xc - Ub^T ya.
-  WithBand([&](const auto& band) { band.Forward(x.data(), x.outerStride(), x.cols()); });
+  if (!band_forwarded) WithBand([&](const auto& band) { band.Forward(x.data(), x.outerStride(), x.cols()); });
   const int na = band_dimension_;
   if (dimension_ > na) {
     auto xc = x.bottomRows(dimension_ - na);
@@ -1256,9 +1280,9 @@ void NormalEquations::ForwardEnvelope(Eigen::Ref<Eigen::MatrixXd> x) {
   }
 }
 
-void NormalEquations::SolveEnvelope(Eigen::Ref<Eigen::MatrixXd> x) {
+void NormalEquations::SolveEnvelope(Eigen::Ref<Eigen::MatrixXd> x, bool band_forwarded) {
   // U^T y = x, then U x = y: Uc xc = yc, then Ua xa = ya - Ub xc.
-  ForwardEnvelope(x);
+  ForwardEnvelope(x, band_forwarded);
   const int na = band_dimension_;
   if (dimension_ > na) {
     auto xc = x.bottomRows(dimension_ - na);

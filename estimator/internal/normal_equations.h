@@ -295,11 +295,15 @@ class NormalEquations {
   // over while its variable is the same as the kept column's and no factor on it or a variable before it changed
   // its Jacobians or left since (dirty_), except the new marginalization prior. The border's rows Ub follow the
   // same rule (a row of Ua^-T B depends on B's rows above it); C - Ub^T Ub and Uc are always computed.
-  // factor_corner false: Ua and Ub only, corner_ left holding C - Ub^T Ub (BorderInformation).
-  bool FactorEnvelope(const Eigen::SparseMatrix<double>& A, double lambda, bool factor_corner = true);
+  // factor_corner false: Ua and Ub only, corner_ left holding C - Ub^T Ub (BorderInformation). rhs (dimension_
+  // values, optional): its band rows are substituted forward, Ua^-T, in the factorization's sweep (a step's
+  // right-hand side, solved then with band_forwarded).
+  bool FactorEnvelope(const Eigen::SparseMatrix<double>& A, double lambda, bool factor_corner = true,
+                      double* rhs = nullptr);
   int ReusableBlocks() const;  // leading band blocks of the kept factorization that hold for this one
-  void ForwardEnvelope(Eigen::Ref<Eigen::MatrixXd> x);  // x <- U^-T x with the last FactorEnvelope
-  void SolveEnvelope(Eigen::Ref<Eigen::MatrixXd> x);    // x <- H^-1 x with the last FactorEnvelope
+  // x <- U^-T x and x <- H^-1 x with the last FactorEnvelope; band_forwarded: x's band rows hold Ua^-T x already.
+  void ForwardEnvelope(Eigen::Ref<Eigen::MatrixXd> x, bool band_forwarded = false);
+  void SolveEnvelope(Eigen::Ref<Eigen::MatrixXd> x, bool band_forwarded = false);
   // Calls f with the band (a Band<6> when every block of A is a pose, otherwise a Band<Dynamic>, whose kernels are
   // picked per block size).
   template <typename Function>
@@ -311,6 +315,7 @@ class NormalEquations {
   std::vector<std::ptrdiff_t> envelope_start_;
   std::vector<double> envelope_;
   Eigen::MatrixXd border_;  // Ub
+  std::vector<int> border_cursor_;  // FactorEnvelope's scatter: per border column, its next entry of A
   Eigen::MatrixXd corner_;  // C, then Uc in its upper triangle
 
   // The last undamped factorization with a relinearization threshold (its order and band layout; its Ua and Ub stay

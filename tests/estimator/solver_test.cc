@@ -400,6 +400,38 @@ TEST(NormalEquationsTest, EnvelopeFactorizationOfABandWithABorderMatchesADenseCh
   EXPECT_LT((dx - damped_expected).norm(), 1e-9 * damped_expected.norm());
 }
 
+// The envelope is scattered, factored and its border substituted block column by block column in one sweep: a
+// factorization that fails partway (a pose without any factor: a zero diagonal block) must stop cleanly, and the
+// damped one after it must be the dense Cholesky's.
+TEST(NormalEquationsTest, EnvelopeFactorizationThatFailsPartwayIsFollowedByAGoodDampedOne) {
+  std::mt19937 rng(12);
+  Graph graph;
+  const auto [poses, lever] = AddPosesAndLever(12, &rng, &graph);
+  const auto tie = [&](const std::vector<VariableId>& ids) { TieWithRandomPrior(ids, &rng, &graph); };
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    if (k == 5) continue;
+    tie({poses[k]});
+    if (k + 1 < poses.size() && k + 1 != 5) tie({poses[k], poses[k + 1]});
+  }
+  tie({poses[0], lever});
+  tie({poses[9], lever});
+  internal::NormalEquations system(graph, FreeVariableOrder(graph));
+  ASSERT_TRUE(system.Linearize(graph));
+  ASSERT_TRUE(system.factored_in_envelope());
+  Eigen::VectorXd dx;
+  EXPECT_FALSE(system.Solve(0.0, &dx));
+  const Eigen::MatrixXd H = Eigen::SparseMatrix<double>(system.hessian_upper().selfadjointView<Eigen::Upper>());
+  const double lambda = 0.3;
+  Eigen::MatrixXd damped = H;
+  for (int i = 0; i < H.rows(); ++i) damped(i, i) += lambda * std::max(H(i, i), 1e-12);
+  const Eigen::LLT<Eigen::MatrixXd> dense(damped);
+  ASSERT_EQ(dense.info(), Eigen::Success);
+  ASSERT_TRUE(system.Solve(lambda, &dx));
+  const Eigen::VectorXd expected = dense.solve(-system.gradient());
+  EXPECT_LT((dx - expected).norm(), 1e-9 * expected.norm());
+  EXPECT_TRUE(dx.segment<6>(30).isZero(0.0));  // (pose 5: no gradient)
+}
+
 // A whole recording's system (beyond the size of a tracking window) in natural order: 400 poses tied to their next
 // and to the one after, and a constant parameter tied to a few poses (none of them the first). It is factored in its
 // envelope while the poses are tied to their neighbours in time only, by CHOLMOD once every pose is also tied to the
