@@ -365,9 +365,24 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   natural_order_ = stamped_first && (dimension_ <= kMaxSimplicialDimension || EnvelopeIsNarrow());
   if (natural_order_ != natural_before) cholmod_->analyzed = false;
 
-  // The per-factor linearizations follow their factors (by id). A new factor takes the buffers of one that left, in
-  // order: a window that slid drops its oldest factors and gains new ones of the same kinds, so a factor's buffers
-  // mostly have its own sizes already (no reallocation).
+  // The per-factor linearizations follow their factors (by id). Without keeping them (and without a threshold) they
+  // stay where they are: Linearize writes every factor's anew, and a record left at another factor's place is not
+  // current for it (Current compares the factor's id).
+  if (keep_linearizations_ || relinearize_threshold_ > 0.0) {
+    MoveLinearizationsWithTheirFactors();
+  } else {
+    linearized_.resize(factor_ids_.size());
+  }
+  g_.setZero(dimension_);
+  minus_memo_.assign(nb, MinusMemo());
+  cholmod_->factored_undamped = false;
+  left_out_blocks_ = 0;
+  undamped_step_ = false;
+}
+
+void NormalEquations::MoveLinearizationsWithTheirFactors() {
+  // A new factor takes the buffers of one that left, in order: a window that slid drops its oldest factors and gains
+  // new ones of the same kinds, so a factor's buffers mostly have its own sizes already (no reallocation).
   prev_linearized_.swap(linearized_);
   prev_linearized_.resize(prev_factor_ids_.size());
   linearized_.resize(factor_ids_.size());
@@ -401,11 +416,6 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   for (std::size_t p = 0, i = 0; p < prev_linearized_.size() && i < fresh.size(); ++p)
     if (!taken[p]) std::swap(linearized_[fresh[i++]], prev_linearized_[p]);
   for (std::size_t k : fresh) linearized_[k].id = -1;
-  g_.setZero(dimension_);
-  minus_memo_.assign(nb, MinusMemo());
-  cholmod_->factored_undamped = false;
-  left_out_blocks_ = 0;
-  undamped_step_ = false;
 }
 
 bool NormalEquations::EnvelopeIsNarrow() const {

@@ -210,6 +210,9 @@ class NormalEquations {
   std::vector<bool> taken_scratch_;          // Reset: which of prev_linearized_ found their factor
   std::vector<std::size_t> fresh_scratch_;   // Reset: factors new since the last Reset
   bool Current(std::size_t k) const;  // linearized_[k] holds factor k at the current values
+  // Reset: linearized_ and prev_linearized_ (the last Reset's) rearranged so that each factor still in the system
+  // finds its record at its new place; marks the variables of factors that left while theirs stayed dirty.
+  void MoveLinearizationsWithTheirFactors();
   // Adds factor k's kept J_a^T J_b into the blocks of H that Linearize sums (`left_out` false) or into those it left
   // out (true); computes the products first when they are not kept yet.
   void AddKeptProducts(std::size_t k, bool left_out);
