@@ -241,7 +241,12 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
     const int block = free_it != block_of_id_.end() && free_it->first == id ? free_it->second : -1;
     variable_table_.push_back({id, v.value.data(), block});
   }
-  const auto lookup = [this](VariableId id) -> const VariableSlot& {
+  // (The graph numbers its variables in order: without removals in between, id - the first id is the place.)
+  const VariableId first_id = variable_table_.empty() ? 0 : variable_table_.front().id;
+  const auto lookup = [this, first_id](VariableId id) -> const VariableSlot& {
+    const VariableId place = id - first_id;
+    if (place >= 0 && place < static_cast<VariableId>(variable_table_.size()) && variable_table_[place].id == id)
+      return variable_table_[place];
     const auto it = std::lower_bound(variable_table_.begin(), variable_table_.end(), id,
                                      [](const VariableSlot& slot, VariableId key) { return slot.id < key; });
     ROAMLAB_CHECK(it != variable_table_.end() && it->id == id, "no variable " << id);
