@@ -1051,15 +1051,9 @@ struct Band {
     return Rows<R, M>(x + offset[k], dims[k], m, Eigen::OuterStride<>(ldx));
   }
 
-  // Block Crout: U(r, b) = U(r, r)^-T (A(r, b) - sum_k U(k, r)^T U(k, b)) for r < b, over the row blocks k both
-  // columns hold, and U(b, b)^T U(b, b) = A(b, b) - sum_k U(k, b)^T U(k, b). u holds A's upper triangle on entry.
-  // Block columns from..blocks-1; the ones before hold U already.
-  bool Factor(int from = 0) const {
-    bool ok = true;
-    for (int b = from; b < blocks && ok; ++b) ok = FactorColumn(b);
-    return ok;
-  }
-  // Block column b of U, from its column of A and the columns before it.
+  // Block Crout, block column b: U(r, b) = U(r, r)^-T (A(r, b) - sum_k U(k, r)^T U(k, b)) for r < b, over the row
+  // blocks k both columns hold, and U(b, b)^T U(b, b) = A(b, b) - sum_k U(k, b)^T U(k, b). u holds A's column b
+  // (upper triangle) on entry, and U in the columns before it. False when A is not positive definite.
   bool FactorColumn(int b) const {
     bool ok = true;
     Sized(b, [&](auto nb) {
