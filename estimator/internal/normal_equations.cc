@@ -627,8 +627,8 @@ __attribute__((flatten)) bool NormalEquations::Linearize(const Graph& /*graph*/,
     PrefetchAhead(k);
     const WhitenedFactor* linearized = &linearized_[k].whitened;
     if (!keep && !Current(k)) {
-      // Into the buffer of the factor's shape; the factor keeps what CostWithLastWhitening and the gate read. (A
-      // Gauss-Newton trial point's linearization, which LinearizeForCost keeps, is current.)
+      // Into the buffer of the factor's shape; the factor keeps what CostWithLastWhitening reads. (A Gauss-Newton
+      // trial point's linearization, which LinearizeForCost keeps, is current.)
       WhitenedFactor& buffer = BufferFor(k);
       if (!LinearizeFactorAt(*entries_[k], &values_[var_begin_[k]], want_[k], &buffer)) {
         if (failed_stream != nullptr) *failed_stream = entries_[k]->stream;
@@ -638,8 +638,6 @@ __attribute__((flatten)) bool NormalEquations::Linearize(const Graph& /*graph*/,
       FactorLinearization& l = linearized_[k];
       l.id = -1;  // not a kept linearization
       if (!entries_[k]->factor->additive_noise()) l.whitened.sqrt_covariance = buffer.sqrt_covariance;
-      l.whitened.squared_norm = buffer.squared_norm;
-      l.whitened.cost = buffer.cost;
       linearized = &buffer;
     } else if (!Current(k) && !CarryToFirstOrder(k) && !LinearizeAndRecord(k, nullptr)) {
       if (failed_stream != nullptr) *failed_stream = entries_[k]->stream;

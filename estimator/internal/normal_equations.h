@@ -76,8 +76,8 @@ class NormalEquations {
   // Whether Linearize keeps every factor's linearization (its Jacobians, whitened error, point) for LinearizationAt
   // and KeptProductsAt (default true). Without a relinearization threshold and with keep false, each factor is
   // linearized into a buffer of its shape that the next one of that shape reuses, and only what the trial points'
-  // costs and the outlier gate need stays with the factor (its error covariance's factor when that depends on the
-  // estimate, its cost and squared norm): the same H, g and cost, without streaming a whole recording's
+  // costs need stays with the factor (its error covariance's factor when that depends on the estimate): the same H,
+  // g and cost, without streaming a whole recording's
   // linearizations to memory that nothing reads again. LinearizationAt is then null after Linearize. (With a
   // threshold they are kept whatever this says: the carries need them; LinearizeForCost keeps its linearization of
   // a Gauss-Newton trial point, which the next Linearize takes.)
