@@ -13,8 +13,8 @@ VariableId Graph::AddVariable(Variable variable) {
                 "variable '" << variable.name << "' has " << variable.value.size() << " values for manifold "
                              << variable.manifold.Name());
   const VariableId id = next_variable_++;
-  variables_.emplace(id, std::move(variable));
-  factors_of_[id];
+  variables_.Add(id, std::move(variable));
+  factors_of_.Add(id, {});
   return id;
 }
 
@@ -42,7 +42,7 @@ FactorId Graph::AddFactor(std::unique_ptr<Factor> factor, std::vector<VariableId
                 "factor from '" << stream << "': noise covariance is not symmetric positive definite");
   const FactorId id = next_factor_++;
   const bool factor_is_additive = factor->additive_noise();
-  for (VariableId v : variables) factors_of_[v].push_back(id);
+  for (VariableId v : variables) factors_of_.Find(v)->push_back(id);
   FactorEntry entry;
   entry.factor = std::move(factor);
   entry.variables = std::move(variables);
@@ -60,57 +60,57 @@ FactorId Graph::AddFactor(std::unique_ptr<Factor> factor, std::vector<VariableId
   entry.loss = loss;
   entry.stream = std::move(stream);
   entry.stamp = stamp;
-  factors_.emplace(id, std::move(entry));
+  factors_.Add(id, std::move(entry));
   return id;
 }
 
 void Graph::RemoveFactor(FactorId id) {
-  const auto it = factors_.find(id);
-  ROAMLAB_CHECK(it != factors_.end(), "no factor " << id);
-  for (VariableId v : it->second.variables) {
-    auto& list = factors_of_[v];
+  const FactorEntry* entry = factors_.Find(id);
+  ROAMLAB_CHECK(entry != nullptr, "no factor " << id);
+  for (VariableId v : entry->variables) {
+    std::vector<FactorId>& list = *factors_of_.Find(v);
     list.erase(std::remove(list.begin(), list.end(), id), list.end());
   }
-  factors_.erase(it);
+  factors_.Erase(id);
 }
 
 void Graph::RemoveVariable(VariableId id) {
-  const auto it = variables_.find(id);
-  ROAMLAB_CHECK(it != variables_.end(), "no variable " << id);
-  ROAMLAB_CHECK(factors_of_[id].empty(),
-                "variable '" << it->second.name << "' still has " << factors_of_[id].size() << " factors");
-  factors_of_.erase(id);
-  variables_.erase(it);
+  const Variable* variable = variables_.Find(id);
+  ROAMLAB_CHECK(variable != nullptr, "no variable " << id);
+  const std::vector<FactorId>& factors = *factors_of_.Find(id);
+  ROAMLAB_CHECK(factors.empty(), "variable '" << variable->name << "' still has " << factors.size() << " factors");
+  factors_of_.Erase(id);
+  variables_.Erase(id);
 }
 
 const Variable& Graph::variable(VariableId id) const {
-  const auto it = variables_.find(id);
-  ROAMLAB_CHECK(it != variables_.end(), "no variable " << id);
-  return it->second;
+  const Variable* v = variables_.Find(id);
+  ROAMLAB_CHECK(v != nullptr, "no variable " << id);
+  return *v;
 }
 
 Variable& Graph::mutable_variable(VariableId id) {
-  const auto it = variables_.find(id);
-  ROAMLAB_CHECK(it != variables_.end(), "no variable " << id);
-  return it->second;
+  Variable* v = variables_.Find(id);
+  ROAMLAB_CHECK(v != nullptr, "no variable " << id);
+  return *v;
 }
 
 const FactorEntry& Graph::factor(FactorId id) const {
-  const auto it = factors_.find(id);
-  ROAMLAB_CHECK(it != factors_.end(), "no factor " << id);
-  return it->second;
+  const FactorEntry* entry = factors_.Find(id);
+  ROAMLAB_CHECK(entry != nullptr, "no factor " << id);
+  return *entry;
 }
 
 FactorEntry& Graph::mutable_factor(FactorId id) {
-  const auto it = factors_.find(id);
-  ROAMLAB_CHECK(it != factors_.end(), "no factor " << id);
-  return it->second;
+  FactorEntry* entry = factors_.Find(id);
+  ROAMLAB_CHECK(entry != nullptr, "no factor " << id);
+  return *entry;
 }
 
 std::vector<FactorId> Graph::FactorsOf(VariableId id) const {
-  const auto it = factors_of_.find(id);
-  ROAMLAB_CHECK(it != factors_of_.end(), "no variable " << id);
-  return it->second;
+  const std::vector<FactorId>* factors = factors_of_.Find(id);
+  ROAMLAB_CHECK(factors != nullptr, "no variable " << id);
+  return *factors;
 }
 
 }  // namespace roamlab::estimator

@@ -8,7 +8,6 @@
 #pragma once
 
 #include <cstdint>
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -18,6 +17,7 @@
 
 #include "common/time.h"
 #include "estimator/factor.h"
+#include "estimator/id_table.h"
 #include "estimator/loss.h"
 #include "estimator/manifold.h"
 
@@ -64,15 +64,16 @@ class Graph {
   const FactorEntry& factor(FactorId id) const;
   FactorEntry& mutable_factor(FactorId id);
 
-  const std::map<VariableId, Variable>& variables() const { return variables_; }
-  const std::map<FactorId, FactorEntry>& factors() const { return factors_; }
+  // In id order (IdTable: a std::map's interface for walking and look-ups).
+  const IdTable<Variable>& variables() const { return variables_; }
+  const IdTable<FactorEntry>& factors() const { return factors_; }
   // Factors that reference a variable, in id order.
   std::vector<FactorId> FactorsOf(VariableId id) const;
 
  private:
-  std::map<VariableId, Variable> variables_;
-  std::map<FactorId, FactorEntry> factors_;
-  std::map<VariableId, std::vector<FactorId>> factors_of_;
+  IdTable<Variable> variables_;
+  IdTable<FactorEntry> factors_;
+  IdTable<std::vector<FactorId>> factors_of_;  // by variable
   VariableId next_variable_ = 0;
   FactorId next_factor_ = 0;
 };
