@@ -25,18 +25,7 @@ int GateOutliers(double probability, ProblemBuilder* builder, FactorId first, co
     const auto it = quantiles.find(key);
     return it != quantiles.end() ? it->second : (quantiles[key] = ChiSquareQuantile(probability, dim));
   };
-  // One walk over the measurement factors and the graph's factors in id order, and the variables' values from a table
-  // sorted by id: a whole recording's 10^5-10^6 factors are not looked up in the graph's maps one by one (each look-up
-  // a chain of cache misses).
-  std::vector<std::pair<VariableId, const Variable*>> variables;
-  variables.reserve(graph.variables().size());
-  for (const auto& [id, v] : graph.variables()) variables.emplace_back(id, &v);
-  const auto variable = [&variables](VariableId id) -> const Variable& {
-    const auto it = std::lower_bound(variables.begin(), variables.end(), id,
-                                     [](const auto& slot, VariableId key) { return slot.first < key; });
-    ROAMLAB_CHECK(it != variables.end() && it->first == id, "no variable " << id);
-    return *it->second;
-  };
+  // One walk over the measurement factors and the graph's factors in id order (a whole recording's 10^5-10^6).
   std::vector<FactorId> switched;
   std::vector<const double*> values;
   internal::WhitenedFactor wf;  // reused: its buffers keep their size
@@ -54,13 +43,13 @@ int GateOutliers(double probability, ProblemBuilder* builder, FactorId first, co
     if (last_solve != nullptr && entry.active) {
       std::uint64_t free_mask = 0;
       for (std::size_t i = 0; i < entry.variables.size() && i < 64; ++i)
-        if (!variable(entry.variables[i]).fixed) free_mask |= std::uint64_t{1} << i;
+        if (!graph.variable(entry.variables[i]).fixed) free_mask |= std::uint64_t{1} << i;
       linearized = last_solve->Linearization(id, free_mask);
     }
     bool ok = linearized != nullptr;
     if (!ok) {
       values.clear();
-      for (VariableId v : entry.variables) values.push_back(variable(v).value.data());
+      for (VariableId v : entry.variables) values.push_back(graph.variable(v).value.data());
       ok = internal::LinearizeFactorAt(entry, values.data(), 0, &wf);
       linearized = &wf;
     }

@@ -396,8 +396,8 @@ std::vector<std::string> ProblemBuilder::FreeParameterNames() const {
 }
 
 int ProblemBuilder::StreamOfFactor(FactorId id) const {
-  const auto it = stream_of_factor_.find(id);
-  return it == stream_of_factor_.end() ? -1 : it->second;
+  const int* stream = stream_of_factor_.Find(id);
+  return stream == nullptr ? -1 : *stream;
 }
 
 int ProblemBuilder::ResidualDim(const std::string& stream) const {
@@ -732,7 +732,7 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k)};
     const FactorId id = graph_.AddFactor(std::move(factor), vars, SampleNoiseCovariance(s, row), s.config.loss, s.name,
                                          m.t);
-    stream_of_factor_[id] = m.stream;
+    stream_of_factor_.Add(id, m.stream);
     ++counts_[s.name].attached;
     return true;
   } else if (model == "gyroscope") {
@@ -778,7 +778,7 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
   }
   if (s.time_offset) vars.push_back(slot(static_cast<std::size_t>(s.time_offset_slot), k));
   const FactorId id = graph_.AddFactor(std::move(factor), vars, s.noise_covariance, s.config.loss, s.name, m.t);
-  stream_of_factor_[id] = m.stream;
+  stream_of_factor_.Add(id, m.stream);
   ++counts_[s.name].attached;
   return true;
 }
@@ -824,7 +824,7 @@ bool ProblemBuilder::TryAttachInterval(const MeasurementRef& m) {
                                         ParameterAt(s.slot_parameters[1], a)};
   const FactorId id = graph_.AddFactor(MakeFactor(OdometerError(row.head<6>().transpose(), dt)), vars,
                                        SampleNoiseCovariance(s, row), s.config.loss, s.name, m.t);
-  stream_of_factor_[id] = m.stream;
+  stream_of_factor_.Add(id, m.stream);
   ++counts_[s.name].attached;
   return true;
 }
@@ -858,7 +858,7 @@ void ProblemBuilder::PopOldestPose() {
   // map. (Not "below the oldest factor in the graph": a factor that never leaves, such as the calibration prior, would
   // keep every entry.)
   while (!stream_of_factor_.empty() && graph_.factors().count(stream_of_factor_.begin()->first) == 0)
-    stream_of_factor_.erase(stream_of_factor_.begin());
+    stream_of_factor_.Erase(stream_of_factor_.begin()->first);
   absolute_fixes_.erase(std::remove_if(absolute_fixes_.begin(), absolute_fixes_.end(),
                                        [this](const auto& fix) { return !graph_.HasVariable(fix.first); }),
                         absolute_fixes_.end());

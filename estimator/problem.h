@@ -37,6 +37,7 @@
 #include "common/time.h"
 #include "estimator/config.h"
 #include "estimator/graph.h"
+#include "estimator/id_table.h"
 #include "recording/recording.h"
 
 namespace roamlab::estimator {
@@ -96,7 +97,7 @@ class ProblemBuilder {
   // Stream that produced a factor (by factor id); -1 for process and prior factors.
   int StreamOfFactor(FactorId id) const;
   // The same for every measurement factor added, by id.
-  const std::map<FactorId, int>& factor_streams() const { return stream_of_factor_; }
+  const IdTable<int>& factor_streams() const { return stream_of_factor_; }
   // Chi-square dimension of a stream's factors.
   int ResidualDim(const std::string& stream) const;
 
@@ -153,7 +154,7 @@ class ProblemBuilder {
   std::vector<OrientationFix> orientation_fixes_;
   bool has_absolute_sensor_ = false;
   bool popped_any_ = false;
-  std::map<FactorId, int> stream_of_factor_;
+  IdTable<int> stream_of_factor_;
 };
 
 }  // namespace roamlab::estimator
