@@ -64,7 +64,7 @@ class Graph {
   const FactorEntry& factor(FactorId id) const;
   FactorEntry& mutable_factor(FactorId id);
 
-  // In id order (IdTable: a std::map's interface for walking and look-ups).
+  // In id order; walked as a std::map (begin, end, lower_bound), looked up by Find (id_table.h).
   const IdTable<Variable>& variables() const { return variables_; }
   const IdTable<FactorEntry>& factors() const { return factors_; }
   // Factors that reference a variable, in id order.

@@ -232,7 +232,7 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
                                                                                   << " ordered twice");
 
   // Every variable's value and block (-1 when held constant), by id: one pass over the graph's variables instead of
-  // a map look-up per factor and variable below.
+  // a graph look-up per factor and variable below.
   prev_variable_table_.swap(variable_table_);
   variable_table_.clear();
   auto free_it = block_of_id_.begin();
