@@ -82,12 +82,26 @@ struct CalibrationOptions {
 Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recording::Recording& recording,
                                     const CalibrationOptions& options = {});
 
+// Options of one gating pass (GateOutliers) beyond testing each factor alone.
+struct GateOptions {
+  // > 0: a burst in a stream (at least 3 of its rows failing, at most 10 rows apart, one of them active until now) also
+  // rejects the stream's active rows within burst_margin times the burst's length on either side, which the next pass
+  // re-admits if they fit. Such a burst (an ATV's wheels skidding for a second) pulls the estimate towards itself, so
+  // that its edges pass until the rows next to them are gone (masking): tested alone, each round re-solved without
+  // the failing rows shows the next few beyond them. Rejecting good rows for one round costs no such cascade: the
+  // rest of the measurements agree with them.
+  double burst_margin = 0.0;
+  // Switch nothing when no more factors would switch than the test's own false alarms among the tested ones are
+  // expected to be, (1 - probability) of them: such a set is as stable as the test can tell.
+  bool ignore_chance_changes = false;
+};
+
 // Re-tests the measurement factors with id >= `first` (factor ids grow as factors are added, so `first` selects the
 // newest ones): active exactly when the whitened squared error is within the chi-square quantile `probability` of its
 // dimension. Keeps the per-stream rejected counts up to date; returns how many factors changed state. `last_solve`
 // (optional): the workspace of the solve that left the graph at its current values; a factor it linearized at exactly
 // these values is tested on that linearization's error instead of being evaluated again.
 int GateOutliers(double probability, ProblemBuilder* builder, FactorId first = 0,
-                 const SolverWorkspace* last_solve = nullptr);
+                 const SolverWorkspace* last_solve = nullptr, const GateOptions& options = {});
 
 }  // namespace roamlab::estimator
