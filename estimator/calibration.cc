@@ -127,8 +127,8 @@ int GateOutliers(double probability, ProblemBuilder* builder, FactorId first, co
 namespace {
 
 // Gating in calibration: a burst's neighbours within 1.5 times its length are rejected for one round
-// (GateOptions::burst_margin; on the 30 min weave's two skids, 1.0 left the slip's onset to three more rounds and 2.0
-// kept more of its neighbours out, BENCHMARKS.md, eighteenth pass).
+// (GateOptions::burst_margin; on the 30 min weave's two skids 1.0 took 3 + 3 rounds, 1.5 3 + 1, 2.0 3 + 1 with more of
+// their neighbours kept out in the end: BENCHMARKS.md, eighteenth pass).
 constexpr double kBurstMargin = 1.5;
 
 void SetFree(const std::set<std::string>& free, ProblemBuilder* builder) {
