@@ -6,6 +6,7 @@
 #include <iterator>
 #include <memory>
 #include <set>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -217,14 +218,18 @@ TEST(CalibrationTest, MagnetometerMatrixAndMisalignmentAreDependentWithoutOtherI
   EXPECT_TRUE(named);
 }
 
+recording::Stream* FindStream(recording::Recording* recording, const std::string& name) {
+  for (recording::Stream& s : recording->streams)
+    if (s.info.name == name) return &s;
+  return nullptr;
+}
+
 TEST(CalibrationTest, GatingRejectsGrossGpsOutliers) {
   roamlab::testing::SyntheticOptions options;
   options.duration_s = 8.0;
   auto synthetic = roamlab::testing::MakeAtvRecording(options);
   // Corrupt three GPS fixes by about 50 m (0.0005 deg of latitude).
-  recording::Stream* gps = nullptr;
-  for (auto& s : synthetic.recording.streams)
-    if (s.info.name == "gps") gps = &s;
+  recording::Stream* gps = FindStream(&synthetic.recording, "gps");
   ASSERT_NE(gps, nullptr);
   for (int row : {10, 20, 30}) gps->values(row, 0) += 0.0005;
   // A robust loss keeps the outliers from bending the first solution; the gate then switches them off.
@@ -247,9 +252,7 @@ TEST(GateOutliersTest, ABurstTakesItsNeighboursOutForOneRoundAndChanceSwitchesAr
   roamlab::testing::SyntheticOptions options;
   options.duration_s = 8.0;
   auto synthetic = roamlab::testing::MakeAtvRecording(options);
-  recording::Stream* wheel = nullptr;
-  for (auto& s : synthetic.recording.streams)
-    if (s.info.name == "rear_wheel") wheel = &s;
+  recording::Stream* wheel = FindStream(&synthetic.recording, "rear_wheel");
   ASSERT_NE(wheel, nullptr);
   constexpr int kSkidBegin = 250, kSkidEnd = 350, kLone = 600;
   std::set<std::int64_t> corrupted;  // stamps [ns]
