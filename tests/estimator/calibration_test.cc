@@ -285,31 +285,31 @@ TEST(GateOutliersTest, ABurstTakesItsNeighboursOutForOneRoundAndChanceSwitchesAr
     return stamps;
   };
   constexpr double kProbability = 0.99999;
-  // Gating rounds, each followed by a re-solve, until nothing switches; returns the rounds that switched.
-  const auto gate_until_stable = [&](ProblemBuilder* builder, double first_margin) {
+  // Gating rounds (each factor tested alone), each followed by a re-solve, until nothing switches; returns the rounds
+  // that switched.
+  const auto gate_until_stable = [&](ProblemBuilder* builder) {
     int rounds = 0;
-    for (GateOptions gate{first_margin, false}; rounds < 10; ++rounds, gate.burst_margin = 0.0) {
-      if (GateOutliers(kProbability, builder, 0, nullptr, gate) == 0) break;
+    for (; rounds < 10 && GateOutliers(kProbability, builder) > 0; ++rounds)
       EXPECT_TRUE(Solve(config.solver, &builder->graph()).usable());
-    }
     return rounds;
   };
 
   const std::unique_ptr<ProblemBuilder> alone = solved();
-  const int rounds_alone = gate_until_stable(alone.get(), 0.0);
+  const int rounds_alone = gate_until_stable(alone.get());
   const std::set<std::int64_t> out_alone = rejected(*alone);
 
   const std::unique_ptr<ProblemBuilder> burst = solved();
   ASSERT_GT(GateOutliers(kProbability, burst.get(), 0, nullptr, GateOptions{1.5, false}), 0);
   const std::set<std::int64_t> first_round = rejected(*burst);
-  // Rows on both sides of the skid, which was not corrupted there, are out for this round; the lone row's are not.
+  // Uncorrupted rows on both sides of the skid are out for this round (the last stamp is the lone row's); the lone
+  // row's neighbours are not.
   EXPECT_LT(*first_round.begin(), wheel->t[kSkidBegin].nanoseconds());
   EXPECT_GT(*std::prev(first_round.end(), 2), wheel->t[kSkidEnd - 1].nanoseconds());
   EXPECT_TRUE(first_round.count(wheel->t[kLone].nanoseconds()));
   EXPECT_FALSE(first_round.count(wheel->t[kLone - 1].nanoseconds()));
   EXPECT_FALSE(first_round.count(wheel->t[kLone + 1].nanoseconds()));
   ASSERT_TRUE(Solve(config.solver, &burst->graph()).usable());
-  const int rounds_burst = 1 + gate_until_stable(burst.get(), 0.0);
+  const int rounds_burst = 1 + gate_until_stable(burst.get());
   const std::set<std::int64_t> out_burst = rejected(*burst);
 
   EXPECT_GE(rounds_alone, 4) << "the one-by-one rounds peel the skid";
@@ -327,5 +327,6 @@ TEST(GateOutliersTest, ABurstTakesItsNeighboursOutForOneRoundAndChanceSwitchesAr
   EXPECT_GT(would_switch, 0);
   EXPECT_LE(would_switch, tested * (1.0 - 0.995));
 }
+
 }  // namespace
 }  // namespace roamlab::estimator
