@@ -68,6 +68,8 @@ int GateOutliers(double probability, ProblemBuilder* builder, FactorId first, co
   // One walk over the measurement factors and the graph's factors in id order (a whole recording's 10^5-10^6).
   std::vector<FactorId> switched;
   long tested = 0;
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  std::vector<std::pair<double, int>> failing;  // squared norm and dimension of each active factor that fails
   const bool bursts = options.burst_margin > 0.0;
   std::vector<std::vector<GateRow>> rows(bursts ? builder->stream_names().size() : 0);  // per stream, in time order
   std::vector<const double*> values;
@@ -98,6 +100,7 @@ int GateOutliers(double probability, ProblemBuilder* builder, FactorId first, co
     }
     const bool pass = ok && linearized->squared_norm <= threshold(dim);
     ++tested;
+    if (!pass && entry.active) failing.push_back({ok ? linearized->squared_norm : kInfinity, dim});
     if (bursts)
       rows[stream->second].push_back({id, entry.active, pass});
     else if (pass != entry.active)
@@ -113,8 +116,14 @@ int GateOutliers(double probability, ProblemBuilder* builder, FactorId first, co
     }
     std::sort(switched.begin(), switched.end());
   }
-  if (options.ignore_chance_changes &&
-      static_cast<double>(switched.size()) <= static_cast<double>(tested) * (1.0 - probability))
+  // By chance: no more switches than the test's false alarms among the tested factors, and no newly failing factor
+  // beyond the quantile that all of them pass with the test's probability (1 - (1 - p) / N each): a gross outlier
+  // is rejected however few there are.
+  const double false_alarms = static_cast<double>(tested) * (1.0 - probability);
+  if (options.ignore_chance_changes && static_cast<double>(switched.size()) <= false_alarms &&
+      std::none_of(failing.begin(), failing.end(), [&](const std::pair<double, int>& f) {
+        return f.first > ChiSquareQuantile(1.0 - (1.0 - probability) / static_cast<double>(tested), f.second);
+      }))
     return 0;
   for (FactorId id : switched) {
     FactorEntry& entry = graph.mutable_factor(id);

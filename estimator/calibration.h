@@ -92,7 +92,9 @@ struct GateOptions {
   // rest of the measurements agree with them.
   double burst_margin = 0.0;
   // Switch nothing when no more factors would switch than the test's own false alarms among the tested ones are
-  // expected to be, (1 - probability) of them: such a set is as stable as the test can tell.
+  // expected to be, (1 - probability) of them, and none that would be rejected is a gross outlier (beyond the quantile
+  // that all N tested factors pass with the test's probability, 1 - (1 - probability) / N each): such a set is as
+  // stable as the test can tell.
   bool ignore_chance_changes = false;
 };
 

@@ -246,8 +246,8 @@ TEST(CalibrationTest, GatingRejectsGrossGpsOutliers) {
 // The rear wheel skids for a second (its reading up to 8 % low, as a sine) and one more row is off alone. Tested one by
 // one, each re-solve without the failing rows lets the skid's next rows fail (masking: the skid bends the estimate
 // towards itself); rejecting the rows around a burst for one round reaches a stable set in fewer rounds, with every
-// row the one-by-one rounds reject and no row that was not corrupted. A lone outlier takes no neighbours with it, and
-// a set that would change by fewer factors than the test's own false alarms is left as it is.
+// row the one-by-one rounds reject and no row that was not corrupted. A lone outlier takes no neighbours with it; a set
+// that would change by fewer factors than the test's own false alarms is left as it is, unless one of them is gross.
 TEST(GateOutliersTest, ABurstTakesItsNeighboursOutForOneRoundAndChanceSwitchesAreIgnored) {
   roamlab::testing::SyntheticOptions options;
   options.duration_s = 8.0;
@@ -326,6 +326,24 @@ TEST(GateOutliersTest, ABurstTakesItsNeighboursOutForOneRoundAndChanceSwitchesAr
   const int would_switch = GateOutliers(0.995, burst.get());
   EXPECT_GT(would_switch, 0);
   EXPECT_LE(would_switch, tested * (1.0 - 0.995));
+
+  // A gross outlier is rejected however few factors switch: the same drive with the lone row alone corrupted.
+  auto lone_only = roamlab::testing::MakeAtvRecording(options);
+  FindStream(&lone_only.recording, "rear_wheel")->values(kLone, 0) *= 0.5;
+  auto built = ProblemBuilder::Create(config, lone_only.recording);
+  ASSERT_TRUE(built.ok()) << built.status().message();
+  ProblemBuilder& gross = *built.value();
+  for (const MeasurementRef& m : gross.Measurements()) gross.Add(m);
+  gross.Finish();
+  gross.AlignToAbsoluteFixes();
+  ASSERT_TRUE(Solve(config.solver, &gross.graph()).usable());
+  const int gross_switched = GateOutliers(0.999, &gross, 0, nullptr, GateOptions{0.0, true});
+  EXPECT_GE(gross_switched, 1);
+  EXPECT_LE(gross_switched, tested * (1.0 - 0.999)) << "few enough to pass for chance by their number";
+  bool lone_rejected = false;
+  for (const auto& [id, entry] : gross.graph().factors())
+    lone_rejected |= !entry.active && entry.stream == "odometer" && entry.stamp == wheel->t[kLone];
+  EXPECT_TRUE(lone_rejected);
 }
 
 }  // namespace
