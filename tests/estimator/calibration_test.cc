@@ -264,8 +264,8 @@ TEST(GateOutliersTest, ABurstTakesItsNeighboursOutForOneRoundAndChanceSwitchesAr
   corrupted.insert(wheel->t[kLone].nanoseconds());
 
   const EstimatorConfig config = testing::AtvConfig({});
-  const auto solved = [&]() {
-    auto built = ProblemBuilder::Create(config, synthetic.recording);
+  const auto solved = [&](const recording::Recording& recording) {
+    auto built = ProblemBuilder::Create(config, recording);
     EXPECT_TRUE(built.ok()) << built.status().message();
     std::unique_ptr<ProblemBuilder> builder = std::move(built.value());
     for (const MeasurementRef& m : builder->Measurements()) builder->Add(m);
@@ -294,11 +294,11 @@ TEST(GateOutliersTest, ABurstTakesItsNeighboursOutForOneRoundAndChanceSwitchesAr
     return rounds;
   };
 
-  const std::unique_ptr<ProblemBuilder> alone = solved();
+  const std::unique_ptr<ProblemBuilder> alone = solved(synthetic.recording);
   const int rounds_alone = gate_until_stable(alone.get());
   const std::set<std::int64_t> out_alone = rejected(*alone);
 
-  const std::unique_ptr<ProblemBuilder> burst = solved();
+  const std::unique_ptr<ProblemBuilder> burst = solved(synthetic.recording);
   ASSERT_GT(GateOutliers(kProbability, burst.get(), 0, nullptr, GateOptions{1.5, false}), 0);
   const std::set<std::int64_t> first_round = rejected(*burst);
   // Uncorrupted rows on both sides of the skid are out for this round (the last stamp is the lone row's); the lone
@@ -330,18 +330,12 @@ TEST(GateOutliersTest, ABurstTakesItsNeighboursOutForOneRoundAndChanceSwitchesAr
   // A gross outlier is rejected however few factors switch: the same drive with the lone row alone corrupted.
   auto lone_only = roamlab::testing::MakeAtvRecording(options);
   FindStream(&lone_only.recording, "rear_wheel")->values(kLone, 0) *= 0.5;
-  auto built = ProblemBuilder::Create(config, lone_only.recording);
-  ASSERT_TRUE(built.ok()) << built.status().message();
-  ProblemBuilder& gross = *built.value();
-  for (const MeasurementRef& m : gross.Measurements()) gross.Add(m);
-  gross.Finish();
-  gross.AlignToAbsoluteFixes();
-  ASSERT_TRUE(Solve(config.solver, &gross.graph()).usable());
-  const int gross_switched = GateOutliers(0.999, &gross, 0, nullptr, GateOptions{0.0, true});
+  const std::unique_ptr<ProblemBuilder> gross = solved(lone_only.recording);
+  const int gross_switched = GateOutliers(0.999, gross.get(), 0, nullptr, GateOptions{0.0, true});
   EXPECT_GE(gross_switched, 1);
   EXPECT_LE(gross_switched, tested * (1.0 - 0.999)) << "few enough to pass for chance by their number";
   bool lone_rejected = false;
-  for (const auto& [id, entry] : gross.graph().factors())
+  for (const auto& [id, entry] : gross->graph().factors())
     lone_rejected |= !entry.active && entry.stream == "odometer" && entry.stamp == wheel->t[kLone];
   EXPECT_TRUE(lone_rejected);
 }
