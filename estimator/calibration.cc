@@ -69,7 +69,8 @@ int GateOutliers(double probability, ProblemBuilder* builder, FactorId first, co
   std::vector<FactorId> switched;
   long tested = 0;
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
-  std::vector<std::pair<double, int>> failing;  // squared norm and dimension of each active factor that fails
+  std::vector<std::pair<double, int>> failing;  // (ignore_chance_changes) squared norm and dimension of each active
+                                                // factor that fails
   const bool bursts = options.burst_margin > 0.0;
   std::vector<std::vector<GateRow>> rows(bursts ? builder->stream_names().size() : 0);  // per stream, in time order
   std::vector<const double*> values;
@@ -100,7 +101,8 @@ int GateOutliers(double probability, ProblemBuilder* builder, FactorId first, co
     }
     const bool pass = ok && linearized->squared_norm <= threshold(dim);
     ++tested;
-    if (!pass && entry.active) failing.push_back({ok ? linearized->squared_norm : kInfinity, dim});
+    if (options.ignore_chance_changes && !pass && entry.active)
+      failing.push_back({ok ? linearized->squared_norm : kInfinity, dim});
     if (bursts)
       rows[stream->second].push_back({id, entry.active, pass});
     else if (pass != entry.active)

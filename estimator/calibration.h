@@ -100,9 +100,10 @@ struct GateOptions {
 
 // Re-tests the measurement factors with id >= `first` (factor ids grow as factors are added, so `first` selects the
 // newest ones): active exactly when the whitened squared error is within the chi-square quantile `probability` of its
-// dimension. Keeps the per-stream rejected counts up to date; returns how many factors changed state. `last_solve`
-// (optional): the workspace of the solve that left the graph at its current values; a factor it linearized at exactly
-// these values is tested on that linearization's error instead of being evaluated again.
+// dimension, but for what `options` add. Keeps the per-stream rejected counts up to date; returns how many factors
+// changed state. `last_solve` (optional): the workspace of the solve that left the graph at its current values; a
+// factor it linearized at exactly these values is tested on that linearization's error instead of being evaluated
+// again.
 int GateOutliers(double probability, ProblemBuilder* builder, FactorId first = 0,
                  const SolverWorkspace* last_solve = nullptr, const GateOptions& options = {});
 
