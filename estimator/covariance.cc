@@ -21,7 +21,8 @@ const char* ObservabilityName(Observability observability) {
   return "unknown";
 }
 
-Result<MarginalInformation> ComputeMarginalInformation(const Graph& graph, const std::vector<VariableId>& variables) {
+Result<MarginalInformation> ComputeMarginalInformation(const Graph& graph, const std::vector<VariableId>& variables,
+                                                       SolverWorkspace* workspace) {
   // Order every other free variable first, the requested ones last.
   const std::unordered_set<VariableId> requested(variables.begin(), variables.end());
   std::vector<VariableId> order;
@@ -38,8 +39,12 @@ Result<MarginalInformation> ComputeMarginalInformation(const Graph& graph, const
     order.push_back(id);
   }
 
-  internal::NormalEquations system(graph, order);
+  internal::NormalEquations local;
+  internal::NormalEquations& system = workspace != nullptr ? *workspace->system_ : local;
+  system.set_relinearize_threshold(0.0);
   system.set_keep_linearizations(false);  // (one linearization, H alone read)
+  system.Reset(graph, std::move(order));
+  system.ForgetLinearizations();  // (a workspace's may have been carried to first order)
   std::string failed;
   if (!system.Linearize(graph, &failed)) return Status::Error("a factor from '" + failed + "' cannot be evaluated");
   const int n = system.dimension();

@@ -85,6 +85,7 @@ struct CovarianceRequest {
   bool computed = false;
 };
 
+struct MarginalInformation;  // covariance.h
 namespace internal {
 class NormalEquations;
 struct WhitenedFactor;
@@ -119,6 +120,8 @@ class SolverWorkspace {
 
  private:
   friend SolverSummary Solve(const SolverOptions&, Graph*, CovarianceRequest*, SolverWorkspace*);
+  friend Result<MarginalInformation> ComputeMarginalInformation(const Graph&, const std::vector<VariableId>&,
+                                                                SolverWorkspace*);
   bool keep_linearizations_ = true;
   std::unique_ptr<internal::NormalEquations> system_;
   std::vector<double> saved_;

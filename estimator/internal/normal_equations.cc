@@ -385,6 +385,10 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   undamped_step_ = false;
 }
 
+void NormalEquations::ForgetLinearizations() {
+  for (FactorLinearization& l : linearized_) l.id = -1;
+}
+
 void NormalEquations::MoveLinearizationsWithTheirFactors() {
   // A new factor takes the buffers of one that left, in order: a window that slid drops its oldest factors and gains
   // new ones of the same kinds, so a factor's buffers mostly have its own sizes already (no reallocation).

@@ -82,6 +82,9 @@ class NormalEquations {
   // threshold they are kept whatever this says: the carries need them; LinearizeForCost keeps its linearization of
   // a Gauss-Newton trial point, which the next Linearize takes.)
   void set_keep_linearizations(bool keep) { keep_linearizations_ = keep; }
+  // Drops every factor's kept linearization: the next Linearize evaluates each factor exactly (none is carried to
+  // first order or taken as current).
+  void ForgetLinearizations();
   // Factor evaluations (with Jacobians) and first-order carries since construction.
   long evaluations() const { return evaluations_; }
   long carries() const { return carries_; }

@@ -485,6 +485,31 @@ TEST(NormalEquationsTest, LargeBandIsFactoredInItsEnvelopeUnlessManyPosesFarApar
     const auto marginal = ComputeMarginalInformation(graph, {lever});
     ASSERT_TRUE(marginal.ok()) << marginal.status().message();
     EXPECT_LT((marginal.value().information - schur).norm(), 1e-9 * schur.norm());
+
+    // In the buffers of a solver workspace whose last solve kept its factorization and carried linearizations to
+    // first order (a relinearization threshold): the same information bit for bit, and the workspace's next solve is
+    // the same as a fresh one's.
+    SolverOptions carrying;
+    carrying.method = SolverOptions::Method::kGaussNewton;
+    carrying.relinearize_threshold = 1e-2;
+    carrying.max_iterations = 3;
+    SolverWorkspace workspace;
+    ASSERT_TRUE(Solve(carrying, &graph, nullptr, &workspace).usable());
+    ASSERT_GT(workspace.carries(), 0);
+    const auto fresh = ComputeMarginalInformation(graph, {lever});
+    const auto reused = ComputeMarginalInformation(graph, {lever}, &workspace);
+    ASSERT_TRUE(fresh.ok() && reused.ok());
+    EXPECT_EQ(reused.value().information, fresh.value().information);
+    EXPECT_EQ(reused.value().conditional, fresh.value().conditional);
+    std::vector<std::pair<VariableId, Eigen::VectorXd>> start;
+    for (const auto& [id, v] : graph.variables()) start.emplace_back(id, v.value);
+    const SolverOptions options;
+    const SolverSummary after = Solve(options, &graph, nullptr, &workspace);
+    const Eigen::VectorXd lever_after = graph.variable(lever).value;
+    for (const auto& [id, value] : start) graph.mutable_variable(id).value = value;
+    const SolverSummary alone = Solve(options, &graph, nullptr);
+    EXPECT_EQ(after.final_cost, alone.final_cost);
+    EXPECT_EQ(lever_after, graph.variable(lever).value);
   }
 }
 
