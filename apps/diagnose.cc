@@ -373,13 +373,21 @@ int RunDiagnose(const DiagnoseArgs& args) {
   // The baseline: the nominal scenario simulated over the recording's span and diagnosed without effects.
   gap::DiagnoseOptions options;
   options.progress = [&](const std::string& line) { say("  " + line); };
+  double span_s = 0.0;
+  for (const recording::Stream& s : recording.streams)
+    if (!s.t.empty()) span_s = std::max(span_s, s.t.back().seconds());
+  if (args.max_shift_s) {
+    // The held-out third loses twice the range of its position fixes at each end (gap::Diagnose's Slice).
+    const double limit = span_s / 12.0;
+    if (!(*args.max_shift_s > 0.0) || !(*args.max_shift_s < limit))
+      return bad("--max-shift " + Fixed(*args.max_shift_s, 3) + " s: must be above 0 and below " + Fixed(limit, 3) +
+                 " s, 1/12 of " + args.recording + "'s span");
+    options.max_shift_s = *args.max_shift_s;
+  }
   gap::Baseline baseline;
   if (!args.no_baseline) {
     sim::Scenario nominal = *scenario;
     nominal.effects.clear();
-    double span_s = 0.0;
-    for (const recording::Stream& s : recording.streams)
-      if (!s.t.empty()) span_s = std::max(span_s, s.t.back().seconds());
     nominal.duration_s = std::min(nominal.duration_s, std::max(span_s, 1.0));
     sim::SimulateOptions sim_options;
     sim_options.seed = args.baseline_seed;

@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <iosfwd>
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -29,6 +30,7 @@ struct DiagnoseArgs {
   std::string out;
   bool no_baseline = false;
   std::uint64_t baseline_seed = 900001;  // noise seed of the nominal simulation
+  std::optional<double> max_shift_s;     // --max-shift: the time-shift search range (default gap::DiagnoseOptions')
   bool no_plots = false;
   bool quiet = false;
   std::ostream* err = nullptr;           // receives the one-line error; nullptr: stderr

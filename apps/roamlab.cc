@@ -93,6 +93,9 @@ int main(int argc, char** argv) {
   dia->add_flag("--no-baseline", diagnose.no_baseline,
                 "Do not simulate the nominal scenario to learn its levels (compare with chi2/dof 1)");
   dia->add_option("--baseline-seed", diagnose.baseline_seed, "Noise seed of the nominal simulation (default 900001)");
+  dia->add_option("--max-shift", diagnose.max_shift_s,
+                  "Time-shift search range [s] of gps_latency, imu_time_offset and pose_time_offset (default 0.5; "
+                  "below 1/12 of the recording's span)");
   dia->add_flag("--no-plots", diagnose.no_plots, "No figures");
   dia->add_flag("--quiet", diagnose.quiet, "No progress and no summary");
 

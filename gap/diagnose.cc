@@ -1118,6 +1118,19 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
         e.decision = "rejected: BIC does not favour it";
         continue;
       }
+      // The parts were cut for shifts within the search range (Slice): beyond it, shifted fixes leave the poses' span
+      // and the held-out comparison counts other measurements.
+      const auto beyond = std::find_if(f.next.shift_s.begin(), f.next.shift_s.end(), [&](const auto& shift) {
+        return std::abs(shift.second) > options.max_shift_s;
+      });
+      if (beyond != f.next.shift_s.end()) {
+        std::ostringstream decision;
+        decision << "rejected: the fitted shift of " << beyond->first << " (" << beyond->second
+                 << " s) is beyond the time-shift range +-" << options.max_shift_s << " s (--max-shift)";
+        e.decision = decision.str();
+        dropped.insert(e.name);
+        continue;
+      }
       auto h = heldout(f.next);
       if (!h.ok()) return Status::Error("held-out evaluation of " + e.name + ": " + h.status().message());
       e.evaluated_heldout = true;

@@ -1,6 +1,6 @@
 // `roamlab diagnose` end to end on short simulated drives: it never opens the recording's truth.yaml (garbage there
 // changes nothing), writes gap.json with the documented keys, and refuses a recording of another robot kind with one
-// line and exit code 2.
+// line and exit code 2, as it does a time-shift range the recording cannot hold.
 #include <sys/wait.h>
 
 #include <cstdlib>
@@ -97,6 +97,26 @@ TEST(DiagnoseCliTest, RefusesARecordingOfAnotherRobotKind) {
       << run.err;
   EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1);
   EXPECT_FALSE(std::ifstream(dir.File("out/gap.json")).good());
+}
+
+TEST(DiagnoseCliTest, RefusesAShiftRangeTheRecordingCannotHold) {
+  testing::TempDir dir;
+  const std::string scenario = Scenario(dir, 1.5, "[]");
+  ASSERT_EQ(Roamlab("simulate " + scenario + " --out " + dir.File("rec") + " --quiet", dir).exit_code, 0);
+  for (const std::string shift : {"0.5", "0"}) {
+    const CommandRun run = Roamlab("diagnose --real " + dir.File("rec") + " --scenario " + scenario + " --out " +
+                                       dir.File("out") + " --max-shift " + shift,
+                                   dir);
+    EXPECT_EQ(run.exit_code, 2) << shift;
+    // The limit is 1/12 of the 1.5 s span, about 0.125 s.
+    EXPECT_NE(run.err.find("roamlab diagnose: --max-shift " + shift +
+                           " s: must be above 0 and below 0.12"),
+              std::string::npos)
+        << run.err;
+    EXPECT_NE(run.err.find(" s, 1/12 of " + dir.File("rec") + "'s span"), std::string::npos) << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1);
+    EXPECT_FALSE(std::ifstream(dir.File("out/gap.json")).good());
+  }
 }
 
 }  // namespace

@@ -282,6 +282,12 @@ TEST(GapBenchmarkScore, SummarizesTheIssuesFigures) {
   EXPECT_NEAR(f["median_resimulated_rms_reduction_all_effect_cases"].get<double>(), 0.35, 1e-12);
   EXPECT_NEAR(f["median_resimulated_rms_1s_reduction"].get<double>(), 0.75, 1e-12);
   EXPECT_NEAR(f["median_resimulated_rms_1s_reduction_all_effect_cases"].get<double>(), 0.625, 1e-12);
+  // The one top-1 case's simulation as believed misses its stream by 1.5 >= sqrt(2) times the noise.
+  EXPECT_EQ(f["above_noise"]["cases"], 1);
+  EXPECT_NEAR(f["above_noise"]["median_resimulated_rms_reduction"].get<double>(), 0.2, 1e-12);
+  EXPECT_DOUBLE_EQ(f["above_noise"]["median_heldout_rms_reduction"].get<double>(), 0.5);
+  EXPECT_EQ(f["below_noise"]["cases"], 0);
+  EXPECT_TRUE(f["below_noise"]["median_resimulated_rms_reduction"].is_null());
   EXPECT_FALSE(f["targets"]["median_resimulated_rms_reduction"]["met"].get<bool>());
   EXPECT_TRUE(f["targets"]["median_resimulated_rms_1s_reduction"]["met"].get<bool>());
   EXPECT_FALSE(f["targets"]["top1_strong"]["met"].get<bool>());
