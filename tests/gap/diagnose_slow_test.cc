@@ -133,8 +133,8 @@ TEST_F(DiagnoseTest, GpsLatency) {
 
 // A latency beyond the time-shift range (0.5 s by default): the parabola's vertex past the grid's end is rejected as
 // out of range, not kept and not blamed on the held-out part (the parts are cut for shifts within the range; before
-// the check, this case was fitted at 0.563 s and then failed the held-out test on lost fixes); with the range widened
-// to 0.8 s it is named (0.711 +- 0.079 s, 1.8 std off).
+// the check, a gap-benchmark case of this latency was fitted at 0.563 s and then failed the held-out test on lost
+// fixes); with the range widened to 0.8 s it is named (0.711 +- 0.079 s, 1.8 std off).
 TEST_F(DiagnoseTest, GpsLatencyBeyondTheShiftRange) {
   sim::Simulation sim;
   const Diagnosis d = Run({{"gps_latency", {{"latency_s", 0.572}}}}, 16, &sim);
