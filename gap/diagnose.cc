@@ -1124,6 +1124,7 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
         return std::abs(shift.second) > options.max_shift_s;
       });
       if (beyond != f.next.shift_s.end()) {
+        if (extra) continue;   // evaluated for the record only: neither a decision nor a drop for the later rounds
         std::ostringstream decision;
         decision << "rejected: the fitted shift of " << beyond->first << " (" << beyond->second
                  << " s) is beyond the time-shift range +-" << options.max_shift_s << " s (--max-shift)";
