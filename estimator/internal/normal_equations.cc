@@ -516,14 +516,22 @@ void NormalEquations::BuildPattern() {
 
   // Value index of block (r, b): start of column block_offset[b] plus the row offset of r in that column; later
   // columns of the block are found by adding j * column_length[b].
+  // A column whose row blocks are consecutive (a constant parameter's in natural order: all up to the diagonal; most
+  // of a band's) has block r at the scalar row offset block_offset[r] - block_offset[rows.front()] within it: per
+  // column one flat base, read without chasing rows_of_'s vectors; -1 marks the others, which search their rows. (A
+  // base is never negative: the entries before column block_offset[b] number at least block_offset[b].)
   const int* outer = H_.outerIndexPtr();
-  const auto value_index = [&](int r, int b) {
-    // A column whose row blocks are consecutive (a constant parameter's in natural order: all up to the diagonal; most
-    // of a band's) has r at r - rows.front().
+  column_base_.resize(nb);
+  for (int b = 0; b < nb; ++b) {
     const auto& rows = rows_of_[b];
-    const std::ptrdiff_t position = rows.back() - rows.front() + 1 == static_cast<int>(rows.size())
-                                        ? r - rows.front()
-                                        : std::lower_bound(rows.begin(), rows.end(), r) - rows.begin();
+    column_base_[b] = rows.back() - rows.front() + 1 == static_cast<int>(rows.size())
+                          ? static_cast<std::ptrdiff_t>(outer[block_offset_[b]]) - block_offset_[rows.front()]
+                          : -1;
+  }
+  const auto value_index = [&](int r, int b) -> std::ptrdiff_t {
+    if (column_base_[b] >= 0) return column_base_[b] + block_offset_[r];
+    const auto& rows = rows_of_[b];
+    const std::ptrdiff_t position = std::lower_bound(rows.begin(), rows.end(), r) - rows.begin();
     return static_cast<std::ptrdiff_t>(outer[block_offset_[b]]) + row_offset_[b][position];
   };
   // Counted first (a pair of free positions i <= j gives one slot, two when i < j take the same variable), then
