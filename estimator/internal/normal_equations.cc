@@ -113,22 +113,27 @@ void AddBlock(const double* src, int rows, int cols, bool transposed, double* ds
     block += Eigen::Map<const Eigen::MatrixXd>(src, rows, cols);
 }
 
-// r += J d (d: J.cols() entries), with fixed-size kernels for 3-row errors and the models' block sizes.
+// r += J d (d: J.cols() entries), with fixed-size kernels for 3- and 4-row errors (the IMU's, magnetometer's, GPS's
+// and Ackermann velocity's) and the models' block sizes: the general product's set-up costs more than the arithmetic.
 template <int M, int A>
 void AddJacobianTimesFixed(const double* j, const double* d, double* r) {
   Eigen::Map<Eigen::Matrix<double, M, 1>>(r).noalias() +=
       Eigen::Map<const Eigen::Matrix<double, M, A>>(j) * Eigen::Map<const Eigen::Matrix<double, A, 1>>(d);
 }
-void AddJacobianTimes(const Eigen::MatrixXd& j, const double* d, Eigen::VectorXd* r) {
-  if (j.rows() == 3) {
-    switch (j.cols()) {
-      case 1: AddJacobianTimesFixed<3, 1>(j.data(), d, r->data()); return;
-      case 3: AddJacobianTimesFixed<3, 3>(j.data(), d, r->data()); return;
-      case 6: AddJacobianTimesFixed<3, 6>(j.data(), d, r->data()); return;
-      case 9: AddJacobianTimesFixed<3, 9>(j.data(), d, r->data()); return;
-      default: break;
-    }
+template <int M>
+bool AddJacobianTimesRows(const double* j, int a, const double* d, double* r) {
+  switch (a) {
+    case 1: AddJacobianTimesFixed<M, 1>(j, d, r); return true;
+    case 3: AddJacobianTimesFixed<M, 3>(j, d, r); return true;
+    case 6: AddJacobianTimesFixed<M, 6>(j, d, r); return true;
+    case 9: AddJacobianTimesFixed<M, 9>(j, d, r); return true;
+    default: return false;
   }
+}
+void AddJacobianTimes(const Eigen::MatrixXd& j, const double* d, Eigen::VectorXd* r) {
+  const int a = static_cast<int>(j.cols());
+  if (j.rows() == 3 && AddJacobianTimesRows<3>(j.data(), a, d, r->data())) return;
+  if (j.rows() == 4 && AddJacobianTimesRows<4>(j.data(), a, d, r->data())) return;
   r->noalias() += j * Eigen::Map<const Eigen::VectorXd>(d, j.cols());
 }
 
@@ -537,14 +542,24 @@ void NormalEquations::BuildPattern() {
   // Counted first (a pair of free positions i <= j gives one slot, two when i < j take the same variable), then
   // written in place: a PairSlot assembled on the stack and copied in stalls on the store forwarding of its
   // mixed-width fields.
+  // (The pairs i < j on one block, counted by the block's earlier occurrences in the factor: a stamp per block.)
   int free[64];
   std::size_t pair_count = 0;
+  block_stamp_.assign(nb, -1);
+  block_count_.resize(nb);
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
     const int* block = &var_block_[var_begin_[k]];
     const int nf = FreePositions(block, var_begin_[k + 1] - var_begin_[k], free);
     pair_count += static_cast<std::size_t>(nf) * (nf + 1) / 2;
-    for (int i = 0; i < nf; ++i)
-      for (int j = i + 1; j < nf; ++j) pair_count += block[free[i]] == block[free[j]];
+    for (int i = 0; i < nf; ++i) {
+      const int b = block[free[i]];
+      if (block_stamp_[b] == static_cast<int>(k)) {
+        pair_count += block_count_[b]++;
+      } else {
+        block_stamp_[b] = static_cast<int>(k);
+        block_count_[b] = 1;
+      }
+    }
   }
   pairs_.resize(pair_count);
   pair_begin_.assign(1, 0);

@@ -259,6 +259,7 @@ class NormalEquations {
   std::vector<std::vector<int>> row_offset_;
   std::vector<int> column_length_;
   std::vector<std::ptrdiff_t> column_base_;  // BuildPattern: per block column, see value_index there
+  std::vector<int> block_stamp_, block_count_;  // BuildPattern: per block, the factor that last took it and how often
   std::vector<int> outer_, inner_;
   // The block pattern (dims_ and rows_of_) that H's pattern was built for, and the last few other patterns of a small
   // system with their H (BuildPattern), oldest first.
