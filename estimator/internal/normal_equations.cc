@@ -204,6 +204,7 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   prev_factor_ids_.swap(factor_ids_);
   prev_entries_.swap(entries_);
   prev_var_begin_.swap(var_begin_);
+  prev_want_.swap(want_);
   prev_var_id_.swap(var_id_);
   prev_var_block_.swap(var_block_);
   prev_values_.swap(values_);
@@ -292,6 +293,7 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   factor_ids_.clear();
   entries_.clear();
   want_.clear();
+  kept_from_.clear();
   var_begin_.assign(1, 0);
   var_id_.clear();
   var_block_.clear();
@@ -347,6 +349,8 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
     factor_ids_.push_back(fid);
     entries_.push_back(&entry);
     want_.push_back(mask);
+    // (BuildPattern copies the pairs of a factor kept with the same free variables.)
+    kept_from_.push_back(kept && prev_want_[prev] == mask ? static_cast<int>(prev) : -1);
     var_begin_.push_back(static_cast<int>(var_block_.size()));
   }
   // In a small system (a tracking window), the block column of a free constant parameter (no time stamp) holds every
@@ -407,7 +411,7 @@ void NormalEquations::MoveLinearizationsWithTheirFactors() {
   for (std::size_t k = 0, p = 0; k < factor_ids_.size(); ++k) {
     while (p < prev_factor_ids_.size() && prev_factor_ids_[p] < factor_ids_[k]) ++p;
     if (p < prev_factor_ids_.size() && prev_factor_ids_[p] == factor_ids_[k]) {
-      std::swap(linearized_[k], prev_linearized_[p]);
+      swap(linearized_[k], prev_linearized_[p]);
       taken[p] = true;
     } else {
       fresh.push_back(k);
@@ -428,7 +432,7 @@ void NormalEquations::MoveLinearizationsWithTheirFactors() {
     }
   }
   for (std::size_t p = 0, i = 0; p < prev_linearized_.size() && i < fresh.size(); ++p)
-    if (!taken[p]) std::swap(linearized_[fresh[i++]], prev_linearized_[p]);
+    if (!taken[p]) swap(linearized_[fresh[i++]], prev_linearized_[p]);
   for (std::size_t k : fresh) linearized_[k].id = -1;
 }
 
@@ -542,12 +546,19 @@ void NormalEquations::BuildPattern() {
   // Counted first (a pair of free positions i <= j gives one slot, two when i < j take the same variable), then
   // written in place: a PairSlot assembled on the stack and copied in stalls on the store forwarding of its
   // mixed-width fields.
-  // (The pairs i < j on one block, counted by the block's earlier occurrences in the factor: a stamp per block.)
+  // (The pairs i < j on one block, counted by the block's earlier occurrences in the factor: a stamp per block. A
+  // factor kept from the last Reset has as many as then.)
+  prev_pairs_.swap(pairs_);
+  prev_pair_begin_.swap(pair_begin_);
   int free[64];
   std::size_t pair_count = 0;
   block_stamp_.assign(nb, -1);
   block_count_.resize(nb);
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
+    if (kept_from_[k] >= 0) {
+      pair_count += prev_pair_begin_[kept_from_[k] + 1] - prev_pair_begin_[kept_from_[k]];
+      continue;
+    }
     const int* block = &var_block_[var_begin_[k]];
     const int nf = FreePositions(block, var_begin_[k + 1] - var_begin_[k], free);
     pair_count += static_cast<std::size_t>(nf) * (nf + 1) / 2;
@@ -576,6 +587,29 @@ void NormalEquations::BuildPattern() {
     ++pair;
   };
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
+    // A factor kept from the last Reset with the same free variables: its pairs are the last ones with their blocks
+    // renumbered (the same positions, products and transposition while the renumbering keeps its blocks' order, as a
+    // window's slide does; otherwise they are built anew) and their places in this H.
+    if (kept_from_[k] >= 0) {
+      PairSlot* const first = pair;
+      for (int q = prev_pair_begin_[kept_from_[k]]; q < prev_pair_begin_[kept_from_[k] + 1]; ++q) {
+        const PairSlot& old = prev_pairs_[q];
+        const int row = old_to_new_[old.row], column = old_to_new_[old.column];
+        if (row < 0 || row > column) {
+          pair = first;
+          break;
+        }
+        *pair = old;
+        pair->row = row;
+        pair->column = column;
+        pair->value = value_index(row, column);
+        ++pair;
+      }
+      if (pair != first || prev_pair_begin_[kept_from_[k]] == prev_pair_begin_[kept_from_[k] + 1]) {
+        pair_begin_.push_back(static_cast<int>(pair - pairs_.data()));
+        continue;
+      }
+    }
     const int* block = &var_block_[var_begin_[k]];
     const int nf = FreePositions(block, var_begin_[k + 1] - var_begin_[k], free);
     for (int i = 0, product = 0; i < nf; ++i) {

@@ -177,6 +177,11 @@ class NormalEquations {
     bool transposed;       // the block receives that product's transpose
   };
   std::vector<PairSlot> pairs_;
+  // The last Reset's pairs and masks, and per factor its index there when it was kept with the same mask (else -1).
+  std::vector<PairSlot> prev_pairs_;
+  std::vector<int> prev_pair_begin_;
+  std::vector<std::uint64_t> prev_want_;
+  std::vector<int> kept_from_;
   // Per included factor, its last linearization and the point it was computed at: Linearize evaluates a factor again
   // only when its variables' values (bit for bit), its entry or its Jacobians' mask changed since.
   struct FactorLinearization {
@@ -193,6 +198,24 @@ class NormalEquations {
     // (i outer), each column-major.
     std::vector<double> products;
     bool products_valid = false;
+    // Member by member (MoveLinearizationsWithTheirFactors swaps one per factor and Reset): each buffer's pointers
+    // change hands, where std::swap's three moves would also clear and re-fill them. A member added to this struct or
+    // to WhitenedFactor goes here too.
+    friend void swap(FactorLinearization& a, FactorLinearization& b) noexcept {
+      a.whitened.residual.swap(b.whitened.residual);
+      a.whitened.jacobians.swap(b.whitened.jacobians);
+      a.whitened.sqrt_covariance.swap(b.whitened.sqrt_covariance);
+      std::swap(a.whitened.squared_norm, b.whitened.squared_norm);
+      std::swap(a.whitened.cost, b.whitened.cost);
+      std::swap(a.id, b.id);
+      std::swap(a.entry, b.entry);
+      std::swap(a.mask, b.mask);
+      a.at.swap(b.at);
+      a.lin_at.swap(b.lin_at);
+      a.lin_residual.swap(b.lin_residual);
+      a.products.swap(b.products);
+      std::swap(a.products_valid, b.products_valid);
+    }
   };
   std::vector<FactorLinearization> linearized_;
   bool keep_linearizations_ = true;
