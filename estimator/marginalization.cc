@@ -38,8 +38,11 @@ Eigen::Matrix3d InverseRightJacobian(const Eigen::Vector3d& phi) {
 // same prior: |r0 + J dx|^2 depends on them only through J^T J and J^T r0 (up to a constant), the same as the
 // reference when both keep the same directions. They do when
 //  - the dropped eigenvalues are below the floor: lambda_{r+1..n}(H) <= |S|_2 <= n max diag(S) <= floor;
-//  - the kept ones are above it: by interlacing they are at least lambda_min(L11 L11^T) >= 1 / |L11^-1|_F^2, which is
-//    checked against the floor.
+//  - the kept ones are above it: by interlacing they are at least lambda_min(L11 L11^T) = 1 / |L11^-1|_2^2, which is
+//    checked against the floor through an upper bound of |L11^-1|_2^2: first |L11^-1|_1 |L11^-1|_inf <= |M^-T e|_inf
+//    |M^-1 e|_inf, with M the comparison matrix of L11 (|l_ii| on the diagonal, -|l_ij| below: |L11^-1| <= M^-1
+//    entrywise, Higham, Accuracy and Stability of Numerical Algorithms, Thm. 8.12), two substitutions; where that is
+//    too loose, |L11^-1|_F^2 (each column of the inverse).
 // Otherwise (an eigenvalue near the floor) the eigen-decomposition decides. Returns false when H carries no
 // information above the floor.
 bool SquareRootInformation(const Eigen::MatrixXd& H_in, const Eigen::VectorXd& g, double floor, Eigen::MatrixXd* J,
@@ -79,10 +82,30 @@ bool SquareRootInformation(const Eigen::MatrixXd& H_in, const Eigen::VectorXd& g
     }
     rank = k + 1;
   }
-  // The kept eigenvalues' bound 1 / |L11^-1|_F^2: each column of L11^-1 by a forward substitution from its diagonal
-  // on (the rows above are zero).
+  // The kept eigenvalues' bound from the comparison matrix: y = M^-1 e (forward) and z = M^-T e (backward).
   bool gap = rank > 0;
+  bool certified = false;
   if (gap) {
+    std::vector<double> y(rank), z(rank);
+    double y_max = 0.0, z_max = 0.0;
+    for (int i = 0; i < rank; ++i) {
+      double sum = 1.0;
+      for (int j = 0; j < i; ++j) sum += std::abs(H(i, j)) * y[j];
+      y[i] = sum / H(i, i);
+      y_max = std::max(y_max, y[i]);
+    }
+    for (int j = rank - 1; j >= 0; --j) {
+      const double* column_j = H.data() + static_cast<std::ptrdiff_t>(j) * n;
+      double sum = 1.0;
+      for (int i = j + 1; i < rank; ++i) sum += std::abs(column_j[i]) * z[i];
+      z[j] = sum / column_j[j];
+      z_max = std::max(z_max, z[j]);
+    }
+    certified = 1.0 / (y_max * z_max) > floor;
+  }
+  // Otherwise 1 / |L11^-1|_F^2: each column of L11^-1 by a forward substitution from its diagonal on (the rows above
+  // are zero).
+  if (gap && !certified) {
     std::vector<double> x(rank);
     double squared_norm = 0.0;
     for (int c = 0; c < rank; ++c) {
