@@ -547,16 +547,26 @@ void NormalEquations::BuildPattern() {
   // written in place: a PairSlot assembled on the stack and copied in stalls on the store forwarding of its
   // mixed-width fields.
   // (The pairs i < j on one block, counted by the block's earlier occurrences in the factor: a stamp per block. A
-  // factor kept from the last Reset has as many as then.)
-  prev_pairs_.swap(pairs_);
-  prev_pair_begin_.swap(pair_begin_);
+  // factor kept from the last Reset has as many as then.) A small system (a window that slides) keeps its pairs for
+  // the next Reset to copy; a large one (a whole recording, whose pairs take hundreds of MB) builds them in place.
+  if (dimension_ <= kMaxSimplicialDimension) {
+    prev_pairs_.swap(pairs_);
+    prev_pair_begin_.swap(pair_begin_);
+  } else {
+    std::vector<PairSlot>().swap(prev_pairs_);
+    prev_pair_begin_.clear();
+  }
+  // The last Reset's factor whose pairs factor k takes, or -1.
+  const auto from = [&](std::size_t k) {
+    return kept_from_[k] >= 0 && kept_from_[k] + 1 < static_cast<int>(prev_pair_begin_.size()) ? kept_from_[k] : -1;
+  };
   int free[64];
   std::size_t pair_count = 0;
   block_stamp_.assign(nb, -1);
   block_count_.resize(nb);
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
-    if (kept_from_[k] >= 0) {
-      pair_count += prev_pair_begin_[kept_from_[k] + 1] - prev_pair_begin_[kept_from_[k]];
+    if (from(k) >= 0) {
+      pair_count += prev_pair_begin_[from(k) + 1] - prev_pair_begin_[from(k)];
       continue;
     }
     const int* block = &var_block_[var_begin_[k]];
@@ -590,9 +600,10 @@ void NormalEquations::BuildPattern() {
     // A factor kept from the last Reset with the same free variables: its pairs are the last ones with their blocks
     // renumbered (the same positions, products and transposition while the renumbering keeps its blocks' order, as a
     // window's slide does; otherwise they are built anew) and their places in this H.
-    if (kept_from_[k] >= 0) {
+    const int p = from(k);
+    if (p >= 0) {
       PairSlot* const first = pair;
-      for (int q = prev_pair_begin_[kept_from_[k]]; q < prev_pair_begin_[kept_from_[k] + 1]; ++q) {
+      for (int q = prev_pair_begin_[p]; q < prev_pair_begin_[p + 1]; ++q) {
         const PairSlot& old = prev_pairs_[q];
         const int row = old_to_new_[old.row], column = old_to_new_[old.column];
         if (row < 0 || row > column) {
@@ -605,7 +616,7 @@ void NormalEquations::BuildPattern() {
         pair->value = value_index(row, column);
         ++pair;
       }
-      if (pair != first || prev_pair_begin_[kept_from_[k]] == prev_pair_begin_[kept_from_[k] + 1]) {
+      if (pair != first || prev_pair_begin_[p] == prev_pair_begin_[p + 1]) {
         pair_begin_.push_back(static_cast<int>(pair - pairs_.data()));
         continue;
       }
