@@ -113,51 +113,44 @@ void AddBlock(const double* src, int rows, int cols, bool transposed, double* ds
     block += Eigen::Map<const Eigen::MatrixXd>(src, rows, cols);
 }
 
-// r += J d (d: J.cols() entries), with fixed-size kernels for 3- and 4-row errors (the IMU's, magnetometer's, GPS's
-// and Ackermann velocity's) and the models' block sizes: the general product's set-up costs more than the arithmetic.
-template <int M, int A>
-void AddJacobianTimesFixed(const double* j, const double* d, double* r) {
-  Eigen::Map<Eigen::Matrix<double, M, 1>>(r).noalias() +=
-      Eigen::Map<const Eigen::Matrix<double, M, A>>(j) * Eigen::Map<const Eigen::Matrix<double, A, 1>>(d);
-}
-template <int M>
-bool AddJacobianTimesRows(const double* j, int a, const double* d, double* r) {
+// Calls f(std::integral_constant<int, M>(), std::integral_constant<int, A>()) for a J of M = 3 or 4 rows (the IMU's,
+// magnetometer's, GPS's and Ackermann velocity's errors) and A = 1, 3, 6 or 9 columns (the models' block sizes), whose
+// fixed-size kernels cost less than a general product's set-up; false for other shapes.
+template <int M, typename Function>
+bool WithColumns(int a, Function f) {
   switch (a) {
-    case 1: AddJacobianTimesFixed<M, 1>(j, d, r); return true;
-    case 3: AddJacobianTimesFixed<M, 3>(j, d, r); return true;
-    case 6: AddJacobianTimesFixed<M, 6>(j, d, r); return true;
-    case 9: AddJacobianTimesFixed<M, 9>(j, d, r); return true;
+    case 1: f(std::integral_constant<int, M>(), std::integral_constant<int, 1>()); return true;
+    case 3: f(std::integral_constant<int, M>(), std::integral_constant<int, 3>()); return true;
+    case 6: f(std::integral_constant<int, M>(), std::integral_constant<int, 6>()); return true;
+    case 9: f(std::integral_constant<int, M>(), std::integral_constant<int, 9>()); return true;
     default: return false;
   }
 }
-void AddJacobianTimes(const Eigen::MatrixXd& j, const double* d, Eigen::VectorXd* r) {
+template <typename Function>
+bool WithFixedShape(const Eigen::MatrixXd& j, Function f) {
   const int a = static_cast<int>(j.cols());
-  if (j.rows() == 3 && AddJacobianTimesRows<3>(j.data(), a, d, r->data())) return;
-  if (j.rows() == 4 && AddJacobianTimesRows<4>(j.data(), a, d, r->data())) return;
-  r->noalias() += j * Eigen::Map<const Eigen::VectorXd>(d, j.cols());
+  return (j.rows() == 3 && WithColumns<3>(a, f)) || (j.rows() == 4 && WithColumns<4>(a, f));
+}
+
+// r += J d (d: J.cols() entries).
+void AddJacobianTimes(const Eigen::MatrixXd& j, const double* d, Eigen::VectorXd* r) {
+  const bool fixed = WithFixedShape(j, [&](auto m, auto a) {
+    constexpr int M = decltype(m)::value, A = decltype(a)::value;
+    Eigen::Map<Eigen::Matrix<double, M, 1>>(r->data()).noalias() +=
+        Eigen::Map<const Eigen::Matrix<double, M, A>>(j.data()) * Eigen::Map<const Eigen::Matrix<double, A, 1>>(d);
+  });
+  if (!fixed) r->noalias() += j * Eigen::Map<const Eigen::VectorXd>(d, j.cols());
 }
 
 // g_segment += J^T r.
-template <int M, int A>
-void AddGradientFixed(const double* j, const double* r, double* g) {
-  Eigen::Map<Eigen::Matrix<double, A, 1>>(g).noalias() +=
-      Eigen::Map<const Eigen::Matrix<double, M, A>>(j).transpose() * Eigen::Map<const Eigen::Matrix<double, M, 1>>(r);
-}
-template <int M>
-bool AddGradientRows(const double* j, int a, const double* r, double* g) {
-  switch (a) {
-    case 1: AddGradientFixed<M, 1>(j, r, g); return true;
-    case 3: AddGradientFixed<M, 3>(j, r, g); return true;
-    case 6: AddGradientFixed<M, 6>(j, r, g); return true;
-    case 9: AddGradientFixed<M, 9>(j, r, g); return true;
-    default: return false;
-  }
-}
 void AddGradient(const Eigen::MatrixXd& j, const Eigen::VectorXd& r, double* g) {
-  const int a = static_cast<int>(j.cols());
-  if (j.rows() == 3 && AddGradientRows<3>(j.data(), a, r.data(), g)) return;
-  if (j.rows() == 4 && AddGradientRows<4>(j.data(), a, r.data(), g)) return;
-  Eigen::Map<Eigen::VectorXd>(g, j.cols()).noalias() += j.transpose() * r;
+  const bool fixed = WithFixedShape(j, [&](auto m, auto a) {
+    constexpr int M = decltype(m)::value, A = decltype(a)::value;
+    Eigen::Map<Eigen::Matrix<double, A, 1>>(g).noalias() +=
+        Eigen::Map<const Eigen::Matrix<double, M, A>>(j.data()).transpose() *
+        Eigen::Map<const Eigen::Matrix<double, M, 1>>(r.data());
+  });
+  if (!fixed) Eigen::Map<Eigen::VectorXd>(g, j.cols()).noalias() += j.transpose() * r;
 }
 
 // The positions i < n with block[i] >= 0 (a factor's free variables), in order, into free; returns their count. The
