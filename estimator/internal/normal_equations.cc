@@ -35,6 +35,10 @@ constexpr int kMaxForwardCovarianceColumns = 16;
 // a window's instances of a parameter per 0.1 s repeat every ten poses.
 constexpr std::size_t kPatternCache = 16;
 
+// How far a pass over a whole recording's factors or variables prefetches ahead: their data lie in heap blocks of their
+// own, whose addresses the hardware's prefetcher cannot follow.
+constexpr std::size_t kPrefetchAhead = 8;  // factors or variables
+
 // dst (A x B block of H's value array, column stride `stride`) += Ja^T Jb, Ja M x A, Jb M x B.
 template <int M, int A, int B>
 void AddProductFixed(const double* ja, const double* jb, double* dst, std::ptrdiff_t stride) {
@@ -297,7 +301,14 @@ void NormalEquations::Reset(const Graph& graph, std::vector<VariableId> order) {
   rows_of_.resize(nb);
   for (int b = 0; b < nb; ++b) rows_of_[b].assign(1, b);
   std::size_t prev = 0;  // next factor of the last Reset to compare with (both lists in id order)
+  // (Each factor's variable list is a heap block of its own: prefetched kPrefetchAhead factors ahead.)
+  auto ahead = graph.factors().begin();
+  for (std::size_t i = 0; i < kPrefetchAhead && ahead != graph.factors().end(); ++i) ++ahead;
   for (const auto& [fid, entry] : graph.factors()) {
+    if (ahead != graph.factors().end()) {
+      __builtin_prefetch(ahead->second.variables.data());
+      ++ahead;
+    }
     if (!entry.active) continue;
     ROAMLAB_CHECK(entry.variables.size() <= 64, "factor from '" << entry.stream << "' has over 64 variables");
     const std::size_t begin = var_block_.size();
@@ -637,10 +648,6 @@ void NormalEquations::BuildPattern() {
       diagonal_index_[block_offset_[b] + j] = diagonal + static_cast<std::ptrdiff_t>(j) * column_length_[b] + j;
   }
 }
-
-namespace {
-constexpr std::size_t kPrefetchAhead = 8;  // factors or variables
-}  // namespace
 
 void NormalEquations::PrefetchAhead(std::size_t k) const {
   const std::size_t n = factor_ids_.size();
