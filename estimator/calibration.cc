@@ -55,8 +55,8 @@ void RejectAroundBursts(const std::vector<GateRow>& rows, double margin, std::ve
 
 }  // namespace
 
-int GateOutliers(double probability, ProblemBuilder* builder, FactorId first, const SolverWorkspace* last_solve,
-                 const GateOptions& options) {
+GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId first,
+                          const SolverWorkspace* last_solve, const GateOptions& options) {
   Graph& graph = builder->graph();
   // Quantiles per (probability, dimension), kept across calls: online tracking gates at every update.
   thread_local std::map<std::pair<double, int>, double> quantiles;
@@ -118,21 +118,30 @@ int GateOutliers(double probability, ProblemBuilder* builder, FactorId first, co
     }
     std::sort(switched.begin(), switched.end());
   }
-  // By chance: no more switches than the test's false alarms among the tested factors, and no newly failing factor
-  // beyond the quantile that all of them pass with the test's probability (1 - (1 - p) / N each): a gross outlier
-  // is rejected however few there are.
+  // By chance: no more newly failing factors than the test's false alarms among the tested factors, and none beyond
+  // the quantile that all of them pass with the test's probability (1 - (1 - p) / N each): a gross outlier is rejected
+  // however few there are. The factors that fit again are re-admitted, unless they and the failing ones together are
+  // no more than the false alarms either.
+  GateSwitches result;
+  for (FactorId id : switched) (graph.factor(id).active ? result.rejected : result.readmitted) += 1;
   const double false_alarms = static_cast<double>(tested) * (1.0 - probability);
-  if (options.ignore_chance_changes && static_cast<double>(switched.size()) <= false_alarms &&
+  const bool by_chance =
+      options.ignore_chance_changes && static_cast<double>(result.rejected) <= false_alarms &&
       std::none_of(failing.begin(), failing.end(), [&](const std::pair<double, int>& f) {
         return f.first > ChiSquareQuantile(1.0 - (1.0 - probability) / static_cast<double>(tested), f.second);
-      }))
-    return 0;
+      });
+  if (by_chance) {
+    std::swap(result.ignored, result.rejected);
+    if (static_cast<double>(switched.size()) <= false_alarms) result.readmitted = 0;
+  }
+  result.settled = result.rejected == 0;
   for (FactorId id : switched) {
     FactorEntry& entry = graph.mutable_factor(id);
+    if (by_chance && (entry.active || result.readmitted == 0)) continue;
     entry.active = !entry.active;
     builder->mutable_counts(entry.stream).rejected += entry.active ? -1 : 1;
   }
-  return static_cast<int>(switched.size());
+  return result;
 }
 
 namespace {
@@ -229,10 +238,12 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
     if (!stage.solver.usable()) return Status::Error("stage " + std::to_string(s + 1) + ": " + stage.solver.message);
     // Gate gross outliers at the converged estimate and re-solve without them.
     // Gross outliers bend the estimate and make inliers look bad too: re-test every measurement after each re-solve,
-    // re-admitting those that fit again, until the set is stable (at most 5 rounds; stable: no more switches than the
-    // test's own false alarms). The first round also rejects a burst's neighbours (kBurstMargin), so that the rounds
-    // do not peel a skid's edges a few rows at a time (the 30 min weave: 5 + 3 rounds, 46 iterations before; 3 + 1,
-    // 42 iterations with it).
+    // re-admitting those that fit again, until the set has settled (at most 5 rounds; settled: no more newly failing
+    // measurements than the test's own false alarms, GateOutliers). The first round also rejects a burst's neighbours
+    // (kBurstMargin), so that the rounds do not peel a skid's edges a few rows at a time (the 30 min weave: 5 + 3
+    // rounds, 46 iterations before; 3 + 1, 42 iterations with it). A round that only re-admits ends the rounds: its
+    // measurements fit already (the 30 min weave: the margin's 180 rows back after one round, 2 + 1 rounds and 41
+    // iterations, where stepping and testing again re-admitted 9 more in a third round).
     // A round's re-solve is one step (the damping has come down to 1e-16-1e-18 by then: a Gauss-Newton step): from a
     // converged point with a few measurements switched the problem is all but quadratic, and that step leaves less
     // than a thousandth of its decrease to the next ones (30 min drive: 310, then 0.23, 3e-4, 2e-6), which do not move
@@ -264,11 +275,19 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
       GateOptions gate;
       gate.burst_margin = round == 0 ? kBurstMargin : 0.0;
       gate.ignore_chance_changes = true;
-      const int changed = GateOutliers(*config.gate_probability, &builder, 0, nullptr, gate);
-      if (changed == 0) break;
+      const GateSwitches changed = GateOutliers(*config.gate_probability, &builder, 0, nullptr, gate);
+      if (changed.switched() == 0) break;
       gated = true;
-      const Status stepped = resolve(1, "gating round " + std::to_string(round + 1) + ": " + std::to_string(changed) +
-                                            " measurements switched, one step");
+      const std::string what = "gating round " + std::to_string(round + 1) + ": " + std::to_string(changed.rejected) +
+                               " measurements rejected, " + std::to_string(changed.readmitted) + " re-admitted" +
+                               (changed.ignored > 0 ? ", " + std::to_string(changed.ignored) + " failing by chance" : "");
+      // Settled (nothing rejected): the re-admitted measurements fit the estimate already, and the solve to
+      // convergence below takes them in; a step and another round would test the same set again.
+      if (changed.settled) {
+        say("stage " + std::to_string(s + 1) + ": " + what + ", settled");
+        break;
+      }
+      const Status stepped = resolve(1, what + ", one step");
       if (!stepped.ok()) return stepped;
     }
     if (gated) {

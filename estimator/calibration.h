@@ -91,20 +91,31 @@ struct GateOptions {
   // the failing rows shows the next few beyond them. Rejecting good rows for one round costs no such cascade: the
   // rest of the measurements agree with them.
   double burst_margin = 0.0;
-  // Switch nothing when no more factors would switch than the test's own false alarms among the tested ones are
-  // expected to be, (1 - probability) of them, and none that would be rejected is a gross outlier (beyond the quantile
-  // that all N tested factors pass with the test's probability, 1 - (1 - probability) / N each): such a set is as
-  // stable as the test can tell.
+  // Reject no factor when no more would be newly rejected than the test's own false alarms among the tested ones are
+  // expected to be, (1 - probability) of them, and none of them is a gross outlier (beyond the quantile that all N
+  // tested factors pass with the test's probability, 1 - (1 - probability) / N each): such a set is as stable as the
+  // test can tell. The factors that fit again are re-admitted all the same (unless they too, with the failing ones,
+  // are no more than the false alarms: then nothing switches), and the result is `settled`.
   bool ignore_chance_changes = false;
+};
+
+// What one gating pass switched.
+struct GateSwitches {
+  int rejected = 0;    // active factors switched off
+  int readmitted = 0;  // inactive factors switched on again
+  int ignored = 0;     // newly failing factors left active as chance would explain them
+  // No factor was rejected (none failed, or only as many as chance explains: GateOptions::ignore_chance_changes): the
+  // set changed at most by factors that fit at the current estimate, and another pass after a re-solve is not needed.
+  bool settled = false;
+  int switched() const { return rejected + readmitted; }
 };
 
 // Re-tests the measurement factors with id >= `first` (factor ids grow as factors are added, so `first` selects the
 // newest ones): active exactly when the whitened squared error is within the chi-square quantile `probability` of its
-// dimension, but for what `options` add. Keeps the per-stream rejected counts up to date; returns how many factors
-// changed state. `last_solve` (optional): the workspace of the solve that left the graph at its current values; a
-// factor it linearized at exactly these values is tested on that linearization's error instead of being evaluated
-// again.
-int GateOutliers(double probability, ProblemBuilder* builder, FactorId first = 0,
-                 const SolverWorkspace* last_solve = nullptr, const GateOptions& options = {});
+// dimension, but for what `options` add. Keeps the per-stream rejected counts up to date. `last_solve` (optional): the
+// workspace of the solve that left the graph at its current values; a factor it linearized at exactly these values is
+// tested on that linearization's error instead of being evaluated again.
+GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId first = 0,
+                          const SolverWorkspace* last_solve = nullptr, const GateOptions& options = {});
 
 }  // namespace roamlab::estimator

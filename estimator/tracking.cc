@@ -203,7 +203,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
       builder.AlignToAbsoluteFixes();
       const SolverSummary s = Solve(config.solver, &builder.graph());
       if (!s.usable()) return Status::Error("initialization failed: " + s.message);
-      if (config.gate_probability && GateOutliers(*config.gate_probability, &builder) > 0)
+      if (config.gate_probability && GateOutliers(*config.gate_probability, &builder).switched() > 0)
         Solve(config.solver, &builder.graph());
       initialized = true;
     } else {
@@ -218,7 +218,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
       if (!s.usable()) return Status::Error("update at t = " + FormatSeconds(m.t) + " failed: " + s.message);
       iterations += s.iterations;
       if (config.gate_probability &&
-          GateOutliers(*config.gate_probability, &builder, first_new_factor, &workspace) > 0) {
+          GateOutliers(*config.gate_probability, &builder, first_new_factor, &workspace).switched() > 0) {
         // Without a gated measurement the window may not factor (a gated odometer factor leaves the newest pose's
         // position free until the next samples attach), and the Schur complement EmitOldest would fall back to runs
         // through that singular block: keep the leaving pose's covariance from before the gate then.

@@ -7,6 +7,7 @@
 #include <memory>
 #include <set>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -289,7 +290,7 @@ TEST(GateOutliersTest, ABurstTakesItsNeighboursOutForOneRoundAndChanceSwitchesAr
   // that switched.
   const auto gate_until_stable = [&](ProblemBuilder* builder) {
     int rounds = 0;
-    for (; rounds < 10 && GateOutliers(kProbability, builder) > 0; ++rounds)
+    for (; rounds < 10 && GateOutliers(kProbability, builder).switched() > 0; ++rounds)
       EXPECT_TRUE(Solve(config.solver, &builder->graph()).usable());
     return rounds;
   };
@@ -299,7 +300,7 @@ TEST(GateOutliersTest, ABurstTakesItsNeighboursOutForOneRoundAndChanceSwitchesAr
   const std::set<std::int64_t> out_alone = rejected(*alone);
 
   const std::unique_ptr<ProblemBuilder> burst = solved(synthetic.recording);
-  ASSERT_GT(GateOutliers(kProbability, burst.get(), 0, nullptr, GateOptions{1.5, false}), 0);
+  ASSERT_GT(GateOutliers(kProbability, burst.get(), 0, nullptr, GateOptions{1.5, false}).switched(), 0);
   const std::set<std::int64_t> first_round = rejected(*burst);
   // Uncorrupted rows on both sides of the skid are out for this round (the last stamp is the lone row's); the lone
   // row's neighbours are not.
@@ -321,9 +322,9 @@ TEST(GateOutliersTest, ABurstTakesItsNeighboursOutForOneRoundAndChanceSwitchesAr
   // At the stable set, a looser test (0.995) would switch a few factors, fewer than its false alarms among the tested
   // ones: with chance switches ignored, nothing switches.
   const int tested = static_cast<int>(burst->factor_streams().size());
-  EXPECT_EQ(GateOutliers(0.995, burst.get(), 0, nullptr, GateOptions{0.0, true}), 0);
+  EXPECT_EQ(GateOutliers(0.995, burst.get(), 0, nullptr, GateOptions{0.0, true}).switched(), 0);
   EXPECT_EQ(rejected(*burst), out_burst);
-  const int would_switch = GateOutliers(0.995, burst.get());
+  const int would_switch = GateOutliers(0.995, burst.get()).switched();
   EXPECT_GT(would_switch, 0);
   EXPECT_LE(would_switch, tested * (1.0 - 0.995));
 
@@ -331,13 +332,70 @@ TEST(GateOutliersTest, ABurstTakesItsNeighboursOutForOneRoundAndChanceSwitchesAr
   auto lone_only = roamlab::testing::MakeAtvRecording(options);
   FindStream(&lone_only.recording, "rear_wheel")->values(kLone, 0) *= 0.5;
   const std::unique_ptr<ProblemBuilder> gross = solved(lone_only.recording);
-  const int gross_switched = GateOutliers(0.999, gross.get(), 0, nullptr, GateOptions{0.0, true});
+  const int gross_switched = GateOutliers(0.999, gross.get(), 0, nullptr, GateOptions{0.0, true}).switched();
   EXPECT_GE(gross_switched, 1);
   EXPECT_LE(gross_switched, tested * (1.0 - 0.999)) << "few enough to pass for chance by their number";
   bool lone_rejected = false;
   for (const auto& [id, entry] : gross->graph().factors())
     lone_rejected |= !entry.active && entry.stream == "odometer" && entry.stamp == wheel->t[kLone];
   EXPECT_TRUE(lone_rejected);
+}
+
+// A pass that rejects nothing (or only as many factors as chance explains) re-admits the factors that fit again and says
+// the set has settled, so that the calibration's rounds stop without another re-solve and pass; one that rejects a
+// gross outlier has not settled, whatever else it re-admits.
+TEST(GateOutliersTest, APassThatOnlyReadmitsHasSettled) {
+  roamlab::testing::SyntheticOptions options;
+  options.duration_s = 8.0;
+  const EstimatorConfig config = testing::AtvConfig({});
+  const auto solved = [&](const recording::Recording& recording) {
+    auto built = ProblemBuilder::Create(config, recording);
+    EXPECT_TRUE(built.ok()) << built.status().message();
+    std::unique_ptr<ProblemBuilder> builder = std::move(built.value());
+    for (const MeasurementRef& m : builder->Measurements()) builder->Add(m);
+    builder->Finish();
+    builder->AlignToAbsoluteFixes();
+    EXPECT_TRUE(Solve(config.solver, &builder->graph()).usable());
+    return builder;
+  };
+  // Every 40th odometer factor (from the 8th) switched off by hand (as a burst's margin does for one round): they fit the estimate.
+  const auto switch_off_good_rows = [](ProblemBuilder* builder) {
+    std::vector<FactorId> ids;
+    for (const auto& [id, entry] : builder->graph().factors())
+      if (entry.stream == "odometer") ids.push_back(id);
+    int off = 0;
+    for (std::size_t k = 7; k < ids.size(); k += 40, ++off) {
+      builder->graph().mutable_factor(ids[k]).active = false;
+      builder->mutable_counts("odometer").rejected += 1;
+    }
+    return off;
+  };
+  constexpr double kProbability = 0.99999;
+  const GateOptions chance_ignored{0.0, true};
+
+  const auto clean = roamlab::testing::MakeAtvRecording(options);
+  const std::unique_ptr<ProblemBuilder> builder = solved(clean.recording);
+  const int off = switch_off_good_rows(builder.get());
+  ASSERT_GT(off, 5);
+  const GateSwitches readmit = GateOutliers(kProbability, builder.get(), 0, nullptr, chance_ignored);
+  EXPECT_EQ(readmit.readmitted, off);
+  EXPECT_EQ(readmit.rejected, 0);
+  EXPECT_TRUE(readmit.settled);
+  EXPECT_EQ(builder->counts().at("odometer").rejected, 0);
+  // Nothing left to switch.
+  const GateSwitches again = GateOutliers(kProbability, builder.get(), 0, nullptr, chance_ignored);
+  EXPECT_EQ(again.switched(), 0);
+  EXPECT_TRUE(again.settled);
+
+  // The same with one wheel reading 50 % low: it is rejected, the pass has not settled.
+  auto gross = roamlab::testing::MakeAtvRecording(options);
+  FindStream(&gross.recording, "rear_wheel")->values(600, 0) *= 0.5;
+  const std::unique_ptr<ProblemBuilder> with_outlier = solved(gross.recording);
+  const int off_too = switch_off_good_rows(with_outlier.get());
+  const GateSwitches mixed = GateOutliers(kProbability, with_outlier.get(), 0, nullptr, chance_ignored);
+  EXPECT_GE(mixed.rejected, 1);
+  EXPECT_GE(mixed.readmitted, off_too - 1);  // (the outlier's pull may keep a neighbour out)
+  EXPECT_FALSE(mixed.settled);
 }
 
 }  // namespace
