@@ -137,7 +137,7 @@ class CovarianceCallback final : public ceres::EvaluationCallback {
       Eigen::VectorXd error(f.residual_dim());
       Eigen::MatrixXd J_eta(f.residual_dim(), f.noise_dim());
       if (!f.Evaluate(e.values.data(), error.data(), nullptr, J_eta.data())) return false;
-      const Eigen::LLT<Eigen::MatrixXd> llt(J_eta * e.factor->noise_covariance * J_eta.transpose());
+      const Eigen::LLT<Eigen::MatrixXd> llt(J_eta * e.factor->noise->covariance * J_eta.transpose());
       if (llt.info() != Eigen::Success) return false;
       e.whitening->inverse_sqrt_covariance =
           llt.matrixL().solve(Eigen::MatrixXd::Identity(f.residual_dim(), f.residual_dim()));
@@ -180,7 +180,7 @@ CeresPeerResult SolveWithCeres(const estimator::Graph& graph, const CeresPeerOpt
     if (entry.factor->additive_noise()) {
       const int m = entry.factor->residual_dim();
       whitening->inverse_sqrt_covariance =
-          entry.noise_sqrt_covariance.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(m, m));
+          entry.noise->sqrt_covariance.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(m, m));
     } else {
       callback.Add({&entry, std::vector<const double*>(blocks.begin(), blocks.end()), whitening.get()});
     }

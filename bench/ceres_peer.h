@@ -4,7 +4,7 @@
 //
 // Each factor becomes an AutoDiffCostFunction whose functor calls the roamlab model's templated error with Ceres jets
 // (the models are written for any scalar type), with zero noise, and whitens it by L^-1 (L L^T = error covariance,
-// seed eq. 1). For additive-noise models L is constant (FactorEntry::noise_sqrt_covariance). For the others (the
+// seed eq. 1). For additive-noise models L is constant (NoiseModel::sqrt_covariance, graph.h). For the others (the
 // gyroscope) roamlab re-evaluates L at every linearization and holds it while it judges a trial step; the peer does the
 // same through an EvaluationCallback that recomputes L whenever Ceres asks for Jacobians. Poses and quaternions use
 // roamlab's right perturbation x [+] d = x Exp(d) through AutoDiffManifold.

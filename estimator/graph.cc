@@ -18,6 +18,38 @@ VariableId Graph::AddVariable(Variable variable) {
   return id;
 }
 
+std::shared_ptr<const NoiseModel> Graph::SharedNoise(Eigen::MatrixXd covariance, const std::string& stream) {
+  constexpr std::size_t kRecent = 8;
+  for (std::size_t i = 0; i < recent_noise_.size(); ++i) {
+    const Eigen::MatrixXd& c = recent_noise_[i]->covariance;
+    if (c.rows() == covariance.rows() && c.cols() == covariance.cols() && c == covariance) {
+      std::rotate(recent_noise_.begin(), recent_noise_.begin() + static_cast<std::ptrdiff_t>(i),
+                  recent_noise_.begin() + static_cast<std::ptrdiff_t>(i) + 1);
+      return recent_noise_.front();
+    }
+  }
+  // Unit noise (the marginalization's and the calibration's linear priors, added at every step of a window) is
+  // positive definite and its own square root: no factorization needed.
+  auto model = std::make_shared<NoiseModel>();
+  const bool identity = covariance.isIdentity(0.0);
+  if (identity) {
+    model->sqrt_covariance = covariance;
+  } else {
+    const Eigen::LLT<Eigen::MatrixXd> llt(covariance);
+    ROAMLAB_CHECK(covariance.isApprox(covariance.transpose()) && llt.info() == Eigen::Success,
+                  "factor from '" << stream << "': noise covariance is not symmetric positive definite");
+    model->sqrt_covariance = llt.matrixL();
+  }
+  model->sqrt_diagonal = true;
+  for (int c = 0; c < model->sqrt_covariance.cols(); ++c)
+    for (int r = c + 1; r < model->sqrt_covariance.rows(); ++r)
+      model->sqrt_diagonal &= model->sqrt_covariance(r, c) == 0.0;
+  model->covariance = std::move(covariance);
+  if (recent_noise_.size() == kRecent) recent_noise_.pop_back();
+  recent_noise_.insert(recent_noise_.begin(), std::move(model));
+  return recent_noise_.front();
+}
+
 FactorId Graph::AddFactor(std::unique_ptr<Factor> factor, std::vector<VariableId> variables,
                           Eigen::MatrixXd noise_covariance, Loss loss, std::string stream, Time stamp) {
   ROAMLAB_CHECK(factor != nullptr, "null factor");
@@ -34,29 +66,13 @@ FactorId Graph::AddFactor(std::unique_ptr<Factor> factor, std::vector<VariableId
   ROAMLAB_CHECK(noise_covariance.rows() == factor->noise_dim() && noise_covariance.cols() == factor->noise_dim(),
                 "factor from '" << stream << "': noise covariance is " << noise_covariance.rows() << "x"
                                 << noise_covariance.cols() << ", expected " << factor->noise_dim());
-  // Unit noise (the marginalization's and the calibration's linear priors, added at every step of a window) is
-  // positive definite and its own square root: no factorization needed.
-  const bool identity = noise_covariance.isIdentity(0.0);
-  ROAMLAB_CHECK(identity || (noise_covariance.isApprox(noise_covariance.transpose()) &&
-                             Eigen::LLT<Eigen::MatrixXd>(noise_covariance).info() == Eigen::Success),
-                "factor from '" << stream << "': noise covariance is not symmetric positive definite");
+  std::shared_ptr<const NoiseModel> noise = SharedNoise(std::move(noise_covariance), stream);
   const FactorId id = next_factor_++;
-  const bool factor_is_additive = factor->additive_noise();
   for (VariableId v : variables) factors_of_.Find(v)->push_back(id);
   FactorEntry entry;
   entry.factor = std::move(factor);
   entry.variables = std::move(variables);
-  if (factor_is_additive && identity) {
-    entry.noise_sqrt_covariance = noise_covariance;
-    entry.noise_sqrt_diagonal = true;
-  } else if (factor_is_additive) {
-    entry.noise_sqrt_covariance = Eigen::LLT<Eigen::MatrixXd>(noise_covariance).matrixL();
-    entry.noise_sqrt_diagonal = true;
-    for (int c = 0; c < entry.noise_sqrt_covariance.cols(); ++c)
-      for (int r = c + 1; r < entry.noise_sqrt_covariance.rows(); ++r)
-        entry.noise_sqrt_diagonal &= entry.noise_sqrt_covariance(r, c) == 0.0;
-  }
-  entry.noise_covariance = std::move(noise_covariance);
+  entry.noise = std::move(noise);
   entry.loss = loss;
   entry.stream = std::move(stream);
   entry.stamp = stamp;

@@ -34,12 +34,19 @@ struct Variable {
   std::optional<Time> stamp;     // poses and time-varying parameter instances
 };
 
+// The noise input of a factor: Sigma_eta and its Cholesky factor. A stream's factors mostly share one (a whole
+// recording's would otherwise hold a million copies of a few matrices, each in its own heap blocks, read from memory
+// one by one at every linearization).
+struct NoiseModel {
+  Eigen::MatrixXd covariance;       // noise_dim x noise_dim, Sigma_eta
+  Eigen::MatrixXd sqrt_covariance;  // L (lower) with L L^T = Sigma_eta
+  bool sqrt_diagonal = false;       // L is diagonal (independent noise components): whitening is a division
+};
+
 struct FactorEntry {
   std::unique_ptr<Factor> factor;
   std::vector<VariableId> variables;
-  Eigen::MatrixXd noise_covariance;  // noise_dim x noise_dim, Sigma_eta
-  Eigen::MatrixXd noise_sqrt_covariance;  // L (lower) with L L^T = Sigma_eta, for factors with additive noise
-  bool noise_sqrt_diagonal = false;       // L is diagonal (independent noise components): whitening is a division
+  std::shared_ptr<const NoiseModel> noise;  // shared by the factors added with the same covariance
   Loss loss;
   std::string stream;
   Time stamp;
@@ -74,6 +81,11 @@ class Graph {
   IdTable<Variable> variables_;
   IdTable<FactorEntry> factors_;
   IdTable<std::vector<FactorId>> factors_of_;  // by variable
+  // The noise models of the last few distinct covariances added, the newest first (AddFactor shares them).
+  std::vector<std::shared_ptr<const NoiseModel>> recent_noise_;
+  // The model of `covariance` (checked symmetric positive definite): a recent one if equal, else a new one.
+  std::shared_ptr<const NoiseModel> SharedNoise(Eigen::MatrixXd covariance, const std::string& stream);
+
   VariableId next_variable_ = 0;
   FactorId next_factor_ = 0;
 };

@@ -57,7 +57,7 @@ void Whiten(const Eigen::MatrixXd& L, bool diagonal, Eigen::MatrixBase<Derived>*
 double WhitenedCost(const FactorEntry& entry, const Eigen::MatrixXd& sqrt_covariance, const Eigen::VectorXd& error) {
   thread_local Eigen::VectorXd whitened;
   whitened = error;
-  Whiten(sqrt_covariance, &sqrt_covariance == &entry.noise_sqrt_covariance && entry.noise_sqrt_diagonal, &whitened);
+  Whiten(sqrt_covariance, &sqrt_covariance == &entry.noise->sqrt_covariance && entry.noise->sqrt_diagonal, &whitened);
   double rho = 0.0, rho_prime = 1.0;
   entry.loss.Evaluate(whitened.squaredNorm(), &rho, &rho_prime);
   return 0.5 * rho;
@@ -99,7 +99,7 @@ bool LinearizeFactorAt(const FactorEntry& entry, const double* const* values, st
     // Error covariance = noise covariance, factored once when the factor was added.
     if (!factor.Evaluate(values, out->residual.data(), want_mask != 0 ? jacobian_ptrs.data() : nullptr, nullptr))
       return false;
-    diagonal = entry.noise_sqrt_diagonal;
+    diagonal = entry.noise->sqrt_diagonal;
   } else {
     // Error covariance of eq. 1 at the current estimate, and its Cholesky factor.
     thread_local Eigen::MatrixXd noise_jacobian;
@@ -111,7 +111,7 @@ bool LinearizeFactorAt(const FactorEntry& entry, const double* const* values, st
     // expression J Sigma J^T would evaluate them.
     thread_local Eigen::MatrixXd half, covariance;
     thread_local Eigen::LLT<Eigen::MatrixXd> llt;
-    half.noalias() = noise_jacobian * entry.noise_covariance;
+    half.noalias() = noise_jacobian * entry.noise->covariance;
     covariance.noalias() = half * noise_jacobian.transpose();
     llt.compute(covariance);
     if (llt.info() != Eigen::Success) return false;

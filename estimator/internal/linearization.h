@@ -4,7 +4,7 @@
 // the covariance recovery and the fixed-lag marginalization.
 //
 // Additive-noise factors (Factor::additive_noise) have a constant error covariance, factored once when the factor was
-// added (FactorEntry::noise_sqrt_covariance); when that factor is diagonal the whitening is a division per row.
+// added (NoiseModel::sqrt_covariance, graph.h); when that factor is diagonal the whitening is a division per row.
 #pragma once
 
 #include <cstdint>
@@ -28,7 +28,7 @@ struct WhitenedFactor {
 
 // The L of `out`'s linearization of `entry`.
 inline const Eigen::MatrixXd& SqrtCovariance(const FactorEntry& entry, const WhitenedFactor& out) {
-  return entry.factor->additive_noise() ? entry.noise_sqrt_covariance : out.sqrt_covariance;
+  return entry.factor->additive_noise() ? entry.noise->sqrt_covariance : out.sqrt_covariance;
 }
 
 // Linearizes `entry` at the graph's current values. want_jacobian[i] says whether the Jacobian of variable i is

@@ -661,7 +661,6 @@ void NormalEquations::PrefetchAhead(std::size_t k) const {
   const char* factor = reinterpret_cast<const char*>(entry.factor.get());
   __builtin_prefetch(factor);
   __builtin_prefetch(factor + 64);
-  __builtin_prefetch(entry.noise_sqrt_covariance.data());
   __builtin_prefetch(linearized_[j].whitened.sqrt_covariance.data());
   for (int v = var_begin_[j]; v < var_begin_[j + 1]; ++v) __builtin_prefetch(values_[v]);
 }

@@ -93,13 +93,13 @@ TEST(ProblemBuilderTest, GaussMarkovDisturbanceHasAProcessPerComponentAndAStatio
       for (int i = 0; i < 3; ++i) {
         const double expected = std::pow(disturbance.process.sigma[i], 2) *
                                 (1.0 - std::exp(-2.0 * dt / disturbance.process.tau_s[i]));
-        EXPECT_NEAR(f.noise_covariance(i, i), expected, 1e-12 * expected) << i;
+        EXPECT_NEAR(f.noise->covariance(i, i), expected, 1e-12 * expected) << i;
       }
-      EXPECT_DOUBLE_EQ(f.noise_covariance(0, 1), 0.0);
+      EXPECT_DOUBLE_EQ(f.noise->covariance(0, 1), 0.0);
     } else if (f.stream == "odometer.disturbance") {
       ++prior;
       EXPECT_EQ(f.variables[0], builder.poses().front().instances.at("odometer.disturbance"));
-      EXPECT_TRUE(f.noise_covariance.diagonal().isApprox(disturbance.process.sigma.array().square().matrix()));
+      EXPECT_TRUE(f.noise->covariance.diagonal().isApprox(disturbance.process.sigma.array().square().matrix()));
     } else if (f.stream == "odometer") {
       ++odometer;
       // Poses k and k+1, the eight scalars, then the disturbance at pose k.
@@ -180,7 +180,7 @@ TEST(ProblemBuilderTest, ProcessIntervalSharesOneInstanceAmongItsPoses) {
       const double tau = disturbance.process.tau_s[i];
       EXPECT_NEAR(error[i], -std::exp(-dt / tau), 1e-12) << i;
       const double expected = std::pow(disturbance.process.sigma[i], 2) * -std::expm1(-2.0 * dt / tau);
-      EXPECT_NEAR(f.noise_covariance(i, i), expected, 1e-12 * expected) << i;
+      EXPECT_NEAR(f.noise->covariance(i, i), expected, 1e-12 * expected) << i;
     }
     ++process;
   }
