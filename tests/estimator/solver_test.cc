@@ -59,6 +59,51 @@ struct MultiAntennaProblem {
   }
 };
 
+// Factors added with the same noise covariance share one model, factored once; one that differs in any entry gets its
+// own model.
+TEST(GraphTest, FactorsWithTheSameNoiseCovarianceShareOneModel) {
+  Graph graph;
+  const VariableId pose = graph.AddVariable(
+      {"pose", Manifold::Pose(), Manifold::Pose().Identity(), false, Time::FromSeconds(0.0)});
+  const VariableId lever = graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), true, {}});
+  const auto add = [&](const Eigen::Matrix3d& covariance) {
+    const FactorId id = graph.AddFactor(MakeFactor(GpsError(Eigen::Vector3d::Zero())), {pose, lever}, covariance,
+                                        Loss::Trivial(), "gps", Time::FromSeconds(0.0));
+    return graph.factor(id).noise;
+  };
+  Eigen::Matrix3d a;
+  a << 4.0, 1.0, 0.0, 1.0, 3.0, 0.5, 0.0, 0.5, 2.0;
+  const Eigen::Matrix3d b = Eigen::Vector3d(1.0, 2.0, 3.0).asDiagonal();
+  const auto first = add(a);
+  EXPECT_EQ(add(a), first);
+  const auto other = add(b);
+  EXPECT_NE(other, first);
+  EXPECT_EQ(add(a), first);
+  Eigen::Matrix3d nearly = a;
+  nearly(2, 2) = std::nextafter(2.0, 3.0);
+  EXPECT_NE(add(nearly), first);
+  // The factor and its diagonal flag, as computed for each factor before.
+  EXPECT_EQ(first->covariance, a);
+  EXPECT_TRUE(first->sqrt_covariance.isApprox(Eigen::LLT<Eigen::MatrixXd>(a).matrixL().toDenseMatrix(), 0.0));
+  EXPECT_FALSE(first->sqrt_diagonal);
+  EXPECT_TRUE(other->sqrt_diagonal);
+  EXPECT_TRUE(other->sqrt_covariance.isApprox(Eigen::LLT<Eigen::MatrixXd>(b).matrixL().toDenseMatrix(), 0.0));
+}
+
+TEST(GraphDeathTest, NoiseCovarianceThatIsNotPositiveDefiniteIsRefused) {
+  Graph graph;
+  const VariableId pose = graph.AddVariable(
+      {"pose", Manifold::Pose(), Manifold::Pose().Identity(), false, Time::FromSeconds(0.0)});
+  const VariableId lever = graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), true, {}});
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+  graph.AddFactor(MakeFactor(GpsError(Eigen::Vector3d::Zero())), {pose, lever}, covariance, Loss::Trivial(), "gps",
+                  Time::FromSeconds(0.0));
+  covariance(0, 0) = -1.0;
+  EXPECT_DEATH(graph.AddFactor(MakeFactor(GpsError(Eigen::Vector3d::Zero())), {pose, lever}, covariance,
+                               Loss::Trivial(), "gps", Time::FromSeconds(0.0)),
+               "factor from 'gps': noise covariance is not symmetric positive definite");
+}
+
 TEST(SolverTest, LevenbergMarquardtRecoversNoiseFreePose) {
   MultiAntennaProblem problem(0.0, 3);
   const SolverSummary summary = Solve(SolverOptions{}, &problem.graph);
