@@ -541,18 +541,20 @@ void NormalEquations::BuildPattern() {
                           ? static_cast<std::ptrdiff_t>(outer[block_offset_[b]]) - block_offset_[rows.front()]
                           : -1;
   }
-  const auto value_index = [&](int r, int b) -> std::ptrdiff_t {
-    if (column_base_[b] >= 0) return column_base_[b] + block_offset_[r];
-    const auto& rows = rows_of_[b];
-    const std::ptrdiff_t position = std::lower_bound(rows.begin(), rows.end(), r) - rows.begin();
-    return static_cast<std::ptrdiff_t>(outer[block_offset_[b]]) + row_offset_[b][position];
-  };
-  // Counted first (a pair of free positions i <= j gives one slot, two when i < j take the same variable), then
-  // written in place: a PairSlot assembled on the stack and copied in stalls on the store forwarding of its
-  // mixed-width fields.
-  // (The pairs i < j on one block, counted by the block's earlier occurrences in the factor: a stamp per block. A
-  // factor kept from the last Reset has as many as then.) A small system (a window that slides) keeps its pairs for
-  // the next Reset to copy; a large one (a whole recording, whose pairs take hundreds of MB) builds them in place.
+  diagonal_index_.resize(dimension_);
+  for (int b = 0; b < nb; ++b) {
+    const std::ptrdiff_t diagonal = ValueIndex(b, b);
+    for (int j = 0; j < dims_[b]; ++j)
+      diagonal_index_[block_offset_[b] + j] = diagonal + static_cast<std::ptrdiff_t>(j) * column_length_[b] + j;
+  }
+  // Each factor's pairs of H blocks (BuildPairs) serve the kept products of a relinearization threshold. Without
+  // one, Linearize finds each block as it sums the factor's products into H, and a whole recording's pairs (250 MB
+  // for 30 min) are neither built nor streamed through at every linearization. A small system (a window that slides)
+  // keeps its pairs for the next Reset to copy; a large one builds them in place.
+  if (!pairs_built_) {  // (the last Reset's were not built: none to take over)
+    pairs_.clear();
+    pair_begin_.clear();
+  }
   if (dimension_ <= kMaxSimplicialDimension) {
     prev_pairs_.swap(pairs_);
     prev_pair_begin_.swap(pair_begin_);
@@ -560,6 +562,21 @@ void NormalEquations::BuildPattern() {
     std::vector<PairSlot>().swap(prev_pairs_);
     prev_pair_begin_.clear();
   }
+  pairs_built_ = false;
+  if (relinearize_threshold_ > 0.0) {
+    BuildPairs();
+  } else if (dimension_ > kMaxSimplicialDimension) {
+    std::vector<PairSlot>().swap(pairs_);
+    pair_begin_.clear();
+  }
+}
+
+void NormalEquations::BuildPairs() {
+  // Counted first (a pair of free positions i <= j gives one slot, two when i < j take the same variable), then
+  // written in place: a PairSlot assembled on the stack and copied in stalls on the store forwarding of its
+  // mixed-width fields. (The pairs i < j on one block, counted by the block's earlier occurrences in the factor: a
+  // stamp per block. A factor kept from the last Reset has as many as then.)
+  const int nb = static_cast<int>(order_.size());
   // The last Reset's factor whose pairs factor k takes, or -1.
   const auto from = [&](std::size_t k) {
     return kept_from_[k] >= 0 && kept_from_[k] + 1 < static_cast<int>(prev_pair_begin_.size()) ? kept_from_[k] : -1;
@@ -617,7 +634,7 @@ void NormalEquations::BuildPattern() {
         *pair = old;
         pair->row = row;
         pair->column = column;
-        pair->value = value_index(row, column);
+        pair->value = ValueIndex(row, column);
         ++pair;
       }
       if (pair != first || prev_pair_begin_[p] == prev_pair_begin_[p + 1]) {
@@ -630,7 +647,7 @@ void NormalEquations::BuildPattern() {
     for (int i = 0, product = 0; i < nf; ++i) {
       for (int j = i; j < nf; ++j) {
         const int a = block[free[i]], b = block[free[j]];
-        const std::ptrdiff_t value = value_index(std::min(a, b), std::max(a, b));
+        const std::ptrdiff_t value = ValueIndex(std::min(a, b), std::max(a, b));
         if (a <= b) add_pair(value, a, b, free[i], free[j], product, false);
         // (A variable the factor takes twice gets both products in its diagonal block.)
         if (a > b || (a == b && i != j)) add_pair(value, b, a, free[j], free[i], product, true);
@@ -641,12 +658,7 @@ void NormalEquations::BuildPattern() {
   }
   ROAMLAB_CHECK(pair == pairs_.data() + pairs_.size(), "pair count " << pairs_.size() << ", written "
                                                                      << pair - pairs_.data());
-  diagonal_index_.resize(dimension_);
-  for (int b = 0; b < nb; ++b) {
-    const std::ptrdiff_t diagonal = value_index(b, b);
-    for (int j = 0; j < dims_[b]; ++j)
-      diagonal_index_[block_offset_[b] + j] = diagonal + static_cast<std::ptrdiff_t>(j) * column_length_[b] + j;
-  }
+  pairs_built_ = true;
 }
 
 void NormalEquations::PrefetchAhead(std::size_t k) const {
@@ -722,13 +734,23 @@ __attribute__((flatten)) bool NormalEquations::Linearize(const Graph& /*graph*/,
       AddGradient(wf.jacobians[free[i]], wf.residual, g_.data() + block_offset_[block[free[i]]]);
     if (!summed_in_pass) continue;
     // J_a^T J_b into the blocks of the upper triangle, which sit in H's value array with the column length of their
-    // block column as outer stride.
-    for (int p = pair_begin_[k]; p < pair_begin_[k + 1]; ++p) {
-      const PairSlot& pair = pairs_[p];
-      AddProduct(wf.jacobians[pair.a], wf.jacobians[pair.b], values + pair.value, column_length_[pair.column]);
+    // block column as outer stride; for a < b in block order, J_b^T J_a into the block (a, b) instead (in BuildPairs'
+    // order: the same sums).
+    for (int i = 0; i < nf; ++i) {
+      const Eigen::MatrixXd& ji = wf.jacobians[free[i]];
+      const int a = block[free[i]];
+      for (int j = i; j < nf; ++j) {
+        const Eigen::MatrixXd& jj = wf.jacobians[free[j]];
+        const int b = block[free[j]];
+        double* destination = values + ValueIndex(std::min(a, b), std::max(a, b));
+        if (a <= b) AddProduct(ji, jj, destination, column_length_[b]);
+        // (A variable the factor takes twice gets both products in its diagonal block.)
+        if (a > b || (a == b && i != j)) AddProduct(jj, ji, destination, column_length_[a]);
+      }
     }
   }
   if (summed_in_pass) return true;
+  EnsurePairs();
 
   // H from the kept products. The blocks the next factorization takes over from the kept one (every factor evaluated
   // since is known now: ReusableBlocks) are left out; their band columns come first in H's values and stay as they are.

@@ -14,6 +14,7 @@
 // block columns of the last factor whose rows of H did not change are taken over (FactorEnvelope).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -139,6 +140,19 @@ class NormalEquations {
   // Block column of a free variable, or -1.
   int BlockOf(VariableId id) const;
   void BuildPattern();
+  // pairs_ and pair_begin_ for the included factors (BuildPattern with a relinearization threshold; else at their first
+  // use, EnsurePairs: a pass that sums each factor's products into H as it linearizes finds the blocks itself).
+  void BuildPairs();
+  void EnsurePairs() {
+    if (!pairs_built_) BuildPairs();
+  }
+  // Index in H's value array of block (r, c), r <= c (BuildPattern's tables).
+  std::ptrdiff_t ValueIndex(int r, int c) const {
+    if (column_base_[c] >= 0) return column_base_[c] + block_offset_[r];
+    const std::vector<int>& rows = rows_of_[c];
+    const std::ptrdiff_t position = std::lower_bound(rows.begin(), rows.end(), r) - rows.begin();
+    return static_cast<std::ptrdiff_t>(H_.outerIndexPtr()[block_offset_[c]]) + row_offset_[c][position];
+  }
   bool EnvelopeIsNarrow() const;  // the envelopes hold little more than H's pattern (Reset)
   // The symbolic analysis of a new pattern: a natural-order system's band and border layout, or CHOLMOD's.
   void Analyze();
@@ -177,6 +191,7 @@ class NormalEquations {
     bool transposed;       // the block receives that product's transpose
   };
   std::vector<PairSlot> pairs_;
+  bool pairs_built_ = false;  // pairs_ are those of the last Reset
   // The last Reset's pairs and masks, and per factor its index there when it was kept with the same mask (else -1).
   std::vector<PairSlot> prev_pairs_;
   std::vector<int> prev_pair_begin_;
@@ -281,7 +296,7 @@ class NormalEquations {
   std::vector<std::vector<int>> rows_of_;
   std::vector<std::vector<int>> row_offset_;
   std::vector<int> column_length_;
-  std::vector<std::ptrdiff_t> column_base_;  // BuildPattern: per block column, see value_index there
+  std::vector<std::ptrdiff_t> column_base_;  // BuildPattern: per block column, see ValueIndex
   std::vector<int> block_stamp_, block_count_;  // BuildPattern: per block, the factor that last took it and how often
   std::vector<int> outer_, inner_;
   // The block pattern (dims_ and rows_of_) that H's pattern was built for, and the last few other patterns of a small
