@@ -225,6 +225,18 @@ recording::Stream* FindStream(recording::Recording* recording, const std::string
   return nullptr;
 }
 
+// The whole recording in one graph, aligned to the absolute fixes and solved once (no gating).
+std::unique_ptr<ProblemBuilder> SolvedProblem(const EstimatorConfig& config, const recording::Recording& recording) {
+  auto built = ProblemBuilder::Create(config, recording);
+  EXPECT_TRUE(built.ok()) << built.status().message();
+  std::unique_ptr<ProblemBuilder> builder = std::move(built.value());
+  for (const MeasurementRef& m : builder->Measurements()) builder->Add(m);
+  builder->Finish();
+  builder->AlignToAbsoluteFixes();
+  EXPECT_TRUE(Solve(config.solver, &builder->graph()).usable());
+  return builder;
+}
+
 TEST(CalibrationTest, GatingRejectsGrossGpsOutliers) {
   roamlab::testing::SyntheticOptions options;
   options.duration_s = 8.0;
@@ -265,16 +277,6 @@ TEST(GateOutliersTest, ABurstTakesItsNeighboursOutForOneRoundAndChanceSwitchesAr
   corrupted.insert(wheel->t[kLone].nanoseconds());
 
   const EstimatorConfig config = testing::AtvConfig({});
-  const auto solved = [&](const recording::Recording& recording) {
-    auto built = ProblemBuilder::Create(config, recording);
-    EXPECT_TRUE(built.ok()) << built.status().message();
-    std::unique_ptr<ProblemBuilder> builder = std::move(built.value());
-    for (const MeasurementRef& m : builder->Measurements()) builder->Add(m);
-    builder->Finish();
-    builder->AlignToAbsoluteFixes();
-    EXPECT_TRUE(Solve(config.solver, &builder->graph()).usable());
-    return builder;
-  };
   // Stamps [ns] of the rejected factors (all of them odometer rows, checked).
   const auto rejected = [](const ProblemBuilder& builder) {
     std::set<std::int64_t> stamps;
@@ -295,11 +297,11 @@ TEST(GateOutliersTest, ABurstTakesItsNeighboursOutForOneRoundAndChanceSwitchesAr
     return rounds;
   };
 
-  const std::unique_ptr<ProblemBuilder> alone = solved(synthetic.recording);
+  const std::unique_ptr<ProblemBuilder> alone = SolvedProblem(config, synthetic.recording);
   const int rounds_alone = gate_until_stable(alone.get());
   const std::set<std::int64_t> out_alone = rejected(*alone);
 
-  const std::unique_ptr<ProblemBuilder> burst = solved(synthetic.recording);
+  const std::unique_ptr<ProblemBuilder> burst = SolvedProblem(config, synthetic.recording);
   ASSERT_GT(GateOutliers(kProbability, burst.get(), 0, nullptr, GateOptions{1.5, false}).switched(), 0);
   const std::set<std::int64_t> first_round = rejected(*burst);
   // Uncorrupted rows on both sides of the skid are out for this round (the last stamp is the lone row's); the lone
@@ -331,7 +333,7 @@ TEST(GateOutliersTest, ABurstTakesItsNeighboursOutForOneRoundAndChanceSwitchesAr
   // A gross outlier is rejected however few factors switch: the same drive with the lone row alone corrupted.
   auto lone_only = roamlab::testing::MakeAtvRecording(options);
   FindStream(&lone_only.recording, "rear_wheel")->values(kLone, 0) *= 0.5;
-  const std::unique_ptr<ProblemBuilder> gross = solved(lone_only.recording);
+  const std::unique_ptr<ProblemBuilder> gross = SolvedProblem(config, lone_only.recording);
   const int gross_switched = GateOutliers(0.999, gross.get(), 0, nullptr, GateOptions{0.0, true}).switched();
   EXPECT_GE(gross_switched, 1);
   EXPECT_LE(gross_switched, tested * (1.0 - 0.999)) << "few enough to pass for chance by their number";
@@ -348,16 +350,6 @@ TEST(GateOutliersTest, APassThatOnlyReadmitsHasSettled) {
   roamlab::testing::SyntheticOptions options;
   options.duration_s = 8.0;
   const EstimatorConfig config = testing::AtvConfig({});
-  const auto solved = [&](const recording::Recording& recording) {
-    auto built = ProblemBuilder::Create(config, recording);
-    EXPECT_TRUE(built.ok()) << built.status().message();
-    std::unique_ptr<ProblemBuilder> builder = std::move(built.value());
-    for (const MeasurementRef& m : builder->Measurements()) builder->Add(m);
-    builder->Finish();
-    builder->AlignToAbsoluteFixes();
-    EXPECT_TRUE(Solve(config.solver, &builder->graph()).usable());
-    return builder;
-  };
   // Every 40th odometer factor (from the 8th) switched off by hand (as a burst's margin does for one round): they fit the estimate.
   const auto switch_off_good_rows = [](ProblemBuilder* builder) {
     std::vector<FactorId> ids;
@@ -374,7 +366,7 @@ TEST(GateOutliersTest, APassThatOnlyReadmitsHasSettled) {
   const GateOptions chance_ignored{0.0, true};
 
   const auto clean = roamlab::testing::MakeAtvRecording(options);
-  const std::unique_ptr<ProblemBuilder> builder = solved(clean.recording);
+  const std::unique_ptr<ProblemBuilder> builder = SolvedProblem(config, clean.recording);
   const int off = switch_off_good_rows(builder.get());
   ASSERT_GT(off, 5);
   const GateSwitches readmit = GateOutliers(kProbability, builder.get(), 0, nullptr, chance_ignored);
@@ -390,7 +382,7 @@ TEST(GateOutliersTest, APassThatOnlyReadmitsHasSettled) {
   // The same with one wheel reading 50 % low: it is rejected, the pass has not settled.
   auto gross = roamlab::testing::MakeAtvRecording(options);
   FindStream(&gross.recording, "rear_wheel")->values(600, 0) *= 0.5;
-  const std::unique_ptr<ProblemBuilder> with_outlier = solved(gross.recording);
+  const std::unique_ptr<ProblemBuilder> with_outlier = SolvedProblem(config, gross.recording);
   const int off_too = switch_off_good_rows(with_outlier.get());
   const GateSwitches mixed = GateOutliers(kProbability, with_outlier.get(), 0, nullptr, chance_ignored);
   EXPECT_GE(mixed.rejected, 1);
