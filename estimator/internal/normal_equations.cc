@@ -734,8 +734,8 @@ __attribute__((flatten)) bool NormalEquations::Linearize(const Graph& /*graph*/,
       AddGradient(wf.jacobians[free[i]], wf.residual, g_.data() + block_offset_[block[free[i]]]);
     if (!summed_in_pass) continue;
     // J_a^T J_b into the blocks of the upper triangle, which sit in H's value array with the column length of their
-    // block column as outer stride; for a < b in block order, J_b^T J_a into the block (a, b) instead (in BuildPairs'
-    // order: the same sums).
+    // block column as outer stride; where i's block comes after j's, J_j^T J_i into the block (j's, i's) instead
+    // (BuildPairs' order: the same sums).
     for (int i = 0; i < nf; ++i) {
       const Eigen::MatrixXd& ji = wf.jacobians[free[i]];
       const int a = block[free[i]];
