@@ -202,6 +202,14 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
         summary.message = "Gauss-Newton step could not be evaluated";
         break;
       }
+      // Both the model's and the actual change of the cost within the function tolerance: the point is a minimum to
+      // that tolerance and the rejection is round-off (a fit that starts at, or has reached, its minimum, where the
+      // damping would otherwise climb to its limit on changes of 1e-14 of the cost and report a failure).
+      const double tolerance = options.function_tolerance * old_cost;
+      if (evaluated && predicted <= tolerance && std::abs(actual) <= tolerance) {
+        summary.termination = Termination::kFunctionTolerance;
+        break;
+      }
       lambda *= nu;
       nu *= 2.0;
       if (lambda > 1e16) {

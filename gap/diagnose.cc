@@ -781,6 +781,7 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
   if (!train_fit.ok()) return Status::Error("nominal calibration (training part): " + train_fit.status().message());
   State state;
   state.train_values = train_fit.value().values;
+  out.training_parameters_before = state.train_values;
   state.train_trajectory = train_fit.value().trajectory;
   state.train_chi2 = train_fit.value().chi2;
   state.train_measurements = train_fit.value().measurements;
@@ -1133,7 +1134,13 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
         continue;
       }
       auto h = heldout(f.next);
-      if (!h.ok()) return Status::Error("held-out evaluation of " + e.name + ": " + h.status().message());
+      if (!h.ok()) {
+        // As a candidate whose training fit fails: rejected, and the diagnosis goes on.
+        if (extra) continue;
+        e.decision = "rejected: the held-out fit failed: " + h.status().message();
+        dropped.insert(e.name);
+        continue;
+      }
       e.evaluated_heldout = true;
       e.heldout_improvement = state.heldout_chi2 > 0.0 ? 1.0 - h.value().chi2 / state.heldout_chi2 : 0.0;
       e.heldout_excess_before = HeldoutExcess(state.heldout_components, located_keys, heldout_levels);
@@ -1176,6 +1183,7 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
   }
   out.after = state.heldout;
   out.heldout_components_after = state.heldout_components;
+  out.training_parameters_after = state.train_values;
   for (const std::string& name : state.extra_free) out.effect_parameters[name] = state.train_values.at(name);
   out.stream_shifts_s = state.shift_s;
 

@@ -95,6 +95,9 @@ struct Diagnosis {
   std::vector<estimator::MeasurementResidual> residuals;   // whole-run nominal fit
   Conditions conditions;                              // from the whole-run nominal trajectory
   std::map<std::string, Eigen::VectorXd> nominal_parameters;   // whole-run nominal calibration
+  // The training part's calibration (every parameter: fitted, or at its configured value), nominal and with the
+  // accepted effects: what the held-out part's `before` and `after` are fitted with.
+  std::map<std::string, Eigen::VectorXd> training_parameters_before, training_parameters_after;
   // The accepted effects as estimator settings: parameters (name -> value) and stream time shifts [s]
   // (recording stream -> seconds to subtract from its stamps).
   std::map<std::string, Eigen::VectorXd> effect_parameters;
