@@ -1004,37 +1004,65 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
     // side, and the standard deviation of its vertex combines the curvature's (1 / sqrt(a) grid steps: cost = chi2 / 2
     // has second derivative a) and the vertex's own spread from the jitter (delta method on the fitted a, b).
     constexpr int kHalfWindow = 3;
-    std::vector<int> ks;
-    for (int k = best - kHalfWindow; k <= best + kHalfWindow; ++k) {
-      if (std::abs(k) > k_max) continue;
-      if (auto f = at(k); !f.ok()) return f.status();
-      ks.push_back(k);
+    struct Parabola {
+      double a = 0.0, b = 0.0, c = 0.0, jitter2 = 0.0;
+      Eigen::Matrix3d XtX_inv = Eigen::Matrix3d::Zero();
+    };
+    // The least-squares parabola in u = k - center over the window center +- kHalfWindow (within the range).
+    const auto window = [&](int center) -> Result<std::optional<Parabola>> {
+      std::vector<int> ks;
+      for (int k = center - kHalfWindow; k <= center + kHalfWindow; ++k) {
+        if (std::abs(k) > k_max) continue;
+        if (auto f = at(k); !f.ok()) return f.status();
+        ks.push_back(k);
+      }
+      if (ks.size() < 4) return std::optional<Parabola>{};
+      Eigen::MatrixXd X(static_cast<Eigen::Index>(ks.size()), 3);
+      Eigen::VectorXd y(static_cast<Eigen::Index>(ks.size()));
+      for (std::size_t i = 0; i < ks.size(); ++i) {
+        const double u = ks[i] - center;
+        X.row(static_cast<Eigen::Index>(i)) << u * u, u, 1.0;
+        y[static_cast<Eigen::Index>(i)] = chi2_at[ks[i]].chi2;
+      }
+      Parabola q;
+      q.XtX_inv = (X.transpose() * X).inverse();
+      const Eigen::Vector3d abc = q.XtX_inv * X.transpose() * y;
+      q.a = abc[0];
+      q.b = abc[1];
+      q.c = abc[2];
+      const double dof = static_cast<double>(ks.size()) - 3.0;
+      q.jitter2 = dof > 0.0 ? (y - X * abc).squaredNorm() / dof : 0.0;
+      return std::optional<Parabola>{q};
+    };
+    // The walk stops at the first step uphill, which the jitter fakes where the minimum is flat (an IMU clock offset
+    // of 0.096 s beside the nominal model's own 0.025 s: the walk stopped at 0.10 s, the minimum near 0.12 s, and the
+    // window's parabola, its vertex clamped at the edge, gave 0.105 +- 0.096 s). So while the vertex lies beyond the
+    // window's inner points, the window moves toward it (at most kHalfWindow steps, three times).
+    auto parabola = window(best);
+    if (!parabola.ok()) return parabola.status();
+    for (int move = 0; move < 3 && parabola.value() && parabola.value()->a > 0.0; ++move) {
+      const double u = -parabola.value()->b / (2.0 * parabola.value()->a);
+      if (std::abs(u) <= kHalfWindow - 1) break;
+      const int next = std::clamp(best + static_cast<int>(std::lround(std::clamp(u, -1.0 * kHalfWindow,
+                                                                                   1.0 * kHalfWindow))),
+                                  -k_max, k_max);
+      if (next == best) break;
+      best = next;
+      parabola = window(best);
+      if (!parabola.ok()) return parabola.status();
     }
     double k_hat = best;
     double chi2_min = chi2_at[best].chi2;
     double stdev = std::numeric_limits<double>::quiet_NaN();
-    if (ks.size() >= 4) {
-      Eigen::MatrixXd X(static_cast<Eigen::Index>(ks.size()), 3);
-      Eigen::VectorXd y(static_cast<Eigen::Index>(ks.size()));
-      for (std::size_t i = 0; i < ks.size(); ++i) {
-        const double u = ks[i] - best;
-        X.row(static_cast<Eigen::Index>(i)) << u * u, u, 1.0;
-        y[static_cast<Eigen::Index>(i)] = chi2_at[ks[i]].chi2;
-      }
-      const Eigen::Matrix3d XtX_inv = (X.transpose() * X).inverse();
-      const Eigen::Vector3d abc = XtX_inv * X.transpose() * y;
-      const double a = abc[0], b = abc[1], cc = abc[2];
-      if (a > 0.0) {
-        const double u_hat = std::clamp(-b / (2.0 * a), -static_cast<double>(kHalfWindow),
-                                        static_cast<double>(kHalfWindow));
-        k_hat = best + u_hat;
-        chi2_min = a * u_hat * u_hat + b * u_hat + cc;
-        const double dof = static_cast<double>(ks.size()) - 3.0;
-        const double jitter2 = dof > 0.0 ? (y - X * abc).squaredNorm() / dof : 0.0;
-        const Eigen::Vector3d J(b / (2.0 * a * a), -1.0 / (2.0 * a), 0.0);
-        const double vertex_var = jitter2 * J.dot(XtX_inv * J);
-        stdev = period * std::sqrt(1.0 / a + vertex_var);
-      }
+    if (parabola.value() && parabola.value()->a > 0.0) {
+      const Parabola& q = *parabola.value();
+      const double u_hat = std::clamp(-q.b / (2.0 * q.a), -static_cast<double>(kHalfWindow),
+                                      static_cast<double>(kHalfWindow));
+      k_hat = best + u_hat;
+      chi2_min = q.a * u_hat * u_hat + q.b * u_hat + q.c;
+      const Eigen::Vector3d J(q.b / (2.0 * q.a * q.a), -1.0 / (2.0 * q.a), 0.0);
+      const double vertex_var = q.jitter2 * J.dot(q.XtX_inv * J);
+      stdev = period * std::sqrt(1.0 / q.a + vertex_var);
     }
     const double shift = k_hat * period;
     e.parameters[c.shift_parameter] = shift;
