@@ -1037,15 +1037,14 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
     // The walk stops at the first step uphill, which the jitter fakes where the minimum is flat (an IMU clock offset
     // of 0.096 s beside the nominal model's own 0.025 s: the walk stopped at 0.10 s, the minimum near 0.12 s, and the
     // window's parabola, its vertex clamped at the edge, gave 0.105 +- 0.096 s). So while the vertex lies beyond the
-    // window's inner points, the window moves toward it (at most kHalfWindow steps, three times).
+    // window's inner points, the window moves toward it (by at most kHalfWindow points, three times at most).
     auto parabola = window(best);
     if (!parabola.ok()) return parabola.status();
     for (int move = 0; move < 3 && parabola.value() && parabola.value()->a > 0.0; ++move) {
       const double u = -parabola.value()->b / (2.0 * parabola.value()->a);
       if (std::abs(u) <= kHalfWindow - 1) break;
-      const int next = std::clamp(best + static_cast<int>(std::lround(std::clamp(u, -1.0 * kHalfWindow,
-                                                                                   1.0 * kHalfWindow))),
-                                  -k_max, k_max);
+      const double reach = kHalfWindow;
+      const int next = std::clamp(best + static_cast<int>(std::lround(std::clamp(u, -reach, reach))), -k_max, k_max);
       if (next == best) break;
       best = next;
       parabola = window(best);
