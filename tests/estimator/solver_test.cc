@@ -214,11 +214,12 @@ TEST(SolverTest, LevenbergMarquardtStartedAtItsMinimumConvergesThere) {
   // whose cost changes only in the round-off met (the diagnosis's held-out fits, gap-benchmark seed 2).
   Graph graph;
   const VariableId x = graph.AddVariable({"x", Manifold::Euclidean(1), Eigen::VectorXd::Zero(1), false, std::nullopt});
+  const Eigen::MatrixXd one = Eigen::MatrixXd::Identity(1, 1);
   for (const double r0 : {1.0, -1.0})
     graph.AddFactor(std::make_unique<LinearPriorFactor>(std::vector<Manifold>{Manifold::Euclidean(1)},
-                                                        std::vector<Eigen::VectorXd>{Eigen::VectorXd::Zero(1)},
-                                                        Eigen::MatrixXd::Identity(1, 1), Eigen::VectorXd::Constant(1, r0)),
-                    {x}, Eigen::MatrixXd::Identity(1, 1), Loss::Trivial(), "prior", Time());
+                                                        std::vector<Eigen::VectorXd>{Eigen::VectorXd::Zero(1)}, one,
+                                                        Eigen::VectorXd::Constant(1, r0)),
+                    {x}, one, Loss::Trivial(), "prior", Time());
   SolverOptions options;
   options.initial_lambda = 1e-11;   // as the diagnosis's warm fits
   const SolverSummary summary = Solve(options, &graph);

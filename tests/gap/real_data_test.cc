@@ -122,15 +122,12 @@ TEST(RealDataTest, OptiOdomDifferentialDriveTrackAndWheelRatio) {
   // Other runs of the set: dead reckoning with the geometry calibrated on the training part of run 01 with the
   // accepted effects (the radius re-fitted beside them) against the nominal model calibrated on the same part (one
   // radius, track 0.2 m: the held-out part's `before` and `after`), and against the manufacturer's values.
-  const auto value = [](const std::map<std::string, Eigen::VectorXd>& values, const std::string& name,
-                        double otherwise) {
-    const auto it = values.find(name);
-    return it != values.end() ? it->second[0] : otherwise;
-  };
-  const double r0 = value(diagnosis.training_parameters_before, "wheels.radius", 0.042);
-  const double r = value(diagnosis.training_parameters_after, "wheels.radius", 0.042);
-  const double rho_fit = value(diagnosis.training_parameters_after, "wheels.right_left_ratio", 1.0);
-  const double b = value(diagnosis.training_parameters_after, "wheels.baseline", 0.2);
+  const auto& before = diagnosis.training_parameters_before;
+  const auto& after = diagnosis.training_parameters_after;
+  const double r0 = before.at("wheels.radius")[0];
+  const double r = after.at("wheels.radius")[0];
+  const double rho_fit = after.at("wheels.right_left_ratio")[0];
+  const double b = after.at("wheels.baseline")[0];
   std::cout << "radius: nominal " << r0 << " m; patched left " << r << " m, right " << rho_fit * r << " m, track " << b
             << " m\n";
   // The data README's quick look (D_R / D_L 0.986, the middle of its 0.983-0.989, track 0.2027 m) at the patch's
@@ -148,9 +145,10 @@ TEST(RealDataTest, OptiOdomDifferentialDriveTrackAndWheelRatio) {
     const double nominal_10s = DeadReckoningRms(o, r0, r0, 0.2, 200);
     const double patched_10s = DeadReckoningRms(o, r, rho_fit * r, b, 200);
     std::cout << "run " << run << ": dead-reckoning RMS whole run: manufacturer "
-              << DeadReckoningRms(o, 0.042, 0.042, 0.2) << " m, nominal self-calibrated " << nominal << " m, patched "
-              << patched << " m, data README's ratio " << readme << " m; 10 s segments: manufacturer " << DeadReckoningRms(o, 0.042, 0.042, 0.2, 200)
-              << " m, nominal " << nominal_10s << " m, patched " << patched_10s << " m\n";
+              << DeadReckoningRms(o, 0.042, 0.042, 0.2) << " m, nominal " << nominal << " m, patched " << patched
+              << " m, data README's ratio " << readme << " m; 10 s segments: manufacturer "
+              << DeadReckoningRms(o, 0.042, 0.042, 0.2, 200) << " m, nominal " << nominal_10s << " m, patched "
+              << patched_10s << " m\n";
     // The yaw's ratio, not the data README's, is what these runs bear out.
     EXPECT_LT(patched, readme) << "run " << run;
     whole_nominal += nominal / 5.0;
