@@ -125,7 +125,7 @@ double NoiseRatio(const std::map<std::string, std::map<std::string, double>>& si
                   const std::string& effect, const std::string& parameter, double value);
 
 // The rear axle's cornering compliance c_rear [s] of a drive, measured on its truth (how the diagnosis's lateral_slip
-// candidate states a tire's sideways slip, as scripts/atv_odometer_residuals.py measures it): O's sideways velocity
+// candidate states a tire's sideways slip, as tools/atv_odometer_residuals.py measures it): O's sideways velocity
 // regressed on the lateral acceleration a_y = v_x omega_z and on the roll rate (which moves O sideways over the ground
 // contact), velocities between consecutive poses, after the first 2 s and above 0.5 m/s forward; c_rear = -(slope on
 // a_y). NaN with fewer than 10 such pose pairs.

@@ -6,11 +6,11 @@
 //
 // 1. Simulation of scenarios/atv_hills.yaml with every sensor (multiple of real time).
 // 2. Offline calibration of that recording by roamlab and by the Ceres peer (bench/ceres_peer.h) on the same graph:
-//    one stage with every parameter of scenarios/atv_calibration.yaml free, from the same aligned initial values,
+//    one stage with every parameter of configs/atv_calibration.yaml free, from the same aligned initial values,
 //    no gating; final costs (both evaluated by roamlab's objective) and parameters compared; time ratio (each solver's
 //    least time of three runs).
 // 3. The floor: one CHOLMOD factorization of the final Hessian, against roamlab's time per iteration.
-// 4. Online tracking (scenarios/atv_tracking.yaml) with windows of 10, 40 and 160 poses, parameters fixed and under
+// 4. Online tracking (configs/atv_tracking.yaml) with windows of 10, 40 and 160 poses, parameters fixed and under
 //    the calibration prior (the configuration's default), at the product's calibration of step 1's recording (as
 //    `roamlab calibrate`): multiple of real time by wall time and by CPU time of the tracking thread, mean and p99
 //    update latency; the 40-pose window best of three runs (least CPU time) with the median beside it, and also
@@ -197,7 +197,7 @@ nlohmann::json BenchRenderVo(const std::string& root, double duration_s, std::st
 // poses is 0.37 m/s RMS and the accelerometer's y 1.4-1.9 m/s^2 (0.015 m/s and 0.04 m/s^2 without the offset), and
 // the calibration, whose model does not hold there, converges slowly to a lever arm 2-3 m high; 0.02 rad as well. With
 // 0.01 rad the 5 min drive's rows stay near the 30 s drive's (speed 0.038 m/s, accelerometer 0.06-0.07 m/s^2; README,
-// scripts/atv_odometer_residuals.py) and it calibrates in 106 iterations to within 3 reported std of the truth.
+// tools/atv_odometer_residuals.py) and it calibrates in 106 iterations to within 3 reported std of the truth.
 roamlab::sim::Scenario LongerDrive(roamlab::sim::Scenario scenario, double duration_s) {
   scenario.duration_s = duration_s;
   if (duration_s > 30.0) {
@@ -504,8 +504,8 @@ int main(int argc, char** argv) {
   const std::string self = std::filesystem::canonical("/proc/self/exe").string();
   const std::string root = ROAMLAB_SOURCE_DIR;
   const std::string scenario_path = root + "/scenarios/atv_hills.yaml";
-  const std::string calibration_path = root + "/scenarios/atv_calibration.yaml";
-  const std::string tracking_path = root + "/scenarios/atv_tracking.yaml";
+  const std::string calibration_path = root + "/configs/atv_calibration.yaml";
+  const std::string tracking_path = root + "/configs/atv_tracking.yaml";
   auto scenario = roamlab::sim::LoadScenario(scenario_path);
   if (!scenario.ok()) return Fail(scenario.status().message());
   auto calibration_config = est::LoadEstimatorConfig(calibration_path);
@@ -684,7 +684,7 @@ int main(int argc, char** argv) {
   const std::string calibration_json = (tmp / "calibration.json").string();
   WriteCalibrationJson(calibrated, calibrated_prior, calibration_json);
 
-  // 4. Online tracking: parameters fixed, and free under the calibration prior (scenarios/atv_tracking.yaml's
+  // 4. Online tracking: parameters fixed, and free under the calibration prior (configs/atv_tracking.yaml's
   // default); the headline keys are the default's.
   // The 40-pose window (the targets') is tracked three times and the run with the least CPU time reported: other
   // work on the machine only ever slows a run down, so the fastest is the closest to the code's own cost (as the

@@ -484,7 +484,7 @@ estimator::StreamConfig ImuStream(const std::string& model, const std::string& n
 // robot's geometry measured on its model (sim::NominalPlatformGeometry): one radius for both wheels, free (the
 // odometry's scale), the baseline fixed (a track_width_error is a departure from it), the right/left ratio at its
 // default 1; the gyroscope (the yaw reference) with the scenario's noise and misalignment free. Encoder noise as
-// scenarios/indoor_diffdrive_tracking.yaml (2048-tick quantization over 10 ms, the casters' slack), no robust loss
+// configs/indoor_diffdrive_tracking.yaml (2048-tick quantization over 10 ms, the casters' slack), no robust loss
 // (the chi-square comparisons need Gaussian costs).
 Result<estimator::EstimatorConfig> NominalDiffDriveConfig(const sim::Scenario& scenario) {
   const sim::SensorOptions& s = scenario.sensors;
@@ -521,7 +521,7 @@ Result<estimator::EstimatorConfig> NominalDiffDriveConfig(const sim::Scenario& s
 // (sim::NominalPlatformGeometry): one radius for all wheels, free (the odometry's scale), the yaw lever arm fixed
 // (omni3 `distance` = wheel_distance_m; mecanum `lx_plus_ly` = half_length_m + half_width_m: a track_width_error is a
 // departure from it); the gyroscope (the yaw reference) with the scenario's noise and misalignment free. Encoder noise
-// as scenarios/indoor_omni_tracking.yaml (quantization plus the rollers' bumps; the rollers rock the chassis), no
+// as configs/indoor_omni_tracking.yaml (quantization plus the rollers' bumps; the rollers rock the chassis), no
 // robust loss (the chi-square comparisons need Gaussian costs).
 Result<estimator::EstimatorConfig> NominalHolonomicConfig(const sim::Scenario& scenario) {
   const sim::SensorOptions& s = scenario.sensors;
@@ -603,7 +603,7 @@ Result<estimator::EstimatorConfig> NominalConfig(const sim::Scenario& scenario) 
     estimator::StreamConfig odo;
     odo.model = "ackermann";
     odo.sources = {{"speed", "rear_wheel"}, {"steering", "steering"}};
-    // lateral / vertical: eq. 15's non-holonomic assumptions on a suspended vehicle (scenarios/atv_calibration.yaml).
+    // lateral / vertical: eq. 15's non-holonomic assumptions on a suspended vehicle (configs/atv_calibration.yaml).
     odo.noise = {{"speed_mps", s.odometer->speed_sigma_mps},
                  {"steering_rad", s.odometer->steering_sigma_rad},
                  {"lateral_mps", 0.02},
@@ -664,7 +664,7 @@ Result<estimator::EstimatorConfig> NominalConfig(const sim::Scenario& scenario) 
     param("gps.lever_arm", vec({l.x(), l.y(), l.z()}), true);
     stage1.insert(stage1.begin(), "gps.lever_arm");
   }
-  // Stages as scenarios/atv_calibration.yaml: attitude and lever arm, then the rest, then all jointly.
+  // Stages as configs/atv_calibration.yaml: attitude and lever arm, then the rest, then all jointly.
   std::vector<std::string> all = stage1;
   all.insert(all.end(), stage2.begin(), stage2.end());
   if (!stage1.empty()) c.stages.push_back(stage1);

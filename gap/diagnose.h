@@ -131,7 +131,7 @@ const std::vector<std::string>& CandidateNames();
 
 // The nominal estimator configuration of an Ackermann scenario: the streams its sensors produce with the scenario's
 // noise, the Table I calibration free with the scenario's values as the initial guess (staged as
-// scenarios/atv_calibration.yaml), k_gamma fixed at the scenario's value (the handlebar sensor's zero is believed;
+// configs/atv_calibration.yaml), k_gamma fixed at the scenario's value (the handlebar sensor's zero is believed;
 // a steering_offset is a departure from it), gyroscope scale 1 and cornering compliance 0 fixed (eq. 15 as written),
 // the magnetometer's motor interference 0 fixed on the IMU's specific force as the drive torque's proxy (c = m r / 2
 // from the nominal vehicle's mass and rear tire radius, models/magnetometer.h), no outlier gating (the chi-square comparisons need the same measurements in every fit). differential_drive, omni3

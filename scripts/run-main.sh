@@ -9,8 +9,8 @@ roamlab=${BUILD_DIR:-build}/apps/roamlab
 out=${OUT_DIR:-out/main}
 rm -rf "$out" && mkdir -p "$out"
 "$roamlab" simulate scenarios/atv_hills.yaml --out "$out/recording"
-"$roamlab" calibrate "$out/recording" --config scenarios/atv_calibration.yaml --out "$out/calibration"
-"$roamlab" track "$out/recording" --config scenarios/atv_tracking.yaml \
+"$roamlab" calibrate "$out/recording" --config configs/atv_calibration.yaml --out "$out/calibration"
+"$roamlab" track "$out/recording" --config configs/atv_tracking.yaml \
   --calibration "$out/calibration/calibration.json" --out "$out/tracking"
 "$roamlab" evaluate --estimate "$out/calibration" --recording "$out/recording" --out "$out/report/calibration"
 "$roamlab" evaluate --estimate "$out/tracking" --recording "$out/recording" --out "$out/report/tracking"

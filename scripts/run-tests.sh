@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Sets up (scripts/setup.sh) and runs the default test suite, then the quick subset of the regression suite
-# (scenarios/regression.yaml, results in BUILD_DIR/regress/). Slow tests carry the ctest label "slow" and are left out
+# (regression/suite.yaml, results in BUILD_DIR/regress/). Slow tests carry the ctest label "slow" and are left out
 # unless ROAMLAB_SLOW_TESTS=1; ROAMLAB_FULL_REGRESSION=1 runs every regression case.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -18,5 +18,5 @@ if grep -q 'FAILED TEST SUITE' "$junit"; then
 fi
 regress=(--quick)
 [ "${ROAMLAB_FULL_REGRESSION:-0}" = "1" ] && regress=()
-"$build_dir/apps/roamlab" regress scenarios/regression.yaml --out "$build_dir/regress" --jobs "${JOBS:-$(nproc)}" \
+"$build_dir/apps/roamlab" regress regression/suite.yaml --out "$build_dir/regress" --jobs "${JOBS:-$(nproc)}" \
   "${regress[@]}"

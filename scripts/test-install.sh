@@ -9,6 +9,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cmake --install "$build_dir" --prefix "$work/prefix" >/dev/null
 scenarios="$work/prefix/share/roamlab/scenarios"
+configs="$work/prefix/share/roamlab/configs"
 mkdir -p "$work/consumer"
 cat > "$work/consumer/CMakeLists.txt" <<EOF
 cmake_minimum_required(VERSION 3.22)
@@ -27,7 +28,7 @@ cases:
   - name: atv_calibration
     mode: calibrate
     scenario: $scenarios/atv_hills.yaml
-    config: $scenarios/atv_calibration.yaml
+    config: $configs/atv_calibration.yaml
     checks:
       - {metric: metrics.ate_m, bound: "$bound"}
       - {metric: metrics.parameters.odometer.k_gamma.error.max_abs, bound: "<= 0.005"}

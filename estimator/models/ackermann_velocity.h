@@ -23,7 +23,7 @@
 // contact moves along the ground's tangent: the two differ by half the angle the ground turns over the wheelbase, so
 // the contact moves along O's z at d omega_y with d = L / 2 (crest: nose going down, omega_y > 0, v_z > 0).
 // Measured on the MuJoCo ATV (30 s, 4 m hills, true readings without noise, O at the wheel centres, r = 0.28 m;
-// scripts/atv_odometer_residuals.py):
+// tools/atv_odometer_residuals.py):
 // regressed on the rates, O's v_x - speed reading has slope 0.30 m on omega_y, O's v_y -0.25 m on omega_x (besides
 // -0.021 s on a_y, the cornering compliance), O's v_z 0.62 m on omega_y (L / 2 = 0.625).
 //
@@ -32,7 +32,7 @@
 // (c_rear [s], m/s of side slip per m/s^2), and the front wheels' velocity points c_front a_y (c_front [rad s^2/m])
 // less into the turn than they are steered (understeer): the front axle moves along atan((L omega_z + v_y) / v_x).
 // With c_front = c_rear = 0 (their defaults) this is eq. 15 with the non-holonomic constraints. Measured on the MuJoCo
-// ATV (30 s, 4 m hills, scripts/atv_odometer_residuals.py; the former drive, scenarios/atv_hills_sines.yaml): at the
+// ATV (30 s, 4 m hills, tools/atv_odometer_residuals.py; the former drive, scenarios/atv_hills_sines.yaml): at the
 // contact v_y has slope -0.0207 s on a_y and leaves 0.0022 m/s rms of 0.035; the steering row -0.0047 rad s^2/m,
 // leaving 0.0025 rad of 0.0083 (on the weave, atv_hills.yaml's drive now: -0.0208 s and -0.0058 rad s^2/m).
 //
@@ -42,7 +42,7 @@
 // steered at
 //   delta = atan((L omega_z + v_y + c_front a_y) / v_x),
 // an angle c_front a_y / v_x = c_front omega_z to first order: the angle form's coefficient is this one over the speed
-// at which the drive corners. Measured on the MuJoCo ATV (scripts/atv_understeer_fit.py, noise-free, at the contact):
+// at which the drive corners. Measured on the MuJoCo ATV (tools/atv_understeer_fit.py, noise-free, at the contact):
 // 0.0209 s on the former drive (atv_hills_sines.yaml) and 0.0208 s on the steering-rich weave (atv_hills.yaml) alike
 // (the angle form: 0.0047 and 0.0058 rad s^2/m).
 //
@@ -58,7 +58,7 @@
 //
 // Coloured disturbance w = (w_v, w_lat, w_vert) [m/s] (slot disturbance, default 0 and constant): what the speed,
 // lateral and vertical rows still see once the terms above are modelled is not white (suspension and terrain: on the
-// MuJoCo ATV 1/e correlation times of 0.5-1.8 s, scripts/atv_odometer_residuals.py). Declared time-varying with a
+// MuJoCo ATV 1/e correlation times of 0.5-1.8 s, tools/atv_odometer_residuals.py). Declared time-varying with a
 // first-order Gauss-Markov process per component (EST.yaml: process {type: gauss_markov, sigma: [...], tau_s: [...]}),
 // w is one more state per pose that the IMU and the GPS can observe, instead of white noise that claims to average
 // out over a second; eta keeps the white part.

@@ -83,11 +83,12 @@ class SuiteTest : public ::testing::Test {
     testing::WriteFile(path, "suite: test\ncases:\n" + cases);
     return path;
   }
-  static std::string Config(const std::string& name) {
+  static std::string Scenario(const std::string& name) {
     return std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/" + name;
   }
+  static std::string Config(const std::string& name) { return std::string(ROAMLAB_SOURCE_DIR) + "/configs/" + name; }
   std::string CalibrateCase(const std::string& checks, const std::string& extra = "") {
-    return "  - name: cal\n    mode: calibrate\n    scenario: " + Config("atv_hills.yaml") +
+    return "  - name: cal\n    mode: calibrate\n    scenario: " + Scenario("atv_hills.yaml") +
            "\n    seed: 3\n    config: " + Config("atv_calibration.yaml") + "\n" + extra + "    checks:\n" + checks;
   }
   std::string Odometry(const std::string& checks, const std::string& models = "    models: [{model: gp}]\n") {
@@ -95,7 +96,7 @@ class SuiteTest : public ::testing::Test {
            checks;
   }
   std::string Diagnose(const std::string& extra) {
-    return "  - name: cal\n    mode: diagnose\n    scenario: " + Config("atv_hills.yaml") + "\n" + extra +
+    return "  - name: cal\n    mode: diagnose\n    scenario: " + Scenario("atv_hills.yaml") + "\n" + extra +
            "    checks:\n      - {metric: gap.verdict, equals: named}\n";
   }
   testing::TempDir dir_;
@@ -111,7 +112,7 @@ TEST_F(SuiteTest, LoadsOdometryAndDiagnoseCasesWithSelectorsTextsAndOpenTargets)
       "      - {metric: \"table.rows[model=gp,mean=linear,kernel=rbf+linear].ate_m\",\n"
       "         bound: \"<= 0.5 * table.rows[model=nominal].ate_m\", open: \"issue 5 target\"}\n"
       "      - {metric: table.rows.ate_m.max, bound: \"<= 1\"}\n"
-      "  - name: gap\n    mode: diagnose\n    scenario: " + Config("atv_hills.yaml") + "\n    seed: 13\n"
+      "  - name: gap\n    mode: diagnose\n    scenario: " + Scenario("atv_hills.yaml") + "\n    seed: 13\n"
       "    effects: [{name: steering_offset, offset_rad: 0.03}]\n    checks:\n"
       "      - {metric: gap.verdict, equals: named}\n"
       "      - {metric: \"gap.effects[name=steering_offset].parameters.offset_rad\", bound: \"<= 0.035\"}\n");
@@ -149,7 +150,7 @@ TEST_F(SuiteTest, LoadsCasesWithTheirChecks) {
                     "      - {metric: metrics.ate_m, bound: \"<= 1.10 * baseline\"}\n"
                     "      - {metric: calibration.measurements.gps.rejected, bound: \"<= 3\"}\n",
                     "    quick: true\n") +
-      "  - name: mc\n    mode: montecarlo\n    scenario: " + Config("atv_hills.yaml") + "\n    config: " +
+      "  - name: mc\n    mode: montecarlo\n    scenario: " + Scenario("atv_hills.yaml") + "\n    config: " +
       Config("atv_tracking.yaml") + "\n    runs: 4\n    checks:\n"
       "      - {metric: nees.fraction_in_band, bound: \">= baseline - 0.03\"}\n"
       "      - {metric: runs.runs.ate_m.max, bound: \"<= 2\"}\n"
@@ -179,7 +180,7 @@ TEST_F(SuiteTest, EachKindOfBadSuiteIsOneLineNamingFileCaseAndProblem) {
     std::string cases;
     std::string problem;
   };
-  const std::string hills = Config("atv_hills.yaml"), cal = Config("atv_calibration.yaml");
+  const std::string hills = Scenario("atv_hills.yaml"), cal = Config("atv_calibration.yaml");
   const Bad bad[] = {
       {CalibrateCase("      - {metric: metrics.ate_meters, bound: \"<= 1\"}\n"), "unknown key 'ate_meters'"},
       {CalibrateCase("      - {metric: metrics.parameters.gps.lever_arm.eror.norm, bound: \"<= 1\"}\n"),

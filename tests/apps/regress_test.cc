@@ -27,7 +27,7 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-std::string Source(const std::string& name) { return std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/" + name; }
+std::string Source(const std::string& name) { return std::string(ROAMLAB_SOURCE_DIR) + "/configs/" + name; }
 
 // The ATV tracking configuration with the synthetic drive's calibration (seed Table I, tests/support/synthetic.h)
 // and a noise value replaced: tracking with known parameters (no calibration prior), whose consistency then depends

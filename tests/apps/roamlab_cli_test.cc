@@ -41,7 +41,7 @@ TEST_F(CliTest, CalibrateAndTrackWriteTheirOutputs) {
   options.duration_s = 5.0;
   ASSERT_TRUE(recording::WriteRecording(roamlab::testing::MakeAtvRecording(options).recording,
                                         (dir_ / "rec").string()).ok());
-  const std::string config = std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/atv_calibration.yaml";
+  const std::string config = std::string(ROAMLAB_SOURCE_DIR) + "/configs/atv_calibration.yaml";
   CommandRun r = Roamlab("calibrate " + (dir_ / "rec").string() + " --config " + config + " --out " +
                       (dir_ / "cal").string() + " --quiet",
                   dir_);
@@ -65,7 +65,7 @@ TEST_F(CliTest, CalibrateAndTrackWriteTheirOutputs) {
   EXPECT_EQ(cal["information"]["parameters"].size(), cal["parameters"].size());
   EXPECT_EQ(cal["information"]["matrix"].size(), 21u);
 
-  const std::string track_config = std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/atv_tracking.yaml";
+  const std::string track_config = std::string(ROAMLAB_SOURCE_DIR) + "/configs/atv_tracking.yaml";
   r = Roamlab("track " + (dir_ / "rec").string() + " --config " + track_config + " --calibration " +
                   (dir_ / "cal" / "calibration.json").string() + " --out " + (dir_ / "trk").string() + " --quiet",
               dir_);
@@ -94,7 +94,7 @@ TEST_F(CliTest, CalibrateAndTrackWriteTheirOutputs) {
   EXPECT_NE(r.err.find("no 'information'"), std::string::npos) << r.err;
 }
 
-// montecarlo without --calibration, with tracking.calibrate (scenarios/atv_tracking.yaml): one offline calibration
+// montecarlo without --calibration, with tracking.calibrate (configs/atv_tracking.yaml): one offline calibration
 // on the scenario's own noise seed, then the runs track under its prior. A 6 s drive keeps the test short.
 TEST_F(CliTest, MonteCarloCalibratesOnceWhenTheConfigSaysHow) {
   std::ifstream in(std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/atv_hills.yaml");
@@ -107,7 +107,7 @@ TEST_F(CliTest, MonteCarloCalibratesOnceWhenTheConfigSaysHow) {
   scenario.replace(scenario.find(model), model.size(), std::string(ROAMLAB_SOURCE_DIR) + "/models/atv.xml");
   const std::string short_scenario = (dir_ / "atv_short.yaml").string();
   std::ofstream(short_scenario) << scenario;
-  const std::string config = std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/atv_tracking.yaml";
+  const std::string config = std::string(ROAMLAB_SOURCE_DIR) + "/configs/atv_tracking.yaml";
   const CommandRun r = Roamlab("montecarlo " + short_scenario + " --config " + config + " --runs 2 --jobs 1 --t0 1" +
                                    " --out " + (dir_ / "mc").string(),
                                dir_);
@@ -126,7 +126,7 @@ TEST_F(CliTest, MonteCarloCalibratesOnceWhenTheConfigSaysHow) {
 }
 
 TEST_F(CliTest, BadInputGivesOneLineAndNonZeroExit) {
-  const std::string config = std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/atv_calibration.yaml";
+  const std::string config = std::string(ROAMLAB_SOURCE_DIR) + "/configs/atv_calibration.yaml";
   for (const std::string& args :
        {"calibrate /nonexistent/rec --config " + config + " --out " + (dir_ / "o").string(),
         "calibrate " + dir_.string() + " --config /nonexistent.yaml --out " + (dir_ / "o").string(),

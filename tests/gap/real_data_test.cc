@@ -86,7 +86,7 @@ TEST(RealDataTest, OptiOdomDifferentialDriveTrackAndWheelRatio) {
   auto rec = recording::ImportOptiOdom(kSet + "_run-01.csv", kSet + "_metadata.csv");
   ASSERT_TRUE(rec.ok()) << rec.status().message();
   auto config = estimator::LoadEstimatorConfig(std::string(ROAMLAB_SOURCE_DIR) +
-                                               "/scenarios/real/optiodom_diff_nominal.yaml");
+                                               "/configs/real/optiodom_diff_nominal.yaml");
   ASSERT_TRUE(config.ok()) << config.status().message();
   auto d = Diagnose(config.value(), rec.value());
   ASSERT_TRUE(d.ok()) << d.status().message();
@@ -198,7 +198,7 @@ TEST(RealDataTest, HuskySkidSteerYawMismatch) {
   auto rec = recording::ImportRosbag(bag, options);
   ASSERT_TRUE(rec.ok()) << rec.status().message();
   auto config =
-      estimator::LoadEstimatorConfig(std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/real/husky_nominal.yaml");
+      estimator::LoadEstimatorConfig(std::string(ROAMLAB_SOURCE_DIR) + "/configs/real/husky_nominal.yaml");
   ASSERT_TRUE(config.ok()) << config.status().message();
   auto d = Diagnose(config.value(), rec.value());
   ASSERT_TRUE(d.ok()) << d.status().message();

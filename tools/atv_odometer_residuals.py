@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
 """What eq. 15's rows see on the nominal MuJoCo ATV: an analysis tool (it reads the truth; the estimator never does).
 
-    python3 scripts/atv_odometer_residuals.py [--roamlab build/apps/roamlab] [--scenario scenarios/atv_hills.yaml]
+    python3 tools/atv_odometer_residuals.py [--roamlab build/apps/roamlab] [--scenario scenarios/atv_hills.yaml]
                                               [--drive NAME]
                                               [--seed 1] [--height 0.28] [--lever 0.625]
 
-Simulates the scenario (with --drive, its variant of scripts/atv_calibration_information.py's DRIVES, e.g. `sines`,
+Simulates the scenario (with --drive, its variant of tools/atv_calibration_information.py's DRIVES, e.g. `sines`,
 the default drive before 2026-11-26) with every sensor noise set to zero, then takes the velocities between consecutive
 ground-truth poses of O (eq. 7 inverted, as the estimator does) and the true calibration, and prints, for the rows of
 estimator/models/ackermann_velocity.h: their RMS, 1/e correlation time and white-noise equivalent (the per-sample

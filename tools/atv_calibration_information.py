@@ -2,8 +2,8 @@
 """How much the ATV's 30 s drives can tell the calibration: an analysis tool (it reads the truth; the estimator never
 does).
 
-    python3 scripts/atv_calibration_information.py [--roamlab build/apps/roamlab] [--scenario scenarios/atv_hills.yaml]
-        [--config scenarios/atv_calibration.yaml] [--drives NAME,...] [--noisy DRIVE [--seeds 1,2,3]]
+    python3 tools/atv_calibration_information.py [--roamlab build/apps/roamlab] [--scenario scenarios/atv_hills.yaml]
+        [--config configs/atv_calibration.yaml] [--drives NAME,...] [--noisy DRIVE [--seeds 1,2,3]]
         [--sweep DRIVE [--terrain-seeds 7,...,16] [--reliefs 4,5]] [--keep DIR]
 
 For each drive (a variant of the scenario: terrain seed and relief, speed and handlebar profiles; DRIVES below) it
@@ -377,7 +377,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--roamlab", default="build/apps/roamlab")
     ap.add_argument("--scenario", default="scenarios/atv_hills.yaml")
-    ap.add_argument("--config", default="scenarios/atv_calibration.yaml")
+    ap.add_argument("--config", default="configs/atv_calibration.yaml")
     ap.add_argument("--drives", default=",".join(DRIVES), help="comma-separated names of DRIVES")
     ap.add_argument("--noisy", help="calibrate this drive with sensor noise instead (seeds --seeds)")
     ap.add_argument("--seeds", default="1,2,3")

@@ -2,16 +2,16 @@
 """Which steering-row model holds across drives on the nominal MuJoCo ATV: an analysis tool (it reads the truth; the
 estimator never does).
 
-    python3 scripts/atv_understeer_fit.py [--roamlab build/apps/roamlab] [--scenario scenarios/atv_hills.yaml]
+    python3 tools/atv_understeer_fit.py [--roamlab build/apps/roamlab] [--scenario scenarios/atv_hills.yaml]
                                           [--drives default,weave] [--seed 1] [--height 0.28]
 
-Simulates each drive (scripts/atv_calibration_information.py's DRIVES) with every sensor noise set to zero, takes the
+Simulates each drive (tools/atv_calibration_information.py's DRIVES) with every sensor noise set to zero, takes the
 velocities between consecutive ground-truth poses of O at the rear ground contact (--height below O, as
 estimator/models/ackermann_velocity.h with contact_height_m) and the true steered angle delta = k_theta z + k_gamma,
 and fits the understeer u = delta - atan((L omega_z + v_y) / v_x) with candidate terms (least squares with an offset,
 which k_gamma absorbs): per drive, and jointly on all drives. For the joint coefficients it prints each drive's
 residual RMS, its white equivalent (a first-order Gauss-Markov fit's power at zero frequency as white noise per
-sample, as scripts/atv_odometer_residuals.py: the steering row's noise term) and k_theta's relative error: a
+sample, as tools/atv_odometer_residuals.py: the steering row's noise term) and k_theta's relative error: a
 calibration that fixes the candidate's coefficients predicts delta minus the residual, so k_theta absorbs the
 residual's slope on delta, negated. Standard library only.
 """

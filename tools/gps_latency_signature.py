@@ -2,7 +2,7 @@
 """How much a GPS latency shows beside a free lever arm, per part of a simulated drive: an analysis tool (it reads the
 truth; `roamlab diagnose` never does).
 
-    python3 scripts/gps_latency_signature.py REC [--windows 1-20,21-29]
+    python3 tools/gps_latency_signature.py REC [--windows 1-20,21-29]
 
 REC is a simulated recording (ground_truth.tum, gps.csv, recording.yaml, truth.yaml with `gps.lever_arm` and a
 `gps_latency` effect). A fix stamped t is the antenna at t - latency. Without the latency in the model, a self-
