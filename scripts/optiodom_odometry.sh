@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Model-free odometry on the real OptiOdom recordings (seed 001 on real data): imports every run, learns each model on
 # the runs of some shapes and evaluates it on runs of another shape, one table per split.
-#   bash scripts/optiodom_odometry.sh [DATA_DIR] [OUT_DIR]     (defaults ../shared/data/optiodom/data, out/optiodom)
+#   bash scripts/optiodom_odometry.sh [DATA_DIR] [OUT_DIR]     (DATA_DIR: the OptiOdom dataset's data/ folder; OUT_DIR: out/optiodom)
 # Needs build/apps/roamlab. Splits (sets recorded the same day; the Jun-2020 and Dec-2020 robots differ):
 #   diff_dec_sq2circ  train square + ivanjko (Dec 2020)   test circular (Dec 2020)
 #   diff_jun_sq2circ  train square + ivanjko (Jun 2020)   test circular (Jun 2020)

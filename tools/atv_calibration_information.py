@@ -11,7 +11,7 @@ simulates the scenario with every sensor noise set to zero and calibrates that r
 recording without noise the solution sits at the truth (up to the physics the configuration does not model) and the
 standard deviation `calibrate` reports is the Cramer-Rao bound of the configured noise. Printed per drive: the drive's
 tilt (roll and pitch of O: RMS about the mean and range), heading span, peak lateral acceleration v omega_z (0.2 s
-means), the largest side slip simulate reports, and the reported std of every target of issue 3 next to the target
+means), the largest side slip simulate reports, and the reported std of every Table I target next to the target
 (k_theta also with its error without noise: a bias of the physics the configuration does not model); then two bounds
 with the true trajectory known up to an offset (linear least squares, no dead-reckoning error): the GPS lever arm's
 height from sigma_GPS and the tilts at the fixes, and the magnetometer's b from sigma_MAG and the spread of the field in
@@ -37,7 +37,7 @@ TARGETS = {"lever_norm": 0.10, "misalignment_deg": 2.0, "A": 0.02, "b": 0.01, "k
            "kgamma": 0.005}
 
 # Handlebar and speed coupled: slow where the handlebar is turned most, so that v^2 tan(delta) / L stays < 0.45 g.
-# atv_hills.yaml's drive since 2026-11-26.
+# atv_hills.yaml's drive.
 WEAVE = """driver:
   type: ackermann
   lead_in_s: 4.0
@@ -47,7 +47,7 @@ WEAVE = """driver:
   handlebar_rad:
     - sine: {amplitude: 0.40, period_s: 11.0, phase_rad: 0.0}
 """
-# atv_hills.yaml's drive before 2026-11-26: turns both ways (handlebar +-0.22 rad), speed 2.9-5.1 m/s.
+# atv_hills_sines.yaml's drive: turns both ways (handlebar +-0.22 rad), speed 2.9-5.1 m/s.
 SINES = """driver:
   type: ackermann
   lead_in_s: 4.0
@@ -73,8 +73,8 @@ LOOPS = """driver:
 
 # name: (description, substitutions): terrain_seed, relief_m, driver (a whole driver block).
 DRIVES = {
-    "default": ("atv_hills.yaml as it is (terrain seed 7, 4 m relief; the weave since 2026-11-26)", {}),
-    "sines": ("the former default: terrain 7, 4 m; handlebar +-0.22 rad, speed 2.9-5.1 m/s", {"driver": SINES}),
+    "default": ("atv_hills.yaml as it is (terrain seed 7, 4 m relief; the weave)", {}),
+    "sines": ("atv_hills_sines.yaml: terrain 7, 4 m; handlebar +-0.22 rad, speed 2.9-5.1 m/s", {"driver": SINES}),
     "terrain9": ("sines, terrain seed 9", {"driver": SINES, "terrain_seed": 9}),
     "terrain11": ("sines, terrain seed 11", {"driver": SINES, "terrain_seed": 11}),
     "relief5": ("sines, 5 m relief", {"driver": SINES, "relief_m": 5.0}),
@@ -296,7 +296,7 @@ def information_table(opts, work):
           "| lever std x, y, z [m] (known traj. z) | misalignment [deg] | A max std | b max std (known traj.) "
           "| kv/L [%] | k_theta [%] (noise-free error) | k_gamma [rad] |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
-    print("| target (issue 3) | | | | < 0.45, - | norm %.2f | %.1f | %.2f | %.2f | %.1f | %.1f | %.3f |" % (
+    print("| target (Table I) | | | | < 0.45, - | norm %.2f | %.1f | %.2f | %.2f | %.1f | %.1f | %.3f |" % (
         TARGETS["lever_norm"], TARGETS["misalignment_deg"], TARGETS["A"], TARGETS["b"], 100 * TARGETS["kv_rel"],
         100 * TARGETS["ktheta_rel"], TARGETS["kgamma"]))
     for name in opts.drives:

@@ -6,7 +6,7 @@
                                               [--seed 1] [--height 0.28] [--lever 0.625]
 
 Simulates the scenario (with --drive, its variant of tools/atv_calibration_information.py's DRIVES, e.g. `sines`,
-the default drive before 2026-11-26) with every sensor noise set to zero, then takes the velocities between consecutive
+the drive of atv_hills_sines.yaml) with every sensor noise set to zero, then takes the velocities between consecutive
 ground-truth poses of O (eq. 7 inverted, as the estimator does) and the true calibration, and prints, for the rows of
 estimator/models/ackermann_velocity.h: their RMS, 1/e correlation time and white-noise equivalent (the per-sample
 sigma of white noise with the same low-frequency power, sqrt of the summed autocovariance over +-3 s), at O and at the
