@@ -1,12 +1,12 @@
-// The scoring of `roamlab gap-benchmark` on made-up cases (no simulation): replay of the first round's decision,
-// threshold choice on calibration cases, noise ratios and the issue's figures.
-#include "apps/gap_benchmark_score.h"
+// The scoring of the gap benchmark (gap/benchmark/score.h) on made-up cases (no simulation): replay of the first round's decision,
+// threshold choice on calibration cases, noise ratios and the benchmark's figures.
+#include "gap/benchmark/score.h"
 
 #include <cmath>
 
 #include <gtest/gtest.h>
 
-namespace roamlab::apps::gapbench {
+namespace roamlab::gap::benchmark {
 namespace {
 
 CandidateStats Candidate(const std::string& name, double p, double delta_bic, double heldout, bool evaluated = true) {
@@ -304,4 +304,4 @@ TEST(GapBenchmarkScore, SummarizesTheIssuesFigures) {
 }
 
 }  // namespace
-}  // namespace roamlab::apps::gapbench
+}  // namespace roamlab::gap::benchmark

@@ -1,7 +1,7 @@
 // The nominal estimator configuration that `roamlab diagnose` builds from a scenario (gap::NominalConfig).
 #include <gtest/gtest.h>
 
-#include "gap/diagnose.h"
+#include "gap/nominal_config.h"
 #include "sim/scenario.h"
 
 namespace roamlab::gap {
