@@ -207,33 +207,28 @@ struct Tally {
   std::map<std::string, std::pair<int, int>> by_effect;   // name -> (top-1 correct, cases)
 };
 
+// 1 - after / before into `all`, and into `named` when the case's effect was identified (`first`).
+void AddReduction(double before, double after, bool first, std::vector<double>* all, std::vector<double>* named) {
+  const double reduction = 1.0 - after / before;
+  all->push_back(reduction);
+  if (first) named->push_back(reduction);
+}
+
 // An effect case's RMS reductions (held-out fit and re-simulation, per sample and of the 1 s means); `first`: its
 // effect was identified.
 void CountReductions(const CaseResult& c, bool first, Tally* t) {
-  if (c.has_rms && c.rms_before > 0.0) {
-    const double reduction = 1.0 - c.rms_after / c.rms_before;
-    t->rms_all.push_back(reduction);
-    if (first) t->rms_named.push_back(reduction);
-  }
+  if (c.has_rms && c.rms_before > 0.0) AddReduction(c.rms_before, c.rms_after, first, &t->rms_all, &t->rms_named);
   if (c.has_sim_rms && c.sim_rms_before > 0.0) {
-    const double reduction = 1.0 - c.sim_rms_after / c.sim_rms_before;
-    t->sim_all.push_back(reduction);
-    if (first) t->sim_named.push_back(reduction);
+    AddReduction(c.sim_rms_before, c.sim_rms_after, first, &t->sim_all, &t->sim_named);
     const bool above = c.sim_rms_before >= std::sqrt(2.0);
-    if (first) (above ? t->sim_above : t->sim_below).push_back(reduction);
+    if (first) (above ? t->sim_above : t->sim_below).push_back(1.0 - c.sim_rms_after / c.sim_rms_before);
     if (first && c.has_rms && c.rms_before > 0.0)
       (above ? t->rms_above : t->rms_below).push_back(1.0 - c.rms_after / c.rms_before);
   }
-  if (c.has_sim_rms && c.sim_rms_1s_before > 0.0) {
-    const double reduction = 1.0 - c.sim_rms_1s_after / c.sim_rms_1s_before;
-    t->sim_1s_all.push_back(reduction);
-    if (first) t->sim_1s_named.push_back(reduction);
-  }
-  if (c.has_rms && c.rms_1s_before > 0.0) {
-    const double reduction = 1.0 - c.rms_1s_after / c.rms_1s_before;
-    t->rms_1s_all.push_back(reduction);
-    if (first) t->rms_1s_named.push_back(reduction);
-  }
+  if (c.has_sim_rms && c.sim_rms_1s_before > 0.0)
+    AddReduction(c.sim_rms_1s_before, c.sim_rms_1s_after, first, &t->sim_1s_all, &t->sim_1s_named);
+  if (c.has_rms && c.rms_1s_before > 0.0)
+    AddReduction(c.rms_1s_before, c.rms_1s_after, first, &t->rms_1s_all, &t->rms_1s_named);
 }
 
 void Count(const CaseResult& c, double min_noise_ratio, Tally* t) {

@@ -73,8 +73,8 @@ struct CaseResult {
   double seconds = 0.0;
 };
 
-// The benchmark's targets on the effect-free cases: false discoveries on none cases <= 10 %, decoys reported `unknown` (and
-// nothing kept) >= 70 %, i.e. at most 30 % of the decoys with a library effect kept.
+// The benchmark's targets on the effect-free cases: false discoveries on none cases <= 10 %, decoys reported `unknown`
+// (and nothing kept) >= 70 %, i.e. at most 30 % of the decoys with a library effect kept.
 constexpr double kMaxNoneFalseRate = 0.10;
 constexpr double kMinDecoysUnknown = 0.70;
 

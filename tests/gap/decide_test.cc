@@ -1,4 +1,4 @@
-// The diagnosis's share rule (gap/diagnose.h: HeldoutExcess, ExplainedShare; decide.cc) on made-up held-out statistics: a
+// The diagnosis's share rule (gap/diagnose.h: HeldoutExcess, ExplainedShare) on made-up held-out statistics: a
 // candidate that removes the mismatch explains most of it; one that leaves another stream's large excess in place (an
 // out-of-library effect pulling a library parameter) explains little.
 #include "gap/diagnose.h"

@@ -1,5 +1,5 @@
-// The scoring of the gap benchmark (gap/benchmark/score.h) on made-up cases (no simulation): replay of the first round's decision,
-// threshold choice on calibration cases, noise ratios and the benchmark's figures.
+// The scoring of the gap benchmark (gap/benchmark/score.h) on made-up cases (no simulation): replay of the first
+// round's decision, threshold choice on calibration cases, noise ratios and the benchmark's figures.
 #include "gap/benchmark/score.h"
 
 #include <cmath>
@@ -221,7 +221,7 @@ CaseResult Scored(const std::string& kind, const std::string& truth, const std::
   return c;
 }
 
-TEST(GapBenchmarkScore, SummarizesTheIssuesFigures) {
+TEST(GapBenchmarkScore, SummarizesTheBenchmarksFigures) {
   std::vector<CaseResult> cases;
   // Strong effect named right, with a 10 % parameter error on a scale (1.05 vs 1.045: error 0.005 of 0.05) and the
   // affected stream's held-out RMS from 2.0 to 1.0.
