@@ -1,437 +1,135 @@
 #include "apps/diagnose.h"
 
 #include <algorithm>
-#include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <iomanip>
 #include <iostream>
-#include <optional>
 #include <sstream>
 
-#include <nlohmann/json.hpp>
-
 #include "estimator/config.h"
-#include "eval/plots.h"
 #include "gap/diagnose.h"
+#include "gap/nominal_config.h"
+#include "gap/report.h"
 #include "gap/resimulate.h"
 #include "recording/recording.h"
 #include "sim/scenario.h"
-#include "sim/simulator.h"
 
 namespace roamlab::apps {
 namespace {
 
-using nlohmann::json;
-
-json Number(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
-
-json FitsJson(const std::map<std::string, gap::StreamFit>& fits) {
-  json j = json::object();
-  for (const auto& [name, f] : fits)
-    j[name] = {{"rms", Number(f.rms)}, {"rms_1s", Number(f.rms_1s)}, {"chi2_per_dof", Number(f.chi2_per_dof)},
-               {"dof", f.dof},
-               {"measurements", f.measurements}};
-  return j;
-}
-
-json EffectJson(const gap::EffectEstimate& e) {
-  json p = json::object(), s = json::object(), b = json::object();
-  for (const auto& [k, v] : e.parameters) p[k] = Number(v);
-  for (const auto& [k, v] : e.baseline_parameters) b[k] = Number(v);
-  for (const auto& [k, v] : e.std) s[k] = Number(v);
-  return {{"name", e.name},
-          {"parameters", p},
-          {"std", s},
-          {"baseline_parameters", b},
-          {"dof", e.dof},
-          {"lr_statistic", Number(e.lr)},
-          {"chi2_drop", Number(e.lr_raw)},
-          {"baseline_lr_statistic", Number(e.baseline_lr)},
-          {"lr_pvalue", Number(e.lr_pvalue)},
-          {"delta_bic", Number(e.delta_bic)},
-          {"heldout_improvement", e.evaluated_heldout ? Number(e.heldout_improvement) : json(nullptr)},
-          {"heldout_excess_before", e.evaluated_heldout ? Number(e.heldout_excess_before) : json(nullptr)},
-          {"heldout_excess_after", e.evaluated_heldout ? Number(e.heldout_excess_after) : json(nullptr)},
-          {"explained_share", e.evaluated_heldout ? Number(e.explained_share) : json(nullptr)},
-          {"decision", e.decision}};
-}
-
-json LocatedJson(const gap::LocatedComponent& lc) {
-  json intervals = json::array(), correlates = json::array();
-  for (const auto& [a, b] : lc.intervals) intervals.push_back({a, b});
-  for (const gap::Correlate& c : lc.correlates)
-    correlates.push_back({{"condition", c.condition}, {"rho", Number(c.rho)}, {"lag_s", c.lag_s}});
-  return {{"stream", lc.stream},
-          {"component", lc.component},
-          {"chi2_per_dof", Number(lc.chi2_per_dof)},
-          {"expected_chi2_per_dof", Number(lc.expected_chi2_per_dof)},
-          {"inconsistent", lc.inconsistent},
-          {"intervals", intervals},
-          {"correlates", correlates}};
-}
-
-Status WriteText(const std::string& path, const std::string& text) {
-  std::ofstream out(path);
-  if (!out) return Status::Error(path + ": cannot write");
-  out << text;
-  return out ? Status::Ok() : Status::Error(path + ": write failed");
-}
-
 std::string Fixed(double x, int digits) {
   std::ostringstream s;
-  s << std::setprecision(digits) << x;
+  s.precision(digits);
+  s << x;
   return s.str();
 }
 
-// The located component most out of its level (inconsistent ones first), or null.
-const gap::LocatedComponent* Worst(const gap::Diagnosis& d) {
-  const gap::LocatedComponent* worst = nullptr;
-  for (const gap::LocatedComponent& lc : d.located) {
-    const double ratio = lc.chi2_per_dof / lc.expected_chi2_per_dof;
-    if (!worst || (lc.inconsistent && !worst->inconsistent) ||
-        (lc.inconsistent == worst->inconsistent && ratio > worst->chi2_per_dof / worst->expected_chi2_per_dof))
-      worst = &lc;
-  }
-  return worst;
-}
-
-// Figures: the worst component's residuals against the condition it correlates with most (at its lag), and the
-// held-out chi2/dof per stream before and after.
-std::vector<std::string> WritePlots(const gap::Diagnosis& d, const std::string& dir, std::string* note) {
-  std::vector<std::string> images;
-  if (!eval::GnuplotAvailable()) {
-    *note = "gnuplot is not installed: no figures";
-    return images;
-  }
-  if (const gap::LocatedComponent* lc = Worst(d); lc && !lc->correlates.empty()) {
-    const gap::Correlate& c = lc->correlates.front();
-    const auto column = std::find(d.conditions.names.begin(), d.conditions.names.end(), c.condition);
-    const int ci = static_cast<int>(column - d.conditions.names.begin());
-    std::ofstream data(dir + "/residual_vs_condition.dat");
-    data << "# " << c.condition << " (at t + " << c.lag_s << " s)  whitened residual of " << lc->stream << "["
-         << lc->component << "]\n";
-    for (const estimator::MeasurementResidual& r : d.residuals) {
-      if (!r.active || r.stream != lc->stream || lc->component >= r.whitened.size()) continue;
-      const Time t = Time::FromNanoseconds(r.t.nanoseconds() + std::llround(c.lag_s * 1e9));
-      data << d.conditions.At(ci, t) << " " << r.whitened[lc->component] << "\n";
-    }
-    data.close();   // gnuplot reads it below: every line on disk first
-    std::ofstream gp(dir + "/residual_vs_condition.gp");
-    gp << "set terminal pngcairo size 800,500 noenhanced\nset output 'residual_vs_condition.png'\n"
-       << "set title \"" << lc->stream << "[" << lc->component << "]: chi2/dof " << Fixed(lc->chi2_per_dof, 3)
-       << " (nominal " << Fixed(lc->expected_chi2_per_dof, 3) << "), rho " << Fixed(c.rho, 2) << "\"\n"
-       << "set xlabel '" << c.condition << " at t + " << c.lag_s << " s'\nset ylabel 'whitened residual'\n"
-       << "set grid\nplot 'residual_vs_condition.dat' using 1:2 with dots lc rgb '#1f77b4' notitle\n";
-    gp.close();
-    if (eval::RunGnuplot(dir, "residual_vs_condition.gp").ok()) images.push_back("residual_vs_condition.png");
-  }
-  {
-    std::ofstream data(dir + "/heldout_fit.dat");
-    data << "# stream  chi2_per_dof_before  chi2_per_dof_after (held-out part)\n";
-    for (const auto& [name, before] : d.before) {
-      const auto after = d.after.find(name);
-      data << name << " " << before.chi2_per_dof << " "
-           << (after != d.after.end() ? after->second.chi2_per_dof : before.chi2_per_dof) << "\n";
-    }
-    data.close();
-    std::ofstream gp(dir + "/heldout_fit.gp");
-    gp << "set terminal pngcairo size 800,450 noenhanced\nset output 'heldout_fit.png'\n"
-       << "set title 'held-out part (after t = " << Fixed(d.train_end_s, 4) << " s): chi2/dof per stream'\n"
-       << "set style data histograms\nset style fill solid 0.8\nset yrange [0:*]\nset grid y\nset ylabel 'chi2/dof'\n"
-       << "plot 'heldout_fit.dat' using 2:xtic(1) title 'nominal', '' using 3 title 'with the accepted effects'\n";
-    gp.close();
-    if (eval::RunGnuplot(dir, "heldout_fit.gp").ok()) images.push_back("heldout_fit.png");
-  }
-  return images;
-}
-
-std::string Report(const gap::Diagnosis& d, const std::string& recording, const std::string& scenario,
-                   bool baseline, const gap::SimulationComparison* simulation,
-                   const std::vector<std::string>& images) {
-  std::ostringstream r;
-  r << "# Reality-gap diagnosis\n\nRecording `" << recording << "` against the nominal scenario `" << scenario
-    << "`.\n\n## Verdict: **" << d.verdict << "**\n\n";
-  if (d.verdict == "named") {
-    for (const gap::EffectEstimate& e : d.effects) {
-      r << "- **" << e.name << "**:";
-      for (const auto& [k, v] : e.parameters) {
-        const auto s = e.std.find(k);
-        r << " " << k << " = " << Fixed(v, 4);
-        if (s != e.std.end() && std::isfinite(s->second)) r << " +- " << Fixed(s->second, 2);
-      }
-      r << " (likelihood ratio " << Fixed(e.lr, 4) << ", p = " << Fixed(e.lr_pvalue, 3) << ", Delta BIC "
-        << Fixed(e.delta_bic, 4) << ", held-out chi2 " << Fixed(100.0 * e.heldout_improvement, 3) << " % lower)\n";
-    }
-  } else if (d.verdict == "unknown") {
-    r << "No effect of the library explains it; what stays inconsistent:\n";
-    for (const std::string& u : d.unexplained) r << "- " << u << "\n";
-  } else {
-    r << "Every stream is as consistent as the nominal model is on a nominal simulation"
-      << (baseline ? "" : " (no baseline: levels compared with 1)") << ".\n";
-  }
-  r << "\n## Where (whole run, nominal self-calibration)\n\n| stream[component] | chi2/dof | nominal level | "
-       "inconsistent | intervals [s] | strongest condition (rho, lag) |\n|---|---|---|---|---|---|\n";
-  for (const gap::LocatedComponent& lc : d.located) {
-    r << "| " << lc.stream << "[" << lc.component << "] | " << Fixed(lc.chi2_per_dof, 3) << " | "
-      << Fixed(lc.expected_chi2_per_dof, 3) << " | " << (lc.inconsistent ? "**yes**" : "no") << " | ";
-    for (std::size_t i = 0; i < lc.intervals.size() && i < 3; ++i)
-      r << (i ? ", " : "") << Fixed(lc.intervals[i].first, 3) << "-" << Fixed(lc.intervals[i].second, 3);
-    if (lc.intervals.size() > 3) r << " (+" << lc.intervals.size() - 3 << ")";
-    r << " | ";
-    if (!lc.correlates.empty())
-      r << lc.correlates.front().condition << " (" << Fixed(lc.correlates.front().rho, 2) << ", "
-        << lc.correlates.front().lag_s << " s)";
-    r << " |\n";
-  }
-  r << "\n## Candidates (fitted on the first part, up to t = " << Fixed(d.train_end_s, 4)
-    << " s)\n\n| effect | parameters | LR | chi2 drop / on baseline | p | Delta BIC | held-out | share of the held-out "
-       "mismatch | decision |\n|---|---|---|---|---|---|---|---|---|\n";
-  for (const gap::EffectEstimate& e : d.candidates) {
-    r << "| " << e.name << " | ";
-    for (const auto& [k, v] : e.parameters) r << k << " = " << Fixed(v, 4) << " ";
-    r << "| " << Fixed(e.lr, 4) << " | " << Fixed(e.lr_raw, 4) << " / " << Fixed(e.baseline_lr, 4) << " | "
-      << Fixed(e.lr_pvalue, 3) << " | "
-      << Fixed(e.delta_bic, 4) << " | "
-      << (e.evaluated_heldout ? Fixed(100.0 * e.heldout_improvement, 3) + " %" : std::string("-")) << " | "
-      << (e.evaluated_heldout ? Fixed(e.explained_share, 3) : std::string("-")) << " | " << e.decision << " |\n";
-  }
-  r << "\n## Fit on the held-out part (parameters fixed at the training values)\n\nWhitened residuals: RMS per "
-       "sample, RMS of their 1 s means (the systematic part) and chi2/dof.\n\n| stream | RMS before | RMS after | "
-       "1 s RMS before | 1 s RMS after | chi2/dof before | chi2/dof after |\n|---|---|---|---|---|---|---|\n";
-  for (const auto& [name, b] : d.before) {
-    const auto a = d.after.count(name) ? d.after.at(name) : b;
-    r << "| " << name << " | " << Fixed(b.rms, 4) << " | " << Fixed(a.rms, 4) << " | " << Fixed(b.rms_1s, 4) << " | "
-      << Fixed(a.rms_1s, 4) << " | " << Fixed(b.chi2_per_dof, 4) << " | " << Fixed(a.chi2_per_dof, 4) << " |\n";
-  }
-  if (simulation) {
-    r << "\n## The simulation against the recording (held-out part, after t = " << Fixed(simulation->from_s, 4)
-      << " s)\n\nThe nominal scenario simulated again without noise, as believed and with the accepted effects "
-         "applied (scenario_patch.yaml), compared sample by sample with the recording: RMS of recorded minus "
-         "simulated in units of each stream's stated noise (1 = noise only; meaningful for a recording of the "
-         "scenario's drive), and of its 1 s means (the systematic part).\n\n| stream | RMS as believed | RMS with the "
-         "effects | change | 1 s RMS as believed | 1 s RMS with the effects |\n|---|---|---|---|---|---|\n";
-    for (const auto& [name, b] : simulation->before) {
-      const auto a = simulation->after.find(name);
-      r << "| " << name << " | " << Fixed(b.rms, 4) << " | ";
-      if (a == simulation->after.end()) {
-        r << "- | - | " << Fixed(b.rms_1s, 4) << " | - |\n";
-        continue;
-      }
-      r << Fixed(a->second.rms, 4) << " | "
-        << (b.rms > 0.0 ? Fixed(100.0 * (a->second.rms / b.rms - 1.0), 3) + " %" : std::string("-")) << " | "
-        << Fixed(b.rms_1s, 4) << " | " << Fixed(a->second.rms_1s, 4) << " |\n";
-    }
-    for (const std::string& l : simulation->left_out) r << "\nNot compared: " << l << ".";
-    if (!simulation->not_simulated.empty())
-      r << "\nThe effects could not be simulated: " << simulation->not_simulated << ".";
-    r << "\n";
-  }
-  r << "\n";
-  for (const std::string& image : images) r << "![" << image << "](" << image << ")\n\n";
-  r << d.fits << " calibrations in " << Fixed(d.seconds, 3) << " s.\n";
-  return r.str();
-}
-
-// The accepted effects as the simulator takes them: as simulated when the scenario was simulated again (time shifts
-// in whole physics steps), otherwise converted without the step.
-std::string ScenarioPatch(const gap::Diagnosis& d, const gap::SimulationComparison* simulation) {
-  std::ostringstream y;
-  y << "# Accepted effects of `roamlab diagnose`, in the form of a scenario's `effects:` section (sim/scenario.h).\n"
-    << "# Standard deviations are comments.\neffects:\n";
-  if (d.effects.empty()) y << "  []\n";
-  for (std::size_t i = 0; i < d.effects.size(); ++i) {
-    const gap::EffectEstimate& e = d.effects[i];
-    std::map<std::string, double> std;
-    sim::EffectOptions effect = gap::SimulatorEffect(e, &std);
-    if (simulation && simulation->effects.size() == d.effects.size()) effect = simulation->effects[i];
-    y << "  - name: " << e.name << "\n";
-    bool same = effect.parameters.size() == e.parameters.size();
-    for (const auto& [k, v] : effect.parameters) same = same && e.parameters.count(k);
-    if (!same) {   // parameters the simulator takes in another form (lateral_slip): the diagnosed ones as comments
-      y << "    # diagnosed:";
-      for (const auto& [k, v] : e.parameters) y << " " << k << " = " << std::setprecision(6) << v;
-      y << "\n";
-    }
-    y << "    parameters:\n";
-    for (const auto& [k, v] : effect.parameters) {
-      y << "      " << k << ": " << std::setprecision(10) << v;
-      if (std.count(k) && std::isfinite(std.at(k))) y << "   # +- " << std::setprecision(3) << std.at(k);
-      y << "\n";
-    }
-  }
-  return y.str();
-}
-
-std::string EstimatorPatch(const gap::Diagnosis& d) {
-  std::ostringstream y;
-  y << "# The accepted effects as estimator settings: parameter values to add to the nominal configuration's\n"
-    << "# `parameters`, and time shifts [s] to subtract from the named recording streams' stamps.\nparameters:\n";
-  if (d.effect_parameters.empty()) y << "  {}\n";
-  for (const auto& [name, v] : d.effect_parameters) {
-    y << "  " << name << ": {value: [";
-    for (int i = 0; i < v.size(); ++i) y << (i ? ", " : "") << std::setprecision(10) << v[i];
-    y << "], free: false}\n";
-  }
-  y << "stream_time_shifts_s:\n";
-  if (d.stream_shifts_s.empty()) y << "  {}\n";
-  for (const auto& [name, s] : d.stream_shifts_s) y << "  " << name << ": " << std::setprecision(10) << s << "\n";
-  return y.str();
-}
-
-json SimulationJson(const gap::SimulationComparison& c) {
-  const auto fits = [](const std::map<std::string, gap::SimulatedStreamFit>& m) {
-    json j = json::object();
-    for (const auto& [name, f] : m)
-      j[name] = {{"rms", Number(f.rms)}, {"rms_1s", Number(f.rms_1s)}, {"component_rms", f.component_rms},
-                 {"samples", f.samples}};
-    return j;
-  };
-  json effects = json::array();
-  for (const sim::EffectOptions& e : c.effects) effects.push_back({{"name", e.name}, {"parameters", e.parameters}});
-  return {{"from_s", c.from_s},         {"duration_s", c.duration_s}, {"effects", effects},
-          {"before", fits(c.before)},   {"after", fits(c.after)},     {"left_out", c.left_out},
-          {"not_simulated", c.not_simulated.empty() ? json(nullptr) : json(c.not_simulated)}};
-}
-
-}  // namespace
-
-json DiagnosisJson(const gap::Diagnosis& d, const gap::Baseline* baseline, std::uint64_t baseline_seed,
-                   const gap::SimulationComparison* simulation) {
-  json located = json::array(), components = json::array(), effects = json::array(), candidates = json::array();
-  for (const gap::LocatedComponent& lc : d.located) {
-    components.push_back(LocatedJson(lc));
-    if (lc.inconsistent) located.push_back(LocatedJson(lc));
-  }
-  for (const gap::EffectEstimate& e : d.effects) effects.push_back(EffectJson(e));
-  for (const gap::EffectEstimate& e : d.candidates) candidates.push_back(EffectJson(e));
-  json base = json::object();
-  if (baseline) {
-    base["seed"] = baseline_seed;
-    base["streams"] = FitsJson(baseline->streams);
-    json lr = json::object();
-    for (const auto& [name, v] : baseline->candidate_lr) lr[name] = Number(v);
-    base["candidate_lr_statistic"] = lr;
-  }
-  return {{"verdict", d.verdict},
-          {"located", located},
-          {"effects", effects},
-          {"fit", {{"before", FitsJson(d.before)}, {"after", FitsJson(d.after)},
-                   {"heldout_start_s", d.train_end_s}, {"whole_run_nominal", FitsJson(d.whole_run)}}},
-          {"unexplained", d.unexplained},
-          {"candidates", candidates},
-          {"components", components},
-          {"baseline", base},
-          {"simulation", simulation ? SimulationJson(*simulation) : json(nullptr)},
-          {"run", {{"fits", d.fits}, {"seconds", d.seconds}}}};
-}
-
-int RunDiagnose(const DiagnoseArgs& args) {
-  std::ostream& err = args.err ? *args.err : std::cerr;
-  const auto bad = [&](const std::string& message) {
-    err << "roamlab diagnose: " << message << "\n";
-    return 2;
-  };
-  const auto fail = [&](const std::string& message) {
-    err << "roamlab diagnose: " << message << "\n";
-    return 1;
-  };
-  const auto say = [&](const std::string& line) {
-    if (!args.quiet) std::cout << line << std::endl;
-  };
-
-  // Inputs: the nominal scenario (optional for a robot without a MuJoCo twin: then --config and --no-baseline), the
-  // recording's streams (never its truth.yaml), the nominal configuration.
-  if (args.scenario.empty() && (args.config.empty() || !args.no_baseline))
-    return bad("without --scenario, give the nominal model as --config EST.yaml and --no-baseline");
+// What the diagnosis reads: the nominal scenario (none for a robot without a MuJoCo twin), the recording's streams
+// (never its truth.yaml), the nominal configuration.
+struct Inputs {
   std::optional<sim::Scenario> scenario;
+  recording::Recording recording;
+  estimator::EstimatorConfig config;
+  double span_s = 0.0;   // the recording's last stamp
+};
+
+// The inputs, checked against each other; errors are bad input (exit 2).
+Result<Inputs> LoadInputs(const DiagnoseArgs& args) {
+  if (args.scenario.empty() && (args.config.empty() || !args.no_baseline))
+    return Status::Error("without --scenario, give the nominal model as --config EST.yaml and --no-baseline");
+  Inputs in;
   if (!args.scenario.empty()) {
     auto loaded = sim::LoadScenario(args.scenario);
-    if (!loaded.ok()) return bad(loaded.status().message());
-    scenario = std::move(loaded).value();
+    if (!loaded.ok()) return loaded.status();
+    in.scenario = std::move(loaded).value();
   }
   recording::ReadOptions read;
   read.load_ground_truth = false;
   auto rec = recording::ReadRecording(args.recording, read);
-  if (!rec.ok()) return bad(rec.status().message());
-  const recording::Recording& recording = rec.value();
-  if (scenario && recording.platform.kind != scenario->robot.kind)
-    return bad(args.recording + ": platform kind '" + recording.platform.kind + "' does not match the robot kind '" +
-               scenario->robot.kind + "' of " + args.scenario);
-  auto config = args.config.empty() ? gap::NominalConfig(*scenario) : estimator::LoadEstimatorConfig(args.config);
+  if (!rec.ok()) return rec.status();
+  in.recording = std::move(rec).value();
+  if (in.scenario && in.recording.platform.kind != in.scenario->robot.kind)
+    return Status::Error(args.recording + ": platform kind '" + in.recording.platform.kind +
+                         "' does not match the robot kind '" + in.scenario->robot.kind + "' of " + args.scenario);
+  auto config = args.config.empty() ? gap::NominalConfig(*in.scenario) : estimator::LoadEstimatorConfig(args.config);
   if (!config.ok())
-    return bad((args.config.empty() ? args.scenario + ": " : std::string()) + config.status().message());
-  for (const auto& [name, stream] : config.value().streams)
+    return Status::Error((args.config.empty() ? args.scenario + ": " : std::string()) + config.status().message());
+  in.config = std::move(config).value();
+  for (const auto& [name, stream] : in.config.streams)
     for (const auto& [role, source] : stream.sources)
-      if (!recording.Find(source))
-        return bad(args.recording + ": no stream '" + source + "' (the nominal model's stream '" + name +
-                   "' reads it)");
+      if (!in.recording.Find(source))
+        return Status::Error(args.recording + ": no stream '" + source + "' (the nominal model's stream '" + name +
+                             "' reads it)");
   std::error_code ec;
   std::filesystem::create_directories(args.out, ec);
-  if (ec) return bad(args.out + ": cannot create the output directory: " + ec.message());
+  if (ec) return Status::Error(args.out + ": cannot create the output directory: " + ec.message());
+  for (const recording::Stream& s : in.recording.streams)
+    if (!s.t.empty()) in.span_s = std::max(in.span_s, s.t.back().seconds());
+  // The held-out third loses twice the range of its position fixes at each end (the diagnosis's slices).
+  if (args.max_shift_s && (!(*args.max_shift_s > 0.0) || !(*args.max_shift_s < in.span_s / 12.0)))
+    return Status::Error("--max-shift " + Fixed(*args.max_shift_s, 3) + " s: must be above 0 and below " +
+                         Fixed(in.span_s / 12.0, 3) + " s, 1/12 of " + args.recording + "'s span");
+  return in;
+}
 
-  // The baseline: the nominal scenario simulated over the recording's span and diagnosed without effects.
+}  // namespace
+
+int RunDiagnose(const DiagnoseArgs& args) {
+  std::ostream& err = args.err ? *args.err : std::cerr;
+  const auto say = [&](const std::string& line) {
+    if (!args.quiet) std::cout << line << std::endl;
+  };
+  auto inputs = LoadInputs(args);
+  if (!inputs.ok()) {
+    err << "roamlab diagnose: " << inputs.status().message() << "\n";
+    return 2;
+  }
+  const Inputs& in = inputs.value();
+  const auto fail = [&](const std::string& message) {
+    err << "roamlab diagnose: " << message << "\n";
+    return 1;
+  };
   gap::DiagnoseOptions options;
   options.progress = [&](const std::string& line) { say("  " + line); };
-  double span_s = 0.0;
-  for (const recording::Stream& s : recording.streams)
-    if (!s.t.empty()) span_s = std::max(span_s, s.t.back().seconds());
-  if (args.max_shift_s) {
-    // The held-out third loses twice the range of its position fixes at each end (gap::Diagnose's Slice).
-    const double limit = span_s / 12.0;
-    if (!(*args.max_shift_s > 0.0) || !(*args.max_shift_s < limit))
-      return bad("--max-shift " + Fixed(*args.max_shift_s, 3) + " s: must be above 0 and below " + Fixed(limit, 3) +
-                 " s, 1/12 of " + args.recording + "'s span");
-    options.max_shift_s = *args.max_shift_s;
-  }
+  if (args.max_shift_s) options.max_shift_s = *args.max_shift_s;
+
+  // The baseline: the nominal scenario simulated over the recording's span and diagnosed without effects.
   gap::Baseline baseline;
   if (!args.no_baseline) {
-    sim::Scenario nominal = *scenario;
-    nominal.effects.clear();
-    nominal.duration_s = std::min(nominal.duration_s, std::max(span_s, 1.0));
-    sim::SimulateOptions sim_options;
-    sim_options.seed = args.baseline_seed;
-    say("baseline: simulating the nominal scenario (" + Fixed(nominal.duration_s, 4) + " s, seed " +
-        std::to_string(args.baseline_seed) + ")");
-    auto simulated = sim::Simulate(nominal, sim_options);
-    if (!simulated.ok()) return fail("nominal simulation: " + simulated.status().message());
-    gap::DiagnoseOptions learn = options;
-    learn.max_effects = 0;
-    say("baseline: diagnosing the nominal simulation");
-    auto learned = gap::Diagnose(config.value(), simulated.value().recording, learn);
-    if (!learned.ok()) return fail("baseline: " + learned.status().message());
-    baseline = gap::BaselineFrom(learned.value());
+    sim::Scenario nominal = *in.scenario;
+    nominal.duration_s = std::min(nominal.duration_s, std::max(in.span_s, 1.0));
+    gap::LearnBaselineOptions learn;
+    learn.seed = args.baseline_seed;
+    learn.diagnose = options;
+    learn.progress = say;
+    auto learned = gap::LearnBaseline(nominal, in.config, learn);
+    if (!learned.ok()) return fail(learned.status().message());
+    baseline = std::move(learned).value().baseline;
     options.baseline = &baseline;
   }
 
   say("diagnosing " + args.recording);
-  auto diagnosis = gap::Diagnose(config.value(), recording, options);
+  auto diagnosis = gap::Diagnose(in.config, in.recording, options);
   if (!diagnosis.ok()) return fail(diagnosis.status().message());
   const gap::Diagnosis& d = diagnosis.value();
 
   // The simulation again, as believed and with the accepted effects, against the recording's held-out part.
   std::optional<gap::SimulationComparison> simulation;
-  if (scenario) {
+  if (in.scenario) {
     say("re-simulating the nominal scenario without noise, as believed and with the accepted effects");
-    auto compared = gap::CompareWithSimulation(*scenario, d.effects, recording, d.train_end_s);
+    auto compared = gap::CompareWithSimulation(*in.scenario, d.effects, in.recording, d.train_end_s);
     if (!compared.ok()) return fail("re-simulation: " + compared.status().message());
     simulation = std::move(compared).value();
   }
 
-  // gap.json, the patches, the figures and the report.
-  const json gap_json = DiagnosisJson(d, args.no_baseline ? nullptr : &baseline, args.baseline_seed,
-                                      simulation ? &*simulation : nullptr);
-  if (Status s = WriteText(args.out + "/gap.json", gap_json.dump(2) + "\n"); !s.ok()) return fail(s.message());
-  const std::string patch = ScenarioPatch(d, simulation ? &*simulation : nullptr);
-  if (Status s = WriteText(args.out + "/scenario_patch.yaml", patch); !s.ok()) return fail(s.message());
-  if (Status s = WriteText(args.out + "/estimator_patch.yaml", EstimatorPatch(d)); !s.ok()) return fail(s.message());
-  std::string note;
-  const std::vector<std::string> images = args.no_plots ? std::vector<std::string>{} : WritePlots(d, args.out, &note);
-  if (!note.empty()) say(note);
-  const std::string report = Report(d, args.recording, args.scenario.empty() ? args.config : args.scenario,
-                                    !args.no_baseline, simulation ? &*simulation : nullptr, images);
-  if (Status s = WriteText(args.out + "/report.md", report); !s.ok())
-    return fail(s.message());
+  gap::ReportInputs report;
+  report.recording = args.recording;
+  report.model = args.scenario.empty() ? args.config : args.scenario;
+  report.baseline = args.no_baseline ? nullptr : &baseline;
+  report.baseline_seed = args.baseline_seed;
+  report.simulation = simulation ? &*simulation : nullptr;
+  report.plots = !args.no_plots;
+  report.progress = say;
+  if (Status s = gap::WriteReport(d, report, args.out); !s.ok()) return fail(s.message());
   std::string summary = "verdict: " + d.verdict;
   for (const gap::EffectEstimate& e : d.effects) {
     summary += "; " + e.name;

@@ -1,11 +1,10 @@
 // `roamlab diagnose --real REC --scenario SCENARIO.yaml --out DIR`: the reality-gap diagnosis of a recording against
 // the nominal scenario (gap/diagnose.h). Reads REC's streams only (never truth.yaml). Unless --no-baseline, first
 // simulates the nominal scenario (its effects removed, the recording's duration, seed --baseline-seed) and diagnoses
-// that, to learn the levels and candidate gains the nominal model reaches on MuJoCo data without any hidden effect.
-// Writes DIR/gap.json, DIR/report.md, DIR/scenario_patch.yaml (the accepted effects in the scenario's `effects:`
-// form), DIR/estimator_patch.yaml (the same as estimator parameters and stream time shifts) and PNG figures with
-// their gnuplot scripts. With a scenario, the nominal scenario is simulated again without noise, as believed and with
+// that, to learn the levels and candidate gains the nominal model reaches on MuJoCo data without any hidden effect
+// (gap/learn_baseline.h). With a scenario, the nominal scenario is simulated again without noise, as believed and with
 // the accepted effects, and compared with the recording's held-out part (gap/resimulate.h; gap.json "simulation").
+// Writes DIR/gap.json, DIR/report.md, the patches and the figures (gap/report.h).
 // Exit codes: 0 done, 2 bad input (one line naming the file), 1 a failure at run time.
 #pragma once
 
@@ -14,10 +13,7 @@
 #include <optional>
 #include <string>
 
-#include <nlohmann/json.hpp>
-
-#include "gap/diagnose.h"
-#include "gap/resimulate.h"
+#include "gap/learn_baseline.h"
 
 namespace roamlab::apps {
 
@@ -29,17 +25,12 @@ struct DiagnoseArgs {
                                          // scenario, gap::NominalConfig)
   std::string out;
   bool no_baseline = false;
-  std::uint64_t baseline_seed = 900001;  // noise seed of the nominal simulation
+  std::uint64_t baseline_seed = gap::kDefaultBaselineSeed;   // noise seed of the nominal simulation
   std::optional<double> max_shift_s;     // --max-shift: the time-shift search range (default gap::DiagnoseOptions')
   bool no_plots = false;
   bool quiet = false;
   std::ostream* err = nullptr;           // receives the one-line error; nullptr: stderr
 };
 int RunDiagnose(const DiagnoseArgs& args);
-
-// A diagnosis as DIR/gap.json (README, `roamlab diagnose`); `baseline` null: diagnosed without one; `simulation` null:
-// no re-simulation (a robot without a MuJoCo twin).
-nlohmann::json DiagnosisJson(const gap::Diagnosis& d, const gap::Baseline* baseline, std::uint64_t baseline_seed,
-                             const gap::SimulationComparison* simulation);
 
 }  // namespace roamlab::apps

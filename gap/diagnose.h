@@ -1,34 +1,37 @@
-// Reality-gap diagnosis (DESIGN.md, "Reality-gap diagnosis"; issue 6): given a recording and the nominal model of the
-// robot (an estimator configuration whose free parameters are the ordinary calibration), find where the recording
-// departs from the model, name the physical effect from a library, fit it and show the held-out fit improve.
+// Reality-gap diagnosis: given a recording and the nominal model of the robot (an estimator configuration whose free
+// parameters are the ordinary calibration), find where the recording departs from the model, name the physical effect
+// from a library, fit it and show the held-out fit improve. Diagnose runs these steps (diagnose.cc):
 //
 //   1. replay: self-calibrate the nominal parameters on the whole recording (the estimator's models are the nominal
 //      model) and keep the whitened residuals;
 //   2. locate: per stream and component, chi-square per dof, intervals and correlated conditions (locate.h), against
 //      the levels the nominal model reaches on a nominal simulation (Baseline) when one is given;
-//   3. name: every candidate effect of the library is fitted on the first `train_fraction` of the recording with the
-//      full solver (all calibration parameters free, warm-started at the nominal fit): a parameter slot freed in an
-//      error model (also the IMU's clock offset, the time_offset_s the gyroscope and accelerometer share, started from
-//      a profile over it), or a time shift of a stream found by a 1-D search on the master period's grid with a
-//      parabola through the best points (its curvature gives the standard deviation; GPS latency, an absolute pose
-//      stream's offset, and an IMU offset beyond the first-order model's range). Statistic: without a baseline the
-//      chi-square drop LR = chi2_nominal - chi2_effect ~ chi2(k) (cost = chi2 / 2, estimator/solver.h); with one, the
-//      nominal model is not exact on MuJoCo data and already moves each candidate's parameters on the nominal
-//      simulation, so H0 is "the parameters take the baseline's values" and LR is its Wald form with both fits'
-//      variances (Score in diagnose.cc). p = 1 - F_chi2(k)(LR), Delta BIC = -LR + k ln n. In order of Delta BIC,
-//      the first candidate with p < alpha, Delta BIC < max_delta_bic and a held-out chi-square drop above
-//      min_heldout_improvement (defaults 1e-3, 0, 0; gap-benchmark calibrates them) (the last part of the
-//      recording, every parameter fixed at the training values) and that explains at least min_explained_share of
-//      the mismatch there (ExplainedShare: its held-out chi-square drop over that drop plus the chi-square left above
-//      the nominal level in the components Locate found inconsistent; with effects kept, the drop is theirs and its
-//      together; default 0.25) is kept; one that fails a held-out test is dropped.
-//      Then the others are scored again on top, up to max_effects;
-//   4. model: the accepted effects' parameters and standard deviations (training fit);
+//   3. name: every candidate effect of the library (internal/effect_library.h) is fitted on the first
+//      `train_fraction` of the recording with the full solver (all calibration parameters free, warm-started at the
+//      nominal fit; internal/candidate_fit.h): a parameter slot freed in an error model (also the IMU's clock offset,
+//      the time_offset_s the gyroscope and accelerometer share, started from a profile over it), or a time shift of
+//      a stream found by a 1-D search on the master period's grid with a parabola through the best points (its
+//      curvature gives the standard deviation; GPS latency, an absolute pose stream's offset, and an IMU offset
+//      beyond the first-order model's range; internal/time_shift.h). Statistic (internal/decide.h, Score): without a
+//      baseline the chi-square drop LR = chi2_nominal - chi2_effect ~ chi2(k) (cost = chi2 / 2, estimator/solver.h);
+//      with one, the nominal model is not exact on MuJoCo data and already moves each candidate's parameters on the
+//      nominal simulation, so H0 is "the parameters take the baseline's values" and LR is its Wald form with both
+//      fits' variances. p = 1 - F_chi2(k)(LR), Delta BIC = -LR + k ln n. In order of Delta BIC, the first candidate
+//      with p < alpha, Delta BIC < max_delta_bic and a held-out chi-square drop above min_heldout_improvement
+//      (defaults 1e-3, 0, 0; gap-benchmark calibrates them) (the last part of the recording, every parameter fixed
+//      at the training values) and that explains at least min_explained_share of the mismatch there (ExplainedShare:
+//      its held-out chi-square drop over that drop plus the chi-square left above the nominal level in the
+//      components Locate found inconsistent; with effects kept, the drop is theirs and its together; default 0.25)
+//      is kept; one that fails a held-out test is dropped. Then the others are scored again on top, up to
+//      max_effects;
+//   4. model: the accepted effects' parameters and standard deviations (training fit), as estimator settings too;
 //   5. show: per-stream whitened RMS and chi2/dof on the held-out part before (nominal) and after (with the effects).
-// Verdict: "named" (some effect kept and every inconsistent component explained), "unknown" (some component stays
-// inconsistent: without a kept effect, or on the held-out part with the kept effects against the nominal model's
-// held-out level; its conditions say what it depends on; the kept effects are still listed) or "none". The diagnosis
-// reads the recording's streams only (never truth.yaml).
+// Verdict (internal/decide.h): "named" (some effect kept and every inconsistent component explained), "unknown" (some
+// component stays inconsistent: without a kept effect, or on the held-out part with the kept effects against the
+// nominal model's held-out level; its conditions say what it depends on; the kept effects are still listed) or
+// "none". The diagnosis reads the recording's streams only (never truth.yaml), and needs no simulator: the nominal
+// configuration of a simulated robot, the baseline and the re-simulation live in roamlab::gap_sim
+// (nominal_config.h, learn_baseline.h, resimulate.h).
 #pragma once
 
 #include <functional>
@@ -44,7 +47,6 @@
 #include "estimator/config.h"
 #include "gap/locate.h"
 #include "recording/recording.h"
-#include "sim/scenario.h"
 
 namespace roamlab::gap {
 
@@ -56,7 +58,7 @@ struct EffectEstimate {
   std::map<std::string, double> baseline_parameters;   // the raw fit on the nominal simulation, subtracted
   double lr_raw = 0.0;                          // chi2 drop on the training part against the nominal model
   double baseline_lr = 0.0;                     // the same candidate's drop on the nominal simulation
-  double lr = 0.0;                              // the test statistic (Score in diagnose.cc), ~ chi2(dof) under H0
+  double lr = 0.0;                              // the test statistic (Score, internal/decide.h), ~ chi2(dof) under H0
   double lr_pvalue = 1.0;
   double delta_bic = 0.0;                       // < 0 favours the effect
   double heldout_improvement = 0.0;             // relative drop of the held-out chi2 (0.1 = 10 % lower)
@@ -126,19 +128,8 @@ struct DiagnoseOptions {
   std::function<void(const std::string&)> progress;
 };
 
-// The candidate effects the library knows (issue 6), whether or not a configuration supports them.
+// The candidate effects the library knows, whether or not a configuration supports them.
 const std::vector<std::string>& CandidateNames();
-
-// The nominal estimator configuration of an Ackermann scenario: the streams its sensors produce with the scenario's
-// noise, the Table I calibration free with the scenario's values as the initial guess (staged as
-// configs/atv_calibration.yaml), k_gamma fixed at the scenario's value (the handlebar sensor's zero is believed;
-// a steering_offset is a departure from it), gyroscope scale 1 and cornering compliance 0 fixed (eq. 15 as written),
-// the magnetometer's motor interference 0 fixed on the IMU's specific force as the drive torque's proxy (c = m r / 2
-// from the nominal vehicle's mass and rear tire radius, models/magnetometer.h), no outlier gating (the chi-square comparisons need the same measurements in every fit). differential_drive, omni3
-// and mecanum scenarios: the wheel encoders (master) with the platform geometry measured on the robot's model, one
-// radius free for all wheels, the yaw lever arm (baseline, distance, lx_plus_ly) fixed, and the gyroscope with the
-// IMU misalignment free (diagnose.cc). Errors: another robot kind, or a master or yaw sensor missing.
-Result<estimator::EstimatorConfig> NominalConfig(const sim::Scenario& scenario);
 
 // Runs the diagnosis. Errors: the configuration does not fit the recording, or a fit fails.
 Result<Diagnosis> Diagnose(const estimator::EstimatorConfig& nominal, const recording::Recording& recording,
@@ -148,8 +139,7 @@ Result<Diagnosis> Diagnose(const estimator::EstimatorConfig& nominal, const reco
 // max(0, chi2 - expected * count), with `components` the fit's per-component statistics and `expected` the nominal
 // model's held-out chi2/dof per component (missing keys: 1; keys absent from `components` add nothing). Every located
 // component counts, also one back within Locate's ratio there: a decoy's accelerometer at a few times its tiny level
-// can fall under the verdict's rule on 10 s (measured: gap-benchmark case 055 of the 60-case run) and still hold
-// most of the mismatch.
+// can fall under the verdict's rule on a short held-out part and still hold most of the mismatch.
 double HeldoutExcess(const std::map<std::string, ComponentLevel>& components, const std::vector<std::string>& keys,
                      const std::map<std::string, double>& expected);
 // The share of the held-out mismatch a candidate explains: its held-out chi-square drop D over D plus the located

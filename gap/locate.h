@@ -1,4 +1,4 @@
-// Locating a reality gap (DESIGN.md, "Reality-gap diagnosis", step 2): where the whitened residuals of a calibrated
+// Locating a reality gap (the diagnosis's step 2, gap/diagnose.h): where the whitened residuals of a calibrated
 // estimate stop looking like N(0, 1) noise. Per stream and residual component: the chi-square per degree of freedom
 // against the level expected of the nominal model (1, or what the nominal simulation gives: MuJoCo's suspension and
 // tire compliance already make some streams inconsistent); when: sliding-window statistics flag the intervals whose
@@ -111,12 +111,9 @@ std::map<std::string, ComponentLevel> ComponentStatistics(const std::vector<esti
 // part of the noise (the poses follow the IMU: its components sit at 0.01-0.4): the residuals are the noise projected
 // away from what the fit moves, whose chi-square has mean expected * count and a variance between 2 expected^2 count
 // (the projection's eigenvalues all equal) and 2 expected count (each 0 or 1); the quantile takes the wider,
-// chi2(expected * count). Measured on the ATV's nominal 30 s drives (`roamlab diagnose --no-baseline`, noise seeds 12,
-// 13, 14, 16, 17, 21, 22, 900001; the truth is the same, only the noise differs): the gyroscope's world x and y, at
-// levels 0.01-0.04 over 2900 residuals, spread by 14-22 % (coefficient of variation) between seeds on the weave and on
-// the former drive, as chi2(expected * count) predicts (17 % at 0.03), not 2.6 % as chi2(count) scaled does; with
-// the latter, the weave's world y at 0.033 on seed 12 against the baseline seed's 0.025 (the lowest of the eight)
-// was "inconsistent" with no effect hidden.
+// chi2(expected * count). Between noise seeds of one nominal drive, a low level (the gyroscope's world x and y at
+// 0.01-0.04) spreads as chi2(expected * count) predicts, far more than chi2(count) scaled: with the latter, a
+// nominal drive's component would be "inconsistent" with no effect hidden.
 double LevelQuantile(double p, double expected_chi2_per_dof, int count);
 // Locate's rule: chi2_per_dof above `ratio` times the expected level and above the level's 99.9 % quantile
 // (LevelQuantile) for `count` residuals.

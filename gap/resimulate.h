@@ -1,7 +1,7 @@
-// The diagnosis's last step on the simulator's side (issue 6, "Shows": "re-simulates ... with the patch and compares
-// before/after on held-out data"): the nominal scenario is simulated again without sensor noise over the recording's
-// span, once as believed and once with the accepted effects applied as the simulator applies them, and each of the
-// recording's streams is compared sample by sample with both simulations on the held-out part.
+// The diagnosis's last step on the simulator's side (gap/diagnose.h, step 5, shown by simulation): the nominal
+// scenario is simulated again without sensor noise over the recording's span, once as believed and once with the
+// accepted effects applied as the simulator applies them, and each of the recording's streams is compared sample by
+// sample with both simulations on the held-out part.
 //
 // The simulation is driven by the scenario's own driver, so the comparison means something only for a recording of the
 // scenario's drive (a simulated recording with hidden effects, or a real robot driven by the same command schedule):

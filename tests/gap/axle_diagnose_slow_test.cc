@@ -1,5 +1,5 @@
 // The reality-gap diagnosis of a misaligned rear axle on 30 s ATV drives (scenarios/atv_hills_sines.yaml, the drive
-// these diagnose tests were measured on): a thrust angle (sim axle_misalignment on the ackermann rear axle, estimator
+// of the other diagnose tests): a thrust angle (sim axle_misalignment on the ackermann rear axle, estimator
 // odometer.thrust_angle) against a steering offset.
 // Kinematics (estimator/models/ackermann_velocity.h): the thrust angle alpha turns the vehicle at -v tan(alpha) / L at
 // zero handlebar, as a steering offset of -alpha does, and makes it crab by alpha. The crab is seen only against a
@@ -109,10 +109,8 @@ class NominalAxleTest : public ::testing::Test {
 testing::LearnedNominal* NominalAxleTest::nominal_ = nullptr;
 
 // With the nominal model (IMU misalignment free) the thrust angle and a steering offset of -alpha explain the drive
-// alike (to alpha sin^2(delta)): measured with the candidate in the library, both fitted to within a chi2 of 2 (yaw_deg
-// 2.024 +- 0.031 against offset_rad -0.0348; on a hidden steering offset of 0.03 rad, yaw_deg -1.765 +- 0.031 fitted
-// as well as the offset), so the library leaves the candidate out there, and the thrust angle reads as a steering
-// offset of -alpha.
+// alike (to alpha sin^2(delta)): with the candidate in the library both fit about equally well, so the library leaves
+// the candidate out there, and the thrust angle reads as a steering offset of -alpha.
 TEST_F(NominalAxleTest, ThrustAngleReadsAsASteeringOffsetWhenTheImuMountingIsFree) {
   const double yaw_deg = 2.0;
   const Diagnosis d = Diagnosed(*nominal_, {{"axle_misalignment", {{"yaw_deg", yaw_deg}}}}, 18);

@@ -11,6 +11,8 @@
 #include <gtest/gtest.h>
 
 #include "gap/diagnose.h"
+#include "gap/learn_baseline.h"
+#include "gap/nominal_config.h"
 #include "sim/simulator.h"
 
 namespace roamlab::gap::testing {
@@ -24,8 +26,8 @@ inline sim::Simulation SimulatedWithSeed(const sim::Scenario& scenario, std::uin
   return std::move(simulation).value();
 }
 
-// A nominal scenario with its nominal model and the baseline learned on its simulation with noise seed 900001 (a seed
-// no test case uses), as `roamlab diagnose` learns it.
+// A nominal scenario with its nominal model and the baseline learned on its simulation with noise seed
+// kDefaultBaselineSeed (a seed no test case uses), as `roamlab diagnose` learns it (LearnBaseline).
 struct LearnedNominal {
   sim::Scenario scenario;
   estimator::EstimatorConfig config;
@@ -46,12 +48,10 @@ inline std::unique_ptr<LearnedNominal> LearnNominal(
   if (!config.ok()) return nullptr;
   out->config = config.value();
   if (adjust) adjust(&out->config);
-  DiagnoseOptions learn;
-  learn.max_effects = 0;
-  auto learned = Diagnose(out->config, SimulatedWithSeed(out->scenario, 900001).recording, learn);
+  auto learned = LearnBaseline(out->scenario, out->config);
   EXPECT_TRUE(learned.ok()) << learned.status().message();
   if (!learned.ok()) return nullptr;
-  out->baseline = BaselineFrom(learned.value());
+  out->baseline = learned.value().baseline;
   return out;
 }
 

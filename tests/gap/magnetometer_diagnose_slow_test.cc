@@ -27,7 +27,7 @@ testing::LearnedNominal* MagnetometerDiagnoseTest::nominal_ = nullptr;
 
 // |k| = 1.5e-3 per N m: at the drive torque (48 N m rms, peaks 130 N m) a bias of 0.07 rms, 0.19 at peak, of the
 // unit field (the noise is 0.067 per axis): a heading error of several degrees whenever the ATV climbs. Smaller ones
-// are named too (1e-3 on two seeds of two, 4e-4 on one of two: README), but the stream chi-square stays near its band.
+// can be named too, but the stream chi-square stays near its band.
 TEST_F(MagnetometerDiagnoseTest, InterferenceIsNamedFirstWithItsBiasPerNewtonMetre) {
   ASSERT_NE(nominal_, nullptr);
   const Eigen::Vector3d k = Eigen::Vector3d(0.6, -0.64, 0.48).normalized() * 1.5e-3;

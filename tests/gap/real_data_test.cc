@@ -1,4 +1,4 @@
-// The diagnosis on real recordings (../shared/data, skipped when absent), where nothing labels the effects:
+// The diagnosis on real recordings (ROAMLAB_SHARED_DIR/data, skipped when absent), where nothing labels the effects:
 // OptiOdom's differential drive (unequal wheel diameters, a wider effective track) and the Husky bag (skid-steer yaw
 // mismatch). The data README's reference values come from a "quick least-squares look", not from ground truth; the
 // OptiOdom test checks the diagnosis against an independent least-squares fit on the same run instead (YawRatio).
@@ -158,9 +158,9 @@ TEST(RealDataTest, OptiOdomDifferentialDriveTrackAndWheelRatio) {
   }
   std::cout << "mean over runs 02-06: whole run nominal " << whole_nominal << " m, patched " << whole_patched
             << " m; 10 s segments nominal " << seg_nominal << " m, patched " << seg_patched << " m\n";
-  // Only the whole runs are asserted: over 10 s segments (errors of 3-10 mm) the patch does not help (measured 9.0 mm
-  // nominal, 10.3 mm patched), since there the error is of the size of the clock offset between the encoders and
-  // the motion capture, one 50 ms cycle that jumps within a run (README, diagnose on real recordings).
+  // Only the whole runs are asserted: over 10 s segments (errors of 3-10 mm) the patch does not help, since there the
+  // error is of the size of the clock offset between the encoders and the motion capture, one 50 ms cycle that jumps
+  // within a run.
   EXPECT_LT(whole_patched, whole_nominal);
 }
 
@@ -211,8 +211,8 @@ TEST(RealDataTest, HuskySkidSteerYawMismatch) {
     std::cout << " LR " << e.lr << " dBIC " << e.delta_bic << " " << e.decision << "\n";
   }
   for (const std::string& u : d.value().unexplained) std::cout << "unexplained: " << u << "\n";
-  // Both effects below are kept. The verdict is "unknown" (measured 2026-11-26, also on e2d7b3b): a GPS component
-  // stays 2.6 times its level on the held-out part with them, structure of the real receiver that no candidate of
+  // Both effects below are kept. The verdict is "unknown": a GPS component stays several times its level on
+  // the held-out part with them, structure of the real receiver that no candidate of
   // the library models (the verdict's rule), so it is reported beside the named effects rather than hidden.
   EXPECT_NE(d.value().verdict, "none");
   EXPECT_EQ(d.value().effects.size(), 2u);

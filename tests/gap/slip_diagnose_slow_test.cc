@@ -5,7 +5,7 @@
 // slope_slip_per_mps2 (on the poses' pitch) slots (models/ackermann_velocity.h). The ATV without an effect stays "none"
 // with both in the library: DiagnoseTest.NoEffectGivesNone (diagnose_slow_test.cc). Also softer tires (lateral_slip:
 // the tires' contact time constant in MuJoCo scaled) against the lateral_slip candidate (cornering compliance). The
-// truth is the case's own parameter (for lateral_slip the compliance measured on the truth, README); the diagnosis
+// truth is the case's own parameter (for lateral_slip the compliance measured on the truth); the diagnosis
 // sees the recording only.
 #include <cmath>
 #include <iostream>
@@ -65,11 +65,10 @@ TEST_F(SlipDiagnoseTest, LongitudinalSlipIsNamedFirstWithItsSlipPerTraction) {
 TEST_F(SlipDiagnoseTest, SlopeSlipIsNamedFirstWithItsSlipPerSlope) { ExpectNamedFirst("slope_slip", 0.02, 32); }
 
 // Softer tires (sim/scenario.h lateral_slip: the tires' contact time constant times k) raise the cornering compliance
-// on the truth of this drive by 0.0203 (k - 1) s at the rear (v_y at the contact regressed on a_y: 0.0207 s at k = 1,
-// 0.0409 at 2, 0.0614 at 3, 0.0816 at 4; the noise seed does not change the physics). At k = 3 the lateral_slip
-// candidate (cornering_front / cornering_rear freed, reported as departures from the baseline) is named first and
-// recovers the rear departure within 3 reported std. (By hand with this code: k = 3 seed 35 and k = 4, 2.5 named
-// first too; k = 2 named gyro_scale_error first, k = 1.5 nothing: README.)
+// on the truth of this drive by about 0.02 (k - 1) s at the rear (v_y at the contact regressed on a_y; the noise seed
+// does not change the physics). At k = 3 the lateral_slip candidate (cornering_front / cornering_rear freed, reported
+// as departures from the baseline) is named first and recovers the rear departure within 3 reported std; at k = 2 and
+// below the compliance is too small to be named first.
 TEST_F(SlipDiagnoseTest, LateralSlipIsNamedFirstWithTheComplianceOfSofterTires) {
   ASSERT_NE(nominal_, nullptr);
   const double k = 3.0;

@@ -1,11 +1,11 @@
-#include "apps/gap_benchmark_score.h"
+#include "gap/benchmark/score.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <tuple>
 
-namespace roamlab::apps::gapbench {
+namespace roamlab::gap::benchmark {
 namespace {
 
 using nlohmann::json;
@@ -13,7 +13,7 @@ using nlohmann::json;
 constexpr double kAlphas[] = {1e-2, 1e-3, 1e-4, 1e-6};
 constexpr double kDeltaBics[] = {0.0, -10.0, -30.0, -100.0};
 constexpr double kHeldouts[] = {0.0, 0.01, 0.03};
-constexpr double kShares[] = {0.0, 0.1, gap::kDefaultMinExplainedShare, 0.5};
+constexpr double kShares[] = {0.0, 0.1, kDefaultMinExplainedShare, 0.5};
 
 double Median(std::vector<double> v) {
   if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
@@ -191,7 +191,10 @@ double RearCorneringCompliance(const Trajectory& truth) {
   return -X.colPivHouseholderQr().solve(y)[1];
 }
 
-json Summarize(const std::vector<CaseResult>& cases, double min_noise_ratio) {
+namespace {
+
+// The counts and per-case figures Summarize reduces.
+struct Tally {
   int effects = 0, top1 = 0, top3 = 0, strong = 0, strong_top1 = 0, strong_top3 = 0;
   int nones = 0, none_false = 0, none_none = 0, decoys = 0, decoy_false = 0, decoy_unknown = 0, decoy_unknown_any = 0;
   int top1_unknown = 0;
@@ -202,108 +205,117 @@ json Summarize(const std::vector<CaseResult>& cases, double min_noise_ratio) {
   // whatever the model does.
   std::vector<double> sim_above, rms_above, sim_below, rms_below;
   std::map<std::string, std::pair<int, int>> by_effect;   // name -> (top-1 correct, cases)
-  for (const CaseResult& c : cases) {
-    const std::string kept = FirstKept(c);
-    if (c.kind == "none") {
-      ++nones;
-      none_false += FalseDiscovery(c, kept);
-      none_none += c.verdict == "none";
-      continue;
-    }
-    if (c.kind == "decoy") {
-      ++decoys;
-      decoy_false += FalseDiscovery(c, kept);
-      decoy_unknown += c.verdict == "unknown" && !FalseDiscovery(c, kept);
-      decoy_unknown_any += c.verdict == "unknown";
-      continue;
-    }
-    ++effects;
-    const bool first = Identified(c, kept);
-    const auto end3 = c.ranked.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(3, c.ranked.size()));
-    const bool in3 = !kept.empty() && std::find(c.ranked.begin(), end3, c.truth_name) != end3;
-    top1 += first;
-    top1_unknown += first && c.verdict == "unknown";
-    top3 += in3;
-    ++by_effect[c.truth_name].second;
-    by_effect[c.truth_name].first += first;
-    if (c.noise_ratio >= min_noise_ratio) {
-      ++strong;
-      strong_top1 += first;
-      strong_top3 += in3;
-    }
-    // Relative to the effect's size (its departure from neutral), so that a scale of 1.03 estimated as 1.02 is a
-    // 33 % error, not 1 %.
-    const double size = std::abs(c.truth_value - NeutralValue(c.truth_parameter));
-    if (first && c.has_estimate && size > 0.0) relative_error.push_back(std::abs(c.estimate - c.truth_value) / size);
-    if (c.has_rms && c.rms_before > 0.0) {
-      const double reduction = 1.0 - c.rms_after / c.rms_before;
-      rms_all.push_back(reduction);
-      if (first) rms_named.push_back(reduction);
-    }
-    if (c.has_sim_rms && c.sim_rms_before > 0.0) {
-      const double reduction = 1.0 - c.sim_rms_after / c.sim_rms_before;
-      sim_all.push_back(reduction);
-      if (first) sim_named.push_back(reduction);
-      const bool above = c.sim_rms_before >= std::sqrt(2.0);
-      if (first) (above ? sim_above : sim_below).push_back(reduction);
-      if (first && c.has_rms && c.rms_before > 0.0)
-        (above ? rms_above : rms_below).push_back(1.0 - c.rms_after / c.rms_before);
-    }
-    if (c.has_sim_rms && c.sim_rms_1s_before > 0.0) {
-      const double reduction = 1.0 - c.sim_rms_1s_after / c.sim_rms_1s_before;
-      sim_1s_all.push_back(reduction);
-      if (first) sim_1s_named.push_back(reduction);
-    }
-    if (c.has_rms && c.rms_1s_before > 0.0) {
-      const double reduction = 1.0 - c.rms_1s_after / c.rms_1s_before;
-      rms_1s_all.push_back(reduction);
-      if (first) rms_1s_named.push_back(reduction);
-    }
+};
+
+// 1 - after / before into `all`, and into `named` when the case's effect was identified (`first`).
+void AddReduction(double before, double after, bool first, std::vector<double>* all, std::vector<double>* named) {
+  const double reduction = 1.0 - after / before;
+  all->push_back(reduction);
+  if (first) named->push_back(reduction);
+}
+
+// An effect case's RMS reductions (held-out fit and re-simulation, per sample and of the 1 s means); `first`: its
+// effect was identified.
+void CountReductions(const CaseResult& c, bool first, Tally* t) {
+  if (c.has_rms && c.rms_before > 0.0) AddReduction(c.rms_before, c.rms_after, first, &t->rms_all, &t->rms_named);
+  if (c.has_sim_rms && c.sim_rms_before > 0.0) {
+    AddReduction(c.sim_rms_before, c.sim_rms_after, first, &t->sim_all, &t->sim_named);
+    const bool above = c.sim_rms_before >= std::sqrt(2.0);
+    if (first) (above ? t->sim_above : t->sim_below).push_back(1.0 - c.sim_rms_after / c.sim_rms_before);
+    if (first && c.has_rms && c.rms_before > 0.0)
+      (above ? t->rms_above : t->rms_below).push_back(1.0 - c.rms_after / c.rms_before);
   }
+  if (c.has_sim_rms && c.sim_rms_1s_before > 0.0)
+    AddReduction(c.sim_rms_1s_before, c.sim_rms_1s_after, first, &t->sim_1s_all, &t->sim_1s_named);
+  if (c.has_rms && c.rms_1s_before > 0.0)
+    AddReduction(c.rms_1s_before, c.rms_1s_after, first, &t->rms_1s_all, &t->rms_1s_named);
+}
+
+void Count(const CaseResult& c, double min_noise_ratio, Tally* t) {
+  const std::string kept = FirstKept(c);
+  if (c.kind == "none") {
+    ++t->nones;
+    t->none_false += FalseDiscovery(c, kept);
+    t->none_none += c.verdict == "none";
+    return;
+  }
+  if (c.kind == "decoy") {
+    ++t->decoys;
+    t->decoy_false += FalseDiscovery(c, kept);
+    t->decoy_unknown += c.verdict == "unknown" && !FalseDiscovery(c, kept);
+    t->decoy_unknown_any += c.verdict == "unknown";
+    return;
+  }
+  ++t->effects;
+  const bool first = Identified(c, kept);
+  const auto end3 = c.ranked.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(3, c.ranked.size()));
+  const bool in3 = !kept.empty() && std::find(c.ranked.begin(), end3, c.truth_name) != end3;
+  t->top1 += first;
+  t->top1_unknown += first && c.verdict == "unknown";
+  t->top3 += in3;
+  ++t->by_effect[c.truth_name].second;
+  t->by_effect[c.truth_name].first += first;
+  if (c.noise_ratio >= min_noise_ratio) {
+    ++t->strong;
+    t->strong_top1 += first;
+    t->strong_top3 += in3;
+  }
+  // Relative to the effect's size (its departure from neutral), so that a scale of 1.03 estimated as 1.02 is a
+  // 33 % error, not 1 %.
+  const double size = std::abs(c.truth_value - NeutralValue(c.truth_parameter));
+  if (first && c.has_estimate && size > 0.0) t->relative_error.push_back(std::abs(c.estimate - c.truth_value) / size);
+  CountReductions(c, first, t);
+}
+
+}  // namespace
+
+json Summarize(const std::vector<CaseResult>& cases, double min_noise_ratio) {
+  Tally t;
+  for (const CaseResult& c : cases) Count(c, min_noise_ratio, &t);
   json per_effect = json::object();
-  for (const auto& [name, k] : by_effect) per_effect[name] = {{"top1", k.first}, {"cases", k.second}};
-  const json top1_strong = Fraction(strong_top1, strong);
-  const json false_rate = Fraction(none_false, nones);
-  const json unknown_rate = Fraction(decoy_unknown, decoys);
-  const json rel = Number(Median(relative_error));
-  const json rms = Number(Median(rms_named));
-  const json rms_1s = Number(Median(rms_1s_named));
-  const json sim = Number(Median(sim_named));
-  const json sim_1s = Number(Median(sim_1s_named));
-  return {{"effect_cases", effects},
-          {"top1", Fraction(top1, effects)},
-          {"top3", Fraction(top3, effects)},
-          {"top1_with_verdict_unknown", top1_unknown},
+  for (const auto& [name, k] : t.by_effect) per_effect[name] = {{"top1", k.first}, {"cases", k.second}};
+  const json top1_strong = Fraction(t.strong_top1, t.strong);
+  const json false_rate = Fraction(t.none_false, t.nones);
+  const json unknown_rate = Fraction(t.decoy_unknown, t.decoys);
+  const json rel = Number(Median(t.relative_error));
+  const json rms = Number(Median(t.rms_named));
+  const json rms_1s = Number(Median(t.rms_1s_named));
+  const json sim = Number(Median(t.sim_named));
+  const json sim_1s = Number(Median(t.sim_1s_named));
+  return {{"effect_cases", t.effects},
+          {"top1", Fraction(t.top1, t.effects)},
+          {"top3", Fraction(t.top3, t.effects)},
+          {"top1_with_verdict_unknown", t.top1_unknown},
           {"min_noise_ratio", min_noise_ratio},
-          {"strong_effect_cases", strong},
+          {"strong_effect_cases", t.strong},
           {"top1_strong", top1_strong},
-          {"top3_strong", Fraction(strong_top3, strong)},
+          {"top3_strong", Fraction(t.strong_top3, t.strong)},
           {"by_effect", per_effect},
-          {"none_cases", nones},
+          {"none_cases", t.nones},
           {"false_discovery_rate", false_rate},
-          {"none_reported_none", Fraction(none_none, nones)},
-          {"decoy_cases", decoys},
+          {"none_reported_none", Fraction(t.none_none, t.nones)},
+          {"decoy_cases", t.decoys},
           {"decoys_unknown", unknown_rate},
-          {"decoy_false_discovery_rate", Fraction(decoy_false, decoys)},
-          {"decoys_unknown_effect_kept_or_not", Fraction(decoy_unknown_any, decoys)},
+          {"decoy_false_discovery_rate", Fraction(t.decoy_false, t.decoys)},
+          {"decoys_unknown_effect_kept_or_not", Fraction(t.decoy_unknown_any, t.decoys)},
           {"median_parameter_relative_error", rel},
-          {"parameter_errors", relative_error.size()},
+          {"parameter_errors", t.relative_error.size()},
           {"median_heldout_rms_reduction", rms},
-          {"median_heldout_rms_reduction_all_effect_cases", Number(Median(rms_all))},
+          {"median_heldout_rms_reduction_all_effect_cases", Number(Median(t.rms_all))},
           {"median_heldout_rms_1s_reduction", rms_1s},
-          {"median_heldout_rms_1s_reduction_all_effect_cases", Number(Median(rms_1s_all))},
+          {"median_heldout_rms_1s_reduction_all_effect_cases", Number(Median(t.rms_1s_all))},
           {"median_resimulated_rms_reduction", sim},
-          {"median_resimulated_rms_reduction_all_effect_cases", Number(Median(sim_all))},
+          {"median_resimulated_rms_reduction_all_effect_cases", Number(Median(t.sim_all))},
           {"median_resimulated_rms_1s_reduction", sim_1s},
-          {"median_resimulated_rms_1s_reduction_all_effect_cases", Number(Median(sim_1s_all))},
+          {"median_resimulated_rms_1s_reduction_all_effect_cases", Number(Median(t.sim_1s_all))},
           {"above_noise",
-           {{"cases", sim_above.size()},
-            {"median_resimulated_rms_reduction", Number(Median(sim_above))},
-            {"median_heldout_rms_reduction", Number(Median(rms_above))}}},
+           {{"cases", t.sim_above.size()},
+            {"median_resimulated_rms_reduction", Number(Median(t.sim_above))},
+            {"median_heldout_rms_reduction", Number(Median(t.rms_above))}}},
           {"below_noise",
-           {{"cases", sim_below.size()},
-            {"median_resimulated_rms_reduction", Number(Median(sim_below))},
-            {"median_heldout_rms_reduction", Number(Median(rms_below))}}},
+           {{"cases", t.sim_below.size()},
+            {"median_resimulated_rms_reduction", Number(Median(t.sim_below))},
+            {"median_heldout_rms_reduction", Number(Median(t.rms_below))}}},
           {"targets",
            {{"top1_strong", Target(top1_strong, 0.85, true)},
             {"false_discovery_rate", Target(false_rate, kMaxNoneFalseRate, false)},
@@ -350,4 +362,4 @@ json CaseRow(const CaseResult& c) {
           {"seconds", c.seconds}};
 }
 
-}  // namespace roamlab::apps::gapbench
+}  // namespace roamlab::gap::benchmark

@@ -1,12 +1,12 @@
-// The scoring of `roamlab gap-benchmark` on made-up cases (no simulation): replay of the first round's decision,
-// threshold choice on calibration cases, noise ratios and the issue's figures.
-#include "apps/gap_benchmark_score.h"
+// The scoring of the gap benchmark (gap/benchmark/score.h) on made-up cases (no simulation): replay of the first
+// round's decision, threshold choice on calibration cases, noise ratios and the benchmark's figures.
+#include "gap/benchmark/score.h"
 
 #include <cmath>
 
 #include <gtest/gtest.h>
 
-namespace roamlab::apps::gapbench {
+namespace roamlab::gap::benchmark {
 namespace {
 
 CandidateStats Candidate(const std::string& name, double p, double delta_bic, double heldout, bool evaluated = true) {
@@ -221,7 +221,18 @@ CaseResult Scored(const std::string& kind, const std::string& truth, const std::
   return c;
 }
 
-TEST(GapBenchmarkScore, SummarizesTheIssuesFigures) {
+// The re-simulation's RMS of a case's stream, per sample and of the 1 s means, as believed and with the effects.
+void Resimulated(CaseResult* c, const std::string& stream, double before, double after, double before_1s,
+                 double after_1s) {
+  c->sim_stream = stream;
+  c->sim_rms_before = before;
+  c->sim_rms_after = after;
+  c->sim_rms_1s_before = before_1s;
+  c->sim_rms_1s_after = after_1s;
+  c->has_sim_rms = true;
+}
+
+TEST(GapBenchmarkScore, SummarizesTheBenchmarksFigures) {
   std::vector<CaseResult> cases;
   // Strong effect named right, with a 10 % parameter error on a scale (1.05 vs 1.045: error 0.005 of 0.05) and the
   // affected stream's held-out RMS from 2.0 to 1.0.
@@ -234,12 +245,7 @@ TEST(GapBenchmarkScore, SummarizesTheIssuesFigures) {
   right.rms_after = 1.0;
   right.has_rms = true;
   // The re-simulation: 1.5 -> 1.2 per sample (20 %), 0.4 -> 0.1 in the 1 s means (75 %).
-  right.sim_stream = "gyroscope";
-  right.sim_rms_before = 1.5;
-  right.sim_rms_after = 1.2;
-  right.sim_rms_1s_before = 0.4;
-  right.sim_rms_1s_after = 0.1;
-  right.has_sim_rms = true;
+  Resimulated(&right, "gyroscope", 1.5, 1.2, 0.4, 0.1);
   cases.push_back(right);
   // Strong effect, second in the ranking: top-3 but not top-1; RMS 1.2 -> 1.14 (5 %).
   CaseResult second = Scored("effect", "gps_latency", "named", {"imu_time_offset"}, 4.0);
@@ -248,11 +254,7 @@ TEST(GapBenchmarkScore, SummarizesTheIssuesFigures) {
   second.rms_before = 1.2;
   second.rms_after = 1.14;
   second.has_rms = true;
-  second.sim_rms_before = 2.0;
-  second.sim_rms_after = 1.0;
-  second.sim_rms_1s_before = 1.0;
-  second.sim_rms_1s_after = 0.5;
-  second.has_sim_rms = true;
+  Resimulated(&second, "", 2.0, 1.0, 1.0, 0.5);
   cases.push_back(second);
   // Weak effect (below 3 x noise) not found: counts overall only.
   cases.push_back(Scored("effect", "imu_time_offset", "unknown", {}, 1.5));
@@ -304,4 +306,4 @@ TEST(GapBenchmarkScore, SummarizesTheIssuesFigures) {
 }
 
 }  // namespace
-}  // namespace roamlab::apps::gapbench
+}  // namespace roamlab::gap::benchmark

@@ -1,4 +1,4 @@
-// Scoring of `roamlab gap-benchmark` (issue 6, "The proof"): pure functions on the cases' outcomes, no simulation.
+// Scoring of the gap benchmark (gap/benchmark/benchmark.h): pure functions on the cases' outcomes, no simulation.
 //
 //   - ReplayFirstRound: the diagnosis's first-round decision (gap/diagnose.h, step 3) under other thresholds, from the
 //     candidates' statistics of a run with looser ones (held-out evaluated for every candidate passing them);
@@ -7,12 +7,12 @@
 //   - ChooseThresholds: the thresholds (alpha, Delta BIC, held-out drop, share of the held-out mismatch explained)
 //     fixed on the calibration cases only (drawn stratified, CalibrationKind): the
 //     grid point that identifies the most calibration cases correctly with false discoveries on the none cases and
-//     on the decoys at or under the issue's targets;
+//     on the decoys at or under the benchmark's targets;
 //   - CalibrationSigmas / NoiseRatio: the noise of an effect's parameter is the median standard deviation the
 //     diagnosis reports for that candidate's parameter over the calibration cases of the platform (every case fits
 //     every candidate); an effect's magnitude relative to the noise is |theta - neutral| / that sigma;
 //   - RearCorneringCompliance: a lateral_slip effect's size in the candidate's units, measured on a drive's truth;
-//   - Summarize: the issue's figures and targets.
+//   - Summarize: the benchmark's figures and targets.
 #pragma once
 
 #include <limits>
@@ -25,9 +25,9 @@
 #include "gap/diagnose.h"
 #include "recording/trajectory.h"
 
-namespace roamlab::apps::gapbench {
+namespace roamlab::gap::benchmark {
 
-// A first-round candidate's statistics (gap::EffectEstimate).
+// A first-round candidate's statistics (EffectEstimate).
 struct CandidateStats {
   std::string name;
   double lr_pvalue = 1.0;
@@ -35,7 +35,7 @@ struct CandidateStats {
   bool evaluated_heldout = false;
   double heldout_improvement = 0.0;
   std::map<std::string, double> std;      // reported standard deviations (NaN when unknown)
-  // The share of the held-out mismatch it explains (gap::ExplainedShare; NaN: not evaluated).
+  // The share of the held-out mismatch it explains (ExplainedShare; NaN: not evaluated).
   double explained_share = std::numeric_limits<double>::quiet_NaN();
 };
 
@@ -43,7 +43,7 @@ struct Thresholds {
   double alpha = 1e-3;
   double max_delta_bic = 0.0;
   double min_heldout_improvement = 0.0;
-  double min_explained_share = gap::kDefaultMinExplainedShare;
+  double min_explained_share = kDefaultMinExplainedShare;
 };
 
 // One benchmark case: what was hidden, what the diagnosis said, and the figures scored from truth.yaml.
@@ -61,7 +61,7 @@ struct CaseResult {
   double estimate = 0.0;                   // the diagnosis's value of truth_parameter, when the truth was named
   bool has_estimate = false;
   double rms_before = 0.0, rms_after = 0.0;   // held-out whitened RMS of the affected stream
-  double rms_1s_before = 0.0, rms_1s_after = 0.0;   // its systematic part (gap::StreamFit::rms_1s)
+  double rms_1s_before = 0.0, rms_1s_after = 0.0;   // its systematic part (StreamFit::rms_1s)
   bool has_rms = false;
   // The re-simulation's (gap/resimulate.h): RMS of recorded minus simulated in the stream the effect shows in
   // (SimulatedStream), in units of its stated noise, on the held-out part, as believed and with the accepted effects.
@@ -73,8 +73,8 @@ struct CaseResult {
   double seconds = 0.0;
 };
 
-// The issue's targets on the effect-free cases: false discoveries on none cases <= 10 %, decoys reported `unknown` (and
-// nothing kept) >= 70 %, i.e. at most 30 % of the decoys with a library effect kept.
+// The benchmark's targets on the effect-free cases: false discoveries on none cases <= 10 %, decoys reported `unknown`
+// (and nothing kept) >= 70 %, i.e. at most 30 % of the decoys with a library effect kept.
 constexpr double kMaxNoneFalseRate = 0.10;
 constexpr double kMinDecoysUnknown = 0.70;
 
@@ -112,7 +112,7 @@ Thresholds Loosest();
 // Thresholds from calibration cases: the grid point with the most correct replays among those whose false-discovery
 // rate is <= max_none_false_rate on the none cases and <= max_decoy_false_rate on the decoys (all points when none
 // is); ties go to the point nearest diagnose's defaults (alpha 1e-3, Delta BIC 0, held-out drop 0, explained share
-// gap::kDefaultMinExplainedShare), then the strictest. `table` (optional) receives every grid
+// kDefaultMinExplainedShare), then the strictest. `table` (optional) receives every grid
 // point's counts.
 Thresholds ChooseThresholds(const std::vector<CaseResult>& calibration, double max_none_false_rate,
                             double max_decoy_false_rate, nlohmann::json* table = nullptr);
@@ -131,10 +131,10 @@ double NoiseRatio(const std::map<std::string, std::map<std::string, double>>& si
 // a_y). NaN with fewer than 10 such pose pairs.
 double RearCorneringCompliance(const Trajectory& truth);
 
-// The issue's figures over the scored cases, with the targets and whether each is met.
+// The benchmark's figures over the scored cases, with the targets and whether each is met.
 nlohmann::json Summarize(const std::vector<CaseResult>& cases, double min_noise_ratio = 3.0);
 
 // One case as a row of score.json's table.
 nlohmann::json CaseRow(const CaseResult& c);
 
-}  // namespace roamlab::apps::gapbench
+}  // namespace roamlab::gap::benchmark

@@ -1,13 +1,26 @@
 // The nominal estimator configuration that `roamlab diagnose` builds from a scenario (gap::NominalConfig).
+#include <optional>
+
 #include <gtest/gtest.h>
 
-#include "gap/diagnose.h"
+#include "gap/nominal_config.h"
 #include "sim/scenario.h"
 
 namespace roamlab::gap {
 namespace {
 
 std::string Source(const std::string& relative) { return std::string(ROAMLAB_SOURCE_DIR) + "/" + relative; }
+
+// The nominal configuration of the scenario at `relative`; none (with a test failure) when either fails.
+std::optional<estimator::EstimatorConfig> NominalOf(const std::string& relative) {
+  auto scenario = sim::LoadScenario(Source(relative));
+  EXPECT_TRUE(scenario.ok()) << scenario.status().message();
+  if (!scenario.ok()) return std::nullopt;
+  auto config = NominalConfig(scenario.value());
+  EXPECT_TRUE(config.ok()) << config.status().message();
+  if (!config.ok()) return std::nullopt;
+  return config.value();
+}
 
 TEST(NominalConfigTest, TheAtvScenarioGivesTheCalibrationWithKGammaFixedAtTheBelievedValue) {
   auto scenario = sim::LoadScenario(Source("scenarios/atv_hills.yaml"));
@@ -51,11 +64,9 @@ TEST(NominalConfigTest, TheAtvScenarioGivesTheCalibrationWithKGammaFixedAtTheBel
 // The differential drive's nominal model: its geometry measured on models/diffdrive.xml (wheel radius 0.075 m at
 // +-0.2 m), one radius free for both wheels, the baseline fixed, the gyroscope as the yaw reference.
 TEST(NominalConfigTest, DifferentialDriveGeometryFromTheModel) {
-  auto scenario = sim::LoadScenario(Source("scenarios/indoor_diffdrive_gap.yaml"));
-  ASSERT_TRUE(scenario.ok()) << scenario.status().message();
-  auto config = NominalConfig(scenario.value());
-  ASSERT_TRUE(config.ok()) << config.status().message();
-  const estimator::EstimatorConfig& c = config.value();
+  const std::optional<estimator::EstimatorConfig> config = NominalOf("scenarios/indoor_diffdrive_gap.yaml");
+  ASSERT_TRUE(config);
+  const estimator::EstimatorConfig& c = *config;
   EXPECT_EQ(c.master, "odometer");
   EXPECT_EQ(c.streams.at("odometer").model, "differential_drive");
   EXPECT_EQ(c.streams.at("odometer").parameters.at("radius_left"), "odometer.radius");
@@ -69,11 +80,9 @@ TEST(NominalConfigTest, DifferentialDriveGeometryFromTheModel) {
 // The omni3 robot's nominal model: models/omni3.xml's wheels (radius 0.05 m at L = 0.2 m), one radius free for the
 // three wheels, the distance fixed, the gyroscope as the yaw reference.
 TEST(NominalConfigTest, Omni3GeometryFromTheModel) {
-  auto scenario = sim::LoadScenario(Source("scenarios/indoor_omni_slip.yaml"));
-  ASSERT_TRUE(scenario.ok()) << scenario.status().message();
-  auto config = NominalConfig(scenario.value());
-  ASSERT_TRUE(config.ok()) << config.status().message();
-  const estimator::EstimatorConfig& c = config.value();
+  const std::optional<estimator::EstimatorConfig> config = NominalOf("scenarios/indoor_omni_slip.yaml");
+  ASSERT_TRUE(config);
+  const estimator::EstimatorConfig& c = *config;
   EXPECT_EQ(c.master, "odometer");
   ASSERT_EQ(c.streams.size(), 2u);
   const estimator::StreamConfig& odo = c.streams.at("odometer");
@@ -97,11 +106,9 @@ TEST(NominalConfigTest, Omni3GeometryFromTheModel) {
 // The mecanum robot's nominal model: models/mecanum.xml's wheels (radius 0.05 m at lx = 0.2 m, ly = 0.18 m), one
 // radius free for the four wheels, lx + ly fixed, and the scenario's position fixes.
 TEST(NominalConfigTest, MecanumGeometryFromTheModel) {
-  auto scenario = sim::LoadScenario(Source("scenarios/indoor_mecanum_gap.yaml"));
-  ASSERT_TRUE(scenario.ok()) << scenario.status().message();
-  auto config = NominalConfig(scenario.value());
-  ASSERT_TRUE(config.ok()) << config.status().message();
-  const estimator::EstimatorConfig& c = config.value();
+  const std::optional<estimator::EstimatorConfig> config = NominalOf("scenarios/indoor_mecanum_gap.yaml");
+  ASSERT_TRUE(config);
+  const estimator::EstimatorConfig& c = *config;
   ASSERT_EQ(c.streams.size(), 3u);
   const estimator::StreamConfig& odo = c.streams.at("odometer");
   EXPECT_EQ(odo.model, "mecanum_drive");

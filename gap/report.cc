@@ -1,0 +1,332 @@
+#include "gap/report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include "eval/plots.h"
+
+namespace roamlab::gap {
+namespace {
+
+using nlohmann::json;
+
+json Number(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
+
+json FitsJson(const std::map<std::string, StreamFit>& fits) {
+  json j = json::object();
+  for (const auto& [name, f] : fits)
+    j[name] = {{"rms", Number(f.rms)}, {"rms_1s", Number(f.rms_1s)}, {"chi2_per_dof", Number(f.chi2_per_dof)},
+               {"dof", f.dof},
+               {"measurements", f.measurements}};
+  return j;
+}
+
+json EffectJson(const EffectEstimate& e) {
+  json p = json::object(), s = json::object(), b = json::object();
+  for (const auto& [k, v] : e.parameters) p[k] = Number(v);
+  for (const auto& [k, v] : e.baseline_parameters) b[k] = Number(v);
+  for (const auto& [k, v] : e.std) s[k] = Number(v);
+  return {{"name", e.name},
+          {"parameters", p},
+          {"std", s},
+          {"baseline_parameters", b},
+          {"dof", e.dof},
+          {"lr_statistic", Number(e.lr)},
+          {"chi2_drop", Number(e.lr_raw)},
+          {"baseline_lr_statistic", Number(e.baseline_lr)},
+          {"lr_pvalue", Number(e.lr_pvalue)},
+          {"delta_bic", Number(e.delta_bic)},
+          {"heldout_improvement", e.evaluated_heldout ? Number(e.heldout_improvement) : json(nullptr)},
+          {"heldout_excess_before", e.evaluated_heldout ? Number(e.heldout_excess_before) : json(nullptr)},
+          {"heldout_excess_after", e.evaluated_heldout ? Number(e.heldout_excess_after) : json(nullptr)},
+          {"explained_share", e.evaluated_heldout ? Number(e.explained_share) : json(nullptr)},
+          {"decision", e.decision}};
+}
+
+json LocatedJson(const LocatedComponent& lc) {
+  json intervals = json::array(), correlates = json::array();
+  for (const auto& [a, b] : lc.intervals) intervals.push_back({a, b});
+  for (const Correlate& c : lc.correlates)
+    correlates.push_back({{"condition", c.condition}, {"rho", Number(c.rho)}, {"lag_s", c.lag_s}});
+  return {{"stream", lc.stream},
+          {"component", lc.component},
+          {"chi2_per_dof", Number(lc.chi2_per_dof)},
+          {"expected_chi2_per_dof", Number(lc.expected_chi2_per_dof)},
+          {"inconsistent", lc.inconsistent},
+          {"intervals", intervals},
+          {"correlates", correlates}};
+}
+
+std::string Fixed(double x, int digits) {
+  std::ostringstream s;
+  s << std::setprecision(digits) << x;
+  return s.str();
+}
+
+// The located component most out of its level (inconsistent ones first), or null.
+const LocatedComponent* Worst(const Diagnosis& d) {
+  const LocatedComponent* worst = nullptr;
+  for (const LocatedComponent& lc : d.located) {
+    const double ratio = lc.chi2_per_dof / lc.expected_chi2_per_dof;
+    if (!worst || (lc.inconsistent && !worst->inconsistent) ||
+        (lc.inconsistent == worst->inconsistent && ratio > worst->chi2_per_dof / worst->expected_chi2_per_dof))
+      worst = &lc;
+  }
+  return worst;
+}
+
+// Figures: the worst component's residuals against the condition it correlates with most (at its lag), and the
+// held-out chi2/dof per stream before and after.
+std::vector<std::string> WritePlots(const Diagnosis& d, const std::string& dir, std::string* note) {
+  std::vector<std::string> images;
+  if (!eval::GnuplotAvailable()) {
+    *note = "gnuplot is not installed: no figures";
+    return images;
+  }
+  if (const LocatedComponent* lc = Worst(d); lc && !lc->correlates.empty()) {
+    const Correlate& c = lc->correlates.front();
+    const auto column = std::find(d.conditions.names.begin(), d.conditions.names.end(), c.condition);
+    const int ci = static_cast<int>(column - d.conditions.names.begin());
+    std::ofstream data(dir + "/residual_vs_condition.dat");
+    data << "# " << c.condition << " (at t + " << c.lag_s << " s)  whitened residual of " << lc->stream << "["
+         << lc->component << "]\n";
+    for (const estimator::MeasurementResidual& r : d.residuals) {
+      if (!r.active || r.stream != lc->stream || lc->component >= r.whitened.size()) continue;
+      const Time t = Time::FromNanoseconds(r.t.nanoseconds() + std::llround(c.lag_s * 1e9));
+      data << d.conditions.At(ci, t) << " " << r.whitened[lc->component] << "\n";
+    }
+    data.close();   // gnuplot reads it below: every line on disk first
+    std::ofstream gp(dir + "/residual_vs_condition.gp");
+    gp << "set terminal pngcairo size 800,500 noenhanced\nset output 'residual_vs_condition.png'\n"
+       << "set title \"" << lc->stream << "[" << lc->component << "]: chi2/dof " << Fixed(lc->chi2_per_dof, 3)
+       << " (nominal " << Fixed(lc->expected_chi2_per_dof, 3) << "), rho " << Fixed(c.rho, 2) << "\"\n"
+       << "set xlabel '" << c.condition << " at t + " << c.lag_s << " s'\nset ylabel 'whitened residual'\n"
+       << "set grid\nplot 'residual_vs_condition.dat' using 1:2 with dots lc rgb '#1f77b4' notitle\n";
+    gp.close();
+    if (eval::RunGnuplot(dir, "residual_vs_condition.gp").ok()) images.push_back("residual_vs_condition.png");
+  }
+  {
+    std::ofstream data(dir + "/heldout_fit.dat");
+    data << "# stream  chi2_per_dof_before  chi2_per_dof_after (held-out part)\n";
+    for (const auto& [name, before] : d.before) {
+      const auto after = d.after.find(name);
+      data << name << " " << before.chi2_per_dof << " "
+           << (after != d.after.end() ? after->second.chi2_per_dof : before.chi2_per_dof) << "\n";
+    }
+    data.close();
+    std::ofstream gp(dir + "/heldout_fit.gp");
+    gp << "set terminal pngcairo size 800,450 noenhanced\nset output 'heldout_fit.png'\n"
+       << "set title 'held-out part (after t = " << Fixed(d.train_end_s, 4) << " s): chi2/dof per stream'\n"
+       << "set style data histograms\nset style fill solid 0.8\nset yrange [0:*]\nset grid y\nset ylabel 'chi2/dof'\n"
+       << "plot 'heldout_fit.dat' using 2:xtic(1) title 'nominal', '' using 3 title 'with the accepted effects'\n";
+    gp.close();
+    if (eval::RunGnuplot(dir, "heldout_fit.gp").ok()) images.push_back("heldout_fit.png");
+  }
+  return images;
+}
+
+Status WriteText(const std::string& path, const std::string& text) {
+  std::ofstream out(path);
+  if (!out) return Status::Error(path + ": cannot write");
+  out << text;
+  return out ? Status::Ok() : Status::Error(path + ": write failed");
+}
+
+json SimulationJson(const SimulationComparison& c) {
+  const auto fits = [](const std::map<std::string, SimulatedStreamFit>& m) {
+    json j = json::object();
+    for (const auto& [name, f] : m)
+      j[name] = {{"rms", Number(f.rms)}, {"rms_1s", Number(f.rms_1s)}, {"component_rms", f.component_rms},
+                 {"samples", f.samples}};
+    return j;
+  };
+  json effects = json::array();
+  for (const sim::EffectOptions& e : c.effects) effects.push_back({{"name", e.name}, {"parameters", e.parameters}});
+  return {{"from_s", c.from_s},         {"duration_s", c.duration_s}, {"effects", effects},
+          {"before", fits(c.before)},   {"after", fits(c.after)},     {"left_out", c.left_out},
+          {"not_simulated", c.not_simulated.empty() ? json(nullptr) : json(c.not_simulated)}};
+}
+
+// The report's section on the re-simulation (gap/resimulate.h) against the recording's held-out part.
+void SimulationSection(const SimulationComparison& c, std::ostringstream& r) {
+  r << "\n## The simulation against the recording (held-out part, after t = " << Fixed(c.from_s, 4)
+    << " s)\n\nThe nominal scenario simulated again without noise, as believed and with the accepted effects "
+       "applied (scenario_patch.yaml), compared sample by sample with the recording: RMS of recorded minus "
+       "simulated in units of each stream's stated noise (1 = noise only; meaningful for a recording of the "
+       "scenario's drive), and of its 1 s means (the systematic part).\n\n| stream | RMS as believed | RMS with the "
+       "effects | change | 1 s RMS as believed | 1 s RMS with the effects |\n|---|---|---|---|---|---|\n";
+  for (const auto& [name, b] : c.before) {
+    const auto a = c.after.find(name);
+    r << "| " << name << " | " << Fixed(b.rms, 4) << " | ";
+    if (a == c.after.end()) {
+      r << "- | - | " << Fixed(b.rms_1s, 4) << " | - |\n";
+      continue;
+    }
+    r << Fixed(a->second.rms, 4) << " | "
+      << (b.rms > 0.0 ? Fixed(100.0 * (a->second.rms / b.rms - 1.0), 3) + " %" : std::string("-")) << " | "
+      << Fixed(b.rms_1s, 4) << " | " << Fixed(a->second.rms_1s, 4) << " |\n";
+  }
+  for (const std::string& l : c.left_out) r << "\nNot compared: " << l << ".";
+  if (!c.not_simulated.empty())
+    r << "\nThe effects could not be simulated: " << c.not_simulated << ".";
+  r << "\n";
+}
+
+}  // namespace
+
+std::string ReportMarkdown(const Diagnosis& d, const std::string& recording, const std::string& scenario,
+                           bool baseline, const SimulationComparison* simulation,
+                           const std::vector<std::string>& images) {
+  std::ostringstream r;
+  r << "# Reality-gap diagnosis\n\nRecording `" << recording << "` against the nominal scenario `" << scenario
+    << "`.\n\n## Verdict: **" << d.verdict << "**\n\n";
+  if (d.verdict == "named") {
+    for (const EffectEstimate& e : d.effects) {
+      r << "- **" << e.name << "**:";
+      for (const auto& [k, v] : e.parameters) {
+        const auto s = e.std.find(k);
+        r << " " << k << " = " << Fixed(v, 4);
+        if (s != e.std.end() && std::isfinite(s->second)) r << " +- " << Fixed(s->second, 2);
+      }
+      r << " (likelihood ratio " << Fixed(e.lr, 4) << ", p = " << Fixed(e.lr_pvalue, 3) << ", Delta BIC "
+        << Fixed(e.delta_bic, 4) << ", held-out chi2 " << Fixed(100.0 * e.heldout_improvement, 3) << " % lower)\n";
+    }
+  } else if (d.verdict == "unknown") {
+    r << "No effect of the library explains it; what stays inconsistent:\n";
+    for (const std::string& u : d.unexplained) r << "- " << u << "\n";
+  } else {
+    r << "Every stream is as consistent as the nominal model is on a nominal simulation"
+      << (baseline ? "" : " (no baseline: levels compared with 1)") << ".\n";
+  }
+  r << "\n## Where (whole run, nominal self-calibration)\n\n| stream[component] | chi2/dof | nominal level | "
+       "inconsistent | intervals [s] | strongest condition (rho, lag) |\n|---|---|---|---|---|---|\n";
+  for (const LocatedComponent& lc : d.located) {
+    r << "| " << lc.stream << "[" << lc.component << "] | " << Fixed(lc.chi2_per_dof, 3) << " | "
+      << Fixed(lc.expected_chi2_per_dof, 3) << " | " << (lc.inconsistent ? "**yes**" : "no") << " | ";
+    for (std::size_t i = 0; i < lc.intervals.size() && i < 3; ++i)
+      r << (i ? ", " : "") << Fixed(lc.intervals[i].first, 3) << "-" << Fixed(lc.intervals[i].second, 3);
+    if (lc.intervals.size() > 3) r << " (+" << lc.intervals.size() - 3 << ")";
+    r << " | ";
+    if (!lc.correlates.empty())
+      r << lc.correlates.front().condition << " (" << Fixed(lc.correlates.front().rho, 2) << ", "
+        << lc.correlates.front().lag_s << " s)";
+    r << " |\n";
+  }
+  r << "\n## Candidates (fitted on the first part, up to t = " << Fixed(d.train_end_s, 4)
+    << " s)\n\n| effect | parameters | LR | chi2 drop / on baseline | p | Delta BIC | held-out | share of the held-out "
+       "mismatch | decision |\n|---|---|---|---|---|---|---|---|---|\n";
+  for (const EffectEstimate& e : d.candidates) {
+    r << "| " << e.name << " | ";
+    for (const auto& [k, v] : e.parameters) r << k << " = " << Fixed(v, 4) << " ";
+    r << "| " << Fixed(e.lr, 4) << " | " << Fixed(e.lr_raw, 4) << " / " << Fixed(e.baseline_lr, 4) << " | "
+      << Fixed(e.lr_pvalue, 3) << " | "
+      << Fixed(e.delta_bic, 4) << " | "
+      << (e.evaluated_heldout ? Fixed(100.0 * e.heldout_improvement, 3) + " %" : std::string("-")) << " | "
+      << (e.evaluated_heldout ? Fixed(e.explained_share, 3) : std::string("-")) << " | " << e.decision << " |\n";
+  }
+  r << "\n## Fit on the held-out part (parameters fixed at the training values)\n\nWhitened residuals: RMS per "
+       "sample, RMS of their 1 s means (the systematic part) and chi2/dof.\n\n| stream | RMS before | RMS after | "
+       "1 s RMS before | 1 s RMS after | chi2/dof before | chi2/dof after |\n|---|---|---|---|---|---|---|\n";
+  for (const auto& [name, b] : d.before) {
+    const auto a = d.after.count(name) ? d.after.at(name) : b;
+    r << "| " << name << " | " << Fixed(b.rms, 4) << " | " << Fixed(a.rms, 4) << " | " << Fixed(b.rms_1s, 4) << " | "
+      << Fixed(a.rms_1s, 4) << " | " << Fixed(b.chi2_per_dof, 4) << " | " << Fixed(a.chi2_per_dof, 4) << " |\n";
+  }
+  if (simulation) SimulationSection(*simulation, r);
+  r << "\n";
+  for (const std::string& image : images) r << "![" << image << "](" << image << ")\n\n";
+  r << d.fits << " calibrations in " << Fixed(d.seconds, 3) << " s.\n";
+  return r.str();
+}
+
+std::string ScenarioPatch(const Diagnosis& d, const SimulationComparison* simulation) {
+  std::ostringstream y;
+  y << "# Accepted effects of `roamlab diagnose`, in the form of a scenario's `effects:` section (sim/scenario.h).\n"
+    << "# Standard deviations are comments.\neffects:\n";
+  if (d.effects.empty()) y << "  []\n";
+  for (std::size_t i = 0; i < d.effects.size(); ++i) {
+    const EffectEstimate& e = d.effects[i];
+    std::map<std::string, double> std;
+    sim::EffectOptions effect = SimulatorEffect(e, &std);
+    if (simulation && simulation->effects.size() == d.effects.size()) effect = simulation->effects[i];
+    y << "  - name: " << e.name << "\n";
+    bool same = effect.parameters.size() == e.parameters.size();
+    for (const auto& [k, v] : effect.parameters) same = same && e.parameters.count(k);
+    if (!same) {   // parameters the simulator takes in another form (lateral_slip): the diagnosed ones as comments
+      y << "    # diagnosed:";
+      for (const auto& [k, v] : e.parameters) y << " " << k << " = " << std::setprecision(6) << v;
+      y << "\n";
+    }
+    y << "    parameters:\n";
+    for (const auto& [k, v] : effect.parameters) {
+      y << "      " << k << ": " << std::setprecision(10) << v;
+      if (std.count(k) && std::isfinite(std.at(k))) y << "   # +- " << std::setprecision(3) << std.at(k);
+      y << "\n";
+    }
+  }
+  return y.str();
+}
+
+std::string EstimatorPatch(const Diagnosis& d) {
+  std::ostringstream y;
+  y << "# The accepted effects as estimator settings: parameter values to add to the nominal configuration's\n"
+    << "# `parameters`, and time shifts [s] to subtract from the named recording streams' stamps.\nparameters:\n";
+  if (d.effect_parameters.empty()) y << "  {}\n";
+  for (const auto& [name, v] : d.effect_parameters) {
+    y << "  " << name << ": {value: [";
+    for (int i = 0; i < v.size(); ++i) y << (i ? ", " : "") << std::setprecision(10) << v[i];
+    y << "], free: false}\n";
+  }
+  y << "stream_time_shifts_s:\n";
+  if (d.stream_shifts_s.empty()) y << "  {}\n";
+  for (const auto& [name, s] : d.stream_shifts_s) y << "  " << name << ": " << std::setprecision(10) << s << "\n";
+  return y.str();
+}
+
+json DiagnosisJson(const Diagnosis& d, const Baseline* baseline, std::uint64_t baseline_seed,
+                   const SimulationComparison* simulation) {
+  json located = json::array(), components = json::array(), effects = json::array(), candidates = json::array();
+  for (const LocatedComponent& lc : d.located) {
+    components.push_back(LocatedJson(lc));
+    if (lc.inconsistent) located.push_back(LocatedJson(lc));
+  }
+  for (const EffectEstimate& e : d.effects) effects.push_back(EffectJson(e));
+  for (const EffectEstimate& e : d.candidates) candidates.push_back(EffectJson(e));
+  json base = json::object();
+  if (baseline) {
+    base["seed"] = baseline_seed;
+    base["streams"] = FitsJson(baseline->streams);
+    json lr = json::object();
+    for (const auto& [name, v] : baseline->candidate_lr) lr[name] = Number(v);
+    base["candidate_lr_statistic"] = lr;
+  }
+  return {{"verdict", d.verdict},
+          {"located", located},
+          {"effects", effects},
+          {"fit", {{"before", FitsJson(d.before)}, {"after", FitsJson(d.after)},
+                   {"heldout_start_s", d.train_end_s}, {"whole_run_nominal", FitsJson(d.whole_run)}}},
+          {"unexplained", d.unexplained},
+          {"candidates", candidates},
+          {"components", components},
+          {"baseline", base},
+          {"simulation", simulation ? SimulationJson(*simulation) : json(nullptr)},
+          {"run", {{"fits", d.fits}, {"seconds", d.seconds}}}};
+}
+
+Status WriteReport(const Diagnosis& d, const ReportInputs& in, const std::string& dir) {
+  const json gap_json = DiagnosisJson(d, in.baseline, in.baseline_seed, in.simulation);
+  if (Status s = WriteText(dir + "/gap.json", gap_json.dump(2) + "\n"); !s.ok()) return s;
+  if (Status s = WriteText(dir + "/scenario_patch.yaml", ScenarioPatch(d, in.simulation)); !s.ok()) return s;
+  if (Status s = WriteText(dir + "/estimator_patch.yaml", EstimatorPatch(d)); !s.ok()) return s;
+  std::string note;
+  const std::vector<std::string> images = in.plots ? WritePlots(d, dir, &note) : std::vector<std::string>{};
+  if (!note.empty() && in.progress) in.progress(note);
+  const std::string report =
+      ReportMarkdown(d, in.recording, in.model, in.baseline != nullptr, in.simulation, images);
+  return WriteText(dir + "/report.md", report);
+}
+
+}  // namespace roamlab::gap
