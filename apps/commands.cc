@@ -40,10 +40,7 @@ void PrintCalibration(const estimator::CalibrationResult& r, const std::string& 
 }  // namespace
 
 int RunCalibrate(const CalibrateArgs& args) {
-  experiment::CalibrateRequest request;
-  request.recording = args.recording;
-  request.config = args.config;
-  request.out = args.out;
+  experiment::CalibrateRequest request = args;
   if (!args.quiet) request.progress = [](const std::string& line) { std::cerr << "calibrate: " << line << "\n"; };
   estimator::CalibrationResult result;
   const experiment::Outcome outcome = experiment::CalibrateToDirectory(request, &result);
@@ -53,11 +50,7 @@ int RunCalibrate(const CalibrateArgs& args) {
 }
 
 int RunTrack(const TrackArgs& args) {
-  experiment::TrackRequest request;
-  request.recording = args.recording;
-  request.config = args.config;
-  request.calibration = args.calibration;
-  request.out = args.out;
+  experiment::TrackRequest request = args;
   if (!args.quiet)
     request.progress = [](double f) { std::cerr << "\rtrack: " << static_cast<int>(100 * f) << "%" << std::flush; };
   estimator::TrackingResult r;

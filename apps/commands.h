@@ -4,25 +4,21 @@
 #pragma once
 
 #include <iosfwd>
-#include <string>
+
+#include "experiment/steps.h"
 
 namespace roamlab::apps {
 
-struct CalibrateArgs {
-  std::string recording;
-  std::string config;
-  std::string out;
+// The step's request (without progress, which the command sets).
+struct CalibrateArgs : experiment::CalibrateRequest {
   bool quiet = false;            // no progress and no summary
   std::ostream* err = nullptr;   // receives the one-line error; nullptr: stderr
 };
 // Offline self-calibration: writes OUT/calibration.json and OUT/trajectory.tum.
 int RunCalibrate(const CalibrateArgs& args);
 
-struct TrackArgs {
-  std::string recording;
-  std::string config;
-  std::string calibration;  // optional calibration.json
-  std::string out;
+// The step's request (without progress, which the command sets; no_time_budget is not an option of the command).
+struct TrackArgs : experiment::TrackRequest {
   bool quiet = false;            // no progress and no summary
   std::ostream* err = nullptr;   // receives the one-line error; nullptr: stderr
 };

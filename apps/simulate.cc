@@ -35,10 +35,7 @@ void PrintSummary(const sim::Simulation& s, const std::string& out) {
 }  // namespace
 
 int RunSimulate(const SimulateArgs& args) {
-  experiment::SimulateRequest request;
-  request.scenario = args.scenario;
-  request.out = args.out;
-  request.seed = args.seed;
+  experiment::SimulateRequest request = args;
   if (!args.quiet) {
     request.progress = [](double fraction) {
       std::cerr << "\rsimulate: " << static_cast<int>(100.0 * fraction) << "%" << std::flush;
