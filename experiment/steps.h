@@ -1,6 +1,6 @@
 // The steps of the `roamlab` commands that write files, as library calls: simulate a scenario into a recording
 // directory, calibrate a recording into calibration.json, track it into trajectory.tum, covariance.csv and
-// summary.json. The command line, the Monte-Carlo runner and the regression suite call them.
+// summary.json, import an OptiOdom run. The command line, the Monte-Carlo runner and the regression suite call them.
 #pragma once
 
 #include <cstdint>

@@ -219,7 +219,7 @@ Status RunMonteCarloCase(const CaseContext& context) {
   return outcome.ok() ? Status::Ok() : Failed("montecarlo", outcome);
 }
 
-// What `roamlab odometry evaluate` writes (apps/odometry.h).
+// What `roamlab odometry evaluate` writes (experiment/odometry.h).
 json TableSchema() {
   return {{"rows", json::array({{{"model", "string"}, {"mean", "string"}, {"kernel", "string"}, {"ate_m", "number"},
                                  {"rpe_mm", "number"}, {"model_file", "string"}}})},
