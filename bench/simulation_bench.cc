@@ -98,7 +98,7 @@ int BenchSimulation(const Context& ctx, Json* j, recording::Recording* recording
         std::pair<std::string, std::string>{"indoor_omni_slip", "indoor_omni_simulation_realtime_factor"}}) {
     auto indoor = sim::LoadScenario(ctx.root + "/scenarios/" + name + ".yaml");
     if (!indoor.ok()) return Fail(indoor.status().message());
-    indoor.value().sensors.camera.reset();  // rendering: 1d
+    indoor.value().sensors.camera.reset();  // rendering: 1c and 1e
     indoor.value().duration_s = ctx.sizes.indoor_s;
     const auto t_indoor = Clock::now();
     const std::clock_t cpu_indoor = std::clock();
