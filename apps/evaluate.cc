@@ -5,17 +5,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "apps/cli.h"
 #include "eval/evaluate.h"
 
 namespace roamlab::apps {
 namespace {
 
 using nlohmann::json;
-
-int Fail(std::ostream* err, int code, const std::string& message) {
-  (err ? *err : std::cerr) << "roamlab evaluate: " << message << "\n";
-  return code;
-}
 
 // A number from the metrics, "-" when absent or null.
 std::string Format(const json& node, const char* format = "%.4g") {
@@ -75,17 +71,18 @@ int RunEvaluate(const EvaluateArgs& args) {
   if (!args.align.empty()) {
     options.alignment = eval::ParseAlignmentKind(args.align);
     if (!options.alignment)
-      return Fail(args.err, 2, "--align: unknown alignment '" + args.align + "' (none, se3 or yaw_translation)");
+      return BadInput(args.err, "evaluate",
+                      "--align: unknown alignment '" + args.align + "' (none, se3 or yaw_translation)");
   }
-  if (const std::string problem = options.Validate(); !problem.empty()) return Fail(args.err, 2, problem);
+  if (const std::string problem = options.Validate(); !problem.empty()) return BadInput(args.err, "evaluate", problem);
 
   Result<eval::Evaluation> evaluation = eval::Evaluate(options);
-  if (!evaluation.ok()) return Fail(args.err, 2, evaluation.status().message());
+  if (!evaluation.ok()) return BadInput(args.err, "evaluate", evaluation.status().message());
   Result<eval::WrittenEvaluation> written = eval::WriteEvaluation(evaluation.value(), args.out, !args.no_plots);
-  if (!written.ok()) return Fail(args.err, 1, written.status().message());
+  if (!written.ok()) return Failure(args.err, "evaluate", written.status().message());
 
   if (!written.value().note.empty())
-    (args.err ? *args.err : std::cerr) << "roamlab evaluate: " << written.value().note << "\n";
+    Report(args.err, "evaluate", written.value().note, 0);
   if (!args.quiet) {
     PrintSummary(evaluation.value().metrics);
     std::printf("wrote %s", written.value().metrics_path.c_str());

@@ -1,42 +1,20 @@
-// `roamlab montecarlo`: consistency of online tracking over noise realizations (seed 000, Section V, Fig. 4).
+// `roamlab montecarlo`: consistency of online tracking over noise realizations (experiment/montecarlo.h).
 #pragma once
 
 #include <iosfwd>
-#include <string>
+
+#include "experiment/montecarlo.h"
 
 namespace roamlab::apps {
 
-// Run i's calibration drive simulates with noise seed seed_base + kCalibrationSeedOffset + i.
-inline constexpr unsigned long long kCalibrationSeedOffset = 1000000;
-
-struct MonteCarloArgs {
-  std::string scenario;
-  std::string config;
-  std::string calibration;  // optional calibration.json: tracking uses its values
-  std::string out;
-  int runs = 50;
-  int jobs = 0;             // 0: one per core
-  unsigned long long seed_base = 1000;  // run i simulates with noise seed seed_base + i
-  double t0_s = 2.0;        // fraction_in_band counts time steps from t0_s on
-  bool no_time_budget = false;  // ignore tracking.time_budget_s: results that do not depend on the machine's speed
-  // With tracking.calibrate and no --calibration: one calibration per run on its own calibration drive instead of
-  // one shared by every run (the seed's protocol; see RunMonteCarlo).
-  bool calibrate_each_run = false;
+// The runner's options (without log and progress, which the command sets).
+struct MonteCarloArgs : experiment::MonteCarloOptions {
   bool quiet = false;           // no progress bar and no summary
   std::ostream* err = nullptr;  // receives the one-line error; nullptr: stderr
 };
 
-// Simulates `runs` noise realizations of the scenario (the terrain and the drive stay the same), tracks each online,
-// computes the position NEES (eq. 16) of every pose against the truth, and writes OUT/nees.json
-// ({"runs", "dof", "band", "t", "mean_nees", "fraction_in_band", ...}), OUT/runs.json (per-run ATE and mean NEES) and
-// OUT/nees.png. Runs are spread over `jobs` threads; results do not depend on the number of jobs.
-// Calibration (the configuration's tracking.calibrate, when no --calibration file is given): by default one
-// calibration of the scenario simulated with its own noise seed, shared by every run (the seed's protocol). Its error
-// is then one draw common to all runs, so the average NEES tests that draw as much as the tracker (the band assumes
-// independent runs). With calibrate_each_run, run i also simulates a calibration drive of its own (noise seed
-// seed_base + kCalibrationSeedOffset + i), calibrates it (warm-started at the shared calibration, a single stage with
-// every parameter free: the same minimum, fewer iterations) and tracks with those values under that calibration's
-// prior: every random input of the run is its own.
+// Runs experiment::RunMonteCarlo and prints a progress bar and a one-line summary. Exit code 0; 2 on bad input; 1
+// when a run fails.
 int RunMonteCarlo(const MonteCarloArgs& args);
 
 }  // namespace roamlab::apps

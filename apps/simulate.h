@@ -4,17 +4,14 @@
 // vehicle leaves the terrain, MuJoCo diverges) or the recording cannot be written.
 #pragma once
 
-#include <cstdint>
 #include <iosfwd>
-#include <optional>
-#include <string>
+
+#include "experiment/steps.h"
 
 namespace roamlab::apps {
 
-struct SimulateArgs {
-  std::string scenario;                 // SCENARIO.yaml
-  std::string out;                      // recording directory
-  std::optional<std::uint64_t> seed;    // overrides the scenario's noise seed
+// The step's request (without progress, which the command sets).
+struct SimulateArgs : experiment::SimulateRequest {
   bool quiet = false;                   // no progress and no summary
   std::ostream* err = nullptr;          // receives the one-line error; nullptr: stderr
 };

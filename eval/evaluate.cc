@@ -10,7 +10,7 @@
 
 #include <GeographicLib/LocalCartesian.hpp>
 
-#include "eval/internal/json_util.h"
+#include "common/json.h"
 #include "eval/visual_odometry.h"
 #include "recording/truth.h"
 #include "recording/wheel_kinematics.h"
@@ -19,8 +19,6 @@ namespace roamlab::eval {
 namespace {
 
 namespace fs = std::filesystem;
-using internal::Number;
-using internal::NumberArray;
 using nlohmann::json;
 
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -123,80 +121,93 @@ std::vector<PositionFixes> AbsoluteFixes(const recording::Recording& recording) 
   return fixes;
 }
 
-Result<Evaluation> Evaluate(const EvaluateOptions& options) {
-  if (const std::string problem = options.Validate(); !problem.empty()) return Status::Error(problem);
+namespace {
 
+// What an evaluation reads: the recording with its ground truth, the estimate's trajectory, and the optional
+// covariance.csv, calibration.json and truth.yaml.
+struct Inputs {
+  recording::Recording recording;
+  Trajectory estimate;
+  std::optional<std::vector<StampedCovariance>> covariances;
+  std::optional<std::map<std::string, ParameterEstimate>> calibration;
+  std::optional<recording::Truth> true_values;
+  std::string truth_path, trajectory_path, covariance_path, calibration_path;
+  const Trajectory& truth() const { return *recording.ground_truth; }
+};
+
+Result<Inputs> ReadInputs(const EvaluateOptions& options) {
+  Inputs in;
   // Recording and its ground truth.
   recording::ReadOptions read;
   read.load_ground_truth = true;
   Result<recording::Recording> rec = recording::ReadRecording(options.recording_dir, read);
   if (!rec.ok()) return rec.status();
-  const std::string truth_path = Join(options.recording_dir, "ground_truth.tum");
-  if (!rec.value().ground_truth)
-    return Status::Error(truth_path + ": missing; evaluation needs the ground-truth trajectory");
-  const Trajectory& truth = *rec.value().ground_truth;
-  if (truth.empty()) return Status::Error(truth_path + ": no poses");
+  in.recording = std::move(rec).value();
+  in.truth_path = Join(options.recording_dir, "ground_truth.tum");
+  if (!in.recording.ground_truth)
+    return Status::Error(in.truth_path + ": missing; evaluation needs the ground-truth trajectory");
+  if (in.truth().empty()) return Status::Error(in.truth_path + ": no poses");
 
   // The estimate: trajectory (required), covariance and calibration (optional).
-  const std::string trajectory_path = Join(options.estimate_dir, "trajectory.tum");
-  if (!IsFile(trajectory_path)) return Status::Error(trajectory_path + ": missing; the estimate needs a trajectory");
-  Result<Trajectory> estimate_read = ReadTum(trajectory_path);
-  if (!estimate_read.ok()) return estimate_read.status();
-  const Trajectory& estimate = estimate_read.value();
-  if (estimate.empty()) return Status::Error(trajectory_path + ": no poses");
-  const std::string covariance_path = Join(options.estimate_dir, "covariance.csv");
-  std::optional<std::vector<StampedCovariance>> covariances;
-  if (Status s = ReadOptional(covariance_path, ReadPositionCovariances, &covariances); !s.ok()) return s;
-  const std::string calibration_path = Join(options.estimate_dir, "calibration.json");
-  std::optional<std::map<std::string, ParameterEstimate>> calibration;
-  if (Status s = ReadOptional(calibration_path, ReadCalibrationEstimates, &calibration); !s.ok()) return s;
-  std::optional<recording::Truth> true_values;
-  if (calibration && IsFile(Join(options.recording_dir, "truth.yaml"))) {
+  in.trajectory_path = Join(options.estimate_dir, "trajectory.tum");
+  if (!IsFile(in.trajectory_path))
+    return Status::Error(in.trajectory_path + ": missing; the estimate needs a trajectory");
+  Result<Trajectory> estimate = ReadTum(in.trajectory_path);
+  if (!estimate.ok()) return estimate.status();
+  in.estimate = std::move(estimate).value();
+  if (in.estimate.empty()) return Status::Error(in.trajectory_path + ": no poses");
+  in.covariance_path = Join(options.estimate_dir, "covariance.csv");
+  if (Status s = ReadOptional(in.covariance_path, ReadPositionCovariances, &in.covariances); !s.ok()) return s;
+  in.calibration_path = Join(options.estimate_dir, "calibration.json");
+  if (Status s = ReadOptional(in.calibration_path, ReadCalibrationEstimates, &in.calibration); !s.ok()) return s;
+  if (in.calibration && IsFile(Join(options.recording_dir, "truth.yaml"))) {
     Result<recording::Truth> t = recording::ReadTruth(options.recording_dir);
     if (!t.ok()) return t.status();
-    true_values = std::move(t).value();
+    in.true_values = std::move(t).value();
   }
+  return in;
+}
 
-  // Association by time.
+// The estimate's poses matched to the truth by time; an error when none matches.
+Result<MatchedTrajectories> Associate(const Inputs& in, const EvaluateOptions& options, json* m) {
   AssociationOptions association_options;
   association_options.max_time_difference_s = options.max_time_difference_s;
-  const Association association = AssociateByTime(estimate, truth, association_options);
+  const Association association = AssociateByTime(in.estimate, in.truth(), association_options);
   if (association.matched() == 0) {
     char tolerance[32];
     std::snprintf(tolerance, sizeof tolerance, "%g", options.max_time_difference_s);
-    return Status::Error(trajectory_path + ": no pose within " + tolerance + " s of a pose of " + truth_path);
+    return Status::Error(in.trajectory_path + ": no pose within " + tolerance + " s of a pose of " + in.truth_path);
   }
-  const MatchedTrajectories matched = SelectMatched(estimate, truth, association);
+  (*m)["association"] = {{"estimate_poses", association.estimate_size},
+                         {"reference_poses", association.reference_size},
+                         {"matched", association.matched()},
+                         {"tolerance_s", options.max_time_difference_s},
+                         {"max_time_difference_s", association.max_time_difference_s}};
+  return SelectMatched(in.estimate, in.truth(), association);
+}
 
-  // Alignment and ATE.
-  Evaluation ev;
-  ev.alignment = options.alignment.value_or(DefaultAlignment(rec.value()));
-  const AbsoluteTrajectoryError ate = ComputeAte(matched.estimate, matched.reference, ev.alignment);
-  std::string alignment_reason;
-  if (options.alignment) {
-    alignment_reason = "requested";
-  } else if (ev.alignment == AlignmentKind::kNone) {
-    alignment_reason = "the recording has an absolute sensor: the estimate shares its world frame";
-  } else {
-    alignment_reason = "no absolute sensor in the recording: the estimate's world frame is its own";
-  }
+// Why the alignment is what it is.
+std::string AlignmentReason(const EvaluateOptions& options, AlignmentKind alignment) {
+  if (options.alignment) return "requested";
+  if (alignment == AlignmentKind::kNone)
+    return "the recording has an absolute sensor: the estimate shares its world frame";
+  return "no absolute sensor in the recording: the estimate's world frame is its own";
+}
 
-  // RPE by step and by distance (independent of the alignment).
-  const std::size_t step = StepForDuration(matched.estimate, options.rpe_delta_s);
-  const RelativePoseError rpe_step = RpeByStep(matched.estimate, matched.reference, step);
+// Alignment and ATE, then RPE by step and by distance (independent of the alignment). Returns the ATE; `rpe_step`
+// and `step` receive the RPE by step and its pose step.
+AbsoluteTrajectoryError Accuracy(const Inputs& in, const MatchedTrajectories& matched, const EvaluateOptions& options,
+                                 Evaluation* ev, RelativePoseError* rpe_step, std::size_t* step) {
+  ev->alignment = options.alignment.value_or(DefaultAlignment(in.recording));
+  const AbsoluteTrajectoryError ate = ComputeAte(matched.estimate, matched.reference, ev->alignment);
+  *step = StepForDuration(matched.estimate, options.rpe_delta_s);
+  *rpe_step = RpeByStep(matched.estimate, matched.reference, *step);
   const RelativePoseError rpe_distance = RpeByDistance(matched.estimate, matched.reference, options.rpe_distance_m);
 
-  json& m = ev.metrics;
-  m["estimate"] = options.estimate_dir;
-  m["recording"] = options.recording_dir;
-  m["association"] = {{"estimate_poses", association.estimate_size},
-                      {"reference_poses", association.reference_size},
-                      {"matched", association.matched()},
-                      {"tolerance_s", options.max_time_difference_s},
-                      {"max_time_difference_s", association.max_time_difference_s}};
+  json& m = ev->metrics;
   const Eigen::Quaterniond& q = ate.alignment.q_ref_est;
-  m["alignment"] = {{"kind", AlignmentKindName(ev.alignment)},
-                    {"reason", alignment_reason},
+  m["alignment"] = {{"kind", AlignmentKindName(ev->alignment)},
+                    {"reason", AlignmentReason(options, ev->alignment)},
                     {"q_ref_est_wxyz", {q.w(), q.x(), q.y(), q.z()}},
                     {"p_ref_est_m", {ate.alignment.p_ref_est.x(), ate.alignment.p_ref_est.y(),
                                      ate.alignment.p_ref_est.z()}}};
@@ -206,110 +217,148 @@ Result<Evaluation> Evaluate(const EvaluateOptions& options) {
               {"mean_m", Number(ate.statistics.mean)},
               {"median_m", Number(ate.statistics.median)},
               {"max_m", Number(ate.statistics.max)}};
-  m["rpe_trans_m"] = Number(rpe_step.translation.rmse);
-  m["rpe_rot_deg"] = Number(rpe_step.rotation.rmse);
-  m["rpe"] = RpeJson(rpe_step);
-  m["rpe"]["delta_poses"] = step;
+  m["rpe_trans_m"] = Number(rpe_step->translation.rmse);
+  m["rpe_rot_deg"] = Number(rpe_step->rotation.rmse);
+  m["rpe"] = RpeJson(*rpe_step);
+  m["rpe"]["delta_poses"] = *step;
   m["rpe"]["delta_s"] = options.rpe_delta_s;
   m["rpe_distance"] = RpeJson(rpe_distance);
   m["rpe_distance"]["distance_m"] = options.rpe_distance_m;
+  return ate;
+}
 
-  // Velocities of wheeled robots: the fused estimate and the encoders alone against the truth (seed Fig. 6).
-  if (recording::IsWheeledPlatform(rec.value().platform.kind)) {
-    Result<EncoderOdometry> encoders = EncoderOnlyOdometry(rec.value());
-    if (encoders.ok()) {
-      Evaluation::Velocity v;
-      v.fused = CompareVelocities(TrajectoryVelocities(estimate), truth, options.max_time_difference_s);
-      v.encoders_only = CompareVelocities(encoders.value().twists, truth, options.max_time_difference_s);
-      const Association encoder_association =
-          AssociateByTime(encoders.value().dead_reckoning, truth, association_options);
-      const MatchedTrajectories encoder_matched =
-          SelectMatched(encoders.value().dead_reckoning, truth, encoder_association);
-      const RelativePoseError rpe_encoders =
-          RpeByStep(encoder_matched.estimate, encoder_matched.reference,
-                    StepForDuration(encoder_matched.estimate, options.rpe_delta_s));
-      const auto series = [&truth](const RelativePoseError& rpe, const Trajectory& poses, std::vector<double>* t,
-                                   std::vector<double>* rot) {
-        for (std::size_t n = 0; n < rpe.first.size(); ++n) {
-          t->push_back(SecondsBetween(truth.front().t, poses[rpe.first[n]].t));
-          rot->push_back(rpe.rotation_deg[n]);
-        }
-      };
-      series(rpe_step, matched.estimate, &v.rpe_t_fused_s, &v.rpe_rot_fused_deg);
-      series(rpe_encoders, encoder_matched.estimate, &v.rpe_t_encoders_s, &v.rpe_rot_encoders_deg);
-      m["velocity"] = {{"fused", VelocityJson(v.fused, rpe_step.rotation.rmse)},
-                       {"encoders_only", VelocityJson(v.encoders_only, rpe_encoders.rotation.rmse)},
-                       {"rpe_delta_poses", step}};
-      ev.velocity = std::move(v);
+// Velocities of wheeled robots: the fused estimate and the encoders alone against the truth (seed Fig. 6).
+void Velocities(const Inputs& in, const MatchedTrajectories& matched, const RelativePoseError& rpe_step,
+                std::size_t step, const EvaluateOptions& options, Evaluation* ev) {
+  if (!recording::IsWheeledPlatform(in.recording.platform.kind)) return;
+  Result<EncoderOdometry> encoders = EncoderOnlyOdometry(in.recording);
+  if (!encoders.ok()) return;
+  const Trajectory& truth = in.truth();
+  AssociationOptions association_options;
+  association_options.max_time_difference_s = options.max_time_difference_s;
+  Evaluation::Velocity v;
+  v.fused = CompareVelocities(TrajectoryVelocities(in.estimate), truth, options.max_time_difference_s);
+  v.encoders_only = CompareVelocities(encoders.value().twists, truth, options.max_time_difference_s);
+  const Association encoder_association =
+      AssociateByTime(encoders.value().dead_reckoning, truth, association_options);
+  const MatchedTrajectories encoder_matched =
+      SelectMatched(encoders.value().dead_reckoning, truth, encoder_association);
+  const RelativePoseError rpe_encoders =
+      RpeByStep(encoder_matched.estimate, encoder_matched.reference,
+                StepForDuration(encoder_matched.estimate, options.rpe_delta_s));
+  const auto series = [&truth](const RelativePoseError& rpe, const Trajectory& poses, std::vector<double>* t,
+                               std::vector<double>* rot) {
+    for (std::size_t n = 0; n < rpe.first.size(); ++n) {
+      t->push_back(SecondsBetween(truth.front().t, poses[rpe.first[n]].t));
+      rot->push_back(rpe.rotation_deg[n]);
     }
-  }
+  };
+  series(rpe_step, matched.estimate, &v.rpe_t_fused_s, &v.rpe_rot_fused_deg);
+  series(rpe_encoders, encoder_matched.estimate, &v.rpe_t_encoders_s, &v.rpe_rot_encoders_deg);
+  ev->metrics["velocity"] = {{"fused", VelocityJson(v.fused, rpe_step.rotation.rmse)},
+                             {"encoders_only", VelocityJson(v.encoders_only, rpe_encoders.rotation.rmse)},
+                             {"rpe_delta_poses", step}};
+  ev->velocity = std::move(v);
+}
 
-  // Visual odometry streams against the truth, independently of the estimate (issue 4's per-pair targets).
-  for (const recording::Stream& stream : rec.value().streams) {
+// Visual odometry streams against the truth, independently of the estimate (per-pair errors).
+void VisualOdometry(const Inputs& in, json* m) {
+  for (const recording::Stream& stream : in.recording.streams) {
     if (stream.info.type != recording::StreamType::kVisualOdometry) continue;
-    if (const auto vo = CompareVisualOdometry(stream, truth)) m["visual_odometry"][stream.info.name] = VisualOdometryJson(*vo);
+    if (const auto vo = CompareVisualOdometry(stream, in.truth()))
+      (*m)["visual_odometry"][stream.info.name] = VisualOdometryJson(*vo);
   }
+}
+
+// NEES of each matched pose that has a covariance row, in the aligned frame.
+Status Consistency(const Inputs& in, const Eigen::Quaterniond& q_ref_est, const EvaluateOptions& options,
+                   Evaluation* ev) {
+  if (!in.covariances) return Status::Ok();
+  const std::vector<long> row = MatchCovariances(ev->matched_t, *in.covariances);
+  const Eigen::Matrix3d r = q_ref_est.toRotationMatrix();
+  std::vector<Time> nees_t;
+  std::vector<double> nees_values;
+  std::size_t without_row = 0;
+  std::size_t not_positive_definite = 0;
+  for (std::size_t i = 0; i < ev->matched_t.size(); ++i) {
+    if (row[i] < 0) {
+      ++without_row;
+      ev->sigma_world.push_back(Eigen::Vector3d::Constant(kNaN));
+      continue;
+    }
+    const Eigen::Matrix3d sigma = r * (*in.covariances)[row[i]].covariance_world * r.transpose();
+    ev->sigma_world.push_back(sigma.diagonal().cwiseMax(0.0).cwiseSqrt());
+    // eq. 16 with the error O - O_hat; its sign does not matter in the quadratic form.
+    const double nees = PositionNees(ev->error_world[i], sigma);
+    if (std::isnan(nees)) {
+      ++not_positive_definite;
+      continue;
+    }
+    nees_t.push_back(ev->matched_t[i]);
+    nees_values.push_back(nees);
+  }
+  if (nees_values.empty())
+    return Status::Error(in.covariance_path + ": no usable covariance at the stamps of the matched poses of " +
+                         in.trajectory_path);
+  ev->nees = AggregateNees(nees_t, {nees_values}, 3, options.nees_t0_s);
+  double sum = 0.0;
+  for (double v : nees_values) sum += v;
+  json& m = ev->metrics;
+  m["nees_mean"] = Number(sum / static_cast<double>(nees_values.size()));
+  m["nees"] = {{"poses", nees_values.size()},
+               {"without_covariance", without_row},
+               {"not_positive_definite", not_positive_definite},
+               {"dof", 3},
+               {"band_single_run", {ev->nees->band.lo, ev->nees->band.hi}},
+               {"t0_s", options.nees_t0_s},
+               {"fraction_in_band", Number(ev->nees->fraction_in_band)}};
+  return Status::Ok();
+}
+
+// The parameter table: calibration.json against truth.yaml.
+Status Parameters(const Inputs& in, json* m) {
+  if (!in.calibration) return Status::Ok();
+  std::vector<std::string> without_truth;
+  const std::map<std::string, std::vector<double>> none;
+  Result<std::vector<ParameterComparison>> rows =
+      CompareParameters(in.true_values ? in.true_values->calibration : none, *in.calibration, &without_truth);
+  if (!rows.ok()) return Status::Error(in.calibration_path + ": " + rows.status().message());
+  (*m)["parameters"] = ParameterTableJson(rows.value());
+  (*m)["parameters_without_truth"] = without_truth;
+  return Status::Ok();
+}
+
+}  // namespace
+
+Result<Evaluation> Evaluate(const EvaluateOptions& options) {
+  if (const std::string problem = options.Validate(); !problem.empty()) return Status::Error(problem);
+  Result<Inputs> read = ReadInputs(options);
+  if (!read.ok()) return read.status();
+  const Inputs& in = read.value();
+
+  Evaluation ev;
+  json& m = ev.metrics;
+  m["estimate"] = options.estimate_dir;
+  m["recording"] = options.recording_dir;
+  Result<MatchedTrajectories> matched = Associate(in, options, &m);
+  if (!matched.ok()) return matched.status();
+  RelativePoseError rpe_step;
+  std::size_t step = 0;
+  const AbsoluteTrajectoryError ate = Accuracy(in, matched.value(), options, &ev, &rpe_step, &step);
+  Velocities(in, matched.value(), rpe_step, step, options, &ev);
+  VisualOdometry(in, &m);
 
   // Figures' data: whole trajectories, matched errors.
-  ev.t_origin = truth.front().t;
-  ev.ground_truth = truth;
-  ev.aligned_estimate = TransformTrajectory(ate.alignment, estimate);
-  for (const StampedPose& pose : matched.estimate) ev.matched_t.push_back(pose.t);
+  ev.t_origin = in.truth().front().t;
+  ev.ground_truth = in.truth();
+  ev.aligned_estimate = TransformTrajectory(ate.alignment, in.estimate);
+  for (const StampedPose& pose : matched.value().estimate) ev.matched_t.push_back(pose.t);
   ev.error_world = ate.error_world;
-  ev.fixes = AbsoluteFixes(rec.value());
+  ev.fixes = AbsoluteFixes(in.recording);
   ev.estimate_label = "estimate (" + DirectoryName(options.estimate_dir) + ")";
 
-  // NEES of each matched pose that has a covariance row, in the aligned frame.
-  if (covariances) {
-    const std::vector<long> row = MatchCovariances(ev.matched_t, *covariances);
-    const Eigen::Matrix3d r = q.toRotationMatrix();
-    std::vector<Time> nees_t;
-    std::vector<double> nees_values;
-    std::size_t without_row = 0;
-    std::size_t not_positive_definite = 0;
-    for (std::size_t i = 0; i < ev.matched_t.size(); ++i) {
-      if (row[i] < 0) {
-        ++without_row;
-        ev.sigma_world.push_back(Eigen::Vector3d::Constant(kNaN));
-        continue;
-      }
-      const Eigen::Matrix3d sigma = r * (*covariances)[row[i]].covariance_world * r.transpose();
-      ev.sigma_world.push_back(sigma.diagonal().cwiseMax(0.0).cwiseSqrt());
-      // eq. 16 with the error O - O_hat; its sign does not matter in the quadratic form.
-      const double nees = PositionNees(ev.error_world[i], sigma);
-      if (std::isnan(nees)) {
-        ++not_positive_definite;
-        continue;
-      }
-      nees_t.push_back(ev.matched_t[i]);
-      nees_values.push_back(nees);
-    }
-    if (nees_values.empty())
-      return Status::Error(covariance_path + ": no usable covariance at the stamps of the matched poses of " +
-                           trajectory_path);
-    ev.nees = AggregateNees(nees_t, {nees_values}, 3, options.nees_t0_s);
-    double sum = 0.0;
-    for (double v : nees_values) sum += v;
-    m["nees_mean"] = Number(sum / static_cast<double>(nees_values.size()));
-    m["nees"] = {{"poses", nees_values.size()},
-                 {"without_covariance", without_row},
-                 {"not_positive_definite", not_positive_definite},
-                 {"dof", 3},
-                 {"band_single_run", {ev.nees->band.lo, ev.nees->band.hi}},
-                 {"t0_s", options.nees_t0_s},
-                 {"fraction_in_band", Number(ev.nees->fraction_in_band)}};
-  }
-
-  // Parameter table.
-  if (calibration) {
-    std::vector<std::string> without_truth;
-    const std::map<std::string, std::vector<double>> none;
-    Result<std::vector<ParameterComparison>> rows =
-        CompareParameters(true_values ? true_values->calibration : none, *calibration, &without_truth);
-    if (!rows.ok()) return Status::Error(calibration_path + ": " + rows.status().message());
-    m["parameters"] = ParameterTableJson(rows.value());
-    m["parameters_without_truth"] = without_truth;
-  }
+  if (Status s = Consistency(in, ate.alignment.q_ref_est, options, &ev); !s.ok()) return s;
+  if (Status s = Parameters(in, &m); !s.ok()) return s;
   return ev;
 }
 

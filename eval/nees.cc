@@ -10,7 +10,7 @@
 #include <string_view>
 
 #include "common/check.h"
-#include "eval/internal/json_util.h"
+#include "common/json.h"
 
 namespace roamlab::eval {
 namespace {
@@ -145,7 +145,6 @@ MonteCarloNees AggregateNees(const std::vector<Time>& t, const std::vector<std::
 }
 
 nlohmann::json NeesJson(const MonteCarloNees& nees) {
-  using internal::Number;
   nlohmann::json t = nlohmann::json::array();
   for (Time time : nees.t) t.push_back(time.seconds());
   nlohmann::json mean = nlohmann::json::array();

@@ -7,7 +7,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "eval/internal/json_util.h"
+#include "common/json.h"
 
 namespace roamlab::eval {
 namespace {
@@ -213,8 +213,6 @@ Result<std::map<std::string, ParameterEstimate>> ReadCalibrationEstimates(const 
 }
 
 json ParameterTableJson(const std::vector<ParameterComparison>& rows) {
-  using internal::Number;
-  using internal::NumberArray;
   json table = json::object();
   for (const ParameterComparison& row : rows) {
     json entry = {{"truth", NumberArray(row.truth)},

@@ -1,4 +1,4 @@
-// Accuracy of a visual_odometry stream against the ground truth (issue 4's targets: median rotation error per frame
+// Accuracy of a visual_odometry stream against the ground truth (the targets: median rotation error per frame
 // pair, failure rate), without the estimator.
 //
 // A row stamped at t holds the camera's mean velocity over the frame pair [t - T/2, t + T/2], T = 1 / rate_hz, in

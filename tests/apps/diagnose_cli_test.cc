@@ -69,7 +69,7 @@ TEST(DiagnoseCliTest, NeverOpensTruthYamlAndWritesGapJson) {
   EXPECT_EQ(gap["candidates"].size(), 9u);
   EXPECT_TRUE(std::ifstream(dir.File("out/report.md")).good());
   EXPECT_TRUE(std::ifstream(dir.File("out/scenario_patch.yaml")).good());
-  // The figures are drawn from complete data files (the held-out bars were once plotted from an unflushed, empty one).
+  // The figures are drawn from complete data files (each flushed before gnuplot reads it).
   if (eval::GnuplotAvailable()) {
     const std::string report = testing::ReadFile(dir.File("out/report.md"));
     EXPECT_NE(report.find("![heldout_fit.png]"), std::string::npos) << report;

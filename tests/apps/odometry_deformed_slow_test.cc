@@ -1,6 +1,6 @@
 // Seed 001's configuration F1 end to end (label slow: two simulated drives of 150 s and 100 s with the laser scan
 // matcher, about a minute): the taped-wheel differential drive of scenarios/deformed_f1_train.yaml, models learned from
-// the scan matcher's displacements, evaluated on the other path of deformed_f1_test.yaml. The targets: the
+// the scan matcher's displacements, evaluated on the other path of deformed_f1_test.yaml. The targets: the
 // best learned model's ATE at most 1/5 of the nominal model's, and the linear-kernel CGP within 10 % of the robust
 // linear model.
 #include <algorithm>

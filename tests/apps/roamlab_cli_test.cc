@@ -137,6 +137,21 @@ TEST_F(CliTest, BadInputGivesOneLineAndNonZeroExit) {
   }
 }
 
+TEST_F(CliTest, EvaluateBadInputGivesOneLineAndExitCodeTwo) {
+  fs::create_directories(dir_ / "est");
+  fs::create_directories(dir_ / "rec");
+  const std::string inputs = "evaluate --estimate " + (dir_ / "est").string() + " --recording " +
+                             (dir_ / "rec").string() + " --out " + (dir_ / "out").string();
+  const CommandRun missing = Roamlab(inputs + " --quiet", dir_);
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_EQ(missing.err.rfind("roamlab evaluate: ", 0), 0u) << missing.err;
+  EXPECT_EQ(std::count(missing.err.begin(), missing.err.end(), '\n'), 1) << missing.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "metrics.json"));
+  const CommandRun align = Roamlab(inputs + " --align sim3", dir_);
+  EXPECT_EQ(align.exit_code, 2);
+  EXPECT_NE(align.err.find("unknown alignment 'sim3'"), std::string::npos) << align.err;
+}
+
 TEST_F(CliTest, HelpDescribesEveryCommand) {
   for (const char* cmd : {"--help", "calibrate --help", "track --help"}) {
     const CommandRun r = Roamlab(cmd, dir_);

@@ -1,4 +1,4 @@
-// `roamlab evaluate` end to end on hand-written recording and estimate directories.
+// The evaluation (eval/evaluate.h) end to end on hand-written recording and estimate directories.
 #include "eval/evaluate.h"
 
 #include <gmock/gmock.h>
@@ -9,7 +9,6 @@
 #include <filesystem>
 #include <fstream>
 
-#include "apps/evaluate.h"
 #include "tests/recording/temp_dir.h"
 
 namespace roamlab::eval {
@@ -218,20 +217,6 @@ TEST_F(EvaluateTest, MissingGroundTruthIsAClearError) {
   fs::remove(rec("ground_truth.tum"));
   EXPECT_EQ(EvaluateError(Options()),
             rec("ground_truth.tum") + ": missing; evaluation needs the ground-truth trajectory");
-
-  // The command: one line on stderr, exit code 2, no output written.
-  apps::EvaluateArgs args;
-  args.estimate = est_dir();
-  args.recording = rec_dir();
-  args.out = out_dir();
-  args.quiet = true;
-  ::testing::internal::CaptureStderr();
-  const int code = apps::RunEvaluate(args);
-  const std::string err = ::testing::internal::GetCapturedStderr();
-  EXPECT_EQ(code, 2);
-  EXPECT_EQ(err, "roamlab evaluate: " + rec("ground_truth.tum") +
-                     ": missing; evaluation needs the ground-truth trajectory\n");
-  EXPECT_FALSE(fs::exists(out_dir() + "/metrics.json"));
 }
 
 TEST_F(EvaluateTest, BadInputsNameTheFile) {
@@ -257,15 +242,6 @@ TEST_F(EvaluateTest, BadInputsNameTheFile) {
   EvaluateOptions bad = Options();
   bad.rpe_distance_m = 0.0;
   EXPECT_THAT(EvaluateError(bad), HasSubstr("rpe_distance_m"));
-
-  apps::EvaluateArgs args;
-  args.estimate = est_dir();
-  args.recording = rec_dir();
-  args.out = out_dir();
-  args.align = "sim3";
-  ::testing::internal::CaptureStderr();
-  EXPECT_EQ(apps::RunEvaluate(args), 2);
-  EXPECT_THAT(::testing::internal::GetCapturedStderr(), HasSubstr("unknown alignment 'sim3'"));
 }
 
 }  // namespace

@@ -5,9 +5,9 @@
 //   baseline: regression_baseline       # optional baseline directory, relative to the suite file
 //   cases:
 //     - name: atv_calibration           # [A-Za-z0-9_.-]+, unique: names the case's output and baseline files
-//       mode: calibrate                 # one of the modes of apps/regress_modes.h (its keys are listed there)
+//       mode: calibrate                 # one of the modes of regress/modes.h (its keys are listed there)
 //       quick: true                     # in the quick subset (`--quick`); default false
-//       data: ../../shared/data/x       # optional: a directory the case needs (real data); when it is absent the
+//       data: data/optiodom             # optional: a directory the case needs (real data); when it is absent the
 //                                       # case is skipped (reported as skipped with this path, never as passed)
 //       scenario: atv_hills.yaml        # simulated with `seed` (default: the scenario's own); or recording: DIR
 //       seed: 1
@@ -18,7 +18,7 @@
 //         - {metric: metrics.velocity.fused.linear_rmse, bound: "<= 0.5 * metrics.velocity.encoders_only.linear_rmse"}
 //         - {metric: gap.verdict, equals: named}
 //         - {metric: "gap.effects[name=gps_latency].parameters.latency_s", bound: "<= 0.54"}  # quoted: [ ] , in {}
-//         - {metric: metrics.parameters.imu.misalignment.angle_error_deg, bound: "<= 2", open: "issue 3 target"}
+//         - {metric: metrics.parameters.imu.misalignment.angle_error_deg, bound: "<= 2", open: "needs a longer drive"}
 //
 // A metric is a dotted path into one of the mode's output files (ModeSpec::outputs): the output's name, then keys
 // (parameter names keep their dots: metrics.parameters.gps.lever_arm.error), then for an array of numbers one of
@@ -33,7 +33,7 @@
 // metric path of the same case (its value in this run); the threshold is K * REF + D. A string metric (gap.verdict,
 // a selected row's name) takes `equals: TEXT` instead (a bound on it, or `equals` on a number, is refused).
 //
-// `open: REASON` marks a target that is known not to be met yet (an issue's target, with the reason): the check is
+// `open: REASON` marks a target that is known not to be met yet (with the reason): the check is
 // evaluated and reported as usual (table, results.json, and junit.xml as a <skipped> testcase whose message holds
 // the value, the bound and the reason) but does not fail the run; when it holds it is reported as met, so that the
 // marker can be removed. A check without `open` fails the run when it does not hold.
@@ -49,7 +49,7 @@
 
 #include "common/status.h"
 
-namespace roamlab::apps::regress {
+namespace roamlab::regress {
 
 struct Bound {
   enum class Comparator { kLess, kLessEqual, kGreater, kGreaterEqual };
@@ -140,4 +140,4 @@ struct Suite {
 // error is one line "FILE:LINE: case 'NAME': problem" (or "FILE: problem" outside a case).
 Result<Suite> LoadSuite(const std::string& path);
 
-}  // namespace roamlab::apps::regress
+}  // namespace roamlab::regress

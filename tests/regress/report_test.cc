@@ -1,6 +1,6 @@
 // Regression reports: JUnit XML that is well-formed whatever the names and messages hold, one testcase per check,
 // failures naming value, bound and baseline.
-#include "apps/regress_report.h"
+#include "regress/report.h"
 
 #include <cctype>
 #include <string>
@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-namespace roamlab::apps::regress {
+namespace roamlab::regress {
 namespace {
 
 // A small XML 1.0 well-formedness checker for what JunitXml writes: declaration, elements with quoted attributes,
@@ -245,4 +245,4 @@ TEST(ResultsTest, CountsAndTableShowEveryCheck) {
 }
 
 }  // namespace
-}  // namespace roamlab::apps::regress
+}  // namespace roamlab::regress

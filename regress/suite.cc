@@ -1,4 +1,4 @@
-#include "apps/regress_suite.h"
+#include "regress/suite.h"
 
 #include <algorithm>
 #include <cctype>
@@ -9,12 +9,12 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "apps/commands.h"
-#include "apps/regress_modes.h"
+#include "estimator/calibration_io.h"
 #include "estimator/config.h"
+#include "regress/modes.h"
 #include "sim/scenario.h"
 
-namespace roamlab::apps::regress {
+namespace roamlab::regress {
 namespace {
 
 namespace fs = std::filesystem;
@@ -314,133 +314,145 @@ std::string ResolvePath(const std::string& suite_file, const std::string& path) 
   return (fs::path(suite_file).parent_path() / path).lexically_normal().string();
 }
 
-// Loads and validates one case; `seen` holds the names of the cases before it.
-Result<Case> LoadCase(const YAML::Node& node, const Context& suite, std::set<std::string>* seen) {
-  Context ctx = suite;
-  if (!node.IsMap()) return ctx.Error(node, "a case must be a map");
-  if (!node["name"] || !node["name"].IsScalar()) return ctx.Error(node, "a case needs a 'name'");
-  Case c;
-  c.name = node["name"].as<std::string>();
-  c.line = node.Mark().line + 1;
-  ctx.case_name = c.name;
-  if (c.name.empty() || !std::all_of(c.name.begin(), c.name.end(), [](char ch) {
+// The case's name (unique, [A-Za-z0-9_.-]+) and mode; `ctx` receives the case name for later messages.
+Result<const ModeSpec*> LoadNameAndMode(const YAML::Node& node, Context* ctx, std::set<std::string>* seen, Case* c) {
+  if (!node.IsMap()) return ctx->Error(node, "a case must be a map");
+  if (!node["name"] || !node["name"].IsScalar()) return ctx->Error(node, "a case needs a 'name'");
+  c->name = node["name"].as<std::string>();
+  c->line = node.Mark().line + 1;
+  ctx->case_name = c->name;
+  if (c->name.empty() || !std::all_of(c->name.begin(), c->name.end(), [](char ch) {
         return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-' || ch == '.';
       }))
-    return ctx.Error(node["name"], "a case name may only hold letters, digits, '_', '-' and '.'");
-  if (!seen->insert(c.name).second) return ctx.Error(node["name"], "a second case of this name");
+    return ctx->Error(node["name"], "a case name may only hold letters, digits, '_', '-' and '.'");
+  if (!seen->insert(c->name).second) return ctx->Error(node["name"], "a second case of this name");
 
-  // Mode.
   if (!node["mode"] || !node["mode"].IsScalar())
-    return ctx.Error(node, "no 'mode' (" + AvailableModeNames() + ")");
-  c.mode = node["mode"].as<std::string>();
-  const ModeSpec* mode = FindMode(c.mode);
-  if (!mode) return ctx.Error(node["mode"], "unknown mode '" + c.mode + "' (" + AvailableModeNames() + ")");
-  if (!mode->run) return ctx.Error(node["mode"], "mode " + c.mode + " is not available in this build");
+    return ctx->Error(node, "no 'mode' (" + AvailableModeNames() + ")");
+  c->mode = node["mode"].as<std::string>();
+  const ModeSpec* mode = FindMode(c->mode);
+  if (!mode) return ctx->Error(node["mode"], "unknown mode '" + c->mode + "' (" + AvailableModeNames() + ")");
+  if (!mode->run) return ctx->Error(node["mode"], "mode " + c->mode + " is not available in this build");
+  return mode;
+}
 
-  // Keys.
+// Every key is one the mode reads; the required ones are there ("a|b": exactly one of them).
+Status CheckKeys(const YAML::Node& node, const Context& ctx, const ModeSpec& mode) {
   for (const auto& entry : node) {
     const std::string key = entry.first.as<std::string>();
     const bool common = key == "name" || key == "mode" || key == "quick" || key == "data" || key == "checks";
-    if (!common && std::find(mode->keys.begin(), mode->keys.end(), key) == mode->keys.end()) {
+    if (!common && std::find(mode.keys.begin(), mode.keys.end(), key) == mode.keys.end()) {
       std::string allowed = "name, mode, quick, data, checks";
-      for (const std::string& k : mode->keys) allowed += ", " + k;
-      return ctx.Error(entry.first, "unknown key '" + key + "' for mode " + c.mode + " (" + allowed + ")");
+      for (const std::string& k : mode.keys) allowed += ", " + k;
+      return ctx.Error(entry.first, "unknown key '" + key + "' for mode " + mode.name + " (" + allowed + ")");
     }
   }
-  for (const std::string& required : mode->required) {
+  for (const std::string& required : mode.required) {
     const std::size_t bar = required.find('|');
     if (bar == std::string::npos) {
-      if (!node[required]) return ctx.Error(node, "mode " + c.mode + " needs '" + required + "'");
+      if (!node[required]) return ctx.Error(node, "mode " + mode.name + " needs '" + required + "'");
       continue;
     }
     const std::string a = required.substr(0, bar), b = required.substr(bar + 1);
     if (static_cast<bool>(node[a]) == static_cast<bool>(node[b]))
-      return ctx.Error(node, "mode " + c.mode + " needs exactly one of '" + a + "' and '" + b + "'");
+      return ctx.Error(node, "mode " + mode.name + " needs exactly one of '" + a + "' and '" + b + "'");
   }
   if (node["calibration"] && node["calibrate"])
     return ctx.Error(node, "give 'calibration' (a file) or 'calibrate' (a configuration), not both");
+  return Status::Ok();
+}
 
-  // Values.
+// The scalar values and the paths (resolved against the suite file, or `data` for train and test).
+Status LoadValues(const YAML::Node& node, const Context& ctx, const std::string& suite_file, Case* c) {
   try {
-    if (node["quick"]) c.quick = node["quick"].as<bool>();
-    if (node["seed"]) c.seed = node["seed"].as<std::uint64_t>();
-    if (node["runs"]) c.runs = node["runs"].as<int>();
-    if (node["seed_base"]) c.seed_base = node["seed_base"].as<std::uint64_t>();
-    if (node["t0_s"]) c.t0_s = node["t0_s"].as<double>();
-    if (node["baseline_seed"]) c.baseline_seed = node["baseline_seed"].as<std::uint64_t>();
-    if (node["interval_s"]) c.interval_s = node["interval_s"].as<double>();
-    for (auto [key, field] : {std::pair{"scenario", &c.scenario}, {"recording", &c.recording},
-                              {"config", &c.config}, {"calibration", &c.calibration}, {"calibrate", &c.calibrate},
-                              {"data", &c.data}})
-      if (node[key]) *field = ResolvePath(suite.file, node[key].as<std::string>());
-    for (auto [key, field] : {std::pair{"train", &c.train}, {"test", &c.test}})
+    if (node["quick"]) c->quick = node["quick"].as<bool>();
+    if (node["seed"]) c->seed = node["seed"].as<std::uint64_t>();
+    if (node["runs"]) c->runs = node["runs"].as<int>();
+    if (node["seed_base"]) c->seed_base = node["seed_base"].as<std::uint64_t>();
+    if (node["t0_s"]) c->t0_s = node["t0_s"].as<double>();
+    if (node["baseline_seed"]) c->baseline_seed = node["baseline_seed"].as<std::uint64_t>();
+    if (node["interval_s"]) c->interval_s = node["interval_s"].as<double>();
+    for (auto [key, field] : {std::pair{"scenario", &c->scenario}, {"recording", &c->recording},
+                              {"config", &c->config}, {"calibration", &c->calibration},
+                              {"calibrate", &c->calibrate}, {"data", &c->data}})
+      if (node[key]) *field = ResolvePath(suite_file, node[key].as<std::string>());
+    for (auto [key, field] : {std::pair{"train", &c->train}, {"test", &c->test}})
       if (node[key]) {
         if (!node[key].IsSequence() || node[key].size() == 0)
           return ctx.Error(node[key], std::string("'") + key + "' is a non-empty list of paths or globs");
         for (const YAML::Node& entry : node[key])
-          field->push_back(ResolvePath(c.data.empty() ? suite.file : c.data + "/.", entry.as<std::string>()));
+          field->push_back(ResolvePath(c->data.empty() ? suite_file : c->data + "/.", entry.as<std::string>()));
       }
   } catch (const YAML::Exception& e) {
     return ctx.Error(node, std::string("malformed value: ") + e.msg);
   }
-  if (node["runs"] && c.runs < 1) return ctx.Error(node["runs"], "runs must be at least 1");
-  if (c.interval_s && !(*c.interval_s > 0.0)) return ctx.Error(node["interval_s"], "interval_s must be positive");
+  if (node["runs"] && c->runs < 1) return ctx.Error(node["runs"], "runs must be at least 1");
+  if (c->interval_s && !(*c->interval_s > 0.0))
+    return ctx.Error(node["interval_s"], "interval_s must be positive");
+  return Status::Ok();
+}
 
-  // Effects hidden in a simulated recording (diagnose): names and parameters the simulator knows.
-  if (const YAML::Node effects = node["effects"]) {
-    if (!effects.IsSequence()) return ctx.Error(effects, "'effects' is a list of {name: EFFECT, PARAMETER: value}");
-    for (const YAML::Node& effect : effects) {
-      if (!effect.IsMap() || !effect["name"] || !effect["name"].IsScalar())
-        return ctx.Error(effect, "an effect is {name: EFFECT, PARAMETER: value, ...}");
-      const std::string name = effect["name"].as<std::string>();
-      const auto known = sim::KnownEffects().find(name);
-      if (known == sim::KnownEffects().end()) {
-        std::string list;
-        for (const auto& [n, p] : sim::KnownEffects()) list += (list.empty() ? "" : ", ") + n;
-        return ctx.Error(effect["name"], "unknown effect '" + name + "' (" + list + ")");
-      }
-      std::map<std::string, double> parameters;
-      for (const auto& entry : effect) {
-        const std::string key = entry.first.as<std::string>();
-        if (key == "name") continue;
-        if (!known->second.count(key)) return ctx.Error(entry.first, "effect " + name + " has no parameter " + key);
-        try {
-          parameters[key] = entry.second.as<double>();
-        } catch (const YAML::Exception&) {
-          return ctx.Error(entry.second, "effect parameter " + key + " is not a number");
-        }
-      }
-      c.effects.emplace_back(name, parameters);
+// Effects hidden in a simulated recording (diagnose): names and parameters the simulator knows.
+Status LoadEffects(const YAML::Node& effects, const Context& ctx, Case* c) {
+  if (!effects) return Status::Ok();
+  if (!effects.IsSequence()) return ctx.Error(effects, "'effects' is a list of {name: EFFECT, PARAMETER: value}");
+  for (const YAML::Node& effect : effects) {
+    if (!effect.IsMap() || !effect["name"] || !effect["name"].IsScalar())
+      return ctx.Error(effect, "an effect is {name: EFFECT, PARAMETER: value, ...}");
+    const std::string name = effect["name"].as<std::string>();
+    const auto known = sim::KnownEffects().find(name);
+    if (known == sim::KnownEffects().end()) {
+      std::string list;
+      for (const auto& [n, p] : sim::KnownEffects()) list += (list.empty() ? "" : ", ") + n;
+      return ctx.Error(effect["name"], "unknown effect '" + name + "' (" + list + ")");
     }
-  }
-
-  // Odometry models (`roamlab odometry learn` options).
-  if (const YAML::Node models = node["models"]) {
-    if (!models.IsSequence() || models.size() == 0)
-      return ctx.Error(models, "'models' is a non-empty list of {model: gp|linear|parametric, mean, kernel}");
-    for (const YAML::Node& m : models) {
-      if (!m.IsMap() || !m["model"]) return ctx.Error(m, "a model is {model: gp|linear|parametric[, mean, kernel]}");
-      Case::OdometryModel model;
-      for (const auto& entry : m) {
-        const std::string key = entry.first.as<std::string>();
-        const std::string value = entry.second.IsScalar() ? entry.second.as<std::string>() : "";
-        const bool ok = key == "model"    ? (value == "gp" || value == "linear" || value == "parametric")
-                        : key == "mean"   ? (value == "zero" || value == "linear")
-                        : key == "kernel" ? (value == "rbf" || value == "linear" || value == "rbf+linear")
-                                          : false;
-        if (!ok)
-          return ctx.Error(entry.first, "bad model entry '" + key + ": " + value +
-                                            "' (model: gp|linear|parametric, mean: zero|linear, kernel: rbf|linear|"
-                                            "rbf+linear)");
-        (key == "model" ? model.model : key == "mean" ? model.mean : model.kernel) = value;
+    std::map<std::string, double> parameters;
+    for (const auto& entry : effect) {
+      const std::string key = entry.first.as<std::string>();
+      if (key == "name") continue;
+      if (!known->second.count(key)) return ctx.Error(entry.first, "effect " + name + " has no parameter " + key);
+      try {
+        parameters[key] = entry.second.as<double>();
+      } catch (const YAML::Exception&) {
+        return ctx.Error(entry.second, "effect parameter " + key + " is not a number");
       }
-      if (model.model != "gp" && (!model.mean.empty() || !model.kernel.empty()))
-        return ctx.Error(m, "mean and kernel are options of the gp model only");
-      c.models.push_back(model);
     }
+    c->effects.emplace_back(name, parameters);
   }
+  return Status::Ok();
+}
 
-  // Inputs exist and load (a case's `data` may be absent: the case is then skipped, and its inputs are not checked).
+// Odometry models (`roamlab odometry learn` options).
+Status LoadOdometryModels(const YAML::Node& models, const Context& ctx, Case* c) {
+  if (!models) return Status::Ok();
+  if (!models.IsSequence() || models.size() == 0)
+    return ctx.Error(models, "'models' is a non-empty list of {model: gp|linear|parametric, mean, kernel}");
+  for (const YAML::Node& m : models) {
+    if (!m.IsMap() || !m["model"]) return ctx.Error(m, "a model is {model: gp|linear|parametric[, mean, kernel]}");
+    Case::OdometryModel model;
+    for (const auto& entry : m) {
+      const std::string key = entry.first.as<std::string>();
+      const std::string value = entry.second.IsScalar() ? entry.second.as<std::string>() : "";
+      const bool ok = key == "model"    ? (value == "gp" || value == "linear" || value == "parametric")
+                      : key == "mean"   ? (value == "zero" || value == "linear")
+                      : key == "kernel" ? (value == "rbf" || value == "linear" || value == "rbf+linear")
+                                        : false;
+      if (!ok)
+        return ctx.Error(entry.first, "bad model entry '" + key + ": " + value +
+                                          "' (model: gp|linear|parametric, mean: zero|linear, kernel: rbf|linear|"
+                                          "rbf+linear)");
+      (key == "model" ? model.model : key == "mean" ? model.mean : model.kernel) = value;
+    }
+    if (model.model != "gp" && (!model.mean.empty() || !model.kernel.empty()))
+      return ctx.Error(m, "mean and kernel are options of the gp model only");
+    c->models.push_back(model);
+  }
+  return Status::Ok();
+}
+
+// Inputs exist and load (a case's `data` may be absent: the case is then skipped, and its inputs are not checked);
+// `names` receives the parameter and stream names of the case's configuration.
+Status CheckInputs(const YAML::Node& node, const Context& ctx, const Case& c, Names* names) {
   const bool data_absent = !c.data.empty() && !fs::is_directory(c.data);
   if (!c.scenario.empty()) {
     if (!fs::is_regular_file(c.scenario)) return ctx.Error(node["scenario"], "missing scenario " + c.scenario);
@@ -449,63 +461,83 @@ Result<Case> LoadCase(const YAML::Node& node, const Context& suite, std::set<std
   }
   if (!c.recording.empty() && !data_absent && !fs::is_regular_file(fs::path(c.recording) / "recording.yaml"))
     return ctx.Error(node["recording"], "missing recording " + c.recording + " (no recording.yaml)");
-  Names names;
   if (!c.config.empty()) {
     const auto config = estimator::LoadEstimatorConfig(c.config);
     if (!config.ok()) return ctx.Error(node["config"], "bad config: " + config.status().message());
-    names = NamesOf(config.value());
+    *names = NamesOf(config.value());
   }
   if (!c.calibrate.empty()) {
     const auto config = estimator::LoadEstimatorConfig(c.calibrate);
     if (!config.ok()) return ctx.Error(node["calibrate"], "bad config: " + config.status().message());
   }
   if (!c.calibration.empty()) {
-    const auto values = ReadCalibrationValues(c.calibration);
+    const auto values = estimator::ReadCalibrationValues(c.calibration);
     if (!values.ok()) return ctx.Error(node["calibration"], "bad calibration: " + values.status().message());
   }
+  return Status::Ok();
+}
 
-  // Checks.
+// One check: a metric path with a bound (and the bound's reference metric) or, for a text, `equals`.
+Result<Check> LoadCheck(const YAML::Node& check, const Context& ctx, const ModeSpec& mode, const Names& names) {
+  const bool is_map = check.IsMap() && check["metric"] && check["metric"].IsScalar();
+  const bool one_test = is_map && (static_cast<bool>(check["bound"]) != static_cast<bool>(check["equals"]));
+  const std::size_t keys = 2 + (is_map && check["open"] ? 1 : 0);
+  if (!is_map || !one_test || check.size() != keys)
+    return ctx.Error(check, "a check is {metric: PATH, bound: BOUND} or {metric: PATH, equals: TEXT}, "
+                            "optionally with open: REASON, and nothing else");
+  Check k;
+  k.line = check.Mark().line + 1;
+  auto metric = ParseMetricPath(check["metric"].as<std::string>(), mode, names);
+  if (!metric.ok()) return ctx.Error(check["metric"], metric.status().message());
+  k.metric = std::move(metric).value();
+  if (check["open"]) {
+    k.open = check["open"].IsScalar() ? check["open"].as<std::string>() : "";
+    if (k.open.empty()) return ctx.Error(check["open"], "'open' needs the reason the target is not met yet");
+  }
+  if (check["equals"]) {
+    if (!k.metric.is_string)
+      return ctx.Error(check["equals"], "metric '" + k.metric.text + "' is a number: give a bound, not 'equals'");
+    if (!check["equals"].IsScalar()) return ctx.Error(check["equals"], "'equals' takes one text");
+    k.equals = check["equals"].as<std::string>();
+    return k;
+  }
+  if (k.metric.is_string)
+    return ctx.Error(check["bound"], "metric '" + k.metric.text + "' is a text: check it with 'equals: TEXT'");
+  auto bound = ParseBound(check["bound"].as<std::string>());
+  if (!bound.ok()) return ctx.Error(check["bound"], bound.status().message());
+  k.bound = std::move(bound).value();
+  if (!k.bound.reference.empty()) {
+    auto reference = ParseMetricPath(k.bound.reference, mode, names);
+    if (!reference.ok()) return ctx.Error(check["bound"], "bound '" + k.bound.text + "': " +
+                                                              reference.status().message());
+    if (reference.value().is_string)
+      return ctx.Error(check["bound"], "bound '" + k.bound.text + "': '" + k.bound.reference + "' is a text");
+    k.reference = std::move(reference).value();
+  }
+  return k;
+}
+
+// Loads and validates one case; `seen` holds the names of the cases before it.
+Result<Case> LoadCase(const YAML::Node& node, const Context& suite, std::set<std::string>* seen) {
+  Context ctx = suite;
+  Case c;
+  const Result<const ModeSpec*> mode = LoadNameAndMode(node, &ctx, seen, &c);
+  if (!mode.ok()) return mode.status();
+  Status st = CheckKeys(node, ctx, *mode.value());
+  if (st.ok()) st = LoadValues(node, ctx, suite.file, &c);
+  if (st.ok()) st = LoadEffects(node["effects"], ctx, &c);
+  if (st.ok()) st = LoadOdometryModels(node["models"], ctx, &c);
+  Names names;
+  if (st.ok()) st = CheckInputs(node, ctx, c, &names);
+  if (!st.ok()) return st;
+
   const YAML::Node checks = node["checks"];
   if (!checks || !checks.IsSequence() || checks.size() == 0)
     return ctx.Error(node, "no 'checks' (a list of {metric: PATH, bound: \"<= 0.5\"})");
   for (const YAML::Node& check : checks) {
-    const bool is_map = check.IsMap() && check["metric"] && check["metric"].IsScalar();
-    const bool one_test = is_map && (static_cast<bool>(check["bound"]) != static_cast<bool>(check["equals"]));
-    const std::size_t keys = 2 + (is_map && check["open"] ? 1 : 0);
-    if (!is_map || !one_test || check.size() != keys)
-      return ctx.Error(check, "a check is {metric: PATH, bound: BOUND} or {metric: PATH, equals: TEXT}, "
-                              "optionally with open: REASON, and nothing else");
-    Check k;
-    k.line = check.Mark().line + 1;
-    auto metric = ParseMetricPath(check["metric"].as<std::string>(), *mode, names);
-    if (!metric.ok()) return ctx.Error(check["metric"], metric.status().message());
-    k.metric = std::move(metric).value();
-    if (check["open"]) {
-      k.open = check["open"].IsScalar() ? check["open"].as<std::string>() : "";
-      if (k.open.empty()) return ctx.Error(check["open"], "'open' needs the reason the target is not met yet");
-    }
-    if (check["equals"]) {
-      if (!k.metric.is_string)
-        return ctx.Error(check["equals"], "metric '" + k.metric.text + "' is a number: give a bound, not 'equals'");
-      if (!check["equals"].IsScalar()) return ctx.Error(check["equals"], "'equals' takes one text");
-      k.equals = check["equals"].as<std::string>();
-      c.checks.push_back(std::move(k));
-      continue;
-    }
-    if (k.metric.is_string)
-      return ctx.Error(check["bound"], "metric '" + k.metric.text + "' is a text: check it with 'equals: TEXT'");
-    auto bound = ParseBound(check["bound"].as<std::string>());
-    if (!bound.ok()) return ctx.Error(check["bound"], bound.status().message());
-    k.bound = std::move(bound).value();
-    if (!k.bound.reference.empty()) {
-      auto reference = ParseMetricPath(k.bound.reference, *mode, names);
-      if (!reference.ok()) return ctx.Error(check["bound"], "bound '" + k.bound.text + "': " +
-                                                                reference.status().message());
-      if (reference.value().is_string)
-        return ctx.Error(check["bound"], "bound '" + k.bound.text + "': '" + k.bound.reference + "' is a text");
-      k.reference = std::move(reference).value();
-    }
-    c.checks.push_back(std::move(k));
+    Result<Check> k = LoadCheck(check, ctx, *mode.value(), names);
+    if (!k.ok()) return k.status();
+    c.checks.push_back(std::move(k).value());
   }
   return c;
 }
@@ -713,4 +745,4 @@ Result<Suite> LoadSuite(const std::string& path) {
   return suite;
 }
 
-}  // namespace roamlab::apps::regress
+}  // namespace roamlab::regress

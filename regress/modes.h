@@ -1,6 +1,6 @@
 // The modes a regression case can run, one table entry each: the case keys the mode reads, its output files with
-// their key schemas (what a check's metric path may name), and the function that runs a case in its own directory
-// by calling the `roamlab` commands in process. A mode without a run function is known but not available in this
+// their key schemas (what a check's metric path may name), and the function that runs a case in its own directory,
+// writing the files the `roamlab` commands write. A mode without a run function is known but not available in this
 // build: suites naming it are refused when loaded.
 #pragma once
 
@@ -9,10 +9,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "apps/regress_suite.h"
 #include "common/status.h"
+#include "regress/suite.h"
 
-namespace roamlab::apps::regress {
+namespace roamlab::regress {
 
 struct CaseContext {
   const Case& c;
@@ -29,13 +29,16 @@ struct ModeOutput {
   nlohmann::json schema;
 };
 
+// Runs a case, writing the mode's outputs; the error is one line.
+using ModeRunner = Status (*)(const CaseContext& context);
+
 struct ModeSpec {
   std::string name;
   std::vector<std::string> keys;       // case keys the mode reads besides name, mode, quick and checks
   std::vector<std::string> required;   // of those, the required ones; "a|b" means exactly one of a and b
   std::vector<ModeOutput> outputs;
   // Runs the case, writing the outputs above; nullptr: not available in this build.
-  Status (*run)(const CaseContext& context) = nullptr;
+  ModeRunner run = nullptr;
 };
 
 // The mode of this name, nullptr when unknown.
@@ -43,4 +46,4 @@ const ModeSpec* FindMode(const std::string& name);
 // Names of the modes available in this build, for messages.
 std::string AvailableModeNames();
 
-}  // namespace roamlab::apps::regress
+}  // namespace roamlab::regress

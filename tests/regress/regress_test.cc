@@ -1,7 +1,7 @@
-// `roamlab regress` end to end on a short synthetic drive: a baseline made with the right estimator configuration,
+// A regression run (regress/regress.h) end to end on a short synthetic drive: a baseline made with the right estimator configuration,
 // the same values again (with another number of jobs), and a configuration with a wrong noise level caught by the
 // baseline checks, named in results.json and junit.xml.
-#include "apps/regress.h"
+#include "regress/regress.h"
 
 #include <cmath>
 #include <set>
@@ -13,19 +13,29 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "apps/commands.h"
-#include "apps/evaluate.h"
-#include "apps/regress_modes.h"
+#include "eval/evaluate.h"
+#include "experiment/steps.h"
+#include "regress/modes.h"
 #include "recording/recording.h"
 #include "recording/truth.h"
 #include "tests/recording/temp_dir.h"
 #include "tests/support/synthetic.h"
 
-namespace roamlab::apps {
+namespace roamlab::regress {
 namespace {
 
 using nlohmann::json;
 namespace fs = std::filesystem;
+
+// The exit code `roamlab regress` gives for a run: 2 on bad input, 1 when a check fails or a report cannot be
+// written, 0 when every check passes.
+int RunRegress(const RunOptions& options) {
+  SuiteResult result;
+  RunReports reports;
+  const experiment::Outcome outcome = RunSuite(options, &result, &reports);
+  if (!outcome.ok()) return outcome.bad_input ? 2 : 1;
+  return result.Passed() ? 0 : 1;
+}
 
 std::string Source(const std::string& name) { return std::string(ROAMLAB_SOURCE_DIR) + "/configs/" + name; }
 
@@ -105,12 +115,11 @@ class RegressTest : public ::testing::Test {
   }
 
   static int Run(const std::string& suite, const std::string& out, bool update, int jobs) {
-    RegressArgs args;
+    RunOptions args;
     args.suite = suite;
     args.out = dir_->File(out);
     args.update_baseline = update;
     args.jobs = jobs;
-    args.quiet = true;
     return RunRegress(args);
   }
 
@@ -152,11 +161,10 @@ TEST_F(RegressTest, BaselineCatchesWrongNoiseLevels) {
 
 TEST_F(RegressTest, MissingBaselineIsAnErrorNotAPass) {
   fs::remove_all(dir_->File("empty_baseline"));
-  RegressArgs args;
+  RunOptions args;
   args.suite = Suite("good.yaml");
   args.out = dir_->File("out_no_baseline");
   args.baseline = dir_->File("empty_baseline");
-  args.quiet = true;
   args.filter = "synthetic_*";
   EXPECT_EQ(RunRegress(args), 1);
   const json results = ReadJson(dir_->File("out_no_baseline/results.json"));
@@ -166,7 +174,7 @@ TEST_F(RegressTest, MissingBaselineIsAnErrorNotAPass) {
   EXPECT_EQ(RunRegress(args), 2);
 }
 
-// The "done when": one bound made impossible makes the run exit non-zero, and junit.xml names that check with
+// One bound made impossible makes the run exit non-zero, and junit.xml names that check with
 // its value and bound (and only that one fails).
 TEST_F(RegressTest, ImpossibleBoundFailsAndJunitNamesTheCheck) {
   const std::string path = dir_->File("suite_impossible.yaml");
@@ -303,7 +311,7 @@ void MissingKeys(const json& schema, const json& actual, const std::string& pref
 }
 
 json Output(const std::string& mode, const std::string& name) {
-  for (const regress::ModeOutput& o : regress::FindMode(mode)->outputs)
+  for (const ModeOutput& o : FindMode(mode)->outputs)
     if (o.name == name) return o.schema;
   ADD_FAILURE() << mode << " has no output " << name;
   return json::object();
@@ -312,26 +320,25 @@ json Output(const std::string& mode, const std::string& name) {
 // The schemas that metric paths are validated against are what the commands write: every key is there, except
 // those the commands write only in some cases (a NEES without covariance, rotation errors of vectors).
 TEST_F(RegressTest, OutputSchemasMatchWhatTheCommandsWrite) {
-  CalibrateArgs calibrate;
+  experiment::CalibrateRequest calibrate;
   calibrate.recording = dir_->File("rec");
   calibrate.config = Source("atv_calibration.yaml");
   calibrate.out = dir_->File("schema_cal");
-  calibrate.quiet = true;
-  ASSERT_EQ(RunCalibrate(calibrate), 0);
-  EvaluateArgs evaluate;
-  evaluate.estimate = calibrate.out;
-  evaluate.recording = calibrate.recording;
-  evaluate.out = dir_->File("schema_eval");
-  evaluate.no_plots = true;
-  evaluate.quiet = true;
-  ASSERT_EQ(RunEvaluate(evaluate), 0);
+  ASSERT_TRUE(experiment::CalibrateToDirectory(calibrate).ok());
+  eval::EvaluateOptions evaluate;
+  evaluate.estimate_dir = calibrate.out;
+  evaluate.recording_dir = calibrate.recording;
+  const Result<eval::Evaluation> evaluation = eval::Evaluate(evaluate);
+  ASSERT_TRUE(evaluation.ok());
+  const std::string evaluation_dir = dir_->File("schema_eval");
+  ASSERT_TRUE(eval::WriteEvaluation(evaluation.value(), evaluation_dir, false).ok());
 
   std::set<std::string> missing;
   MissingKeys(Output("calibrate", "calibration"), ReadJson(calibrate.out + "/calibration.json"), "calibration",
               &missing);
   EXPECT_TRUE(missing.empty()) << *missing.begin();
   missing.clear();
-  const json metrics = ReadJson(evaluate.out + "/metrics.json");
+  const json metrics = ReadJson(evaluation_dir + "/metrics.json");
   MissingKeys(Output("calibrate", "metrics"), metrics, "metrics", &missing);
   for (const std::string& key : missing) {
     const bool no_covariance = key == "metrics.nees" || key == "metrics.nees_mean";
@@ -356,4 +363,4 @@ TEST_F(RegressTest, OutputSchemasMatchWhatTheCommandsWrite) {
 }
 
 }  // namespace
-}  // namespace roamlab::apps
+}  // namespace roamlab::regress

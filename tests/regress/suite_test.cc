@@ -1,6 +1,6 @@
 // Regression suites: the bound grammar, metric paths against the outputs' schemas, and one clear line for each kind
 // of bad suite file.
-#include "apps/regress_suite.h"
+#include "regress/suite.h"
 
 #include <algorithm>
 #include <string>
@@ -10,7 +10,7 @@
 
 #include "tests/recording/temp_dir.h"
 
-namespace roamlab::apps::regress {
+namespace roamlab::regress {
 namespace {
 
 using nlohmann::json;
@@ -326,4 +326,4 @@ TEST(ResolveMetricTest, SelectsOneRowByItsTextFields) {
 }
 
 }  // namespace
-}  // namespace roamlab::apps::regress
+}  // namespace roamlab::regress

@@ -1,9 +1,9 @@
-#include "apps/regress_report.h"
+#include "regress/report.h"
 
 #include <algorithm>
 #include <cstdio>
 
-namespace roamlab::apps::regress {
+namespace roamlab::regress {
 namespace {
 
 using nlohmann::json;
@@ -207,4 +207,4 @@ std::string JunitXml(const SuiteResult& result) {
   return xml;
 }
 
-}  // namespace roamlab::apps::regress
+}  // namespace roamlab::regress

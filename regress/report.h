@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-namespace roamlab::apps::regress {
+namespace roamlab::regress {
 
 struct CheckResult {
   // kOpen: an open target (`open:` in the suite) that does not hold; kSkipped: its case was skipped. Neither fails
@@ -56,4 +56,4 @@ std::string JunitXml(const SuiteResult& result);
 // `text` with &, <, >, " and ' escaped for XML, and characters XML 1.0 does not allow replaced by '?'.
 std::string XmlEscape(const std::string& text);
 
-}  // namespace roamlab::apps::regress
+}  // namespace roamlab::regress

@@ -1,31 +1,29 @@
-#include "apps/regress_modes.h"
+#include "regress/modes.h"
 
 #include <glob.h>
 
 #include <algorithm>
 #include <filesystem>
 #include <sstream>
-#include <type_traits>
 #include <utility>
 
-#include "apps/commands.h"
 #include "apps/diagnose.h"
-#include "apps/evaluate.h"
-#include "apps/import.h"
-#include "apps/montecarlo.h"
-#include "apps/odometry.h"
-#include "apps/simulate.h"
+#include "eval/evaluate.h"
+#include "experiment/montecarlo.h"
+#include "experiment/odometry.h"
+#include "experiment/steps.h"
 #include "recording/recording.h"
 #include "recording/truth.h"
+#include "sim/scenario.h"
 #include "sim/simulator.h"
 
-namespace roamlab::apps::regress {
+namespace roamlab::regress {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// What `roamlab evaluate` writes (apps/evaluate.cc, eval/evaluate.cc, eval/parameters.cc).
+// What `roamlab evaluate` writes (eval/evaluate.cc, eval/parameters.cc).
 json MetricsSchema() {
   const json stats = {{"rmse", "number"}, {"mean", "number"}, {"median", "number"}, {"max", "number"}};
   return {{"ate_m", "number"},
@@ -78,7 +76,7 @@ json CountsSchema() {
                         {"outside", "number"}}}};
 }
 
-// What `roamlab calibrate` writes (apps/commands.cc).
+// What `roamlab calibrate` writes (estimator/calibration_io.h).
 json CalibrationSchema() {
   return {{"parameters", {{"<parameter>", {{"estimate", "numbers"}, {"std", "numbers"}}}}},
           {"solver",
@@ -95,7 +93,7 @@ json CalibrationSchema() {
           {"measurements", CountsSchema()}};
 }
 
-// What `roamlab track` writes to summary.json (apps/commands.cc).
+// What `roamlab track` writes to summary.json (estimator/tracking_io.h).
 json SummarySchema() {
   return {{"poses", "number"},
           {"updates", "number"},
@@ -110,7 +108,7 @@ json SummarySchema() {
           {"measurements", CountsSchema()}};
 }
 
-// What `roamlab montecarlo` writes (apps/montecarlo.cc, eval/nees.cc).
+// What `roamlab montecarlo` writes (experiment/montecarlo.h, eval/nees.h).
 json NeesSchema() {
   return {{"runs", "number"}, {"dof", "number"},       {"band", "numbers"},     {"alpha", "number"},
           {"t0_s", "number"}, {"t", "numbers"},        {"mean_nees", "numbers"}, {"fraction_in_band", "number"}};
@@ -120,72 +118,64 @@ json RunsSchema() {
                                   {"track_seconds", "timing"}}})}};
 }
 
-// Whether a command's arguments take an error stream (`err`).
-template <typename Args, typename = void>
-struct HasErr : std::false_type {};
-template <typename Args>
-struct HasErr<Args, std::void_t<decltype(std::declval<Args&>().err)>> : std::true_type {};
-
-// Calls a command with its one-line error captured: the error of a failed command becomes the case's error (commands
-// without an error stream print it to stderr; the case's error then names the command and its exit code).
-template <typename Args>
-Status Call(int (*command)(const Args&), Args args, const std::string& what) {
-  std::ostringstream err;
-  args.quiet = true;
-  if constexpr (HasErr<Args>::value) args.err = &err;
-  const int code = command(args);
-  if (code == 0) return Status::Ok();
-  std::string message = err.str();
-  while (!message.empty() && message.back() == '\n') message.pop_back();
-  if (message.empty()) message = what + " failed with exit code " + std::to_string(code);
-  return Status::Error(message);
+// A failed step's error as the command would print it: "roamlab COMMAND: message" (Outcome::step names an inner
+// command).
+Status Failed(const std::string& command, const experiment::Outcome& outcome) {
+  return Status::Error("roamlab " + (outcome.step.empty() ? command : outcome.step) + ": " + outcome.status.message());
 }
 
 // The case's recording: the given directory, or the scenario simulated with the case's seed into DIR/recording.
 Result<std::string> Recording(const CaseContext& context) {
   if (!context.c.recording.empty()) return context.c.recording;
-  SimulateArgs args;
-  args.scenario = context.c.scenario;
-  args.out = context.dir + "/recording";
-  args.seed = context.c.seed;
-  const Status st = Call(RunSimulate, args, "simulate");
-  if (!st.ok()) return st;
-  return args.out;
+  experiment::SimulateRequest request;
+  request.scenario = context.c.scenario;
+  request.out = context.dir + "/recording";
+  request.seed = context.c.seed;
+  const experiment::Outcome outcome = experiment::SimulateToDirectory(request);
+  if (!outcome.ok()) return Failed("simulate", outcome);
+  return request.out;
+}
+
+// Calibrates `recording` with `config` into DIR/calibration.
+Status Calibrate(const CaseContext& context, const std::string& recording, const std::string& config) {
+  experiment::CalibrateRequest request;
+  request.recording = recording;
+  request.config = config;
+  request.out = context.dir + "/calibration";
+  const experiment::Outcome outcome = experiment::CalibrateToDirectory(request);
+  return outcome.ok() ? Status::Ok() : Failed("calibrate", outcome);
 }
 
 // The calibration.json tracking uses: the given file, one calibrated into DIR/calibration, or none ("").
 Result<std::string> CalibrationFile(const CaseContext& context, const std::string& recording) {
   if (!context.c.calibration.empty()) return context.c.calibration;
   if (context.c.calibrate.empty()) return std::string();
-  CalibrateArgs args;
-  args.recording = recording;
-  args.config = context.c.calibrate;
-  args.out = context.dir + "/calibration";
-  const Status st = Call(RunCalibrate, args, "calibrate");
+  const Status st = Calibrate(context, recording, context.c.calibrate);
   if (!st.ok()) return st;
-  return args.out + "/calibration.json";
+  return context.dir + "/calibration/calibration.json";
 }
 
+// Evaluates the estimate in `estimate` against the recording's truth into DIR/evaluation (no figures).
 Status Evaluate(const CaseContext& context, const std::string& estimate, const std::string& recording) {
-  EvaluateArgs args;
-  args.estimate = estimate;
-  args.recording = recording;
-  args.out = context.dir + "/evaluation";
-  if (context.c.t0_s) args.nees_t0_s = *context.c.t0_s;
-  args.no_plots = true;
-  return Call(RunEvaluate, args, "evaluate");
+  eval::EvaluateOptions options;
+  options.estimate_dir = estimate;
+  options.recording_dir = recording;
+  if (context.c.t0_s) options.nees_t0_s = *context.c.t0_s;
+  const auto failed = [](const std::string& message) { return Status::Error("roamlab evaluate: " + message); };
+  if (const std::string problem = options.Validate(); !problem.empty()) return failed(problem);
+  const Result<eval::Evaluation> evaluation = eval::Evaluate(options);
+  if (!evaluation.ok()) return failed(evaluation.status().message());
+  const Result<eval::WrittenEvaluation> written =
+      eval::WriteEvaluation(evaluation.value(), context.dir + "/evaluation", false);
+  return written.ok() ? Status::Ok() : failed(written.status().message());
 }
 
 Status RunCalibrateCase(const CaseContext& context) {
   const Result<std::string> recording = Recording(context);
   if (!recording.ok()) return recording.status();
-  CalibrateArgs args;
-  args.recording = recording.value();
-  args.config = context.c.config;
-  args.out = context.dir + "/calibration";
-  const Status st = Call(RunCalibrate, args, "calibrate");
+  const Status st = Calibrate(context, recording.value(), context.c.config);
   if (!st.ok()) return st;
-  return Evaluate(context, args.out, recording.value());
+  return Evaluate(context, context.dir + "/calibration", recording.value());
 }
 
 // Tracking runs without its per-update time budget (tracking.time_budget_s): where an update reaches it, the result
@@ -195,15 +185,15 @@ Status RunTrackCase(const CaseContext& context) {
   if (!recording.ok()) return recording.status();
   const Result<std::string> calibration = CalibrationFile(context, recording.value());
   if (!calibration.ok()) return calibration.status();
-  TrackArgs args;
-  args.recording = recording.value();
-  args.config = context.c.config;
-  args.calibration = calibration.value();
-  args.out = context.dir + "/tracking";
-  args.no_time_budget = true;
-  const Status st = Call(RunTrack, args, "track");
-  if (!st.ok()) return st;
-  return Evaluate(context, args.out, recording.value());
+  experiment::TrackRequest request;
+  request.recording = recording.value();
+  request.config = context.c.config;
+  request.calibration = calibration.value();
+  request.out = context.dir + "/tracking";
+  request.no_time_budget = true;
+  const experiment::Outcome outcome = experiment::TrackToDirectory(request);
+  if (!outcome.ok()) return Failed("track", outcome);
+  return Evaluate(context, request.out, recording.value());
 }
 
 Status RunMonteCarloCase(const CaseContext& context) {
@@ -215,20 +205,21 @@ Status RunMonteCarloCase(const CaseContext& context) {
     if (!file.ok()) return file.status();
     calibration = file.value();
   }
-  MonteCarloArgs args;
-  args.scenario = context.c.scenario;
-  args.config = context.c.config;
-  args.calibration = calibration;
-  args.out = context.dir + "/montecarlo";
-  args.runs = context.c.runs;
-  args.jobs = context.jobs;
-  args.seed_base = context.c.seed_base;
-  args.no_time_budget = true;
-  if (context.c.t0_s) args.t0_s = *context.c.t0_s;
-  return Call(RunMonteCarlo, args, "montecarlo");
+  experiment::MonteCarloOptions options;
+  options.scenario = context.c.scenario;
+  options.config = context.c.config;
+  options.calibration = calibration;
+  options.out = context.dir + "/montecarlo";
+  options.runs = context.c.runs;
+  options.jobs = context.jobs;
+  options.seed_base = context.c.seed_base;
+  options.no_time_budget = true;
+  if (context.c.t0_s) options.t0_s = *context.c.t0_s;
+  const experiment::Outcome outcome = experiment::RunMonteCarlo(options);
+  return outcome.ok() ? Status::Ok() : Failed("montecarlo", outcome);
 }
 
-// What `roamlab odometry evaluate` writes (apps/odometry.h).
+// What `roamlab odometry evaluate` writes (experiment/odometry.h).
 json TableSchema() {
   return {{"rows", json::array({{{"model", "string"}, {"mean", "string"}, {"kernel", "string"}, {"ate_m", "number"},
                                  {"rpe_mm", "number"}, {"model_file", "string"}}})},
@@ -289,19 +280,16 @@ Result<std::vector<std::string>> OdometryRecordings(const CaseContext& context, 
       if (fs::is_regular_file(fs::path(path) / "recording.yaml")) {
         recordings.push_back(path);
       } else if (fs::path(path).extension() == ".csv") {
-        ImportOptiOdomArgs args;
-        args.run_csv = path;
-        args.out = out;
-        const Status st = Call(RunImportOptiOdom, args, "import optiodom " + path);
-        if (!st.ok()) return st;
+        const experiment::Outcome outcome = experiment::ImportOptiOdomToDirectory(path, "", out);
+        if (!outcome.ok()) return Failed("import", outcome);
         recordings.push_back(out);
       } else if (fs::path(path).extension() == ".yaml") {
-        SimulateArgs args;
-        args.scenario = path;
-        args.out = out;
-        args.seed = context.c.seed;
-        const Status st = Call(RunSimulate, args, "simulate " + path);
-        if (!st.ok()) return st;
+        experiment::SimulateRequest request;
+        request.scenario = path;
+        request.out = out;
+        request.seed = context.c.seed;
+        const experiment::Outcome outcome = experiment::SimulateToDirectory(request);
+        if (!outcome.ok()) return Failed("simulate", outcome);
         recordings.push_back(out);
       } else {
         return Status::Error(kind + ": " + path + " is not an OptiOdom run (.csv), a scenario (.yaml) or a recording");
@@ -317,30 +305,33 @@ Status RunOdometryCase(const CaseContext& context) {
   if (!train.ok()) return train.status();
   const Result<std::vector<std::string>> test = OdometryRecordings(context, context.c.test, "test");
   if (!test.ok()) return test.status();
-  OdometryEvaluateArgs evaluate;
+  experiment::OdometryEvaluateOptions evaluate;
   for (std::size_t i = 0; i < context.c.models.size(); ++i) {
     const Case::OdometryModel& m = context.c.models[i];
-    OdometryLearnArgs args;
-    args.recordings = train.value();
-    args.model = m.model;
-    if (!m.mean.empty()) args.mean = m.mean;
-    if (!m.kernel.empty()) args.kernel = m.kernel;
-    if (context.c.interval_s) args.interval_s = *context.c.interval_s;
-    args.out = context.dir + "/models/" + std::to_string(i) + "_" + m.model + (m.mean.empty() ? "" : "_" + m.mean) +
-               (m.kernel.empty() ? "" : "_" + m.kernel) + ".json";
+    experiment::OdometryLearnOptions options;
+    options.recordings = train.value();
+    options.model = m.model;
+    if (!m.mean.empty()) options.mean = m.mean;
+    if (!m.kernel.empty()) options.kernel = m.kernel;
+    if (context.c.interval_s) options.interval_s = *context.c.interval_s;
+    options.out = context.dir + "/models/" + std::to_string(i) + "_" + m.model +
+                  (m.mean.empty() ? "" : "_" + m.mean) + (m.kernel.empty() ? "" : "_" + m.kernel) + ".json";
     std::error_code ec;
     fs::create_directories(context.dir + "/models", ec);
-    const Status st = Call(RunOdometryLearn, args, "odometry learn (" + m.model + ")");
-    if (!st.ok()) return st;
-    evaluate.models.push_back(args.out);
+    const experiment::Outcome outcome = experiment::LearnOdometry(options);
+    if (!outcome.ok()) return Failed("odometry", outcome);
+    evaluate.models.push_back(options.out);
   }
   evaluate.recordings = test.value();
   evaluate.out = context.dir + "/odometry";
-  evaluate.no_plots = true;
-  return Call(RunOdometryEvaluate, evaluate, "odometry evaluate");
+  evaluate.plots = false;
+  const experiment::Outcome outcome = experiment::EvaluateOdometry(evaluate);
+  return outcome.ok() ? Status::Ok() : Failed("odometry", outcome);
 }
 
 // Diagnoses the case's recording, or the scenario simulated with the case's hidden effects, against the scenario.
+// The diagnosis runs the `roamlab diagnose` command in process (apps/diagnose.h) until its core is a library function
+// of gap/.
 Status RunDiagnoseCase(const CaseContext& context) {
   std::string recording = context.c.recording;
   if (recording.empty()) {
@@ -357,14 +348,22 @@ Status RunDiagnoseCase(const CaseContext& context) {
     if (st.ok()) st = recording::WriteTruth(simulated.value().truth, recording);  // for people; diagnose never reads it
     if (!st.ok()) return st;
   }
-  DiagnoseArgs args;
+  apps::DiagnoseArgs args;
   args.recording = recording;
   args.scenario = context.c.scenario;
   args.config = context.c.config;
   args.out = context.dir + "/diagnosis";
   if (context.c.baseline_seed) args.baseline_seed = *context.c.baseline_seed;
   args.no_plots = true;
-  return Call(RunDiagnose, args, "diagnose");
+  args.quiet = true;
+  std::ostringstream err;
+  args.err = &err;
+  const int code = apps::RunDiagnose(args);
+  if (code == 0) return Status::Ok();
+  std::string message = err.str();
+  while (!message.empty() && message.back() == '\n') message.pop_back();
+  if (message.empty()) message = "diagnose failed with exit code " + std::to_string(code);
+  return Status::Error(message);
 }
 
 const std::vector<ModeSpec>& Modes() {
@@ -415,4 +414,4 @@ std::string AvailableModeNames() {
   return names;
 }
 
-}  // namespace roamlab::apps::regress
+}  // namespace roamlab::regress

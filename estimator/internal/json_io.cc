@@ -1,0 +1,35 @@
+#include "estimator/internal/json_io.h"
+
+#include <fstream>
+
+namespace roamlab::estimator::internal {
+
+using nlohmann::json;
+
+Status WriteJson(const json& j, const std::string& path) {
+  std::ofstream out(path);
+  if (!out) return Status::Error(path + ": cannot write");
+  out << j.dump(2) << "\n";
+  return out ? Status::Ok() : Status::Error(path + ": write failed");
+}
+
+Result<json> ReadJsonFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return Status::Error(path + ": cannot open");
+  json j;
+  try {
+    in >> j;
+  } catch (const json::exception& e) {
+    return Status::Error(path + ": not valid JSON: " + e.what());
+  }
+  return j;
+}
+
+json CountsJson(const std::map<std::string, StreamCounts>& counts) {
+  json j = json::object();
+  for (const auto& [name, c] : counts)
+    j[name] = {{"attached", c.attached}, {"rejected", c.rejected}, {"too_late", c.too_late}, {"outside", c.outside}};
+  return j;
+}
+
+}  // namespace roamlab::estimator::internal

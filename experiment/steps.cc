@@ -1,0 +1,124 @@
+#include "experiment/steps.h"
+
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <utility>
+
+#include <Eigen/Core>
+
+#include "estimator/calibration_io.h"
+#include "estimator/config.h"
+#include "estimator/tracking_io.h"
+#include "recording/import_optiodom.h"
+#include "recording/recording.h"
+#include "recording/trajectory.h"
+#include "recording/truth.h"
+#include "sim/scenario.h"
+
+namespace roamlab::experiment {
+namespace {
+
+// The configuration and the recording streams it reads (without the ground truth).
+struct Inputs {
+  estimator::EstimatorConfig config;
+  recording::Recording recording;
+};
+Result<Inputs> LoadInputs(const std::string& config_path, const std::string& recording_dir) {
+  auto config = estimator::LoadEstimatorConfig(config_path);
+  if (!config.ok()) return config.status();
+  recording::ReadOptions read;
+  read.load_ground_truth = false;
+  for (const auto& [name, stream] : config.value().streams)
+    for (const auto& [role, source] : stream.sources) read.required_streams.push_back(source);
+  auto rec = recording::ReadRecording(recording_dir, read);
+  if (!rec.ok()) return rec.status();
+  return Inputs{std::move(config).value(), std::move(rec).value()};
+}
+
+}  // namespace
+
+Status MakeOutputDirectory(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return Status::Error(dir + ": cannot create the output directory: " + ec.message());
+  return Status::Ok();
+}
+
+Outcome SimulateToDirectory(const SimulateRequest& request, sim::Simulation* simulation) {
+  auto scenario = sim::LoadScenario(request.scenario);
+  if (!scenario.ok()) return Outcome::BadInput(scenario.status());
+  sim::SimulateOptions options;
+  options.seed = request.seed;
+  options.image_directory = request.out;
+  options.progress = request.progress;
+  auto simulator = sim::Simulator::Create(scenario.value(), options);
+  if (!simulator.ok()) return Outcome::BadInput(simulator.status());
+  auto run = simulator.value()->Run();
+  if (!run.ok()) return Outcome::Failed(run.status());
+
+  // The recording and its truth.
+  Status status = recording::WriteRecording(run.value().recording, request.out);
+  if (status.ok()) status = recording::WriteTruth(run.value().truth, request.out);
+  if (!status.ok()) return Outcome::Failed(status);
+  if (simulation) *simulation = std::move(run).value();
+  return Outcome::Ok();
+}
+
+Outcome CalibrateToDirectory(const CalibrateRequest& request, estimator::CalibrationResult* result) {
+  auto inputs = LoadInputs(request.config, request.recording);
+  if (!inputs.ok()) return Outcome::BadInput(inputs.status());
+  const Status dir = MakeOutputDirectory(request.out);
+  if (!dir.ok()) return Outcome::BadInput(dir);
+
+  estimator::CalibrationOptions options;
+  options.progress = request.progress;
+  auto calibrated = estimator::Calibrate(inputs.value().config, inputs.value().recording, options);
+  if (!calibrated.ok()) return Outcome::Failed(calibrated.status());
+  const estimator::CalibrationResult& r = calibrated.value();
+  Status st = estimator::WriteCalibrationFile(r, request.recording, request.config, request.out + "/calibration.json");
+  if (st.ok()) st = WriteTum(r.trajectory, request.out + "/trajectory.tum");
+  if (!st.ok()) return Outcome::Failed(st);
+  if (result) *result = std::move(calibrated).value();
+  return Outcome::Ok();
+}
+
+Outcome TrackToDirectory(const TrackRequest& request, estimator::TrackingResult* result) {
+  auto inputs = LoadInputs(request.config, request.recording);
+  if (!inputs.ok()) return Outcome::BadInput(inputs.status());
+  estimator::EstimatorConfig& config = inputs.value().config;
+  if (request.no_time_budget) config.tracking.time_budget_s = std::numeric_limits<double>::infinity();
+  std::map<std::string, Eigen::VectorXd> calibration;
+  if (!request.calibration.empty()) {
+    auto values = estimator::ReadCalibrationValues(request.calibration);
+    if (!values.ok()) return Outcome::BadInput(values.status());
+    calibration = std::move(values).value();
+  }
+  auto options = estimator::TrackingOptionsFor(config, request.calibration);
+  if (!options.ok()) return Outcome::BadInput(options.status());
+  const Status dir = MakeOutputDirectory(request.out);
+  if (!dir.ok()) return Outcome::BadInput(dir);
+
+  options.value().progress = request.progress;
+  auto tracked = estimator::Track(config, inputs.value().recording, calibration, options.value());
+  if (!tracked.ok()) return Outcome::Failed(tracked.status());
+  const Status st = estimator::WriteTrackingFiles(tracked.value(), config.tracking.window, request.out);
+  if (!st.ok()) return Outcome::Failed(st);
+  if (result) *result = std::move(tracked).value();
+  return Outcome::Ok();
+}
+
+Outcome ImportOptiOdomToDirectory(const std::string& run_csv, const std::string& metadata, const std::string& out,
+                                  recording::Recording* imported) {
+  const std::string metadata_path = metadata.empty() ? recording::OptiOdomMetadataPath(run_csv) : metadata;
+  if (metadata_path.empty())
+    return Outcome::BadInput(Status::Error(
+        run_csv + ": cannot find the metadata file (expected <set>_run-NN.csv; use --metadata)"));
+  Result<recording::Recording> rec = recording::ImportOptiOdom(run_csv, metadata_path);
+  if (!rec.ok()) return Outcome::BadInput(rec.status());
+  if (Status s = recording::WriteRecording(rec.value(), out); !s.ok()) return Outcome::Failed(s);
+  if (imported) *imported = std::move(rec).value();
+  return Outcome::Ok();
+}
+
+}  // namespace roamlab::experiment
