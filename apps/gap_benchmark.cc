@@ -5,15 +5,13 @@
 #include <iomanip>
 #include <iostream>
 
+#include "apps/cli.h"
+
 namespace roamlab::apps {
 
 int RunGapBenchmark(const GapBenchmarkArgs& args) {
   namespace benchmark = gap::benchmark;
-  std::ostream& err = args.err ? *args.err : std::cerr;
-  const auto bad = [&](const std::string& message) {
-    err << "roamlab gap-benchmark: " << message << "\n";
-    return 2;
-  };
+  const auto bad = [&](const std::string& message) { return BadInput(args.err, "gap-benchmark", message); };
   if (args.cases < 1 || args.cases > benchmark::kMaxCases || args.calibration_cases < 1 ||
       args.calibration_cases > benchmark::kMaxCases)
     return bad("--cases and --calibration-cases must be in [1, " + std::to_string(benchmark::kMaxCases) + "]");
@@ -26,16 +24,10 @@ int RunGapBenchmark(const GapBenchmarkArgs& args) {
   if (ec) return bad(args.out + ": cannot create the output directory");
 
   auto score = benchmark::RunBenchmark(args, std::move(platforms).value(), args.quiet ? nullptr : &std::cout);
-  if (!score.ok()) {
-    err << "roamlab gap-benchmark: " << score.status().message() << "\n";
-    return 1;
-  }
+  if (!score.ok()) return Failure(args.err, "gap-benchmark", score.status().message());
   std::ofstream out(args.out + "/score.json");
   out << score.value().dump(2) << "\n";
-  if (!out) {
-    err << "roamlab gap-benchmark: " << args.out << "/score.json: cannot write\n";
-    return 1;
-  }
+  if (!out) return Failure(args.err, "gap-benchmark", args.out + "/score.json: cannot write");
   if (!args.quiet) {
     std::cout << "figures: " << score.value()["figures"].dump() << "\n"
               << "total " << std::fixed << std::setprecision(0) << score.value()["seconds"]["total"].get<double>()

@@ -123,7 +123,7 @@ void AddDiagnose(CLI::App* app, Commands* commands) {
   Add(commands, RunDiagnose, [app](auto* args) {
     CLI::App* dia = app->add_subcommand(
         "diagnose", "Reality-gap diagnosis: locate where a recording departs from the nominal model, name the physical "
-                    "effect, fit it and show the held-out fit improve (issue 6).");
+                    "effect, fit it and show the held-out fit improve.");
     dia->add_option("--real", args->recording, "Recording directory (its truth.yaml is never read)")->required();
     dia->add_option("--scenario", args->scenario,
                     "The nominal scenario: the robot as believed (optional with --config and --no-baseline)");

@@ -6,14 +6,13 @@
 #include <iomanip>
 #include <sstream>
 
+#include "common/json.h"
 #include "eval/plots.h"
 
 namespace roamlab::gap {
 namespace {
 
 using nlohmann::json;
-
-json Number(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
 
 json FitsJson(const std::map<std::string, StreamFit>& fits) {
   json j = json::object();

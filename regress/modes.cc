@@ -7,7 +7,7 @@
 #include <sstream>
 #include <utility>
 
-#include "apps/diagnose.h"
+#include "experiment/diagnose.h"
 #include "eval/evaluate.h"
 #include "experiment/montecarlo.h"
 #include "experiment/odometry.h"
@@ -330,8 +330,6 @@ Status RunOdometryCase(const CaseContext& context) {
 }
 
 // Diagnoses the case's recording, or the scenario simulated with the case's hidden effects, against the scenario.
-// The diagnosis runs the `roamlab diagnose` command in process (apps/diagnose.h) until its core is a library function
-// of gap/.
 Status RunDiagnoseCase(const CaseContext& context) {
   std::string recording = context.c.recording;
   if (recording.empty()) {
@@ -348,22 +346,16 @@ Status RunDiagnoseCase(const CaseContext& context) {
     if (st.ok()) st = recording::WriteTruth(simulated.value().truth, recording);  // for people; diagnose never reads it
     if (!st.ok()) return st;
   }
-  apps::DiagnoseArgs args;
-  args.recording = recording;
-  args.scenario = context.c.scenario;
-  args.config = context.c.config;
-  args.out = context.dir + "/diagnosis";
-  if (context.c.baseline_seed) args.baseline_seed = *context.c.baseline_seed;
-  args.no_plots = true;
-  args.quiet = true;
-  std::ostringstream err;
-  args.err = &err;
-  const int code = apps::RunDiagnose(args);
-  if (code == 0) return Status::Ok();
-  std::string message = err.str();
-  while (!message.empty() && message.back() == '\n') message.pop_back();
-  if (message.empty()) message = "diagnose failed with exit code " + std::to_string(code);
-  return Status::Error(message);
+  experiment::DiagnoseRequest request;
+  request.recording = recording;
+  request.scenario = context.c.scenario;
+  request.config = context.c.config;
+  request.out = context.dir + "/diagnosis";
+  if (context.c.baseline_seed) request.baseline_seed = *context.c.baseline_seed;
+  request.no_plots = true;
+  const experiment::Outcome outcome = experiment::DiagnoseToDirectory(request);
+  if (outcome.ok()) return Status::Ok();
+  return Status::Error("roamlab diagnose: " + outcome.status.message());
 }
 
 const std::vector<ModeSpec>& Modes() {

@@ -5,6 +5,8 @@
 #include <limits>
 #include <tuple>
 
+#include "common/json.h"
+
 namespace roamlab::gap::benchmark {
 namespace {
 
@@ -24,8 +26,6 @@ double Median(std::vector<double> v) {
 
 // A fraction as JSON (null when there is nothing to count).
 json Fraction(int k, int n) { return n > 0 ? json(static_cast<double>(k) / n) : json(nullptr); }
-json Number(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
-
 // Index of x in a grid array (exact values from the same array).
 template <std::size_t N>
 int IndexOf(const double (&grid)[N], double x) {

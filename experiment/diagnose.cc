@@ -1,0 +1,138 @@
+#include "experiment/diagnose.h"
+
+#include <algorithm>
+#include <sstream>
+
+#include "estimator/config.h"
+#include "gap/nominal_config.h"
+#include "gap/report.h"
+#include "gap/resimulate.h"
+#include "recording/recording.h"
+#include "sim/scenario.h"
+
+namespace roamlab::experiment {
+namespace {
+
+std::string Fixed(double x, int digits) {
+  std::ostringstream s;
+  s.precision(digits);
+  s << x;
+  return s.str();
+}
+
+// What the diagnosis reads: the nominal scenario (none for a robot without a MuJoCo twin), the recording's streams
+// (never its truth.yaml), the nominal configuration.
+struct Inputs {
+  std::optional<sim::Scenario> scenario;
+  recording::Recording recording;
+  estimator::EstimatorConfig config;
+  double span_s = 0.0;   // the recording's last stamp
+};
+
+// The nominal model: the configuration given, or the one built from the scenario; every stream it reads present.
+Status LoadNominalModel(const DiagnoseRequest& request, Inputs* in) {
+  auto config = request.config.empty() ? gap::NominalConfig(*in->scenario)
+                                       : estimator::LoadEstimatorConfig(request.config);
+  if (!config.ok())
+    return Status::Error((request.config.empty() ? request.scenario + ": " : std::string()) +
+                         config.status().message());
+  in->config = std::move(config).value();
+  for (const auto& [name, stream] : in->config.streams)
+    for (const auto& [role, source] : stream.sources)
+      if (!in->recording.Find(source))
+        return Status::Error(request.recording + ": no stream '" + source + "' (the nominal model's stream '" + name +
+                             "' reads it)");
+  return Status::Ok();
+}
+
+// The inputs, checked against each other; errors are bad input.
+Result<Inputs> LoadInputs(const DiagnoseRequest& request) {
+  if (request.scenario.empty() && (request.config.empty() || !request.no_baseline))
+    return Status::Error("without --scenario, give the nominal model as --config EST.yaml and --no-baseline");
+  Inputs in;
+  if (!request.scenario.empty()) {
+    auto loaded = sim::LoadScenario(request.scenario);
+    if (!loaded.ok()) return loaded.status();
+    in.scenario = std::move(loaded).value();
+  }
+  recording::ReadOptions read;
+  read.load_ground_truth = false;
+  auto rec = recording::ReadRecording(request.recording, read);
+  if (!rec.ok()) return rec.status();
+  in.recording = std::move(rec).value();
+  if (in.scenario && in.recording.platform.kind != in.scenario->robot.kind)
+    return Status::Error(request.recording + ": platform kind '" + in.recording.platform.kind +
+                         "' does not match the robot kind '" + in.scenario->robot.kind + "' of " + request.scenario);
+  if (Status s = LoadNominalModel(request, &in); !s.ok()) return s;
+  if (Status s = MakeOutputDirectory(request.out); !s.ok()) return s;
+  for (const recording::Stream& s : in.recording.streams)
+    if (!s.t.empty()) in.span_s = std::max(in.span_s, s.t.back().seconds());
+  // The held-out third loses twice the range of its position fixes at each end (the diagnosis's slices).
+  if (request.max_shift_s && (!(*request.max_shift_s > 0.0) || !(*request.max_shift_s < in.span_s / 12.0)))
+    return Status::Error("--max-shift " + Fixed(*request.max_shift_s, 3) + " s: must be above 0 and below " +
+                         Fixed(in.span_s / 12.0, 3) + " s, 1/12 of " + request.recording + "'s span");
+  return in;
+}
+
+// The baseline: the nominal scenario simulated over the recording's span and diagnosed without effects.
+Result<gap::Baseline> NominalBaseline(const DiagnoseRequest& request, const Inputs& in, const gap::DiagnoseOptions& options) {
+  sim::Scenario nominal = *in.scenario;
+  nominal.duration_s = std::min(nominal.duration_s, std::max(in.span_s, 1.0));
+  gap::LearnBaselineOptions learn;
+  learn.seed = request.baseline_seed;
+  learn.diagnose = options;
+  learn.progress = request.progress;
+  auto learned = gap::LearnBaseline(nominal, in.config, learn);
+  if (!learned.ok()) return learned.status();
+  return std::move(learned).value().baseline;
+}
+
+}  // namespace
+
+Outcome DiagnoseToDirectory(const DiagnoseRequest& request, gap::Diagnosis* diagnosis) {
+  const auto say = [&](const std::string& line) {
+    if (request.progress) request.progress(line);
+  };
+  auto inputs = LoadInputs(request);
+  if (!inputs.ok()) return Outcome::BadInput(inputs.status());
+  const Inputs& in = inputs.value();
+  gap::DiagnoseOptions options;
+  options.progress = [&](const std::string& line) { say("  " + line); };
+  if (request.max_shift_s) options.max_shift_s = *request.max_shift_s;
+
+  gap::Baseline baseline;
+  if (!request.no_baseline) {
+    auto learned = NominalBaseline(request, in, options);
+    if (!learned.ok()) return Outcome::Failed(learned.status());
+    baseline = std::move(learned).value();
+    options.baseline = &baseline;
+  }
+
+  say("diagnosing " + request.recording);
+  auto diagnosed = gap::Diagnose(in.config, in.recording, options);
+  if (!diagnosed.ok()) return Outcome::Failed(diagnosed.status());
+  const gap::Diagnosis& d = diagnosed.value();
+
+  // The simulation again, as believed and with the accepted effects, against the recording's held-out part.
+  std::optional<gap::SimulationComparison> simulation;
+  if (in.scenario) {
+    say("re-simulating the nominal scenario without noise, as believed and with the accepted effects");
+    auto compared = gap::CompareWithSimulation(*in.scenario, d.effects, in.recording, d.train_end_s);
+    if (!compared.ok()) return Outcome::Failed(Status::Error("re-simulation: " + compared.status().message()));
+    simulation = std::move(compared).value();
+  }
+
+  gap::ReportInputs report;
+  report.recording = request.recording;
+  report.model = request.scenario.empty() ? request.config : request.scenario;
+  report.baseline = request.no_baseline ? nullptr : &baseline;
+  report.baseline_seed = request.baseline_seed;
+  report.simulation = simulation ? &*simulation : nullptr;
+  report.plots = !request.no_plots;
+  report.progress = say;
+  if (Status s = gap::WriteReport(d, report, request.out); !s.ok()) return Outcome::Failed(s);
+  if (diagnosis) *diagnosis = std::move(diagnosed).value();
+  return Outcome::Ok();
+}
+
+}  // namespace roamlab::experiment

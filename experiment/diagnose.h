@@ -1,0 +1,43 @@
+// The step of `roamlab diagnose` as a library call: the reality-gap diagnosis of a recording against the nominal
+// robot (gap/diagnose.h), with its baseline and re-simulation, into an output directory. The command line and the
+// regression suite call it.
+//
+// Reads the recording's streams only (never truth.yaml). Unless `no_baseline`, first simulates the nominal scenario
+// (its effects removed, the recording's duration, seed `baseline_seed`) and diagnoses that, to learn the levels and
+// candidate gains the nominal model reaches on MuJoCo data without any hidden effect (gap/learn_baseline.h). With a
+// scenario, the nominal scenario is simulated again without noise, as believed and with the accepted effects, and
+// compared with the recording's held-out part (gap/resimulate.h; gap.json "simulation"). Writes gap.json, report.md,
+// the patches and the figures (gap/report.h).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "experiment/steps.h"
+#include "gap/diagnose.h"
+#include "gap/learn_baseline.h"
+
+namespace roamlab::experiment {
+
+struct DiagnoseRequest {
+  std::string recording;                 // REC
+  std::string scenario;                  // SCENARIO.yaml (the nominal robot); "" for a robot without a MuJoCo twin:
+                                         // then config and no_baseline are required
+  std::string config;                    // EST.yaml: nominal estimator configuration (default: from the scenario,
+                                         // gap::NominalConfig)
+  std::string out;                       // output directory
+  bool no_baseline = false;
+  std::uint64_t baseline_seed = gap::kDefaultBaselineSeed;   // noise seed of the nominal simulation
+  std::optional<double> max_shift_s;     // the time-shift search range (default gap::DiagnoseOptions')
+  bool no_plots = false;                 // no figures beside report.md
+  std::function<void(const std::string& line)> progress;     // optional
+};
+
+// Diagnoses the recording and writes the outputs. Inputs that do not load or do not fit each other (a stream the
+// nominal model reads missing, the platform kind not the scenario's robot) are bad input; a fit or a simulation that
+// fails, or a file that cannot be written, is a failure. `diagnosis` (optional) receives the result.
+Outcome DiagnoseToDirectory(const DiagnoseRequest& request, gap::Diagnosis* diagnosis = nullptr);
+
+}  // namespace roamlab::experiment
