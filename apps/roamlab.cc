@@ -7,6 +7,7 @@
 #include "apps/commands.h"
 #include "apps/diagnose.h"
 #include "apps/evaluate.h"
+#include "apps/frontend.h"
 #include "apps/gap_benchmark.h"
 #include "apps/import.h"
 #include "apps/montecarlo.h"
@@ -186,6 +187,19 @@ int main(int argc, char** argv) {
                        "Also write wheel angles re-expressed from the odometry (needs wheel_radius_m, baseline_m)");
   imp_rosbag->add_flag("--quiet", import_rosbag.quiet, "No summary");
 
+  roamlab::apps::FrontEndArgs front_end;
+  CLI::App* fe = app.add_subcommand(
+      "frontend", "Run a sensor front end over a recording: visual odometry on a camera stream (vo) or scan "
+                  "matching on a laser_scan stream (scan); writes REC2 with the derived stream.");
+  fe->add_option("front_end", front_end.front_end, "vo | scan")->required()->check(CLI::IsMember({"vo", "scan"}));
+  fe->add_option("recording", front_end.recording, "Recording directory")->required();
+  fe->add_option("--out", front_end.out, "Output recording directory (REC's streams plus the derived one)")
+      ->required();
+  fe->add_option("--input", front_end.input_stream, "Input stream (default: the only camera or laser_scan stream)");
+  fe->add_option("--stream", front_end.output_stream,
+                 "Name of the derived stream (default visual_odometry or scan_matching; replaces one of that name)");
+  fe->add_flag("--quiet", front_end.quiet, "No summary");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -212,5 +226,6 @@ int main(int argc, char** argv) {
   if (*odo_evaluate) return roamlab::apps::RunOdometryEvaluate(odo_eval);
   if (*imp_optiodom) return roamlab::apps::RunImportOptiOdom(import_optiodom);
   if (*imp_rosbag) return roamlab::apps::RunImportRosbag(import_rosbag);
+  if (*fe) return roamlab::apps::RunFrontEnd(front_end);
   return 2;
 }

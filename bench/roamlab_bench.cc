@@ -60,12 +60,12 @@
 #include "estimator/problem.h"
 #include "estimator/solver.h"
 #include "estimator/tracking.h"
+#include "frontend/visual_odometry.h"
 #include "recording/recording.h"
 #include "sim/mujoco_model.h"
 #include "sim/render.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
-#include "sim/visual_odometry.h"
 
 extern char** environ;
 
@@ -154,10 +154,10 @@ nlohmann::json BenchRenderVo(const std::string& root, double duration_s, std::st
     render.height_px = height;
     auto renderer = sim::CameraRenderer::Create(m, "camera", render);
     if (!renderer.ok()) return *error = renderer.status().message(), nlohmann::json();
-    sim::VisualOdometryOptions options;
+    roamlab::frontend::VisualOdometryOptions options;
     options.camera_height_m = 0.30;  // the rig's mounting: 0.30 m high, pitched 15 deg down
     options.floor_normal_camera = Eigen::Vector3d(0.0, std::cos(0.2617993877991494), std::sin(0.2617993877991494));
-    sim::VisualOdometry vo(renderer.value()->intrinsics(), options);
+    roamlab::frontend::VisualOdometry vo(renderer.value()->intrinsics(), options);
     cv::Mat gray;
     double render_s = 0.0;
     double vo_s = 0.0;
@@ -583,7 +583,7 @@ int main(int argc, char** argv) {
         name.c_str(), indoor_factor, indoor_factor / 10.0, indoor_cpu_factor);
   }
 
-  // 1c. The indoor issue's camera yardstick: rendering + visual odometry at 15 Hz (sim/visual_odometry_stream.h) on
+  // 1c. The indoor issue's camera yardstick: rendering + visual odometry at 15 Hz (sim/simulated_camera.h) on
   // the test room of models/vo_test_room.xml, at 320x240 and 640x480, OpenCV on one thread (target >= 1x).
   {
     std::string vo_error;

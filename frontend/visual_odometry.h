@@ -16,7 +16,7 @@
 //      ray x1 lies at X1 = x1 h / (n . x1), so with t_21 = s t_hat it must appear at x2 = proj(R_21 X1 + s t_hat).
 //      Each point below the horizon (n . x1 > 0) gives a 1-point hypothesis of s; RANSAC keeps the s with the most
 //      points within `floor_threshold_px` (walls and boxes are the outliers), Gauss-Newton on their reprojection
-//      error refines it. This is the "known camera height over the floor".
+//      error refines it: the scale comes from the known camera height over the floor.
 //      Limits: the floor must be planar and visible in the lower image (enough textured floor points); n and h are
 //      those of the mounting on a level robot, so a robot that pitches or rolls (bumps, hard braking on a soft
 //      suspension) biases the scale by about the relative height change; obstacles that cover the floor near the
@@ -43,9 +43,9 @@
 #include <opencv2/core.hpp>
 
 #include "common/time.h"
-#include "sim/render.h"
+#include "frontend/pinhole.h"
 
-namespace roamlab::sim {
+namespace roamlab::frontend {
 
 struct VisualOdometryOptions {
   // Mounting: camera height over the floor [m] and the floor's unit normal in C, pointing down to the floor, for the
@@ -144,4 +144,4 @@ class VisualOdometry {
   VoCounters counters_;
 };
 
-}  // namespace roamlab::sim
+}  // namespace roamlab::frontend

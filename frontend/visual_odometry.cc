@@ -1,8 +1,9 @@
-#include "sim/visual_odometry.h"
+#include "frontend/visual_odometry.h"
 
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <utility>
 
 #include <Eigen/Geometry>
 #include <opencv2/calib3d.hpp>
@@ -11,7 +12,7 @@
 
 #include "common/check.h"
 
-namespace roamlab::sim {
+namespace roamlab::frontend {
 namespace {
 
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
@@ -142,6 +143,216 @@ double Median(std::vector<double> values) {
   return *mid;
 }
 
+// Step 2 of the header: pyramidal Lucas-Kanade forward and backward; the tracks that come back to where they
+// started, with their flow.
+struct Tracks {
+  std::vector<cv::Point2f> p1;
+  std::vector<cv::Point2f> p2;
+  std::vector<double> flow_px;
+};
+
+Tracks TrackForwardBackward(const cv::Mat& previous, const cv::Mat& gray, const std::vector<cv::Point2f>& p1,
+                            const VisualOdometryOptions& options, double pixel_scale) {
+  int window = static_cast<int>(std::lround(options.klt_window_px * pixel_scale)) | 1;
+  const cv::Size window_size(window, window);
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
+  std::vector<cv::Point2f> p2;
+  std::vector<cv::Point2f> p1_back;
+  std::vector<unsigned char> status;
+  std::vector<unsigned char> status_back;
+  std::vector<float> error;
+  cv::calcOpticalFlowPyrLK(previous, gray, p1, p2, status, error, window_size, options.klt_pyramid_levels, criteria);
+  cv::calcOpticalFlowPyrLK(gray, previous, p2, p1_back, status_back, error, window_size, options.klt_pyramid_levels,
+                           criteria);
+  const double max_fb = options.max_forward_backward_px * pixel_scale;
+  const cv::Rect2f inside(0.0f, 0.0f, static_cast<float>(gray.cols - 1), static_cast<float>(gray.rows - 1));
+  Tracks tracks;
+  for (std::size_t i = 0; i < p1.size(); ++i) {
+    if (!status[i] || !status_back[i] || !inside.contains(p2[i])) continue;
+    if (cv::norm(p1_back[i] - p1[i]) > max_fb) continue;
+    tracks.p1.push_back(p1[i]);
+    tracks.p2.push_back(p2[i]);
+    tracks.flow_px.push_back(cv::norm(p2[i] - p1[i]));
+  }
+  return tracks;
+}
+
+// No measurable motion: the covariance of zero velocities, that of a flow at the threshold seen on the optical axis
+// (rotation) and at the floor point on the optical axis (translation; the camera height when it does not see the
+// floor there).
+Matrix6d StationaryCovariance(const VisualOdometryOptions& options, double pixel_scale, double f, double dt) {
+  const double sigma_angle = options.stationary_flow_px * pixel_scale / f / dt;
+  const double n_z = options.floor_normal_camera.z();
+  const double depth = n_z > 0.05 ? options.camera_height_m / n_z : options.camera_height_m;
+  Matrix6d covariance = Matrix6d::Zero();
+  covariance.topLeftCorner<3, 3>() = Eigen::Matrix3d::Identity() * std::pow(sigma_angle * depth, 2);
+  covariance.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * sigma_angle * sigma_angle;
+  return covariance;
+}
+
+// Step 3, first half: the essential matrix by 5-point RANSAC and the pose by the cheirality check; the inliers'
+// normalized coordinates and their pixels in frame 2. nullopt with fewer than min_inliers.
+struct EssentialInliers {
+  PairPose pose;
+  std::vector<Eigen::Vector3d> x1;
+  std::vector<Eigen::Vector3d> x2;
+  std::vector<cv::Point2f> p2;
+};
+
+std::optional<EssentialInliers> FitEssential(const Tracks& tracks, const PinholeIntrinsics& intrinsics,
+                                             const VisualOdometryOptions& options, double pixel_scale) {
+  cv::Mat mask;
+  const cv::Mat K(intrinsics.K());
+  const cv::Mat E = cv::findEssentialMat(tracks.p1, tracks.p2, K, cv::RANSAC, options.ransac_confidence,
+                                         options.ransac_threshold_px * pixel_scale, mask);
+  cv::Mat R_cv;
+  cv::Mat t_cv;
+  int inliers = 0;
+  if (E.rows == 3 && E.cols == 3) inliers = cv::recoverPose(E, tracks.p1, tracks.p2, K, R_cv, t_cv, mask);
+  if (inliers < options.min_inliers) return std::nullopt;
+  EssentialInliers out;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) out.pose.R21(r, c) = R_cv.at<double>(r, c);
+    out.pose.t21[r] = t_cv.at<double>(r);
+  }
+  out.pose.t21.normalize();
+  const auto normalized = [&intrinsics](const cv::Point2f& p) {
+    return Eigen::Vector3d((p.x - intrinsics.cx_px) / intrinsics.fx_px, (p.y - intrinsics.cy_px) / intrinsics.fy_px,
+                           1.0);
+  };
+  for (std::size_t i = 0; i < tracks.p1.size(); ++i) {
+    if (!mask.at<unsigned char>(static_cast<int>(i))) continue;
+    out.x1.push_back(normalized(tracks.p1[i]));
+    out.x2.push_back(normalized(tracks.p2[i]));
+    out.p2.push_back(tracks.p2[i]);
+  }
+  return out;
+}
+
+// Step 3, second half: Gauss-Newton on the Sampson error over (R21, t21); the normal matrix at the solution, the
+// pixel noise sigma^2 = sum e^2 / (N - 5) and the tangent basis of t21 give the pose covariance sigma^2 (J^T J)^-1.
+struct SampsonFit {
+  PairPose pose;
+  Eigen::Matrix<double, 3, 2> B;
+  Matrix5d JtJ;
+  double sigma2 = 0.0;
+};
+
+SampsonFit RefineOnSampson(PairPose pose, const std::vector<Eigen::Vector3d>& x1,
+                           const std::vector<Eigen::Vector3d>& x2) {
+  const auto n_inliers = static_cast<Eigen::Index>(x1.size());
+  Matrix5d JtJ = Matrix5d::Identity();
+  for (int iteration = 0; iteration < 5; ++iteration) {
+    const Eigen::Matrix<double, 3, 2> B = TangentBasis(pose.t21);
+    const auto residuals = [&](const Vector5d& d) { return SampsonResiduals(Perturb(pose, B, d), x1, x2); };
+    const Eigen::VectorXd r = residuals(Vector5d::Zero());
+    const Eigen::MatrixXd J = NumericJacobian5(residuals, n_inliers);
+    JtJ = J.transpose() * J;
+    const Vector5d step = JtJ.ldlt().solve(-J.transpose() * r);
+    pose = Perturb(pose, B, step);
+    if (step.norm() < 1e-10) break;
+  }
+  SampsonFit fit;
+  fit.pose = pose;
+  fit.B = TangentBasis(pose.t21);
+  const auto residuals = [&](const Vector5d& d) { return SampsonResiduals(Perturb(pose, fit.B, d), x1, x2); };
+  const Eigen::VectorXd r = residuals(Vector5d::Zero());
+  const Eigen::MatrixXd J = NumericJacobian5(residuals, n_inliers);
+  fit.JtJ = J.transpose() * J;
+  fit.sigma2 = r.squaredNorm() / static_cast<double>(n_inliers - 5);
+  return fit;
+}
+
+// Step 4: the floor points (inliers whose ray meets the floor within 30 camera heights) and the scale they agree on
+// by 1-point RANSAC: each floor point's own least-squares scale is a hypothesis; the one with the most points within
+// `threshold` (normalized units; ties: smaller squared error) wins, then Gauss-Newton refines it on them. The scale's
+// own variance comes from its residuals: sigma_s^2 = sigma^2 / sum |dr/ds|^2 (2 residuals per point). nullopt with
+// fewer than min_floor_inliers points or a scale that is not positive.
+struct FloorScale {
+  std::vector<FloorPoint> floor;
+  std::vector<int> inliers;  // into floor
+  double s = 0.0;
+  double variance = 0.0;
+};
+
+std::optional<FloorScale> ScaleFromFloor(const PairPose& pose, const std::vector<Eigen::Vector3d>& x1,
+                                         const std::vector<Eigen::Vector3d>& x2, const VisualOdometryOptions& options,
+                                         double threshold) {
+  const double h = options.camera_height_m;
+  const Eigen::Vector3d& n = options.floor_normal_camera;
+  FloorScale out;
+  std::vector<FloorPoint>& floor = out.floor;
+  for (std::size_t i = 0; i < x1.size(); ++i) {
+    const double n_dot = n.dot(x1[i]);
+    if (n_dot * 30.0 < x1[i].norm()) continue;
+    floor.push_back({x1[i] * (h / n_dot), x2[i].head<2>()});
+  }
+  const auto inliers_of = [&](double s, double* cost) {
+    std::vector<int> use;
+    *cost = 0.0;
+    for (std::size_t i = 0; i < floor.size(); ++i) {
+      const double e = FloorResidual(pose, s, floor[i], nullptr).norm();
+      if (e < threshold) {
+        use.push_back(static_cast<int>(i));
+        *cost += e * e;
+      }
+    }
+    return use;
+  };
+  std::vector<int>& best = out.inliers;
+  double best_s = 0.0;
+  double best_cost = 0.0;
+  for (std::size_t i = 0; i < floor.size(); ++i) {
+    const double s = RefineScale(pose, floor, {static_cast<int>(i)}, h);
+    if (!(s > 0.0) || !std::isfinite(s)) continue;
+    double cost = 0.0;
+    std::vector<int> use = inliers_of(s, &cost);
+    if (use.size() > best.size() || (use.size() == best.size() && cost < best_cost)) {
+      best = std::move(use);
+      best_s = s;
+      best_cost = cost;
+    }
+  }
+  double s = best_s;
+  if (static_cast<int>(best.size()) >= options.min_floor_inliers) {
+    s = RefineScale(pose, floor, best, s);
+    best = inliers_of(s, &best_cost);
+    if (static_cast<int>(best.size()) >= 2) s = RefineScale(pose, floor, best, s);
+  }
+  if (static_cast<int>(best.size()) < options.min_floor_inliers || !(s > 0.0)) return std::nullopt;
+  out.s = s;
+  double floor_r2 = 0.0;
+  double floor_J2 = 0.0;
+  for (int i : best) {
+    Eigen::Vector2d J;
+    floor_r2 += FloorResidual(pose, s, floor[static_cast<std::size_t>(i)], &J).squaredNorm();
+    floor_J2 += J.squaredNorm();
+  }
+  out.variance = floor_r2 / std::max(1.0, 2.0 * best.size() - 1.0) / floor_J2;
+  return out;
+}
+
+// Step 6: the first-order covariance of the velocities over the parameters (dtheta, dphi, ds), the scale re-solved
+// for each perturbed pose.
+Matrix6d OutputCovariance(const SampsonFit& fit, const FloorScale& scale, double dt) {
+  const auto outputs = [&](const Vector6d& d) {
+    const PairPose perturbed = Perturb(fit.pose, fit.B, d.head<5>());
+    const double s_perturbed = RefineScale(perturbed, scale.floor, scale.inliers, scale.s) + d[5];
+    return Velocities(perturbed, s_perturbed, dt);
+  };
+  Matrix6d J_out;
+  for (int k = 0; k < 6; ++k) {
+    const double step = k < 5 ? 1e-6 : 1e-6 * scale.s;
+    Vector6d d = Vector6d::Zero();
+    d[k] = step;
+    J_out.col(k) = (outputs(d) - outputs(-d)) / (2.0 * step);
+  }
+  Matrix6d input_covariance = Matrix6d::Zero();
+  input_covariance.topLeftCorner<5, 5>() = fit.sigma2 * fit.JtJ.inverse();
+  input_covariance(5, 5) = scale.variance;
+  return J_out * input_covariance * J_out.transpose();
+}
+
 }  // namespace
 
 std::string VisualOdometryOptions::Validate() const {
@@ -257,200 +468,55 @@ std::optional<VoEstimate> VisualOdometry::Estimate(Time t, const cv::Mat& gray) 
     return std::nullopt;
   }
 
-  // Pyramidal Lucas-Kanade forward and backward; keep tracks that come back to where they started.
-  int window = static_cast<int>(std::lround(options_.klt_window_px * pixel_scale_)) | 1;
-  const cv::Size window_size(window, window);
-  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
-  std::vector<cv::Point2f> p2;
-  std::vector<cv::Point2f> p1_back;
-  std::vector<unsigned char> status;
-  std::vector<unsigned char> status_back;
-  std::vector<float> error;
-  cv::calcOpticalFlowPyrLK(previous_, gray, p1, p2, status, error, window_size, options_.klt_pyramid_levels, criteria);
-  cv::calcOpticalFlowPyrLK(gray, previous_, p2, p1_back, status_back, error, window_size,
-                           options_.klt_pyramid_levels, criteria);
-  const double max_fb = options_.max_forward_backward_px * pixel_scale_;
-  const cv::Rect2f inside(0.0f, 0.0f, static_cast<float>(gray.cols - 1), static_cast<float>(gray.rows - 1));
-  std::vector<cv::Point2f> kept1;
-  std::vector<cv::Point2f> kept2;
-  std::vector<double> flow_px;
-  for (std::size_t i = 0; i < p1.size(); ++i) {
-    if (!status[i] || !status_back[i] || !inside.contains(p2[i])) continue;
-    if (cv::norm(p1_back[i] - p1[i]) > max_fb) continue;
-    kept1.push_back(p1[i]);
-    kept2.push_back(p2[i]);
-    flow_px.push_back(cv::norm(p2[i] - p1[i]));
-  }
-  const int tracks = static_cast<int>(kept1.size());
-  if (tracks < options_.min_tracks) {
-    previous_points_ = kept2;
+  // Step 2: tracks that survive the forward-backward check.
+  const Tracks tracks = TrackForwardBackward(previous_, gray, p1, options_, pixel_scale_);
+  const int n_tracks = static_cast<int>(tracks.p1.size());
+  if (n_tracks < options_.min_tracks) {
+    previous_points_ = tracks.p2;
     Fail(VoFailure::kTooFewTracks);
     return std::nullopt;
   }
-
   VoEstimate out;
   out.t_begin = *t_previous_;
   out.t_end = t;
   out.t_mid = Time::FromNanoseconds(t_previous_->nanoseconds() + (t.nanoseconds() - t_previous_->nanoseconds()) / 2);
-  out.tracks = tracks;
-
-  // No measurable motion: zero velocities with the covariance of a flow at the threshold, seen on the optical axis
-  // (rotation) and at the floor point on the optical axis (translation; the camera height when it does not see the
-  // floor there).
-  if (Median(flow_px) < options_.stationary_flow_px * pixel_scale_) {
-    previous_points_ = kept2;
-    const double sigma_angle = options_.stationary_flow_px * pixel_scale_ / f / dt;
-    const double n_z = options_.floor_normal_camera.z();
-    const double depth = n_z > 0.05 ? options_.camera_height_m / n_z : options_.camera_height_m;
-    out.covariance.topLeftCorner<3, 3>() = Eigen::Matrix3d::Identity() * std::pow(sigma_angle * depth, 2);
-    out.covariance.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * sigma_angle * sigma_angle;
+  out.tracks = n_tracks;
+  if (Median(tracks.flow_px) < options_.stationary_flow_px * pixel_scale_) {
+    previous_points_ = tracks.p2;
+    out.covariance = StationaryCovariance(options_, pixel_scale_, f, dt);
     out.stationary = true;
     return out;
   }
 
-  // Essential matrix by 5-point RANSAC, pose by the cheirality check.
-  cv::Mat mask;
-  const cv::Mat K(intrinsics_.K());
-  const cv::Mat E = cv::findEssentialMat(kept1, kept2, K, cv::RANSAC, options_.ransac_confidence,
-                                         options_.ransac_threshold_px * pixel_scale_, mask);
-  cv::Mat R_cv;
-  cv::Mat t_cv;
-  int inliers = 0;
-  if (E.rows == 3 && E.cols == 3) inliers = cv::recoverPose(E, kept1, kept2, K, R_cv, t_cv, mask);
-  if (inliers < options_.min_inliers) {
-    previous_points_ = kept2;
+  // Step 3: rotation and translation direction; the inliers are the tracks carried to the next pair.
+  std::optional<EssentialInliers> essential = FitEssential(tracks, intrinsics_, options_, pixel_scale_);
+  if (!essential) {
+    previous_points_ = tracks.p2;
     Fail(VoFailure::kTooFewInliers);
     return std::nullopt;
   }
-  PairPose pose;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) pose.R21(r, c) = R_cv.at<double>(r, c);
-    pose.t21[r] = t_cv.at<double>(r);
-  }
-  pose.t21.normalize();
+  previous_points_ = std::move(essential->p2);
+  out.inliers = static_cast<int>(essential->x1.size());
+  const SampsonFit fit = RefineOnSampson(essential->pose, essential->x1, essential->x2);
+  out.pixel_sigma_px = std::sqrt(fit.sigma2) * f;
 
-  // Normalized coordinates of the inliers; they are also the tracks carried to the next pair.
-  std::vector<Eigen::Vector3d> x1;
-  std::vector<Eigen::Vector3d> x2;
-  for (int i = 0; i < tracks; ++i) {
-    if (!mask.at<unsigned char>(i)) continue;
-    const auto normalized = [&](const cv::Point2f& p) {
-      return Eigen::Vector3d((p.x - intrinsics_.cx_px) / intrinsics_.fx_px, (p.y - intrinsics_.cy_px) / intrinsics_.fy_px,
-                             1.0);
-    };
-    x1.push_back(normalized(kept1[static_cast<std::size_t>(i)]));
-    x2.push_back(normalized(kept2[static_cast<std::size_t>(i)]));
-    previous_points_.push_back(kept2[static_cast<std::size_t>(i)]);
-  }
-  const auto n_inliers = static_cast<Eigen::Index>(x1.size());
-  out.inliers = static_cast<int>(n_inliers);
-
-  // Gauss-Newton on the Sampson error over (R21, t21); its normal matrix gives the pose covariance.
-  Matrix5d JtJ = Matrix5d::Identity();
-  double sigma2 = 0.0;
-  for (int iteration = 0; iteration < 5; ++iteration) {
-    const Eigen::Matrix<double, 3, 2> B = TangentBasis(pose.t21);
-    const auto residuals = [&](const Vector5d& d) { return SampsonResiduals(Perturb(pose, B, d), x1, x2); };
-    const Eigen::VectorXd r = residuals(Vector5d::Zero());
-    const Eigen::MatrixXd J = NumericJacobian5(residuals, n_inliers);
-    JtJ = J.transpose() * J;
-    sigma2 = r.squaredNorm() / static_cast<double>(n_inliers - 5);
-    const Vector5d step = JtJ.ldlt().solve(-J.transpose() * r);
-    pose = Perturb(pose, B, step);
-    if (step.norm() < 1e-10) break;
-  }
-  const Eigen::Matrix<double, 3, 2> B = TangentBasis(pose.t21);
-  {
-    const auto residuals = [&](const Vector5d& d) { return SampsonResiduals(Perturb(pose, B, d), x1, x2); };
-    const Eigen::VectorXd r = residuals(Vector5d::Zero());
-    const Eigen::MatrixXd J = NumericJacobian5(residuals, n_inliers);
-    JtJ = J.transpose() * J;
-    sigma2 = r.squaredNorm() / static_cast<double>(n_inliers - 5);
-  }
-  out.pixel_sigma_px = std::sqrt(sigma2) * f;
-
-  // Floor points: inliers whose ray meets the floor within 30 camera heights.
-  const double h = options_.camera_height_m;
-  const Eigen::Vector3d& n = options_.floor_normal_camera;
-  std::vector<FloorPoint> floor;
-  for (Eigen::Index i = 0; i < n_inliers; ++i) {
-    const double n_dot = n.dot(x1[static_cast<std::size_t>(i)]);
-    if (n_dot * 30.0 < x1[static_cast<std::size_t>(i)].norm()) continue;
-    floor.push_back({x1[static_cast<std::size_t>(i)] * (h / n_dot), x2[static_cast<std::size_t>(i)].head<2>()});
-  }
-  // 1-point RANSAC over the scale: each floor point's own least-squares scale is a hypothesis; the one with the
-  // most points within the threshold (ties: smaller squared error) wins, then Gauss-Newton refines it on them.
-  const double threshold = options_.floor_threshold_px * pixel_scale_ / f;
-  const auto inliers_of = [&](double s, double* cost) {
-    std::vector<int> use;
-    *cost = 0.0;
-    for (std::size_t i = 0; i < floor.size(); ++i) {
-      const double e = FloorResidual(pose, s, floor[i], nullptr).norm();
-      if (e < threshold) {
-        use.push_back(static_cast<int>(i));
-        *cost += e * e;
-      }
-    }
-    return use;
-  };
-  std::vector<int> best;
-  double best_s = 0.0;
-  double best_cost = 0.0;
-  for (std::size_t i = 0; i < floor.size(); ++i) {
-    const double s = RefineScale(pose, floor, {static_cast<int>(i)}, h);
-    if (!(s > 0.0) || !std::isfinite(s)) continue;
-    double cost = 0.0;
-    std::vector<int> use = inliers_of(s, &cost);
-    if (use.size() > best.size() || (use.size() == best.size() && cost < best_cost)) {
-      best = std::move(use);
-      best_s = s;
-      best_cost = cost;
-    }
-  }
-  double s = best_s;
-  if (static_cast<int>(best.size()) >= options_.min_floor_inliers) {
-    s = RefineScale(pose, floor, best, s);
-    best = inliers_of(s, &best_cost);
-    if (static_cast<int>(best.size()) >= 2) s = RefineScale(pose, floor, best, s);
-  }
-  if (static_cast<int>(best.size()) < options_.min_floor_inliers || !(s > 0.0)) {
+  // Step 4: the metric scale from the floor points.
+  const std::optional<FloorScale> scale =
+      ScaleFromFloor(fit.pose, essential->x1, essential->x2, options_, options_.floor_threshold_px * pixel_scale_ / f);
+  if (!scale) {
     Fail(VoFailure::kNoScale);
     return std::nullopt;
   }
-  out.floor_inliers = static_cast<int>(best.size());
-  // The scale's own variance from its residuals: sigma_s^2 = sigma^2 / sum |dr/ds|^2 (2 residuals per point).
-  double floor_r2 = 0.0;
-  double floor_J2 = 0.0;
-  for (int i : best) {
-    Eigen::Vector2d J;
-    floor_r2 += FloorResidual(pose, s, floor[static_cast<std::size_t>(i)], &J).squaredNorm();
-    floor_J2 += J.squaredNorm();
-  }
-  const double var_s = floor_r2 / std::max(1.0, 2.0 * best.size() - 1.0) / floor_J2;
+  out.floor_inliers = static_cast<int>(scale->inliers.size());
 
-  // Outputs and their first-order covariance: parameters (dtheta, dphi, ds), the scale re-solved for each pose.
-  const auto outputs = [&](const Vector6d& d) {
-    const PairPose perturbed = Perturb(pose, B, d.head<5>());
-    const double s_perturbed = RefineScale(perturbed, floor, best, s) + d[5];
-    return Velocities(perturbed, s_perturbed, dt);
-  };
-  Matrix6d J_out;
-  for (int k = 0; k < 6; ++k) {
-    const double step = k < 5 ? 1e-6 : 1e-6 * s;
-    Vector6d d = Vector6d::Zero();
-    d[k] = step;
-    J_out.col(k) = (outputs(d) - outputs(-d)) / (2.0 * step);
-  }
-  Matrix6d input_covariance = Matrix6d::Zero();
-  input_covariance.topLeftCorner<5, 5>() = sigma2 * JtJ.inverse();
-  input_covariance(5, 5) = var_s;
-  out.covariance = J_out * input_covariance * J_out.transpose();
-  const Vector6d velocities = Velocities(pose, s, dt);
+  // Steps 5 and 6: velocities and their covariance.
+  out.covariance = OutputCovariance(fit, *scale, dt);
+  const Vector6d velocities = Velocities(fit.pose, scale->s, dt);
   out.v_camera_mps = velocities.head<3>();
   out.omega_camera_radps = velocities.tail<3>();
-  out.R_prev_curr = pose.R21.transpose();
-  out.p_prev_curr_m = -out.R_prev_curr * pose.t21 * s;
+  out.R_prev_curr = fit.pose.R21.transpose();
+  out.p_prev_curr_m = -out.R_prev_curr * fit.pose.t21 * scale->s;
   return out;
 }
 
-}  // namespace roamlab::sim
+}  // namespace roamlab::frontend
