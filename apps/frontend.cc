@@ -10,7 +10,8 @@ namespace roamlab::apps {
 int RunFrontEnd(const FrontEndArgs& args) {
   std::ostream& err = args.err != nullptr ? *args.err : std::cerr;
   frontend::FrontEndOptions options;
-  options.front_end = args.front_end == "scan" ? frontend::FrontEnd::kScanMatching : frontend::FrontEnd::kVisualOdometry;
+  options.front_end =
+      args.front_end == "scan" ? frontend::FrontEnd::kScanMatching : frontend::FrontEnd::kVisualOdometry;
   options.input_stream = args.input_stream;
   options.output_stream = args.output_stream;
   bool bad_input = true;

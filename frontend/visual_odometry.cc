@@ -350,7 +350,11 @@ Matrix6d OutputCovariance(const SampsonFit& fit, const FloorScale& scale, double
   Matrix6d input_covariance = Matrix6d::Zero();
   input_covariance.topLeftCorner<5, 5>() = fit.sigma2 * fit.JtJ.inverse();
   input_covariance(5, 5) = scale.variance;
-  return J_out * input_covariance * J_out.transpose();
+  // Assigned, not constructed from the product: Eigen evaluates the two differently (a temporary for `=`), and the
+  // recorded streams keep the rounding of the assignment.
+  Matrix6d covariance = Matrix6d::Zero();
+  covariance = J_out * input_covariance * J_out.transpose();
+  return covariance;
 }
 
 }  // namespace

@@ -48,7 +48,8 @@ inline constexpr int kFormatVersion = 1;
 // Camera intrinsics (camera and visual_odometry streams): the attributes width_px, height_px, fx_px, fy_px, cx_px,
 // cy_px, all six or none: the pinhole model u = fx x / z + cx, v = fy y / z + cy in OpenCV's pixel coordinates (the
 // centre of the top-left pixel is (0, 0)) for a point (x, y, z) in the camera frame (x right, y down, z forward).
-// Sizes are positive integers, focal lengths positive, the principal point inside the image.
+// Sizes are positive integers, focal lengths positive, the principal point inside the image. Other attributes are free;
+// the visual odometry front end reads its floor reference from a camera stream's (frontend/visual_odometry_stream.h).
 //   inputs           free columns named in the stream entry (control commands)
 //   laser_scan       angle_min_rad angle_increment_rad range_min_m range_max_m range_0 ... range_<N-1> [rad, m]: one
 //                    raw planar scan per row; beam k points at angle_min_rad + k angle_increment_rad in the sensor

@@ -17,7 +17,7 @@
 // Integration in a simulation loop (one physics step per iteration, data advanced by mj_step):
 //   auto camera = SimulatedCamera::Create(model, data, options);       // once, robot at rest at its start pose
 //   for (...) { mj_step(model, data); ...; camera->Observe(t, data); }  // t: simulation time of `data`
-//   recording.streams.push_back(camera->TakeStream());                   // plus TakeCameraStream() when images are kept
+//   recording.streams.push_back(camera->TakeStream());                   // and TakeCameraStream() when images are kept
 #pragma once
 
 #include <memory>

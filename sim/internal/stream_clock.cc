@@ -15,7 +15,8 @@ recording::Stream MakeStream(const std::string& name, recording::StreamType type
   stream.t.reserve(clock.samples);
   for (std::size_t k = 0; k < clock.samples; ++k)
     stream.t.push_back(Time::FromNanoseconds(static_cast<std::int64_t>(k) * clock.period_ns));
-  stream.values.setZero(static_cast<Eigen::Index>(clock.samples), static_cast<Eigen::Index>(stream.info.columns.size()));
+  stream.values.setZero(static_cast<Eigen::Index>(clock.samples),
+                        static_cast<Eigen::Index>(stream.info.columns.size()));
   return stream;
 }
 
