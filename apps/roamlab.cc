@@ -10,6 +10,7 @@
 #include "apps/commands.h"
 #include "apps/diagnose.h"
 #include "apps/evaluate.h"
+#include "apps/frontend.h"
 #include "apps/gap_benchmark.h"
 #include "apps/import.h"
 #include "apps/montecarlo.h"
@@ -251,13 +252,29 @@ void AddImport(CLI::App* app, Commands* commands) {
   });
 }
 
+void AddFrontEnd(CLI::App* app, Commands* commands) {
+  Add(commands, RunFrontEnd, [app](auto* args) {
+    CLI::App* fe = app->add_subcommand(
+        "frontend", "Run a sensor front end over a recording: visual odometry on a camera stream (vo) or scan "
+                    "matching on a laser_scan stream (scan); writes REC2 with the derived stream.");
+    fe->add_option("front_end", args->front_end, "vo | scan")->required()->check(CLI::IsMember({"vo", "scan"}));
+    fe->add_option("recording", args->recording, "Recording directory")->required();
+    fe->add_option("--out", args->out, "Output recording directory (REC's streams plus the derived one)")->required();
+    fe->add_option("--input", args->input_stream, "Input stream (default: the only camera or laser_scan stream)");
+    fe->add_option("--stream", args->output_stream,
+                   "Name of the derived stream (default visual_odometry or scan_matching; replaces one of that name)");
+    fe->add_flag("--quiet", args->quiet, "No summary");
+    return fe;
+  });
+}
+
 // Registers every command, parses the command line and runs the command it names; the process exit code.
 int RunCommandLine(int argc, char** argv) {
   CLI::App app{"roamlab: mobile-robot pose tracking and sensor self-calibration testbed"};
   app.require_subcommand(1);
   Commands commands;
   for (const auto add : {AddSimulate, AddCalibrate, AddTrack, AddEvaluate, AddMonteCarlo, AddDiagnose,
-                         AddGapBenchmark, AddRegress, AddOdometry, AddImport})
+                         AddGapBenchmark, AddRegress, AddOdometry, AddImport, AddFrontEnd})
     add(&app, &commands);
 
   try {

@@ -13,7 +13,7 @@
 #include "sim/mujoco_model.h"
 #include "sim/render.h"
 #include "sim/simulator.h"
-#include "sim/visual_odometry.h"
+#include "frontend/visual_odometry.h"
 
 namespace roamlab::bench {
 namespace {
@@ -37,10 +37,10 @@ nlohmann::json BenchRenderVo(const std::string& root, double duration_s, std::st
     render.height_px = height;
     auto renderer = sim::CameraRenderer::Create(m, "camera", render);
     if (!renderer.ok()) return *error = renderer.status().message(), nlohmann::json();
-    sim::VisualOdometryOptions options;
+    frontend::VisualOdometryOptions options;
     options.camera_height_m = 0.30;  // the rig's mounting: 0.30 m high, pitched 15 deg down
     options.floor_normal_camera = Eigen::Vector3d(0.0, std::cos(0.2617993877991494), std::sin(0.2617993877991494));
-    sim::VisualOdometry vo(renderer.value()->intrinsics(), options);
+    frontend::VisualOdometry vo(renderer.value()->intrinsics(), options);
     cv::Mat gray;
     double render_s = 0.0;
     double vo_s = 0.0;

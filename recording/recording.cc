@@ -21,6 +21,7 @@
 //       columns: [latitude, longitude, altitude]    # optional for fixed-column types (must then match exactly, or
 //                                                   # for velocity types be followed by the 21 covariance columns);
 //                                                   # required for wheel_encoders and inputs ([A-Za-z0-9_]+, unique)
+//                                                   # and laser_scan (LaserScanColumns)
 //       mounting: {p_body_sensor_m: [0.57, -0.46, 0.32], q_body_sensor_wxyz: [1, 0, 0, 0]}
 //                                                   # optional, each key optional (zero, identity); |q| within 1e-3
 //       noise: {sigma_m: 0.33}                      # optional, name -> number
@@ -34,6 +35,7 @@
 //   gps              deg                               position, pose  m
 //   steering         rad | deg                         odometry, visual_odometry, scan_matching   m/s,rad/s
 //   wheel_encoders   rad (default) | rad/s | m/s | ticks: ticks -> rad with attributes.ticks_per_revolution (required)
+//   laser_scan       rad,m
 //   inputs, camera   anything, kept as given
 //
 // Reading is strict: unknown or duplicate keys, missing required keys, wrong types, non-finite numbers are errors
@@ -52,6 +54,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "recording/internal/laser_scan.h"
 #include "recording/internal/stream_csv.h"
 #include "recording/internal/text_io.h"
 #include "recording/internal/yaml_util.h"
@@ -99,6 +102,7 @@ const std::vector<TypeRow>& TypeTable() {
       {StreamType::kScanMatching, "scan_matching", {"vx", "vy", "vz", "wx", "wy", "wz"}},
       {StreamType::kCamera, "camera", {"frame"}},
       {StreamType::kInputs, "inputs", {}},
+      {StreamType::kLaserScan, "laser_scan", {}},
   };
   return table;
 }
@@ -231,6 +235,8 @@ constexpr UnitRow kUnitTable[] = {
     {StreamType::kVisualOdometry, "m/s,rad/s", "m/s,rad/s", 1.0, 1.0, false},
     {StreamType::kScanMatching, "", "m/s,rad/s", 1.0, 1.0, false},
     {StreamType::kScanMatching, "m/s,rad/s", "m/s,rad/s", 1.0, 1.0, false},
+    {StreamType::kLaserScan, "", "rad,m", 1.0, 1.0, false},
+    {StreamType::kLaserScan, "rad,m", "rad,m", 1.0, 1.0, false},
 };
 
 const UnitRow* FindUnitRow(StreamType type, const std::string& declared) {
@@ -289,6 +295,12 @@ std::string FreeColumnsProblem(const std::vector<std::string>& columns) {
     if (!seen.insert(column).second) return "duplicate column '" + column + "'";
   }
   return "";
+}
+
+// Problem with the columns named in the entry of a stream whose type fixes none, or "" when they are fine.
+std::string NamedColumnsProblem(StreamType type, const std::vector<std::string>& columns) {
+  if (type == StreamType::kLaserScan) return internal::LaserScanColumnsProblem(columns);
+  return FreeColumnsProblem(columns);
 }
 
 // Problem with an origin, or "" when it is fine.
@@ -388,12 +400,12 @@ Status ParseColumns(const YAML::Node& entry, const std::string& path, const std:
     info->columns = covariance ? declared : fixed;
     return Status::Ok();
   }
-  // wheel_encoders and inputs name their own columns.
+  // wheel_encoders, inputs and laser_scan name their own columns.
   if (!node) {
     return ErrorAt(path, entry,
                    "missing required key 'columns' in " + context + " (type " + StreamTypeName(info->type) + ")");
   }
-  const std::string problem = FreeColumnsProblem(declared);
+  const std::string problem = NamedColumnsProblem(info->type, declared);
   if (!problem.empty()) return ErrorAt(path, node, context + ": " + problem);
   info->columns = std::move(declared);
   return Status::Ok();
@@ -565,7 +577,8 @@ Status ReadStreamFile(const fs::path& directory, const UnitConversion& conversio
   stream->values = std::move(data.values);
   stream->text = std::move(data.text);
   ApplyConversion(conversion, &stream->values);
-  const std::string problem = CovarianceProblem(*stream);
+  std::string problem = CovarianceProblem(*stream);
+  if (problem.empty()) problem = internal::LaserScanRowsProblem(*stream);
   return problem.empty() ? Status::Ok() : Status::Error(path + ":" + problem);
 }
 
@@ -596,7 +609,7 @@ Status ValidateInfoForWrite(const StreamInfo& info, const std::string& prefix) {
                          CovarianceNote(info.type));
   }
   if (fixed.empty()) {
-    const std::string problem = FreeColumnsProblem(info.columns);
+    const std::string problem = NamedColumnsProblem(info.type, info.columns);
     if (!problem.empty()) return Status::Error(prefix + problem);
   }
   // Units, mounting, noise and attributes.
@@ -646,7 +659,8 @@ Status ValidateDataForWrite(const Stream& stream, const std::string& prefix) {
     }
     if (!stream.text.empty()) return Status::Error(prefix + "text is only for camera streams");
     if (!stream.values.allFinite()) return Status::Error(prefix + "values contain NaN or Inf");
-    const std::string problem = CovarianceProblem(stream);
+    std::string problem = CovarianceProblem(stream);
+    if (problem.empty()) problem = internal::LaserScanRowsProblem(stream);
     if (!problem.empty()) return Status::Error(prefix + "row " + problem);
   }
   // Time strictly increasing.
@@ -779,6 +793,12 @@ std::optional<StreamType> ParseStreamType(const std::string& name) {
 }
 
 const std::vector<std::string>& FixedColumns(StreamType type) { return RowOf(type).columns; }
+
+std::vector<std::string> LaserScanColumns(int beams) {
+  std::vector<std::string> columns = {"angle_min_rad", "angle_increment_rad", "range_min_m", "range_max_m"};
+  for (int k = 0; k < beams; ++k) columns.push_back("range_" + std::to_string(k));
+  return columns;
+}
 
 const std::vector<std::string>& CovarianceColumns(StreamType type) {
   static const std::vector<std::string> none;

@@ -48,8 +48,15 @@ inline constexpr int kFormatVersion = 1;
 // Camera intrinsics (camera and visual_odometry streams): the attributes width_px, height_px, fx_px, fy_px, cx_px,
 // cy_px, all six or none: the pinhole model u = fx x / z + cx, v = fy y / z + cy in OpenCV's pixel coordinates (the
 // centre of the top-left pixel is (0, 0)) for a point (x, y, z) in the camera frame (x right, y down, z forward).
-// Sizes are positive integers, focal lengths positive, the principal point inside the image.
+// Sizes are positive integers, focal lengths positive, the principal point inside the image. Other attributes are free;
+// the visual odometry front end reads its floor reference from a camera stream's (frontend/visual_odometry_stream.h).
 //   inputs           free columns named in the stream entry (control commands)
+//   laser_scan       angle_min_rad angle_increment_rad range_min_m range_max_m range_0 ... range_<N-1> [rad, m]: one
+//                    raw planar scan per row; beam k points at angle_min_rad + k angle_increment_rad in the sensor
+//                    frame (x forward, angles counter-clockwise); a range outside [range_min_m, range_max_m] (the
+//                    simulator writes 0) is no return. The columns are named in the stream entry (LaserScanColumns);
+//                    the reader refuses a row with angle_increment_rad = 0, range_min_m < 0 or range_max_m <=
+//                    range_min_m. units: rad,m (the only accepted value).
 enum class StreamType {
   kImu,
   kGyroscope,
@@ -65,19 +72,24 @@ enum class StreamType {
   kScanMatching,
   kCamera,
   kInputs,
+  kLaserScan,
 };
 
 // "imu", "gyroscope", ..., as written in recording.yaml; ParseStreamType is its inverse (nullopt for unknown names).
 const char* StreamTypeName(StreamType type);
 std::optional<StreamType> ParseStreamType(const std::string& name);
 
-// The CSV columns (after "t") that a type fixes, in the table above; empty for wheel_encoders and inputs, whose columns
-// come from the stream entry.
+// The CSV columns (after "t") that a type fixes, in the table above; empty for wheel_encoders, inputs and laser_scan,
+// whose columns come from the stream entry.
 const std::vector<std::string>& FixedColumns(StreamType type);
 // The covariance columns that may follow the fixed columns of a velocity type or gps (table above); empty for the other
 // types.
 // A stream carries them when its info.columns are FixedColumns() followed by these.
 const std::vector<std::string>& CovarianceColumns(StreamType type);
+
+// The columns (after "t") of a laser_scan stream of `beams` beams: the four geometry columns, then range_0 ...
+// range_<beams - 1>.
+std::vector<std::string> LaserScanColumns(int beams);
 
 // Nominal mounting of a sensor frame S in the odometric frame O.
 struct Mounting {

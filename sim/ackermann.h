@@ -79,7 +79,7 @@ class AckermannVehicle {
   // Softer tires (the scenario's lateral_slip effect): the four tires' contact time constant (MuJoCo's solref[0], the
   // ground geom takes the robot's softness) times `scale`. MuJoCo's soft contact lets a tangential force through by a
   // slip velocity proportional to it and to the time constant, so the cornering compliance grows with `scale` (on the
-  // ATV about linearly, README); the vertical contact softens too (a lower tire pressure). Changes the compiled model
+  // ATV about linearly); the vertical contact softens too (a lower tire pressure). Changes the compiled model
   // only. Fails, naming `what`, when a tire's solref is not in the time-constant form (solref[0] <= 0).
   Status SoftenTires(mjModel* model, double scale, const std::string& what) const;
   // Steering servo targets for the handlebar angle (clamped to +-max_handlebar_rad) and the drive torque per rear wheel.

@@ -5,7 +5,8 @@
 
 namespace roamlab::sim {
 
-std::vector<double> CastScan(const mjModel* model, const mjData* data, int laser_site, const ScanGeometry& geometry) {
+std::vector<double> CastScan(const mjModel* model, const mjData* data, int laser_site,
+                             const frontend::ScanGeometry& geometry) {
   const mjtNum* origin = data->site_xpos + 3 * laser_site;
   const mjtNum* R = data->site_xmat + 9 * laser_site;  // row-major, site -> world
   const mjtByte world_only[mjNGROUP] = {1, 0, 0, 0, 0, 0};

@@ -8,11 +8,12 @@
 
 #include <mujoco/mujoco.h>
 
-#include "sim/scan_matcher.h"
+#include "frontend/scan_matcher.h"
 
 namespace roamlab::sim {
 
 // Noise-free ranges [m] of one scan; precondition: kinematics of `data` are current (mj_forward).
-std::vector<double> CastScan(const mjModel* model, const mjData* data, int laser_site, const ScanGeometry& geometry);
+std::vector<double> CastScan(const mjModel* model, const mjData* data, int laser_site,
+                             const frontend::ScanGeometry& geometry);
 
 }  // namespace roamlab::sim

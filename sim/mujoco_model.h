@@ -1,7 +1,7 @@
 // MuJoCo 2.2.2 glue for the simulator: error and warning handlers, owning pointers, and models compiled from text held
 // in memory (2.2.2 has no load-from-string: the text goes through a heap-allocated mjVFS).
 //
-// Handlers (TOOLCHAIN.md): MuJoCo's default error handler prints "Press Enter to exit", blocks on stdin and writes
+// Handlers: MuJoCo's default error handler prints "Press Enter to exit", blocks on stdin and writes
 // MUJOCO_LOG.TXT. InstallMujocoHandlers() replaces it with one that throws MujocoError (a C++ exception passes through
 // MuJoCo's C frames), and replaces the warning handler with one that appends the message to a per-thread list that
 // TakeMujocoWarnings() returns. Every function here installs them first; it is idempotent and thread-safe.

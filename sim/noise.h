@@ -1,4 +1,4 @@
-// One seeded stream of zero-mean Gaussian noise per noise source (DESIGN.md: no global generator). The generator is a
+// One seeded stream of zero-mean Gaussian noise per noise source (no global generator). The generator is a
 // std::mt19937_64 seeded with std::seed_seq{low 32 bits of seed, high 32 bits of seed, source}, so every source has
 // its own sequence, the same seed and source always give the same numbers, and adding a source never shifts another.
 #pragma once

@@ -1,5 +1,5 @@
-// Offscreen rendering of a MuJoCo camera without a display: EGL on Mesa's surfaceless platform (TOOLCHAIN.md,
-// "Headless rendering"), MuJoCo's own renderer (mjr_*) into its offscreen framebuffer, read back into OpenCV images.
+// Offscreen rendering of a MuJoCo camera without a display: EGL on Mesa's surfaceless platform, MuJoCo's own
+// renderer (mjr_*) into its offscreen framebuffer, read back into OpenCV images.
 //
 // Camera conventions. MuJoCo's camera frame is OpenGL's: x right, y up, looking down -z. Everything this header
 // returns uses OpenCV's camera frame C instead: x right, y down, z forward (the optical axis); the rotation between
@@ -18,8 +18,8 @@
 // renderer's context); creating and destroying the MuJoCo contexts is serialized by a process-wide mutex because
 // MuJoCo loads its OpenGL entry points into globals there. Never load OSMesa into the same process.
 //
-// Speed: multisampling, shadows, reflections and the skybox are off (3-5x faster than MuJoCo's defaults, TOOLCHAIN.md);
-// sites and decorations are not drawn.
+// Speed: multisampling, shadows, reflections and the skybox are off (several times faster than MuJoCo's
+// defaults); sites and decorations are not drawn.
 #pragma once
 
 #include <memory>
@@ -30,24 +30,12 @@
 #include <opencv2/core.hpp>
 
 #include "common/status.h"
+#include "frontend/pinhole.h"
 
 namespace roamlab::sim {
 
-// Pinhole intrinsics in OpenCV's conventions (above). Units: pixels.
-struct PinholeIntrinsics {
-  int width_px = 0;
-  int height_px = 0;
-  double fx_px = 0.0;
-  double fy_px = 0.0;
-  double cx_px = 0.0;
-  double cy_px = 0.0;
-
-  cv::Matx33d K() const { return {fx_px, 0.0, cx_px, 0.0, fy_px, cy_px, 0.0, 0.0, 1.0}; }
-  // Pixel of a point in the camera frame C (z > 0).
-  Eigen::Vector2d Project(const Eigen::Vector3d& p_camera_m) const {
-    return {fx_px * p_camera_m.x() / p_camera_m.z() + cx_px, fy_px * p_camera_m.y() / p_camera_m.z() + cy_px};
-  }
-};
+// Pinhole intrinsics in OpenCV's conventions (above), shared with the visual odometry front end.
+using frontend::PinholeIntrinsics;
 
 // The intrinsics of a camera with vertical field of view `fovy_deg` rendered at width x height pixels.
 PinholeIntrinsics IntrinsicsFromFovy(double fovy_deg, int width_px, int height_px);

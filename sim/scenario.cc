@@ -15,10 +15,6 @@ using internal::YamlReader;
 
 constexpr double kPi = 3.14159265358979323846;
 
-bool Finite(double x) { return std::isfinite(x); }
-bool Positive(double x) { return std::isfinite(x) && x > 0.0; }
-bool NonNegative(double x) { return std::isfinite(x) && x >= 0.0; }
-
 Eigen::Vector3d ToVector3(const std::vector<double>& v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
 
 // One profile term: a mapping with exactly one of the term types (plus an optional window_s).
@@ -364,7 +360,7 @@ void ReadIndoorSensors(YamlReader& r, const YAML::Node& node, Scenario* s) {
     LaserOptions& laser = s->sensors.laser.emplace();
     const YAML::Node n = node["laser"];
     const std::string k = "sensors.laser";
-    r.CheckKeys(n, k, {"rate_hz", "beams", "fov_deg", "min_range_m", "max_range_m", "sigma_m"});
+    r.CheckKeys(n, k, {"rate_hz", "beams", "fov_deg", "min_range_m", "max_range_m", "sigma_m", "store_scans"});
     r.Number(n, k, "rate_hz", &laser.rate_hz);
     std::int64_t beams = laser.beams;
     r.Integer(n, k, "beams", &beams);
@@ -373,6 +369,7 @@ void ReadIndoorSensors(YamlReader& r, const YAML::Node& node, Scenario* s) {
     r.Number(n, k, "min_range_m", &laser.min_range_m);
     r.Number(n, k, "max_range_m", &laser.max_range_m);
     r.Number(n, k, "sigma_m", &laser.sigma_m);
+    r.Bool(n, k, "store_scans", &laser.store_scans);
   } else if (node["laser"]) {
     s->sensors.laser.emplace();
   }
@@ -423,61 +420,6 @@ void ReadEffects(YamlReader& r, const YAML::Node& node, Scenario* s) {
   }
 }
 
-std::optional<Scenario::Problem> ProfileProblem(const Profile& profile, const std::string& key) {
-  for (std::size_t i = 0; i < profile.terms.size(); ++i) {
-    const std::string problem = profile.terms[i].Validate();
-    if (!problem.empty()) return Scenario::Problem{key + "[" + std::to_string(i) + "]", problem};
-  }
-  return std::nullopt;
-}
-
-// The wheeled robots' effects (scenario.h): the kinds they apply to and their parameters' ranges.
-std::optional<Scenario::Problem> WheelEffectProblem(const std::vector<EffectOptions>& effects, const std::string& name,
-                                                    const std::string& kind, const std::string& k) {
-  using P = Scenario::Problem;
-  const bool wheel_effect = name == "wheel_radius_asymmetry" || name == "track_width_error" ||
-                            name == "wheel_deformation" || name == "axle_misalignment";
-  if (!wheel_effect) return std::nullopt;
-  if (kind == "ackermann" && name == "axle_misalignment") {
-    // The Ackermann vehicle's rear axle (both rear wheels: a thrust angle); the front wheels are steered, and their
-    // zero is steering_offset.
-    for (const EffectOptions& e : effects)
-      if (e.name == name && e.parameters.count("wheel"))
-        return P{k + ".parameters.wheel", "ackermann: axle_misalignment turns the rear axle (both rear wheels); "
-                                          "no wheel index"};
-    if (!(std::abs(EffectParameter(effects, name, "yaw_deg", 0.0)) <= 5.0))
-      return P{k + ".parameters.yaw_deg", "must be within +-5 on the ackermann rear axle"};
-    return std::nullopt;
-  }
-  const int wheels = kind == "differential_drive" ? 2 : kind == "omni3" ? 3 : kind == "mecanum" ? 4 : 0;
-  if (wheels == 0) return P{k + ".name", name + " is for wheeled indoor robots, not '" + kind + "'"};
-  if (name == "wheel_radius_asymmetry") {
-    if (kind != "differential_drive") return P{k + ".name", name + " is for differential_drive robots only"};
-    const double ratio = EffectParameter(effects, name, "ratio_right_left", 1.0);
-    if (!(ratio >= 0.8 && ratio <= 1.2)) return P{k + ".parameters.ratio_right_left", "must be in [0.8, 1.2]"};
-  }
-  if (name == "track_width_error") {
-    if (kind != "differential_drive" && kind != "mecanum")
-      return P{k + ".name", name + " is for differential_drive and mecanum robots only"};
-    if (!(std::abs(EffectParameter(effects, name, "track_error_m", 0.0)) <= 0.1))
-      return P{k + ".parameters.track_error_m", "must be in [-0.1, 0.1] m"};
-  }
-  if (name == "wheel_deformation" || name == "axle_misalignment") {
-    const double wheel = EffectParameter(effects, name, "wheel", 0.0);
-    if (!(wheel >= 0.0 && wheel < wheels && wheel == std::floor(wheel)))
-      return P{k + ".parameters.wheel", "no such wheel: the " + kind + " robot has wheels 0 to " +
-                                            std::to_string(wheels - 1)};
-  }
-  if (name == "wheel_deformation") {
-    if (kind != "differential_drive") return P{k + ".name", name + " needs sphere tires (differential_drive)"};
-    const double ovality = EffectParameter(effects, name, "ovality_m", 0.0);
-    if (!(ovality >= 0.0 && ovality <= 0.02)) return P{k + ".parameters.ovality_m", "must be in [0, 0.02] m"};
-  }
-  if (name == "axle_misalignment" && !(std::abs(EffectParameter(effects, name, "yaw_deg", 0.0)) <= 20.0))
-    return P{k + ".parameters.yaw_deg", "must be within +-20"};
-  return std::nullopt;
-}
-
 }  // namespace
 
 const std::map<std::string, std::map<std::string, double>>& KnownEffects() {
@@ -512,219 +454,6 @@ double EffectParameter(const std::vector<EffectOptions>& effects, const std::str
     return fallback;
   }
   return fallback;
-}
-
-std::optional<Scenario::Problem> Scenario::Validate() const {
-  using P = Scenario::Problem;
-  if (!Positive(duration_s) || duration_s > 1.0e6) return P{"duration_s", "must be > 0 (and at most 1e6)"};
-  if (!(Finite(origin.latitude_deg) && std::abs(origin.latitude_deg) <= 90.0))
-    return P{"origin.latitude_deg", "must be in [-90, 90]"};
-  if (!(Finite(origin.longitude_deg) && std::abs(origin.longitude_deg) <= 180.0))
-    return P{"origin.longitude_deg", "must be in [-180, 180]"};
-  if (!Finite(origin.altitude_m)) return P{"origin.altitude_m", "must be finite"};
-  if (!Positive(ground_truth_rate_hz)) return P{"ground_truth_rate_hz", "must be > 0"};
-
-  // Robot and driver: the Ackermann vehicle, or a wheeled indoor robot driven by body-velocity set-points.
-  const bool ackermann = robot.kind == "ackermann";
-  const bool holonomic = robot.kind == "omni3" || robot.kind == "mecanum";
-  if (!ackermann && !holonomic && robot.kind != "differential_drive")
-    return P{"robot.kind",
-             "unsupported kind '" + robot.kind + "' (supported: ackermann, differential_drive, omni3, mecanum)"};
-  if (robot.model_file.empty() && robot.model_xml.empty()) return P{"robot.model", "missing"};
-  if (!robot.start_position_m.allFinite()) return P{"robot.start.position_m", "must be finite"};
-  if (!Finite(robot.start_heading_rad)) return P{"robot.start.heading_deg", "must be finite"};
-  if (const std::string p = robot.speed_controller.Validate(); !p.empty())
-    return P{"robot.speed_controller." + p.substr(0, p.find(':')), p.substr(p.find(':') + 2)};
-  if (const std::string p = terrain.Validate(); !p.empty())
-    return P{"world.terrain." + p.substr(0, p.find(':')), p.substr(p.find(':') + 2)};
-  if (terrain.type == TerrainOptions::Type::kHills &&
-      !(std::abs(robot.start_position_m.x()) < 0.5 * terrain.size_m.x() - 5.0 &&
-        std::abs(robot.start_position_m.y()) < 0.5 * terrain.size_m.y() - 5.0))
-    return P{"robot.start.position_m", "must be on the terrain, at least 5 m from its edge"};
-  const std::string driver_type = ackermann ? "ackermann" : "body_velocity";
-  if (driver.type != driver_type)
-    return P{"driver.type", "'" + driver.type + "' does not drive a robot of kind '" + robot.kind +
-                                "' (use " + driver_type + ")"};
-  if (!ackermann && terrain.type != TerrainOptions::Type::kFlat)
-    return P{"world.terrain.type", "a " + robot.kind + " robot needs a flat floor (type: flat)"};
-  if (!NonNegative(driver.lead_in_s) || driver.lead_in_s > 60.0) return P{"driver.lead_in_s", "must be in [0, 60]"};
-  if (auto p = ProfileProblem(driver.speed_mps, "driver.speed_mps")) return p;
-  if (auto p = ProfileProblem(driver.handlebar_rad, "driver.handlebar_rad")) return p;
-  if (auto p = ProfileProblem(driver.linear_mps, "driver.linear_mps")) return p;
-  if (auto p = ProfileProblem(driver.angular_radps, "driver.angular_radps")) return p;
-  if (auto p = ProfileProblem(driver.lateral_mps, "driver.lateral_mps")) return p;
-  for (const ProfileTerm& term : driver.lateral_mps.terms) {
-    if (!holonomic && !(term.type == ProfileTerm::Type::kConstant && term.value == 0.0))
-      return P{"driver.lateral_mps", "only for holonomic robots (omni3, mecanum); a " + robot.kind + " cannot"};
-  }
-  if (ackermann && !robot.wheel_mounting.empty()) return P{"robot.wheel_mounting", "only for wheeled indoor robots"};
-  for (std::size_t i = 0; i < robot.wheel_mounting.size(); ++i) {
-    const WheelMountingChange& c = robot.wheel_mounting[i];
-    const std::string k = "robot.wheel_mounting[" + std::to_string(i) + "]";
-    if (c.wheel < 0) return P{k + ".wheel", "must be >= 0"};
-    if (!(Finite(c.yaw_rad) && std::abs(c.yaw_rad) <= 0.35)) return P{k + ".yaw_deg", "must be within +-20"};
-    if (!(Finite(c.tilt_rad) && std::abs(c.tilt_rad) <= 0.35)) return P{k + ".tilt_deg", "must be within +-20"};
-  }
-  if (ackermann && !robot.wheel_deformation.empty())
-    return P{"robot.wheel_deformation", "only for wheeled indoor robots"};
-  for (std::size_t i = 0; i < robot.wheel_deformation.size(); ++i) {
-    const WheelDeformation& d = robot.wheel_deformation[i];
-    const std::string k = "robot.wheel_deformation[" + std::to_string(i) + "]";
-    if (d.wheel < 0) return P{k + ".wheel", "must be >= 0"};
-    if (!(Finite(d.radius_scale) && d.radius_scale >= 0.8 && d.radius_scale <= 1.2))
-      return P{k + ".radius_scale", "must be in [0.8, 1.2]"};
-    if (!(Finite(d.ovality_m) && d.ovality_m >= 0.0 && d.ovality_m <= 0.02))
-      return P{k + ".ovality_m", "must be in [0, 0.02]"};
-  }
-
-  if (ackermann && !robot.wheel_offset.empty()) return P{"robot.wheel_offset", "only for wheeled indoor robots"};
-  for (std::size_t i = 0; i < robot.wheel_offset.size(); ++i) {
-    const WheelOffset& o = robot.wheel_offset[i];
-    const std::string k = "robot.wheel_offset[" + std::to_string(i) + "]";
-    if (o.wheel < 0) return P{k + ".wheel", "must be >= 0"};
-    for (std::size_t j = 0; j < i; ++j)
-      if (robot.wheel_offset[j].wheel == o.wheel) return P{k + ".wheel", "wheel listed twice"};
-    // An assembly error of a few cm; beyond that a wheel could change sides of O or run into the chassis.
-    if (!(Finite(o.offset_m.x()) && Finite(o.offset_m.y()) && o.offset_m.cwiseAbs().maxCoeff() <= 0.05))
-      return P{k + ".offset_m", "each component must be within +-0.05 m"};
-  }
-
-  // Sensors.
-  if (const auto& imu = sensors.imu) {
-    if (!Positive(imu->rate_hz)) return P{"sensors.imu.rate_hz", "must be > 0"};
-    if (!NonNegative(imu->gyro_sigma_radps)) return P{"sensors.imu.gyro_sigma_radps", "must be >= 0"};
-    if (!NonNegative(imu->accel_sigma_mps2)) return P{"sensors.imu.accel_sigma_mps2", "must be >= 0"};
-    const double norm = imu->misalignment.norm();
-    if (!(imu->misalignment.coeffs().allFinite() && norm > 0.5 && norm < 2.0))
-      return P{"sensors.imu.misalignment", "must be a quaternion [w, x, y, z] near unit norm"};
-    if (!imu->lever_arm_m.allFinite()) return P{"sensors.imu.lever_arm_m", "must be finite"};
-  }
-  if (const auto& mag = sensors.magnetometer) {
-    if (!sensors.imu) return P{"sensors.magnetometer", "needs sensors.imu (it shares the IMU's frame)"};
-    if (!Positive(mag->rate_hz)) return P{"sensors.magnetometer.rate_hz", "must be > 0"};
-    if (!NonNegative(mag->sigma)) return P{"sensors.magnetometer.sigma", "must be >= 0"};
-    if (!mag->A.allFinite()) return P{"sensors.magnetometer.A", "must be finite"};
-    if (!mag->b.allFinite()) return P{"sensors.magnetometer.b", "must be finite"};
-    if (!(mag->field_world.allFinite() && mag->field_world.norm() > 0.0))
-      return P{"sensors.magnetometer.field_world", "must be finite and nonzero"};
-  }
-  if (const auto& gps = sensors.gps) {
-    if (!Positive(gps->rate_hz)) return P{"sensors.gps.rate_hz", "must be > 0"};
-    if (!NonNegative(gps->sigma_m)) return P{"sensors.gps.sigma_m", "must be >= 0"};
-    if (!gps->lever_arm_m.allFinite()) return P{"sensors.gps.lever_arm_m", "must be finite"};
-  }
-  if (sensors.odometer && !ackermann)
-    return P{"sensors.odometer", "is the Ackermann odometer; a " + robot.kind + " robot has wheel_encoders"};
-  if ((sensors.wheel_encoders || sensors.laser) && ackermann)
-    return P{sensors.laser ? "sensors.laser" : "sensors.wheel_encoders", "only for wheeled indoor robots"};
-  if (sensors.camera && ackermann) return P{"sensors.camera", "only for wheeled indoor robots"};
-  if (const auto& camera = sensors.camera) {
-    if (!(Finite(camera->rate_hz) && camera->rate_hz >= 10.0 && camera->rate_hz <= 30.0))
-      return P{"sensors.camera.rate_hz", "must be in [10, 30]"};
-    const bool small = camera->width_px == 320 && camera->height_px == 240;
-    const bool large = camera->width_px == 640 && camera->height_px == 480;
-    if (!small && !large)
-      return P{camera->width_px != 320 && camera->width_px != 640 ? "sensors.camera.width_px"
-                                                                    : "sensors.camera.height_px",
-               "the image must be 320x240 or 640x480"};
-  }
-  if (const auto& enc = sensors.wheel_encoders) {
-    if (!Positive(enc->rate_hz)) return P{"sensors.wheel_encoders.rate_hz", "must be > 0"};
-    if (!(Positive(enc->ticks_per_revolution) && enc->ticks_per_revolution == std::floor(enc->ticks_per_revolution)))
-      return P{"sensors.wheel_encoders.ticks_per_revolution", "must be a positive whole number"};
-  }
-  if (const auto& laser = sensors.laser) {
-    if (!Positive(laser->rate_hz)) return P{"sensors.laser.rate_hz", "must be > 0"};
-    if (laser->beams < 10 || laser->beams > 10000) return P{"sensors.laser.beams", "must be in [10, 10000]"};
-    if (!(Positive(laser->fov_deg) && laser->fov_deg <= 360.0))
-      return P{"sensors.laser.fov_deg", "must be in (0, 360]"};
-    if (!NonNegative(laser->min_range_m)) return P{"sensors.laser.min_range_m", "must be >= 0"};
-    if (!(Positive(laser->max_range_m) && laser->max_range_m > laser->min_range_m))
-      return P{"sensors.laser.max_range_m", "must be > min_range_m"};
-    if (!NonNegative(laser->sigma_m)) return P{"sensors.laser.sigma_m", "must be >= 0"};
-  }
-  if (const auto& odo = sensors.odometer) {
-    if (!Positive(odo->rate_hz)) return P{"sensors.odometer.rate_hz", "must be > 0"};
-    if (!NonNegative(odo->speed_sigma_mps)) return P{"sensors.odometer.speed_sigma_mps", "must be >= 0"};
-    if (!NonNegative(odo->steering_sigma_rad)) return P{"sensors.odometer.steering_sigma_rad", "must be >= 0"};
-    if (!Positive(odo->kv_over_L)) return P{"sensors.odometer.kv_over_L", "must be > 0"};
-    if (!(Finite(odo->k_theta) && odo->k_theta != 0.0)) return P{"sensors.odometer.k_theta", "must be nonzero"};
-    if (!Finite(odo->k_gamma)) return P{"sensors.odometer.k_gamma", "must be finite"};
-  }
-
-  // Effects: known names and parameters, each at most once, with values in range.
-  std::set<std::string> seen;
-  for (std::size_t i = 0; i < effects.size(); ++i) {
-    const std::string k = "effects[" + std::to_string(i) + "]";
-    const EffectOptions& e = effects[i];
-    const auto known = KnownEffects().find(e.name);
-    if (known == KnownEffects().end()) {
-      std::string names;
-      for (const auto& [name, unused] : KnownEffects()) names += (names.empty() ? "" : ", ") + name;
-      return P{k + ".name", "unknown effect '" + e.name + "' (known: " + names + ")"};
-    }
-    if (!seen.insert(e.name).second) return P{k + ".name", "effect '" + e.name + "' appears twice"};
-    for (const auto& [parameter, value] : e.parameters) {
-      if (!known->second.count(parameter))
-        return P{k + ".parameters." + parameter, "unknown parameter of " + e.name};
-      if (!Finite(value)) return P{k + ".parameters." + parameter, "must be finite"};
-    }
-    const double latency = EffectParameter(effects, "gps_latency", "latency_s", 0.0);
-    if (e.name == "gps_latency" && !(latency >= 0.0 && latency <= 1.0))
-      return P{k + ".parameters.latency_s", "must be in [0, 1]"};
-    if (e.name == "imu_time_offset" && !(std::abs(EffectParameter(effects, e.name, "offset_s", 0.0)) <= 0.5))
-      return P{k + ".parameters.offset_s", "must be in [-0.5, 0.5]"};
-    if (e.name == "gps_latency" && !sensors.gps) return P{k + ".name", "gps_latency needs sensors.gps"};
-    if (e.name == "gyro_bias_drift") {
-      if (!(EffectParameter(effects, e.name, "random_walk", 0.0) >= 0.0))
-        return P{k + ".parameters.random_walk", "must be >= 0"};
-      for (const char* axis : {"initial_x", "initial_y", "initial_z"})
-        if (!(std::abs(EffectParameter(effects, e.name, axis, 0.0)) <= 0.5))
-          return P{k + ".parameters." + axis, "must be in [-0.5, 0.5] rad/s"};
-    }
-    if ((e.name == "imu_time_offset" || e.name == "gyro_scale_error" || e.name == "gyro_bias_drift" ||
-         e.name == "accelerometer_scale_error") &&
-        !sensors.imu)
-      return P{k + ".name", e.name + " needs sensors.imu"};
-    if (e.name == "accelerometer_scale_error") {
-      for (const char* axis : {"scale_x", "scale_y", "scale_z"}) {
-        const double scale = EffectParameter(effects, e.name, axis, 1.0);
-        if (!(scale >= 0.5 && scale <= 1.5)) return P{k + ".parameters." + axis, "must be in [0.5, 1.5]"};
-      }
-    }
-    if (e.name == "gps_multipath") {
-      if (!sensors.gps) return P{k + ".name", "gps_multipath needs sensors.gps"};
-      const double sigma = EffectParameter(effects, e.name, "sigma_m", 0.0);
-      if (!(sigma >= 0.0 && sigma <= 10.0)) return P{k + ".parameters.sigma_m", "must be in [0, 10] m"};
-      const double tau = EffectParameter(effects, e.name, "correlation_s", 5.0);
-      if (!(tau >= 0.1 && tau <= 600.0)) return P{k + ".parameters.correlation_s", "must be in [0.1, 600] s"};
-    }
-    if (e.name == "tire_growth") {
-      if (!ackermann) return P{k + ".name", "tire_growth is implemented for ackermann robots only"};
-      if (!sensors.odometer) return P{k + ".name", "tire_growth needs sensors.odometer"};
-      const double c = EffectParameter(effects, e.name, "growth_per_mps2", 0.0);
-      if (!(c >= 0.0 && c <= 0.01)) return P{k + ".parameters.growth_per_mps2", "must be in [0, 0.01] s^2/m^2"};
-    }
-    if (e.name == "longitudinal_slip" || e.name == "slope_slip") {
-      if (!ackermann) return P{k + ".name", e.name + " is implemented for ackermann robots only"};
-      if (!sensors.odometer) return P{k + ".name", e.name + " needs sensors.odometer"};
-      const double s = EffectParameter(effects, e.name, "slip_per_mps2", 0.0);
-      if (!(s >= 0.0 && s <= 0.2)) return P{k + ".parameters.slip_per_mps2", "must be in [0, 0.2] s^2/m"};
-    }
-    if (e.name == "lateral_slip") {
-      if (!ackermann) return P{k + ".name", "lateral_slip is implemented for ackermann robots only"};
-      const double scale = EffectParameter(effects, e.name, "contact_time_scale", 1.0);
-      if (!(scale >= 1.0 && scale <= 4.0)) return P{k + ".parameters.contact_time_scale", "must be in [1, 4]"};
-    }
-    if (e.name == "steering_offset" && !sensors.odometer)
-      return P{k + ".name", "steering_offset needs sensors.odometer"};
-    if (e.name == "magnetometer_motor_interference" && !sensors.magnetometer)
-      return P{k + ".name", e.name + " needs sensors.magnetometer"};
-    if ((e.name == "steering_offset" || e.name == "magnetometer_motor_interference") && !ackermann)
-      return P{k + ".name", e.name + " is implemented for ackermann robots only"};
-    if (auto p = WheelEffectProblem(effects, e.name, robot.kind, k)) return p;
-  }
-  return std::nullopt;
 }
 
 Result<Scenario> LoadScenario(const std::string& path) {

@@ -40,7 +40,7 @@
 //   effects: []                             # hidden physical effects, each {name: ..., parameters: {...}}; written
 //                                           # to truth.yaml only (the recording does not say they are there)
 //
-// Effects (issue 6's library). Each lives where it physically belongs; parameters not given take the default shown,
+// Effects. Each lives where it physically belongs; parameters not given take the default shown,
 // unknown names or parameters are errors. The sensor effects apply to any robot with the sensor (the IMU and GPS
 // synthesis is shared); steering_offset and magnetometer_motor_interference to Ackermann robots only:
 //   gps_latency {latency_s: 0}             the fix stamped t is the antenna's position at t - latency_s
@@ -86,11 +86,9 @@
 //                                          constant (solref[0], 0.04 s in models/atv.xml) times contact_time_scale in
 //                                          [1, 4] (AckermannVehicle::SoftenTires). A soft contact carries a sideways
 //                                          force by a slip velocity proportional to it and to the time constant, so
-//                                          the cornering compliance grows about linearly: measured on the truth of
-//                                          atv_hills_sines.yaml (v_y at the rear contact on a_y), c_rear = 0.0207
-//                                          s at 1, 0.0409 at 2, 0.0816 at 4, i.e. +0.0203 (k - 1) s; the steering
-//                                          row's c_front +0.0045 (k - 1) rad s^2/m (README); the tires also sink
-//                                          more (vertical softness); the diagnosis's candidate is lateral_slip
+//                                          the cornering compliance (c_rear: v_y at the rear contact over a_y)
+//                                          grows about linearly with contact_time_scale; the tires also sink more
+//                                          (vertical softness); the diagnosis's candidate is lateral_slip
 // Wheeled indoor robots (below); in the compiled MuJoCo model after the robot is bound, so that the recording's
 // platform geometry and the driver's inverse kinematics stay nominal; truth.yaml's odometer geometry is the true one:
 //   wheel_radius_asymmetry {ratio_right_left: 1}   differential_drive: the right tire's radius (wheel_1) times the
@@ -139,25 +137,31 @@
 //   sensors:
 //     imu: {...}                            # as above (vibration comes from the physics)
 //     wheel_encoders: {rate_hz: 100, ticks_per_revolution: 2048}
-//     laser: {rate_hz: 10, beams: 683, fov_deg: 240, min_range_m: 0.02, max_range_m: 4.0, sigma_m: 0.01}
+//     laser: {rate_hz: 10, beams: 683, fov_deg: 240, min_range_m: 0.02, max_range_m: 4.0, sigma_m: 0.01,
+//             store_scans: false}
 //     camera: {rate_hz: 15, width_px: 320, height_px: 240, store_images: false}   # rate 10-30 Hz; 320x240 or 640x480
 // Streams written: imu; wheel_encoders (wheel_encoders: one column per wheel, "left" "right", the cumulative wheel
 // angle quantized to whole ticks and written in rad, attributes.ticks_per_revolution; angle 0 at t = 0);
 // scan_matching (scan_matching: the velocity of the laser frame between consecutive scans, from the project's scan
-// matcher (sim/scan_matcher.h) on the ray-cast scans (sim/laser.h) with Gaussian range noise sigma_m, stamped at the
-// middle of the scan interval, vz = wx = wy = 0; mounting = the laser site in O). The platform geometry
-// (wheel_radius_m, baseline_m) is measured on the model. truth.yaml: imu.misalignment, scan_matching.lever_arm,
+// matcher (frontend/scan_matching_stream.h) on the ray-cast scans (sim/laser.h) with Gaussian range noise sigma_m,
+// stamped at the middle of the scan interval, vz = wx = wy = 0; mounting = the laser site in O). store_scans: true
+// also writes the noisy scans themselves as a laser_scan stream named laser_scan (recording.h; beam k at
+// -fov / 2 + k fov / (beams - 1), no return written as 0; mounting = the laser site in O), from which
+// `roamlab frontend scan` reproduces the scan_matching stream. The platform geometry (wheel_radius_m, baseline_m) is
+// measured on the model. truth.yaml: imu.misalignment, scan_matching.lever_arm,
 // scan_matching.misalignment, odometer.radius_left, odometer.radius_right, odometer.baseline (the true geometry, the
 // names the differential_drive estimator model uses when its stream is called odometer).
 // visual_odometry (sensors.camera; any wheeled kind whose model has a camera named "camera"): the model's camera
-// rendered offscreen (sim/render.h) and fed to the monocular visual odometry (sim/visual_odometry_stream.h, scale
+// rendered offscreen (sim/render.h) and fed to the monocular visual odometry (sim/simulated_camera.h, scale
 // from the camera's height over the floor measured at the start pose): the velocity of the camera frame C (OpenCV:
 // x right, y down, z forward) between consecutive frames, stamped at the middle of the frame pair, with the 21
 // covariance columns and the intrinsics; mounting = the camera's pose in O. Frame k is taken at the first physics
 // step at or after k / rate_hz (a 15 Hz camera on a 1 ms step: pairs of 66 or 67 ms); a failed pair writes no row
 // (simulate prints the counts by reason). store_images: true also writes every frame as a PNG into the recording,
 // listed by a camera stream visual_odometry_images (needs the recording directory: SimulateOptions::
-// image_directory). truth.yaml: visual_odometry.lever_arm, visual_odometry.misalignment.
+// image_directory) whose attributes hold the intrinsics and the VO's floor reference (camera_height_m,
+// floor_normal_x/y/z), from which `roamlab frontend vo` reproduces the visual_odometry stream. truth.yaml:
+// visual_odometry.lever_arm, visual_odometry.misalignment.
 //
 // Holonomic robots: `robot.kind: omni3` (models/omni3.xml, Triskar2-like: three omni wheels at 120 deg) and
 // `robot.kind: mecanum` (models/mecanum.xml: four mecanum wheels, X layout), scenarios/indoor_omni_slip.yaml. As the
@@ -274,6 +278,7 @@ struct LaserOptions {
   double min_range_m = 0.02;
   double max_range_m = 4.0;
   double sigma_m = 0.01;                  // Gaussian range noise
+  bool store_scans = false;               // the raw scans in the recording (laser_scan stream)
 };
 
 struct CameraOptions {

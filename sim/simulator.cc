@@ -11,19 +11,28 @@
 #include <GeographicLib/LocalCartesian.hpp>
 
 #include "common/check.h"
+#include "frontend/laser_scan.h"
+#include "frontend/scan_matching_stream.h"
 #include "sim/ackermann.h"
+#include "sim/internal/scenario_effects.h"
+#include "sim/internal/stream_clock.h"
+#include "sim/internal/simulation_metadata.h"
 #include "sim/laser.h"
 #include "sim/mujoco_model.h"
 #include "sim/noise.h"
 #include "sim/sensors.h"
-#include "sim/scan_matcher.h"
+#include "sim/simulated_camera.h"
 #include "sim/terrain.h"
-#include "sim/visual_odometry_stream.h"
 #include "sim/wheeled_robot.h"
 
 namespace roamlab::sim {
 namespace {
 
+using frontend::LaserScanRow;
+using internal::Clock;
+using internal::HasEffect;
+using internal::MakeStream;
+using internal::TireDeformations;
 using recording::StreamType;
 
 // Fraction of the lead-in spent at rest before the set-points ramp up.
@@ -48,62 +57,6 @@ std::string FormatTime(std::int64_t t_ns) { return FormatSeconds(Time::FromNanos
 
 // Nominal geometry is reported to the micrometre: enough, and free of floating-point noise from the model's frames.
 double Micrometres(double x) { return std::round(x * 1e6) / 1e6; }
-
-// A stream's clock: its period and the number of samples in [0, end]. Sample k is stamped k * period and taken at
-// k * period - shift (a time-shift effect: a late GPS fix, an IMU whose clock runs ahead); Due and Row take the time
-// the sample is taken.
-struct Clock {
-  std::int64_t period_ns = 0;
-  std::size_t samples = 0;
-  std::int64_t shift_ns = 0;
-  bool Due(std::int64_t t_ns) const {
-    const std::int64_t stamp_ns = t_ns + shift_ns;
-    return period_ns > 0 && stamp_ns >= 0 && stamp_ns % period_ns == 0 &&
-           stamp_ns / period_ns < static_cast<std::int64_t>(samples);
-  }
-  Eigen::Index Row(std::int64_t t_ns) const { return static_cast<Eigen::Index>((t_ns + shift_ns) / period_ns); }
-};
-
-bool HasEffect(const Scenario& s, const std::string& name) {
-  return std::any_of(s.effects.begin(), s.effects.end(), [&](const EffectOptions& e) { return e.name == name; });
-}
-
-// The tires' deformations: robot.wheel_deformation with the tire effects on top, one entry per deformed wheel so that
-// Deform changes each tire once: wheel_radius_asymmetry multiplies the right tire's radius (wheel_1) by the ratio
-// rho = r_R / r_L, wheel_deformation adds its ovality to its wheel's and keeps that tire's mean rolling radius (an
-// out-of-round tire: the periodic part of the radius only, not a ratio).
-std::vector<WheelDeformation> TireDeformations(const Scenario& s) {
-  std::vector<WheelDeformation> out = s.robot.wheel_deformation;
-  const auto entry = [&out](int wheel) -> WheelDeformation& {
-    for (WheelDeformation& d : out)
-      if (d.wheel == wheel) return d;
-    out.push_back(WheelDeformation{wheel, 1.0, 0.0});
-    return out.back();
-  };
-  if (HasEffect(s, "wheel_radius_asymmetry"))
-    entry(1).radius_scale *= EffectParameter(s.effects, "wheel_radius_asymmetry", "ratio_right_left", 1.0);
-  if (HasEffect(s, "wheel_deformation")) {
-    const int wheel = static_cast<int>(EffectParameter(s.effects, "wheel_deformation", "wheel", 0.0));
-    entry(wheel).ovality_m += EffectParameter(s.effects, "wheel_deformation", "ovality_m", 0.0);
-    entry(wheel).keep_mean_radius = true;
-  }
-  return out;
-}
-
-recording::Stream MakeStream(const std::string& name, StreamType type, double rate_hz, std::vector<std::string> columns,
-                             const std::string& units, const Clock& clock) {
-  recording::Stream stream;
-  stream.info.name = name;
-  stream.info.type = type;
-  stream.info.rate_hz = rate_hz;
-  stream.info.columns = std::move(columns);
-  stream.info.units = units;
-  stream.t.reserve(clock.samples);
-  for (std::size_t k = 0; k < clock.samples; ++k)
-    stream.t.push_back(Time::FromNanoseconds(static_cast<std::int64_t>(k) * clock.period_ns));
-  stream.values.setZero(static_cast<Eigen::Index>(clock.samples), static_cast<Eigen::Index>(stream.info.columns.size()));
-  return stream;
-}
 
 }  // namespace
 
@@ -147,6 +100,19 @@ class Simulator::Impl {
 
   // Compiles the world, binds the vehicle, sets up clocks, streams and noise, and places the vehicle.
   Status Setup() {
+    if (Status s = CompileWorld(); !s.ok()) return s;
+    if (Status s = BindRobot(); !s.ok()) return s;
+    if (Status s = SetupClocks(); !s.ok()) return s;
+    if (Status s = SetupEffects(); !s.ok()) return s;
+    SetupStreams();
+    PlaceRobot();
+    return Status::Ok();
+  }
+
+ private:
+  // The world: the robot's MJCF plus the terrain (plus the static world model, if any), compiled through the VFS;
+  // then the heightfield samples and the wheel mounting changes.
+  Status CompileWorld() {
     // The robot's MJCF text.
     std::string robot_xml = scenario_.robot.model_xml;
     if (robot_xml.empty()) {
@@ -180,6 +146,11 @@ class Simulator::Impl {
         return st;
     }
     data_ = MakeData(model_.get());
+    return Status::Ok();
+  }
+
+  // Binds the Ackermann vehicle or the wheeled robot to the compiled model and applies the effects that change it.
+  Status BindRobot() {
     if (ackermann_) {
       auto vehicle = AckermannVehicle::Bind(model_.get(), model_where_);
       if (!vehicle.ok()) return vehicle.status();
@@ -222,7 +193,11 @@ class Simulator::Impl {
         return Status::Error(where_ + ": sensors.camera.store_images: no recording directory to store images in");
     }
 
-    // Physics step and stream clocks: every period a whole number of steps.
+    return Status::Ok();
+  }
+
+  // The physics step, the duration, the lead-in and every stream's clock (every period a whole number of steps).
+  Status SetupClocks() {
     step_ns_ = std::llround(model_->opt.timestep * 1e9);
     if (step_ns_ <= 0) return Status::Error(model_where_ + ": the timestep must be positive");
     end_ns_ = std::llround(scenario_.duration_s * 1e9);
@@ -276,9 +251,12 @@ class Simulator::Impl {
       scan_geometry_.max_range_m = l.max_range_m;
     }
     if (ackermann_) wheelbase_m_ = Micrometres(vehicle_.wheelbase_m());
-    if (Status s = SetupEffects(); !s.ok()) return s;
+    return Status::Ok();
+  }
 
-    // Streams, laid out as tests/support/synthetic.h lays them out.
+  // The streams, laid out as tests/support/synthetic.h lays them out.
+  void SetupStreams() {
+    const SensorOptions& sensors = scenario_.sensors;
     if (sensors.imu) {
       imu_stream_ = MakeStream("imu", StreamType::kImu, sensors.imu->rate_hz, {"wx", "wy", "wz", "ax", "ay", "az"}, "",
                                imu_clock_);
@@ -304,11 +282,11 @@ class Simulator::Impl {
       encoder_stream_.info.attributes = {{"ticks_per_revolution", sensors.wheel_encoders->ticks_per_revolution}};
     }
     if (sensors.laser) {
-      scan_stream_.info.name = "scan_matching";
-      scan_stream_.info.type = StreamType::kScanMatching;
-      scan_stream_.info.rate_hz = sensors.laser->rate_hz;
-      scan_stream_.info.columns = recording::FixedColumns(StreamType::kScanMatching);
-      scan_stream_.info.units = "m/s,rad/s";
+      scan_matching_.emplace("scan_matching", sensors.laser->rate_hz);
+      if (sensors.laser->store_scans) {
+        laser_scan_stream_ = MakeStream("laser_scan", StreamType::kLaserScan, sensors.laser->rate_hz,
+                                        recording::LaserScanColumns(sensors.laser->beams), "rad,m", laser_clock_);
+      }
     }
     if (sensors.odometer) {
       wheel_stream_ = MakeStream("rear_wheel", StreamType::kWheelEncoders, sensors.odometer->rate_hz, {"rear"}, "m/s",
@@ -321,22 +299,20 @@ class Simulator::Impl {
     local_.emplace(scenario_.origin.latitude_deg, scenario_.origin.longitude_deg, scenario_.origin.altitude_m);
     truth_.reserve(truth_clock_.samples);
 
-    // The vehicle at rest at the start pose.
+  }
+
+  // The vehicle at rest at the start pose.
+  void PlaceRobot() {
     if (ackermann_) {
       vehicle_.Place(model_.get(), data_.get(), terrain_, scenario_.robot.start_position_m.x(),
                      scenario_.robot.start_position_m.y(), scenario_.robot.start_heading_rad, kPlacementClearanceM);
     } else {
       wheeled_.Place(model_.get(), data_.get(), scenario_.robot.start_position_m.x(),
                      scenario_.robot.start_position_m.y(), scenario_.robot.start_heading_rad, kPlacementClearanceM);
-      if (scenario_.sensors.laser) {
-        laser_mounting_ = SiteInOdom(wheeled_.laser_site());
-        scan_stream_.info.mounting = laser_mounting_;
-      }
+      if (scenario_.sensors.laser) laser_mounting_ = SiteInOdom(wheeled_.laser_site());
     }
-    return Status::Ok();
   }
 
- private:
   // The set-points at t_ns (Ackermann: speed [m/s], handlebar [rad] and 0; body velocity: v_x [m/s], omega_z
   // [rad/s] and v_y [m/s]): the profiles from t = 0, the lead-in's rest and ramp before.
   std::array<double, 3> SetPoints(std::int64_t t_ns) const {
@@ -476,7 +452,7 @@ class Simulator::Impl {
   }
 
   // Camera frame k is due at the first step at or after k / rate_hz (rounded to the nanosecond, not accumulated):
-  // the schedule VisualOdometryStream::Observe keeps when its first call is at t = 0.
+  // the schedule SimulatedCamera::Observe keeps when its first call is at t = 0.
   std::int64_t CameraFrameNs(std::int64_t k) const {
     return std::llround(1e9 * static_cast<double>(k) / scenario_.sensors.camera->rate_hz);
   }
@@ -487,13 +463,13 @@ class Simulator::Impl {
   // stream's own reference is a body).
   Status StartCamera() {
     const CameraOptions& c = *scenario_.sensors.camera;
-    VisualOdometryStreamOptions o;
+    SimulatedCameraOptions o;
     o.camera = kCameraName;
     o.rate_hz = c.rate_hz;
     o.render.width_px = c.width_px;
     o.render.height_px = c.height_px;
     if (c.store_images) o.image_directory = options_.image_directory;
-    auto stream = VisualOdometryStream::Create(model_.get(), data_.get(), o);
+    auto stream = SimulatedCamera::Create(model_.get(), data_.get(), o);
     if (!stream.ok()) return Status::Error(model_where_ + ": sensors.camera: " + stream.status().message());
     camera_ = std::move(stream).value();
     const FrameKinematics odom = ReadSiteKinematics(model_.get(), data_.get(), odom_site_);
@@ -586,9 +562,8 @@ class Simulator::Impl {
     return Status::Ok();
   }
 
-  // One laser scan: ray casts plus range noise; from the second scan on, the scan matcher's displacement since the
-  // previous scan becomes one scan_matching sample at the middle of the interval. The velocities follow eq. 7's
-  // motion (rotate half, translate, rotate half): omega = theta / dt, v = R(-theta / 2) t / dt.
+  // One laser scan: ray casts plus range noise, stored when the scenario asks; the scan matcher's stream takes it
+  // (frontend/scan_matching_stream.h).
   void SampleLaser(std::int64_t t_ns) {
     const LaserOptions& l = *scenario_.sensors.laser;
     std::vector<double> ranges = CastScan(model_.get(), data_.get(), wheeled_.laser_site(), scan_geometry_);
@@ -596,22 +571,8 @@ class Simulator::Impl {
       const double noise = laser_noise_.Draw(l.sigma_m);  // drawn for every beam, so returns never shift the stream
       if (std::isfinite(r)) r += noise;
     }
-    if (!previous_scan_.empty()) {
-      const double dt = static_cast<double>(laser_clock_.period_ns) * 1e-9;
-      const ScanMatch match = MatchScansFrom(scan_geometry_, previous_scan_, ranges,
-                                             {Eigen::Vector3d::Zero(), previous_scan_velocity_ * dt});
-      if (match.ok) {
-        const double theta = match.pose[2];
-        const Eigen::Vector2d v = Eigen::Rotation2Dd(-0.5 * theta) * match.pose.head<2>() / dt;
-        previous_scan_velocity_ << match.pose.head<2>() / dt, theta / dt;
-        scan_stream_.t.push_back(Time::FromNanoseconds(t_ns - laser_clock_.period_ns / 2));
-        scan_rows_.push_back({v.x(), v.y(), 0.0, 0.0, 0.0, theta / dt});
-        scan_sigma_sum_ += Eigen::Vector2d(std::sqrt(match.covariance(0, 0)), std::sqrt(match.covariance(2, 2))) / dt;
-      } else {
-        ++out_.stats.failed_scan_matches;
-      }
-    }
-    previous_scan_ = std::move(ranges);
+    if (l.store_scans) laser_scan_stream_.values.row(laser_clock_.Row(t_ns)) = LaserScanRow(scan_geometry_, ranges);
+    scan_matching_->AddScan(Time::FromNanoseconds(t_ns), scan_geometry_, std::move(ranges));
   }
 
   // The drive must stay on the heightfield and upright.
@@ -659,17 +620,7 @@ class Simulator::Impl {
     rec.platform.kind = scenario_.robot.kind;
     rec.platform.geometry = PlatformGeometry();
     rec.origin = scenario_.origin;
-    rec.provenance.source = "simulated";
-    rec.provenance.scenario = scenario_.source_file;
-    rec.provenance.seed = seed_;
-    std::ostringstream description;
-    if (!scenario_.name.empty()) description << scenario_.name << ": ";
-    description << "MuJoCo " << mj_versionString() << ", model " << model_where_ << ", terrain "
-                << (scenario_.terrain.type == TerrainOptions::Type::kHills
-                        ? "hills (seed " + std::to_string(scenario_.terrain.seed) + ")"
-                        : std::string("flat"))
-                << (options_.noise ? "" : ", noise off");
-    rec.provenance.description = description.str();
+    rec.provenance = internal::SimulatedProvenance(scenario_, seed_, model_where_, options_.noise);
     if (sensors.imu) rec.streams.push_back(std::move(imu_stream_));
     if (sensors.magnetometer) rec.streams.push_back(std::move(mag_stream_));
     if (sensors.gps) rec.streams.push_back(std::move(gps_stream_));
@@ -679,13 +630,14 @@ class Simulator::Impl {
     }
     if (sensors.wheel_encoders) rec.streams.push_back(std::move(encoder_stream_));
     if (sensors.laser) {
-      scan_stream_.values.resize(static_cast<Eigen::Index>(scan_rows_.size()), 6);
-      for (std::size_t k = 0; k < scan_rows_.size(); ++k)
-        for (int c = 0; c < 6; ++c) scan_stream_.values(static_cast<Eigen::Index>(k), c) = scan_rows_[k][c];
-      // Nominal noise: the scan matcher's mean standard deviations over the run.
-      const Eigen::Vector2d sigma = scan_sigma_sum_ / std::max<double>(1.0, static_cast<double>(scan_rows_.size()));
-      scan_stream_.info.noise = {{"sigma_mps", sigma.x()}, {"sigma_radps", sigma.y()}};
-      rec.streams.push_back(std::move(scan_stream_));
+      recording::Stream scan_stream = scan_matching_->TakeStream();
+      scan_stream.info.mounting = laser_mounting_;
+      out_.stats.failed_scan_matches = scan_matching_->failed_matches();
+      rec.streams.push_back(std::move(scan_stream));
+      if (sensors.laser->store_scans) {
+        laser_scan_stream_.info.mounting = laser_mounting_;
+        rec.streams.push_back(std::move(laser_scan_stream_));
+      }
     }
     if (camera_ != nullptr) {
       recording::Stream vo = camera_->TakeStream();
@@ -699,44 +651,11 @@ class Simulator::Impl {
     }
     rec.ground_truth = std::move(truth_);
 
-    // True calibration, named as calibration.json names the estimated parameters.
-    auto& cal = out_.truth.calibration;
-    if (sensors.gps) {
-      const Eigen::Vector3d& s = sensors.gps->lever_arm_m;
-      cal["gps.lever_arm"] = {s.x(), s.y(), s.z()};
-    }
-    if (sensors.imu) {
-      const Eigen::Quaterniond& q = imu_.q_body_imu;
-      cal["imu.misalignment"] = {q.w(), q.x(), q.y(), q.z()};
-      if (!imu_.p_body_imu.isZero(0.0))
-        cal["imu.lever_arm"] = {imu_.p_body_imu.x(), imu_.p_body_imu.y(), imu_.p_body_imu.z()};
-    }
-    if (sensors.magnetometer) {
-      const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> A = magnetometer_.A;
-      cal["magnetometer.A"] = std::vector<double>(A.data(), A.data() + 9);
-      cal["magnetometer.b"] = {magnetometer_.b.x(), magnetometer_.b.y(), magnetometer_.b.z()};
-    }
-    if (sensors.wheel_encoders) {
-      for (const auto& [name, value] : wheeled_.TrueOdometerCalibration()) cal[name] = value;
-    }
-    if (sensors.laser) {
-      const Eigen::Vector3d& s = laser_mounting_.p_body_sensor;
-      const Eigen::Quaterniond& q = laser_mounting_.q_body_sensor;
-      cal["scan_matching.lever_arm"] = {s.x(), s.y(), s.z()};
-      cal["scan_matching.misalignment"] = {q.w(), q.x(), q.y(), q.z()};
-    }
-    if (camera_ != nullptr) {
-      const Eigen::Vector3d& s = camera_mounting_.p_body_sensor;
-      const Eigen::Quaterniond& q = camera_mounting_.q_body_sensor;
-      cal["visual_odometry.lever_arm"] = {s.x(), s.y(), s.z()};
-      cal["visual_odometry.misalignment"] = {q.w(), q.x(), q.y(), q.z()};
-    }
-    if (sensors.odometer) {
-      cal["odometer.kv_over_L"] = {sensors.odometer->kv_over_L};
-      cal["odometer.k_theta"] = {sensors.odometer->k_theta};
-      cal["odometer.k_gamma"] = {sensors.odometer->k_gamma};
-    }
-
+    // True calibration.
+    internal::TrueSensorFrames frames{imu_, magnetometer_, {}, laser_mounting_, std::nullopt};
+    if (sensors.wheel_encoders) frames.wheels = wheeled_.TrueOdometerCalibration();
+    if (camera_ != nullptr) frames.camera = camera_mounting_;
+    out_.truth.calibration = internal::TrueCalibration(sensors, frames);
     out_.stats.terrain_relief_m = terrain_.Relief();
     out_.stats.path_height_range_m = max_height_ >= min_height_ ? max_height_ - min_height_ : 0.0;
   }
@@ -754,15 +673,12 @@ class Simulator::Impl {
   AckermannVehicle vehicle_;
   WheeledRobot wheeled_;
   int odom_site_ = -1;
-  ScanGeometry scan_geometry_;
+  frontend::ScanGeometry scan_geometry_;
   recording::Mounting laser_mounting_;
-  std::vector<double> previous_scan_;
-  std::unique_ptr<VisualOdometryStream> camera_;
+  std::optional<frontend::ScanMatchingStream> scan_matching_;
+  std::unique_ptr<SimulatedCamera> camera_;
   recording::Mounting camera_mounting_;
   std::int64_t next_camera_frame_ = 0;
-  Eigen::Vector3d previous_scan_velocity_ = Eigen::Vector3d::Zero();   // (x, y, theta) rates of the last match
-  std::vector<std::array<double, 6>> scan_rows_;
-  Eigen::Vector2d scan_sigma_sum_ = Eigen::Vector2d::Zero();
   std::vector<double> encoder_zero_rad_;
   std::optional<SpeedController> controller_;
   std::optional<GeographicLib::LocalCartesian> local_;
@@ -802,7 +718,7 @@ class Simulator::Impl {
   NoiseStream multipath_noise_{seed_, NoiseSource::kGpsMultipath};   // likewise
 
   recording::Stream imu_stream_, mag_stream_, gps_stream_, wheel_stream_, steering_stream_, encoder_stream_,
-      scan_stream_;
+      laser_scan_stream_;
   Trajectory truth_;
   double min_height_ = 1e300;
   double max_height_ = -1e300;

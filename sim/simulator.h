@@ -28,10 +28,10 @@
 
 #include "common/status.h"
 #include "common/time.h"
+#include "frontend/visual_odometry.h"
 #include "recording/recording.h"
 #include "recording/truth.h"
 #include "sim/scenario.h"
-#include "sim/visual_odometry.h"
 
 namespace roamlab::sim {
 
@@ -61,7 +61,7 @@ struct SimulationStats {
   double max_wheel_slip_mps = 0.0;      // max |omega_rear r - v_x| of O (wheeled robots: of every driven wheel's
                                         // rim against the ground point below it): longitudinal slip and creep
   int failed_scan_matches = 0;          // scan pairs the scan matcher could not match (no scan_matching sample)
-  std::optional<VoCounters> visual_odometry;   // sensors.camera: frames, pairs, estimates, failures by reason
+  std::optional<frontend::VoCounters> visual_odometry;   // sensors.camera: frames, pairs, estimates, failures by reason
   double camera_height_m = 0.0;         // sensors.camera: the floor height the VO uses (measured at rest)
   std::vector<std::string> warnings;    // MuJoCo warnings, if any
 };

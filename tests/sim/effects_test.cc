@@ -1,4 +1,4 @@
-// Physical effects of a scenario (sim/scenario.h, issue 6): each changes exactly what it says, against the same drive
+// Physical effects of a scenario (sim/scenario.h): each changes exactly what it says, against the same drive
 // without it (noise off, so that the difference is the effect alone), and is stated in truth.yaml only.
 #include <algorithm>
 #include <cmath>
@@ -207,8 +207,7 @@ TEST(AxleMisalignmentTest, AtvRearAxleThrustAngleCrabsAndTurnsAtZeroHandlebar) {
   EXPECT_LT(std::abs(straight.yaw_rate_radps), 0.002);
   EXPECT_LT(std::abs(straight.crab_rad), 0.002);
   // Within 10 % of the kinematic values: the tires' cornering compliance (about 0.015 s, slip under the 0.45 m/s^2 of
-  // the turn) is what the rigid kinematics leave out. Measured: yaw rate -0.1123 rad/s (kinematic -0.1124), crab
-  // 0.0372 rad (alpha 0.0349; the outward slip adds about 0.0017).
+  // the turn) is what the rigid kinematics leave out.
   EXPECT_NEAR(crab.yaw_rate_radps, -crab.speed_mps * std::tan(alpha) / wheelbase_m,
               0.1 * crab.speed_mps * std::tan(alpha) / wheelbase_m);
   EXPECT_NEAR(crab.crab_rad, alpha, 0.1 * alpha);
@@ -218,7 +217,7 @@ TEST(LateralSlipTest, SofterTiresRaiseTheCorneringCompliance) {
   // A steady turn on flat ground (4 m/s, handlebar 0.15 rad): the rear axle drifts outwards, v_y = -c_rear a_y with
   // a_y = v omega_z (estimator/models/ackermann_velocity.h). Softer tires (contact time constant times k) let the
   // sideways force through at a proportionally larger slip velocity (MuJoCo's soft contact), so c_rear grows about
-  // as k: measured 0.0202 s at k = 1, 0.0604 s at k = 3 (ratio 2.99; on the hills drive 0.0207 and 0.0614 s, README).
+  // as k.
   // The physics is deterministic (noise plays no part); the bounds check the proportionality, not a tolerance.
   const auto compliance = [](double scale) {
     Scenario s = testing::AtvHills(6.0);

@@ -1,6 +1,6 @@
 // The camera of the indoor scenario (sensors.camera): the simulator renders the robot's camera, runs the visual
 // odometry at 15 Hz on the robot's real (slipping, vibrating) motion and writes the visual_odometry stream; its
-// per-pair accuracy is held to issue 4's targets against the ground truth (eval/visual_odometry.h).
+// per-pair accuracy is held to the VO's accuracy targets against the ground truth (eval/visual_odometry.h).
 #include <gtest/gtest.h>
 
 #include "eval/visual_odometry.h"
@@ -10,7 +10,7 @@
 namespace roamlab::sim {
 namespace {
 
-TEST(IndoorCameraTest, VisualOdometryOnTheSquareWaveDriveMeetsTheIssueTargets) {
+TEST(IndoorCameraTest, VisualOdometryOnTheSquareWaveDriveMeetsTheAccuracyTargets) {
   auto scenario = LoadScenario(testing::SourcePath("scenarios/indoor_diffdrive_slip.yaml"));
   ASSERT_TRUE(scenario.ok()) << scenario.status().message();
   Scenario s = scenario.value();

@@ -167,6 +167,12 @@ TEST_F(ScenarioErrorTest, MissingFilesAndKeys) {
   EXPECT_EQ(LoadScenario(dir_.File("absent.yaml")).status().message(), dir_.File("absent.yaml") + ": cannot open file");
 }
 
+TEST_F(ScenarioErrorTest, LaserStoreScans) {
+  EXPECT_EQ(LoadIndoorWith("    sigma_m: 0.01\n", "    sigma_m: 0.01\n    store_scans: true\n"), "");
+  ExpectError(LoadIndoorWith("    sigma_m: 0.01\n", "    sigma_m: 0.01\n    store_scans: 1.5\n"), "store_scans",
+              "sensors.laser.store_scans", "expected true or false");
+}
+
 TEST_F(ScenarioErrorTest, CameraSection) {
   EXPECT_EQ(LoadIndoorWith("    rate_hz: 15\n", "    rate_hz: 15\n    store_images: true\n"), "");
   ExpectError(LoadIndoorWith("    rate_hz: 15\n", "    rate_hz: 40\n"), "rate_hz: 40", "sensors.camera.rate_hz",

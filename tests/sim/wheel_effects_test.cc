@@ -1,4 +1,4 @@
-// The wheeled robots' physical effects (sim/scenario.h, issue 6): each changes the physics as it says, against the
+// The wheeled robots' physical effects (sim/scenario.h): each changes the physics as it says, against the
 // same drive without it (noise off), keeps the recording's platform geometry nominal and is stated in truth.yaml only;
 // the robot-independent IMU effects apply to wheeled robots too; bad parameters are one-line validation errors.
 #include <algorithm>

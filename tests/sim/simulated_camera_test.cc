@@ -1,4 +1,4 @@
-#include "sim/visual_odometry_stream.h"
+#include "sim/simulated_camera.h"
 
 #include <cmath>
 #include <filesystem>
@@ -16,22 +16,22 @@ namespace {
 
 using ::testing::HasSubstr;
 
-// A 2 s drive of the test room's rig stepped at 500 Hz, with the stream observing every step and keeping its images:
+// A 2 s drive of the test room's rig stepped at 500 Hz, with the camera observing every step and keeping its images:
 // rows at 15 Hz in the recording format, the measured mounting and floor, PNGs listed in a camera stream.
-TEST(VisualOdometryStreamTest, RowsMountingAndImagesFromASteppingLoop) {
+TEST(SimulatedCameraTest, RowsMountingAndImagesFromASteppingLoop) {
   ModelPtr model = testing::VoTestRoom();
   ASSERT_NE(model, nullptr);
   DataPtr data = MakeData(model.get());
   testing::PlaceRig(model.get(), data.get(), testing::RigPoseAt(0.0));
   roamlab::testing::TempDir dir;
-  VisualOdometryStreamOptions options;
+  SimulatedCameraOptions options;
   options.image_directory = dir.path();
-  auto created = VisualOdometryStream::Create(model.get(), data.get(), options);
+  auto created = SimulatedCamera::Create(model.get(), data.get(), options);
   if (!created.ok() && created.status().message().rfind("EGL:", 0) == 0) {
     GTEST_SKIP() << "no headless OpenGL: " << created.status().message();
   }
   ASSERT_TRUE(created.ok()) << created.status().message();
-  VisualOdometryStream& vo = *created.value();
+  SimulatedCamera& vo = *created.value();
 
   // Mounting and floor from the initial state: 0.30 m above the rig's origin, pitched 15 deg down.
   EXPECT_NEAR(vo.vo_options().camera_height_m, 0.30, 1e-9);
@@ -85,24 +85,28 @@ TEST(VisualOdometryStreamTest, RowsMountingAndImagesFromASteppingLoop) {
   const recording::Stream& camera = *read.value().Find("visual_odometry_images");
   ASSERT_EQ(camera.text.size(), 31u);
   EXPECT_EQ(camera.text[0], "visual_odometry/000000.png");
+  // Its attributes hold what the front end needs to reproduce the stream: the intrinsics and the floor reference.
+  EXPECT_EQ(camera.info.attributes.at("fx_px"), stream.info.attributes.at("fx_px"));
+  EXPECT_EQ(camera.info.attributes.at("camera_height_m"), vo.vo_options().camera_height_m);
+  EXPECT_EQ(camera.info.attributes.at("floor_normal_y"), vo.vo_options().floor_normal_camera.y());
   const cv::Mat png = cv::imread(dir.File(camera.text[30]), cv::IMREAD_COLOR);
   EXPECT_EQ(png.cols, 320);
   EXPECT_EQ(png.rows, 240);
 }
 
-TEST(VisualOdometryStreamTest, BadOptionsAreErrors) {
+TEST(SimulatedCameraTest, BadOptionsAreErrors) {
   ModelPtr model = testing::VoTestRoom();
   ASSERT_NE(model, nullptr);
   DataPtr data = MakeData(model.get());
   mj_forward(model.get(), data.get());
-  VisualOdometryStreamOptions options;
+  SimulatedCameraOptions options;
   options.rate_hz = 0.0;
-  auto rate = VisualOdometryStream::Create(model.get(), data.get(), options);
+  auto rate = SimulatedCamera::Create(model.get(), data.get(), options);
   ASSERT_FALSE(rate.ok());
   EXPECT_THAT(rate.status().message(), HasSubstr("rate_hz must be in (0, 1000]"));
   options.rate_hz = 15.0;
   options.camera = "missing";
-  auto camera = VisualOdometryStream::Create(model.get(), data.get(), options);
+  auto camera = SimulatedCamera::Create(model.get(), data.get(), options);
   ASSERT_FALSE(camera.ok());
   EXPECT_THAT(camera.status().message(), HasSubstr("camera"));
 }

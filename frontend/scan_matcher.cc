@@ -1,4 +1,4 @@
-#include "sim/scan_matcher.h"
+#include "frontend/scan_matcher.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include <Eigen/Dense>
 
-namespace roamlab::sim {
+namespace roamlab::frontend {
 namespace {
 
 struct Points {
@@ -180,4 +180,4 @@ ScanMatch MatchScansFrom(const ScanGeometry& geometry, const std::vector<double>
   return best;
 }
 
-}  // namespace roamlab::sim
+}  // namespace roamlab::frontend

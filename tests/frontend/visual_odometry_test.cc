@@ -1,4 +1,4 @@
-#include "sim/visual_odometry.h"
+#include "frontend/visual_odometry.h"
 
 #include <algorithm>
 #include <cmath>
@@ -14,8 +14,17 @@
 #include "sim/render.h"
 #include "tests/sim/vo_testing.h"
 
-namespace roamlab::sim {
+namespace roamlab::frontend {
 namespace {
+
+using sim::CameraPose;
+using sim::CameraPoseInWorld;
+using sim::CameraRenderer;
+using sim::DataPtr;
+using sim::IntrinsicsFromFovy;
+using sim::MakeData;
+using sim::ModelPtr;
+using sim::RenderOptions;
 
 constexpr double kRadToDeg = 180.0 / M_PI;
 
@@ -55,10 +64,10 @@ struct DriveResult {
 DriveResult Drive(double duration_s, double rate_hz, int width, int height) {
   DriveResult result;
   cv::setNumThreads(0);  // OpenCV on the calling thread only, as on one core
-  ModelPtr model = testing::VoTestRoom();
+  ModelPtr model = sim::testing::VoTestRoom();
   if (model == nullptr) return result;
   DataPtr data = MakeData(model.get());
-  testing::PlaceRig(model.get(), data.get(), testing::RigPoseAt(0.0));
+  sim::testing::PlaceRig(model.get(), data.get(), sim::testing::RigPoseAt(0.0));
   RenderOptions render;
   render.width_px = width;
   render.height_px = height;
@@ -81,7 +90,7 @@ DriveResult Drive(double duration_s, double rate_hz, int width, int height) {
   const int frames = static_cast<int>(std::lround(duration_s * rate_hz)) + 1;
   for (int k = 0; k < frames; ++k) {
     const Time t = Time::FromSeconds(k / rate_hz);
-    testing::PlaceRig(model.get(), data.get(), testing::RigPoseAt(t.seconds()));
+    sim::testing::PlaceRig(model.get(), data.get(), sim::testing::RigPoseAt(t.seconds()));
     renderer->RenderGray(data.get(), &gray);
     const CameraPose truth = CameraPoseInWorld(model.get(), data.get(), renderer->camera_id());
     const double start = ThreadCpuSeconds();
@@ -124,13 +133,12 @@ void Report(const char* name, const DriveResult& r) {
       Median(r.rotation_nees), Median(r.velocity_nees), r.ms_per_pair);
 }
 
-// The issue's targets on rendered frames at 15 Hz, 320x240, against MuJoCo's camera pose: median rotation error per
-// pair <= 0.2 deg, no estimate on <= 5 % of the pairs. Measured (this drive): 0.025 deg median, no failure, speed
-// error 0.3 % median. The speed bound, 1.5 %, leaves a factor 5 for other textures and image sizes (0.44 % at
-// 640x480). Covariance: the median NEES of a consistent 3-dof estimate is 2.37 (chi-square(3)); measured 3.6 for the
-// angular and 4.9 for the linear velocity, i.e. the first-order covariance is optimistic by about 1.5-2 in variance
-// (visual_odometry.h says why); the test holds it within a factor 3 of consistency either way.
-TEST(VisualOdometryTest, RenderedDriveMeetsTheIssueTargets) {
+// The accuracy targets on rendered frames at 15 Hz, 320x240, against MuJoCo's camera pose: median rotation error per
+// pair <= 0.2 deg, no estimate on <= 5 % of the pairs, median speed error <= 1.5 % (room for other textures and image
+// sizes). Covariance: the median NEES of a consistent 3-dof estimate is 2.37 (chi-square(3)); the first-order
+// covariance is optimistic (visual_odometry.h says why), and the test holds it within a factor 3 of consistency
+// either way.
+TEST(VisualOdometryTest, RenderedDriveMeetsTheAccuracyTargets) {
   const DriveResult r = Drive(10.0, 15.0, 320, 240);
   if (r.skipped) GTEST_SKIP() << "no headless OpenGL: " << r.skip_reason;
   Report("320x240 15 Hz", r);
@@ -159,10 +167,10 @@ TEST(VisualOdometryTest, RenderedDriveAt640x480) {
 
 // The same image twice: no flow, a zero velocity flagged stationary with a positive-definite covariance.
 TEST(VisualOdometryTest, SameImageTwiceIsStationary) {
-  ModelPtr model = testing::VoTestRoom();
+  ModelPtr model = sim::testing::VoTestRoom();
   ASSERT_NE(model, nullptr);
   DataPtr data = MakeData(model.get());
-  testing::PlaceRig(model.get(), data.get(), testing::RigPoseAt(0.0));
+  sim::testing::PlaceRig(model.get(), data.get(), sim::testing::RigPoseAt(0.0));
   auto renderer = CameraRenderer::Create(model.get(), "camera", RenderOptions{});
   if (!renderer.ok()) GTEST_SKIP() << "no headless OpenGL: " << renderer.status().message();
   cv::Mat gray;
@@ -210,4 +218,4 @@ TEST(VisualOdometryOptionsTest, ValidateNamesTheProblem) {
 }
 
 }  // namespace
-}  // namespace roamlab::sim
+}  // namespace roamlab::frontend

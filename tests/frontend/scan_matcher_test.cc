@@ -1,4 +1,4 @@
-#include "sim/scan_matcher.h"
+#include "frontend/scan_matcher.h"
 
 #include <cmath>
 #include <limits>
@@ -8,7 +8,7 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
-namespace roamlab::sim {
+namespace roamlab::frontend {
 namespace {
 
 // A synthetic room: the walls of a 7 m x 5 m rectangle and two boxes, as segments in the world frame.
@@ -90,8 +90,8 @@ TEST(ScanMatcherTest, RecoversTrueDisplacementsWithinReportedCovariance) {
 
 // The displacement scale: over many independent scan pairs with 1 cm range noise, the least-squares slope of the
 // matched displacement on the true one is 1 within 4 of its standard errors per axis (the standard error from the
-// scatter of the errors: se = rms(error) / sqrt(sum d^2)). The two-point reference line that the matcher used
-// before under-read these steps by 3 % (x, forward) and 0.5-1 % (y, heading); see scan_matcher.h.
+// scatter of the errors: se = rms(error) / sqrt(sum d^2)). A two-point reference line would under-read these steps by
+// a few percent (scan_matcher.h says why).
 TEST(ScanMatcherTest, DisplacementScaleIsUnbiasedUnderRangeNoise) {
   const ScanGeometry g;
   std::mt19937 rng(11);
@@ -138,4 +138,4 @@ TEST(ScanMatcherTest, BestOfSeveralGuessesHandlesLargeRotation) {
 }
 
 }  // namespace
-}  // namespace roamlab::sim
+}  // namespace roamlab::frontend

@@ -1,4 +1,4 @@
-#include "sim/visual_odometry_stream.h"
+#include "sim/simulated_camera.h"
 
 #include <cmath>
 #include <cstdio>
@@ -27,7 +27,7 @@ Eigen::Matrix3d BodyRotation(const mjData* data, int body_id) {
 
 }  // namespace
 
-std::string VisualOdometryStreamOptions::Validate() const {
+std::string SimulatedCameraOptions::Validate() const {
   if (camera.empty()) return "camera name is empty";
   if (stream_name.empty()) return "stream name is empty";
   if (!(rate_hz > 0.0) || !std::isfinite(rate_hz) || rate_hz > 1000.0) return "rate_hz must be in (0, 1000]";
@@ -35,21 +35,11 @@ std::string VisualOdometryStreamOptions::Validate() const {
   return render.Validate();
 }
 
-Eigen::Matrix<double, 1, 27> VisualOdometryRow(const VoEstimate& estimate) {
-  Eigen::Matrix<double, 1, 27> row;
-  row.head<3>() = estimate.v_camera_mps.transpose();
-  row.segment<3>(3) = estimate.omega_camera_radps.transpose();
-  int k = 6;
-  for (int i = 0; i < 6; ++i)
-    for (int j = i; j < 6; ++j) row[k++] = estimate.covariance(i, j);
-  return row;
-}
-
-class VisualOdometryStream::Impl {
+class SimulatedCamera::Impl {
  public:
-  VisualOdometryStreamOptions options;
+  SimulatedCameraOptions options;
   std::unique_ptr<CameraRenderer> renderer;
-  std::optional<VisualOdometry> vo;
+  std::optional<frontend::VisualOdometryStream> vo;
   recording::Mounting mounting;
   std::optional<Time> t0;              // first call
   std::int64_t next_frame = 0;         // index of the next frame due
@@ -57,14 +47,12 @@ class VisualOdometryStream::Impl {
   cv::Mat rgb;
   cv::Mat gray;
   cv::Mat bgr;
-  std::vector<Time> t;
-  std::vector<Eigen::Matrix<double, 1, 27>> rows;
   std::vector<Time> image_t;
   std::vector<std::string> image_names;
 };
 
-Result<std::unique_ptr<VisualOdometryStream>> VisualOdometryStream::Create(
-    const mjModel* model, const mjData* data, const VisualOdometryStreamOptions& options) {
+Result<std::unique_ptr<SimulatedCamera>> SimulatedCamera::Create(const mjModel* model, const mjData* data,
+                                                                 const SimulatedCameraOptions& options) {
   if (const std::string problem = options.Validate(); !problem.empty()) {
     return Status::Error("visual odometry stream '" + options.stream_name + "': " + problem);
   }
@@ -88,7 +76,7 @@ Result<std::unique_ptr<VisualOdometryStream>> VisualOdometryStream::Create(
   impl->mounting.q_body_sensor = Eigen::Quaterniond(R_world_body.transpose() * camera.R_world_camera).normalized();
 
   // The floor's height and normal in C, unless given.
-  VisualOdometryOptions vo = options.vo;
+  frontend::VisualOdometryOptions vo = options.vo;
   if (!(vo.camera_height_m > 0.0)) vo.camera_height_m = camera.p_world_camera_m.z() - options.floor_height_m;
   if (vo.floor_normal_camera.isZero()) {
     vo.floor_normal_camera = camera.R_world_camera.transpose() * Eigen::Vector3d(0.0, 0.0, -1.0);
@@ -100,7 +88,7 @@ Result<std::unique_ptr<VisualOdometryStream>> VisualOdometryStream::Create(
   if (const std::string problem = vo.Validate(); !problem.empty()) {
     return Status::Error("visual odometry stream '" + options.stream_name + "': " + problem);
   }
-  impl->vo.emplace(impl->renderer->intrinsics(), vo);
+  impl->vo.emplace(impl->renderer->intrinsics(), vo, options.stream_name, options.rate_hz);
 
   // Image directory.
   if (!options.image_directory.empty()) {
@@ -109,13 +97,13 @@ Result<std::unique_ptr<VisualOdometryStream>> VisualOdometryStream::Create(
     fs::create_directories(dir, error);
     if (error) return Status::Error(dir.string() + ": cannot create directory: " + error.message());
   }
-  return std::unique_ptr<VisualOdometryStream>(new VisualOdometryStream(std::move(impl)));
+  return std::unique_ptr<SimulatedCamera>(new SimulatedCamera(std::move(impl)));
 }
 
-VisualOdometryStream::VisualOdometryStream(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
-VisualOdometryStream::~VisualOdometryStream() = default;
+SimulatedCamera::SimulatedCamera(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+SimulatedCamera::~SimulatedCamera() = default;
 
-Result<std::optional<VoEstimate>> VisualOdometryStream::Observe(Time t, mjData* data) {
+Result<std::optional<frontend::VoEstimate>> SimulatedCamera::Observe(Time t, mjData* data) {
   Impl& s = *impl_;
   // Frame k is due at t0 + k / rate (rounded to the nanosecond, without accumulating); a late call does not shift
   // the schedule, a frame whose time has passed entirely is skipped.
@@ -123,7 +111,7 @@ Result<std::optional<VoEstimate>> VisualOdometryStream::Observe(Time t, mjData* 
   const auto due = [&s](std::int64_t k) {
     return Time::FromNanoseconds(s.t0->nanoseconds() + std::llround(1e9 * static_cast<double>(k) / s.options.rate_hz));
   };
-  if (t < due(s.next_frame)) return std::optional<VoEstimate>();
+  if (t < due(s.next_frame)) return std::optional<frontend::VoEstimate>();
   while (due(s.next_frame + 1) <= t) ++s.next_frame;
   ++s.next_frame;
   // Render, keep the image when asked, run the VO.
@@ -146,34 +134,16 @@ Result<std::optional<VoEstimate>> VisualOdometryStream::Observe(Time t, mjData* 
   }
   ++s.frame_index;
   cv::cvtColor(s.rgb, s.gray, cv::COLOR_RGB2GRAY);
-  std::optional<VoEstimate> estimate = s.vo->ProcessFrame(t, s.gray);
-  if (estimate) {
-    s.t.push_back(estimate->t_mid);
-    s.rows.push_back(VisualOdometryRow(*estimate));
-  }
-  return estimate;
+  return s.vo->ProcessFrame(t, s.gray);
 }
 
-recording::Stream VisualOdometryStream::TakeStream() const {
-  const Impl& s = *impl_;
-  recording::Stream stream;
-  stream.info.name = s.options.stream_name;
-  stream.info.type = recording::StreamType::kVisualOdometry;
-  stream.info.rate_hz = s.options.rate_hz;
-  stream.info.columns = recording::FixedColumns(recording::StreamType::kVisualOdometry);
-  const std::vector<std::string>& covariance = recording::CovarianceColumns(recording::StreamType::kVisualOdometry);
-  stream.info.columns.insert(stream.info.columns.end(), covariance.begin(), covariance.end());
-  stream.info.mounting = s.mounting;
-  const PinholeIntrinsics& k = s.renderer->intrinsics();
-  stream.info.attributes = {{"width_px", k.width_px}, {"height_px", k.height_px}, {"fx_px", k.fx_px},
-                            {"fy_px", k.fy_px},       {"cx_px", k.cx_px},         {"cy_px", k.cy_px}};
-  stream.t = s.t;
-  stream.values.resize(static_cast<Eigen::Index>(s.rows.size()), 27);
-  for (std::size_t i = 0; i < s.rows.size(); ++i) stream.values.row(static_cast<Eigen::Index>(i)) = s.rows[i];
+recording::Stream SimulatedCamera::TakeStream() const {
+  recording::Stream stream = impl_->vo->TakeStream();
+  stream.info.mounting = impl_->mounting;
   return stream;
 }
 
-std::optional<recording::Stream> VisualOdometryStream::TakeCameraStream() const {
+std::optional<recording::Stream> SimulatedCamera::TakeCameraStream() const {
   const Impl& s = *impl_;
   if (s.options.image_directory.empty()) return std::nullopt;
   recording::Stream stream;
@@ -182,18 +152,17 @@ std::optional<recording::Stream> VisualOdometryStream::TakeCameraStream() const 
   stream.info.rate_hz = s.options.rate_hz;
   stream.info.units = "png";
   stream.info.mounting = s.mounting;
-  const PinholeIntrinsics& k = s.renderer->intrinsics();
-  stream.info.attributes = {{"width_px", k.width_px}, {"height_px", k.height_px}, {"fx_px", k.fx_px},
-                            {"fy_px", k.fy_px},       {"cx_px", k.cx_px},         {"cy_px", k.cy_px}};
+  stream.info.attributes = frontend::IntrinsicsAttributes(s.renderer->intrinsics());
+  stream.info.attributes.merge(frontend::FloorAttributes(s.vo->options()));
   stream.t = s.image_t;
   stream.text = s.image_names;
   return stream;
 }
 
-const VoCounters& VisualOdometryStream::counters() const { return impl_->vo->counters(); }
-const PinholeIntrinsics& VisualOdometryStream::intrinsics() const { return impl_->renderer->intrinsics(); }
-const VisualOdometryOptions& VisualOdometryStream::vo_options() const { return impl_->vo->options(); }
-const recording::Mounting& VisualOdometryStream::mounting() const { return impl_->mounting; }
-int VisualOdometryStream::camera_id() const { return impl_->renderer->camera_id(); }
+const frontend::VoCounters& SimulatedCamera::counters() const { return impl_->vo->counters(); }
+const PinholeIntrinsics& SimulatedCamera::intrinsics() const { return impl_->renderer->intrinsics(); }
+const frontend::VisualOdometryOptions& SimulatedCamera::vo_options() const { return impl_->vo->options(); }
+const recording::Mounting& SimulatedCamera::mounting() const { return impl_->mounting; }
+int SimulatedCamera::camera_id() const { return impl_->renderer->camera_id(); }
 
 }  // namespace roamlab::sim

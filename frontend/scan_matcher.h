@@ -1,6 +1,6 @@
 // Planar scan matcher: the logical-sensor front end that turns two consecutive 2-D laser scans into the displacement
-// of the laser between them, with a covariance (DESIGN.md: logical sensors live in sim/; the estimator sees only
-// its output, a scan_matching velocity stream, seed 000 Section VI).
+// of the laser between them, with a covariance (the estimator sees only its output, a scan_matching velocity stream,
+// seed 000 Section VI; scan_matching_stream.h builds that stream).
 //
 // Point-to-line ICP. The reference scan's points q_j and the current scan's points p_i are in their own laser frames.
 // The unknown is the pose of the current frame in the reference frame, x = (t_x, t_y, theta): p_i maps to
@@ -14,7 +14,7 @@
 // and beam spacing h = range x increment (h ~ sigma at 1-2 m for the URG-04LX) the two-point normal is off by
 // ~sqrt(2) sigma / h rad, the residual then mixes in the tangential offset to the nearest point, and the cost gets
 // a minimum where the two scans' beam grids line up, at zero motion: the matcher under-reads the displacement (by
-// 1-3 % at sigma = 1 cm, tests/sim/scan_matcher_test.cc). A line over 2w + 1 points has a slope error
+// 1-3 % at sigma = 1 cm, tests/frontend/scan_matcher_test.cc). A line over 2w + 1 points has a slope error
 // ~sigma / (h sqrt(w (w + 1) (2w + 1) / 3)) (least-squares slope), 7x smaller for w = 3, and averages the
 // reference point's noise.
 // The gate starts at max_correspondence_m and shrinks to max(min_gate_m, 3 rms) once the step is small.
@@ -27,7 +27,7 @@
 
 #include <Eigen/Core>
 
-namespace roamlab::sim {
+namespace roamlab::frontend {
 
 // Beam layout of a planar range finder; beam k points at first_angle_rad + k increment_rad in the laser frame (x
 // forward, angles counter-clockwise). A range that is not finite means no return.
@@ -72,4 +72,4 @@ ScanMatch MatchScansFrom(const ScanGeometry& geometry, const std::vector<double>
                          const std::vector<double>& current, const std::vector<Eigen::Vector3d>& initial_guesses,
                          const ScanMatcherOptions& options = {});
 
-}  // namespace roamlab::sim
+}  // namespace roamlab::frontend

@@ -3,36 +3,37 @@
 // seed eqs. 5-8, stream type visual_odometry).
 //
 // Per frame pair (previous frame 1, current frame 2, both in OpenCV's camera frame C: x right, y down, z forward):
-//   1. Features: Shi-Tomasi corners (GFTT) in a grid of cells, so that floor and walls both get some; the tracks
-//      that survived the previous pair are kept and topped up.
-//   2. Tracking: pyramidal Lucas-Kanade from frame 1 to 2 and back; a track is kept when it returns within
-//      `max_forward_backward_px` of where it started.
-//   3. Rotation and translation direction: essential matrix by 5-point RANSAC (findEssentialMat), the cheirality
-//      check of recoverPose, then Gauss-Newton on the Sampson error of the inliers over (R, t/|t|) (5 parameters).
-//      Convention: a point X1 in C1 is X2 = R_21 X1 + t_21 in C2; the camera moves by R_12 = R_21^T,
-//      p_12 = -R_21^T t_21 (the pose of C2 in C1).
-//   4. Metric scale from the floor: the camera's height h over the floor and the floor's unit normal n (pointing from
-//      the camera down to the floor, in C) are known from the mounting (options). A floor point seen at normalized
-//      ray x1 lies at X1 = x1 h / (n . x1), so with t_21 = s t_hat it must appear at x2 = proj(R_21 X1 + s t_hat).
-//      Each point below the horizon (n . x1 > 0) gives a 1-point hypothesis of s; RANSAC keeps the s with the most
-//      points within `floor_threshold_px` (walls and boxes are the outliers), Gauss-Newton on their reprojection
-//      error refines it. This is the "known camera height over the floor".
-//      Limits: the floor must be planar and visible in the lower image (enough textured floor points); n and h are
-//      those of the mounting on a level robot, so a robot that pitches or rolls (bumps, hard braking on a soft
-//      suspension) biases the scale by about the relative height change; obstacles that cover the floor near the
-//      robot leave no scale (a failure is counted, never a guess).
-//   5. Velocities, held constant over dt = t2 - t1 as the estimator's eq. 7 assumes:
+//   1. Features (DetectFeatures): Shi-Tomasi corners (GFTT) in a grid of cells, so that floor and walls both get some;
+//      the tracks that survived the previous pair are kept and topped up.
+//   2. Tracking (TrackForwardBackward): pyramidal Lucas-Kanade from frame 1 to 2 and back; a track is kept when it
+//      returns within `max_forward_backward_px` of where it started.
+//   3. Rotation and translation direction (FitEssential, RefineOnSampson): essential matrix by 5-point RANSAC
+//      (findEssentialMat), the cheirality check of recoverPose, then Gauss-Newton on the Sampson error of the inliers
+//      over (R, t/|t|) (5 parameters). Convention: a point X1 in C1 is X2 = R_21 X1 + t_21 in C2; the camera moves by
+//      R_12 = R_21^T, p_12 = -R_21^T t_21 (the pose of C2 in C1).
+//   4. Metric scale from the floor (ScaleFromFloor): the camera's height h over the floor and the floor's unit normal n
+//      (pointing from the camera down to the floor, in C) are known from the mounting (options). A floor point seen at
+//      normalized ray x1 lies at X1 = x1 h / (n . x1), so with t_21 = s t_hat it must appear at
+//      x2 = proj(R_21 X1 + s t_hat). Each point below the horizon (n . x1 > 0) gives a 1-point hypothesis of s; RANSAC
+//      keeps the s with the most points within `floor_threshold_px` (walls and boxes are the outliers), Gauss-Newton on
+//      their reprojection error refines it: the scale comes from the known camera height over the floor. Limits: the
+//      floor must be planar and visible in the lower image (enough textured floor points); n and h are those of the
+//      mounting on a level robot, so a robot that pitches or rolls (bumps, hard braking on a soft suspension) biases
+//      the scale by about the relative height change; obstacles that cover the floor near the robot leave no scale (a
+//      failure is counted, never a guess).
+//   5. Velocities (Velocities), held constant over dt = t2 - t1 as the estimator's eq. 7 assumes:
 //        omega_C = Log(R_12) / dt,   v_C = Exp(-omega_C dt / 2) p_12 / dt
 //      (eq. 7 moves by q_mid v dt with q_mid = Exp(omega dt / 2): this v reproduces p_12 exactly). Both are in the
 //      camera frame C1 at the start of the pair, stamped at the middle of the pair (the mean velocity over the pair
 //      equals the velocity at its middle to second order).
-//   6. Covariance (first order): the Sampson residuals give the pixel noise sigma^2 = sum e^2 / (N - 5) and the
-//      pose covariance sigma^2 (J^T J)^-1; the floor residuals give the scale's own variance; both are propagated
-//      through step 4 (the scale depends on R and t) and step 5 by central differences. It describes the pixel
-//      noise only: not the floor's flatness nor the robot's pitch (tests compare it with the errors).
+//   6. Covariance (OutputCovariance), first order: the Sampson residuals give the pixel noise
+//      sigma^2 = sum e^2 / (N - 5) and the pose covariance sigma^2 (J^T J)^-1; the floor residuals give the scale's own
+//      variance; both are propagated through step 4 (the scale depends on R and t) and step 5 by central differences.
+//      It describes the pixel noise only: not the floor's flatness nor the robot's pitch (tests compare it with the
+//      errors).
 // A pair with too few features, tracks, inliers or floor points gives no estimate, and the failure is counted by
 // reason. Two frames with no measurable motion (median flow below `stationary_flow_px`) give a zero velocity whose
-// covariance is that of a flow at the threshold.
+// covariance is that of a flow at the threshold (StationaryCovariance).
 #pragma once
 
 #include <optional>
@@ -43,9 +44,9 @@
 #include <opencv2/core.hpp>
 
 #include "common/time.h"
-#include "sim/render.h"
+#include "frontend/pinhole.h"
 
-namespace roamlab::sim {
+namespace roamlab::frontend {
 
 struct VisualOdometryOptions {
   // Mounting: camera height over the floor [m] and the floor's unit normal in C, pointing down to the floor, for the
@@ -144,4 +145,4 @@ class VisualOdometry {
   VoCounters counters_;
 };
 
-}  // namespace roamlab::sim
+}  // namespace roamlab::frontend
