@@ -16,8 +16,8 @@
 namespace roamlab::estimator {
 namespace {
 
-// Margin of the rank decision over the Schur complement's rounding (n eps max|H|): measured noise eigenvalues were
-// within 0.1 of that bound on the ATV (BENCHMARKS.md, "Marginalization and rounding").
+// Margin of the rank decision over the Schur complement's rounding (n eps max|H|): the eigenvalues of rounding alone
+// stay well below that bound.
 constexpr double kRoundingFloor = 10.0;
 
 // Inverse right Jacobian of SO(3): d Log(Exp(phi) Exp(d)) / dd at d = 0.
@@ -242,7 +242,7 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const Sol
     }
     const internal::WhitenedFactor& lf = *linearized;
     // The solve's own products J_a^T J_b of these Jacobians when it kept them (relinearization threshold): the same
-    // coefficient-wise sums as the products below, bit for bit (measured over the ATV run), without computing them
+    // coefficient-wise sums as the products below, bit for bit, without computing them
     // again. Kept per pair of wanted positions i <= j (i outer); product_offset at i * nv + j.
     const std::vector<double>* products = linearized != &wf ? last_solve->Products(f, mask) : nullptr;
     const std::size_t nv = e.variables.size();
@@ -258,7 +258,7 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const Sol
       if (!want[a]) continue;
       const int oa = var_offset[a];
       // Coefficient-wise products, in this order: tracking under a calibration prior is sensitive to the rounding of
-      // H here (other kernels moved its positions by metres; BENCHMARKS.md, fourth tracking pass).
+      // H here (a different summation order moves its positions by metres).
       g.segment(oa, lf.jacobians[a].cols()) += lf.jacobians[a].transpose().lazyProduct(lf.residual);
       for (std::size_t b = 0; b < nv; ++b) {
         if (!want[b] || var_offset[b] < oa) continue;  // the lower triangle is mirrored below
@@ -315,9 +315,9 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const Sol
   Eigen::VectorXd r0;
   // The floor: the Schur complement is computed with an absolute error of about n eps max|H| (H over leaving and
   // blanket; the leaving pose's own information is often 1e2-1e3 times the blanket's), so its eigenvalues below that
-  // are rounding, of either sign. Keeping such a direction (the old floor, 1e-12 of the blanket's largest eigenvalue,
-  // sat within 5x of that noise) turns rounding into information with a mean of noise / lambda, and which side of the
-  // floor it falls on flips with the summation order. 1e-12 of the largest eigenvalue stays a lower bound.
+  // are rounding, of either sign. Keeping such a direction (a floor of 1e-12 of the blanket's largest eigenvalue alone
+  // lies within a few times that noise) turns rounding into information with a mean of noise / lambda, and which side
+  // of the floor it falls on flips with the summation order. 1e-12 of the largest eigenvalue stays a lower bound.
   const Eigen::MatrixXd S = 0.5 * (Hbb + Hbb.transpose());
   const double floor =
       std::max(kRoundingFloor * n * std::numeric_limits<double>::epsilon() * std::max(H.diagonal().maxCoeff(), 0.0),
