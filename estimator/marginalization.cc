@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Cholesky>
@@ -188,7 +189,21 @@ bool LinearPriorFactor::Evaluate(const double* const* values, double* error, dou
   return error != nullptr && r0_.allFinite();
 }
 
-bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const SolverWorkspace* last_solve) {
+namespace {
+
+// The variables of an elimination: the leaving ones (free) first, then the blanket (the other free variables that
+// their active factors touch), each one's offset in [leaving, blanket] tangent coordinates, n coordinates in all of
+// which nm leaving; and the factors on the leaving variables.
+struct EliminationOrder {
+  std::vector<FactorId> factors;  // sorted, once each
+  std::vector<VariableId> order;
+  std::size_t n_leaving = 0;
+  std::vector<int> offset;
+  int n = 0;
+  int nm = 0;
+};
+
+EliminationOrder OrderForElimination(const std::vector<VariableId>& leaving, const Graph* graph) {
   // The factors on the leaving variables (sorted, once each), and the blanket: the other free variables they touch.
   // Small sets (a pose and its blanket of a few dozen coordinates): sorted or searched vectors, no node containers.
   std::vector<FactorId> factors;
@@ -215,10 +230,19 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const Sol
     n += graph->variable(order[i]).manifold.tangent_dim();
     if (i + 1 == n_leaving) nm = n;
   }
+  return {std::move(factors), std::move(order), n_leaving, std::move(offset), n, nm};
+}
 
-  // Dense H and g over [leaving, blanket].
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n, n);
-  Eigen::VectorXd g = Eigen::VectorXd::Zero(n);
+// Adds the active factors' J^T J and J^T r over [leaving, blanket] to H (the blocks on and above the diagonal) and g:
+// the last solve's linearizations and kept products where they are current, else linearized here. False when a
+// factor cannot be linearized.
+bool AddFactorInformation(const EliminationOrder& elimination, const Graph* graph, const SolverWorkspace* last_solve,
+                          Eigen::MatrixXd* H_out, Eigen::VectorXd* g_out) {
+  Eigen::MatrixXd& H = *H_out;
+  Eigen::VectorXd& g = *g_out;
+  const std::vector<FactorId>& factors = elimination.factors;
+  const std::vector<VariableId>& order = elimination.order;
+  const std::vector<int>& offset = elimination.offset;
   std::vector<bool> want;
   std::vector<int> var_offset;
   internal::WhitenedFactor wf;  // reused: its buffers keep their size
@@ -273,9 +297,14 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const Sol
       }
     }
   }
-  H.triangularView<Eigen::StrictlyLower>() = H.transpose();
+  return true;
+}
 
-  // Schur complement onto the blanket, factored as J^T J (SquareRootInformation, dropping null directions).
+// The Schur complement of H = [Hmm Hmb; Hbm Hbb] onto its trailing blanket coordinates (nm leaving ones first), and
+// the matching gradient gb - Hbm Hmm^-1 gm.
+void SchurComplementOntoBlanket(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int nm, Eigen::MatrixXd* Hbb_out,
+                                Eigen::VectorXd* gb_out) {
+  const int n = static_cast<int>(H.rows());
   const int nb = n - nm;
   Eigen::MatrixXd Hbb = H.bottomRightCorner(nb, nb);
   Eigen::VectorXd gb = g.tail(nb);
@@ -299,6 +328,31 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const Sol
       gb -= Hmb.transpose() * ldlt.solve(g.head(nm));
     }
   }
+  *Hbb_out = std::move(Hbb);
+  *gb_out = std::move(gb);
+}
+
+}  // namespace
+
+bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const SolverWorkspace* last_solve) {
+  // The factors on the leaving variables and the blanket: the other free variables they touch.
+  const EliminationOrder elimination = OrderForElimination(leaving, graph);
+  const std::vector<FactorId>& factors = elimination.factors;
+  const std::vector<VariableId>& order = elimination.order;
+  const std::size_t n_leaving = elimination.n_leaving;
+  const int n = elimination.n, nm = elimination.nm;
+
+  // Dense H and g over [leaving, blanket].
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n, n);
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(n);
+  if (!AddFactorInformation(elimination, graph, last_solve, &H, &g)) return false;
+  H.triangularView<Eigen::StrictlyLower>() = H.transpose();
+
+  // Schur complement onto the blanket, factored as J^T J (SquareRootInformation, dropping null directions).
+  const int nb = n - nm;
+  Eigen::MatrixXd Hbb;
+  Eigen::VectorXd gb;
+  SchurComplementOntoBlanket(H, g, nm, &Hbb, &gb);
   std::vector<Manifold> manifolds;
   std::vector<Eigen::VectorXd> x0;
   std::vector<VariableId> blanket(order.begin() + static_cast<std::ptrdiff_t>(n_leaving), order.end());
