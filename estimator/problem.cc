@@ -308,6 +308,39 @@ void ProblemBuilder::AddMasterSample(const MeasurementRef& m) {
   TryAttach(odo);
 }
 
+ProblemBuilder::Placement ProblemBuilder::PlaceSample(const MeasurementRef& m, const StreamBinding& s,
+                                                      std::size_t* k) {
+  if (poses_.empty() || m.t > poses_.back().t) return Placement::kWait;
+  if (m.t < poses_.front().t) {
+    ++counts_[s.name].outside;
+    return Placement::kOutside;
+  }
+  switch (s.attachment) {
+    case Attachment::kMaster:
+    case Attachment::kPair: {
+      if (m.t >= poses_.back().t) return Placement::kWait;
+      const auto it = std::upper_bound(poses_.begin(), poses_.end(), m.t,
+                                       [](Time time, const PoseNode& p) { return time < p.t; });
+      *k = static_cast<std::size_t>(it - poses_.begin()) - 1;
+      break;
+    }
+    case Attachment::kTriple:
+      *k = NearestPose(m.t);
+      if (*k + 1 >= poses_.size()) return Placement::kWait;
+      if (*k == 0) {
+        ++counts_[s.name].outside;
+        return Placement::kOutside;
+      }
+      break;
+    case Attachment::kOnePose:
+      *k = NearestPose(m.t);
+      break;
+    case Attachment::kInterval:
+      break;
+  }
+  return Placement::kAttach;
+}
+
 bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
   Impl& im = *impl_;
   StreamBinding& s = im.streams[m.stream];
@@ -318,35 +351,12 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
   const auto reading_rate = [&] { return ReadingRate(data, s.column, m.row); };
 
   // Which poses: bail out (keep waiting) until they exist.
-  std::size_t k = 0;
   if (s.attachment == Attachment::kInterval) return TryAttachInterval(m);
-  if (poses_.empty() || m.t > poses_.back().t) return false;
-  if (m.t < poses_.front().t) {
-    ++counts_[s.name].outside;
-    return true;
-  }
-  switch (s.attachment) {
-    case Attachment::kMaster:
-    case Attachment::kPair: {
-      if (m.t >= poses_.back().t) return false;
-      const auto it = std::upper_bound(poses_.begin(), poses_.end(), m.t,
-                                       [](Time time, const PoseNode& p) { return time < p.t; });
-      k = static_cast<std::size_t>(it - poses_.begin()) - 1;
-      break;
-    }
-    case Attachment::kTriple:
-      k = NearestPose(m.t);
-      if (k + 1 >= poses_.size()) return false;
-      if (k == 0) {
-        ++counts_[s.name].outside;
-        return true;
-      }
-      break;
-    case Attachment::kOnePose:
-      k = NearestPose(m.t);
-      break;
-    case Attachment::kInterval:
-      break;
+  std::size_t k = 0;
+  switch (PlaceSample(m, s, &k)) {
+    case Placement::kWait: return false;
+    case Placement::kOutside: return true;
+    case Placement::kAttach: break;
   }
 
   // The factor, by model.
