@@ -147,9 +147,11 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
 namespace {
 
 // Gating in calibration: a burst's neighbours within 1.5 times its length are rejected for one round
-// (GateOptions::burst_margin; on the 30 min weave's two skids 1.0 took 3 + 3 rounds, 1.5 3 + 1, 2.0 3 + 1 with more of
-// their neighbours kept out in the end: BENCHMARKS.md, eighteenth pass).
+// (GateOptions::burst_margin), so that the rounds do not peel a skid's edges a few rows at a time.
 constexpr double kBurstMargin = 1.5;
+
+// Gating rounds per stage: re-tests of every measurement at the re-solved estimate.
+constexpr int kMaxGatingRounds = 5;
 
 void SetFree(const std::set<std::string>& free, ProblemBuilder* builder) {
   for (const auto& [name, id] : builder->parameters())
@@ -165,19 +167,14 @@ Trajectory ExtractTrajectory(const ProblemBuilder& builder) {
   return out;
 }
 
-}  // namespace
+void Say(const CalibrationOptions& options, const std::string& line) {
+  if (options.progress) options.progress(line);
+}
 
-Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recording::Recording& recording,
-                                    const CalibrationOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  const auto say = [&](const std::string& line) {
-    if (options.progress) options.progress(line);
-  };
-  auto built = ProblemBuilder::Create(config, recording);
-  if (!built.ok()) return built.status();
-  ProblemBuilder& builder = *built.value();
-
-  // The whole recording in one graph, dead-reckoned from the master stream, then aligned to the absolute fixes.
+// The whole recording in one graph, dead-reckoned from the master stream, then started from the given trajectory
+// (the nearest pose in time) or aligned to the absolute fixes and the IMU misalignment to the motion.
+Status BuildGraph(const CalibrationOptions& options, ProblemBuilder* builder_ptr) {
+  ProblemBuilder& builder = *builder_ptr;
   for (const MeasurementRef& m : builder.Measurements()) builder.Add(m);
   builder.Finish();
   if (builder.poses().size() < 3) return Status::Error("the recording gives fewer than 3 poses on the master stream");
@@ -193,120 +190,103 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
       PoseToArray(Pose<double>{it->p_world_body, it->q_world_body},
                   builder.graph().mutable_variable(node.id).value.data());
     }
-    say("initial poses from the given trajectory");
+    Say(options, "initial poses from the given trajectory");
   } else {
     builder.AlignToAbsoluteFixes();
     if (const auto q = builder.AlignImuToMotion()) {
       std::ostringstream line;
       line << "initial IMU misalignment from the motion (Wahba): [" << q->w() << ", " << q->x() << ", " << q->y()
            << ", " << q->z() << "]";
-      say(line.str());
+      Say(options, line.str());
     }
   }
-  say("graph: " + std::to_string(builder.poses().size()) + " poses, " +
-      std::to_string(builder.graph().factors().size()) + " factors");
+  Say(options, "graph: " + std::to_string(builder.poses().size()) + " poses, " +
+                   std::to_string(builder.graph().factors().size()) + " factors");
+  return Status::Ok();
+}
 
-  // Stages: the configured ones, or all free parameters at once.
-  std::vector<std::vector<std::string>> stages = config.stages;
-  const std::vector<std::string> all_free = builder.FreeParameterNames();
-  if (stages.empty()) stages.push_back(all_free);
-
-  CalibrationResult result;
-  // Levenberg-Marquardt's damping, carried from one solve to the next. The first stage starts from the configured one:
-  // its parameters and the dead-reckoned poses may be far from the minimum (from an identity IMU misalignment 40
-  // degrees off, a first damping of 1e-12 led Levenberg-Marquardt and Ceres alike to a minimum 9 times costlier).
-  // Every later solve starts where the last one ended: restarted from the configured 1e-4, every step was accepted with
-  // a gain ratio of 0.95-1.00 while the damping, cut by at most 3 per step, held the steps back along the weakly
-  // observed directions (lever arm against height, magnetometer b against A) for a dozen or more iterations until it
-  // had come down to about 1e-13, whatever the stage freed (BENCHMARKS.md, thirteenth tracking pass).
-  double lambda = config.solver.initial_lambda;
+// One stage (stage index s of `stage_count`, its parameters free): a solve, then gating rounds with their re-solves.
+// `lambda` carries Levenberg-Marquardt's damping from solve to solve: the first stage starts from the configured one,
+// as its parameters and the dead-reckoned poses may be far from the minimum; every later solve starts where the last
+// one ended, as a restart from the configured damping holds the steps back along weakly observed directions (lever
+// arm against height, magnetometer b against A) for many iterations while the damping comes down again.
+Result<StageSummary> SolveStage(const EstimatorConfig& config, const CalibrationOptions& options,
+                                const std::vector<std::string>& free, std::size_t s, std::size_t stage_count,
+                                ProblemBuilder* builder_ptr, SolverWorkspace* workspace, double* lambda) {
+  ProblemBuilder& builder = *builder_ptr;
   const bool lm = config.solver.method == SolverOptions::Method::kLevenbergMarquardt;
-  // The solves' buffers, carried from one solve to the next: a gating round's one-step solve on the 30 min drive took
-  // 1.5-2.0 s with them against 2.1-2.9 s (its pattern and envelope allocated and paged in again); peak memory +6 %.
-  // The observability analysis at the end uses them too (its own would page in 1.2 GB again on the 30 min drive). The
-  // factors' linearizations are not kept (the gate evaluates the errors at the converged point, where no solve
-  // linearized them).
-  auto workspace = std::make_unique<SolverWorkspace>();
-  workspace->set_keep_linearizations(false);
-  for (std::size_t s = 0; s < stages.size(); ++s) {
-    SetFree({stages[s].begin(), stages[s].end()}, &builder);
-    StageSummary stage;
-    stage.free_parameters = stages[s];
-    SolverOptions stage_options = config.solver;
-    if (lm) stage_options.initial_lambda = std::max(lambda, std::numeric_limits<double>::epsilon());
-    stage.solver = Solve(stage_options, &builder.graph(), nullptr, workspace.get());
-    if (!stage.solver.usable()) return Status::Error("stage " + std::to_string(s + 1) + ": " + stage.solver.message);
-    // Gate gross outliers at the converged estimate and re-solve without them.
-    // Gross outliers bend the estimate and make inliers look bad too: re-test every measurement after each re-solve,
-    // re-admitting those that fit again, until the set has settled (at most 5 rounds; settled: no more newly failing
-    // measurements than the test's own false alarms, GateOutliers). The first round also rejects a burst's neighbours
-    // (kBurstMargin), so that the rounds do not peel a skid's edges a few rows at a time (the 30 min weave: 5 + 3
-    // rounds, 46 iterations before; 3 + 1, 42 iterations with it). A round that only re-admits ends the rounds: its
-    // measurements fit already (the 30 min weave: the margin's 180 rows back after one round, 2 + 1 rounds and 41
-    // iterations, where stepping and testing again re-admitted 9 more in a third round).
-    // A round's re-solve is one step (the damping has come down to 1e-16-1e-18 by then: a Gauss-Newton step): from a
-    // converged point with a few measurements switched the problem is all but quadratic, and that step leaves less
-    // than a thousandth of its decrease to the next ones (30 min drive: 310, then 0.23, 3e-4, 2e-6), which do not move
-    // the next round's test. Once the set is stable the solve runs to convergence: the same rejected set and final cost
-    // as re-solving to convergence in every round, in 46 iterations instead of 62 on the long weave, whose gate takes
-    // 5 + 3 rounds against 1 + 1 on 30 s (BENCHMARKS.md, fourteenth pass).
-    // Each re-solve starts from the last one's damping too (the problem changed by a few measurements).
-    lambda = stage.solver.final_lambda;
-    const auto resolve = [&](int max_iterations, const std::string& what) -> Status {
-      SolverOptions warm = config.solver;
-      warm.max_iterations = max_iterations;
-      if (lm) warm.initial_lambda = std::max(lambda, std::numeric_limits<double>::epsilon());
-      const SolverSummary again = Solve(warm, &builder.graph(), nullptr, workspace.get());
-      lambda = again.final_lambda;
-      say("stage " + std::to_string(s + 1) + ": " + what + " in " + std::to_string(again.iterations) +
-          " iterations, " + std::to_string(again.seconds) + " s");
-      if (!again.usable()) return Status::Error("stage " + std::to_string(s + 1) + ": " + again.message);
-      stage.solver.iterations += again.iterations;
-      stage.solver.final_cost = again.final_cost;
-      stage.solver.cost_history.insert(stage.solver.cost_history.end(), again.cost_history.begin(),
-                                       again.cost_history.end());
-      stage.solver.termination = again.termination;
-      stage.solver.seconds += again.seconds;
-      return Status::Ok();
-    };
-    bool gated = false;
-    for (int round = 0; config.gate_probability && round < 5; ++round) {
-      // (Not handed the workspace: Levenberg-Marquardt's last point had its cost evaluated, not its linearization.)
-      GateOptions gate;
-      gate.burst_margin = round == 0 ? kBurstMargin : 0.0;
-      gate.ignore_chance_changes = true;
-      const GateSwitches changed = GateOutliers(*config.gate_probability, &builder, 0, nullptr, gate);
-      if (changed.switched() == 0) break;
-      gated = true;
-      const std::string what = "gating round " + std::to_string(round + 1) + ": " + std::to_string(changed.rejected) +
-                               " measurements rejected, " + std::to_string(changed.readmitted) + " re-admitted" +
-                               (changed.ignored > 0 ? ", " + std::to_string(changed.ignored) + " failing by chance" : "");
-      // Settled (nothing rejected): the re-admitted measurements fit the estimate already, and the solve to
-      // convergence below takes them in; a step and another round would test the same set again.
-      if (changed.settled) {
-        say("stage " + std::to_string(s + 1) + ": " + what + ", settled");
-        break;
-      }
-      const Status stepped = resolve(1, what + ", one step");
-      if (!stepped.ok()) return stepped;
+  SetFree({free.begin(), free.end()}, &builder);
+  StageSummary stage;
+  stage.free_parameters = free;
+  SolverOptions stage_options = config.solver;
+  if (lm) stage_options.initial_lambda = std::max(*lambda, std::numeric_limits<double>::epsilon());
+  stage.solver = Solve(stage_options, &builder.graph(), nullptr, workspace);
+  if (!stage.solver.usable()) return Status::Error("stage " + std::to_string(s + 1) + ": " + stage.solver.message);
+  // Gate gross outliers at the converged estimate and re-solve without them. Gross outliers bend the estimate and make
+  // inliers look bad too: every measurement is re-tested after each re-solve, re-admitting those that fit again, until
+  // the set has settled (at most kMaxGatingRounds rounds; settled: no more newly failing measurements than the test's
+  // own false alarms, GateOutliers). The first round also rejects a burst's neighbours (kBurstMargin). A round that
+  // only re-admits ends the rounds: its measurements fit already.
+  // A round's re-solve is one step: from a converged point with a few measurements switched the problem is all but
+  // quadratic (the damping has come down to a Gauss-Newton step), and that step leaves a small fraction of its decrease
+  // to the next ones, which do not move the next round's test. Once the set is stable the solve runs to convergence.
+  // Each re-solve starts from the last one's damping too (the problem changed by a few measurements).
+  *lambda = stage.solver.final_lambda;
+  const auto resolve = [&](int max_iterations, const std::string& what) -> Status {
+    SolverOptions warm = config.solver;
+    warm.max_iterations = max_iterations;
+    if (lm) warm.initial_lambda = std::max(*lambda, std::numeric_limits<double>::epsilon());
+    const SolverSummary again = Solve(warm, &builder.graph(), nullptr, workspace);
+    *lambda = again.final_lambda;
+    Say(options, "stage " + std::to_string(s + 1) + ": " + what + " in " + std::to_string(again.iterations) +
+                     " iterations, " + std::to_string(again.seconds) + " s");
+    if (!again.usable()) return Status::Error("stage " + std::to_string(s + 1) + ": " + again.message);
+    stage.solver.iterations += again.iterations;
+    stage.solver.final_cost = again.final_cost;
+    stage.solver.cost_history.insert(stage.solver.cost_history.end(), again.cost_history.begin(),
+                                     again.cost_history.end());
+    stage.solver.termination = again.termination;
+    stage.solver.seconds += again.seconds;
+    return Status::Ok();
+  };
+  bool gated = false;
+  for (int round = 0; config.gate_probability && round < kMaxGatingRounds; ++round) {
+    // (Not handed the workspace: Levenberg-Marquardt's last point had its cost evaluated, not its linearization.)
+    GateOptions gate;
+    gate.burst_margin = round == 0 ? kBurstMargin : 0.0;
+    gate.ignore_chance_changes = true;
+    const GateSwitches changed = GateOutliers(*config.gate_probability, &builder, 0, nullptr, gate);
+    if (changed.switched() == 0) break;
+    gated = true;
+    const std::string what = "gating round " + std::to_string(round + 1) + ": " + std::to_string(changed.rejected) +
+                             " measurements rejected, " + std::to_string(changed.readmitted) + " re-admitted" +
+                             (changed.ignored > 0 ? ", " + std::to_string(changed.ignored) + " failing by chance" : "");
+    // Settled (nothing rejected): the re-admitted measurements fit the estimate already, and the solve to
+    // convergence below takes them in; a step and another round would test the same set again.
+    if (changed.settled) {
+      Say(options, "stage " + std::to_string(s + 1) + ": " + what + ", settled");
+      break;
     }
-    if (gated) {
-      const Status converged = resolve(config.solver.max_iterations, "gated set re-solved");
-      if (!converged.ok()) return converged;
-    }
-    for (const auto& [stream, c] : builder.counts()) stage.rejected += c.rejected;
-    say("stage " + std::to_string(s + 1) + "/" + std::to_string(stages.size()) + ": cost " +
-        std::to_string(stage.solver.initial_cost) + " -> " + std::to_string(stage.solver.final_cost) + " in " +
-        std::to_string(stage.solver.iterations) + " iterations (" + TerminationName(stage.solver.termination) + "), " +
-        std::to_string(stage.solver.seconds) + " s");
-    result.iterations += stage.solver.iterations;
-    result.termination = TerminationName(stage.solver.termination);
-    result.stages.push_back(std::move(stage));
+    const Status stepped = resolve(1, what + ", one step");
+    if (!stepped.ok()) return stepped;
   }
-  result.initial_cost = result.stages.front().solver.initial_cost;
-  result.final_cost = result.stages.back().solver.final_cost;
+  if (gated) {
+    const Status converged = resolve(config.solver.max_iterations, "gated set re-solved");
+    if (!converged.ok()) return converged;
+  }
+  for (const auto& [stream, c] : builder.counts()) stage.rejected += c.rejected;
+  Say(options, "stage " + std::to_string(s + 1) + "/" + std::to_string(stage_count) + ": cost " +
+                   std::to_string(stage.solver.initial_cost) + " -> " + std::to_string(stage.solver.final_cost) +
+                   " in " + std::to_string(stage.solver.iterations) + " iterations (" +
+                   TerminationName(stage.solver.termination) + "), " + std::to_string(stage.solver.seconds) + " s");
+  return stage;
+}
 
-  // Joint marginal information of every parameter free in some stage, at the final estimate.
+// The estimate of every parameter free in some stage, with its standard deviations, observability and correlations
+// from their joint marginal information at the final estimate (when options.analyze_observability).
+Status EstimateParameters(const CalibrationOptions& options, const std::vector<std::vector<std::string>>& stages,
+                          ProblemBuilder* builder_ptr, SolverWorkspace* workspace, CalibrationResult* result) {
+  ProblemBuilder& builder = *builder_ptr;
   std::set<std::string> ever_free;
   for (const auto& st : stages) ever_free.insert(st.begin(), st.end());
   SetFree(ever_free, &builder);
@@ -321,14 +301,15 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
   std::vector<int> offsets;
   if (!ids.empty() && options.analyze_observability) {
     const auto analysis_start = std::chrono::steady_clock::now();
-    auto info = ComputeMarginalInformation(builder.graph(), ids, workspace.get());
+    auto info = ComputeMarginalInformation(builder.graph(), ids, workspace);
     if (!info.ok()) return info.status();
     analysis = AnalyzeObservability(info.value().information, info.value().conditional, options.observability);
     offsets = info.value().offsets;
-    result.information = info.value().information;
-    say("observability analysis: " +
-        std::to_string(std::chrono::duration<double>(std::chrono::steady_clock::now() - analysis_start).count()) +
-        " s");
+    result->information = info.value().information;
+    Say(options, "observability analysis: " +
+                     std::to_string(
+                         std::chrono::duration<double>(std::chrono::steady_clock::now() - analysis_start).count()) +
+                     " s");
   }
   for (std::size_t i = 0; i < ids.size(); ++i) {
     const Variable& v = builder.graph().variable(ids[i]);
@@ -340,7 +321,7 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
     if (!options.analyze_observability) {
       p.std = Eigen::VectorXd::Constant(dim, std::numeric_limits<double>::quiet_NaN());
       p.components.assign(dim, Observability::kObservable);
-      result.parameters.push_back(std::move(p));
+      result->parameters.push_back(std::move(p));
       continue;
     }
     p.std = analysis.std.segment(offsets[i], dim);
@@ -349,8 +330,9 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
       p.components.push_back(o);
       if (static_cast<int>(o) > static_cast<int>(p.observability)) p.observability = o;
     }
-    result.parameters.push_back(std::move(p));
+    result->parameters.push_back(std::move(p));
   }
+  // The strongest correlation between the components of each pair of parameters, when above the threshold.
   for (std::size_t i = 0; i < ids.size() && options.analyze_observability; ++i) {
     for (std::size_t j = i + 1; j < ids.size(); ++j) {
       double best = 0.0;
@@ -361,22 +343,65 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
           const double rho = analysis.correlation(offsets[i] + a, offsets[j] + b);
           if (std::abs(rho) > std::abs(best)) best = rho;
         }
-      if (std::abs(best) >= options.correlation_threshold) result.correlations.push_back({names[i], names[j], best});
+      if (std::abs(best) >= options.correlation_threshold) result->correlations.push_back({names[i], names[j], best});
     }
   }
-  if (options.keep_residuals) {
-    for (const auto& [id, entry] : builder.graph().factors()) {
-      if (builder.StreamOfFactor(id) < 0) continue;
-      internal::WhitenedFactor wf;
-      const bool ok =
-          internal::LinearizeFactor(builder.graph(), entry, std::vector<bool>(entry.variables.size(), false), &wf);
-      if (!ok) continue;
-      // Undo the loss weighting: sqrt(s) along the weighted residual's direction.
-      Eigen::VectorXd whitened = wf.residual;
-      if (whitened.norm() > 0.0) whitened *= std::sqrt(wf.squared_norm) / whitened.norm();
-      result.residuals.push_back({entry.stream, entry.stamp, whitened, entry.active});
-    }
+  return Status::Ok();
+}
+
+// Every measurement factor's whitened residual at the final estimate, without the loss weighting.
+void KeepResiduals(const ProblemBuilder& builder, CalibrationResult* result) {
+  for (const auto& [id, entry] : builder.graph().factors()) {
+    if (builder.StreamOfFactor(id) < 0) continue;
+    internal::WhitenedFactor wf;
+    const bool ok =
+        internal::LinearizeFactor(builder.graph(), entry, std::vector<bool>(entry.variables.size(), false), &wf);
+    if (!ok) continue;
+    // Undo the loss weighting: sqrt(s) along the weighted residual's direction.
+    Eigen::VectorXd whitened = wf.residual;
+    if (whitened.norm() > 0.0) whitened *= std::sqrt(wf.squared_norm) / whitened.norm();
+    result->residuals.push_back({entry.stream, entry.stamp, whitened, entry.active});
   }
+}
+
+}  // namespace
+
+Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recording::Recording& recording,
+                                    const CalibrationOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  auto built = ProblemBuilder::Create(config, recording);
+  if (!built.ok()) return built.status();
+  ProblemBuilder& builder = *built.value();
+  const Status graph = BuildGraph(options, &builder);
+  if (!graph.ok()) return graph;
+
+  // Stages: the configured ones, or all free parameters at once.
+  std::vector<std::vector<std::string>> stages = config.stages;
+  const std::vector<std::string> all_free = builder.FreeParameterNames();
+  if (stages.empty()) stages.push_back(all_free);
+
+  CalibrationResult result;
+  double lambda = config.solver.initial_lambda;
+  // The solves' buffers, carried from one solve to the next (a gating round's one-step solve would otherwise allocate
+  // and page in its pattern and envelope again); the observability analysis at the end uses them too. The factors'
+  // linearizations are not kept (the gate evaluates the errors at the converged point, where no solve linearized
+  // them).
+  auto workspace = std::make_unique<SolverWorkspace>();
+  workspace->set_keep_linearizations(false);
+  for (std::size_t s = 0; s < stages.size(); ++s) {
+    Result<StageSummary> stage =
+        SolveStage(config, options, stages[s], s, stages.size(), &builder, workspace.get(), &lambda);
+    if (!stage.ok()) return stage.status();
+    result.iterations += stage.value().solver.iterations;
+    result.termination = TerminationName(stage.value().solver.termination);
+    result.stages.push_back(std::move(stage).value());
+  }
+  result.initial_cost = result.stages.front().solver.initial_cost;
+  result.final_cost = result.stages.back().solver.final_cost;
+
+  const Status estimated = EstimateParameters(options, stages, &builder, workspace.get(), &result);
+  if (!estimated.ok()) return estimated;
+  if (options.keep_residuals) KeepResiduals(builder, &result);
   result.counts = builder.counts();
   result.trajectory = ExtractTrajectory(builder);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -35,9 +35,9 @@
 //     - [gps.lever_arm, imu.misalignment]
 //     - [magnetometer.A, magnetometer.b, odometer.kv_over_L, odometer.k_theta, odometer.k_gamma]
 //
-// Models, their noise keys, parameter slots (default value) and options are listed in kModelSpecs (config.cc) and in
-// the README. `odometer` joins the two master poses around its sample's stamp (one master interval: for sources at the
-// master's rate or faster). `relative_motion` reads the same velocity streams, whose rows hold the mean velocity over
+// Models, their noise keys, parameter slots (default value) and options are listed in kModelSpecs (config.cc).
+// `odometer` joins the two master poses around its sample's stamp (one master interval: for sources at the master's
+// rate or faster). `relative_motion` reads the same velocity streams, whose rows hold the mean velocity over
 // [t - T/2, t + T/2] stamped at the middle (scan_matching, visual_odometry), and joins the master poses nearest the
 // two ends, so that a 10 Hz scan matcher constrains the whole 0.1 s displacement instead of one 10 ms interval;
 // options.interval_s gives T (default: 1 / the stream's rate_hz). Both accept options.row_covariance_scale: k > 0

@@ -37,8 +37,8 @@ class SolverWorkspace;
 
 // Requires the listed variables to be free. Fails with a message if the rest of the problem is singular even after a
 // tiny regularization. `workspace` (optional): the buffers of the solves that reached the estimate are used again
-// instead of new ones (a 30 min calibration's are 1.2 GB, each page of which would be cleared by the kernel on first
-// touch); the result is the same.
+// instead of new ones (a long recording's run to gigabytes, each page of which would be cleared by the kernel on
+// first touch); the result is the same.
 Result<MarginalInformation> ComputeMarginalInformation(const Graph& graph, const std::vector<VariableId>& variables,
                                                        SolverWorkspace* workspace = nullptr);
 

@@ -9,7 +9,7 @@
 // jets: every block is perturbed as x [+] d with d = 0 carrying one derivative slot per tangent coordinate, and the
 // noise carries one slot per component, so one evaluation yields both Jacobians exactly.
 //
-// A model may also provide analytic Jacobians (STYLE.md: analytic where profiling says so, jets as the test oracle):
+// A model may also provide analytic Jacobians (where profiling asks for them; the jets stay their test oracle):
 //   bool Linearize(const double* const* x, double* error, double* const* jacobians, double* noise_jacobian) const;
 // with Factor::Evaluate's layout and zero noise. AutoDiffFactor then calls it whenever a Jacobian is requested; it
 // must fill exactly the requested blocks (a null jacobians[i] is skipped) and the same error as operator(). Models

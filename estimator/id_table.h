@@ -2,8 +2,8 @@
 //
 // A whole recording's graph holds 10^5-10^6 of each, added in id order; a tracking window adds at the back and erases
 // mostly at the front. The elements sit in chunks of kChunk consecutive ids, so that a walk in id order reads memory
-// in order and a look-up by id is an index (a std::map's walk chased a pointer per node, and its look-ups one per
-// level: 8 % of a 30 min drive's calibration). An element never moves while it is in the table: pointers and
+// in order and a look-up by id is an index (a std::map's walk chases a pointer per node, and its look-ups one per
+// level). An element never moves while it is in the table: pointers and
 // references to it stay valid until it is erased; iterators are invalidated by Add and Erase.
 //
 // A chunk is released once every id in it is erased: the table holds the chunks of its live elements only (a window

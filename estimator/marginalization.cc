@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Cholesky>
@@ -16,8 +17,8 @@
 namespace roamlab::estimator {
 namespace {
 
-// Margin of the rank decision over the Schur complement's rounding (n eps max|H|): measured noise eigenvalues were
-// within 0.1 of that bound on the ATV (BENCHMARKS.md, "Marginalization and rounding").
+// Margin of the rank decision over the Schur complement's rounding (n eps max|H|): the eigenvalues of rounding alone
+// stay well below that bound.
 constexpr double kRoundingFloor = 10.0;
 
 // Inverse right Jacobian of SO(3): d Log(Exp(phi) Exp(d)) / dd at d = 0.
@@ -188,7 +189,21 @@ bool LinearPriorFactor::Evaluate(const double* const* values, double* error, dou
   return error != nullptr && r0_.allFinite();
 }
 
-bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const SolverWorkspace* last_solve) {
+namespace {
+
+// The variables of an elimination: the leaving ones (free) first, then the blanket (the other free variables that
+// their active factors touch), each one's offset in [leaving, blanket] tangent coordinates, n coordinates in all of
+// which nm leaving; and the factors on the leaving variables.
+struct EliminationOrder {
+  std::vector<FactorId> factors;  // sorted, once each
+  std::vector<VariableId> order;
+  std::size_t n_leaving = 0;
+  std::vector<int> offset;
+  int n = 0;
+  int nm = 0;
+};
+
+EliminationOrder OrderForElimination(const std::vector<VariableId>& leaving, const Graph* graph) {
   // The factors on the leaving variables (sorted, once each), and the blanket: the other free variables they touch.
   // Small sets (a pose and its blanket of a few dozen coordinates): sorted or searched vectors, no node containers.
   std::vector<FactorId> factors;
@@ -215,10 +230,19 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const Sol
     n += graph->variable(order[i]).manifold.tangent_dim();
     if (i + 1 == n_leaving) nm = n;
   }
+  return {std::move(factors), std::move(order), n_leaving, std::move(offset), n, nm};
+}
 
-  // Dense H and g over [leaving, blanket].
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n, n);
-  Eigen::VectorXd g = Eigen::VectorXd::Zero(n);
+// Adds the active factors' J^T J and J^T r over [leaving, blanket] to H (the blocks on and above the diagonal) and g:
+// the last solve's linearizations and kept products where they are current, else linearized here. False when a
+// factor cannot be linearized.
+bool AddFactorInformation(const EliminationOrder& elimination, const Graph* graph, const SolverWorkspace* last_solve,
+                          Eigen::MatrixXd* H_out, Eigen::VectorXd* g_out) {
+  Eigen::MatrixXd& H = *H_out;
+  Eigen::VectorXd& g = *g_out;
+  const std::vector<FactorId>& factors = elimination.factors;
+  const std::vector<VariableId>& order = elimination.order;
+  const std::vector<int>& offset = elimination.offset;
   std::vector<bool> want;
   std::vector<int> var_offset;
   internal::WhitenedFactor wf;  // reused: its buffers keep their size
@@ -242,7 +266,7 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const Sol
     }
     const internal::WhitenedFactor& lf = *linearized;
     // The solve's own products J_a^T J_b of these Jacobians when it kept them (relinearization threshold): the same
-    // coefficient-wise sums as the products below, bit for bit (measured over the ATV run), without computing them
+    // coefficient-wise sums as the products below, bit for bit, without computing them
     // again. Kept per pair of wanted positions i <= j (i outer); product_offset at i * nv + j.
     const std::vector<double>* products = linearized != &wf ? last_solve->Products(f, mask) : nullptr;
     const std::size_t nv = e.variables.size();
@@ -258,7 +282,7 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const Sol
       if (!want[a]) continue;
       const int oa = var_offset[a];
       // Coefficient-wise products, in this order: tracking under a calibration prior is sensitive to the rounding of
-      // H here (other kernels moved its positions by metres; BENCHMARKS.md, fourth tracking pass).
+      // H here (a different summation order moves its positions by metres).
       g.segment(oa, lf.jacobians[a].cols()) += lf.jacobians[a].transpose().lazyProduct(lf.residual);
       for (std::size_t b = 0; b < nv; ++b) {
         if (!want[b] || var_offset[b] < oa) continue;  // the lower triangle is mirrored below
@@ -273,9 +297,14 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const Sol
       }
     }
   }
-  H.triangularView<Eigen::StrictlyLower>() = H.transpose();
+  return true;
+}
 
-  // Schur complement onto the blanket, factored as J^T J (SquareRootInformation, dropping null directions).
+// The Schur complement of H = [Hmm Hmb; Hbm Hbb] onto its trailing blanket coordinates (nm leaving ones first), and
+// the matching gradient gb - Hbm Hmm^-1 gm.
+void SchurComplementOntoBlanket(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int nm, Eigen::MatrixXd* Hbb_out,
+                                Eigen::VectorXd* gb_out) {
+  const int n = static_cast<int>(H.rows());
   const int nb = n - nm;
   Eigen::MatrixXd Hbb = H.bottomRightCorner(nb, nb);
   Eigen::VectorXd gb = g.tail(nb);
@@ -299,6 +328,31 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const Sol
       gb -= Hmb.transpose() * ldlt.solve(g.head(nm));
     }
   }
+  *Hbb_out = std::move(Hbb);
+  *gb_out = std::move(gb);
+}
+
+}  // namespace
+
+bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const SolverWorkspace* last_solve) {
+  // The factors on the leaving variables and the blanket: the other free variables they touch.
+  const EliminationOrder elimination = OrderForElimination(leaving, graph);
+  const std::vector<FactorId>& factors = elimination.factors;
+  const std::vector<VariableId>& order = elimination.order;
+  const std::size_t n_leaving = elimination.n_leaving;
+  const int n = elimination.n, nm = elimination.nm;
+
+  // Dense H and g over [leaving, blanket].
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n, n);
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(n);
+  if (!AddFactorInformation(elimination, graph, last_solve, &H, &g)) return false;
+  H.triangularView<Eigen::StrictlyLower>() = H.transpose();
+
+  // Schur complement onto the blanket, factored as J^T J (SquareRootInformation, dropping null directions).
+  const int nb = n - nm;
+  Eigen::MatrixXd Hbb;
+  Eigen::VectorXd gb;
+  SchurComplementOntoBlanket(H, g, nm, &Hbb, &gb);
   std::vector<Manifold> manifolds;
   std::vector<Eigen::VectorXd> x0;
   std::vector<VariableId> blanket(order.begin() + static_cast<std::ptrdiff_t>(n_leaving), order.end());
@@ -315,9 +369,9 @@ bool Marginalize(const std::vector<VariableId>& leaving, Graph* graph, const Sol
   Eigen::VectorXd r0;
   // The floor: the Schur complement is computed with an absolute error of about n eps max|H| (H over leaving and
   // blanket; the leaving pose's own information is often 1e2-1e3 times the blanket's), so its eigenvalues below that
-  // are rounding, of either sign. Keeping such a direction (the old floor, 1e-12 of the blanket's largest eigenvalue,
-  // sat within 5x of that noise) turns rounding into information with a mean of noise / lambda, and which side of the
-  // floor it falls on flips with the summation order. 1e-12 of the largest eigenvalue stays a lower bound.
+  // are rounding, of either sign. Keeping such a direction (a floor of 1e-12 of the blanket's largest eigenvalue alone
+  // lies within a few times that noise) turns rounding into information with a mean of noise / lambda, and which side
+  // of the floor it falls on flips with the summation order. 1e-12 of the largest eigenvalue stays a lower bound.
   const Eigen::MatrixXd S = 0.5 * (Hbb + Hbb.transpose());
   const double floor =
       std::max(kRoundingFloor * n * std::numeric_limits<double>::epsilon() * std::max(H.diagonal().maxCoeff(), 0.0),

@@ -127,6 +127,11 @@ class ProblemBuilder {
   void AttachPending();
   // Attaches one measurement if its poses exist; returns false to keep it waiting.
   bool TryAttach(const MeasurementRef& m);
+  // Where a sample of stream s (not relative_motion) attaches: at pose index *k (the first of its pair, the middle of
+  // its triple), not yet (its poses do not exist), or nowhere (before the first pose or the first triple: counted as
+  // outside).
+  enum class Placement { kAttach, kWait, kOutside };
+  Placement PlaceSample(const MeasurementRef& m, const StreamBinding& s, std::size_t* k);
   // TryAttach for relative_motion (the class comment).
   bool TryAttachInterval(const MeasurementRef& m);
   // The noise covariance of one sample: the configured one, plus the row's own when the stream is set to use it.

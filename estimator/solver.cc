@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -96,6 +97,41 @@ double TangentNorm(const std::vector<Variable*>& variables) {
   return std::sqrt(sq);
 }
 
+// Solves the damped system, raising the damping up to ten times while the matrix is not positive definite.
+bool SolveWithDamping(internal::NormalEquations* system, double* lambda, Eigen::VectorXd* dx) {
+  bool solved = system->Solve(*lambda, dx);
+  for (int retry = 0; !solved && retry < 10; ++retry) {
+    *lambda = std::max(*lambda * 10.0, 1e-9);
+    solved = system->Solve(*lambda, dx);
+  }
+  return solved;
+}
+
+// The free variables' values, concatenated, and back.
+void SaveValues(const std::vector<Variable*>& free_variables, std::vector<double>* saved) {
+  saved->clear();
+  for (const Variable* v : free_variables)
+    saved->insert(saved->end(), v->value.data(), v->value.data() + v->value.size());
+}
+void RestoreValues(const std::vector<double>& saved, const std::vector<Variable*>& free_variables) {
+  const double* from = saved.data();
+  for (Variable* v : free_variables) {
+    std::copy(from, from + v->value.size(), v->value.data());
+    from += v->value.size();
+  }
+}
+
+// The tolerance an accepted step met (function, model, then step), if any.
+std::optional<Termination> ToleranceMet(const SolverOptions& options, double old_cost, double actual,
+                                        double predicted, double step_norm,
+                                        const std::vector<Variable*>& free_variables) {
+  if (std::abs(actual) <= options.function_tolerance * old_cost) return Termination::kFunctionTolerance;
+  if (std::abs(actual - predicted) <= options.model_tolerance * old_cost) return Termination::kModelTolerance;
+  if (step_norm <= options.step_tolerance * (TangentNorm(free_variables) + options.step_tolerance))
+    return Termination::kStepTolerance;
+  return std::nullopt;
+}
+
 }  // namespace
 
 SolverWorkspace::SolverWorkspace() : system_(std::make_unique<internal::NormalEquations>()) {}
@@ -162,12 +198,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
     }
     // Solve the damped system; raise the damping if the matrix is not positive definite.
     Eigen::VectorXd dx;
-    bool solved = system.Solve(lambda, &dx);
-    for (int retry = 0; !solved && retry < 10; ++retry) {
-      lambda = std::max(lambda * 10.0, 1e-9);
-      solved = system.Solve(lambda, &dx);
-    }
-    if (!solved) {
+    if (!SolveWithDamping(&system, &lambda, &dx)) {
       summary.termination = Termination::kFailure;
       summary.message = "normal equations are not positive definite even with damping";
       break;
@@ -175,10 +206,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
     ++summary.iterations;
 
     // Try the step, keeping a copy of the free variables' values.
-    std::vector<double>& saved = ws.saved_;
-    saved.clear();
-    for (const Variable* v : free_variables)
-      saved.insert(saved.end(), v->value.data(), v->value.data() + v->value.size());
+    SaveValues(free_variables, &ws.saved_);
     system.Update(dx, free_variables);
     // Gauss-Newton takes every step it can evaluate: its trial point is linearized at once (the next iteration, or
     // the next solve of a workspace, starts there), Levenberg-Marquardt only evaluates the cost of a trial that may
@@ -192,11 +220,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
     const bool accept = evaluated && (lm ? (predicted > 0.0 && actual / predicted > 1e-3) : true);
 
     if (!accept) {
-      const double* from = saved.data();
-      for (Variable* v : free_variables) {
-        std::copy(from, from + v->value.size(), v->value.data());
-        from += v->value.size();
-      }
+      RestoreValues(ws.saved_, free_variables);
       if (!lm) {
         summary.termination = Termination::kFailure;
         summary.message = "Gauss-Newton step could not be evaluated";
@@ -229,17 +253,8 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
     // re-evaluates every error covariance, eq. 1).
     summary.cost_history.push_back(new_cost);
     summary.final_cost = new_cost;
-    const double step_norm = dx.norm();
-    if (std::abs(actual) <= options.function_tolerance * old_cost) {
-      summary.termination = Termination::kFunctionTolerance;
-      break;
-    }
-    if (std::abs(actual - predicted) <= options.model_tolerance * old_cost) {
-      summary.termination = Termination::kModelTolerance;
-      break;
-    }
-    if (step_norm <= options.step_tolerance * (TangentNorm(free_variables) + options.step_tolerance)) {
-      summary.termination = Termination::kStepTolerance;
+    if (const auto met = ToleranceMet(options, old_cost, actual, predicted, dx.norm(), free_variables)) {
+      summary.termination = *met;
       break;
     }
     if (iteration + 1 == options.max_iterations) break;

@@ -114,7 +114,8 @@ class SolverWorkspace {
   // Whether the solves keep each factor's last linearization for Linearization and Products (default true). A caller
   // that does not read them (a whole recording's calibration) sets false: a solve without a relinearization threshold
   // then uses each factor's Jacobians as they are computed and keeps only its whitening, instead of writing
-  // about 1 KB per factor and iteration to memory that nothing reads again (a 30 min drive has 729 001 factors).
+  // about 1 KB per factor and iteration to memory that nothing reads again (a long drive has close to a million
+  // factors).
   // Results are the same.
   void set_keep_linearizations(bool keep) { keep_linearizations_ = keep; }
 

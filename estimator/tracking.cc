@@ -135,13 +135,11 @@ Status AddCalibrationPrior(const CalibrationPrior& prior, ProblemBuilder* builde
   return Status::Ok();
 }
 
-}  // namespace
-
-Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::Recording& recording,
-                             const std::map<std::string, Eigen::VectorXd>& calibration,
-                             const TrackingOptions& options) {
-  const auto start = Clock::now();
-  // Constant parameters are fixed at their calibrated (or configured) values.
+// The tracking configuration: constant parameters fixed at their calibrated (or configured) values, those under the
+// calibration prior (when given) free; no stages.
+Result<EstimatorConfig> ConfigForTracking(const EstimatorConfig& config_in,
+                                          const std::map<std::string, Eigen::VectorXd>& calibration,
+                                          const CalibrationPrior* prior) {
   EstimatorConfig config = config_in;
   for (auto& [name, p] : config.parameters)
     if (p.process.type == ProcessConfig::Type::kConstant) p.free = false;
@@ -150,8 +148,6 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
     p.value = value;
     if (p.process.type == ProcessConfig::Type::kConstant) p.free = false;
   }
-  const CalibrationPrior* prior =
-      config.tracking.calibration_prior && options.calibration_prior ? &*options.calibration_prior : nullptr;
   if (prior != nullptr) {
     for (const std::string& name : prior->names) {
       if (!calibration.count(name) || !config.parameters.count(name))
@@ -160,6 +156,49 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
     }
   }
   config.stages.clear();
+  return config;
+}
+
+// An update's solver: Gauss-Newton under the tracking options' iteration cap, improvement threshold, time budget and
+// relinearization threshold.
+SolverOptions UpdateOptions(const EstimatorConfig& config) {
+  SolverOptions update_options = config.solver;
+  update_options.method = SolverOptions::Method::kGaussNewton;
+  update_options.max_iterations = config.tracking.max_iterations;
+  update_options.function_tolerance = config.tracking.improvement_threshold;
+  update_options.model_tolerance = config.tracking.improvement_threshold;
+  update_options.time_budget_s = config.tracking.time_budget_s;
+  update_options.relinearize_threshold = config.tracking.relinearize_threshold;
+  return update_options;
+}
+
+// Whatever is left in the window at the end (short recordings never leave initialization): solved, and every pose
+// reported, their covariances from one factorization.
+Status EmitFinalWindow(const EstimatorConfig& config, const TrackingOptions& options, ProblemBuilder* builder,
+                       TrackingResult* out) {
+  const SolverSummary s = Solve(config.solver, &builder->graph());
+  if (!s.usable()) return Status::Error("final window: " + s.message);
+  const std::vector<CovarianceRequest> last = OldestPoseCovariances(*builder, builder->poses().size());
+  for (std::size_t k = 0; !builder->poses().empty(); ++k) {
+    const CovarianceRequest* known = &last[k];
+    if (builder->poses().size() == 1) return EmitOldest(builder, known, options, out);
+    const Status st = EmitAndMarginalizeOldest(builder, known, nullptr, options, out);
+    if (!st.ok()) return st;
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::Recording& recording,
+                             const std::map<std::string, Eigen::VectorXd>& calibration,
+                             const TrackingOptions& options) {
+  const auto start = Clock::now();
+  const CalibrationPrior* prior =
+      config_in.tracking.calibration_prior && options.calibration_prior ? &*options.calibration_prior : nullptr;
+  const Result<EstimatorConfig> tracking_config = ConfigForTracking(config_in, calibration, prior);
+  if (!tracking_config.ok()) return tracking_config.status();
+  const EstimatorConfig& config = tracking_config.value();
   auto built = ProblemBuilder::Create(config, recording);
   if (!built.ok()) return built.status();
   ProblemBuilder& builder = *built.value();
@@ -168,13 +207,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
     if (!added.ok()) return added;
   }
 
-  SolverOptions update_options = config.solver;
-  update_options.method = SolverOptions::Method::kGaussNewton;
-  update_options.max_iterations = config.tracking.max_iterations;
-  update_options.function_tolerance = config.tracking.improvement_threshold;
-  update_options.model_tolerance = config.tracking.improvement_threshold;
-  update_options.time_budget_s = config.tracking.time_budget_s;
-  update_options.relinearize_threshold = config.tracking.relinearize_threshold;
+  const SolverOptions update_options = UpdateOptions(config);
 
   TrackingResult out;
   const std::vector<MeasurementRef> measurements = builder.Measurements();
@@ -249,20 +282,8 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
   }
   builder.Finish();
 
-  // Whatever is left (short recordings never leave initialization): solve and report the final window.
-  const SolverSummary s = Solve(config.solver, &builder.graph());
-  if (!s.usable()) return Status::Error("final window: " + s.message);
-  const std::vector<CovarianceRequest> last = OldestPoseCovariances(builder, builder.poses().size());
-  for (std::size_t k = 0; !builder.poses().empty(); ++k) {
-    const CovarianceRequest* known = &last[k];
-    if (builder.poses().size() == 1) {
-      const Status st = EmitOldest(&builder, known, options, &out);
-      if (!st.ok()) return st;
-      break;
-    }
-    const Status st = EmitAndMarginalizeOldest(&builder, known, nullptr, options, &out);
-    if (!st.ok()) return st;
-  }
+  const Status final_window = EmitFinalWindow(config, options, &builder, &out);
+  if (!final_window.ok()) return final_window;
   out.mean_update_s = out.updates > 0 ? update_seconds / out.updates : 0.0;
   if (!update_times.empty()) {
     const std::size_t k = std::min(update_times.size() - 1, (update_times.size() * 99) / 100);

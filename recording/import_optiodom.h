@@ -1,4 +1,4 @@
-// Importer for the OptiOdom recordings (Sousa et al., J Intell Robot Syst 2022; ../shared/data/optiodom): wheel
+// Importer for the OptiOdom recordings (Sousa et al., J Intell Robot Syst 2022): wheel
 // encoder ticks synchronized with OptiTrack motion capture, differential-drive and 3-wheel omnidirectional robots.
 //
 // Input files (no header row):
@@ -22,7 +22,7 @@
 //                        matcher in seed 001) when learning odometry.
 //   ground_truth.tum     the same poses: the reference for ATE/RPE and `roamlab evaluate`.
 // The manufacturer values are what the metadata says; the real robot differs (unequal wheel diameters, a wider
-// effective track, a time offset between encoders and motion capture: see ../shared/data/README.md), and finding that
+// effective track, a time offset between encoders and motion capture), and finding that
 // is the learner's job, not the importer's.
 #pragma once
 

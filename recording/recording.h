@@ -1,4 +1,4 @@
-// The recording directory: one format for simulated and real data (DESIGN.md, "The recording directory").
+// The recording directory: one format for simulated and real data.
 //
 //   REC/recording.yaml     format version, platform, origin (when GPS is present), one entry per stream, provenance
 //   REC/<stream>.csv       header row "t,<columns...>", first column time in seconds with nine fractional digits

@@ -139,6 +139,16 @@ class NormalEquations {
  private:
   // Block column of a free variable, or -1.
   int BlockOf(VariableId id) const;
+  // Reset's steps: the last Reset's tables set aside for the factors still in the graph (KeepLastTables); the free
+  // variables' blocks, returning whether every time-stamped variable comes before the constant ones (OrderBlocks);
+  // every variable's value and block, by id (BuildVariableTable); whether the factors still in the graph keep their
+  // tables, and their blocks' renumbering (PrepareIncremental); the included factors, their variables' blocks and
+  // values, and the row blocks of each block column (CollectFactors).
+  void KeepLastTables();
+  bool OrderBlocks(const Graph& graph, std::vector<VariableId> order);
+  void BuildVariableTable(const Graph& graph);
+  bool PrepareIncremental();
+  void CollectFactors(const Graph& graph, bool incremental, bool stamped_first);
   void BuildPattern();
   // pairs_ and pair_begin_ for the included factors (BuildPattern with a relinearization threshold; else at their first
   // use, EnsurePairs: a pass that sums each factor's products into H as it linearizes finds the blocks itself).

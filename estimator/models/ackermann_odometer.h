@@ -12,7 +12,7 @@
 // misalignment. Position error in W [m], orientation error a full-angle rotation vector in W [rad] (see odometer.h).
 // Measurements: z_v = rear-wheel speed computed with the nominal wheel radius [m/s]; z_theta = handlebar angle [rad];
 // both held constant over [t_k, t_k+1], dt = t_k+1 - t_k [s].
-// Calibration (eq. 15 written with one name each, DESIGN.md): kv_over_L = k_v / L [1/m] (speed gain over wheelbase),
+// Calibration (eq. 15 written with one name each): kv_over_L = k_v / L [1/m] (speed gain over wheelbase),
 // k_theta [-] (steering gain), k_gamma [rad] (steering offset). The wheelbase L [m] is a known constant, so the speed
 // gain k_v = kv_over_L * L is not a separate variable.
 //

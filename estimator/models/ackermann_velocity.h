@@ -22,19 +22,17 @@
 // on curved ground a chassis resting on both axles pitches with the chord between the contacts, while the rear
 // contact moves along the ground's tangent: the two differ by half the angle the ground turns over the wheelbase, so
 // the contact moves along O's z at d omega_y with d = L / 2 (crest: nose going down, omega_y > 0, v_z > 0).
-// Measured on the MuJoCo ATV (30 s, 4 m hills, true readings without noise, O at the wheel centres, r = 0.28 m;
-// tools/atv_odometer_residuals.py):
-// regressed on the rates, O's v_x - speed reading has slope 0.30 m on omega_y, O's v_y -0.25 m on omega_x (besides
-// -0.021 s on a_y, the cornering compliance), O's v_z 0.62 m on omega_y (L / 2 = 0.625).
+// tools/atv_odometer_residuals.py regresses the MuJoCo ATV's noise-free readings on the rates: the speed row follows
+// omega_y, the lateral row omega_x (besides a_y, the cornering compliance below) and the vertical row omega_y with
+// d = L / 2, as this geometry predicts.
 //
 // Cornering compliance. Eq. 15 assumes rolling without side slip. Real tires (and MuJoCo's soft contacts) carry the
 // centripetal force by slipping sideways in proportion to it: the rear axle drifts outwards, v_y = -c_rear a_y
 // (c_rear [s], m/s of side slip per m/s^2), and the front wheels' velocity points c_front a_y (c_front [rad s^2/m])
 // less into the turn than they are steered (understeer): the front axle moves along atan((L omega_z + v_y) / v_x).
-// With c_front = c_rear = 0 (their defaults) this is eq. 15 with the non-holonomic constraints. Measured on the MuJoCo
-// ATV (30 s, 4 m hills, tools/atv_odometer_residuals.py; the former drive, scenarios/atv_hills_sines.yaml): at the
-// contact v_y has slope -0.0207 s on a_y and leaves 0.0022 m/s rms of 0.035; the steering row -0.0047 rad s^2/m,
-// leaving 0.0025 rad of 0.0083 (on the weave, atv_hills.yaml's drive now: -0.0208 s and -0.0058 rad s^2/m).
+// With c_front = c_rear = 0 (their defaults) this is eq. 15 with the non-holonomic constraints. On the MuJoCo ATV the
+// two terms explain most of the contact's side velocity and of the steering row's residual
+// (tools/atv_odometer_residuals.py fits them).
 //
 // Understeer as a slip velocity (option front_slip_velocity, default off). MuJoCo's soft contacts let a tire slip at a
 // velocity proportional to the force it carries (as the rear axle's v_y = -c_rear a_y above), not at an angle: the
@@ -42,9 +40,8 @@
 // steered at
 //   delta = atan((L omega_z + v_y + c_front a_y) / v_x),
 // an angle c_front a_y / v_x = c_front omega_z to first order: the angle form's coefficient is this one over the speed
-// at which the drive corners. Measured on the MuJoCo ATV (tools/atv_understeer_fit.py, noise-free, at the contact):
-// 0.0209 s on the former drive (atv_hills_sines.yaml) and 0.0208 s on the steering-rich weave (atv_hills.yaml) alike
-// (the angle form: 0.0047 and 0.0058 rad s^2/m).
+// at which the drive corners. On the MuJoCo ATV the slip-velocity coefficient is the same on drives that corner at
+// different speeds, the angle form's is not (tools/atv_understeer_fit.py fits both, noise-free, at the contact).
 //
 // Rear-axle thrust angle alpha [rad] (a misaligned rear axle: both rear wheels turned about z by alpha, positive
 // counter-clockwise). The rear wheels roll along d = (cos alpha, sin alpha) in O, so without side slip O's velocity
@@ -58,7 +55,7 @@
 //
 // Coloured disturbance w = (w_v, w_lat, w_vert) [m/s] (slot disturbance, default 0 and constant): what the speed,
 // lateral and vertical rows still see once the terms above are modelled is not white (suspension and terrain: on the
-// MuJoCo ATV 1/e correlation times of 0.5-1.8 s, tools/atv_odometer_residuals.py). Declared time-varying with a
+// MuJoCo ATV correlated over about a second, tools/atv_odometer_residuals.py). Declared time-varying with a
 // first-order Gauss-Markov process per component (EST.yaml: process {type: gauss_markov, sigma: [...], tau_s: [...]}),
 // w is one more state per pose that the IMU and the GPS can observe, instead of white noise that claims to average
 // out over a second; eta keeps the white part.
@@ -66,11 +63,11 @@
 // Why not the seed's form (ackermann_odometer.h, eqs. 7-8 with the readings as inputs): there the reading noise
 // passes through the nonlinear model, so the error covariance of eq. 1 depends on the parameters, and the
 // Gauss-Newton fixed point (which holds the covariance constant within an iteration) regresses the precise motion on
-// noisy readings: an errors-in-variables bias. With sensor noise on, the seed form estimates kv_over_L 0.5-0.7% low
-// (2-3 reported standard deviations on 12 s drives); here the noise is additive on the readings, the covariance is
-// constant, and the least-squares problem is the likelihood of the readings themselves.
+// noisy readings: an errors-in-variables bias. With sensor noise on, the seed form estimates kv_over_L low by more than
+// its reported standard deviation (tests/estimator/calibration_test.cc); here the noise is additive on the readings,
+// the covariance is constant, and the least-squares problem is the likelihood of the readings themselves.
 //
-// Longitudinal slip (issue 6, longitudinal_slip and slope_slip). A driven tire carries its traction force by slipping:
+// Longitudinal slip (the simulator's longitudinal_slip and slope_slip effects, sim/scenario.h). A driven tire carries its traction force by slipping:
 // the wheel turns faster than the ground passes, v_wheel = v (1 + s) with the slip ratio s growing with the force.
 // The recording has no force: the traction per unit mass is the forward specific force f_x = a_x + g sin(theta)
 // [m/s^2] (aerodynamic drag and rolling resistance aside), read from the IMU (an input of the factor, in O: the

@@ -1,5 +1,5 @@
 // The IMU's readings with a time offset delta of the IMU's clock (the slot time_offset_s of the gyroscope,
-// accelerometer and magnetometer models; issue 6, imu_time_offset): the reading stamped t is the sensor's quantity at
+// accelerometer and magnetometer models): the reading stamped t is the sensor's quantity at
 // t - delta (as the simulator's imu_time_offset effect, sim/scenario.h). The samples keep the poses they attach to
 // (problem.h); instead the reading is moved back to t to first order along the stream's own rate,
 //
@@ -23,9 +23,8 @@
 // so the moved reading carries an extra delta^2 var(z'), correlated between neighbouring samples; at 100 Hz and
 // W = 0.3 s (n = 30) std(z') = 0.73 sigma / s: 0.022 sigma at |delta| = 30 ms (+0.05 % of the variance), 0.07 sigma
 // at 0.1 s (+0.5 %). The slope's noise also biases delta towards zero (an error in the regressor: the estimate shrinks
-// by about var(z' true) / var(z' measured)): with W = 0.05 s (std(z') = 9.5 sigma / s) the synthetic ATV's -23 and
-// +31 ms came out as -5 and +7 ms with a reported std of 2 ms; W = 0.1, 0.15, 0.2, 0.3 s gave -14 / +19, -19 / +26,
-// -21 / +29, -23 / +31 ms (std 3.4 to 4.4 ms; tests/estimator/time_offset_test.cc).
+// by about var(z' true) / var(z' measured)): a narrow window (W = 0.05 s: std(z') = 9.5 sigma / s) shrinks the
+// estimate to a fraction of the offset, hence W = 0.3 s, as wide as the motion's bandwidth allows.
 #pragma once
 
 #include <array>

@@ -1,5 +1,5 @@
 // Three-axis magnetometer with hard/soft iron distortion, misalignment and motor interference. Seed 000, eq. 10,
-// with one added term (issue 6, magnetometer_motor_interference):
+// with one added term, the motor interference:
 //
 //   z_hat = A (q_O^W q_S^O)^-1 h^(W) + b + k tau_hat + eta,      e = z_hat - z           e, eta in R^3 [units of z]
 //   tau_hat = c e_x^T q_S^O f^(S)                                                         [N m]

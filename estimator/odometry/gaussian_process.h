@@ -1,8 +1,8 @@
 // Calibration via Gaussian-process regression, CGP (seed 001, Section III-A, Algorithm 1).
 //
 // The sensor motion model f: R^m -> R^3 maps the wheel rotations delta_jk over an interval to the exteroceptive
-// sensor's planar displacement s_jk = f(delta_jk) + eps_jk (eq. 1). f gets a GP prior with a diagonal 3x3 kernel
-// (DESIGN.md, "Notes on the seed's math"): each output i in {x, y, theta} is an independent scalar GP
+// sensor's planar displacement s_jk = f(delta_jk) + eps_jk (eq. 1). f gets a GP prior with a diagonal 3x3 kernel (the
+// seed's matrix-valued kernel restricted to its diagonal): each output i in {x, y, theta} is an independent scalar GP
 //
 //   f_i ~ GP(mu_i(x), k_i(x, x')),   mu_i(x) = 0 or c_i^T x  (eq. 6, c_i is row i of C)
 //   k_i = sf_i^2 exp(-1/2 sum_d (x_d - x'_d)^2 / l_id^2)      "rbf": eq. 7 with B_ii = diag(l_i^2)

@@ -68,8 +68,8 @@ TEST(CalibrationTest, RecoversSpeedGainWithinReportedUncertainty) {
 }
 
 // The seed's form of the Ackermann odometer (eqs. 7-8 with the noisy readings as inputs) is biased: averaged over
-// six noise realizations, kv_over_L lies more than 1.5 reported standard deviations below the truth (measured: -3.1),
-// while the measurement-space form used by default (ackermann_velocity.h) is unbiased (measured: -0.02). The test
+// six noise realizations, kv_over_L lies more than 1.5 reported standard deviations below the truth, while the
+// measurement-space form used by default (ackermann_velocity.h) is unbiased. The test
 // keeps both facts so that a change to either model shows.
 TEST(CalibrationTest, SeedFormOfAckermannOdometerIsBiasedAndMeasurementFormIsNot) {
   for (const std::string model : {"ackermann_seed", "ackermann"}) {

@@ -96,7 +96,7 @@ void ExpectModelJacobiansMatchNumeric(const Model& model, const std::vector<Eige
   ExpectNoiseJacobianMatchesNumeric(model, values);
 }
 
-// Small end-to-end solves (STYLE.md, Tests: one tiny end-to-end solve per error model).
+// Small end-to-end solves (one tiny end-to-end solve per error model).
 
 // Poses at t_k = k dt driven by a body twist (v, omega) held over each interval and composed as the seed's eq. 7
 // describes the motion: turn half-way at omega, move v dt along the body axes of that orientation, turn the rest.

@@ -243,7 +243,7 @@ TEST(ImportRosbagErrorTest, RefusesLz4ChunksOtherVersionsAndOtherFiles) {
   EXPECT_THAT(Import("hello", dir).rec.status().message(), HasSubstr("not a ROS bag"));
 }
 
-// The real Husky bag (../shared/data/husky_test1, see its README): counts, span and rates.
+// The real Husky bag (data/husky_test1 of the shared data directory): counts, span and rates.
 TEST(ImportRosbagRealTest, HuskyTest1) {
   const std::string path = std::string(ROAMLAB_SHARED_DIR) + "/data/husky_test1/test1.bag";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "real data absent: " << path;

@@ -1,4 +1,4 @@
-// The analytic Jacobians of the error models (their Linearize) against the jets, which stay the oracle (STYLE.md):
+// The analytic Jacobians of the error models (their Linearize) against the jets, which stay the oracle:
 // every block and the noise Jacobian to 1e-9 relative at seeded random points (plausible motions at dt = 0.01 s and a
 // few large rotations), the same error as operator(), and the same blocks when only some are requested. Also the
 // dispatch in AutoDiffFactor: a model with the hook is linearized by it, through Factor::Evaluate.
