@@ -2,7 +2,7 @@
 // pair, failure rate), without the estimator.
 //
 // A row stamped at t holds the camera's mean velocity over the frame pair [t - T/2, t + T/2], T = 1 / rate_hz, in
-// the camera frame C at the pair's start (sim/visual_odometry.h, step 5). The truth over the same interval: the poses
+// the camera frame C at the pair's start (frontend/visual_odometry.h, step 5). The truth over the same interval: the poses
 // of O interpolated at both ends (linear in position, slerp in orientation) and carried to C by the stream's mounting
 // (R_OC, p_OC):
 //   R_true = R_OC^T R_a^T R_b R_OC,   p_true = R_OC^T (R_a^T (p_b - p_a) + (R_a^T R_b - I) p_OC)

@@ -56,6 +56,7 @@
 
 #include "recording/internal/laser_scan.h"
 #include "recording/internal/stream_csv.h"
+#include "recording/internal/stream_types.h"
 #include "recording/internal/text_io.h"
 #include "recording/internal/yaml_util.h"
 
@@ -63,6 +64,30 @@ namespace roamlab::recording {
 namespace {
 
 namespace fs = std::filesystem;
+using internal::AcceptedUnits;
+using internal::AllFinite;
+using internal::ApplyConversion;
+using internal::CarriesCovariance;
+using internal::ColumnsWithCovariance;
+using internal::CovarianceNote;
+using internal::CovarianceProblem;
+using internal::FindUnitRow;
+using internal::FreeColumnsProblem;
+using internal::HasCovarianceColumns;
+using internal::HasFreeUnits;
+using internal::IntrinsicsProblem;
+using internal::IsIdentifier;
+using internal::JoinColumns;
+using internal::kGroundTruthFile;
+using internal::kYamlFile;
+using internal::kPi;
+using internal::NamedColumnsProblem;
+using internal::OriginProblem;
+using internal::RowOf;
+using internal::TypeRow;
+using internal::TypeTable;
+using internal::UnitConversion;
+using internal::UnitRow;
 using internal::CheckKeys;
 using internal::ReadNumber;
 using internal::ReadNumberList;
@@ -71,247 +96,6 @@ using internal::ReadString;
 using internal::ReadStringList;
 using internal::RequireKey;
 using internal::Where;
-
-constexpr const char* kYamlFile = "recording.yaml";
-constexpr const char* kGroundTruthFile = "ground_truth.tum";
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDegree = kPi / 180.0;       // rad per degree
-constexpr double kStandardGravity = 9.80665;  // m/s^2 per g
-
-// Stream types and units.
-
-struct TypeRow {
-  StreamType type;
-  const char* name;
-  std::vector<std::string> columns;  // empty: named in the stream entry
-};
-
-const std::vector<TypeRow>& TypeTable() {
-  static const std::vector<TypeRow> table = {
-      {StreamType::kImu, "imu", {"wx", "wy", "wz", "ax", "ay", "az"}},
-      {StreamType::kGyroscope, "gyroscope", {"wx", "wy", "wz"}},
-      {StreamType::kAccelerometer, "accelerometer", {"ax", "ay", "az"}},
-      {StreamType::kMagnetometer, "magnetometer", {"mx", "my", "mz"}},
-      {StreamType::kGps, "gps", {"latitude", "longitude", "altitude"}},
-      {StreamType::kPosition, "position", {"x", "y", "z"}},
-      {StreamType::kPose, "pose", {"x", "y", "z", "qx", "qy", "qz", "qw"}},
-      {StreamType::kWheelEncoders, "wheel_encoders", {}},
-      {StreamType::kSteering, "steering", {"angle"}},
-      {StreamType::kOdometry, "odometry", {"vx", "vy", "vz", "wx", "wy", "wz"}},
-      {StreamType::kVisualOdometry, "visual_odometry", {"vx", "vy", "vz", "wx", "wy", "wz"}},
-      {StreamType::kScanMatching, "scan_matching", {"vx", "vy", "vz", "wx", "wy", "wz"}},
-      {StreamType::kCamera, "camera", {"frame"}},
-      {StreamType::kInputs, "inputs", {}},
-      {StreamType::kLaserScan, "laser_scan", {}},
-  };
-  return table;
-}
-
-const TypeRow& RowOf(StreamType type) {
-  for (const TypeRow& row : TypeTable()) {
-    if (row.type == type) return row;
-  }
-  ROAMLAB_CHECK(false, "stream type " << static_cast<int>(type) << " missing from the type table");
-}
-
-// The types whose fixed columns may be followed by the covariance columns: the velocity types (6x6) and gps (3x3).
-bool HasCovarianceColumns(StreamType type) {
-  return type == StreamType::kOdometry || type == StreamType::kVisualOdometry || type == StreamType::kScanMatching ||
-         type == StreamType::kGps;
-}
-
-// Fixed columns followed by the covariance columns (HasCovarianceColumns types only).
-std::vector<std::string> ColumnsWithCovariance(StreamType type) {
-  std::vector<std::string> columns = FixedColumns(type);
-  const std::vector<std::string>& covariance = CovarianceColumns(type);
-  columns.insert(columns.end(), covariance.begin(), covariance.end());
-  return columns;
-}
-
-// " (optionally followed by the N covariance columns)" for the types that may carry them, else "".
-std::string CovarianceNote(StreamType type) {
-  if (!HasCovarianceColumns(type)) return "";
-  return " (optionally followed by the " + std::to_string(CovarianceColumns(type).size()) + " covariance columns)";
-}
-
-bool CarriesCovariance(const StreamInfo& info) {
-  return HasCovarianceColumns(info.type) && info.columns == ColumnsWithCovariance(info.type);
-}
-
-// Camera intrinsics in the attributes of camera and visual_odometry streams: all six or none; "" when fine.
-std::string IntrinsicsProblem(const StreamInfo& info) {
-  if (info.type != StreamType::kCamera && info.type != StreamType::kVisualOdometry) return "";
-  static const char* const kKeys[] = {"width_px", "height_px", "fx_px", "fy_px", "cx_px", "cy_px"};
-  int present = 0;
-  for (const char* key : kKeys) present += static_cast<int>(info.attributes.count(key));
-  if (present == 0) return "";
-  for (const char* key : kKeys) {
-    if (!info.attributes.count(key)) {
-      return std::string("camera intrinsics need all of width_px, height_px, fx_px, fy_px, cx_px, cy_px (") + key +
-             " is missing)";
-    }
-  }
-  const auto& a = info.attributes;
-  const double width = a.at("width_px");
-  const double height = a.at("height_px");
-  if (!(width >= 1.0 && height >= 1.0) || width != std::floor(width) || height != std::floor(height)) {
-    return "camera intrinsics: width_px and height_px must be positive integers";
-  }
-  if (!(a.at("fx_px") > 0.0 && a.at("fy_px") > 0.0)) return "camera intrinsics: fx_px and fy_px must be positive";
-  if (!(a.at("cx_px") >= 0.0 && a.at("cx_px") < width && a.at("cy_px") >= 0.0 && a.at("cy_px") < height)) {
-    return "camera intrinsics: the principal point (cx_px, cy_px) must lie inside the image";
-  }
-  return "";
-}
-
-// Problem with the covariance columns of a stream's values (a negative diagonal entry) as "<line>: <problem>" for the
-// first bad row, or "" when fine. Row i is on line i + 2 of its file (after the header).
-std::string CovarianceProblem(const Stream& stream) {
-  if (!CarriesCovariance(stream.info)) return "";
-  const Eigen::Index fixed = static_cast<Eigen::Index>(FixedColumns(stream.info.type).size());
-  const std::vector<std::string>& names = CovarianceColumns(stream.info.type);
-  for (Eigen::Index row = 0; row < stream.values.rows(); ++row) {
-    // The diagonal of an n x n upper triangle stored row by row: 6x6 entries 0, 6, 11, 15, 18, 20; 3x3: 0, 3, 5.
-    const Eigen::Index n = stream.info.type == StreamType::kGps ? 3 : 6;
-    Eigen::Index index = 0;
-    for (Eigen::Index k = 0; k < n; index += n - k, ++k) {
-      if (stream.values(row, fixed + index) < 0.0) {
-        return std::to_string(row + 2) + ": " + names[static_cast<std::size_t>(index)] + " is negative";
-      }
-    }
-  }
-  return "";
-}
-
-// Types whose `units:` is free text, kept as given.
-bool HasFreeUnits(StreamType type) { return type == StreamType::kInputs || type == StreamType::kCamera; }
-
-// One accepted `units:` value of a type: what info.units becomes after reading, and the factors to canonical units
-// for the first three columns and for the others (they differ for imu only). `ticks` takes its factor from
-// attributes.ticks_per_revolution instead.
-struct UnitRow {
-  StreamType type;
-  const char* declared;
-  const char* canonical;
-  double first;
-  double rest;
-  bool ticks;
-};
-
-constexpr UnitRow kUnitTable[] = {
-    {StreamType::kImu, "", "rad/s,m/s^2", 1.0, 1.0, false},
-    {StreamType::kImu, "rad/s,m/s^2", "rad/s,m/s^2", 1.0, 1.0, false},
-    {StreamType::kImu, "deg/s,m/s^2", "rad/s,m/s^2", kDegree, 1.0, false},
-    {StreamType::kImu, "rad/s,g", "rad/s,m/s^2", 1.0, kStandardGravity, false},
-    {StreamType::kImu, "deg/s,g", "rad/s,m/s^2", kDegree, kStandardGravity, false},
-    {StreamType::kGyroscope, "", "rad/s", 1.0, 1.0, false},
-    {StreamType::kGyroscope, "rad/s", "rad/s", 1.0, 1.0, false},
-    {StreamType::kGyroscope, "deg/s", "rad/s", kDegree, kDegree, false},
-    {StreamType::kAccelerometer, "", "m/s^2", 1.0, 1.0, false},
-    {StreamType::kAccelerometer, "m/s^2", "m/s^2", 1.0, 1.0, false},
-    {StreamType::kAccelerometer, "g", "m/s^2", kStandardGravity, kStandardGravity, false},
-    {StreamType::kMagnetometer, "", "", 1.0, 1.0, false},
-    {StreamType::kMagnetometer, "normalized", "normalized", 1.0, 1.0, false},
-    {StreamType::kMagnetometer, "uT", "uT", 1.0, 1.0, false},
-    {StreamType::kMagnetometer, "nT", "nT", 1.0, 1.0, false},
-    {StreamType::kMagnetometer, "gauss", "gauss", 1.0, 1.0, false},
-    {StreamType::kGps, "", "deg", 1.0, 1.0, false},
-    {StreamType::kGps, "deg", "deg", 1.0, 1.0, false},
-    {StreamType::kPosition, "", "m", 1.0, 1.0, false},
-    {StreamType::kPosition, "m", "m", 1.0, 1.0, false},
-    {StreamType::kPose, "", "m", 1.0, 1.0, false},
-    {StreamType::kPose, "m", "m", 1.0, 1.0, false},
-    {StreamType::kWheelEncoders, "", "rad", 1.0, 1.0, false},
-    {StreamType::kWheelEncoders, "rad", "rad", 1.0, 1.0, false},
-    {StreamType::kWheelEncoders, "rad/s", "rad/s", 1.0, 1.0, false},
-    {StreamType::kWheelEncoders, "m/s", "m/s", 1.0, 1.0, false},
-    {StreamType::kWheelEncoders, "ticks", "rad", 1.0, 1.0, true},
-    {StreamType::kSteering, "", "rad", 1.0, 1.0, false},
-    {StreamType::kSteering, "rad", "rad", 1.0, 1.0, false},
-    {StreamType::kSteering, "deg", "rad", kDegree, kDegree, false},
-    {StreamType::kOdometry, "", "m/s,rad/s", 1.0, 1.0, false},
-    {StreamType::kOdometry, "m/s,rad/s", "m/s,rad/s", 1.0, 1.0, false},
-    {StreamType::kVisualOdometry, "", "m/s,rad/s", 1.0, 1.0, false},
-    {StreamType::kVisualOdometry, "m/s,rad/s", "m/s,rad/s", 1.0, 1.0, false},
-    {StreamType::kScanMatching, "", "m/s,rad/s", 1.0, 1.0, false},
-    {StreamType::kScanMatching, "m/s,rad/s", "m/s,rad/s", 1.0, 1.0, false},
-    {StreamType::kLaserScan, "", "rad,m", 1.0, 1.0, false},
-    {StreamType::kLaserScan, "rad,m", "rad,m", 1.0, 1.0, false},
-};
-
-const UnitRow* FindUnitRow(StreamType type, const std::string& declared) {
-  for (const UnitRow& row : kUnitTable) {
-    if (row.type == type && declared == row.declared) return &row;
-  }
-  return nullptr;
-}
-
-// "deg/s, rad/s" for messages.
-std::string AcceptedUnits(StreamType type) {
-  std::string list;
-  for (const UnitRow& row : kUnitTable) {
-    if (row.type != type || *row.declared == '\0') continue;
-    list += (list.empty() ? "" : " | ") + std::string(row.declared);
-  }
-  return list;
-}
-
-// How to bring a stream file to canonical units: multiply the first three columns by `first`, the others by `rest`.
-struct UnitConversion {
-  double first = 1.0;
-  double rest = 1.0;
-};
-
-void ApplyConversion(const UnitConversion& conversion, Eigen::MatrixXd* values) {
-  const Eigen::Index split = std::min<Eigen::Index>(3, values->cols());
-  if (conversion.first != 1.0) values->leftCols(split) *= conversion.first;
-  if (conversion.rest != 1.0) values->rightCols(values->cols() - split) *= conversion.rest;
-}
-
-// Small checks shared by the reader and the writer.
-
-bool IsIdentifier(const std::string& name) {
-  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
-    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
-  });
-}
-
-bool AllFinite(const std::map<std::string, double>& values) {
-  return std::all_of(values.begin(), values.end(), [](const auto& item) { return std::isfinite(item.second); });
-}
-
-std::string JoinColumns(const std::vector<std::string>& columns) {
-  std::string text = "[";
-  for (std::size_t i = 0; i < columns.size(); ++i) text += (i > 0 ? ", " : "") + columns[i];
-  return text + "]";
-}
-
-// Problem with the columns named for a wheel_encoders or inputs stream, or "" when they are fine.
-std::string FreeColumnsProblem(const std::vector<std::string>& columns) {
-  if (columns.empty()) return "needs at least one column";
-  std::set<std::string> seen;
-  for (const std::string& column : columns) {
-    if (!IsIdentifier(column) || column == "t") return "invalid column name '" + column + "'";
-    if (!seen.insert(column).second) return "duplicate column '" + column + "'";
-  }
-  return "";
-}
-
-// Problem with the columns named in the entry of a stream whose type fixes none, or "" when they are fine.
-std::string NamedColumnsProblem(StreamType type, const std::vector<std::string>& columns) {
-  if (type == StreamType::kLaserScan) return internal::LaserScanColumnsProblem(columns);
-  return FreeColumnsProblem(columns);
-}
-
-// Problem with an origin, or "" when it is fine.
-std::string OriginProblem(const GeodeticOrigin& origin) {
-  if (!std::isfinite(origin.latitude_deg) || std::abs(origin.latitude_deg) > 90.0) return "latitude_deg out of range";
-  if (!std::isfinite(origin.longitude_deg) || std::abs(origin.longitude_deg) > 180.0) {
-    return "longitude_deg out of range";
-  }
-  if (!std::isfinite(origin.altitude_m)) return "altitude_m is not finite";
-  return "";
-}
 
 // Reading recording.yaml.
 
@@ -582,203 +366,6 @@ Status ReadStreamFile(const fs::path& directory, const UnitConversion& conversio
   return problem.empty() ? Status::Ok() : Status::Error(path + ":" + problem);
 }
 
-// Validation before writing: refuse what the reader would refuse, so that every written recording reads back.
-
-// Units the writer may write for a type: empty, or a canonical (non-converting) value.
-bool WritableUnits(StreamType type, const std::string& units) {
-  if (units.empty() || HasFreeUnits(type)) return true;
-  const UnitRow* row = FindUnitRow(type, units);
-  return row != nullptr && units == row->canonical;
-}
-
-// Columns written for a stream: the fixed ones of its type (with the covariance columns when it carries them), or
-// the named ones.
-const std::vector<std::string>& WrittenColumns(const StreamInfo& info) {
-  const std::vector<std::string>& fixed = FixedColumns(info.type);
-  return fixed.empty() || CarriesCovariance(info) ? info.columns : fixed;
-}
-
-Status ValidateInfoForWrite(const StreamInfo& info, const std::string& prefix) {
-  if (!IsIdentifier(info.name)) return Status::Error(prefix + "invalid stream name (use [A-Za-z0-9_]+)");
-  if (!(info.rate_hz > 0.0) || !std::isfinite(info.rate_hz)) return Status::Error(prefix + "rate_hz must be positive");
-  // Columns: as fixed by the type (or left empty), or named validly.
-  const std::vector<std::string>& fixed = FixedColumns(info.type);
-  if (!fixed.empty() && !info.columns.empty() && info.columns != fixed && !CarriesCovariance(info)) {
-    return Status::Error(prefix + "columns " + JoinColumns(info.columns) + " do not match type " +
-                         StreamTypeName(info.type) + ": expected " + JoinColumns(fixed) +
-                         CovarianceNote(info.type));
-  }
-  if (fixed.empty()) {
-    const std::string problem = NamedColumnsProblem(info.type, info.columns);
-    if (!problem.empty()) return Status::Error(prefix + problem);
-  }
-  // Units, mounting, noise and attributes.
-  if (!WritableUnits(info.type, info.units)) {
-    return Status::Error(prefix + "units '" + info.units + "' are not canonical for type " + StreamTypeName(info.type) +
-                         " (values are held in canonical units)");
-  }
-  if (info.mounting && (!info.mounting->p_body_sensor.allFinite() ||
-                        !(std::abs(info.mounting->q_body_sensor.norm() - 1.0) < internal::kQuaternionNormTolerance))) {
-    return Status::Error(prefix + "mounting has a non-finite lever arm or a non-unit quaternion");
-  }
-  if (!AllFinite(info.noise) || !AllFinite(info.attributes)) {
-    return Status::Error(prefix + "noise and attributes must be finite");
-  }
-  const std::string problem = IntrinsicsProblem(info);
-  return problem.empty() ? Status::Ok() : Status::Error(prefix + problem);
-}
-
-// Camera frame names must survive the CSV: non-empty, no comma or line break, no surrounding blanks.
-bool IsWritableText(const std::string& text) {
-  return !text.empty() && text.find_first_of(",\n\r") == std::string::npos && internal::Trim(text) == text;
-}
-
-Status ValidateDataForWrite(const Stream& stream, const std::string& prefix) {
-  const std::size_t n = stream.t.size();
-  const Eigen::Index rows = stream.values.rows();
-  // Sizes: a numeric stream has one value per column and sample, a camera stream one text per sample.
-  if (stream.info.type == StreamType::kCamera) {
-    if (stream.values.cols() != 0 || (rows != 0 && static_cast<std::size_t>(rows) != n) || stream.text.size() != n) {
-      return Status::Error(prefix + "a camera stream needs one text per sample and no values");
-    }
-    for (std::size_t i = 0; i < n; ++i) {
-      if (!IsWritableText(stream.text[i])) {
-        return Status::Error(prefix + "sample " + std::to_string(i) + ": frame name '" + stream.text[i] +
-                             "' is empty or holds a comma, line break or surrounding blank");
-      }
-    }
-  } else {
-    const std::size_t cols = WrittenColumns(stream.info).size();
-    if (static_cast<std::size_t>(stream.values.cols()) != cols) {
-      return Status::Error(prefix + "values have " + std::to_string(stream.values.cols()) + " columns, expected " +
-                           std::to_string(cols) + " " + JoinColumns(WrittenColumns(stream.info)));
-    }
-    if (static_cast<std::size_t>(rows) != n) {
-      return Status::Error(prefix + "values have " + std::to_string(rows) + " rows for " + std::to_string(n) +
-                           " timestamps");
-    }
-    if (!stream.text.empty()) return Status::Error(prefix + "text is only for camera streams");
-    if (!stream.values.allFinite()) return Status::Error(prefix + "values contain NaN or Inf");
-    std::string problem = CovarianceProblem(stream);
-    if (problem.empty()) problem = internal::LaserScanRowsProblem(stream);
-    if (!problem.empty()) return Status::Error(prefix + "row " + problem);
-  }
-  // Time strictly increasing.
-  for (std::size_t i = 1; i < n; ++i) {
-    if (stream.t[i] <= stream.t[i - 1]) {
-      return Status::Error(prefix + "sample " + std::to_string(i) + ": " +
-                           internal::TimeOrderProblem(stream.t[i - 1], stream.t[i]));
-    }
-  }
-  return Status::Ok();
-}
-
-Status ValidateForWrite(const Recording& recording, const std::string& directory) {
-  const std::string prefix = directory + ": ";
-  // Metadata.
-  if (recording.format_version != kFormatVersion) return Status::Error(prefix + "format_version must be 1");
-  if (recording.platform.kind.empty()) return Status::Error(prefix + "platform.kind is empty");
-  if (!AllFinite(recording.platform.geometry)) return Status::Error(prefix + "platform.geometry must be finite");
-  if (recording.origin) {
-    const std::string problem = OriginProblem(*recording.origin);
-    if (!problem.empty()) return Status::Error(prefix + "origin: " + problem);
-  }
-  const Provenance& provenance = recording.provenance;
-  if (provenance.source.empty() &&
-      (!provenance.scenario.empty() || provenance.seed || !provenance.description.empty())) {
-    return Status::Error(prefix + "provenance.source is empty");
-  }
-  // Streams: unique names, valid metadata and data, an origin for gps.
-  std::set<std::string> names;
-  for (const Stream& stream : recording.streams) {
-    const std::string stream_prefix = prefix + "stream '" + stream.info.name + "': ";
-    if (!names.insert(stream.info.name).second) {
-      return Status::Error(prefix + "duplicate stream name '" + stream.info.name + "'");
-    }
-    if (Status s = ValidateInfoForWrite(stream.info, stream_prefix); !s.ok()) return s;
-    if (Status s = ValidateDataForWrite(stream, stream_prefix); !s.ok()) return s;
-    if (stream.info.type == StreamType::kGps && !recording.origin) {
-      return Status::Error(stream_prefix + "type gps needs an origin");
-    }
-  }
-  return Status::Ok();
-}
-
-// Writing recording.yaml.
-
-void EmitStreamInfo(const StreamInfo& info, YAML::Emitter* out) {
-  *out << YAML::BeginMap;
-  *out << YAML::Key << "name" << YAML::Value << info.name;
-  *out << YAML::Key << "type" << YAML::Value << StreamTypeName(info.type);
-  *out << YAML::Key << "rate_hz" << YAML::Value;
-  internal::EmitNumber(info.rate_hz, out);
-  if (!info.units.empty()) *out << YAML::Key << "units" << YAML::Value << info.units;
-  *out << YAML::Key << "columns" << YAML::Value;
-  internal::EmitStringList(WrittenColumns(info), out);
-  if (info.mounting) {
-    const Eigen::Vector3d& p = info.mounting->p_body_sensor;
-    const Eigen::Quaterniond& q = info.mounting->q_body_sensor;
-    *out << YAML::Key << "mounting" << YAML::Value << YAML::Flow << YAML::BeginMap;
-    *out << YAML::Key << "p_body_sensor_m" << YAML::Value;
-    internal::EmitNumberList({p.x(), p.y(), p.z()}, out);
-    *out << YAML::Key << "q_body_sensor_wxyz" << YAML::Value;
-    internal::EmitNumberList({q.w(), q.x(), q.y(), q.z()}, out);
-    *out << YAML::EndMap;
-  }
-  if (!info.noise.empty()) {
-    *out << YAML::Key << "noise" << YAML::Value;
-    internal::EmitNumberMap(info.noise, out);
-  }
-  if (!info.attributes.empty()) {
-    *out << YAML::Key << "attributes" << YAML::Value;
-    internal::EmitNumberMap(info.attributes, out);
-  }
-  *out << YAML::EndMap;
-}
-
-std::string EmitRecordingYaml(const Recording& recording) {
-  YAML::Emitter out;
-  out << YAML::BeginMap;
-  out << YAML::Key << "format_version" << YAML::Value << recording.format_version;
-  // Platform.
-  out << YAML::Key << "platform" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "kind" << YAML::Value << recording.platform.kind;
-  if (!recording.platform.geometry.empty()) {
-    out << YAML::Key << "geometry" << YAML::Value;
-    internal::EmitNumberMap(recording.platform.geometry, &out);
-  }
-  out << YAML::EndMap;
-  // Origin.
-  if (recording.origin) {
-    out << YAML::Key << "origin" << YAML::Value << YAML::Flow << YAML::BeginMap;
-    out << YAML::Key << "latitude_deg" << YAML::Value;
-    internal::EmitNumber(recording.origin->latitude_deg, &out);
-    out << YAML::Key << "longitude_deg" << YAML::Value;
-    internal::EmitNumber(recording.origin->longitude_deg, &out);
-    out << YAML::Key << "altitude_m" << YAML::Value;
-    internal::EmitNumber(recording.origin->altitude_m, &out);
-    out << YAML::EndMap;
-  }
-  // Provenance.
-  const Provenance& provenance = recording.provenance;
-  if (!provenance.source.empty()) {
-    out << YAML::Key << "provenance" << YAML::Value << YAML::BeginMap;
-    out << YAML::Key << "source" << YAML::Value << provenance.source;
-    if (!provenance.scenario.empty()) out << YAML::Key << "scenario" << YAML::Value << provenance.scenario;
-    if (provenance.seed) out << YAML::Key << "seed" << YAML::Value << std::to_string(*provenance.seed);
-    if (!provenance.description.empty()) out << YAML::Key << "description" << YAML::Value << provenance.description;
-    out << YAML::EndMap;
-  }
-  // Streams.
-  out << YAML::Key << "streams" << YAML::Value;
-  if (recording.streams.empty()) out << YAML::Flow;  // "[]" on the same line
-  out << YAML::BeginSeq;
-  for (const Stream& stream : recording.streams) EmitStreamInfo(stream.info, &out);
-  out << YAML::EndSeq;
-  out << YAML::EndMap;
-  return std::string(out.c_str()) + "\n";
-}
-
 }  // namespace
 
 // Public interface.
@@ -851,34 +438,6 @@ Result<Recording> ReadRecording(const std::string& directory, const ReadOptions&
     recording.ground_truth = std::move(ground_truth).value();
   }
   return recording;
-}
-
-Status WriteRecording(const Recording& recording, const std::string& directory) {
-  // Validate everything first: nothing is written for a recording that would not read back.
-  if (Status s = ValidateForWrite(recording, directory); !s.ok()) return s;
-  const fs::path dir(directory);
-  std::error_code error;
-  fs::create_directories(dir, error);
-  if (error) return Status::Error(directory + ": cannot create directory: " + error.message());
-  // Stream files.
-  for (const Stream& stream : recording.streams) {
-    const std::string path = (dir / (stream.info.name + ".csv")).string();
-    const bool camera = stream.info.type == StreamType::kCamera;
-    const Eigen::MatrixXd no_values(static_cast<Eigen::Index>(stream.t.size()), 0);
-    const std::string text = internal::FormatStreamCsv(
-        WrittenColumns(stream.info), stream.t, camera ? no_values : stream.values, camera ? &stream.text : nullptr);
-    if (Status s = internal::WriteTextFile(path, text); !s.ok()) return s;
-  }
-  // Ground truth; a stale file from an earlier recording in the same directory is removed.
-  const fs::path ground_truth_path = dir / kGroundTruthFile;
-  if (recording.ground_truth) {
-    if (Status s = WriteTum(*recording.ground_truth, ground_truth_path.string()); !s.ok()) return s;
-  } else {
-    fs::remove(ground_truth_path, error);
-    if (error) return Status::Error(ground_truth_path.string() + ": cannot remove stale file: " + error.message());
-  }
-  // recording.yaml last: an interrupted write leaves a directory that does not read as a recording.
-  return internal::WriteTextFile((dir / kYamlFile).string(), EmitRecordingYaml(recording));
 }
 
 }  // namespace roamlab::recording

@@ -16,7 +16,7 @@
 // at delta = 0 the plain model exactly. The pairing of the IMU's samples with the other streams' never changes and
 // the chi-square is smooth in delta. Errors: the second-order remainder delta^2 z'' / 2 (a few master periods at the
 // motion's bandwidth; beyond 0.1 s the diagnosis searches the offset on a grid of whole-master-period stamp
-// shifts instead, gap/diagnose.cc), the slope's smoothing (a line over +-W passes a sine of angular frequency w
+// shifts instead, gap/time_shift.cc), the slope's smoothing (a line over +-W passes a sine of angular frequency w
 // at about 1 - (w W)^2 / 10), and the slope's noise. A symmetric line fit over 2n + 1 samples at rate f (n = W f)
 // leaves the middle sample's own noise out and has
 //   var(z') = 3 f^2 sigma^2 / (n (n + 1) (2n + 1)),

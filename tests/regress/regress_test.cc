@@ -204,8 +204,8 @@ TEST_F(RegressTest, OpenTargetsAndAbsentDataDoNotFailTheRun) {
   const std::string path = dir_->File("suite_open.yaml");
   testing::WriteFile(path, "cases:\n  - name: synthetic_track\n    mode: track\n    recording: rec\n"
                            "    config: good.yaml\n    checks:\n"
-                           "      - {metric: summary.poses, bound: \"<= 1\", open: \"issue 99 target, not met yet\"}\n"
-                           "      - {metric: summary.poses, bound: \">= 100\", open: \"issue 99 target\"}\n"
+                           "      - {metric: summary.poses, bound: \"<= 1\", open: \"speed target, not met yet\"}\n"
+                           "      - {metric: summary.poses, bound: \">= 100\", open: \"speed target\"}\n"
                            "      - {metric: metrics.rpe_trans_m, bound: \"<= 2 * metrics.ate_m + 1\"}\n"
                            "  - name: real_data\n    mode: track\n    data: no_such_directory\n"
                            "    recording: no_such_directory/rec\n    config: good.yaml\n    checks:\n"
@@ -214,14 +214,14 @@ TEST_F(RegressTest, OpenTargetsAndAbsentDataDoNotFailTheRun) {
   const json results = ReadJson(dir_->File("out_open/results.json"));
   const json& checks = results["cases"][0]["checks"];
   EXPECT_EQ(checks[0]["result"], "open");
-  EXPECT_NE(checks[0]["message"].get<std::string>().find("issue 99 target, not met yet"), std::string::npos);
+  EXPECT_NE(checks[0]["message"].get<std::string>().find("speed target, not met yet"), std::string::npos);
   EXPECT_EQ(checks[1]["result"], "open met");
   EXPECT_EQ(checks[2]["result"], "passed");
   EXPECT_TRUE(checks[2]["threshold"].is_number());
   EXPECT_EQ(results["cases"][1]["checks"][0]["result"], "skipped");
   EXPECT_NE(results["cases"][1]["skipped"].get<std::string>().find("no_such_directory"), std::string::npos);
   const std::string junit = testing::ReadFile(dir_->File("out_open/junit.xml"));
-  EXPECT_NE(junit.find("<skipped message=\"open target not met (issue 99 target, not met yet): value "),
+  EXPECT_NE(junit.find("<skipped message=\"open target not met (speed target, not met yet): value "),
             std::string::npos)
       << junit;
   EXPECT_NE(junit.find("violates bound &apos;&lt;= 1&apos;\"/>"), std::string::npos) << junit;

@@ -160,11 +160,11 @@ TEST(JunitTest, OpenTargetsAndSkippedCasesAreSkippedTestcases) {
   a.mode = "calibrate";
   CheckResult open{"metrics.ate_m", "<= 0.1", 0.25, std::nullopt, 0.1, CheckResult::Outcome::kOpen, "",
                    std::nullopt, ""};
-  open.open = "issue 3 target, not met yet";
+  open.open = "calibration target, not met yet";
   open.message = "open target not met (" + open.open + "): " + FailureMessage(open);
   CheckResult met{"metrics.rpe_trans_m", "<= 0.5", 0.25, std::nullopt, 0.5, CheckResult::Outcome::kPassed, "",
                   std::nullopt, ""};
-  met.open = "issue 3 target";
+  met.open = "calibration target";
   CheckResult text{"gap.verdict", "equals named", std::nullopt, std::nullopt, std::nullopt,
                    CheckResult::Outcome::kFailed, "", std::nullopt, ""};
   text.text = "unknown";
@@ -182,15 +182,15 @@ TEST(JunitTest, OpenTargetsAndSkippedCasesAreSkippedTestcases) {
   EXPECT_EQ(XmlChecker(xml).Check(), "") << xml;
   EXPECT_EQ(Occurrences(xml, "<testcase "), 4u);
   EXPECT_NE(xml.find("tests=\"4\" failures=\"1\" errors=\"0\" skipped=\"2\""), std::string::npos) << xml;
-  EXPECT_NE(xml.find("<skipped message=\"open target not met (issue 3 target, not met yet): value 0.25 violates "
+  EXPECT_NE(xml.find("<skipped message=\"open target not met (calibration target, not met yet): value 0.25 violates "
                      "bound &apos;&lt;= 0.1&apos;\"/>"),
             std::string::npos)
       << xml;
-  EXPECT_NE(xml.find("<system-out>open target met (issue 3 target)"), std::string::npos) << xml;
+  EXPECT_NE(xml.find("<system-out>open target met (calibration target)"), std::string::npos) << xml;
   EXPECT_NE(xml.find("<skipped message=\"case skipped: data directory /x is absent\"/>"), std::string::npos) << xml;
   const nlohmann::json j = ResultsJson(r);
   EXPECT_EQ(j["cases"][0]["checks"][0]["result"], "open");
-  EXPECT_EQ(j["cases"][0]["checks"][0]["open"], "issue 3 target, not met yet");
+  EXPECT_EQ(j["cases"][0]["checks"][0]["open"], "calibration target, not met yet");
   EXPECT_EQ(j["cases"][0]["checks"][1]["result"], "open met");
   EXPECT_EQ(j["cases"][0]["checks"][2]["value"], "unknown");
   EXPECT_EQ(j["cases"][1]["skipped"], b.skipped);

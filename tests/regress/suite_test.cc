@@ -110,7 +110,7 @@ TEST_F(SuiteTest, LoadsOdometryAndDiagnoseCasesWithSelectorsTextsAndOpenTargets)
       "    test: [\"diff/circular/*.csv\"]\n    interval_s: 0.25\n"
       "    models: [{model: linear}, {model: gp, mean: linear, kernel: rbf+linear}]\n    checks:\n"
       "      - {metric: \"table.rows[model=gp,mean=linear,kernel=rbf+linear].ate_m\",\n"
-      "         bound: \"<= 0.5 * table.rows[model=nominal].ate_m\", open: \"issue 5 target\"}\n"
+      "         bound: \"<= 0.5 * table.rows[model=nominal].ate_m\", open: \"odometry target\"}\n"
       "      - {metric: table.rows.ate_m.max, bound: \"<= 1\"}\n"
       "  - name: gap\n    mode: diagnose\n    scenario: " + Scenario("atv_hills.yaml") + "\n    seed: 13\n"
       "    effects: [{name: steering_offset, offset_rad: 0.03}]\n    checks:\n"
@@ -129,7 +129,7 @@ TEST_F(SuiteTest, LoadsOdometryAndDiagnoseCasesWithSelectorsTextsAndOpenTargets)
   EXPECT_EQ(ratio.metric.keys, (std::vector<std::string>{"rows", "ate_m"}));
   EXPECT_EQ(ratio.metric.select.at(0),
             (Selector{{"model", "gp"}, {"mean", "linear"}, {"kernel", "rbf+linear"}}));
-  EXPECT_EQ(ratio.open, "issue 5 target");
+  EXPECT_EQ(ratio.open, "odometry target");
   ASSERT_TRUE(ratio.reference.has_value());
   EXPECT_EQ(ratio.reference->select.at(0), (Selector{{"model", "nominal"}}));
   EXPECT_DOUBLE_EQ(ratio.bound.Threshold(0.1), 0.05);
