@@ -64,38 +64,8 @@ namespace roamlab::recording {
 namespace {
 
 namespace fs = std::filesystem;
-using internal::AcceptedUnits;
-using internal::AllFinite;
-using internal::ApplyConversion;
-using internal::CarriesCovariance;
-using internal::ColumnsWithCovariance;
-using internal::CovarianceNote;
-using internal::CovarianceProblem;
-using internal::FindUnitRow;
-using internal::FreeColumnsProblem;
-using internal::HasCovarianceColumns;
-using internal::HasFreeUnits;
-using internal::IntrinsicsProblem;
-using internal::IsIdentifier;
-using internal::JoinColumns;
-using internal::kGroundTruthFile;
-using internal::kYamlFile;
-using internal::kPi;
-using internal::NamedColumnsProblem;
-using internal::OriginProblem;
-using internal::RowOf;
-using internal::TypeRow;
-using internal::TypeTable;
-using internal::UnitConversion;
-using internal::UnitRow;
-using internal::CheckKeys;
-using internal::ReadNumber;
-using internal::ReadNumberList;
-using internal::ReadNumberMap;
-using internal::ReadString;
-using internal::ReadStringList;
-using internal::RequireKey;
-using internal::Where;
+// The format's tables and the parsing helpers (recording/internal/).
+using namespace internal;
 
 // Reading recording.yaml.
 

@@ -20,27 +20,8 @@ namespace roamlab::recording {
 namespace {
 
 namespace fs = std::filesystem;
-using internal::AcceptedUnits;
-using internal::AllFinite;
-using internal::ApplyConversion;
-using internal::CarriesCovariance;
-using internal::ColumnsWithCovariance;
-using internal::CovarianceNote;
-using internal::CovarianceProblem;
-using internal::FindUnitRow;
-using internal::FreeColumnsProblem;
-using internal::HasCovarianceColumns;
-using internal::HasFreeUnits;
-using internal::IntrinsicsProblem;
-using internal::IsIdentifier;
-using internal::JoinColumns;
-using internal::kGroundTruthFile;
-using internal::kYamlFile;
-using internal::NamedColumnsProblem;
-using internal::OriginProblem;
-using internal::RowOf;
-using internal::UnitConversion;
-using internal::UnitRow;
+// The format's tables and the parsing helpers (recording/internal/).
+using namespace internal;
 
 // Validation before writing: refuse what the reader would refuse, so that every written recording reads back.
 
