@@ -11,16 +11,16 @@ namespace roamlab::apps {
 
 // The step's request (without progress, which the command sets).
 struct CalibrateArgs : experiment::CalibrateRequest {
-  bool quiet = false;            // no progress and no summary
-  std::ostream* err = nullptr;   // receives the one-line error; nullptr: stderr
+  bool quiet = false;           // no progress and no summary
+  std::ostream* err = nullptr;  // receives the one-line error; nullptr: stderr
 };
 // Offline self-calibration: writes OUT/calibration.json and OUT/trajectory.tum.
 int RunCalibrate(const CalibrateArgs& args);
 
 // The step's request (without progress, which the command sets; no_time_budget is not an option of the command).
 struct TrackArgs : experiment::TrackRequest {
-  bool quiet = false;            // no progress and no summary
-  std::ostream* err = nullptr;   // receives the one-line error; nullptr: stderr
+  bool quiet = false;           // no progress and no summary
+  std::ostream* err = nullptr;  // receives the one-line error; nullptr: stderr
 };
 // Online fixed-lag tracking: writes OUT/trajectory.tum, OUT/covariance.csv and OUT/summary.json.
 int RunTrack(const TrackArgs& args);

@@ -11,8 +11,8 @@ namespace roamlab::apps {
 
 // The step's request (without progress, which the command sets).
 struct DiagnoseArgs : experiment::DiagnoseRequest {
-  bool quiet = false;                    // no progress and no summary
-  std::ostream* err = nullptr;           // receives the one-line error; nullptr: stderr
+  bool quiet = false;           // no progress and no summary
+  std::ostream* err = nullptr;  // receives the one-line error; nullptr: stderr
 };
 int RunDiagnose(const DiagnoseArgs& args);
 

@@ -81,8 +81,7 @@ int RunEvaluate(const EvaluateArgs& args) {
   Result<eval::WrittenEvaluation> written = eval::WriteEvaluation(evaluation.value(), args.out, !args.no_plots);
   if (!written.ok()) return Failure(args.err, "evaluate", written.status().message());
 
-  if (!written.value().note.empty())
-    Report(args.err, "evaluate", written.value().note, 0);
+  if (!written.value().note.empty()) Report(args.err, "evaluate", written.value().note, 0);
   if (!args.quiet) {
     PrintSummary(evaluation.value().metrics);
     std::printf("wrote %s", written.value().metrics_path.c_str());

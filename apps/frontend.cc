@@ -19,13 +19,13 @@ int RunFrontEnd(const FrontEndArgs& args) {
   if (!run.ok()) return Report(args.err, "frontend", run.status().message(), bad_input ? kBadInputExit : kFailureExit);
   if (args.quiet) return 0;
   const frontend::FrontEndResult& r = run.value();
-  std::printf("%s: %zu rows from stream '%s'\n", r.stream.info.name.c_str(), r.stream.t.size(),
-              r.input_stream.c_str());
+  std::printf("%s: %zu rows from stream '%s'\n", r.stream.info.name.c_str(), r.stream.t.size(), r.input_stream.c_str());
   if (const auto& vo = r.visual_odometry) {
-    std::printf("visual odometry: %d frames, %d pairs, %d estimates, %d failures (features %d, tracks %d, inliers "
-                "%d, scale %d)\n",
-                vo->frames, vo->pairs, vo->estimates, vo->failures, vo->too_few_features, vo->too_few_tracks,
-                vo->too_few_inliers, vo->no_scale);
+    std::printf(
+        "visual odometry: %d frames, %d pairs, %d estimates, %d failures (features %d, tracks %d, inliers "
+        "%d, scale %d)\n",
+        vo->frames, vo->pairs, vo->estimates, vo->failures, vo->too_few_features, vo->too_few_tracks,
+        vo->too_few_inliers, vo->no_scale);
   } else {
     std::printf("scan matcher: %d scan pairs not matched\n", r.failed_scan_matches);
   }

@@ -10,7 +10,7 @@
 namespace roamlab::apps {
 
 struct FrontEndArgs {
-  std::string front_end;        // "vo" or "scan"
+  std::string front_end;  // "vo" or "scan"
   std::string recording;
   std::string out;
   std::string input_stream;     // empty: the recording's only camera (laser_scan) stream

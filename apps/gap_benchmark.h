@@ -12,7 +12,7 @@ namespace roamlab::apps {
 
 struct GapBenchmarkArgs : gap::benchmark::BenchmarkOptions {
   bool quiet = false;
-  std::ostream* err = nullptr;   // receives the one-line error; nullptr: stderr
+  std::ostream* err = nullptr;  // receives the one-line error; nullptr: stderr
 };
 int RunGapBenchmark(const GapBenchmarkArgs& args);
 

@@ -26,7 +26,8 @@ int Written(const Result<recording::Recording>& rec, const std::string& out) {
 
 int RunImportOptiOdom(const ImportOptiOdomArgs& args) {
   recording::Recording rec;
-  const experiment::Outcome outcome = experiment::ImportOptiOdomToDirectory(args.run_csv, args.metadata, args.out, &rec);
+  const experiment::Outcome outcome =
+      experiment::ImportOptiOdomToDirectory(args.run_csv, args.metadata, args.out, &rec);
   if (!outcome.ok()) return Exit(nullptr, kCommand, outcome);
   if (!args.quiet) {
     const recording::Stream& enc = rec.streams.front();

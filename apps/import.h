@@ -24,10 +24,10 @@ int RunImportOptiOdom(const ImportOptiOdomArgs& args);
 struct ImportRosbagArgs {
   std::string bag;
   std::string out;
-  std::vector<double> imu_mounting_wxyz;   // q_body_imu; empty = identity (no mounting written)
+  std::vector<double> imu_mounting_wxyz;  // q_body_imu; empty = identity (no mounting written)
   std::string platform_kind = "unknown";
-  std::vector<std::string> geometry;       // "key=value", e.g. "baseline_m=0.555"
-  bool wheels_from_odometry = false;       // also write the `wheels` stream (recording/import_rosbag.h)
+  std::vector<std::string> geometry;  // "key=value", e.g. "baseline_m=0.555"
+  bool wheels_from_odometry = false;  // also write the `wheels` stream (recording/import_rosbag.h)
   bool quiet = false;
 };
 int RunImportRosbag(const ImportRosbagArgs& args);

@@ -21,8 +21,7 @@ void PrintLearned(const experiment::LearnedOdometry& learned, const std::string&
     const odo::WheelKinematics& k = learned.model.kinematics;
     std::cout << "  Censi et al.: wheel radii [m]";
     for (std::size_t w = 0; w < k.wheels.size(); ++w) std::cout << " " << k.wheels[w] << " " << k.radius_m[w];
-    std::cout << ", track " << k.J.col(2).cwiseAbs().sum() << " m, sensor pose [" << k.sensor_pose.transpose()
-              << "]\n";
+    std::cout << ", track " << k.J.col(2).cwiseAbs().sum() << " m, sensor pose [" << k.sensor_pose.transpose() << "]\n";
   }
 }
 
@@ -31,8 +30,8 @@ void PrintTable(const json& table) {
   for (const json& row : table["rows"]) {
     std::printf("%-12s %-8s %-11s %10.4f %10.3f\n", row["model"].get<std::string>().c_str(),
                 row["mean"].is_null() ? "-" : row["mean"].get<std::string>().c_str(),
-                row["kernel"].is_null() ? "-" : row["kernel"].get<std::string>().c_str(),
-                row["ate_m"].get<double>(), row["rpe_mm"].get<double>());
+                row["kernel"].is_null() ? "-" : row["kernel"].get<std::string>().c_str(), row["ate_m"].get<double>(),
+                row["rpe_mm"].get<double>());
   }
 }
 

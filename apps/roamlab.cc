@@ -46,17 +46,16 @@ void AddSimulate(CLI::App* app, Commands* commands) {
   CLI::Option* seed_option = sim->add_option("--seed", *seed, "Sensor-noise seed (overrides the scenario's)");
   sim->add_flag("--quiet", args->quiet, "No progress and no summary");
   commands->push_back({sim, [args, seed, seed_option] {
-    if (seed_option->count() > 0) args->seed = *seed;
-    return RunSimulate(*args);
-  }});
+                         if (seed_option->count() > 0) args->seed = *seed;
+                         return RunSimulate(*args);
+                       }});
 }
 
 void AddCalibrate(CLI::App* app, Commands* commands) {
   Add(commands, RunCalibrate, [app](auto* args) {
     CLI::App* cal = app->add_subcommand(
         "calibrate", "Offline self-calibration of the free parameters over a whole recording (seed 000, Section V).");
-    cal->add_option("recording", args->recording, "Recording directory (recording.yaml + CSV streams)")
-        ->required();
+    cal->add_option("recording", args->recording, "Recording directory (recording.yaml + CSV streams)")->required();
     cal->add_option("--config", args->config, "Estimator configuration (EST.yaml)")->required();
     cal->add_option("--out", args->out, "Output directory: calibration.json, trajectory.tum")->required();
     cal->add_flag("--quiet", args->quiet, "No progress and no summary");
@@ -66,8 +65,8 @@ void AddCalibrate(CLI::App* app, Commands* commands) {
 
 void AddTrack(CLI::App* app, Commands* commands) {
   Add(commands, RunTrack, [app](auto* args) {
-    CLI::App* trk = app->add_subcommand(
-        "track", "Online fixed-lag tracking with marginalization (seed 000, Section III-B).");
+    CLI::App* trk =
+        app->add_subcommand("track", "Online fixed-lag tracking with marginalization (seed 000, Section III-B).");
     trk->add_option("recording", args->recording, "Recording directory")->required();
     trk->add_option("--config", args->config, "Estimator configuration (EST.yaml)")->required();
     trk->add_option("--calibration", args->calibration, "calibration.json from `roamlab calibrate` (fixes parameters)");
@@ -82,15 +81,14 @@ void AddEvaluate(CLI::App* app, Commands* commands) {
     CLI::App* evl = app->add_subcommand(
         "evaluate", "Accuracy (ATE, RPE), consistency (NEES, seed eq. 16) and parameter errors against the truth.");
     evl->add_option("--estimate", args->estimate,
-                    "Estimate directory: trajectory.tum [, covariance.csv, calibration.json]")->required();
+                    "Estimate directory: trajectory.tum [, covariance.csv, calibration.json]")
+        ->required();
     evl->add_option("--recording", args->recording, "Recording directory with ground_truth.tum [, truth.yaml]")
         ->required();
-    evl->add_option("--out", args->out, "Output directory: metrics.json, figures (PNG + gnuplot scripts)")
-        ->required();
+    evl->add_option("--out", args->out, "Output directory: metrics.json, figures (PNG + gnuplot scripts)")->required();
     evl->add_option("--align", args->align,
                     "none | se3 | yaw_translation (default: none with gps/position/pose streams, se3 otherwise)");
-    evl->add_option("--max-time-difference", args->max_time_difference_s,
-                    "Association tolerance [s] (default 0.01)");
+    evl->add_option("--max-time-difference", args->max_time_difference_s, "Association tolerance [s] (default 0.01)");
     evl->add_option("--rpe-delta", args->rpe_delta_s, "RPE pose pairs about this far apart [s] (default 1)");
     evl->add_option("--rpe-distance", args->rpe_distance_m, "RPE segments along the truth [m] (default 10)");
     evl->add_option("--nees-t0", args->nees_t0_s, "Leave the first T0 seconds out of the NEES in-band fraction");
@@ -123,8 +121,9 @@ void AddMonteCarlo(CLI::App* app, Commands* commands) {
 void AddDiagnose(CLI::App* app, Commands* commands) {
   Add(commands, RunDiagnose, [app](auto* args) {
     CLI::App* dia = app->add_subcommand(
-        "diagnose", "Reality-gap diagnosis: locate where a recording departs from the nominal model, name the physical "
-                    "effect, fit it and show the held-out fit improve.");
+        "diagnose",
+        "Reality-gap diagnosis: locate where a recording departs from the nominal model, name the physical "
+        "effect, fit it and show the held-out fit improve.");
     dia->add_option("--real", args->recording, "Recording directory (its truth.yaml is never read)")->required();
     dia->add_option("--scenario", args->scenario,
                     "The nominal scenario: the robot as believed (optional with --config and --no-baseline)");
@@ -145,9 +144,10 @@ void AddDiagnose(CLI::App* app, Commands* commands) {
 
 void AddGapBenchmark(CLI::App* app, Commands* commands) {
   Add(commands, RunGapBenchmark, [app](auto* args) {
-    CLI::App* gbm = app->add_subcommand(
-        "gap-benchmark", "Blind benchmark of the diagnosis: hidden effects (or none, or a decoy) drawn, simulated, "
-                         "diagnosed, then scored against truth.yaml.");
+    CLI::App* gbm =
+        app->add_subcommand("gap-benchmark",
+                            "Blind benchmark of the diagnosis: hidden effects (or none, or a decoy) drawn, simulated, "
+                            "diagnosed, then scored against truth.yaml.");
     gbm->add_option("--cases", args->cases, "Scored cases (default 16)");
     gbm->add_option("--calibration-cases", args->calibration_cases,
                     "Calibration cases, run first, that fix the thresholds (default 8)");
@@ -212,7 +212,8 @@ void AddOdometry(CLI::App* app, Commands* commands) {
   });
   Add(commands, RunOdometryEvaluate, [odo](auto* args) {
     CLI::App* odo_evaluate = odo->add_subcommand(
-        "evaluate", "Dead-reckon test recordings with models and the nominal model: ATE (eq. 11), RPE (eq. 10), plots.");
+        "evaluate",
+        "Dead-reckon test recordings with models and the nominal model: ATE (eq. 11), RPE (eq. 10), plots.");
     odo_evaluate->add_option("--model", args->models, "Model files from `odometry learn`")->required();
     odo_evaluate->add_option("--recording", args->recordings, "Test recordings with ground_truth.tum")->required();
     odo_evaluate->add_option("--encoders", args->encoder_stream, "wheel_encoders stream (default: the only one)");
@@ -236,12 +237,14 @@ void AddImport(CLI::App* app, Commands* commands) {
     return imp_optiodom;
   });
   Add(commands, RunImportRosbag, [imp](auto* args) {
-    CLI::App* imp_rosbag = imp->add_subcommand("rosbag", "A ROS1 bag (v2.0): sensor_msgs/Imu, nav_msgs/Odometry, "
-                                                         "sensor_msgs/NavSatFix.");
+    CLI::App* imp_rosbag = imp->add_subcommand("rosbag",
+                                               "A ROS1 bag (v2.0): sensor_msgs/Imu, nav_msgs/Odometry, "
+                                               "sensor_msgs/NavSatFix.");
     imp_rosbag->add_option("bag", args->bag, "BAG.bag")->required();
     imp_rosbag->add_option("--out", args->out, "Output recording directory")->required();
-    imp_rosbag->add_option("--imu-mounting", args->imu_mounting_wxyz,
-                           "IMU mounting q_body_imu as W X Y Z (rotates IMU coordinates into the body frame)")
+    imp_rosbag
+        ->add_option("--imu-mounting", args->imu_mounting_wxyz,
+                     "IMU mounting q_body_imu as W X Y Z (rotates IMU coordinates into the body frame)")
         ->expected(4);
     imp_rosbag->add_option("--platform", args->platform_kind, "Platform kind (e.g. skid_steer)");
     imp_rosbag->add_option("--geometry", args->geometry, "Nominal geometry KEY=VALUE (repeatable)");
@@ -254,9 +257,10 @@ void AddImport(CLI::App* app, Commands* commands) {
 
 void AddFrontEnd(CLI::App* app, Commands* commands) {
   Add(commands, RunFrontEnd, [app](auto* args) {
-    CLI::App* fe = app->add_subcommand(
-        "frontend", "Run a sensor front end over a recording: visual odometry on a camera stream (vo) or scan "
-                    "matching on a laser_scan stream (scan); writes REC2 with the derived stream.");
+    CLI::App* fe =
+        app->add_subcommand("frontend",
+                            "Run a sensor front end over a recording: visual odometry on a camera stream (vo) or scan "
+                            "matching on a laser_scan stream (scan); writes REC2 with the derived stream.");
     fe->add_option("front_end", args->front_end, "vo | scan")->required()->check(CLI::IsMember({"vo", "scan"}));
     fe->add_option("recording", args->recording, "Recording directory")->required();
     fe->add_option("--out", args->out, "Output recording directory (REC's streams plus the derived one)")->required();
@@ -273,8 +277,8 @@ int RunCommandLine(int argc, char** argv) {
   CLI::App app{"roamlab: mobile-robot pose tracking and sensor self-calibration testbed"};
   app.require_subcommand(1);
   Commands commands;
-  for (const auto add : {AddSimulate, AddCalibrate, AddTrack, AddEvaluate, AddMonteCarlo, AddDiagnose,
-                         AddGapBenchmark, AddRegress, AddOdometry, AddImport, AddFrontEnd})
+  for (const auto add : {AddSimulate, AddCalibrate, AddTrack, AddEvaluate, AddMonteCarlo, AddDiagnose, AddGapBenchmark,
+                         AddRegress, AddOdometry, AddImport, AddFrontEnd})
     add(&app, &commands);
 
   try {

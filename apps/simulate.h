@@ -12,8 +12,8 @@ namespace roamlab::apps {
 
 // The step's request (without progress, which the command sets).
 struct SimulateArgs : experiment::SimulateRequest {
-  bool quiet = false;                   // no progress and no summary
-  std::ostream* err = nullptr;          // receives the one-line error; nullptr: stderr
+  bool quiet = false;           // no progress and no summary
+  std::ostream* err = nullptr;  // receives the one-line error; nullptr: stderr
 };
 int RunSimulate(const SimulateArgs& args);
 

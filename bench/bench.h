@@ -50,12 +50,12 @@ Sizes QuickSizes();
 struct Context {
   bool quick = false;
   Sizes sizes;
-  std::string self;              // this program, for the child processes
-  std::string root;              // the source tree
+  std::string self;  // this program, for the child processes
+  std::string root;  // the source tree
   std::string scenario_path, calibration_path, tracking_path;
-  sim::Scenario scenario;        // scenarios/atv_hills.yaml
+  sim::Scenario scenario;  // scenarios/atv_hills.yaml
   est::EstimatorConfig calibration_config, tracking_config;
-  std::filesystem::path tmp;     // scratch directory, removed at the end
+  std::filesystem::path tmp;  // scratch directory, removed at the end
 };
 
 // The calibration tracking runs under: values and their joint marginal information.
@@ -74,17 +74,17 @@ Result<Json> RunChild(const std::string& self, std::vector<std::string> args, co
 // The steps (bench/*_bench.cc), in the order main runs them; each returns 0 or the exit code of a failure and adds
 // its figures to `j`.
 int BenchSimulation(const Context& ctx, Json* j, recording::Recording* recording);  // 1, 1b, 1c
-void BenchCgp(Json* j);                                                              // 1d
-int BenchIndoorCamera(const Context& ctx, Json* j);                                  // 1e
+void BenchCgp(Json* j);                                                             // 1d
+int BenchIndoorCamera(const Context& ctx, Json* j);                                 // 1e
 int BenchCeresPeer(const Context& ctx, const recording::Recording& rec, Json* j,
-                   TrackingCalibration* peer);                                       // 2-3
+                   TrackingCalibration* peer);  // 2-3
 int CalibrateForTracking(const Context& ctx, const recording::Recording& rec, TrackingCalibration* calibrated,
                          std::string* calibration_json);
 int BenchTracking(const Context& ctx, const recording::Recording& rec, const TrackingCalibration& calibrated,
-                  const TrackingCalibration& peer, Json* j);                         // 4
+                  const TrackingCalibration& peer, Json* j);                                // 4
 int BenchCalibrationScaling(const Context& ctx, const recording::Recording& rec, Json* j);  // 5
 int BenchOnlineMemory(const Context& ctx, const std::string& calibration_json, Json* j);    // 6
-int BenchMonteCarlo(const Context& ctx, const std::string& calibration_json, Json* j);     // 7
+int BenchMonteCarlo(const Context& ctx, const std::string& calibration_json, Json* j);      // 7
 
 // The child processes (own address space: their peak memory is their own).
 int ChildCalibrate(const std::string& rec_dir, const std::string& config_path, const std::string& out_path);

@@ -37,11 +37,11 @@ struct PeerComparison {
   double final_cost_rel_diff = 0.0;
   double max_parameter_diff_over_std = 0.0;
   std::string worst_parameter;
-  double factorization_seconds = 0.0;   // one numeric CHOLMOD factorization of the final Hessian (best of 5)
+  double factorization_seconds = 0.0;  // one numeric CHOLMOD factorization of the final Hessian (best of 5)
   int dimension = 0;
   std::string ceres_termination, roamlab_termination;
   std::map<std::string, Eigen::VectorXd> calibration;  // roamlab's final parameter values
-  est::CalibrationPrior prior;  // their joint marginal information at roamlab's estimate
+  est::CalibrationPrior prior;                         // their joint marginal information at roamlab's estimate
 };
 
 // Cost of the graph at its current values under roamlab's objective (whitening at those values).
@@ -176,15 +176,19 @@ int ChildCalibrate(const std::string& rec_dir, const std::string& config_path, c
   auto result = est::Calibrate(config.value(), rec.value());
   const double wall = Since(t0), cpu = ProcessCpu() - c0;
   if (!result.ok()) return Fail(result.status().message());
-  const Json j = {{"seconds", wall},           {"cpu_seconds", cpu},
-                  {"iterations", result.value().iterations}, {"final_cost", result.value().final_cost},
-                  {"peak_rss_kb", StatusKb("VmHWM")}, {"poses", result.value().trajectory.size()}};
+  const Json j = {{"seconds", wall},
+                  {"cpu_seconds", cpu},
+                  {"iterations", result.value().iterations},
+                  {"final_cost", result.value().final_cost},
+                  {"peak_rss_kb", StatusKb("VmHWM")},
+                  {"poses", result.value().trajectory.size()}};
   std::ofstream(out_path) << j.dump(2) << "\n";
   return 0;
 }
 
 // 2-3. The Ceres peer and the floor; `peer` receives the peer problem's calibration (roamlab's solution of it).
-int BenchCeresPeer(const Context& ctx, const recording::Recording& rec, Json* j, TrackingCalibration* peer_calibration) {
+int BenchCeresPeer(const Context& ctx, const recording::Recording& rec, Json* j,
+                   TrackingCalibration* peer_calibration) {
   std::optional<sim::Simulation> peer_simulation;
   if (ctx.sizes.peer_drive_s != ctx.scenario.duration_s) {
     auto shorter = sim::Simulate(LongerDrive(ctx.scenario, ctx.sizes.peer_drive_s));
@@ -200,15 +204,22 @@ int BenchCeresPeer(const Context& ctx, const recording::Recording& rec, Json* j,
   (*j)["ceres_time_ratio"] = ceres_ratio;
   (*j)["final_cost_rel_diff"] = p.final_cost_rel_diff;
   (*j)["iteration_over_floor"] = over_floor;
-  (*j)["ceres"] = {{"roamlab_seconds", p.roamlab_seconds}, {"roamlab_cpu_seconds", p.roamlab_cpu_seconds},
-                {"ceres_seconds", p.ceres_seconds}, {"roamlab_iterations", p.roamlab_iterations},
-                {"ceres_iterations", p.ceres_iterations}, {"roamlab_final_cost", p.roamlab_final_cost},
-                {"ceres_final_cost", p.ceres_final_cost}, {"roamlab_reported_cost", p.roamlab_reported_cost},
-                {"ceres_reported_cost", p.ceres_reported_cost}, {"roamlab_termination", p.roamlab_termination},
-                {"ceres_termination", p.ceres_termination},
-                {"max_parameter_diff_over_std", p.max_parameter_diff_over_std},
-                {"worst_parameter", p.worst_parameter}, {"hessian_dimension", p.dimension},
-                {"factorization_seconds", p.factorization_seconds}, {"roamlab_seconds_per_iteration", per_iteration}};
+  (*j)["ceres"] = {{"roamlab_seconds", p.roamlab_seconds},
+                   {"roamlab_cpu_seconds", p.roamlab_cpu_seconds},
+                   {"ceres_seconds", p.ceres_seconds},
+                   {"roamlab_iterations", p.roamlab_iterations},
+                   {"ceres_iterations", p.ceres_iterations},
+                   {"roamlab_final_cost", p.roamlab_final_cost},
+                   {"ceres_final_cost", p.ceres_final_cost},
+                   {"roamlab_reported_cost", p.roamlab_reported_cost},
+                   {"ceres_reported_cost", p.ceres_reported_cost},
+                   {"roamlab_termination", p.roamlab_termination},
+                   {"ceres_termination", p.ceres_termination},
+                   {"max_parameter_diff_over_std", p.max_parameter_diff_over_std},
+                   {"worst_parameter", p.worst_parameter},
+                   {"hessian_dimension", p.dimension},
+                   {"factorization_seconds", p.factorization_seconds},
+                   {"roamlab_seconds_per_iteration", per_iteration}};
   Say("  calibration vs Ceres 2.1           roamlab %.2f s (%d it), Ceres %.2f s (%d it): roamlab/Ceres %.2f"
       "   target <= 0.5   ratio %.2f\n",
       p.roamlab_seconds, p.roamlab_iterations, p.ceres_seconds, p.ceres_iterations, ceres_ratio, 0.5 / ceres_ratio);
@@ -216,8 +227,8 @@ int BenchCeresPeer(const Context& ctx, const recording::Recording& rec, Json* j,
       "most %.3f std (%s)\n",
       p.roamlab_final_cost, p.ceres_final_cost, p.final_cost_rel_diff, p.max_parameter_diff_over_std,
       p.worst_parameter.c_str());
-  Say("  iteration over factorization floor %8.2f (%.1f ms / %.2f ms, n = %d)   target <= 3   ratio %.2f\n",
-      over_floor, 1e3 * per_iteration, 1e3 * p.factorization_seconds, p.dimension, 3.0 / over_floor);
+  Say("  iteration over factorization floor %8.2f (%.1f ms / %.2f ms, n = %d)   target <= 3   ratio %.2f\n", over_floor,
+      1e3 * per_iteration, 1e3 * p.factorization_seconds, p.dimension, 3.0 / over_floor);
   peer_calibration->values = p.calibration;
   peer_calibration->prior = p.prior;
   return 0;
@@ -252,9 +263,8 @@ int BenchCalibrationScaling(const Context& ctx, const recording::Recording& rec,
     const std::string dir = (ctx.tmp / ("rec_" + std::to_string(static_cast<int>(size)))).string();
     // A drive as long as the scenario's (up to 30 s, which LongerDrive leaves unchanged) is the recording of step 1,
     // the simulation being deterministic: written out instead of simulated again.
-    const Status simulated = size == ctx.scenario.duration_s && size <= 30.0
-                                          ? recording::WriteRecording(rec, dir)
-                                          : SimulateTo(ctx.scenario, size, dir);
+    const Status simulated = size == ctx.scenario.duration_s && size <= 30.0 ? recording::WriteRecording(rec, dir)
+                                                                             : SimulateTo(ctx.scenario, size, dir);
     if (!simulated.ok()) return Fail(simulated.message());
     // The shorter drives' calibrations (under a second for 30 s) move by 10 % from one process to the next on a
     // shared host: the median of several runs, each in its own process; the 30 min one averages over its 45-60 s.
@@ -267,9 +277,8 @@ int BenchCalibrationScaling(const Context& ctx, const recording::Recording& rec,
       repeats.push_back(child.value());
     }
     std::filesystem::remove_all(dir);
-    std::sort(repeats.begin(), repeats.end(), [](const Json& a, const Json& b) {
-      return a["seconds"].get<double>() < b["seconds"].get<double>();
-    });
+    std::sort(repeats.begin(), repeats.end(),
+              [](const Json& a, const Json& b) { return a["seconds"].get<double>() < b["seconds"].get<double>(); });
     Json c = repeats[repeats.size() / 2];
     c["runs"] = runs;
     c["seconds_min"] = repeats.front()["seconds"];

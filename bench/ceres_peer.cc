@@ -6,8 +6,8 @@
 #include <type_traits>
 #include <utility>
 
-#include <Eigen/Cholesky>
 #include <ceres/ceres.h>
+#include <Eigen/Cholesky>
 
 #include "common/check.h"
 #include "estimator/factor.h"
@@ -61,8 +61,8 @@ struct QuaternionPlus {
   }
   template <typename T>
   bool Minus(const T* y, const T* x, T* out) const {
-    const Vector3<T> phi = estimator::QuaternionLog<T>(estimator::QuaternionFromArray(x).conjugate() *
-                                                       estimator::QuaternionFromArray(y));
+    const Vector3<T> phi =
+        estimator::QuaternionLog<T>(estimator::QuaternionFromArray(x).conjugate() * estimator::QuaternionFromArray(y));
     for (int i = 0; i < 3; ++i) out[i] = phi[i];
     return true;
   }
@@ -117,8 +117,7 @@ template <typename Model>
 ceres::CostFunction* TryModel(const estimator::Factor& factor, const Whitening* whitening) {
   const auto* f = dynamic_cast<const estimator::AutoDiffFactor<Model>*>(&factor);
   if (f == nullptr) return nullptr;
-  return MakeCost(&f->model(), whitening,
-                  std::make_index_sequence<std::tuple_size_v<typename Model::Blocks>>());
+  return MakeCost(&f->model(), whitening, std::make_index_sequence<std::tuple_size_v<typename Model::Blocks>>());
 }
 
 // Recomputes L^-1 of the factors whose error covariance depends on the estimate (eq. 1) at every new linearization

@@ -20,11 +20,11 @@
 namespace roamlab::bench {
 
 struct CeresPeerResult {
-  double seconds = 0.0;         // Ceres' total solve time
+  double seconds = 0.0;  // Ceres' total solve time
   int iterations = 0;
-  double initial_cost = 0.0;    // Ceres' own cost (1/2 sum of squared whitened residuals)
+  double initial_cost = 0.0;  // Ceres' own cost (1/2 sum of squared whitened residuals)
   double final_cost = 0.0;
-  std::string termination;      // Ceres' message
+  std::string termination;  // Ceres' message
   bool usable = false;
   // Final values of the free variables, by id (ambient).
   std::vector<std::pair<estimator::VariableId, Eigen::VectorXd>> values;

@@ -81,10 +81,14 @@ Json SizesJson(const Context& ctx) {
   const Sizes& sizes = ctx.sizes;
   return {{"quick", ctx.quick},
           {"sizes",
-           {{"indoor_s", sizes.indoor_s}, {"render_vo_s", sizes.render_vo_s},
-            {"indoor_camera_s", sizes.indoor_camera_s}, {"ceres_drive_s", sizes.peer_drive_s},
-            {"tracking_windows", sizes.windows}, {"calibration_drives_s", sizes.calibration_s},
-            {"online_run_s", sizes.online_s}, {"montecarlo_drive_s", sizes.montecarlo_drive_s},
+           {{"indoor_s", sizes.indoor_s},
+            {"render_vo_s", sizes.render_vo_s},
+            {"indoor_camera_s", sizes.indoor_camera_s},
+            {"ceres_drive_s", sizes.peer_drive_s},
+            {"tracking_windows", sizes.windows},
+            {"calibration_drives_s", sizes.calibration_s},
+            {"online_run_s", sizes.online_s},
+            {"montecarlo_drive_s", sizes.montecarlo_drive_s},
             {"montecarlo_runs", {sizes.montecarlo_runs_jobs1, sizes.montecarlo_runs_jobs2}}}}};
 }
 

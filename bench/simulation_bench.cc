@@ -10,10 +10,10 @@
 #include <opencv2/core/utility.hpp>
 
 #include "bench/bench.h"
+#include "frontend/visual_odometry.h"
 #include "sim/mujoco_model.h"
 #include "sim/render.h"
 #include "sim/simulator.h"
-#include "frontend/visual_odometry.h"
 
 namespace roamlab::bench {
 namespace {
@@ -109,8 +109,8 @@ int BenchSimulation(const Context& ctx, Json* j, recording::Recording* recording
     const double indoor_factor = indoor_simulation.value().stats.simulated_s / indoor_wall;
     const double indoor_cpu_factor = indoor_simulation.value().stats.simulated_s / indoor_cpu;
     (*j)[key] = indoor_factor;
-    Say("  %-22s no rendering %8.1fx real time    target >= 10x       ratio %.2f   (CPU time: %.1fx)\n",
-        name.c_str(), indoor_factor, indoor_factor / 10.0, indoor_cpu_factor);
+    Say("  %-22s no rendering %8.1fx real time    target >= 10x       ratio %.2f   (CPU time: %.1fx)\n", name.c_str(),
+        indoor_factor, indoor_factor / 10.0, indoor_cpu_factor);
   }
 
   // 1c. The indoor camera yardstick: rendering + visual odometry at 15 Hz (sim/visual_odometry_stream.h) on

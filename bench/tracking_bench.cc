@@ -24,8 +24,8 @@ struct TrackingFigures {
 
 // `prior` null: parameters fixed at `calibration`; otherwise free under that prior.
 Result<TrackingFigures> TrackWindow(est::EstimatorConfig config, const recording::Recording& rec,
-                                             const std::map<std::string, Eigen::VectorXd>& calibration, int window,
-                                             const est::CalibrationPrior* prior) {
+                                    const std::map<std::string, Eigen::VectorXd>& calibration, int window,
+                                    const est::CalibrationPrior* prior) {
   config.tracking.window = window;
   config.tracking.calibration_prior = prior != nullptr;
   est::TrackingOptions options;
@@ -36,8 +36,9 @@ Result<TrackingFigures> TrackWindow(est::EstimatorConfig config, const recording
   if (!tracked.ok()) return tracked.status();
   const auto& r = tracked.value();
   const double duration = SecondsBetween(r.trajectory.front().t, r.trajectory.back().t);
-  return TrackingFigures{window, duration / r.total_seconds, duration / cpu, 1e3 * r.mean_update_s,
-                         1e3 * r.p99_update_s, r.mean_iterations};
+  return TrackingFigures{
+      window,           duration / r.total_seconds, duration / cpu, 1e3 * r.mean_update_s, 1e3 * r.p99_update_s,
+      r.mean_iterations};
 }
 
 }  // namespace
@@ -111,8 +112,8 @@ int BenchTracking(const Context& ctx, const recording::Recording& rec, const Tra
         {"fixed", &calibrated.values, nullptr, "_fixed", "   targets >= 50x, p99 < 10 ms"},
         {"calibration_prior", &calibrated.values, &calibrated.prior, "", "   targets >= 50x, p99 < 10 ms"}};
     if (window == 40)
-      modes.push_back({"prior_peer_calibration", &peer.values, &peer.prior, "_peer_calibration",
-                       "   (step 2's calibration)"});
+      modes.push_back(
+          {"prior_peer_calibration", &peer.values, &peer.prior, "_peer_calibration", "   (step 2's calibration)"});
     for (const TrackingMode& mode : modes) {
       const int runs = window == 40 ? 3 : 1;
       std::vector<TrackingFigures> repeats;
@@ -127,12 +128,12 @@ int BenchTracking(const Context& ctx, const recording::Recording& rec, const Tra
       const TrackingFigures& f = repeats.front();
       const double median_cpu_factor = repeats[repeats.size() / 2].cpu_realtime_factor;
       (*j)["tracking"][std::to_string(window)][mode.name] = {{"runs", runs},
-                                                          {"realtime_factor", f.realtime_factor},
-                                                          {"cpu_realtime_factor", f.cpu_realtime_factor},
-                                                          {"median_cpu_realtime_factor", median_cpu_factor},
-                                                          {"mean_update_ms", f.mean_update_ms},
-                                                          {"p99_update_ms", f.p99_update_ms},
-                                                          {"mean_iterations", f.mean_iterations}};
+                                                             {"realtime_factor", f.realtime_factor},
+                                                             {"cpu_realtime_factor", f.cpu_realtime_factor},
+                                                             {"median_cpu_realtime_factor", median_cpu_factor},
+                                                             {"mean_update_ms", f.mean_update_ms},
+                                                             {"p99_update_ms", f.p99_update_ms},
+                                                             {"mean_iterations", f.mean_iterations}};
       char spread[64] = "";
       if (runs > 1) std::snprintf(spread, sizeof spread, "; best of %d, median %.1fx", runs, median_cpu_factor);
       Say("  tracking, %3d-pose window, %-22s %6.1fx real time (%.1fx per CPU second%s), update mean %.3f ms, "

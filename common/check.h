@@ -9,11 +9,11 @@ namespace roamlab::internal {
 [[noreturn]] void CheckFailed(const char* file, int line, const char* condition, const std::string& message);
 }  // namespace roamlab::internal
 
-#define ROAMLAB_CHECK(condition, message)                                                        \
-  do {                                                                                           \
-    if (!(condition)) {                                                                          \
-      std::ostringstream roamlab_check_stream;                                                   \
-      roamlab_check_stream << message;                                                           \
+#define ROAMLAB_CHECK(condition, message)                                                           \
+  do {                                                                                              \
+    if (!(condition)) {                                                                             \
+      std::ostringstream roamlab_check_stream;                                                      \
+      roamlab_check_stream << message;                                                              \
       ::roamlab::internal::CheckFailed(__FILE__, __LINE__, #condition, roamlab_check_stream.str()); \
-    }                                                                                            \
+    }                                                                                               \
   } while (false)

@@ -32,8 +32,10 @@ class Status {
 template <typename T>
 class Result {
  public:
-  Result(T value) : data_(std::move(value)) {}                                              // NOLINT
-  Result(Status status) : data_(std::move(status)) { ROAMLAB_CHECK(!std::get<Status>(data_).ok(), "ok status"); }  // NOLINT
+  Result(T value) : data_(std::move(value)) {}  // NOLINT
+  Result(Status status) : data_(std::move(status)) {
+    ROAMLAB_CHECK(!std::get<Status>(data_).ok(), "ok status");
+  }  // NOLINT
 
   bool ok() const { return std::holds_alternative<T>(data_); }
   const Status& status() const {

@@ -184,8 +184,8 @@ Status BuildGraph(const CalibrationOptions& options, ProblemBuilder* builder_ptr
       auto it = std::lower_bound(initial.begin(), initial.end(), node.t,
                                  [](const StampedPose& p, Time t) { return p.t < t; });
       if (it == initial.end()) --it;
-      if (it != initial.begin() && node.t.nanoseconds() - std::prev(it)->t.nanoseconds() <
-                                       it->t.nanoseconds() - node.t.nanoseconds())
+      if (it != initial.begin() &&
+          node.t.nanoseconds() - std::prev(it)->t.nanoseconds() < it->t.nanoseconds() - node.t.nanoseconds())
         --it;
       PoseToArray(Pose<double>{it->p_world_body, it->q_world_body},
                   builder.graph().mutable_variable(node.id).value.data());
@@ -306,10 +306,10 @@ Status EstimateParameters(const CalibrationOptions& options, const std::vector<s
     analysis = AnalyzeObservability(info.value().information, info.value().conditional, options.observability);
     offsets = info.value().offsets;
     result->information = info.value().information;
-    Say(options, "observability analysis: " +
-                     std::to_string(
-                         std::chrono::duration<double>(std::chrono::steady_clock::now() - analysis_start).count()) +
-                     " s");
+    Say(options,
+        "observability analysis: " +
+            std::to_string(std::chrono::duration<double>(std::chrono::steady_clock::now() - analysis_start).count()) +
+            " s");
   }
   for (std::size_t i = 0; i < ids.size(); ++i) {
     const Variable& v = builder.graph().variable(ids[i]);

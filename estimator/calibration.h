@@ -23,9 +23,9 @@ namespace roamlab::estimator {
 struct ParameterEstimate {
   std::string name;
   Manifold manifold = Manifold::Euclidean(0);
-  Eigen::VectorXd estimate;                  // ambient: quaternions [w, x, y, z], matrices row-major
-  Eigen::VectorXd std;                       // tangent; NaN where unobservable
-  std::vector<Observability> components;     // per tangent component
+  Eigen::VectorXd estimate;                                  // ambient: quaternions [w, x, y, z], matrices row-major
+  Eigen::VectorXd std;                                       // tangent; NaN where unobservable
+  std::vector<Observability> components;                     // per tangent component
   Observability observability = Observability::kObservable;  // the worst component
 };
 
@@ -51,13 +51,13 @@ struct MeasurementResidual {
 
 struct CalibrationResult {
   std::vector<ParameterEstimate> parameters;
-  std::vector<Correlation> correlations;   // pairs of parameters with |rho| >= correlation_threshold
+  std::vector<Correlation> correlations;  // pairs of parameters with |rho| >= correlation_threshold
   // Joint marginal information of `parameters` (tangent coordinates, stacked in their order) at the final estimate:
   // what the recording says about them once the poses are eliminated. Zero along unobservable directions.
   Eigen::MatrixXd information;
   std::vector<StageSummary> stages;
   std::map<std::string, StreamCounts> counts;
-  Trajectory trajectory;                    // the smoothed trajectory of the final estimate
+  Trajectory trajectory;                       // the smoothed trajectory of the final estimate
   std::vector<MeasurementResidual> residuals;  // with CalibrationOptions::keep_residuals, in factor id order
   double seconds = 0.0;
   // Totals over the stages.
@@ -76,7 +76,7 @@ struct CalibrationOptions {
   // pose of the nearest stamp, and neither the alignment to the absolute fixes nor the IMU misalignment from the
   // motion replaces the configured values. Null: dead reckoning, then both alignments.
   const Trajectory* initial_trajectory = nullptr;
-  bool analyze_observability = true;                 // false: no marginal covariance (parameters get NaN std)
+  bool analyze_observability = true;  // false: no marginal covariance (parameters get NaN std)
 };
 
 Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recording::Recording& recording,

@@ -48,12 +48,8 @@ json SolverJson(const CalibrationResult& r) {
                       {"cost_history", s.solver.cost_history},
                       {"rejected", s.rejected},
                       {"seconds", s.solver.seconds}});
-  return {{"iterations", r.iterations},
-          {"initial_cost", r.initial_cost},
-          {"final_cost", r.final_cost},
-          {"termination", r.termination},
-          {"seconds", r.seconds},
-          {"stages", stages}};
+  return {{"iterations", r.iterations},   {"initial_cost", r.initial_cost}, {"final_cost", r.final_cost},
+          {"termination", r.termination}, {"seconds", r.seconds},           {"stages", stages}};
 }
 
 }  // namespace

@@ -23,7 +23,9 @@ SlotSpec Vector3Slot(const std::string& name, double fill) {
   return {name, Manifold::Euclidean(3), Eigen::VectorXd::Constant(3, fill)};
 }
 SlotSpec RotationSlot(const std::string& name) { return {name, Manifold::UnitQuaternion(), Vec({1, 0, 0, 0})}; }
-SlotSpec MatrixSlot(const std::string& name) { return {name, Manifold::Euclidean(9), Vec({1, 0, 0, 0, 1, 0, 0, 0, 1})}; }
+SlotSpec MatrixSlot(const std::string& name) {
+  return {name, Manifold::Euclidean(9), Vec({1, 0, 0, 0, 1, 0, 0, 0, 1})};
+}
 
 }  // namespace
 
@@ -43,14 +45,16 @@ const std::vector<ModelSpec>& ModelSpecs() {
         ScalarSlot("thrust_angle", 0.0), ScalarSlot("slip_per_mps2", 0.0), ScalarSlot("slope_slip_per_mps2", 0.0),
         Vector3Slot("disturbance", 0.0)},
        {"wheelbase_m", "speed_column", "contact_height_m", "pitch_lever_m", "forward_in_sensor", "front_slip_velocity"},
-       true, {"specific_force"}},
+       true,
+       {"specific_force"}},
       {"ackermann_seed",
        {"speed", "steering"},
        {"speed_mps", "steering_rad", "lateral_mps", "vertical_mps", "roll_rate_radps", "pitch_rate_radps"},
        {ScalarSlot("kv_over_L", std::numeric_limits<double>::quiet_NaN()), ScalarSlot("k_theta", 1.0),
         ScalarSlot("k_gamma", 0.0)},
        {"wheelbase_m", "speed_column"},
-       true, {}},
+       true,
+       {}},
       // Wheel radii and baseline default to NaN: the builder takes them from the recording's platform geometry.
       // right_left_ratio multiplies radius_right; deformation_left/right are the tires' second harmonic (a, b) [m]
       // (models/differential_drive.h).
@@ -59,11 +63,13 @@ const std::vector<ModelSpec>& ModelSpecs() {
        {"wheel_radps", "lateral_mps", "vertical_mps", "tilt_radps"},
        {ScalarSlot("radius_left", std::numeric_limits<double>::quiet_NaN()),
         ScalarSlot("radius_right", std::numeric_limits<double>::quiet_NaN()),
-        ScalarSlot("baseline", std::numeric_limits<double>::quiet_NaN()), ScalarSlot("right_left_ratio", 1.0),
+        ScalarSlot("baseline", std::numeric_limits<double>::quiet_NaN()),
+        ScalarSlot("right_left_ratio", 1.0),
         {"deformation_left", Manifold::Euclidean(2), Vec({0.0, 0.0})},
         {"deformation_right", Manifold::Euclidean(2), Vec({0.0, 0.0})}},
        {},
-       true, {}},
+       true,
+       {}},
       // Omni and mecanum wheel radii and geometry: NaN too, taken from the platform geometry.
       {"omni3_drive",
        {""},
@@ -73,7 +79,8 @@ const std::vector<ModelSpec>& ModelSpecs() {
         ScalarSlot("radius_2", std::numeric_limits<double>::quiet_NaN()),
         ScalarSlot("distance", std::numeric_limits<double>::quiet_NaN())},
        {},
-       true, {}},
+       true,
+       {}},
       {"mecanum_drive",
        {""},
        {"wheel_radps", "vertical_mps", "tilt_radps"},
@@ -83,26 +90,41 @@ const std::vector<ModelSpec>& ModelSpecs() {
         ScalarSlot("radius_3", std::numeric_limits<double>::quiet_NaN()),
         ScalarSlot("lx_plus_ly", std::numeric_limits<double>::quiet_NaN())},
        {},
-       true, {}},
-      {"odometer", {""}, {"linear_mps", "angular_radps"}, {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")},
-       {"row_covariance_scale"}, true, {}},
+       true,
+       {}},
+      {"odometer",
+       {""},
+       {"linear_mps", "angular_radps"},
+       {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")},
+       {"row_covariance_scale"},
+       true,
+       {}},
       // The odometer's eqs. 5-8 over the sample's whole interval: see problem.h (relative motion).
-      {"relative_motion", {""}, {"linear_mps", "angular_radps"},
-       {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")}, {"interval_s", "row_covariance_scale"}, false,
+      {"relative_motion",
+       {""},
+       {"linear_mps", "angular_radps"},
+       {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")},
+       {"interval_s", "row_covariance_scale"},
+       false,
        {}},
       // time_offset_s: the IMU clock's offset [s], the reading stamped t taken at t - time_offset_s
       // (models/imu_time_offset.h); share one parameter between the IMU's streams (e.g. imu.time_offset_s).
-      {"gyroscope", {""}, {"sigma_radps"},
+      {"gyroscope",
+       {""},
+       {"sigma_radps"},
        {RotationSlot("misalignment"), Vector3Slot("bias", 0.0), Vector3Slot("scale", 1.0),
         ScalarSlot("time_offset_s", 0.0)},
-       {}, false, {}},
+       {},
+       false,
+       {}},
       {"accelerometer",
        {""},
        {"sigma_mps2"},
-       {RotationSlot("misalignment"), Vector3Slot("lever_arm", 0.0), Vector3Slot("bias", 0.0), Vector3Slot("scale", 1.0),
-        ScalarSlot("time_offset_s", 0.0)},
+       {RotationSlot("misalignment"), Vector3Slot("lever_arm", 0.0), Vector3Slot("bias", 0.0),
+        Vector3Slot("scale", 1.0), ScalarSlot("time_offset_s", 0.0)},
        {},
-       false, {}},
+       false,
+       {}},
       // b_per_drive_nm: the motor interference per N m of drive torque, estimated from the forward specific force read
       // from inputs.specific_force (an imu or accelerometer stream) times options.drive_nm_per_mps2
       // (models/magnetometer.h).
@@ -115,9 +137,19 @@ const std::vector<ModelSpec>& ModelSpecs() {
        false,
        {"specific_force"}},
       {"gps", {""}, {"sigma_m"}, {Vector3Slot("lever_arm", 0.0)}, {}, false, {}},
-      {"absolute_pose", {""}, {"position_m", "orientation_rad"}, {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")},
-       {}, false, {}},
-      {"linear_velocity", {""}, {"sigma_mps"}, {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")}, {}, false,
+      {"absolute_pose",
+       {""},
+       {"position_m", "orientation_rad"},
+       {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")},
+       {},
+       false,
+       {}},
+      {"linear_velocity",
+       {""},
+       {"sigma_mps"},
+       {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")},
+       {},
+       false,
        {}},
   };
   return specs;
@@ -195,8 +227,8 @@ class Parser {
   }
 
   void ParseSolver(const YAML::Node& n, SolverOptions* s) const {
-    CheckKeys(n, {"method", "max_iterations", "function_tolerance", "step_tolerance", "time_budget_s",
-                  "initial_lambda"},
+    CheckKeys(n,
+              {"method", "max_iterations", "function_tolerance", "step_tolerance", "time_budget_s", "initial_lambda"},
               "solver");
     if (n["method"]) {
       const std::string m = String(n["method"], "solver.method");
@@ -268,13 +300,13 @@ class Parser {
       if (p.process.type != ProcessConfig::Type::kConstant) {
         if (!pr["sigma"]) Fail(pr, "parameter '" + name + "': process needs sigma");
         p.process.sigma = PerComponent(pr["sigma"], "parameters." + name + ".process.sigma");
-        if (!(p.process.sigma.array() > 0).all())
-          Fail(pr, "parameter '" + name + "': process sigma must be positive");
+        if (!(p.process.sigma.array() > 0).all()) Fail(pr, "parameter '" + name + "': process sigma must be positive");
       }
       if (pr["interval_s"]) {
         if (p.process.type == ProcessConfig::Type::kConstant)
-          Fail(pr["interval_s"], "parameter '" + name + "': process.interval_s needs a random_walk or gauss_markov "
-                                 "process");
+          Fail(pr["interval_s"], "parameter '" + name +
+                                     "': process.interval_s needs a random_walk or gauss_markov "
+                                     "process");
         p.process.interval_s = Number(pr["interval_s"], "parameters." + name + ".process.interval_s");
         if (!(p.process.interval_s > 0.0) || !std::isfinite(p.process.interval_s))
           Fail(pr["interval_s"], "parameter '" + name + "': process.interval_s must be a positive number of seconds");
@@ -324,8 +356,7 @@ class Parser {
     }
     if (n["options"]) {
       CheckKeys(n["options"], {spec->option_keys.begin(), spec->option_keys.end()}, where + " options");
-      for (const auto& kv : n["options"])
-        s.options[kv.first.as<std::string>()] = Numbers(kv.second, where + " option");
+      for (const auto& kv : n["options"]) s.options[kv.first.as<std::string>()] = Numbers(kv.second, where + " option");
     }
     if (n["inputs"]) {
       CheckKeys(n["inputs"], {spec->input_roles.begin(), spec->input_roles.end()}, where + " inputs");

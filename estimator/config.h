@@ -41,7 +41,8 @@
 // [t - T/2, t + T/2] stamped at the middle (scan_matching, visual_odometry), and joins the master poses nearest the
 // two ends, so that a 10 Hz scan matcher constrains the whole 0.1 s displacement instead of one 10 ms interval;
 // options.interval_s gives T (default: 1 / the stream's rate_hz). Both accept options.row_covariance_scale: k > 0
-// adds k times the row's own covariance (the stream's 21 covariance columns) to the configured noise, per sample. Unknown keys, unknown models, missing noise keys and malformed values are errors naming the file and key.
+// adds k times the row's own covariance (the stream's 21 covariance columns) to the configured noise, per sample.
+// Unknown keys, unknown models, missing noise keys and malformed values are errors naming the file and key.
 #pragma once
 
 #include <map>
@@ -78,26 +79,26 @@ struct ParameterConfig {
 
 struct StreamConfig {
   std::string model;
-  std::map<std::string, std::string> sources;       // role -> recording stream ("" role for single-source models)
+  std::map<std::string, std::string> sources;  // role -> recording stream ("" role for single-source models)
   std::map<std::string, double> noise;
-  std::map<std::string, std::string> parameters;    // slot -> parameter name
+  std::map<std::string, std::string> parameters;  // slot -> parameter name
   std::map<std::string, std::vector<double>> options;
-  std::map<std::string, std::string> inputs;        // role -> recording stream read as an extra input (optional)
+  std::map<std::string, std::string> inputs;  // role -> recording stream read as an extra input (optional)
   Loss loss;
 };
 
 struct TrackingConfig {
-  int window = 40;                       // poses kept in the fixed-lag window
-  int max_iterations = 10;               // per update
+  int window = 40;          // poses kept in the fixed-lag window
+  int max_iterations = 10;  // per update
   // Stop iterating when the cost drops by less than this fraction, or when the drop matches the Gauss-Newton
   // model's prediction to within this fraction (SolverOptions::model_tolerance).
   double improvement_threshold = 1e-3;
-  double time_budget_s = 0.05;           // per update
+  double time_budget_s = 0.05;  // per update
   // Relinearization threshold of the updates (SolverOptions::relinearize_threshold, iSAM2's): a factor whose
   // variables all moved by at most this much in every tangent component [m, rad, parameter units] since it was last
   // linearized keeps its Jacobians, its error carried to first order. 0: every factor is relinearized at every step.
   double relinearize_threshold = 0.0;
-  double initialization_s = 2.0;         // data buffered before the first window is solved
+  double initialization_s = 2.0;  // data buffered before the first window is solved
   // With a calibration that carries its information matrix (TrackingOptions::calibration_prior), the calibrated
   // constant parameters stay free in the window under that Gaussian prior instead of being fixed at their values.
   bool calibration_prior = false;
@@ -107,13 +108,13 @@ struct TrackingConfig {
 };
 
 struct EstimatorConfig {
-  std::string source_file;               // for messages
+  std::string source_file;  // for messages
   std::string master;
   SolverOptions solver;
   std::optional<double> gate_probability;
   TrackingConfig tracking;
   std::map<std::string, ParameterConfig> parameters;
-  std::map<std::string, StreamConfig> streams;   // by stream name (ordered: deterministic)
+  std::map<std::string, StreamConfig> streams;  // by stream name (ordered: deterministic)
   std::vector<std::vector<std::string>> stages;
 };
 
@@ -129,8 +130,8 @@ struct ModelSpec {
   std::vector<std::string> noise_keys;
   std::vector<SlotSpec> slots;
   std::vector<std::string> option_keys;
-  bool odometric = false;                  // can be the master stream
-  std::vector<std::string> input_roles;    // optional extra inputs (StreamConfig::inputs)
+  bool odometric = false;                // can be the master stream
+  std::vector<std::string> input_roles;  // optional extra inputs (StreamConfig::inputs)
 };
 const ModelSpec* FindModelSpec(const std::string& model);
 const std::vector<ModelSpec>& ModelSpecs();

@@ -14,9 +14,12 @@ namespace roamlab::estimator {
 
 const char* ObservabilityName(Observability observability) {
   switch (observability) {
-    case Observability::kObservable: return "observable";
-    case Observability::kWeak: return "weak";
-    case Observability::kUnobservable: return "unobservable";
+    case Observability::kObservable:
+      return "observable";
+    case Observability::kWeak:
+      return "weak";
+    case Observability::kUnobservable:
+      return "unobservable";
   }
   return "unknown";
 }

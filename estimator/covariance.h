@@ -28,9 +28,9 @@ namespace roamlab::estimator {
 
 struct MarginalInformation {
   std::vector<VariableId> variables;
-  std::vector<int> offsets;       // of each variable in the matrix
-  Eigen::MatrixXd information;    // Schur complement, tangent coordinates
-  Eigen::VectorXd conditional;    // diagonal of the Hessian for the same components (every other variable known)
+  std::vector<int> offsets;     // of each variable in the matrix
+  Eigen::MatrixXd information;  // Schur complement, tangent coordinates
+  Eigen::VectorXd conditional;  // diagonal of the Hessian for the same components (every other variable known)
 };
 
 class SolverWorkspace;
@@ -46,18 +46,18 @@ enum class Observability { kObservable, kWeak, kUnobservable };
 const char* ObservabilityName(Observability observability);
 
 struct ObservabilityOptions {
-  double null_eigenvalue = 1e-9;     // normalized eigenvalues below this are null directions
-  double null_loading = 1e-2;        // a component whose squared loading on null directions exceeds this is unobservable
-  double weak_inflation = 100.0;          // variance inflation factor above which a component is weak
+  double null_eigenvalue = 1e-9;  // normalized eigenvalues below this are null directions
+  double null_loading = 1e-2;     // a component whose squared loading on null directions exceeds this is unobservable
+  double weak_inflation = 100.0;  // variance inflation factor above which a component is weak
   double unobservable_inflation = 1.0e4;  // ... and above which it is unobservable
 };
 
 struct ObservabilityAnalysis {
-  Eigen::MatrixXd covariance;                 // pseudo-inverse of the information on its observable subspace
-  Eigen::VectorXd std;                        // per component; NaN when unobservable
-  Eigen::VectorXd inflation;                  // variance inflation factor per component (inf on a null direction)
-  std::vector<Observability> observability;   // per component
-  Eigen::MatrixXd correlation;                // from the regularized inverse
+  Eigen::MatrixXd covariance;                // pseudo-inverse of the information on its observable subspace
+  Eigen::VectorXd std;                       // per component; NaN when unobservable
+  Eigen::VectorXd inflation;                 // variance inflation factor per component (inf on a null direction)
+  std::vector<Observability> observability;  // per component
+  Eigen::MatrixXd correlation;               // from the regularized inverse
 };
 
 // `conditional`: the Hessian's diagonal for the same components (MarginalInformation::conditional); pass

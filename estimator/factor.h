@@ -66,15 +66,16 @@ struct AdditiveNoise<Model, std::void_t<decltype(Model::kAdditiveNoise)>>
 
 // True when the model has the analytic hook `bool Linearize(x, error, jacobians, noise_jacobian) const`.
 template <typename Model>
-using LinearizeResult = decltype(std::declval<const Model&>().Linearize(
-    std::declval<const double* const*>(), std::declval<double*>(), std::declval<double* const*>(),
-    std::declval<double*>()));
+using LinearizeResult =
+    decltype(std::declval<const Model&>().Linearize(std::declval<const double* const*>(), std::declval<double*>(),
+                                                    std::declval<double* const*>(), std::declval<double*>()));
 template <typename Model, typename = void>
 struct HasLinearize : std::false_type {};
 template <typename Model>
 struct HasLinearize<Model, std::void_t<LinearizeResult<Model>>> : std::is_same<LinearizeResult<Model>, bool> {};
 
-template <typename Tuple> struct BlockSizes;
+template <typename Tuple>
+struct BlockSizes;
 template <typename... B>
 struct BlockSizes<std::tuple<B...>> {
   static constexpr int kCount = sizeof...(B);
@@ -206,7 +207,7 @@ class AutoDiffFactor final : public Factor {
                             std::index_sequence<I...>) {
     int slot = 0;
     (PerturbBlock<J, kAllBlocks, std::tuple_element_t<I, Blocks>>(values[I], &slot, (*out)[I].data(),
-                                                                   &(*first_slot)[I]),
+                                                                  &(*first_slot)[I]),
      ...);
   }
 

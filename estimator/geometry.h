@@ -10,7 +10,8 @@
 //  - Poses are stored as 7 numbers [x, y, z, qw, qx, qy, qz] (position of O in W [m], then q_world_body). Their tangent
 //    is [dp (world frame, m), dtheta (body frame, rad)]: (p, q) [+] (dp, dtheta) = (p + dp, q * Exp(dtheta)).
 //  - Box-minus: x [-] y = d with y [+] d = x, i.e. (p_x - p_y, Log(q_y^-1 * q_x)).
-//  - Orientation errors are Log(q_hat * q^-1) (a full-angle rotation vector). The seed keeps the vector part of the error
+//  - Orientation errors are Log(q_hat * q^-1) (a full-angle rotation vector). The seed keeps the vector part of the
+//  error
 //    quaternion, which is half this angle to first order; Log stays exact away from identity.
 //  - The world frame W is East-North-Up; gravity is -9.81 m/s^2 along z. An accelerometer measures specific force:
 //    at rest it reads +9.81 along its up axis. kSpecificForceAtRest_world is that reading in W.
@@ -25,9 +26,12 @@
 
 namespace roamlab::estimator {
 
-template <typename T> using Vector3 = Eigen::Matrix<T, 3, 1>;
-template <typename T> using Matrix3 = Eigen::Matrix<T, 3, 3>;
-template <typename T> using Quaternion = Eigen::Quaternion<T>;
+template <typename T>
+using Vector3 = Eigen::Matrix<T, 3, 1>;
+template <typename T>
+using Matrix3 = Eigen::Matrix<T, 3, 3>;
+template <typename T>
+using Quaternion = Eigen::Quaternion<T>;
 
 inline constexpr double kStandardGravity = 9.80665;  // [m/s^2]
 inline const Eigen::Vector3d kSpecificForceAtRest_world(0.0, 0.0, kStandardGravity);
@@ -59,8 +63,7 @@ Quaternion<T> QuaternionExp(const Vector3<T>& rotation_vector) {
   using std::sqrt;
   const T theta = sqrt(theta_sq);
   const T k = sin(theta * T(0.5)) / theta;
-  return Quaternion<T>(cos(theta * T(0.5)), k * rotation_vector.x(), k * rotation_vector.y(),
-                       k * rotation_vector.z());
+  return Quaternion<T>(cos(theta * T(0.5)), k * rotation_vector.x(), k * rotation_vector.y(), k * rotation_vector.z());
 }
 
 // Log: unit quaternion -> rotation vector [rad] with angle in [0, pi] (q and -q give the same result).
@@ -135,8 +138,9 @@ Pose<T> PredictPose(const Pose<T>& pose, const Vector3<T>& v_body, const Vector3
 
 // The seed's eq. 5: velocities of O from those of a sensor frame S mounted at p_body_sensor with q_body_sensor.
 template <typename T>
-void SensorToBodyVelocity(const Vector3<T>& v_sensor, const Vector3<T>& omega_sensor, const Quaternion<T>& q_body_sensor,
-                          const Vector3<T>& p_body_sensor, Vector3<T>* v_body, Vector3<T>* omega_body) {
+void SensorToBodyVelocity(const Vector3<T>& v_sensor, const Vector3<T>& omega_sensor,
+                          const Quaternion<T>& q_body_sensor, const Vector3<T>& p_body_sensor, Vector3<T>* v_body,
+                          Vector3<T>* omega_body) {
   *v_body = q_body_sensor * (v_sensor - omega_sensor.cross(q_body_sensor.conjugate() * p_body_sensor));
   *omega_body = q_body_sensor * omega_sensor;
 }

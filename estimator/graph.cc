@@ -53,15 +53,14 @@ std::shared_ptr<const NoiseModel> Graph::SharedNoise(Eigen::MatrixXd covariance,
 FactorId Graph::AddFactor(std::unique_ptr<Factor> factor, std::vector<VariableId> variables,
                           Eigen::MatrixXd noise_covariance, Loss loss, std::string stream, Time stamp) {
   ROAMLAB_CHECK(factor != nullptr, "null factor");
-  ROAMLAB_CHECK(factor->manifolds().size() == variables.size(),
-                "factor from '" << stream << "' takes " << factor->manifolds().size() << " variables, got "
-                                << variables.size());
+  ROAMLAB_CHECK(
+      factor->manifolds().size() == variables.size(),
+      "factor from '" << stream << "' takes " << factor->manifolds().size() << " variables, got " << variables.size());
   for (std::size_t i = 0; i < variables.size(); ++i) {
     const Variable& v = variable(variables[i]);
-    ROAMLAB_CHECK(v.manifold == factor->manifolds()[i], "factor from '" << stream << "': variable " << i << " ('"
-                                                                         << v.name << "') is " << v.manifold.Name()
-                                                                         << ", expected "
-                                                                         << factor->manifolds()[i].Name());
+    ROAMLAB_CHECK(v.manifold == factor->manifolds()[i],
+                  "factor from '" << stream << "': variable " << i << " ('" << v.name << "') is " << v.manifold.Name()
+                                  << ", expected " << factor->manifolds()[i].Name());
   }
   ROAMLAB_CHECK(noise_covariance.rows() == factor->noise_dim() && noise_covariance.cols() == factor->noise_dim(),
                 "factor from '" << stream << "': noise covariance is " << noise_covariance.rows() << "x"

@@ -27,11 +27,11 @@ using VariableId = std::int64_t;
 using FactorId = std::int64_t;
 
 struct Variable {
-  std::string name;              // e.g. "pose", "gps.lever_arm"
+  std::string name;  // e.g. "pose", "gps.lever_arm"
   Manifold manifold = Manifold::Euclidean(0);
-  Eigen::VectorXd value;         // ambient representation
+  Eigen::VectorXd value;  // ambient representation
   bool fixed = false;
-  std::optional<Time> stamp;     // poses and time-varying parameter instances
+  std::optional<Time> stamp;  // poses and time-varying parameter instances
 };
 
 // The noise input of a factor: Sigma_eta and its Cholesky factor. A stream's factors mostly share one (a whole

@@ -161,8 +161,8 @@ class IdTable {
   // The first element with an id not less than `id`.
   const_iterator lower_bound(Id id) const {
     const Id first = FirstOfChunk(id);
-    const auto chunk = std::lower_bound(chunks_.begin(), chunks_.end(), first,
-                                        [](const auto& c, Id key) { return c->first < key; });
+    const auto chunk =
+        std::lower_bound(chunks_.begin(), chunks_.end(), first, [](const auto& c, Id key) { return c->first < key; });
     const int slot = chunk != chunks_.end() && (*chunk)->first == first ? static_cast<int>(id - first) : 0;
     return First<true>(this, static_cast<std::size_t>(chunk - chunks_.begin()), slot);
   }
@@ -177,8 +177,8 @@ class IdTable {
     const Id guess = (first - chunks_.front()->first) / kChunk;
     if (guess >= 0 && guess < static_cast<Id>(chunks_.size()) && chunks_[guess]->first == first)
       return static_cast<std::size_t>(guess);
-    const auto chunk = std::lower_bound(chunks_.begin(), chunks_.end(), first,
-                                        [](const auto& c, Id key) { return c->first < key; });
+    const auto chunk =
+        std::lower_bound(chunks_.begin(), chunks_.end(), first, [](const auto& c, Id key) { return c->first < key; });
     return chunk != chunks_.end() && (*chunk)->first == first ? static_cast<std::size_t>(chunk - chunks_.begin())
                                                               : chunks_.size();
   }
@@ -190,7 +190,7 @@ class IdTable {
   }
 
   std::deque<std::unique_ptr<Chunk>> chunks_;  // the chunks with live elements, in id order
-  Id next_ = 0;  // ids below it have been added
+  Id next_ = 0;                                // ids below it have been added
   std::size_t size_ = 0;
 };
 

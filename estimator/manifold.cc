@@ -6,9 +6,12 @@ namespace roamlab::estimator {
 
 std::string Manifold::Name() const {
   switch (kind_) {
-    case ManifoldKind::kEuclidean: return "R" + std::to_string(ambient_dim_);
-    case ManifoldKind::kQuaternion: return "S3";
-    case ManifoldKind::kPose: return "SE3";
+    case ManifoldKind::kEuclidean:
+      return "R" + std::to_string(ambient_dim_);
+    case ManifoldKind::kQuaternion:
+      return "S3";
+    case ManifoldKind::kPose:
+      return "SE3";
   }
   return "?";
 }

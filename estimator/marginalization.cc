@@ -11,8 +11,8 @@
 #include <Eigen/Eigenvalues>
 
 #include "estimator/geometry.h"
-#include "estimator/solver.h"
 #include "estimator/internal/linearization.h"
+#include "estimator/solver.h"
 
 namespace roamlab::estimator {
 namespace {

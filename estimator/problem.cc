@@ -148,8 +148,8 @@ Eigen::Vector3d ReadingRate(const recording::Stream& data, int column, int row) 
   const auto first = std::lower_bound(data.t.begin(), data.t.end(), Time::FromNanoseconds(t.nanoseconds() - half_ns));
   const auto last = std::upper_bound(data.t.begin(), data.t.end(), Time::FromNanoseconds(t.nanoseconds() + half_ns));
   const int lo = std::min(static_cast<int>(first - data.t.begin()), std::max(row - 1, 0));
-  const int hi = std::max(static_cast<int>(last - data.t.begin()) - 1,
-                          std::min(row + 1, static_cast<int>(data.t.size()) - 1));
+  const int hi =
+      std::max(static_cast<int>(last - data.t.begin()) - 1, std::min(row + 1, static_cast<int>(data.t.size()) - 1));
   double mean_t = 0.0;
   Eigen::Vector3d mean_z = Eigen::Vector3d::Zero();
   for (int i = lo; i <= hi; ++i) {
@@ -186,8 +186,8 @@ void ProblemBuilder::Add(const MeasurementRef& m) {
   AttachPending();
 }
 std::size_t ProblemBuilder::NearestPose(Time t) const {
-  const auto it = std::lower_bound(poses_.begin(), poses_.end(), t,
-                                   [](const PoseNode& p, Time time) { return p.t < time; });
+  const auto it =
+      std::lower_bound(poses_.begin(), poses_.end(), t, [](const PoseNode& p, Time time) { return p.t < time; });
   if (it == poses_.end()) return poses_.size() - 1;
   const std::size_t i = static_cast<std::size_t>(it - poses_.begin());
   if (i == 0) return 0;
@@ -218,8 +218,8 @@ VariableId ProblemBuilder::CreatePose(Time t, const Eigen::VectorXd& value) {
         continue;
       }
     }
-    const Eigen::VectorXd init = first ? im.parameter_initial.at(pname)
-                                       : graph_.variable(poses_.back().instances.at(pname)).value;
+    const Eigen::VectorXd init =
+        first ? im.parameter_initial.at(pname) : graph_.variable(poses_.back().instances.at(pname)).value;
     const VariableId id = graph_.AddVariable({pname, Manifold::Euclidean(3), init, !pc.free, t});
     node.instances[pname] = id;
     const Eigen::Vector3d& sigma = pc.process.sigma;
@@ -272,7 +272,9 @@ void ProblemBuilder::AddMasterSample(const MeasurementRef& m) {
   const double dt = SecondsBetween(odo.t, m.t);
   const StreamBinding& s = im.streams[odo.stream];
   const Eigen::RowVectorXd row = s.primary->values.row(odo.row);
-  const auto value = [&](std::size_t slot) { return graph_.variable(ParameterAt(s.slot_parameters[slot], poses_.size() - 1)).value; };
+  const auto value = [&](std::size_t slot) {
+    return graph_.variable(ParameterAt(s.slot_parameters[slot], poses_.size() - 1)).value;
+  };
   Eigen::Vector3d v_body = Eigen::Vector3d::Zero(), omega_body = Eigen::Vector3d::Zero();
   if (s.config.model == "ackermann" || s.config.model == "ackermann_seed") {
     const double kv_over_l = value(0)[0], k_theta = value(1)[0], k_gamma = value(2)[0];
@@ -299,8 +301,8 @@ void ProblemBuilder::AddMasterSample(const MeasurementRef& m) {
     SensorToBodyVelocity<double>(row.head<3>().transpose(), row.segment<3>(3).transpose(),
                                  Eigen::Quaterniond(q[0], q[1], q[2], q[3]), value(0), &v_body, &omega_body);
   }
-  const Pose<double> predicted = PredictPose<double>(PoseFromArray(graph_.variable(prev).value.data()), v_body,
-                                                     omega_body, dt);
+  const Pose<double> predicted =
+      PredictPose<double>(PoseFromArray(graph_.variable(prev).value.data()), v_body, omega_body, dt);
   Eigen::VectorXd next_value(7);
   PoseToArray(predicted, next_value.data());
   CreatePose(m.t, next_value);
@@ -308,8 +310,7 @@ void ProblemBuilder::AddMasterSample(const MeasurementRef& m) {
   TryAttach(odo);
 }
 
-ProblemBuilder::Placement ProblemBuilder::PlaceSample(const MeasurementRef& m, const StreamBinding& s,
-                                                      std::size_t* k) {
+ProblemBuilder::Placement ProblemBuilder::PlaceSample(const MeasurementRef& m, const StreamBinding& s, std::size_t* k) {
   if (poses_.empty() || m.t > poses_.back().t) return Placement::kWait;
   if (m.t < poses_.front().t) {
     ++counts_[s.name].outside;
@@ -319,8 +320,8 @@ ProblemBuilder::Placement ProblemBuilder::PlaceSample(const MeasurementRef& m, c
     case Attachment::kMaster:
     case Attachment::kPair: {
       if (m.t >= poses_.back().t) return Placement::kWait;
-      const auto it = std::upper_bound(poses_.begin(), poses_.end(), m.t,
-                                       [](Time time, const PoseNode& p) { return time < p.t; });
+      const auto it =
+          std::upper_bound(poses_.begin(), poses_.end(), m.t, [](Time time, const PoseNode& p) { return time < p.t; });
       *k = static_cast<std::size_t>(it - poses_.begin()) - 1;
       break;
     }
@@ -354,9 +355,12 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
   if (s.attachment == Attachment::kInterval) return TryAttachInterval(m);
   std::size_t k = 0;
   switch (PlaceSample(m, s, &k)) {
-    case Placement::kWait: return false;
-    case Placement::kOutside: return true;
-    case Placement::kAttach: break;
+    case Placement::kWait:
+      return false;
+    case Placement::kOutside:
+      return true;
+    case Placement::kAttach:
+      break;
   }
 
   // The factor, by model.
@@ -400,8 +404,8 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
   } else if (model == "odometer") {
     factor = MakeFactor(OdometerError(row.head<6>().transpose(), dt));
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k)};
-    const FactorId id = graph_.AddFactor(std::move(factor), vars, SampleNoiseCovariance(s, row), s.config.loss, s.name,
-                                         m.t);
+    const FactorId id =
+        graph_.AddFactor(std::move(factor), vars, SampleNoiseCovariance(s, row), s.config.loss, s.name, m.t);
     stream_of_factor_.Add(id, m.stream);
     ++counts_[s.name].attached;
     return true;
@@ -628,8 +632,8 @@ std::optional<Eigen::Quaterniond> ProblemBuilder::AlignImuToMotion() {
     const Pose<double> c = PoseFromArray(graph_.variable(poses_[k + 1].id).value.data());
     const double dt_ab = SecondsBetween(poses_[k - 1].t, poses_[k].t);
     const double dt_bc = SecondsBetween(poses_[k].t, poses_[k + 1].t);
-    const Eigen::Vector3d accel_world = 2.0 *
-        ((c.p_world_body - b.p_world_body) / dt_bc - (b.p_world_body - a.p_world_body) / dt_ab) / (dt_ab + dt_bc);
+    const Eigen::Vector3d accel_world =
+        2.0 * ((c.p_world_body - b.p_world_body) / dt_bc - (b.p_world_body - a.p_world_body) / dt_ab) / (dt_ab + dt_bc);
     const Eigen::Matrix3d R_T = b.q_world_body.toRotationMatrix().transpose();
     const Eigen::Vector3d f_body = R_T * (accel_world + g_world);
     const Eigen::Vector3d omega_body =

@@ -58,9 +58,9 @@ struct PoseNode {
 
 struct StreamCounts {
   int attached = 0;
-  int rejected = 0;    // switched off by the chi-square gate
-  int too_late = 0;    // older than the oldest pose in the graph
-  int outside = 0;     // no pose around its time stamp (before the first or after the last master sample)
+  int rejected = 0;  // switched off by the chi-square gate
+  int too_late = 0;  // older than the oldest pose in the graph
+  int outside = 0;   // no pose around its time stamp (before the first or after the last master sample)
 };
 
 struct StreamBinding;  // a configured stream bound to its recording data (problem.cc)

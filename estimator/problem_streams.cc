@@ -18,8 +18,7 @@ Attachment AttachmentOf(const std::string& model, bool master) {
   if (master) return Attachment::kMaster;
   if (model == "relative_motion") return Attachment::kInterval;
   if (model == "gyroscope" || model == "linear_velocity" || model == "odometer" || model == "ackermann" ||
-      model == "ackermann_seed" || model == "differential_drive" || model == "omni3_drive" ||
-      model == "mecanum_drive")
+      model == "ackermann_seed" || model == "differential_drive" || model == "omni3_drive" || model == "mecanum_drive")
     return Attachment::kPair;
   if (model == "accelerometer") return Attachment::kTriple;
   return Attachment::kOnePose;
@@ -123,7 +122,8 @@ Status BindAckermann(const EstimatorConfig& config, const recording::Recording& 
     const auto f = sc.options.find("forward_in_sensor");
     if (f == sc.options.end() || f->second.size() != 3 ||
         !(Eigen::Vector3d(f->second[0], f->second[1], f->second[2]).norm() > 0.5))
-      return Error(config, "stream '" + name + "': inputs.specific_force needs options.forward_in_sensor: "
+      return Error(config, "stream '" + name +
+                               "': inputs.specific_force needs options.forward_in_sensor: "
                                "[x, y, z], O's forward axis in the accelerometer's frame (a unit vector)");
     b->forward_in_sensor = Eigen::Vector3d(f->second[0], f->second[1], f->second[2]).normalized();
   } else if (sc.options.count("forward_in_sensor")) {
@@ -157,7 +157,8 @@ Status BindOtherModel(const EstimatorConfig& config, const recording::Recording&
     if (input.value()) {
       if (!sc.options.count("drive_nm_per_mps2") || sc.options.at("drive_nm_per_mps2").size() != 1 ||
           !std::isfinite(sc.options.at("drive_nm_per_mps2")[0]))
-        return Error(config, "stream '" + name + "': inputs.specific_force needs options.drive_nm_per_mps2: [c], "
+        return Error(config, "stream '" + name +
+                                 "': inputs.specific_force needs options.drive_nm_per_mps2: [c], "
                                  "the drive torque per wheel per m/s^2 of forward specific force");
       b->drive_nm_per_mps2 = sc.options.at("drive_nm_per_mps2")[0];
     } else if (sc.options.count("drive_nm_per_mps2")) {
@@ -197,8 +198,10 @@ Status BindRowOptions(const EstimatorConfig& config, const std::string& source, 
     if (k.size() != 1 || !(k[0] > 0.0))
       return Error(config, "stream '" + name + "': options.row_covariance_scale must be one positive number");
     if (b->primary->values.cols() != 27)
-      return Error(config, "stream '" + name + "': options.row_covariance_scale needs the 21 covariance columns, "
-                               "which recording stream '" + source + "' lacks");
+      return Error(config, "stream '" + name +
+                               "': options.row_covariance_scale needs the 21 covariance columns, "
+                               "which recording stream '" +
+                               source + "' lacks");
     b->row_covariance_scale = k[0];
   }
   if (m == "relative_motion") {
@@ -210,8 +213,8 @@ Status BindRowOptions(const EstimatorConfig& config, const std::string& source, 
     } else if (b->primary->info.rate_hz > 0.0) {
       b->interval_s = 1.0 / b->primary->info.rate_hz;
     } else {
-      return Error(config, "stream '" + name + "': recording stream '" + source +
-                               "' has no rate_hz; give options.interval_s");
+      return Error(config,
+                   "stream '" + name + "': recording stream '" + source + "' has no rate_hz; give options.interval_s");
     }
   }
   return Status::Ok();
@@ -258,8 +261,8 @@ Status AddSlotParameters(const EstimatorConfig& config, const recording::Recordi
     b->slot_parameters.push_back(pname);
     const auto known = parameter_manifold->find(pname);
     if (known != parameter_manifold->end() && !(known->second == slot.manifold))
-      return Error(config, "parameter '" + pname + "' is used as " + known->second.Name() + " and as " +
-                               slot.manifold.Name());
+      return Error(config,
+                   "parameter '" + pname + "' is used as " + known->second.Name() + " and as " + slot.manifold.Name());
     parameter_manifold->emplace(pname, slot.manifold);
     Eigen::VectorXd init = slot.default_value;
     if (ackermann && slot.name == "kv_over_L") init[0] = 1.0 / b->wheelbase_m;
@@ -293,8 +296,7 @@ Status ApplyParameterConfig(const EstimatorConfig& config, const std::map<std::s
                             std::map<std::string, ParameterConfig>* parameter_config) {
   for (const auto& [pname, pc] : config.parameters) {
     const auto it = parameter_manifold.find(pname);
-    if (it == parameter_manifold.end())
-      return Error(config, "parameter '" + pname + "' is not used by any stream");
+    if (it == parameter_manifold.end()) return Error(config, "parameter '" + pname + "' is not used by any stream");
     if (pc.value) {
       if (pc.value->size() != it->second.ambient_dim())
         return Error(config, "parameter '" + pname + "' needs " + std::to_string(it->second.ambient_dim()) +
@@ -326,8 +328,7 @@ void BindTimeOffsets(const std::map<std::string, ParameterConfig>& parameter_con
     if (b.time_offset_slot < 0) continue;
     const std::string& pname = b.slot_parameters[static_cast<std::size_t>(b.time_offset_slot)];
     const auto pc = parameter_config.find(pname);
-    b.time_offset =
-        (pc != parameter_config.end() && pc->second.free) || parameter_initial.at(pname)[0] != 0.0;
+    b.time_offset = (pc != parameter_config.end() && pc->second.free) || parameter_initial.at(pname)[0] != 0.0;
   }
 }
 

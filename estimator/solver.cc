@@ -6,11 +6,11 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <tuple>
 #include <utility>
 #include <vector>
-#include <sstream>
 
 #include "estimator/internal/normal_equations.h"
 
@@ -31,13 +31,20 @@ std::string SolverOptions::Validate() const {
 
 const char* TerminationName(Termination termination) {
   switch (termination) {
-    case Termination::kFunctionTolerance: return "function_tolerance";
-    case Termination::kModelTolerance: return "model_tolerance";
-    case Termination::kStepTolerance: return "step_tolerance";
-    case Termination::kMaxIterations: return "max_iterations";
-    case Termination::kTimeBudget: return "time_budget";
-    case Termination::kNoFreeVariables: return "no_free_variables";
-    case Termination::kFailure: return "failure";
+    case Termination::kFunctionTolerance:
+      return "function_tolerance";
+    case Termination::kModelTolerance:
+      return "model_tolerance";
+    case Termination::kStepTolerance:
+      return "step_tolerance";
+    case Termination::kMaxIterations:
+      return "max_iterations";
+    case Termination::kTimeBudget:
+      return "time_budget";
+    case Termination::kNoFreeVariables:
+      return "no_free_variables";
+    case Termination::kFailure:
+      return "failure";
   }
   return "unknown";
 }
@@ -122,9 +129,8 @@ void RestoreValues(const std::vector<double>& saved, const std::vector<Variable*
 }
 
 // The tolerance an accepted step met (function, model, then step), if any.
-std::optional<Termination> ToleranceMet(const SolverOptions& options, double old_cost, double actual,
-                                        double predicted, double step_norm,
-                                        const std::vector<Variable*>& free_variables) {
+std::optional<Termination> ToleranceMet(const SolverOptions& options, double old_cost, double actual, double predicted,
+                                        double step_norm, const std::vector<Variable*>& free_variables) {
   if (std::abs(actual) <= options.function_tolerance * old_cost) return Termination::kFunctionTolerance;
   if (std::abs(actual - predicted) <= options.model_tolerance * old_cost) return Termination::kModelTolerance;
   if (step_norm <= options.step_tolerance * (TangentNorm(free_variables) + options.step_tolerance))
@@ -212,8 +218,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
     // the next solve of a workspace, starts there), Levenberg-Marquardt only evaluates the cost of a trial that may
     // be rejected.
     double new_cost = 0.0;
-    const bool evaluated =
-        lm ? system.CostWithLastWhitening(*graph, &new_cost) : system.LinearizeForCost(&new_cost);
+    const bool evaluated = lm ? system.CostWithLastWhitening(*graph, &new_cost) : system.LinearizeForCost(&new_cost);
     const double old_cost = system.cost();
     const double predicted = system.ModelDecrease(dx);
     const double actual = old_cost - new_cost;
@@ -270,8 +275,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
   }
   summary.final_lambda = lambda;
   if (covariance != nullptr && summary.usable())
-    covariance->computed =
-        system.Covariance(covariance->variables, &covariance->covariance, covariance->leading_dims);
+    covariance->computed = system.Covariance(covariance->variables, &covariance->covariance, covariance->leading_dims);
   summary.seconds = elapsed();
   return summary;
 }

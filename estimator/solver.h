@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "common/status.h"
 #include <Eigen/Core>
+#include "common/status.h"
 
 #include "estimator/graph.h"
 
@@ -57,8 +57,8 @@ const char* TerminationName(Termination termination);
 
 struct SolverSummary {
   Termination termination = Termination::kFailure;
-  int iterations = 0;                 // linearizations that produced a step
-  double initial_cost = 0.0;          // 1/2 sum of robustified squared whitened errors
+  int iterations = 0;         // linearizations that produced a step
+  double initial_cost = 0.0;  // 1/2 sum of robustified squared whitened errors
   double final_cost = 0.0;
   // The initial cost, then after each accepted step the cost at the new point, evaluated with the error covariances
   // of the linearization that step came from (they are re-evaluated at the next linearization).
@@ -69,7 +69,7 @@ struct SolverSummary {
   double final_lambda = 0.0;
   int free_dimension = 0;
   int factors = 0;
-  std::string message;                // details on failure
+  std::string message;  // details on failure
 
   bool usable() const { return termination != Termination::kFailure; }
 };
@@ -89,7 +89,7 @@ struct MarginalInformation;  // covariance.h
 namespace internal {
 class NormalEquations;
 struct WhitenedFactor;
-}
+}  // namespace internal
 
 // State kept between solves of graphs whose structure repeats (fixed-lag tracking: the window slides by one pose and
 // keeps its band): the buffers of the normal equations, CHOLMOD's symbolic analysis, reused while the Hessian's

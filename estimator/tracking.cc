@@ -23,9 +23,7 @@ using Clock = std::chrono::steady_clock;
 // A pose's tangent starts with its position (manifold.h); the output is the position's covariance.
 constexpr int kPositionDims = 3;
 
-FactorId NextFactorId(const Graph& graph) {
-  return graph.factors().empty() ? 0 : graph.factors().rbegin()->first + 1;
-}
+FactorId NextFactorId(const Graph& graph) { return graph.factors().empty() ? 0 : graph.factors().rbegin()->first + 1; }
 
 // The oldest pose's estimate and position covariance (marginal of the whole window): from `known` when it holds that
 // pose (a request of poses' positions only, kPositionDims each, computed by a solve or by OldestPoseCovariances),
@@ -130,8 +128,7 @@ Status AddCalibrationPrior(const CalibrationPrior& prior, ProblemBuilder* builde
     J.row(static_cast<int>(r)) = std::sqrt(eig.eigenvalues()[kept[r]]) * eig.eigenvectors().col(kept[r]).transpose();
   const int rows = static_cast<int>(J.rows());
   builder->graph().AddFactor(std::make_unique<LinearPriorFactor>(manifolds, values, J, Eigen::VectorXd::Zero(rows)),
-                             ids, Eigen::MatrixXd::Identity(rows, rows), Loss::Trivial(), "calibration_prior",
-                             Time());
+                             ids, Eigen::MatrixXd::Identity(rows, rows), Loss::Trivial(), "calibration_prior", Time());
   return Status::Ok();
 }
 

@@ -33,8 +33,8 @@ struct TrackingResult {
   int updates = 0;
   double mean_update_s = 0.0;
   double max_update_s = 0.0;
-  double p99_update_s = 0.0;                          // 99th percentile of the update times
-  double mean_iterations = 0.0;                      // Gauss-Newton iterations per update
+  double p99_update_s = 0.0;     // 99th percentile of the update times
+  double mean_iterations = 0.0;  // Gauss-Newton iterations per update
   // Factor linearizations of the updates: evaluated with Jacobians, and carried to first order under
   // tracking.relinearize_threshold.
   long factor_evaluations = 0;

@@ -26,9 +26,12 @@ std::vector<Eigen::Vector3d> Positions(const Trajectory& trajectory) {
 
 const char* AlignmentKindName(AlignmentKind kind) {
   switch (kind) {
-    case AlignmentKind::kNone: return "none";
-    case AlignmentKind::kSe3: return "se3";
-    case AlignmentKind::kYawTranslation: return "yaw_translation";
+    case AlignmentKind::kNone:
+      return "none";
+    case AlignmentKind::kSe3:
+      return "se3";
+    case AlignmentKind::kYawTranslation:
+      return "yaw_translation";
   }
   return "none";
 }
@@ -49,8 +52,8 @@ StampedPose RigidTransform::Apply(const StampedPose& pose_est) const {
 
 RigidTransform AlignPositions(const std::vector<Eigen::Vector3d>& p_est, const std::vector<Eigen::Vector3d>& p_ref,
                               AlignmentKind kind) {
-  ROAMLAB_CHECK(p_est.size() == p_ref.size(), "alignment needs matched points: " << p_est.size() << " estimate vs "
-                                                                                  << p_ref.size() << " reference");
+  ROAMLAB_CHECK(p_est.size() == p_ref.size(),
+                "alignment needs matched points: " << p_est.size() << " estimate vs " << p_ref.size() << " reference");
   RigidTransform transform;
   if (kind == AlignmentKind::kNone || p_est.empty()) return transform;
   const Eigen::Vector3d mean_est = Mean(p_est);

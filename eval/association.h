@@ -36,8 +36,7 @@ struct Association {
 // Pairs the stamps. Both lists must be strictly increasing (CHECK); options must validate (CHECK).
 Association AssociateByTime(const std::vector<Time>& estimate, const std::vector<Time>& reference,
                             const AssociationOptions& options);
-Association AssociateByTime(const Trajectory& estimate, const Trajectory& reference,
-                            const AssociationOptions& options);
+Association AssociateByTime(const Trajectory& estimate, const Trajectory& reference, const AssociationOptions& options);
 
 // The paired poses as two trajectories of equal length (each keeps its own stamps).
 struct MatchedTrajectories {

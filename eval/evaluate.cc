@@ -206,11 +206,11 @@ AbsoluteTrajectoryError Accuracy(const Inputs& in, const MatchedTrajectories& ma
 
   json& m = ev->metrics;
   const Eigen::Quaterniond& q = ate.alignment.q_ref_est;
-  m["alignment"] = {{"kind", AlignmentKindName(ev->alignment)},
-                    {"reason", AlignmentReason(options, ev->alignment)},
-                    {"q_ref_est_wxyz", {q.w(), q.x(), q.y(), q.z()}},
-                    {"p_ref_est_m", {ate.alignment.p_ref_est.x(), ate.alignment.p_ref_est.y(),
-                                     ate.alignment.p_ref_est.z()}}};
+  m["alignment"] = {
+      {"kind", AlignmentKindName(ev->alignment)},
+      {"reason", AlignmentReason(options, ev->alignment)},
+      {"q_ref_est_wxyz", {q.w(), q.x(), q.y(), q.z()}},
+      {"p_ref_est_m", {ate.alignment.p_ref_est.x(), ate.alignment.p_ref_est.y(), ate.alignment.p_ref_est.z()}}};
   m["ate_m"] = Number(ate.statistics.rmse);
   m["ate"] = {{"poses", ate.statistics.count},
               {"rmse_m", Number(ate.statistics.rmse)},
@@ -239,13 +239,11 @@ void Velocities(const Inputs& in, const MatchedTrajectories& matched, const Rela
   Evaluation::Velocity v;
   v.fused = CompareVelocities(TrajectoryVelocities(in.estimate), truth, options.max_time_difference_s);
   v.encoders_only = CompareVelocities(encoders.value().twists, truth, options.max_time_difference_s);
-  const Association encoder_association =
-      AssociateByTime(encoders.value().dead_reckoning, truth, association_options);
+  const Association encoder_association = AssociateByTime(encoders.value().dead_reckoning, truth, association_options);
   const MatchedTrajectories encoder_matched =
       SelectMatched(encoders.value().dead_reckoning, truth, encoder_association);
-  const RelativePoseError rpe_encoders =
-      RpeByStep(encoder_matched.estimate, encoder_matched.reference,
-                StepForDuration(encoder_matched.estimate, options.rpe_delta_s));
+  const RelativePoseError rpe_encoders = RpeByStep(encoder_matched.estimate, encoder_matched.reference,
+                                                   StepForDuration(encoder_matched.estimate, options.rpe_delta_s));
   const auto series = [&truth](const RelativePoseError& rpe, const Trajectory& poses, std::vector<double>* t,
                                std::vector<double>* rot) {
     for (std::size_t n = 0; n < rpe.first.size(); ++n) {
@@ -384,19 +382,20 @@ Result<WrittenEvaluation> WriteEvaluation(const Evaluation& evaluation, const st
   const std::string alignment = AlignmentKindName(evaluation.alignment);
   const std::string label = evaluation.estimate_label + ", alignment " + alignment;
   Result<PlotFiles> trajectory = WriteTrajectoryPlot(
-      out_dir, "Trajectory, top view: ground truth, " + evaluation.estimate_label +
-                   (evaluation.fixes.empty() ? std::string() : " and absolute fixes"),
+      out_dir,
+      "Trajectory, top view: ground truth, " + evaluation.estimate_label +
+          (evaluation.fixes.empty() ? std::string() : " and absolute fixes"),
       evaluation.t_origin, evaluation.ground_truth, evaluation.aligned_estimate, label, evaluation.fixes);
   if (!trajectory.ok()) return trajectory.status();
   figures.push_back(trajectory.value());
   char ate[64];
-  std::snprintf(ate, sizeof ate, "%.3f", evaluation.metrics.value("ate_m", json()).is_number()
-                                              ? evaluation.metrics["ate_m"].get<double>()
-                                              : kNaN);
+  std::snprintf(
+      ate, sizeof ate, "%.3f",
+      evaluation.metrics.value("ate_m", json()).is_number() ? evaluation.metrics["ate_m"].get<double>() : kNaN);
   Result<PlotFiles> error = WritePositionErrorPlot(
       out_dir,
-      "Position error, " + evaluation.estimate_label + " - ground truth (alignment " + alignment + ", ATE RMSE " +
-          ate + " m)" + (evaluation.sigma_world.empty() ? ", no covariance" : ""),
+      "Position error, " + evaluation.estimate_label + " - ground truth (alignment " + alignment + ", ATE RMSE " + ate +
+          " m)" + (evaluation.sigma_world.empty() ? ", no covariance" : ""),
       evaluation.t_origin, evaluation.matched_t, evaluation.error_world, evaluation.sigma_world);
   if (!error.ok()) return error.status();
   figures.push_back(error.value());
@@ -410,8 +409,8 @@ Result<WrittenEvaluation> WriteEvaluation(const Evaluation& evaluation, const st
     const Evaluation::Velocity& v = *evaluation.velocity;
     Result<PlotFiles> velocity = WriteVelocityPlot(
         out_dir, "Velocities: ground truth, encoders' forward kinematics, " + evaluation.estimate_label,
-        {v.fused.t_s, v.fused.truth, v.fused.estimate, v.encoders_only.t_s, v.encoders_only.estimate,
-         v.rpe_t_fused_s, v.rpe_rot_fused_deg, v.rpe_t_encoders_s, v.rpe_rot_encoders_deg});
+        {v.fused.t_s, v.fused.truth, v.fused.estimate, v.encoders_only.t_s, v.encoders_only.estimate, v.rpe_t_fused_s,
+         v.rpe_rot_fused_deg, v.rpe_t_encoders_s, v.rpe_rot_encoders_deg});
     if (!velocity.ok()) return velocity.status();
     figures.push_back(velocity.value());
   }

@@ -71,17 +71,17 @@ struct Evaluation {
   nlohmann::json metrics;  // the content of metrics.json
 
   // What the figures draw.
-  Time t_origin;                            // first ground-truth stamp
+  Time t_origin;  // first ground-truth stamp
   AlignmentKind alignment = AlignmentKind::kNone;
-  Trajectory ground_truth;                  // whole
-  Trajectory aligned_estimate;              // whole estimate, mapped by the alignment
-  std::vector<Time> matched_t;              // stamps of the matched estimate poses
+  Trajectory ground_truth;                   // whole
+  Trajectory aligned_estimate;               // whole estimate, mapped by the alignment
+  std::vector<Time> matched_t;               // stamps of the matched estimate poses
   std::vector<Eigen::Vector3d> error_world;  // aligned estimate - truth at the matched poses [m]
   std::vector<Eigen::Vector3d> sigma_world;  // per-axis std [m] at the matched poses (NaN without a covariance row);
                                              // empty without covariance.csv
   std::vector<PositionFixes> fixes;
-  std::optional<MonteCarloNees> nees;       // single-run NEES of the poses that have one (runs = 1)
-  std::string estimate_label;               // e.g. "estimate (tracking)"
+  std::optional<MonteCarloNees> nees;  // single-run NEES of the poses that have one (runs = 1)
+  std::string estimate_label;          // e.g. "estimate (tracking)"
   // Wheeled platforms with encoders: velocities of the fused estimate and of the encoders against the truth, and the
   // rotational RPE per pair (stamp of the pair's first pose, seconds since t_origin).
   struct Velocity {

@@ -47,7 +47,7 @@ struct AbsoluteTrajectoryError {
 AbsoluteTrajectoryError ComputeAte(const Trajectory& estimate, const Trajectory& reference, AlignmentKind kind);
 
 struct RelativePoseError {
-  std::vector<std::size_t> first;    // pair (first[n], second[n]) of pose indices
+  std::vector<std::size_t> first;  // pair (first[n], second[n]) of pose indices
   std::vector<std::size_t> second;
   std::vector<double> translation_m;  // per pair [m]
   std::vector<double> rotation_deg;   // per pair [deg]

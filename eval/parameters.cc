@@ -20,17 +20,23 @@ const double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Ambient and tangent sizes of a kind (vectors: the given size).
 int AmbientSize(ParameterKind kind, int vector_size) {
   switch (kind) {
-    case ParameterKind::kQuaternion: return 4;
-    case ParameterKind::kPose: return 7;
-    case ParameterKind::kVector: break;
+    case ParameterKind::kQuaternion:
+      return 4;
+    case ParameterKind::kPose:
+      return 7;
+    case ParameterKind::kVector:
+      break;
   }
   return vector_size;
 }
 int TangentSize(ParameterKind kind, int vector_size) {
   switch (kind) {
-    case ParameterKind::kQuaternion: return 3;
-    case ParameterKind::kPose: return 6;
-    case ParameterKind::kVector: break;
+    case ParameterKind::kQuaternion:
+      return 3;
+    case ParameterKind::kPose:
+      return 6;
+    case ParameterKind::kVector:
+      break;
   }
   return vector_size;
 }
@@ -74,9 +80,12 @@ bool QuaternionNonZero(const std::vector<double>& values, int offset) {
 
 const char* ManifoldName(const ParameterComparison& row) {
   switch (row.kind) {
-    case ParameterKind::kQuaternion: return "S3";
-    case ParameterKind::kPose: return "SE3";
-    case ParameterKind::kVector: break;
+    case ParameterKind::kQuaternion:
+      return "S3";
+    case ParameterKind::kPose:
+      return "SE3";
+    case ParameterKind::kVector:
+      break;
   }
   return nullptr;
 }

@@ -44,10 +44,10 @@ struct ParameterComparison {
   ParameterKind kind = ParameterKind::kVector;
   std::vector<double> truth;
   std::vector<double> estimate;
-  std::vector<double> std;             // tangent size; NaN where unknown
-  std::vector<double> error;           // tangent size (see the table above)
-  std::vector<double> error_over_std;  // tangent size
-  double angle_error_deg = 0.0;        // rotations only (NaN for kVector)
+  std::vector<double> std;              // tangent size; NaN where unknown
+  std::vector<double> error;            // tangent size (see the table above)
+  std::vector<double> error_over_std;   // tangent size
+  double angle_error_deg = 0.0;         // rotations only (NaN for kVector)
   std::vector<double> component_error;  // rotations only: ambient size (empty for kVector)
 };
 
@@ -59,9 +59,9 @@ Result<ParameterComparison> CompareParameter(const std::string& name, const std:
 
 // The rows for every estimated parameter that has a true value, by name; the other estimated names go to
 // `without_truth` when given.
-Result<std::vector<ParameterComparison>> CompareParameters(
-    const std::map<std::string, std::vector<double>>& truth, const std::map<std::string, ParameterEstimate>& estimates,
-    std::vector<std::string>* without_truth = nullptr);
+Result<std::vector<ParameterComparison>> CompareParameters(const std::map<std::string, std::vector<double>>& truth,
+                                                           const std::map<std::string, ParameterEstimate>& estimates,
+                                                           std::vector<std::string>* without_truth = nullptr);
 
 // Reads parameters.NAME.{estimate, std, manifold} from a calibration.json written by `roamlab calibrate` (std entries
 // may be null: unknown; a missing manifold means "R<n>"). Errors name the file and the parameter.

@@ -205,16 +205,15 @@ Result<PlotFiles> WriteNeesPlot(const std::string& directory, const std::string&
   return files;
 }
 
-Result<PlotFiles> WriteVelocityPlot(const std::string& directory, const std::string& title,
-                                    const VelocityPlotData& d) {
+Result<PlotFiles> WriteVelocityPlot(const std::string& directory, const std::string& title, const VelocityPlotData& d) {
   ROAMLAB_CHECK(d.fused_t_s.size() == d.truth.size() && d.fused_t_s.size() == d.fused.size() &&
                     d.encoders_t_s.size() == d.encoders.size() && d.rpe_fused_t_s.size() == d.rpe_fused_deg.size() &&
                     d.rpe_encoders_t_s.size() == d.rpe_encoders_deg.size(),
                 "velocity plot: sizes differ");
-  PlotFiles files{"velocity.gp",
-                  "velocity.png",
-                  {"velocity_fused.dat", "velocity_encoders.dat", "velocity_rpe_fused.dat",
-                   "velocity_rpe_encoders.dat"}};
+  PlotFiles files{
+      "velocity.gp",
+      "velocity.png",
+      {"velocity_fused.dat", "velocity_encoders.dat", "velocity_rpe_fused.dat", "velocity_rpe_encoders.dat"}};
   std::ostringstream fused, encoders, rpe_fused, rpe_encoders;
   fused << "# t_s true_vx_mps true_wz_radps fused_vx_mps fused_wz_radps\n";
   for (std::size_t i = 0; i < d.fused_t_s.size(); ++i)

@@ -30,10 +30,10 @@ struct PlotFiles {
 
 // Positions of an absolute sensor in the reference world frame (GPS converted to ENU, motion capture, ...).
 struct PositionFixes {
-  std::string name;                       // stream name; the data file is trajectory_fixes_<name>.dat
-  std::string label;                      // legend text, e.g. "GPS fixes (gps)"
+  std::string name;   // stream name; the data file is trajectory_fixes_<name>.dat
+  std::string label;  // legend text, e.g. "GPS fixes (gps)"
   std::vector<Time> t;
-  std::vector<Eigen::Vector3d> p_world;   // [m]
+  std::vector<Eigen::Vector3d> p_world;  // [m]
 };
 
 // Top view. `estimate` is drawn as given (align it first); `estimate_label` is its legend text. Time columns are
@@ -56,10 +56,10 @@ Result<PlotFiles> WriteNeesPlot(const std::string& directory, const std::string&
 // What the velocity figure draws; times in seconds since the truth's first stamp, one per twist or RPE pair.
 struct VelocityPlotData {
   std::vector<double> fused_t_s;
-  std::vector<StampedTwist> truth;        // at fused_t_s
-  std::vector<StampedTwist> fused;        // at fused_t_s
+  std::vector<StampedTwist> truth;  // at fused_t_s
+  std::vector<StampedTwist> fused;  // at fused_t_s
   std::vector<double> encoders_t_s;
-  std::vector<StampedTwist> encoders;     // at encoders_t_s
+  std::vector<StampedTwist> encoders;  // at encoders_t_s
   std::vector<double> rpe_fused_t_s, rpe_fused_deg, rpe_encoders_t_s, rpe_encoders_deg;
 };
 // Three stacked panels: v_x [m/s], omega_z [rad/s], rotational RPE [deg]. Files velocity.gp, velocity_*.dat,

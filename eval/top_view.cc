@@ -26,8 +26,8 @@ double WrapAngle(double angle_rad) { return std::atan2(std::sin(angle_rad), std:
 
 bool PlanarPoseAt(const Trajectory& trajectory, Time t, Eigen::Vector3d* x_y_yaw) {
   if (trajectory.size() < 2 || t < trajectory.front().t || t > trajectory.back().t) return false;
-  const auto it = std::upper_bound(trajectory.begin(), trajectory.end(), t,
-                                   [](Time q, const StampedPose& p) { return q < p.t; });
+  const auto it =
+      std::upper_bound(trajectory.begin(), trajectory.end(), t, [](Time q, const StampedPose& p) { return q < p.t; });
   std::size_t i = it == trajectory.begin() ? 0 : static_cast<std::size_t>(it - trajectory.begin()) - 1;
   i = std::min(i, trajectory.size() - 2);
   const double w = SecondsBetween(trajectory[i].t, t) / SecondsBetween(trajectory[i].t, trajectory[i + 1].t);
@@ -59,8 +59,8 @@ Status WriteTopViewFigure(const std::string& dir, const std::string& name, const
   static const char* kColors[] = {"#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd",
                                   "#8c564b", "#e377c2", "#17becf", "#bcbd22", "#7f7f7f"};
   for (std::size_t i = 0; i < series.size(); ++i) {
-    gp << ", \\\n     '' using " << 3 + 2 * i << ":" << 4 + 2 * i << " with lines lw 1.5 lc rgb '"
-       << kColors[i % 10] << "' title '" << series[i].label << "'";
+    gp << ", \\\n     '' using " << 3 + 2 * i << ":" << 4 + 2 * i << " with lines lw 1.5 lc rgb '" << kColors[i % 10]
+       << "' title '" << series[i].label << "'";
   }
   gp << "\n";
   for (const auto& [file, text] : {std::pair{name + ".dat", data.str()}, std::pair{name + ".gp", gp.str()}}) {

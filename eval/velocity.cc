@@ -25,8 +25,8 @@ StampedTwist Between(const StampedPose& a, const StampedPose& b) {
   const Eigen::Vector3d phi = Log(a.q_world_body.conjugate() * b.q_world_body);
   s.omega_body = phi / dt;
   const double angle = phi.norm();
-  const Eigen::Quaterniond half = angle > 0.0 ? Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * angle, phi / angle))
-                                              : Eigen::Quaterniond::Identity();
+  const Eigen::Quaterniond half =
+      angle > 0.0 ? Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * angle, phi / angle)) : Eigen::Quaterniond::Identity();
   s.v_body = (a.q_world_body * half).conjugate() * ((b.p_world_body - a.p_world_body) / dt);
   return s;
 }
@@ -72,8 +72,10 @@ Result<EncoderOdometry> EncoderOnlyOdometry(const recording::Recording& rec) {
   out.dead_reckoning.push_back(pose);
   for (std::size_t k = 0; k + 1 < encoders->t.size(); ++k) {
     const double dt = SecondsBetween(encoders->t[k], encoders->t[k + 1]);
-    const Eigen::VectorXd rates = (encoders->values.row(static_cast<Eigen::Index>(k) + 1) -
-                                   encoders->values.row(static_cast<Eigen::Index>(k))).transpose() / dt;
+    const Eigen::VectorXd rates =
+        (encoders->values.row(static_cast<Eigen::Index>(k) + 1) - encoders->values.row(static_cast<Eigen::Index>(k)))
+            .transpose() /
+        dt;
     const Eigen::Vector3d twist = kinematics.value().TwistFromRates(rates);
     StampedTwist s;
     s.t_begin = encoders->t[k];

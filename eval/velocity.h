@@ -28,8 +28,8 @@ namespace roamlab::eval {
 
 struct StampedTwist {
   Time t_begin, t_end;
-  Eigen::Vector3d v_body = Eigen::Vector3d::Zero();        // [m/s], in O
-  Eigen::Vector3d omega_body = Eigen::Vector3d::Zero();    // [rad/s], in O
+  Eigen::Vector3d v_body = Eigen::Vector3d::Zero();      // [m/s], in O
+  Eigen::Vector3d omega_body = Eigen::Vector3d::Zero();  // [rad/s], in O
 };
 
 // Velocities between consecutive poses.
@@ -37,15 +37,15 @@ std::vector<StampedTwist> TrajectoryVelocities(const Trajectory& trajectory);
 
 struct EncoderOdometry {
   std::vector<StampedTwist> twists;
-  Trajectory dead_reckoning;   // from the identity at the first encoder stamp
+  Trajectory dead_reckoning;  // from the identity at the first encoder stamp
 };
 // Forward kinematics of the recording's wheel-encoder stream (cumulative angles, rad). Errors: no wheeled platform,
 // no such stream, or a geometry key missing.
 Result<EncoderOdometry> EncoderOnlyOdometry(const recording::Recording& recording);
 
 struct VelocityErrors {
-  std::vector<double> t_s;            // interval middles, seconds since the truth's first stamp
-  std::vector<StampedTwist> estimate; // the compared intervals
+  std::vector<double> t_s;             // interval middles, seconds since the truth's first stamp
+  std::vector<StampedTwist> estimate;  // the compared intervals
   std::vector<StampedTwist> truth;
   ErrorStatistics linear_mps;
   ErrorStatistics angular_radps;

@@ -38,7 +38,10 @@ std::optional<StampedPose> PoseAt(const Trajectory& truth, Time t) {
 double Json(double x) { return std::isfinite(x) ? x : 0.0; }
 
 nlohmann::json StatsJson(const ErrorStatistics& s) {
-  return {{"count", s.count}, {"rmse", Json(s.rmse)}, {"mean", Json(s.mean)}, {"median", Json(s.median)},
+  return {{"count", s.count},
+          {"rmse", Json(s.rmse)},
+          {"mean", Json(s.mean)},
+          {"median", Json(s.median)},
           {"max", Json(s.max)}};
 }
 
@@ -54,7 +57,8 @@ std::optional<VisualOdometryErrors> CompareVisualOdometry(const recording::Strea
   const bool with_covariance = stream.values.cols() == 27;
 
   VisualOdometryErrors out;
-  out.pairs = static_cast<int>(std::floor(SecondsBetween(truth.front().t, truth.back().t) * stream.info.rate_hz + 1e-9));
+  out.pairs =
+      static_cast<int>(std::floor(SecondsBetween(truth.front().t, truth.back().t) * stream.info.rate_hz + 1e-9));
   std::vector<double> rotation_deg, speed_ratio;
   for (std::size_t r = 0; r < stream.t.size(); ++r) {
     const auto a = PoseAt(truth, Time::FromNanoseconds(stream.t[r].nanoseconds() - half_ns));
@@ -63,8 +67,8 @@ std::optional<VisualOdometryErrors> CompareVisualOdometry(const recording::Strea
     const Eigen::Matrix3d R_a = a->q_world_body.toRotationMatrix();
     const Eigen::Matrix3d R_ab = R_a.transpose() * b->q_world_body.toRotationMatrix();
     const Eigen::Matrix3d R_true = R_oc.transpose() * R_ab * R_oc;
-    const Eigen::Vector3d p_true =
-        R_oc.transpose() * (R_a.transpose() * (b->p_world_body - a->p_world_body) + (R_ab - Eigen::Matrix3d::Identity()) * p_oc);
+    const Eigen::Vector3d p_true = R_oc.transpose() * (R_a.transpose() * (b->p_world_body - a->p_world_body) +
+                                                       (R_ab - Eigen::Matrix3d::Identity()) * p_oc);
     const Eigen::Vector3d v = stream.values.block<1, 3>(static_cast<Eigen::Index>(r), 0).transpose();
     const Eigen::Vector3d omega = stream.values.block<1, 3>(static_cast<Eigen::Index>(r), 3).transpose();
     rotation_deg.push_back(Log(Exp(omega * T).transpose() * R_true).norm() * kDegPerRad);

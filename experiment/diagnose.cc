@@ -26,13 +26,13 @@ struct Inputs {
   std::optional<sim::Scenario> scenario;
   recording::Recording recording;
   estimator::EstimatorConfig config;
-  double span_s = 0.0;   // the recording's last stamp
+  double span_s = 0.0;  // the recording's last stamp
 };
 
 // The nominal model: the configuration given, or the one built from the scenario; every stream it reads present.
 Status LoadNominalModel(const DiagnoseRequest& request, Inputs* in) {
-  auto config = request.config.empty() ? gap::NominalConfig(*in->scenario)
-                                       : estimator::LoadEstimatorConfig(request.config);
+  auto config =
+      request.config.empty() ? gap::NominalConfig(*in->scenario) : estimator::LoadEstimatorConfig(request.config);
   if (!config.ok())
     return Status::Error((request.config.empty() ? request.scenario + ": " : std::string()) +
                          config.status().message());
@@ -75,7 +75,8 @@ Result<Inputs> LoadInputs(const DiagnoseRequest& request) {
 }
 
 // The baseline: the nominal scenario simulated over the recording's span and diagnosed without effects.
-Result<gap::Baseline> NominalBaseline(const DiagnoseRequest& request, const Inputs& in, const gap::DiagnoseOptions& options) {
+Result<gap::Baseline> NominalBaseline(const DiagnoseRequest& request, const Inputs& in,
+                                      const gap::DiagnoseOptions& options) {
   sim::Scenario nominal = *in.scenario;
   nominal.duration_s = std::min(nominal.duration_s, std::max(in.span_s, 1.0));
   gap::LearnBaselineOptions learn;

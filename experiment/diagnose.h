@@ -22,17 +22,17 @@
 namespace roamlab::experiment {
 
 struct DiagnoseRequest {
-  std::string recording;                 // REC
-  std::string scenario;                  // SCENARIO.yaml (the nominal robot); "" for a robot without a MuJoCo twin:
-                                         // then config and no_baseline are required
-  std::string config;                    // EST.yaml: nominal estimator configuration (default: from the scenario,
-                                         // gap::NominalConfig)
-  std::string out;                       // output directory
+  std::string recording;  // REC
+  std::string scenario;   // SCENARIO.yaml (the nominal robot); "" for a robot without a MuJoCo twin:
+                          // then config and no_baseline are required
+  std::string config;     // EST.yaml: nominal estimator configuration (default: from the scenario,
+                          // gap::NominalConfig)
+  std::string out;        // output directory
   bool no_baseline = false;
-  std::uint64_t baseline_seed = gap::kDefaultBaselineSeed;   // noise seed of the nominal simulation
-  std::optional<double> max_shift_s;     // the time-shift search range (default gap::DiagnoseOptions')
-  bool no_plots = false;                 // no figures beside report.md
-  std::function<void(const std::string& line)> progress;     // optional
+  std::uint64_t baseline_seed = gap::kDefaultBaselineSeed;  // noise seed of the nominal simulation
+  std::optional<double> max_shift_s;                      // the time-shift search range (default gap::DiagnoseOptions')
+  bool no_plots = false;                                  // no figures beside report.md
+  std::function<void(const std::string& line)> progress;  // optional
 };
 
 // Diagnoses the recording and writes the outputs. Inputs that do not load or do not fit each other (a stream the

@@ -68,16 +68,16 @@ struct RunCalibration {
 
 // Run `seed`'s own calibration: the scenario simulated with `seed` (a realization apart from the tracked one) and
 // calibrated with `warm`, the calibration configuration warm-started at the shared calibration (see RunMonteCarlo).
-Result<RunCalibration> CalibrateRun(const sim::Scenario& scenario, const estimator::EstimatorConfig& warm,
-                                    bool prior, std::uint64_t seed) {
+Result<RunCalibration> CalibrateRun(const sim::Scenario& scenario, const estimator::EstimatorConfig& warm, bool prior,
+                                    std::uint64_t seed) {
   sim::SimulateOptions sim_options;
   sim_options.seed = seed;
   auto simulation = sim::Simulate(scenario, sim_options);
-  if (!simulation.ok()) return Status::Error("calibration seed " + std::to_string(seed) + ": " +
-                                             simulation.status().message());
+  if (!simulation.ok())
+    return Status::Error("calibration seed " + std::to_string(seed) + ": " + simulation.status().message());
   auto calibrated = estimator::Calibrate(warm, simulation.value().recording);
-  if (!calibrated.ok()) return Status::Error("calibration seed " + std::to_string(seed) + ": " +
-                                             calibrated.status().message());
+  if (!calibrated.ok())
+    return Status::Error("calibration seed " + std::to_string(seed) + ": " + calibrated.status().message());
   RunCalibration out;
   estimator::CalibrationPrior p;
   for (const estimator::ParameterEstimate& e : calibrated.value().parameters) {
@@ -230,8 +230,8 @@ std::string WriteOutputs(const MonteCarloOptions& options, const eval::MonteCarl
                     {"track_seconds", results[i].track_seconds}});
   std::ofstream(options.out + "/runs.json") << nlohmann::json{{"runs", runs}}.dump(2) << "\n";
   if (!eval::GnuplotAvailable()) return " (gnuplot not found: no nees.png)";
-  auto plot = eval::WriteNeesPlot(options.out,
-                                  "Average position NEES over " + std::to_string(options.runs) + " runs", nees);
+  auto plot =
+      eval::WriteNeesPlot(options.out, "Average position NEES over " + std::to_string(options.runs) + " runs", nees);
   const Status drawn = plot.ok() ? eval::RunGnuplot(options.out, plot.value().script) : plot.status();
   return drawn.ok() ? "" : " (plot failed: " + drawn.message() + ")";
 }

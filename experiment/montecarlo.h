@@ -19,15 +19,15 @@ struct MonteCarloOptions {
   std::string calibration;  // optional calibration.json: tracking uses its values
   std::string out;
   int runs = 50;
-  int jobs = 0;             // 0: one per core
+  int jobs = 0;                         // 0: one per core
   unsigned long long seed_base = 1000;  // run i simulates with noise seed seed_base + i
-  double t0_s = 2.0;        // fraction_in_band counts time steps from t0_s on
+  double t0_s = 2.0;                    // fraction_in_band counts time steps from t0_s on
   bool no_time_budget = false;  // ignore tracking.time_budget_s: results that do not depend on the machine's speed
   // With tracking.calibrate and no calibration file: one calibration per run on its own calibration drive instead of
   // one shared by every run (the seed's protocol; see RunMonteCarlo).
   bool calibrate_each_run = false;
-  std::function<void(const std::string& line)> log;        // optional: what is being done, one line at a time
-  std::function<void(int finished, int runs)> progress;    // optional: after each run
+  std::function<void(const std::string& line)> log;      // optional: what is being done, one line at a time
+  std::function<void(int finished, int runs)> progress;  // optional: after each run
 
   // What is wrong with the options ("--runs must be at least 1"), "" when nothing.
   std::string Validate() const;

@@ -13,8 +13,8 @@
 #include "estimator/odometry/gaussian_process.h"
 #include "estimator/odometry/parametric.h"
 #include "estimator/odometry/robust_linear.h"
-#include "estimator/odometry/trajectory.h"
 #include "estimator/odometry/training_data.h"
+#include "estimator/odometry/trajectory.h"
 #include "eval/plots.h"
 #include "eval/top_view.h"
 #include "recording/recording.h"
@@ -149,8 +149,11 @@ struct Evaluated {
 };
 
 json Row(const std::string& model, const std::string& mean, const std::string& kernel, double ate_m, double rpe_m) {
-  return {{"model", model}, {"mean", mean == "-" ? json(nullptr) : json(mean)},
-          {"kernel", kernel == "-" ? json(nullptr) : json(kernel)}, {"ate_m", ate_m}, {"rpe_mm", 1000.0 * rpe_m}};
+  return {{"model", model},
+          {"mean", mean == "-" ? json(nullptr) : json(mean)},
+          {"kernel", kernel == "-" ? json(nullptr) : json(kernel)},
+          {"ate_m", ate_m},
+          {"rpe_mm", 1000.0 * rpe_m}};
 }
 
 // Key times of the first model's interval where the reference exists: the reference poses and the wheel-angle
@@ -199,18 +202,22 @@ Outcome EvaluateRecording(const OdometryEvaluateOptions& options, const std::vec
   Result<odo::WheelKinematics> nominal = odo::NominalKinematics(rec.value().platform, seq.value().wheels);
   if (!nominal.ok()) return Bad(dir + ": " + nominal.status().message());
   std::vector<Evaluated> evaluated;
-  evaluated.push_back({"nominal", odo::PredictTrajectory(
-                                      [&](const Eigen::VectorXd& d) { return nominal.value().Displacement(d); },
-                                      delta, reference.front()), {}, {}});
+  evaluated.push_back({"nominal",
+                       odo::PredictTrajectory([&](const Eigen::VectorXd& d) { return nominal.value().Displacement(d); },
+                                              delta, reference.front()),
+                       {},
+                       {}});
   for (std::size_t i = 0; i < models.size(); ++i) {
     const odo::OdometryModel& model = models[i];
     if (model.wheels != seq.value().wheels)
       return Bad(options.models[i] + ": the model's wheels do not match the encoder columns of " + dir);
     if (std::abs(model.interval_s - models.front().interval_s) > 1e-12)
       return Bad(options.models[i] + ": all models must share one key interval");
-    evaluated.push_back({DescribeOdometryModel(model) + " [" + fs::path(options.models[i]).filename().string() + "]",
-                         odo::PredictTrajectory([&](const Eigen::VectorXd& d) { return model.Predict(d); }, delta,
-                                                reference.front()), {}, {}});
+    evaluated.push_back(
+        {DescribeOdometryModel(model) + " [" + fs::path(options.models[i]).filename().string() + "]",
+         odo::PredictTrajectory([&](const Eigen::VectorXd& d) { return model.Predict(d); }, delta, reference.front()),
+         {},
+         {}});
   }
 
   // Errors, the recording's rows and its figure.
@@ -229,12 +236,15 @@ Outcome EvaluateRecording(const OdometryEvaluateOptions& options, const std::vec
   }
   char name[32];
   std::snprintf(name, sizeof name, "trajectory_%02zu", r + 1);
-  per_recording->push_back({{"recording", dir}, {"key_poses", reference.size()}, {"rows", rows_json},
+  per_recording->push_back({{"recording", dir},
+                            {"key_poses", reference.size()},
+                            {"rows", rows_json},
                             {"figure", plots ? std::string(name) + ".png" : std::string()}});
   if (!plots) return Outcome::Ok();
   std::vector<eval::TopViewSeries> series;
   for (const Evaluated& e : evaluated) series.push_back({e.label, e.poses});
-  const Status drawn = eval::WriteTopViewFigure(options.out, name, fs::path(dir).filename().string(), reference, series);
+  const Status drawn =
+      eval::WriteTopViewFigure(options.out, name, fs::path(dir).filename().string(), reference, series);
   return drawn.ok() ? Outcome::Ok() : Outcome::Failed(drawn);
 }
 
@@ -243,8 +253,8 @@ json PooledTable(const OdometryEvaluateOptions& options, const std::vector<odo::
                  const Pooled& pooled, const json& per_recording) {
   json table;
   table["rows"] = json::array();
-  table["rows"].push_back(Row("nominal", "-", "-", odo::RootMeanSquare(pooled.absolute[0]),
-                              odo::RootMeanSquare(pooled.relative[0])));
+  table["rows"].push_back(
+      Row("nominal", "-", "-", odo::RootMeanSquare(pooled.absolute[0]), odo::RootMeanSquare(pooled.relative[0])));
   for (std::size_t i = 0; i < models.size(); ++i) {
     json row = Row(odo::ModelKindName(models[i].kind), models[i].MeanLabel(), models[i].KernelLabel(),
                    odo::RootMeanSquare(pooled.absolute[i + 1]), odo::RootMeanSquare(pooled.relative[i + 1]));

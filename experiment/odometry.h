@@ -24,23 +24,24 @@ namespace roamlab::experiment {
 
 struct OdometryLearnOptions {
   std::vector<std::string> recordings;
-  std::string model = "gp";        // gp | linear | parametric
-  std::string mean = "linear";     // gp: zero | linear
-  std::string kernel = "rbf";      // gp: rbf | linear | rbf+linear
-  double interval_s = 0.5;         // T between key times
-  std::string encoder_stream;      // "" = the only wheel_encoders stream
-  std::string sensor_stream;       // "" = the only pose stream
-  int hyperparameter_subset = 400; // gp: pairs for the hyper-parameter optimization (0 = all)
-  double outlier_threshold = 5.0;  // gp, parametric: drop pairs beyond this many robust sigmas of eq. 9's fit (0 = keep)
-  int max_pairs = 6000;            // gp: condition on a seeded random subset of at most this many pairs (0 = all)
-  std::string out;                 // model file (JSON)
+  std::string model = "gp";         // gp | linear | parametric
+  std::string mean = "linear";      // gp: zero | linear
+  std::string kernel = "rbf";       // gp: rbf | linear | rbf+linear
+  double interval_s = 0.5;          // T between key times
+  std::string encoder_stream;       // "" = the only wheel_encoders stream
+  std::string sensor_stream;        // "" = the only pose stream
+  int hyperparameter_subset = 400;  // gp: pairs for the hyper-parameter optimization (0 = all)
+  double outlier_threshold =
+      5.0;               // gp, parametric: drop pairs beyond this many robust sigmas of eq. 9's fit (0 = keep)
+  int max_pairs = 6000;  // gp: condition on a seeded random subset of at most this many pairs (0 = all)
+  std::string out;       // model file (JSON)
   std::function<void(const std::string& line)> log;  // optional: what is being done, one line at a time
 };
 
 struct LearnedOdometry {
   estimator::odometry::OdometryModel model;
-  std::string platform;   // the recordings' platform kind
-  double seconds = 0.0;   // training time
+  std::string platform;  // the recordings' platform kind
+  double seconds = 0.0;  // training time
 };
 
 // Learns the model from the recordings and writes it to `out`. `learned` (optional) receives it.
@@ -51,7 +52,7 @@ struct OdometryEvaluateOptions {
   std::vector<std::string> recordings;  // test recordings with ground_truth.tum
   std::string encoder_stream;
   std::string out;
-  bool plots = true;                    // draw trajectory_NN.png (with gnuplot, when it is installed)
+  bool plots = true;                                 // draw trajectory_NN.png (with gnuplot, when it is installed)
   std::function<void(const std::string& line)> log;  // optional: notes ("gnuplot not found, no figures")
 };
 

@@ -112,8 +112,8 @@ Outcome ImportOptiOdomToDirectory(const std::string& run_csv, const std::string&
                                   recording::Recording* imported) {
   const std::string metadata_path = metadata.empty() ? recording::OptiOdomMetadataPath(run_csv) : metadata;
   if (metadata_path.empty())
-    return Outcome::BadInput(Status::Error(
-        run_csv + ": cannot find the metadata file (expected <set>_run-NN.csv; use --metadata)"));
+    return Outcome::BadInput(
+        Status::Error(run_csv + ": cannot find the metadata file (expected <set>_run-NN.csv; use --metadata)"));
   Result<recording::Recording> rec = recording::ImportOptiOdom(run_csv, metadata_path);
   if (!rec.ok()) return Outcome::BadInput(rec.status());
   if (Status s = recording::WriteRecording(rec.value(), out); !s.ok()) return Outcome::Failed(s);

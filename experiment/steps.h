@@ -35,9 +35,9 @@ struct Outcome {
 Status MakeOutputDirectory(const std::string& dir);
 
 struct SimulateRequest {
-  std::string scenario;                  // SCENARIO.yaml
-  std::string out;                       // recording directory; also where sensors.camera.store_images writes
-  std::optional<std::uint64_t> seed;     // overrides the scenario's noise seed
+  std::string scenario;                           // SCENARIO.yaml
+  std::string out;                                // recording directory; also where sensors.camera.store_images writes
+  std::optional<std::uint64_t> seed;              // overrides the scenario's noise seed
   std::function<void(double fraction)> progress;  // optional
 };
 // Simulates the scenario and writes the recording with ground_truth.tum and truth.yaml. A bad scenario or model is
@@ -48,8 +48,8 @@ Outcome SimulateToDirectory(const SimulateRequest& request, sim::Simulation* sim
 struct CalibrateRequest {
   std::string recording;
   std::string config;
-  std::string out;                                           // receives calibration.json and trajectory.tum
-  std::function<void(const std::string& line)> progress;     // optional
+  std::string out;                                        // receives calibration.json and trajectory.tum
+  std::function<void(const std::string& line)> progress;  // optional
 };
 // Offline self-calibration of the recording (estimator/calibration.h). `result` (optional) receives it.
 Outcome CalibrateToDirectory(const CalibrateRequest& request, estimator::CalibrationResult* result = nullptr);
@@ -57,9 +57,9 @@ Outcome CalibrateToDirectory(const CalibrateRequest& request, estimator::Calibra
 struct TrackRequest {
   std::string recording;
   std::string config;
-  std::string calibration;        // optional calibration.json: its values (and prior) for tracking
-  std::string out;                // receives trajectory.tum, covariance.csv and summary.json (estimator/tracking_io.h)
-  bool no_time_budget = false;    // ignore tracking.time_budget_s: results that do not depend on the machine's speed
+  std::string calibration;      // optional calibration.json: its values (and prior) for tracking
+  std::string out;              // receives trajectory.tum, covariance.csv and summary.json (estimator/tracking_io.h)
+  bool no_time_budget = false;  // ignore tracking.time_budget_s: results that do not depend on the machine's speed
   std::function<void(double fraction)> progress;  // optional
 };
 // Online fixed-lag tracking of the recording (estimator/tracking.h). `result` (optional) receives it.

@@ -97,8 +97,8 @@ Result<FrontEndResult> ScanMatchingOfScans(const recording::Stream& laser, const
   for (Eigen::Index row = 0; row < laser.values.rows(); ++row) {
     const ScanGeometry geometry = LaserScanGeometry(laser, row);
     if (laser.values.row(row).head<4>() != laser.values.row(0).head<4>()) {
-      return Status::Error((fs::path(directory) / (laser.info.name + ".csv")).string() + ":" +
-                           std::to_string(row + 2) + ": the scan geometry differs from the first scan's");
+      return Status::Error((fs::path(directory) / (laser.info.name + ".csv")).string() + ":" + std::to_string(row + 2) +
+                           ": the scan geometry differs from the first scan's");
     }
     matching.AddScan(laser.t[static_cast<std::size_t>(row)], geometry, LaserScanRanges(laser, row));
   }
@@ -142,8 +142,9 @@ Status CopyUnwrittenFiles(const recording::Recording& recording, const std::stri
 Result<FrontEndResult> DeriveStream(const recording::Recording& recording, const std::string& directory,
                                     const FrontEndOptions& options) {
   const bool vo = options.front_end == FrontEnd::kVisualOdometry;
-  const std::string output_stream =
-      !options.output_stream.empty() ? options.output_stream : vo ? "visual_odometry" : "scan_matching";
+  const std::string output_stream = !options.output_stream.empty() ? options.output_stream
+                                    : vo                           ? "visual_odometry"
+                                                                   : "scan_matching";
   const recording::StreamType type = vo ? recording::StreamType::kCamera : recording::StreamType::kLaserScan;
   Result<const recording::Stream*> input = FindInput(recording, directory, options.input_stream, type);
   if (!input.ok()) return input.status();

@@ -24,8 +24,8 @@ enum class FrontEnd { kVisualOdometry, kScanMatching };
 
 struct FrontEndOptions {
   FrontEnd front_end = FrontEnd::kVisualOdometry;
-  std::string input_stream;    // empty: the recording's only stream of type camera (laser_scan)
-  std::string output_stream;   // empty: visual_odometry (scan_matching)
+  std::string input_stream;   // empty: the recording's only stream of type camera (laser_scan)
+  std::string output_stream;  // empty: visual_odometry (scan_matching)
 };
 
 struct FrontEndResult {

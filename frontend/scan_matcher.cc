@@ -48,13 +48,13 @@ Lines FitLines(const Points& ref, int half_window, double max_segment_m) {
   std::vector<int> chain_begin(ref.xy.size()), chain_end(ref.xy.size());
   const double max_segment2 = max_segment_m * max_segment_m;
   for (int j = 0; j < n; ++j) {
-    const bool joined = j > 0 && ref.valid[j] && ref.valid[j - 1] &&
-                        (ref.xy[j] - ref.xy[j - 1]).squaredNorm() <= max_segment2;
+    const bool joined =
+        j > 0 && ref.valid[j] && ref.valid[j - 1] && (ref.xy[j] - ref.xy[j - 1]).squaredNorm() <= max_segment2;
     chain_begin[j] = joined ? chain_begin[j - 1] : j;
   }
   for (int j = n - 1; j >= 0; --j) {
-    const bool joined = j < n - 1 && ref.valid[j] && ref.valid[j + 1] &&
-                        (ref.xy[j] - ref.xy[j + 1]).squaredNorm() <= max_segment2;
+    const bool joined =
+        j < n - 1 && ref.valid[j] && ref.valid[j + 1] && (ref.xy[j] - ref.xy[j + 1]).squaredNorm() <= max_segment2;
     chain_end[j] = joined ? chain_end[j + 1] : j;
   }
   Lines lines;
@@ -117,8 +117,8 @@ ScanMatch MatchScans(const ScanGeometry& g, const std::vector<double>& reference
       if (!cur.valid[i]) continue;
       const Eigen::Vector2d p = R * cur.xy[i] + x.head<2>();
       // Nearest reference point among the beams around p's bearing.
-      const int centre = static_cast<int>(std::lround((std::atan2(p.y(), p.x()) - g.first_angle_rad) /
-                                                      g.increment_rad));
+      const int centre =
+          static_cast<int>(std::lround((std::atan2(p.y(), p.x()) - g.first_angle_rad) / g.increment_rad));
       const int lo = std::max(0, centre - o.search_window_beams);
       const int hi = std::min(n_ref - 1, centre + o.search_window_beams);
       int a = -1;

@@ -33,8 +33,8 @@ namespace roamlab::frontend {
 // forward, angles counter-clockwise). A range that is not finite means no return.
 struct ScanGeometry {
   int beams = 683;
-  double first_angle_rad = -2.0943951023931953;   // -120 deg
-  double increment_rad = 0.0061419211213877;      // 240 deg / 682
+  double first_angle_rad = -2.0943951023931953;  // -120 deg
+  double increment_rad = 0.0061419211213877;     // 240 deg / 682
   double min_range_m = 0.02;
   double max_range_m = 4.0;
 
@@ -43,22 +43,22 @@ struct ScanGeometry {
 
 struct ScanMatcherOptions {
   int max_iterations = 40;
-  double max_correspondence_m = 0.4;   // initial gate on the point distance
+  double max_correspondence_m = 0.4;  // initial gate on the point distance
   double min_gate_m = 0.05;
-  double max_segment_m = 0.25;         // two reference points further apart are not one surface
-  int line_half_window_beams = 3;      // the reference line at q_a fits q_a and up to this many beams either side
+  double max_segment_m = 0.25;     // two reference points further apart are not one surface
+  int line_half_window_beams = 3;  // the reference line at q_a fits q_a and up to this many beams either side
   int search_window_beams = 60;
   int min_correspondences = 30;
-  double step_tolerance = 1e-7;        // stop when |dt| [m] + |dtheta| [rad] falls below
+  double step_tolerance = 1e-7;  // stop when |dt| [m] + |dtheta| [rad] falls below
 };
 
 struct ScanMatch {
-  bool ok = false;                                              // converged with enough correspondences
-  Eigen::Vector3d pose = Eigen::Vector3d::Zero();               // (t_x [m], t_y [m], theta [rad]): current in
-                                                                // the reference frame
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();     // of pose
+  bool ok = false;                                           // converged with enough correspondences
+  Eigen::Vector3d pose = Eigen::Vector3d::Zero();            // (t_x [m], t_y [m], theta [rad]): current in
+                                                             // the reference frame
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // of pose
   int correspondences = 0;
-  double rms_m = 0.0;                                           // point-to-line residual at the solution
+  double rms_m = 0.0;  // point-to-line residual at the solution
   int iterations = 0;
 };
 

@@ -19,8 +19,8 @@ bool ScanMatchingStream::AddScan(Time t, const ScanGeometry& geometry, std::vect
   if (t_previous_) {
     const std::int64_t dt_ns = t.nanoseconds() - t_previous_->nanoseconds();
     const double dt = static_cast<double>(dt_ns) * 1e-9;
-    const ScanMatch match = MatchScansFrom(geometry, previous_scan_, ranges,
-                                           {Eigen::Vector3d::Zero(), previous_velocity_ * dt}, options_);
+    const ScanMatch match =
+        MatchScansFrom(geometry, previous_scan_, ranges, {Eigen::Vector3d::Zero(), previous_velocity_ * dt}, options_);
     if (match.ok) {
       const double theta = match.pose[2];
       const Eigen::Vector2d v = Eigen::Rotation2Dd(-0.5 * theta) * match.pose.head<2>() / dt;

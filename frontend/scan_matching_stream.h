@@ -43,7 +43,7 @@ class ScanMatchingStream {
   ScanMatcherOptions options_;
   std::optional<Time> t_previous_;
   std::vector<double> previous_scan_;
-  Eigen::Vector3d previous_velocity_ = Eigen::Vector3d::Zero();   // (x, y, theta) rates of the last match
+  Eigen::Vector3d previous_velocity_ = Eigen::Vector3d::Zero();  // (x, y, theta) rates of the last match
   std::vector<Time> t_;
   std::vector<std::array<double, 6>> rows_;
   Eigen::Vector2d sigma_sum_ = Eigen::Vector2d::Zero();

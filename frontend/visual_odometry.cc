@@ -100,8 +100,8 @@ Eigen::Vector2d FloorResidual(const PairPose& pose, double s, const FloorPoint& 
   const double inv_z = 1.0 / X2.z();
   if (d_ds != nullptr) {
     const Eigen::Vector3d& t = pose.t21;
-    *d_ds = Eigen::Vector2d(t.x() * inv_z - X2.x() * t.z() * inv_z * inv_z,
-                            t.y() * inv_z - X2.y() * t.z() * inv_z * inv_z);
+    *d_ds =
+        Eigen::Vector2d(t.x() * inv_z - X2.x() * t.z() * inv_z * inv_z, t.y() * inv_z - X2.y() * t.z() * inv_z * inv_z);
   }
   return X2.head<2>() * inv_z - p.x2;
 }
@@ -382,11 +382,16 @@ std::string VisualOdometryOptions::Validate() const {
 
 const char* VoFailureName(VoFailure failure) {
   switch (failure) {
-    case VoFailure::kNone: return "none";
-    case VoFailure::kTooFewFeatures: return "too_few_features";
-    case VoFailure::kTooFewTracks: return "too_few_tracks";
-    case VoFailure::kTooFewInliers: return "too_few_inliers";
-    case VoFailure::kNoScale: return "no_scale";
+    case VoFailure::kNone:
+      return "none";
+    case VoFailure::kTooFewFeatures:
+      return "too_few_features";
+    case VoFailure::kTooFewTracks:
+      return "too_few_tracks";
+    case VoFailure::kTooFewInliers:
+      return "too_few_inliers";
+    case VoFailure::kNoScale:
+      return "no_scale";
   }
   return "unknown";
 }
@@ -395,8 +400,7 @@ VisualOdometry::VisualOdometry(const PinholeIntrinsics& intrinsics, const Visual
     : intrinsics_(intrinsics), options_(options), pixel_scale_(intrinsics.width_px / 320.0) {
   const std::string problem = options.Validate();
   ROAMLAB_CHECK(problem.empty(), "VisualOdometryOptions: " << problem);
-  ROAMLAB_CHECK(intrinsics.width_px > 0 && intrinsics.height_px > 0 && intrinsics.fx_px > 0.0 &&
-                    intrinsics.fy_px > 0.0,
+  ROAMLAB_CHECK(intrinsics.width_px > 0 && intrinsics.height_px > 0 && intrinsics.fx_px > 0.0 && intrinsics.fy_px > 0.0,
                 "intrinsics");
 }
 
@@ -404,11 +408,20 @@ void VisualOdometry::Fail(VoFailure failure) {
   last_failure_ = failure;
   ++counters_.failures;
   switch (failure) {
-    case VoFailure::kTooFewFeatures: ++counters_.too_few_features; break;
-    case VoFailure::kTooFewTracks: ++counters_.too_few_tracks; break;
-    case VoFailure::kTooFewInliers: ++counters_.too_few_inliers; break;
-    case VoFailure::kNoScale: ++counters_.no_scale; break;
-    case VoFailure::kNone: break;
+    case VoFailure::kTooFewFeatures:
+      ++counters_.too_few_features;
+      break;
+    case VoFailure::kTooFewTracks:
+      ++counters_.too_few_tracks;
+      break;
+    case VoFailure::kTooFewInliers:
+      ++counters_.too_few_inliers;
+      break;
+    case VoFailure::kNoScale:
+      ++counters_.no_scale;
+      break;
+    case VoFailure::kNone:
+      break;
   }
 }
 

@@ -58,17 +58,17 @@ struct VisualOdometryOptions {
   int max_features = 300;
   int grid_columns = 4;
   int grid_rows = 4;
-  double feature_quality = 0.01;          // GFTT quality level, relative to the strongest corner
+  double feature_quality = 0.01;  // GFTT quality level, relative to the strongest corner
   double min_feature_distance_px = 7.0;
   int klt_window_px = 15;
   int klt_pyramid_levels = 3;
   double max_forward_backward_px = 0.5;
 
   // Geometry.
-  double ransac_threshold_px = 0.8;       // essential-matrix RANSAC, distance to the epipolar line
+  double ransac_threshold_px = 0.8;  // essential-matrix RANSAC, distance to the epipolar line
   double ransac_confidence = 0.999;
-  double floor_threshold_px = 1.0;        // floor reprojection inlier threshold
-  double stationary_flow_px = 0.05;       // median flow below this: no motion
+  double floor_threshold_px = 1.0;   // floor reprojection inlier threshold
+  double stationary_flow_px = 0.05;  // median flow below this: no motion
 
   // Failure thresholds.
   int min_tracks = 30;
@@ -82,34 +82,34 @@ struct VisualOdometryOptions {
 // Why a pair gave no estimate.
 enum class VoFailure {
   kNone = 0,
-  kTooFewFeatures,    // fewer than min_tracks corners in frame 1
-  kTooFewTracks,      // fewer than min_tracks tracks survived the forward-backward check
-  kTooFewInliers,     // essential-matrix RANSAC or cheirality left fewer than min_inliers
-  kNoScale,           // fewer than min_floor_inliers floor points agree on a scale
+  kTooFewFeatures,  // fewer than min_tracks corners in frame 1
+  kTooFewTracks,    // fewer than min_tracks tracks survived the forward-backward check
+  kTooFewInliers,   // essential-matrix RANSAC or cheirality left fewer than min_inliers
+  kNoScale,         // fewer than min_floor_inliers floor points agree on a scale
 };
 const char* VoFailureName(VoFailure failure);
 
 struct VoEstimate {
-  Time t_begin;                            // frame 1
-  Time t_end;                              // frame 2
-  Time t_mid;                              // stamp of the velocities
+  Time t_begin;                                               // frame 1
+  Time t_end;                                                 // frame 2
+  Time t_mid;                                                 // stamp of the velocities
   Eigen::Matrix3d R_prev_curr = Eigen::Matrix3d::Identity();  // rotates C2 coordinates into C1
   Eigen::Vector3d p_prev_curr_m = Eigen::Vector3d::Zero();    // C2's centre in C1 [m]
   Eigen::Vector3d v_camera_mps = Eigen::Vector3d::Zero();     // step 5, in C1
   Eigen::Vector3d omega_camera_radps = Eigen::Vector3d::Zero();
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();  // of [v (m/s); omega (rad/s)]
-  bool stationary = false;                 // no measurable motion: zero velocities
-  int tracks = 0;                          // tracks after the forward-backward check
-  int inliers = 0;                         // essential-matrix inliers
-  int floor_inliers = 0;                   // floor points that fixed the scale
-  double pixel_sigma_px = 0.0;             // noise level of the Sampson residuals
+  bool stationary = false;      // no measurable motion: zero velocities
+  int tracks = 0;               // tracks after the forward-backward check
+  int inliers = 0;              // essential-matrix inliers
+  int floor_inliers = 0;        // floor points that fixed the scale
+  double pixel_sigma_px = 0.0;  // noise level of the Sampson residuals
 };
 
 struct VoCounters {
-  int frames = 0;                          // frames given
-  int pairs = 0;                           // frame pairs (frames - 1)
+  int frames = 0;  // frames given
+  int pairs = 0;   // frame pairs (frames - 1)
   int estimates = 0;
-  int failures = 0;                        // pairs - estimates
+  int failures = 0;  // pairs - estimates
   int too_few_features = 0;
   int too_few_tracks = 0;
   int too_few_inliers = 0;
@@ -137,7 +137,7 @@ class VisualOdometry {
 
   PinholeIntrinsics intrinsics_;
   VisualOdometryOptions options_;
-  double pixel_scale_ = 1.0;               // image width / 320
+  double pixel_scale_ = 1.0;  // image width / 320
   cv::Mat previous_;
   std::optional<Time> t_previous_;
   std::vector<cv::Point2f> previous_points_;  // tracks kept for the next pair, in previous_

@@ -63,9 +63,8 @@ Result<PinholeIntrinsics> IntrinsicsOfAttributes(const std::map<std::string, dou
   PinholeIntrinsics k;
   double width = 0.0;
   double height = 0.0;
-  const std::pair<const char*, double*> fields[] = {{"width_px", &width}, {"height_px", &height},
-                                                    {"fx_px", &k.fx_px},  {"fy_px", &k.fy_px},
-                                                    {"cx_px", &k.cx_px},  {"cy_px", &k.cy_px}};
+  const std::pair<const char*, double*> fields[] = {{"width_px", &width}, {"height_px", &height}, {"fx_px", &k.fx_px},
+                                                    {"fy_px", &k.fy_px},  {"cx_px", &k.cx_px},    {"cy_px", &k.cy_px}};
   for (const auto& [key, value] : fields) {
     if (Status s = ReadAttribute(attributes, key, value); !s.ok()) return s;
   }

@@ -14,7 +14,7 @@ namespace {
 // stamp, the simulator reads the rate at it), so the range holds those plus the offsets the benchmark draws; a
 // smaller range sends the small offsets to the grid.
 constexpr double kFirstOrderOffsetS = 0.1;
-constexpr double kProfileStepS = 0.01;   // the profile's step: a master period of the 100 Hz drives
+constexpr double kProfileStepS = 0.01;  // the profile's step: a master period of the 100 Hz drives
 
 // A parameter-slot candidate: its parameters freed with the full solver, warm-started at `base`.
 Result<CandidateFit> FitSlots(const TrainingFits& fits, const Candidate& c, const State& base, CandidateFit cf) {
@@ -39,7 +39,9 @@ Result<CandidateFit> FitSlots(const TrainingFits& fits, const Candidate& c, cons
 class OffsetProfile {
  public:
   OffsetProfile(const TrainingFits& fits, const State& base, const std::string& parameter)
-      : fits_(fits), base_(base), parameter_(parameter),
+      : fits_(fits),
+        base_(base),
+        parameter_(parameter),
         start_(base.train_values.count(parameter) ? base.train_values.at(parameter)[0] : 0.0) {
     points_[0] = {base.train_chi2, base.train_values, base.train_trajectory};
   }
@@ -85,8 +87,8 @@ class OffsetProfile {
 
 // The offset fitted as a parameter, from the vertex of the parabola through the profile's best point and its
 // neighbours: the estimate, its std from the solver's covariance, and the state with it accepted.
-Status FitOffsetAtVertex(const TrainingFits& fits, const Candidate& c, const State& base,
-                         const OffsetProfile& profile, int best, CandidateFit* cf) {
+Status FitOffsetAtVertex(const TrainingFits& fits, const Candidate& c, const State& base, const OffsetProfile& profile,
+                         int best, CandidateFit* cf) {
   const std::string& p = c.free.front();
   const double y0 = profile.At(best - 1).chi2, y1 = profile.At(best).chi2, y2 = profile.At(best + 1).chi2;
   const double curvature = y0 - 2.0 * y1 + y2;
@@ -191,7 +193,7 @@ Result<CandidateFit> FitCandidate(const TrainingFits& fits, const Candidate& c, 
   cf.next = base;
   cf.estimate.name = c.name;
   if (c.shifted.empty()) return FitSlots(fits, c, base, std::move(cf));
-  double guess_s = c.guess_s;   // a time shift's first guess on the grid
+  double guess_s = c.guess_s;  // a time shift's first guess on the grid
   if (!c.free.empty()) {
     auto done = FitClockOffset(fits, c, base, &cf, &guess_s);
     if (!done.ok()) return done.status();

@@ -26,9 +26,8 @@ std::string TrainingTestFailure(const EffectEstimate& e, const DiagnoseOptions& 
 // shifts within the search range (Slice), and beyond it shifted fixes leave the poses' span and the held-out
 // comparison counts other measurements.
 std::string ShiftRangeFailure(const CandidateFit& f, const DiagnoseOptions& options) {
-  const auto beyond = std::find_if(f.next.shift_s.begin(), f.next.shift_s.end(), [&](const auto& shift) {
-    return std::abs(shift.second) > options.max_shift_s;
-  });
+  const auto beyond = std::find_if(f.next.shift_s.begin(), f.next.shift_s.end(),
+                                   [&](const auto& shift) { return std::abs(shift.second) > options.max_shift_s; });
   if (beyond == f.next.shift_s.end()) return "";
   std::ostringstream decision;
   decision << "rejected: the fitted shift of " << beyond->first << " (" << beyond->second

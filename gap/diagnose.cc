@@ -21,7 +21,7 @@ using recording::Recording;
 // within the time-shift range).
 struct Parts {
   Recording whole, train, test;
-  double split_s = 0.0;   // the held-out part starts here (recording time)
+  double split_s = 0.0;  // the held-out part starts here (recording time)
 };
 
 // The master stream's span and the split into training and held-out parts. Errors: no master stream, or too short.
@@ -123,8 +123,9 @@ void RecordRound(const internal::TrainingFits& fits, int round, std::vector<Cand
                  const std::vector<EffectEstimate>& failed, Diagnosis* out) {
   for (CandidateFit& f : *candidates) {
     if (f.estimate.evaluated_heldout)
-      fits.Say("candidate " + f.estimate.name + ": held-out chi2 " + std::to_string(100.0 * f.estimate.heldout_improvement) +
-               " % lower, share of the held-out mismatch " + std::to_string(f.estimate.explained_share) + ": " +
+      fits.Say("candidate " + f.estimate.name + ": held-out chi2 " +
+               std::to_string(100.0 * f.estimate.heldout_improvement) + " % lower, share of the held-out mismatch " +
+               std::to_string(f.estimate.explained_share) + ": " +
                (f.estimate.decision.empty() ? "evaluated" : f.estimate.decision));
     if (f.estimate.decision.empty()) f.estimate.decision = "not the best candidate";
     if (round == 0) out->candidates.push_back(f.estimate);
@@ -153,9 +154,8 @@ State NameEffects(const internal::TrainingFits& fits, const std::vector<internal
       if (round == 0) out->candidates = failed;
       break;
     }
-    std::sort(candidates.begin(), candidates.end(), [](const CandidateFit& a, const CandidateFit& b) {
-      return a.estimate.delta_bic < b.estimate.delta_bic;
-    });
+    std::sort(candidates.begin(), candidates.end(),
+              [](const CandidateFit& a, const CandidateFit& b) { return a.estimate.delta_bic < b.estimate.delta_bic; });
     const internal::RoundRules rules{options, state, located_keys, heldout_levels, nominal_heldout_chi2};
     CandidateFit* kept = internal::DecideRound(rules, round, heldout, &candidates, &dropped);
     RecordRound(fits, round, &candidates, failed, out);
@@ -174,13 +174,14 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
                            const DiagnoseOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   EstimatorConfig nominal = nominal_in;
-  nominal.gate_probability.reset();   // the same measurements in every fit
+  nominal.gate_probability.reset();  // the same measurements in every fit
   Diagnosis out;
   auto parts = SplitRecording(nominal, recording, options);
   if (!parts.ok()) return parts.status();
   out.train_end_s = parts.value().split_s;
-  const internal::TrainingFits fits{nominal, parts.value().train, internal::MasterPeriod(nominal, recording),
-                                    options.max_shift_s, &out.fits, options.progress};
+  const internal::TrainingFits fits{
+      nominal,   parts.value().train, internal::MasterPeriod(nominal, recording), options.max_shift_s,
+      &out.fits, options.progress};
   std::vector<internal::Candidate> library = internal::Library(nominal);
 
   // 1. Replay: the nominal self-calibration of the whole recording, with its residuals.

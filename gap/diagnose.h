@@ -52,16 +52,16 @@ namespace roamlab::gap {
 
 struct EffectEstimate {
   std::string name;
-  int dof = 0;                                  // parameters added
-  std::map<std::string, double> parameters;     // names as the simulator's effects (sim/scenario.h)
+  int dof = 0;                               // parameters added
+  std::map<std::string, double> parameters;  // names as the simulator's effects (sim/scenario.h)
   std::map<std::string, double> std;
-  std::map<std::string, double> baseline_parameters;   // the raw fit on the nominal simulation, subtracted
-  double lr_raw = 0.0;                          // chi2 drop on the training part against the nominal model
-  double baseline_lr = 0.0;                     // the same candidate's drop on the nominal simulation
-  double lr = 0.0;                              // the test statistic (Score, internal/decide.h), ~ chi2(dof) under H0
+  std::map<std::string, double> baseline_parameters;  // the raw fit on the nominal simulation, subtracted
+  double lr_raw = 0.0;                                // chi2 drop on the training part against the nominal model
+  double baseline_lr = 0.0;                           // the same candidate's drop on the nominal simulation
+  double lr = 0.0;  // the test statistic (Score, internal/decide.h), ~ chi2(dof) under H0
   double lr_pvalue = 1.0;
-  double delta_bic = 0.0;                       // < 0 favours the effect
-  double heldout_improvement = 0.0;             // relative drop of the held-out chi2 (0.1 = 10 % lower)
+  double delta_bic = 0.0;            // < 0 favours the effect
+  double heldout_improvement = 0.0;  // relative drop of the held-out chi2 (0.1 = 10 % lower)
   // The located mismatch on the held-out part (HeldoutExcess over the components Locate found inconsistent) before
   // the candidate (the nominal model with the effects kept so far) and with it, and the share of the mismatch the
   // effects kept so far and the candidate explain together (ExplainedShare of their held-out chi2 drop from the
@@ -71,32 +71,32 @@ struct EffectEstimate {
   double explained_share = std::numeric_limits<double>::quiet_NaN();
   bool evaluated_heldout = false;
   bool accepted = false;
-  std::string decision;                         // why kept or not, one phrase
+  std::string decision;  // why kept or not, one phrase
 };
 
 // What the nominal model gives on a nominal simulation of the same robot and drive.
 struct Baseline {
-  std::map<std::string, double> component_levels;   // ComponentKey -> chi2/dof, whole run
-  std::map<std::string, double> heldout_component_levels;   // ComponentKey -> chi2/dof, held-out part (nominal fit)
-  std::map<std::string, StreamFit> streams;          // whole run
-  std::map<std::string, double> candidate_lr;        // candidate -> chi2 drop on the training part
+  std::map<std::string, double> component_levels;          // ComponentKey -> chi2/dof, whole run
+  std::map<std::string, double> heldout_component_levels;  // ComponentKey -> chi2/dof, held-out part (nominal fit)
+  std::map<std::string, StreamFit> streams;                // whole run
+  std::map<std::string, double> candidate_lr;              // candidate -> chi2 drop on the training part
   // candidate -> parameter -> (value, std) fitted on the nominal simulation
   std::map<std::string, std::map<std::string, std::pair<double, double>>> candidate_parameters;
 };
 
 struct Diagnosis {
-  std::string verdict;                                // named | unknown | none
-  std::vector<LocatedComponent> located;              // every component; inconsistent ones flagged
-  std::vector<EffectEstimate> candidates;             // the first round's scores, best first
-  std::vector<EffectEstimate> effects;                // accepted, in order
-  std::vector<std::string> unexplained;               // for "unknown": "stream/component depends on condition"
-  std::map<std::string, StreamFit> whole_run;         // the nominal fit of the whole recording
-  std::map<std::string, StreamFit> before, after;     // held-out part: nominal, with the accepted effects
-  std::map<std::string, ComponentLevel> heldout_components_before, heldout_components_after;   // per ComponentKey
-  double train_end_s = 0.0;                           // the held-out part starts here (recording time)
-  std::vector<estimator::MeasurementResidual> residuals;   // whole-run nominal fit
-  Conditions conditions;                              // from the whole-run nominal trajectory
-  std::map<std::string, Eigen::VectorXd> nominal_parameters;   // whole-run nominal calibration
+  std::string verdict;                             // named | unknown | none
+  std::vector<LocatedComponent> located;           // every component; inconsistent ones flagged
+  std::vector<EffectEstimate> candidates;          // the first round's scores, best first
+  std::vector<EffectEstimate> effects;             // accepted, in order
+  std::vector<std::string> unexplained;            // for "unknown": "stream/component depends on condition"
+  std::map<std::string, StreamFit> whole_run;      // the nominal fit of the whole recording
+  std::map<std::string, StreamFit> before, after;  // held-out part: nominal, with the accepted effects
+  std::map<std::string, ComponentLevel> heldout_components_before, heldout_components_after;  // per ComponentKey
+  double train_end_s = 0.0;                                   // the held-out part starts here (recording time)
+  std::vector<estimator::MeasurementResidual> residuals;      // whole-run nominal fit
+  Conditions conditions;                                      // from the whole-run nominal trajectory
+  std::map<std::string, Eigen::VectorXd> nominal_parameters;  // whole-run nominal calibration
   // The training part's calibration (every parameter: fitted, or at its configured value), nominal and with the
   // accepted effects: what the held-out part's `before` and `after` are fitted with.
   std::map<std::string, Eigen::VectorXd> training_parameters_before, training_parameters_after;
@@ -104,18 +104,18 @@ struct Diagnosis {
   // (recording stream -> seconds to subtract from its stamps).
   std::map<std::string, Eigen::VectorXd> effect_parameters;
   std::map<std::string, double> stream_shifts_s;
-  int fits = 0;                                       // calibrations run
+  int fits = 0;  // calibrations run
   double seconds = 0.0;
 };
 
 inline constexpr double kDefaultMinExplainedShare = 0.25;
 
 struct DiagnoseOptions {
-  const Baseline* baseline = nullptr;   // null: levels 1 and no baseline drops
+  const Baseline* baseline = nullptr;  // null: levels 1 and no baseline drops
   double train_fraction = 2.0 / 3.0;
-  double alpha = 1e-3;                  // likelihood-ratio test level
-  double max_delta_bic = 0.0;           // kept only with Delta BIC below this
-  double min_heldout_improvement = 0.0; // kept only when the held-out chi2 drops by more than this fraction
+  double alpha = 1e-3;                   // likelihood-ratio test level
+  double max_delta_bic = 0.0;            // kept only with Delta BIC below this
+  double min_heldout_improvement = 0.0;  // kept only when the held-out chi2 drops by more than this fraction
   // Kept only when it explains at least this share of the mismatch on the held-out part (ExplainedShare). An effect
   // outside the library can pull a library parameter through the shared attitude or trajectory and pass the tests
   // above, but leaves its own stream about as inconsistent as before: the share it explains is small.
@@ -123,8 +123,8 @@ struct DiagnoseOptions {
   // First round: also evaluate the held-out part for the candidates after the kept one that pass the p and BIC
   // tests (decisions unchanged; lets gap-benchmark replay the first round's decision under stricter thresholds).
   bool heldout_all_candidates = false;
-  int max_effects = 3;                  // 0: score the candidates only (learning a baseline)
-  double max_shift_s = 0.5;             // time-shift search range and the margin cut from shifted streams
+  int max_effects = 3;       // 0: score the candidates only (learning a baseline)
+  double max_shift_s = 0.5;  // time-shift search range and the margin cut from shifted streams
   std::function<void(const std::string&)> progress;
 };
 

@@ -17,8 +17,8 @@ constexpr double kPi = 3.14159265358979323846;
 
 // The configured streams the candidates attach to (the first of each model; every source of the repeated ones).
 struct LibraryStreams {
-  std::vector<std::string> gps, imu, pose;   // recording streams
-  std::string gyro, ackermann, diff_drive, mecanum, magnetometer, pose_stream;   // configured streams
+  std::vector<std::string> gps, imu, pose;                                      // recording streams
+  std::string gyro, ackermann, diff_drive, mecanum, magnetometer, pose_stream;  // configured streams
 };
 
 LibraryStreams FindStreams(const EstimatorConfig& config) {
@@ -305,9 +305,10 @@ namespace roamlab::gap {
 
 const std::vector<std::string>& CandidateNames() {
   static const std::vector<std::string> names = {
-      "gps_latency",  "imu_time_offset",        "pose_time_offset",  "steering_offset",
-      "gyro_scale_error", "gyro_bias_drift", "lateral_slip", "wheel_radius_asymmetry", "track_width_error",
-      "wheel_deformation", "axle_misalignment", "magnetometer_motor_interference", "longitudinal_slip", "slope_slip"};
+      "gps_latency",       "imu_time_offset",   "pose_time_offset",  "steering_offset",
+      "gyro_scale_error",  "gyro_bias_drift",   "lateral_slip",      "wheel_radius_asymmetry",
+      "track_width_error", "wheel_deformation", "axle_misalignment", "magnetometer_motor_interference",
+      "longitudinal_slip", "slope_slip"};
   return names;
 }
 

@@ -19,7 +19,7 @@ namespace roamlab::gap {
 inline constexpr std::uint64_t kDefaultBaselineSeed = 900001;
 
 struct LearnBaselineOptions {
-  std::uint64_t seed = kDefaultBaselineSeed;   // noise seed of the nominal simulation
+  std::uint64_t seed = kDefaultBaselineSeed;  // noise seed of the nominal simulation
   // The diagnosis of the nominal simulation: these options with max_effects = 0 and no baseline.
   DiagnoseOptions diagnose;
   // Receives "baseline: simulating ..." before the simulation and "baseline: diagnosing ..." before the diagnosis.
@@ -28,7 +28,7 @@ struct LearnBaselineOptions {
 
 struct LearnedBaseline {
   Baseline baseline;
-  sim::Simulation simulation;   // the nominal simulation (its truth, for a caller that scores against it)
+  sim::Simulation simulation;  // the nominal simulation (its truth, for a caller that scores against it)
 };
 
 // Simulates `nominal` (its effects removed, its duration as given) with options.seed, diagnoses the simulation with

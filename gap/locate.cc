@@ -57,8 +57,8 @@ double Conditions::At(int c, Time time) const {
 Conditions ComputeConditions(const Trajectory& trajectory, const recording::Recording& recording) {
   Conditions out;
   const int n = static_cast<int>(trajectory.size());
-  out.names = {"speed_mps",        "accel_long_mps2", "accel_lat_mps2", "yaw_rate_radps", "yaw_accel_radps2",
-               "slope_rad",        "v_east_mps",      "v_north_mps"};
+  out.names = {"speed_mps",        "accel_long_mps2", "accel_lat_mps2", "yaw_rate_radps",
+               "yaw_accel_radps2", "slope_rad",       "v_east_mps",     "v_north_mps"};
   const recording::Stream* steering = nullptr;
   for (const recording::Stream& s : recording.streams)
     if (s.info.type == recording::StreamType::kSteering && s.values.rows() > 0) steering = &s;
@@ -152,11 +152,10 @@ std::map<std::string, StreamFit> StreamFits(const std::vector<estimator::Measure
   return out;
 }
 
-std::string ComponentKey(const std::string& stream, int component) {
-  return stream + "/" + std::to_string(component);
-}
+std::string ComponentKey(const std::string& stream, int component) { return stream + "/" + std::to_string(component); }
 
-std::map<std::string, ComponentLevel> ComponentStatistics(const std::vector<estimator::MeasurementResidual>& residuals) {
+std::map<std::string, ComponentLevel> ComponentStatistics(
+    const std::vector<estimator::MeasurementResidual>& residuals) {
   std::map<std::string, std::pair<double, int>> sums;
   for (const estimator::MeasurementResidual& r : residuals) {
     if (!r.active) continue;
@@ -226,7 +225,8 @@ std::vector<LocatedComponent> Locate(const std::vector<estimator::MeasurementRes
       lc.chi2_per_dof = chi2 / lc.count;
       const auto level = expected.find(ComponentKey(stream, component));
       lc.expected_chi2_per_dof = level != expected.end() ? std::max(level->second, 1e-6) : 1.0;
-      lc.inconsistent = Inconsistent({lc.chi2_per_dof, lc.count}, lc.expected_chi2_per_dof, options.inconsistency_ratio);
+      lc.inconsistent =
+          Inconsistent({lc.chi2_per_dof, lc.count}, lc.expected_chi2_per_dof, options.inconsistency_ratio);
 
       // When: windows of window_s, half overlapping, whose chi-square exceeds the level's quantile (Bonferroni:
       // 1 - (1 - kQuantile) / windows, so that a consistent component has no interval with probability kQuantile);
@@ -243,9 +243,8 @@ std::vector<LocatedComponent> Locate(const std::vector<estimator::MeasurementRes
         int count = 0;
         for (std::size_t i = lo; i < s.t.size() && s.t[i].seconds() < w1; ++i, ++count) sum += s.r[i] * s.r[i];
         if (count < 5) continue;
-        const double threshold =
-            std::max(LevelQuantile(window_quantile, lc.expected_chi2_per_dof, count),
-                     options.inconsistency_ratio * lc.expected_chi2_per_dof * count);
+        const double threshold = std::max(LevelQuantile(window_quantile, lc.expected_chi2_per_dof, count),
+                                          options.inconsistency_ratio * lc.expected_chi2_per_dof * count);
         if (sum <= threshold) continue;
         if (!lc.intervals.empty() && lc.intervals.back().second >= w0)
           lc.intervals.back().second = std::min(w1, t_last);
@@ -271,8 +270,8 @@ std::vector<LocatedComponent> Locate(const std::vector<estimator::MeasurementRes
         for (int l = -lags; l <= lags; ++l) {
           if (l == 0) continue;
           const double rho = rho_at(l * options.lag_step_s);
-          if (std::abs(rho) > std::max(std::abs(best.rho), zero_lag)) best = {conditions.names[c], rho,
-                                                                                      l * options.lag_step_s};
+          if (std::abs(rho) > std::max(std::abs(best.rho), zero_lag))
+            best = {conditions.names[c], rho, l * options.lag_step_s};
         }
         all.push_back(best);
       }

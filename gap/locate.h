@@ -38,10 +38,10 @@ Conditions ComputeConditions(const Trajectory& trajectory, const recording::Reco
 // Totals of one stream's whitened residuals (active measurements only).
 struct StreamFit {
   int measurements = 0;
-  int dof = 0;                 // scalar residuals
-  double chi2 = 0.0;           // sum of squared whitened residuals
+  int dof = 0;        // scalar residuals
+  double chi2 = 0.0;  // sum of squared whitened residuals
   double chi2_per_dof = 0.0;
-  double rms = 0.0;            // sqrt(chi2_per_dof): whitened RMS
+  double rms = 0.0;  // sqrt(chi2_per_dof): whitened RMS
   // The systematic part: the RMS over components and 1 s windows (kSystematicWindowS, from the stream's first
   // residual) of each window's mean whitened residual. White noise averages out of it (by sqrt of the samples in a
   // window: 10x at 100 Hz), a bias or a slowly varying mismatch does not; it is what a residual plot shows as a trend.
@@ -61,12 +61,12 @@ class WindowMeans {
 
  private:
   std::optional<Time> first_;
-  std::map<long, std::pair<Eigen::VectorXd, int>> windows_;   // window index -> (sum, count)
+  std::map<long, std::pair<Eigen::VectorXd, int>> windows_;  // window index -> (sum, count)
 };
 
 struct Correlate {
   std::string condition;
-  double rho = 0.0;            // Pearson correlation of the residual with the condition at t + lag_s
+  double rho = 0.0;  // Pearson correlation of the residual with the condition at t + lag_s
   double lag_s = 0.0;
 };
 
@@ -75,10 +75,10 @@ struct LocatedComponent {
   int component = 0;
   int count = 0;
   double chi2_per_dof = 0.0;
-  double expected_chi2_per_dof = 1.0;          // the nominal level it was compared with
-  bool inconsistent = false;                   // above the level by more than kInconsistencyRatio and its quantile
-  std::vector<std::pair<double, double>> intervals;   // [t0, t1] in seconds where the windows exceed the level
-  std::vector<Correlate> correlates;                  // the strongest first, at most three
+  double expected_chi2_per_dof = 1.0;  // the nominal level it was compared with
+  bool inconsistent = false;           // above the level by more than kInconsistencyRatio and its quantile
+  std::vector<std::pair<double, double>> intervals;  // [t0, t1] in seconds where the windows exceed the level
+  std::vector<Correlate> correlates;                 // the strongest first, at most three
 };
 
 struct LocateOptions {

@@ -213,8 +213,10 @@ Result<EstimatorConfig> NominalConfig(const sim::Scenario& scenario) {
   if (scenario.robot.kind == "differential_drive") return NominalDiffDriveConfig(scenario);
   if (scenario.robot.kind == "omni3" || scenario.robot.kind == "mecanum") return NominalHolonomicConfig(scenario);
   if (scenario.robot.kind != "ackermann")
-    return Status::Error("the nominal configuration is implemented for ackermann, differential_drive, omni3 and "
-                         "mecanum robots only, not '" + scenario.robot.kind + "'");
+    return Status::Error(
+        "the nominal configuration is implemented for ackermann, differential_drive, omni3 and "
+        "mecanum robots only, not '" +
+        scenario.robot.kind + "'");
   return NominalAckermannConfig(scenario);
 }
 

@@ -17,7 +17,9 @@ using nlohmann::json;
 json FitsJson(const std::map<std::string, StreamFit>& fits) {
   json j = json::object();
   for (const auto& [name, f] : fits)
-    j[name] = {{"rms", Number(f.rms)}, {"rms_1s", Number(f.rms_1s)}, {"chi2_per_dof", Number(f.chi2_per_dof)},
+    j[name] = {{"rms", Number(f.rms)},
+               {"rms_1s", Number(f.rms_1s)},
+               {"chi2_per_dof", Number(f.chi2_per_dof)},
                {"dof", f.dof},
                {"measurements", f.measurements}};
   return j;
@@ -97,7 +99,7 @@ std::vector<std::string> WritePlots(const Diagnosis& d, const std::string& dir, 
       const Time t = Time::FromNanoseconds(r.t.nanoseconds() + std::llround(c.lag_s * 1e9));
       data << d.conditions.At(ci, t) << " " << r.whitened[lc->component] << "\n";
     }
-    data.close();   // gnuplot reads it below: every line on disk first
+    data.close();  // gnuplot reads it below: every line on disk first
     std::ofstream gp(dir + "/residual_vs_condition.gp");
     gp << "set terminal pngcairo size 800,500 noenhanced\nset output 'residual_vs_condition.png'\n"
        << "set title \"" << lc->stream << "[" << lc->component << "]: chi2/dof " << Fixed(lc->chi2_per_dof, 3)
@@ -138,14 +140,20 @@ json SimulationJson(const SimulationComparison& c) {
   const auto fits = [](const std::map<std::string, SimulatedStreamFit>& m) {
     json j = json::object();
     for (const auto& [name, f] : m)
-      j[name] = {{"rms", Number(f.rms)}, {"rms_1s", Number(f.rms_1s)}, {"component_rms", f.component_rms},
+      j[name] = {{"rms", Number(f.rms)},
+                 {"rms_1s", Number(f.rms_1s)},
+                 {"component_rms", f.component_rms},
                  {"samples", f.samples}};
     return j;
   };
   json effects = json::array();
   for (const sim::EffectOptions& e : c.effects) effects.push_back({{"name", e.name}, {"parameters", e.parameters}});
-  return {{"from_s", c.from_s},         {"duration_s", c.duration_s}, {"effects", effects},
-          {"before", fits(c.before)},   {"after", fits(c.after)},     {"left_out", c.left_out},
+  return {{"from_s", c.from_s},
+          {"duration_s", c.duration_s},
+          {"effects", effects},
+          {"before", fits(c.before)},
+          {"after", fits(c.after)},
+          {"left_out", c.left_out},
           {"not_simulated", c.not_simulated.empty() ? json(nullptr) : json(c.not_simulated)}};
 }
 
@@ -169,16 +177,14 @@ void SimulationSection(const SimulationComparison& c, std::ostringstream& r) {
       << Fixed(b.rms_1s, 4) << " | " << Fixed(a->second.rms_1s, 4) << " |\n";
   }
   for (const std::string& l : c.left_out) r << "\nNot compared: " << l << ".";
-  if (!c.not_simulated.empty())
-    r << "\nThe effects could not be simulated: " << c.not_simulated << ".";
+  if (!c.not_simulated.empty()) r << "\nThe effects could not be simulated: " << c.not_simulated << ".";
   r << "\n";
 }
 
 }  // namespace
 
-std::string ReportMarkdown(const Diagnosis& d, const std::string& recording, const std::string& scenario,
-                           bool baseline, const SimulationComparison* simulation,
-                           const std::vector<std::string>& images) {
+std::string ReportMarkdown(const Diagnosis& d, const std::string& recording, const std::string& scenario, bool baseline,
+                           const SimulationComparison* simulation, const std::vector<std::string>& images) {
   std::ostringstream r;
   r << "# Reality-gap diagnosis\n\nRecording `" << recording << "` against the nominal scenario `" << scenario
     << "`.\n\n## Verdict: **" << d.verdict << "**\n\n";
@@ -221,8 +227,7 @@ std::string ReportMarkdown(const Diagnosis& d, const std::string& recording, con
     r << "| " << e.name << " | ";
     for (const auto& [k, v] : e.parameters) r << k << " = " << Fixed(v, 4) << " ";
     r << "| " << Fixed(e.lr, 4) << " | " << Fixed(e.lr_raw, 4) << " / " << Fixed(e.baseline_lr, 4) << " | "
-      << Fixed(e.lr_pvalue, 3) << " | "
-      << Fixed(e.delta_bic, 4) << " | "
+      << Fixed(e.lr_pvalue, 3) << " | " << Fixed(e.delta_bic, 4) << " | "
       << (e.evaluated_heldout ? Fixed(100.0 * e.heldout_improvement, 3) + " %" : std::string("-")) << " | "
       << (e.evaluated_heldout ? Fixed(e.explained_share, 3) : std::string("-")) << " | " << e.decision << " |\n";
   }
@@ -254,7 +259,7 @@ std::string ScenarioPatch(const Diagnosis& d, const SimulationComparison* simula
     y << "  - name: " << e.name << "\n";
     bool same = effect.parameters.size() == e.parameters.size();
     for (const auto& [k, v] : effect.parameters) same = same && e.parameters.count(k);
-    if (!same) {   // parameters the simulator takes in another form (lateral_slip): the diagnosed ones as comments
+    if (!same) {  // parameters the simulator takes in another form (lateral_slip): the diagnosed ones as comments
       y << "    # diagnosed:";
       for (const auto& [k, v] : e.parameters) y << " " << k << " = " << std::setprecision(6) << v;
       y << "\n";
@@ -305,8 +310,11 @@ json DiagnosisJson(const Diagnosis& d, const Baseline* baseline, std::uint64_t b
   return {{"verdict", d.verdict},
           {"located", located},
           {"effects", effects},
-          {"fit", {{"before", FitsJson(d.before)}, {"after", FitsJson(d.after)},
-                   {"heldout_start_s", d.train_end_s}, {"whole_run_nominal", FitsJson(d.whole_run)}}},
+          {"fit",
+           {{"before", FitsJson(d.before)},
+            {"after", FitsJson(d.after)},
+            {"heldout_start_s", d.train_end_s},
+            {"whole_run_nominal", FitsJson(d.whole_run)}}},
           {"unexplained", d.unexplained},
           {"candidates", candidates},
           {"components", components},
@@ -323,8 +331,7 @@ Status WriteReport(const Diagnosis& d, const ReportInputs& in, const std::string
   std::string note;
   const std::vector<std::string> images = in.plots ? WritePlots(d, dir, &note) : std::vector<std::string>{};
   if (!note.empty() && in.progress) in.progress(note);
-  const std::string report =
-      ReportMarkdown(d, in.recording, in.model, in.baseline != nullptr, in.simulation, images);
+  const std::string report = ReportMarkdown(d, in.recording, in.model, in.baseline != nullptr, in.simulation, images);
   return WriteText(dir + "/report.md", report);
 }
 

@@ -34,13 +34,13 @@ std::string ScenarioPatch(const Diagnosis& d, const SimulationComparison* simula
 std::string EstimatorPatch(const Diagnosis& d);
 
 struct ReportInputs {
-  std::string recording;                           // the recording's path, as given
-  std::string model;                               // the nominal scenario's (or configuration's) path
-  const Baseline* baseline = nullptr;              // null: diagnosed without one
+  std::string recording;               // the recording's path, as given
+  std::string model;                   // the nominal scenario's (or configuration's) path
+  const Baseline* baseline = nullptr;  // null: diagnosed without one
   std::uint64_t baseline_seed = 0;
-  const SimulationComparison* simulation = nullptr;   // null: no re-simulation
-  bool plots = true;                               // write the figures (when gnuplot is installed)
-  std::function<void(const std::string&)> progress;   // receives a note when no figure can be drawn
+  const SimulationComparison* simulation = nullptr;  // null: no re-simulation
+  bool plots = true;                                 // write the figures (when gnuplot is installed)
+  std::function<void(const std::string&)> progress;  // receives a note when no figure can be drawn
 };
 
 // Writes gap.json, scenario_patch.yaml, estimator_patch.yaml, the figures and report.md into `dir` (which exists).

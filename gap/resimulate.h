@@ -32,20 +32,20 @@ sim::EffectOptions SimulatorEffect(const EffectEstimate& effect, std::map<std::s
                                    double physics_step_s = 0.0);
 
 struct SimulatedStreamFit {
-  double rms = 0.0;                    // over the compared samples and components, in units of the stated noise
-  double rms_1s = 0.0;                 // of the 1 s means per component (the systematic part, as StreamFit::rms_1s)
-  std::vector<double> component_rms;   // per component (a GPS stream's East, North, Up)
-  int samples = 0;                     // samples matched in time
+  double rms = 0.0;                   // over the compared samples and components, in units of the stated noise
+  double rms_1s = 0.0;                // of the 1 s means per component (the systematic part, as StreamFit::rms_1s)
+  std::vector<double> component_rms;  // per component (a GPS stream's East, North, Up)
+  int samples = 0;                    // samples matched in time
 };
 
 struct SimulationComparison {
-  double from_s = 0.0;                                        // compared from here to the end of the recording
-  double duration_s = 0.0;                                    // of the simulations
-  std::map<std::string, SimulatedStreamFit> before, after;    // as believed; with the effects. The imu's columns as
-                                                              // "gyroscope" and "accelerometer"
-  std::vector<std::string> left_out;                          // streams not compared, with the reason
-  std::vector<sim::EffectOptions> effects;   // as applied (SimulatorEffect, time shifts in whole physics steps)
-  std::string not_simulated;   // why the simulation with the effects failed (then `after` is empty)
+  double from_s = 0.0;                                      // compared from here to the end of the recording
+  double duration_s = 0.0;                                  // of the simulations
+  std::map<std::string, SimulatedStreamFit> before, after;  // as believed; with the effects. The imu's columns as
+                                                            // "gyroscope" and "accelerometer"
+  std::vector<std::string> left_out;                        // streams not compared, with the reason
+  std::vector<sim::EffectOptions> effects;  // as applied (SimulatorEffect, time shifts in whole physics steps)
+  std::string not_simulated;                // why the simulation with the effects failed (then `after` is empty)
 };
 
 // Simulates `nominal` (its effects replaced) without noise, without and with `effects`, and compares them with

@@ -115,8 +115,8 @@ Result<Recording> ImportOptiOdom(const std::string& run_csv, const std::string& 
   if (!meta_result.ok()) return meta_result.status();
   const Metadata& meta = meta_result.value();
   const bool diff = meta.type == "diff";
-  const std::vector<std::string> wheels = diff ? std::vector<std::string>{"right", "left"}
-                                               : std::vector<std::string>{"w1", "w2", "w3"};
+  const std::vector<std::string> wheels =
+      diff ? std::vector<std::string>{"right", "left"} : std::vector<std::string>{"w1", "w2", "w3"};
   const auto m = static_cast<Eigen::Index>(wheels.size());
   const std::size_t columns = 4 + wheels.size();
 

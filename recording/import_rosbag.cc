@@ -1,7 +1,7 @@
 #include "recording/import_rosbag.h"
 
-#include <algorithm>
 #include <bzlib.h>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -42,7 +42,7 @@ class Cursor {
   }
   std::uint32_t U32() { return Read<std::uint32_t>(); }
   double F64() { return Read<double>(); }
-  std::string_view String() { return Bytes(U32()); }   // ROS string: u32 length, bytes
+  std::string_view String() { return Bytes(U32()); }  // ROS string: u32 length, bytes
   void Skip(std::size_t n) { Bytes(n); }
 
  private:
@@ -54,7 +54,7 @@ class Cursor {
 struct Record {
   std::map<std::string, std::string_view> fields;
   std::string_view data;
-  std::size_t offset = 0;   // of the record in its buffer
+  std::size_t offset = 0;  // of the record in its buffer
 };
 
 // Reads the next record; "" on success, else the problem.
@@ -108,10 +108,10 @@ struct Connection {
 
 // The header stamp of a std_msgs/Header, then its frame id skipped.
 Time ReadHeader(Cursor* c) {
-  c->U32();   // seq
+  c->U32();  // seq
   const std::uint32_t sec = c->U32();
   const std::uint32_t nsec = c->U32();
-  c->String();   // frame_id
+  c->String();  // frame_id
   return Time::FromNanoseconds(static_cast<std::int64_t>(sec) * 1000000000 + nsec);
 }
 
@@ -124,7 +124,7 @@ struct Sample {
 struct TopicData {
   std::string type;
   std::vector<Sample> samples;
-  std::vector<double> sigma_a, sigma_b;   // imu: gyro, accel; gps: horizontal
+  std::vector<double> sigma_a, sigma_b;  // imu: gyro, accel; gps: horizontal
   int no_fix = 0;
 };
 
@@ -138,8 +138,8 @@ bool Decode(std::string_view data, TopicData* topic) {
     return v;
   };
   if (topic->type == "sensor_msgs/Imu") {
-    read(4);                                    // orientation (not imported)
-    read(9);                                    // its covariance
+    read(4);  // orientation (not imported)
+    read(9);  // its covariance
     const Eigen::VectorXd w = read(3);
     const Eigen::VectorXd cov_w = read(9);
     const Eigen::VectorXd a = read(3);
@@ -153,8 +153,8 @@ bool Decode(std::string_view data, TopicData* topic) {
     return true;
   }
   if (topic->type == "nav_msgs/Odometry") {
-    c.String();                                 // child_frame_id: the frame of the twist
-    read(7);                                    // pose (not imported: the integral of the twist)
+    c.String();  // child_frame_id: the frame of the twist
+    read(7);     // pose (not imported: the integral of the twist)
     read(36);
     const Eigen::VectorXd twist = read(6);
     const Eigen::VectorXd cov = read(36);
@@ -169,10 +169,10 @@ bool Decode(std::string_view data, TopicData* topic) {
   }
   // sensor_msgs/NavSatFix
   const auto status = c.Read<std::int8_t>();
-  c.Read<std::uint16_t>();                      // service
+  c.Read<std::uint16_t>();  // service
   const Eigen::VectorXd lla = read(3);
   const Eigen::VectorXd cov = read(9);
-  c.Read<std::uint8_t>();                       // position_covariance_type
+  c.Read<std::uint8_t>();  // position_covariance_type
   if (!c.ok()) return false;
   if (status < 0 || !lla.allFinite()) {
     ++topic->no_fix;
@@ -206,7 +206,7 @@ std::string StreamNameOf(const std::string& topic) {
 
 // What the walk over the records collects.
 struct BagContents {
-  std::deque<std::string> unpacked;   // decompressed chunks (the messages point into them)
+  std::deque<std::string> unpacked;  // decompressed chunks (the messages point into them)
   std::map<std::uint32_t, Connection> connections;
   std::vector<Message> messages;
   bool saw_bag_header = false;
@@ -280,8 +280,7 @@ Result<Recording> ImportRosbag(const std::string& bag_path, const RosbagImportOp
     return fail("not a ROS bag (no '#ROSBAG V2.0' line at the start)");
   }
   BagContents bag;
-  if (std::string problem = WalkRecords(std::string_view(content).substr(magic), magic, false, &bag);
-      !problem.empty())
+  if (std::string problem = WalkRecords(std::string_view(content).substr(magic), magic, false, &bag); !problem.empty())
     return fail(problem);
   if (!bag.saw_bag_header) return fail("no bag header record");
   rep.chunks = bag.chunks;

@@ -47,15 +47,15 @@
 namespace roamlab::recording {
 
 struct RosbagImportOptions {
-  std::optional<Eigen::Quaterniond> q_body_imu;   // IMU mounting (rotates IMU coordinates into the body frame)
-  Platform platform;                              // written as is (kind, nominal geometry)
-  bool wheels_from_odometry = false;              // also write `wheels` (header comment)
+  std::optional<Eigen::Quaterniond> q_body_imu;  // IMU mounting (rotates IMU coordinates into the body frame)
+  Platform platform;                             // written as is (kind, nominal geometry)
+  bool wheels_from_odometry = false;             // also write `wheels` (header comment)
 };
 
 struct RosbagImportReport {
-  std::map<std::string, int> messages;            // topic -> messages read
-  std::map<std::string, int> skipped;             // "topic: reason" -> samples skipped
-  std::map<std::string, std::string> types;       // topic -> message type
+  std::map<std::string, int> messages;       // topic -> messages read
+  std::map<std::string, int> skipped;        // "topic: reason" -> samples skipped
+  std::map<std::string, std::string> types;  // topic -> message type
   int chunks = 0;
 };
 

@@ -148,8 +148,7 @@ Status ParseColumns(const YAML::Node& entry, const std::string& path, const std:
     if (node && declared != fixed && !covariance) {
       return ErrorAt(path, node,
                      "columns " + JoinColumns(declared) + " of " + context + " do not match type " +
-                         StreamTypeName(info->type) + ": expected " + JoinColumns(fixed) +
-                         CovarianceNote(info->type));
+                         StreamTypeName(info->type) + ": expected " + JoinColumns(fixed) + CovarianceNote(info->type));
     }
     info->columns = covariance ? declared : fixed;
     return Status::Ok();

@@ -93,33 +93,33 @@ std::vector<std::string> LaserScanColumns(int beams);
 
 // Nominal mounting of a sensor frame S in the odometric frame O.
 struct Mounting {
-  Eigen::Vector3d p_body_sensor = Eigen::Vector3d::Zero();                // [m], lever arm S^(O)
-  Eigen::Quaterniond q_body_sensor = Eigen::Quaterniond::Identity();      // rotates S coordinates into O
+  Eigen::Vector3d p_body_sensor = Eigen::Vector3d::Zero();            // [m], lever arm S^(O)
+  Eigen::Quaterniond q_body_sensor = Eigen::Quaterniond::Identity();  // rotates S coordinates into O
 };
 
 struct StreamInfo {
-  std::string name;                     // unique; the CSV file is <name>.csv
+  std::string name;  // unique; the CSV file is <name>.csv
   StreamType type = StreamType::kInputs;
-  double rate_hz = 0.0;                 // nominal rate
-  std::vector<std::string> columns;     // after "t"; fixed by the type except wheel_encoders and inputs (and the
-                                        // optional covariance columns of the velocity types and gps)
-  std::string units;                    // after reading: the canonical unit of the type (table above; magnetometer,
-                                        // camera and inputs keep what was declared); empty = canonical
+  double rate_hz = 0.0;              // nominal rate
+  std::vector<std::string> columns;  // after "t"; fixed by the type except wheel_encoders and inputs (and the
+                                     // optional covariance columns of the velocity types and gps)
+  std::string units;                 // after reading: the canonical unit of the type (table above; magnetometer,
+                                     // camera and inputs keep what was declared); empty = canonical
   std::optional<Mounting> mounting;
-  std::map<std::string, double> noise;  // nominal noise, keys carry units, e.g. "sigma_m", "sigma_radps"
+  std::map<std::string, double> noise;       // nominal noise, keys carry units, e.g. "sigma_m", "sigma_radps"
   std::map<std::string, double> attributes;  // type-specific scalars, e.g. "ticks_per_revolution", "fx_px"
 };
 
 struct Stream {
   StreamInfo info;
-  std::vector<Time> t;                  // strictly increasing
-  Eigen::MatrixXd values;               // rows = samples, columns = info.columns, canonical units
-  std::vector<std::string> text;        // camera only: one file name per row
+  std::vector<Time> t;            // strictly increasing
+  Eigen::MatrixXd values;         // rows = samples, columns = info.columns, canonical units
+  std::vector<std::string> text;  // camera only: one file name per row
 };
 
 struct Platform {
-  std::string kind;                          // "ackermann", "differential_drive", "omni3", "mecanum", "skid_steer", ...
-  std::map<std::string, double> geometry;    // nominal geometry, keys with units: "wheelbase_m", "track_m", ...
+  std::string kind;                        // "ackermann", "differential_drive", "omni3", "mecanum", "skid_steer", ...
+  std::map<std::string, double> geometry;  // nominal geometry, keys with units: "wheelbase_m", "track_m", ...
 };
 
 struct GeodeticOrigin {
@@ -129,10 +129,10 @@ struct GeodeticOrigin {
 };
 
 struct Provenance {
-  std::string source;                   // "simulated" or "imported"
-  std::string scenario;                 // scenario file, when simulated
-  std::optional<std::uint64_t> seed;    // when simulated
-  std::string description;              // free text: importer and original file, ...
+  std::string source;                 // "simulated" or "imported"
+  std::string scenario;               // scenario file, when simulated
+  std::optional<std::uint64_t> seed;  // when simulated
+  std::string description;            // free text: importer and original file, ...
 };
 
 struct Recording {

@@ -46,8 +46,7 @@ Status ValidateInfoForWrite(const StreamInfo& info, const std::string& prefix) {
   const std::vector<std::string>& fixed = FixedColumns(info.type);
   if (!fixed.empty() && !info.columns.empty() && info.columns != fixed && !CarriesCovariance(info)) {
     return Status::Error(prefix + "columns " + JoinColumns(info.columns) + " do not match type " +
-                         StreamTypeName(info.type) + ": expected " + JoinColumns(fixed) +
-                         CovarianceNote(info.type));
+                         StreamTypeName(info.type) + ": expected " + JoinColumns(fixed) + CovarianceNote(info.type));
   }
   if (fixed.empty()) {
     const std::string problem = NamedColumnsProblem(info.type, info.columns);

@@ -14,8 +14,8 @@ namespace roamlab {
 
 struct StampedPose {
   Time t;
-  Eigen::Vector3d p_world_body = Eigen::Vector3d::Zero();               // [m]
-  Eigen::Quaterniond q_world_body = Eigen::Quaterniond::Identity();     // rotates O coordinates into W
+  Eigen::Vector3d p_world_body = Eigen::Vector3d::Zero();            // [m]
+  Eigen::Quaterniond q_world_body = Eigen::Quaterniond::Identity();  // rotates O coordinates into W
 };
 
 using Trajectory = std::vector<StampedPose>;

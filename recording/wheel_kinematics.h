@@ -32,8 +32,8 @@
 namespace roamlab::recording {
 
 struct WheelKinematics {
-  Eigen::MatrixXd J_rates_twist;   // n x 3: wheel rates [rad/s] = J [v_x (m/s), v_y (m/s), omega_z (rad/s)]
-  bool holonomic = false;          // false: v_y is zero by construction
+  Eigen::MatrixXd J_rates_twist;  // n x 3: wheel rates [rad/s] = J [v_x (m/s), v_y (m/s), omega_z (rad/s)]
+  bool holonomic = false;         // false: v_y is zero by construction
 
   int wheels() const { return static_cast<int>(J_rates_twist.rows()); }
   // Least-squares body twist [v_x, v_y, omega_z] from wheel rates (n), v_y = 0 when not holonomic.

@@ -7,8 +7,8 @@
 #include <sstream>
 #include <utility>
 
-#include "experiment/diagnose.h"
 #include "eval/evaluate.h"
+#include "experiment/diagnose.h"
 #include "experiment/montecarlo.h"
 #include "experiment/odometry.h"
 #include "experiment/steps.h"
@@ -26,54 +26,52 @@ using nlohmann::json;
 // What `roamlab evaluate` writes (eval/evaluate.cc, eval/parameters.cc).
 json MetricsSchema() {
   const json stats = {{"rmse", "number"}, {"mean", "number"}, {"median", "number"}, {"max", "number"}};
-  return {{"ate_m", "number"},
-          {"rpe_trans_m", "number"},
-          {"rpe_rot_deg", "number"},
-          {"nees_mean", "number"},
-          {"association",
-           {{"estimate_poses", "number"},
-            {"reference_poses", "number"},
-            {"matched", "number"},
-            {"tolerance_s", "number"},
-            {"max_time_difference_s", "number"}}},
-          {"alignment", {{"q_ref_est_wxyz", "numbers"}, {"p_ref_est_m", "numbers"}}},
-          {"ate",
-           {{"poses", "number"}, {"rmse_m", "number"}, {"mean_m", "number"}, {"median_m", "number"},
-            {"max_m", "number"}}},
-          {"rpe",
-           {{"delta_poses", "number"}, {"delta_s", "number"}, {"pairs", "number"}, {"trans_m", stats},
-            {"rot_deg", stats}}},
-          {"rpe_distance",
-           {{"distance_m", "number"}, {"pairs", "number"}, {"trans_m", stats}, {"rot_deg", stats}}},
-          {"nees",
-           {{"poses", "number"},
-            {"without_covariance", "number"},
-            {"not_positive_definite", "number"},
-            {"dof", "number"},
-            {"band_single_run", "numbers"},
-            {"t0_s", "number"},
-            {"fraction_in_band", "number"}}},
-          {"velocity",
-           {{"fused", {{"linear_rmse", "number"}, {"angular_rmse", "number"}, {"rpe_rot_deg", "number"},
-                       {"intervals", "number"}}},
-            {"encoders_only", {{"linear_rmse", "number"}, {"angular_rmse", "number"}, {"rpe_rot_deg", "number"},
-                               {"intervals", "number"}}},
-            {"rpe_delta_poses", "number"}}},
-          {"parameters",
-           {{"<parameter>",
-             {{"truth", "numbers"},
-              {"estimate", "numbers"},
-              {"std", "numbers"},
-              {"error", "numbers"},
-              {"error_over_std", "numbers"},
-              {"angle_error_deg", "number"},
-              {"component_error", "numbers"},
-              {"relative_error", "relative"}}}}}};
+  return {
+      {"ate_m", "number"},
+      {"rpe_trans_m", "number"},
+      {"rpe_rot_deg", "number"},
+      {"nees_mean", "number"},
+      {"association",
+       {{"estimate_poses", "number"},
+        {"reference_poses", "number"},
+        {"matched", "number"},
+        {"tolerance_s", "number"},
+        {"max_time_difference_s", "number"}}},
+      {"alignment", {{"q_ref_est_wxyz", "numbers"}, {"p_ref_est_m", "numbers"}}},
+      {"ate",
+       {{"poses", "number"}, {"rmse_m", "number"}, {"mean_m", "number"}, {"median_m", "number"}, {"max_m", "number"}}},
+      {"rpe",
+       {{"delta_poses", "number"}, {"delta_s", "number"}, {"pairs", "number"}, {"trans_m", stats}, {"rot_deg", stats}}},
+      {"rpe_distance", {{"distance_m", "number"}, {"pairs", "number"}, {"trans_m", stats}, {"rot_deg", stats}}},
+      {"nees",
+       {{"poses", "number"},
+        {"without_covariance", "number"},
+        {"not_positive_definite", "number"},
+        {"dof", "number"},
+        {"band_single_run", "numbers"},
+        {"t0_s", "number"},
+        {"fraction_in_band", "number"}}},
+      {"velocity",
+       {{"fused",
+         {{"linear_rmse", "number"}, {"angular_rmse", "number"}, {"rpe_rot_deg", "number"}, {"intervals", "number"}}},
+        {"encoders_only",
+         {{"linear_rmse", "number"}, {"angular_rmse", "number"}, {"rpe_rot_deg", "number"}, {"intervals", "number"}}},
+        {"rpe_delta_poses", "number"}}},
+      {"parameters",
+       {{"<parameter>",
+         {{"truth", "numbers"},
+          {"estimate", "numbers"},
+          {"std", "numbers"},
+          {"error", "numbers"},
+          {"error_over_std", "numbers"},
+          {"angle_error_deg", "number"},
+          {"component_error", "numbers"},
+          {"relative_error", "relative"}}}}}};
 }
 
 json CountsSchema() {
-  return {{"<stream>", {{"attached", "number"}, {"rejected", "number"}, {"too_late", "number"},
-                        {"outside", "number"}}}};
+  return {
+      {"<stream>", {{"attached", "number"}, {"rejected", "number"}, {"too_late", "number"}, {"outside", "number"}}}};
 }
 
 // What `roamlab calibrate` writes (estimator/calibration_io.h).
@@ -84,12 +82,11 @@ json CalibrationSchema() {
             {"initial_cost", "number"},
             {"final_cost", "number"},
             {"seconds", "timing"},
-            {"stages",
-             json::array({{{"iterations", "number"},
-                           {"initial_cost", "number"},
-                           {"final_cost", "number"},
-                           {"rejected", "number"},
-                           {"seconds", "timing"}}})}}},
+            {"stages", json::array({{{"iterations", "number"},
+                                     {"initial_cost", "number"},
+                                     {"final_cost", "number"},
+                                     {"rejected", "number"},
+                                     {"seconds", "timing"}}})}}},
           {"measurements", CountsSchema()}};
 }
 
@@ -110,12 +107,13 @@ json SummarySchema() {
 
 // What `roamlab montecarlo` writes (experiment/montecarlo.h, eval/nees.h).
 json NeesSchema() {
-  return {{"runs", "number"}, {"dof", "number"},       {"band", "numbers"},     {"alpha", "number"},
-          {"t0_s", "number"}, {"t", "numbers"},        {"mean_nees", "numbers"}, {"fraction_in_band", "number"}};
+  return {{"runs", "number"}, {"dof", "number"}, {"band", "numbers"},      {"alpha", "number"},
+          {"t0_s", "number"}, {"t", "numbers"},  {"mean_nees", "numbers"}, {"fraction_in_band", "number"}};
 }
 json RunsSchema() {
-  return {{"runs", json::array({{{"seed", "number"}, {"ate_m", "number"}, {"mean_nees", "number"},
-                                  {"track_seconds", "timing"}}})}};
+  return {
+      {"runs",
+       json::array({{{"seed", "number"}, {"ate_m", "number"}, {"mean_nees", "number"}, {"track_seconds", "timing"}}})}};
 }
 
 // A failed step's error as the command would print it: "roamlab COMMAND: message" (Outcome::step names an inner
@@ -221,8 +219,12 @@ Status RunMonteCarloCase(const CaseContext& context) {
 
 // What `roamlab odometry evaluate` writes (experiment/odometry.h).
 json TableSchema() {
-  return {{"rows", json::array({{{"model", "string"}, {"mean", "string"}, {"kernel", "string"}, {"ate_m", "number"},
-                                 {"rpe_mm", "number"}, {"model_file", "string"}}})},
+  return {{"rows", json::array({{{"model", "string"},
+                                 {"mean", "string"},
+                                 {"kernel", "string"},
+                                 {"ate_m", "number"},
+                                 {"rpe_mm", "number"},
+                                 {"model_file", "string"}}})},
           {"recordings", json::array({{{"recording", "string"}, {"key_poses", "number"}}})},
           {"interval_s", "number"}};
 }
@@ -241,10 +243,10 @@ json GapSchema() {
                        {"delta_bic", "number"},
                        {"heldout_improvement", "number"},
                        {"decision", "string"}};
-  const json fits = {{"<any>", {{"rms", "number"}, {"chi2_per_dof", "number"}, {"dof", "number"},
-                                {"measurements", "number"}}}};
-  const json component = {{"stream", "string"}, {"component", "number"}, {"chi2_per_dof", "number"},
-                          {"expected_chi2_per_dof", "number"}};
+  const json fits = {
+      {"<any>", {{"rms", "number"}, {"chi2_per_dof", "number"}, {"dof", "number"}, {"measurements", "number"}}}};
+  const json component = {
+      {"stream", "string"}, {"component", "number"}, {"chi2_per_dof", "number"}, {"expected_chi2_per_dof", "number"}};
   return {{"verdict", "string"},
           {"located", json::array({component})},
           {"effects", json::array({effect})},
@@ -314,8 +316,8 @@ Status RunOdometryCase(const CaseContext& context) {
     if (!m.mean.empty()) options.mean = m.mean;
     if (!m.kernel.empty()) options.kernel = m.kernel;
     if (context.c.interval_s) options.interval_s = *context.c.interval_s;
-    options.out = context.dir + "/models/" + std::to_string(i) + "_" + m.model +
-                  (m.mean.empty() ? "" : "_" + m.mean) + (m.kernel.empty() ? "" : "_" + m.kernel) + ".json";
+    options.out = context.dir + "/models/" + std::to_string(i) + "_" + m.model + (m.mean.empty() ? "" : "_" + m.mean) +
+                  (m.kernel.empty() ? "" : "_" + m.kernel) + ".json";
     std::error_code ec;
     fs::create_directories(context.dir + "/models", ec);
     const experiment::Outcome outcome = experiment::LearnOdometry(options);
@@ -369,8 +371,7 @@ const std::vector<ModeSpec>& Modes() {
       {"track",
        {"scenario", "recording", "seed", "config", "calibration", "calibrate", "t0_s"},
        {"scenario|recording", "config"},
-       {{"summary", "tracking/summary.json", SummarySchema()},
-        {"metrics", "evaluation/metrics.json", MetricsSchema()}},
+       {{"summary", "tracking/summary.json", SummarySchema()}, {"metrics", "evaluation/metrics.json", MetricsSchema()}},
        RunTrackCase},
       {"montecarlo",
        {"scenario", "seed", "config", "calibration", "calibrate", "runs", "seed_base", "t0_s"},

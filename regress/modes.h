@@ -16,13 +16,13 @@ namespace roamlab::regress {
 
 struct CaseContext {
   const Case& c;
-  std::string dir;   // the case's output directory (exists, empty)
-  int jobs = 1;      // threads a mode may use inside the case (montecarlo runs)
+  std::string dir;  // the case's output directory (exists, empty)
+  int jobs = 1;     // threads a mode may use inside the case (montecarlo runs)
 };
 
 struct ModeOutput {
-  std::string name;   // first component of a metric path
-  std::string file;   // relative to the case directory
+  std::string name;  // first component of a metric path
+  std::string file;  // relative to the case directory
   // Key schema: an object whose leaves are "number", "numbers" (array of numbers), "timing" (not deterministic:
   // never a check), "relative" (derived: max_i |error_i / truth_i| of a parameter row); "<parameter>" and "<stream>"
   // stand for the names of the case's estimator configuration; an array of one object is an array of such objects.
@@ -34,8 +34,8 @@ using ModeRunner = Status (*)(const CaseContext& context);
 
 struct ModeSpec {
   std::string name;
-  std::vector<std::string> keys;       // case keys the mode reads besides name, mode, quick and checks
-  std::vector<std::string> required;   // of those, the required ones; "a|b" means exactly one of a and b
+  std::vector<std::string> keys;      // case keys the mode reads besides name, mode, quick and checks
+  std::vector<std::string> required;  // of those, the required ones; "a|b" means exactly one of a and b
   std::vector<ModeOutput> outputs;
   // Runs the case, writing the outputs above; nullptr: not available in this build.
   ModeRunner run = nullptr;

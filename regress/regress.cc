@@ -22,8 +22,8 @@ namespace roamlab::regress {
 namespace {
 
 namespace fs = std::filesystem;
-using nlohmann::json;
 using experiment::Outcome;
+using nlohmann::json;
 
 // Baseline values of one case: metric path -> value.
 using Baseline = std::map<std::string, double>;
@@ -83,8 +83,8 @@ CaseResult RunCase(const Case& c, const std::string& out_dir, int jobs) {
   // The values, from the output files the checks name.
   std::map<std::string, json> outputs;
   const auto output = [&](const std::string& name, std::string* file) -> const json* {
-    const auto o = std::find_if(mode.outputs.begin(), mode.outputs.end(),
-                                [&](const ModeOutput& m) { return m.name == name; });
+    const auto o =
+        std::find_if(mode.outputs.begin(), mode.outputs.end(), [&](const ModeOutput& m) { return m.name == name; });
     ROAMLAB_CHECK(o != mode.outputs.end(), "output " << name << " was validated against mode " << c.mode);
     *file = dir + "/" + o->file;
     if (!outputs.count(name)) {
@@ -132,8 +132,8 @@ CaseResult RunCase(const Case& c, const std::string& out_dir, int jobs) {
     // The bound's reference metric: its value stands in `baseline`'s place in the threshold.
     if (check.reference && r.message.empty()) {
       const json* ref = output(check.reference->output, &file);
-      const Result<double> value = ref ? ResolveMetric(*ref, *check.reference)
-                                       : Result<double>(Status::Error("missing or not valid JSON"));
+      const Result<double> value =
+          ref ? ResolveMetric(*ref, *check.reference) : Result<double>(Status::Error("missing or not valid JSON"));
       if (value.ok()) {
         r.threshold = check.bound.Threshold(value.value());
       } else {
@@ -211,7 +211,10 @@ void RunCases(const std::vector<const Case*>& cases, const RunOptions& options, 
         char line[512];
         std::snprintf(line, sizeof line, "regress [%zu/%zu] %s (%s): %s in %.1f s", finished, cases.size(),
                       cases[i]->name.c_str(), cases[i]->mode.c_str(),
-                      !r.error.empty() ? "error" : !r.skipped.empty() ? "skipped" : "ran", r.seconds);
+                      !r.error.empty()     ? "error"
+                      : !r.skipped.empty() ? "skipped"
+                                           : "ran",
+                      r.seconds);
         std::lock_guard<std::mutex> lock(print);
         options.progress(line);
       }

@@ -24,7 +24,7 @@ struct RunOptions {
 
 // Paths of the reports a run wrote.
 struct RunReports {
-  std::string baseline_dir;      // where the baseline was read (and, with update_baseline, written)
+  std::string baseline_dir;  // where the baseline was read (and, with update_baseline, written)
   std::string results_json;
   std::string junit_xml;
 };

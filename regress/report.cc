@@ -17,22 +17,32 @@ std::string Format(std::optional<double> x) {
 
 const char* OutcomeName(CheckResult::Outcome outcome) {
   switch (outcome) {
-    case CheckResult::Outcome::kPassed: return "pass";
-    case CheckResult::Outcome::kFailed: return "FAIL";
-    case CheckResult::Outcome::kError: return "ERROR";
-    case CheckResult::Outcome::kOpen: return "open (not met)";
-    case CheckResult::Outcome::kSkipped: return "skipped";
+    case CheckResult::Outcome::kPassed:
+      return "pass";
+    case CheckResult::Outcome::kFailed:
+      return "FAIL";
+    case CheckResult::Outcome::kError:
+      return "ERROR";
+    case CheckResult::Outcome::kOpen:
+      return "open (not met)";
+    case CheckResult::Outcome::kSkipped:
+      return "skipped";
   }
   return "?";
 }
 
 const char* ResultName(const CheckResult& k) {
   switch (k.outcome) {
-    case CheckResult::Outcome::kPassed: return k.open.empty() ? "passed" : "open met";
-    case CheckResult::Outcome::kFailed: return "failed";
-    case CheckResult::Outcome::kError: return "error";
-    case CheckResult::Outcome::kOpen: return "open";
-    case CheckResult::Outcome::kSkipped: return "skipped";
+    case CheckResult::Outcome::kPassed:
+      return k.open.empty() ? "passed" : "open met";
+    case CheckResult::Outcome::kFailed:
+      return "failed";
+    case CheckResult::Outcome::kError:
+      return "error";
+    case CheckResult::Outcome::kOpen:
+      return "open";
+    case CheckResult::Outcome::kSkipped:
+      return "skipped";
   }
   return "?";
 }
@@ -160,12 +170,23 @@ std::string XmlEscape(const std::string& text) {
   for (const char ch : text) {
     const unsigned char u = static_cast<unsigned char>(ch);
     switch (ch) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += (u < 0x20 && ch != '\t' && ch != '\n' && ch != '\r') ? '?' : ch;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
+      default:
+        out += (u < 0x20 && ch != '\t' && ch != '\n' && ch != '\r') ? '?' : ch;
     }
   }
   return out;
@@ -191,8 +212,9 @@ std::string JunitXml(const SuiteResult& result) {
       if (k.outcome == CheckResult::Outcome::kPassed && k.open.empty()) {
         xml += "/>\n";
       } else if (k.outcome == CheckResult::Outcome::kPassed) {
-        xml += ">\n      <system-out>" + XmlEscape("open target met (" + k.open + "): remove the 'open' marker; " +
-                                                   detail) + "</system-out>\n    </testcase>\n";
+        xml += ">\n      <system-out>" +
+               XmlEscape("open target met (" + k.open + "): remove the 'open' marker; " + detail) +
+               "</system-out>\n    </testcase>\n";
       } else if (k.outcome == CheckResult::Outcome::kOpen || k.outcome == CheckResult::Outcome::kSkipped) {
         xml += ">\n      <skipped message=\"" + XmlEscape(k.message) + "\"/>\n    </testcase>\n";
       } else if (k.outcome == CheckResult::Outcome::kFailed) {

@@ -16,23 +16,23 @@ struct CheckResult {
   // kOpen: an open target (`open:` in the suite) that does not hold; kSkipped: its case was skipped. Neither fails
   // the run. An open target that holds is kPassed (with `open` set: "met, remove the marker").
   enum class Outcome { kPassed, kFailed, kError, kOpen, kSkipped };
-  std::string metric;                 // the metric path as written
-  std::string bound;                  // the bound as written ("equals TEXT" for a text)
-  std::optional<double> value;        // absent when it could not be read (or is a text)
-  std::optional<double> baseline;     // absent when the bound has none or none is stored
-  std::optional<double> threshold;    // the bound's right-hand side, when it could be computed
+  std::string metric;               // the metric path as written
+  std::string bound;                // the bound as written ("equals TEXT" for a text)
+  std::optional<double> value;      // absent when it could not be read (or is a text)
+  std::optional<double> baseline;   // absent when the bound has none or none is stored
+  std::optional<double> threshold;  // the bound's right-hand side, when it could be computed
   Outcome outcome = Outcome::kError;
-  std::string message;                // failure, error, open or skip: what and why, one line
-  std::optional<std::string> text;    // the value of a text metric
-  std::string open;                   // the open marker's reason; "" for an ordinary check
+  std::string message;              // failure, error, open or skip: what and why, one line
+  std::optional<std::string> text;  // the value of a text metric
+  std::string open;                 // the open marker's reason; "" for an ordinary check
 };
 
 struct CaseResult {
   std::string name;
   std::string mode;
-  std::string error;                  // empty when the case ran
-  std::string skipped;                // why the case did not run (absent data); empty when it ran
-  double seconds = 0.0;               // wall time (reported, never checked)
+  std::string error;     // empty when the case ran
+  std::string skipped;   // why the case did not run (absent data); empty when it ran
+  double seconds = 0.0;  // wall time (reported, never checked)
   std::vector<CheckResult> checks;
 };
 
@@ -43,7 +43,7 @@ struct SuiteResult {
   std::vector<CaseResult> cases;
 
   int Count(CheckResult::Outcome outcome) const;
-  bool Passed() const;                // no check failed, no check or case errored (open and skipped do not count)
+  bool Passed() const;  // no check failed, no check or case errored (open and skipped do not count)
 };
 
 // "value V violates bound B (threshold T, baseline X)", "value 'unknown' is not 'named'".

@@ -211,8 +211,7 @@ Result<MetricPath> ParseMetricPath(const std::string& text, const ModeSpec& mode
     if (!placeholder)
       return Status::Error("metric '" + text + "': unknown key '" + parts[i] + "' after '" + Join(parts, 0, i) +
                            "' (known: " + KeyList(*node) + ")");
-    const std::set<std::string>& known =
-        std::string(placeholder) == "<parameter>" ? names.parameters : names.streams;
+    const std::set<std::string>& known = std::string(placeholder) == "<parameter>" ? names.parameters : names.streams;
     std::size_t matched = 0;
     for (std::size_t j = parts.size(); j > i && matched == 0; --j)
       if (known.count(Join(parts, i, j))) matched = j;
@@ -242,11 +241,11 @@ Result<MetricPath> ParseMetricPath(const std::string& text, const ModeSpec& mode
   if (leaf == "numbers") {
     const std::string hint = "add .norm, .max_abs, .min, .max, .mean or an index";
     if (rest == 0) return Status::Error("metric '" + text + "' is an array: " + hint);
-    const bool known = IsIndex(parts[i]) || std::find(std::begin(kReductions), std::end(kReductions), parts[i]) !=
-                                                 std::end(kReductions);
+    const bool known = IsIndex(parts[i]) ||
+                       std::find(std::begin(kReductions), std::end(kReductions), parts[i]) != std::end(kReductions);
     if (rest > 1 || !known)
-      return Status::Error("metric '" + text + "': '" + Join(parts, i, parts.size()) + "' is not a reduction (" +
-                           hint + ")");
+      return Status::Error("metric '" + text + "': '" + Join(parts, i, parts.size()) + "' is not a reduction (" + hint +
+                           ")");
     path.reduction = parts[i];
     return path;
   }
@@ -327,8 +326,7 @@ Result<const ModeSpec*> LoadNameAndMode(const YAML::Node& node, Context* ctx, st
     return ctx->Error(node["name"], "a case name may only hold letters, digits, '_', '-' and '.'");
   if (!seen->insert(c->name).second) return ctx->Error(node["name"], "a second case of this name");
 
-  if (!node["mode"] || !node["mode"].IsScalar())
-    return ctx->Error(node, "no 'mode' (" + AvailableModeNames() + ")");
+  if (!node["mode"] || !node["mode"].IsScalar()) return ctx->Error(node, "no 'mode' (" + AvailableModeNames() + ")");
   c->mode = node["mode"].as<std::string>();
   const ModeSpec* mode = FindMode(c->mode);
   if (!mode) return ctx->Error(node["mode"], "unknown mode '" + c->mode + "' (" + AvailableModeNames() + ")");
@@ -372,9 +370,12 @@ Status LoadValues(const YAML::Node& node, const Context& ctx, const std::string&
     if (node["t0_s"]) c->t0_s = node["t0_s"].as<double>();
     if (node["baseline_seed"]) c->baseline_seed = node["baseline_seed"].as<std::uint64_t>();
     if (node["interval_s"]) c->interval_s = node["interval_s"].as<double>();
-    for (auto [key, field] : {std::pair{"scenario", &c->scenario}, {"recording", &c->recording},
-                              {"config", &c->config}, {"calibration", &c->calibration},
-                              {"calibrate", &c->calibrate}, {"data", &c->data}})
+    for (auto [key, field] : {std::pair{"scenario", &c->scenario},
+                              {"recording", &c->recording},
+                              {"config", &c->config},
+                              {"calibration", &c->calibration},
+                              {"calibrate", &c->calibrate},
+                              {"data", &c->data}})
       if (node[key]) *field = ResolvePath(suite_file, node[key].as<std::string>());
     for (auto [key, field] : {std::pair{"train", &c->train}, {"test", &c->test}})
       if (node[key]) {
@@ -387,8 +388,7 @@ Status LoadValues(const YAML::Node& node, const Context& ctx, const std::string&
     return ctx.Error(node, std::string("malformed value: ") + e.msg);
   }
   if (node["runs"] && c->runs < 1) return ctx.Error(node["runs"], "runs must be at least 1");
-  if (c->interval_s && !(*c->interval_s > 0.0))
-    return ctx.Error(node["interval_s"], "interval_s must be positive");
+  if (c->interval_s && !(*c->interval_s > 0.0)) return ctx.Error(node["interval_s"], "interval_s must be positive");
   return Status::Ok();
 }
 
@@ -483,8 +483,9 @@ Result<Check> LoadCheck(const YAML::Node& check, const Context& ctx, const ModeS
   const bool one_test = is_map && (static_cast<bool>(check["bound"]) != static_cast<bool>(check["equals"]));
   const std::size_t keys = 2 + (is_map && check["open"] ? 1 : 0);
   if (!is_map || !one_test || check.size() != keys)
-    return ctx.Error(check, "a check is {metric: PATH, bound: BOUND} or {metric: PATH, equals: TEXT}, "
-                            "optionally with open: REASON, and nothing else");
+    return ctx.Error(check,
+                     "a check is {metric: PATH, bound: BOUND} or {metric: PATH, equals: TEXT}, "
+                     "optionally with open: REASON, and nothing else");
   Check k;
   k.line = check.Mark().line + 1;
   auto metric = ParseMetricPath(check["metric"].as<std::string>(), mode, names);
@@ -508,8 +509,8 @@ Result<Check> LoadCheck(const YAML::Node& check, const Context& ctx, const ModeS
   k.bound = std::move(bound).value();
   if (!k.bound.reference.empty()) {
     auto reference = ParseMetricPath(k.bound.reference, mode, names);
-    if (!reference.ok()) return ctx.Error(check["bound"], "bound '" + k.bound.text + "': " +
-                                                              reference.status().message());
+    if (!reference.ok())
+      return ctx.Error(check["bound"], "bound '" + k.bound.text + "': " + reference.status().message());
     if (reference.value().is_string)
       return ctx.Error(check["bound"], "bound '" + k.bound.text + "': '" + k.bound.reference + "' is a text");
     k.reference = std::move(reference).value();
@@ -547,10 +548,14 @@ Result<Case> LoadCase(const YAML::Node& node, const Context& suite, std::set<std
 bool Bound::Holds(double value, double threshold) const {
   if (std::isnan(value) || std::isnan(threshold)) return false;
   switch (comparator) {
-    case Comparator::kLess: return value < threshold;
-    case Comparator::kLessEqual: return value <= threshold;
-    case Comparator::kGreater: return value > threshold;
-    case Comparator::kGreaterEqual: return value >= threshold;
+    case Comparator::kLess:
+      return value < threshold;
+    case Comparator::kLessEqual:
+      return value <= threshold;
+    case Comparator::kGreater:
+      return value > threshold;
+    case Comparator::kGreaterEqual:
+      return value >= threshold;
   }
   return false;
 }
@@ -594,8 +599,7 @@ Result<Bound> ParseBound(const std::string& text) {
   b.scale = first.value_or(1.0);
   if (s.AtEnd()) return b;
   const bool plus = s.Accept("+");
-  if (!plus && !s.Accept("-"))
-    return Status::Error(prefix + "unexpected '" + s.Rest() + "' after '" + reference + "'");
+  if (!plus && !s.Accept("-")) return Status::Error(prefix + "unexpected '" + s.Rest() + "' after '" + reference + "'");
   const std::optional<double> d = s.Number();
   if (!d) return Status::Error(prefix + "expected a number after '" + (plus ? "+" : "-") + "'");
   b.offset = plus ? *d : -*d;
@@ -701,8 +705,7 @@ Result<double> ResolveMetric(const json& output, const MetricPath& path) {
 Result<std::string> ResolveText(const json& output, const MetricPath& path) {
   const Result<Walked> w = Walk(output, path);
   if (!w.ok()) return w.status();
-  if (w.value().is_column || !w.value().node->is_string())
-    return Status::Error(w.value().where + " is not a text");
+  if (w.value().is_column || !w.value().node->is_string()) return Status::Error(w.value().where + " is not a text");
   return w.value().node->get<std::string>();
 }
 
@@ -730,8 +733,7 @@ Result<Suite> LoadSuite(const std::string& path) {
     return Status::Error(path + ":" + std::to_string(e.mark.line + 1) + ": 'suite' and 'baseline' are strings");
   }
   const YAML::Node cases = root["cases"];
-  if (!cases || !cases.IsSequence() || cases.size() == 0)
-    return Status::Error(path + ": no 'cases' (a list of cases)");
+  if (!cases || !cases.IsSequence() || cases.size() == 0) return Status::Error(path + ": no 'cases' (a list of cases)");
   std::set<std::string> seen;
   for (const YAML::Node& node : cases) {
     try {

@@ -58,7 +58,7 @@ struct Bound {
   std::string reference;  // the other metric the threshold scales (as written); "" = none
   double scale = 0.0;     // threshold = scale * (baseline or reference) + offset; scale = 0 without either
   double offset = 0.0;
-  std::string text;       // as written
+  std::string text;  // as written
 
   bool Relative() const { return uses_baseline || !reference.empty(); }
   // The threshold for the baseline's or the reference metric's value (ignored when !Relative()).
@@ -74,12 +74,12 @@ Result<Bound> ParseBound(const std::string& text);
 using Selector = std::vector<std::pair<std::string, std::string>>;
 
 struct MetricPath {
-  std::string text;                 // as written
-  std::string output;               // output name (first component)
-  std::vector<std::string> keys;    // JSON keys; a key applied to an array of objects selects that column
+  std::string text;                        // as written
+  std::string output;                      // output name (first component)
+  std::vector<std::string> keys;           // JSON keys; a key applied to an array of objects selects that column
   std::map<std::size_t, Selector> select;  // keys[i] with a row selector (an array of objects: that one row)
-  std::string reduction;            // "", norm, max_abs, min, max, mean, or a decimal index
-  bool is_string = false;           // the leaf is a string (checked with `equals`)
+  std::string reduction;                   // "", norm, max_abs, min, max, mean, or a decimal index
+  bool is_string = false;                  // the leaf is a string (checked with `equals`)
 };
 
 // The metric's value in `output` (the parsed output file). Errors: a key absent from the output, a null (a NaN
@@ -90,11 +90,11 @@ Result<std::string> ResolveText(const nlohmann::json& output, const MetricPath& 
 
 struct Check {
   MetricPath metric;
-  Bound bound;                      // numeric metrics
+  Bound bound;                          // numeric metrics
   std::optional<MetricPath> reference;  // the bound's reference metric, when it names one
   std::optional<std::string> equals;    // string metrics: the expected text
-  std::string open;                 // "" or why the target is open (not met yet): never fails the run
-  int line = 0;                     // 1-based line in the suite file
+  std::string open;                     // "" or why the target is open (not met yet): never fails the run
+  int line = 0;                         // 1-based line in the suite file
 };
 
 struct Case {
@@ -102,17 +102,17 @@ struct Case {
   std::string mode;
   int line = 0;
   bool quick = false;
-  std::string data;                       // a directory the case needs; absent: the case is skipped
+  std::string data;  // a directory the case needs; absent: the case is skipped
   // Inputs (paths resolved against the suite file's directory; empty when not given).
   std::string scenario;
   std::string recording;
-  std::optional<std::uint64_t> seed;      // noise seed of the simulated recording
+  std::optional<std::uint64_t> seed;  // noise seed of the simulated recording
   std::string config;
-  std::string calibration;                // calibration.json whose values tracking uses
-  std::string calibrate;                  // or: calibrate first with this configuration, track with its values
-  int runs = 0;                           // montecarlo
-  std::uint64_t seed_base = 1000;         // montecarlo: run i uses noise seed seed_base + i
-  std::optional<double> t0_s;             // NEES in-band fraction from t0_s on (default: the command's)
+  std::string calibration;         // calibration.json whose values tracking uses
+  std::string calibrate;           // or: calibrate first with this configuration, track with its values
+  int runs = 0;                    // montecarlo
+  std::uint64_t seed_base = 1000;  // montecarlo: run i uses noise seed seed_base + i
+  std::optional<double> t0_s;      // NEES in-band fraction from t0_s on (default: the command's)
   // diagnose: the effects hidden in the simulated recording ({name, parameters} as a scenario's `effects:`) and the
   // noise seed of the nominal simulation (default: the command's).
   std::vector<std::pair<std::string, std::map<std::string, double>>> effects;
@@ -132,7 +132,7 @@ struct Case {
 struct Suite {
   std::string file;
   std::string name;
-  std::string baseline_dir;               // empty when the suite names none
+  std::string baseline_dir;  // empty when the suite names none
   std::vector<Case> cases;
 };
 

@@ -128,8 +128,9 @@ Result<AckermannVehicle> AckermannVehicle::Bind(const mjModel* model, const std:
   v.front_track_m_ = centre[kFrontLeft].y() - centre[kFrontRight].y();
   v.rear_track_m_ = centre[kRearLeft].y() - centre[kRearRight].y();
   if (!(v.wheelbase_m_ > 0.0 && v.front_track_m_ > 0.0 && v.rear_track_m_ > 0.0))
-    return Status::Error(what + ": the front tires must be ahead of the rear ones (+x of 'odom') and the left tires "
-                                "on +y");
+    return Status::Error(what +
+                         ": the front tires must be ahead of the rear ones (+x of 'odom') and the left tires "
+                         "on +y");
   if (std::hypot(rear_mid.x(), rear_mid.y()) > 0.05)
     return Status::Error(what + ": site 'odom' must be at the midpoint of the rear axle (it is " +
                          std::to_string(std::hypot(rear_mid.x(), rear_mid.y())) + " m away)");
@@ -162,20 +163,19 @@ void AckermannVehicle::Place(const mjModel* model, mjData* data, const Terrain& 
     ground[i] = terrain.HeightAt(x + offset.x(), y + offset.y());
   }
   // Pitch and roll of the plane through them; nose up is a negative rotation about y.
-  const double pitch = std::atan2(0.5 * (ground[kFrontLeft] + ground[kFrontRight]) -
-                                      0.5 * (ground[kRearLeft] + ground[kRearRight]),
-                                  wheelbase_m_);
-  const double roll = std::atan2(0.5 * (ground[kFrontLeft] + ground[kRearLeft]) -
-                                     0.5 * (ground[kFrontRight] + ground[kRearRight]),
-                                 0.5 * (front_track_m_ + rear_track_m_));
+  const double pitch = std::atan2(
+      0.5 * (ground[kFrontLeft] + ground[kFrontRight]) - 0.5 * (ground[kRearLeft] + ground[kRearRight]), wheelbase_m_);
+  const double roll =
+      std::atan2(0.5 * (ground[kFrontLeft] + ground[kRearLeft]) - 0.5 * (ground[kFrontRight] + ground[kRearRight]),
+                 0.5 * (front_track_m_ + rear_track_m_));
   const Eigen::Quaterniond q_world_odom = Eigen::Quaterniond(Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ())) *
                                           Eigen::AngleAxisd(-pitch, Eigen::Vector3d::UnitY()) *
                                           Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX());
   // Height of O: every tire (on average) its radius plus the clearance above the ground.
   double z = 0.0;
   for (int i = 0; i < 4; ++i) {
-    const Eigen::Vector3d tire = q_world_odom * Eigen::Vector3d(tire_in_odom_[i][0], tire_in_odom_[i][1],
-                                                                 tire_in_odom_[i][2]);
+    const Eigen::Vector3d tire =
+        q_world_odom * Eigen::Vector3d(tire_in_odom_[i][0], tire_in_odom_[i][1], tire_in_odom_[i][2]);
     z += 0.25 * (ground[i] - tire.z());
   }
   z += wheel_radius_m_ + clearance_m;

@@ -4,7 +4,8 @@
 // Steering. The driver commands one handlebar angle delta [rad], the steering angle of the equivalent bicycle (one
 // front wheel on the centre line; positive turns left). With wheelbase L and front track w, the two front wheels are
 // set to the Ackermann angles that share the bicycle's turning centre on the rear-axle line:
-//     tan(delta_left)  = L tan(delta) / (L - (w/2) tan(delta)),   tan(delta_right) = L tan(delta) / (L + (w/2) tan(delta))
+//     tan(delta_left)  = L tan(delta) / (L - (w/2) tan(delta)),   tan(delta_right) = L tan(delta) / (L + (w/2)
+//     tan(delta))
 // and, back from the two joint angles (whatever they are, e.g. lagging the servos), the bicycle-equivalent angle is
 //     cot(delta) = (cot(delta_left) + cot(delta_right)) / 2,   i.e. tan(delta) = 2 t_l t_r / (t_l + t_r),
 // which inverts the first pair exactly and does not depend on L or w. If the two wheels point to opposite sides (only
@@ -32,9 +33,9 @@ void AckermannWheelAngles(double delta_rad, double wheelbase_m, double front_tra
 double BicycleEquivalentAngle(double left_rad, double right_rad);
 
 struct SpeedControllerOptions {
-  double kp_nm_per_mps = 300.0;      // torque per rear wheel per m/s of speed error
-  double ki_nm_per_m = 150.0;        // torque per rear wheel per m of integrated speed error
-  double torque_limit_nm = 400.0;    // per rear wheel, both ways
+  double kp_nm_per_mps = 300.0;    // torque per rear wheel per m/s of speed error
+  double ki_nm_per_m = 150.0;      // torque per rear wheel per m of integrated speed error
+  double torque_limit_nm = 400.0;  // per rear wheel, both ways
 
   // Empty when usable; otherwise "<field>: <problem>".
   std::string Validate() const;
@@ -58,11 +59,11 @@ class AckermannVehicle {
   // and the missing or malformed element.
   static Result<AckermannVehicle> Bind(const mjModel* model, const std::string& what);
 
-  double wheelbase_m() const { return wheelbase_m_; }          // rear to front wheel centres along x of O
+  double wheelbase_m() const { return wheelbase_m_; }  // rear to front wheel centres along x of O
   double front_track_m() const { return front_track_m_; }
   double rear_track_m() const { return rear_track_m_; }
-  double wheel_radius_m() const { return wheel_radius_m_; }    // true rolling radius of the rear tires
-  double mass_kg() const { return mass_kg_; }                  // the whole vehicle (the root body's subtree)
+  double wheel_radius_m() const { return wheel_radius_m_; }        // true rolling radius of the rear tires
+  double mass_kg() const { return mass_kg_; }                      // the whole vehicle (the root body's subtree)
   double max_handlebar_rad() const { return max_handlebar_rad_; }  // the inner wheel reaches the servo limit
   int odom_site() const { return odom_site_; }
 
@@ -82,7 +83,8 @@ class AckermannVehicle {
   // ATV about linearly); the vertical contact softens too (a lower tire pressure). Changes the compiled model
   // only. Fails, naming `what`, when a tire's solref is not in the time-constant form (solref[0] <= 0).
   Status SoftenTires(mjModel* model, double scale, const std::string& what) const;
-  // Steering servo targets for the handlebar angle (clamped to +-max_handlebar_rad) and the drive torque per rear wheel.
+  // Steering servo targets for the handlebar angle (clamped to +-max_handlebar_rad) and the drive torque per rear
+  // wheel.
   void Apply(double handlebar_rad, double torque_per_wheel_nm, mjData* data) const;
   // Mean rear-wheel spin rate relative to the chassis [rad/s], positive forward.
   double RearWheelRate(const mjData* data) const;
@@ -90,7 +92,7 @@ class AckermannVehicle {
   double SteeringAngle(const mjData* data) const;
 
  private:
-  int root_qpos_ = -1;          // free joint: x y z qw qx qy qz
+  int root_qpos_ = -1;  // free joint: x y z qw qx qy qz
   int root_body_ = -1;
   double mass_kg_ = 0.0;
   int odom_site_ = -1;
@@ -102,7 +104,7 @@ class AckermannVehicle {
   double max_handlebar_rad_ = 0.0;
   // Tire centres in O at qpos0 (front left, front right, rear left, rear right) and O in the root body's frame.
   double tire_in_odom_[4][3] = {};
-  int tire_geoms_[4] = {-1, -1, -1, -1};   // front left, front right, rear left, rear right
+  int tire_geoms_[4] = {-1, -1, -1, -1};  // front left, front right, rear left, rear right
   double odom_in_root_pos_[3] = {};
   double odom_in_root_quat_[4] = {1, 0, 0, 0};
 };

@@ -80,8 +80,6 @@ DataPtr MakeData(const mjModel* model) {
   return DataPtr(data);
 }
 
-int IdOf(const mjModel* model, mjtObj type, const std::string& name) {
-  return mj_name2id(model, type, name.c_str());
-}
+int IdOf(const mjModel* model, mjtObj type, const std::string& name) { return mj_name2id(model, type, name.c_str()); }
 
 }  // namespace roamlab::sim

@@ -19,8 +19,8 @@ enum class NoiseSource : std::uint32_t {
   kSpeed = 4,
   kSteering = 5,
   kLaserRange = 6,
-  kGyroBiasWalk = 7,   // the gyro_bias_drift effect's random walk
-  kGpsMultipath = 8,   // the gps_multipath effect's Gauss-Markov error
+  kGyroBiasWalk = 7,  // the gyro_bias_drift effect's random walk
+  kGpsMultipath = 8,  // the gps_multipath effect's Gauss-Markov error
 };
 
 class NoiseStream {

@@ -23,19 +23,19 @@ struct ProfileTerm {
   enum class Interpolation { kLinear, kStep };
 
   Type type = Type::kConstant;
-  double value = 0.0;                  // constant
-  double amplitude = 0.0;              // sine, square
-  double period_s = 1.0;               // sine, square; > 0
-  double phase_rad = 0.0;              // sine, square
-  double start_s = 0.0;                // ramp
-  double end_s = 0.0;                  // ramp; >= start_s
-  double from = 0.0;                   // ramp
-  double to = 0.0;                     // ramp
-  std::vector<double> times_s;         // piecewise; strictly increasing, at least one
-  std::vector<double> values;          // piecewise; same size as times_s
+  double value = 0.0;           // constant
+  double amplitude = 0.0;       // sine, square
+  double period_s = 1.0;        // sine, square; > 0
+  double phase_rad = 0.0;       // sine, square
+  double start_s = 0.0;         // ramp
+  double end_s = 0.0;           // ramp; >= start_s
+  double from = 0.0;            // ramp
+  double to = 0.0;              // ramp
+  std::vector<double> times_s;  // piecewise; strictly increasing, at least one
+  std::vector<double> values;   // piecewise; same size as times_s
   Interpolation interpolation = Interpolation::kLinear;
   bool windowed = false;
-  double window_begin_s = 0.0;         // when windowed: active on [begin, end)
+  double window_begin_s = 0.0;  // when windowed: active on [begin, end)
   double window_end_s = 0.0;
 
   double Evaluate(double t) const;

@@ -25,8 +25,8 @@
 #include <memory>
 #include <string>
 
-#include <Eigen/Core>
 #include <mujoco/mujoco.h>
+#include <Eigen/Core>
 #include <opencv2/core.hpp>
 
 #include "common/status.h"

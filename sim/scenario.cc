@@ -444,8 +444,8 @@ const std::map<std::string, std::map<std::string, double>>& KnownEffects() {
   return known;
 }
 
-double EffectParameter(const std::vector<EffectOptions>& effects, const std::string& name,
-                       const std::string& parameter, double fallback) {
+double EffectParameter(const std::vector<EffectOptions>& effects, const std::string& name, const std::string& parameter,
+                       double fallback) {
   for (const EffectOptions& e : effects) {
     if (e.name != name) continue;
     if (const auto it = e.parameters.find(parameter); it != e.parameters.end()) return it->second;
@@ -462,8 +462,9 @@ Result<Scenario> LoadScenario(const std::string& path) {
   Scenario s;
   s.source_file = path;
   const YAML::Node root = r.root();
-  r.CheckKeys(root, "", {"name", "duration_s", "seed", "origin", "ground_truth_rate_hz", "robot", "world", "driver",
-                         "sensors", "effects"});
+  r.CheckKeys(root, "",
+              {"name", "duration_s", "seed", "origin", "ground_truth_rate_hz", "robot", "world", "driver", "sensors",
+               "effects"});
   for (const char* required : {"duration_s", "robot", "world", "driver", "sensors"}) r.Require(root, "", required);
   r.String(root, "", "name", &s.name);
   r.Number(root, "", "duration_s", &s.duration_s);

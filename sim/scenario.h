@@ -212,39 +212,39 @@ namespace roamlab::sim {
 
 struct RobotOptions {
   std::string kind = "ackermann";
-  std::string model_file;         // path as resolved (relative to the scenario file's directory, or absolute)
-  std::string model_xml;          // when non-empty, the MJCF text used instead of model_file (tests, generated models)
+  std::string model_file;  // path as resolved (relative to the scenario file's directory, or absolute)
+  std::string model_xml;   // when non-empty, the MJCF text used instead of model_file (tests, generated models)
   Eigen::Vector2d start_position_m = Eigen::Vector2d::Zero();
   double start_heading_rad = 0.0;
   SpeedControllerOptions speed_controller;
-  std::vector<WheelMountingChange> wheel_mounting;   // wheeled robots: wheels turned off their nominal mounting
-  std::vector<WheelDeformation> wheel_deformation;   // wheeled robots with sphere tires: deformed tires
-  std::vector<WheelOffset> wheel_offset;             // wheeled robots: wheels moved off their nominal positions
+  std::vector<WheelMountingChange> wheel_mounting;  // wheeled robots: wheels turned off their nominal mounting
+  std::vector<WheelDeformation> wheel_deformation;  // wheeled robots with sphere tires: deformed tires
+  std::vector<WheelOffset> wheel_offset;            // wheeled robots: wheels moved off their nominal positions
 };
 
 struct DriverOptions {
   std::string type = "ackermann";
-  double lead_in_s = 4.0;         // >= 0
-  Profile speed_mps = Profile::Constant(0.0);        // ackermann
-  Profile handlebar_rad = Profile::Constant(0.0);    // ackermann
-  Profile linear_mps = Profile::Constant(0.0);       // body_velocity: v_x of O
-  Profile angular_radps = Profile::Constant(0.0);    // body_velocity: omega_z
-  Profile lateral_mps = Profile::Constant(0.0);      // body_velocity: v_y of O (omni3, mecanum)
+  double lead_in_s = 4.0;                          // >= 0
+  Profile speed_mps = Profile::Constant(0.0);      // ackermann
+  Profile handlebar_rad = Profile::Constant(0.0);  // ackermann
+  Profile linear_mps = Profile::Constant(0.0);     // body_velocity: v_x of O
+  Profile angular_radps = Profile::Constant(0.0);  // body_velocity: omega_z
+  Profile lateral_mps = Profile::Constant(0.0);    // body_velocity: v_y of O (omni3, mecanum)
 };
 
 struct ImuOptions {
   double rate_hz = 100.0;
   double gyro_sigma_radps = 0.033;
   double accel_sigma_mps2 = 0.067;
-  Eigen::Quaterniond misalignment{0.938, 0.104, 0.313, 0.104};    // q_body_imu, normalized by the loader
+  Eigen::Quaterniond misalignment{0.938, 0.104, 0.313, 0.104};  // q_body_imu, normalized by the loader
   Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();
 };
 
 struct MagnetometerOptions {
   double rate_hz = 100.0;
-  double sigma = 0.067;                                           // normalized field units
-  Eigen::Matrix3d A = (Eigen::Matrix3d() << 0.87, -0.02, -0.02,   //
-                       0.00, 0.88, 0.00,                          //
+  double sigma = 0.067;                                          // normalized field units
+  Eigen::Matrix3d A = (Eigen::Matrix3d() << 0.87, -0.02, -0.02,  //
+                       0.00, 0.88, 0.00,                         //
                        -0.02, -0.04, 0.85)
                           .finished();
   Eigen::Vector3d b{-0.008, -0.007, -0.040};
@@ -259,33 +259,33 @@ struct GpsOptions {
 
 struct OdometerOptions {
   double rate_hz = 100.0;
-  double speed_sigma_mps = 0.033;       // on z_v
-  double steering_sigma_rad = 0.014;    // on z_theta
-  double kv_over_L = 0.8;               // 1/m, > 0
-  double k_theta = 1.0;                 // nonzero
-  double k_gamma = 0.0;                 // rad
+  double speed_sigma_mps = 0.033;     // on z_v
+  double steering_sigma_rad = 0.014;  // on z_theta
+  double kv_over_L = 0.8;             // 1/m, > 0
+  double k_theta = 1.0;               // nonzero
+  double k_gamma = 0.0;               // rad
 };
 
 struct WheelEncoderOptions {
   double rate_hz = 100.0;
-  double ticks_per_revolution = 2048.0;   // > 0, whole number
+  double ticks_per_revolution = 2048.0;  // > 0, whole number
 };
 
 struct LaserOptions {
   double rate_hz = 10.0;
   int beams = 683;
-  double fov_deg = 240.0;                 // centred on the laser's x axis
+  double fov_deg = 240.0;  // centred on the laser's x axis
   double min_range_m = 0.02;
   double max_range_m = 4.0;
-  double sigma_m = 0.01;                  // Gaussian range noise
-  bool store_scans = false;               // the raw scans in the recording (laser_scan stream)
+  double sigma_m = 0.01;     // Gaussian range noise
+  bool store_scans = false;  // the raw scans in the recording (laser_scan stream)
 };
 
 struct CameraOptions {
-  double rate_hz = 15.0;                  // in [10, 30]
-  int width_px = 320;                     // 320x240 or 640x480
+  double rate_hz = 15.0;  // in [10, 30]
+  int width_px = 320;     // 320x240 or 640x480
   int height_px = 240;
-  bool store_images = false;              // PNGs in the recording (visual_odometry_images stream)
+  bool store_images = false;  // PNGs in the recording (visual_odometry_images stream)
 };
 
 struct SensorOptions {
@@ -307,11 +307,11 @@ struct EffectOptions {
 const std::map<std::string, std::map<std::string, double>>& KnownEffects();
 // The value of `parameter` of the effect `name` in `effects` (its default when the effect omits it); `fallback` when
 // the effect is absent.
-double EffectParameter(const std::vector<EffectOptions>& effects, const std::string& name,
-                       const std::string& parameter, double fallback);
+double EffectParameter(const std::vector<EffectOptions>& effects, const std::string& name, const std::string& parameter,
+                       double fallback);
 
 struct Scenario {
-  std::string source_file;              // for messages and provenance; empty when built in code
+  std::string source_file;  // for messages and provenance; empty when built in code
   std::string name;
   double duration_s = 30.0;
   std::uint64_t seed = 1;
@@ -319,7 +319,7 @@ struct Scenario {
   double ground_truth_rate_hz = 100.0;
   RobotOptions robot;
   TerrainOptions terrain;
-  std::string world_model_file;         // world.model as resolved; empty: none
+  std::string world_model_file;  // world.model as resolved; empty: none
   DriverOptions driver;
   SensorOptions sensors;
   std::vector<EffectOptions> effects;

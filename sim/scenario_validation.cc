@@ -34,8 +34,9 @@ std::optional<Scenario::Problem> WheelEffectProblem(const std::vector<EffectOpti
     // zero is steering_offset.
     for (const EffectOptions& e : effects)
       if (e.name == name && e.parameters.count("wheel"))
-        return P{k + ".parameters.wheel", "ackermann: axle_misalignment turns the rear axle (both rear wheels); "
-                                          "no wheel index"};
+        return P{k + ".parameters.wheel",
+                 "ackermann: axle_misalignment turns the rear axle (both rear wheels); "
+                 "no wheel index"};
     if (!(std::abs(EffectParameter(effects, name, "yaw_deg", 0.0)) <= 5.0))
       return P{k + ".parameters.yaw_deg", "must be within +-5 on the ackermann rear axle"};
     return std::nullopt;
@@ -56,8 +57,8 @@ std::optional<Scenario::Problem> WheelEffectProblem(const std::vector<EffectOpti
   if (name == "wheel_deformation" || name == "axle_misalignment") {
     const double wheel = EffectParameter(effects, name, "wheel", 0.0);
     if (!(wheel >= 0.0 && wheel < wheels && wheel == std::floor(wheel)))
-      return P{k + ".parameters.wheel", "no such wheel: the " + kind + " robot has wheels 0 to " +
-                                            std::to_string(wheels - 1)};
+      return P{k + ".parameters.wheel",
+               "no such wheel: the " + kind + " robot has wheels 0 to " + std::to_string(wheels - 1)};
   }
   if (name == "wheel_deformation") {
     if (kind != "differential_drive") return P{k + ".name", name + " needs sphere tires (differential_drive)"};
@@ -68,7 +69,6 @@ std::optional<Scenario::Problem> WheelEffectProblem(const std::vector<EffectOpti
     return P{k + ".parameters.yaw_deg", "must be within +-20"};
   return std::nullopt;
 }
-
 
 // Validate's parts, in the order of its checks: the first problem found is the one reported.
 
@@ -104,8 +104,8 @@ std::optional<P> RobotAndDriverProblem(const Scenario& s) {
     return P{"robot.start.position_m", "must be on the terrain, at least 5 m from its edge"};
   const std::string driver_type = ackermann ? "ackermann" : "body_velocity";
   if (s.driver.type != driver_type)
-    return P{"driver.type", "'" + s.driver.type + "' does not drive a robot of kind '" + s.robot.kind +
-                                "' (use " + driver_type + ")"};
+    return P{"driver.type",
+             "'" + s.driver.type + "' does not drive a robot of kind '" + s.robot.kind + "' (use " + driver_type + ")"};
   if (!ackermann && s.terrain.type != TerrainOptions::Type::kFlat)
     return P{"world.terrain.type", "a " + s.robot.kind + " robot needs a flat floor (type: flat)"};
   if (!NonNegative(s.driver.lead_in_s) || s.driver.lead_in_s > 60.0) return P{"driver.lead_in_s", "must be in [0, 60]"};
@@ -200,9 +200,9 @@ std::optional<P> OdometrySensorsProblem(const Scenario& s) {
     const bool small = camera->width_px == 320 && camera->height_px == 240;
     const bool large = camera->width_px == 640 && camera->height_px == 480;
     if (!small && !large)
-      return P{camera->width_px != 320 && camera->width_px != 640 ? "sensors.camera.width_px"
-                                                                    : "sensors.camera.height_px",
-               "the image must be 320x240 or 640x480"};
+      return P{
+          camera->width_px != 320 && camera->width_px != 640 ? "sensors.camera.width_px" : "sensors.camera.height_px",
+          "the image must be 320x240 or 640x480"};
   }
   if (const auto& enc = s.sensors.wheel_encoders) {
     if (!Positive(enc->rate_hz)) return P{"sensors.wheel_encoders.rate_hz", "must be > 0"};
@@ -246,8 +246,7 @@ std::optional<P> EffectsProblem(const Scenario& s) {
     }
     if (!seen.insert(e.name).second) return P{k + ".name", "effect '" + e.name + "' appears twice"};
     for (const auto& [parameter, value] : e.parameters) {
-      if (!known->second.count(parameter))
-        return P{k + ".parameters." + parameter, "unknown parameter of " + e.name};
+      if (!known->second.count(parameter)) return P{k + ".parameters." + parameter, "unknown parameter of " + e.name};
       if (!Finite(value)) return P{k + ".parameters." + parameter, "must be finite"};
     }
     const double latency = EffectParameter(s.effects, "gps_latency", "latency_s", 0.0);

@@ -21,20 +21,20 @@
 // mj_objectAcceleration is the specific force, the same quantity as MuJoCo's own accelerometer sensor.
 #pragma once
 
+#include <mujoco/mujoco.h>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <mujoco/mujoco.h>
 
 namespace roamlab::sim {
 
 // Motion of a frame B fixed on the robot (here O), all rates and accelerations expressed in B.
 struct FrameKinematics {
-  Eigen::Vector3d p_world_body = Eigen::Vector3d::Zero();                  // [m]
-  Eigen::Quaterniond q_world_body = Eigen::Quaterniond::Identity();        // B -> W
-  Eigen::Vector3d v_body = Eigen::Vector3d::Zero();                        // linear velocity of B's origin [m/s]
-  Eigen::Vector3d omega_body = Eigen::Vector3d::Zero();                    // angular velocity [rad/s]
-  Eigen::Vector3d alpha_body = Eigen::Vector3d::Zero();                    // angular acceleration [rad/s^2]
-  Eigen::Vector3d specific_force_body = Eigen::Vector3d::Zero();           // a - g at B's origin [m/s^2]
+  Eigen::Vector3d p_world_body = Eigen::Vector3d::Zero();            // [m]
+  Eigen::Quaterniond q_world_body = Eigen::Quaterniond::Identity();  // B -> W
+  Eigen::Vector3d v_body = Eigen::Vector3d::Zero();                  // linear velocity of B's origin [m/s]
+  Eigen::Vector3d omega_body = Eigen::Vector3d::Zero();              // angular velocity [rad/s]
+  Eigen::Vector3d alpha_body = Eigen::Vector3d::Zero();              // angular acceleration [rad/s^2]
+  Eigen::Vector3d specific_force_body = Eigen::Vector3d::Zero();     // a - g at B's origin [m/s^2]
 };
 
 // Reads the kinematics of `site` from `data`. Precondition: mj_forward (or mj_step's forward part) and
@@ -47,16 +47,16 @@ struct ImuCalibration {
 };
 
 struct MagnetometerCalibration {
-  Eigen::Matrix3d A = Eigen::Matrix3d::Identity();                 // soft iron, scale, non-orthogonality
-  Eigen::Vector3d b = Eigen::Vector3d::Zero();                     // hard iron [field units]
-  Eigen::Vector3d field_world{0.0, 0.5, -0.8660254037844386};      // ENU, unit magnitude (dip 60 deg)
+  Eigen::Matrix3d A = Eigen::Matrix3d::Identity();             // soft iron, scale, non-orthogonality
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();                 // hard iron [field units]
+  Eigen::Vector3d field_world{0.0, 0.5, -0.8660254037844386};  // ENU, unit magnitude (dip 60 deg)
 };
 
-Eigen::Vector3d GyroReading(const FrameKinematics& body, const ImuCalibration& imu);                 // [rad/s]
-Eigen::Vector3d AccelReading(const FrameKinematics& body, const ImuCalibration& imu);                // [m/s^2]
+Eigen::Vector3d GyroReading(const FrameKinematics& body, const ImuCalibration& imu);   // [rad/s]
+Eigen::Vector3d AccelReading(const FrameKinematics& body, const ImuCalibration& imu);  // [m/s^2]
 Eigen::Vector3d MagnetometerReading(const FrameKinematics& body, const Eigen::Quaterniond& q_body_imu,
                                     const MagnetometerCalibration& magnetometer);
-Eigen::Vector3d GpsAntennaWorld(const FrameKinematics& body, const Eigen::Vector3d& lever_arm_m);     // ENU [m]
+Eigen::Vector3d GpsAntennaWorld(const FrameKinematics& body, const Eigen::Vector3d& lever_arm_m);  // ENU [m]
 
 // Eq. 15 readings. rear_wheel_rate_radps: mean rear-wheel spin rate; wheel_radius_m: true rolling radius.
 double SpeedReading(double rear_wheel_rate_radps, double wheel_radius_m, double kv_over_L, double wheelbase_m);

@@ -41,8 +41,8 @@ class SimulatedCamera::Impl {
   std::unique_ptr<CameraRenderer> renderer;
   std::optional<frontend::VisualOdometryStream> vo;
   recording::Mounting mounting;
-  std::optional<Time> t0;              // first call
-  std::int64_t next_frame = 0;         // index of the next frame due
+  std::optional<Time> t0;       // first call
+  std::int64_t next_frame = 0;  // index of the next frame due
   int frame_index = 0;
   cv::Mat rgb;
   cv::Mat gray;
@@ -82,8 +82,8 @@ Result<std::unique_ptr<SimulatedCamera>> SimulatedCamera::Create(const mjModel* 
     vo.floor_normal_camera = camera.R_world_camera.transpose() * Eigen::Vector3d(0.0, 0.0, -1.0);
   }
   if (!(vo.camera_height_m > 0.0)) {
-    return Status::Error("camera '" + options.camera + "' is not above the floor z = " +
-                         std::to_string(options.floor_height_m) + " m");
+    return Status::Error("camera '" + options.camera +
+                         "' is not above the floor z = " + std::to_string(options.floor_height_m) + " m");
   }
   if (const std::string problem = vo.Validate(); !problem.empty()) {
     return Status::Error("visual odometry stream '" + options.stream_name + "': " + problem);

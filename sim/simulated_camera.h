@@ -36,14 +36,14 @@
 namespace roamlab::sim {
 
 struct SimulatedCameraOptions {
-  std::string camera = "camera";           // MuJoCo camera name
-  std::string body;                        // mounting reference body; empty: the camera's body
+  std::string camera = "camera";  // MuJoCo camera name
+  std::string body;               // mounting reference body; empty: the camera's body
   std::string stream_name = "visual_odometry";
-  double rate_hz = 15.0;                   // frames per second; frame k is due at t0 + k / rate_hz
-  RenderOptions render;                    // 320x240 by default
-  frontend::VisualOdometryOptions vo;      // camera_height_m <= 0: measured at Create(); likewise a zero normal
-  double floor_height_m = 0.0;             // the floor plane z = floor_height_m in the world
-  std::string image_directory;             // empty: no images; else PNGs and a camera stream (above)
+  double rate_hz = 15.0;               // frames per second; frame k is due at t0 + k / rate_hz
+  RenderOptions render;                // 320x240 by default
+  frontend::VisualOdometryOptions vo;  // camera_height_m <= 0: measured at Create(); likewise a zero normal
+  double floor_height_m = 0.0;         // the floor plane z = floor_height_m in the world
+  std::string image_directory;         // empty: no images; else PNGs and a camera stream (above)
 
   // "" when fine, else what is wrong (the VO options are checked once the floor is known).
   std::string Validate() const;

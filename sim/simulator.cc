@@ -15,8 +15,8 @@
 #include "frontend/scan_matching_stream.h"
 #include "sim/ackermann.h"
 #include "sim/internal/scenario_effects.h"
-#include "sim/internal/stream_clock.h"
 #include "sim/internal/simulation_metadata.h"
+#include "sim/internal/stream_clock.h"
 #include "sim/laser.h"
 #include "sim/mujoco_model.h"
 #include "sim/noise.h"
@@ -232,12 +232,10 @@ class Simulator::Impl {
       if (Status s = clock(sensors.gps->rate_hz, "sensors.gps.rate_hz", &gps_clock_); !s.ok()) return s;
     }
     if (sensors.odometer) {
-      if (Status s = clock(sensors.odometer->rate_hz, "sensors.odometer.rate_hz", &odometer_clock_); !s.ok())
-        return s;
+      if (Status s = clock(sensors.odometer->rate_hz, "sensors.odometer.rate_hz", &odometer_clock_); !s.ok()) return s;
     }
     if (sensors.wheel_encoders) {
-      if (Status s = clock(sensors.wheel_encoders->rate_hz, "sensors.wheel_encoders.rate_hz", &encoder_clock_);
-          !s.ok())
+      if (Status s = clock(sensors.wheel_encoders->rate_hz, "sensors.wheel_encoders.rate_hz", &encoder_clock_); !s.ok())
         return s;
     }
     if (sensors.laser) {
@@ -292,13 +290,12 @@ class Simulator::Impl {
       wheel_stream_ = MakeStream("rear_wheel", StreamType::kWheelEncoders, sensors.odometer->rate_hz, {"rear"}, "m/s",
                                  odometer_clock_);
       wheel_stream_.info.noise = {{"sigma_mps", sensors.odometer->speed_sigma_mps}};
-      steering_stream_ = MakeStream("steering", StreamType::kSteering, sensors.odometer->rate_hz, {"angle"}, "rad",
-                                    odometer_clock_);
+      steering_stream_ =
+          MakeStream("steering", StreamType::kSteering, sensors.odometer->rate_hz, {"angle"}, "rad", odometer_clock_);
       steering_stream_.info.noise = {{"sigma_rad", sensors.odometer->steering_sigma_rad}};
     }
     local_.emplace(scenario_.origin.latitude_deg, scenario_.origin.longitude_deg, scenario_.origin.altitude_m);
     truth_.reserve(truth_clock_.samples);
-
   }
 
   // The vehicle at rest at the start pose.
@@ -555,7 +552,7 @@ class Simulator::Impl {
                          speed_noise_.Draw(odo.speed_sigma_mps);
       const double z_theta =
           SteeringReading(vehicle_.SteeringAngle(data_.get()), odo.k_theta, odo.k_gamma + steering_offset_rad_) +
-                             steering_noise_.Draw(odo.steering_sigma_rad);
+          steering_noise_.Draw(odo.steering_sigma_rad);
       wheel_stream_.values(odometer_clock_.Row(t_ns), 0) = z_v;
       steering_stream_.values(odometer_clock_.Row(t_ns), 0) = z_theta;
     }
@@ -685,26 +682,26 @@ class Simulator::Impl {
   ImuCalibration imu_;
   MagnetometerCalibration magnetometer_;
   double wheelbase_m_ = 0.0;
-  double drive_torque_nm_ = 0.0;   // per rear wheel, applied over the current step
+  double drive_torque_nm_ = 0.0;  // per rear wheel, applied over the current step
   // Effects (scenario.h); neutral values when absent.
   double steering_offset_rad_ = 0.0;
   Eigen::Vector3d gyro_scale_ = Eigen::Vector3d::Ones();
-  Eigen::Vector3d gyro_bias_radps_ = Eigen::Vector3d::Zero();   // gyro_bias_drift: the bias at the next sample
-  double gyro_bias_walk_ = 0.0;                                 // [rad/s/sqrt(s)]
+  Eigen::Vector3d gyro_bias_radps_ = Eigen::Vector3d::Zero();  // gyro_bias_drift: the bias at the next sample
+  double gyro_bias_walk_ = 0.0;                                // [rad/s/sqrt(s)]
   Eigen::Vector3d mag_per_nm_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d accel_scale_ = Eigen::Vector3d::Ones();
-  double multipath_sigma_m_ = 0.0;                              // gps_multipath: stationary std per axis
+  double multipath_sigma_m_ = 0.0;  // gps_multipath: stationary std per axis
   double multipath_correlation_s_ = 5.0;
-  Eigen::Vector3d multipath_m_ = Eigen::Vector3d::Zero();       // the error of the next fix, ENU [m]
-  double tire_growth_per_mps2_ = 0.0;                           // tire_growth's c [s^2/m^2]
-  double slip_per_mps2_ = 0.0;                                  // longitudinal_slip's s_f [s^2/m]
-  double slope_slip_per_mps2_ = 0.0;                            // slope_slip's s_p [s^2/m]
+  Eigen::Vector3d multipath_m_ = Eigen::Vector3d::Zero();  // the error of the next fix, ENU [m]
+  double tire_growth_per_mps2_ = 0.0;                      // tire_growth's c [s^2/m^2]
+  double slip_per_mps2_ = 0.0;                             // longitudinal_slip's s_f [s^2/m]
+  double slope_slip_per_mps2_ = 0.0;                       // slope_slip's s_p [s^2/m]
 
   std::int64_t step_ns_ = 0;
   std::int64_t end_ns_ = 0;
   std::int64_t lead_in_ns_ = 0;
-  std::int64_t loop_end_ns_ = 0;   // end_ns_, or later when a sample is taken after the recording's end
-  std::int64_t t_ns_ = 0;          // the current time, for messages
+  std::int64_t loop_end_ns_ = 0;  // end_ns_, or later when a sample is taken after the recording's end
+  std::int64_t t_ns_ = 0;         // the current time, for messages
   Clock truth_clock_, imu_clock_, mag_clock_, gps_clock_, odometer_clock_, encoder_clock_, laser_clock_;
 
   NoiseStream gyro_noise_{seed_, NoiseSource::kGyro, options_.noise};
@@ -714,8 +711,8 @@ class Simulator::Impl {
   NoiseStream speed_noise_{seed_, NoiseSource::kSpeed, options_.noise};
   NoiseStream steering_noise_{seed_, NoiseSource::kSteering, options_.noise};
   NoiseStream laser_noise_{seed_, NoiseSource::kLaserRange, options_.noise};
-  NoiseStream gyro_bias_noise_{seed_, NoiseSource::kGyroBiasWalk};   // an effect, not sensor noise: always on
-  NoiseStream multipath_noise_{seed_, NoiseSource::kGpsMultipath};   // likewise
+  NoiseStream gyro_bias_noise_{seed_, NoiseSource::kGyroBiasWalk};  // an effect, not sensor noise: always on
+  NoiseStream multipath_noise_{seed_, NoiseSource::kGpsMultipath};  // likewise
 
   recording::Stream imu_stream_, mag_stream_, gps_stream_, wheel_stream_, steering_stream_, encoder_stream_,
       laser_scan_stream_;

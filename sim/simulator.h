@@ -36,8 +36,8 @@
 namespace roamlab::sim {
 
 struct SimulateOptions {
-  std::optional<std::uint64_t> seed;        // overrides scenario.seed (the sensor noise)
-  bool noise = true;                        // false: every noise source off; calibration effects stay
+  std::optional<std::uint64_t> seed;  // overrides scenario.seed (the sensor noise)
+  bool noise = true;                  // false: every noise source off; calibration effects stay
   // Called with the fraction done in [0, 1], about every 1 % and at the end.
   std::function<void(double fraction)> progress;
   // Called at every sample instant of any stream or of the ground truth, with the state at t completed as in step 4
@@ -48,27 +48,27 @@ struct SimulateOptions {
 };
 
 struct SimulationStats {
-  double simulated_s = 0.0;             // lead-in + recorded time [s]
-  double wall_s = 0.0;                  // [s]
-  double realtime_factor = 0.0;         // simulated_s / wall_s
+  double simulated_s = 0.0;      // lead-in + recorded time [s]
+  double wall_s = 0.0;           // [s]
+  double realtime_factor = 0.0;  // simulated_s / wall_s
   long physics_steps = 0;
-  double distance_m = 0.0;              // path length of O over the recording (from the ground-truth samples)
-  double max_abs_pitch_rad = 0.0;       // of O, over the recording
+  double distance_m = 0.0;         // path length of O over the recording (from the ground-truth samples)
+  double max_abs_pitch_rad = 0.0;  // of O, over the recording
   double max_abs_roll_rad = 0.0;
-  double path_height_range_m = 0.0;     // max - min height of O over the recording
-  double terrain_relief_m = 0.0;        // peak-to-peak over the whole heightfield (0 on a flat floor)
-  double max_lateral_speed_mps = 0.0;   // max |v_y| of O: side slip, which eq. 15 assumes to be zero
-  double max_wheel_slip_mps = 0.0;      // max |omega_rear r - v_x| of O (wheeled robots: of every driven wheel's
-                                        // rim against the ground point below it): longitudinal slip and creep
-  int failed_scan_matches = 0;          // scan pairs the scan matcher could not match (no scan_matching sample)
-  std::optional<frontend::VoCounters> visual_odometry;   // sensors.camera: frames, pairs, estimates, failures by reason
-  double camera_height_m = 0.0;         // sensors.camera: the floor height the VO uses (measured at rest)
-  std::vector<std::string> warnings;    // MuJoCo warnings, if any
+  double path_height_range_m = 0.0;    // max - min height of O over the recording
+  double terrain_relief_m = 0.0;       // peak-to-peak over the whole heightfield (0 on a flat floor)
+  double max_lateral_speed_mps = 0.0;  // max |v_y| of O: side slip, which eq. 15 assumes to be zero
+  double max_wheel_slip_mps = 0.0;     // max |omega_rear r - v_x| of O (wheeled robots: of every driven wheel's
+                                       // rim against the ground point below it): longitudinal slip and creep
+  int failed_scan_matches = 0;         // scan pairs the scan matcher could not match (no scan_matching sample)
+  std::optional<frontend::VoCounters> visual_odometry;  // sensors.camera: frames, pairs, estimates, failures by reason
+  double camera_height_m = 0.0;       // sensors.camera: the floor height the VO uses (measured at rest)
+  std::vector<std::string> warnings;  // MuJoCo warnings, if any
 };
 
 struct Simulation {
-  recording::Recording recording;       // streams, ground truth, platform, origin, provenance
-  recording::Truth truth;               // true calibration (names in scenario.h), effects
+  recording::Recording recording;  // streams, ground truth, platform, origin, provenance
+  recording::Truth truth;          // true calibration (names in scenario.h), effects
   SimulationStats stats;
 };
 

@@ -151,8 +151,8 @@ std::string Terrain::Mjcf() const {
         << 0.5 * options_.size_m.x() << " " << 0.5 * options_.size_m.y() << " " << options_.relief_m << " "
         << kBaseThicknessM << "\"/>\n"
         << "</asset>\n<worldbody>\n"
-        << "  <geom name=\"terrain\" type=\"hfield\" hfield=\"terrain\" pos=\"0 0 " << offset_z_m_ << "\" "
-        << ground << "/>\n";
+        << "  <geom name=\"terrain\" type=\"hfield\" hfield=\"terrain\" pos=\"0 0 " << offset_z_m_ << "\" " << ground
+        << "/>\n";
   }
   xml << "  <light name=\"sun\" directional=\"true\" pos=\"0 0 100\" dir=\"0.3 0.2 -1\" castshadow=\"false\"/>\n"
       << "</worldbody>\n";

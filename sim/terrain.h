@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
 #include <mujoco/mujoco.h>
+#include <Eigen/Core>
 
 #include "common/status.h"
 
@@ -28,14 +28,14 @@ namespace roamlab::sim {
 struct TerrainOptions {
   enum class Type { kFlat, kHills };
   Type type = Type::kHills;
-  std::uint64_t seed = 7;                              // hills only; independent of the sensor-noise seed
-  Eigen::Vector2d size_m{300.0, 300.0};                // extent along x (east) and y (north) [m]
-  double resolution_m = 1.0;                           // grid spacing [m]
-  double relief_m = 4.0;                               // peak-to-peak height [m]
+  std::uint64_t seed = 7;                // hills only; independent of the sensor-noise seed
+  Eigen::Vector2d size_m{300.0, 300.0};  // extent along x (east) and y (north) [m]
+  double resolution_m = 1.0;             // grid spacing [m]
+  double relief_m = 4.0;                 // peak-to-peak height [m]
   double min_wavelength_m = 20.0;
   double max_wavelength_m = 60.0;
   int waves = 16;
-  double friction = 0.8;                               // sliding friction coefficient of the ground
+  double friction = 0.8;  // sliding friction coefficient of the ground
 
   // Empty when usable; otherwise "<field>: <problem>" with the field as named in the scenario.
   std::string Validate() const;

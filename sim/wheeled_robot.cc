@@ -42,8 +42,8 @@ std::string LayoutProblem(const std::string& kind, const std::vector<WheelGeomet
     for (int i = 0; i < 3; ++i) {
       const double alpha = (60.0 + 120.0 * i) * kPi / 180.0;
       const Eigen::Vector2d radial(std::cos(alpha), std::sin(alpha));
-      if ((w[i].p_body_m - distance * radial).norm() > 0.02 || w[i].drive_direction.dot(Eigen::Vector2d(
-                                                                       -radial.y(), radial.x())) < 0.98 ||
+      if ((w[i].p_body_m - distance * radial).norm() > 0.02 ||
+          w[i].drive_direction.dot(Eigen::Vector2d(-radial.y(), radial.x())) < 0.98 ||
           w[i].locked_direction.dot(w[i].drive_direction) < 0.98)
         return "omni3: wheel_" + std::to_string(i) + " must be at " + std::to_string(60 + 120 * i) +
                " deg from x at the same distance as wheel_0, its axle towards 'odom', its bottom roller along the "
@@ -60,7 +60,8 @@ std::string LayoutProblem(const std::string& kind, const std::vector<WheelGeomet
             std::abs(std::abs(w[i].locked_direction.dot(w[i].drive_direction)) - std::sqrt(0.5)) < 0.1 &&
             std::abs(w[i].locked_direction.dot(across.normalized())) > 0.9))
         return "mecanum: wheel_" + std::to_string(i) + " must be " + (i < 2 ? "front " : "rear ") +
-               (i % 2 == 0 ? "left" : "right") + ", rolling forward, its bottom roller's axis 45 deg off x and "
+               (i % 2 == 0 ? "left" : "right") +
+               ", rolling forward, its bottom roller's axis 45 deg off x and "
                "across the diagonal through the wheel (X layout)";
     }
   }
@@ -102,18 +103,18 @@ Result<WheeledRobot> WheeledRobot::Bind(const mjModel* model, const std::string&
         model->actuator_trnid[2 * actuator] != joint)
       return Missing(what, kind, "a velocity actuator 'drive_" + index + "' on joint 'wheel_" + index + "'");
     const int tire = IdOf(model, mjOBJ_GEOM, "tire_" + index);
-    if (tire < 0 || !(model->geom_type[tire] == mjGEOM_SPHERE ||
-                      (HasRollers(kind) && model->geom_type[tire] == mjGEOM_CYLINDER)))
-      return Missing(what, kind, std::string("a ") + (HasRollers(kind) ? "sphere or cylinder" : "sphere") +
-                                     " geom 'tire_" + index + "'");
+    if (tire < 0 ||
+        !(model->geom_type[tire] == mjGEOM_SPHERE || (HasRollers(kind) && model->geom_type[tire] == mjGEOM_CYLINDER)))
+      return Missing(
+          what, kind,
+          std::string("a ") + (HasRollers(kind) ? "sphere or cylinder" : "sphere") + " geom 'tire_" + index + "'");
     r.wheel_qpos_.push_back(model->jnt_qposadr[joint]);
     r.wheel_dof_.push_back(model->jnt_dofadr[joint]);
     r.actuators_.push_back(actuator);
     r.tires_.push_back(tire);
 
     // Geometry in O: centre, axis, rolling direction d = a x e_z.
-    const Eigen::Vector3d centre =
-        R_world_odom.transpose() * (Eigen::Vector3d(scratch->geom_xpos + 3 * tire) - p_odom);
+    const Eigen::Vector3d centre = R_world_odom.transpose() * (Eigen::Vector3d(scratch->geom_xpos + 3 * tire) - p_odom);
     const Eigen::Vector3d axis = R_world_odom.transpose() * Eigen::Vector3d(scratch->xaxis + 3 * joint);
     const Eigen::Vector3d direction = axis.cross(Eigen::Vector3d::UnitZ());
     if (direction.head<2>().norm() < 0.5)
@@ -301,8 +302,8 @@ std::map<std::string, std::vector<double>> WheeledRobot::TrueOdometerCalibration
       return w.locked_direction.dot(Eigen::Vector2d(-p.y(), p.x())) / w.locked_direction.dot(w.drive_direction);
     };
     lever_change[i] = lever(o);
-    change_of_mean_abs_lever_m += (lever(w.p_body_m) < 0.0 ? -1.0 : 1.0) * lever_change[i] /
-                             static_cast<double>(wheels_.size());
+    change_of_mean_abs_lever_m +=
+        (lever(w.p_body_m) < 0.0 ? -1.0 : 1.0) * lever_change[i] / static_cast<double>(wheels_.size());
   }
   if (kind_ == "differential_drive")
     return {{"odometer.radius_left", {wheels_[0].mean_rolling_radius_m}},

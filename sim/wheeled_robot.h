@@ -24,19 +24,19 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
 #include <mujoco/mujoco.h>
+#include <Eigen/Core>
 
 #include "common/status.h"
 
 namespace roamlab::sim {
 
 struct WheelGeometry {
-  Eigen::Vector2d p_body_m = Eigen::Vector2d::Zero();     // contact point below the wheel centre, in O [m]
+  Eigen::Vector2d p_body_m = Eigen::Vector2d::Zero();  // contact point below the wheel centre, in O [m]
   Eigen::Vector2d drive_direction = Eigen::Vector2d::UnitX();
-  Eigen::Vector2d locked_direction = Eigen::Vector2d::UnitX();   // u: unit, the direction the wheel cannot slide in
-  double radius_m = 0.0;                                 // nominal rolling radius (the tire as modelled)
-  double mean_rolling_radius_m = 0.0;                    // travel per revolution / 2 pi (radius_m unless deformed)
+  Eigen::Vector2d locked_direction = Eigen::Vector2d::UnitX();  // u: unit, the direction the wheel cannot slide in
+  double radius_m = 0.0;                                        // nominal rolling radius (the tire as modelled)
+  double mean_rolling_radius_m = 0.0;  // travel per revolution / 2 pi (radius_m unless deformed)
 };
 
 // A change of one wheel's mounting, applied to the compiled model before binding (the wheel turns about its centre):
@@ -128,9 +128,9 @@ class WheeledRobot {
   std::vector<int> wheel_qpos_, wheel_dof_, actuators_, tires_;
   std::vector<WheelGeometry> wheels_;
   Eigen::MatrixXd J_rates_twist_;
-  double track_error_m_ = 0.0;      // ChangeTrack's, for the true geometry
-  std::vector<Eigen::Vector2d> offsets_m_;   // MoveWheels', per wheel in O, for the true geometry
-  double odom_height_m_ = 0.0;      // height of O above the tires' lowest points at qpos0
+  double track_error_m_ = 0.0;              // ChangeTrack's, for the true geometry
+  std::vector<Eigen::Vector2d> offsets_m_;  // MoveWheels', per wheel in O, for the true geometry
+  double odom_height_m_ = 0.0;              // height of O above the tires' lowest points at qpos0
   double odom_in_root_pos_[3] = {};
   double odom_in_root_quat_[4] = {1, 0, 0, 0};
 };

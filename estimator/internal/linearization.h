@@ -17,13 +17,13 @@
 namespace roamlab::estimator::internal {
 
 struct WhitenedFactor {
-  Eigen::VectorXd residual;               // whitened and loss-weighted
-  std::vector<Eigen::MatrixXd> jacobians; // per connected variable (tangent columns); empty matrix when not asked
+  Eigen::VectorXd residual;                // whitened and loss-weighted
+  std::vector<Eigen::MatrixXd> jacobians;  // per connected variable (tangent columns); empty matrix when not asked
   // L (lower) with L L^T = error covariance, kept to evaluate trial points; only for factors whose error covariance
   // depends on the estimate (SqrtCovariance gives it for every factor).
   Eigen::MatrixXd sqrt_covariance;
-  double squared_norm = 0.0;              // s = |L^-1 e|^2 before the loss
-  double cost = 0.0;                      // rho(s) / 2
+  double squared_norm = 0.0;  // s = |L^-1 e|^2 before the loss
+  double cost = 0.0;          // rho(s) / 2
 };
 
 // The L of `out`'s linearization of `entry`.

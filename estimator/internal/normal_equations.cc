@@ -115,8 +115,8 @@ bool NormalEquations::OrderBlocks(const Graph& graph, std::vector<VariableId> or
   }
   std::sort(block_of_id_.begin(), block_of_id_.end());
   for (std::size_t i = 1; i < block_of_id_.size(); ++i)
-    ROAMLAB_CHECK(block_of_id_[i].first != block_of_id_[i - 1].first, "variable " << block_of_id_[i].first
-                                                                                  << " ordered twice");
+    ROAMLAB_CHECK(block_of_id_[i].first != block_of_id_[i - 1].first,
+                  "variable " << block_of_id_[i].first << " ordered twice");
   return stamped_first;
 }
 
@@ -208,11 +208,11 @@ void NormalEquations::CollectFactors(const Graph& graph, bool incremental, bool 
     const std::size_t begin = var_block_.size();
     std::uint64_t mask = 0;
     while (incremental && prev < prev_factor_ids_.size() && prev_factor_ids_[prev] < fid) ++prev;
-    const bool kept = incremental && prev < prev_factor_ids_.size() && prev_factor_ids_[prev] == fid &&
-                      prev_entries_[prev] == &entry &&
-                      prev_var_begin_[prev + 1] - prev_var_begin_[prev] == static_cast<int>(entry.variables.size()) &&
-                      std::equal(entry.variables.begin(), entry.variables.end(),
-                                 prev_var_id_.begin() + prev_var_begin_[prev]);
+    const bool kept =
+        incremental && prev < prev_factor_ids_.size() && prev_factor_ids_[prev] == fid &&
+        prev_entries_[prev] == &entry &&
+        prev_var_begin_[prev + 1] - prev_var_begin_[prev] == static_cast<int>(entry.variables.size()) &&
+        std::equal(entry.variables.begin(), entry.variables.end(), prev_var_id_.begin() + prev_var_begin_[prev]);
     for (std::size_t i = 0; i < entry.variables.size(); ++i) {
       int b = -1;
       if (kept) {
@@ -461,8 +461,7 @@ void NormalEquations::BuildPairs() {
   pairs_.resize(pair_count);
   pair_begin_.assign(1, 0);
   PairSlot* pair = pairs_.data();
-  const auto add_pair = [&pair](std::ptrdiff_t value, int row, int column, int a, int b, int product,
-                                bool transposed) {
+  const auto add_pair = [&pair](std::ptrdiff_t value, int row, int column, int a, int b, int product, bool transposed) {
     pair->value = value;
     pair->row = row;
     pair->column = column;
@@ -511,8 +510,8 @@ void NormalEquations::BuildPairs() {
     }
     pair_begin_.push_back(static_cast<int>(pair - pairs_.data()));
   }
-  ROAMLAB_CHECK(pair == pairs_.data() + pairs_.size(), "pair count " << pairs_.size() << ", written "
-                                                                     << pair - pairs_.data());
+  ROAMLAB_CHECK(pair == pairs_.data() + pairs_.size(),
+                "pair count " << pairs_.size() << ", written " << pair - pairs_.data());
   pairs_built_ = true;
 }
 
@@ -524,8 +523,8 @@ void NormalEquations::Update(const Eigen::VectorXd& dx, Graph* graph) const {
 }
 
 void NormalEquations::Update(const Eigen::VectorXd& dx, const std::vector<Variable*>& free_variables) const {
-  ROAMLAB_CHECK(free_variables.size() == order_.size(), "Update with " << free_variables.size() << " variables for "
-                                                                        << order_.size() << " blocks");
+  ROAMLAB_CHECK(free_variables.size() == order_.size(),
+                "Update with " << free_variables.size() << " variables for " << order_.size() << " blocks");
   // (The variables lie in separate heap blocks, their values in others: both prefetched ahead.)
   const std::size_t n = order_.size();
   for (std::size_t b = 0; b < n; ++b) {

@@ -108,8 +108,8 @@ class NormalEquations {
 
   // The information of the border (the trailing constant parameters of a system factored in its envelope, when they
   // span exactly border_dimension) with every other free variable marginalized out: the Schur complement
-  // C - B^T A^-1 B of H = [A B; B^T C], from the envelope factorization of A (Ua^T Ua = A, Ub = Ua^-T B, S = C - Ub^T Ub).
-  // False when the system has no such border or A is not positive definite. The next Solve or Covariance factors
+  // C - B^T A^-1 B of H = [A B; B^T C], from the envelope factorization of A (Ua^T Ua = A, Ub = Ua^-T B, S = C - Ub^T
+  // Ub). False when the system has no such border or A is not positive definite. The next Solve or Covariance factors
   // again.
   bool BorderInformation(int border_dimension, Eigen::MatrixXd* information);
 
@@ -175,9 +175,9 @@ class NormalEquations {
     int block;  // -1: held constant
   };
   std::vector<VariableSlot> variable_table_;  // every variable of the graph, sorted by id
-  std::vector<int> dims_;                                // per block
-  std::vector<char> full_column_;                        // per block: its column holds every row block before it
-  std::vector<int> block_offset_;                        // per block: first column
+  std::vector<int> dims_;                     // per block
+  std::vector<char> full_column_;             // per block: its column holds every row block before it
+  std::vector<int> block_offset_;             // per block: first column
   int dimension_ = 0;
 
   // Included factors, and per factor k the range [var_begin_[k], var_begin_[k + 1]) of its variables in var_block_
@@ -258,9 +258,9 @@ class NormalEquations {
   // blocks far out of the cache, a chain of misses that the hardware's prefetcher cannot follow.
   void PrefetchAhead(std::size_t k) const;
   std::vector<FactorLinearization> prev_linearized_;
-  std::vector<bool> taken_scratch_;          // Reset: which of prev_linearized_ found their factor
-  std::vector<std::size_t> fresh_scratch_;   // Reset: factors new since the last Reset
-  bool Current(std::size_t k) const;  // linearized_[k] holds factor k at the current values
+  std::vector<bool> taken_scratch_;         // Reset: which of prev_linearized_ found their factor
+  std::vector<std::size_t> fresh_scratch_;  // Reset: factors new since the last Reset
+  bool Current(std::size_t k) const;        // linearized_[k] holds factor k at the current values
   // Reset: linearized_ and prev_linearized_ (the last Reset's) rearranged so that each factor still in the system
   // finds its record at its new place; marks the variables of factors that left while theirs stayed dirty.
   void MoveLinearizationsWithTheirFactors();
@@ -306,7 +306,7 @@ class NormalEquations {
   std::vector<std::vector<int>> rows_of_;
   std::vector<std::vector<int>> row_offset_;
   std::vector<int> column_length_;
-  std::vector<std::ptrdiff_t> column_base_;  // BuildPattern: per block column, see ValueIndex
+  std::vector<std::ptrdiff_t> column_base_;     // BuildPattern: per block column, see ValueIndex
   std::vector<int> block_stamp_, block_count_;  // BuildPattern: per block, the factor that last took it and how often
   std::vector<int> outer_, inner_;
   // The block pattern (dims_ and rows_of_) that H's pattern was built for, and the last few other patterns of a small
@@ -364,15 +364,15 @@ class NormalEquations {
   // picked per block size).
   template <typename Function>
   void WithBand(Function f);
-  int band_blocks_ = 0;                 // block columns of A
-  bool band_pose_blocks_ = false;       // every block column of A has 6 columns
-  int band_dimension_ = 0;              // scalar columns of A
+  int band_blocks_ = 0;            // block columns of A
+  bool band_pose_blocks_ = false;  // every block column of A has 6 columns
+  int band_dimension_ = 0;         // scalar columns of A
   std::vector<int> first_block_;
   std::vector<std::ptrdiff_t> envelope_start_;
   std::vector<double> envelope_;
-  Eigen::MatrixXd border_;  // Ub
+  Eigen::MatrixXd border_;          // Ub
   std::vector<int> border_cursor_;  // FactorEnvelope's scatter: per border column, its next entry of A
-  Eigen::MatrixXd corner_;  // C, then Uc in its upper triangle
+  Eigen::MatrixXd corner_;          // C, then Uc in its upper triangle
 
   // The last undamped factorization with a relinearization threshold (its order and band layout; its Ua and Ub stay
   // in envelope_ and border_ until the next factorization swaps them here), and the free variables of factors whose

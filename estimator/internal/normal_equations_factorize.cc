@@ -308,8 +308,8 @@ bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, doubl
   if (reused > 0) {
     // Columns 0..reused-1 of Ua from the kept ones shifted by the blocks that left (their rows above the first
     // block now are dropped), and the rows of Ub before row block `reused`.
-    const int shift = static_cast<int>(std::find(kept_order_.begin(), kept_order_.end(), order_.front()) -
-                                       kept_order_.begin());
+    const int shift =
+        static_cast<int>(std::find(kept_order_.begin(), kept_order_.end(), order_.front()) - kept_order_.begin());
     const int row_shift = kept_block_offset_[shift];
     for (int b = 0; b < reused; ++b) {
       const int kb = b + shift;

@@ -20,8 +20,8 @@ namespace {
 template <int M, int A, int B>
 void AddProductFixed(const double* ja, const double* jb, double* dst, std::ptrdiff_t stride) {
   Eigen::Map<Eigen::Matrix<double, A, B>, 0, Eigen::OuterStride<>> block(dst, A, B, Eigen::OuterStride<>(stride));
-  block.noalias() += Eigen::Map<const Eigen::Matrix<double, M, A>>(ja).transpose() *
-                     Eigen::Map<const Eigen::Matrix<double, M, B>>(jb);
+  block.noalias() +=
+      Eigen::Map<const Eigen::Matrix<double, M, A>>(ja).transpose() * Eigen::Map<const Eigen::Matrix<double, M, B>>(jb);
 }
 
 // The same with the column counts as template arguments when they are among the block sizes of the error models
@@ -29,21 +29,35 @@ void AddProductFixed(const double* ja, const double* jb, double* dst, std::ptrdi
 template <int M, int A>
 bool AddProductColumns(const double* ja, const double* jb, int b, double* dst, std::ptrdiff_t stride) {
   switch (b) {
-    case 1: AddProductFixed<M, A, 1>(ja, jb, dst, stride); return true;
-    case 3: AddProductFixed<M, A, 3>(ja, jb, dst, stride); return true;
-    case 6: AddProductFixed<M, A, 6>(ja, jb, dst, stride); return true;
-    case 9: AddProductFixed<M, A, 9>(ja, jb, dst, stride); return true;
-    default: return false;
+    case 1:
+      AddProductFixed<M, A, 1>(ja, jb, dst, stride);
+      return true;
+    case 3:
+      AddProductFixed<M, A, 3>(ja, jb, dst, stride);
+      return true;
+    case 6:
+      AddProductFixed<M, A, 6>(ja, jb, dst, stride);
+      return true;
+    case 9:
+      AddProductFixed<M, A, 9>(ja, jb, dst, stride);
+      return true;
+    default:
+      return false;
   }
 }
 template <int M>
 bool AddProductRows(const double* ja, int a, const double* jb, int b, double* dst, std::ptrdiff_t stride) {
   switch (a) {
-    case 1: return AddProductColumns<M, 1>(ja, jb, b, dst, stride);
-    case 3: return AddProductColumns<M, 3>(ja, jb, b, dst, stride);
-    case 6: return AddProductColumns<M, 6>(ja, jb, b, dst, stride);
-    case 9: return AddProductColumns<M, 9>(ja, jb, b, dst, stride);
-    default: return false;
+    case 1:
+      return AddProductColumns<M, 1>(ja, jb, b, dst, stride);
+    case 3:
+      return AddProductColumns<M, 3>(ja, jb, b, dst, stride);
+    case 6:
+      return AddProductColumns<M, 6>(ja, jb, b, dst, stride);
+    case 9:
+      return AddProductColumns<M, 9>(ja, jb, b, dst, stride);
+    default:
+      return false;
   }
 }
 
@@ -70,21 +84,39 @@ void AddBlockFixed(const double* src, bool transposed, double* dst, std::ptrdiff
 template <int A>
 bool AddBlockColumns(const double* src, int cols, bool transposed, double* dst, std::ptrdiff_t stride) {
   switch (cols) {
-    case 1: AddBlockFixed<A, 1>(src, transposed, dst, stride); return true;
-    case 3: AddBlockFixed<A, 3>(src, transposed, dst, stride); return true;
-    case 6: AddBlockFixed<A, 6>(src, transposed, dst, stride); return true;
-    case 9: AddBlockFixed<A, 9>(src, transposed, dst, stride); return true;
-    default: return false;
+    case 1:
+      AddBlockFixed<A, 1>(src, transposed, dst, stride);
+      return true;
+    case 3:
+      AddBlockFixed<A, 3>(src, transposed, dst, stride);
+      return true;
+    case 6:
+      AddBlockFixed<A, 6>(src, transposed, dst, stride);
+      return true;
+    case 9:
+      AddBlockFixed<A, 9>(src, transposed, dst, stride);
+      return true;
+    default:
+      return false;
   }
 }
 void AddBlock(const double* src, int rows, int cols, bool transposed, double* dst, std::ptrdiff_t stride) {
   bool done = false;
   switch (rows) {
-    case 1: done = AddBlockColumns<1>(src, cols, transposed, dst, stride); break;
-    case 3: done = AddBlockColumns<3>(src, cols, transposed, dst, stride); break;
-    case 6: done = AddBlockColumns<6>(src, cols, transposed, dst, stride); break;
-    case 9: done = AddBlockColumns<9>(src, cols, transposed, dst, stride); break;
-    default: break;
+    case 1:
+      done = AddBlockColumns<1>(src, cols, transposed, dst, stride);
+      break;
+    case 3:
+      done = AddBlockColumns<3>(src, cols, transposed, dst, stride);
+      break;
+    case 6:
+      done = AddBlockColumns<6>(src, cols, transposed, dst, stride);
+      break;
+    case 9:
+      done = AddBlockColumns<9>(src, cols, transposed, dst, stride);
+      break;
+    default:
+      break;
   }
   if (done) return;
   Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> block(dst, rows, cols, Eigen::OuterStride<>(stride));
@@ -100,11 +132,20 @@ void AddBlock(const double* src, int rows, int cols, bool transposed, double* ds
 template <int M, typename Function>
 bool WithColumns(int a, Function f) {
   switch (a) {
-    case 1: f(std::integral_constant<int, M>(), std::integral_constant<int, 1>()); return true;
-    case 3: f(std::integral_constant<int, M>(), std::integral_constant<int, 3>()); return true;
-    case 6: f(std::integral_constant<int, M>(), std::integral_constant<int, 6>()); return true;
-    case 9: f(std::integral_constant<int, M>(), std::integral_constant<int, 9>()); return true;
-    default: return false;
+    case 1:
+      f(std::integral_constant<int, M>(), std::integral_constant<int, 1>());
+      return true;
+    case 3:
+      f(std::integral_constant<int, M>(), std::integral_constant<int, 3>());
+      return true;
+    case 6:
+      f(std::integral_constant<int, M>(), std::integral_constant<int, 6>());
+      return true;
+    case 9:
+      f(std::integral_constant<int, M>(), std::integral_constant<int, 9>());
+      return true;
+    default:
+      return false;
   }
 }
 template <typename Function>
@@ -297,8 +338,7 @@ bool NormalEquations::CostWithLastWhitening(const Graph& /*graph*/, double* cost
     PrefetchAhead(k);
     double c = 0.0;
     const FactorEntry& entry = *entries_[k];
-    if (!FactorCostAt(entry, &values_[var_begin_[k]], SqrtCovariance(entry, linearized_[k].whitened), &c))
-      return false;
+    if (!FactorCostAt(entry, &values_[var_begin_[k]], SqrtCovariance(entry, linearized_[k].whitened), &c)) return false;
     *cost += c;
   }
   return true;
@@ -432,8 +472,8 @@ bool NormalEquations::CarryToFirstOrder(std::size_t k) {
 
 const std::vector<double>* NormalEquations::KeptProductsAt(FactorId id, std::uint64_t want_mask) const {
   if (LinearizationAt(id, want_mask) == nullptr) return nullptr;
-  const FactorLinearization& l = linearized_[std::lower_bound(factor_ids_.begin(), factor_ids_.end(), id) -
-                                             factor_ids_.begin()];
+  const FactorLinearization& l =
+      linearized_[std::lower_bound(factor_ids_.begin(), factor_ids_.end(), id) - factor_ids_.begin()];
   return l.products_valid ? &l.products : nullptr;
 }
 

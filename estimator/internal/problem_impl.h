@@ -38,14 +38,14 @@ struct StreamBinding {
   bool right_then_left = false;                 // differential_drive: columns named [right, left] (else left, right)
   std::vector<std::string> slot_parameters;     // parameter name per model slot
   Eigen::MatrixXd noise_covariance;
-  double row_covariance_scale = 0.0;            // odometer, relative_motion: weight of the rows' own covariance
-  double interval_s = 0.0;                      // relative_motion: T
+  double row_covariance_scale = 0.0;  // odometer, relative_motion: weight of the rows' own covariance
+  double interval_s = 0.0;            // relative_motion: T
   double wheelbase_m = 0.0;
   AckermannVelocityError::Options ackermann;  // ackermann: options contact_height_m, pitch_lever_m, front_slip_velocity
   Eigen::Vector3d field_world = Eigen::Vector3d::Zero();
-  const recording::Stream* specific_force = nullptr;   // magnetometer, ackermann: inputs.specific_force
-  int specific_force_column = 0;                       // its first accelerometer column
-  double drive_nm_per_mps2 = 0.0;                      // magnetometer: options.drive_nm_per_mps2
+  const recording::Stream* specific_force = nullptr;             // magnetometer, ackermann: inputs.specific_force
+  int specific_force_column = 0;                                 // its first accelerometer column
+  double drive_nm_per_mps2 = 0.0;                                // magnetometer: options.drive_nm_per_mps2
   Eigen::Vector3d forward_in_sensor = Eigen::Vector3d::UnitX();  // ackermann: options.forward_in_sensor (unit)
   // gyroscope, accelerometer, magnetometer: the slot time_offset_s (its index), and whether the samples take the
   // time-offset model (models/imu_time_offset.h): when the parameter is free or not zero.

@@ -61,8 +61,7 @@ namespace roamlab::estimator {
 
 class AccelerometerError {
  public:
-  using Blocks =
-      std::tuple<PoseBlock, PoseBlock, PoseBlock, QuaternionBlock, Vector3Block, Vector3Block, Vector3Block>;
+  using Blocks = std::tuple<PoseBlock, PoseBlock, PoseBlock, QuaternionBlock, Vector3Block, Vector3Block, Vector3Block>;
   static constexpr int kResidualDim = 3;
   static constexpr int kNoiseDim = 3;
   static constexpr bool kAdditiveNoise = true;  // e = f(x) + eta
@@ -102,9 +101,8 @@ class AccelerometerError {
     const Vector3<T> alpha_body = (omega12_body - omega01_body) / half_span;
 
     // Specific force at the sensor, in O (eq. 14), then in S.
-    const Vector3<T> f_body = q1.conjugate() * kSpecificForceAtRest_world.cast<T>() +
-                              alpha_body.cross(p_body_sensor) + a_body +
-                              omega_body.cross(omega_body.cross(p_body_sensor));
+    const Vector3<T> f_body = q1.conjugate() * kSpecificForceAtRest_world.cast<T>() + alpha_body.cross(p_body_sensor) +
+                              a_body + omega_body.cross(omega_body.cross(p_body_sensor));
     const Vector3<T> f_sensor = q_body_sensor.conjugate() * f_body;
 
     // Through the sensor model.
@@ -140,8 +138,8 @@ class AccelerometerError {
     const Eigen::Vector3d omega_body = phi02 / (dt0 + dt1);
     const Eigen::Vector3d alpha_body = (phi12 / dt1 - phi01 / dt0) / half_span;
     const Eigen::Vector3d g_body = q1.conjugate() * kSpecificForceAtRest_world;
-    const Eigen::Vector3d f_body = g_body + alpha_body.cross(p_body_sensor) + a_body +
-                                   omega_body.cross(omega_body.cross(p_body_sensor));
+    const Eigen::Vector3d f_body =
+        g_body + alpha_body.cross(p_body_sensor) + a_body + omega_body.cross(omega_body.cross(p_body_sensor));
     const Eigen::Vector3d f_sensor = q_body_sensor.conjugate() * f_body;
     e = scale.cwiseProduct(f_sensor) + bias - z_mps2_;
     if (jacobians == nullptr) return true;
@@ -166,13 +164,12 @@ class AccelerometerError {
       const Eigen::Matrix3d jr_inv12 = need12 ? internal::InverseRightJacobianSO3(phi12) : Eigen::Matrix3d();
       if (wanted(0)) {
         J_e_pose(0).leftCols<3>() = D_R1T / (dt0 * half_span);
-        J_e_pose(0).rightCols<3>() =
-            D_K_alpha * jr_inv01.transpose() / dt0 - D_K_omega * jr_inv02.transpose();
+        J_e_pose(0).rightCols<3>() = D_K_alpha * jr_inv01.transpose() / dt0 - D_K_omega * jr_inv02.transpose();
       }
       if (wanted(1)) {
         J_e_pose(1).leftCols<3>() = D_R1T * (-(1.0 / dt0 + 1.0 / dt1) / half_span);
-        J_e_pose(1).rightCols<3>() = D * Skew<double>(g_body + a_body) -
-                                     D_K_alpha * (jr_inv12.transpose() / dt1 + jr_inv01 / dt0);
+        J_e_pose(1).rightCols<3>() =
+            D * Skew<double>(g_body + a_body) - D_K_alpha * (jr_inv12.transpose() / dt1 + jr_inv01 / dt0);
       }
       if (wanted(2)) {
         J_e_pose(2).leftCols<3>() = D_R1T / (dt1 * half_span);

@@ -67,15 +67,15 @@
 // its reported standard deviation (tests/estimator/calibration_test.cc); here the noise is additive on the readings,
 // the covariance is constant, and the least-squares problem is the likelihood of the readings themselves.
 //
-// Longitudinal slip (the simulator's longitudinal_slip and slope_slip effects, sim/scenario.h). A driven tire carries its traction force by slipping:
-// the wheel turns faster than the ground passes, v_wheel = v (1 + s) with the slip ratio s growing with the force.
-// The recording has no force: the traction per unit mass is the forward specific force f_x = a_x + g sin(theta)
-// [m/s^2] (aerodynamic drag and rolling resistance aside), read from the IMU (an input of the factor, in O: the
-// accelerometer's reading turned by the believed mounting; 0 without the input), so s = s_f f_x with s_f
-// (slot slip_per_mps2) [s^2/m]. slope_slip: a slip that follows the slope only, s = s_p g sin(theta), theta the pitch
-// of O at the middle of the interval (sin(theta) = e_z^T R_mid e_x, positive nose up; from the poses, so no input),
-// s_p (slot slope_slip_per_mps2) [s^2/m]. The two differ by the acceleration a_x, which only s_f follows. Both 0 (the
-// defaults): the speed row above without slip. A constant error of f_x (the mounting's pitch error times g) only
+// Longitudinal slip (the simulator's longitudinal_slip and slope_slip effects, sim/scenario.h). A driven tire carries
+// its traction force by slipping: the wheel turns faster than the ground passes, v_wheel = v (1 + s) with the slip
+// ratio s growing with the force. The recording has no force: the traction per unit mass is the forward specific force
+// f_x = a_x + g sin(theta) [m/s^2] (aerodynamic drag and rolling resistance aside), read from the IMU (an input of the
+// factor, in O: the accelerometer's reading turned by the believed mounting; 0 without the input), so s = s_f f_x with
+// s_f (slot slip_per_mps2) [s^2/m]. slope_slip: a slip that follows the slope only, s = s_p g sin(theta), theta the
+// pitch of O at the middle of the interval (sin(theta) = e_z^T R_mid e_x, positive nose up; from the poses, so no
+// input), s_p (slot slope_slip_per_mps2) [s^2/m]. The two differ by the acceleration a_x, which only s_f follows. Both
+// 0 (the defaults): the speed row above without slip. A constant error of f_x (the mounting's pitch error times g) only
 // scales the speed row: kv_over_L absorbs it.
 //
 // Frames: O is the middle of the rear axle (x forward, z up). Measurements: z_v rear-wheel speed with the nominal
@@ -133,12 +133,11 @@ struct AckermannOptions {
 
 class AckermannVelocityError {
  public:
-  using Blocks =
-      std::tuple<PoseBlock, PoseBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock,
-                 ScalarBlock, ScalarBlock, Vector3Block>;
+  using Blocks = std::tuple<PoseBlock, PoseBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock,
+                            ScalarBlock, ScalarBlock, ScalarBlock, Vector3Block>;
   static constexpr int kResidualDim = 4;
   static constexpr int kNoiseDim = 4;
-  static constexpr bool kAdditiveNoise = true;  // e = f(x) + eta
+  static constexpr bool kAdditiveNoise = true;      // e = f(x) + eta
   static constexpr double kMinSteeringSpeed = 0.2;  // [m/s]
 
   using Options = AckermannOptions;
@@ -268,15 +267,15 @@ class AckermannVelocityError {
       const Eigen::Matrix3d R_mid_T = R_mid.transpose();
       // de/deps: through O's velocity, and through the pitch on the speed row (slope slip).
       Eigen::Matrix<double, 4, 3> J_e_eps = J_e_v * Skew<double>(v_odom);
-      J_e_eps.row(0) -= (v_roll * slip_p * kStandardGravity / k_v) * R_mid.row(2) *
-                        Skew<double>(Eigen::Vector3d::UnitX());
+      J_e_eps.row(0) -=
+          (v_roll * slip_p * kStandardGravity / k_v) * R_mid.row(2) * Skew<double>(Eigen::Vector3d::UnitX());
       const Eigen::Matrix3d jr_inv = internal::InverseRightJacobianSO3(phi);
       const Eigen::Matrix3d half_jr = 0.5 * internal::RightJacobianSO3(phi * 0.5);
       const Eigen::Matrix<double, 4, 3> J_e_dp1 = J_e_v * R_mid_T / dt_s_;
       if (jacobians[0] != nullptr) {
         Eigen::Map<Eigen::Matrix<double, 4, 6>> J_e_pose_k(jacobians[0]);
-        const Eigen::Matrix3d eps_theta = QuaternionExp<double>(phi * -0.5).toRotationMatrix() -
-                                          half_jr * jr_inv.transpose();
+        const Eigen::Matrix3d eps_theta =
+            QuaternionExp<double>(phi * -0.5).toRotationMatrix() - half_jr * jr_inv.transpose();
         J_e_pose_k.leftCols<3>() = -J_e_dp1;
         J_e_pose_k.rightCols<3>() = J_e_eps * eps_theta - J_e_omega * (jr_inv.transpose() / dt_s_);
       }
@@ -292,8 +291,8 @@ class AckermannVelocityError {
       Eigen::Map<Eigen::Vector4d>{jacobians[2]} << -v_roll * slip / (kv_over_l * k_v), 0.0, 0.0, 0.0;
     }
     if (jacobians[3] != nullptr) {
-      Eigen::Map<Eigen::Vector4d>{jacobians[3]} << 0.0, steering ? -(delta - k_gamma) / (k_theta * k_theta) : 0.0,
-          0.0, 0.0;
+      Eigen::Map<Eigen::Vector4d>{jacobians[3]} << 0.0, steering ? -(delta - k_gamma) / (k_theta * k_theta) : 0.0, 0.0,
+          0.0;
     }
     if (jacobians[4] != nullptr) {
       Eigen::Map<Eigen::Vector4d>{jacobians[4]} << 0.0, steering ? -1.0 / k_theta : 0.0, 0.0, 0.0;
@@ -304,8 +303,8 @@ class AckermannVelocityError {
     }
     if (jacobians[6] != nullptr) Eigen::Map<Eigen::Vector4d>{jacobians[6]} << 0.0, 0.0, a_y, 0.0;
     if (jacobians[7] != nullptr) {
-      Eigen::Map<Eigen::Vector4d>{jacobians[7]} << (v_body.y() * cos_alpha - v_body.x() * sin_alpha) * slip / k_v,
-          0.0, -v_body.x() * (1.0 + tan_alpha * tan_alpha), 0.0;
+      Eigen::Map<Eigen::Vector4d>{jacobians[7]} << (v_body.y() * cos_alpha - v_body.x() * sin_alpha) * slip / k_v, 0.0,
+          -v_body.x() * (1.0 + tan_alpha * tan_alpha), 0.0;
     }
     if (jacobians[8] != nullptr) {
       Eigen::Map<Eigen::Vector4d>{jacobians[8]} << v_roll * forward_specific_force_mps2_ / k_v, 0.0, 0.0, 0.0;

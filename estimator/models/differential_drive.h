@@ -18,13 +18,13 @@
 // Calibration: radius_left r_L [m], radius_right r_R [m], baseline B [m] (distance between the contact points; for a
 // skid-steer robot the effective track, wider than the geometric one when the tires scrub in turns), and
 // right_left_ratio rho [-] (default 1), a multiplier of r_R. rho lets a configuration that believes both wheels equal
-// (radius_left and radius_right mapped to one parameter) free their ratio r_R_eff / r_L = rho on its own: the reality-gap
-// diagnosis's wheel_radius_asymmetry candidate (gap/diagnose.h); freeing rho together with two separate radii leaves
-// the product rho r_R unobservable.
-// Deformed tires (the reality-gap diagnosis's wheel_deformation candidate): a tire that is not round rolls on a radius
-// that depends on the wheel angle theta. For an oval (elliptic) tire of semi-axes r + d and r the centre's height
-// above the contact, which is the ground speed per wheel rate, is sqrt((r+d)^2 cos^2 + r^2 sin^2) = r + d/2 +
-// (d/2) cos 2(theta - phi) to first order in d: a mean radius (the radius slot) plus the second harmonic
+// (radius_left and radius_right mapped to one parameter) free their ratio r_R_eff / r_L = rho on its own: the
+// reality-gap diagnosis's wheel_radius_asymmetry candidate (gap/diagnose.h); freeing rho together with two separate
+// radii leaves the product rho r_R unobservable. Deformed tires (the reality-gap diagnosis's wheel_deformation
+// candidate): a tire that is not round rolls on a radius that depends on the wheel angle theta. For an oval (elliptic)
+// tire of semi-axes r + d and r the centre's height above the contact, which is the ground speed per wheel rate, is
+// sqrt((r+d)^2 cos^2 + r^2 sin^2) = r + d/2 + (d/2) cos 2(theta - phi) to first order in d: a mean radius (the radius
+// slot) plus the second harmonic
 //     r(theta) = r_mean + a cos 2 theta + b sin 2 theta,        deformation = (a, b) [m] per wheel, default 0,
 // whose amplitude sqrt(a^2 + b^2) is half the ovality d. Over an interval the encoder turns the wheel from theta_k to
 // theta_k+1, and the rim travels the integral of r(theta) dtheta, so the wheel row uses the interval's effective
@@ -65,7 +65,10 @@ class DifferentialDriveError {
   DifferentialDriveError(double z_left_radps, double z_right_radps, double dt_s,
                          const Eigen::Vector2d& harmonics_left = Eigen::Vector2d::Zero(),
                          const Eigen::Vector2d& harmonics_right = Eigen::Vector2d::Zero())
-      : z_left_radps_(z_left_radps), z_right_radps_(z_right_radps), dt_s_(dt_s), harmonics_left_(harmonics_left),
+      : z_left_radps_(z_left_radps),
+        z_right_radps_(z_right_radps),
+        dt_s_(dt_s),
+        harmonics_left_(harmonics_left),
         harmonics_right_(harmonics_right) {
     ROAMLAB_CHECK(dt_s > 0.0, "differential drive dt " << dt_s);
   }

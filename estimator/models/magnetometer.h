@@ -86,7 +86,7 @@ class MagnetometerError {
     const Quaternion<double> q_world_sensor = q_world_body * q_body_sensor;
     const Eigen::Vector3d h_sensor = q_world_sensor.conjugate() * h_world_;
     const Eigen::Matrix3d R_S = q_body_sensor.toRotationMatrix();
-    const double tau_hat = drive_nm_per_mps2_ * (q_body_sensor * f_sensor_mps2_)[0];   // as operator(), to the bit
+    const double tau_hat = drive_nm_per_mps2_ * (q_body_sensor * f_sensor_mps2_)[0];  // as operator(), to the bit
     e = A * h_sensor + b + k * tau_hat - z_;
     if (jacobians == nullptr) return true;
 

@@ -32,8 +32,7 @@ namespace roamlab::estimator {
 
 class MecanumDriveError {
  public:
-  using Blocks =
-      std::tuple<PoseBlock, PoseBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock>;
+  using Blocks = std::tuple<PoseBlock, PoseBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock, ScalarBlock>;
   static constexpr int kResidualDim = 7;
   static constexpr int kNoiseDim = 7;
   static constexpr bool kAdditiveNoise = true;  // e = f(x) + eta
@@ -49,8 +48,8 @@ class MecanumDriveError {
     VelocitiesBetween<T>(PoseFromArray(x[0]), PoseFromArray(x[1]), T(dt_s_), &v_body, &omega_body);
     const T turn = omega_body.z() * x[6][0];
     for (int i = 0; i < 4; ++i)
-      error[i] = (v_body.x() + T(kSideSign[i]) * v_body.y() + T(kTurnSign[i]) * turn) / x[2 + i][0] -
-                 T(z_radps_[i]) + noise[i];
+      error[i] = (v_body.x() + T(kSideSign[i]) * v_body.y() + T(kTurnSign[i]) * turn) / x[2 + i][0] - T(z_radps_[i]) +
+                 noise[i];
     error[4] = v_body.z() + noise[4];
     error[5] = omega_body.x() + noise[5];
     error[6] = omega_body.y() + noise[6];

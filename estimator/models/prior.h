@@ -58,8 +58,8 @@ class PriorError {
     ROAMLAB_CHECK(x0.size() == Block::kAmbient,
                   "prior of size " << x0.size() << " for a block of ambient size " << Block::kAmbient);
     if (Block::manifold().kind() != ManifoldKind::kEuclidean) {
-      ROAMLAB_CHECK(std::abs(x0.tail<4>().norm() - 1.0) < 1e-6, "prior quaternion " << x0.tail<4>().transpose()
-                                                                    << " is not unit-norm");
+      ROAMLAB_CHECK(std::abs(x0.tail<4>().norm() - 1.0) < 1e-6,
+                    "prior quaternion " << x0.tail<4>().transpose() << " is not unit-norm");
     }
   }
 

@@ -76,17 +76,24 @@ const char* GpKernelName(GpKernel kernel) {
 }
 
 bool ParseGpMean(const std::string& name, GpMean* mean) {
-  if (name == "zero") *mean = GpMean::kZero;
-  else if (name == "linear") *mean = GpMean::kLinear;
-  else return false;
+  if (name == "zero")
+    *mean = GpMean::kZero;
+  else if (name == "linear")
+    *mean = GpMean::kLinear;
+  else
+    return false;
   return true;
 }
 
 bool ParseGpKernel(const std::string& name, GpKernel* kernel) {
-  if (name == "rbf") *kernel = GpKernel::kRbf;
-  else if (name == "linear") *kernel = GpKernel::kLinear;
-  else if (name == "rbf+linear") *kernel = GpKernel::kRbfPlusLinear;
-  else return false;
+  if (name == "rbf")
+    *kernel = GpKernel::kRbf;
+  else if (name == "linear")
+    *kernel = GpKernel::kLinear;
+  else if (name == "rbf+linear")
+    *kernel = GpKernel::kRbfPlusLinear;
+  else
+    return false;
   return true;
 }
 
@@ -105,10 +112,10 @@ GpLayout::GpLayout(int inputs, GpMean mean, GpKernel kernel)
 int GpLayout::size() const { return log_sn() + 1 + (linear_mean ? m : 0); }
 
 double GpLogMarginalLikelihood(const GpLayout& layout, const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
-                               const Eigen::VectorXd& noise_var, const Eigen::VectorXd& p,
-                               Eigen::VectorXd* gradient) {
-  ROAMLAB_CHECK(X.cols() == layout.m && X.rows() == y.size() && y.size() == noise_var.size() &&
-                    p.size() == layout.size(), "GpLogMarginalLikelihood: sizes");
+                               const Eigen::VectorXd& noise_var, const Eigen::VectorXd& p, Eigen::VectorXd* gradient) {
+  ROAMLAB_CHECK(
+      X.cols() == layout.m && X.rows() == y.size() && y.size() == noise_var.size() && p.size() == layout.size(),
+      "GpLogMarginalLikelihood: sizes");
   const Eigen::Index n = X.rows();
   // K = K(X, X) + diag(noise) and its Cholesky factor.
   Eigen::MatrixXd rbf;
@@ -181,9 +188,9 @@ Eigen::VectorXd GpInitialParameters(const GpLayout& layout, const Eigen::MatrixX
   return p;
 }
 
-GpOptimization MaximizeLogMarginalLikelihood(const GpLayout& layout, const Eigen::MatrixXd& X,
-                                             const Eigen::VectorXd& y, const Eigen::VectorXd& noise_var,
-                                             const Eigen::VectorXd& p0, int max_iterations) {
+GpOptimization MaximizeLogMarginalLikelihood(const GpLayout& layout, const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
+                                             const Eigen::VectorXd& noise_var, const Eigen::VectorXd& p0,
+                                             int max_iterations) {
   // L-BFGS minimizes the negative log marginal likelihood.
   const auto cost = [&](const Eigen::VectorXd& p, Eigen::VectorXd* gradient) {
     const double value = GpLogMarginalLikelihood(layout, X, y, noise_var, p, gradient);
@@ -210,10 +217,9 @@ Result<GaussianProcess> GaussianProcess::Train(const Eigen::MatrixXd& X, const E
     return Status::Error("GP: training data must be finite with non-negative noise variances");
   }
   const GpLayout layout(static_cast<int>(X.cols()), options.mean, options.kernel);
-  if (!fixed_parameters.empty() &&
-      (fixed_parameters.size() != 3 ||
-       std::any_of(fixed_parameters.begin(), fixed_parameters.end(),
-                   [&](const Eigen::VectorXd& p) { return p.size() != layout.size(); }))) {
+  if (!fixed_parameters.empty() && (fixed_parameters.size() != 3 ||
+                                    std::any_of(fixed_parameters.begin(), fixed_parameters.end(),
+                                                [&](const Eigen::VectorXd& p) { return p.size() != layout.size(); }))) {
     return Status::Error("GP: fixed parameters must be three vectors of size " + std::to_string(layout.size()));
   }
   // The seeded subset for the hyper-parameter optimization.

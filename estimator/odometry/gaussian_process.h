@@ -75,8 +75,7 @@ struct GpLayout {
 // layout.size()). X: n x m inputs, y: n targets, noise_var: n known noise variances (>= 0). Returns -infinity when
 // K is not positive definite.
 double GpLogMarginalLikelihood(const GpLayout& layout, const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
-                               const Eigen::VectorXd& noise_var, const Eigen::VectorXd& p,
-                               Eigen::VectorXd* gradient);
+                               const Eigen::VectorXd& noise_var, const Eigen::VectorXd& p, Eigen::VectorXd* gradient);
 
 // Initial hyper-parameters from the data: c by least squares, length scales from the input spread, variances from
 // the residual spread.
@@ -89,9 +88,9 @@ struct GpOptimization {
   int iterations = 0;
   int evaluations = 0;
 };
-GpOptimization MaximizeLogMarginalLikelihood(const GpLayout& layout, const Eigen::MatrixXd& X,
-                                             const Eigen::VectorXd& y, const Eigen::VectorXd& noise_var,
-                                             const Eigen::VectorXd& p0, int max_iterations);
+GpOptimization MaximizeLogMarginalLikelihood(const GpLayout& layout, const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
+                                             const Eigen::VectorXd& noise_var, const Eigen::VectorXd& p0,
+                                             int max_iterations);
 
 // The trained CGP model f: R^m -> R^3.
 class GaussianProcess {
@@ -119,8 +118,8 @@ class GaussianProcess {
   GpKernel kernel() const { return kernel_; }
   int inputs_dimension() const { return static_cast<int>(X_.cols()); }
   const Eigen::MatrixXd& inputs() const { return X_; }
-  const std::vector<Eigen::VectorXd>& parameters() const { return p_; }        // per output, layout order
-  const std::vector<Eigen::VectorXd>& weights() const { return alpha_; }       // per output: (K + Sigma)^-1 r
+  const std::vector<Eigen::VectorXd>& parameters() const { return p_; }           // per output, layout order
+  const std::vector<Eigen::VectorXd>& weights() const { return alpha_; }          // per output: (K + Sigma)^-1 r
   const std::vector<double>& log_likelihoods() const { return log_likelihood_; }  // per output, on the subset
 
  private:

@@ -101,15 +101,18 @@ Status SaveOdometryModel(const OdometryModel& model, const std::string& path) {
       parameters.push_back(VectorJson(gp.parameters()[i]));
       weights.push_back(VectorJson(gp.weights()[i]));
     }
-    j["gp"] = {{"mean", GpMeanName(gp.mean())}, {"kernel", GpKernelName(gp.kernel())},
-               {"inputs", MatrixRows(gp.inputs())}, {"parameters", parameters}, {"weights", weights},
+    j["gp"] = {{"mean", GpMeanName(gp.mean())},
+               {"kernel", GpKernelName(gp.kernel())},
+               {"inputs", MatrixRows(gp.inputs())},
+               {"parameters", parameters},
+               {"weights", weights},
                {"log_likelihood", gp.log_likelihoods()}};
   } else if (model.kind == ModelKind::kLinear) {
     j["linear"] = {{"W", MatrixRows(model.W)}, {"scale", VectorJson(model.huber_scale)}};
   } else {
     const WheelKinematics& k = model.kinematics;
-    j["kinematics"] = {{"J", MatrixRows(k.J)}, {"radius_m", VectorJson(k.radius_m)},
-                       {"sensor_pose", VectorJson(k.sensor_pose)}};
+    j["kinematics"] = {
+        {"J", MatrixRows(k.J)}, {"radius_m", VectorJson(k.radius_m)}, {"sensor_pose", VectorJson(k.sensor_pose)}};
   }
   std::ofstream out(path);
   if (!out) return Status::Error(path + ": cannot write");

@@ -32,10 +32,10 @@ struct OdometryModel {
   double interval_s = 0.5;
   std::vector<std::string> training_recordings;
   int training_pairs = 0;
-  std::optional<GaussianProcess> gp;       // kGp
-  Eigen::MatrixXd W;                       // kLinear: 3 x m
+  std::optional<GaussianProcess> gp;  // kGp
+  Eigen::MatrixXd W;                  // kLinear: 3 x m
   Eigen::Vector3d huber_scale = Eigen::Vector3d::Ones();
-  WheelKinematics kinematics;              // kParametric, kNominal
+  WheelKinematics kinematics;  // kParametric, kNominal
 
   // Predicted sensor displacement over one key interval.
   Pose2 Predict(const Eigen::VectorXd& delta) const;

@@ -79,8 +79,7 @@ WheelKinematics DifferentialDrive(const std::vector<std::string>& wheels, double
   return k;
 }
 
-Result<WheelKinematics> NominalKinematics(const recording::Platform& platform,
-                                          const std::vector<std::string>& wheels) {
+Result<WheelKinematics> NominalKinematics(const recording::Platform& platform, const std::vector<std::string>& wheels) {
   const auto m = static_cast<Eigen::Index>(wheels.size());
   const auto require_wheels = [&](const std::vector<std::string>& names) -> Status {
     for (const std::string& name : names) {
@@ -179,8 +178,7 @@ Result<CensiCalibration> CalibrateDifferentialDrive(const TrainingSet& data) {
     const double cq = std::cos(th), sq = std::sin(th);
     const double sx = data.s(k, 0), sy = data.s(k, 1);
     Eigen::Matrix<double, 2, 5> G;
-    G << 1.0 - cq, sq, -c[0], sx, -sy,
-         -sq, 1.0 - cq, -c[1], sy, sx;
+    G << 1.0 - cq, sq, -c[0], sx, -sy, -sq, 1.0 - cq, -c[1], sy, sx;
     M += G.transpose() * G;
   }
   const Eigen::Matrix3d A = M.topLeftCorner<3, 3>();

@@ -44,11 +44,11 @@
 namespace roamlab::estimator::odometry {
 
 struct WheelKinematics {
-  std::string kind;                  // platform kind
-  std::vector<std::string> wheels;   // encoder column names, in the order of the rows of J
-  Eigen::MatrixXd J;                 // m x 3
-  Eigen::VectorXd radius_m;          // m
-  Pose2 sensor_pose = Pose2::Zero(); // l: sensor in O
+  std::string kind;                   // platform kind
+  std::vector<std::string> wheels;    // encoder column names, in the order of the rows of J
+  Eigen::MatrixXd J;                  // m x 3
+  Eigen::VectorXd radius_m;           // m
+  Pose2 sensor_pose = Pose2::Zero();  // l: sensor in O
 
   // Sensor displacement for wheel rotations delta [rad] (m entries).
   Pose2 Displacement(const Eigen::VectorXd& delta) const;

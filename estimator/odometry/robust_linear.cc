@@ -75,8 +75,8 @@ Result<HuberFit> FitHuberLinear(const Eigen::MatrixXd& X, const Eigen::MatrixXd&
 
 std::vector<int> InlierRows(const HuberFit& fit, const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y,
                             const Eigen::MatrixXd& sigma, double threshold) {
-  const Eigen::MatrixXd u = ((Y - X * fit.W.transpose()).array() / sigma.array()).rowwise() /
-                            fit.scale.transpose().array();
+  const Eigen::MatrixXd u =
+      ((Y - X * fit.W.transpose()).array() / sigma.array()).rowwise() / fit.scale.transpose().array();
   std::vector<int> rows;
   for (Eigen::Index k = 0; k < X.rows(); ++k) {
     if (u.row(k).cwiseAbs().maxCoeff() <= threshold) rows.push_back(static_cast<int>(k));

@@ -20,15 +20,15 @@
 namespace roamlab::estimator::odometry {
 
 struct HuberOptions {
-  double c = 1.345;           // Huber threshold in robust standard deviations
+  double c = 1.345;  // Huber threshold in robust standard deviations
   int max_iterations = 100;
-  double tolerance = 1e-10;   // relative change of W that stops IRLS
+  double tolerance = 1e-10;  // relative change of W that stops IRLS
 };
 
 struct HuberFit {
-  Eigen::MatrixXd W;          // 3 x m
-  Eigen::Vector3d scale;      // robust scale of the whitened residuals, per output
-  int iterations = 0;         // the largest over the outputs
+  Eigen::MatrixXd W;      // 3 x m
+  Eigen::Vector3d scale;  // robust scale of the whitened residuals, per output
+  int iterations = 0;     // the largest over the outputs
 };
 
 // X: n x m wheel rotations, Y: n x 3 displacements, sigma: n x 3 standard deviations (> 0). Errors: sizes, fewer pairs

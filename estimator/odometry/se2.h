@@ -20,9 +20,7 @@ namespace roamlab::estimator::odometry {
 using Pose2 = Eigen::Vector3d;
 
 // Angle in (-pi, pi].
-inline double WrapAngle(double angle_rad) {
-  return std::atan2(std::sin(angle_rad), std::cos(angle_rad));
-}
+inline double WrapAngle(double angle_rad) { return std::atan2(std::sin(angle_rad), std::cos(angle_rad)); }
 
 // a (+) b (Table I).
 inline Pose2 Compose(const Pose2& a, const Pose2& b) {

@@ -106,7 +106,8 @@ Status PoseSteps(const Stream& sensor, const std::string& rec_name, KeySequence*
   if (auto it = noise.find("position_m"); it != noise.end()) sigma[0] = it->second;
   if (auto it = noise.find("orientation_rad"); it != noise.end()) sigma[1] = it->second;
   if (!(sigma.array() > 0.0).all()) {
-    return Status::Error(rec_name + ": stream '" + sensor.info.name + "' needs positive position_m and "
+    return Status::Error(rec_name + ": stream '" + sensor.info.name +
+                         "' needs positive position_m and "
                          "orientation_rad noise");
   }
   std::vector<Pose2> poses;
@@ -133,7 +134,8 @@ Status IntervalSteps(const Stream& sensor, const std::string& rec_name, KeySeque
   const auto sv = noise.find("sigma_mps");
   const auto sw = noise.find("sigma_radps");
   if (sv == noise.end() || sw == noise.end() || !(sv->second > 0.0) || !(sw->second > 0.0)) {
-    return Status::Error(rec_name + ": stream '" + sensor.info.name + "' needs positive sigma_mps and sigma_radps "
+    return Status::Error(rec_name + ": stream '" + sensor.info.name +
+                         "' needs positive sigma_mps and sigma_radps "
                          "noise");
   }
   if (!(sensor.info.rate_hz > 0.0)) return Status::Error(rec_name + ": stream '" + sensor.info.name + "' has no rate");

@@ -49,9 +49,9 @@ struct KeyTimeOptions {
 
 // One recording cut at key times t_0 < t_1 < ... (T apart, from the first time both streams cover).
 struct KeySequence {
-  std::vector<std::string> wheels;        // encoder column names
-  std::vector<Time> t;                    // key times
-  Eigen::MatrixXd wheel_angle_rad;        // rows = key times, columns = wheels: cumulative angle
+  std::vector<std::string> wheels;  // encoder column names
+  std::vector<Time> t;              // key times
+  Eigen::MatrixXd wheel_angle_rad;  // rows = key times, columns = wheels: cumulative angle
   // With a sensor, for k = 1..size()-1 (index k-1): the displacement q_(k-1)k in O, its standard deviations
   // (diagonal of the covariance; [m, m, rad]) and whether the sensor covered the interval.
   std::vector<Pose2> sensor_step;
@@ -72,9 +72,9 @@ Result<KeySequence> CutAtKeyTimes(const recording::Recording& recording, const s
 // Training pairs D = (delta_jk, s_jk) stacked over one or more sequences (n rows).
 struct TrainingSet {
   std::vector<std::string> wheels;
-  Eigen::MatrixXd delta;      // n x m wheel rotations [rad]
-  Eigen::MatrixXd s;          // n x 3 sensor displacements [m, m, rad]
-  Eigen::MatrixXd s_sigma;    // n x 3 standard deviations of s (diagonal of Sigma_jk)
+  Eigen::MatrixXd delta;    // n x m wheel rotations [rad]
+  Eigen::MatrixXd s;        // n x 3 sensor displacements [m, m, rad]
+  Eigen::MatrixXd s_sigma;  // n x 3 standard deviations of s (diagonal of Sigma_jk)
 
   int size() const { return static_cast<int>(delta.rows()); }
 };

@@ -34,8 +34,8 @@ Status RunParallel(int n, int jobs, const std::string& label, std::ostream* prog
     const int filled = n > 0 ? kWidth * done / n : kWidth;
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::ostringstream s;
-    s << "\r" << label << " [" << std::string(filled, '#') << std::string(kWidth - filled, '.') << "] " << done
-      << "/" << n << "  " << std::fixed << std::setprecision(0) << elapsed << " s";
+    s << "\r" << label << " [" << std::string(filled, '#') << std::string(kWidth - filled, '.') << "] " << done << "/"
+      << n << "  " << std::fixed << std::setprecision(0) << elapsed << " s";
     if (done > 0 && done < n) s << ", about " << elapsed / done * (n - done) << " s left";
     *progress << s.str() << std::flush;
   };
@@ -71,7 +71,7 @@ Result<std::vector<CaseResult>> RunPhase(const std::vector<Platform>& platforms,
                                          std::ostream* progress) {
   std::mt19937_64 rng(draw_seed);
   std::vector<Draw> draws;
-  for (int i = 0; i < n; ++i)   // all drawn first: independent of scheduling
+  for (int i = 0; i < n; ++i)  // all drawn first: independent of scheduling
     draws.push_back(DrawCase(rng, stratified ? CalibrationKind(i) : std::string()));
   std::vector<CaseResult> results(static_cast<std::size_t>(n));
   const Status st = RunParallel(n, jobs, label, progress, [&](int i) -> Result<std::string> {
@@ -130,7 +130,8 @@ Result<Calibration> Calibrate(const BenchmarkOptions& options, const std::vector
   out.sigmas = CalibrationSigmas(cases.value());
   json rows = json::array();
   for (CaseResult& c : cases.value()) {
-    if (c.kind == "effect") c.noise_ratio = NoiseRatio(out.sigmas, c.platform, c.truth_name, c.truth_parameter, c.truth_value);
+    if (c.kind == "effect")
+      c.noise_ratio = NoiseRatio(out.sigmas, c.platform, c.truth_name, c.truth_parameter, c.truth_value);
     json row = CaseRow(c);
     row["replayed_first_round"] = ReplayFirstRound(c.candidates, out.chosen);
     rows.push_back(row);
@@ -155,10 +156,9 @@ Result<Calibration> Calibrate(const BenchmarkOptions& options, const std::vector
 
 Result<std::vector<Platform>> LoadPlatforms(const BenchmarkOptions& options) {
   std::vector<Platform> platforms;
-  for (const auto& [name, path, kind] :
-       {std::make_tuple("atv", options.atv_scenario, "ackermann"),
-        std::make_tuple("diffdrive", options.diffdrive_scenario, "differential_drive"),
-        std::make_tuple("mecanum", options.mecanum_scenario, "mecanum")}) {
+  for (const auto& [name, path, kind] : {std::make_tuple("atv", options.atv_scenario, "ackermann"),
+                                         std::make_tuple("diffdrive", options.diffdrive_scenario, "differential_drive"),
+                                         std::make_tuple("mecanum", options.mecanum_scenario, "mecanum")}) {
     auto p = LoadPlatform(name, path, kind, options.duration_s);
     if (!p.ok()) return p.status();
     platforms.push_back(std::move(p).value());
@@ -192,22 +192,23 @@ Result<json> RunBenchmark(const BenchmarkOptions& options, std::vector<Platform>
   }
   const double scored_s = SecondsSince(scored_start);
   const double total_s = SecondsSince(start);
-  json score = {{"seed", options.seed},
-              {"jobs", options.jobs},
-              {"duration_s",
-               {{"atv", platforms[0].scenario.duration_s},
-                {"diffdrive", platforms[1].scenario.duration_s},
-                {"mecanum", platforms[2].scenario.duration_s}}},
-              {"figures", Summarize(scored.value())},
-              {"thresholds", calibration.value().thresholds},
-              {"calibration", calibration.value().section},
-              {"cases", rows},
-              {"seconds",
-               {{"total", total_s},
-                {"baselines", baseline_s},
-                {"calibration", calibration_s},
-                {"scored", scored_s},
-                {"extrapolated_total_for_60_scored_cases", baseline_s + calibration_s + scored_s / options.cases * 60.0}}}};
+  json score = {
+      {"seed", options.seed},
+      {"jobs", options.jobs},
+      {"duration_s",
+       {{"atv", platforms[0].scenario.duration_s},
+        {"diffdrive", platforms[1].scenario.duration_s},
+        {"mecanum", platforms[2].scenario.duration_s}}},
+      {"figures", Summarize(scored.value())},
+      {"thresholds", calibration.value().thresholds},
+      {"calibration", calibration.value().section},
+      {"cases", rows},
+      {"seconds",
+       {{"total", total_s},
+        {"baselines", baseline_s},
+        {"calibration", calibration_s},
+        {"scored", scored_s},
+        {"extrapolated_total_for_60_scored_cases", baseline_s + calibration_s + scored_s / options.cases * 60.0}}}};
   return score;
 }
 

@@ -28,18 +28,18 @@
 
 namespace roamlab::gap::benchmark {
 
-inline constexpr int kMaxCases = 500;   // per phase: the calibration seeds start 500 after the scored ones
+inline constexpr int kMaxCases = 500;  // per phase: the calibration seeds start 500 after the scored ones
 
 struct BenchmarkOptions {
-  int cases = 16;                  // scored cases, in [1, kMaxCases]
-  int calibration_cases = 8;       // in [1, kMaxCases]
+  int cases = 16;             // scored cases, in [1, kMaxCases]
+  int calibration_cases = 8;  // in [1, kMaxCases]
   std::uint64_t seed = 1;
-  int jobs = 2;                    // cases run in parallel
-  double duration_s = 0.0;         // 0: the scenarios' own
+  int jobs = 2;             // cases run in parallel
+  double duration_s = 0.0;  // 0: the scenarios' own
   std::string atv_scenario = "scenarios/atv_hills_sines.yaml";
   std::string diffdrive_scenario = "scenarios/indoor_diffdrive_gap.yaml";
   std::string mecanum_scenario = "scenarios/indoor_mecanum_gap.yaml";
-  std::string out;                 // output directory (exists)
+  std::string out;  // output directory (exists)
 };
 
 // The three platforms (atv, diffdrive, mecanum), in that order. Errors name the scenario file.

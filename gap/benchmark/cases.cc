@@ -207,10 +207,10 @@ void RecordDiagnosis(const Diagnosis& d, CaseResult* c) {
   c->verdict = d.verdict;
   for (const EffectEstimate& e : d.effects) c->named.push_back(e.name);
   c->ranked = c->named;
-  for (const EffectEstimate& e : d.candidates) {   // in order of Delta BIC
+  for (const EffectEstimate& e : d.candidates) {  // in order of Delta BIC
     if (std::find(c->ranked.begin(), c->ranked.end(), e.name) == c->ranked.end()) c->ranked.push_back(e.name);
-    CandidateStats stats{e.name, e.lr_pvalue, e.delta_bic, e.evaluated_heldout, e.heldout_improvement,
-                         e.std, e.explained_share};
+    CandidateStats stats{e.name, e.lr_pvalue,      e.delta_bic, e.evaluated_heldout, e.heldout_improvement,
+                         e.std,  e.explained_share};
     c->candidates.push_back(stats);
   }
 }
@@ -332,9 +332,8 @@ Result<CaseResult> RunCase(const Platform& platform, const Draw& draw, std::uint
   auto blind = DiagnoseBlind(platform, rec_dir, setup);
   if (!blind.ok()) return blind.status();
   const BlindDiagnosis& b = blind.value();
-  std::ofstream(dir + "/gap.json") << DiagnosisJson(b.diagnosis, &platform.baseline, kDefaultBaselineSeed,
-                                                    &b.simulation).dump(2)
-                                   << "\n";
+  std::ofstream(dir + "/gap.json")
+      << DiagnosisJson(b.diagnosis, &platform.baseline, kDefaultBaselineSeed, &b.simulation).dump(2) << "\n";
   CaseResult c;
   c.id = id;
   c.platform = platform.name;

@@ -17,11 +17,11 @@ namespace roamlab::gap::benchmark {
 
 // A robot of the benchmark: its nominal scenario (no effects), nominal configuration and learned baseline.
 struct Platform {
-  std::string name;                            // atv | diffdrive | mecanum
+  std::string name;  // atv | diffdrive | mecanum
   sim::Scenario scenario;
   estimator::EstimatorConfig config;
   Baseline baseline;
-  double rear_compliance_s = 0.0;              // ATV: the nominal drive's cornering compliance, on its truth
+  double rear_compliance_s = 0.0;  // ATV: the nominal drive's cornering compliance, on its truth
 };
 
 // Loads the scenario at `path` (a robot of kind `kind`), its effects removed and its duration set to `duration_s`
@@ -31,10 +31,10 @@ Result<Platform> LoadPlatform(const std::string& name, const std::string& path, 
 
 // One drawn case: the platform, the kind and the effect hidden in its scenario (empty name: none).
 struct Draw {
-  int platform = 0;                            // index into the platforms
-  std::string kind;                            // none | effect | decoy
+  int platform = 0;  // index into the platforms
+  std::string kind;  // none | effect | decoy
   sim::EffectOptions effect;
-  std::string parameter;                       // the parameter drawn away from neutral
+  std::string parameter;  // the parameter drawn away from neutral
 };
 
 // Draws a case: platform 0 is the ATV (half of the cases: its library is the largest), 1 the differential drive and

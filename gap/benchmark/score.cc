@@ -117,16 +117,16 @@ Thresholds ChooseThresholds(const std::vector<CaseResult>& calibration, double m
         p.decoy_false += FalseDiscovery(c, kept);
       }
     }
-    p.feasible = within(p.none_false, p.nones, max_none_false_rate) &&
-                 within(p.decoy_false, p.decoys, max_decoy_false_rate);
+    p.feasible =
+        within(p.none_false, p.nones, max_none_false_rate) && within(p.decoy_false, p.decoys, max_decoy_false_rate);
     points.push_back(p);
   }
   const bool any_feasible = std::any_of(points.begin(), points.end(), [](const Point& p) { return p.feasible; });
   const auto key = [&](const Point& p) {
     return std::make_tuple(!(p.feasible || !any_feasible), -p.correct, distance(p.t), p.t.alpha, p.t.max_delta_bic);
   };
-  const Point& best = *std::min_element(points.begin(), points.end(),
-                                        [&](const Point& a, const Point& b) { return key(a) < key(b); });
+  const Point& best =
+      *std::min_element(points.begin(), points.end(), [&](const Point& a, const Point& b) { return key(a) < key(b); });
   if (table) {
     *table = json::array();
     for (const Point& p : points)
@@ -174,8 +174,8 @@ double RearCorneringCompliance(const Trajectory& truth) {
     if (t0 < 2.0 || !(dt > 0.0)) continue;
     const Eigen::AngleAxisd turn(truth[k].q_world_body.conjugate() * truth[k + 1].q_world_body);
     const Eigen::Vector3d omega = turn.angle() * turn.axis() / dt;
-    const Eigen::Quaterniond q_mid = truth[k].q_world_body * Eigen::Quaterniond(
-                                                                 Eigen::AngleAxisd(0.5 * turn.angle(), turn.axis()));
+    const Eigen::Quaterniond q_mid =
+        truth[k].q_world_body * Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * turn.angle(), turn.axis()));
     const Eigen::Vector3d v = q_mid.conjugate() * (truth[k + 1].p_world_body - truth[k].p_world_body) / dt;
     if (v.x() < 0.5) continue;
     rows.emplace_back(1.0, v.x() * omega.z(), omega.x());
@@ -204,7 +204,7 @@ struct Tally {
   // (per-sample RMS >= sqrt(2): the effect's trace at least the noise): below it, per-sample reductions are small
   // whatever the model does.
   std::vector<double> sim_above, rms_above, sim_below, rms_below;
-  std::map<std::string, std::pair<int, int>> by_effect;   // name -> (top-1 correct, cases)
+  std::map<std::string, std::pair<int, int>> by_effect;  // name -> (top-1 correct, cases)
 };
 
 // 1 - after / before into `all`, and into `named` when the case's effect was identified (`first`).

@@ -34,7 +34,7 @@ struct CandidateStats {
   double delta_bic = 0.0;
   bool evaluated_heldout = false;
   double heldout_improvement = 0.0;
-  std::map<std::string, double> std;      // reported standard deviations (NaN when unknown)
+  std::map<std::string, double> std;  // reported standard deviations (NaN when unknown)
   // The share of the held-out mismatch it explains (ExplainedShare; NaN: not evaluated).
   double explained_share = std::numeric_limits<double>::quiet_NaN();
 };
@@ -49,25 +49,25 @@ struct Thresholds {
 // One benchmark case: what was hidden, what the diagnosis said, and the figures scored from truth.yaml.
 struct CaseResult {
   std::string id;
-  std::string platform;                    // atv | diffdrive | mecanum
-  std::string kind;                        // none | effect | decoy
-  std::string truth_name;                  // empty for none
-  std::string truth_parameter;             // the parameter drawn away from neutral (effect, decoy)
+  std::string platform;         // atv | diffdrive | mecanum
+  std::string kind;             // none | effect | decoy
+  std::string truth_name;       // empty for none
+  std::string truth_parameter;  // the parameter drawn away from neutral (effect, decoy)
   double truth_value = 0.0;
-  double noise_ratio = -1.0;               // |truth - neutral| / sigma; < 0 when not defined
-  std::string verdict;                     // named | unknown | none
-  std::vector<std::string> named;          // accepted effects, in order
-  std::vector<std::string> ranked;         // accepted effects, then the other first-round candidates by Delta BIC
-  double estimate = 0.0;                   // the diagnosis's value of truth_parameter, when the truth was named
+  double noise_ratio = -1.0;        // |truth - neutral| / sigma; < 0 when not defined
+  std::string verdict;              // named | unknown | none
+  std::vector<std::string> named;   // accepted effects, in order
+  std::vector<std::string> ranked;  // accepted effects, then the other first-round candidates by Delta BIC
+  double estimate = 0.0;            // the diagnosis's value of truth_parameter, when the truth was named
   bool has_estimate = false;
-  double rms_before = 0.0, rms_after = 0.0;   // held-out whitened RMS of the affected stream
-  double rms_1s_before = 0.0, rms_1s_after = 0.0;   // its systematic part (StreamFit::rms_1s)
+  double rms_before = 0.0, rms_after = 0.0;        // held-out whitened RMS of the affected stream
+  double rms_1s_before = 0.0, rms_1s_after = 0.0;  // its systematic part (StreamFit::rms_1s)
   bool has_rms = false;
   // The re-simulation's (gap/resimulate.h): RMS of recorded minus simulated in the stream the effect shows in
   // (SimulatedStream), in units of its stated noise, on the held-out part, as believed and with the accepted effects.
   std::string sim_stream;
   double sim_rms_before = 0.0, sim_rms_after = 0.0;
-  double sim_rms_1s_before = 0.0, sim_rms_1s_after = 0.0;   // of its 1 s means
+  double sim_rms_1s_before = 0.0, sim_rms_1s_after = 0.0;  // of its 1 s means
   bool has_sim_rms = false;
   std::vector<CandidateStats> candidates;  // first round
   double seconds = 0.0;

@@ -56,9 +56,9 @@ int NearestPoint(const std::map<int, SearchPoint>& points, int k);
 struct TrainingFits {
   const estimator::EstimatorConfig& nominal;
   const recording::Recording& train;
-  double period = 0.01;    // the master stream's sample period [s]
-  double margin_s = 0.0;   // the time-shift range (DiagnoseOptions::max_shift_s)
-  int* fits = nullptr;     // incremented by every fit
+  double period = 0.01;   // the master stream's sample period [s]
+  double margin_s = 0.0;  // the time-shift range (DiagnoseOptions::max_shift_s)
+  int* fits = nullptr;    // incremented by every fit
   std::function<void(const std::string&)> progress;
 
   // Fits the training part as `spec` says, counting the fit.

@@ -55,9 +55,9 @@ class HeldoutEvaluator {
 // What a round's candidates are judged against.
 struct RoundRules {
   const DiagnoseOptions& options;
-  const State& state;                                    // the effects kept so far
-  const std::vector<std::string>& located_keys;          // the components Locate found inconsistent
-  const std::map<std::string, double>& heldout_levels;   // the nominal model's held-out level per component
+  const State& state;                                   // the effects kept so far
+  const std::vector<std::string>& located_keys;         // the components Locate found inconsistent
+  const std::map<std::string, double>& heldout_levels;  // the nominal model's held-out level per component
   // The held-out chi2 of the nominal model: the share is of the effects kept so far and the candidate together
   // (their held-out drop from the nominal model), so that a later effect that refines an explained mismatch is not
   // judged against the whole remainder alone.

@@ -19,7 +19,7 @@ namespace roamlab::gap::internal {
 // One candidate of the library, as it applies to a configuration.
 struct Candidate {
   std::string name;
-  std::string stream;                        // configured stream whose dispersion scales its statistic
+  std::string stream;  // configured stream whose dispersion scales its statistic
   // A parameter-slot effect: estimator parameters freed, and how their values become the effect's parameters.
   std::vector<std::string> free;
   std::function<void(const std::map<std::string, Eigen::VectorXd>& value,
@@ -30,8 +30,8 @@ struct Candidate {
   // stamps moving by whole master periods only when the offset is beyond the first-order model's range.
   std::vector<std::string> shifted;
   std::string shift_parameter;
-  double guess_s = 0.0;                      // first guess of the shift
-  int free_dof = 0;                          // tangent dimension of `free`
+  double guess_s = 0.0;  // first guess of the shift
+  int free_dof = 0;      // tangent dimension of `free`
 };
 
 // The candidates of CandidateNames() that apply to `config`, in that order.
@@ -39,7 +39,8 @@ std::vector<Candidate> Library(const estimator::EstimatorConfig& config);
 
 // Sets the gps_latency candidate's first guess from the nominal fit's residuals: the fix stamped t is p(t - tau), so
 // e = z_hat - z ~ tau v(t) (eq. 9), and tau is the least-squares slope of the residuals on the horizontal velocity.
-void GuessGpsLatency(const estimator::EstimatorConfig& config, const std::vector<estimator::MeasurementResidual>& residuals,
-                     const Conditions& conditions, std::vector<Candidate>* library);
+void GuessGpsLatency(const estimator::EstimatorConfig& config,
+                     const std::vector<estimator::MeasurementResidual>& residuals, const Conditions& conditions,
+                     std::vector<Candidate>* library);
 
 }  // namespace roamlab::gap::internal

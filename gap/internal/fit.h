@@ -20,26 +20,26 @@ namespace roamlab::gap::internal {
 
 // How the fit treats the calibration parameters.
 enum class FitMode {
-  kStaged,   // the configuration's stages from its initial values
-  kWarm,     // one stage, every free parameter plus the candidate's, from given values
-  kFixed,    // every parameter fixed at given values; poses only
+  kStaged,  // the configuration's stages from its initial values
+  kWarm,    // one stage, every free parameter plus the candidate's, from given values
+  kFixed,   // every parameter fixed at given values; poses only
 };
 
 struct FitSpec {
   FitMode mode = FitMode::kStaged;
-  std::map<std::string, Eigen::VectorXd> values;   // warm / fixed values (names absent: the configuration's)
-  std::set<std::string> extra_free;                 // freed on top of the configuration's free parameters
-  std::map<std::string, double> shift_s;            // recording stream -> seconds subtracted from its stamps
+  std::map<std::string, Eigen::VectorXd> values;  // warm / fixed values (names absent: the configuration's)
+  std::set<std::string> extra_free;               // freed on top of the configuration's free parameters
+  std::map<std::string, double> shift_s;          // recording stream -> seconds subtracted from its stamps
   bool keep_residuals = false;
   bool observability = false;
-  const Trajectory* initial = nullptr;              // warm-start poses (estimator/calibration.h)
+  const Trajectory* initial = nullptr;  // warm-start poses (estimator/calibration.h)
 };
 
 struct FitOutcome {
   double chi2 = 0.0;
   int measurements = 0;
-  std::map<std::string, Eigen::VectorXd> values;   // every configured parameter (free ones estimated)
-  std::map<std::string, Eigen::VectorXd> std;      // free ones, when observability was asked for
+  std::map<std::string, Eigen::VectorXd> values;  // every configured parameter (free ones estimated)
+  std::map<std::string, Eigen::VectorXd> std;     // free ones, when observability was asked for
   std::vector<estimator::MeasurementResidual> residuals;
   Trajectory trajectory;
 };

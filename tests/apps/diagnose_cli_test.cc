@@ -44,15 +44,14 @@ std::string Scenario(const testing::TempDir& dir, double duration_s, const std::
 
 TEST(DiagnoseCliTest, NeverOpensTruthYamlAndWritesGapJson) {
   testing::TempDir dir;
-  const std::string scenario =
-      Scenario(dir, 6.0, "[{name: steering_offset, parameters: {offset_rad: 0.03}}]");
+  const std::string scenario = Scenario(dir, 6.0, "[{name: steering_offset, parameters: {offset_rad: 0.03}}]");
   ASSERT_EQ(Roamlab("simulate " + scenario + " --out " + dir.File("rec") + " --quiet", dir).exit_code, 0);
   // What a reader of truth.yaml would refuse (and what would give the effect away).
   testing::WriteFile(dir.File("rec/truth.yaml"), "{{{ not yaml: [steering_offset");
-  const CommandRun run = Roamlab("diagnose --real " + dir.File("rec") + " --scenario " +
-                                     Source("scenarios/atv_hills.yaml") + " --out " + dir.File("out") +
-                                     " --no-baseline --quiet",
-                                 dir);
+  const CommandRun run =
+      Roamlab("diagnose --real " + dir.File("rec") + " --scenario " + Source("scenarios/atv_hills.yaml") + " --out " +
+                  dir.File("out") + " --no-baseline --quiet",
+              dir);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   std::ifstream in(dir.File("out/gap.json"));
   ASSERT_TRUE(in.good());
@@ -109,8 +108,7 @@ TEST(DiagnoseCliTest, RefusesAShiftRangeTheRecordingCannotHold) {
                                    dir);
     EXPECT_EQ(run.exit_code, 2) << shift;
     // The limit is 1/12 of the 1.5 s span, about 0.125 s.
-    EXPECT_NE(run.err.find("roamlab diagnose: --max-shift " + shift +
-                           " s: must be above 0 and below 0.12"),
+    EXPECT_NE(run.err.find("roamlab diagnose: --max-shift " + shift + " s: must be above 0 and below 0.12"),
               std::string::npos)
         << run.err;
     EXPECT_NE(run.err.find(" s, 1/12 of " + dir.File("rec") + "'s span"), std::string::npos) << run.err;

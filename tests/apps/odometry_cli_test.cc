@@ -89,20 +89,23 @@ TEST_F(OdometryCliTest, LearnedModelsBeatTheNominalModelOnAnotherShape) {
   WriteRun(dir_ / "syn_run-02.csv", 1, 40.0);
   for (const char* run : {"01", "02"}) {
     const CommandRun r = Roamlab("import optiodom " + (dir_ / ("syn_run-" + std::string(run) + ".csv")).string() +
-                                 " --out " + (dir_ / ("rec" + std::string(run))).string() + " --quiet", dir_);
+                                     " --out " + (dir_ / ("rec" + std::string(run))).string() + " --quiet",
+                                 dir_);
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
   const std::string train = (dir_ / "rec01").string();
   for (const std::string model : {"linear", "parametric", "gp --mean linear --kernel rbf --max-pairs 300"}) {
     const std::string file = (dir_ / (model.substr(0, model.find(' ')) + ".json")).string();
-    const CommandRun r = Roamlab("odometry learn --recording " + train + " --model " + model +
-                                 " --interval 0.25 --out " + file + " --quiet", dir_);
+    const CommandRun r = Roamlab(
+        "odometry learn --recording " + train + " --model " + model + " --interval 0.25 --out " + file + " --quiet",
+        dir_);
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
-  const CommandRun r = Roamlab("odometry evaluate --model " + (dir_ / "linear.json").string() + " " +
-                               (dir_ / "parametric.json").string() + " " + (dir_ / "gp.json").string() +
-                               " --recording " + (dir_ / "rec02").string() + " --out " + (dir_ / "eval").string() +
-                               " --no-plots --quiet", dir_);
+  const CommandRun r =
+      Roamlab("odometry evaluate --model " + (dir_ / "linear.json").string() + " " +
+                  (dir_ / "parametric.json").string() + " " + (dir_ / "gp.json").string() + " --recording " +
+                  (dir_ / "rec02").string() + " --out " + (dir_ / "eval").string() + " --no-plots --quiet",
+              dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::ifstream in(dir_ / "eval" / "table.json");
   const nlohmann::json table = nlohmann::json::parse(in);
@@ -122,16 +125,16 @@ TEST_F(OdometryCliTest, LearnedModelsBeatTheNominalModelOnAnotherShape) {
 TEST_F(OdometryCliTest, MalformedOptiOdomFileGivesOneLineAndExitCode2) {
   WriteMetadata(dir_ / "bad_metadata.csv");
   std::ofstream(dir_ / "bad_run-01.csv") << "0,0,0,0,0,0\n0.05,0.001,0,0,3\n";
-  const CommandRun r = Roamlab("import optiodom " + (dir_ / "bad_run-01.csv").string() + " --out " +
-                               (dir_ / "rec").string(), dir_);
+  const CommandRun r =
+      Roamlab("import optiodom " + (dir_ / "bad_run-01.csv").string() + " --out " + (dir_ / "rec").string(), dir_);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_NE(r.err.find("bad_run-01.csv:2:"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "rec" / "recording.yaml"));
   // A metadata file of an unsupported robot type.
   std::ofstream(dir_ / "bad_metadata.csv") << "type,omni4,\nngear,12,\nencRes,1024,\nLi,0.2,\nDi,0.1,0.1,0.1,0.1,\n";
-  const CommandRun m = Roamlab("import optiodom " + (dir_ / "bad_run-01.csv").string() + " --out " +
-                               (dir_ / "rec").string(), dir_);
+  const CommandRun m =
+      Roamlab("import optiodom " + (dir_ / "bad_run-01.csv").string() + " --out " + (dir_ / "rec").string(), dir_);
   EXPECT_EQ(m.exit_code, 2);
   EXPECT_NE(m.err.find("bad_metadata.csv: type 'omni4' is not supported"), std::string::npos) << m.err;
 }
@@ -141,7 +144,8 @@ TEST_F(OdometryCliTest, ImportsARealOptiOdomRun) {
   const fs::path set = fs::path(ROAMLAB_SHARED_DIR) / "data/optiodom/data/diff/circular/231220200121";
   if (!fs::exists(set)) GTEST_SKIP() << "OptiOdom data not found at " << set << " (../shared/data absent)";
   const CommandRun r = Roamlab("import optiodom " + (set / "231220200121_run-01.csv").string() + " --out " +
-                               (dir_ / "rec").string() + " --quiet", dir_);
+                                   (dir_ / "rec").string() + " --quiet",
+                               dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::ifstream yaml(dir_ / "rec" / "recording.yaml");
   std::stringstream text;

@@ -27,21 +27,22 @@ TEST(DeformedOdometryTest, TapedWheelLearnedModelsBeatTheNominalModel) {
   testing::TempDir temp;
   const fs::path dir = temp.path();
   for (const std::string role : {"train", "test"}) {
-    const testing::CommandRun r =
-        Roamlab("simulate " + std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/deformed_f1_" + role + ".yaml --out " +
-                    (dir / role).string() + " --quiet", dir);
+    const testing::CommandRun r = Roamlab("simulate " + std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/deformed_f1_" +
+                                              role + ".yaml --out " + (dir / role).string() + " --quiet",
+                                          dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
   for (const std::string model : {"linear", "gp --mean zero --kernel linear"}) {
     const std::string file = (dir / (model == "linear" ? "linear.json" : "gp.json")).string();
     const testing::CommandRun r = Roamlab("odometry learn --recording " + (dir / "train").string() + " --model " +
-                                              model + " --interval 0.3 --out " + file + " --quiet", dir);
+                                              model + " --interval 0.3 --out " + file + " --quiet",
+                                          dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
-  const testing::CommandRun r =
-      Roamlab("odometry evaluate --model " + (dir / "linear.json").string() + " " + (dir / "gp.json").string() +
-                  " --recording " + (dir / "test").string() + " --out " + (dir / "eval").string() +
-                  " --no-plots --quiet", dir);
+  const testing::CommandRun r = Roamlab("odometry evaluate --model " + (dir / "linear.json").string() + " " +
+                                            (dir / "gp.json").string() + " --recording " + (dir / "test").string() +
+                                            " --out " + (dir / "eval").string() + " --no-plots --quiet",
+                                        dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::ifstream in(dir / "eval" / "table.json");
   const nlohmann::json table = nlohmann::json::parse(in);

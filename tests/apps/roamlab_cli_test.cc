@@ -39,12 +39,12 @@ class CliTest : public ::testing::Test {
 TEST_F(CliTest, CalibrateAndTrackWriteTheirOutputs) {
   roamlab::testing::SyntheticOptions options;
   options.duration_s = 5.0;
-  ASSERT_TRUE(recording::WriteRecording(roamlab::testing::MakeAtvRecording(options).recording,
-                                        (dir_ / "rec").string()).ok());
+  ASSERT_TRUE(
+      recording::WriteRecording(roamlab::testing::MakeAtvRecording(options).recording, (dir_ / "rec").string()).ok());
   const std::string config = std::string(ROAMLAB_SOURCE_DIR) + "/configs/atv_calibration.yaml";
-  CommandRun r = Roamlab("calibrate " + (dir_ / "rec").string() + " --config " + config + " --out " +
-                      (dir_ / "cal").string() + " --quiet",
-                  dir_);
+  CommandRun r = Roamlab(
+      "calibrate " + (dir_ / "rec").string() + " --config " + config + " --out " + (dir_ / "cal").string() + " --quiet",
+      dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::ifstream in(dir_ / "cal" / "calibration.json");
   const nlohmann::json cal = nlohmann::json::parse(in);

@@ -170,7 +170,7 @@ TEST(CalibrationTest, ResidualsAreTheWhitenedErrorsOfTheCostAndAWarmStartLandsOn
   EXPECT_NEAR(second.value().final_cost, first.value().final_cost, 1e-6 * first.value().final_cost);
   const ParameterEstimate& lever = Find(second.value(), "gps.lever_arm");
   EXPECT_NEAR((lever.estimate - Find(first.value(), "gps.lever_arm").estimate).norm(), 0.0, 1e-5);
-  EXPECT_TRUE(std::isnan(lever.std[0]));   // no observability analysis asked for
+  EXPECT_TRUE(std::isnan(lever.std[0]));  // no observability analysis asked for
 }
 
 TEST(CalibrationTest, PlanarDriveLeavesGpsLeverArmHeightUnobservable) {
@@ -343,14 +343,15 @@ TEST(GateOutliersTest, ABurstTakesItsNeighboursOutForOneRoundAndChanceSwitchesAr
   EXPECT_TRUE(lone_rejected);
 }
 
-// A pass that rejects nothing (or only as many factors as chance explains) re-admits the factors that fit again and says
-// the set has settled, so that the calibration's rounds stop without another re-solve and pass; one that rejects a
+// A pass that rejects nothing (or only as many factors as chance explains) re-admits the factors that fit again and
+// says the set has settled, so that the calibration's rounds stop without another re-solve and pass; one that rejects a
 // gross outlier has not settled, whatever else it re-admits.
 TEST(GateOutliersTest, APassThatOnlyReadmitsHasSettled) {
   roamlab::testing::SyntheticOptions options;
   options.duration_s = 8.0;
   const EstimatorConfig config = testing::AtvConfig({});
-  // Every 40th odometer factor (from the 8th) switched off by hand (as a burst's margin does for one round): they fit the estimate.
+  // Every 40th odometer factor (from the 8th) switched off by hand (as a burst's margin does for one round): they fit
+  // the estimate.
   const auto switch_off_good_rows = [](ProblemBuilder* builder) {
     std::vector<FactorId> ids;
     for (const auto& [id, entry] : builder->graph().factors())

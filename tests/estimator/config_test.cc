@@ -60,8 +60,8 @@ TEST(ConfigTest, ProcessSigmaAndTauAreOneNumberOrOnePerComponent) {
   EXPECT_TRUE(gm.tau_s.isApprox(Eigen::Vector3d(0.7, 1.2, 1.8)));
   config = ParseEstimatorConfig(parameter("{type: random_walk, sigma: 1.0e-4}"), "est.yaml");
   ASSERT_TRUE(config.ok()) << config.status().message();
-  EXPECT_TRUE(config.value().parameters.at("odometer.disturbance").process.sigma.isApprox(
-      Eigen::Vector3d::Constant(1.0e-4)));
+  EXPECT_TRUE(
+      config.value().parameters.at("odometer.disturbance").process.sigma.isApprox(Eigen::Vector3d::Constant(1.0e-4)));
   ExpectError(parameter("{type: gauss_markov, sigma: [0.006, 0.002], tau_s: 1.0}"), "a list of 3 numbers");
   ExpectError(parameter("{type: gauss_markov, sigma: 0.01, tau_s: [0.7, -1.2, 1.8]}"), "tau_s must be positive");
   ExpectError(parameter("{type: gauss_markov, sigma: [0.01, 0, 0.01], tau_s: 1.0}"), "sigma must be positive");
@@ -78,8 +78,8 @@ TEST(ConfigTest, ProcessIntervalIsAPositiveNumberOfSeconds) {
   auto config = ParseEstimatorConfig(parameter("{type: gauss_markov, sigma: 0.01, tau_s: 1.0}"), "est.yaml");
   ASSERT_TRUE(config.ok()) << config.status().message();
   EXPECT_EQ(config.value().parameters.at("odometer.disturbance").process.interval_s, 0.0);
-  config = ParseEstimatorConfig(parameter("{type: gauss_markov, sigma: 0.01, tau_s: 1.0, interval_s: 0.1}"),
-                                "est.yaml");
+  config =
+      ParseEstimatorConfig(parameter("{type: gauss_markov, sigma: 0.01, tau_s: 1.0, interval_s: 0.1}"), "est.yaml");
   ASSERT_TRUE(config.ok()) << config.status().message();
   EXPECT_DOUBLE_EQ(config.value().parameters.at("odometer.disturbance").process.interval_s, 0.1);
   config = ParseEstimatorConfig(parameter("{type: random_walk, sigma: 1.0e-4, interval_s: 0.5}"), "est.yaml");
@@ -98,8 +98,8 @@ TEST(ConfigTest, ProcessIntervalIsAPositiveNumberOfSeconds) {
 TEST(ConfigTest, MagnetometerTakesTheSpecificForceInput) {
   const std::string good = testing::AtvConfigYaml({});
   const std::string mag = "options: {field_world: [0.0, 0.5, -0.8660254037844386]}";
-  const auto config = ParseEstimatorConfig(
-      Replace(good, mag, mag + ",\n                 inputs: {specific_force: imu}"), "est.yaml");
+  const auto config =
+      ParseEstimatorConfig(Replace(good, mag, mag + ",\n                 inputs: {specific_force: imu}"), "est.yaml");
   ASSERT_TRUE(config.ok()) << config.status().message();
   EXPECT_EQ(config.value().streams.at("magnetometer").inputs.at("specific_force"), "imu");
   EXPECT_TRUE(config.value().streams.at("gps").inputs.empty());

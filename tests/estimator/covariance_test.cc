@@ -33,10 +33,7 @@ TEST(ObservabilityTest, ClassifiesNullAndWeakDirections) {
   // Component 0 well determined; components 1 and 2 only through their sum (a null direction); component 3 nearly
   // collinear with component 0.
   Eigen::MatrixXd J(4, 4);
-  J << 1, 0, 0, 0,
-       0, 1, 1, 0,
-       0, 2, 2, 0,
-       1, 0, 0, 1.001;
+  J << 1, 0, 0, 0, 0, 1, 1, 0, 0, 2, 2, 0, 1, 0, 0, 1.001;
   Eigen::MatrixXd H = J.transpose() * J;
   H(0, 0) += 1.0;
   const ObservabilityAnalysis a = AnalyzeObservability(H, H.diagonal());

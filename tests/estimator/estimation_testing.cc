@@ -11,8 +11,10 @@ std::string AtvConfigYaml(const std::vector<std::string>& free, int window) {
   // Nominal (initial) values for free parameters, true values (synthetic defaults) for fixed ones.
   const std::map<std::string, std::pair<std::string, std::string>> values = {
       {"gps.lever_arm", {"[0, 0, 0]", "[0.57, -0.46, 0.32]"}},
-      {"imu.misalignment", {"[1, 0, 0, 0]", "[0.9382604033979289, 0.1040288720185337, 0.31308689367116393, "
-                                             "0.1040288720185337]"}},
+      {"imu.misalignment",
+       {"[1, 0, 0, 0]",
+        "[0.9382604033979289, 0.1040288720185337, 0.31308689367116393, "
+        "0.1040288720185337]"}},
       {"magnetometer.A", {"[1, 0, 0, 0, 1, 0, 0, 0, 1]", "[0.87, -0.02, -0.02, 0, 0.88, 0, -0.02, -0.04, 0.85]"}},
       {"magnetometer.b", {"[0, 0, 0]", "[-0.008, -0.007, -0.04]"}},
       {"odometer.kv_over_L", {"0.8", "0.8"}},
@@ -20,15 +22,17 @@ std::string AtvConfigYaml(const std::vector<std::string>& free, int window) {
       {"odometer.k_gamma", {"0.0", "0.0"}},
       {"imu.time_offset_s", {"0.0", "0.0"}},
   };
-  std::string yaml = "master: odometer\n"
-                     "solver: {method: levenberg_marquardt, max_iterations: 100, function_tolerance: 1.0e-9}\n"
-                     "tracking: {window: " + std::to_string(window) +
-                     ", max_iterations: 5, improvement_threshold: 1.0e-3, time_budget_s: 1.0, initialization_s: 1.0}\n"
-                     "parameters:\n";
+  std::string yaml =
+      "master: odometer\n"
+      "solver: {method: levenberg_marquardt, max_iterations: 100, function_tolerance: 1.0e-9}\n"
+      "tracking: {window: " +
+      std::to_string(window) +
+      ", max_iterations: 5, improvement_threshold: 1.0e-3, time_budget_s: 1.0, initialization_s: 1.0}\n"
+      "parameters:\n";
   for (const auto& [name, v] : values) {
     const bool is_free = std::find(free.begin(), free.end(), name) != free.end();
-    yaml += "  " + name + ": {value: " + (is_free ? v.first : v.second) + ", free: " + (is_free ? "true" : "false") +
-            "}\n";
+    yaml +=
+        "  " + name + ": {value: " + (is_free ? v.first : v.second) + ", free: " + (is_free ? "true" : "false") + "}\n";
   }
   yaml += R"(streams:
   odometer:

@@ -104,7 +104,9 @@ void ExpectJacobiansMatchNumeric(const Factor& factor, const std::vector<Eigen::
   for (std::size_t i = 0; i < values.size(); ++i) {
     const double scale = std::max(1.0, numeric[i].cwiseAbs().maxCoeff());
     EXPECT_LE((lin.jacobians[i] - numeric[i]).cwiseAbs().maxCoeff(), tolerance * scale)
-        << "variable " << i << "\nanalytic\n" << lin.jacobians[i] << "\nnumeric\n" << numeric[i];
+        << "variable " << i << "\nanalytic\n"
+        << lin.jacobians[i] << "\nnumeric\n"
+        << numeric[i];
   }
 }
 
@@ -251,8 +253,8 @@ Eigen::VectorXd ExpectWithinSigmas(const Graph& graph, const std::vector<Variabl
     const Eigen::VectorXd error = TangentError(graph, variables[i], truth[i]);
     const Eigen::VectorXd s = sigma.segment(info.value().offsets[i], error.size());
     for (int c = 0; c < error.size(); ++c) {
-      EXPECT_LT(std::abs(error[c]), k * s[c]) << graph.variable(variables[i]).name << " component " << c
-                                              << ": error " << error.transpose() << ", sigma " << s.transpose();
+      EXPECT_LT(std::abs(error[c]), k * s[c]) << graph.variable(variables[i]).name << " component " << c << ": error "
+                                              << error.transpose() << ", sigma " << s.transpose();
     }
   }
   return sigma;

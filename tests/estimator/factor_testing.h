@@ -6,15 +6,15 @@
 
 #include <cstdint>
 #include <functional>
-#include <tuple>
 #include <random>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
+#include <gtest/gtest.h>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <gtest/gtest.h>
 
 #include "estimator/factor.h"
 #include "estimator/graph.h"
@@ -212,8 +212,8 @@ SmallProblem AckermannProblem(bool noisy, std::uint32_t seed) {
   constexpr bool kCornering = std::tuple_size_v<typename Model::Blocks> == 11;
   std::vector<VariableId> compliances;
   if constexpr (kCornering) {
-    for (const char* name : {"cornering_front", "cornering_rear", "thrust_angle", "slip_per_mps2",
-                             "slope_slip_per_mps2"})
+    for (const char* name :
+         {"cornering_front", "cornering_rear", "thrust_angle", "slip_per_mps2", "slope_slip_per_mps2"})
       compliances.push_back(problem.graph.AddVariable({name, Manifold::Euclidean(1), scalar(0.0), true, std::nullopt}));
     compliances.push_back(problem.graph.AddVariable(
         {"disturbance", Manifold::Euclidean(3), Eigen::VectorXd::Zero(3), true, std::nullopt}));

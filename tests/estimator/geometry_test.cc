@@ -84,9 +84,9 @@ TEST(GeometryConventionsTest, BoxPlusIsARightPerturbationInTheBodyFrame) {
   delta << 1.0, -2.0, 0.5, d;
   const Eigen::VectorXd pose_plus = testing::Plus(Manifold::Pose(), pose, delta);
   EXPECT_LE((pose_plus.head<3>() - (pose.head<3>() + delta.head<3>())).norm(), kRoundingUlps * kEpsilon * 5.0);
-  EXPECT_LE(QuaternionDistance(QuaternionFromArray(pose_plus.data() + 3),
-                               QuaternionFromArray(pose.data() + 3) * Exp(d)),
-            kRoundingUlps * kEpsilon);
+  EXPECT_LE(
+      QuaternionDistance(QuaternionFromArray(pose_plus.data() + 3), QuaternionFromArray(pose.data() + 3) * Exp(d)),
+      kRoundingUlps * kEpsilon);
 
   // Box-minus: x [-] y = (p_x - p_y, Log(q_y^-1 q_x)).
   const Eigen::VectorXd other = testing::RandomPoint(Manifold::Pose(), &rng, 5.0);
@@ -283,8 +283,8 @@ TEST(GeometryTest, VelocitiesBetweenInvertsPredictPose) {
 TEST(GeometryTest, SensorToBodyVelocityIsTheRigidBodyRelation) {
   std::mt19937 rng(29);
   for (int trial = 0; trial < 4; ++trial) {
-    const Eigen::Quaterniond q_body_sensor = QuaternionFromArray(
-        testing::RandomPoint(Manifold::UnitQuaternion(), &rng).data());
+    const Eigen::Quaterniond q_body_sensor =
+        QuaternionFromArray(testing::RandomPoint(Manifold::UnitQuaternion(), &rng).data());
     const Eigen::Vector3d p_body_sensor = testing::GaussianNoise(3, 1.0, &rng);
     const Eigen::Vector3d v_sensor = testing::GaussianNoise(3, 3.0, &rng);
     const Eigen::Vector3d omega_sensor = testing::GaussianNoise(3, 1.0, &rng);

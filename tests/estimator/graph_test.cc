@@ -17,8 +17,8 @@ namespace {
 // own model.
 TEST(GraphTest, FactorsWithTheSameNoiseCovarianceShareOneModel) {
   Graph graph;
-  const VariableId pose = graph.AddVariable(
-      {"pose", Manifold::Pose(), Manifold::Pose().Identity(), false, Time::FromSeconds(0.0)});
+  const VariableId pose =
+      graph.AddVariable({"pose", Manifold::Pose(), Manifold::Pose().Identity(), false, Time::FromSeconds(0.0)});
   const VariableId lever = graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), true, {}});
   const auto add = [&](const Eigen::Matrix3d& covariance) {
     const FactorId id = graph.AddFactor(MakeFactor(GpsError(Eigen::Vector3d::Zero())), {pose, lever}, covariance,
@@ -46,8 +46,8 @@ TEST(GraphTest, FactorsWithTheSameNoiseCovarianceShareOneModel) {
 
 TEST(GraphDeathTest, NoiseCovarianceThatIsNotPositiveDefiniteIsRefused) {
   Graph graph;
-  const VariableId pose = graph.AddVariable(
-      {"pose", Manifold::Pose(), Manifold::Pose().Identity(), false, Time::FromSeconds(0.0)});
+  const VariableId pose =
+      graph.AddVariable({"pose", Manifold::Pose(), Manifold::Pose().Identity(), false, Time::FromSeconds(0.0)});
   const VariableId lever = graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), true, {}});
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
   graph.AddFactor(MakeFactor(GpsError(Eigen::Vector3d::Zero())), {pose, lever}, covariance, Loss::Trivial(), "gps",
@@ -61,8 +61,8 @@ TEST(GraphDeathTest, NoiseCovarianceThatIsNotPositiveDefiniteIsRefused) {
 // A small graph: a pose and a fixed lever arm, each GPS factor on both.
 struct PoseAndLever {
   Graph graph;
-  VariableId pose = graph.AddVariable(
-      {"pose", Manifold::Pose(), Manifold::Pose().Identity(), false, Time::FromSeconds(0.0)});
+  VariableId pose =
+      graph.AddVariable({"pose", Manifold::Pose(), Manifold::Pose().Identity(), false, Time::FromSeconds(0.0)});
   VariableId lever = graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), true, {}});
 
   FactorId AddGps(const std::string& stream = "gps") {

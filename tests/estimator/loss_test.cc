@@ -28,9 +28,12 @@ std::vector<Loss> AllLosses() {
 
 const char* Name(const Loss& loss) {
   switch (loss.type) {
-    case Loss::Type::kTrivial: return "trivial";
-    case Loss::Type::kHuber: return "huber";
-    case Loss::Type::kCauchy: return "cauchy";
+    case Loss::Type::kTrivial:
+      return "trivial";
+    case Loss::Type::kHuber:
+      return "huber";
+    case Loss::Type::kCauchy:
+      return "cauchy";
   }
   return "?";
 }

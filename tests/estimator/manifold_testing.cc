@@ -9,9 +9,12 @@ namespace {
 // Offset of the rotation part in the ambient and tangent vectors, or -1 for a Euclidean manifold.
 int RotationAmbientOffset(const Manifold& manifold) {
   switch (manifold.kind()) {
-    case ManifoldKind::kEuclidean: return -1;
-    case ManifoldKind::kQuaternion: return 0;
-    case ManifoldKind::kPose: return 3;
+    case ManifoldKind::kEuclidean:
+      return -1;
+    case ManifoldKind::kQuaternion:
+      return 0;
+    case ManifoldKind::kPose:
+      return 3;
   }
   return -1;
 }
@@ -79,7 +82,8 @@ void ExpectManifoldInvariantsHold(const Manifold& manifold, const Eigen::VectorX
   const double h = CentralDifferenceStep();
   EXPECT_LE((NumericMinusPlusJacobian(manifold, x) - Eigen::MatrixXd::Identity(n, n)).lpNorm<Eigen::Infinity>(),
             CentralDifferenceTolerance(h, x_scale))
-      << manifold.Name() << ": Minus Jacobian of Plus\n" << NumericMinusPlusJacobian(manifold, x);
+      << manifold.Name() << ": Minus Jacobian of Plus\n"
+      << NumericMinusPlusJacobian(manifold, x);
 
   std::mt19937 rng(seed);
   for (int trial = 0; trial < trials; ++trial) {

@@ -62,8 +62,7 @@ double AmbientDistance(const Manifold& manifold, const Eigen::VectorXd& a, const
 
 // A random tangent vector: Gaussian of standard deviation `scale` in Euclidean components, and for a rotation part a
 // uniformly random axis with an angle uniform in [0, max_angle] (below pi, so that Log inverts Exp).
-Eigen::VectorXd RandomTangent(const Manifold& manifold, std::mt19937* rng, double scale = 1.0,
-                              double max_angle = 3.0);
+Eigen::VectorXd RandomTangent(const Manifold& manifold, std::mt19937* rng, double scale = 1.0, double max_angle = 3.0);
 
 // x [+] delta and y [-] x as vectors.
 Eigen::VectorXd Plus(const Manifold& manifold, const Eigen::VectorXd& x, const Eigen::VectorXd& delta);
@@ -116,13 +115,14 @@ void ExpectBlockInvariantsHold(const Eigen::VectorXd& x, std::uint32_t seed, int
     const double h = CentralDifferenceStep();
     const double tolerance = CentralDifferenceTolerance(h, x_scale + delta.norm());
     EXPECT_LE((jet - NumericPlusJacobian(manifold, x, delta)).lpNorm<Eigen::Infinity>(), tolerance)
-        << "jet Plus Jacobian\n" << jet << "\nnumeric\n" << NumericPlusJacobian(manifold, x, delta);
+        << "jet Plus Jacobian\n"
+        << jet << "\nnumeric\n"
+        << NumericPlusJacobian(manifold, x, delta);
     if (trial == 0) {
       const Eigen::MatrixXd product = minus_jacobian * jet;
-      const Eigen::MatrixXd off_identity = product - Eigen::MatrixXd::Identity(manifold.tangent_dim(),
-                                                                               manifold.tangent_dim());
-      EXPECT_LE(off_identity.lpNorm<Eigen::Infinity>(), tolerance)
-          << "Minus Jacobian times Plus Jacobian\n" << product;
+      const Eigen::MatrixXd off_identity =
+          product - Eigen::MatrixXd::Identity(manifold.tangent_dim(), manifold.tangent_dim());
+      EXPECT_LE(off_identity.lpNorm<Eigen::Infinity>(), tolerance) << "Minus Jacobian times Plus Jacobian\n" << product;
     }
   }
 }

@@ -29,8 +29,7 @@ TEST(MarginalizationTest, StiffLeavingVariableLeavesNoRoundingInThePrior) {
   std::normal_distribution<double> normal;
   const std::vector<Manifold> xy = {Manifold::Euclidean(3), Manifold::Euclidean(3)};
   Eigen::MatrixXd J_weak(2, 3);  // information ~1e3, y's direction (1, 1, 1) unobserved
-  J_weak << 30.0, -20.0, -10.0,
-            5.0, 25.0, -30.0;
+  J_weak << 30.0, -20.0, -10.0, 5.0, 25.0, -30.0;
   const Eigen::Vector2d r_weak(0.7, -1.1);
   // The weak factor's minimum-norm step: what the prior must propose for y.
   const Eigen::Vector3d expected_step = -J_weak.completeOrthogonalDecomposition().solve(r_weak);
@@ -43,14 +42,14 @@ TEST(MarginalizationTest, StiffLeavingVariableLeavesNoRoundingInThePrior) {
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) J_stiff(i, 3 + j) = 1e5 * normal(rng);
     const Eigen::Vector3d r_stiff = 1e2 * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
-    graph.AddFactor(std::make_unique<LinearPriorFactor>(
-                        xy, std::vector<Eigen::VectorXd>{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()}, J_stiff,
-                        r_stiff),
-                    {x, y}, Eigen::Matrix3d::Identity(), Loss::Trivial(), "stiff", Time());
-    graph.AddFactor(std::make_unique<LinearPriorFactor>(std::vector<Manifold>{Manifold::Euclidean(3)},
-                                                        std::vector<Eigen::VectorXd>{Eigen::Vector3d::Zero()},
-                                                        J_weak, r_weak),
-                    {y}, Eigen::Matrix2d::Identity(), Loss::Trivial(), "weak", Time());
+    graph.AddFactor(
+        std::make_unique<LinearPriorFactor>(
+            xy, std::vector<Eigen::VectorXd>{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()}, J_stiff, r_stiff),
+        {x, y}, Eigen::Matrix3d::Identity(), Loss::Trivial(), "stiff", Time());
+    graph.AddFactor(
+        std::make_unique<LinearPriorFactor>(std::vector<Manifold>{Manifold::Euclidean(3)},
+                                            std::vector<Eigen::VectorXd>{Eigen::Vector3d::Zero()}, J_weak, r_weak),
+        {y}, Eigen::Matrix2d::Identity(), Loss::Trivial(), "weak", Time());
     ASSERT_TRUE(Marginalize({x}, &graph));
     // What y's factors now say (the weak one, and a prior if any): stacked, their minimum-norm step.
     Eigen::MatrixXd J(0, 3);
@@ -86,21 +85,19 @@ TEST(MarginalizationTest, PriorHoldsTheSchurComplementAlsoWhenRankDeficient) {
         graph.AddVariable({"y", Manifold::Euclidean(3), Eigen::Vector3d(1.0, 2.0, -1.0), false, std::nullopt});
     const std::vector<Manifold> xy = {Manifold::Euclidean(2), Manifold::Euclidean(3)};
     Eigen::MatrixXd J1(3, 5);  // on (x, y): y's third column zero, its second scaled by `weak`
-    J1 << 1.0, 0.5, -1.0, 0.2 * weak, 0.0,
-          0.0, 2.0, 0.3, -1.0 * weak, 0.0,
-          0.4, 0.0, 0.0, 0.7 * weak, 0.0;
+    J1 << 1.0, 0.5, -1.0, 0.2 * weak, 0.0, 0.0, 2.0, 0.3, -1.0 * weak, 0.0, 0.4, 0.0, 0.0, 0.7 * weak, 0.0;
     const Eigen::Vector3d r1(0.1, -0.4, 0.25);
-    graph.AddFactor(std::make_unique<LinearPriorFactor>(xy, std::vector<Eigen::VectorXd>{Eigen::Vector2d(0.3, -0.2),
-                                                                                      Eigen::Vector3d(1.0, 2.0, -1.0)},
-                                                        J1, r1),
-                    {x, y}, Eigen::Matrix3d::Identity(), Loss::Trivial(), "test", Time());
+    graph.AddFactor(
+        std::make_unique<LinearPriorFactor>(
+            xy, std::vector<Eigen::VectorXd>{Eigen::Vector2d(0.3, -0.2), Eigen::Vector3d(1.0, 2.0, -1.0)}, J1, r1),
+        {x, y}, Eigen::Matrix3d::Identity(), Loss::Trivial(), "test", Time());
     Eigen::MatrixXd J2(2, 2);
     J2 << 3.0, 0.0, 1.0, 1.0;
     const Eigen::Vector2d r2(-0.3, 0.2);
-    graph.AddFactor(std::make_unique<LinearPriorFactor>(std::vector<Manifold>{Manifold::Euclidean(2)},
-                                                        std::vector<Eigen::VectorXd>{Eigen::Vector2d(0.3, -0.2)}, J2,
-                                                        r2),
-                    {x}, Eigen::Matrix2d::Identity(), Loss::Trivial(), "test", Time());
+    graph.AddFactor(
+        std::make_unique<LinearPriorFactor>(std::vector<Manifold>{Manifold::Euclidean(2)},
+                                            std::vector<Eigen::VectorXd>{Eigen::Vector2d(0.3, -0.2)}, J2, r2),
+        {x}, Eigen::Matrix2d::Identity(), Loss::Trivial(), "test", Time());
     // Expected: H and g of both factors at the current values, Schur complement onto y.
     Eigen::MatrixXd H = J1.transpose() * J1;
     Eigen::VectorXd g = J1.transpose() * r1;

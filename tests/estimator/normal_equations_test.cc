@@ -29,8 +29,8 @@ using testing::TieWithRandomPrior;
 std::pair<std::vector<VariableId>, VariableId> AddPosesAndLever(int count, std::mt19937* rng, Graph* graph) {
   std::vector<VariableId> poses;
   for (int k = 0; k < count; ++k)
-    poses.push_back(graph->AddVariable({"pose", Manifold::Pose(), testing::RandomPoint(Manifold::Pose(), rng, 5.0),
-                                        false, Time::FromSeconds(k)}));
+    poses.push_back(graph->AddVariable(
+        {"pose", Manifold::Pose(), testing::RandomPoint(Manifold::Pose(), rng, 5.0), false, Time::FromSeconds(k)}));
   const VariableId lever =
       graph->AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d(0.1, 0.2, 0.3), false, std::nullopt});
   return {poses, lever};
@@ -372,8 +372,7 @@ TEST(NormalEquationsTest, PatternsThatComeBackAsTheWindowSlidesMatchAFreshBuild)
     ASSERT_EQ(a.nonZeros(), b.nonZeros()) << "step " << step;
     EXPECT_TRUE(std::equal(a.outerIndexPtr(), a.outerIndexPtr() + a.outerSize() + 1, b.outerIndexPtr()))
         << "step " << step;
-    EXPECT_TRUE(std::equal(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros(), b.innerIndexPtr()))
-        << "step " << step;
+    EXPECT_TRUE(std::equal(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros(), b.innerIndexPtr())) << "step " << step;
     EXPECT_TRUE(std::equal(a.valuePtr(), a.valuePtr() + a.nonZeros(), b.valuePtr())) << "step " << step;
     EXPECT_EQ(incremental.gradient(), fresh.gradient()) << "step " << step;
     Eigen::VectorXd dx_incremental, dx_fresh;
@@ -576,8 +575,8 @@ TEST(NormalEquationsTest, RelinearizationThresholdCarriesTheErrorToFirstOrderAnd
   Graph graph;
   std::vector<VariableId> poses;
   for (int k = 0; k < 5; ++k)
-    poses.push_back(graph.AddVariable({"pose", Manifold::Pose(), testing::RandomPoint(Manifold::Pose(), &rng, 5.0),
-                                       false, Time::FromSeconds(k)}));
+    poses.push_back(graph.AddVariable(
+        {"pose", Manifold::Pose(), testing::RandomPoint(Manifold::Pose(), &rng, 5.0), false, Time::FromSeconds(k)}));
   const VariableId lever =
       graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d(0.1, 0.2, 0.3), false, std::nullopt});
   for (std::size_t k = 0; k < poses.size(); ++k) {
@@ -617,8 +616,7 @@ TEST(NormalEquationsTest, RelinearizationThresholdCarriesTheErrorToFirstOrderAnd
     for (std::size_t i = 0; i < entry.variables.size(); ++i) {
       const Manifold& m = graph.variable(entry.variables[i]).manifold;
       Eigen::VectorXd d(m.tangent_dim());
-      m.Minus(graph.variable(entry.variables[i]).value.data(), start.at(entry.variables[i]).data(),
-              d.data());
+      m.Minus(graph.variable(entry.variables[i]).value.data(), start.at(entry.variables[i]).data(), d.data());
       expected += lin.jacobians[i] * d;
       EXPECT_EQ(kept->jacobians[i], lin.jacobians[i]);
     }

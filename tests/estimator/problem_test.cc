@@ -36,8 +36,10 @@ TEST(ProblemBuilderTest, OnePosePerMasterSampleAndEveryMeasurementAccountedFor) 
   const std::size_t samples = synthetic.recording.Find("rear_wheel")->t.size();
   EXPECT_EQ(builder.value()->poses().size(), samples);
   // Attached + outside = samples of the source stream, for every stream: nothing silently dropped.
-  const std::map<std::string, std::string> source = {{"odometer", "rear_wheel"}, {"gyroscope", "imu"},
-                                                     {"accelerometer", "imu"}, {"magnetometer", "magnetometer"},
+  const std::map<std::string, std::string> source = {{"odometer", "rear_wheel"},
+                                                     {"gyroscope", "imu"},
+                                                     {"accelerometer", "imu"},
+                                                     {"magnetometer", "magnetometer"},
                                                      {"gps", "gps"}};
   for (const auto& [stream, counts] : builder.value()->counts()) {
     EXPECT_EQ(counts.attached + counts.outside + counts.too_late + counts.rejected,
@@ -91,8 +93,8 @@ TEST(ProblemBuilderTest, GaussMarkovDisturbanceHasAProcessPerComponentAndAStatio
       ++process;
       const double dt = SecondsBetween(*graph.variable(f.variables[0]).stamp, *graph.variable(f.variables[1]).stamp);
       for (int i = 0; i < 3; ++i) {
-        const double expected = std::pow(disturbance.process.sigma[i], 2) *
-                                (1.0 - std::exp(-2.0 * dt / disturbance.process.tau_s[i]));
+        const double expected =
+            std::pow(disturbance.process.sigma[i], 2) * (1.0 - std::exp(-2.0 * dt / disturbance.process.tau_s[i]));
         EXPECT_NEAR(f.noise->covariance(i, i), expected, 1e-12 * expected) << i;
       }
       EXPECT_DOUBLE_EQ(f.noise->covariance(0, 1), 0.0);

@@ -4,8 +4,8 @@
 #include <random>
 #include <string>
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "estimator/config.h"
 #include "estimator/geometry.h"
@@ -105,13 +105,17 @@ EstimatorConfig Config(const std::string& scan_model) {
       "solver: {method: levenberg_marquardt, max_iterations: 50}\n"
       "tracking: {window: 40, max_iterations: 5, time_budget_s: 10.0, initialization_s: 0.3}\n"
       "parameters:\n"
-      "  scan.lever_arm: {value: [" + std::to_string(kLever.x()) + ", " + std::to_string(kLever.y()) + ", " +
-      std::to_string(kLever.z()) + "]}\n"
-      "  scan.misalignment: {value: [" + std::to_string(q.w()) + ", " + std::to_string(q.x()) + ", " +
-      std::to_string(q.y()) + ", " + std::to_string(q.z()) + "]}\n"
+      "  scan.lever_arm: {value: [" +
+      std::to_string(kLever.x()) + ", " + std::to_string(kLever.y()) + ", " + std::to_string(kLever.z()) +
+      "]}\n"
+      "  scan.misalignment: {value: [" +
+      std::to_string(q.w()) + ", " + std::to_string(q.x()) + ", " + std::to_string(q.y()) + ", " +
+      std::to_string(q.z()) +
+      "]}\n"
       "streams:\n"
       "  odometer: {model: odometer, source: odometry, noise: {linear_mps: 0.1, angular_radps: 0.1}}\n"
-      "  scan: {model: " + scan_model + ", source: scan, noise: {linear_mps: 0.001, angular_radps: 0.001}}\n";
+      "  scan: {model: " +
+      scan_model + ", source: scan, noise: {linear_mps: 0.001, angular_radps: 0.001}}\n";
   auto config = ParseEstimatorConfig(yaml, "test.yaml");
   EXPECT_TRUE(config.ok()) << config.status().message();
   EstimatorConfig c = config.value();

@@ -137,7 +137,7 @@ TEST(SolverTest, LevenbergMarquardtStartedAtItsMinimumConvergesThere) {
                                                         Eigen::VectorXd::Constant(1, r0)),
                     {x}, one, Loss::Trivial(), "prior", Time());
   SolverOptions options;
-  options.initial_lambda = 1e-11;   // as the diagnosis's warm fits
+  options.initial_lambda = 1e-11;  // as the diagnosis's warm fits
   const SolverSummary summary = Solve(options, &graph);
   ASSERT_TRUE(summary.usable()) << summary.message;
   EXPECT_EQ(summary.termination, Termination::kFunctionTolerance);
@@ -157,13 +157,12 @@ TEST(SolverTest, FreeVariableOrderPutsEachInstanceAfterTheLastPoseItServes) {
   for (int k = 0; k < 8; ++k) {
     const Time t = Time::FromSeconds(0.1 * k);
     poses.push_back(graph.AddVariable({"pose", Manifold::Pose(), Manifold::Pose().Identity(), false, t}));
-    if (k % 3 == 0)
-      a.push_back(graph.AddVariable({"a", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), k == 3, t}));
+    if (k % 3 == 0) a.push_back(graph.AddVariable({"a", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), k == 3, t}));
     b.push_back(graph.AddVariable({"b", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), false, t}));
   }
   const std::vector<VariableId> expected = {poses[0], b[0], poses[1], b[1], poses[2], a[0], b[2],
                                             poses[3], b[3], poses[4], b[4], poses[5], b[5], /* a[1] fixed */
-                                            poses[6], b[6], poses[7], a[2], b[7], lever};
+                                            poses[6], b[6], poses[7], a[2], b[7],     lever};
   EXPECT_EQ(FreeVariableOrder(graph), expected);
 }
 
@@ -215,8 +214,8 @@ TEST(SolverTest, GaussNewtonWorkspaceKeepsTheFinalLinearizationForMarginalizeAnd
       ASSERT_NE(kept, nullptr) << "step " << step << ", factor " << id;
       EXPECT_EQ(workspace.Linearization(id, mask & ~std::uint64_t{1}), nullptr);
       internal::WhitenedFactor fresh;
-      ASSERT_TRUE(internal::LinearizeFactor(reused.graph, entry, std::vector<bool>(entry.variables.size(), true),
-                                            &fresh));
+      ASSERT_TRUE(
+          internal::LinearizeFactor(reused.graph, entry, std::vector<bool>(entry.variables.size(), true), &fresh));
       EXPECT_EQ(kept->residual, fresh.residual);
       for (std::size_t i = 0; i < entry.variables.size(); ++i) EXPECT_EQ(kept->jacobians[i], fresh.jacobians[i]);
     }
@@ -225,8 +224,7 @@ TEST(SolverTest, GaussNewtonWorkspaceKeepsTheFinalLinearizationForMarginalizeAnd
     const double before = x[0];
     x[0] = std::nextafter(before, 1e300);
     for (FactorId f : reused.graph.FactorsOf(reused.poses.front()))
-      EXPECT_EQ(workspace.Linearization(f, (std::uint64_t{1} << reused.graph.factor(f).variables.size()) - 1),
-                nullptr);
+      EXPECT_EQ(workspace.Linearization(f, (std::uint64_t{1} << reused.graph.factor(f).variables.size()) - 1), nullptr);
     x[0] = before;
     ASSERT_TRUE(Marginalize({reused.poses.front()}, &reused.graph, &workspace));
     ASSERT_TRUE(Marginalize({plain.poses.front()}, &plain.graph));

@@ -14,18 +14,18 @@ MultiAntennaProblem::MultiAntennaProblem(double noise_sigma, std::uint32_t seed)
   std::mt19937 rng(seed);
   truth = RandomPoint(Manifold::Pose(), &rng, 5.0);
   const Pose<double> T = PoseFromArray(truth.data());
-  pose = graph.AddVariable({"pose", Manifold::Pose(), Perturb(Manifold::Pose(), truth, 0.3, &rng), false,
-                            Time::FromSeconds(0.0)});
+  pose = graph.AddVariable(
+      {"pose", Manifold::Pose(), Perturb(Manifold::Pose(), truth, 0.3, &rng), false, Time::FromSeconds(0.0)});
   const std::vector<Eigen::Vector3d> levers = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {-1, -1, 0.5}};
   std::normal_distribution<double> noise(0.0, noise_sigma);
   for (const Eigen::Vector3d& lever : levers) {
     const VariableId l = graph.AddVariable({"lever", Manifold::Euclidean(3), lever, true, std::nullopt});
     for (int k = 0; k < 20; ++k) {
-      const Eigen::Vector3d z = T.p_world_body + T.q_world_body * lever +
-                                Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+      const Eigen::Vector3d z =
+          T.p_world_body + T.q_world_body * lever + Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
       graph.AddFactor(MakeFactor(GpsError(z)), {pose, l},
-                      Eigen::Matrix3d::Identity() * std::max(noise_sigma * noise_sigma, 1e-6), Loss::Trivial(),
-                      "gps", Time::FromSeconds(0.0));
+                      Eigen::Matrix3d::Identity() * std::max(noise_sigma * noise_sigma, 1e-6), Loss::Trivial(), "gps",
+                      Time::FromSeconds(0.0));
     }
   }
 }

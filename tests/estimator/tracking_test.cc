@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 #include "common/chi_square.h"
 #include "estimator/calibration.h"
@@ -255,8 +255,7 @@ TEST(TrackingTest, CalibrationPriorWidensThePositionCovarianceByTheCalibrationUn
   ASSERT_EQ(fixed.value().trajectory.size(), marginal.value().trajectory.size());
   double growth = 0.0;
   for (std::size_t i = 0; i < fixed.value().trajectory.size(); ++i) {
-    const Eigen::Matrix3d difference =
-        marginal.value().position_covariance[i] - fixed.value().position_covariance[i];
+    const Eigen::Matrix3d difference = marginal.value().position_covariance[i] - fixed.value().position_covariance[i];
     const double scale = fixed.value().position_covariance[i].trace();
     EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(difference).eigenvalues().minCoeff(), -1e-6 * scale)
         << "pose " << i;

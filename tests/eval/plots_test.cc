@@ -55,8 +55,8 @@ bool IsPng(const std::string& path) { return ReadFile(path).rfind("\x89PNG\r\n\x
 
 TEST(PlotsTest, TrajectoryPlotWritesDataAndAScriptThatReadsThem) {
   TempDir dir;
-  PositionFixes gps{"gps", "GPS fixes (gps)", {Time::FromSeconds(0.0), Time::FromSeconds(0.2)},
-                    {{0.1, 0.0, 0.0}, {2.0, 1.1, 0.0}}};
+  PositionFixes gps{
+      "gps", "GPS fixes (gps)", {Time::FromSeconds(0.0), Time::FromSeconds(0.2)}, {{0.1, 0.0, 0.0}, {2.0, 1.1, 0.0}}};
   const Result<PlotFiles> files =
       WriteTrajectoryPlot(dir.path(), "Trajectory", Time(), Line(10), Line(10), "estimate", {gps});
   ASSERT_TRUE(files.ok()) << files.status().message();

@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 namespace roamlab::eval {
 namespace {
@@ -22,8 +22,8 @@ Time At(double seconds) { return Time::FromNanoseconds(static_cast<std::int64_t>
 
 // Linear in position; the yaw goes the shorter way across +-pi.
 TEST(PlanarPoseAtTest, InterpolatesPositionAndYawAlongTheShorterArc) {
-  const Trajectory trajectory = {Pose(0.0, 0.0, 0.0, 0.0), Pose(1.0, 2.0, -4.0, 0.5),
-                                 Pose(2.0, 2.0, -4.0, kPi - 0.1), Pose(3.0, 2.0, -4.0, -kPi + 0.1)};
+  const Trajectory trajectory = {Pose(0.0, 0.0, 0.0, 0.0), Pose(1.0, 2.0, -4.0, 0.5), Pose(2.0, 2.0, -4.0, kPi - 0.1),
+                                 Pose(3.0, 2.0, -4.0, -kPi + 0.1)};
   Eigen::Vector3d pose;
   ASSERT_TRUE(PlanarPoseAt(trajectory, At(0.25), &pose));
   EXPECT_NEAR(pose.x(), 0.5, 1e-12);

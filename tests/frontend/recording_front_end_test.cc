@@ -15,9 +15,9 @@
 namespace roamlab::frontend {
 namespace {
 
-using ::testing::HasSubstr;
 using roamlab::testing::ReadFile;
 using roamlab::testing::TempDir;
+using ::testing::HasSubstr;
 
 // Simulates 3 s of scenarios/indoor_diffdrive_slip.yaml with stored frames and scans into `directory`; false when
 // rendering is unavailable.

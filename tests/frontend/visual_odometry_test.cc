@@ -6,8 +6,8 @@
 #include <ctime>
 #include <vector>
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 #include <opencv2/core/utility.hpp>
 
 #include "sim/mujoco_model.h"
@@ -51,11 +51,11 @@ struct DriveResult {
   bool skipped = false;
   std::string skip_reason;
   VoCounters counters;
-  std::vector<double> rotation_error_deg;        // angle of R_est^T R_true per pair
-  std::vector<double> speed_relative_error;      // (|p_est| - |p_true|) / |p_true|
-  std::vector<double> velocity_error_mps;        // |v_est - v_true|
-  std::vector<double> rotation_nees;             // e_w^T P_w^-1 e_w (3 dof), angular velocity
-  std::vector<double> velocity_nees;             // e_v^T P_v^-1 e_v (3 dof), linear velocity
+  std::vector<double> rotation_error_deg;    // angle of R_est^T R_true per pair
+  std::vector<double> speed_relative_error;  // (|p_est| - |p_true|) / |p_true|
+  std::vector<double> velocity_error_mps;    // |v_est - v_true|
+  std::vector<double> rotation_nees;         // e_w^T P_w^-1 e_w (3 dof), angular velocity
+  std::vector<double> velocity_nees;         // e_v^T P_v^-1 e_v (3 dof), linear velocity
   double ms_per_pair = 0.0;
 };
 
@@ -104,8 +104,8 @@ DriveResult Drive(double duration_s, double rate_hz, int width, int height) {
           previous.R_world_camera.transpose() * (truth.p_world_camera_m - previous.p_world_camera_m);
       const Eigen::Vector3d omega = LogRotation(R12) / dt;
       const Eigen::Vector3d v = Eigen::AngleAxisd(-0.5 * dt * omega.norm(), omega.normalized()) * p12 / dt;
-      result.rotation_error_deg.push_back(
-          Eigen::AngleAxisd(estimate->R_prev_curr.transpose() * R12).angle() * kRadToDeg);
+      result.rotation_error_deg.push_back(Eigen::AngleAxisd(estimate->R_prev_curr.transpose() * R12).angle() *
+                                          kRadToDeg);
       result.speed_relative_error.push_back((estimate->p_prev_curr_m.norm() - p12.norm()) / p12.norm());
       result.velocity_error_mps.push_back((estimate->v_camera_mps - v).norm());
       const Eigen::Vector3d e_w = estimate->omega_camera_radps - omega;

@@ -10,10 +10,10 @@ namespace {
 
 TEST(DecisionTest, HeldoutExcessSumsTheChiSquareAboveTheNominalLevel) {
   const std::map<std::string, ComponentLevel> components = {
-      {"gyroscope/2", {3.0, 1000}},        // 2000 above a level of 1
-      {"accelerometer/1", {1.2, 1000}},    // 200 above a level of 1 (missing from `expected`)
-      {"gps/0", {0.5, 100}},               // below its level 0.8: adds nothing
-      {"odometer/0", {10.0, 1000}}};       // not located: not counted
+      {"gyroscope/2", {3.0, 1000}},      // 2000 above a level of 1
+      {"accelerometer/1", {1.2, 1000}},  // 200 above a level of 1 (missing from `expected`)
+      {"gps/0", {0.5, 100}},             // below its level 0.8: adds nothing
+      {"odometer/0", {10.0, 1000}}};     // not located: not counted
   const std::map<std::string, double> expected = {{"gyroscope/2", 1.0}, {"gps/0", 0.8}};
   const std::vector<std::string> keys = {"gyroscope/2", "accelerometer/1", "gps/0", "wheels/0"};
   EXPECT_NEAR(HeldoutExcess(components, keys, expected), 2200.0, 1e-9);

@@ -69,8 +69,8 @@ class DiagnoseTest : public ::testing::Test {
     for (const std::string& p : checked) {
       ASSERT_TRUE(e.parameters.count(p) && e.std.count(p)) << p;
       const double error = e.parameters.at(p) - truth.parameters.at(p);
-      std::cout << truth.name << "." << p << ": truth " << truth.parameters.at(p) << " estimate "
-                << e.parameters.at(p) << " std " << e.std.at(p) << " error/std " << error / e.std.at(p) << "\n";
+      std::cout << truth.name << "." << p << ": truth " << truth.parameters.at(p) << " estimate " << e.parameters.at(p)
+                << " std " << e.std.at(p) << " error/std " << error / e.std.at(p) << "\n";
       EXPECT_LT(std::abs(error), 3.0 * e.std.at(p)) << p;
     }
     EXPECT_GT(e.heldout_improvement, 0.0);

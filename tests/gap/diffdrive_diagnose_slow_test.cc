@@ -18,9 +18,7 @@ namespace {
 
 class DiffDriveDiagnoseTest : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
-    nominal_ = testing::LearnNominal("scenarios/indoor_diffdrive_gap.yaml").release();
-  }
+  static void SetUpTestSuite() { nominal_ = testing::LearnNominal("scenarios/indoor_diffdrive_gap.yaml").release(); }
   static void TearDownTestSuite() { delete nominal_; }
   void SetUp() override { ASSERT_NE(nominal_, nullptr); }
 

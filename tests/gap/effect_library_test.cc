@@ -38,9 +38,15 @@ const Candidate* Find(const std::vector<Candidate>& library, const std::string& 
 // steering offset), the time shifts of the GPS and the IMU, in the library's order.
 TEST(EffectLibraryTest, TheAtvGetsItsSensorsAndTiresCandidates) {
   const std::vector<Candidate> library = Library(Nominal("scenarios/atv_hills_sines.yaml"));
-  const std::vector<std::string> expected = {"gps_latency",     "imu_time_offset", "steering_offset",
-                                             "gyro_scale_error", "gyro_bias_drift", "lateral_slip",
-                                             "magnetometer_motor_interference", "longitudinal_slip", "slope_slip"};
+  const std::vector<std::string> expected = {"gps_latency",
+                                             "imu_time_offset",
+                                             "steering_offset",
+                                             "gyro_scale_error",
+                                             "gyro_bias_drift",
+                                             "lateral_slip",
+                                             "magnetometer_motor_interference",
+                                             "longitudinal_slip",
+                                             "slope_slip"};
   EXPECT_EQ(Names(library), expected);
   const Candidate* gps = Find(library, "gps_latency");
   ASSERT_NE(gps, nullptr);
@@ -73,7 +79,7 @@ TEST(EffectLibraryTest, AFreedSlotReadsAsTheDepartureFromItsNominalValue) {
 TEST(EffectLibraryTest, TheDifferentialDriveGetsItsWheelCandidates) {
   const estimator::EstimatorConfig config = Nominal("scenarios/indoor_diffdrive_gap.yaml");
   const std::vector<Candidate> library = Library(config);
-  const std::vector<std::string> expected = {"imu_time_offset", "gyro_scale_error", "gyro_bias_drift",
+  const std::vector<std::string> expected = {"imu_time_offset",        "gyro_scale_error",  "gyro_bias_drift",
                                              "wheel_radius_asymmetry", "track_width_error", "wheel_deformation"};
   EXPECT_EQ(Names(library), expected);
   const Candidate* track = Find(library, "track_width_error");

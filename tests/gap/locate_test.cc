@@ -59,7 +59,7 @@ TEST(LocateTest, WhiteNoiseIsConsistentABurstIsLocatedALagIsFound) {
   EXPECT_TRUE(by_stream["white"].intervals.empty());
 
   const LocatedComponent& burst = by_stream["burst"];
-  EXPECT_TRUE(burst.inconsistent) << burst.chi2_per_dof;   // (1 * 16.8 + 9 * 3) / 19.8 = 2.2
+  EXPECT_TRUE(burst.inconsistent) << burst.chi2_per_dof;  // (1 * 16.8 + 9 * 3) / 19.8 = 2.2
   ASSERT_EQ(burst.intervals.size(), 1u) << burst.intervals[0].first << " " << burst.intervals[0].second;
   EXPECT_LE(burst.intervals[0].first, 8.5);
   EXPECT_GE(burst.intervals[0].first, 6.0);
@@ -81,10 +81,9 @@ TEST(LocateTest, WhiteNoiseIsConsistentABurstIsLocatedALagIsFound) {
 }
 
 TEST(LocateTest, StreamFitsCountActiveMeasurementsOnly) {
-  std::vector<estimator::MeasurementResidual> r = {
-      {"a", Time::FromSeconds(0.0), Eigen::Vector2d(1.0, 2.0), true},
-      {"a", Time::FromSeconds(0.1), Eigen::Vector2d(3.0, 0.0), true},
-      {"a", Time::FromSeconds(0.2), Eigen::Vector2d(100.0, 0.0), false}};
+  std::vector<estimator::MeasurementResidual> r = {{"a", Time::FromSeconds(0.0), Eigen::Vector2d(1.0, 2.0), true},
+                                                   {"a", Time::FromSeconds(0.1), Eigen::Vector2d(3.0, 0.0), true},
+                                                   {"a", Time::FromSeconds(0.2), Eigen::Vector2d(100.0, 0.0), false}};
   const auto fits = StreamFits(r);
   EXPECT_EQ(fits.at("a").measurements, 2);
   EXPECT_EQ(fits.at("a").dof, 4);
@@ -126,7 +125,7 @@ TEST(LocateTest, ALevelBelowOneSpreadsAsTheNoiseTheFitLeaves) {
     for (int i = 0; i < 87; ++i) chi2 += std::pow(n(rng), 2);
     flagged += Inconsistent({chi2 / 2900.0, 2900}, 0.03, 1.3) ? 1 : 0;
   }
-  EXPECT_LE(flagged, 3);   // 0.4 expected of 400
+  EXPECT_LE(flagged, 3);  // 0.4 expected of 400
   EXPECT_FALSE(Inconsistent({0.0435, 2900}, 0.03, 1.3));
   EXPECT_TRUE(Inconsistent({0.06, 2900}, 0.03, 1.3));
   // At level 1 and above: the level times chi2(count), as before.

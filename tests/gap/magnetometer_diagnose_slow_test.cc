@@ -32,8 +32,8 @@ TEST_F(MagnetometerDiagnoseTest, InterferenceIsNamedFirstWithItsBiasPerNewtonMet
   ASSERT_NE(nominal_, nullptr);
   const Eigen::Vector3d k = Eigen::Vector3d(0.6, -0.64, 0.48).normalized() * 1.5e-3;
   auto diagnosis = testing::DiagnoseHidden(
-      *nominal_, {{"magnetometer_motor_interference", {{"b_per_nm_x", k.x()}, {"b_per_nm_y", k.y()},
-                                                       {"b_per_nm_z", k.z()}}}}, 21);
+      *nominal_,
+      {{"magnetometer_motor_interference", {{"b_per_nm_x", k.x()}, {"b_per_nm_y", k.y()}, {"b_per_nm_z", k.z()}}}}, 21);
   ASSERT_TRUE(diagnosis.ok()) << diagnosis.status().message();
   const Diagnosis& d = diagnosis.value();
 

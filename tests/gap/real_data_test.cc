@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <iostream>
 
-#include <Eigen/Dense>
 #include <gtest/gtest.h>
+#include <Eigen/Dense>
 
 #include "estimator/config.h"
 #include "estimator/models/differential_drive.h"
@@ -85,8 +85,8 @@ TEST(RealDataTest, OptiOdomDifferentialDriveTrackAndWheelRatio) {
   if (!std::filesystem::exists(kSet + "_metadata.csv")) GTEST_SKIP() << "real data absent: " << kSet;
   auto rec = recording::ImportOptiOdom(kSet + "_run-01.csv", kSet + "_metadata.csv");
   ASSERT_TRUE(rec.ok()) << rec.status().message();
-  auto config = estimator::LoadEstimatorConfig(std::string(ROAMLAB_SOURCE_DIR) +
-                                               "/configs/real/optiodom_diff_nominal.yaml");
+  auto config =
+      estimator::LoadEstimatorConfig(std::string(ROAMLAB_SOURCE_DIR) + "/configs/real/optiodom_diff_nominal.yaml");
   ASSERT_TRUE(config.ok()) << config.status().message();
   auto d = Diagnose(config.value(), rec.value());
   ASSERT_TRUE(d.ok()) << d.status().message();
@@ -197,8 +197,7 @@ TEST(RealDataTest, HuskySkidSteerYawMismatch) {
   options.wheels_from_odometry = true;
   auto rec = recording::ImportRosbag(bag, options);
   ASSERT_TRUE(rec.ok()) << rec.status().message();
-  auto config =
-      estimator::LoadEstimatorConfig(std::string(ROAMLAB_SOURCE_DIR) + "/configs/real/husky_nominal.yaml");
+  auto config = estimator::LoadEstimatorConfig(std::string(ROAMLAB_SOURCE_DIR) + "/configs/real/husky_nominal.yaml");
   ASSERT_TRUE(config.ok()) << config.status().message();
   auto d = Diagnose(config.value(), rec.value());
   ASSERT_TRUE(d.ok()) << d.status().message();

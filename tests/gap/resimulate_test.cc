@@ -52,12 +52,12 @@ TEST(ResimulateTest, AHiddenGpsLatencyIsInTheGpsStreamUntilTheSimulationAppliesI
   const sim::Simulation recorded = testing::SimulatedWithSeed(hidden, 5);
   EffectEstimate latency;
   latency.name = "gps_latency";
-  latency.parameters = {{"latency_s", 0.3004}};   // as fitted: the simulator takes whole 1 ms physics steps
+  latency.parameters = {{"latency_s", 0.3004}};  // as fitted: the simulator takes whole 1 ms physics steps
   auto c = CompareWithSimulation(ShortAtv(), {latency}, recorded.recording, 2.0);
   ASSERT_TRUE(c.ok()) << c.status().message();
   // 0.3 s at about 4 m/s is about 1.2 m along the track, several times the fix's 0.33 m.
   EXPECT_GT(c.value().before.at("gps").rms, 2.0);
-  EXPECT_GT(c.value().before.at("gps").rms_1s, 2.0);   // a systematic offset: it stays in the means
+  EXPECT_GT(c.value().before.at("gps").rms_1s, 2.0);  // a systematic offset: it stays in the means
   ExpectNoiseLevel(c.value().after.at("gps"), "gps");
   ExpectNoiseLevel(c.value().after.at("gyroscope"), "gyroscope");
   EXPECT_TRUE(c.value().not_simulated.empty()) << c.value().not_simulated;
@@ -76,7 +76,7 @@ TEST(ResimulateTest, TheRearCorneringComplianceBecomesTheTiresContactTimeScale) 
   ASSERT_EQ(e.parameters.size(), 1u);
   EXPECT_NEAR(e.parameters.at("contact_time_scale"), 3.0, 1e-12);
   EXPECT_NEAR(std.at("contact_time_scale"), 0.1, 1e-12);
-  slip.parameters["cornering_rear_s"] = -0.01;   // stiffer than nominal: the simulator's tires go no stiffer
+  slip.parameters["cornering_rear_s"] = -0.01;  // stiffer than nominal: the simulator's tires go no stiffer
   EXPECT_EQ(SimulatorEffect(slip).parameters.at("contact_time_scale"), 1.0);
 }
 

@@ -1,7 +1,7 @@
 // The reality-gap diagnosis of a 30 s ATV drive (scenarios/atv_hills_sines.yaml, baseline seed 900001) with a hidden
-// longitudinal slip of the driven tires (sim/scenario.h longitudinal_slip: the rear wheel over-reads the ground speed by
-// 1 + s f_x, f_x the forward specific force) or a slip that follows the slope alone (slope_slip: 1 + s g sin(pitch)).
-// The candidates free the ackermann model's slip_per_mps2 (on the IMU's forward specific force) and
+// longitudinal slip of the driven tires (sim/scenario.h longitudinal_slip: the rear wheel over-reads the ground speed
+// by 1 + s f_x, f_x the forward specific force) or a slip that follows the slope alone (slope_slip: 1 + s g
+// sin(pitch)). The candidates free the ackermann model's slip_per_mps2 (on the IMU's forward specific force) and
 // slope_slip_per_mps2 (on the poses' pitch) slots (models/ackermann_velocity.h). The ATV without an effect stays "none"
 // with both in the library: DiagnoseTest.NoEffectGivesNone (diagnose_slow_test.cc). Also softer tires (lateral_slip:
 // the tires' contact time constant in MuJoCo scaled) against the lateral_slip candidate (cornering compliance). The
@@ -34,9 +34,9 @@ class SlipDiagnoseTest : public ::testing::Test {
     const Diagnosis& d = diagnosis.value();
     for (const EffectEstimate& c : d.candidates)
       std::cout << "candidate " << c.name << " LR " << c.lr << " delta_bic " << c.delta_bic << " held-out "
-                << c.heldout_improvement << (c.parameters.count("slip_per_mps2")
-                                                 ? " slip " + std::to_string(c.parameters.at("slip_per_mps2"))
-                                                 : std::string())
+                << c.heldout_improvement
+                << (c.parameters.count("slip_per_mps2") ? " slip " + std::to_string(c.parameters.at("slip_per_mps2"))
+                                                        : std::string())
                 << "\n";
     ASSERT_EQ(d.verdict, "named");
     ASSERT_FALSE(d.effects.empty());
@@ -45,8 +45,8 @@ class SlipDiagnoseTest : public ::testing::Test {
     ASSERT_TRUE(e.parameters.count("slip_per_mps2") && e.std.count("slip_per_mps2")) << e.name;
     const double estimate = e.parameters.at("slip_per_mps2"), std = e.std.at("slip_per_mps2");
     std::cout << effect << ": truth " << s << " estimate " << estimate << " std " << std << " error/std "
-              << (estimate - s) / std << ", held-out chi2 drop " << e.heldout_improvement << ", diagnosis "
-              << d.seconds << " s, " << d.fits << " fits\n";
+              << (estimate - s) / std << ", held-out chi2 drop " << e.heldout_improvement << ", diagnosis " << d.seconds
+              << " s, " << d.fits << " fits\n";
     EXPECT_LT(std::abs(estimate - s), 3.0 * std);
     EXPECT_GT(e.heldout_improvement, 0.0);
     EXPECT_LT(d.after.at("odometer").chi2, d.before.at("odometer").chi2);
@@ -85,9 +85,9 @@ TEST_F(SlipDiagnoseTest, LateralSlipIsNamedFirstWithTheComplianceOfSofterTires) 
   EXPECT_EQ(e.name, "lateral_slip");
   ASSERT_TRUE(e.parameters.count("cornering_rear_s") && e.std.count("cornering_rear_s")) << e.name;
   const double estimate = e.parameters.at("cornering_rear_s"), std = e.std.at("cornering_rear_s");
-  std::cout << "lateral_slip: truth c_rear +" << truth << " s, estimate " << estimate << " +- " << std
-            << " (error/std " << (estimate - truth) / std << "), held-out chi2 drop " << e.heldout_improvement
-            << ", diagnosis " << d.seconds << " s, " << d.fits << " fits\n";
+  std::cout << "lateral_slip: truth c_rear +" << truth << " s, estimate " << estimate << " +- " << std << " (error/std "
+            << (estimate - truth) / std << "), held-out chi2 drop " << e.heldout_improvement << ", diagnosis "
+            << d.seconds << " s, " << d.fits << " fits\n";
   EXPECT_LT(std::abs(estimate - truth), 3.0 * std);
   EXPECT_GT(e.heldout_improvement, 0.0);
 }

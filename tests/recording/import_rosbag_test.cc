@@ -49,9 +49,9 @@ std::string Doubles(const std::vector<double>& v) {
 }
 
 std::string Connection(std::uint32_t id, const std::string& topic, const std::string& type) {
-  return BagRecord(Op(0x07) + BagField("conn", U32(id)) + BagField("topic", topic),
-                   BagField("topic", topic) + BagField("type", type) + BagField("md5sum", "0") +
-                       BagField("message_definition", ""));
+  return BagRecord(
+      Op(0x07) + BagField("conn", U32(id)) + BagField("topic", topic),
+      BagField("topic", topic) + BagField("type", type) + BagField("md5sum", "0") + BagField("message_definition", ""));
 }
 // A message received at bag time (sec + 1, nsec): later than its header stamp, which the importer must keep.
 std::string MessageRecord(std::uint32_t conn, std::uint32_t sec, std::uint32_t nsec, const std::string& data) {
@@ -60,16 +60,16 @@ std::string MessageRecord(std::uint32_t conn, std::uint32_t sec, std::uint32_t n
 
 std::string Imu(std::uint32_t seq, std::uint32_t sec, std::uint32_t nsec, double wz) {
   std::vector<double> cov(9, 0.0);
-  cov[0] = cov[4] = cov[8] = 0.0004;   // gyro sigma 0.02 rad/s
+  cov[0] = cov[4] = cov[8] = 0.0004;  // gyro sigma 0.02 rad/s
   std::vector<double> cov_a(9, 0.0);
-  cov_a[0] = cov_a[4] = cov_a[8] = 0.01;   // accel sigma 0.1 m/s^2
+  cov_a[0] = cov_a[4] = cov_a[8] = 0.01;  // accel sigma 0.1 m/s^2
   return RosHeader(seq, sec, nsec, "imu_link") + Doubles({0, 0, 0, 1}) + Doubles(std::vector<double>(9, 0.0)) +
          Doubles({0.01, wz, -0.02}) + Doubles(cov) + Doubles({0.1, 9.81, 0.2}) + Doubles(cov_a);
 }
 std::string Odometry(std::uint32_t seq, std::uint32_t sec, std::uint32_t nsec, double vx, double wz) {
   std::vector<double> cov(36, 0.0);
   for (int i = 0; i < 6; ++i) cov[7 * i] = 0.001 * (i + 1);
-  cov[5] = cov[30] = 1e-5;   // vx-wz correlation
+  cov[5] = cov[30] = 1e-5;  // vx-wz correlation
   return RosHeader(seq, sec, nsec, "odom") + RosString("base_link") + Doubles({1, 2, 0, 0, 0, 0, 1}) +
          Doubles(std::vector<double>(36, 0.0)) + Doubles({vx, 0, 0, 0, 0, wz}) + Doubles(cov);
 }
@@ -86,16 +86,15 @@ std::string Fix(std::uint32_t seq, std::uint32_t sec, std::uint32_t nsec, std::i
 // A bag: header record (padded as rosbag does), one chunk with three connections and the messages, an unsupported
 // topic, one IMU message out of order and one repeated, and a fix without a fix.
 std::string TinyBag(const std::string& compression) {
-  std::string chunk = Connection(0, "/imu/data", "sensor_msgs/Imu") +
-                      Connection(1, "/odom", "nav_msgs/Odometry") + Connection(2, "/fix", "sensor_msgs/NavSatFix") +
-                      Connection(3, "/rosout", "rosgraph_msgs/Log");
+  std::string chunk = Connection(0, "/imu/data", "sensor_msgs/Imu") + Connection(1, "/odom", "nav_msgs/Odometry") +
+                      Connection(2, "/fix", "sensor_msgs/NavSatFix") + Connection(3, "/rosout", "rosgraph_msgs/Log");
   chunk += MessageRecord(0, 100, 0, Imu(0, 100, 0, 0.5));
   chunk += MessageRecord(0, 100, 200000000, Imu(2, 100, 200000000, 0.7));
-  chunk += MessageRecord(0, 100, 100000000, Imu(1, 100, 100000000, 0.6));   // late: sorted back
-  chunk += MessageRecord(0, 100, 100000000, Imu(3, 100, 100000000, 0.6));   // repeated stamp: skipped
+  chunk += MessageRecord(0, 100, 100000000, Imu(1, 100, 100000000, 0.6));  // late: sorted back
+  chunk += MessageRecord(0, 100, 100000000, Imu(3, 100, 100000000, 0.6));  // repeated stamp: skipped
   chunk += MessageRecord(1, 100, 50000000, Odometry(0, 100, 50000000, 1.0, 0.1));
   chunk += MessageRecord(1, 100, 150000000, Odometry(1, 100, 150000000, 1.1, 0.2));
-  chunk += MessageRecord(2, 100, 0, Fix(0, 100, 0, -1, 0.0));                // no fix: skipped
+  chunk += MessageRecord(2, 100, 0, Fix(0, 100, 0, -1, 0.0));  // no fix: skipped
   chunk += MessageRecord(2, 100, 100000000, Fix(1, 100, 100000000, 0, 48.1));
   chunk += MessageRecord(2, 100, 300000000, Fix(2, 100, 300000000, 1, 48.2));
   chunk += MessageRecord(3, 100, 0, "log text");
@@ -103,15 +102,14 @@ std::string TinyBag(const std::string& compression) {
   if (compression == "bz2") {
     data.assign(chunk.size() + 1000, '\0');
     unsigned int size = static_cast<unsigned int>(data.size());
-    EXPECT_EQ(BZ2_bzBuffToBuffCompress(data.data(), &size, chunk.data(), static_cast<unsigned int>(chunk.size()), 9,
-                                       0, 0),
-              BZ_OK);
+    EXPECT_EQ(
+        BZ2_bzBuffToBuffCompress(data.data(), &size, chunk.data(), static_cast<unsigned int>(chunk.size()), 9, 0, 0),
+        BZ_OK);
     data.resize(size);
   }
-  const std::string chunk_record =
-      BagRecord(Op(0x05) + BagField("compression", compression) +
-                    BagField("size", U32(static_cast<std::uint32_t>(chunk.size()))),
-                data);
+  const std::string chunk_record = BagRecord(
+      Op(0x05) + BagField("compression", compression) + BagField("size", U32(static_cast<std::uint32_t>(chunk.size()))),
+      data);
   const std::string header_fields = Op(0x03) + BagField("index_pos", Raw(std::uint64_t{0})) +
                                     BagField("conn_count", U32(4)) + BagField("chunk_count", U32(1));
   const std::string padding(4096 - header_fields.size() - 8, ' ');
@@ -167,9 +165,9 @@ TEST_P(ImportRosbagTest, TinyBagRoundTripsThroughTheRecordingFormat) {
   ASSERT_EQ(odo->values.cols(), 27);
   EXPECT_DOUBLE_EQ(odo->values(1, 0), 1.1);
   EXPECT_DOUBLE_EQ(odo->values(1, 5), 0.2);
-  EXPECT_DOUBLE_EQ(odo->values(0, 6), 0.001);    // cov_vx_vx
-  EXPECT_DOUBLE_EQ(odo->values(0, 11), 1e-5);    // cov_vx_wz
-  EXPECT_DOUBLE_EQ(odo->values(0, 26), 0.006);   // cov_wz_wz
+  EXPECT_DOUBLE_EQ(odo->values(0, 6), 0.001);   // cov_vx_vx
+  EXPECT_DOUBLE_EQ(odo->values(0, 11), 1e-5);   // cov_vx_wz
+  EXPECT_DOUBLE_EQ(odo->values(0, 26), 0.006);  // cov_wz_wz
 
   // GPS: the kept fixes, the ENU covariance, the origin at the first kept fix.
   const Stream* gps = rec.Find("gps");

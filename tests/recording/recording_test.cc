@@ -125,8 +125,8 @@ Recording MakeFullRecording() {
   recording.streams[4].info.noise = {{"sigma_m", 0.33}};
   recording.streams[7].info.units = "rad/s";
   recording.streams[7].info.attributes = {{"ticks_per_revolution", 2048}, {"radius_m", 0.3}};
-  recording.streams[12].info.attributes = {{"width_px", 640}, {"height_px", 480}, {"fx_px", 525.0}, {"fy_px", 525.0},
-                                           {"cx_px", 319.5},  {"cy_px", 239.5}};
+  recording.streams[12].info.attributes = {{"width_px", 640}, {"height_px", 480}, {"fx_px", 525.0},
+                                           {"fy_px", 525.0},  {"cx_px", 319.5},   {"cy_px", 239.5}};
   // Ground truth.
   Trajectory truth;
   for (int i = 0; i < 5; ++i) {
@@ -520,7 +520,6 @@ TEST(RecordingWriteTest, RejectsInvalidRecordings) {
   EXPECT_THAT(WriteError(no_origin, dir), HasSubstr("needs an origin"));
 }
 
-
 // Velocity streams may carry their covariance; camera and visual_odometry streams their intrinsics.
 
 // A visual_odometry stream with the covariance columns and the intrinsics: two samples.
@@ -533,8 +532,8 @@ Recording MakeVisualOdometryRecording() {
   stream.info.rate_hz = 15.0;
   stream.info.columns = FixedColumns(StreamType::kVisualOdometry);
   for (const std::string& c : CovarianceColumns(StreamType::kVisualOdometry)) stream.info.columns.push_back(c);
-  stream.info.attributes = {{"width_px", 320}, {"height_px", 240}, {"fx_px", 207.8}, {"fy_px", 207.8},
-                            {"cx_px", 159.5},  {"cy_px", 119.5}};
+  stream.info.attributes = {{"width_px", 320}, {"height_px", 240}, {"fx_px", 207.8},
+                            {"fy_px", 207.8},  {"cx_px", 159.5},   {"cy_px", 119.5}};
   stream.t = {Time::FromSeconds(0.1), Time::FromSeconds(0.2)};
   stream.values = Eigen::MatrixXd::Constant(2, 27, 1e-4);
   stream.values.leftCols(6).setConstant(0.5);

@@ -1,6 +1,6 @@
-// A regression run (regress/regress.h) end to end on a short synthetic drive: a baseline made with the right estimator configuration,
-// the same values again (with another number of jobs), and a configuration with a wrong noise level caught by the
-// baseline checks, named in results.json and junit.xml.
+// A regression run (regress/regress.h) end to end on a short synthetic drive: a baseline made with the right estimator
+// configuration, the same values again (with another number of jobs), and a configuration with a wrong noise level
+// caught by the baseline checks, named in results.json and junit.xml.
 #include "regress/regress.h"
 
 #include <cmath>
@@ -15,9 +15,9 @@
 
 #include "eval/evaluate.h"
 #include "experiment/steps.h"
-#include "regress/modes.h"
 #include "recording/recording.h"
 #include "recording/truth.h"
+#include "regress/modes.h"
 #include "tests/recording/temp_dir.h"
 #include "tests/support/synthetic.h"
 
@@ -100,17 +100,20 @@ class RegressTest : public ::testing::Test {
   // A suite with one tracking case on the synthetic recording, with baseline checks.
   static std::string Suite(const std::string& config) {
     const std::string path = dir_->File("suite_" + config);
-    testing::WriteFile(path, "suite: degraded\nbaseline: baseline\ncases:\n"
-                             "  - name: synthetic_track\n"
-                             "    mode: track\n"
-                             "    recording: rec\n"
-                             "    config: " + config + "\n"
-                             "    checks:\n"
-                             "      - {metric: metrics.ate_m, bound: \"<= 1.25 * baseline\"}\n"
-                             "      - {metric: metrics.nees_mean, bound: \"<= 2 * baseline\"}\n"
-                             "      - {metric: metrics.nees_mean, bound: \">= 0.5 * baseline\"}\n"
-                             "      - {metric: metrics.nees.fraction_in_band, bound: \">= baseline - 0.1\"}\n"
-                             "      - {metric: summary.poses, bound: \">= 100\"}\n");
+    testing::WriteFile(path,
+                       "suite: degraded\nbaseline: baseline\ncases:\n"
+                       "  - name: synthetic_track\n"
+                       "    mode: track\n"
+                       "    recording: rec\n"
+                       "    config: " +
+                           config +
+                           "\n"
+                           "    checks:\n"
+                           "      - {metric: metrics.ate_m, bound: \"<= 1.25 * baseline\"}\n"
+                           "      - {metric: metrics.nees_mean, bound: \"<= 2 * baseline\"}\n"
+                           "      - {metric: metrics.nees_mean, bound: \">= 0.5 * baseline\"}\n"
+                           "      - {metric: metrics.nees.fraction_in_band, bound: \">= baseline - 0.1\"}\n"
+                           "      - {metric: summary.poses, bound: \">= 100\"}\n");
     return path;
   }
 
@@ -178,10 +181,11 @@ TEST_F(RegressTest, MissingBaselineIsAnErrorNotAPass) {
 // its value and bound (and only that one fails).
 TEST_F(RegressTest, ImpossibleBoundFailsAndJunitNamesTheCheck) {
   const std::string path = dir_->File("suite_impossible.yaml");
-  testing::WriteFile(path, "cases:\n  - name: synthetic_track\n    mode: track\n    recording: rec\n"
-                           "    config: good.yaml\n    checks:\n"
-                           "      - {metric: metrics.ate_m, bound: \"<= 100\"}\n"
-                           "      - {metric: summary.poses, bound: \"<= 1\"}\n");
+  testing::WriteFile(path,
+                     "cases:\n  - name: synthetic_track\n    mode: track\n    recording: rec\n"
+                     "    config: good.yaml\n    checks:\n"
+                     "      - {metric: metrics.ate_m, bound: \"<= 100\"}\n"
+                     "      - {metric: summary.poses, bound: \"<= 1\"}\n");
   EXPECT_EQ(Run(path, "out_impossible", false, 1), 1);
   const json results = ReadJson(dir_->File("out_impossible/results.json"));
   EXPECT_EQ(results["checks"]["failed"], 1);
@@ -192,7 +196,8 @@ TEST_F(RegressTest, ImpossibleBoundFailsAndJunitNamesTheCheck) {
   char value[32];
   std::snprintf(value, sizeof value, "%.6g", poses);
   EXPECT_NE(junit.find("<testcase classname=\"synthetic_track\" name=\"summary.poses\">\n      <failure message=\""
-                       "value " + std::string(value) + " violates bound &apos;&lt;= 1&apos;\""),
+                       "value " +
+                       std::string(value) + " violates bound &apos;&lt;= 1&apos;\""),
             std::string::npos)
       << junit;
   EXPECT_EQ(junit.find("<failure", junit.find("<failure") + 1), std::string::npos) << junit;
@@ -202,14 +207,15 @@ TEST_F(RegressTest, ImpossibleBoundFailsAndJunitNamesTheCheck) {
 // data directory is absent is skipped (exit 0, every check a <skipped> testcase naming the directory).
 TEST_F(RegressTest, OpenTargetsAndAbsentDataDoNotFailTheRun) {
   const std::string path = dir_->File("suite_open.yaml");
-  testing::WriteFile(path, "cases:\n  - name: synthetic_track\n    mode: track\n    recording: rec\n"
-                           "    config: good.yaml\n    checks:\n"
-                           "      - {metric: summary.poses, bound: \"<= 1\", open: \"speed target, not met yet\"}\n"
-                           "      - {metric: summary.poses, bound: \">= 100\", open: \"speed target\"}\n"
-                           "      - {metric: metrics.rpe_trans_m, bound: \"<= 2 * metrics.ate_m + 1\"}\n"
-                           "  - name: real_data\n    mode: track\n    data: no_such_directory\n"
-                           "    recording: no_such_directory/rec\n    config: good.yaml\n    checks:\n"
-                           "      - {metric: metrics.ate_m, bound: \"<= 1\"}\n");
+  testing::WriteFile(path,
+                     "cases:\n  - name: synthetic_track\n    mode: track\n    recording: rec\n"
+                     "    config: good.yaml\n    checks:\n"
+                     "      - {metric: summary.poses, bound: \"<= 1\", open: \"speed target, not met yet\"}\n"
+                     "      - {metric: summary.poses, bound: \">= 100\", open: \"speed target\"}\n"
+                     "      - {metric: metrics.rpe_trans_m, bound: \"<= 2 * metrics.ate_m + 1\"}\n"
+                     "  - name: real_data\n    mode: track\n    data: no_such_directory\n"
+                     "    recording: no_such_directory/rec\n    config: good.yaml\n    checks:\n"
+                     "      - {metric: metrics.ate_m, bound: \"<= 1\"}\n");
   EXPECT_EQ(Run(path, "out_open", false, 1), 0);
   const json results = ReadJson(dir_->File("out_open/results.json"));
   const json& checks = results["cases"][0]["checks"];
@@ -221,15 +227,15 @@ TEST_F(RegressTest, OpenTargetsAndAbsentDataDoNotFailTheRun) {
   EXPECT_EQ(results["cases"][1]["checks"][0]["result"], "skipped");
   EXPECT_NE(results["cases"][1]["skipped"].get<std::string>().find("no_such_directory"), std::string::npos);
   const std::string junit = testing::ReadFile(dir_->File("out_open/junit.xml"));
-  EXPECT_NE(junit.find("<skipped message=\"open target not met (speed target, not met yet): value "),
-            std::string::npos)
+  EXPECT_NE(junit.find("<skipped message=\"open target not met (speed target, not met yet): value "), std::string::npos)
       << junit;
   EXPECT_NE(junit.find("violates bound &apos;&lt;= 1&apos;\"/>"), std::string::npos) << junit;
   EXPECT_NE(junit.find("<skipped message=\"case skipped: data directory "), std::string::npos) << junit;
 
   // Without the marker the same bound fails the run.
-  testing::WriteFile(path, "cases:\n  - name: synthetic_track\n    mode: track\n    recording: rec\n"
-                           "    config: good.yaml\n    checks:\n      - {metric: summary.poses, bound: \"<= 1\"}\n");
+  testing::WriteFile(path,
+                     "cases:\n  - name: synthetic_track\n    mode: track\n    recording: rec\n"
+                     "    config: good.yaml\n    checks:\n      - {metric: summary.poses, bound: \"<= 1\"}\n");
   EXPECT_EQ(Run(path, "out_closed", false, 1), 1);
 }
 
@@ -262,24 +268,25 @@ TEST_F(RegressTest, OdometryCaseLearnsAndEvaluatesFromOptiOdomFiles) {
       x += v * dt * std::cos(mid);
       y += v * dt * std::sin(mid);
       th += w * dt;
-      out << k * dt << "," << x << "," << y << "," << th << "," << std::round(exact_r) << ","
-          << std::round(exact_l) << "\n";
+      out << k * dt << "," << x << "," << y << "," << th << "," << std::round(exact_r) << "," << std::round(exact_l)
+          << "\n";
     }
   };
   write_run(data / "train/syn_run-01.csv", 0, 60.0);
   write_run(data / "test/syn_run-01.csv", 1, 30.0);
   const std::string path = dir_->File("suite_odometry.yaml");
-  testing::WriteFile(path, "cases:\n  - name: odometry\n    mode: odometry\n    data: optiodom\n"
-                           "    train: [\"train/*_run-??.csv\"]\n    test: [\"test/*_run-??.csv\"]\n"
-                           "    interval_s: 0.25\n"
-                           "    models: [{model: linear}, {model: parametric}]\n    checks:\n"
-                           "      - {metric: \"table.rows[model=linear].ate_m\", bound: \"<= 0.2 * "
-                           "table.rows[model=nominal].ate_m\"}\n"
-                           "      - {metric: \"table.rows[model=parametric].ate_m\", bound: \"<= 0.2 * "
-                           "table.rows[model=nominal].ate_m\"}\n"
-                           "      - {metric: \"table.rows[model=nominal].ate_m\", bound: \">= 0.1\"}\n"
-                           "      - {metric: \"table.rows[model=linear].model_file\", equals: nothing}\n"
-                           "      - {metric: table.recordings.key_poses.min, bound: \">= 100\"}\n");
+  testing::WriteFile(path,
+                     "cases:\n  - name: odometry\n    mode: odometry\n    data: optiodom\n"
+                     "    train: [\"train/*_run-??.csv\"]\n    test: [\"test/*_run-??.csv\"]\n"
+                     "    interval_s: 0.25\n"
+                     "    models: [{model: linear}, {model: parametric}]\n    checks:\n"
+                     "      - {metric: \"table.rows[model=linear].ate_m\", bound: \"<= 0.2 * "
+                     "table.rows[model=nominal].ate_m\"}\n"
+                     "      - {metric: \"table.rows[model=parametric].ate_m\", bound: \"<= 0.2 * "
+                     "table.rows[model=nominal].ate_m\"}\n"
+                     "      - {metric: \"table.rows[model=nominal].ate_m\", bound: \">= 0.1\"}\n"
+                     "      - {metric: \"table.rows[model=linear].model_file\", equals: nothing}\n"
+                     "      - {metric: table.recordings.key_poses.min, bound: \">= 100\"}\n");
   EXPECT_EQ(Run(path, "out_odometry", false, 1), 1);  // the text check cannot hold
   const json results = ReadJson(dir_->File("out_odometry/results.json"));
   ASSERT_FALSE(results["cases"][0].contains("error")) << results.dump(2);
@@ -344,10 +351,9 @@ TEST_F(RegressTest, OutputSchemasMatchWhatTheCommandsWrite) {
     const bool no_covariance = key == "metrics.nees" || key == "metrics.nees_mean";
     const bool not_wheeled = key == "metrics.velocity";  // written for wheel_encoders streams only
     const std::string name = key.substr(key.find('.', 8) + 1, key.rfind('.') - key.find('.', 8) - 1);
-    const bool vector_parameter = key.rfind("metrics.parameters.", 0) == 0 &&
-                                  metrics["parameters"][name]["manifold"] != "S3" &&
-                                  (key.find(".angle_error_deg") != std::string::npos ||
-                                   key.find(".component_error") != std::string::npos);
+    const bool vector_parameter =
+        key.rfind("metrics.parameters.", 0) == 0 && metrics["parameters"][name]["manifold"] != "S3" &&
+        (key.find(".angle_error_deg") != std::string::npos || key.find(".component_error") != std::string::npos);
     EXPECT_TRUE(no_covariance || not_wheeled || vector_parameter) << key;
   }
   EXPECT_TRUE(metrics["parameters"].contains("imu.misalignment"));

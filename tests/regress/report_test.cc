@@ -117,9 +117,16 @@ SuiteResult Example() {
   a.name = "atv&calibration";
   a.mode = "calibrate";
   CheckResult pass{"metrics.ate_m", "<= 0.5", 0.25, std::nullopt, 0.5, CheckResult::Outcome::kPassed, "",
-                   std::nullopt, ""};
-  CheckResult fail{"metrics.nees.fraction_in_band", ">= baseline - 0.03", 0.5, 0.9, 0.87,
-                   CheckResult::Outcome::kFailed, "", std::nullopt, ""};
+                   std::nullopt,    ""};
+  CheckResult fail{"metrics.nees.fraction_in_band",
+                   ">= baseline - 0.03",
+                   0.5,
+                   0.9,
+                   0.87,
+                   CheckResult::Outcome::kFailed,
+                   "",
+                   std::nullopt,
+                   ""};
   fail.message = FailureMessage(fail);
   a.checks = {pass, fail};
   CaseResult b;
@@ -159,14 +166,21 @@ TEST(JunitTest, OpenTargetsAndSkippedCasesAreSkippedTestcases) {
   a.name = "targets";
   a.mode = "calibrate";
   CheckResult open{"metrics.ate_m", "<= 0.1", 0.25, std::nullopt, 0.1, CheckResult::Outcome::kOpen, "",
-                   std::nullopt, ""};
+                   std::nullopt,    ""};
   open.open = "calibration target, not met yet";
   open.message = "open target not met (" + open.open + "): " + FailureMessage(open);
   CheckResult met{"metrics.rpe_trans_m", "<= 0.5", 0.25, std::nullopt, 0.5, CheckResult::Outcome::kPassed, "",
-                  std::nullopt, ""};
+                  std::nullopt,          ""};
   met.open = "calibration target";
-  CheckResult text{"gap.verdict", "equals named", std::nullopt, std::nullopt, std::nullopt,
-                   CheckResult::Outcome::kFailed, "", std::nullopt, ""};
+  CheckResult text{"gap.verdict",
+                   "equals named",
+                   std::nullopt,
+                   std::nullopt,
+                   std::nullopt,
+                   CheckResult::Outcome::kFailed,
+                   "",
+                   std::nullopt,
+                   ""};
   text.text = "unknown";
   text.message = FailureMessage(text);
   EXPECT_EQ(text.message, "value 'unknown' is not 'named'");
@@ -205,7 +219,7 @@ TEST(JunitTest, OpenTargetsAndSkippedCasesAreSkippedTestcases) {
       << table;
   EXPECT_FALSE(r.Passed());  // the text check failed
   r.cases[0].checks.pop_back();
-  EXPECT_TRUE(r.Passed());   // open and skipped alone do not fail
+  EXPECT_TRUE(r.Passed());  // open and skipped alone do not fail
 }
 
 TEST(JunitTest, CheckerCatchesMalformedXml) {

@@ -112,7 +112,9 @@ TEST_F(SuiteTest, LoadsOdometryAndDiagnoseCasesWithSelectorsTextsAndOpenTargets)
       "      - {metric: \"table.rows[model=gp,mean=linear,kernel=rbf+linear].ate_m\",\n"
       "         bound: \"<= 0.5 * table.rows[model=nominal].ate_m\", open: \"odometry target\"}\n"
       "      - {metric: table.rows.ate_m.max, bound: \"<= 1\"}\n"
-      "  - name: gap\n    mode: diagnose\n    scenario: " + Scenario("atv_hills.yaml") + "\n    seed: 13\n"
+      "  - name: gap\n    mode: diagnose\n    scenario: " +
+      Scenario("atv_hills.yaml") +
+      "\n    seed: 13\n"
       "    effects: [{name: steering_offset, offset_rad: 0.03}]\n    checks:\n"
       "      - {metric: gap.verdict, equals: named}\n"
       "      - {metric: \"gap.effects[name=steering_offset].parameters.offset_rad\", bound: \"<= 0.035\"}\n");
@@ -120,15 +122,14 @@ TEST_F(SuiteTest, LoadsOdometryAndDiagnoseCasesWithSelectorsTextsAndOpenTargets)
   ASSERT_TRUE(suite.ok()) << suite.status().message();
   const Case& odo = suite.value().cases[0];
   EXPECT_EQ(odo.data, dir_.File("no_such_data"));
-  EXPECT_EQ(odo.train, (std::vector<std::string>{dir_.File("no_such_data/diff/square/*.csv"),
-                                                 dir_.File("no_such_data/rec")}));
+  EXPECT_EQ(odo.train,
+            (std::vector<std::string>{dir_.File("no_such_data/diff/square/*.csv"), dir_.File("no_such_data/rec")}));
   ASSERT_EQ(odo.models.size(), 2u);
   EXPECT_EQ(odo.models[1].kernel, "rbf+linear");
   EXPECT_EQ(odo.interval_s, 0.25);
   const Check& ratio = odo.checks[0];
   EXPECT_EQ(ratio.metric.keys, (std::vector<std::string>{"rows", "ate_m"}));
-  EXPECT_EQ(ratio.metric.select.at(0),
-            (Selector{{"model", "gp"}, {"mean", "linear"}, {"kernel", "rbf+linear"}}));
+  EXPECT_EQ(ratio.metric.select.at(0), (Selector{{"model", "gp"}, {"mean", "linear"}, {"kernel", "rbf+linear"}}));
   EXPECT_EQ(ratio.open, "odometry target");
   ASSERT_TRUE(ratio.reference.has_value());
   EXPECT_EQ(ratio.reference->select.at(0), (Selector{{"model", "nominal"}}));
@@ -150,8 +151,9 @@ TEST_F(SuiteTest, LoadsCasesWithTheirChecks) {
                     "      - {metric: metrics.ate_m, bound: \"<= 1.10 * baseline\"}\n"
                     "      - {metric: calibration.measurements.gps.rejected, bound: \"<= 3\"}\n",
                     "    quick: true\n") +
-      "  - name: mc\n    mode: montecarlo\n    scenario: " + Scenario("atv_hills.yaml") + "\n    config: " +
-      Config("atv_tracking.yaml") + "\n    runs: 4\n    checks:\n"
+      "  - name: mc\n    mode: montecarlo\n    scenario: " + Scenario("atv_hills.yaml") +
+      "\n    config: " + Config("atv_tracking.yaml") +
+      "\n    runs: 4\n    checks:\n"
       "      - {metric: nees.fraction_in_band, bound: \">= baseline - 0.03\"}\n"
       "      - {metric: runs.runs.ate_m.max, bound: \"<= 2\"}\n"
       "      - {metric: nees.band.1, bound: \"<= 4\"}\n");
@@ -187,8 +189,7 @@ TEST_F(SuiteTest, EachKindOfBadSuiteIsOneLineNamingFileCaseAndProblem) {
        "unknown key 'eror'"},
       {CalibrateCase("      - {metric: metrics.parameters.wheel.radius.error.0, bound: \"<= 1\"}\n"),
        "does not start with a parameter"},
-      {CalibrateCase("      - {metric: metrics.parameters.gps.lever_arm.error, bound: \"<= 1\"}\n"),
-       "is an array"},
+      {CalibrateCase("      - {metric: metrics.parameters.gps.lever_arm.error, bound: \"<= 1\"}\n"), "is an array"},
       {CalibrateCase("      - {metric: metrics.ate_m.norm, bound: \"<= 1\"}\n"), "is a number"},
       {CalibrateCase("      - {metric: nees.fraction_in_band, bound: \"<= 1\"}\n"), "writes no output 'nees'"},
       {CalibrateCase("      - {metric: calibration.solver.seconds, bound: \"<= 1\"}\n"), "timing value"},
@@ -219,8 +220,7 @@ TEST_F(SuiteTest, EachKindOfBadSuiteIsOneLineNamingFileCaseAndProblem) {
       {Diagnose("    effects: [{name: steering_ofset, offset_rad: 0.03}]\n"), "unknown effect 'steering_ofset'"},
       {Diagnose("    effects: [{name: steering_offset, offset: 0.03}]\n"), "has no parameter offset"},
       {Diagnose("    effects: [{name: steering_offset, offset_rad: big}]\n"), "is not a number"},
-      {"  - name: cal\n    mode: calibrate\n    scenario: nowhere.yaml\n    config: " + cal + "\n    checks:\n" +
-           check,
+      {"  - name: cal\n    mode: calibrate\n    scenario: nowhere.yaml\n    config: " + cal + "\n    checks:\n" + check,
        "missing scenario"},
       {"  - name: cal\n    mode: calibrate\n    recording: no_rec\n    config: " + cal + "\n    checks:\n" + check,
        "missing recording"},
@@ -277,8 +277,8 @@ TEST(ResolveMetricTest, WalksKeysReducesArraysAndDerivesRelativeErrors) {
   EXPECT_DOUBLE_EQ(ResolveMetric(metrics, path({"parameters", "gps.lever_arm", "error"}, "1")).value(), -0.04);
   EXPECT_DOUBLE_EQ(ResolveMetric(metrics, path({"parameters", "odometer.kv_over_L", "relative_error"}, "")).value(),
                    0.0025);
-  EXPECT_FALSE(ResolveMetric(metrics, path({"nees_mean"}, "")).ok());                            // null
-  EXPECT_FALSE(ResolveMetric(metrics, path({"rpe_trans_m"}, "")).ok());                          // absent
+  EXPECT_FALSE(ResolveMetric(metrics, path({"nees_mean"}, "")).ok());                              // null
+  EXPECT_FALSE(ResolveMetric(metrics, path({"rpe_trans_m"}, "")).ok());                            // absent
   EXPECT_FALSE(ResolveMetric(metrics, path({"parameters", "gps.lever_arm", "error"}, "3")).ok());  // out of range
 
   const json runs = json::parse(R"({"runs": [{"ate_m": 0.5}, {"ate_m": 1.5}, {"ate_m": 1.0}]})");

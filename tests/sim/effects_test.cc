@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include <GeographicLib/LocalCartesian.hpp>
 #include <gtest/gtest.h>
+#include <GeographicLib/LocalCartesian.hpp>
 
 #include "recording/recording.h"
 #include "sim/simulator.h"
@@ -60,13 +60,13 @@ TEST_F(EffectsTest, GyroScaleMultipliesEachAxisAndNothingElse) {
   EXPECT_GT(a.values.col(2).cwiseAbs().maxCoeff(), 0.05);  // the drive turns
   for (Eigen::Index k = 0; k < a.values.rows(); ++k) {
     EXPECT_NEAR(b.values(k, 0), 0.98 * a.values(k, 0), 1e-12);
-    EXPECT_NEAR(b.values(k, 1), a.values(k, 1), 1e-12);              // default scale 1
+    EXPECT_NEAR(b.values(k, 1), a.values(k, 1), 1e-12);  // default scale 1
     EXPECT_NEAR(b.values(k, 2), 1.03 * a.values(k, 2), 1e-12);
-    EXPECT_NEAR(b.values(k, 3), a.values(k, 3), 1e-12);              // accelerometer untouched
+    EXPECT_NEAR(b.values(k, 3), a.values(k, 3), 1e-12);  // accelerometer untouched
   }
   ASSERT_EQ(sim.truth.effects.size(), 1u);
   EXPECT_EQ(sim.truth.effects[0].name, "gyro_scale_error");
-  EXPECT_EQ(sim.truth.effects[0].parameters.at("scale_y"), 1.0);     // defaults are written out
+  EXPECT_EQ(sim.truth.effects[0].parameters.at("scale_y"), 1.0);  // defaults are written out
   EXPECT_EQ(sim.truth.effects[0].parameters.at("scale_z"), 1.03);
   EXPECT_TRUE(nominal_->truth.effects.empty());
 }
@@ -75,8 +75,8 @@ TEST_F(EffectsTest, GyroScaleMultipliesEachAxisAndNothingElse) {
 // the gyroscope changes. The variance test uses the chi-square spread of a sample variance: relative std sqrt(2 / n).
 TEST_F(EffectsTest, GyroBiasDriftStartsAtItsInitialValueAndWalks) {
   const double walk = 0.01;  // rad/s/sqrt(s)
-  const Simulation sim = Simulated(
-      Drive({{"gyro_bias_drift", {{"initial_x", 0.02}, {"initial_z", -0.01}, {"random_walk", walk}}}}));
+  const Simulation sim =
+      Simulated(Drive({{"gyro_bias_drift", {{"initial_x", 0.02}, {"initial_z", -0.01}, {"random_walk", walk}}}}));
   const recording::Stream& a = StreamOf(*nominal_, "imu");
   const recording::Stream& b = StreamOf(sim, "imu");
   ASSERT_EQ(a.values.rows(), b.values.rows());
@@ -107,7 +107,7 @@ TEST_F(EffectsTest, GpsLatencyReportsTheAntennaPositionTauEarlier) {
   const recording::Stream& a = StreamOf(*nominal_, "gps");
   const recording::Stream& b = StreamOf(sim, "gps");
   ASSERT_EQ(a.values.rows(), b.values.rows());
-  EXPECT_EQ(a.t, b.t);                                               // the stamps do not say it
+  EXPECT_EQ(a.t, b.t);  // the stamps do not say it
   // At 100 Hz, 0.05 s is 5 rows: the fix stamped t_k is the nominal fix of t_k - 0.05.
   for (Eigen::Index k = 5; k < a.values.rows(); ++k)
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(b.values(k, c), a.values(k - 5, c), 1e-9) << k;
@@ -123,7 +123,7 @@ TEST_F(EffectsTest, ImuTimeOffsetStampsReadingsAheadAndTheMagnetometerFollows) {
     const recording::Stream& b = StreamOf(late, name);
     const recording::Stream& c = StreamOf(early, name);
     ASSERT_EQ(a.values.rows(), b.values.rows());
-    ASSERT_EQ(a.values.rows(), c.values.rows());    // samples taken after the end: the physics runs on
+    ASSERT_EQ(a.values.rows(), c.values.rows());  // samples taken after the end: the physics runs on
     for (Eigen::Index k = 0; k + 3 < a.values.rows(); ++k) {
       if (k >= 2) {
         EXPECT_NEAR((b.values.row(k) - a.values.row(k - 2)).norm(), 0.0, 1e-9) << name << " " << k;
@@ -139,9 +139,9 @@ TEST_F(EffectsTest, ImuTimeOffsetStampsReadingsAheadAndTheMagnetometerFollows) {
 
 TEST_F(EffectsTest, MagnetometerInterferenceIsABiasAlongItsDirectionThatFollowsTheTorque) {
   const Eigen::Vector3d per_nm(2e-4, -1e-4, 3e-4);
-  const Simulation sim = Simulated(Drive({{"magnetometer_motor_interference",
-                                     {{"b_per_nm_x", per_nm.x()}, {"b_per_nm_y", per_nm.y()},
-                                      {"b_per_nm_z", per_nm.z()}}}}));
+  const Simulation sim =
+      Simulated(Drive({{"magnetometer_motor_interference",
+                        {{"b_per_nm_x", per_nm.x()}, {"b_per_nm_y", per_nm.y()}, {"b_per_nm_z", per_nm.z()}}}}));
   const recording::Stream& a = StreamOf(*nominal_, "magnetometer");
   const recording::Stream& b = StreamOf(sim, "magnetometer");
   ASSERT_EQ(a.values.rows(), b.values.rows());
@@ -149,12 +149,12 @@ TEST_F(EffectsTest, MagnetometerInterferenceIsABiasAlongItsDirectionThatFollowsT
   for (Eigen::Index k = 0; k < a.values.rows(); ++k) {
     const Eigen::Vector3d d = (b.values.row(k) - a.values.row(k)).transpose();
     const double torque_nm = d.dot(per_nm) / per_nm.squaredNorm();
-    EXPECT_NEAR((d - torque_nm * per_nm).norm(), 0.0, 1e-12) << k;   // along b_per_nm
-    EXPECT_LE(std::abs(torque_nm), 400.0 + 1e-9);                     // within the torque limit
+    EXPECT_NEAR((d - torque_nm * per_nm).norm(), 0.0, 1e-12) << k;  // along b_per_nm
+    EXPECT_LE(std::abs(torque_nm), 400.0 + 1e-9);                   // within the torque limit
     min_torque = std::min(min_torque, torque_nm);
     max_torque = std::max(max_torque, torque_nm);
   }
-  EXPECT_GT(max_torque - min_torque, 5.0);                            // the speed controller works
+  EXPECT_GT(max_torque - min_torque, 5.0);  // the speed controller works
 }
 
 // Mean yaw rate [rad/s] and mean crab angle (course minus heading, [rad]) of O over [t0, end] of the ground truth.
@@ -227,12 +227,12 @@ TEST(LateralSlipTest, SofterTiresRaiseTheCorneringCompliance) {
     if (scale != 1.0) s.effects = {{"lateral_slip", {{"contact_time_scale", scale}}}};
     const Crab turn = CrabOf(*Simulated(s).recording.ground_truth, 3.0);
     const double a_y = turn.speed_mps * turn.yaw_rate_radps;
-    EXPECT_GT(a_y, 1.0);   // a real turn
+    EXPECT_GT(a_y, 1.0);  // a real turn
     return -turn.speed_mps * std::sin(turn.crab_rad) / a_y;
   };
   const double nominal = compliance(1.0), soft = compliance(3.0);
   std::cout << "c_rear: nominal " << nominal << " s, contact time x3 " << soft << " s\n";
-  EXPECT_GT(nominal, 0.0);   // outwards
+  EXPECT_GT(nominal, 0.0);  // outwards
   EXPECT_GT(soft / nominal, 2.5);
   EXPECT_LT(soft / nominal, 3.5);
 }
@@ -243,8 +243,8 @@ TEST_F(EffectsTest, AccelerometerScaleMultipliesEachAxisAndNothingElse) {
   const recording::Stream& b = StreamOf(sim, "imu");
   ASSERT_EQ(a.values.rows(), b.values.rows());
   for (Eigen::Index k = 0; k < a.values.rows(); ++k) {
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(b.values(k, c), a.values(k, c), 1e-12);   // gyroscope untouched
-    EXPECT_NEAR(b.values(k, 3), a.values(k, 3), 1e-12);                             // default scale 1
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(b.values(k, c), a.values(k, c), 1e-12);  // gyroscope untouched
+    EXPECT_NEAR(b.values(k, 3), a.values(k, 3), 1e-12);                              // default scale 1
     EXPECT_NEAR(b.values(k, 4), 0.97 * a.values(k, 4), 1e-12);
     EXPECT_NEAR(b.values(k, 5), 1.04 * a.values(k, 5), 1e-12);
   }
@@ -256,7 +256,8 @@ TEST_F(EffectsTest, AccelerometerScaleMultipliesEachAxisAndNothingElse) {
 // untouched.
 TEST_F(EffectsTest, GpsMultipathIsAGaussMarkovErrorOfTheFix) {
   const double sigma_m = 1.5, correlation_s = 0.2;
-  const Simulation sim = Simulated(Drive({{"gps_multipath", {{"sigma_m", sigma_m}, {"correlation_s", correlation_s}}}}));
+  const Simulation sim =
+      Simulated(Drive({{"gps_multipath", {{"sigma_m", sigma_m}, {"correlation_s", correlation_s}}}}));
   const recording::Stream& a = StreamOf(*nominal_, "gps");
   const recording::Stream& b = StreamOf(sim, "gps");
   ASSERT_EQ(a.values.rows(), b.values.rows());
@@ -269,13 +270,13 @@ TEST_F(EffectsTest, GpsMultipathIsAGaussMarkovErrorOfTheFix) {
     local.Forward(b.values(k, 0), b.values(k, 1), b.values(k, 2), pb.x(), pb.y(), pb.z());
     error.push_back(pb - pa);
   }
-  const double a_k = std::exp(-0.01 / correlation_s);   // the 100 Hz GPS of Drive
+  const double a_k = std::exp(-0.01 / correlation_s);  // the 100 Hz GPS of Drive
   double sum = 0.0;
   int n = 0;
   for (std::size_t k = 0; k + 1 < error.size(); ++k, n += 3) sum += (error[k + 1] - a_k * error[k]).squaredNorm();
   const double ratio = sum / n / (sigma_m * sigma_m * (1.0 - a_k * a_k));
   EXPECT_NEAR(ratio, 1.0, 4.0 * std::sqrt(2.0 / n));
-  EXPECT_GT(error.front().norm(), 1e-3);   // starts in the stationary distribution, not at zero
+  EXPECT_GT(error.front().norm(), 1e-3);  // starts in the stationary distribution, not at zero
   EXPECT_LT((StreamOf(sim, "imu").values - StreamOf(*nominal_, "imu").values).cwiseAbs().maxCoeff(), 1e-12);
 }
 
@@ -295,7 +296,7 @@ TEST_F(EffectsTest, TireGrowthMakesTheSpeedSensorUnderReadWithTheSquareOfTheSpee
     EXPECT_NEAR(b.values(k, 0), a.values(k, 0) / (1.0 + c * v_mps * v_mps), 1e-9) << k;
     min_ratio = std::min(min_ratio, b.values(k, 0) / a.values(k, 0));
   }
-  EXPECT_LT(min_ratio, 0.95);   // about 4 m/s: a 6 % under-reading
+  EXPECT_LT(min_ratio, 0.95);  // about 4 m/s: a 6 % under-reading
   EXPECT_LT((StreamOf(sim, "steering").values - StreamOf(*nominal_, "steering").values).cwiseAbs().maxCoeff(), 1e-12);
 }
 
@@ -374,8 +375,7 @@ TEST(EffectsValidationTest, UnknownNamesParametersAndRangesAreErrors) {
             "wheel index");
   EXPECT_NE(problem({{"accelerometer_scale_error", {{"scale_x", 1.6}}}}).find("scale_x: must be in [0.5, 1.5]"),
             std::string::npos);
-  EXPECT_NE(problem({{"gps_multipath", {{"sigma_m", -1.0}}}}).find("sigma_m: must be in [0, 10] m"),
-            std::string::npos);
+  EXPECT_NE(problem({{"gps_multipath", {{"sigma_m", -1.0}}}}).find("sigma_m: must be in [0, 10] m"), std::string::npos);
   EXPECT_NE(problem({{"gps_multipath", {{"correlation_s", 0.0}}}}).find("correlation_s: must be in [0.1, 600] s"),
             std::string::npos);
   EXPECT_NE(problem({{"tire_growth", {{"growth_per_mps2", 0.02}}}}).find("growth_per_mps2: must be in [0, 0.01]"),

@@ -20,8 +20,8 @@ Eigen::Vector3d TrueTwist(const StampedPose& a, const StampedPose& b) {
   const double dt = SecondsBetween(a.t, b.t);
   const Eigen::AngleAxisd turn(a.q_world_body.conjugate() * b.q_world_body);
   const double yaw = turn.angle() * turn.axis().z();
-  const Eigen::Quaterniond q_mid = a.q_world_body * Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * yaw,
-                                                                                          Eigen::Vector3d::UnitZ()));
+  const Eigen::Quaterniond q_mid =
+      a.q_world_body * Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * yaw, Eigen::Vector3d::UnitZ()));
   const Eigen::Vector3d v = q_mid.conjugate() * (b.p_world_body - a.p_world_body) / dt;
   return Eigen::Vector3d(v.x(), v.y(), yaw / dt);
 }
@@ -36,7 +36,8 @@ TEST(HolonomicRobotTest, MeasuredWheelRowsAreTheNominalKinematics) {
   for (const auto& [file, kind, geometry] :
        std::vector<std::tuple<std::string, std::string, std::map<std::string, double>>>{
            {"models/omni3.xml", "omni3", {{"wheel_radius_m", 0.05}, {"wheel_distance_m", 0.2}}},
-           {"models/mecanum.xml", "mecanum",
+           {"models/mecanum.xml",
+            "mecanum",
             {{"wheel_radius_m", 0.05}, {"half_length_m", 0.2}, {"half_width_m", 0.18}}}}) {
     auto robot = BindModel(file, kind);
     ASSERT_TRUE(robot.ok()) << robot.status().message();
@@ -46,7 +47,9 @@ TEST(HolonomicRobotTest, MeasuredWheelRowsAreTheNominalKinematics) {
     auto nominal = recording::NominalWheelKinematics(platform);
     ASSERT_TRUE(nominal.ok()) << nominal.status().message();
     EXPECT_LT((robot.value().J_rates_twist() - nominal.value().J_rates_twist).cwiseAbs().maxCoeff(), 1e-4)
-        << kind << "\nmeasured\n" << robot.value().J_rates_twist() << "\nnominal\n" << nominal.value().J_rates_twist;
+        << kind << "\nmeasured\n"
+        << robot.value().J_rates_twist() << "\nnominal\n"
+        << nominal.value().J_rates_twist;
     for (const auto& [key, value] : robot.value().PlatformGeometry()) EXPECT_NEAR(value, geometry.at(key), 1e-5) << key;
     // Full rank with a yaw column: the robot can turn in place.
     const Eigen::MatrixXd& J = robot.value().J_rates_twist();
@@ -105,9 +108,8 @@ TEST(HolonomicRobotTest, MovedWheelMovesInThePhysicsOnlyAndTheTrueLeverArmFollow
   const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> R_world_odom(data->site_xmat + 9 * odom);
   for (int i = 0; i < 4; ++i) {
     const int tire = IdOf(m, mjOBJ_GEOM, "tire_" + std::to_string(i));
-    const Eigen::Vector3d p_odom_m =
-        R_world_odom.transpose() * (Eigen::Vector3d(data->geom_xpos + 3 * tire) - Eigen::Vector3d(data->site_xpos +
-                                                                                                   3 * odom));
+    const Eigen::Vector3d p_odom_m = R_world_odom.transpose() * (Eigen::Vector3d(data->geom_xpos + 3 * tire) -
+                                                                 Eigen::Vector3d(data->site_xpos + 3 * odom));
     const Eigen::Vector2d expected = robot.wheels()[i].p_body_m + (i == 1 ? offset_m : Eigen::Vector2d::Zero());
     EXPECT_LT((p_odom_m.head<2>() - expected).norm(), 1e-9) << "wheel " << i << ": " << p_odom_m.transpose();
   }

@@ -25,8 +25,8 @@ Eigen::Vector3d TrueTwist(const StampedPose& a, const StampedPose& b) {
   const double dt = SecondsBetween(a.t, b.t);
   const Eigen::AngleAxisd turn(a.q_world_body.conjugate() * b.q_world_body);
   const double yaw = turn.angle() * turn.axis().z();
-  const Eigen::Quaterniond q_mid = a.q_world_body * Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * yaw,
-                                                                                          Eigen::Vector3d::UnitZ()));
+  const Eigen::Quaterniond q_mid =
+      a.q_world_body * Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * yaw, Eigen::Vector3d::UnitZ()));
   const Eigen::Vector3d v = q_mid.conjugate() * (b.p_world_body - a.p_world_body) / dt;
   return Eigen::Vector3d(v.x(), v.y(), yaw / dt);
 }
@@ -86,8 +86,8 @@ TEST_F(IndoorSimulationTest, ScanMatchingFollowsTheLaserMotion) {
   for (std::size_t k = 0; k < scans->t.size(); ++k) {
     // The sample is stamped mid-interval; the scans were 0.1 s apart at 100 Hz truth indices.
     const long mid = std::lround(scans->t[k].nanoseconds() * 1e-7);
-    const Eigen::Vector3d twist = TrueTwist(truth[static_cast<std::size_t>(mid - 5)],
-                                            truth[static_cast<std::size_t>(mid + 5)]);
+    const Eigen::Vector3d twist =
+        TrueTwist(truth[static_cast<std::size_t>(mid - 5)], truth[static_cast<std::size_t>(mid + 5)]);
     // Eq. 5 with S at (lever.x, 0): v_S = v_O + omega x S.
     const Eigen::Vector2d v_laser(twist.x(), twist.y() + twist.z() * lever.x());
     sum_v2 += (scans->values.row(k).head<2>().transpose() - v_laser).squaredNorm();

@@ -15,12 +15,12 @@ namespace {
 using ::testing::HasSubstr;
 
 // Creates a renderer or skips the test when EGL is unavailable (any other error fails it).
-#define ROAMLAB_RENDERER_OR_SKIP(var, model, camera, options)                                        \
-  auto var##_result = CameraRenderer::Create(model, camera, options);                              \
-  if (!var##_result.ok() && var##_result.status().message().rfind("EGL:", 0) == 0) {               \
-    GTEST_SKIP() << "no headless OpenGL: " << var##_result.status().message();                     \
-  }                                                                                                \
-  ASSERT_TRUE(var##_result.ok()) << var##_result.status().message();                               \
+#define ROAMLAB_RENDERER_OR_SKIP(var, model, camera, options)                        \
+  auto var##_result = CameraRenderer::Create(model, camera, options);                \
+  if (!var##_result.ok() && var##_result.status().message().rfind("EGL:", 0) == 0) { \
+    GTEST_SKIP() << "no headless OpenGL: " << var##_result.status().message();       \
+  }                                                                                  \
+  ASSERT_TRUE(var##_result.ok()) << var##_result.status().message();                 \
   std::unique_ptr<CameraRenderer> var = std::move(var##_result).value()
 
 TEST(IntrinsicsTest, FromFovy) {

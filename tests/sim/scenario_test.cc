@@ -177,16 +177,16 @@ TEST_F(ScenarioErrorTest, CameraSection) {
   EXPECT_EQ(LoadIndoorWith("    rate_hz: 15\n", "    rate_hz: 15\n    store_images: true\n"), "");
   ExpectError(LoadIndoorWith("    rate_hz: 15\n", "    rate_hz: 40\n"), "rate_hz: 40", "sensors.camera.rate_hz",
               "must be in [10, 30]");
-  ExpectError(LoadIndoorWith("    width_px: 320\n", "    width_px: 640\n"), "height_px: 240", "sensors.camera.height_px",
-              "320x240 or 640x480");
+  ExpectError(LoadIndoorWith("    width_px: 320\n", "    width_px: 640\n"), "height_px: 240",
+              "sensors.camera.height_px", "320x240 or 640x480");
   ExpectError(LoadIndoorWith("    width_px: 320\n", "    width_px: 300\n"), "width_px: 300", "sensors.camera.width_px",
               "320x240 or 640x480");
   ExpectError(LoadIndoorWith("    rate_hz: 15\n", "    rate_hz: 15\n    store_images: maybe\n"), "store_images",
               "sensors.camera.store_images", "expected true or false");
   ExpectError(LoadIndoorWith("    rate_hz: 15\n", "    rate_hz: 15\n    fps: 15\n"), "fps", "sensors.camera.fps",
               "unknown key");
-  ExpectError(LoadWith("lever_arm_m: [0.57, -0.46, 0.32]", "lever_arm_m: [0.57, -0.46, 0.32]\n  camera: {}"), "camera: {}", "sensors.camera",
-              "only for wheeled indoor robots");
+  ExpectError(LoadWith("lever_arm_m: [0.57, -0.46, 0.32]", "lever_arm_m: [0.57, -0.46, 0.32]\n  camera: {}"),
+              "camera: {}", "sensors.camera", "only for wheeled indoor robots");
 }
 
 TEST_F(ScenarioErrorTest, YamlSyntaxErrorsGiveLineAndColumn) {
@@ -230,9 +230,8 @@ TEST(ScenarioTest, IndoorOmniDrivesSidewaysAndWheelMountingIsParsedAndChecked) {
   EXPECT_NEAR(mounted.value().robot.wheel_mounting[0].tilt_rad, -3.0 * M_PI / 180.0, 1e-15);
 
   // Wheel deformation from YAML, then the checks of Validate.
-  const std::string deformed_text =
-      std::string(text).replace(text.find(kind), kind.size(),
-                                kind + "  wheel_deformation: [{wheel: 1, radius_scale: 1.01, ovality_m: 0.003}]\n");
+  const std::string deformed_text = std::string(text).replace(
+      text.find(kind), kind.size(), kind + "  wheel_deformation: [{wheel: 1, radius_scale: 1.01, ovality_m: 0.003}]\n");
   roamlab::testing::WriteFile(dir.File("deformed.yaml"), deformed_text);
   auto deformed = LoadScenario(dir.File("deformed.yaml"));
   ASSERT_TRUE(deformed.ok()) << deformed.status().message();
@@ -240,8 +239,9 @@ TEST(ScenarioTest, IndoorOmniDrivesSidewaysAndWheelMountingIsParsedAndChecked) {
   EXPECT_EQ(deformed.value().robot.wheel_deformation[0].wheel, 1);
   EXPECT_EQ(deformed.value().robot.wheel_deformation[0].radius_scale, 1.01);
   EXPECT_EQ(deformed.value().robot.wheel_deformation[0].ovality_m, 0.003);
-  roamlab::testing::WriteFile(dir.File("typo.yaml"), std::string(text).replace(
-      text.find(kind), kind.size(), kind + "  wheel_deformation: [{wheel: 1, ovality: 0.003}]\n"));
+  roamlab::testing::WriteFile(dir.File("typo.yaml"),
+                              std::string(text).replace(text.find(kind), kind.size(),
+                                                        kind + "  wheel_deformation: [{wheel: 1, ovality: 0.003}]\n"));
   auto typo = LoadScenario(dir.File("typo.yaml"));
   ASSERT_FALSE(typo.ok());
   EXPECT_NE(typo.status().message().find("robot.wheel_deformation[0]"), std::string::npos) << typo.status().message();

@@ -8,8 +8,8 @@
 #include <sstream>
 #include <vector>
 
-#include <GeographicLib/LocalCartesian.hpp>
 #include <gtest/gtest.h>
+#include <GeographicLib/LocalCartesian.hpp>
 
 #include "sim/simulator.h"
 #include "tests/sim/sim_testing.h"

@@ -19,9 +19,10 @@ TEST(SimulatorSlowTest, DefaultDriveRoamsTheHills) {
   ASSERT_TRUE(run.ok()) << run.status().message();
   const Simulation& sim = run.value();
   const SimulationStats& st = sim.stats;
-  std::printf("30 s drive: %.1f m, pitch %.1f deg, roll %.1f deg, height range %.2f m, relief %.2f m, %.1fx real time\n",
-              st.distance_m, st.max_abs_pitch_rad * 57.29578, st.max_abs_roll_rad * 57.29578, st.path_height_range_m,
-              st.terrain_relief_m, st.realtime_factor);
+  std::printf(
+      "30 s drive: %.1f m, pitch %.1f deg, roll %.1f deg, height range %.2f m, relief %.2f m, %.1fx real time\n",
+      st.distance_m, st.max_abs_pitch_rad * 57.29578, st.max_abs_roll_rad * 57.29578, st.path_height_range_m,
+      st.terrain_relief_m, st.realtime_factor);
   EXPECT_GT(st.distance_m, 80.0);
   EXPECT_GT(st.max_abs_pitch_rad, 4.0 * kDeg);
   EXPECT_GT(st.max_abs_roll_rad, 4.0 * kDeg);

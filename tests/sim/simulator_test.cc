@@ -5,8 +5,8 @@
 #include <cmath>
 #include <filesystem>
 
-#include <GeographicLib/LocalCartesian.hpp>
 #include <gtest/gtest.h>
+#include <GeographicLib/LocalCartesian.hpp>
 
 #include "recording/recording.h"
 #include "recording/truth.h"

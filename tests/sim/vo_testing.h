@@ -5,8 +5,8 @@
 #include <cmath>
 #include <string>
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "sim/mujoco_model.h"
 #include "tests/sim/sim_testing.h"

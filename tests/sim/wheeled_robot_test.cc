@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Dense>
 #include <gtest/gtest.h>
+#include <Eigen/Dense>
 
 #include "sim/mujoco_model.h"
 #include "sim/wheeled_robot.h"
@@ -18,9 +18,9 @@ namespace roamlab::sim {
 namespace {
 
 struct WheelTrace {
-  std::vector<double> angle_rad;   // wheel angle
-  std::vector<double> height_m;    // wheel centre above the floor
-  double travel_m = 0.0;           // wheel centre's travel along the body's forward axis
+  std::vector<double> angle_rad;  // wheel angle
+  std::vector<double> height_m;   // wheel centre above the floor
+  double travel_m = 0.0;          // wheel centre's travel along the body's forward axis
 };
 
 // Drives models/diffdrive.xml (with `deformations`) straight at 0.3 m/s for `seconds` after a 0.5 s settle and traces
@@ -29,9 +29,10 @@ std::vector<WheelTrace> DriveStraight(const std::vector<WheelDeformation>& defor
                                       WheeledRobot* bound) {
   const std::map<std::string, std::string> files{
       {"robot.xml", testing::ReadText(testing::SourcePath("models/diffdrive.xml"))},
-      {"world.xml", "<mujoco><include file=\"robot.xml\"/><worldbody><geom name=\"floor\" type=\"plane\" "
-                    "size=\"50 50 0.1\" contype=\"1\" conaffinity=\"1\" group=\"0\" friction=\"0.6\"/>"
-                    "</worldbody></mujoco>"}};
+      {"world.xml",
+       "<mujoco><include file=\"robot.xml\"/><worldbody><geom name=\"floor\" type=\"plane\" "
+       "size=\"50 50 0.1\" contype=\"1\" conaffinity=\"1\" group=\"0\" friction=\"0.6\"/>"
+       "</worldbody></mujoco>"}};
   auto model = LoadModelFromFiles("world.xml", files, "diffdrive");
   EXPECT_TRUE(model.ok()) << model.status().message();
   if (!model.ok()) return {};

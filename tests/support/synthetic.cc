@@ -50,7 +50,9 @@ struct TerrainSample {
 };
 
 // Speed along the surface [m/s] and steering angle [rad] at t [s].
-double Speed(double t) { return 4.5 + 1.0 * std::sin(2.0 * kPi * t / 13.0) + 0.4 * std::sin(2.0 * kPi * t / 4.7 + 0.6); }
+double Speed(double t) {
+  return 4.5 + 1.0 * std::sin(2.0 * kPi * t / 13.0) + 0.4 * std::sin(2.0 * kPi * t / 4.7 + 0.6);
+}
 double Steering(double t) {
   return 0.18 * std::sin(2.0 * kPi * t / 11.0 + 0.3) + 0.1 * std::sin(2.0 * kPi * t / 3.7 + 1.1);
 }
@@ -209,7 +211,8 @@ recording::Stream MakeStream(const std::string& name, recording::StreamType type
   stream.info.columns = std::move(columns);
   stream.info.units = units;
   stream.t = SampleTimes(rate_hz, end_ns);
-  stream.values.resize(static_cast<Eigen::Index>(stream.t.size()), static_cast<Eigen::Index>(stream.info.columns.size()));
+  stream.values.resize(static_cast<Eigen::Index>(stream.t.size()),
+                       static_cast<Eigen::Index>(stream.info.columns.size()));
   return stream;
 }
 
@@ -281,12 +284,11 @@ SyntheticRecording MakeAtvRecording(const SyntheticOptions& options) {
   for (std::size_t k = 0; k < imu.t.size(); ++k) {
     const AtvTruth::Kinematics truth = truth_model.At(imu.t[k].nanoseconds());
     const AtvTruth::Kinematics read = truth_model.At(imu.t[k].nanoseconds() - imu_offset_ns);
-    const Eigen::Vector3d gyro = q_body_imu.conjugate() * read.omega_body + options.gyro_bias_radps +
-                                 gyro_noise.Draw3(options.sigma_gyro_radps);
-    const Eigen::Vector3d accel =
-        q_body_imu.conjugate() *
-            (read.q_world_body.conjugate() * (read.a_world + estimator::kSpecificForceAtRest_world)) +
-        accel_noise.Draw3(options.sigma_acc_mps2);
+    const Eigen::Vector3d gyro =
+        q_body_imu.conjugate() * read.omega_body + options.gyro_bias_radps + gyro_noise.Draw3(options.sigma_gyro_radps);
+    const Eigen::Vector3d accel = q_body_imu.conjugate() * (read.q_world_body.conjugate() *
+                                                            (read.a_world + estimator::kSpecificForceAtRest_world)) +
+                                  accel_noise.Draw3(options.sigma_acc_mps2);
     imu.values.row(static_cast<Eigen::Index>(k)) << gyro.transpose(), accel.transpose();
 
     StampedPose pose{imu.t[k], truth.p_world_body, truth.q_world_body};
@@ -317,8 +319,8 @@ SyntheticRecording MakeAtvRecording(const SyntheticOptions& options) {
   const GeographicLib::LocalCartesian local(kOrigin.latitude_deg, kOrigin.longitude_deg, kOrigin.altitude_m);
   for (std::size_t k = 0; k < gps.t.size(); ++k) {
     const AtvTruth::Kinematics truth = truth_model.At(gps.t[k].nanoseconds());
-    const Eigen::Vector3d antenna_world = truth.p_world_body + truth.q_world_body * options.gps_lever_arm_m +
-                                          gps_noise.Draw3(options.sigma_gps_m);
+    const Eigen::Vector3d antenna_world =
+        truth.p_world_body + truth.q_world_body * options.gps_lever_arm_m + gps_noise.Draw3(options.sigma_gps_m);
     double latitude = 0.0, longitude = 0.0, altitude = 0.0;
     local.Reverse(antenna_world.x(), antenna_world.y(), antenna_world.z(), latitude, longitude, altitude);
     gps.values.row(static_cast<Eigen::Index>(k)) << latitude, longitude, altitude;
@@ -328,8 +330,8 @@ SyntheticRecording MakeAtvRecording(const SyntheticOptions& options) {
   recording::Stream wheel = MakeStream("rear_wheel", recording::StreamType::kWheelEncoders, options.odometer_rate_hz,
                                        {"rear"}, "m/s", end_ns);
   wheel.info.noise = {{"sigma_mps", options.sigma_speed_mps}};
-  recording::Stream steering = MakeStream("steering", recording::StreamType::kSteering, options.odometer_rate_hz,
-                                          {"angle"}, "rad", end_ns);
+  recording::Stream steering =
+      MakeStream("steering", recording::StreamType::kSteering, options.odometer_rate_hz, {"angle"}, "rad", end_ns);
   steering.info.noise = {{"sigma_rad", options.sigma_steering_rad}};
   for (std::size_t k = 0; k < wheel.t.size(); ++k) {
     const AtvTruth::Kinematics truth = truth_model.At(wheel.t[k].nanoseconds());

@@ -54,38 +54,38 @@
 namespace roamlab::testing {
 
 struct SyntheticOptions {
-  double duration_s = 30.0;      // > 0
-  std::uint32_t seed = 1;        // noise realization
-  bool hilly = true;             // false: flat plane z = 0 (the GPS lever arm's z is then unobservable)
-  bool noise = true;             // false: all sensor noise off (calibration effects still applied)
-  double imu_rate_hz = 100.0;    // also the rate of the magnetometer and of ground_truth; each in (0, 1000]
+  double duration_s = 30.0;         // > 0
+  std::uint32_t seed = 1;           // noise realization
+  bool hilly = true;                // false: flat plane z = 0 (the GPS lever arm's z is then unobservable)
+  bool noise = true;                // false: all sensor noise off (calibration effects still applied)
+  double imu_rate_hz = 100.0;       // also the rate of the magnetometer and of ground_truth; each in (0, 1000]
   double odometer_rate_hz = 100.0;  // rear_wheel and steering
   double gps_rate_hz = 5.0;
 
   // True calibration (defaults: seed Table I). Names in truth.calibration in brackets.
-  Eigen::Vector3d gps_lever_arm_m{0.57, -0.46, 0.32};              // [gps.lever_arm] GPS antenna in O [m]
-  Eigen::Quaterniond q_body_imu{0.938, 0.104, 0.313, 0.104};       // [imu.misalignment] w, x, y, z; normalized on use
+  Eigen::Vector3d gps_lever_arm_m{0.57, -0.46, 0.32};                // [gps.lever_arm] GPS antenna in O [m]
+  Eigen::Quaterniond q_body_imu{0.938, 0.104, 0.313, 0.104};         // [imu.misalignment] w, x, y, z; normalized on use
   Eigen::Matrix3d mag_A = (Eigen::Matrix3d() << 0.87, -0.02, -0.02,  //
-                           0.00, 0.88, 0.00,                          //
+                           0.00, 0.88, 0.00,                         //
                            -0.02, -0.04, 0.85)
-                              .finished();                          // [magnetometer.A]
-  Eigen::Vector3d mag_b{-0.008, -0.007, -0.040};                   // [magnetometer.b] normalized units
-  double kv_over_L = 0.8;                                          // [odometer.kv_over_L] 1/m, > 0
-  double k_theta = 1.0;                                            // [odometer.k_theta] -, nonzero
-  double k_gamma = 0.0;                                            // [odometer.k_gamma] rad
-  double wheelbase_m = 1.25;                                       // L, known (platform geometry), > 0
-  Eigen::Vector3d gyro_bias_radps = Eigen::Vector3d::Zero();       // [imu.gyro_bias] in the IMU frame [rad/s]
+                              .finished();                    // [magnetometer.A]
+  Eigen::Vector3d mag_b{-0.008, -0.007, -0.040};              // [magnetometer.b] normalized units
+  double kv_over_L = 0.8;                                     // [odometer.kv_over_L] 1/m, > 0
+  double k_theta = 1.0;                                       // [odometer.k_theta] -, nonzero
+  double k_gamma = 0.0;                                       // [odometer.k_gamma] rad
+  double wheelbase_m = 1.25;                                  // L, known (platform geometry), > 0
+  Eigen::Vector3d gyro_bias_radps = Eigen::Vector3d::Zero();  // [imu.gyro_bias] in the IMU frame [rad/s]
   // [imu.time_offset_s] the IMU's clock offset [s], |offset| <= 1: the imu and magnetometer rows stamped t hold the
   // readings taken at t - offset (ground_truth stays at the stamps).
   double imu_time_offset_s = 0.0;
 
   // Noise standard deviations per sample (seed Section V), each >= 0.
   double sigma_gps_m = 0.33;
-  double sigma_mag = 0.067;             // normalized units (fraction of |field_world|)
+  double sigma_mag = 0.067;  // normalized units (fraction of |field_world|)
   double sigma_acc_mps2 = 0.067;
   double sigma_gyro_radps = 0.033;
-  double sigma_speed_mps = 0.033;       // on z_v
-  double sigma_steering_rad = 0.014;    // on z_theta
+  double sigma_speed_mps = 0.033;     // on z_v
+  double sigma_steering_rad = 0.014;  // on z_theta
 
   Eigen::Vector3d field_world{0.0, 0.5, -0.8660254037844386};  // Earth field in ENU, unit magnitude (dip 60 deg)
 

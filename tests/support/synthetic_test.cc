@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <gtest/gtest.h>
 
 #include "common/check.h"
 #include "estimator/geometry.h"
@@ -347,7 +347,8 @@ TEST(SyntheticTest, SameOptionsGiveIdenticalRecordings) {
   ASSERT_EQ(a.recording.ground_truth->size(), b.recording.ground_truth->size());
   for (std::size_t k = 0; k < a.recording.ground_truth->size(); ++k) {
     ASSERT_EQ((*a.recording.ground_truth)[k].p_world_body, (*b.recording.ground_truth)[k].p_world_body);
-    ASSERT_EQ((*a.recording.ground_truth)[k].q_world_body.coeffs(), (*b.recording.ground_truth)[k].q_world_body.coeffs());
+    ASSERT_EQ((*a.recording.ground_truth)[k].q_world_body.coeffs(),
+              (*b.recording.ground_truth)[k].q_world_body.coeffs());
   }
   EXPECT_EQ(a.truth.calibration, b.truth.calibration);
 
@@ -422,14 +423,18 @@ TEST(SyntheticTest, NoiseHasTheConfiguredSigmaPerSource) {
   // Pairwise independence, on the first value of each sample of the 100 Hz sources (gyro x, accel x, mag x, speed,
   // steering).
   const std::vector<std::pair<const char*, std::vector<double>>> first = {
-      {"gyro", difference("imu", 0, 1)},           {"accel", difference("imu", 3, 1)},
-      {"magnetometer", difference("magnetometer", 0, 1)}, {"speed", difference("rear_wheel", 0, 1)},
+      {"gyro", difference("imu", 0, 1)},
+      {"accel", difference("imu", 3, 1)},
+      {"magnetometer", difference("magnetometer", 0, 1)},
+      {"speed", difference("rear_wheel", 0, 1)},
       {"steering", difference("steering", 0, 1)},
   };
   for (std::size_t i = 0; i < first.size(); ++i) {
     for (std::size_t j = i + 1; j < first.size(); ++j) {
-      const Eigen::Map<const Eigen::VectorXd> x(first[i].second.data(), static_cast<Eigen::Index>(first[i].second.size()));
-      const Eigen::Map<const Eigen::VectorXd> y(first[j].second.data(), static_cast<Eigen::Index>(first[j].second.size()));
+      const Eigen::Map<const Eigen::VectorXd> x(first[i].second.data(),
+                                                static_cast<Eigen::Index>(first[i].second.size()));
+      const Eigen::Map<const Eigen::VectorXd> y(first[j].second.data(),
+                                                static_cast<Eigen::Index>(first[j].second.size()));
       const Eigen::VectorXd xc = x.array() - x.mean();
       const Eigen::VectorXd yc = y.array() - y.mean();
       const double correlation = xc.dot(yc) / (xc.norm() * yc.norm());

@@ -1,7 +1,7 @@
 #include "estimator/odometry/internal/lbfgs.h"
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <deque>
 #include <vector>
 
@@ -26,8 +26,10 @@ LbfgsResult MinimizeLbfgs(const CostFunction& cost, const Eigen::VectorXd& x0, c
       alpha[j] = s_history[j].dot(q) / y_history[j].dot(s_history[j]);
       q -= alpha[j] * y_history[j];
     }
-    if (k > 0) q *= s_history.back().dot(y_history.back()) / y_history.back().squaredNorm();
-    else q /= std::max(1.0, g.norm());  // first step: at most unit length
+    if (k > 0)
+      q *= s_history.back().dot(y_history.back()) / y_history.back().squaredNorm();
+    else
+      q /= std::max(1.0, g.norm());  // first step: at most unit length
     for (std::size_t j = 0; j < k; ++j) {
       const double beta = y_history[j].dot(q) / y_history[j].dot(s_history[j]);
       q += s_history[j] * (alpha[j] - beta);

@@ -25,8 +25,13 @@ constexpr double kPi = 3.14159265358979323846;
 std::vector<Eigen::VectorXd> IdealSensorValues(const Eigen::VectorXd& pose0, const Eigen::VectorXd& pose1,
                                                const Eigen::VectorXd& pose2,
                                                const Eigen::Vector3d& p_body_sensor = Eigen::Vector3d::Zero()) {
-  return {pose0, pose1, pose2, QuaternionVector(Eigen::Quaterniond::Identity()), p_body_sensor,
-          Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()};
+  return {pose0,
+          pose1,
+          pose2,
+          QuaternionVector(Eigen::Quaterniond::Identity()),
+          p_body_sensor,
+          Eigen::Vector3d::Zero(),
+          Eigen::Vector3d::Ones()};
 }
 
 // The predicted reading: with z = 0, e = scale o a_hat^(S) + bias.
@@ -81,8 +86,8 @@ TEST(AccelerometerErrorTest, ZeroAtTruthForConstantAccelerationAndSpin) {
   const Eigen::Vector3d z = scale.cwiseProduct(q_body_sensor.conjugate() * f_body) + bias;
 
   const AccelerometerError model(z, dt0, dt1);
-  const std::vector<Eigen::VectorXd> values = {pose_at(0.0),  pose_at(dt0), pose_at(dt0 + dt1),
-                                               QuaternionVector(q_body_sensor), p_body_sensor, bias, scale};
+  const std::vector<Eigen::VectorXd> values = {
+      pose_at(0.0), pose_at(dt0), pose_at(dt0 + dt1), QuaternionVector(q_body_sensor), p_body_sensor, bias, scale};
   const testing::Linearization lin = testing::Evaluate(*MakeFactor(model), values);
   EXPECT_LT(lin.error.norm(), 1e-8);
   EXPECT_TRUE(lin.noise_jacobian.isApprox(Eigen::Matrix3d::Identity()));
@@ -91,8 +96,8 @@ TEST(AccelerometerErrorTest, ZeroAtTruthForConstantAccelerationAndSpin) {
 // A body on a horizontal circle of radius r around the world origin, counter-clockwise at speed v, heading along the
 // tangent: yaw = theta + pi/2, so the body's x axis is the direction of travel and its y axis points to the centre.
 struct Circle {
-  double radius = 5.0;                  // [m]
-  double speed = 2.0;                   // [m/s]
+  double radius = 5.0;                            // [m]
+  double speed = 2.0;                             // [m/s]
   double rate() const { return speed / radius; }  // [rad/s]
   Eigen::VectorXd PoseAt(double theta) const {
     return PoseVector(Eigen::Vector3d(radius * std::cos(theta), radius * std::sin(theta), 1.5),
@@ -105,9 +110,9 @@ TEST(AccelerometerErrorTest, CircleReadsCentripetalSpecificForce) {
   const double omega = circle.rate();
   const double dt = 0.01 / omega;  // omega dt = 0.01
   const double theta1 = 0.7;
-  const Eigen::Vector3d reading =
-      PredictedReading(dt, dt, IdealSensorValues(circle.PoseAt(theta1 - omega * dt), circle.PoseAt(theta1),
-                                                 circle.PoseAt(theta1 + omega * dt)));
+  const Eigen::Vector3d reading = PredictedReading(
+      dt, dt,
+      IdealSensorValues(circle.PoseAt(theta1 - omega * dt), circle.PoseAt(theta1), circle.PoseAt(theta1 + omega * dt)));
   // True specific force: v^2/r = 0.8 m/s^2 toward the centre (body +y) and +g up. The second difference of
   // r cos(omega t) underestimates omega^2 r by the factor 2 (1 - cos(omega dt)) / (omega dt)^2 = 1 - (omega dt)^2/12
   // + ..., so the bound is (v^2 / r) (omega dt)^2 / 12 (about 7e-6 m/s^2 here), with 1% slack.
@@ -129,8 +134,8 @@ TEST(AccelerometerErrorTest, DisplacedSensorOnTurningBodySeesOmegaCrossOmegaCros
   const Eigen::Vector3d p_body_sensor(0.3, -0.2, 0.5);
   const std::vector<Eigen::VectorXd> poses = {circle.PoseAt(theta1 - omega * dt), circle.PoseAt(theta1),
                                               circle.PoseAt(theta1 + omega * dt)};
-  const Eigen::Vector3d displaced = PredictedReading(dt, dt, IdealSensorValues(poses[0], poses[1], poses[2],
-                                                                               p_body_sensor));
+  const Eigen::Vector3d displaced =
+      PredictedReading(dt, dt, IdealSensorValues(poses[0], poses[1], poses[2], p_body_sensor));
   const Eigen::Vector3d centred = PredictedReading(dt, dt, IdealSensorValues(poses[0], poses[1], poses[2]));
 
   const Pose<double> pose1 = PoseFromArray(poses[1].data());
@@ -152,9 +157,9 @@ TEST(AccelerometerErrorTest, AngularAccelerationTermAppears) {
   // moves on a circle about O: in the body frame its acceleration is alpha x S + omega x (omega x S), so for
   // S = [s, 0, 0] the reading is [-w1^2 s, alpha s, g]. theta is quadratic in t with a fixed axis, so with equal steps
   // the rate at t1 and the angular acceleration are estimated exactly.
-  const double w1 = 0.8;      // [rad/s]
-  const double alpha = 2.0;   // [rad/s^2]
-  const double s = 0.4;       // [m]
+  const double w1 = 0.8;     // [rad/s]
+  const double alpha = 2.0;  // [rad/s^2]
+  const double s = 0.4;      // [m]
   const double dt = 0.02;
   auto pose_at = [&](double t) {
     const double theta = 0.3 + w1 * t + 0.5 * alpha * t * t;
@@ -163,8 +168,7 @@ TEST(AccelerometerErrorTest, AngularAccelerationTermAppears) {
   };
   const Eigen::Vector3d reading = PredictedReading(
       dt, dt, IdealSensorValues(pose_at(-dt), pose_at(0.0), pose_at(dt), Eigen::Vector3d(s, 0.0, 0.0)));
-  EXPECT_LT((reading - Eigen::Vector3d(-w1 * w1 * s, alpha * s, kStandardGravity)).norm(), 1e-9)
-      << reading.transpose();
+  EXPECT_LT((reading - Eigen::Vector3d(-w1 * w1 * s, alpha * s, kStandardGravity)).norm(), 1e-9) << reading.transpose();
 }
 
 TEST(AccelerometerErrorTest, JacobiansMatchCentralDifferences) {
@@ -191,10 +195,10 @@ TEST(AccelerometerErrorTest, JacobiansMatchCentralDifferences) {
 // fixed in O with constant angular acceleration (the angle is quadratic in t, so the rotation vectors' differences give
 // the rate and the angular acceleration exactly).
 struct FixedAxisStretch {
-  Eigen::Vector3d p0, v0, a0, jerk;  // W, at t = 0 [m, m/s, m/s^2, m/s^3]
-  Eigen::Quaterniond q0;             // q_world_body at t = 0
-  Eigen::Vector3d axis;              // unit, in O
-  double rate0 = 0.0;                // [rad/s] at t = 0
+  Eigen::Vector3d p0, v0, a0, jerk;   // W, at t = 0 [m, m/s, m/s^2, m/s^3]
+  Eigen::Quaterniond q0;              // q_world_body at t = 0
+  Eigen::Vector3d axis;               // unit, in O
+  double rate0 = 0.0;                 // [rad/s] at t = 0
   double angular_acceleration = 0.0;  // [rad/s^2]
 
   Eigen::Quaterniond OrientationAt(double t) const {
@@ -235,8 +239,7 @@ testing::SmallProblem AccelerometerProblem(bool noisy, std::uint32_t seed) {
       testing::AddFreeParameter("misalignment", Manifold::UnitQuaternion(),
                                 QuaternionVector(Eigen::Quaterniond::Identity()), QuaternionVector(q_body_sensor),
                                 &problem),
-      testing::AddFreeParameter("lever_arm", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), p_body_sensor,
-                                &problem),
+      testing::AddFreeParameter("lever_arm", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), p_body_sensor, &problem),
       testing::AddFreeParameter("bias", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), bias, &problem),
       testing::AddFreeParameter("scale", Manifold::Euclidean(3), Eigen::Vector3d::Ones(), scale, &problem)};
   std::uniform_real_distribution<double> rate(1.0, 2.0), angular_acceleration(-4.0, 4.0);
@@ -259,11 +262,11 @@ testing::SmallProblem AccelerometerProblem(bool noisy, std::uint32_t seed) {
       const Eigen::Vector3d f_body = stretch.SpecificForceAt((j - poses_per_stretch / 2) * dt, p_body_sensor);
       const Eigen::Vector3d z = scale.cwiseProduct(q_body_sensor.toRotationMatrix().transpose() * f_body) + bias +
                                 testing::GaussianNoise(3, testing::NoiseSigma(noisy, sigma), &rng);
-      problem.graph.AddFactor(MakeFactor(AccelerometerError(z, dt, dt)),
-                              {ids[j - 1], ids[j], ids[j + 1], parameters[0], parameters[1], parameters[2],
-                               parameters[3]},
-                              Eigen::Matrix3d::Identity() * sigma * sigma, Loss::Trivial(), "accelerometer",
-                              Time::FromNanoseconds(s * poses_per_stretch + j));
+      problem.graph.AddFactor(
+          MakeFactor(AccelerometerError(z, dt, dt)),
+          {ids[j - 1], ids[j], ids[j + 1], parameters[0], parameters[1], parameters[2], parameters[3]},
+          Eigen::Matrix3d::Identity() * sigma * sigma, Loss::Trivial(), "accelerometer",
+          Time::FromNanoseconds(s * poses_per_stretch + j));
     }
   }
   return problem;

@@ -4,9 +4,9 @@
 #include <ostream>
 #include <random>
 
+#include <gtest/gtest.h>
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
-#include <gtest/gtest.h>
 
 #include "estimator/factor.h"
 #include "tests/estimator/factor_testing.h"
@@ -65,9 +65,8 @@ TEST_P(AckermannCalibrationTest, ZeroOnEq7StepOfPlanarArc) {
   const Drive drive;
   const double turn = drive.yaw_rate() * drive.dt;
   const Eigen::VectorXd pose_k = PoseVector(drive.p0, drive.q0);
-  const Eigen::VectorXd pose_k1 =
-      PoseVector(drive.p0 + drive.q0 * (Yaw(0.5 * turn) * Eigen::Vector3d(drive.v * drive.dt, 0.0, 0.0)),
-                 drive.q0 * Yaw(turn));
+  const Eigen::VectorXd pose_k1 = PoseVector(
+      drive.p0 + drive.q0 * (Yaw(0.5 * turn) * Eigen::Vector3d(drive.v * drive.dt, 0.0, 0.0)), drive.q0 * Yaw(turn));
   const testing::Linearization lin =
       testing::Evaluate(*MakeFactor(ModelFor(drive, GetParam())), Values(pose_k, pose_k1, GetParam()));
   EXPECT_LT(lin.error.norm(), 1e-12) << lin.error.transpose();
@@ -134,8 +133,8 @@ TEST(AckermannOdometerErrorTest, JacobiansMatchCentralDifferences) {
 }
 
 // Noise sigmas: the seed's sigma_v, sigma_theta, then lateral/vertical speed and roll/pitch rate slack.
-const Eigen::Matrix<double, 6, 1> kSigmas = (Eigen::Matrix<double, 6, 1>() << 0.033, 0.014, 0.1, 0.1, 0.05, 0.05)
-                                                .finished();
+const Eigen::Matrix<double, 6, 1> kSigmas =
+    (Eigen::Matrix<double, 6, 1>() << 0.033, 0.014, 0.1, 0.1, 0.05, 0.05).finished();
 
 TEST(AckermannOdometerErrorTest, ErrorCovarianceHasFullRank) {
   // To first order, each noise component drives its own direction of the error: eta_v, eta_vy, eta_vz the position

@@ -22,8 +22,8 @@ Eigen::VectorXd Disturbance(double w_v = 0.0, double w_lat = 0.0, double w_vert 
 // Pose after dt on a planar arc at forward speed v, side slip v_y and yaw rate omega, from pose0 (eq. 7 is exact for
 // a constant twist only up to the chord; VelocitiesBetween inverts eq. 7 exactly, so build pose1 with PredictPose).
 Eigen::VectorXd Step(const Eigen::VectorXd& pose0, double v, double omega, double dt, double v_y = 0.0) {
-  const Pose<double> p1 = PredictPose<double>(PoseFromArray(pose0.data()), Eigen::Vector3d(v, v_y, 0),
-                                              Eigen::Vector3d(0, 0, omega), dt);
+  const Pose<double> p1 =
+      PredictPose<double>(PoseFromArray(pose0.data()), Eigen::Vector3d(v, v_y, 0), Eigen::Vector3d(0, 0, omega), dt);
   Eigen::VectorXd out(7);
   PoseToArray(p1, out.data());
   return out;
@@ -39,9 +39,9 @@ TEST(AckermannVelocityErrorTest, ZeroAtTruthForTableIAndSkewedGains) {
     const double z_v = v / (kv_over_l * kL);
     const double z_theta = (delta - k_gamma) / k_theta;
     const auto factor = MakeFactor(AckermannVelocityError(z_v, z_theta, kL, dt));
-    const auto lin = testing::Evaluate(*factor, {pose0, Step(pose0, v, omega, dt), Scalar(kv_over_l), Scalar(k_theta),
-                                                 Scalar(k_gamma), Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0),
-                                                 Scalar(0.0), Disturbance()});
+    const auto lin = testing::Evaluate(
+        *factor, {pose0, Step(pose0, v, omega, dt), Scalar(kv_over_l), Scalar(k_theta), Scalar(k_gamma), Scalar(0.0),
+                  Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0), Disturbance()});
     EXPECT_LT(lin.error.norm(), 1e-10);
     EXPECT_TRUE(lin.noise_jacobian.isApprox(Eigen::MatrixXd::Identity(4, 4)));
   }
@@ -51,9 +51,9 @@ TEST(AckermannVelocityErrorTest, SpeedErrorScalesWithGain) {
   // 10% too large a gain predicts a reading 1/1.1 of the one taken.
   const Eigen::VectorXd pose0 = Manifold::Pose().Identity();
   const auto factor = MakeFactor(AckermannVelocityError(4.0 / kL / 0.8, 0.0, kL, 0.01));
-  const auto lin = testing::Evaluate(*factor, {pose0, Step(pose0, 4.0, 0.0, 0.01), Scalar(0.88), Scalar(1.0),
-                                               Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0),
-                                               Scalar(0.0), Disturbance()});
+  const auto lin =
+      testing::Evaluate(*factor, {pose0, Step(pose0, 4.0, 0.0, 0.01), Scalar(0.88), Scalar(1.0), Scalar(0.0),
+                                  Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0), Disturbance()});
   EXPECT_NEAR(lin.error[0], 4.0 / kL / 0.88 - 4.0 / kL / 0.8, 1e-12);
 }
 
@@ -143,9 +143,9 @@ TEST(AckermannVelocityErrorTest, ContactBelowOExplainsPitchAndRollRates) {
   Eigen::VectorXd pose1(7);
   PoseToArray(PredictPose<double>(PoseFromArray(pose0.data()), v_odom, omega, dt), pose1.data());
   const double delta = std::atan(kL * omega.z() / v);
-  const std::vector<Eigen::VectorXd> values = {pose0,       pose1,       Scalar(0.8), Scalar(1.0), Scalar(0.0),
-                                               Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0),
-                                               Disturbance()};
+  const std::vector<Eigen::VectorXd> values = {pose0,       pose1,       Scalar(0.8),  Scalar(1.0),
+                                               Scalar(0.0), Scalar(0.0), Scalar(0.0),  Scalar(0.0),
+                                               Scalar(0.0), Scalar(0.0), Disturbance()};
   const auto contact = MakeFactor(AckermannVelocityError(v / kL / 0.8, delta, kL, dt, {h, d}));
   const auto lin = testing::Evaluate(*contact, values);
   EXPECT_LT(lin.error.norm(), 1e-9) << lin.error.transpose();
@@ -177,9 +177,9 @@ TEST(AckermannVelocityErrorTest, LongitudinalSlipFollowsTractionAndSlope) {
                                                  Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0), Disturbance()});
   EXPECT_NEAR(rigid.error[0], -v * (s_f * f_x + s_p * g_sin) / kL / 0.8, 1e-9);
   const Eigen::VectorXd flat0 = Manifold::Pose().Identity();
-  const auto flat = testing::Evaluate(*factor, {flat0, Step(flat0, v, 0.0, dt), Scalar(0.8), Scalar(1.0),
-                                                Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(s_f),
-                                                Scalar(s_p), Disturbance()});
+  const auto flat =
+      testing::Evaluate(*factor, {flat0, Step(flat0, v, 0.0, dt), Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
+                                  Scalar(0.0), Scalar(0.0), Scalar(s_f), Scalar(s_p), Disturbance()});
   EXPECT_NEAR(flat.error[0], -v * s_p * g_sin / kL / 0.8, 1e-9);
 }
 
@@ -190,11 +190,11 @@ TEST(AckermannVelocityErrorTest, DisturbanceAddsToTheSpeedLateralAndVerticalRows
   const double v = 4.0, dt = 0.01, w_v = 0.05, v_y = 0.02, v_z = 0.1;
   const Eigen::VectorXd pose0 = Manifold::Pose().Identity();
   Eigen::VectorXd pose1(7);
-  PoseToArray(PredictPose<double>(PoseFromArray(pose0.data()), Eigen::Vector3d(v, v_y, v_z), Eigen::Vector3d::Zero(),
-                                  dt),
-              pose1.data());
+  PoseToArray(
+      PredictPose<double>(PoseFromArray(pose0.data()), Eigen::Vector3d(v, v_y, v_z), Eigen::Vector3d::Zero(), dt),
+      pose1.data());
   const auto factor = MakeFactor(AckermannVelocityError((v + w_v) / kL / 0.8, 0.0, kL, dt));
-  std::vector<Eigen::VectorXd> values = {pose0,       pose1,       Scalar(0.8), Scalar(1.0), Scalar(0.0), Scalar(0.0),
+  std::vector<Eigen::VectorXd> values = {pose0,       pose1,       Scalar(0.8), Scalar(1.0), Scalar(0.0),  Scalar(0.0),
                                          Scalar(0.0), Scalar(0.0), Scalar(0.0), Scalar(0.0), Disturbance()};
   const auto rigid = testing::Evaluate(*factor, values);
   EXPECT_NEAR(rigid.error[0], -w_v / (0.8 * kL), 1e-9);
@@ -212,12 +212,13 @@ TEST(AckermannVelocityErrorTest, JacobiansMatchCentralDifferences) {
     const Eigen::VectorXd pose0 = testing::RandomPoint(Manifold::Pose(), &rng, 10.0);
     const Eigen::VectorXd pose1 = testing::Perturb(Manifold::Pose(), Step(pose0, 3.0 + trial, 0.2, 0.02), 0.002, &rng);
     // Eq. 15 at O, and with the rows at a contact below O (h, d nonzero: the rates enter every row); with slip.
-    for (const AckermannVelocityError::Options contact : {AckermannVelocityError::Options{},
-                                                          AckermannVelocityError::Options{0.28, 0.625}}) {
+    for (const AckermannVelocityError::Options contact :
+         {AckermannVelocityError::Options{}, AckermannVelocityError::Options{0.28, 0.625}}) {
       const auto factor = MakeFactor(AckermannVelocityError(4.0, 0.1, kL, 0.02, contact, 0.7 - 0.4 * trial));
       testing::ExpectJacobiansMatchNumeric(
-          *factor, {pose0, pose1, Scalar(0.78), Scalar(1.02), Scalar(0.01), Scalar(0.004), Scalar(-0.015),
-                      Scalar(0.02), Scalar(0.03), Scalar(0.05), Disturbance(0.01, -0.004, 0.02)},
+          *factor,
+          {pose0, pose1, Scalar(0.78), Scalar(1.02), Scalar(0.01), Scalar(0.004), Scalar(-0.015), Scalar(0.02),
+           Scalar(0.03), Scalar(0.05), Disturbance(0.01, -0.004, 0.02)},
           1e-5);
     }
   }

@@ -10,8 +10,8 @@
 #include <tuple>
 #include <vector>
 
-#include <Eigen/Core>
 #include <gtest/gtest.h>
+#include <Eigen/Core>
 
 #include "estimator/factor.h"
 #include "estimator/geometry.h"
@@ -30,8 +30,8 @@ namespace {
 using testing::Perturb;
 using testing::RandomPoint;
 
-constexpr int kPoints = 24;          // seeded random points per model
-constexpr double kDt = 0.01;         // [s]
+constexpr int kPoints = 24;            // seeded random points per model
+constexpr double kDt = 0.01;           // [s]
 constexpr double kJacobianTol = 1e-9;  // relative to the largest entry of the jet block
 constexpr double kErrorTol = 1e-12;    // relative to the largest error entry (at least 1)
 
@@ -297,10 +297,10 @@ TEST(AnalyticJacobiansTest, AckermannVelocity) {
     const double kv_over_l = 0.8 + 0.02 * normal(rng), k_theta = 1.0 + 0.05 * normal(rng);
     const double k_gamma = 0.02 * normal(rng);
     const double c_front = (slip_velocity ? 0.02 : 0.003) * normal(rng);  // [s] or [rad s^2/m]
-    const double c_rear = 0.015 * normal(rng);                              // [s]
-    const double alpha = 0.03 * normal(rng);                                // [rad]
-    const double s_f = 0.03 * normal(rng), s_p = 0.03 * normal(rng);       // [s^2/m]
-    const double f_x = normal(rng);                                        // [m/s^2]
+    const double c_rear = 0.015 * normal(rng);                            // [s]
+    const double alpha = 0.03 * normal(rng);                              // [rad]
+    const double s_f = 0.03 * normal(rng), s_p = 0.03 * normal(rng);      // [s^2/m]
+    const double f_x = normal(rng);                                       // [m/s^2]
     const Eigen::VectorXd w = Eigen::Vector3d(0.01 * normal(rng), 0.005 * normal(rng), 0.03 * normal(rng));  // [m/s]
     const double z_v = v_body.x() / (kv_over_l * kWheelbase) + 0.03 * normal(rng);
     const double z_theta = 0.2 * normal(rng);

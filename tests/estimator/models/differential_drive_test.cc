@@ -14,12 +14,12 @@ namespace {
 constexpr double kRadiusLeft = 0.074, kRadiusRight = 0.0765, kBaseline = 0.41;
 
 Eigen::VectorXd Scalar(double x) { return Eigen::VectorXd::Constant(1, x); }
-const Eigen::VectorXd kRound = Eigen::VectorXd::Zero(2);   // deformation (a, b) of a round tire
+const Eigen::VectorXd kRound = Eigen::VectorXd::Zero(2);  // deformation (a, b) of a round tire
 
 // Pose after dt at forward speed v and yaw rate omega (eq. 7, which VelocitiesBetween inverts exactly).
 Eigen::VectorXd Step(const Eigen::VectorXd& pose0, double v, double omega, double dt) {
-  const Pose<double> p1 = PredictPose<double>(PoseFromArray(pose0.data()), Eigen::Vector3d(v, 0, 0),
-                                              Eigen::Vector3d(0, 0, omega), dt);
+  const Pose<double> p1 =
+      PredictPose<double>(PoseFromArray(pose0.data()), Eigen::Vector3d(v, 0, 0), Eigen::Vector3d(0, 0, omega), dt);
   Eigen::VectorXd out(7);
   PoseToArray(p1, out.data());
   return out;
@@ -79,8 +79,14 @@ TEST(DifferentialDriveErrorTest, ZeroAtTruthWithADeformedTire) {
   const Eigen::Vector2d h = DifferentialDriveError::DeformationHarmonics(theta0, theta0 + dtheta);
   const auto factor =
       MakeFactor(DifferentialDriveError(dtheta / dt, Rates(v, omega)[1], dt, h, Eigen::Vector2d(0.2, 0.1)));
-  const std::vector<Eigen::VectorXd> at = {pose0,       Step(pose0, v, omega, dt), Scalar(kRadiusLeft),
-                                           Scalar(kRadiusRight), Scalar(kBaseline), Scalar(1.0), deformation, kRound};
+  const std::vector<Eigen::VectorXd> at = {pose0,
+                                           Step(pose0, v, omega, dt),
+                                           Scalar(kRadiusLeft),
+                                           Scalar(kRadiusRight),
+                                           Scalar(kBaseline),
+                                           Scalar(1.0),
+                                           deformation,
+                                           kRound};
   EXPECT_LT(testing::Evaluate(*factor, at).error.norm(), 1e-9);
   std::vector<Eigen::VectorXd> round = at;
   round[6] = kRound;
@@ -119,8 +125,9 @@ TEST(DifferentialDriveErrorTest, JacobiansMatchCentralDifferences) {
     // The ratio slot away from 1 and deformed tires, so that every column and the ratio's effect on the right wheel's
     // row are exercised.
     testing::ExpectJacobiansMatchNumeric(
-        *factor, {pose0, pose1, Scalar(kRadiusLeft), Scalar(kRadiusRight), Scalar(kBaseline),
-                  Scalar(0.97 + 0.02 * trial), Eigen::Vector2d(0.001, -0.0005), Eigen::Vector2d(-0.0007, 0.0012)},
+        *factor,
+        {pose0, pose1, Scalar(kRadiusLeft), Scalar(kRadiusRight), Scalar(kBaseline), Scalar(0.97 + 0.02 * trial),
+         Eigen::Vector2d(0.001, -0.0005), Eigen::Vector2d(-0.0007, 0.0012)},
         1e-5);
   }
 }
@@ -140,22 +147,22 @@ testing::SmallProblem DiffDriveProblem(bool noisy, std::uint32_t seed, bool shar
   std::mt19937 rng(seed);
   testing::SmallProblem problem;
   testing::AddAnchoredPoses(motion.poses, 0.002, 0.001, noisy, &rng, &problem);
-  std::vector<VariableId> slots;   // r_L, r_R, B, rho
+  std::vector<VariableId> slots;  // r_L, r_R, B, rho
   if (shared_radius) {
-    const VariableId r = testing::AddFreeParameter("radius", Manifold::Euclidean(1), Scalar(0.075),
-                                                   Scalar(kRadiusLeft), &problem);
-    const VariableId b = testing::AddFreeParameter("baseline", Manifold::Euclidean(1), Scalar(0.40),
-                                                   Scalar(kBaseline), &problem);
+    const VariableId r =
+        testing::AddFreeParameter("radius", Manifold::Euclidean(1), Scalar(0.075), Scalar(kRadiusLeft), &problem);
+    const VariableId b =
+        testing::AddFreeParameter("baseline", Manifold::Euclidean(1), Scalar(0.40), Scalar(kBaseline), &problem);
     const VariableId rho = testing::AddFreeParameter("right_left_ratio", Manifold::Euclidean(1), Scalar(1.0),
                                                      Scalar(kRadiusRight / kRadiusLeft), &problem);
     slots = {r, r, b, rho};
   } else {
-    slots.push_back(testing::AddFreeParameter("radius_left", Manifold::Euclidean(1), Scalar(0.075),
-                                              Scalar(kRadiusLeft), &problem));
+    slots.push_back(
+        testing::AddFreeParameter("radius_left", Manifold::Euclidean(1), Scalar(0.075), Scalar(kRadiusLeft), &problem));
     slots.push_back(testing::AddFreeParameter("radius_right", Manifold::Euclidean(1), Scalar(0.075),
                                               Scalar(kRadiusRight), &problem));
-    slots.push_back(testing::AddFreeParameter("baseline", Manifold::Euclidean(1), Scalar(0.40), Scalar(kBaseline),
-                                              &problem));
+    slots.push_back(
+        testing::AddFreeParameter("baseline", Manifold::Euclidean(1), Scalar(0.40), Scalar(kBaseline), &problem));
     slots.push_back(problem.graph.AddVariable({"ratio", Manifold::Euclidean(1), Scalar(1.0), true, std::nullopt}));
   }
   const VariableId round =
@@ -163,11 +170,11 @@ testing::SmallProblem DiffDriveProblem(bool noisy, std::uint32_t seed, bool shar
   for (std::size_t k = 0; k + 1 < motion.poses.size(); ++k) {
     const Eigen::Vector2d z = Rates(motion.v_body[k].x(), motion.omega_body[k].z()) +
                               testing::GaussianNoise(2, testing::NoiseSigma(noisy, sigma[0]), &rng);
-    problem.graph.AddFactor(MakeFactor(DifferentialDriveError(z[0], z[1], dt)),
-                            {problem.poses[k], problem.poses[k + 1], slots[0], slots[1], slots[2], slots[3], round,
-                             round},
-                            Eigen::MatrixXd(sigma.cwiseAbs2().asDiagonal()), Loss::Trivial(), "odometer",
-                            Time::FromNanoseconds(static_cast<std::int64_t>(k)));
+    problem.graph.AddFactor(
+        MakeFactor(DifferentialDriveError(z[0], z[1], dt)),
+        {problem.poses[k], problem.poses[k + 1], slots[0], slots[1], slots[2], slots[3], round, round},
+        Eigen::MatrixXd(sigma.cwiseAbs2().asDiagonal()), Loss::Trivial(), "odometer",
+        Time::FromNanoseconds(static_cast<std::int64_t>(k)));
   }
   return problem;
 }
@@ -190,7 +197,7 @@ TEST(DifferentialDriveErrorTest, SmallNoisySolveIsWithinFourSigma) {
 TEST(DifferentialDriveErrorTest, SmallNoisySolveRecoversTheRatioWithOneRadius) {
   testing::SmallProblem problem = DiffDriveProblem(true, 25, true);
   const Eigen::VectorXd sigma = testing::ExpectSolveWithinSigmas(&problem);
-  EXPECT_LT(sigma[2], (kRadiusRight / kRadiusLeft - 1.0) / 3.0);   // the ratio's offset from 1 is resolved
+  EXPECT_LT(sigma[2], (kRadiusRight / kRadiusLeft - 1.0) / 3.0);  // the ratio's offset from 1 is resolved
 }
 
 }  // namespace

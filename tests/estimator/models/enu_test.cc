@@ -9,7 +9,7 @@ namespace roamlab::estimator {
 namespace {
 
 // WGS84 ellipsoid.
-constexpr double kSemiMajorAxis = 6378137.0;                        // [m]
+constexpr double kSemiMajorAxis = 6378137.0;  // [m]
 constexpr double kFlattening = 1.0 / 298.257223563;
 constexpr double kEccentricitySq = kFlattening * (2.0 - kFlattening);
 constexpr double kDegToRad = M_PI / 180.0;

@@ -41,8 +41,8 @@ TEST(GyroscopeErrorTest, ZeroAtTruth) {
   EXPECT_LT(lin.error.norm(), 1e-12);
 
   // At e = 0 the noise Jacobian is -dt R(q1) R(q_body_sensor) diag(1/scale) up to O(|omega dt|).
-  const Eigen::Matrix3d expected_noise_jacobian = -dt * q1.toRotationMatrix() * q_body_sensor.toRotationMatrix() *
-                                                  scale.cwiseInverse().asDiagonal();
+  const Eigen::Matrix3d expected_noise_jacobian =
+      -dt * q1.toRotationMatrix() * q_body_sensor.toRotationMatrix() * scale.cwiseInverse().asDiagonal();
   EXPECT_LT((lin.noise_jacobian - expected_noise_jacobian).norm(), 0.05 * dt);
   EXPECT_LT((lin.noise_jacobian - testing::NumericNoiseJacobian(model, values)).cwiseAbs().maxCoeff(), 1e-9);
 }
@@ -55,10 +55,9 @@ TEST(GyroscopeErrorTest, ErrorIsWorldRotationFromEstimateToPrediction) {
   const Eigen::Quaterniond q_hat = q0 * RotationAbout(omega * dt);
   const Eigen::Vector3d delta(0.01, -0.02, 0.015);
   const Eigen::Quaterniond q1 = RotationAbout(delta).conjugate() * q_hat;
-  const std::vector<Eigen::VectorXd> values = {PoseVector(Eigen::Vector3d::Zero(), q0),
-                                               PoseVector(Eigen::Vector3d::Zero(), q1),
-                                               QuaternionVector(Eigen::Quaterniond::Identity()),
-                                               Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()};
+  const std::vector<Eigen::VectorXd> values = {
+      PoseVector(Eigen::Vector3d::Zero(), q0), PoseVector(Eigen::Vector3d::Zero(), q1),
+      QuaternionVector(Eigen::Quaterniond::Identity()), Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()};
   const testing::Linearization lin = testing::Evaluate(*MakeFactor(GyroscopeError(omega, dt)), values);
   EXPECT_LT((lin.error - delta).norm(), 1e-12);
 }
@@ -74,9 +73,9 @@ TEST(GyroscopeErrorTest, MisalignmentRoutesSensorAxesToBodyAxes) {
   const auto factor = MakeFactor(model);
   auto error_for_body_axis = [&](const Eigen::Vector3d& axis_body) {
     const Eigen::Quaterniond q1 = q0 * RotationAbout(axis_body * rate * dt);
-    return testing::Evaluate(*factor, {PoseVector(Eigen::Vector3d::Zero(), q0),
-                                       PoseVector(Eigen::Vector3d::Zero(), q1), QuaternionVector(q_body_sensor),
-                                       Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()})
+    return testing::Evaluate(*factor,
+                             {PoseVector(Eigen::Vector3d::Zero(), q0), PoseVector(Eigen::Vector3d::Zero(), q1),
+                              QuaternionVector(q_body_sensor), Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()})
         .error;
   };
   EXPECT_LT(error_for_body_axis(Eigen::Vector3d::UnitY()).norm(), 1e-12);
@@ -91,8 +90,8 @@ TEST(GyroscopeErrorTest, JacobiansMatchCentralDifferences) {
   for (int trial = 0; trial < 5; ++trial) {
     const Eigen::VectorXd pose0 = RandomPoint(Manifold::Pose(), &rng, 10.0);
     const Eigen::VectorXd pose1 = Perturb(Manifold::Pose(), pose0, 0.05, &rng);
-    const Eigen::VectorXd q_body_sensor = Perturb(Manifold::UnitQuaternion(),
-                                                  Manifold::UnitQuaternion().Identity(), 0.3, &rng);
+    const Eigen::VectorXd q_body_sensor =
+        Perturb(Manifold::UnitQuaternion(), Manifold::UnitQuaternion().Identity(), 0.3, &rng);
     const Eigen::VectorXd bias = RandomPoint(Manifold::Euclidean(3), &rng, 0.1);
     const Eigen::VectorXd scale = Eigen::Vector3d::Ones() + RandomPoint(Manifold::Euclidean(3), &rng, 0.05);
     const Eigen::Vector3d z = RandomPoint(Manifold::Euclidean(3), &rng, 1.0);
@@ -116,10 +115,9 @@ testing::SmallProblem GyroscopeProblem(bool noisy, std::uint32_t seed) {
   std::mt19937 rng(seed);
   testing::SmallProblem problem;
   testing::AddAnchoredPoses(motion.poses, 0.005, 0.0005, noisy, &rng, &problem);
-  const VariableId misalignment =
-      testing::AddFreeParameter("misalignment", Manifold::UnitQuaternion(),
-                                QuaternionVector(Eigen::Quaterniond::Identity()), QuaternionVector(q_body_sensor),
-                                &problem);
+  const VariableId misalignment = testing::AddFreeParameter("misalignment", Manifold::UnitQuaternion(),
+                                                            QuaternionVector(Eigen::Quaterniond::Identity()),
+                                                            QuaternionVector(q_body_sensor), &problem);
   const VariableId bias_id =
       testing::AddFreeParameter("bias", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), bias, &problem);
   const VariableId scale_id =

@@ -63,11 +63,11 @@ TEST(ImuTimeOffsetTest, EachModelIsThePlainOneWithTheReadingMovedAlongItsRate) {
                   .norm(),
               1e-12);
     const std::vector<Eigen::VectorXd> accel = {p[0], p[1], p[2], q, lever, bias, scale};
-    EXPECT_LT((error(*MakeFactor(AccelerometerTimeOffsetError(AccelerometerError(z, kDt0, kDt1), kRate)), accel,
-                     &delta) -
-               error(*MakeFactor(AccelerometerError(moved, kDt0, kDt1)), accel, nullptr))
-                  .norm(),
-              1e-12);
+    EXPECT_LT(
+        (error(*MakeFactor(AccelerometerTimeOffsetError(AccelerometerError(z, kDt0, kDt1), kRate)), accel, &delta) -
+         error(*MakeFactor(AccelerometerError(moved, kDt0, kDt1)), accel, nullptr))
+            .norm(),
+        1e-12);
     const std::vector<Eigen::VectorXd> mag = {p[1], q, kA, bias, kDriveK};
     EXPECT_LT((error(*MakeFactor(MagnetometerTimeOffsetError(MagnetometerError(z, kFieldWorld, kForce, 49.6), kRate)),
                      mag, &delta) -
@@ -111,10 +111,10 @@ TEST(ImuTimeOffsetTest, GyroscopeIsExactOnAUniformlyAcceleratingTurn) {
   const Eigen::Vector3d z = kQBodySensor.conjugate() * (axis * mean_rate);
   const Eigen::Vector3d z_rate = kQBodySensor.conjugate() * (axis * a);
   const auto factor = MakeFactor(GyroscopeTimeOffsetError(GyroscopeError(z, dt), z_rate));
-  std::vector<Eigen::VectorXd> values = {p0, p1, QuaternionVector(kQBodySensor), Eigen::Vector3d::Zero(),
-                                         Eigen::Vector3d::Ones(), Scalar(delta)};
+  std::vector<Eigen::VectorXd> values = {
+      p0, p1, QuaternionVector(kQBodySensor), Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones(), Scalar(delta)};
   EXPECT_LT(testing::Evaluate(*factor, values).error.norm(), 1e-12);
-  values.back() = Scalar(-delta);   // the other sign is off by 2 delta a dt
+  values.back() = Scalar(-delta);  // the other sign is off by 2 delta a dt
   EXPECT_NEAR(testing::Evaluate(*factor, values).error.norm(), 2.0 * delta * a * dt, 1e-9);
 }
 

@@ -77,16 +77,16 @@ TEST(LinearVelocityErrorTest, DisplacedMisalignedSensorOnScrewMotion) {
   const Eigen::Vector3d c_dot_world = (sensor_origin_at(dt / 2 + h) - sensor_origin_at(dt / 2 - h)) / (2 * h);
   const Eigen::Vector3d z = (pose_at(dt / 2).q_world_body * q_body_sensor).conjugate() * c_dot_world;
 
-  const std::vector<Eigen::VectorXd> values = {
-      PoseVector(pose_at(0.0).p_world_body, pose_at(0.0).q_world_body),
-      PoseVector(pose_at(dt).p_world_body, pose_at(dt).q_world_body), p_body_sensor, QuaternionVector(q_body_sensor)};
+  const std::vector<Eigen::VectorXd> values = {PoseVector(pose_at(0.0).p_world_body, pose_at(0.0).q_world_body),
+                                               PoseVector(pose_at(dt).p_world_body, pose_at(dt).q_world_body),
+                                               p_body_sensor, QuaternionVector(q_body_sensor)};
   const testing::Linearization lin = testing::Evaluate(*MakeFactor(LinearVelocityError(z, dt)), values);
   const Eigen::Vector3d v_normal = v_body - omega_body * omega_body.dot(v_body) / (w * w);
   const double bound = 1.01 * v_normal.norm() * (w * dt) * (w * dt) / 24.0 + 1e-8;
   EXPECT_LE(lin.error.norm(), bound) << lin.error.transpose();
   // The lever arm matters: ignoring it (S = 0) misses omega x S, which is much larger than the bound.
-  const testing::Linearization no_lever = testing::Evaluate(
-      *MakeFactor(LinearVelocityError(z, dt)), {values[0], values[1], Eigen::Vector3d::Zero(), values[3]});
+  const testing::Linearization no_lever = testing::Evaluate(*MakeFactor(LinearVelocityError(z, dt)),
+                                                            {values[0], values[1], Eigen::Vector3d::Zero(), values[3]});
   EXPECT_NEAR(no_lever.error.norm(), omega_body.cross(p_body_sensor).norm(), 10 * bound);
 }
 

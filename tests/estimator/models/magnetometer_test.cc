@@ -37,9 +37,7 @@ TEST(MagnetometerErrorTest, ZeroAtTruth) {
   const Eigen::VectorXd pose = RandomPoint(Manifold::Pose(), &rng, 10.0);
   const Eigen::Quaterniond q_body_sensor(Eigen::AngleAxisd(0.25, Eigen::Vector3d(1.0, -1.0, 0.5).normalized()));
   Eigen::Matrix3d A;  // deliberately not symmetric, so that a transposed read of the block fails
-  A << 1.05, 0.08, -0.02,
-       -0.03, 0.95, 0.06,
-       0.10, 0.01, 1.10;
+  A << 1.05, 0.08, -0.02, -0.03, 0.95, 0.06, 0.10, 0.01, 1.10;
   const Eigen::Vector3d b(0.12, -0.05, 0.3);
   // Motor interference: k per N m, the proxy tau_hat = c (R_S f^(S))_x with c = m r / n for 354 kg, 0.28 m, 2 wheels.
   const Eigen::Vector3d k(4e-4, -2e-4, 1e-4);
@@ -111,8 +109,8 @@ testing::SmallProblem MagnetometerProblem(bool noisy, std::uint32_t seed) {
   const Eigen::Quaterniond q_body_sensor = RotationAbout(Eigen::Vector3d(0.1, -0.05, 0.2));
   const Eigen::Matrix3d A = (Eigen::Matrix3d() << 0.87, -0.02, -0.02, 0.0, 0.88, 0.0, -0.02, -0.04, 0.85).finished();
   const Eigen::Vector3d b(-0.08, 0.07, -0.04);
-  const Eigen::Vector3d k(3e-4, -5e-4, 2e-4);   // per N m
-  const double c = 50.0;                         // N m per m/s^2
+  const Eigen::Vector3d k(3e-4, -5e-4, 2e-4);  // per N m
+  const double c = 50.0;                       // N m per m/s^2
   const testing::TwistTrajectory motion = testing::SmoothMotion(80);
 
   std::mt19937 rng(seed);

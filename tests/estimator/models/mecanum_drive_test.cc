@@ -41,8 +41,7 @@ Eigen::Vector4d Rates(const Eigen::Vector3d& twist) {
 }
 
 std::vector<Eigen::VectorXd> Values(const Eigen::VectorXd& pose0, const Eigen::VectorXd& pose1) {
-  return {pose0, pose1, Scalar(kRadii[0]), Scalar(kRadii[1]), Scalar(kRadii[2]), Scalar(kRadii[3]),
-          Scalar(kLxPlusLy)};
+  return {pose0, pose1, Scalar(kRadii[0]), Scalar(kRadii[1]), Scalar(kRadii[2]), Scalar(kRadii[3]), Scalar(kLxPlusLy)};
 }
 
 TEST(MecanumDriveErrorTest, ZeroAtTruthAndIdentityNoiseJacobian) {

@@ -4,8 +4,8 @@
 #include <random>
 #include <vector>
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "estimator/factor.h"
 #include "tests/estimator/factor_testing.h"
@@ -53,9 +53,9 @@ TEST(OdometerErrorTest, ZeroAtTruthForExactMotions) {
     const Eigen::Quaterniond q0(pose_k[3], pose_k[4], pose_k[5], pose_k[6]);
     const double dt = 0.05;
     const double angle = c.omega_body.norm() * dt;
-    const Eigen::Quaterniond turn =
-        angle > 0.0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, c.omega_body.normalized()))
-                    : Eigen::Quaterniond::Identity();
+    const Eigen::Quaterniond turn = angle > 0.0
+                                        ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, c.omega_body.normalized()))
+                                        : Eigen::Quaterniond::Identity();
     // v is along the rotation axis (or there is no rotation), so its world direction stays q0 v throughout.
     const Eigen::VectorXd pose_k1 = PoseVector(p0 + q0 * (c.v_body * dt), q0 * turn);
 
@@ -133,9 +133,9 @@ testing::SmallProblem OdometerProblem(bool noisy, std::uint32_t seed) {
   testing::AddAnchoredPoses(motion.poses, 0.002, 0.001, noisy, &rng, &problem);
   const auto [displacement, misalignment] = testing::AddFreeMounting(kDisplacement, kMisalignment, &problem);
   for (std::size_t k = 0; k < motion.v_body.size(); ++k) {
-    const Eigen::Matrix<double, 6, 1> z = SensorReading(motion.v_body[k], motion.omega_body[k]) +
-                                          testing::GaussianNoise(6, testing::NoiseSigma(noisy, 1.0), &rng)
-                                              .cwiseProduct(sigma);
+    const Eigen::Matrix<double, 6, 1> z =
+        SensorReading(motion.v_body[k], motion.omega_body[k]) +
+        testing::GaussianNoise(6, testing::NoiseSigma(noisy, 1.0), &rng).cwiseProduct(sigma);
     problem.graph.AddFactor(MakeFactor(OdometerError(z, motion.dt_s)),
                             {problem.poses[k], problem.poses[k + 1], displacement, misalignment},
                             sigma.cwiseAbs2().asDiagonal(), Loss::Trivial(), "odometer",

@@ -71,13 +71,13 @@ TEST(Omni3DriveErrorTest, PureRotationTurnsAllWheelsAlikeAndSidewaysMotionIsNotA
   const Eigen::VectorXd pose0 = Manifold::Pose().Identity();
   Eigen::VectorXd pose1 = pose0;
   pose1[1] = 0.004;  // 0.4 m/s to the left for 10 ms
-  const auto lin = testing::Evaluate(*MakeFactor(Omni3DriveError(Rates(Eigen::Vector3d(0, 0.4, 0)), 0.01)),
-                                     Values(pose0, pose1));
+  const auto lin =
+      testing::Evaluate(*MakeFactor(Omni3DriveError(Rates(Eigen::Vector3d(0, 0.4, 0)), 0.01)), Values(pose0, pose1));
   EXPECT_LT(lin.error.norm(), 1e-9);
   // Motion off the floor shows in the vertical row only.
   pose1[2] = 0.0002;
-  const auto up = testing::Evaluate(*MakeFactor(Omni3DriveError(Rates(Eigen::Vector3d(0, 0.4, 0)), 0.01)),
-                                    Values(pose0, pose1));
+  const auto up =
+      testing::Evaluate(*MakeFactor(Omni3DriveError(Rates(Eigen::Vector3d(0, 0.4, 0)), 0.01)), Values(pose0, pose1));
   EXPECT_NEAR(up.error[3], 0.02, 1e-12);
   EXPECT_LT(up.error.head<3>().norm(), 1e-9);
 }

@@ -46,7 +46,8 @@ TEST_P(GpGradientTest, LogMarginalLikelihoodGradientMatchesCentralDifferences) {
     plus[i] += h;
     minus[i] -= h;
     const double numeric = (GpLogMarginalLikelihood(layout, X, y, noise, plus, nullptr) -
-                            GpLogMarginalLikelihood(layout, X, y, noise, minus, nullptr)) / (2.0 * h);
+                            GpLogMarginalLikelihood(layout, X, y, noise, minus, nullptr)) /
+                           (2.0 * h);
     EXPECT_NEAR(gradient[i], numeric, 1e-5 * std::max(1.0, std::abs(numeric))) << "parameter " << i;
   }
 }

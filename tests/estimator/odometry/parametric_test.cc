@@ -40,8 +40,11 @@ TEST(ParametricTest, NominalNeedsItsGeometry) {
 TEST(ParametricTest, NominalOmni3) {
   recording::Platform platform;
   platform.kind = "omni3";
-  platform.geometry = {{"wheel_distance_m", 0.195}, {"wheel_radius_m", 0.051}, {"wheel_angle_w1_rad", 0.0},
-                       {"wheel_angle_w2_rad", 2.0 * M_PI / 3.0}, {"wheel_angle_w3_rad", -2.0 * M_PI / 3.0}};
+  platform.geometry = {{"wheel_distance_m", 0.195},
+                       {"wheel_radius_m", 0.051},
+                       {"wheel_angle_w1_rad", 0.0},
+                       {"wheel_angle_w2_rad", 2.0 * M_PI / 3.0},
+                       {"wheel_angle_w3_rad", -2.0 * M_PI / 3.0}};
   Result<WheelKinematics> k = NominalKinematics(platform, {"w1", "w2", "w3"});
   ASSERT_TRUE(k.ok()) << k.status().message();
   const Pose2 spin = k.value().Displacement(Eigen::Vector3d(1.0, 1.0, 1.0));

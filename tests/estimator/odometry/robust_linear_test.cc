@@ -3,8 +3,8 @@
 #include <cmath>
 #include <random>
 
-#include <Eigen/Cholesky>
 #include <gtest/gtest.h>
+#include <Eigen/Cholesky>
 
 namespace roamlab::estimator::odometry {
 namespace {
@@ -41,10 +41,10 @@ TEST(RobustLinearTest, HuberRecoversWWithTwentyPercentGrossOutliers) {
 }
 
 TEST(RobustLinearTest, RejectsSizeMismatchAndTooFewPairs) {
-  EXPECT_FALSE(FitHuberLinear(Eigen::MatrixXd::Ones(5, 2), Eigen::MatrixXd::Ones(4, 3),
-                              Eigen::MatrixXd::Ones(5, 3)).ok());
-  EXPECT_FALSE(FitHuberLinear(Eigen::MatrixXd::Ones(2, 2), Eigen::MatrixXd::Ones(2, 3),
-                              Eigen::MatrixXd::Ones(2, 3)).ok());
+  EXPECT_FALSE(
+      FitHuberLinear(Eigen::MatrixXd::Ones(5, 2), Eigen::MatrixXd::Ones(4, 3), Eigen::MatrixXd::Ones(5, 3)).ok());
+  EXPECT_FALSE(
+      FitHuberLinear(Eigen::MatrixXd::Ones(2, 2), Eigen::MatrixXd::Ones(2, 3), Eigen::MatrixXd::Ones(2, 3)).ok());
 }
 
 }  // namespace

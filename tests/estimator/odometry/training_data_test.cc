@@ -1,8 +1,8 @@
 #include "estimator/odometry/training_data.h"
 
+#include <unistd.h>
 #include <cmath>
 #include <filesystem>
-#include <unistd.h>
 
 #include <gtest/gtest.h>
 
@@ -147,8 +147,9 @@ TEST(OdometryModelTest, SaveAndLoadKeepPredictions) {
   }
   Result<GaussianProcess> gp = GaussianProcess::Train(X, Y, Eigen::MatrixXd::Constant(30, 3, 1e-8), {});
   ASSERT_TRUE(gp.ok()) << gp.status().message();
-  const std::string path = (std::filesystem::temp_directory_path() /
-                            ("roamlab_odometry_model_" + std::to_string(::getpid()) + ".json")).string();
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("roamlab_odometry_model_" + std::to_string(::getpid()) + ".json"))
+          .string();
   for (ModelKind kind : {ModelKind::kGp, ModelKind::kLinear, ModelKind::kNominal}) {
     OdometryModel model;
     model.kind = kind;

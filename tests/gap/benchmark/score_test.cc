@@ -23,12 +23,12 @@ CaseResult Case(const std::string& kind, const std::string& truth, std::vector<C
 
 TEST(GapBenchmarkScore, ReplayTakesTheFirstPassingCandidateInBicOrder) {
   const std::vector<CandidateStats> candidates = {Candidate("b", 1e-5, -20.0, 0.05),
-                                                  Candidate("a", 1e-9, -50.0, -0.01),   // fails the held-out part
+                                                  Candidate("a", 1e-9, -50.0, -0.01),  // fails the held-out part
                                                   Candidate("c", 0.5, 1.0, 0.0, false)};
   EXPECT_EQ(ReplayFirstRound(candidates, {1e-3, 0.0, 0.0}), "b");
-  EXPECT_EQ(ReplayFirstRound(candidates, {1e-6, 0.0, 0.0}), "");       // a passes p but not the held-out test
-  EXPECT_EQ(ReplayFirstRound(candidates, {1e-3, -30.0, 0.0}), "");     // b's Delta BIC not low enough
-  EXPECT_EQ(ReplayFirstRound(candidates, {1e-3, 0.0, 0.1}), "");       // b's held-out drop too small
+  EXPECT_EQ(ReplayFirstRound(candidates, {1e-6, 0.0, 0.0}), "");    // a passes p but not the held-out test
+  EXPECT_EQ(ReplayFirstRound(candidates, {1e-3, -30.0, 0.0}), "");  // b's Delta BIC not low enough
+  EXPECT_EQ(ReplayFirstRound(candidates, {1e-3, 0.0, 0.1}), "");    // b's held-out drop too small
   // Passing p and BIC without a held-out evaluation counts as failing it.
   EXPECT_EQ(ReplayFirstRound({Candidate("x", 1e-8, -40.0, 0.2, false)}, {1e-3, 0.0, 0.0}), "");
 }
@@ -112,8 +112,7 @@ TEST(GapBenchmarkScore, ChoosesTheShareThatTurnsDecoysAwayAndKeepsSmallEffects) 
   EXPECT_DOUBLE_EQ(t.min_heldout_improvement, 0.0);
   EXPECT_DOUBLE_EQ(t.min_explained_share, 0.25);
   for (const CaseResult& c : calibration) EXPECT_TRUE(ReplayCorrect(c, ReplayFirstRound(c.candidates, t)));
-  for (const nlohmann::json& p : table)
-    EXPECT_TRUE(p["min_explained_share"] != 0.0 || !p["feasible"].get<bool>());
+  for (const nlohmann::json& p : table) EXPECT_TRUE(p["min_explained_share"] != 0.0 || !p["feasible"].get<bool>());
   // The default share is one of the grid's, and the loosest point applies none.
   EXPECT_DOUBLE_EQ(Loosest().min_explained_share, 0.0);
   EXPECT_DOUBLE_EQ(Thresholds{}.min_explained_share, gap::kDefaultMinExplainedShare);
@@ -173,12 +172,13 @@ TEST(GapBenchmarkScore, CalibrationAndScoreJudgeByOneRule) {
 TEST(GapBenchmarkScore, NoiseRatioUsesTheMedianReportedStd) {
   CaseResult a = Case("none", "", {{"steering_offset", 0.5, 1.0, false, 0.0, {{"offset_rad", 0.001}}}});
   CaseResult b = Case("effect", "gps_latency", {{"steering_offset", 0.5, 1.0, false, 0.0, {{"offset_rad", 0.003}}}});
-  CaseResult c = Case("none", "", {{"steering_offset", 0.5, 1.0, false, 0.0, {{"offset_rad", 0.002}}},
-                                   {"gps_latency", 0.5, 1.0, false, 0.0, {{"latency_s", std::nan("")}}}});
+  CaseResult c = Case("none", "",
+                      {{"steering_offset", 0.5, 1.0, false, 0.0, {{"offset_rad", 0.002}}},
+                       {"gps_latency", 0.5, 1.0, false, 0.0, {{"latency_s", std::nan("")}}}});
   a.platform = b.platform = c.platform = "atv";
   const auto sigmas = CalibrationSigmas({a, b, c});
   EXPECT_DOUBLE_EQ(sigmas.at("atv").at("steering_offset/offset_rad"), 0.002);
-  EXPECT_EQ(sigmas.at("atv").count("gps_latency/latency_s"), 0u);   // NaN skipped
+  EXPECT_EQ(sigmas.at("atv").count("gps_latency/latency_s"), 0u);  // NaN skipped
   EXPECT_DOUBLE_EQ(NoiseRatio(sigmas, "atv", "steering_offset", "offset_rad", -0.02), 10.0);
   EXPECT_DOUBLE_EQ(NoiseRatio(sigmas, "atv", "gps_latency", "latency_s", 0.3), -1.0);
   EXPECT_DOUBLE_EQ(NeutralValue("scale_z"), 1.0);
@@ -206,7 +206,7 @@ TEST(GapBenchmarkScore, RearCorneringComplianceIsTheSideSlipPerLateralAccelerati
     pose.q_world_body = (pose.q_world_body * half * half).normalized();
   }
   EXPECT_NEAR(RearCorneringCompliance(truth), c, 1e-9);
-  EXPECT_TRUE(std::isnan(RearCorneringCompliance(Trajectory(truth.begin(), truth.begin() + 300))));   // all in 2 s
+  EXPECT_TRUE(std::isnan(RearCorneringCompliance(Trajectory(truth.begin(), truth.begin() + 300))));  // all in 2 s
 }
 
 CaseResult Scored(const std::string& kind, const std::string& truth, const std::string& verdict,
@@ -278,9 +278,9 @@ TEST(GapBenchmarkScore, SummarizesTheBenchmarksFigures) {
   EXPECT_NEAR(f["decoys_unknown"].get<double>(), 1.0 / 3.0, 1e-12);
   EXPECT_NEAR(f["decoy_false_discovery_rate"].get<double>(), 1.0 / 3.0, 1e-12);
   EXPECT_NEAR(f["median_parameter_relative_error"].get<double>(), 0.1, 1e-9);
-  EXPECT_DOUBLE_EQ(f["median_heldout_rms_reduction"].get<double>(), 0.5);                  // top-1 cases only
+  EXPECT_DOUBLE_EQ(f["median_heldout_rms_reduction"].get<double>(), 0.5);  // top-1 cases only
   EXPECT_NEAR(f["median_heldout_rms_reduction_all_effect_cases"].get<double>(), 0.275, 1e-12);
-  EXPECT_NEAR(f["median_resimulated_rms_reduction"].get<double>(), 0.2, 1e-12);         // top-1 cases only
+  EXPECT_NEAR(f["median_resimulated_rms_reduction"].get<double>(), 0.2, 1e-12);  // top-1 cases only
   EXPECT_NEAR(f["median_resimulated_rms_reduction_all_effect_cases"].get<double>(), 0.35, 1e-12);
   EXPECT_NEAR(f["median_resimulated_rms_1s_reduction"].get<double>(), 0.75, 1e-12);
   EXPECT_NEAR(f["median_resimulated_rms_1s_reduction_all_effect_cases"].get<double>(), 0.625, 1e-12);
