@@ -52,7 +52,10 @@ TEST(CalibrationIoTest, BadFilesNameTheFileAndTheProblem) {
   WriteFile(path, "{\"parameters\": {\"a\": {\"estimate\": [1, \"x\"]}}}");
   EXPECT_THAT(ReadCalibrationValues(path).status().message(),
               HasSubstr("parameter 'a': 'estimate' must be an array of numbers"));
+  WriteFile(path, "{\"parameters\": {\"a\": {\"estimate\": [1]}}}");
   EXPECT_THAT(ReadCalibrationPrior(path).status().message(), HasSubstr("no 'information'"));
+  WriteFile(path, "{\"parameters\": {}, \"information\": {\"parameters\": [\"a\"], \"matrix\": [[null]]}}");
+  EXPECT_THAT(ReadCalibrationPrior(path).status().message(), HasSubstr("information.matrix has a non-number"));
   WriteFile(path, "{\"parameters\": {}, \"information\": {\"parameters\": [\"a\"], \"matrix\": [[1, 2]]}}");
   EXPECT_THAT(ReadCalibrationPrior(path).status().message(), HasSubstr("information.matrix must be square"));
   WriteFile(path, "not json");
