@@ -252,7 +252,8 @@ int CalibrateForTracking(const Context& ctx, const recording::Recording& rec, Tr
   Say("  calibration for tracking           the product's of step 1's %.0f s drive, %.2f s, %d iterations\n",
       ctx.scenario.duration_s, Since(t_product), product.value().iterations);
   *calibration_json = (ctx.tmp / "calibration.json").string();
-  est::WriteCalibrationValues(calibrated->values, calibrated->prior, *calibration_json);
+  const Status written = est::WriteCalibrationFile(product.value(), "", "", *calibration_json);
+  if (!written.ok()) return Fail(written.message());
   return 0;
 }
 

@@ -9,6 +9,7 @@
 #include "estimator/covariance.h"
 #include "estimator/internal/json_io.h"
 #include "estimator/solver.h"
+#include "recording/calibration_file.h"
 
 namespace roamlab::estimator {
 namespace {
@@ -70,58 +71,25 @@ Status WriteCalibrationFile(const CalibrationResult& result, const std::string& 
   return internal::WriteJson(out, path);
 }
 
-Status WriteCalibrationValues(const std::map<std::string, Eigen::VectorXd>& values, const CalibrationPrior& prior,
-                              const std::string& path) {
-  json j;
-  for (const auto& [name, v] : values) j["parameters"][name]["estimate"] = NumberArray(v);
-  j["information"] = InformationJson(prior.names, prior.information);
-  return internal::WriteJson(j, path);
-}
-
 Result<std::map<std::string, Eigen::VectorXd>> ReadCalibrationValues(const std::string& path) {
-  auto file = internal::ReadJsonFile(path);
+  auto file = recording::ReadCalibrationFile(path);
   if (!file.ok()) return file.status();
-  json j = std::move(file).value();
-  if (!j.contains("parameters") || !j["parameters"].is_object())
-    return Status::Error(path + ": missing object 'parameters'");
   std::map<std::string, Eigen::VectorXd> out;
-  for (const auto& [name, p] : j["parameters"].items()) {
-    if (!p.contains("estimate") || !p["estimate"].is_array())
-      return Status::Error(path + ": parameter '" + name + "' has no 'estimate' array");
-    Eigen::VectorXd v(static_cast<int>(p["estimate"].size()));
-    for (std::size_t i = 0; i < p["estimate"].size(); ++i) {
-      if (!p["estimate"][i].is_number())
-        return Status::Error(path + ": parameter '" + name + "' estimate has a non-number");
-      v[static_cast<int>(i)] = p["estimate"][i].get<double>();
-    }
-    out[name] = v;
-  }
+  for (const auto& [name, p] : file.value().parameters)
+    out[name] = Eigen::Map<const Eigen::VectorXd>(p.estimate.data(), static_cast<Eigen::Index>(p.estimate.size()));
   return out;
 }
 
 Result<CalibrationPrior> ReadCalibrationPrior(const std::string& path) {
-  auto file = internal::ReadJsonFile(path);
+  auto file = recording::ReadCalibrationFile(path);
   if (!file.ok()) return file.status();
-  json j = std::move(file).value();
-  const json& info = j["information"];
-  if (!info.is_object() || !info["parameters"].is_array() || !info["matrix"].is_array())
+  if (!file.value().information)
     return Status::Error(path + ": no 'information' with 'parameters' and 'matrix' (calibrate it again)");
+  const recording::CalibrationInformation& info = *file.value().information;
+  if (!info.matrix.allFinite()) return Status::Error(path + ": information.matrix has a non-number");
   CalibrationPrior prior;
-  for (const auto& name : info["parameters"]) {
-    if (!name.is_string()) return Status::Error(path + ": information.parameters must be names");
-    prior.names.push_back(name.get<std::string>());
-  }
-  const json& m = info["matrix"];
-  const int n = static_cast<int>(m.size());
-  prior.information.resize(n, n);
-  for (int r = 0; r < n; ++r) {
-    if (!m[r].is_array() || static_cast<int>(m[r].size()) != n)
-      return Status::Error(path + ": information.matrix must be square");
-    for (int c = 0; c < n; ++c) {
-      if (!m[r][c].is_number()) return Status::Error(path + ": information.matrix has a non-number");
-      prior.information(r, c) = m[r][c].get<double>();
-    }
-  }
+  prior.names = info.parameters;
+  prior.information = info.matrix;
   return prior;
 }
 

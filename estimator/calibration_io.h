@@ -1,14 +1,4 @@
-// calibration.json: the file `roamlab calibrate` writes and tracking (track, montecarlo, the regression suite, the
-// benchmark) reads.
-//
-//   {"parameters": {NAME: {"estimate": [...], "std": [...], "observability": "...",
-//                          "component_observability": [...], "manifold": "..."}},
-//    "information": {"parameters": [NAME, ...], "matrix": [[...], ...]},
-//    "correlations": [{"a", "b", "rho"}], "solver": {...}, "measurements": {STREAM: {...}},
-//    "recording": PATH, "config": PATH}
-//
-// estimate is ambient (quaternions [w, x, y, z]), std and the information matrix are tangent; a non-finite number is
-// written as null. Tracking reads only parameters.NAME.estimate and information.
+// calibration.json (its format: recording/calibration_file.h): written by `roamlab calibrate`, read for tracking.
 #pragma once
 
 #include <map>
@@ -27,11 +17,7 @@ namespace roamlab::estimator {
 Status WriteCalibrationFile(const CalibrationResult& result, const std::string& recording, const std::string& config,
                             const std::string& path);
 
-// Writes only what tracking reads: parameters.NAME.estimate for `values` and the information of `prior`.
-Status WriteCalibrationValues(const std::map<std::string, Eigen::VectorXd>& values, const CalibrationPrior& prior,
-                              const std::string& path);
-
-// Parameter values (ambient, by name): parameters.NAME.estimate.
+// Parameter values (ambient, by name): parameters.NAME.estimate (recording::ReadCalibrationFile).
 Result<std::map<std::string, Eigen::VectorXd>> ReadCalibrationValues(const std::string& path);
 
 // The joint marginal information of the calibrated parameters, for tracking with tracking.calibration_prior.

@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "common/json.h"
+#include "recording/calibration_file.h"
 
 namespace roamlab::eval {
 namespace {
@@ -88,22 +89,6 @@ const char* ManifoldName(const ParameterComparison& row) {
       break;
   }
   return nullptr;
-}
-
-// An array of numbers (null allowed when `nullable`) into `out`; false if it is not one.
-bool ReadNumbers(const json& node, bool nullable, std::vector<double>* out) {
-  if (!node.is_array()) return false;
-  out->clear();
-  for (const json& v : node) {
-    if (v.is_number()) {
-      out->push_back(v.get<double>());
-    } else if (nullable && v.is_null()) {
-      out->push_back(kNaN);
-    } else {
-      return false;
-    }
-  }
-  return true;
 }
 
 }  // namespace
@@ -190,31 +175,17 @@ Result<std::vector<ParameterComparison>> CompareParameters(const std::map<std::s
 }
 
 Result<std::map<std::string, ParameterEstimate>> ReadCalibrationEstimates(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return Status::Error(path + ": cannot open file");
-  json root;
-  try {
-    in >> root;
-  } catch (const json::exception& e) {
-    return Status::Error(path + ": not valid JSON: " + e.what());
-  }
-  if (!root.is_object() || !root.contains("parameters") || !root["parameters"].is_object())
-    return Status::Error(path + ": missing object 'parameters'");
+  auto file = recording::ReadCalibrationFile(path);
+  if (!file.ok()) return file.status();
   std::map<std::string, ParameterEstimate> out;
-  for (const auto& [name, node] : root["parameters"].items()) {
-    const std::string where = path + ": parameter '" + name + "'";
+  for (const auto& [name, read] : file.value().parameters) {
     ParameterEstimate p;
-    if (!node.is_object() || !node.contains("estimate") || !ReadNumbers(node["estimate"], false, &p.estimate))
-      return Status::Error(where + ": 'estimate' must be an array of numbers");
-    if (node.contains("std") && !ReadNumbers(node["std"], true, &p.std))
-      return Status::Error(where + ": 'std' must be an array of numbers or nulls");
-    std::string manifold = "R" + std::to_string(p.estimate.size());
-    if (node.contains("manifold")) {
-      if (!node["manifold"].is_string()) return Status::Error(where + ": 'manifold' must be a string");
-      manifold = node["manifold"].get<std::string>();
-    }
+    p.estimate = read.estimate;
+    p.std = read.std;
+    const std::string manifold = read.manifold.empty() ? "R" + std::to_string(p.estimate.size()) : read.manifold;
     const std::optional<ParameterKind> kind = ParameterKindFromManifold(manifold);
-    if (!kind) return Status::Error(where + ": unknown manifold '" + manifold + "' (R<n>, S3 or SE3)");
+    if (!kind)
+      return Status::Error(path + ": parameter '" + name + "': unknown manifold '" + manifold + "' (R<n>, S3 or SE3)");
     p.kind = *kind;
     out[name] = std::move(p);
   }

@@ -13,18 +13,6 @@ Status WriteJson(const json& j, const std::string& path) {
   return out ? Status::Ok() : Status::Error(path + ": write failed");
 }
 
-Result<json> ReadJsonFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return Status::Error(path + ": cannot open");
-  json j;
-  try {
-    in >> j;
-  } catch (const json::exception& e) {
-    return Status::Error(path + ": not valid JSON: " + e.what());
-  }
-  return j;
-}
-
 json CountsJson(const std::map<std::string, StreamCounts>& counts) {
   json j = json::object();
   for (const auto& [name, c] : counts)

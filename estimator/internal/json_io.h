@@ -14,9 +14,6 @@ namespace roamlab::estimator::internal {
 // `j` written to `path` with two-space indentation and a final newline.
 Status WriteJson(const nlohmann::json& j, const std::string& path);
 
-// A JSON file, or one line naming it and the problem.
-Result<nlohmann::json> ReadJsonFile(const std::string& path);
-
 // Measurement counts by stream: {STREAM: {"attached", "rejected", "too_late", "outside"}}.
 nlohmann::json CountsJson(const std::map<std::string, StreamCounts>& counts);
 

@@ -12,28 +12,37 @@ using ::roamlab::testing::TempDir;
 using ::roamlab::testing::WriteFile;
 using ::testing::HasSubstr;
 
-// What WriteCalibrationValues writes, ReadCalibrationValues and ReadCalibrationPrior read back.
+// What WriteCalibrationFile writes, ReadCalibrationValues and ReadCalibrationPrior read back.
 TEST(CalibrationIoTest, ValuesAndPriorRoundTrip) {
   TempDir dir;
   const std::string path = dir.File("calibration.json");
-  std::map<std::string, Eigen::VectorXd> values;
-  values["gps.lever_arm"] = Eigen::Vector3d(0.5, -0.25, 1.125);
-  values["imu.time_offset"] = Eigen::VectorXd::Constant(1, 0.003);
-  CalibrationPrior prior;
-  prior.names = {"gps.lever_arm", "imu.time_offset"};
-  prior.information = Eigen::MatrixXd::Identity(4, 4) * 2.0;
-  prior.information(0, 3) = prior.information(3, 0) = 0.5;
-  ASSERT_TRUE(WriteCalibrationValues(values, prior, path).ok());
+  CalibrationResult result;
+  ParameterEstimate lever;
+  lever.name = "gps.lever_arm";
+  lever.manifold = Manifold::Euclidean(3);
+  lever.estimate = Eigen::Vector3d(0.5, -0.25, 1.125);
+  lever.std = Eigen::Vector3d(0.1, 0.2, 0.3);
+  lever.components.assign(3, Observability::kObservable);
+  ParameterEstimate offset = lever;
+  offset.name = "imu.time_offset";
+  offset.manifold = Manifold::Euclidean(1);
+  offset.estimate = Eigen::VectorXd::Constant(1, 0.003);
+  offset.std = Eigen::VectorXd::Constant(1, 0.001);
+  offset.components.assign(1, Observability::kObservable);
+  result.parameters = {lever, offset};
+  result.information = Eigen::MatrixXd::Identity(4, 4) * 2.0;
+  result.information(0, 3) = result.information(3, 0) = 0.5;
+  ASSERT_TRUE(WriteCalibrationFile(result, "REC", "EST.yaml", path).ok());
 
   const auto read = ReadCalibrationValues(path);
   ASSERT_TRUE(read.ok()) << read.status().message();
   ASSERT_EQ(read.value().size(), 2u);
-  EXPECT_EQ(read.value().at("gps.lever_arm"), values["gps.lever_arm"]);
-  EXPECT_EQ(read.value().at("imu.time_offset"), values["imu.time_offset"]);
+  EXPECT_EQ(read.value().at("gps.lever_arm"), lever.estimate);
+  EXPECT_EQ(read.value().at("imu.time_offset"), offset.estimate);
   const auto read_prior = ReadCalibrationPrior(path);
   ASSERT_TRUE(read_prior.ok()) << read_prior.status().message();
-  EXPECT_EQ(read_prior.value().names, prior.names);
-  EXPECT_EQ(read_prior.value().information, prior.information);
+  EXPECT_EQ(read_prior.value().names, (std::vector<std::string>{"gps.lever_arm", "imu.time_offset"}));
+  EXPECT_EQ(read_prior.value().information, result.information);
 }
 
 TEST(CalibrationIoTest, BadFilesNameTheFileAndTheProblem) {
@@ -41,9 +50,13 @@ TEST(CalibrationIoTest, BadFilesNameTheFileAndTheProblem) {
   const std::string path = dir.File("calibration.json");
   EXPECT_THAT(ReadCalibrationValues(path).status().message(), HasSubstr(path + ": cannot open"));
   WriteFile(path, "{\"parameters\": {\"a\": {\"estimate\": [1, \"x\"]}}}");
-  EXPECT_THAT(ReadCalibrationValues(path).status().message(), HasSubstr("parameter 'a' estimate has a non-number"));
+  EXPECT_THAT(ReadCalibrationValues(path).status().message(),
+              HasSubstr("parameter 'a': 'estimate' must be an array of numbers"));
+  WriteFile(path, "{\"parameters\": {\"a\": {\"estimate\": [1]}}}");
   EXPECT_THAT(ReadCalibrationPrior(path).status().message(), HasSubstr("no 'information'"));
-  WriteFile(path, "{\"information\": {\"parameters\": [\"a\"], \"matrix\": [[1, 2]]}}");
+  WriteFile(path, "{\"parameters\": {}, \"information\": {\"parameters\": [\"a\"], \"matrix\": [[null]]}}");
+  EXPECT_THAT(ReadCalibrationPrior(path).status().message(), HasSubstr("information.matrix has a non-number"));
+  WriteFile(path, "{\"parameters\": {}, \"information\": {\"parameters\": [\"a\"], \"matrix\": [[1, 2]]}}");
   EXPECT_THAT(ReadCalibrationPrior(path).status().message(), HasSubstr("information.matrix must be square"));
   WriteFile(path, "not json");
   EXPECT_THAT(ReadCalibrationValues(path).status().message(), HasSubstr("not valid JSON"));
