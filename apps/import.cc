@@ -6,7 +6,7 @@
 
 #include "apps/cli.h"
 #include "experiment/steps.h"
-#include "recording/import_rosbag.h"
+#include "importers/rosbag.h"
 #include "recording/recording.h"
 
 namespace roamlab::apps {
@@ -38,7 +38,7 @@ int RunImportOptiOdom(const ImportOptiOdomArgs& args) {
 }
 
 int RunImportRosbag(const ImportRosbagArgs& args) {
-  recording::RosbagImportOptions options;
+  importers::RosbagImportOptions options;
   options.platform.kind = args.platform_kind;
   options.wheels_from_odometry = args.wheels_from_odometry;
   for (const std::string& kv : args.geometry) {
@@ -58,8 +58,8 @@ int RunImportRosbag(const ImportRosbagArgs& args) {
     }
     options.q_body_imu = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized();
   }
-  recording::RosbagImportReport report;
-  const Result<recording::Recording> rec = recording::ImportRosbag(args.bag, options, &report);
+  importers::RosbagImportReport report;
+  const Result<recording::Recording> rec = importers::ImportRosbag(args.bag, options, &report);
   if (const int code = Written(rec, args.out); code != 0) return code;
   if (!args.quiet) {
     for (const recording::Stream& s : rec.value().streams) {

@@ -10,7 +10,7 @@
 #include "estimator/calibration_io.h"
 #include "estimator/config.h"
 #include "estimator/tracking_io.h"
-#include "recording/import_optiodom.h"
+#include "importers/optiodom.h"
 #include "recording/recording.h"
 #include "recording/trajectory.h"
 #include "recording/truth.h"
@@ -110,11 +110,11 @@ Outcome TrackToDirectory(const TrackRequest& request, estimator::TrackingResult*
 
 Outcome ImportOptiOdomToDirectory(const std::string& run_csv, const std::string& metadata, const std::string& out,
                                   recording::Recording* imported) {
-  const std::string metadata_path = metadata.empty() ? recording::OptiOdomMetadataPath(run_csv) : metadata;
+  const std::string metadata_path = metadata.empty() ? importers::OptiOdomMetadataPath(run_csv) : metadata;
   if (metadata_path.empty())
     return Outcome::BadInput(
         Status::Error(run_csv + ": cannot find the metadata file (expected <set>_run-NN.csv; use --metadata)"));
-  Result<recording::Recording> rec = recording::ImportOptiOdom(run_csv, metadata_path);
+  Result<recording::Recording> rec = importers::ImportOptiOdom(run_csv, metadata_path);
   if (!rec.ok()) return Outcome::BadInput(rec.status());
   if (Status s = recording::WriteRecording(rec.value(), out); !s.ok()) return Outcome::Failed(s);
   if (imported) *imported = std::move(rec).value();

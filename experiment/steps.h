@@ -65,7 +65,7 @@ struct TrackRequest {
 // Online fixed-lag tracking of the recording (estimator/tracking.h). `result` (optional) receives it.
 Outcome TrackToDirectory(const TrackRequest& request, estimator::TrackingResult* result = nullptr);
 
-// Imports an OptiOdom run (recording/import_optiodom.h) into the recording directory `out`; `metadata` "" = the
+// Imports an OptiOdom run (importers/optiodom.h) into the recording directory `out`; `metadata` "" = the
 // <set>_metadata.csv next to the run. `imported` (optional) receives the recording.
 Outcome ImportOptiOdomToDirectory(const std::string& run_csv, const std::string& metadata, const std::string& out,
                                   recording::Recording* imported = nullptr);

@@ -12,8 +12,8 @@
 #include "estimator/config.h"
 #include "estimator/models/differential_drive.h"
 #include "gap/diagnose.h"
-#include "recording/import_optiodom.h"
-#include "recording/import_rosbag.h"
+#include "importers/optiodom.h"
+#include "importers/rosbag.h"
 
 namespace roamlab::gap {
 namespace {
@@ -83,7 +83,7 @@ double YawRatio(const recording::Recording& rec) {
 
 TEST(RealDataTest, OptiOdomDifferentialDriveTrackAndWheelRatio) {
   if (!std::filesystem::exists(kSet + "_metadata.csv")) GTEST_SKIP() << "real data absent: " << kSet;
-  auto rec = recording::ImportOptiOdom(kSet + "_run-01.csv", kSet + "_metadata.csv");
+  auto rec = importers::ImportOptiOdom(kSet + "_run-01.csv", kSet + "_metadata.csv");
   ASSERT_TRUE(rec.ok()) << rec.status().message();
   auto config =
       estimator::LoadEstimatorConfig(std::string(ROAMLAB_SOURCE_DIR) + "/configs/real/optiodom_diff_nominal.yaml");
@@ -137,7 +137,7 @@ TEST(RealDataTest, OptiOdomDifferentialDriveTrackAndWheelRatio) {
   // Whole runs (the robot's 69 s drives) and 10 s segments (200 samples).
   double whole_nominal = 0.0, whole_patched = 0.0, seg_nominal = 0.0, seg_patched = 0.0;
   for (const char* run : {"02", "03", "04", "05", "06"}) {
-    auto other = recording::ImportOptiOdom(kSet + "_run-" + run + ".csv", kSet + "_metadata.csv");
+    auto other = importers::ImportOptiOdom(kSet + "_run-" + run + ".csv", kSet + "_metadata.csv");
     ASSERT_TRUE(other.ok()) << other.status().message();
     const recording::Recording& o = other.value();
     const double nominal = DeadReckoningRms(o, r0, r0, 0.2), patched = DeadReckoningRms(o, r, rho_fit * r, b);
@@ -191,11 +191,11 @@ double HeadingRatioInTurns(const recording::Recording& rec) {
 TEST(RealDataTest, HuskySkidSteerYawMismatch) {
   const std::string bag = kData + "/husky_test1/test1.bag";
   if (!std::filesystem::exists(bag)) GTEST_SKIP() << "real data absent: " << bag;
-  recording::RosbagImportOptions options;
+  importers::RosbagImportOptions options;
   options.platform = {"skid_steer", {{"wheel_radius_m", 0.1651}, {"baseline_m", 0.555}}};
   options.q_body_imu = Eigen::Quaterniond(std::sqrt(0.5), std::sqrt(0.5), 0.0, 0.0);
   options.wheels_from_odometry = true;
-  auto rec = recording::ImportRosbag(bag, options);
+  auto rec = importers::ImportRosbag(bag, options);
   ASSERT_TRUE(rec.ok()) << rec.status().message();
   auto config = estimator::LoadEstimatorConfig(std::string(ROAMLAB_SOURCE_DIR) + "/configs/real/husky_nominal.yaml");
   ASSERT_TRUE(config.ok()) << config.status().message();

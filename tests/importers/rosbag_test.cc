@@ -1,4 +1,4 @@
-#include "recording/import_rosbag.h"
+#include "importers/rosbag.h"
 
 #include <bzlib.h>
 
@@ -14,9 +14,13 @@
 
 #include "tests/recording/temp_dir.h"
 
-namespace roamlab::recording {
+namespace roamlab::importers {
 namespace {
 
+using ::roamlab::recording::ReadRecording;
+using ::roamlab::recording::Recording;
+using ::roamlab::recording::Stream;
+using ::roamlab::recording::StreamType;
 using ::roamlab::testing::TempDir;
 using ::roamlab::testing::WriteFile;
 using ::testing::HasSubstr;
@@ -268,4 +272,4 @@ TEST(ImportRosbagRealTest, HuskyTest1) {
 }
 
 }  // namespace
-}  // namespace roamlab::recording
+}  // namespace roamlab::importers

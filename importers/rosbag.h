@@ -44,11 +44,11 @@
 #include "common/status.h"
 #include "recording/recording.h"
 
-namespace roamlab::recording {
+namespace roamlab::importers {
 
 struct RosbagImportOptions {
   std::optional<Eigen::Quaterniond> q_body_imu;  // IMU mounting (rotates IMU coordinates into the body frame)
-  Platform platform;                             // written as is (kind, nominal geometry)
+  recording::Platform platform;                  // written as is (kind, nominal geometry)
   bool wheels_from_odometry = false;             // also write `wheels` (header comment)
 };
 
@@ -61,7 +61,7 @@ struct RosbagImportReport {
 
 // Reads the bag. Errors are one line naming the file and the problem (bad magic or version, a truncated record, a
 // compressed chunk in an unsupported format, a message shorter than its type, no supported topic).
-Result<Recording> ImportRosbag(const std::string& bag_path, const RosbagImportOptions& options,
-                               RosbagImportReport* report = nullptr);
+Result<recording::Recording> ImportRosbag(const std::string& bag_path, const RosbagImportOptions& options,
+                                          RosbagImportReport* report = nullptr);
 
-}  // namespace roamlab::recording
+}  // namespace roamlab::importers

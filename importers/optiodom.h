@@ -31,13 +31,13 @@
 #include "common/status.h"
 #include "recording/recording.h"
 
-namespace roamlab::recording {
+namespace roamlab::importers {
 
 // The metadata file next to a run: "<dir>/<set>_run-NN.csv" -> "<dir>/<set>_metadata.csv"; "" when the name does not
 // follow that pattern.
 std::string OptiOdomMetadataPath(const std::string& run_csv);
 
 // Reads one run and its metadata. Errors are one line naming the file (and line) and the problem.
-Result<Recording> ImportOptiOdom(const std::string& run_csv, const std::string& metadata_csv);
+Result<recording::Recording> ImportOptiOdom(const std::string& run_csv, const std::string& metadata_csv);
 
-}  // namespace roamlab::recording
+}  // namespace roamlab::importers

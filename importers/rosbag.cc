@@ -1,4 +1,4 @@
-#include "recording/import_rosbag.h"
+#include "importers/rosbag.h"
 
 #include <bzlib.h>
 #include <algorithm>
@@ -11,7 +11,15 @@
 #include <sstream>
 #include <vector>
 
-namespace roamlab::recording {
+namespace roamlab::importers {
+
+using recording::GeodeticOrigin;
+using recording::Mounting;
+using recording::Platform;
+using recording::Recording;
+using recording::Stream;
+using recording::StreamType;
+
 namespace {
 
 constexpr char kMagic[] = "#ROSBAG V2.0\n";
@@ -390,4 +398,4 @@ Result<Recording> ImportRosbag(const std::string& bag_path, const RosbagImportOp
   return rec;
 }
 
-}  // namespace roamlab::recording
+}  // namespace roamlab::importers

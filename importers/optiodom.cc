@@ -1,4 +1,4 @@
-#include "recording/import_optiodom.h"
+#include "importers/optiodom.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,15 @@
 
 #include "recording/internal/text_io.h"
 
-namespace roamlab::recording {
+namespace roamlab::importers {
+
+using recording::GeodeticOrigin;
+using recording::Mounting;
+using recording::Platform;
+using recording::Recording;
+using recording::Stream;
+using recording::StreamType;
+
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -22,7 +30,8 @@ std::vector<std::string> SplitCells(std::string_view line) {
   std::size_t start = 0;
   while (true) {
     const std::size_t comma = line.find(',', start);
-    cells.emplace_back(internal::Trim(line.substr(start, comma == std::string_view::npos ? line.npos : comma - start)));
+    cells.emplace_back(
+        recording::internal::Trim(line.substr(start, comma == std::string_view::npos ? line.npos : comma - start)));
     if (comma == std::string_view::npos) break;
     start = comma + 1;
   }
@@ -34,7 +43,7 @@ std::vector<std::string> Lines(const std::string& content) {
   std::vector<std::string> lines;
   std::istringstream in(content);
   std::string line;
-  while (std::getline(in, line)) lines.push_back(std::string(internal::Trim(line)));
+  while (std::getline(in, line)) lines.push_back(std::string(recording::internal::Trim(line)));
   return lines;
 }
 
@@ -52,7 +61,7 @@ struct Metadata {
 
 Result<Metadata> ReadMetadata(const std::string& path) {
   std::string content;
-  if (Status s = internal::ReadTextFile(path, &content); !s.ok()) return s;
+  if (Status s = recording::internal::ReadTextFile(path, &content); !s.ok()) return s;
   static const std::set<std::string> kIgnored = {"Thi", "N", "L", "imarkers", "gt_ti", "gt_tf", "odo_ti", "odo_tf"};
   std::map<std::string, std::vector<double>> numbers;
   Metadata meta;
@@ -73,7 +82,8 @@ Result<Metadata> ReadMetadata(const std::string& path) {
     std::vector<double> values;
     for (std::size_t c = 1; c < cells.size(); ++c) {
       double value = 0.0;
-      if (internal::ParseNumber(cells[c], &value) != internal::NumberParse::kOk || !(value > 0.0)) {
+      if (recording::internal::ParseNumber(cells[c], &value) != recording::internal::NumberParse::kOk ||
+          !(value > 0.0)) {
         return Status::Error(At(path, i) + key + ": '" + cells[c] + "' is not a positive number");
       }
       values.push_back(value);
@@ -122,7 +132,7 @@ Result<Recording> ImportOptiOdom(const std::string& run_csv, const std::string& 
 
   // The run: time, pose, ticks per cycle.
   std::string content;
-  if (Status s = internal::ReadTextFile(run_csv, &content); !s.ok()) return s;
+  if (Status s = recording::internal::ReadTextFile(run_csv, &content); !s.ok()) return s;
   std::vector<Time> t;
   std::vector<Eigen::Vector3d> pose;
   std::vector<Eigen::VectorXd> ticks;
@@ -136,14 +146,15 @@ Result<Recording> ImportOptiOdom(const std::string& run_csv, const std::string& 
     }
     Eigen::VectorXd row(static_cast<Eigen::Index>(columns));
     for (std::size_t c = 0; c < columns; ++c) {
-      if (internal::ParseNumber(cells[c], &row[static_cast<Eigen::Index>(c)]) != internal::NumberParse::kOk) {
+      if (recording::internal::ParseNumber(cells[c], &row[static_cast<Eigen::Index>(c)]) !=
+          recording::internal::NumberParse::kOk) {
         return Status::Error(At(run_csv, i) + "column " + std::to_string(c + 1) + ": '" + cells[c] +
                              "' is not a finite number");
       }
     }
     const Time time = Time::FromSeconds(row[0]);
     if (!t.empty() && time <= t.back()) {
-      return Status::Error(At(run_csv, i) + internal::TimeOrderProblem(t.back(), time));
+      return Status::Error(At(run_csv, i) + recording::internal::TimeOrderProblem(t.back(), time));
     }
     t.push_back(time);
     pose.emplace_back(row[1], row[2], row[3]);
@@ -212,4 +223,4 @@ Result<Recording> ImportOptiOdom(const std::string& run_csv, const std::string& 
   return rec;
 }
 
-}  // namespace roamlab::recording
+}  // namespace roamlab::importers
