@@ -13,6 +13,7 @@
 #include "apps/frontend.h"
 #include "apps/gap_benchmark.h"
 #include "apps/import.h"
+#include "apps/init.h"
 #include "apps/montecarlo.h"
 #include "apps/odometry.h"
 #include "apps/regress.h"
@@ -115,6 +116,20 @@ void AddMonteCarlo(CLI::App* app, Commands* commands) {
     mc->add_option("--out", args->out, "Output directory: nees.json, runs.json, nees.png")->required();
     mc->add_flag("--quiet", args->quiet, "No progress bar and no summary");
     return mc;
+  });
+}
+
+void AddInit(CLI::App* app, Commands* commands) {
+  Add(commands, RunInit, [app](auto* args) {
+    CLI::App* ini = app->add_subcommand(
+        "init", "Write a nominal estimator configuration (EST.yaml) from a recording's streams and platform.");
+    ini->add_option("recording", args->recording, "Recording directory")->required();
+    ini->add_option("--out", args->out, "Estimator configuration to write (EST.yaml)")->required();
+    ini->add_option("--platform", args->platform_kind,
+                    "Platform kind overriding the recording's: differential_drive | skid_steer | omni3 | mecanum | "
+                    "ackermann");
+    ini->add_flag("--quiet", args->quiet, "No summary");
+    return ini;
   });
 }
 
@@ -277,8 +292,8 @@ int RunCommandLine(int argc, char** argv) {
   CLI::App app{"roamlab: mobile-robot pose tracking and sensor self-calibration testbed"};
   app.require_subcommand(1);
   Commands commands;
-  for (const auto add : {AddSimulate, AddCalibrate, AddTrack, AddEvaluate, AddMonteCarlo, AddDiagnose, AddGapBenchmark,
-                         AddRegress, AddOdometry, AddImport, AddFrontEnd})
+  for (const auto add : {AddSimulate, AddCalibrate, AddTrack, AddEvaluate, AddMonteCarlo, AddInit, AddDiagnose,
+                         AddGapBenchmark, AddRegress, AddOdometry, AddImport, AddFrontEnd})
     add(&app, &commands);
 
   try {
