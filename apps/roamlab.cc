@@ -142,7 +142,9 @@ void AddDiagnose(CLI::App* app, Commands* commands) {
     dia->add_option("--real", args->recording, "Recording directory (its truth.yaml is never read)")->required();
     dia->add_option("--scenario", args->scenario,
                     "The nominal scenario: the robot as believed (optional with --config and --no-baseline)");
-    dia->add_option("--config", args->config, "Nominal estimator configuration (default: built from the scenario)");
+    dia->add_option("--config", args->config,
+                    "Nominal estimator configuration (default: built from the scenario; without --scenario, "
+                    "`roamlab init`'s from the recording, written to OUT/nominal_config.yaml, with --no-baseline)");
     dia->add_option("--out", args->out, "Output directory: gap.json, report.md, scenario_patch.yaml, figures")
         ->required();
     dia->add_flag("--no-baseline", args->no_baseline,

@@ -1,9 +1,11 @@
 #include "experiment/diagnose.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <sstream>
 
 #include "estimator/config.h"
+#include "experiment/init.h"
 #include "gap/nominal_config.h"
 #include "gap/report.h"
 #include "gap/resimulate.h"
@@ -48,7 +50,9 @@ Status LoadNominalModel(const DiagnoseRequest& request, Inputs* in) {
 // The inputs, checked against each other; errors are bad input.
 Result<Inputs> LoadInputs(const DiagnoseRequest& request) {
   if (request.scenario.empty() && (request.config.empty() || !request.no_baseline))
-    return Status::Error("without --scenario, give the nominal model as --config EST.yaml and --no-baseline");
+    return Status::Error(
+        "without --scenario, a --config EST.yaml needs --no-baseline (with neither, roamlab init's configuration is "
+        "used)");
   Inputs in;
   if (!request.scenario.empty()) {
     auto loaded = sim::LoadScenario(request.scenario);
@@ -90,10 +94,20 @@ Result<gap::Baseline> NominalBaseline(const DiagnoseRequest& request, const Inpu
 
 }  // namespace
 
-Outcome DiagnoseToDirectory(const DiagnoseRequest& request, gap::Diagnosis* diagnosis) {
+Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagnosis) {
   const auto say = [&](const std::string& line) {
-    if (request.progress) request.progress(line);
+    if (given.progress) given.progress(line);
   };
+  DiagnoseRequest request = given;
+  if (request.scenario.empty() && request.config.empty()) {
+    // No nominal model given: `roamlab init`'s, written beside the outputs; no MuJoCo twin, so no baseline.
+    InitRequest init{request.recording, (std::filesystem::path(request.out) / kInitConfigFile).string(), ""};
+    if (Outcome made = InitToFile(init); !made.ok()) return made;
+    request.config = init.out;
+    request.no_baseline = true;
+    say("no --scenario and no --config: the nominal model is roamlab init's configuration of " + request.recording +
+        " (" + init.out + "), without a baseline");
+  }
   auto inputs = LoadInputs(request);
   if (!inputs.ok()) return Outcome::BadInput(inputs.status());
   const Inputs& in = inputs.value();

@@ -7,7 +7,8 @@
 // candidate gains the nominal model reaches on MuJoCo data without any hidden effect (gap/learn_baseline.h). With a
 // scenario, the nominal scenario is simulated again without noise, as believed and with the accepted effects, and
 // compared with the recording's held-out part (gap/resimulate.h; gap.json "simulation"). Writes gap.json, report.md,
-// the patches and the figures (gap/report.h).
+// the patches and the figures (gap/report.h). Without a scenario and a configuration, the nominal model is the one
+// `roamlab init` writes (experiment/init.h), saved as out/nominal_config.yaml, and there is no baseline.
 #pragma once
 
 #include <cstdint>
@@ -21,12 +22,16 @@
 
 namespace roamlab::experiment {
 
+// The nominal configuration written beside the outputs when neither a scenario nor a configuration is given.
+inline constexpr const char* kInitConfigFile = "nominal_config.yaml";
+
 struct DiagnoseRequest {
   std::string recording;  // REC
   std::string scenario;   // SCENARIO.yaml (the nominal robot); "" for a robot without a MuJoCo twin:
-                          // then config and no_baseline are required
+                          // then no_baseline is required with a config, and implied without one
   std::string config;     // EST.yaml: nominal estimator configuration (default: from the scenario,
-                          // gap::NominalConfig)
+                          // gap::NominalConfig; without a scenario, experiment/init.h's from the recording, written
+                          // to out/kInitConfigFile)
   std::string out;        // output directory
   bool no_baseline = false;
   std::uint64_t baseline_seed = gap::kDefaultBaselineSeed;  // noise seed of the nominal simulation

@@ -157,7 +157,19 @@ class Builder {
 
 void Builder::Parameter(const std::string& name, const std::vector<double>& value, const std::string& value_origin,
                         bool free, const std::string& free_reason, int stage) {
-  Node p{Name(name), "", "", {}};
+  static const std::map<std::string, std::string> what = {
+      {"radius", "wheel radius [m]"},
+      {"baseline", "distance between the wheels' contact points [m]"},
+      {"distance", "the wheels' distance from the centre [m]"},
+      {"lx_plus_ly", "half length plus half width [m]"},
+      {"kv_over_L", "speed scale over the wheelbase [1/m]"},
+      {"k_theta", "steering gain"},
+      {"k_gamma", "steering offset [rad]"},
+      {"misalignment", "rotation of the sensor frame into O [w, x, y, z]"},
+      {"lever_arm", "position of the sensor in O [m]"},
+      {"bias", "gyroscope bias [rad/s]"}};
+  const auto slot = what.find(name.substr(name.rfind('.') + 1));
+  Node p{Name(name), slot != what.end() ? slot->second : std::string("a calibration parameter"), "", {}};
   p.children.push_back({"value", value_origin, List(value), {}});
   p.children.push_back({"free", free_reason, free ? "true" : "false", {}});
   parameters_.push_back(p);
