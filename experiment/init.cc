@@ -111,7 +111,7 @@ class Builder {
   const std::vector<std::string>& left_out() const { return left_out_; }
 
  private:
-  std::string Yaml(const std::string& key) const { return rec_name_ + "/recording.yaml " + key; }
+  std::string Where(const std::string& key) const { return rec_name_ + "/recording.yaml " + key; }
   void LeaveOut(const Stream& s, const std::string& reason) {
     left_out_.push_back(s.info.name + " (" + TypeName(s) + "): " + reason);
   }
@@ -147,7 +147,7 @@ class Builder {
   const Recording& rec_;
   std::string rec_name_, kind_, kind_origin_;
   const Stream* master_ = nullptr;
-  std::string master_name_, master_origin_;
+  std::string master_name_;
   std::set<const Stream*> used_;
   std::set<std::string> used_names_;
   std::vector<Node> streams_, parameters_;
@@ -204,7 +204,7 @@ std::vector<double> Builder::LeverArm(const Stream& s, std::string* origin) cons
     *origin = "no mounting stated for '" + s.info.name + "' in recording.yaml: at O";
     return {0.0, 0.0, 0.0};
   }
-  *origin = "from " + Yaml(s.info.name + ".mounting p_body_sensor [m]");
+  *origin = "from " + Where(s.info.name + ".mounting.p_body_sensor_m");
   const Eigen::Vector3d& p = s.info.mounting->p_body_sensor;
   return {p.x(), p.y(), p.z()};
 }
@@ -214,7 +214,7 @@ std::vector<double> Builder::Rotation(const Stream& s, std::string* origin) cons
     *origin = "no mounting stated for '" + s.info.name + "' in recording.yaml: aligned with O [w, x, y, z]";
     return {1.0, 0.0, 0.0, 0.0};
   }
-  *origin = "from " + Yaml(s.info.name + ".mounting q_body_sensor [w, x, y, z]");
+  *origin = "from " + Where(s.info.name + ".mounting.q_body_sensor_wxyz");
   const Eigen::Quaterniond q = s.info.mounting->q_body_sensor.normalized();
   return {q.w(), q.x(), q.y(), q.z()};
 }
@@ -282,7 +282,7 @@ Status Builder::AddWheels(const Stream& s) {
   if (wheel.origin.rfind("default", 0) == 0 && ticks != s.info.attributes.end() && ticks->second > 0.0 &&
       s.info.rate_hz > 0.0) {
     wheel = {2.0 * kPi / ticks->second * s.info.rate_hz / std::sqrt(6.0),
-             "quantization of " + Yaml(s.info.name + ".attributes.ticks_per_revolution") + " = " +
+             "quantization of " + Where(s.info.name + ".attributes.ticks_per_revolution") + " = " +
                  Number(ticks->second) + " over 1 / rate_hz = 1 / " + Number(s.info.rate_hz) +
                  " s: 2 pi / ticks * rate_hz / sqrt(6)"};
   }
@@ -314,7 +314,7 @@ Status Builder::AddWheelGeometry(const Stream& s, const std::string& model, cons
   double radius = 0.0;
   if (g.count("wheel_radius_m")) {
     radius = g.at("wheel_radius_m");
-    origin = "from " + Yaml("platform.geometry.wheel_radius_m");
+    origin = "from " + Where("platform.geometry.wheel_radius_m");
   } else {
     std::vector<std::string> keys;
     for (const std::string& column : s.info.columns) {
@@ -328,31 +328,38 @@ Status Builder::AddWheelGeometry(const Stream& s, const std::string& model, cons
                            "/recording.yaml: platform.geometry has no wheel_radius_m (nor "
                            "wheel_radius_<wheel>_m for every column of '" +
                            s.info.name + "') for the " + model + " model");
-    origin = "mean of " + Yaml("platform.geometry");
+    origin = "mean of " + Where("platform.geometry");
     for (const std::string& key : keys) origin += " " + key;
   }
   if (!(radius > 0.0))
     return Status::Error(rec_name_ + "/recording.yaml: platform.geometry: wheel radius must be positive");
   Parameter(name + ".radius", {radius}, origin, true, "free: the odometry's scale, self-calibrated", 1);
-  std::string slot = "baseline";
-  std::vector<std::string> keys = {"baseline_m", "track_m"};
-  if (model == "omni3_drive") slot = "distance", keys = {"wheel_distance_m"};
-  if (model == "mecanum_drive") slot = "lx_plus_ly", keys = {"half_length_m", "half_width_m"};
+  // The yaw lever arm's slot and the geometry keys it is read from: the first of the alternatives, or their sum.
+  struct YawLever {
+    std::string slot;
+    std::vector<std::string> keys;
+    bool sum;
+    std::string described;
+  };
+  const YawLever lever =
+      model == "omni3_drive" ? YawLever{"distance", {"wheel_distance_m"}, false, "wheel_distance_m"}
+      : model == "mecanum_drive"
+          ? YawLever{"lx_plus_ly", {"half_length_m", "half_width_m"}, true, "half_length_m and half_width_m"}
+          : YawLever{"baseline", {"baseline_m", "track_m"}, false, "baseline_m or track_m"};
   double value = 0.0;
   std::string used;
-  for (const std::string& key : keys) {
-    if (!g.count(key)) continue;
+  std::size_t found = 0;
+  for (const std::string& key : lever.keys) {
+    if (!g.count(key) || (!lever.sum && found > 0)) continue;
     value += g.at(key);
     used += (used.empty() ? "" : " + ") + key;
-    if (slot != "lx_plus_ly") break;
+    ++found;
   }
-  if (used.empty() || (slot == "lx_plus_ly" && used.find('+') == std::string::npos))
-    return Status::Error(rec_name_ + "/recording.yaml: platform.geometry has no " +
-                         (slot == "baseline"   ? std::string("baseline_m or track_m")
-                          : slot == "distance" ? std::string("wheel_distance_m")
-                                               : std::string("half_length_m and half_width_m")) +
+  if (found == 0 || (lever.sum && found != lever.keys.size()) || !(value > 0.0))
+    return Status::Error(rec_name_ + "/recording.yaml: platform.geometry has no positive " + lever.described +
                          " for the " + model + " model");
-  Parameter(name + "." + slot, {value}, "from " + Yaml("platform.geometry." + used), false,
+  const std::string slot = lever.slot;
+  Parameter(name + "." + slot, {value}, "from " + Where("platform.geometry." + used), false,
             "fixed: the yaw lever arm is believed (with one free radius it trades with the yaw reference's scale)", 1);
   return Status::Ok();
 }
@@ -385,7 +392,7 @@ Status Builder::AddAckermann(const Stream& s) {
   AddNoise(&n, "vertical_mps", {0.1, "default: eq. 15's no vertical motion on a suspended vehicle (0.1 m/s)"});
   n.children.push_back({"options", "the wheelbase", "", {}});
   n.children.back().children.push_back(
-      {"wheelbase_m", "from " + Yaml("platform.geometry.wheelbase_m"), Number(wheelbase->second), {}});
+      {"wheelbase_m", "from " + Where("platform.geometry.wheelbase_m"), Number(wheelbase->second), {}});
   streams_.push_back(n);
   master_ = &s;
   master_name_ = name;
