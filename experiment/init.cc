@@ -471,7 +471,17 @@ void Builder::AddGps(const Stream& s) {
   streams_.push_back(n);
   std::string origin;
   const std::vector<double> p = LeverArm(s, &origin);
-  Parameter(name + ".lever_arm", p, origin, true, "free: the antenna's position on the body, self-calibrated", 0);
+  // Free on a vehicle driving over relief (the seed's ATV, configs/atv_calibration.yaml); on a robot that moves in a
+  // plane its height is unobservable and the rest trades with the IMU's misalignment, so it is believed there (as
+  // gap/nominal_config.h does for the holonomic robots).
+  if (kind_ == "ackermann") {
+    Parameter(name + ".lever_arm", p, origin, true, "free: the antenna's position on the body, self-calibrated", 0);
+  } else {
+    Parameter(name + ".lever_arm", p, origin, false,
+              "fixed: on a platform moving in a plane ('" + kind_ +
+                  "') the antenna's height is unobservable and its horizontal offset trades with the IMU's yaw",
+              0);
+  }
 }
 
 void Builder::AddPose(const Stream& s) {

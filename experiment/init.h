@@ -14,7 +14,9 @@
 //                    relative_motion; odometer as the master when the recording has nothing better.
 //   imu              gyroscope and accelerometer sharing one misalignment (free, from the stream's mounting), the
 //                    gyroscope bias free; gyroscope, accelerometer streams alike with a misalignment of their own.
-//   gps, position    gps, the lever arm free from the stream's mounting.
+//   gps, position    gps, the lever arm from the stream's mounting: free on an ackermann vehicle (as
+//                    configs/atv_calibration.yaml), fixed on the other kinds, which move in a plane (its height is
+//                    unobservable there and its horizontal offset trades with the IMU's yaw).
 //   pose             absolute_pose, its mounting fixed (the reference the rest is calibrated against).
 //   magnetometer, steering (outside ackermann), camera, laser_scan, inputs
 //                    left out, each with its reason (the magnetometer model needs the field in W, which a recording
