@@ -256,10 +256,13 @@ Status Builder::ChooseMaster() {
     for (const Stream& s : rec_.streams)
       if (s.info.type == type && !master_) AddVelocity(s, true);
   if (master_) return Status::Ok();
+  const std::string wheels = left_out_.empty() ? std::string()
+                                               : " (" + left_out_.front().substr(0, left_out_.front().find(' ')) +
+                                                     ": no wheel model for platform kind '" + kind_ + "')";
   return Status::Error(rec_name_ +
-                       ": no stream can make the poses: the master needs wheel_encoders (platform kind "
-                       "differential_drive, skid_steer, omni3, mecanum or ackermann), odometry, visual_odometry or "
-                       "scan_matching");
+                       ": no stream can make the poses: the master needs wheel_encoders of platform kind "
+                       "differential_drive, skid_steer, omni3, mecanum or ackermann (--platform KIND)" +
+                       wheels + ", odometry, visual_odometry or scan_matching");
 }
 
 Status Builder::AddWheels(const Stream& s) {

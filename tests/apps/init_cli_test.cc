@@ -174,7 +174,8 @@ TEST(InitCliTest, BadInputsGiveOneLineAndExitCodeTwo) {
 }
 
 // --platform overrides the recording's kind: the simulated differential drive read as a skid steer takes the
-// skid-steer defaults, and as an omni3 it is refused for its two wheels.
+// skid-steer defaults, as an omni3 it is refused for its two wheels, and a kind without a wheel model is refused
+// unless --platform names one.
 TEST(InitCliTest, PlatformOverridesTheRecordingsKind) {
   testing::TempDir dir;
   const std::string rec = SimulateDiffDrive(dir, 2.0);
@@ -187,6 +188,19 @@ TEST(InitCliTest, PlatformOverridesTheRecordingsKind) {
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_EQ(Lines(run.err), 1u) << run.err;
   EXPECT_NE(run.err.find("needs 3 wheel angle columns"), std::string::npos) << run.err;
+
+  // A kind without a wheel model: refused, naming the kind, unless --platform gives one.
+  std::string text = testing::ReadFile(rec + "/recording.yaml");
+  const std::size_t at = text.find("kind: differential_drive");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 24, "kind: tricycle");
+  testing::WriteFile(rec + "/recording.yaml", text);
+  run = Roamlab("init " + rec + " --out " + dir.File("tricycle.yaml"), dir);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_EQ(Lines(run.err), 1u) << run.err;
+  EXPECT_NE(run.err.find("no wheel model for platform kind 'tricycle'"), std::string::npos) << run.err;
+  run = Roamlab("init " + rec + " --out " + dir.File("tricycle.yaml") + " --platform differential_drive --quiet", dir);
+  EXPECT_EQ(run.exit_code, 0) << run.err;
 }
 
 // The OptiOdom differential drive: init's configuration calibrates the radius as configs/real's hand-written one
