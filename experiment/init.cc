@@ -69,9 +69,23 @@ std::string NameList(const std::vector<std::string>& names) {
   return text + "]";
 }
 
+// `text` as comment lines of at most 120 characters (a longer word keeps its own line).
+void Comment(const std::string& text, const std::string& pad, std::ostringstream* out) {
+  std::istringstream words(text);
+  std::string word, line;
+  while (words >> word) {
+    if (!line.empty() && pad.size() + 2 + line.size() + 1 + word.size() > 120) {
+      *out << pad << "# " << line << "\n";
+      line.clear();
+    }
+    line += (line.empty() ? "" : " ") + word;
+  }
+  if (!line.empty()) *out << pad << "# " << line << "\n";
+}
+
 void Emit(const Node& node, int indent, std::ostringstream* out) {
   const std::string pad(static_cast<std::size_t>(indent), ' ');
-  if (!node.comment.empty()) *out << pad << "# " << node.comment << "\n";
+  Comment(node.comment, pad, out);
   *out << pad << (node.key.empty() ? "-" : node.key + ":");
   if (node.children.empty()) {
     *out << " " << node.value << "\n";
@@ -559,10 +573,13 @@ Status Builder::Build() {
 
 std::string Builder::Yaml() const {
   std::ostringstream out;
-  out << "# Nominal estimator configuration of " << rec_name_ << ", written by `roamlab init` from what its\n"
-      << "# recording.yaml states (platform kind '" << kind_ << "', " << kind_origin_ << "). The comment above each\n"
-      << "# key says where its value came from. Edit it before trusting it: defaults are generic.\n";
-  for (const std::string& line : left_out_) out << "# Left out: " << line << "\n";
+  Comment("Nominal estimator configuration of " + rec_name_ +
+              ", written by `roamlab init` from what its recording.yaml " + "states (platform kind '" + kind_ + "', " +
+              kind_origin_ +
+              "). The comment above each key says where its value came from. Edit it before trusting it: the " +
+              "defaults are generic.",
+          "", &out);
+  for (const std::string& line : left_out_) Comment("Left out: " + line, "", &out);
   Emit({"master", "the odometric stream that creates the pose nodes", Name(master_name_), {}}, 0, &out);
   Node solver{
       "solver", "the batch solves, as the simulated robots' nominal configurations (gap/nominal_config.h)", "", {}};
