@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -38,7 +39,7 @@ std::string Number(double x) {
     std::ostringstream s;
     s.precision(digits);
     s << x;
-    if (std::stod(s.str()) == x) return s.str();
+    if (std::strtod(s.str().c_str(), nullptr) == x) return s.str();
   }
   return std::to_string(x);
 }
