@@ -441,7 +441,10 @@ void Builder::AddVelocity(const Stream& s, bool master) {
     AddNoise(&n, "angular_radps", StatedNoise(rec_name_, s.info, {"angular_radps", "sigma_radps"}, 0.05, "0.05 rad/s"));
   }
   streams_.push_back(n);
-  if (master) master_ = &s, master_name_ = name;
+  if (master) {
+    master_ = &s;
+    master_name_ = name;
+  }
   MountingParameters(name, s, true, false, "fixed: the sensor's mounting is believed", 0);
 }
 
