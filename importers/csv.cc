@@ -83,7 +83,7 @@ class FileReader {
  private:
   std::string At(std::int64_t line) const { return path_ + ":" + std::to_string(line) + ": "; }
   Status LoadText();
-  Status Resolve(const ColumnRef& ref, const std::string& what, int* index) const;
+  Status Resolve(const ColumnRef& ref, const std::string& owner, int* index) const;
   Status ResolveColumns();
   Status ReadRow(std::int64_t line, bool truncated);
   // Parses the stream cells of the current row into the jobs' staging; *skip when a non-numeric cell drops the row.
@@ -115,10 +115,11 @@ Status FileReader::LoadText() {
   return Status::Ok();
 }
 
-Status FileReader::Resolve(const ColumnRef& ref, const std::string& what, int* index) const {
+// `owner` completes the messages: " (time)", " (stream 'imu')".
+Status FileReader::Resolve(const ColumnRef& ref, const std::string& owner, int* index) const {
   if (ref.index >= 0) {
     if (ref.index >= static_cast<int>(names_.size())) {
-      return Status::Error(path_ + ": " + what + " is column " + std::to_string(ref.index) + ", beyond the " +
+      return Status::Error(path_ + ": column " + std::to_string(ref.index) + owner + " is beyond the " +
                            std::to_string(names_.size()) + " columns of the file");
     }
     *index = ref.index;
@@ -128,25 +129,25 @@ Status FileReader::Resolve(const ColumnRef& ref, const std::string& what, int* i
   if (it == names_.end()) {
     std::string list;
     for (const std::string& name : names_) list += (list.empty() ? "" : ", ") + name;
-    return Status::Error(path_ + ": " + what + " '" + ref.name + "' is not in the header (" + list + ")");
+    return Status::Error(path_ + ": column '" + ref.name + "'" + owner + " is not in the header (" + list + ")");
   }
   if (std::find(it + 1, names_.end(), ref.name) != names_.end()) {
-    return Status::Error(path_ + ": " + what + " '" + ref.name + "' appears more than once in the header");
+    return Status::Error(path_ + ": column '" + ref.name + "'" + owner + " appears more than once in the header");
   }
   *index = static_cast<int>(it - names_.begin());
   return Status::Ok();
 }
 
 Status FileReader::ResolveColumns() {
-  if (Status s = Resolve(spec_.time.column, "time column", &time_column_); !s.ok()) return s;
+  if (Status s = Resolve(spec_.time.column, " (time)", &time_column_); !s.ok()) return s;
   for (StreamJob* job : jobs_) {
-    const std::string what = "column of stream '" + job->spec->info.name + "'";
+    const std::string what = " (stream '" + job->spec->info.name + "')";
     job->columns.resize(job->spec->sources.size());
     for (std::size_t c = 0; c < job->columns.size(); ++c) {
       if (Status s = Resolve(job->spec->sources[c], what, &job->columns[c]); !s.ok()) return s;
     }
     if (job->spec->collapse == Collapse::kByColumn) {
-      if (Status s = Resolve(job->spec->collapse_column, "by_column of stream '" + job->spec->info.name + "'",
+      if (Status s = Resolve(job->spec->collapse_column, " (by_column of stream '" + job->spec->info.name + "')",
                              &job->collapse_column);
           !s.ok()) {
         return s;
