@@ -476,7 +476,7 @@ Status ReadStream(const Context& ctx, const YAML::Node& entry, const std::string
   const YAML::Node columns = entry["columns"];
   if (!columns.IsSequence() || columns.size() != spec->info.columns.size()) {
     return ctx.Error(columns, "columns of " + context + " must list " + std::to_string(spec->info.columns.size()) +
-                                  " source columns (" + rin::JoinColumns(spec->info.columns) + ")");
+                                  " source columns, one for each of " + rin::JoinColumns(spec->info.columns));
   }
   spec->sources.resize(columns.size());
   for (std::size_t c = 0; c < columns.size(); ++c) {
