@@ -9,6 +9,7 @@
 
 #include "importers/internal/csv_mapping.h"
 #include "importers/internal/csv_text.h"
+#include "recording/internal/stream_types.h"
 #include "recording/internal/text_io.h"
 
 namespace roamlab::importers {
@@ -376,6 +377,10 @@ Result<recording::Recording> ImportCsv(const std::vector<std::string>& csv_files
     const recording::Stream& s = rec.streams.back();
     if (s.info.type == recording::StreamType::kGps && !rec.origin) {
       rec.origin = recording::GeodeticOrigin{s.values(0, 0), s.values(0, 1), s.values(0, 2)};
+      const std::string problem = recording::internal::OriginProblem(*rec.origin);
+      if (!problem.empty()) {
+        return Status::Error(csv_files[file] + ": the first fix of stream '" + s.info.name + "' as origin: " + problem);
+      }
     }
   }
   if (report) *report = std::move(local);
