@@ -66,6 +66,23 @@ class Lines {
   bool terminated_ = true;
 };
 
+// A cell for a one-line message: bytes outside printable ASCII as \xNN, at most 40 characters.
+std::string Printable(std::string_view cell) {
+  constexpr std::size_t kMax = 40;
+  std::string out;
+  for (std::size_t i = 0; i < cell.size() && i < kMax; ++i) {
+    const auto c = static_cast<unsigned char>(cell[i]);
+    if (c >= 0x20 && c < 0x7f) {
+      out += static_cast<char>(c);
+      continue;
+    }
+    const char* hex = "0123456789abcdef";
+    out += std::string("\\x") + hex[c >> 4] + hex[c & 15];
+  }
+  if (cell.size() > kMax) out += "...";
+  return out;
+}
+
 bool Ignored(std::string_view line, const std::string& comment) {
   std::size_t i = 0;
   while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
@@ -129,7 +146,8 @@ Status FileReader::Resolve(const ColumnRef& ref, const std::string& owner, int* 
   const auto it = std::find(names_.begin(), names_.end(), ref.name);
   if (it == names_.end()) {
     std::string list;
-    for (const std::string& name : names_) list += (list.empty() ? "" : ", ") + name;
+    for (std::size_t c = 0; c < names_.size() && c < 30; ++c) list += (c == 0 ? "" : ", ") + Printable(names_[c]);
+    if (names_.size() > 30) list += ", ...";
     return Status::Error(path_ + ": column '" + ref.name + "'" + owner + " is not in the header (" + list + ")");
   }
   if (std::find(it + 1, names_.end(), ref.name) != names_.end()) {
@@ -164,8 +182,8 @@ Status FileReader::NotANumber(std::int64_t line, int column, const std::string& 
     *skip = true;
     return Status::Ok();
   }
-  const std::string cell(cells_[static_cast<std::size_t>(column)]);
-  return Status::Error(At(line) + "column '" + names_[static_cast<std::size_t>(column)] + "'" +
+  const std::string cell = Printable(cells_[static_cast<std::size_t>(column)]);
+  return Status::Error(At(line) + "column '" + Printable(names_[static_cast<std::size_t>(column)]) + "'" +
                        (stream.empty() ? "" : " (stream '" + stream + "')") + ": '" + cell + "' is not a number");
 }
 
@@ -231,7 +249,7 @@ Status FileReader::Commit(std::int64_t line, std::int64_t t_ns) {
     if (collapse == Collapse::kByColumn && job->spec->collapse_exponent >= 0) {
       stamp = job->key_ns + offset_ns_;
       if (!job->t_ns.empty() && stamp <= job->t_ns.back()) {
-        return Status::Error(At(line) + "column '" + names_[static_cast<std::size_t>(job->collapse_column)] +
+        return Status::Error(At(line) + "column '" + Printable(names_[static_cast<std::size_t>(job->collapse_column)]) +
                              "' (by_column of stream '" + job->spec->info.name + "') does not increase");
       }
     }
@@ -263,8 +281,8 @@ Status FileReader::ReadRow(std::int64_t line, bool truncated) {
   }
   if (previous_ns_ && t_ns <= *previous_ns_) {
     if (t_ns < *previous_ns_) {
-      return Status::Error(At(line) + "time '" + std::string(time_cell) + "' goes backwards (previous row '" +
-                           previous_text_ + "')");
+      return Status::Error(At(line) + "time '" + Printable(time_cell) + "' goes backwards (previous row '" +
+                           Printable(previous_text_) + "')");
     }
     ++report_->skipped_duplicate_time;
     return Status::Ok();

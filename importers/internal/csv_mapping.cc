@@ -523,13 +523,10 @@ Status ReadPlatformAndOrigin(const Context& ctx, const YAML::Node& root, Mapping
   return Status::Ok();
 }
 
-}  // namespace
-
-Result<Mapping> ReadCsvMapping(const std::string& path, int file_count) {
-  YAML::Node root;
-  if (Status s = rin::LoadYamlFile(path, &root); !s.ok()) return s;
+Result<Mapping> ReadMapping(const std::string& path, const YAML::Node& root, int file_count) {
   const Context ctx{path};
-  if (Status s = rin::CheckKeys(root, path, "the mapping", {"csv", "time", "files", "platform", "origin", "streams"});
+  if (Status s =
+          rin::CheckKeys(root, path, "the mapping file", {"csv", "time", "files", "platform", "origin", "streams"});
       !s.ok()) {
     return s;
   }
@@ -549,6 +546,18 @@ Result<Mapping> ReadCsvMapping(const std::string& path, int file_count) {
     mapping.streams.push_back(std::move(spec));
   }
   return mapping;
+}
+
+}  // namespace
+
+Result<Mapping> ReadCsvMapping(const std::string& path, int file_count) {
+  YAML::Node root;
+  if (Status s = rin::LoadYamlFile(path, &root); !s.ok()) return s;
+  try {
+    return ReadMapping(path, root, file_count);
+  } catch (const YAML::Exception& e) {  // a node shape the checks above did not foresee
+    return Status::Error(path + ": " + e.msg);
+  }
 }
 
 }  // namespace roamlab::importers::internal

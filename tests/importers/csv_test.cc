@@ -445,7 +445,7 @@ TEST_F(CsvImportTest, BadMappingsNameTheKey) {
   const std::string map = (dir_ / "map.yaml").string();
   EXPECT_EQ(ImportError(csv, "time: {column: t}\nstreams: {x: {type: steering, colums: [x]}}\n"),
             map + ":2: unknown key 'colums' in stream 'x'");
-  EXPECT_EQ(ImportError(csv, "time: {column: t}\nstream: {}\n"), map + ":2: unknown key 'stream' in the mapping");
+  EXPECT_EQ(ImportError(csv, "time: {column: t}\nstream: {}\n"), map + ":2: unknown key 'stream' in the mapping file");
   EXPECT_EQ(ImportError(csv, "time: {column: t}\nstreams: {x: {type: steering, columns: [x], units: furlong}}\n"),
             map +
                 ":2: unknown unit 'furlong' in stream 'x' (known: 1, normalized, rad, deg, ticks, rad/s, deg/s, rpm, "
