@@ -162,7 +162,8 @@ TEST(McapReader, EveryTruncationIsAnErrorNamingAnOffset) {
   TempDir dir;
   std::vector<Expected> expected;
   const std::string whole = SmallMcap(&expected);
-  for (std::size_t cut = 0; cut < whole.size(); ++cut) {
+  // Every fifth byte, and every byte of the footer and closing magic (file writes are what costs here).
+  for (std::size_t cut = 0; cut < whole.size(); cut += cut + 60 < whole.size() ? 5 : 1) {
     WriteFile(dir.File("cut.mcap"), whole.substr(0, cut));
     const Result<Bag> bag = ReadMcap(dir.File("cut.mcap"));
     ASSERT_FALSE(bag.ok()) << "cut at " << cut;
