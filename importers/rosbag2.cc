@@ -1,15 +1,18 @@
-// The rosbag2 reader: metadata.yaml names the storage (SQLite .db3 files or MCAP files) and the files; each .db3 is
-// opened read-only and immutable (a bag left in WAL mode is read as its main file holds it).
+// The rosbag2 reader: metadata.yaml names the storage (SQLite .db3 files or MCAP files), the files and their zstd
+// compression (none, per file or per message); each .db3 is opened read-only and immutable (a bag left in WAL mode is
+// read as its main file holds it), a compressed one is decompressed into memory.
 #include <sqlite3.h>
+#include <zstd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstdint>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -24,11 +27,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
+enum class Compression { kNone, kFile, kMessage };  // zstd per file or per message
+
 struct Metadata {
   std::string storage;             // "sqlite3" or "mcap"
   std::vector<std::string> files;  // relative_file_paths
   std::string compression_format;  // "" when none
-  std::string compression_mode;
+  std::string compression_mode;    // "FILE" or "MESSAGE"
+  Compression compression = Compression::kNone;
 };
 
 std::string Scalar(const YAML::Node& map, const char* key) {
@@ -59,11 +65,20 @@ std::string ReadMetadata(const std::string& path, Metadata* out) {
   return "";
 }
 
-// The metadata's compression, when this reader can read it; the problem otherwise.
-std::string CheckCompression(const std::string& path, const Metadata& metadata) {
-  if (metadata.compression_format.empty() || metadata.compression_format == "none") return "";
-  return path + ": compressed bag (compression_format '" + metadata.compression_format + "', mode '" +
-         metadata.compression_mode + "'), which this reader does not read; decompress it first (ros2 bag decompress)";
+// The metadata's compression into `out`, when this reader reads it.
+std::string ReadCompression(const std::string& path, Metadata* metadata) {
+  std::string mode = metadata->compression_mode;
+  for (char& ch : mode) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  const std::string& format = metadata->compression_format;
+  if (format.empty() || format == "none") {
+    metadata->compression = Compression::kNone;
+  } else if (format == "zstd" && (mode == "file" || mode == "message")) {
+    metadata->compression = mode == "file" ? Compression::kFile : Compression::kMessage;
+  } else {
+    return path + ": compression_format '" + format + "' with compression_mode '" + metadata->compression_mode +
+           "', which this reader does not read (only zstd, by file or by message)";
+  }
+  return "";
 }
 
 using Database = std::unique_ptr<sqlite3, decltype(&sqlite3_close)>;
@@ -157,14 +172,23 @@ std::string ReadMessages(sqlite3* db, const std::string& path, const std::map<st
   return "";
 }
 
-std::string CheckSqliteHeader(const std::string& path) {
-  static constexpr char kHeader[] = "SQLite format 3";  // with its terminating NUL: the file's first 16 bytes
-  char head[sizeof(kHeader)] = {};
-  std::ifstream file(path, std::ios::binary);
-  if (!file) return path + ": cannot open the file";
-  file.read(head, sizeof(head));
-  if (file.gcount() != sizeof(head) || std::memcmp(head, kHeader, sizeof(kHeader)) != 0)
-    return path + ": not an SQLite database";
+bool IsSqlite(std::string_view head) {
+  static constexpr std::string_view kHeader("SQLite format 3\0", 16);
+  return head.substr(0, kHeader.size()) == kHeader;
+}
+
+// The open database's topics and messages, appended to `bag`; `size_hint` bytes are reserved for the messages.
+std::string AppendDatabase(sqlite3* db, const std::string& path, std::size_t size_hint, Bag* bag) {
+  std::map<std::int64_t, std::size_t> topic_ids;
+  if (std::string problem = ReadTopics(db, path, bag, &topic_ids); !problem.empty()) return problem;
+  std::string& bytes = bag->storage.emplace_back();
+  bytes.reserve(size_hint);
+  std::vector<StoredMessage> stored;
+  if (std::string problem = ReadMessages(db, path, topic_ids, &bytes, &stored); !problem.empty()) return problem;
+  const std::string_view all = bytes;
+  bag->messages.reserve(bag->messages.size() + stored.size());
+  for (const StoredMessage& m : stored)
+    bag->messages.push_back({m.topic, Time::FromNanoseconds(m.timestamp_ns), all.substr(m.offset, m.size)});
   return "";
 }
 
@@ -172,21 +196,91 @@ std::string CheckSqliteHeader(const std::string& path) {
 std::string AppendDb3(const std::string& path, Bag* bag) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) return path + ": no such file";
-  if (std::string problem = CheckSqliteHeader(path); !problem.empty()) return problem;
+  char head[16] = {};
+  std::ifstream file(path, std::ios::binary);
+  if (!file) return path + ": cannot open the file";
+  file.read(head, sizeof(head));
+  if (!IsSqlite(std::string_view(head, static_cast<std::size_t>(file.gcount()))))
+    return path + ": not an SQLite database";
   sqlite3* raw = nullptr;
   const int rc = sqlite3_open_v2(FileUri(path).c_str(), &raw, SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, nullptr);
   Database db(raw, &sqlite3_close);
   if (rc != SQLITE_OK) return path + ": cannot open the database (" + (raw ? sqlite3_errmsg(raw) : "no memory") + ")";
-  std::map<std::int64_t, std::size_t> topic_ids;
-  if (std::string problem = ReadTopics(db.get(), path, bag, &topic_ids); !problem.empty()) return problem;
-  std::string& bytes = bag->storage.emplace_back();
-  bytes.reserve(static_cast<std::size_t>(fs::file_size(path, ec)));  // the blobs take at most the file's size
-  std::vector<StoredMessage> stored;
-  if (std::string problem = ReadMessages(db.get(), path, topic_ids, &bytes, &stored); !problem.empty()) return problem;
-  const std::string_view all = bytes;
-  bag->messages.reserve(bag->messages.size() + stored.size());
-  for (const StoredMessage& m : stored)
-    bag->messages.push_back({m.topic, Time::FromNanoseconds(m.timestamp_ns), all.substr(m.offset, m.size)});
+  return AppendDatabase(db.get(), path, static_cast<std::size_t>(fs::file_size(path, ec)), bag);
+}
+
+// Appends the database whose file content is `image` (a decompressed .db3.zstd, named `path`) to `bag`.
+std::string AppendDb3Image(const std::string& path, std::string image, Bag* bag) {
+  if (image.size() < 100 || !IsSqlite(image)) return path + ": the decompressed file is not an SQLite database";
+  image[18] = image[19] = 1;  // a WAL-mode file is read as the complete rollback-journal file it is
+  sqlite3* raw = nullptr;
+  const int rc = sqlite3_open_v2(":memory:", &raw, SQLITE_OPEN_READWRITE, nullptr);
+  Database db(raw, &sqlite3_close);
+  if (rc != SQLITE_OK ||
+      sqlite3_deserialize(db.get(), "main", reinterpret_cast<unsigned char*>(image.data()),
+                          static_cast<sqlite3_int64>(image.size()), static_cast<sqlite3_int64>(image.size()),
+                          SQLITE_DESERIALIZE_READONLY) != SQLITE_OK)
+    return path + ": cannot open the decompressed database";
+  return AppendDatabase(db.get(), path, image.size(), bag);
+}
+
+// The whole zstd-compressed file at `path` (one or more frames) into `out`.
+std::string ReadZstdFile(const std::string& path, std::string* out) {
+  std::string compressed;
+  if (std::string problem = ReadFileBytes(path, &compressed); !problem.empty()) return problem;
+  const std::unique_ptr<ZSTD_DCtx, decltype(&ZSTD_freeDCtx)> dctx(ZSTD_createDCtx(), &ZSTD_freeDCtx);
+  ZSTD_inBuffer in{compressed.data(), compressed.size(), 0};
+  std::size_t produced = 0;
+  try {
+    out->resize(std::max<std::size_t>(4 * compressed.size(), std::size_t{1} << 16));
+    while (true) {
+      if (produced == out->size()) out->resize(2 * out->size());
+      ZSTD_outBuffer chunk{out->data(), out->size(), produced};
+      const std::size_t rc = ZSTD_decompressStream(dctx.get(), &chunk, &in);
+      if (ZSTD_isError(rc)) return path + ": the zstd data does not decompress (" + ZSTD_getErrorName(rc) + ")";
+      produced = chunk.pos;
+      if (rc == 0 && in.pos == in.size) break;
+      if (in.pos == in.size && chunk.pos < chunk.size) return path + ": the zstd data ends inside a frame (truncated)";
+    }
+  } catch (const std::exception&) {
+    return path + ": too large to decompress in memory";
+  }
+  out->resize(produced);
+  return "";
+}
+
+// Replaces the data of bag->messages[first...] (each one zstd frame stating its size) with its decompressed bytes.
+std::string DecompressMessages(const std::string& path, std::size_t first, Bag* bag) {
+  constexpr unsigned long long kMaxMessageBytes = 1ull << 30;
+  const auto where = [&](std::size_t i) {
+    return path + ": message " + std::to_string(i - first) + " (topic " + bag->topics[bag->messages[i].topic].name +
+           ")";
+  };
+  std::vector<std::size_t> sizes;
+  std::size_t total = 0;
+  for (std::size_t i = first; i < bag->messages.size(); ++i) {
+    const std::string_view data = bag->messages[i].data;
+    const unsigned long long size = ZSTD_getFrameContentSize(data.data(), data.size());
+    if (size == ZSTD_CONTENTSIZE_ERROR || size == ZSTD_CONTENTSIZE_UNKNOWN || size > kMaxMessageBytes)
+      return where(i) + ": not a zstd frame that states its size";
+    sizes.push_back(static_cast<std::size_t>(size));
+    total += sizes.back();
+  }
+  std::string* out = nullptr;
+  try {
+    out = &bag->storage.emplace_back(total, '\0');
+  } catch (const std::exception&) {
+    return path + ": the decompressed messages are too large for memory";
+  }
+  std::size_t offset = 0;
+  for (std::size_t i = first; i < bag->messages.size(); ++i) {
+    const std::size_t size = sizes[i - first];
+    const std::string_view data = bag->messages[i].data;
+    const std::size_t n = ZSTD_decompress(out->data() + offset, size, data.data(), data.size());
+    if (ZSTD_isError(n) || n != size) return where(i) + ": the zstd frame does not decompress to its stated size";
+    bag->messages[i].data = std::string_view(*out).substr(offset, size);
+    offset += size;
+  }
   return "";
 }
 
@@ -201,11 +295,25 @@ std::string ResolveFile(const fs::path& dir, const std::string& relative) {
   return in_dir.string();
 }
 
-std::string AppendFile(const std::string& storage, const std::string& file, Bag* bag) {
-  if (storage == "sqlite3") return AppendDb3(file, bag);
-  std::string content;
-  if (std::string problem = ReadFileBytes(file, &content); !problem.empty()) return problem;
-  return AppendMcap(file, std::move(content), bag);
+// Appends one file of the bag, decompressing it or its messages as the metadata says.
+std::string AppendFile(const Metadata& metadata, const std::string& file, Bag* bag) {
+  const std::size_t first = bag->messages.size();
+  std::string problem;
+  if (metadata.compression == Compression::kFile) {
+    std::string content;
+    problem = ReadZstdFile(file, &content);
+    if (problem.empty())
+      problem = metadata.storage == "sqlite3" ? AppendDb3Image(file, std::move(content), bag)
+                                              : AppendMcap(file, std::move(content), bag);
+  } else if (metadata.storage == "sqlite3") {
+    problem = AppendDb3(file, bag);
+  } else {
+    std::string content;
+    problem = ReadFileBytes(file, &content);
+    if (problem.empty()) problem = AppendMcap(file, std::move(content), bag);
+  }
+  if (problem.empty() && metadata.compression == Compression::kMessage) problem = DecompressMessages(file, first, bag);
+  return problem;
 }
 
 }  // namespace
@@ -222,7 +330,7 @@ Result<Bag> ReadRosbag2(const std::string& path) {
   Metadata metadata;
   if (has_metadata) {
     if (std::string problem = ReadMetadata(metadata_path, &metadata); !problem.empty()) return Status::Error(problem);
-    if (std::string problem = CheckCompression(metadata_path, metadata); !problem.empty())
+    if (std::string problem = ReadCompression(metadata_path, &metadata); !problem.empty())
       return Status::Error(problem);
   } else if (extension != ".db3") {
     return Status::Error((is_dir ? path : metadata_path) + ": no metadata.yaml (not a rosbag2 bag directory)");
@@ -230,7 +338,9 @@ Result<Bag> ReadRosbag2(const std::string& path) {
   Bag bag;
   if (extension == ".db3") {  // one file of the bag: its own tables describe its topics
     bag.format = "rosbag2 SQLite";
-    if (std::string problem = AppendDb3(path, &bag); !problem.empty()) return Status::Error(problem);
+    std::string problem = AppendDb3(path, &bag);
+    if (problem.empty() && metadata.compression == Compression::kMessage) problem = DecompressMessages(path, 0, &bag);
+    if (!problem.empty()) return Status::Error(problem);
     return bag;
   }
   if (metadata.storage != "sqlite3" && metadata.storage != "mcap")
@@ -238,7 +348,7 @@ Result<Bag> ReadRosbag2(const std::string& path) {
                          "', which this reader does not read (only sqlite3 and mcap)");
   bag.format = metadata.storage == "sqlite3" ? "rosbag2 SQLite" : "rosbag2 MCAP";
   for (const std::string& relative : metadata.files) {
-    if (std::string problem = AppendFile(metadata.storage, ResolveFile(dir, relative), &bag); !problem.empty())
+    if (std::string problem = AppendFile(metadata, ResolveFile(dir, relative), &bag); !problem.empty())
       return Status::Error(problem);
   }
   return bag;

@@ -45,8 +45,9 @@ Result<Bag> ReadRos1Bag(const std::string& path);
 // order), or one .db3 file (its own tables name its topics). storage_identifier sqlite3: each .db3 is opened
 // read-only and immutable (a bag left in WAL mode is read as its main file holds it; nothing is written next to it),
 // the topics and messages tables are read and each file's messages sorted by timestamp (ties in row order); only the
-// cdr serialization is read. storage_identifier mcap: each file is read as ReadMcap does. Bags with a
-// compression_format other than none are refused. Topics of several files merge by name.
+// cdr serialization is read. storage_identifier mcap: each file is read as ReadMcap does. compression_format zstd is
+// read in both modes (FILE: each listed file is one zstd stream, decompressed in memory; MESSAGE: each message is a zstd
+// frame stating its size); other compressions are refused. Topics of several files merge by name.
 Result<Bag> ReadRosbag2(const std::string& path);
 
 // MCAP: the data section is read record by record from the start (the summary section and indexes are not needed,

@@ -9,6 +9,8 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <random>
 #include <set>
@@ -268,36 +270,84 @@ void WriteDb3(const std::string& path, const std::vector<std::pair<std::int64_t,
   sqlite3_close(db);
 }
 
-std::string Metadata(const std::string& storage, const std::string& file, const std::string& compression = "") {
+std::string Metadata(const std::string& storage, const std::string& file, const std::string& compression = "",
+                     const std::string& mode = "") {
   return "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: " + storage +
          "\n  relative_file_paths:\n    - " + file +
          "\n  topics_with_message_count:\n    - topic_metadata:\n        name: /imu\n        type: "
          "sensor_msgs/msg/Imu\n        serialization_format: cdr\n      message_count: 3\n  compression_format: \"" +
-         compression + "\"\n  compression_mode: \"" + (compression.empty() ? "" : "FILE") + "\"\n";
+         compression + "\"\n  compression_mode: \"" + mode + "\"\n";
+}
+
+const std::vector<std::pair<std::int64_t, std::string>> kImu = {{300, Cdr(1)}, {100, Cdr(2)}, {500, Cdr(3, 3)}};
+const std::vector<std::pair<std::int64_t, std::string>> kGps = {{200, Cdr(4, 60)}, {400, Cdr(5)}};
+const std::vector<Expected> kInTimeOrder = {{"/imu", 100, Cdr(2)},
+                                            {"/fix", 200, Cdr(4, 60)},
+                                            {"/imu", 300, Cdr(1)},
+                                            {"/fix", 400, Cdr(5)},
+                                            {"/imu", 500, Cdr(3, 3)}};
+
+void ExpectSmallSqliteBag(const Result<Bag>& bag) {
+  ASSERT_TRUE(bag.ok()) << bag.status().message();
+  EXPECT_EQ(bag.value().format, "rosbag2 SQLite");
+  ASSERT_EQ(bag.value().topics.size(), 2u);
+  EXPECT_EQ(bag.value().topics[0].name, "/imu");
+  EXPECT_EQ(bag.value().topics[0].type, "sensor_msgs/Imu");
+  EXPECT_EQ(bag.value().topics[1].type, "sensor_msgs/NavSatFix");
+  EXPECT_EQ(bag.value().topics[1].encoding, Encoding::kCdr);
+  ExpectMessages(bag.value(), kInTimeOrder);
+}
+
+std::string Rosbag2Error(const std::string& path) {
+  const Result<Bag> bag = ReadAnyBag(path);
+  return bag.ok() ? "" : bag.status().message();
+}
+
+std::string ReadBytes(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
 }
 
 TEST(Rosbag2Reader, ReadsTheSqliteBagInTimestampOrderFromItsDirectoryMetadataOrFile) {
   TempDir dir;
-  const std::vector<std::pair<std::int64_t, std::string>> imu = {{300, Cdr(1)}, {100, Cdr(2)}, {500, Cdr(3, 3)}};
-  const std::vector<std::pair<std::int64_t, std::string>> gps = {{200, Cdr(4, 60)}, {400, Cdr(5)}};
-  WriteDb3(dir.File("bag_0.db3"), imu, gps);
+  WriteDb3(dir.File("bag_0.db3"), kImu, kGps);
   WriteFile(dir.File("metadata.yaml"), Metadata("sqlite3", "bag_0.db3"));
-  const std::vector<Expected> expected = {{"/imu", 100, Cdr(2)},
-                                          {"/fix", 200, Cdr(4, 60)},
-                                          {"/imu", 300, Cdr(1)},
-                                          {"/fix", 400, Cdr(5)},
-                                          {"/imu", 500, Cdr(3, 3)}};
   for (const std::string& path : {dir.path(), dir.File("metadata.yaml"), dir.File("bag_0.db3")}) {
-    const Result<Bag> bag = ReadAnyBag(path);
-    ASSERT_TRUE(bag.ok()) << bag.status().message();
-    EXPECT_EQ(bag.value().format, "rosbag2 SQLite");
-    ASSERT_EQ(bag.value().topics.size(), 2u);
-    EXPECT_EQ(bag.value().topics[0].name, "/imu");
-    EXPECT_EQ(bag.value().topics[0].type, "sensor_msgs/Imu");
-    EXPECT_EQ(bag.value().topics[1].type, "sensor_msgs/NavSatFix");
-    EXPECT_EQ(bag.value().topics[1].encoding, Encoding::kCdr);
-    ExpectMessages(bag.value(), expected);
+    SCOPED_TRACE(path);
+    ExpectSmallSqliteBag(ReadAnyBag(path));
   }
+}
+
+TEST(Rosbag2Reader, ReadsZstdCompressionByFileAndByMessage) {
+  TempDir dir;
+  WriteDb3(dir.File("plain.db3"), kImu, kGps);
+  WriteFile(dir.File("bag_0.db3.zstd"), Zstd(ReadBytes(dir.File("plain.db3"))));
+  std::filesystem::remove(dir.File("plain.db3"));
+  WriteFile(dir.File("metadata.yaml"), Metadata("sqlite3", "bag_0.db3.zstd", "zstd", "FILE"));
+  {
+    SCOPED_TRACE("file");
+    ExpectSmallSqliteBag(ReadRosbag2(dir.path()));
+  }
+  std::vector<std::pair<std::int64_t, std::string>> imu = kImu;
+  std::vector<std::pair<std::int64_t, std::string>> gps = kGps;
+  for (auto& [t, data] : imu) data = Zstd(data);
+  for (auto& [t, data] : gps) data = Zstd(data);
+  WriteDb3(dir.File("bag_0.db3"), imu, gps);
+  WriteFile(dir.File("metadata.yaml"), Metadata("sqlite3", "bag_0.db3", "zstd", "MESSAGE"));
+  {
+    SCOPED_TRACE("message");
+    ExpectSmallSqliteBag(ReadRosbag2(dir.path()));
+  }
+  // Stored uncompressed but declared compressed by message.
+  std::filesystem::remove(dir.File("bag_0.db3"));
+  WriteDb3(dir.File("bag_0.db3"), kImu, kGps);
+  EXPECT_EQ(Rosbag2Error(dir.path()),
+            dir.File("bag_0.db3") + ": message 0 (topic /imu): not a zstd frame that states its size");
+  // A truncated compressed file.
+  const std::string compressed = Zstd(ReadBytes(dir.File("bag_0.db3")));
+  WriteFile(dir.File("bag_0.db3.zstd"), compressed.substr(0, compressed.size() / 2));
+  WriteFile(dir.File("metadata.yaml"), Metadata("sqlite3", "bag_0.db3.zstd", "zstd", "FILE"));
+  EXPECT_EQ(Rosbag2Error(dir.path()), dir.File("bag_0.db3.zstd") + ": the zstd data ends inside a frame (truncated)");
 }
 
 TEST(Rosbag2Reader, ReadsAnMcapStorageBag) {
@@ -310,11 +360,6 @@ TEST(Rosbag2Reader, ReadsAnMcapStorageBag) {
   EXPECT_EQ(bag.value().format, "rosbag2 MCAP");
   EXPECT_EQ(bag.value().chunks, 3);
   ExpectMessages(bag.value(), expected);
-}
-
-std::string Rosbag2Error(const std::string& path) {
-  const Result<Bag> bag = ReadAnyBag(path);
-  return bag.ok() ? "" : bag.status().message();
 }
 
 TEST(Rosbag2Reader, RefusesBadBagsWithOneLineNamingTheFile) {
@@ -333,8 +378,9 @@ TEST(Rosbag2Reader, RefusesBadBagsWithOneLineNamingTheFile) {
   std::filesystem::remove(dir.File("bag_0.db3"));
   WriteDb3(dir.File("bag_0.db3"), {{1, Cdr(1)}}, {{2, Cdr(2)}}, "json");
   EXPECT_THAT(Rosbag2Error(dir.path()), HasSubstr("bag_0.db3: topic /fix has serialization format 'json'"));
-  WriteFile(dir.File("metadata.yaml"), Metadata("sqlite3", "bag_0.db3", "zstd"));
-  EXPECT_THAT(Rosbag2Error(dir.path()), HasSubstr("metadata.yaml: compressed bag (compression_format 'zstd'"));
+  WriteFile(dir.File("metadata.yaml"), Metadata("sqlite3", "bag_0.db3", "lz4", "FILE"));
+  EXPECT_THAT(Rosbag2Error(dir.path()),
+              HasSubstr("metadata.yaml: compression_format 'lz4' with compression_mode 'FILE', which this reader"));
   WriteFile(dir.File("metadata.yaml"), Metadata("rosbag_v2", "bag_0.db3"));
   EXPECT_THAT(Rosbag2Error(dir.path()), HasSubstr("metadata.yaml: storage_identifier 'rosbag_v2'"));
   WriteFile(dir.File("metadata.yaml"), "rosbag2_bagfile_information: [1, 2\n");
