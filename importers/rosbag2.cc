@@ -333,7 +333,8 @@ Result<Bag> ReadRosbag2(const std::string& path) {
     if (std::string problem = ReadCompression(metadata_path, &metadata); !problem.empty())
       return Status::Error(problem);
   } else if (extension != ".db3") {
-    return Status::Error((is_dir ? path : metadata_path) + ": no metadata.yaml (not a rosbag2 bag directory)");
+    return Status::Error((is_dir ? path : metadata_path) +
+                         ": no metadata.yaml (not a rosbag2 bag directory; one .db3 file of a bag is read alone)");
   }
   Bag bag;
   if (extension == ".db3") {  // one file of the bag: its own tables describe its topics

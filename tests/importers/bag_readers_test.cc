@@ -364,7 +364,8 @@ TEST(Rosbag2Reader, ReadsAnMcapStorageBag) {
 
 TEST(Rosbag2Reader, RefusesBadBagsWithOneLineNamingTheFile) {
   TempDir dir;
-  EXPECT_EQ(Rosbag2Error(dir.path()), dir.path() + ": no metadata.yaml (not a rosbag2 bag directory)");
+  EXPECT_EQ(Rosbag2Error(dir.path()),
+            dir.path() + ": no metadata.yaml (not a rosbag2 bag directory; one .db3 file of a bag is read alone)");
   WriteFile(dir.File("metadata.yaml"), Metadata("sqlite3", "bag_0.db3"));
   EXPECT_EQ(Rosbag2Error(dir.path()), dir.File("bag_0.db3") + ": no such file");
   WriteFile(dir.File("bag_0.db3"), std::string(4096, '\x01'));
