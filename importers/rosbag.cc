@@ -198,18 +198,15 @@ void AddScan(const RosMessage& m, const internal::RosLaserScan& s, Time receive,
   b.samples.push_back({m.header.stamp, receive, row, "", ""});
 }
 
-// sensor_msgs/Image as PGM / PPM bytes; "" or the refusal (the image does not hold its declared rows).
-std::string AddImage(const RosMessage& m, const internal::RosImage& im, Time receive, TopicWork* w) {
+// sensor_msgs/Image as PGM / PPM bytes.
+void AddImage(const RosMessage& m, const internal::RosImage& im, Time receive, TopicWork* w) {
   Build& b = w->builds[0];
   const int channels = im.encoding == "mono8" ? 1 : (im.encoding == "rgb8" || im.encoding == "bgr8") ? 3 : 0;
-  if (channels == 0) return Skip(w, b, "image encoding '" + im.encoding + "' not written"), "";
-  if (im.width == 0 || im.height == 0) return Skip(w, b, "empty image"), "";
+  if (channels == 0) return Skip(w, b, "image encoding '" + im.encoding + "' not written");
+  if (im.width == 0 || im.height == 0) return Skip(w, b, "empty image");
   const std::uint64_t row_bytes = std::uint64_t{im.width} * static_cast<std::uint64_t>(channels);
-  if (im.step < row_bytes || std::uint64_t{im.step} * im.height > im.data.size()) {
-    return "image " + std::to_string(im.width) + "x" + std::to_string(im.height) + " " + im.encoding + " with step " +
-           std::to_string(im.step) + " needs " + std::to_string(std::uint64_t{im.step} * im.height) +
-           " bytes but holds " + std::to_string(im.data.size());
-  }
+  if (im.step < row_bytes || std::uint64_t{im.step} * im.height > im.data.size())
+    return Skip(w, b, "image data shorter than height x step");
   Sample s{m.header.stamp, receive, Eigen::VectorXd(), "", channels == 1 ? "pgm" : "ppm"};
   s.frame = (channels == 1 ? "P5\n" : "P6\n") + std::to_string(im.width) + " " + std::to_string(im.height) + "\n255\n";
   for (std::uint32_t y = 0; y < im.height; ++y) {
@@ -219,7 +216,6 @@ std::string AddImage(const RosMessage& m, const internal::RosImage& im, Time rec
     s.frame += line;
   }
   b.samples.push_back(std::move(s));
-  return "";
 }
 
 // sensor_msgs/CompressedImage: the bytes as given, named by their signature (else by the format string).
@@ -251,7 +247,10 @@ std::string AddMessage(const RosMessage& m, Time receive, TopicWork* w) {
     if (imu->linear_acceleration_covariance[0] > 0.0)
       b.sigma_b.push_back(std::sqrt(imu->linear_acceleration_covariance[0]));
   } else if (const auto* fix = std::get_if<internal::RosNavSatFix>(&m.body)) {
-    if (fix->status < 0) return Skip(w, b, "no fix"), "";
+    if (fix->status < 0) {
+      Skip(w, b, "no fix");
+      return "";
+    }
     const auto& c = fix->position_covariance;
     Eigen::VectorXd row(9);
     row << fix->latitude_deg, fix->longitude_deg, fix->altitude_m, c[0], c[1], c[2], c[4], c[5], c[8];
@@ -264,7 +263,7 @@ std::string AddMessage(const RosMessage& m, Time receive, TopicWork* w) {
   } else if (const auto* scan = std::get_if<internal::RosLaserScan>(&m.body)) {
     AddScan(m, *scan, receive, w);
   } else if (const auto* image = std::get_if<internal::RosImage>(&m.body)) {
-    return AddImage(m, *image, receive, w);
+    AddImage(m, *image, receive, w);
   } else if (const auto* compressed = std::get_if<internal::RosCompressedImage>(&m.body)) {
     AddCompressed(m, *compressed, receive, w);
   } else if (const auto* odometry = std::get_if<internal::RosOdometry>(&m.body)) {
@@ -326,7 +325,7 @@ bool Finish(Build* b, TopicWork* w, std::vector<CameraFrame>* frames, std::vecto
   std::vector<Sample> kept;
   for (Sample& s : b->samples) {
     if (s.row.allFinite()) {
-      kept.push_back(s);
+      kept.push_back(std::move(s));
     } else {
       Skip(w, *b, "non-finite value");
     }

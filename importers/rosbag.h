@@ -15,7 +15,7 @@
 //                               written as -1, outside [range_min, range_max]; a scan with another beam count or an
 //                               invalid geometry is skipped and counted
 //   sensor_msgs/Image        -> camera: each frame written as <stream>/<index>.pgm (mono8) or .ppm (rgb8, bgr8);
-//                               other encodings skipped and counted
+//                               other encodings, and images with fewer bytes than height x step, skipped and counted
 //   sensor_msgs/CompressedImage -> camera: each frame's bytes as given, <stream>/<index>.jpg or .png (by the bytes'
 //                               signature, else the format string); other formats skipped and counted
 //   nav_msgs/Odometry        -> odometry <name>: the twist in the body (child) frame and its 21 covariance columns;

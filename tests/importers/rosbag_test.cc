@@ -507,5 +507,77 @@ TEST(ImportRosbagRealTest, HuskyTest1) {
   EXPECT_NEAR(report.Find("/fix")->clock_offset_s, 0.0, 0.01);
 }
 
+// A real rosbag2 (SQLite, CDR) bag of a 1/10-scale car (data/ros2/av1tenth_car of the shared data directory).
+TEST(ImportRosbagRealTest, Av1tenthRosbag2) {
+  const std::string path = std::string(ROAMLAB_SHARED_DIR) + "/data/ros2/av1tenth_car/bag2_deadreck_data";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "real data absent: " << path;
+  RosbagImportReport report;
+  RosbagImportOptions options;
+  options.platform.kind = "ackermann";
+  Result<Recording> rec = ImportRosbag(path, options, &report);
+  ASSERT_TRUE(rec.ok()) << rec.status().message();
+  EXPECT_EQ(report.format, "rosbag2 SQLite");
+  EXPECT_EQ(report.Find("/odometry")->messages, 690);
+  EXPECT_EQ(report.Find("/GPSNavSat")->messages, 220);
+  EXPECT_EQ(report.Find("/GPSData")->messages, 220);
+  const Stream* odometry = rec.value().Find("odometry");
+  const Stream* heading = rec.value().Find("odometry_pose");
+  const Stream* fix = rec.value().Find("GPSNavSat");
+  const Stream* utm = rec.value().Find("GPSData");
+  ASSERT_TRUE(odometry && heading && fix && utm);
+  EXPECT_EQ(odometry->t.size(), 690u);
+  EXPECT_EQ(heading->t.size(), 690u);
+  EXPECT_NEAR(SecondsBetween(odometry->t.front(), odometry->t.back()), 103.0, 1.0);
+  // Every orientation decoded is a unit quaternion about the vertical (a planar car): the CDR alignment is right.
+  for (Eigen::Index i = 0; i < heading->values.rows(); ++i) {
+    ASSERT_NEAR(heading->values.row(i).tail<4>().norm(), 1.0, 1e-6) << i;
+    ASSERT_EQ(heading->values(i, 3), 0.0) << i;
+  }
+  // The fix: the campus in Gainesville, Florida; its pose topic carries UTM (zone 17) easting and northing.
+  EXPECT_NEAR(fix->values(0, 0), 29.6, 0.1);
+  EXPECT_NEAR(fix->values(0, 1), -82.3, 0.1);
+  EXPECT_NEAR(utm->values(0, 0), 369375.0, 1000.0);
+  EXPECT_NEAR(utm->values(0, 1), 3280343.0, 1000.0);
+  // Its header stamps precede the bag's receive times by a few tens of milliseconds.
+  EXPECT_LT(report.Find("/GPSNavSat")->clock_offset_s, -0.02);
+  EXPECT_GT(report.Find("/GPSNavSat")->clock_offset_s, -0.05);
+}
+
+// The MCAP format fixture (data/ros2/rosbags_fixture): every supported type decoded from CDR, with the fixture's
+// values.
+TEST(ImportRosbagRealTest, McapFixtureEveryType) {
+  const std::string path = std::string(ROAMLAB_SHARED_DIR) + "/data/ros2/rosbags_fixture/test_bag_mcap";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "data absent: " << path;
+  RosbagImportReport report;
+  RosbagImportOptions options;
+  options.platform.kind = "unknown";
+  Result<Recording> rec = ImportRosbag(path, options, &report);
+  ASSERT_TRUE(rec.ok()) << rec.status().message();
+  EXPECT_EQ(report.topics.size(), 94u);
+  const auto row = [&](const std::string& name) {
+    const Stream* s = rec.value().Find("test_" + name);
+    EXPECT_NE(s, nullptr) << name;
+    return s ? Eigen::RowVectorXd(s->values.row(1)) : Eigen::RowVectorXd();
+  };
+  EXPECT_TRUE(row("sensor_msgs_imu").isApprox((Eigen::RowVectorXd(6) << 0.01, 0.02, 0.03, 0.1, 0.2, 9.8).finished()));
+  EXPECT_NEAR(row("sensor_msgs_nav_sat_fix")[0], 37.7749, 1e-9);
+  EXPECT_NEAR(row("sensor_msgs_nav_sat_fix")[1], -122.4194, 1e-9);
+  EXPECT_EQ(rec.value().Find("test_sensor_msgs_joint_state")->info.columns,
+            (std::vector<std::string>{"joint1", "joint2", "joint3"}));
+  EXPECT_TRUE(row("sensor_msgs_joint_state").isApprox(Eigen::RowVector3d(0.1, 0.2, 0.3)));
+  EXPECT_NEAR(row("sensor_msgs_laser_scan")[4], 1.0, 1e-6);
+  EXPECT_NEAR(row("sensor_msgs_laser_scan")[8], 5.0, 1e-6);
+  EXPECT_TRUE(row("sensor_msgs_magnetic_field").isApprox(Eigen::RowVector3d(1e5, 2e5, 3e5)));
+  EXPECT_TRUE(row("nav_msgs_odometry").head<6>().isApprox((Eigen::RowVectorXd(6) << 1, 0, 0, 0, 0, 0.1).finished()));
+  EXPECT_TRUE(row("nav_msgs_odometry_pose").isApprox((Eigen::RowVectorXd(7) << 1, 2, 0, 0, 0, 0, 1).finished()));
+  EXPECT_TRUE(row("geometry_msgs_twist_stamped").isApprox((Eigen::RowVectorXd(6) << 1, 0, 0, 0, 0, 0.5).finished()));
+  EXPECT_TRUE(row("geometry_msgs_pose_stamped").isApprox((Eigen::RowVectorXd(7) << 1, 2, 3, 0, 0, 0, 1).finished()));
+  EXPECT_EQ(rec.value().Find("test_sensor_msgs_compressed_image")->text.size(), 2u);
+  // The fixture's raw image declares 640 x 480 pixels but holds a few bytes: skipped and counted, not imported.
+  EXPECT_EQ(report.Find("/test/sensor_msgs/image")->skipped.at("image data shorter than height x step"), 2);
+  EXPECT_TRUE(report.Find("/test/sensor_msgs/image")->streams.empty());
+  EXPECT_TRUE(report.Find("/test/sensor_msgs/imu")->constant);
+}
+
 }  // namespace
 }  // namespace roamlab::importers
