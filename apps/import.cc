@@ -88,10 +88,11 @@ int ListRosbagTopics(const std::string& bag) {
 void PrintRosbagSummary(const recording::Recording& rec, const importers::RosbagImportReport& report,
                         const std::string& out) {
   for (const importers::RosbagTopicReport& t : report.topics) {
-    if (t.streams.empty()) {
+    if (!t.decoded) {
       std::cout << "ignored " << t.messages << " messages on " << t.topic << " (" << t.type << ")\n";
       continue;
     }
+    if (t.streams.empty()) std::cout << t.topic << " (" << t.type << "): not imported\n";
     for (const std::string& name : t.streams) {
       const recording::Stream& s = *rec.Find(name);
       std::cout << t.topic << " (" << t.type << ") -> " << name << ": " << s.t.size() << " samples, "
@@ -99,7 +100,7 @@ void PrintRosbagSummary(const recording::Recording& rec, const importers::Rosbag
                 << importers::DescribeClockOffset(t.clock_offset_s) << "\n";
     }
     for (const auto& [what, n] : t.skipped)
-      std::cout << "skipped " << n << " samples of " << t.topic << " (" << what << ")\n";
+      std::cout << "skipped " << n << " messages of " << t.topic << " (" << what << ")\n";
   }
   if (const recording::Stream* wheels = rec.Find("wheels");
       wheels && wheels->info.attributes.count("derived_from_odometry"))

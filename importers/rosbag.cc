@@ -459,11 +459,16 @@ std::string BuildStreams(const Bag& bag, const RosbagImportOptions& options,
   for (const auto& [index, name] : selected) {
     TopicWork w{&bag.topics[index], &rep->topics[index], &options, BuildsOf(bag.topics[index].type, name), {}, -1};
     if (std::string problem = DecodeTopic(bag, per_topic[index], &w); !problem.empty()) return problem;
+    w.report->decoded = true;
     for (Build& b : w.builds) {
       Stream s;
       if (!Finish(&b, &w, &rep->frames, &rep->warnings, &s)) {
-        if (!options.topics.empty() && b.reason_prefix.empty())
-          return w.topic->name + " has fewer than two usable messages";
+        if (!options.topics.empty() && b.reason_prefix.empty()) {
+          std::string skipped;
+          for (const auto& [reason, n] : w.report->skipped)
+            skipped += (skipped.empty() ? " (skipped: " : ", ") + std::to_string(n) + " " + reason;
+          return w.topic->name + " has fewer than two usable messages" + (skipped.empty() ? "" : skipped + ")");
+        }
         rep->warnings.push_back(w.topic->name + " (" + b.info.name +
                                 "): not imported (fewer than two usable messages)");
         continue;
@@ -493,6 +498,7 @@ const RosbagTopicReport* RosbagImportReport::Find(const std::string& topic) cons
 }
 
 std::string DescribeClockOffset(double offset_s) {
+  if (std::lround(std::abs(offset_s) * 1e3) == 0) return "header stamps match the bag's receive times (within 1 ms)";
   return "header stamps are " + std::to_string(std::lround(std::abs(offset_s) * 1e3)) + " ms " +
          (offset_s < 0.0 ? "earlier" : "later") + " than the bag's receive times";
 }
@@ -520,7 +526,8 @@ Result<Recording> ImportRosbag(const std::string& bag_path, const RosbagImportOp
   const Bag& bag = read.value();
   rep.format = bag.format;
   rep.chunks = bag.chunks;
-  for (const BagTopic& t : bag.topics) rep.topics.push_back({t.name, t.type, {}, 0, {}, 0, 0, 0.0, 0.0, false, false});
+  for (const BagTopic& t : bag.topics)
+    rep.topics.push_back({t.name, t.type, false, {}, 0, {}, 0, 0, 0.0, 0.0, false, false});
   for (const internal::BagMessage& m : bag.messages) ++rep.topics[m.topic].messages;
   std::map<std::size_t, std::string> selected;
   if (std::string problem = Select(bag, options, &selected); !problem.empty())

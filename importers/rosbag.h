@@ -90,6 +90,7 @@ struct RosbagImportOptions {
 struct RosbagTopicReport {
   std::string topic;
   std::string type;
+  bool decoded = false;                // selected, of a supported type, and decoded
   std::vector<std::string> streams;    // the streams written from it (none: ignored or not imported)
   int messages = 0;                    // in the bag
   std::map<std::string, int> skipped;  // reason -> samples skipped
