@@ -2,7 +2,8 @@
 // (internal/bag.h). Records are `header_len (u32) header data_len (u32) data`, a header being `field_len (u32)
 // name=value` fields; the op codes read are 0x03 bag header, 0x05 chunk (compression "none", "bz2" or "lz4", the
 // latter an LZ4 frame), 0x07 connection (topic, type) and 0x02 message data (conn, time); index (0x04) and chunk-info
-// (0x06) records are skipped: every message is found by walking the chunks.
+// (0x06) records are skipped: every message is found by walking the chunks. A chunk may hold at most 1 GiB
+// uncompressed.
 #include <bzlib.h>
 #include <lz4frame.h>
 
@@ -20,6 +21,7 @@ namespace roamlab::importers::internal {
 namespace {
 
 constexpr char kMagic[] = "#ROSBAG V2.0\n";
+constexpr std::uint32_t kMaxChunkBytes = 1u << 30;
 constexpr std::uint8_t kOpMessage = 0x02, kOpBagHeader = 0x03, kOpChunk = 0x05, kOpConnection = 0x07;
 
 struct Record {
@@ -104,6 +106,7 @@ std::string Lz4Frame(std::string_view in, std::uint32_t size, std::string* out) 
 std::string Unpack(const Record& r, std::string* out) {
   std::uint32_t size = 0;
   if (!Field(r, "size", &size)) return "chunk without size";
+  if (size > kMaxChunkBytes) return "chunk of " + std::to_string(size) + " bytes uncompressed (more than 1 GiB)";
   const std::string compression = Text(r, "compression");
   if (compression == "none") {
     out->assign(r.data);

@@ -154,13 +154,20 @@ std::string AddOdometry(const RosMessage& m, const internal::RosOdometry& o, Tim
   return "";
 }
 
-// sensor_msgs/JointState: the selected joints' positions or velocities.
-void AddJoints(const RosMessage& m, const internal::RosJointState& j, Time receive, TopicWork* w) {
+// sensor_msgs/JointState: the selected joints' positions or velocities; "" or the refusal (no joint, or two joint
+// names that give one column name).
+std::string AddJoints(const RosMessage& m, const internal::RosJointState& j, Time receive, TopicWork* w) {
   Build& b = w->builds[0];
   const bool velocity = w->options->joint_velocities;
   if (w->joints.empty()) {
     w->joints = w->options->joints.empty() ? j.name : w->options->joints;
-    for (const std::string& name : w->joints) b.info.columns.push_back(StreamNameOfTopic(name));
+    if (w->joints.empty()) return "no joint names in the topic's first message";
+    for (const std::string& name : w->joints) {
+      const std::string column = StreamNameOfTopic(name);
+      if (std::find(b.info.columns.begin(), b.info.columns.end(), column) != b.info.columns.end())
+        return "two joints give the column name '" + column + "'";
+      b.info.columns.push_back(column);
+    }
     b.value_columns = static_cast<int>(b.info.columns.size());
     b.info.units = velocity ? "rad/s" : "rad";
   }
@@ -169,11 +176,14 @@ void AddJoints(const RosMessage& m, const internal::RosJointState& j, Time recei
   for (std::size_t i = 0; i < w->joints.size(); ++i) {
     const auto at = std::find(j.name.begin(), j.name.end(), w->joints[i]);
     const auto k = static_cast<std::size_t>(at - j.name.begin());
-    if (at == j.name.end() || k >= values.size())
-      return Skip(w, b, "joint '" + w->joints[i] + "' without a " + (velocity ? "velocity" : "position"));
+    if (at == j.name.end() || k >= values.size()) {
+      Skip(w, b, "joint '" + w->joints[i] + "' without a " + (velocity ? "velocity" : "position"));
+      return "";
+    }
     row[static_cast<Eigen::Index>(i)] = values[k];
   }
   b.samples.push_back({m.header.stamp, receive, row, "", ""});
+  return "";
 }
 
 // sensor_msgs/LaserScan: geometry and ranges, non-finite ranges as -1 (no return).
@@ -259,7 +269,7 @@ std::string AddMessage(const RosMessage& m, Time receive, TopicWork* w) {
   } else if (const auto* mag = std::get_if<internal::RosMagneticField>(&m.body)) {
     b.samples.push_back({t, receive, Vec(mag->field_t) * 1e6, "", ""});
   } else if (const auto* joints = std::get_if<internal::RosJointState>(&m.body)) {
-    AddJoints(m, *joints, receive, w);
+    return AddJoints(m, *joints, receive, w);
   } else if (const auto* scan = std::get_if<internal::RosLaserScan>(&m.body)) {
     AddScan(m, *scan, receive, w);
   } else if (const auto* image = std::get_if<internal::RosImage>(&m.body)) {
