@@ -473,6 +473,47 @@ TEST(ImportRosbagErrorTest, RefusesOtherCompressionsVersionsFilesAndDirectories)
   EXPECT_EQ(rec.status().message().find('\n'), std::string::npos);
 }
 
+// No cut and no corrupted byte makes the import crash or read past a buffer: each gives a recording or one line.
+TEST(ImportRosbagErrorTest, CutsAndCorruptionsNeverCrash) {
+  TempDir dir;
+  for (const std::string compression : {"none", "bz2", "lz4"}) {
+    const std::string bag = TinyBag(compression);
+    // The bag header record fills the first 4096 bytes; cuts in it are sampled, those after it taken at a stride.
+    for (std::size_t cut = 0; cut < bag.size(); cut += cut < 4096 ? 97 : 7) {
+      Imported in = Import(bag.substr(0, cut), dir);
+      ASSERT_FALSE(in.rec.ok()) << compression << " cut " << cut;
+      EXPECT_EQ(in.rec.status().message().find('\n'), std::string::npos);
+    }
+    for (std::size_t at = 4096; at < bag.size(); at += 11) {
+      std::string corrupt = bag;
+      corrupt[at] = static_cast<char>(corrupt[at] ^ 0xa5);
+      Imported in = Import(corrupt, dir);
+      if (!in.rec.ok()) {
+        EXPECT_EQ(in.rec.status().message().find('\n'), std::string::npos) << at;
+      }
+    }
+  }
+}
+
+TEST(ImportRosbagTypesTest, JointVelocitiesAndUnknownJoints) {
+  TempDir dir;
+  RosbagImportOptions options;
+  options.joint_velocities = true;
+  Imported in = Import(AllTypesBag(), dir, options);
+  ASSERT_TRUE(in.rec.ok()) << in.rec.status().message();
+  const Stream* joints = in.rec.value().Find("joints");
+  ASSERT_NE(joints, nullptr);
+  EXPECT_EQ(joints->info.columns, (std::vector<std::string>{"left_wheel", "right_wheel", "arm"}));
+  EXPECT_EQ(joints->info.units, "rad/s");
+  EXPECT_EQ(joints->values.row(2), Eigen::RowVector3d(-2.0, -1.0, 0.0));
+  options.joints = {"left_wheel", "caster"};
+  in = Import(AllTypesBag(), dir, options);
+  ASSERT_TRUE(in.rec.ok()) << in.rec.status().message();
+  EXPECT_EQ(in.rec.value().Find("joints"), nullptr);
+  EXPECT_EQ(in.report.Find("/joints")->skipped.at("joint 'caster' without a velocity"), 3);
+  EXPECT_THAT(in.report.warnings, Contains("/joints (joints): not imported (fewer than two usable messages)"));
+}
+
 // The real Husky bag (data/husky_test1 of the shared data directory): counts, span, rates and the IMU's clock offset.
 TEST(ImportRosbagRealTest, HuskyTest1) {
   const std::string path = std::string(ROAMLAB_SHARED_DIR) + "/data/husky_test1/test1.bag";
