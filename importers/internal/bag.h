@@ -39,6 +39,10 @@ struct Bag {
 
 // Each reader: errors are one line "<path>: <problem>" (not the format, truncated or corrupt record, unsupported
 // compression, unsupported serialization), never a crash and never a read past a declared length.
+// ROS 1 (format 2.0): the whole file is read and its records walked from the start (index and chunk-info records are
+// not needed); chunks uncompressed, bz2 or lz4 (an LZ4 frame), at most 1 GiB uncompressed each; a message's
+// receive_time is its record's `time` field; connections of one topic merge; messages are views into the file or the
+// uncompressed chunk.
 Result<Bag> ReadRos1Bag(const std::string& path);
 
 // rosbag2: `path` is the bag directory or its metadata.yaml (every file of relative_file_paths is read, in that
