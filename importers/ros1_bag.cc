@@ -144,6 +144,9 @@ std::string OnRecord(const Record& r, std::size_t base, bool in_chunk, Walk* wal
     std::size_t index = 0;
     while (index < bag.topics.size() && bag.topics[index].name != topic) ++index;
     if (index == bag.topics.size()) bag.topics.push_back({topic, std::string(type->second), Encoding::kRos1});
+    if (bag.topics[index].type != type->second)
+      return "topic " + topic + " has connections of types " + bag.topics[index].type + " and " +
+             std::string(type->second);
     walk->connections[id] = index;
   } else if (op == kOpMessage) {
     std::uint32_t id = 0;

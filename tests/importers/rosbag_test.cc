@@ -420,6 +420,21 @@ TEST(ImportRosbagErrorTest, RefusesOtherCompressionsVersionsFilesAndDirectories)
   EXPECT_EQ(rec.status().message().find('\n'), std::string::npos);
 }
 
+// Connections of one topic share one topic (rosbag opens one per publisher); a second type on a topic is refused.
+TEST(ImportRosbagErrorTest, ConnectionsOfOneTopicMerge) {
+  TempDir dir;
+  std::string chunk = Connection(0, "/imu", "sensor_msgs/Imu") + Connection(5, "/imu", "sensor_msgs/Imu");
+  chunk += MessageRecord(0, 10, 0, testing::ImuMessage(kRos1, 10, 0, 0.1));
+  chunk += MessageRecord(5, 11, 0, testing::ImuMessage(kRos1, 11, 0, 0.2));
+  Imported in = Import(BagOf(chunk), dir);
+  ASSERT_TRUE(in.rec.ok()) << in.rec.status().message();
+  EXPECT_EQ(in.report.topics.size(), 1u);
+  EXPECT_EQ(in.rec.value().Find("imu")->t.size(), 2u);
+  chunk += Connection(6, "/imu", "sensor_msgs/MagneticField");
+  EXPECT_THAT(Import(BagOf(chunk), dir).rec.status().message(),
+              HasSubstr("topic /imu has connections of types sensor_msgs/Imu and sensor_msgs/MagneticField"));
+}
+
 // No cut and no corrupted byte makes the import crash or read past a buffer: each gives a recording or one line.
 TEST(ImportRosbagErrorTest, CutsAndCorruptionsNeverCrash) {
   TempDir dir;
