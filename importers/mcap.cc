@@ -97,7 +97,8 @@ class McapParser {
                    : "chunk at byte " + std::to_string(chunk_at) + ", record at byte " + std::to_string(at) +
                          " of its uncompressed records";
       };
-      if (cursor.remaining() < kRecordHeaderBytes) return "truncated " + where() + " (file ends inside its header)";
+      if (cursor.remaining() < kRecordHeaderBytes)
+        return "truncated " + where() + " (the data ends inside its opcode and length)";
       const auto op = cursor.Read<std::uint8_t>();
       const std::uint64_t length = cursor.U64();
       if (length > cursor.remaining())

@@ -60,12 +60,12 @@ std::string ReadMetadata(const std::string& path, Metadata* out) {
     out->compression_format = Scalar(info, "compression_format");
     out->compression_mode = Scalar(info, "compression_mode");
   } catch (const YAML::Exception& e) {
-    return path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg;
+    return path + (e.mark.is_null() ? "" : ":" + std::to_string(e.mark.line + 1)) + ": " + e.msg;
   }
   return "";
 }
 
-// The metadata's compression into `out`, when this reader reads it.
+// Sets metadata->compression from its format and mode when this reader reads them; the problem otherwise.
 std::string ReadCompression(const std::string& path, Metadata* metadata) {
   std::string mode = metadata->compression_mode;
   for (char& ch : mode) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));

@@ -125,6 +125,11 @@ std::string SmallMcap(std::vector<Expected>* expected) {
   lz4 += add(3, 4200, 9);
   file += McapChunk("lz4", Lz4(lz4), lz4.size(), 0);
   file += add(4, 5000, 10);
+  // Records the reader has no use for: an attachment, a metadata record, an opcode the specification reserves.
+  file += Record(0x09, Le(std::uint64_t{1}) + Le(std::uint64_t{1}) + Str("calib.txt") + Str("text/plain") +
+                           Le(std::uint64_t{2}) + "ab" + Le(std::uint32_t{0}));
+  file += Record(0x0C, Str("info") + Str(Str("k") + Str("v")));
+  file += Record(0x80, "reserved");
   // The summary section repeats the schemas and channels.
   file += Record(0x0F, Le(std::uint32_t{0})) + McapSchema(1, "sensor_msgs/msg/Imu") + McapChannel(3, 1, "/imu") +
           Record(0x02, Le(std::uint64_t{0}) + Le(std::uint64_t{0}) + Le(std::uint32_t{0})) + kMcapMagic;
