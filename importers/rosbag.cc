@@ -317,7 +317,7 @@ void Check(const Build& b, const std::vector<Sample>& kept, TopicWork* w, std::v
       warnings->push_back(line.str());
     }
   }
-  if (b.value_columns == 0) return;
+  if (b.value_columns == 0 || kept.size() < 2) return;
   bool zero = true, constant = true;
   for (const Sample& s : kept) {
     zero = zero && s.row.head(b.value_columns).isZero(0.0);
@@ -375,6 +375,7 @@ std::string Select(const Bag& bag, const RosbagImportOptions& options, std::map<
   for (const auto& [topic, stream] : options.topics) {
     const std::size_t i = index_of(topic);
     if (i == bag.topics.size()) return "no topic '" + topic + "' in the bag";
+    if (out->count(i)) return "topic " + topic + " is selected twice";
     if (!internal::IsSupportedRosType(bag.topics[i].type))
       return "topic " + topic + " has type " + bag.topics[i].type + ", which is not imported";
     if (stream.empty() || StreamNameOfTopic(stream) != stream)

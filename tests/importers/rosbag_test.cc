@@ -310,6 +310,8 @@ TEST(ImportRosbagTopicsTest, TopicSelectsAndNamesStreams) {
   options.topics = {{"/rosout", "log"}};
   EXPECT_THAT(Import(TinyBag("none"), dir, options).rec.status().message(),
               HasSubstr("topic /rosout has type rosgraph_msgs/Log, which is not imported"));
+  options.topics = {{"/fix", "gps"}, {"/fix", "gps2"}};
+  EXPECT_THAT(Import(TinyBag("none"), dir, options).rec.status().message(), HasSubstr("topic /fix is selected twice"));
   options.topics = {{"/fix", "bad name"}};
   EXPECT_THAT(Import(TinyBag("none"), dir, options).rec.status().message(), HasSubstr("is not [A-Za-z0-9_]+"));
 }
