@@ -39,6 +39,10 @@ struct Bag {
 
 // Each reader: errors are one line "<path>: <problem>" (not the format, truncated or corrupt record, unsupported
 // compression, unsupported serialization), never a crash and never a read past a declared length.
+// ROS 1 (format 2.0): the whole file is read and its records walked from the start (index and chunk-info records are
+// not needed); chunks uncompressed, bz2 or lz4 (an LZ4 frame), at most 1 GiB uncompressed each; a message's
+// receive_time is its record's `time` field; connections of one topic merge; messages are views into the file or the
+// uncompressed chunk.
 Result<Bag> ReadRos1Bag(const std::string& path);
 
 // rosbag2: `path` is the bag directory or its metadata.yaml (every file of relative_file_paths is read, in that
@@ -46,8 +50,8 @@ Result<Bag> ReadRos1Bag(const std::string& path);
 // read-only and immutable (a bag left in WAL mode is read as its main file holds it; nothing is written next to it),
 // the topics and messages tables are read and each file's messages sorted by timestamp (ties in row order); only the
 // cdr serialization is read. storage_identifier mcap: each file is read as ReadMcap does. compression_format zstd is
-// read in both modes (FILE: each listed file is one zstd stream, decompressed in memory; MESSAGE: each message is a zstd
-// frame stating its size); other compressions are refused. Topics of several files merge by name.
+// read in both modes (FILE: each listed file is one zstd stream, decompressed in memory; MESSAGE: each message is a
+// zstd frame stating its size); other compressions are refused. Topics of several files merge by name.
 Result<Bag> ReadRosbag2(const std::string& path);
 
 // MCAP: the data section is read record by record from the start (the summary section and indexes are not needed,
