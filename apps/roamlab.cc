@@ -241,7 +241,7 @@ void AddOdometry(CLI::App* app, Commands* commands) {
   });
 }
 
-// `import optiodom` and `import rosbag`.
+// `import optiodom`, `import rosbag` and `import csv`.
 void AddImport(CLI::App* app, Commands* commands) {
   CLI::App* imp = app->add_subcommand("import", "Convert real recordings into the recording format.");
   imp->require_subcommand(1);
@@ -254,11 +254,19 @@ void AddImport(CLI::App* app, Commands* commands) {
     return imp_optiodom;
   });
   Add(commands, RunImportRosbag, [imp](auto* args) {
-    CLI::App* imp_rosbag = imp->add_subcommand("rosbag",
-                                               "A ROS1 bag (v2.0): sensor_msgs/Imu, nav_msgs/Odometry, "
-                                               "sensor_msgs/NavSatFix.");
-    imp_rosbag->add_option("bag", args->bag, "BAG.bag")->required();
-    imp_rosbag->add_option("--out", args->out, "Output recording directory")->required();
+    CLI::App* imp_rosbag = imp->add_subcommand(
+        "rosbag",
+        "A ROS 1 bag, rosbag2 directory or MCAP file: Imu, NavSatFix, MagneticField, JointState, "
+        "LaserScan, Image, CompressedImage, Odometry, TwistStamped, PoseStamped, PoseWithCovarianceStamped.");
+    imp_rosbag->add_option("bag", args->bag, "BAG.bag, a rosbag2 directory or FILE.mcap")->required();
+    imp_rosbag->add_option("--out", args->out, "Output recording directory (required unless --list)");
+    imp_rosbag->add_flag("--list", args->list, "Print every topic (type, count, rate, span); import nothing");
+    imp_rosbag->add_option(
+        "--topic", args->topics,
+        "TOPIC=STREAM: import this topic as this stream (repeatable; default every supported topic)");
+    imp_rosbag->add_option("--joints", args->joints, "JointState joints to import (repeatable; default all)");
+    imp_rosbag->add_flag("--joint-velocities", args->joint_velocities,
+                         "JointState: velocities [rad/s] instead of positions [rad]");
     imp_rosbag
         ->add_option("--imu-mounting", args->imu_mounting_wxyz,
                      "IMU mounting q_body_imu as W X Y Z (rotates IMU coordinates into the body frame)")
@@ -267,8 +275,19 @@ void AddImport(CLI::App* app, Commands* commands) {
     imp_rosbag->add_option("--geometry", args->geometry, "Nominal geometry KEY=VALUE (repeatable)");
     imp_rosbag->add_flag("--wheels-from-odometry", args->wheels_from_odometry,
                          "Also write wheel angles re-expressed from the odometry (needs wheel_radius_m, baseline_m)");
+    imp_rosbag->add_option("--odometry-topic", args->odometry_topic,
+                           "The odometry topic the wheels come from, when the bag has several");
     imp_rosbag->add_flag("--quiet", args->quiet, "No summary");
     return imp_rosbag;
+  });
+  Add(commands, RunImportCsv, [imp](auto* args) {
+    CLI::App* imp_csv =
+        imp->add_subcommand("csv", "CSV/TSV files with a column mapping (units, axes, collapse; docs/import-csv.md).");
+    imp_csv->add_option("files", args->files, "CSV files, in the order of the mapping's files entries")->required();
+    imp_csv->add_option("--map", args->map, "Mapping (YAML)")->required();
+    imp_csv->add_option("--out", args->out, "Output recording directory")->required();
+    imp_csv->add_flag("--quiet", args->quiet, "No summary");
+    return imp_csv;
   });
 }
 

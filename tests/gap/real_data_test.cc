@@ -195,6 +195,7 @@ TEST(RealDataTest, HuskySkidSteerYawMismatch) {
   options.platform = {"skid_steer", {{"wheel_radius_m", 0.1651}, {"baseline_m", 0.555}}};
   options.q_body_imu = Eigen::Quaterniond(std::sqrt(0.5), std::sqrt(0.5), 0.0, 0.0);
   options.wheels_from_odometry = true;
+  options.topics = {{"/imu/data", "imu"}, {"/husky_velocity_controller/odom", "odometry"}, {"/fix", "gps"}};
   auto rec = importers::ImportRosbag(bag, options);
   ASSERT_TRUE(rec.ok()) << rec.status().message();
   auto config = estimator::LoadEstimatorConfig(std::string(ROAMLAB_SOURCE_DIR) + "/configs/real/husky_nominal.yaml");
