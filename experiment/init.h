@@ -17,7 +17,9 @@
 //   gps, position    gps, the lever arm from the stream's mounting: free on an ackermann vehicle (as
 //                    configs/atv_calibration.yaml), fixed on the other kinds, which move in a plane (its height is
 //                    unobservable there and its horizontal offset trades with the IMU's yaw).
-//   pose             absolute_pose, its mounting fixed (the reference the rest is calibrated against).
+//   pose             absolute_pose, its mounting fixed (the reference the rest is calibrated against); left out when
+//                    it is an odometry's pose (<odometry>_pose beside an odometry stream <odometry>, as the ROS bag
+//                    importer writes a nav_msgs/Odometry): dead-reckoned, not an absolute reference.
 //   magnetometer, steering (outside ackermann), camera, laser_scan, inputs
 //                    left out, each with its reason (the magnetometer model needs the field in W, which a recording
 //                    does not state; camera and laser_scan need a front end, `roamlab frontend`).

@@ -229,8 +229,9 @@ TEST(InitCliTest, OptiOdomRadiusAgreesWithTheHandWrittenNominal) {
   EXPECT_NEAR(a["estimate"][0].get<double>(), b["estimate"][0].get<double>(), 3.0 * std_ab);
 }
 
-// The Husky bag with wheels re-expressed from its odometry: the odometry is left out (the same information twice)
-// and said so; the configuration loads and binds (init validates it against the recording before writing).
+// The Husky bag with wheels re-expressed from its odometry: the odometry and its pose are left out (the same
+// information twice; a dead-reckoned pose is no reference) and said so; the configuration loads and binds (init
+// validates it against the recording before writing).
 TEST(InitCliTest, HuskyLeavesOutTheOdometryItsWheelsCameFrom) {
   const std::string bag = Shared("data/husky_test1/test1.bag");
   if (!std::filesystem::exists(bag)) GTEST_SKIP() << "Husky bag not found: " << bag;
@@ -244,11 +245,12 @@ TEST(InitCliTest, HuskyLeavesOutTheOdometryItsWheelsCameFrom) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   run = Roamlab("init " + dir.File("rec") + " --out " + dir.File("est.yaml"), dir);
   ASSERT_EQ(run.exit_code, 0) << run.err;
-  EXPECT_NE(run.out.find("left out odometry (odometry): the master 'wheels' was derived from it"), std::string::npos)
-      << run.out;
+  EXPECT_NE(run.out.find(" (odometry): the master 'wheels' was derived from it"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("_pose (pose): the pose of the odometry"), std::string::npos) << run.out;
   const std::string yaml = testing::ReadFile(dir.File("est.yaml"));
   ExpectEveryKeyCommented(yaml);
-  EXPECT_NE(yaml.find("noise from " + dir.File("rec") + "/recording.yaml gps.noise.sigma_m"), std::string::npos);
+  EXPECT_NE(yaml.find("noise from " + dir.File("rec") + "/recording.yaml fix.noise.sigma_m"), std::string::npos);
+  EXPECT_EQ(yaml.find("model: absolute_pose"), std::string::npos);
 }
 
 }  // namespace
