@@ -96,6 +96,9 @@ void Emit(const Node& node, int indent, std::ostringstream* out) {
 }
 
 // A stated noise entry of a stream (the first of `keys` present, positive and finite) or the default.
+// The accelerometer noise a wheeled vehicle's configuration takes at least [m/s^2].
+constexpr double kVehicleAccelFloorMps2 = 0.5;
+
 struct Noise {
   double value = 0.0;
   std::string origin;
@@ -469,9 +472,15 @@ void Builder::AddImu(const Stream& s, bool gyroscope, bool accelerometer) {
   if (accelerometer) {
     const std::string name = UniqueName(both ? std::string("accelerometer") : s.info.name);
     Node n = StreamNode(name, "the specific force", "accelerometer", "stream type " + TypeName(s), s);
-    AddNoise(&n, "sigma_mps2",
-             StatedNoise(rec_name_, s.info, {"accel_sigma_mps2", "sigma_mps2"}, 0.5,
-                         "0.5 m/s^2 (a chassis' vibration over the sensor's own noise)"));
+    Noise noise = StatedNoise(rec_name_, s.info, {"accel_sigma_mps2", "sigma_mps2"}, kVehicleAccelFloorMps2,
+                              "0.5 m/s^2 (a chassis' vibration over the sensor's own noise)");
+    // A stated noise is the sensor's own white noise; on a vehicle the chassis' vibration and the second difference
+    // of the pose grid the model compares with are far larger, and a fit at the sensor's noise lets the accelerometer
+    // pull the wheel radii and the misalignment away (the Husky's stated 0.098 m/s^2 gives chi2/dof about 25).
+    if (master_ && noise.value < kVehicleAccelFloorMps2) {
+      noise = {kVehicleAccelFloorMps2, noise.origin + ", raised to 0.5 m/s^2: a vehicle's vibration floor"};
+    }
+    AddNoise(&n, "sigma_mps2", noise);
     n.children.push_back({"parameters", "the misalignment shared by the IMU's streams", "", {}});
     n.children.back().children.push_back(
         {"misalignment", "the IMU's misalignment " + misalignment, Name(misalignment), {}});

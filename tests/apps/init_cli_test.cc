@@ -87,7 +87,8 @@ TEST(InitCliTest, CalibratesAsTheHandWrittenConfigurationWithTheSameChoices) {
   EXPECT_NE(yaml.find("from " + rec + "/recording.yaml platform.geometry.wheel_radius_m"), std::string::npos);
 
   // The same choices by hand: one radius free, the baseline fixed, the IMU misalignment and gyroscope bias free, the
-  // stated IMU noise, the wheel noise of one tick of quantization per 10 ms sample on each end, staged alike.
+  // stated gyroscope noise, the accelerometer at the vehicle floor of 0.5 m/s^2, the wheel noise of one tick of
+  // quantization per 10 ms sample on each end, staged alike.
   const double wheel_radps = 2.0 * kPi / 2048.0 * 100.0 / std::sqrt(6.0);
   testing::WriteFile(dir.File("hand.yaml"), R"(master: odometer
 solver: {method: levenberg_marquardt, max_iterations: 100, function_tolerance: 1.0e-10}
@@ -103,7 +104,7 @@ streams:
                                                 R"(, lateral_mps: 0.02, vertical_mps: 0.02, tilt_radps: 0.1}
     parameters: {radius_left: odometer.radius, radius_right: odometer.radius}
   gyro: {model: gyroscope, source: imu, noise: {sigma_radps: 0.01}, parameters: {misalignment: imu.misalignment}}
-  accel: {model: accelerometer, source: imu, noise: {sigma_mps2: 0.05}, parameters: {misalignment: imu.misalignment}}
+  accel: {model: accelerometer, source: imu, noise: {sigma_mps2: 0.5}, parameters: {misalignment: imu.misalignment}}
 stages:
   - [imu.misalignment]
   - [odometer.radius, gyro.bias]
