@@ -1,6 +1,6 @@
-// Test helper: ROS messages serialized by hand, in ROS 1 (packed little-endian, u32-length strings) or CDR (a 4-byte
-// encapsulation header, then each primitive aligned to its size from the byte after it; strings count a trailing NUL),
-// written from the formats' documentation rather than from the reader under test.
+// Test and benchmark helper: ROS messages serialized by hand, in ROS 1 (packed little-endian, u32-length strings)
+// or CDR (a 4-byte encapsulation header, then each primitive aligned to its size from the byte after it; strings
+// count a trailing NUL), written from the formats' documentation rather than from the reader under test.
 #pragma once
 
 #include <algorithm>
