@@ -35,6 +35,7 @@ struct ImportInput {
   std::string path;
   std::vector<std::string> files;
   std::int64_t imu_samples = 0;
+  std::uintmax_t uncompressed_bytes = 0;  // MCAP: the records inside its chunks
 };
 
 // A pseudo-random IMU sample (gyro [rad/s], accel [m/s^2]): values that do not repeat, so zstd chunks compress as
@@ -150,9 +151,13 @@ Result<ImportInput> WriteMcap(const fs::path& dir, std::uintmax_t bytes) {
   in.imu_samples = EmitMessages(bag::Wire::kCdrLittle, [&](StampedMessage m) {
     if (file.size() >= bytes) return false;
     records += bag::McapMessage(static_cast<std::uint16_t>(m.topic + 1), static_cast<std::uint64_t>(m.t_ns), m.data);
-    if (records.size() > (4u << 20)) file += bag::McapZstdChunk(std::exchange(records, std::string()));
+    if (records.size() > (4u << 20)) {
+      in.uncompressed_bytes += records.size();
+      file += bag::McapZstdChunk(std::exchange(records, std::string()));
+    }
     return true;
   });
+  in.uncompressed_bytes += records.size();
   if (!records.empty()) file += bag::McapZstdChunk(records);
   if (Status s = WriteBytes(in.path, file + bag::McapEnd()); !s.ok()) return s;
   return in;
@@ -235,10 +240,16 @@ int MeasureImport(const ImportInput& in, double target_s, Json* j) {
                              {"target_s", target_s},
                              {"ratio_to_target", target_s / cpu_s},
                              {"met", met}};
+  std::string records;
+  if (in.uncompressed_bytes > 0) {
+    (*j)["import"][in.name]["uncompressed_mb"] = 1e-6 * static_cast<double>(in.uncompressed_bytes);
+    records =
+        "; " + std::to_string(std::lround(1e-6 * static_cast<double>(in.uncompressed_bytes))) + " MB uncompressed";
+  }
   Say("  import %-31s %6.1f MB %6.2f s CPU %6.1f MB/s  target <= %.0f s   ratio %.2f   %s  (wall %.2f s; read %.3f s, "
-      "%.0fx the floor)\n",
+      "%.0fx the floor%s)\n",
       in.label.c_str(), mb, cpu_s, mb / cpu_s, target_s, target_s / cpu_s, met ? "met" : "NOT MET", wall_s, floor_s,
-      cpu_s / floor_s);
+      cpu_s / floor_s, records.c_str());
   return 0;
 }
 
