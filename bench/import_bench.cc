@@ -38,8 +38,8 @@ struct ImportInput {
   std::uintmax_t uncompressed_bytes = 0;  // MCAP: the records inside its chunks
 };
 
-// A pseudo-random IMU sample (gyro [rad/s], accel [m/s^2]): values that do not repeat, so zstd chunks compress as
-// real logs do rather than to nothing.
+// A pseudo-random IMU sample (gyro [rad/s], accel [m/s^2]): values that do not repeat, so the zstd chunks compress
+// by about six rather than to nothing.
 struct ImuNoise {
   std::mt19937 random{7};
   std::normal_distribution<double> normal;

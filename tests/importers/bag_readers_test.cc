@@ -1,5 +1,6 @@
-// The rosbag2 and MCAP container readers and the dispatch by path, on files written here from the formats'
-// documentation (the MCAP specification's records, rosbag2's metadata.yaml and SQLite schema) and on real bags.
+// The rosbag2 and MCAP container readers and the dispatch by path, on files written from the formats' documentation
+// (tests/support/bag_writers.h: the MCAP specification's records, rosbag2's metadata.yaml and SQLite schema) and on
+// real bags.
 #include <sqlite3.h>
 
 #include <cstdint>
