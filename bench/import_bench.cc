@@ -191,16 +191,16 @@ std::uintmax_t SizeOf(const std::vector<std::string>& files) {
 // The I/O floor: every byte of the input's files read into memory; seconds.
 double ReadSeconds(const std::vector<std::string>& files) {
   const auto t0 = Clock::now();
-  std::size_t checksum = 0;
+  std::size_t read_bytes = 0;
   for (const std::string& f : files) {
     std::string bytes(fs::file_size(f), '\0');
     std::FILE* file = std::fopen(f.c_str(), "rb");
     if (file == nullptr) continue;
-    checksum += std::fread(bytes.data(), 1, bytes.size(), file);
+    read_bytes += std::fread(bytes.data(), 1, bytes.size(), file);
     std::fclose(file);
   }
   const double seconds = Since(t0);
-  return checksum > 0 ? seconds : 0.0;
+  return read_bytes > 0 ? seconds : 0.0;
 }
 
 // Imports the input into a recording in memory: the imu stream's sample count, or an error.
