@@ -61,6 +61,7 @@ Sizes QuickSizes() {
   sizes.montecarlo_drive_s = 10.0;
   sizes.montecarlo_runs_jobs1 = 1;
   sizes.montecarlo_runs_jobs2 = 2;
+  sizes.import_mb = 10.0;
   return sizes;
 }
 

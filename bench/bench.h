@@ -43,6 +43,7 @@ struct Sizes {
   std::vector<double> calibration_s{30.0, 300.0, 1800.0};
   double online_s = 3600.0, montecarlo_drive_s = 30.0;
   int montecarlo_runs_jobs1 = 8, montecarlo_runs_jobs2 = 8;
+  double import_mb = 100.0;  // each input of the import step
 };
 Sizes QuickSizes();
 
@@ -85,6 +86,7 @@ int BenchTracking(const Context& ctx, const recording::Recording& rec, const Tra
 int BenchCalibrationScaling(const Context& ctx, const recording::Recording& rec, Json* j);  // 5
 int BenchOnlineMemory(const Context& ctx, const std::string& calibration_json, Json* j);    // 6
 int BenchMonteCarlo(const Context& ctx, const std::string& calibration_json, Json* j);      // 7
+int BenchImport(const Context& ctx, Json* j);                                               // 8 (runs first)
 
 // The child processes (own address space: their peak memory is their own).
 int ChildCalibrate(const std::string& rec_dir, const std::string& config_path, const std::string& out_path);

@@ -20,9 +20,12 @@
 //    up to 1 min the median of five such processes, up to 10 min of three.
 // 6. Memory of a one-hour online run (child process): resident set after the first minute and at the end.
 // 7. Monte-Carlo runs per minute with one and two jobs.
+// 8. Import speed (runs first: it needs nothing of the others): a CSV log, a ROS 1 bag, an MCAP file with zstd chunks
+//    and a rosbag2 SQLite directory of about 100 MB each, written to the scratch directory and imported into a
+//    recording in memory on one thread, beside a plain read of the same files (the I/O floor); target 10 s each.
 // --quick: the same steps and JSON keys on reduced sizes (JSON `sizes`): 10 s indoor drives, 3 s of rendering, the
 // Ceres comparison on a 10 s drive, windows of 10 and 40 poses, scaling on 10 s and 30 s, a 90 s online run,
-// Monte-Carlo on 10 s drives (one run with one job, two with two).
+// Monte-Carlo on 10 s drives (one run with one job, two with two), 10 MB imports against a 1 s target.
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -89,11 +92,13 @@ Json SizesJson(const Context& ctx) {
             {"calibration_drives_s", sizes.calibration_s},
             {"online_run_s", sizes.online_s},
             {"montecarlo_drive_s", sizes.montecarlo_drive_s},
-            {"montecarlo_runs", {sizes.montecarlo_runs_jobs1, sizes.montecarlo_runs_jobs2}}}}};
+            {"montecarlo_runs", {sizes.montecarlo_runs_jobs1, sizes.montecarlo_runs_jobs2}},
+            {"import_mb", sizes.import_mb}}}};
 }
 
 // Every step in order; 0 or the exit code of the first failure.
 int RunSteps(const Context& ctx, Json* j) {
+  if (int code = BenchImport(ctx, j)) return code;
   recording::Recording rec;
   if (int code = BenchSimulation(ctx, j, &rec)) return code;
   BenchCgp(j);

@@ -11,8 +11,8 @@
 #include <gtest/gtest.h>
 
 #include "recording/recording.h"
-#include "tests/importers/message_writer.h"
-#include "tests/importers/ros1_bag_writer.h"
+#include "tests/support/message_writer.h"
+#include "tests/support/bag_writers.h"
 #include "tests/recording/temp_dir.h"
 
 namespace roamlab {

@@ -1,18 +1,14 @@
-// The rosbag2 and MCAP container readers and the dispatch by path, on files written here from the formats'
-// documentation (the MCAP specification's records, rosbag2's metadata.yaml and SQLite schema) and on real bags.
-#include <lz4frame.h>
+// The rosbag2 and MCAP container readers and the dispatch by path, on files written from the formats' documentation
+// (tests/support/bag_writers.h: the MCAP specification's records, rosbag2's metadata.yaml and SQLite schema) and on
+// real bags.
 #include <sqlite3.h>
-#include <zstd.h>
 
-#include <chrono>
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <map>
-#include <random>
 #include <set>
 #include <string>
 #include <utility>
@@ -23,69 +19,30 @@
 
 #include "importers/internal/bag.h"
 #include "tests/recording/temp_dir.h"
+#include "tests/support/bag_writers.h"
 
 namespace roamlab::importers::internal {
 namespace {
 
+using ::roamlab::importers::testing::Crc32;
+using ::roamlab::importers::testing::kMcapMagic;
+using ::roamlab::importers::testing::Lz4;
+using ::roamlab::importers::testing::McapChannel;
+using ::roamlab::importers::testing::McapChunk;
+using ::roamlab::importers::testing::McapEnd;
+using ::roamlab::importers::testing::McapHeader;
+using ::roamlab::importers::testing::McapMessage;
+using ::roamlab::importers::testing::McapSchema;
+using ::roamlab::importers::testing::Raw;
+using ::roamlab::importers::testing::Record;
+using ::roamlab::importers::testing::Rosbag2Metadata;
+using ::roamlab::importers::testing::SqliteExec;
+using ::roamlab::importers::testing::Str;
+using ::roamlab::importers::testing::WriteDb3;
+using ::roamlab::importers::testing::Zstd;
 using ::roamlab::testing::TempDir;
 using ::roamlab::testing::WriteFile;
 using ::testing::HasSubstr;
-
-template <typename T>
-std::string Le(T value) {
-  std::string out(sizeof(T), '\0');
-  std::memcpy(out.data(), &value, sizeof(T));
-  return out;
-}
-std::string Str(const std::string& s) { return Le(static_cast<std::uint32_t>(s.size())) + s; }
-
-// CRC-32 as MCAP specifies it (IEEE, reflected), bit by bit.
-std::uint32_t Crc32(const std::string& data) {
-  std::uint32_t c = 0xFFFFFFFFu;
-  for (const char ch : data) {
-    c ^= static_cast<unsigned char>(ch);
-    for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-  }
-  return c ^ 0xFFFFFFFFu;
-}
-
-// MCAP records: opcode u8, body length u64, body.
-const std::string kMcapMagic("\x89MCAP0\r\n", 8);
-std::string Record(std::uint8_t op, const std::string& body) {
-  return std::string(1, static_cast<char>(op)) + Le(static_cast<std::uint64_t>(body.size())) + body;
-}
-std::string McapHeader() { return Record(0x01, Str("ros2") + Str("roamlab test")); }
-std::string McapSchema(std::uint16_t id, const std::string& name, const std::string& encoding = "ros2msg") {
-  return Record(0x03, Le(id) + Str(name) + Str(encoding) + Str("float64 x\n"));
-}
-std::string McapChannel(std::uint16_t id, std::uint16_t schema, const std::string& topic,
-                        const std::string& encoding = "cdr") {
-  const std::string metadata = Str("offered_qos_profiles") + Str("");
-  return Record(0x04, Le(id) + Le(schema) + Str(topic) + Str(encoding) + Str(metadata));
-}
-std::string McapMessage(std::uint16_t channel, std::uint64_t log_time_ns, const std::string& data) {
-  return Record(0x05, Le(channel) + Le(std::uint32_t{7}) + Le(log_time_ns) + Le(log_time_ns + 5) + data);
-}
-std::string McapChunk(const std::string& compression, const std::string& compressed, std::uint64_t uncompressed_size,
-                      std::uint32_t crc) {
-  return Record(0x06, Le(std::uint64_t{0}) + Le(std::uint64_t{0}) + Le(uncompressed_size) + Le(crc) + Str(compression) +
-                          Le(static_cast<std::uint64_t>(compressed.size())) + compressed);
-}
-std::string McapEnd() {
-  return Record(0x0F, Le(std::uint32_t{0})) +
-         Record(0x02, Le(std::uint64_t{0}) + Le(std::uint64_t{0}) + Le(std::uint32_t{0})) + kMcapMagic;
-}
-
-std::string Zstd(const std::string& data) {
-  std::string out(ZSTD_compressBound(data.size()), '\0');
-  out.resize(ZSTD_compress(out.data(), out.size(), data.data(), data.size(), 3));
-  return out;
-}
-std::string Lz4(const std::string& data) {
-  std::string out(LZ4F_compressFrameBound(data.size(), nullptr), '\0');
-  out.resize(LZ4F_compressFrame(out.data(), out.size(), data.data(), data.size(), nullptr));
-  return out;
-}
 
 // A CDR message: the little-endian encapsulation header, then `n` bytes of a pattern seeded by `seed`.
 std::string Cdr(int seed, int n = 24) {
@@ -126,13 +83,13 @@ std::string SmallMcap(std::vector<Expected>* expected) {
   file += McapChunk("lz4", Lz4(lz4), lz4.size(), 0);
   file += add(4, 5000, 10);
   // Records the reader has no use for: an attachment, a metadata record, an opcode the specification reserves.
-  file += Record(0x09, Le(std::uint64_t{1}) + Le(std::uint64_t{1}) + Str("calib.txt") + Str("text/plain") +
-                           Le(std::uint64_t{2}) + "ab" + Le(std::uint32_t{0}));
+  file += Record(0x09, Raw(std::uint64_t{1}) + Raw(std::uint64_t{1}) + Str("calib.txt") + Str("text/plain") +
+                           Raw(std::uint64_t{2}) + "ab" + Raw(std::uint32_t{0}));
   file += Record(0x0C, Str("info") + Str(Str("k") + Str("v")));
   file += Record(0x80, "reserved");
   // The summary section repeats the schemas and channels.
-  file += Record(0x0F, Le(std::uint32_t{0})) + McapSchema(1, "sensor_msgs/msg/Imu") + McapChannel(3, 1, "/imu") +
-          Record(0x02, Le(std::uint64_t{0}) + Le(std::uint64_t{0}) + Le(std::uint32_t{0})) + kMcapMagic;
+  file += Record(0x0F, Raw(std::uint32_t{0})) + McapSchema(1, "sensor_msgs/msg/Imu") + McapChannel(3, 1, "/imu") +
+          Record(0x02, Raw(std::uint64_t{0}) + Raw(std::uint64_t{0}) + Raw(std::uint32_t{0})) + kMcapMagic;
   return file;
 }
 
@@ -233,55 +190,9 @@ TEST(McapReader, RefusesUnknownChannelsEncodingsAndNonMcapFiles) {
   EXPECT_THAT(ErrorOf(dir, start + Record(0x05, std::string(4, 'x')).substr(0, 9) + "xx"),
               HasSubstr("truncated record at byte " + std::to_string(start.size())));
   // A record whose fields claim more than its body.
-  EXPECT_THAT(ErrorOf(dir, start + Record(0x04, Le(std::uint16_t{1}) + Le(std::uint16_t{1}) + Str("/imu")) + McapEnd()),
-              HasSubstr("Channel record shorter than its fields"));
-}
-
-// rosbag2: metadata.yaml and one SQLite file with the tables rosbag2 writes.
-void Exec(sqlite3* db, const std::string& sql) {
-  ASSERT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK) << sql;
-}
-
-void WriteDb3(const std::string& path, const std::vector<std::pair<std::int64_t, std::string>>& imu,
-              const std::vector<std::pair<std::int64_t, std::string>>& gps, const std::string& gps_format = "cdr") {
-  sqlite3* db = nullptr;
-  ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
-  Exec(db, "PRAGMA journal_mode=WAL");
-  Exec(db,
-       "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL, serialization_format "
-       "TEXT NOT NULL, offered_qos_profiles TEXT NOT NULL)");
-  Exec(db,
-       "CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, timestamp INTEGER NOT NULL, data "
-       "BLOB NOT NULL)");
-  Exec(db, "CREATE INDEX timestamp_idx ON messages (timestamp ASC)");
-  Exec(db, "INSERT INTO topics VALUES (1, '/imu', 'sensor_msgs/msg/Imu', 'cdr', '')");
-  Exec(db, "INSERT INTO topics VALUES (2, '/fix', 'sensor_msgs/msg/NavSatFix', '" + gps_format + "', '')");
-  sqlite3_stmt* insert = nullptr;
-  ASSERT_EQ(
-      sqlite3_prepare_v2(db, "INSERT INTO messages (topic_id, timestamp, data) VALUES (?, ?, ?)", -1, &insert, nullptr),
-      SQLITE_OK);
-  Exec(db, "BEGIN");
-  for (int topic = 1; topic <= 2; ++topic) {
-    for (const auto& [t, data] : topic == 1 ? imu : gps) {
-      sqlite3_bind_int(insert, 1, topic);
-      sqlite3_bind_int64(insert, 2, t);
-      sqlite3_bind_blob(insert, 3, data.data(), static_cast<int>(data.size()), SQLITE_TRANSIENT);
-      ASSERT_EQ(sqlite3_step(insert), SQLITE_DONE);
-      sqlite3_reset(insert);
-    }
-  }
-  Exec(db, "COMMIT");
-  sqlite3_finalize(insert);
-  sqlite3_close(db);
-}
-
-std::string Metadata(const std::string& storage, const std::string& file, const std::string& compression = "",
-                     const std::string& mode = "") {
-  return "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: " + storage +
-         "\n  relative_file_paths:\n    - " + file +
-         "\n  topics_with_message_count:\n    - topic_metadata:\n        name: /imu\n        type: "
-         "sensor_msgs/msg/Imu\n        serialization_format: cdr\n      message_count: 3\n  compression_format: \"" +
-         compression + "\"\n  compression_mode: \"" + mode + "\"\n";
+  EXPECT_THAT(
+      ErrorOf(dir, start + Record(0x04, Raw(std::uint16_t{1}) + Raw(std::uint16_t{1}) + Str("/imu")) + McapEnd()),
+      HasSubstr("Channel record shorter than its fields"));
 }
 
 const std::vector<std::pair<std::int64_t, std::string>> kImu = {{300, Cdr(1)}, {100, Cdr(2)}, {500, Cdr(3, 3)}};
@@ -315,8 +226,8 @@ std::string ReadBytes(const std::string& path) {
 
 TEST(Rosbag2Reader, ReadsTheSqliteBagInTimestampOrderFromItsDirectoryMetadataOrFile) {
   TempDir dir;
-  WriteDb3(dir.File("bag_0.db3"), kImu, kGps);
-  WriteFile(dir.File("metadata.yaml"), Metadata("sqlite3", "bag_0.db3"));
+  ASSERT_TRUE(WriteDb3(dir.File("bag_0.db3"), kImu, kGps).ok());
+  WriteFile(dir.File("metadata.yaml"), Rosbag2Metadata("sqlite3", "bag_0.db3"));
   for (const std::string& path : {dir.path(), dir.File("metadata.yaml"), dir.File("bag_0.db3")}) {
     SCOPED_TRACE(path);
     ExpectSmallSqliteBag(ReadAnyBag(path));
@@ -325,10 +236,10 @@ TEST(Rosbag2Reader, ReadsTheSqliteBagInTimestampOrderFromItsDirectoryMetadataOrF
 
 TEST(Rosbag2Reader, ReadsZstdCompressionByFileAndByMessage) {
   TempDir dir;
-  WriteDb3(dir.File("plain.db3"), kImu, kGps);
+  ASSERT_TRUE(WriteDb3(dir.File("plain.db3"), kImu, kGps).ok());
   WriteFile(dir.File("bag_0.db3.zstd"), Zstd(ReadBytes(dir.File("plain.db3"))));
   std::filesystem::remove(dir.File("plain.db3"));
-  WriteFile(dir.File("metadata.yaml"), Metadata("sqlite3", "bag_0.db3.zstd", "zstd", "FILE"));
+  WriteFile(dir.File("metadata.yaml"), Rosbag2Metadata("sqlite3", "bag_0.db3.zstd", "zstd", "FILE"));
   {
     SCOPED_TRACE("file");
     ExpectSmallSqliteBag(ReadRosbag2(dir.path()));
@@ -337,21 +248,21 @@ TEST(Rosbag2Reader, ReadsZstdCompressionByFileAndByMessage) {
   std::vector<std::pair<std::int64_t, std::string>> gps = kGps;
   for (auto& [t, data] : imu) data = Zstd(data);
   for (auto& [t, data] : gps) data = Zstd(data);
-  WriteDb3(dir.File("bag_0.db3"), imu, gps);
-  WriteFile(dir.File("metadata.yaml"), Metadata("sqlite3", "bag_0.db3", "zstd", "MESSAGE"));
+  ASSERT_TRUE(WriteDb3(dir.File("bag_0.db3"), imu, gps).ok());
+  WriteFile(dir.File("metadata.yaml"), Rosbag2Metadata("sqlite3", "bag_0.db3", "zstd", "MESSAGE"));
   {
     SCOPED_TRACE("message");
     ExpectSmallSqliteBag(ReadRosbag2(dir.path()));
   }
   // Stored uncompressed but declared compressed by message.
   std::filesystem::remove(dir.File("bag_0.db3"));
-  WriteDb3(dir.File("bag_0.db3"), kImu, kGps);
+  ASSERT_TRUE(WriteDb3(dir.File("bag_0.db3"), kImu, kGps).ok());
   EXPECT_EQ(Rosbag2Error(dir.path()),
             dir.File("bag_0.db3") + ": message 0 (topic /imu): not a zstd frame that states its size");
   // A truncated compressed file.
   const std::string compressed = Zstd(ReadBytes(dir.File("bag_0.db3")));
   WriteFile(dir.File("bag_0.db3.zstd"), compressed.substr(0, compressed.size() / 2));
-  WriteFile(dir.File("metadata.yaml"), Metadata("sqlite3", "bag_0.db3.zstd", "zstd", "FILE"));
+  WriteFile(dir.File("metadata.yaml"), Rosbag2Metadata("sqlite3", "bag_0.db3.zstd", "zstd", "FILE"));
   EXPECT_EQ(Rosbag2Error(dir.path()), dir.File("bag_0.db3.zstd") + ": the zstd data ends inside a frame (truncated)");
 }
 
@@ -359,7 +270,7 @@ TEST(Rosbag2Reader, ReadsAnMcapStorageBag) {
   TempDir dir;
   std::vector<Expected> expected;
   WriteFile(dir.File("bag_0.mcap"), SmallMcap(&expected));
-  WriteFile(dir.File("metadata.yaml"), Metadata("mcap", "bag_0.mcap"));
+  WriteFile(dir.File("metadata.yaml"), Rosbag2Metadata("mcap", "bag_0.mcap"));
   const Result<Bag> bag = ReadRosbag2(dir.path());
   ASSERT_TRUE(bag.ok()) << bag.status().message();
   EXPECT_EQ(bag.value().format, "rosbag2 MCAP");
@@ -371,23 +282,23 @@ TEST(Rosbag2Reader, RefusesBadBagsWithOneLineNamingTheFile) {
   TempDir dir;
   EXPECT_EQ(Rosbag2Error(dir.path()),
             dir.path() + ": no metadata.yaml (not a rosbag2 bag directory; one .db3 file of a bag is read alone)");
-  WriteFile(dir.File("metadata.yaml"), Metadata("sqlite3", "bag_0.db3"));
+  WriteFile(dir.File("metadata.yaml"), Rosbag2Metadata("sqlite3", "bag_0.db3"));
   EXPECT_EQ(Rosbag2Error(dir.path()), dir.File("bag_0.db3") + ": no such file");
   WriteFile(dir.File("bag_0.db3"), std::string(4096, '\x01'));
   EXPECT_EQ(Rosbag2Error(dir.path()), dir.File("bag_0.db3") + ": not an SQLite database");
   std::filesystem::remove(dir.File("bag_0.db3"));
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open(dir.File("bag_0.db3").c_str(), &db), SQLITE_OK);
-  Exec(db, "CREATE TABLE other(x INTEGER)");
+  ASSERT_TRUE(SqliteExec(db, "CREATE TABLE other(x INTEGER)").ok());
   sqlite3_close(db);
   EXPECT_EQ(Rosbag2Error(dir.path()), dir.File("bag_0.db3") + ": no 'topics' table (not a rosbag2 database)");
   std::filesystem::remove(dir.File("bag_0.db3"));
-  WriteDb3(dir.File("bag_0.db3"), {{1, Cdr(1)}}, {{2, Cdr(2)}}, "json");
+  ASSERT_TRUE(WriteDb3(dir.File("bag_0.db3"), {{1, Cdr(1)}}, {{2, Cdr(2)}}, "json").ok());
   EXPECT_THAT(Rosbag2Error(dir.path()), HasSubstr("bag_0.db3: topic /fix has serialization format 'json'"));
-  WriteFile(dir.File("metadata.yaml"), Metadata("sqlite3", "bag_0.db3", "lz4", "FILE"));
+  WriteFile(dir.File("metadata.yaml"), Rosbag2Metadata("sqlite3", "bag_0.db3", "lz4", "FILE"));
   EXPECT_THAT(Rosbag2Error(dir.path()),
               HasSubstr("metadata.yaml: compression_format 'lz4' with compression_mode 'FILE', which this reader"));
-  WriteFile(dir.File("metadata.yaml"), Metadata("rosbag_v2", "bag_0.db3"));
+  WriteFile(dir.File("metadata.yaml"), Rosbag2Metadata("rosbag_v2", "bag_0.db3"));
   EXPECT_THAT(Rosbag2Error(dir.path()), HasSubstr("metadata.yaml: storage_identifier 'rosbag_v2'"));
   WriteFile(dir.File("metadata.yaml"), "rosbag2_bagfile_information: [1, 2\n");
   EXPECT_THAT(Rosbag2Error(dir.path()), HasSubstr("metadata.yaml:"));
@@ -453,50 +364,6 @@ TEST(RealBags, McapFixtureWithEveryCommonMessageType) {
     EXPECT_EQ(types["/test/tf2_msgs/tf_message"], "tf2_msgs/TFMessage");
     EXPECT_EQ(types["/test/sensor_msgs/imu"], "sensor_msgs/Imu");
   }
-}
-
-// Speed on ~100 MB bags (run with --gtest_also_run_disabled_tests; prints the times).
-double SecondsToRead(const std::string& path, std::size_t* messages) {
-  const auto start = std::chrono::steady_clock::now();
-  const Result<Bag> bag = ReadAnyBag(path);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  EXPECT_TRUE(bag.ok()) << bag.status().message();
-  *messages = bag.ok() ? bag.value().messages.size() : 0;
-  return seconds;
-}
-
-TEST(BagReaderSpeed, DISABLED_HundredMegabyteBags) {
-  TempDir dir;
-  std::mt19937 random(7);
-  constexpr int kMessages = 300000;  // ~330 bytes each
-  std::string chunk_records;
-  std::size_t uncompressed_bytes = 0;
-  std::string mcap = kMcapMagic + McapHeader() + McapSchema(1, "sensor_msgs/msg/Imu") + McapChannel(1, 1, "/imu");
-  std::vector<std::pair<std::int64_t, std::string>> imu;
-  for (int i = 0; i < kMessages; ++i) {
-    std::string data = Cdr(i, 320);
-    for (int k = 4; k < 320; k += 8) data[k] = static_cast<char>(random());  // not all compressible
-    chunk_records += McapMessage(1, 1000 + i, data);
-    if (chunk_records.size() > (4u << 20) || i + 1 == kMessages) {
-      uncompressed_bytes += chunk_records.size();
-      mcap += McapChunk("zstd", Zstd(chunk_records), chunk_records.size(), Crc32(chunk_records));
-      chunk_records.clear();
-    }
-    imu.emplace_back(1000 + i, std::move(data));
-  }
-  WriteFile(dir.File("big.mcap"), mcap + McapEnd());
-  WriteDb3(dir.File("big.db3"), imu, {});
-  std::size_t messages = 0;
-  const double mcap_s = SecondsToRead(dir.File("big.mcap"), &messages);
-  EXPECT_EQ(messages, static_cast<std::size_t>(kMessages));
-  std::printf("MCAP of %.1f MB records (zstd chunks, file %.1f MB): %zu messages in %.2f s\n",
-              uncompressed_bytes * 1e-6, std::filesystem::file_size(dir.File("big.mcap")) * 1e-6, messages, mcap_s);
-  const double db3_s = SecondsToRead(dir.File("big.db3"), &messages);
-  EXPECT_EQ(messages, static_cast<std::size_t>(kMessages));
-  std::printf("rosbag2 .db3 %.1f MB: %zu messages in %.2f s\n", std::filesystem::file_size(dir.File("big.db3")) * 1e-6,
-              messages, db3_s);
-  EXPECT_LT(mcap_s, 10.0);
-  EXPECT_LT(db3_s, 10.0);
 }
 
 }  // namespace

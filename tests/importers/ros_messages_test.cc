@@ -7,7 +7,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "tests/importers/message_writer.h"
+#include "tests/support/message_writer.h"
 
 namespace roamlab::importers::internal {
 namespace {

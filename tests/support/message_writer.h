@@ -1,6 +1,6 @@
-// Test helper: ROS messages serialized by hand, in ROS 1 (packed little-endian, u32-length strings) or CDR (a 4-byte
-// encapsulation header, then each primitive aligned to its size from the byte after it; strings count a trailing NUL),
-// written from the formats' documentation rather than from the reader under test.
+// Test and benchmark helper: ROS messages serialized by hand, in ROS 1 (packed little-endian, u32-length strings)
+// or CDR (a 4-byte encapsulation header, then each primitive aligned to its size from the byte after it; strings
+// count a trailing NUL), written from the formats' documentation rather than from the reader under test.
 #pragma once
 
 #include <algorithm>
@@ -62,14 +62,20 @@ class MessageWriter {
 };
 
 // The messages of the tests, each with distinct values the decoders must return.
-inline std::string ImuMessage(Wire wire, std::int32_t sec, std::uint32_t nsec, double wz) {
+// An IMU sample: angular velocity `w_xyz` [rad/s], linear acceleration `a_xyz` [m/s^2], gyro sigma 0.02 rad/s, accel
+// sigma 0.1 m/s^2, an identity orientation without covariance.
+inline std::string ImuMessage(Wire wire, std::int32_t sec, std::uint32_t nsec, const std::vector<double>& w_xyz,
+                              const std::vector<double>& a_xyz) {
   std::vector<double> cov_w(9, 0.0), cov_a(9, 0.0);
-  cov_w[0] = cov_w[4] = cov_w[8] = 0.0004;  // gyro sigma 0.02 rad/s
-  cov_a[0] = cov_a[4] = cov_a[8] = 0.01;    // accel sigma 0.1 m/s^2
+  cov_w[0] = cov_w[4] = cov_w[8] = 0.0004;
+  cov_a[0] = cov_a[4] = cov_a[8] = 0.01;
   MessageWriter w(wire);
   w.Header(sec, nsec, "imu_link").Doubles({0, 0, 0, 1}).Doubles(std::vector<double>(9, 0.0));
-  w.Doubles({0.01, wz, -0.02}).Doubles(cov_w).Doubles({0.1, 9.81, 0.2}).Doubles(cov_a);
+  w.Doubles(w_xyz).Doubles(cov_w).Doubles(a_xyz).Doubles(cov_a);
   return w.bytes();
+}
+inline std::string ImuMessage(Wire wire, std::int32_t sec, std::uint32_t nsec, double wz) {
+  return ImuMessage(wire, sec, nsec, {0.01, wz, -0.02}, {0.1, 9.81, 0.2});
 }
 inline std::string FixMessage(Wire wire, std::int32_t sec, std::uint32_t nsec, std::int8_t status, double lat) {
   std::vector<double> cov(9, 0.0);
