@@ -218,9 +218,13 @@ Outcome EvaluateRecording(const OdometryEvaluateOptions& options, const std::vec
   Result<odo::WheelKinematics> nominal = odo::NominalKinematics(rec.value().platform, seq.value().wheels);
   if (!nominal.ok()) return Bad(dir + ": " + nominal.status().message());
   std::vector<Evaluated> evaluated;
-  evaluated.push_back(
-      {"nominal", odo::PredictTrajectory([&](const Eigen::VectorXd& d) { return nominal.value().Displacement(d); },
-                                         delta, reference.front())});
+  evaluated.push_back({"nominal",
+                       odo::PredictTrajectory([&](const Eigen::VectorXd& d) { return nominal.value().Displacement(d); },
+                                              delta, reference.front()),
+                       {},
+                       {},
+                       {},
+                       {}});
   for (std::size_t i = 0; i < models.size(); ++i) {
     const odo::OdometryModel& model = models[i];
     if (model.wheels != seq.value().wheels)
@@ -229,7 +233,11 @@ Outcome EvaluateRecording(const OdometryEvaluateOptions& options, const std::vec
       return Bad(options.models[i] + ": all models must share one key interval");
     evaluated.push_back(
         {DescribeOdometryModel(model) + " [" + fs::path(options.models[i]).filename().string() + "]",
-         odo::PredictTrajectory([&](const Eigen::VectorXd& d) { return model.Predict(d); }, delta, reference.front())});
+         odo::PredictTrajectory([&](const Eigen::VectorXd& d) { return model.Predict(d); }, delta, reference.front()),
+         {},
+         {},
+         {},
+         {}});
   }
 
   // Errors, the recording's rows and its figure.
