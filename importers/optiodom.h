@@ -5,12 +5,12 @@
 //   <set>_run-NN.csv       t [s], x [m], y [m], theta [rad], then per control cycle that ends at t:
 //                          diff: ticks of the right, left wheels; omni3: ticks of wheels 1, 2, 3; omni4: ticks of
 //                          wheels 1-4; tricyc: ticks of the front wheel, then the steering angle [rad] (the measured
-//                          angle, not a count; positive turns the robot counter-clockwise)
+//                          angle in steps of pi/400, not a count; positive turns the robot counter-clockwise)
 //   <set>_metadata.csv     key, values...: type (diff | omni3 | omni4 | tricyc), ngear (gear ratio), encRes (ticks
 //                          per motor revolution), Li [m] (diff: axle track; omni3: wheel distance from the centre;
 //                          omni4: l1 l2, the front-to-back and left-to-right distances between the wheels; tricyc:
-//                          front wheel to rear axle), Di [m] (wheel diameters, one per wheel in column order: 2, 3, 4,
-//                          1), Thi (tricyc: the steering offset [rad], any sign; required; empty for the others); N,
+//                          front wheel to rear axle), Di [m] (wheel diameters in column order: 2 diff, 3 omni3, 4
+//                          omni4, 1 tricyc), Thi (tricyc: the steering offset [rad], any sign; required; empty for the others); N,
 //                          L, imarkers, gt_ti, gt_tf, odo_ti, odo_tf are accepted and not used; other keys, a wrong
 //                          number of Li or Di values, or a missing key are errors
 // The recording written (recording.h):
@@ -21,14 +21,15 @@
 //                        body x axis, a positive tick count turning the robot clockwise: direction -1; read off a
 //                        least-squares fit of motion-capture displacements on the ticks of the circular runs);
 //                        omni4: wheelbase_m (l1), track_m (l2): wheels 1-4 are front_left, front_right, rear_left,
-//                        rear_right at (+-l1/2, +-l2/2), rollers at 45 deg (the X layout), a positive tick count
+//                        rear_right at (+-l1/2, +-l2/2), turned 45 deg (the X layout), a positive tick count
 //                        turning the robot clockwise; per positive wheel revolution the rim pushes the body along
 //                        (1, -1)/sqrt 2, (-1, -1)/sqrt 2, (1, 1)/sqrt 2, (-1, 1)/sqrt 2 (recording/wheel_kinematics.h,
 //                        omni4). Read off a least-squares fit of the motion-capture displacements (body frame, 0.2 s
 //                        steps) on the ticks of all circular and square runs: rim travel = (0.89, -0.93, -0.183),
 //                        (-0.89, -0.94, -0.182), (0.89, 0.93, -0.183), (-0.89, 0.93, -0.183) . (dx, dy, dtheta):
 //                        directions at 45 deg and a lever of 0.1414 |d| = (l1 + l2) / (2 sqrt 2) |d|, with |d| = 1.29,
-//                        not 1: the real rims travel about 1.29 times the nominal pi Di per counted revolution;
+//                        not 1: a counted revolution moves the contact point by about pi Di / 1.29 (an effective
+//                        radius near 0.023 m, not the nominal 0.03 m; that is the learner's to find);
 //                        tricycle: wheel_to_axle_m (Li), steering_offset_rad (Thi). The steering angle's sign (positive:
 //                        counter-clockwise) was read off the same kind of fit: yaw increments against
 //                        rim travel x sin(steering + offset) over the circular and square runs
