@@ -10,9 +10,9 @@
 //                          per motor revolution), Li [m] (diff: axle track; omni3: wheel distance from the centre;
 //                          omni4: l1 l2, the front-to-back and left-to-right distances between the wheels; tricyc:
 //                          front wheel to rear axle), Di [m] (wheel diameters in column order: 2 diff, 3 omni3, 4
-//                          omni4, 1 tricyc), Thi (tricyc: the steering offset [rad], any sign; required; empty for the others); N,
-//                          L, imarkers, gt_ti, gt_tf, odo_ti, odo_tf are accepted and not used; other keys, a wrong
-//                          number of Li or Di values, or a missing key are errors
+//                          omni4, 1 tricyc), Thi (tricyc: the steering offset [rad], any sign; required; empty
+//                          for the others); N, L, imarkers, gt_ti, gt_tf, odo_ti, odo_tf are accepted and not
+//                          used; other keys, a wrong number of Li or Di values, or a missing key are errors
 // The recording written (recording.h):
 //   platform.kind        differential_drive | omni3 | omni4 | tricycle
 //   platform.geometry    gear_ratio, encoder_ticks_per_motor_revolution, wheel_radius_<wheel>_m (Di / 2), and
