@@ -30,9 +30,9 @@
 //                        directions at 45 deg and a lever of 0.1414 |d| = (l1 + l2) / (2 sqrt 2) |d|, with |d| = 1.29,
 //                        not 1: a counted revolution moves the contact point by about pi Di / 1.29 (an effective
 //                        radius near 0.023 m, not the nominal 0.03 m; that is the learner's to find);
-//                        tricycle: wheel_to_axle_m (Li), steering_offset_rad (Thi). The steering angle's sign (positive:
-//                        counter-clockwise) was read off the same kind of fit: yaw increments against
-//                        rim travel x sin(steering + offset) over the circular and square runs
+//                        tricycle: wheel_to_axle_m (Li), steering_offset_rad (Thi). The steering angle's sign
+//                        (positive: counter-clockwise) was read off the same kind of fit: yaw increments against rim
+//                        travel x sin(steering + offset) over the circular and square runs
 //   wheel_encoders       stream `wheel_encoders`, columns right, left | w1, w2, w3 | front_left, front_right,
 //                        rear_left, rear_right | front: cumulative wheel angle [rad]
 //                        = 2 pi (running sum of ticks) / (ngear encRes); attributes.ticks_per_revolution = ngear encRes
