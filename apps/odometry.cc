@@ -26,12 +26,13 @@ void PrintLearned(const experiment::LearnedOdometry& learned, const std::string&
 }
 
 void PrintTable(const json& table) {
-  std::printf("%-12s %-8s %-11s %10s %10s\n", "model", "mean", "kernel", "ATE [m]", "RPE [mm]");
+  std::printf("%-12s %-8s %-11s %10s %10s %10s %10s\n", "model", "mean", "kernel", "ATE [m]", "RPE [mm]", "ATE [deg]",
+              "RPE [deg]");
   for (const json& row : table["rows"]) {
-    std::printf("%-12s %-8s %-11s %10.4f %10.3f\n", row["model"].get<std::string>().c_str(),
+    std::printf("%-12s %-8s %-11s %10.4f %10.3f %10.3f %10.4f\n", row["model"].get<std::string>().c_str(),
                 row["mean"].is_null() ? "-" : row["mean"].get<std::string>().c_str(),
                 row["kernel"].is_null() ? "-" : row["kernel"].get<std::string>().c_str(), row["ate_m"].get<double>(),
-                row["rpe_mm"].get<double>());
+                row["rpe_mm"].get<double>(), row["ate_deg"].get<double>(), row["rpe_deg"].get<double>());
   }
 }
 

@@ -92,6 +92,29 @@ const std::vector<ModelSpec>& ModelSpecs() {
        {},
        true,
        {}},
+      // Four-wheel omni (X layout): radii and the wheelbase + track sum, NaN: from the platform geometry
+      // (models/omni4_drive.h).
+      {"omni4_drive",
+       {""},
+       {"wheel_radps", "vertical_mps", "tilt_radps"},
+       {ScalarSlot("radius_0", std::numeric_limits<double>::quiet_NaN()),
+        ScalarSlot("radius_1", std::numeric_limits<double>::quiet_NaN()),
+        ScalarSlot("radius_2", std::numeric_limits<double>::quiet_NaN()),
+        ScalarSlot("radius_3", std::numeric_limits<double>::quiet_NaN()),
+        ScalarSlot("wheelbase_plus_track", std::numeric_limits<double>::quiet_NaN())},
+       {},
+       true,
+       {}},
+      // Tricycle: the front wheel's encoder and its steering angle; radius and wheel_to_axle NaN (from the platform
+      // geometry), steering_offset from geometry.steering_offset_rad when present, else 0 (models/tricycle_drive.h).
+      {"tricycle_drive",
+       {"wheel", "steering"},
+       {"wheel_radps", "steering_rad", "lateral_mps", "vertical_mps", "tilt_radps"},
+       {ScalarSlot("radius", std::numeric_limits<double>::quiet_NaN()),
+        ScalarSlot("wheel_to_axle", std::numeric_limits<double>::quiet_NaN()), ScalarSlot("steering_offset", 0.0)},
+       {},
+       true,
+       {}},
       {"odometer",
        {""},
        {"linear_mps", "angular_radps"},
@@ -404,7 +427,7 @@ class Parser {
     if (!FindModelSpec(c.streams[c.master].model)->odometric)
       Fail(root["master"], "master stream '" + c.master +
                                "' must use an odometric model (ackermann, ackermann_seed, differential_drive, "
-                               "omni3_drive, mecanum_drive or odometer)");
+                               "omni3_drive, mecanum_drive, omni4_drive, tricycle_drive or odometer)");
     if (root["parameters"]) {
       if (!root["parameters"].IsMap()) Fail(root["parameters"], "parameters must be a mapping");
       for (const auto& kv : root["parameters"]) {

@@ -3,7 +3,7 @@
 // pose nodes, the solver, outlier gating, the online window and the offline calibration stages.
 //
 //   master: odometer                       # a stream whose model is ackermann, ackermann_seed, differential_drive,
-//                                          # omni3_drive, mecanum_drive or odometer
+//                                          # omni3_drive, mecanum_drive, omni4_drive, tricycle_drive or odometer
 //   solver: {method: levenberg_marquardt, max_iterations: 50, function_tolerance: 1.0e-8, step_tolerance: 1.0e-10}
 //   gating: {probability: 0.99999}         # chi-square gate on whitened errors; omit to disable
 //   tracking: {window: 40, max_iterations: 10, improvement_threshold: 1.0e-3, time_budget_s: 0.05,

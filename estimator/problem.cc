@@ -22,8 +22,10 @@
 #include "estimator/models/mecanum_drive.h"
 #include "estimator/models/odometer.h"
 #include "estimator/models/omni3_drive.h"
+#include "estimator/models/omni4_drive.h"
 #include "estimator/models/prior.h"
 #include "estimator/models/process.h"
+#include "estimator/models/tricycle_drive.h"
 
 namespace roamlab::estimator {
 
@@ -65,9 +67,9 @@ int ProblemBuilder::ResidualDim(const std::string& stream) const {
     if (s.name == stream) {
       const std::string& m = s.config.model;
       if (m == "ackermann") return 4;
-      if (m == "mecanum_drive") return 7;
+      if (m == "mecanum_drive" || m == "omni4_drive") return 7;
       return (m == "ackermann_seed" || m == "odometer" || m == "relative_motion" || m == "absolute_pose" ||
-              m == "differential_drive" || m == "omni3_drive")
+              m == "differential_drive" || m == "omni3_drive" || m == "tricycle_drive")
                  ? 6
                  : 3;
     }
@@ -106,6 +108,11 @@ std::optional<Eigen::VectorXd> WheelRates(const recording::Stream& s, int row) {
   if (row + 1 >= static_cast<int>(s.t.size())) return std::nullopt;
   const double dt = SecondsBetween(s.t[row], s.t[row + 1]);
   return Eigen::VectorXd((s.values.row(row + 1) - s.values.row(row)).transpose() / dt);
+}
+
+// A tricycle's steering angle over [t_row, t_row+1] of its wheel stream: the mean of the interval's ends.
+double IntervalSteering(const StreamBinding& s, int row) {
+  return 0.5 * (SteeringAt(*s.steering, s.primary->t[row]) + SteeringAt(*s.steering, s.primary->t[row + 1]));
 }
 
 // A differential drive's (left, right) wheel rates, whatever the order of the stream's columns.
@@ -291,6 +298,16 @@ void ProblemBuilder::AddMasterSample(const MeasurementRef& m) {
       Omni3DriveError::BodyVelocity(*rates, Eigen::Vector3d(value(0)[0], value(1)[0], value(2)[0]), value(3)[0],
                                     &v_body, &omega_body);
     }
+  } else if (s.config.model == "omni4_drive") {
+    if (const auto rates = WheelRates(*s.primary, odo.row)) {
+      Omni4DriveError::BodyVelocity(*rates, Eigen::Vector4d(value(0)[0], value(1)[0], value(2)[0], value(3)[0]),
+                                    value(4)[0], &v_body, &omega_body);
+    }
+  } else if (s.config.model == "tricycle_drive") {
+    if (const auto rates = WheelRates(*s.primary, odo.row)) {
+      TricycleDriveError::BodyVelocity((*rates)[0], IntervalSteering(s, odo.row), value(0)[0], value(1)[0], value(2)[0],
+                                       &v_body, &omega_body);
+    }
   } else if (s.config.model == "mecanum_drive") {
     if (const auto rates = WheelRates(*s.primary, odo.row)) {
       MecanumDriveError::BodyVelocity(*rates, Eigen::Vector4d(value(0)[0], value(1)[0], value(2)[0], value(3)[0]),
@@ -388,7 +405,15 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     const auto [harmonics_left, harmonics_right] = LeftRightHarmonics(s, m.row);
     factor = MakeFactor(DifferentialDriveError((*rates)[0], (*rates)[1], dt, harmonics_left, harmonics_right));
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k), slot(3, k), slot(4, k), slot(5, k)};
-  } else if (model == "omni3_drive" || model == "mecanum_drive") {
+  } else if (model == "tricycle_drive") {
+    const auto rates = WheelRates(data, m.row);
+    if (!rates) {
+      ++counts_[s.name].outside;
+      return true;
+    }
+    factor = MakeFactor(TricycleDriveError((*rates)[0], IntervalSteering(s, m.row), dt));
+    vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k)};
+  } else if (model == "omni3_drive" || model == "mecanum_drive" || model == "omni4_drive") {
     const auto rates = WheelRates(data, m.row);
     if (!rates) {
       ++counts_[s.name].outside;
@@ -397,6 +422,9 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k), slot(3, k)};
     if (model == "omni3_drive") {
       factor = MakeFactor(Omni3DriveError(*rates, dt));
+    } else if (model == "omni4_drive") {
+      factor = MakeFactor(Omni4DriveError(*rates, dt));
+      vars.push_back(slot(4, k));
     } else {
       factor = MakeFactor(MecanumDriveError(*rates, dt));
       vars.push_back(slot(4, k));

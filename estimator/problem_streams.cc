@@ -18,7 +18,8 @@ Attachment AttachmentOf(const std::string& model, bool master) {
   if (master) return Attachment::kMaster;
   if (model == "relative_motion") return Attachment::kInterval;
   if (model == "gyroscope" || model == "linear_velocity" || model == "odometer" || model == "ackermann" ||
-      model == "ackermann_seed" || model == "differential_drive" || model == "omni3_drive" || model == "mecanum_drive")
+      model == "ackermann_seed" || model == "differential_drive" || model == "omni3_drive" ||
+      model == "mecanum_drive" || model == "omni4_drive" || model == "tricycle_drive")
     return Attachment::kPair;
   if (model == "accelerometer") return Attachment::kTriple;
   return Attachment::kOnePose;
@@ -66,7 +67,11 @@ Eigen::MatrixXd NoiseCovariance(const StreamBinding& s) {
     sigma.resize(6);
     sigma << n.at("wheel_radps"), n.at("wheel_radps"), n.at("lateral_mps"), n.at("vertical_mps"), n.at("tilt_radps"),
         n.at("tilt_radps");
-  } else if (m == "omni3_drive" || m == "mecanum_drive") {
+  } else if (m == "tricycle_drive") {
+    sigma.resize(6);
+    sigma << n.at("wheel_radps"), n.at("steering_rad"), n.at("lateral_mps"), n.at("vertical_mps"), n.at("tilt_radps"),
+        n.at("tilt_radps");
+  } else if (m == "omni3_drive" || m == "mecanum_drive" || m == "omni4_drive") {
     const int wheels = m == "omni3_drive" ? 3 : 4;
     sigma.resize(wheels + 3);
     sigma << Eigen::VectorXd::Constant(wheels, n.at("wheel_radps")), n.at("vertical_mps"), n.at("tilt_radps"),
@@ -138,7 +143,7 @@ Status BindOtherModel(const EstimatorConfig& config, const recording::Recording&
   const std::string& name = b->name;
   const StreamConfig& sc = b->config;
   const std::string& m = sc.model;
-  const std::string& source = sc.sources.at("");
+  const std::string& source = b->primary->info.name;
   const StreamType type = b->primary->info.type;
   if (m == "gyroscope") {
     if (!TypeIn(type, {StreamType::kImu, StreamType::kGyroscope})) return Error(config, bad_type);
@@ -175,7 +180,17 @@ Status BindOtherModel(const EstimatorConfig& config, const recording::Recording&
       return Error(config, "stream '" + name + "': differential_drive source '" + source +
                                "' must hold two cumulative wheel angles (left, right) in rad or ticks");
     b->right_then_left = b->primary->info.columns == std::vector<std::string>{"right", "left"};
-  } else if (m == "omni3_drive" || m == "mecanum_drive") {
+  } else if (m == "tricycle_drive") {
+    if (type != StreamType::kWheelEncoders) return Error(config, bad_type);
+    if (b->primary->info.units != "rad" || b->primary->values.cols() != 1)
+      return Error(config, "stream '" + name + "': tricycle_drive wheel source '" + source +
+                               "' must hold one cumulative wheel angle in rad");
+    const std::string& steering = sc.sources.at("steering");
+    b->steering = rec.Find(steering);
+    if (b->steering == nullptr || b->steering->info.type != StreamType::kSteering || b->steering->t.empty())
+      return Error(config, "stream '" + name + "': steering source '" + steering +
+                               "' is missing, empty or not a steering stream");
+  } else if (m == "omni3_drive" || m == "mecanum_drive" || m == "omni4_drive") {
     const int wheels = m == "omni3_drive" ? 3 : 4;
     if (type != StreamType::kWheelEncoders) return Error(config, bad_type);
     if (b->primary->info.units != "rad" || b->primary->values.cols() != wheels)
@@ -229,7 +244,7 @@ Result<StreamBinding> BindStream(const EstimatorConfig& config, const recording:
   b.spec = FindModelSpec(sc.model);
   b.attachment = AttachmentOf(sc.model, name == config.master);
   const bool ackermann = sc.model == "ackermann" || sc.model == "ackermann_seed";
-  const std::string primary_role = ackermann ? "speed" : "";
+  const std::string primary_role = ackermann ? "speed" : sc.model == "tricycle_drive" ? "wheel" : "";
   const std::string& source = sc.sources.at(primary_role);
   b.primary = rec.Find(source);
   if (b.primary == nullptr)
@@ -266,22 +281,31 @@ Status AddSlotParameters(const EstimatorConfig& config, const recording::Recordi
     parameter_manifold->emplace(pname, slot.manifold);
     Eigen::VectorXd init = slot.default_value;
     if (ackermann && slot.name == "kv_over_L") init[0] = 1.0 / b->wheelbase_m;
-    if ((m == "differential_drive" || m == "omni3_drive" || m == "mecanum_drive") && std::isnan(init[0])) {
+    if (m == "tricycle_drive" && slot.name == "steering_offset") {
+      const auto g = rec.platform.geometry.find("steering_offset_rad");
+      if (g != rec.platform.geometry.end()) init[0] = g->second;
+    }
+    if ((m == "differential_drive" || m == "omni3_drive" || m == "mecanum_drive" || m == "omni4_drive" ||
+         m == "tricycle_drive") &&
+        std::isnan(init[0])) {
       // The geometry slots (default NaN): radii from wheel_radius_m; the other slot from its geometry key
-      // (lx_plus_ly: the sum of two keys).
+      // (lx_plus_ly, wheelbase_plus_track: the sum of two keys).
       std::string key = "wheel_radius_m";
       if (slot.name == "baseline") key = "baseline_m";
       if (slot.name == "distance") key = "wheel_distance_m";
       if (slot.name == "lx_plus_ly") key = "half_length_m";
+      if (slot.name == "wheelbase_plus_track") key = "wheelbase_m";
+      if (slot.name == "wheel_to_axle") key = "wheel_to_axle_m";
       const auto g = rec.platform.geometry.find(key);
       if (g == rec.platform.geometry.end() && !(config.parameters.count(pname) && config.parameters.at(pname).value))
         return Error(config, "stream '" + name + "': no parameters." + pname + ".value and no " + key +
                                  " in the recording's platform");
       if (g != rec.platform.geometry.end()) init[0] = g->second;
-      if (slot.name == "lx_plus_ly" && g != rec.platform.geometry.end()) {
-        const auto width = rec.platform.geometry.find("half_width_m");
+      if ((slot.name == "lx_plus_ly" || slot.name == "wheelbase_plus_track") && g != rec.platform.geometry.end()) {
+        const std::string second = slot.name == "lx_plus_ly" ? "half_width_m" : "track_m";
+        const auto width = rec.platform.geometry.find(second);
         if (width == rec.platform.geometry.end())
-          return Error(config, "stream '" + name + "': no half_width_m in the recording's platform");
+          return Error(config, "stream '" + name + "': no " + second + " in the recording's platform");
         init[0] += width->second;
       }
     }

@@ -1,6 +1,7 @@
 #include "experiment/odometry.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -144,16 +145,21 @@ Outcome ReadTrainingSet(const OdometryLearnOptions& options, odo::TrainingSet* d
 struct Evaluated {
   std::string label;
   std::vector<odo::Pose2> poses;
-  std::vector<double> absolute;
-  std::vector<double> relative;
+  std::vector<double> absolute, relative;                  // [m]
+  std::vector<double> absolute_heading, relative_heading;  // [rad]
 };
 
-json Row(const std::string& model, const std::string& mean, const std::string& kernel, double ate_m, double rpe_m) {
+// One table row; `errors` holds the model's absolute and relative translation [m] and heading [rad] errors.
+json Row(const std::string& model, const std::string& mean, const std::string& kernel,
+         const std::array<const std::vector<double>*, 4>& errors) {
+  constexpr double kDegree = 57.295779513082320877;
   return {{"model", model},
           {"mean", mean == "-" ? json(nullptr) : json(mean)},
           {"kernel", kernel == "-" ? json(nullptr) : json(kernel)},
-          {"ate_m", ate_m},
-          {"rpe_mm", 1000.0 * rpe_m}};
+          {"ate_m", odo::RootMeanSquare(*errors[0])},
+          {"rpe_mm", 1000.0 * odo::RootMeanSquare(*errors[1])},
+          {"ate_deg", kDegree * odo::RootMeanSquare(*errors[2])},
+          {"rpe_deg", kDegree * odo::RootMeanSquare(*errors[3])}};
 }
 
 // Key times of the first model's interval where the reference exists: the reference poses and the wheel-angle
@@ -178,7 +184,17 @@ Outcome ReferenceAtKeyTimes(const recording::Recording& rec, const std::string& 
 
 // Pooled errors over the recordings: index 0 = nominal, then the models in order.
 struct Pooled {
-  std::vector<std::vector<double>> absolute, relative;
+  std::vector<std::vector<double>> absolute, relative, absolute_heading, relative_heading;
+
+  void Add(std::size_t i, const Evaluated& e) {
+    absolute[i].insert(absolute[i].end(), e.absolute.begin(), e.absolute.end());
+    relative[i].insert(relative[i].end(), e.relative.begin(), e.relative.end());
+    absolute_heading[i].insert(absolute_heading[i].end(), e.absolute_heading.begin(), e.absolute_heading.end());
+    relative_heading[i].insert(relative_heading[i].end(), e.relative_heading.begin(), e.relative_heading.end());
+  }
+  std::array<const std::vector<double>*, 4> Errors(std::size_t i) const {
+    return {&absolute[i], &relative[i], &absolute_heading[i], &relative_heading[i]};
+  }
 };
 
 // Dead-reckons recording `r` with the nominal model and every model; adds its errors to `pooled` and its row to
@@ -206,6 +222,8 @@ Outcome EvaluateRecording(const OdometryEvaluateOptions& options, const std::vec
                        odo::PredictTrajectory([&](const Eigen::VectorXd& d) { return nominal.value().Displacement(d); },
                                               delta, reference.front()),
                        {},
+                       {},
+                       {},
                        {}});
   for (std::size_t i = 0; i < models.size(); ++i) {
     const odo::OdometryModel& model = models[i];
@@ -217,6 +235,8 @@ Outcome EvaluateRecording(const OdometryEvaluateOptions& options, const std::vec
         {DescribeOdometryModel(model) + " [" + fs::path(options.models[i]).filename().string() + "]",
          odo::PredictTrajectory([&](const Eigen::VectorXd& d) { return model.Predict(d); }, delta, reference.front()),
          {},
+         {},
+         {},
          {}});
   }
 
@@ -226,11 +246,12 @@ Outcome EvaluateRecording(const OdometryEvaluateOptions& options, const std::vec
     Evaluated& e = evaluated[i];
     e.absolute = odo::AbsoluteErrors(e.poses, reference);
     e.relative = odo::RelativeErrors(e.poses, reference);
-    pooled->absolute[i].insert(pooled->absolute[i].end(), e.absolute.begin(), e.absolute.end());
-    pooled->relative[i].insert(pooled->relative[i].end(), e.relative.begin(), e.relative.end());
+    e.absolute_heading = odo::AbsoluteHeadingErrors(e.poses, reference);
+    e.relative_heading = odo::RelativeHeadingErrors(e.poses, reference);
+    pooled->Add(i, e);
     const std::string kind = i == 0 ? "nominal" : odo::ModelKindName(models[i - 1].kind);
     json row = Row(kind, i == 0 ? "-" : models[i - 1].MeanLabel(), i == 0 ? "-" : models[i - 1].KernelLabel(),
-                   odo::RootMeanSquare(e.absolute), odo::RootMeanSquare(e.relative));
+                   {&e.absolute, &e.relative, &e.absolute_heading, &e.relative_heading});
     if (i > 0) row["model_file"] = options.models[i - 1];
     rows_json.push_back(row);
   }
@@ -253,11 +274,10 @@ json PooledTable(const OdometryEvaluateOptions& options, const std::vector<odo::
                  const Pooled& pooled, const json& per_recording) {
   json table;
   table["rows"] = json::array();
-  table["rows"].push_back(
-      Row("nominal", "-", "-", odo::RootMeanSquare(pooled.absolute[0]), odo::RootMeanSquare(pooled.relative[0])));
+  table["rows"].push_back(Row("nominal", "-", "-", pooled.Errors(0)));
   for (std::size_t i = 0; i < models.size(); ++i) {
-    json row = Row(odo::ModelKindName(models[i].kind), models[i].MeanLabel(), models[i].KernelLabel(),
-                   odo::RootMeanSquare(pooled.absolute[i + 1]), odo::RootMeanSquare(pooled.relative[i + 1]));
+    json row =
+        Row(odo::ModelKindName(models[i].kind), models[i].MeanLabel(), models[i].KernelLabel(), pooled.Errors(i + 1));
     row["model_file"] = options.models[i];
     table["rows"].push_back(row);
   }
@@ -312,8 +332,8 @@ Outcome EvaluateOdometry(const OdometryEvaluateOptions& options, json* table) {
   const bool plots = options.plots && eval::GnuplotAvailable();
   if (options.plots && !plots && options.log) options.log("gnuplot not found, no figures");
 
-  Pooled pooled{std::vector<std::vector<double>>(models.size() + 1),
-                std::vector<std::vector<double>>(models.size() + 1)};
+  const std::vector<std::vector<double>> empty(models.size() + 1);
+  Pooled pooled{empty, empty, empty, empty};
   json per_recording = json::array();
   for (std::size_t r = 0; r < options.recordings.size(); ++r)
     if (Outcome o = EvaluateRecording(options, models, r, plots, &pooled, &per_recording); !o.ok()) return o;

@@ -16,7 +16,7 @@ Eigen::Vector3d WheelKinematics::TwistFromRates(const Eigen::VectorXd& rates_rad
 }
 
 bool IsWheeledPlatform(const std::string& kind) {
-  return kind == "differential_drive" || kind == "omni3" || kind == "mecanum";
+  return kind == "differential_drive" || kind == "omni3" || kind == "mecanum" || kind == "omni4";
 }
 
 Eigen::Matrix3d Omni3RatesFromTwist(const Eigen::Vector3d& radii_m, double distance_m) {
@@ -36,6 +36,21 @@ Eigen::Matrix<double, 4, 3> MecanumRatesFromTwist(const Eigen::Vector4d& radii_m
   Eigen::Matrix<double, 4, 3> J;
   for (int i = 0; i < 4; ++i) J.row(i) << 1.0 / radii_m[i], s_y[i] / radii_m[i], s_w[i] * lx_plus_ly_m / radii_m[i];
   return J;
+}
+
+Eigen::Matrix<double, 4, 3> Omni4RatesFromTwist(const Eigen::Vector4d& radii_m, double wheelbase_m, double track_m) {
+  const double c = 1.0 / std::sqrt(2.0);
+  const double lever = (wheelbase_m + track_m) * c / 2.0;
+  // Rolling directions (x, y) of front left, front right, rear left, rear right.
+  const double d[4][2] = {{c, -c}, {-c, -c}, {c, c}, {-c, c}};
+  Eigen::Matrix<double, 4, 3> J;
+  for (int i = 0; i < 4; ++i) J.row(i) << d[i][0] / radii_m[i], d[i][1] / radii_m[i], -lever / radii_m[i];
+  return J;
+}
+
+Eigen::Vector3d TricycleTwist(double wheel_rate_radps, double steering_rad, double radius_m, double wheel_to_axle_m) {
+  const double rim_mps = radius_m * wheel_rate_radps;
+  return Eigen::Vector3d(rim_mps * std::cos(steering_rad), 0.0, rim_mps * std::sin(steering_rad) / wheel_to_axle_m);
 }
 
 Result<WheelKinematics> NominalWheelKinematics(const Platform& platform) {
@@ -74,8 +89,17 @@ Result<WheelKinematics> NominalWheelKinematics(const Platform& platform) {
     k.holonomic = true;
     return k;
   }
+  if (platform.kind == "omni4") {
+    double r = 0.0, wheelbase = 0.0, track = 0.0;
+    if (Status s = get("wheel_radius_m", &r); !s.ok()) return s;
+    if (Status s = get("wheelbase_m", &wheelbase); !s.ok()) return s;
+    if (Status s = get("track_m", &track); !s.ok()) return s;
+    k.J_rates_twist = Omni4RatesFromTwist(Eigen::Vector4d::Constant(r), wheelbase, track);
+    k.holonomic = true;
+    return k;
+  }
   return Status::Error("platform kind '" + platform.kind +
-                       "' has no wheel kinematics (supported: differential_drive, omni3, mecanum)");
+                       "' has no wheel kinematics (supported: differential_drive, omni3, mecanum, omni4)");
 }
 
 }  // namespace roamlab::recording

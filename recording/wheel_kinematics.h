@@ -20,6 +20,15 @@
 //                        X layout (models/mecanum.xml): with K = lx + ly
 //                        omega_0 = (v_x - v_y - K omega_z) / r,  omega_1 = (v_x + v_y + K omega_z) / r,
 //                        omega_2 = (v_x + v_y - K omega_z) / r,  omega_3 = (v_x - v_y + K omega_z) / r
+//   omni4                geometry: wheel_radius_m, wheelbase_m (l1, front to back), track_m (l2, left to right);
+//                        wheels 0-3 front left, front right, rear left, rear right at (+-l1/2, +-l2/2), omni rollers,
+//                        the wheels turned 45 deg (the X layout of the OptiOdom robot), a positive rotation turning
+//                        the robot clockwise: d_0 = (1, -1)/sqrt 2, d_1 = (-1, -1)/sqrt 2, d_2 = (1, 1)/sqrt 2,
+//                        d_3 = (-1, 1)/sqrt 2; with K = (l1 + l2) / (2 sqrt 2)
+//                        omega_i = (d_i . v - K omega_z) / r
+// A tricycle (one steered and driven front wheel at distance L ahead of O, the centre of the unpowered rear axle) is
+// not linear in its wheel rate alone: at steering angle delta (positive: turning counter-clockwise) the front rim
+// speed v_w = r omega_w gives v_x = v_w cos delta, v_y = 0, omega_z = v_w sin delta / L (TricycleTwist).
 #pragma once
 
 #include <string>
@@ -49,5 +58,10 @@ Result<WheelKinematics> NominalWheelKinematics(const Platform& platform);
 // radii and K = lx + ly. Shared with the estimator's error models, which take the geometry as parameters.
 Eigen::Matrix3d Omni3RatesFromTwist(const Eigen::Vector3d& radii_m, double distance_m);
 Eigen::Matrix<double, 4, 3> MecanumRatesFromTwist(const Eigen::Vector4d& radii_m, double lx_plus_ly_m);
+// omni4 with per-wheel radii, wheelbase l1 and track l2.
+Eigen::Matrix<double, 4, 3> Omni4RatesFromTwist(const Eigen::Vector4d& radii_m, double wheelbase_m, double track_m);
+// Tricycle body twist [v_x, v_y, omega_z] at O from the front wheel's rate [rad/s], its steering angle [rad] (the
+// true angle: a measured angle plus the steering offset), radius [m] and distance to the rear axle L [m].
+Eigen::Vector3d TricycleTwist(double wheel_rate_radps, double steering_rad, double radius_m, double wheel_to_axle_m);
 
 }  // namespace roamlab::recording

@@ -9,6 +9,7 @@
 #   diff_jun_circ2sq  train circular (Jun 2020)           test square + ivanjko (Jun 2020)
 #   omni3_sq2circ     train square                        test circular
 #   omni3_circ2sq     train circular                      test square
+#   omni4_sq2circ, omni4_circ2sq, tricycle_sq2circ, tricycle_circ2sq: likewise
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 data=${1:-$here/../shared/data/optiodom/data}
@@ -23,8 +24,10 @@ for run in "$data"/*/*/*/*_run-??.csv; do
   dest="$out/rec/$(echo "$rel" | cut -d/ -f1-2)/$(basename "$run" .csv)"
   [ -f "$dest/recording.yaml" ] || "$roamlab" import optiodom "$run" --out "$dest" --quiet
 done
+only=${ONLY:-}  # a regular expression: run only the splits whose names match
 split() {  # name, training recordings (glob), test recordings (glob)
   local name=$1 train=$2 test=$3 dir=$out/$1 models=()
+  [[ -z "$only" || "$name" =~ $only ]] || return 0
   mkdir -p "$dir"
   # shellcheck disable=SC2086
   for spec in "linear" "parametric" "gp linear rbf" "gp zero rbf" "gp zero linear" "gp zero rbf+linear" \
@@ -50,3 +53,7 @@ split diff_dec_circ2sq "$r/diff/circular/2312*" "$r/diff/square/2312* $r/diff/iv
 split diff_jun_circ2sq "$r/diff/circular/2506*" "$r/diff/square/2306* $r/diff/ivanjko/2506*"
 split omni3_sq2circ "$r/omni3/square/*" "$r/omni3/circular/*"
 split omni3_circ2sq "$r/omni3/circular/*" "$r/omni3/square/*"
+split omni4_sq2circ "$r/omni4/square/*" "$r/omni4/circular/*"
+split omni4_circ2sq "$r/omni4/circular/*" "$r/omni4/square/*"
+split tricycle_sq2circ "$r/tricyc/square/*" "$r/tricyc/circular/*"
+split tricycle_circ2sq "$r/tricyc/circular/*" "$r/tricyc/square/*"

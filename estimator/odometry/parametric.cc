@@ -44,6 +44,31 @@ bool UsesRecordingKeys(const recording::Platform& platform, const std::vector<st
   return false;
 }
 
+// The tricycle's rows on its two columns <wheel>_cos_steering, <wheel>_sin_steering (training_data.h): with the
+// steering offset o and the wheel-to-axle distance L, xi_x = r (cos o f_c - sin o f_s) and
+// L xi_theta = r (sin o f_c + cos o f_s), i.e. rows [cos o, 0, L sin o] and [-sin o, 0, L cos o], both of radius r.
+Result<WheelKinematics> TricycleKinematics(const recording::Platform& platform, WheelKinematics k) {
+  const std::string suffix = "_cos_steering";
+  const std::string& first = k.wheels.empty() ? suffix : k.wheels.front();
+  const std::string wheel = first.size() > suffix.size() ? first.substr(0, first.size() - suffix.size()) : "";
+  if (k.wheels.size() != 2 || wheel.empty() || k.wheels[0] != wheel + suffix ||
+      k.wheels[1] != wheel + "_sin_steering") {
+    return Status::Error("platform tricycle needs the columns <wheel>_cos_steering and <wheel>_sin_steering");
+  }
+  Result<double> distance = GeometryValue(platform, "wheel_to_axle_m");
+  if (!distance.ok()) return distance.status();
+  const auto offset = platform.geometry.find("steering_offset_rad");
+  const double o = offset == platform.geometry.end() ? 0.0 : offset->second;
+  if (!std::isfinite(o)) return Status::Error("platform geometry.steering_offset_rad must be finite");
+  Result<double> radius = WheelRadius(platform, wheel);
+  if (!radius.ok()) return radius.status();
+  const double L = distance.value();
+  k.J.row(0) << std::cos(o), 0.0, L * std::sin(o);
+  k.J.row(1) << -std::sin(o), 0.0, L * std::cos(o);
+  k.radius_m.setConstant(radius.value());
+  return k;
+}
+
 }  // namespace
 
 Pose2 ExpTwist(const Eigen::Vector3d& xi) {
@@ -141,9 +166,23 @@ Result<WheelKinematics> NominalKinematics(const recording::Platform& platform, c
     k.J.row(WheelIndex(wheels, "front_right")) << 1.0, 1.0, arm;
     k.J.row(WheelIndex(wheels, "rear_left")) << 1.0, 1.0, -arm;
     k.J.row(WheelIndex(wheels, "rear_right")) << 1.0, -1.0, arm;
+  } else if (platform.kind == "omni4") {
+    if (Status s = require_wheels({"front_left", "front_right", "rear_left", "rear_right"}); !s.ok()) return s;
+    if (m != 4) return Status::Error("platform omni4 needs exactly four encoder columns");
+    Result<double> wheelbase = GeometryValue(platform, "wheelbase_m");
+    if (!wheelbase.ok()) return wheelbase.status();
+    Result<double> track = GeometryValue(platform, "track_m");
+    if (!track.ok()) return track.status();
+    // Rim-speed rows: the rate rows of unit radii, in the layout's wheel order.
+    const Eigen::Matrix<double, 4, 3> rows =
+        recording::Omni4RatesFromTwist(Eigen::Vector4d::Ones(), wheelbase.value(), track.value());
+    const char* order[] = {"front_left", "front_right", "rear_left", "rear_right"};
+    for (int i = 0; i < 4; ++i) k.J.row(WheelIndex(wheels, order[i])) = rows.row(i);
+  } else if (platform.kind == "tricycle") {
+    return TricycleKinematics(platform, k);
   } else {
     return Status::Error("no nominal odometry model for platform kind '" + platform.kind +
-                         "' (differential_drive, omni3, mecanum)");
+                         "' (differential_drive, omni3, mecanum, omni4, tricycle)");
   }
   for (Eigen::Index i = 0; i < m; ++i) {
     Result<double> radius = WheelRadius(platform, wheels[i]);

@@ -15,6 +15,12 @@
 //                       (geometry.wheel_direction_<name>, default +1)
 //   mecanum             wheels front_left, front_right, rear_left, rear_right, rollers at 45 deg (Taheri et al., the
 //                       seed's [16]): [1, -1, -k], [1, 1, k], [1, 1, -k], [1, -1, k], k = (wheelbase_m + track_m) / 2
+//   omni4               wheels front_left, front_right, rear_left, rear_right (recording/wheel_kinematics.h omni4):
+//                       (1, -1, -K) / sqrt 2, (-1, -1, -K) / sqrt 2, (1, 1, -K) / sqrt 2, (-1, 1, -K) / sqrt 2,
+//                       K = (wheelbase_m + track_m) / 2
+//   tricycle            columns <wheel>_cos_steering, <wheel>_sin_steering (training_data.h): [cos o, 0, L sin o],
+//                       [-sin o, 0, L cos o], o = geometry.steering_offset_rad (default 0), L =
+//                       geometry.wheel_to_axle_m, radius of <wheel> for both
 // Radii: geometry.wheel_radius_<name>_m, else geometry.wheel_radius_m. The nominal sensor pose is O itself.
 // A simulated recording's platform uses the keys of recording/wheel_kinematics.h instead (differential_drive
 // baseline_m, omni3 wheel_distance_m without per-wheel angles, mecanum half_length_m and half_width_m; wheels in the

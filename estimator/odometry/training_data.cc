@@ -200,6 +200,37 @@ void MountSteps(const Pose2& l, KeySequence* seq) {
   }
 }
 
+// A tricycle's inputs as cumulative columns: for every encoder interval the wheel increment times the cosine and the
+// sine of the measured steering angle (the mean of the interval's two ends); columns <wheel>_cos_steering and
+// <wheel>_sin_steering.
+Status TricycleColumns(const recording::Recording& rec, const std::string& rec_name, const Stream& enc,
+                       Eigen::MatrixXd* angle, std::vector<std::string>* columns) {
+  Result<const Stream*> picked = PickStream(rec, rec_name, StreamType::kSteering, "");
+  if (!picked.ok()) return picked.status();
+  const Stream& steering = *picked.value();
+  if (enc.values.cols() != 1 || steering.t.size() < 2 || steering.values.cols() != 1) {
+    return Status::Error(rec_name + ": a tricycle needs one wheel_encoders column and a steering stream of two or " +
+                         "more samples");
+  }
+  const auto steering_at = [&steering](Time t) {
+    const auto [i, w] = Bracket(steering.t, t);
+    const double clamped = std::clamp(w, 0.0, 1.0);
+    const auto r = static_cast<Eigen::Index>(i);
+    return (1.0 - clamped) * steering.values(r, 0) + clamped * steering.values(r + 1, 0);
+  };
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(angle->rows(), 2);
+  for (Eigen::Index r = 1; r < angle->rows(); ++r) {
+    const auto i = static_cast<std::size_t>(r);
+    const double delta = 0.5 * (steering_at(enc.t[i - 1]) + steering_at(enc.t[i]));
+    const double increment = (*angle)(r, 0) - (*angle)(r - 1, 0);
+    out(r, 0) = out(r - 1, 0) + std::cos(delta) * increment;
+    out(r, 1) = out(r - 1, 1) + std::sin(delta) * increment;
+  }
+  *angle = std::move(out);
+  *columns = {enc.info.columns.front() + "_cos_steering", enc.info.columns.front() + "_sin_steering"};
+  return Status::Ok();
+}
+
 }  // namespace
 
 std::string KeyTimeOptions::Validate() const {
@@ -242,6 +273,10 @@ Result<KeySequence> CutAtKeyTimes(const recording::Recording& rec, const std::st
     return Status::Error(rec_name + ": stream '" + enc.info.name + "' has units '" + enc.info.units +
                          "'; model-free odometry needs wheel angles (rad, ticks) or wheel rates (rad/s)");
   }
+  std::vector<std::string> columns = enc.info.columns;
+  if (rec.platform.kind == "tricycle") {
+    if (Status s = TricycleColumns(rec, rec_name, enc, &angle, &columns); !s.ok()) return s;
+  }
   // Key times T apart inside both streams.
   Time t_begin = enc.t.front();
   Time t_end = enc.t.back();
@@ -257,7 +292,7 @@ Result<KeySequence> CutAtKeyTimes(const recording::Recording& rec, const std::st
   }
   const auto step_ns = static_cast<std::int64_t>(std::llround(options.interval_s * 1e9));
   KeySequence seq;
-  seq.wheels = enc.info.columns;
+  seq.wheels = columns;
   for (Time t = t_begin; t <= t_end; t = Time::FromNanoseconds(t.nanoseconds() + step_ns)) seq.t.push_back(t);
   if (seq.t.size() < 2) {
     return Status::Error(rec_name + ": shorter than two key times " + std::to_string(options.interval_s) + " s apart");

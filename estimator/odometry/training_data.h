@@ -7,6 +7,10 @@
 //     with ticks_per_revolution) or rad/s (integrated here by the trapezoidal rule). delta_jk is the difference of the
 //     cumulative angles, linearly interpolated at the key times. Any linear unit gives the same learned model up to
 //     the scale of C and W; rad keeps encoders of different resolution comparable.
+//     A tricycle (platform.kind tricycle: one wheel column and a steering stream [rad]) is not linear in its wheel
+//     angle: its two columns are <wheel>_cos_steering and <wheel>_sin_steering, the running sums of the wheel
+//     increments times cos and sin of the measured steering angle (mean of each encoder interval's ends). Its motion
+//     is linear in those (v_x ~ cos(delta + offset), omega ~ sin(delta + offset) for any steering offset).
 //   - either a pose stream (absolute pose of the exteroceptive sensor: motion capture, or a SLAM trajectory): its
 //     planar part (x, y, yaw) is interpolated at the key times (position linearly, heading along the shorter arc),
 //     s_jk = (-)s_j (+) s_k. Noise from the stream's noise entry: position_m and orientation_rad (the absolute_pose

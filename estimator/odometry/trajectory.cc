@@ -16,24 +16,57 @@ std::vector<Pose2> PredictTrajectory(const DisplacementFunction& f, const Eigen:
   return poses;
 }
 
-std::vector<double> AbsoluteErrors(const std::vector<Pose2>& estimate, const std::vector<Pose2>& reference) {
+namespace {
+
+// e^a_k for every k.
+std::vector<Pose2> AbsoluteErrorPoses(const std::vector<Pose2>& estimate, const std::vector<Pose2>& reference) {
   ROAMLAB_CHECK(estimate.size() == reference.size(), "AbsoluteErrors: sizes differ");
-  std::vector<double> errors;
-  for (std::size_t k = 0; k < estimate.size(); ++k) {
-    errors.push_back(Compose(Inverse(estimate[k]), reference[k]).head<2>().norm());
+  std::vector<Pose2> errors;
+  for (std::size_t k = 0; k < estimate.size(); ++k) errors.push_back(Compose(Inverse(estimate[k]), reference[k]));
+  return errors;
+}
+
+// e^r_k for every step.
+std::vector<Pose2> RelativeErrorPoses(const std::vector<Pose2>& estimate, const std::vector<Pose2>& reference) {
+  ROAMLAB_CHECK(estimate.size() == reference.size(), "RelativeErrors: sizes differ");
+  std::vector<Pose2> errors;
+  for (std::size_t k = 0; k + 1 < estimate.size(); ++k) {
+    const Pose2 step_estimate = Compose(Inverse(estimate[k]), estimate[k + 1]);
+    const Pose2 step_reference = Compose(Inverse(reference[k]), reference[k + 1]);
+    errors.push_back(Compose(Inverse(step_estimate), step_reference));
   }
   return errors;
 }
 
+std::vector<double> Translations(const std::vector<Pose2>& errors) {
+  std::vector<double> out;
+  for (const Pose2& e : errors) out.push_back(e.head<2>().norm());
+  return out;
+}
+
+std::vector<double> Rotations(const std::vector<Pose2>& errors) {
+  constexpr double kTwoPi = 6.28318530717958647692;
+  std::vector<double> out;
+  for (const Pose2& e : errors) out.push_back(std::abs(std::remainder(e[2], kTwoPi)));
+  return out;
+}
+
+}  // namespace
+
+std::vector<double> AbsoluteErrors(const std::vector<Pose2>& estimate, const std::vector<Pose2>& reference) {
+  return Translations(AbsoluteErrorPoses(estimate, reference));
+}
+
 std::vector<double> RelativeErrors(const std::vector<Pose2>& estimate, const std::vector<Pose2>& reference) {
-  ROAMLAB_CHECK(estimate.size() == reference.size(), "RelativeErrors: sizes differ");
-  std::vector<double> errors;
-  for (std::size_t k = 0; k + 1 < estimate.size(); ++k) {
-    const Pose2 step_estimate = Compose(Inverse(estimate[k]), estimate[k + 1]);
-    const Pose2 step_reference = Compose(Inverse(reference[k]), reference[k + 1]);
-    errors.push_back(Compose(Inverse(step_estimate), step_reference).head<2>().norm());
-  }
-  return errors;
+  return Translations(RelativeErrorPoses(estimate, reference));
+}
+
+std::vector<double> AbsoluteHeadingErrors(const std::vector<Pose2>& estimate, const std::vector<Pose2>& reference) {
+  return Rotations(AbsoluteErrorPoses(estimate, reference));
+}
+
+std::vector<double> RelativeHeadingErrors(const std::vector<Pose2>& estimate, const std::vector<Pose2>& reference) {
+  return Rotations(RelativeErrorPoses(estimate, reference));
 }
 
 double RootMeanSquare(const std::vector<double>& errors) {

@@ -4,6 +4,7 @@
 // them from the reference's first key pose gives the odometry trajectory x^_k = x^_(k-1) (+) f(delta_(k-1)k).
 //   RPE (eq. 10): e^r_k = (-)((-)x^_k (+) x^_(k+1)) (+) ((-)x_k (+) x_(k+1)), RMS of |trans(e^r_k)| over k = 1..n-1;
 //   ATE (eq. 11): e^a_k = (-)x^_k (+) x_k, RMS of |trans(e^a_k)| over k = 1..n.
+// Their rotational counterparts: the RMS of |rot(e^r_k)| and |rot(e^a_k)| (the heading error, wrapped to [-pi, pi]).
 // No alignment beyond the common first pose: the odometry is dead reckoning from where the reference starts.
 #pragma once
 
@@ -24,6 +25,9 @@ std::vector<Pose2> PredictTrajectory(const DisplacementFunction& f, const Eigen:
 // Per-pose translation errors |trans(e^a_k)| (eq. 11) and per-step |trans(e^r_k)| (eq. 10) [m]; same-length inputs.
 std::vector<double> AbsoluteErrors(const std::vector<Pose2>& estimate, const std::vector<Pose2>& reference);
 std::vector<double> RelativeErrors(const std::vector<Pose2>& estimate, const std::vector<Pose2>& reference);
+// The same errors' rotation |rot(e^a_k)| and |rot(e^r_k)| [rad].
+std::vector<double> AbsoluteHeadingErrors(const std::vector<Pose2>& estimate, const std::vector<Pose2>& reference);
+std::vector<double> RelativeHeadingErrors(const std::vector<Pose2>& estimate, const std::vector<Pose2>& reference);
 
 // Root mean square; 0 for an empty list.
 double RootMeanSquare(const std::vector<double>& errors);

@@ -131,12 +131,17 @@ TEST_F(OdometryCliTest, MalformedOptiOdomFileGivesOneLineAndExitCode2) {
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_NE(r.err.find("bad_run-01.csv:2:"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "rec" / "recording.yaml"));
-  // A metadata file of an unsupported robot type.
-  std::ofstream(dir_ / "bad_metadata.csv") << "type,omni4,\nngear,12,\nencRes,1024,\nLi,0.2,\nDi,0.1,0.1,0.1,0.1,\n";
+  // A metadata file of an unsupported robot type, and an omni4 one with a single distance (it needs l1 and l2).
+  std::ofstream(dir_ / "bad_metadata.csv") << "type,omni5,\nngear,12,\nencRes,1024,\nLi,0.2,\nDi,0.1,0.1,0.1,0.1,\n";
   const CommandRun m =
       Roamlab("import optiodom " + (dir_ / "bad_run-01.csv").string() + " --out " + (dir_ / "rec").string(), dir_);
   EXPECT_EQ(m.exit_code, 2);
-  EXPECT_NE(m.err.find("bad_metadata.csv: type 'omni4' is not supported"), std::string::npos) << m.err;
+  EXPECT_NE(m.err.find("bad_metadata.csv: type 'omni5' is not supported"), std::string::npos) << m.err;
+  std::ofstream(dir_ / "bad_metadata.csv") << "type,omni4,\nngear,12,\nencRes,1024,\nLi,0.2,\nDi,0.1,0.1,0.1,0.1,\n";
+  const CommandRun l =
+      Roamlab("import optiodom " + (dir_ / "bad_run-01.csv").string() + " --out " + (dir_ / "rec").string(), dir_);
+  EXPECT_EQ(l.exit_code, 2);
+  EXPECT_NE(l.err.find("bad_metadata.csv: Li has 1 distances, type omni4 needs 2"), std::string::npos) << l.err;
 }
 
 // The real data: one differential-drive run imports with its metadata and ground truth.
