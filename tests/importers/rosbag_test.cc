@@ -12,9 +12,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "tests/support/message_writer.h"
-#include "tests/support/bag_writers.h"
 #include "tests/recording/temp_dir.h"
+#include "tests/support/bag_writers.h"
+#include "tests/support/message_writer.h"
 
 namespace roamlab::importers {
 namespace {
@@ -293,6 +293,130 @@ TEST(ImportRosbagTypesTest, EveryTypeFromARos1Bag) {
   bytes << file.rdbuf();
   EXPECT_EQ(bytes.str(), "\xff\xd8\xffjj");
 }
+
+// Every type as ROS 2 stores it (CDR, little-endian), three messages each: the topics and the messages of a bag.
+struct Ros2Bag {
+  std::vector<testing::Db3Topic> topics;
+  std::vector<testing::Db3Message> messages;
+};
+Ros2Bag AllTypesRos2() {
+  Ros2Bag bag;
+  bag.topics = {{"/imu", "sensor_msgs/msg/Imu"},
+                {"/fix", "sensor_msgs/msg/NavSatFix"},
+                {"/mag", "sensor_msgs/msg/MagneticField"},
+                {"/joints", "sensor_msgs/msg/JointState"},
+                {"/scan", "sensor_msgs/msg/LaserScan"},
+                {"/mono", "sensor_msgs/msg/Image"},
+                {"/jpeg", "sensor_msgs/msg/CompressedImage"},
+                {"/odom", "nav_msgs/msg/Odometry"},
+                {"/cmd", "geometry_msgs/msg/TwistStamped"},
+                {"/pose", "geometry_msgs/msg/PoseStamped"},
+                {"/amcl", "geometry_msgs/msg/PoseWithCovarianceStamped"}};
+  const Wire cdr = Wire::kCdrLittle;
+  for (std::int32_t k = 0; k < 3; ++k) {
+    const std::int32_t s = 10 + k;
+    const std::int64_t t_ns = 1000000000LL * (s + 1);  // received a second after the header stamp
+    const std::vector<std::string> data = {
+        testing::ImuMessage(cdr, s, 0, 0.5 + k),
+        testing::FixMessage(cdr, s, 0, 0, 48.1 + 0.001 * k),
+        testing::MagneticFieldMessage(cdr, s, 0, 1e-5 * (k + 1)),
+        testing::JointStateMessage(cdr, s, 0, 0.5 * k, -1.0 * k),
+        testing::LaserScanMessage(cdr, s, 0, 1.0f + static_cast<float>(k)),
+        testing::ImageMessage(cdr, s, 0, "mono8", static_cast<char>(10 * k)),
+        testing::CompressedImageMessage(cdr, s, 0, "\xff\xd8\xff" + std::string(1 + static_cast<std::size_t>(k), 'j')),
+        testing::OdometryMessage(cdr, s, 0, "odom", "base_link", {0, 0, 0, 1}, 1.0 + k, 0.0, 0.1),
+        testing::TwistStampedMessage(cdr, s, 0, 0.3 * (k + 1), 0.2),
+        testing::PoseStampedMessage(cdr, s, 0, 1.0 * k),
+        testing::PoseWithCovarianceMessage(cdr, s, 0, 2.0 * k)};
+    for (std::size_t i = 0; i < data.size(); ++i) bag.messages.push_back({static_cast<int>(i), t_ns, data[i]});
+  }
+  return bag;
+}
+
+// Writes the bag as a rosbag2 SQLite directory ("sqlite") or an MCAP file with one zstd chunk ("mcap"); its path.
+std::string WriteRos2Bag(const Ros2Bag& bag, const std::string& container, const TempDir& dir) {
+  if (container == "sqlite") {
+    const std::string bag_dir = dir.path() + "/bag2";
+    std::filesystem::create_directories(bag_dir);
+    EXPECT_TRUE(testing::WriteDb3(bag_dir + "/bag2_0.db3", bag.topics, bag.messages).ok());
+    WriteFile(bag_dir + "/metadata.yaml", testing::Rosbag2Metadata("sqlite3", "bag2_0.db3"));
+    return bag_dir;
+  }
+  std::string records;
+  for (std::size_t i = 0; i < bag.topics.size(); ++i) {
+    const auto id = static_cast<std::uint16_t>(i + 1);
+    records += testing::McapSchema(id, bag.topics[i].type) + testing::McapChannel(id, id, bag.topics[i].name);
+  }
+  for (const testing::Db3Message& m : bag.messages) {
+    records += testing::McapMessage(static_cast<std::uint16_t>(m.topic + 1), static_cast<std::uint64_t>(m.timestamp_ns),
+                                    m.data);
+  }
+  const std::string path = dir.path() + "/bag.mcap";
+  WriteFile(path, testing::kMcapMagic + testing::McapHeader() + testing::McapZstdChunk(records) + testing::McapEnd());
+  return path;
+}
+
+class ImportRos2TypesTest : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(ImportRos2TypesTest, EveryTypeFromARos2Bag) {
+  TempDir dir;
+  RosbagImportOptions options;
+  options.joints = {"right_wheel", "left_wheel"};
+  RosbagImportReport report;
+  Result<Recording> imported = ImportRosbag(WriteRos2Bag(AllTypesRos2(), GetParam(), dir), options, &report);
+  ASSERT_TRUE(imported.ok()) << imported.status().message();
+  const Recording& rec = imported.value();
+  const auto stream = [&](const std::string& name, StreamType type) {
+    const Stream* s = rec.Find(name);
+    EXPECT_NE(s, nullptr) << name;
+    if (s) EXPECT_EQ(s->info.type, type) << name;
+    return s;
+  };
+  const Stream* imu = stream("imu", StreamType::kImu);
+  ASSERT_NE(imu, nullptr);
+  EXPECT_EQ(imu->values.row(2), (Eigen::RowVectorXd(6) << 0.01, 2.5, -0.02, 0.1, 9.81, 0.2).finished());
+  EXPECT_EQ(imu->t[0], Time::FromNanoseconds(10000000000LL));  // the header stamp, not the receive time
+  const Stream* fix = stream("fix", StreamType::kGps);
+  ASSERT_NE(fix, nullptr);
+  EXPECT_DOUBLE_EQ(fix->values(1, 0), 48.101);
+  const Stream* mag = stream("mag", StreamType::kMagnetometer);
+  ASSERT_NE(mag, nullptr);
+  EXPECT_NEAR(mag->values(2, 0), 30.0, 1e-9);
+  const Stream* joints = stream("joints", StreamType::kWheelEncoders);
+  ASSERT_NE(joints, nullptr);
+  EXPECT_EQ(joints->values.row(2), Eigen::RowVector2d(2.0, 1.0));
+  const Stream* scan = stream("scan", StreamType::kLaserScan);
+  ASSERT_NE(scan, nullptr);
+  EXPECT_EQ(scan->values.row(1), (Eigen::RowVectorXd(7) << -0.5, 0.5, 0.1f, 10.0, 2.0, -1.0, 3.0).finished());
+  const Stream* mono = stream("mono", StreamType::kCamera);
+  ASSERT_NE(mono, nullptr);
+  EXPECT_EQ(mono->text.size(), 3u);
+  const Stream* jpeg = stream("jpeg", StreamType::kCamera);
+  ASSERT_NE(jpeg, nullptr);
+  EXPECT_EQ(jpeg->text.size(), 3u);
+  const Stream* odom = stream("odom", StreamType::kOdometry);
+  ASSERT_NE(odom, nullptr);
+  EXPECT_DOUBLE_EQ(odom->values(2, 0), 3.0);
+  EXPECT_DOUBLE_EQ(odom->values(2, 5), 0.1);
+  const Stream* odom_pose = stream("odom_pose", StreamType::kPose);
+  ASSERT_NE(odom_pose, nullptr);
+  EXPECT_DOUBLE_EQ(odom_pose->values(0, 1), 2.0);
+  const Stream* cmd = stream("cmd", StreamType::kOdometry);
+  ASSERT_NE(cmd, nullptr);
+  EXPECT_DOUBLE_EQ(cmd->values(1, 0), 0.6);
+  const Stream* pose = stream("pose", StreamType::kPose);
+  ASSERT_NE(pose, nullptr);
+  EXPECT_EQ(pose->values.row(2), (Eigen::RowVectorXd(7) << 2, 2, 3, 0, 0, 0.6, 0.8).finished());
+  const Stream* amcl = stream("amcl", StreamType::kPose);
+  ASSERT_NE(amcl, nullptr);
+  EXPECT_DOUBLE_EQ(amcl->values(1, 0), 2.0);
+  EXPECT_DOUBLE_EQ(amcl->info.noise.at("sigma_m"), 0.5);
+  // The receive times are a second after the header stamps: a clock offset, reported with its sign.
+  ASSERT_NE(report.Find("/imu"), nullptr);
+  EXPECT_NEAR(report.Find("/imu")->clock_offset_s, -1.0, 1e-9);
+}
+
+INSTANTIATE_TEST_SUITE_P(Containers, ImportRos2TypesTest, ::testing::Values("sqlite", "mcap"));
 
 TEST(ImportRosbagTopicsTest, TopicSelectsAndNamesStreams) {
   TempDir dir;

@@ -154,46 +154,70 @@ inline Status SqliteExec(sqlite3* db, const std::string& sql) {
   return Status::Ok();
 }
 
-// A .db3 file with topics /imu (sensor_msgs/msg/Imu, cdr) and /fix (sensor_msgs/msg/NavSatFix, `gps_format`) and
-// their messages (timestamp [ns], serialized data), /imu's first.
-inline Status WriteDb3(const std::string& path, const std::vector<std::pair<std::int64_t, std::string>>& imu,
-                       const std::vector<std::pair<std::int64_t, std::string>>& gps,
-                       const std::string& gps_format = "cdr") {
+// One topic of a .db3 file: its name, its ROS 2 type ("sensor_msgs/msg/Imu") and its serialization format.
+struct Db3Topic {
+  std::string name;
+  std::string type;
+  std::string format = "cdr";
+};
+// One message of a .db3 file: the index of its topic, its timestamp [ns] and its serialized data.
+struct Db3Message {
+  int topic = 0;
+  std::int64_t timestamp_ns = 0;
+  std::string data;
+};
+
+// A .db3 file with the tables rosbag2 writes (in WAL journal mode, as rosbag2 leaves them), `topics` and `messages`.
+inline Status WriteDb3(const std::string& path, const std::vector<Db3Topic>& topics,
+                       const std::vector<Db3Message>& messages) {
   sqlite3* db = nullptr;
   if (sqlite3_open(path.c_str(), &db) != SQLITE_OK) {
     sqlite3_close(db);
     return Status::Error(path + ": cannot open");
   }
+  std::vector<std::string> sql = {
+      "PRAGMA journal_mode=WAL",
+      "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL, "
+      "serialization_format TEXT NOT NULL, offered_qos_profiles TEXT NOT NULL)",
+      "CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, timestamp INTEGER NOT "
+      "NULL, data BLOB NOT NULL)",
+      "CREATE INDEX timestamp_idx ON messages (timestamp ASC)"};
+  for (std::size_t i = 0; i < topics.size(); ++i) {
+    sql.push_back("INSERT INTO topics VALUES (" + std::to_string(i + 1) + ", '" + topics[i].name + "', '" +
+                  topics[i].type + "', '" + topics[i].format + "', '')");
+  }
+  sql.push_back("BEGIN");
   Status status = Status::Ok();
-  for (const std::string& sql :
-       {std::string("PRAGMA journal_mode=WAL"),
-        std::string("CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL, "
-                    "serialization_format TEXT NOT NULL, offered_qos_profiles TEXT NOT NULL)"),
-        std::string("CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, timestamp INTEGER NOT "
-                    "NULL, data BLOB NOT NULL)"),
-        std::string("CREATE INDEX timestamp_idx ON messages (timestamp ASC)"),
-        std::string("INSERT INTO topics VALUES (1, '/imu', 'sensor_msgs/msg/Imu', 'cdr', '')"),
-        "INSERT INTO topics VALUES (2, '/fix', 'sensor_msgs/msg/NavSatFix', '" + gps_format + "', '')",
-        std::string("BEGIN")}) {
-    if (status.ok()) status = SqliteExec(db, sql);
+  for (const std::string& statement : sql) {
+    if (status.ok()) status = SqliteExec(db, statement);
   }
   sqlite3_stmt* insert = nullptr;
   if (status.ok() && sqlite3_prepare_v2(db, "INSERT INTO messages (topic_id, timestamp, data) VALUES (?, ?, ?)", -1,
                                         &insert, nullptr) != SQLITE_OK)
     status = Status::Error(path + ": cannot prepare the insert");
-  for (int topic = 1; topic <= 2 && status.ok(); ++topic) {
-    for (const auto& [t, data] : topic == 1 ? imu : gps) {
-      sqlite3_bind_int(insert, 1, topic);
-      sqlite3_bind_int64(insert, 2, t);
-      sqlite3_bind_blob(insert, 3, data.data(), static_cast<int>(data.size()), SQLITE_TRANSIENT);
-      if (sqlite3_step(insert) != SQLITE_DONE) status = Status::Error(path + ": insert failed");
-      sqlite3_reset(insert);
-    }
+  for (const Db3Message& m : messages) {
+    if (!status.ok()) break;
+    sqlite3_bind_int(insert, 1, m.topic + 1);
+    sqlite3_bind_int64(insert, 2, m.timestamp_ns);
+    sqlite3_bind_blob(insert, 3, m.data.data(), static_cast<int>(m.data.size()), SQLITE_TRANSIENT);
+    if (sqlite3_step(insert) != SQLITE_DONE) status = Status::Error(path + ": insert failed");
+    sqlite3_reset(insert);
   }
   if (status.ok()) status = SqliteExec(db, "COMMIT");
   sqlite3_finalize(insert);
   sqlite3_close(db);
   return status;
+}
+
+// A .db3 file with topics /imu (sensor_msgs/msg/Imu, cdr) and /fix (sensor_msgs/msg/NavSatFix, `gps_format`) and
+// their messages (timestamp [ns], serialized data), /imu's first.
+inline Status WriteDb3(const std::string& path, const std::vector<std::pair<std::int64_t, std::string>>& imu,
+                       const std::vector<std::pair<std::int64_t, std::string>>& gps,
+                       const std::string& gps_format = "cdr") {
+  std::vector<Db3Message> messages;
+  for (const auto& [t, data] : imu) messages.push_back({0, t, data});
+  for (const auto& [t, data] : gps) messages.push_back({1, t, data});
+  return WriteDb3(path, {{"/imu", "sensor_msgs/msg/Imu"}, {"/fix", "sensor_msgs/msg/NavSatFix", gps_format}}, messages);
 }
 
 // metadata.yaml of a rosbag2 bag of one file.
