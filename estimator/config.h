@@ -3,7 +3,9 @@
 // pose nodes, the solver, outlier gating, the online window and the offline calibration stages.
 //
 //   master: odometer                       # a stream whose model is ackermann, ackermann_seed, differential_drive,
-//                                          # omni3_drive, mecanum_drive or odometer
+//                                          # omni3_drive, mecanum_drive or odometer; or a gyroscope stream (IMU
+//                                          # master, below)
+//   poses: {rate_hz: 20, position_sigma_m: 1.0}   # IMU master only (PosesConfig)
 //   solver: {method: levenberg_marquardt, max_iterations: 50, function_tolerance: 1.0e-8, step_tolerance: 1.0e-10}
 //   gating: {probability: 0.99999}         # chi-square gate on whitened errors; omit to disable
 //   tracking: {window: 40, max_iterations: 10, improvement_threshold: 1.0e-3, time_budget_s: 0.05,
@@ -107,9 +109,21 @@ struct TrackingConfig {
   std::string calibrate;
 };
 
+// Pose nodes of an IMU master (a gyroscope stream as master; problem.h): the IMU drives the graph instead of an
+// odometric model. The poses sit on a regular grid from the IMU's first sample, rate_hz apart (0: at every IMU
+// sample); consecutive poses are joined by the gyroscope samples between them and every three by the accelerometer.
+// Without an absolute sensor (gps, absolute_pose) every pose's position gets a weak prior N(0, position_sigma_m^2)
+// about the start: the device stays near where it started (handheld), which holds the position and velocity that
+// the accelerometer alone leaves free.
+struct PosesConfig {
+  double rate_hz = 0.0;
+  double position_sigma_m = 1.0;
+};
+
 struct EstimatorConfig {
   std::string source_file;  // for messages
   std::string master;
+  PosesConfig poses;  // IMU master only
   SolverOptions solver;
   std::optional<double> gate_probability;
   TrackingConfig tracking;

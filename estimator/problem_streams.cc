@@ -376,6 +376,16 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
     if (im.streams[i].config.model == "gps" || im.streams[i].config.model == "absolute_pose")
       builder->has_absolute_sensor_ = true;
   }
+  if (im.master >= 0 && im.streams[static_cast<std::size_t>(im.master)].config.model == "gyroscope") {
+    im.imu.emplace();
+    for (std::size_t i = 0; i < im.streams.size(); ++i) {
+      const std::string& model = im.streams[i].config.model;
+      if (model == "accelerometer" && im.imu->accelerometer < 0) im.imu->accelerometer = static_cast<int>(i);
+      if (model == "magnetometer" && im.imu->magnetometer < 0) im.imu->magnetometer = static_cast<int>(i);
+    }
+    if (im.imu->accelerometer < 0)
+      return Error(config, "master stream '" + config.master + "' is a gyroscope, which needs an accelerometer stream");
+  }
 
   // Constant parameter variables (time-varying ones get instances per pose).
   for (const auto& [pname, manifold] : im.parameter_manifold) {

@@ -1,0 +1,226 @@
+// The IMU master on real recordings (skipped when the shared data are absent):
+//  - the Husky bag without its wheel odometry (configs/real/husky_imu_gps.yaml), tracked with its calibration and
+//    compared with the wheel-odometry-aided run (configs/real/husky_nominal.yaml);
+//  - the x-io handheld IMU + magnetometer log (configs/real/xio_imu_mag.yaml): the magnetometer's A and b against the
+//    ellipsoid fit of the raw field (eval/ellipsoid_fit.h).
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "estimator/calibration.h"
+#include "estimator/config.h"
+#include "estimator/geometry.h"
+#include "estimator/tracking.h"
+#include "eval/ellipsoid_fit.h"
+#include "importers/rosbag.h"
+
+namespace roamlab::estimator {
+namespace {
+
+const std::string kData = std::string(ROAMLAB_SHARED_DIR) + "/data";
+const std::string kConfigs = std::string(ROAMLAB_SOURCE_DIR) + "/configs/real/";
+
+std::map<std::string, Eigen::VectorXd> Values(const CalibrationResult& r) {
+  std::map<std::string, Eigen::VectorXd> out;
+  for (const ParameterEstimate& p : r.parameters) out[p.name] = p.estimate;
+  return out;
+}
+
+void Print(const CalibrationResult& r) {
+  for (const ParameterEstimate& p : r.parameters) {
+    std::cout << "  " << p.name << " = [" << p.estimate.transpose() << "] +- [" << p.std.transpose() << "]\n";
+  }
+}
+
+// A run's track of the GPS antenna (the pose moved by the calibrated lever arm) with its position covariance.
+struct AntennaTrack {
+  std::vector<Time> t;
+  std::vector<Eigen::Vector3d> p;
+  std::vector<Eigen::Matrix3d> covariance;
+};
+
+AntennaTrack Antenna(const TrackingResult& track, const Eigen::Vector3d& lever_arm) {
+  AntennaTrack out;
+  for (std::size_t i = 0; i < track.trajectory.size(); ++i) {
+    const StampedPose& p = track.trajectory[i];
+    out.t.push_back(p.t);
+    out.p.push_back(p.p_world_body + p.q_world_body * lever_arm);
+    out.covariance.push_back(track.position_covariance[i]);
+  }
+  return out;
+}
+
+Result<TrackingResult> CalibrateAndTrack(const std::string& config_file, const recording::Recording& rec,
+                                         CalibrationResult* calibration) {
+  auto config = LoadEstimatorConfig(config_file);
+  if (!config.ok()) return config.status();
+  auto calibrated = Calibrate(config.value(), rec);
+  if (!calibrated.ok()) return calibrated.status();
+  *calibration = calibrated.value();
+  return Track(config.value(), rec, Values(*calibration));
+}
+
+TEST(ImuMasterRealTest, HuskyImuGpsTrackWithinThreeSigmaOfWheelOdometryAided) {
+  const std::string bag = kData + "/husky_test1/test1.bag";
+  if (!std::filesystem::exists(bag)) GTEST_SKIP() << "real data absent: " << bag;
+  importers::RosbagImportOptions options;
+  options.platform = {"skid_steer", {{"wheel_radius_m", 0.1651}, {"baseline_m", 0.555}}};
+  options.q_body_imu = Eigen::Quaterniond(std::sqrt(0.5), std::sqrt(0.5), 0.0, 0.0);
+  options.wheels_from_odometry = true;
+  auto rec = importers::ImportRosbag(bag, options);
+  ASSERT_TRUE(rec.ok()) << rec.status().message();
+  // The IMU + GPS recording: the wheel odometry (and the wheels derived from it) dropped.
+  recording::Recording imu_gps = rec.value();
+  imu_gps.streams.erase(
+      std::remove_if(imu_gps.streams.begin(), imu_gps.streams.end(),
+                     [](const recording::Stream& s) { return s.info.name == "odometry" || s.info.name == "wheels"; }),
+      imu_gps.streams.end());
+  ASSERT_EQ(imu_gps.streams.size(), 2u);
+
+  CalibrationResult wheel_calibration, imu_calibration;
+  auto wheel = CalibrateAndTrack(kConfigs + "husky_nominal.yaml", rec.value(), &wheel_calibration);
+  ASSERT_TRUE(wheel.ok()) << wheel.status().message();
+  auto imu = CalibrateAndTrack(kConfigs + "husky_imu_gps.yaml", imu_gps, &imu_calibration);
+  ASSERT_TRUE(imu.ok()) << imu.status().message();
+  std::cout << "wheel-odometry-aided calibration:\n";
+  Print(wheel_calibration);
+  std::cout << "IMU + GPS calibration:\n";
+  Print(imu_calibration);
+  for (const ParameterEstimate& p : imu_calibration.parameters)
+    for (int i = 0; i < p.std.size(); ++i) EXPECT_TRUE(std::isfinite(p.std[i])) << p.name << "[" << i << "]";
+
+  // Horizontal antenna positions at the IMU run's poses, the wheel run's interpolated linearly, with each run's
+  // reported covariance (the wheel run's nearest pose's). Both runs read the same GPS, so their errors are positively
+  // correlated and the sum of the covariances overstates the difference's: the test is conservative in that.
+  const AntennaTrack a = Antenna(imu.value(), Values(imu_calibration).at("gps.lever_arm"));
+  const AntennaTrack b = Antenna(wheel.value(), Eigen::Vector3d::Zero());
+  int compared = 0, within = 0;
+  double max_difference = 0.0, sum_difference = 0.0, sum_std_imu = 0.0, sum_std_wheel = 0.0, max_mahalanobis = 0.0;
+  for (std::size_t i = 0; i < a.t.size(); ++i) {
+    const auto after = std::lower_bound(b.t.begin(), b.t.end(), a.t[i]);
+    if (after == b.t.begin() || after == b.t.end()) continue;
+    const std::size_t j = static_cast<std::size_t>(after - b.t.begin());
+    const double w = SecondsBetween(b.t[j - 1], a.t[i]) / SecondsBetween(b.t[j - 1], b.t[j]);
+    const Eigen::Vector2d d = (a.p[i] - ((1.0 - w) * b.p[j - 1] + w * b.p[j])).head<2>();
+    const Eigen::Matrix2d c_imu = a.covariance[i].topLeftCorner<2, 2>();
+    const Eigen::Matrix2d c_wheel = b.covariance[w < 0.5 ? j - 1 : j].topLeftCorner<2, 2>();
+    const double m2 = d.dot((c_imu + c_wheel).ldlt().solve(d));
+    // The 3-sigma region of a 2-D Gaussian: the chi-square(2) quantile of 0.9973, -2 ln(0.0027) = 11.83.
+    within += m2 <= 11.83 ? 1 : 0;
+    ++compared;
+    max_difference = std::max(max_difference, d.norm());
+    max_mahalanobis = std::max(max_mahalanobis, std::sqrt(m2));
+    sum_difference += d.norm();
+    sum_std_imu += std::sqrt(c_imu.trace());
+    sum_std_wheel += std::sqrt(c_wheel.trace());
+  }
+  ASSERT_GT(compared, 1000);
+  const double fraction = static_cast<double>(within) / compared;
+  std::cout << "Husky: " << compared << " poses compared; horizontal antenna difference mean "
+            << sum_difference / compared << " m, max " << max_difference << " m; reported horizontal std mean: IMU+GPS "
+            << sum_std_imu / compared << " m, wheel-aided " << sum_std_wheel / compared
+            << " m; within the 3-sigma region: " << 100.0 * fraction << "% (max Mahalanobis " << max_mahalanobis
+            << ")\n";
+  // At most the 0.27% a 3-sigma region leaves out, and a margin for the poses' correlation along the track.
+  EXPECT_GE(fraction, 0.99);
+}
+
+// The x-io log (time [s], gyroscope [deg/s], accelerometer [g], magnetometer [uT]) as a recording: stream imu
+// (rad/s, m/s^2) and stream mag (uT). Rows whose time does not increase are skipped and counted.
+recording::Recording ReadXio(const std::string& path, int* skipped) {
+  recording::Recording rec;
+  recording::Stream imu, mag;
+  imu.info = {"imu", recording::StreamType::kImu, 100.0, recording::FixedColumns(recording::StreamType::kImu)};
+  mag.info = {"mag", recording::StreamType::kMagnetometer, 100.0,
+              recording::FixedColumns(recording::StreamType::kMagnetometer)};
+  mag.info.units = "uT";
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::array<double, 10>> rows;
+  while (std::getline(in, line)) {
+    std::array<double, 10> v{};
+    std::stringstream cells(line);
+    std::string cell;
+    int n = 0;
+    while (n < 10 && std::getline(cells, cell, ',')) v[static_cast<std::size_t>(n++)] = std::stod(cell);
+    if (n != 10 || (!rows.empty() && v[0] <= rows.back()[0])) {
+      ++*skipped;
+      continue;
+    }
+    rows.push_back(v);
+  }
+  const double deg = M_PI / 180.0;
+  imu.values.resize(static_cast<Eigen::Index>(rows.size()), 6);
+  mag.values.resize(static_cast<Eigen::Index>(rows.size()), 3);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const auto& v = rows[i];
+    const Time t = Time::FromNanoseconds(std::llround(v[0] * 1e9));
+    imu.t.push_back(t);
+    mag.t.push_back(t);
+    const auto r = static_cast<Eigen::Index>(i);
+    imu.values.row(r) << v[1] * deg, v[2] * deg, v[3] * deg, v[4] * kStandardGravity, v[5] * kStandardGravity,
+        v[6] * kStandardGravity;
+    mag.values.row(r) << v[7], v[8], v[9];
+  }
+  rec.streams = {imu, mag};
+  return rec;
+}
+
+TEST(ImuMasterRealTest, XioMagnetometerCalibrationMatchesTheEllipsoidFit) {
+  const std::string csv = kData + "/xio_imu_mag/sensor_data.csv";
+  if (!std::filesystem::exists(csv)) GTEST_SKIP() << "real data absent: " << csv;
+  int skipped = 0;
+  const recording::Recording rec = ReadXio(csv, &skipped);
+  std::cout << "x-io: " << rec.streams[0].t.size() << " rows, " << skipped << " skipped\n";
+  ASSERT_GT(rec.streams[0].t.size(), 10000u);
+
+  // The ellipsoid fit of the raw field, and the field's dip from the fitted field against the accelerometer's up.
+  std::vector<Eigen::Vector3d> raw;
+  for (Eigen::Index i = 0; i < rec.streams[1].values.rows(); ++i) raw.push_back(rec.streams[1].values.row(i));
+  auto fit = eval::FitEllipsoid(raw);
+  ASSERT_TRUE(fit.ok()) << fit.status().message();
+  double sum_sin_dip = 0.0;
+  for (Eigen::Index i = 0; i < rec.streams[0].values.rows(); ++i) {
+    const Eigen::Vector3d up = rec.streams[0].values.row(i).segment<3>(3).transpose().normalized();
+    const Eigen::Vector3d h = fit.value().correction * (raw[static_cast<std::size_t>(i)] - fit.value().centre);
+    sum_sin_dip += -up.dot(h.normalized());
+  }
+  const double dip = std::asin(sum_sin_dip / static_cast<double>(raw.size()));
+  std::cout << "ellipsoid fit: centre [" << fit.value().centre.transpose() << "] uT, radius " << fit.value().radius
+            << " uT, rms residual " << fit.value().rms_residual << " uT, dip " << dip * 180.0 / M_PI << " deg; W =\n"
+            << fit.value().correction << "\n";
+
+  auto config = LoadEstimatorConfig(kConfigs + "xio_imu_mag.yaml");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  const std::vector<double>& field = config.value().streams.at("mag").options.at("field_world");
+  const Eigen::Vector3d h_world(field[0], field[1], field[2]);
+  std::cout << "configured field: |h| " << h_world.norm() << " uT, dip "
+            << std::asin(-h_world.z() / h_world.norm()) * 180.0 / M_PI << " deg\n";
+  auto result = Calibrate(config.value(), rec);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  Print(result.value());
+  const auto values = Values(result.value());
+  const Eigen::Vector3d b = values.at("mag.b");
+  const Eigen::Matrix3d A = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(values.at("mag.A").data());
+  // z = A h^(S) + b with |h^(S)| = |h_world| and z = W^-1 h' + c with |h'| = r: A A^T = (r / |h_world|)^2 W^-2, so
+  // the symmetric factor of A scaled by |h_world| / r is compared with W^-1 (eval/ellipsoid_fit.h).
+  const Eigen::Matrix3d P = eval::SymmetricFactor(A) * (h_world.norm() / fit.value().radius);
+  const Eigen::Matrix3d W_inv = fit.value().correction.inverse();
+  const double b_error = (b - fit.value().centre).norm();
+  const double A_error = (P - W_inv).cwiseAbs().maxCoeff();
+  std::cout << "x-io: |b - centre| = " << b_error << " uT; max |P - W^-1| = " << A_error << "; P =\n"
+            << P << "\nW^-1 =\n"
+            << W_inv << "\n";
+  EXPECT_LT(b_error, 0.5);
+  EXPECT_LT(A_error, 0.02);
+}
+
+}  // namespace
+}  // namespace roamlab::estimator
