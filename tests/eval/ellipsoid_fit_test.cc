@@ -6,6 +6,7 @@
 #include <random>
 
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 namespace roamlab::eval {
@@ -26,9 +27,11 @@ Synthetic Make(int n, double sigma, std::uint32_t seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> normal;
   for (int i = 0; i < n; ++i) {
-    Eigen::Vector3d direction(normal(rng), normal(rng), normal(rng));
+    Eigen::Vector3d direction, noise;
+    for (int k = 0; k < 3; ++k) direction[k] = normal(rng);
+    for (int k = 0; k < 3; ++k) noise[k] = sigma * normal(rng);
     const Eigen::Vector3d h = s.radius * direction.normalized();
-    s.samples.push_back(s.distortion * h + s.centre + sigma * Eigen::Vector3d(normal(rng), normal(rng), normal(rng)));
+    s.samples.push_back(s.distortion * h + s.centre + noise);
   }
   return s;
 }

@@ -136,9 +136,14 @@ TEST(ImuMasterRealTest, HuskyImuGpsTrackWithinThreeSigmaOfWheelOdometryAided) {
 recording::Recording ReadXio(const std::string& path, int* skipped) {
   recording::Recording rec;
   recording::Stream imu, mag;
-  imu.info = {"imu", recording::StreamType::kImu, 100.0, recording::FixedColumns(recording::StreamType::kImu)};
-  mag.info = {"mag", recording::StreamType::kMagnetometer, 100.0,
-              recording::FixedColumns(recording::StreamType::kMagnetometer)};
+  imu.info.name = "imu";
+  imu.info.type = recording::StreamType::kImu;
+  imu.info.rate_hz = 100.0;
+  imu.info.columns = recording::FixedColumns(recording::StreamType::kImu);
+  mag.info.name = "mag";
+  mag.info.type = recording::StreamType::kMagnetometer;
+  mag.info.rate_hz = 100.0;
+  mag.info.columns = recording::FixedColumns(recording::StreamType::kMagnetometer);
   mag.info.units = "uT";
   std::ifstream in(path);
   std::string line;
