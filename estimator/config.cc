@@ -276,13 +276,19 @@ class Parser {
   }
 
   ParameterConfig ParseParameter(const std::string& name, const YAML::Node& n) const {
-    CheckKeys(n, {"value", "free", "process"}, "parameter '" + name + "'");
+    CheckKeys(n, {"value", "free", "process", "prior_sigma"}, "parameter '" + name + "'");
     ParameterConfig p;
     if (n["value"]) {
       const std::vector<double> v = Numbers(n["value"], "parameters." + name + ".value");
       p.value = Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<int>(v.size()));
     }
     if (n["free"]) p.free = Bool(n["free"], "parameters." + name + ".free");
+    if (n["prior_sigma"]) {
+      const std::vector<double> v = Numbers(n["prior_sigma"], "parameters." + name + ".prior_sigma");
+      for (double sigma : v)
+        if (!(sigma > 0.0)) Fail(n["prior_sigma"], "parameter '" + name + "': prior_sigma must be positive (or .inf)");
+      p.prior_sigma = Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<int>(v.size()));
+    }
     if (n["process"]) {
       const YAML::Node& pr = n["process"];
       CheckKeys(pr, {"type", "sigma", "tau_s", "interval_s"}, "parameter '" + name + "' process");

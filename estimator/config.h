@@ -11,7 +11,7 @@
 //   tracking: {window: 40, max_iterations: 10, improvement_threshold: 1.0e-3, time_budget_s: 0.05,
 //              initialization_s: 2.0, relinearize_threshold: 0.0}
 //   parameters:                            # any parameter not listed here keeps its model default and is fixed
-//     gps.lever_arm: {value: [0, 0, 0], free: true}
+//     gps.lever_arm: {value: [0, 0, 0], free: true}     # optional prior_sigma: [.inf, .inf, 0.5] (ParameterConfig)
 //     imu.gyro_bias: {value: [0, 0, 0], free: true, process: {type: random_walk, sigma: 1.0e-4}}
 //     odometer.disturbance: {value: [0, 0, 0], free: true,   # per component: a list of three (Gauss-Markov:
 //                            process: {type: gauss_markov, sigma: [0.01, 0.002, 0.03], tau_s: [0.5, 1.2, 1.8]}}
@@ -77,6 +77,10 @@ struct ParameterConfig {
   std::optional<Eigen::VectorXd> value;  // ambient; default from the model slot
   bool free = false;
   ProcessConfig process;
+  // A Gaussian prior about the initial value on a constant parameter, one std per tangent component (.inf: none on
+  // that component): for a component the measurements leave unobservable, e.g. the GPS antenna's height above an IMU
+  // master's poses on a planar drive.
+  std::optional<Eigen::VectorXd> prior_sigma;
 };
 
 struct StreamConfig {

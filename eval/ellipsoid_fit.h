@@ -8,7 +8,11 @@
 // algebraically (the right singular vector of the smallest singular value of the N x 10 design matrix, on samples
 // centred at their mean and scaled by their rms distance from it, for conditioning), then converts it:
 //   Q = [a h g; h b f; g f c],  u = [p q r]:   centre = -Q^-1 u,   M = Q / (centre^T Q centre - d).
-// It fails unless M is positive definite (an ellipsoid, not a hyperboloid: the orientations cover too little).
+// When that quadric is no ellipsoid (M not positive definite: the samples cover too little of it, e.g. a device that is
+// only turned about one axis, whose noise then bends the fit into a hyperboloid), the fit is repeated with Li and
+// Griffiths' ellipsoid-specific normalization 4 J - I^2 = 1 instead of |v| = 1 (I = a + b + c, J = ab + bc + ca -
+// f^2 - g^2 - h^2; it admits only ellipsoids whose shortest axis is at least half the longest) and `constrained` is
+// set. It fails when neither gives an ellipsoid.
 //
 // Normalization (what `correction` and `radius` mean): radius r is the geometric mean of the ellipsoid's semi-axes,
 // det(M)^(-1/6), and correction W = r M^(1/2) (the symmetric square root), so that |W (z - b)| = r for every z on the
@@ -33,10 +37,16 @@ struct EllipsoidFit {
   Eigen::Matrix3d correction = Eigen::Matrix3d::Identity();  // W: symmetric, det 1
   double radius = 0.0;                                       // r [units of z]
   double rms_residual = 0.0;                                 // rms of |W (z - b)| - r over the samples [units of z]
+  bool constrained = false;                                  // the ellipsoid-specific fit was needed (header comment)
 };
 
+// kGeneral: the general quadric, the ellipsoid-specific fit when that is no ellipsoid (header comment);
+// kEllipsoidSpecific: the ellipsoid-specific fit only.
+enum class EllipsoidFitMethod { kGeneral, kEllipsoidSpecific };
+
 // At least 10 samples, finite. Errors: too few samples, degenerate spread, not an ellipsoid.
-Result<EllipsoidFit> FitEllipsoid(const std::vector<Eigen::Vector3d>& samples);
+Result<EllipsoidFit> FitEllipsoid(const std::vector<Eigen::Vector3d>& samples,
+                                  EllipsoidFitMethod method = EllipsoidFitMethod::kGeneral);
 
 // (A A^T)^(1/2): the symmetric positive semi-definite factor of A's polar decomposition A = P R.
 Eigen::Matrix3d SymmetricFactor(const Eigen::Matrix3d& A);

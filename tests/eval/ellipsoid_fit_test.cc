@@ -74,6 +74,22 @@ TEST(EllipsoidFitTest, RecoversCentreAndShapeWithinDerivedTolerance) {
   EXPECT_LT((SymmetricFactor(s.distortion * R) - s.distortion).cwiseAbs().maxCoeff(), 1e-12);
 }
 
+TEST(EllipsoidFitTest, EllipsoidSpecificFitIsExactOnNoiseFreeSamples) {
+  // A quarter of the sphere only (h_z < -0.3 r and h_x > 0), as a device kept roughly level covers.
+  Synthetic s = Make(2000, 0.0, 3);
+  std::vector<Eigen::Vector3d> cap;
+  for (const Eigen::Vector3d& z : s.samples) {
+    const Eigen::Vector3d h = s.distortion.inverse() * (z - s.centre);
+    if (h.z() < -0.3 * s.radius && h.x() > 0.0) cap.push_back(z);
+  }
+  ASSERT_GT(cap.size(), 100u);
+  const auto fit = FitEllipsoid(cap, EllipsoidFitMethod::kEllipsoidSpecific);
+  ASSERT_TRUE(fit.ok()) << fit.status().message();
+  EXPECT_TRUE(fit.value().constrained);
+  EXPECT_LT((fit.value().centre - s.centre).norm(), 1e-6);
+  EXPECT_LT((fit.value().correction - s.distortion.inverse()).cwiseAbs().maxCoeff(), 1e-8);
+}
+
 TEST(EllipsoidFitTest, RefusesTooFewOrFlatSamples) {
   EXPECT_FALSE(FitEllipsoid(std::vector<Eigen::Vector3d>(5, Eigen::Vector3d::Ones())).ok());
   EXPECT_FALSE(FitEllipsoid(std::vector<Eigen::Vector3d>(20, Eigen::Vector3d::Ones())).ok());

@@ -16,6 +16,7 @@
 #include "estimator/calibration.h"
 #include "estimator/config.h"
 #include "estimator/geometry.h"
+#include "estimator/models/enu.h"
 #include "estimator/tracking.h"
 #include "eval/ellipsoid_fit.h"
 #include "importers/rosbag.h"
@@ -121,6 +122,24 @@ TEST(ImuMasterRealTest, HuskyImuGpsTrackWithinThreeSigmaOfWheelOdometryAided) {
     sum_std_wheel += std::sqrt(c_wheel.trace());
   }
   ASSERT_GT(compared, 1000);
+  // Each run's horizontal distance from the GPS fixes (rms), to tell which one the difference comes from.
+  const recording::Stream& gps = *rec.value().Find("gps");
+  const EnuConverter enu(*rec.value().origin);
+  for (const AntennaTrack* track : {&a, &b}) {
+    double sum = 0.0;
+    int n = 0;
+    for (std::size_t r = 0; r < gps.t.size(); ++r) {
+      const auto it = std::lower_bound(track->t.begin(), track->t.end(), gps.t[r]);
+      if (it == track->t.end()) continue;
+      const Eigen::Vector3d z =
+          enu.ToEnu(gps.values(static_cast<Eigen::Index>(r), 0), gps.values(static_cast<Eigen::Index>(r), 1),
+                    gps.values(static_cast<Eigen::Index>(r), 2));
+      sum += (track->p[static_cast<std::size_t>(it - track->t.begin())] - z).head<2>().squaredNorm();
+      ++n;
+    }
+    std::cout << (track == &a ? "IMU+GPS" : "wheel-aided") << " track: rms horizontal distance from the GPS fixes "
+              << std::sqrt(sum / n) << " m\n";
+  }
   const double fraction = static_cast<double>(within) / compared;
   std::cout << "Husky: " << compared << " poses compared; horizontal antenna difference mean "
             << sum_difference / compared << " m, max " << max_difference << " m; reported horizontal std mean: IMU+GPS "
@@ -191,6 +210,8 @@ TEST(ImuMasterRealTest, XioMagnetometerCalibrationMatchesTheEllipsoidFit) {
   for (Eigen::Index i = 0; i < rec.streams[1].values.rows(); ++i) raw.push_back(rec.streams[1].values.row(i));
   auto fit = eval::FitEllipsoid(raw);
   ASSERT_TRUE(fit.ok()) << fit.status().message();
+  std::cout << (fit.value().constrained ? "ellipsoid-specific fit (the general quadric is no ellipsoid)\n"
+                                        : "general quadric fit\n");
   double sum_sin_dip = 0.0;
   for (Eigen::Index i = 0; i < rec.streams[0].values.rows(); ++i) {
     const Eigen::Vector3d up = rec.streams[0].values.row(i).segment<3>(3).transpose().normalized();
