@@ -6,6 +6,7 @@
 
 #include "apps/cli.h"
 #include "experiment/steps.h"
+#include "importers/csv.h"
 #include "importers/rosbag.h"
 #include "recording/recording.h"
 
@@ -73,6 +74,27 @@ int RunImportRosbag(const ImportRosbagArgs& args) {
     for (const auto& [what, n] : report.skipped) std::cout << "skipped " << n << " samples (" << what << ")\n";
     std::cout << "imported " << report.chunks << " chunks into " << args.out << "\n";
   }
+  return 0;
+}
+
+int RunImportCsv(const ImportCsvArgs& args) {
+  importers::CsvImportReport report;
+  const Result<recording::Recording> rec = importers::ImportCsv(args.files, args.map, &report);
+  if (const int code = Written(rec, args.out); code != 0) return code;
+  if (args.quiet) return 0;
+  for (const importers::CsvFileReport& f : report.files) {
+    std::cout << f.path << ": " << f.rows << " rows read, " << f.ignored_lines << " blank/comment/skip_rows lines, "
+              << f.skipped_non_numeric << " rows skipped (non-numeric), " << f.skipped_duplicate_time
+              << " rows skipped (duplicate time)\n";
+  }
+  for (std::size_t i = 0; i < report.streams.size(); ++i) {
+    const importers::CsvStreamReport& r = report.streams[i];
+    const recording::Stream& s = rec.value().streams[i];
+    std::cout << r.name << ": " << r.samples << " samples, " << SecondsBetween(s.t.front(), s.t.back()) << " s, "
+              << s.info.rate_hz << " Hz; " << r.empty_cells << " rows with empty cells, " << r.collapsed
+              << " rows collapsed\n";
+  }
+  std::cout << "imported into " << args.out << "\n";
   return 0;
 }
 

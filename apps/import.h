@@ -4,7 +4,9 @@
 // [--wheels-from-odometry]`:
 // converts the Imu, Odometry and NavSatFix topics of a ROS1 bag (recording/import_rosbag.h); the IMU mounting and the
 // platform's nominal geometry, which a bag does not hold, come from the options and go into recording.yaml.
-// Both return the exit code: 0, 2 with one line "roamlab import: <file>[:<line>]: <problem>" on bad input, 1 when the
+// `roamlab import csv FILE... --map MAP.yaml --out REC`: CSV/TSV files with a column mapping (importers/csv.h,
+// docs/import-csv.md); prints rows read per file, samples per stream and every skipped or collapsed row count.
+// All return the exit code: 0, 2 with one line "roamlab import: <file>[:<line>]: <problem>" on bad input, 1 when the
 // recording cannot be written.
 #pragma once
 
@@ -31,5 +33,13 @@ struct ImportRosbagArgs {
   bool quiet = false;
 };
 int RunImportRosbag(const ImportRosbagArgs& args);
+
+struct ImportCsvArgs {
+  std::vector<std::string> files;
+  std::string map;
+  std::string out;
+  bool quiet = false;
+};
+int RunImportCsv(const ImportCsvArgs& args);
 
 }  // namespace roamlab::apps

@@ -224,7 +224,7 @@ void AddOdometry(CLI::App* app, Commands* commands) {
   });
 }
 
-// `import optiodom` and `import rosbag`.
+// `import optiodom`, `import rosbag` and `import csv`.
 void AddImport(CLI::App* app, Commands* commands) {
   CLI::App* imp = app->add_subcommand("import", "Convert real recordings into the recording format.");
   imp->require_subcommand(1);
@@ -252,6 +252,15 @@ void AddImport(CLI::App* app, Commands* commands) {
                          "Also write wheel angles re-expressed from the odometry (needs wheel_radius_m, baseline_m)");
     imp_rosbag->add_flag("--quiet", args->quiet, "No summary");
     return imp_rosbag;
+  });
+  Add(commands, RunImportCsv, [imp](auto* args) {
+    CLI::App* imp_csv =
+        imp->add_subcommand("csv", "CSV/TSV files with a column mapping (units, axes, collapse; docs/import-csv.md).");
+    imp_csv->add_option("files", args->files, "CSV files, in the order of the mapping's files entries")->required();
+    imp_csv->add_option("--map", args->map, "Mapping (YAML)")->required();
+    imp_csv->add_option("--out", args->out, "Output recording directory")->required();
+    imp_csv->add_flag("--quiet", args->quiet, "No summary");
+    return imp_csv;
   });
 }
 

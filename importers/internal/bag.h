@@ -40,7 +40,22 @@ struct Bag {
 // Each reader: errors are one line "<path>: <problem>" (not the format, truncated or corrupt record, unsupported
 // compression, unsupported serialization), never a crash and never a read past a declared length.
 Result<Bag> ReadRos1Bag(const std::string& path);
-Result<Bag> ReadRosbag2(const std::string& path);  // the bag directory, or its metadata.yaml, or one .db3 in it
+
+// rosbag2: `path` is the bag directory or its metadata.yaml (every file of relative_file_paths is read, in that
+// order), or one .db3 file (its own tables name its topics). storage_identifier sqlite3: each .db3 is opened
+// read-only and immutable (a bag left in WAL mode is read as its main file holds it; nothing is written next to it),
+// the topics and messages tables are read and each file's messages sorted by timestamp (ties in row order); only the
+// cdr serialization is read. storage_identifier mcap: each file is read as ReadMcap does. compression_format zstd is
+// read in both modes (FILE: each listed file is one zstd stream, decompressed in memory; MESSAGE: each message is a zstd
+// frame stating its size); other compressions are refused. Topics of several files merge by name.
+Result<Bag> ReadRosbag2(const std::string& path);
+
+// MCAP: the data section is read record by record from the start (the summary section and indexes are not needed,
+// the Footer and the closing magic are required, so a truncated file is refused). Schema names give the types
+// ("sensor_msgs/msg/Imu" -> "sensor_msgs/Imu"); channel message encodings cdr and ros1 are read, others refused;
+// channels of one topic merge. Chunks: uncompressed, zstd or lz4 (frame format), at most 1 GiB uncompressed each,
+// their uncompressed size and (when not 0) CRC-32 checked; messages are views into the file or the uncompressed
+// chunk, nothing is copied. Attachments, metadata records and unknown opcodes are skipped.
 Result<Bag> ReadMcap(const std::string& path);
 
 // Picks the reader by what `path` is: a directory (rosbag2), a file starting with the MCAP magic, or "#ROSBAG V".
