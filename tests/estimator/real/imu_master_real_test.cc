@@ -6,9 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
-#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -19,6 +17,7 @@
 #include "estimator/models/enu.h"
 #include "estimator/tracking.h"
 #include "eval/ellipsoid_fit.h"
+#include "importers/csv.h"
 #include "importers/rosbag.h"
 
 namespace roamlab::estimator {
@@ -160,73 +159,40 @@ TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedT
   EXPECT_GE(imu_consistent, 0.99);
 }
 
-// The x-io log (time [s], gyroscope [deg/s], accelerometer [g], magnetometer [uT]) as a recording: stream imu
-// (rad/s, m/s^2) and stream mag (uT). Rows whose time does not increase are skipped and counted.
-recording::Recording ReadXio(const std::string& path, int* skipped) {
-  recording::Recording rec;
-  recording::Stream imu, mag;
-  imu.info.name = "imu";
-  imu.info.type = recording::StreamType::kImu;
-  imu.info.rate_hz = 100.0;
-  imu.info.columns = recording::FixedColumns(recording::StreamType::kImu);
-  mag.info.name = "mag";
-  mag.info.type = recording::StreamType::kMagnetometer;
-  mag.info.rate_hz = 100.0;
-  mag.info.columns = recording::FixedColumns(recording::StreamType::kMagnetometer);
-  mag.info.units = "uT";
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::array<double, 10>> rows;
-  while (std::getline(in, line)) {
-    std::array<double, 10> v{};
-    std::stringstream cells(line);
-    std::string cell;
-    int n = 0;
-    while (n < 10 && std::getline(cells, cell, ',')) v[static_cast<std::size_t>(n++)] = std::stod(cell);
-    if (n != 10 || (!rows.empty() && v[0] <= rows.back()[0])) {
-      ++*skipped;
-      continue;
-    }
-    rows.push_back(v);
-  }
-  const double deg = M_PI / 180.0;
-  imu.values.resize(static_cast<Eigen::Index>(rows.size()), 6);
-  mag.values.resize(static_cast<Eigen::Index>(rows.size()), 3);
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    const auto& v = rows[i];
-    const Time t = Time::FromNanoseconds(std::llround(v[0] * 1e9));
-    imu.t.push_back(t);
-    mag.t.push_back(t);
-    const auto r = static_cast<Eigen::Index>(i);
-    imu.values.row(r) << v[1] * deg, v[2] * deg, v[3] * deg, v[4] * kStandardGravity, v[5] * kStandardGravity,
-        v[6] * kStandardGravity;
-    mag.values.row(r) << v[7], v[8], v[9];
-  }
-  rec.streams = {imu, mag};
-  return rec;
-}
-
 TEST(ImuMasterRealTest, XioMagnetometerCalibrationAgainstTheEllipsoidFit) {
   const std::string csv = kData + "/xio_imu_mag/sensor_data.csv";
   if (!std::filesystem::exists(csv)) GTEST_SKIP() << "real data absent: " << csv;
-  int skipped = 0;
-  const recording::Recording rec = ReadXio(csv, &skipped);
-  std::cout << "x-io: " << rec.streams[0].t.size() << " rows, " << skipped << " skipped\n";
-  ASSERT_GT(rec.streams[0].t.size(), 10000u);
+  // The recording as `roamlab import csv` makes it (configs/import/xio_imu_mag.yaml): streams imu and magnetometer,
+  // the magnetometer's repeated values between its own updates collapsed.
+  importers::CsvImportReport report;
+  auto imported =
+      importers::ImportCsv({csv}, std::string(ROAMLAB_SOURCE_DIR) + "/configs/import/xio_imu_mag.yaml", &report);
+  ASSERT_TRUE(imported.ok()) << imported.status().message();
+  const recording::Recording& rec = imported.value();
+  const recording::Stream* imu = rec.Find("imu");
+  const recording::Stream* magnetometer = rec.Find("magnetometer");
+  ASSERT_NE(imu, nullptr);
+  ASSERT_NE(magnetometer, nullptr);
+  std::cout << "x-io: " << imu->t.size() << " IMU samples, " << magnetometer->t.size() << " magnetometer samples\n";
+  ASSERT_GT(magnetometer->t.size(), 1000u);
 
   // The ellipsoid fit of the raw field, and the field's dip from the fitted field against the accelerometer's up.
   std::vector<Eigen::Vector3d> raw;
-  for (Eigen::Index i = 0; i < rec.streams[1].values.rows(); ++i) raw.push_back(rec.streams[1].values.row(i));
+  std::vector<Eigen::Vector3d> up;  // the accelerometer's direction at each magnetometer sample (nearest row)
+  for (Eigen::Index i = 0; i < magnetometer->values.rows(); ++i) {
+    raw.push_back(magnetometer->values.row(i));
+    const Time t = magnetometer->t[static_cast<std::size_t>(i)];
+    const auto it = std::min(std::lower_bound(imu->t.begin(), imu->t.end(), t), std::prev(imu->t.end()));
+    up.push_back(imu->values.row(it - imu->t.begin()).segment<3>(3).transpose().normalized());
+  }
   auto fit = eval::FitEllipsoid(raw);
   ASSERT_TRUE(fit.ok()) << fit.status().message();
   std::cout << (fit.value().constrained ? "ellipsoid-specific fit (the general quadric is no ellipsoid)\n"
                                         : "general quadric fit\n");
   double sum_sin_dip = 0.0;
-  for (Eigen::Index i = 0; i < rec.streams[0].values.rows(); ++i) {
-    const Eigen::Vector3d up = rec.streams[0].values.row(i).segment<3>(3).transpose().normalized();
-    const Eigen::Vector3d h = fit.value().correction * (raw[static_cast<std::size_t>(i)] - fit.value().centre);
-    sum_sin_dip += -up.dot(h.normalized());
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    const Eigen::Vector3d h = fit.value().correction * (raw[i] - fit.value().centre);
+    sum_sin_dip += -up[i].dot(h.normalized());
   }
   const double dip = std::asin(sum_sin_dip / static_cast<double>(raw.size()));
   std::cout << "ellipsoid fit: centre [" << fit.value().centre.transpose() << "] uT, radius " << fit.value().radius
