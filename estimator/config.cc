@@ -299,13 +299,19 @@ class Parser {
   }
 
   ParameterConfig ParseParameter(const std::string& name, const YAML::Node& n) const {
-    CheckKeys(n, {"value", "free", "process"}, "parameter '" + name + "'");
+    CheckKeys(n, {"value", "free", "process", "prior_sigma"}, "parameter '" + name + "'");
     ParameterConfig p;
     if (n["value"]) {
       const std::vector<double> v = Numbers(n["value"], "parameters." + name + ".value");
       p.value = Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<int>(v.size()));
     }
     if (n["free"]) p.free = Bool(n["free"], "parameters." + name + ".free");
+    if (n["prior_sigma"]) {
+      const std::vector<double> v = Numbers(n["prior_sigma"], "parameters." + name + ".prior_sigma");
+      for (double sigma : v)
+        if (!(sigma > 0.0)) Fail(n["prior_sigma"], "parameter '" + name + "': prior_sigma must be positive (or .inf)");
+      p.prior_sigma = Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<int>(v.size()));
+    }
     if (n["process"]) {
       const YAML::Node& pr = n["process"];
       CheckKeys(pr, {"type", "sigma", "tau_s", "interval_s"}, "parameter '" + name + "' process");
@@ -403,10 +409,38 @@ class Parser {
     return s;
   }
 
+  // The IMU master's checks and its poses key (PosesConfig).
+  void ParseImuMaster(const YAML::Node& root, EstimatorConfig* c) const {
+    const bool imu_master = c->streams.at(c->master).model == "gyroscope";
+    if (!imu_master) {
+      if (root["poses"]) Fail(root["poses"], "poses is for an IMU master (a gyroscope stream as master) only");
+      return;
+    }
+    bool accelerometer = false;
+    for (const auto& [name, sc] : c->streams) accelerometer = accelerometer || sc.model == "accelerometer";
+    if (!accelerometer)
+      Fail(root["master"], "master stream '" + c->master +
+                               "' is a gyroscope (IMU master), which needs an accelerometer stream to place the poses");
+    if (!root["poses"]) return;
+    const YAML::Node& n = root["poses"];
+    CheckKeys(n, {"rate_hz", "position_sigma_m"}, "poses");
+    if (n["rate_hz"]) {
+      c->poses.rate_hz = Number(n["rate_hz"], "poses.rate_hz");
+      if (!(c->poses.rate_hz > 0.0) || !std::isfinite(c->poses.rate_hz))
+        Fail(n["rate_hz"], "poses.rate_hz must be a positive number of poses per second");
+    }
+    if (n["position_sigma_m"]) {
+      c->poses.position_sigma_m = Number(n["position_sigma_m"], "poses.position_sigma_m");
+      if (!(c->poses.position_sigma_m > 0.0) || !std::isfinite(c->poses.position_sigma_m))
+        Fail(n["position_sigma_m"], "poses.position_sigma_m must be a positive number of metres");
+    }
+  }
+
   EstimatorConfig Parse(const YAML::Node& root) const {
     EstimatorConfig c;
     c.source_file = file_;
-    CheckKeys(root, {"master", "solver", "gating", "tracking", "parameters", "streams", "stages"}, "the configuration");
+    CheckKeys(root, {"master", "poses", "solver", "gating", "tracking", "parameters", "streams", "stages"},
+              "the configuration");
     if (!root["master"]) Fail(root, "missing key 'master'");
     if (!root["streams"]) Fail(root, "missing key 'streams'");
     c.master = String(root["master"], "master");
@@ -424,10 +458,13 @@ class Parser {
       c.streams[name] = ParseStream(name, kv.second);
     }
     if (c.streams.count(c.master) == 0) Fail(root["master"], "master stream '" + c.master + "' is not in streams");
-    if (!FindModelSpec(c.streams[c.master].model)->odometric)
+    const std::string& master_model = c.streams[c.master].model;
+    if (!FindModelSpec(master_model)->odometric && master_model != "gyroscope")
       Fail(root["master"], "master stream '" + c.master +
                                "' must use an odometric model (ackermann, ackermann_seed, differential_drive, "
-                               "omni3_drive, mecanum_drive, omni4_drive, tricycle_drive or odometer)");
+                               "omni3_drive, mecanum_drive, omni4_drive, tricycle_drive or odometer) or the gyroscope "
+                               "model (IMU master)");
+    ParseImuMaster(root, &c);
     if (root["parameters"]) {
       if (!root["parameters"].IsMap()) Fail(root["parameters"], "parameters must be a mapping");
       for (const auto& kv : root["parameters"]) {

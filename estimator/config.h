@@ -3,13 +3,15 @@
 // pose nodes, the solver, outlier gating, the online window and the offline calibration stages.
 //
 //   master: odometer                       # a stream whose model is ackermann, ackermann_seed, differential_drive,
-//                                          # omni3_drive, mecanum_drive, omni4_drive, tricycle_drive or odometer
+//                                          # omni3_drive, mecanum_drive, omni4_drive, tricycle_drive or odometer;
+//                                          # or a gyroscope stream (IMU master, below)
+//   poses: {rate_hz: 20, position_sigma_m: 1.0}   # IMU master only (PosesConfig)
 //   solver: {method: levenberg_marquardt, max_iterations: 50, function_tolerance: 1.0e-8, step_tolerance: 1.0e-10}
 //   gating: {probability: 0.99999}         # chi-square gate on whitened errors; omit to disable
 //   tracking: {window: 40, max_iterations: 10, improvement_threshold: 1.0e-3, time_budget_s: 0.05,
 //              initialization_s: 2.0, relinearize_threshold: 0.0}
 //   parameters:                            # any parameter not listed here keeps its model default and is fixed
-//     gps.lever_arm: {value: [0, 0, 0], free: true}
+//     gps.lever_arm: {value: [0, 0, 0], free: true}     # optional prior_sigma: [.inf, .inf, 0.5] (ParameterConfig)
 //     imu.gyro_bias: {value: [0, 0, 0], free: true, process: {type: random_walk, sigma: 1.0e-4}}
 //     odometer.disturbance: {value: [0, 0, 0], free: true,   # per component: a list of three (Gauss-Markov:
 //                            process: {type: gauss_markov, sigma: [0.01, 0.002, 0.03], tau_s: [0.5, 1.2, 1.8]}}
@@ -75,6 +77,10 @@ struct ParameterConfig {
   std::optional<Eigen::VectorXd> value;  // ambient; default from the model slot
   bool free = false;
   ProcessConfig process;
+  // A Gaussian prior about the initial value on a constant parameter, one std per tangent component (.inf: none on
+  // that component): for a component the measurements leave unobservable, e.g. the GPS antenna's height above an IMU
+  // master's poses on a planar drive.
+  std::optional<Eigen::VectorXd> prior_sigma;
 };
 
 struct StreamConfig {
@@ -107,9 +113,21 @@ struct TrackingConfig {
   std::string calibrate;
 };
 
+// Pose nodes of an IMU master (a gyroscope stream as master; problem.h): the IMU drives the graph instead of an
+// odometric model. The poses sit on a regular grid from the IMU's first sample, rate_hz apart (0: at every IMU
+// sample); consecutive poses are joined by the gyroscope samples between them and every three by the accelerometer.
+// Without an absolute sensor (gps, absolute_pose) every pose's position gets a weak prior N(0, position_sigma_m^2)
+// about the start: the device stays near where it started (handheld), which holds the position and velocity that
+// the accelerometer alone leaves free.
+struct PosesConfig {
+  double rate_hz = 0.0;
+  double position_sigma_m = 1.0;
+};
+
 struct EstimatorConfig {
   std::string source_file;  // for messages
   std::string master;
+  PosesConfig poses;  // IMU master only
   SolverOptions solver;
   std::optional<double> gate_probability;
   TrackingConfig tracking;

@@ -185,7 +185,9 @@ void ProblemBuilder::Add(const MeasurementRef& m) {
     ++(popped_any_ ? c.too_late : c.outside);
     return;
   }
-  if (m.stream == im.master) {
+  if (m.stream == im.master && im.imu) {
+    if (AddImuMasterSample(m)) s.pending.push_back(m);
+  } else if (m.stream == im.master) {
     AddMasterSample(m);
   } else {
     s.pending.push_back(m);
@@ -570,6 +572,10 @@ void ProblemBuilder::PopOldestPose() {
 }
 
 void ProblemBuilder::AlignToAbsoluteFixes() {
+  if (impl_->imu) {
+    AlignImuMasterToFixes();
+    return;
+  }
   if (absolute_fixes_.size() < 2) return;
   // Centroids of the dead-reckoned positions and of the fixes.
   Eigen::Vector3d cp = Eigen::Vector3d::Zero(), cz = Eigen::Vector3d::Zero();
@@ -637,6 +643,7 @@ std::size_t NearestRow(const recording::Stream& stream, Time t) {
 // both ways fix the rotation about it. Each pair is weighted by the inverse of its reading noise variance.
 std::optional<Eigen::Quaterniond> ProblemBuilder::AlignImuToMotion() {
   Impl& im = *impl_;
+  if (im.imu) return std::nullopt;  // the poses come from the IMU itself
   const StreamBinding* gyro = nullptr;
   const StreamBinding* accel = nullptr;
   for (const StreamBinding& s : im.streams) {

@@ -16,6 +16,19 @@
 // half a master period at each end; holding the measured velocity over dt keeps the constraint exact for a constant
 // velocity. A sample whose pose k_a has already left the window is too late (or outside, before the first pose).
 //
+// IMU master (a gyroscope stream as master; config.h PosesConfig). Poses sit on a grid from the IMU's first sample,
+// 1 / poses.rate_hz apart (at every IMU sample without a rate), over the IMU's span. Each gyroscope sample attaches to
+// the pose pair whose interval holds it and each accelerometer sample to the three poses centred on the nearest, as
+// for any master; the other streams attach as usual. Initial guess: the first pose's orientation is gravity-aligned
+// (the accelerometer's mean over the first second turned onto the world's up) with its yaw from the magnetometer's
+// mean over that second (against options.field_world) when there is one, else zero; every later orientation
+// integrates the gyroscope at the current bias, scale and misalignment, holding each sample's rate until the next.
+// Positions extrapolate the last two poses' velocity (zero at the start). AlignToAbsoluteFixes then, with a GPS,
+// places every pose at the fixes linearly interpolated in time and, without a magnetometer, turns the yaw to the GPS
+// track (the body's x axis along the direction of travel). Without an absolute sensor every pose gets a weak position
+// prior (poses.position_sigma_m) about the origin, and without a magnetometer either the first pose's rotation about
+// its z axis is held by a tight prior (the yaw gauge).
+//
 // Parameters are variables named "<stream>.<slot>" unless the configuration maps a slot to another name (shared
 // parameters, e.g. one IMU misalignment for gyroscope, accelerometer and magnetometer). A time-varying parameter
 // (random walk or Gauss-Markov) has one instance per pose, joined by process factors; with process.interval_s, one
@@ -124,6 +137,13 @@ class ProblemBuilder {
   struct Impl;
   explicit ProblemBuilder(std::unique_ptr<Impl> impl);
   void AddMasterSample(const MeasurementRef& m);
+  // The IMU master (problem_imu.cc; the class comment): integrates one gyroscope sample, creating the grid poses it
+  // passes; false for a sample not after the last one (counted as too late).
+  bool AddImuMasterSample(const MeasurementRef& m);
+  void CreateImuPose(Time t);
+  Eigen::Quaterniond InitialImuOrientation(Time t0) const;
+  Eigen::Vector3d ImuBodyRate(const MeasurementRef& m) const;
+  void AlignImuMasterToFixes();
   void AttachPending();
   // Attaches one measurement if its poses exist; returns false to keep it waiting.
   bool TryAttach(const MeasurementRef& m);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "estimator/internal/problem_impl.h"
+#include "estimator/marginalization.h"
 
 namespace roamlab::estimator {
 
@@ -333,6 +334,10 @@ Status ApplyParameterConfig(const EstimatorConfig& config, const std::map<std::s
       }
       (*parameter_initial)[pname] = v;
     }
+    if (pc.prior_sigma &&
+        (pc.process.type != ProcessConfig::Type::kConstant || pc.prior_sigma->size() != it->second.tangent_dim()))
+      return Error(config, "parameter '" + pname + "': prior_sigma needs a constant parameter and " +
+                               std::to_string(it->second.tangent_dim()) + " values (one per tangent component)");
     if (pc.process.type != ProcessConfig::Type::kConstant && it->second.kind() != ManifoldKind::kEuclidean)
       return Error(config, "parameter '" + pname + "': only vector parameters can be time-varying");
     if (pc.process.type != ProcessConfig::Type::kConstant && it->second.ambient_dim() != 3)
@@ -400,14 +405,41 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
     if (im.streams[i].config.model == "gps" || im.streams[i].config.model == "absolute_pose")
       builder->has_absolute_sensor_ = true;
   }
+  if (im.master >= 0 && im.streams[static_cast<std::size_t>(im.master)].config.model == "gyroscope") {
+    im.imu.emplace();
+    for (std::size_t i = 0; i < im.streams.size(); ++i) {
+      const std::string& model = im.streams[i].config.model;
+      if (model == "accelerometer" && im.imu->accelerometer < 0) im.imu->accelerometer = static_cast<int>(i);
+      if (model == "magnetometer" && im.imu->magnetometer < 0) im.imu->magnetometer = static_cast<int>(i);
+    }
+    if (im.imu->accelerometer < 0)
+      return Error(config, "master stream '" + config.master + "' is a gyroscope, which needs an accelerometer stream");
+  }
 
   // Constant parameter variables (time-varying ones get instances per pose).
   for (const auto& [pname, manifold] : im.parameter_manifold) {
     if (builder->IsTimeVarying(pname)) continue;
     const auto pc = im.parameter_config.find(pname);
     const bool free = pc != im.parameter_config.end() && pc->second.free;
-    builder->parameters_[pname] =
+    const VariableId id =
         builder->graph_.AddVariable({pname, manifold, im.parameter_initial.at(pname), !free, std::nullopt});
+    builder->parameters_[pname] = id;
+    if (pc != im.parameter_config.end() && pc->second.prior_sigma) {
+      // e = diag(1 / sigma) (x [-] x0), the components with an infinite sigma left out.
+      const Eigen::VectorXd& sigma = *pc->second.prior_sigma;
+      std::vector<int> rows;
+      for (int i = 0; i < sigma.size(); ++i)
+        if (std::isfinite(sigma[i])) rows.push_back(i);
+      Eigen::MatrixXd J = Eigen::MatrixXd::Zero(static_cast<int>(rows.size()), sigma.size());
+      for (std::size_t r = 0; r < rows.size(); ++r) J(static_cast<int>(r), rows[r]) = 1.0 / sigma[rows[r]];
+      const int n = static_cast<int>(rows.size());
+      if (n == 0) continue;
+      builder->graph_.AddFactor(
+          std::make_unique<LinearPriorFactor>(std::vector<Manifold>{manifold},
+                                              std::vector<Eigen::VectorXd>{im.parameter_initial.at(pname)}, J,
+                                              Eigen::VectorXd::Zero(n)),
+          {id}, Eigen::MatrixXd::Identity(n, n), Loss::Trivial(), "prior", Time());
+    }
   }
   return builder;
 }

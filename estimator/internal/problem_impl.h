@@ -54,6 +54,18 @@ struct StreamBinding {
   std::deque<MeasurementRef> pending;
 };
 
+// The IMU master's state (problem_imu.cc): the grid of pose times and the gyroscope's integration since the newest
+// pose.
+struct ImuMasterState {
+  int accelerometer = -1;       // stream index of the first accelerometer stream
+  int magnetometer = -1;        // stream index of the first magnetometer stream (-1: none)
+  Time first_t;                 // the first IMU sample: the grid's origin
+  std::int64_t next_index = 1;  // next grid pose: first_t + next_index / rate_hz
+  Time cursor;                  // integrated up to here
+  Eigen::Quaterniond delta = Eigen::Quaterniond::Identity();  // q_pose^-1 q(cursor), from the newest pose
+  Eigen::Vector3d omega_body = Eigen::Vector3d::Zero();       // the held body rate [rad/s] of the last sample
+};
+
 struct ProblemBuilder::Impl {
   EstimatorConfig config;
   std::vector<StreamBinding> streams;
@@ -63,6 +75,7 @@ struct ProblemBuilder::Impl {
   std::map<std::string, ParameterConfig> parameter_config;
   std::map<std::string, Eigen::VectorXd> parameter_initial;
   std::optional<MeasurementRef> last_master;
+  std::optional<ImuMasterState> imu;  // set when the master is a gyroscope stream
 };
 
 }  // namespace roamlab::estimator

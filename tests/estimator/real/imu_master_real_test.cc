@@ -1,0 +1,253 @@
+// The IMU master on real recordings (skipped when the shared data are absent):
+//  - the Husky bag without its wheel odometry (configs/real/husky_imu_gps.yaml), tracked with its calibration and
+//    compared with the wheel-odometry-aided run (configs/real/husky_nominal.yaml);
+//  - the x-io handheld IMU + magnetometer log (configs/real/xio_imu_mag.yaml): the magnetometer's A and b against the
+//    ellipsoid fit of the raw field (eval/ellipsoid_fit.h).
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "estimator/calibration.h"
+#include "estimator/config.h"
+#include "estimator/geometry.h"
+#include "estimator/models/enu.h"
+#include "estimator/tracking.h"
+#include "eval/ellipsoid_fit.h"
+#include "importers/csv.h"
+#include "importers/rosbag.h"
+
+namespace roamlab::estimator {
+namespace {
+
+const std::string kData = std::string(ROAMLAB_SHARED_DIR) + "/data";
+const std::string kConfigs = std::string(ROAMLAB_SOURCE_DIR) + "/configs/real/";
+
+std::map<std::string, Eigen::VectorXd> Values(const CalibrationResult& r) {
+  std::map<std::string, Eigen::VectorXd> out;
+  for (const ParameterEstimate& p : r.parameters) out[p.name] = p.estimate;
+  return out;
+}
+
+void Print(const CalibrationResult& r) {
+  for (const ParameterEstimate& p : r.parameters) {
+    std::cout << "  " << p.name << " = [" << p.estimate.transpose() << "] +- [" << p.std.transpose() << "]\n";
+  }
+}
+
+// A run's track of the GPS antenna (the pose moved by the calibrated lever arm) with its position covariance.
+struct AntennaTrack {
+  std::vector<Time> t;
+  std::vector<Eigen::Vector3d> p;
+  std::vector<Eigen::Matrix3d> covariance;
+};
+
+AntennaTrack Antenna(const TrackingResult& track, const Eigen::Vector3d& lever_arm) {
+  AntennaTrack out;
+  for (std::size_t i = 0; i < track.trajectory.size(); ++i) {
+    const StampedPose& p = track.trajectory[i];
+    out.t.push_back(p.t);
+    out.p.push_back(p.p_world_body + p.q_world_body * lever_arm);
+    out.covariance.push_back(track.position_covariance[i]);
+  }
+  return out;
+}
+
+Result<TrackingResult> CalibrateAndTrack(const std::string& config_file, const recording::Recording& rec,
+                                         CalibrationResult* calibration) {
+  auto config = LoadEstimatorConfig(config_file);
+  if (!config.ok()) return config.status();
+  auto calibrated = Calibrate(config.value(), rec);
+  if (!calibrated.ok()) return calibrated.status();
+  *calibration = calibrated.value();
+  return Track(config.value(), rec, Values(*calibration));
+}
+
+TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedTrack) {
+  const std::string bag = kData + "/husky_test1/test1.bag";
+  if (!std::filesystem::exists(bag)) GTEST_SKIP() << "real data absent: " << bag;
+  importers::RosbagImportOptions options;
+  options.platform = {"skid_steer", {{"wheel_radius_m", 0.1651}, {"baseline_m", 0.555}}};
+  options.q_body_imu = Eigen::Quaterniond(std::sqrt(0.5), std::sqrt(0.5), 0.0, 0.0);
+  options.wheels_from_odometry = true;
+  auto rec = importers::ImportRosbag(bag, options);
+  ASSERT_TRUE(rec.ok()) << rec.status().message();
+  // The IMU + GPS recording: the wheel odometry (and the wheels derived from it) dropped.
+  recording::Recording imu_gps = rec.value();
+  imu_gps.streams.erase(
+      std::remove_if(imu_gps.streams.begin(), imu_gps.streams.end(),
+                     [](const recording::Stream& s) { return s.info.name == "odometry" || s.info.name == "wheels"; }),
+      imu_gps.streams.end());
+  ASSERT_EQ(imu_gps.streams.size(), 2u);
+
+  CalibrationResult wheel_calibration, imu_calibration;
+  auto wheel = CalibrateAndTrack(kConfigs + "husky_nominal.yaml", rec.value(), &wheel_calibration);
+  ASSERT_TRUE(wheel.ok()) << wheel.status().message();
+  auto imu = CalibrateAndTrack(kConfigs + "husky_imu_gps.yaml", imu_gps, &imu_calibration);
+  ASSERT_TRUE(imu.ok()) << imu.status().message();
+  std::cout << "wheel-odometry-aided calibration:\n";
+  Print(wheel_calibration);
+  std::cout << "IMU + GPS calibration:\n";
+  Print(imu_calibration);
+  for (const ParameterEstimate& p : imu_calibration.parameters)
+    for (int i = 0; i < p.std.size(); ++i) EXPECT_TRUE(std::isfinite(p.std[i])) << p.name << "[" << i << "]";
+
+  // Horizontal antenna positions at the IMU run's poses, the wheel run's interpolated linearly, with each run's
+  // reported covariance (the wheel run's nearest pose's). Both runs read the same GPS, so their errors are positively
+  // correlated and the sum of the covariances overstates the difference's: the test is conservative in that.
+  const AntennaTrack a = Antenna(imu.value(), Values(imu_calibration).at("gps.lever_arm"));
+  const AntennaTrack b = Antenna(wheel.value(), Eigen::Vector3d::Zero());
+  int compared = 0, within = 0;
+  double max_difference = 0.0, sum_difference = 0.0, sum_std_imu = 0.0, sum_std_wheel = 0.0, max_mahalanobis = 0.0;
+  for (std::size_t i = 0; i < a.t.size(); ++i) {
+    const auto after = std::lower_bound(b.t.begin(), b.t.end(), a.t[i]);
+    if (after == b.t.begin() || after == b.t.end()) continue;
+    const std::size_t j = static_cast<std::size_t>(after - b.t.begin());
+    const double w = SecondsBetween(b.t[j - 1], a.t[i]) / SecondsBetween(b.t[j - 1], b.t[j]);
+    const Eigen::Vector2d d = (a.p[i] - ((1.0 - w) * b.p[j - 1] + w * b.p[j])).head<2>();
+    const Eigen::Matrix2d c_imu = a.covariance[i].topLeftCorner<2, 2>();
+    const Eigen::Matrix2d c_wheel = b.covariance[w < 0.5 ? j - 1 : j].topLeftCorner<2, 2>();
+    const double m2 = d.dot((c_imu + c_wheel).ldlt().solve(d));
+    // The 3-sigma region of a 2-D Gaussian: the chi-square(2) quantile of 0.9973, -2 ln(0.0027) = 11.83.
+    within += m2 <= 11.83 ? 1 : 0;
+    ++compared;
+    max_difference = std::max(max_difference, d.norm());
+    max_mahalanobis = std::max(max_mahalanobis, std::sqrt(m2));
+    sum_difference += d.norm();
+    sum_std_imu += std::sqrt(c_imu.trace());
+    sum_std_wheel += std::sqrt(c_wheel.trace());
+  }
+  ASSERT_GT(compared, 1000);
+  const double fraction = static_cast<double>(within) / compared;
+  std::cout << "Husky: " << compared << " poses compared; horizontal antenna difference mean "
+            << sum_difference / compared << " m, max " << max_difference << " m; reported horizontal std mean: IMU+GPS "
+            << sum_std_imu / compared << " m, wheel-aided " << sum_std_wheel / compared
+            << " m; within the 3-sigma region: " << 100.0 * fraction << "% (max Mahalanobis " << max_mahalanobis
+            << ")\n";
+  // Each run against the GPS fixes it read: the horizontal distance of its antenna from each fix, normalized by its
+  // own reported covariance plus the fix's configured noise (1.2 m per axis in both configurations).
+  const recording::Stream& gps = *rec.value().Find("gps");
+  const EnuConverter enu(*rec.value().origin);
+  const auto against_fixes = [&](const AntennaTrack& track, const char* name) {
+    double sum = 0.0;
+    int n = 0, inside = 0;
+    for (std::size_t r = 0; r < gps.t.size(); ++r) {
+      const auto it = std::lower_bound(track.t.begin(), track.t.end(), gps.t[r]);
+      if (it == track.t.end()) continue;
+      const std::size_t k = static_cast<std::size_t>(it - track.t.begin());
+      const auto row = static_cast<Eigen::Index>(r);
+      const Eigen::Vector3d z = enu.ToEnu(gps.values(row, 0), gps.values(row, 1), gps.values(row, 2));
+      const Eigen::Vector2d d = (track.p[k] - z).head<2>();
+      const Eigen::Matrix2d c = track.covariance[k].topLeftCorner<2, 2>() + 1.2 * 1.2 * Eigen::Matrix2d::Identity();
+      inside += d.dot(c.ldlt().solve(d)) <= 11.83 ? 1 : 0;
+      sum += d.squaredNorm();
+      ++n;
+    }
+    std::cout << name << " track against the GPS fixes: rms horizontal distance " << std::sqrt(sum / n)
+              << " m, within the 3-sigma region " << 100.0 * inside / n << "% of " << n << " fixes\n";
+    return static_cast<double>(inside) / n;
+  };
+  const double imu_consistent = against_fixes(a, "IMU+GPS");
+  against_fixes(b, "wheel-aided");
+  // The IMU+GPS track is consistent with the fixes: at most the 0.27% a 3-sigma region leaves out, with a margin for
+  // the fixes' correlated errors. The comparison with the wheel-aided track above is reported, not asserted: that run
+  // strays from the same fixes by more than its own reported std allows (its rms distance and fraction printed
+  // here), so the difference measures the reference's inconsistency as much as this track's.
+  EXPECT_GE(imu_consistent, 0.99);
+}
+
+TEST(ImuMasterRealTest, XioMagnetometerCalibrationAgainstTheEllipsoidFit) {
+  const std::string csv = kData + "/xio_imu_mag/sensor_data.csv";
+  if (!std::filesystem::exists(csv)) GTEST_SKIP() << "real data absent: " << csv;
+  // The recording as `roamlab import csv` makes it (configs/import/xio_imu_mag.yaml): streams imu and magnetometer,
+  // the magnetometer's repeated values between its own updates collapsed.
+  importers::CsvImportReport report;
+  auto imported =
+      importers::ImportCsv({csv}, std::string(ROAMLAB_SOURCE_DIR) + "/configs/import/xio_imu_mag.yaml", &report);
+  ASSERT_TRUE(imported.ok()) << imported.status().message();
+  const recording::Recording& rec = imported.value();
+  const recording::Stream* imu = rec.Find("imu");
+  const recording::Stream* magnetometer = rec.Find("magnetometer");
+  ASSERT_NE(imu, nullptr);
+  ASSERT_NE(magnetometer, nullptr);
+  std::cout << "x-io: " << imu->t.size() << " IMU samples, " << magnetometer->t.size() << " magnetometer samples\n";
+  ASSERT_GT(magnetometer->t.size(), 1000u);
+
+  // The ellipsoid fit of the raw field, and the field's dip from the fitted field against the accelerometer's up.
+  std::vector<Eigen::Vector3d> raw;
+  std::vector<Eigen::Vector3d> up;  // the accelerometer's direction at each magnetometer sample (nearest row)
+  for (Eigen::Index i = 0; i < magnetometer->values.rows(); ++i) {
+    raw.push_back(magnetometer->values.row(i));
+    const Time t = magnetometer->t[static_cast<std::size_t>(i)];
+    const auto it = std::min(std::lower_bound(imu->t.begin(), imu->t.end(), t), std::prev(imu->t.end()));
+    up.push_back(imu->values.row(it - imu->t.begin()).segment<3>(3).transpose().normalized());
+  }
+  auto fit = eval::FitEllipsoid(raw);
+  ASSERT_TRUE(fit.ok()) << fit.status().message();
+  std::cout << (fit.value().constrained ? "ellipsoid-specific fit (the general quadric is no ellipsoid)\n"
+                                        : "general quadric fit\n");
+  double sum_sin_dip = 0.0;
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    const Eigen::Vector3d h = fit.value().correction * (raw[i] - fit.value().centre);
+    sum_sin_dip += -up[i].dot(h.normalized());
+  }
+  const double dip = std::asin(sum_sin_dip / static_cast<double>(raw.size()));
+  std::cout << "ellipsoid fit: centre [" << fit.value().centre.transpose() << "] uT, radius " << fit.value().radius
+            << " uT, rms residual " << fit.value().rms_residual << " uT, dip " << dip * 180.0 / M_PI << " deg; W =\n"
+            << fit.value().correction << "\n";
+
+  auto config = LoadEstimatorConfig(kConfigs + "xio_imu_mag.yaml");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  const std::vector<double>& field = config.value().streams.at("mag").options.at("field_world");
+  const Eigen::Vector3d h_world(field[0], field[1], field[2]);
+  std::cout << "configured field: |h| " << h_world.norm() << " uT, dip "
+            << std::asin(-h_world.z() / h_world.norm()) * 180.0 / M_PI << " deg\n";
+  auto result = Calibrate(config.value(), rec);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  Print(result.value());
+  const auto values = Values(result.value());
+  const Eigen::Vector3d b = values.at("mag.b");
+  const Eigen::Matrix3d A = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(values.at("mag.A").data());
+  // z = A h^(S) + b with |h^(S)| = |h_world| and z = W^-1 h' + c with |h'| = r: A A^T = (r / |h_world|)^2 W^-2, so
+  // the symmetric factor of A scaled by |h_world| / r is compared with W^-1 (eval/ellipsoid_fit.h).
+  const Eigen::Matrix3d P = eval::SymmetricFactor(A) * (h_world.norm() / fit.value().radius);
+  const Eigen::Matrix3d W_inv = fit.value().correction.inverse();
+  const double b_error = (b - fit.value().centre).norm();
+  const double A_error = (P - W_inv).cwiseAbs().maxCoeff();
+  std::cout << "x-io: |b - centre| = " << b_error << " uT; max |P - W^-1| = " << A_error << "; P =\n"
+            << P << "\nW^-1 =\n"
+            << W_inv << "\n";
+  // How well each maps the raw samples onto its sphere: the rms of |A^-1 (z - b)| - |h_world| for the estimator's,
+  // the fit's rms residual for the fit's.
+  const Eigen::FullPivLU<Eigen::Matrix3d> A_lu(A);
+  double sum_squared = 0.0;
+  for (const Eigen::Vector3d& z : raw) {
+    const double e = A_lu.solve(z - b).norm() - h_world.norm();
+    sum_squared += e * e;
+  }
+  const double estimator_rms = std::sqrt(sum_squared / static_cast<double>(raw.size()));
+  double sum_squared_raw = 0.0;
+  for (const Eigen::Vector3d& z : raw) sum_squared_raw += std::pow(z.norm() - h_world.norm(), 2);
+  std::cout << "uncalibrated (A = I, b = 0) sphere residual rms "
+            << std::sqrt(sum_squared_raw / static_cast<double>(raw.size())) << " uT\n";
+  std::cout << "sphere residual rms: estimator " << estimator_rms << " uT, ellipsoid fit " << fit.value().rms_residual
+            << " uT\n";
+  // The log keeps the device's z axis up (the accelerometer's z stays above 0.2 g): the raw field covers a cap of its
+  // ellipsoid, which does not pin the ellipsoid down. The general quadric through it is no ellipsoid, and the
+  // ellipsoid-specific fit is one of a family that fits the cap about equally well; the estimator, which also knows
+  // the orientations (gyroscope, accelerometer) and the field's direction, finds another member. So the comparison
+  // above (b within 0.5 uT of the fit's centre, P within 0.02 of W^-1) is reported, not asserted (it holds on a
+  // synthetic handheld turned through every orientation: ImuMasterTest.HandheldMagnetometerCalibration...); what is
+  // asserted: the cap is what the fit saw, and the estimator's A and b map the raw field onto the sphere of the
+  // configured magnitude to within twice the configured noise (the radial part of an isotropic noise sigma has rms
+  // sigma; uncalibrated, A = I and b = 0, the rms printed above is several times that).
+  EXPECT_TRUE(fit.value().constrained);
+  EXPECT_LT(estimator_rms, 2.0 * config.value().streams.at("mag").noise.at("sigma"));
+  EXPECT_TRUE(b.allFinite() && A.allFinite());
+}
+
+}  // namespace
+}  // namespace roamlab::estimator
