@@ -165,6 +165,8 @@ class Builder {
   std::string rec_name_, kind_, kind_origin_;
   const Stream* master_ = nullptr;
   std::string master_name_;
+  bool imu_master_ = false;     // no odometric stream: the IMU's gyroscope creates the poses
+  std::string gyroscope_name_;  // the last gyroscope stream added
   std::set<const Stream*> used_;
   std::set<std::string> used_names_;
   std::vector<Node> streams_, parameters_;
@@ -273,13 +275,24 @@ Status Builder::ChooseMaster() {
     for (const Stream& s : rec_.streams)
       if (s.info.type == type && !master_) AddVelocity(s, true);
   if (master_) return Status::Ok();
+  // No odometric stream: an IMU creates a pose at each of its samples (the IMU master); not when wheel encoders are
+  // there without a model for the kind (--platform names one).
+  for (const Stream& s : rec_.streams) {
+    if (s.info.type != StreamType::kImu || master_ || !left_out_.empty()) continue;
+    imu_master_ = true;
+    AddImu(s, true, true);
+    used_.insert(&s);
+    master_ = &s;
+    master_name_ = gyroscope_name_;
+  }
+  if (master_) return Status::Ok();
   const std::string wheels = left_out_.empty() ? std::string()
                                                : " (" + left_out_.front().substr(0, left_out_.front().find(' ')) +
                                                      ": no wheel model for platform kind '" + kind_ + "')";
   return Status::Error(rec_name_ +
                        ": no stream can make the poses: the master needs wheel_encoders of platform kind "
                        "differential_drive, skid_steer, omni3, mecanum or ackermann (--platform KIND)" +
-                       wheels + ", odometry, visual_odometry or scan_matching");
+                       wheels + ", odometry, visual_odometry, scan_matching or an imu");
 }
 
 Status Builder::AddWheels(const Stream& s) {
@@ -456,9 +469,15 @@ void Builder::AddImu(const Stream& s, bool gyroscope, bool accelerometer) {
   const std::string misalignment = s.info.name + ".misalignment";
   std::string origin;
   const std::vector<double> q = Rotation(s, &origin);
-  Parameter(misalignment, q, origin, true, "free: the IMU's attitude on the body, self-calibrated", 0);
+  if (imu_master_) {
+    Parameter(misalignment, q, origin, false,
+              "fixed: with the IMU the only motion sensor its attitude on the body is a gauge freedom", 0);
+  } else {
+    Parameter(misalignment, q, origin, true, "free: the IMU's attitude on the body, self-calibrated", 0);
+  }
   if (gyroscope) {
     const std::string name = UniqueName(both ? std::string("gyroscope") : s.info.name);
+    gyroscope_name_ = name;
     Node n = StreamNode(name, "the turn rates", "gyroscope", "stream type " + TypeName(s), s);
     AddNoise(&n, "sigma_radps",
              StatedNoise(rec_name_, s.info, {"gyro_sigma_radps", "sigma_radps"}, 0.02, "0.02 rad/s"));
@@ -609,7 +628,12 @@ std::string Builder::Yaml() const {
               "defaults are generic.",
           "", &out);
   for (const std::string& line : left_out_) Comment("Left out: " + line, "", &out);
-  Emit({"master", "the odometric stream that creates the pose nodes", Name(master_name_), {}}, 0, &out);
+  Emit({"master",
+        imu_master_ ? "the IMU's gyroscope creates a pose at each IMU sample (no odometric stream: IMU master)"
+                    : "the odometric stream that creates the pose nodes",
+        Name(master_name_),
+        {}},
+       0, &out);
   Node solver{
       "solver", "the batch solves, as the simulated robots' nominal configurations (gap/nominal_config.h)", "", {}};
   solver.children = {{"method", "default: damped Gauss-Newton", "levenberg_marquardt", {}},

@@ -152,7 +152,7 @@ TEST(InitCliTest, BadInputsGiveOneLineAndExitCodeTwo) {
   EXPECT_EQ(Lines(run.err), 1u) << run.err;
   EXPECT_NE(run.err.find(dir.File("missing")), std::string::npos) << run.err;
 
-  // A recording with an IMU only: nothing makes the poses.
+  // A recording with an IMU only: the IMU master; with a GPS only: nothing makes the poses.
   recording::Recording imu_only;
   imu_only.platform.kind = "differential_drive";
   recording::Stream imu;
@@ -164,7 +164,28 @@ TEST(InitCliTest, BadInputsGiveOneLineAndExitCodeTwo) {
   imu.values = Eigen::MatrixXd::Zero(3, 6);
   imu_only.streams.push_back(imu);
   ASSERT_TRUE(recording::WriteRecording(imu_only, dir.File("imu_only")).ok());
-  run = Roamlab("init " + dir.File("imu_only") + " --out " + dir.File("est.yaml"), dir);
+  run = Roamlab("init " + dir.File("imu_only") + " --out " + dir.File("imu_est.yaml") + " --quiet", dir);
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  const std::string imu_yaml = testing::ReadFile(dir.File("imu_est.yaml"));
+  EXPECT_NE(imu_yaml.find("master: gyroscope\n"), std::string::npos) << imu_yaml;
+  EXPECT_NE(imu_yaml.find("# fixed: with the IMU the only motion sensor its attitude on the body is a gauge freedom\n"
+                          "    free: false"),
+            std::string::npos)
+      << imu_yaml;
+  recording::Recording gps_only;
+  gps_only.platform.kind = "differential_drive";
+  gps_only.origin = recording::GeodeticOrigin{45.0, 9.0, 100.0};
+  recording::Stream gps;
+  gps.info.name = "gps";
+  gps.info.type = recording::StreamType::kGps;
+  gps.info.rate_hz = 1.0;
+  gps.info.columns = recording::FixedColumns(recording::StreamType::kGps);
+  for (int k = 0; k < 3; ++k) gps.t.push_back(Time::FromSeconds(1.0 * k));
+  gps.values = Eigen::MatrixXd::Constant(3, 3, 45.0);
+  gps_only.streams.push_back(gps);
+  const Status written = recording::WriteRecording(gps_only, dir.File("gps_only"));
+  ASSERT_TRUE(written.ok()) << written.message();
+  run = Roamlab("init " + dir.File("gps_only") + " --out " + dir.File("est.yaml"), dir);
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_EQ(Lines(run.err), 1u) << run.err;
   EXPECT_NE(run.err.find("no stream can make the poses"), std::string::npos) << run.err;
