@@ -155,6 +155,9 @@ class Builder {
   Status AddWheels(const Stream& s);
   Status AddWheelGeometry(const Stream& s, const std::string& model, const std::string& param_prefix);
   Status AddAckermann(const Stream& s);
+  Status AddTricycle(const Stream& s);
+  Noise WheelRateNoise(const Stream& s) const;
+  Result<double> WheelRadius(const Stream& s, const std::string& model, std::string* origin) const;
   void AddVelocity(const Stream& s, bool master);
   void AddImu(const Stream& s, bool gyroscope, bool accelerometer);
   void AddGps(const Stream& s);
@@ -254,6 +257,8 @@ const std::map<std::string, std::string>& WheelModels() {
                                                             {"skid_steer", "differential_drive"},
                                                             {"omni3", "omni3_drive"},
                                                             {"mecanum", "mecanum_drive"},
+                                                            {"omni4", "omni4_drive"},
+                                                            {"tricycle", "tricycle_drive"},
                                                             {"ackermann", "ackermann"}};
   return models;
 }
@@ -269,7 +274,8 @@ Status Builder::ChooseMaster() {
       used_.insert(&s);
       continue;
     }
-    return model->second == "ackermann" ? AddAckermann(s) : AddWheels(s);
+    if (model->second == "ackermann") return AddAckermann(s);
+    return model->second == "tricycle_drive" ? AddTricycle(s) : AddWheels(s);
   }
   for (StreamType type : {StreamType::kOdometry, StreamType::kVisualOdometry, StreamType::kScanMatching})
     for (const Stream& s : rec_.streams)
@@ -305,21 +311,8 @@ Status Builder::AddWheels(const Stream& s) {
                          std::to_string(s.info.columns.size()) + " in " + (s.info.units.empty() ? "?" : s.info.units));
   Node n = StreamNode(name, "the master: the wheel encoders create the poses", model,
                       "platform kind '" + kind_ + "' (" + kind_origin_ + ")", s);
-  // Wheel-rate noise: one tick of quantization on each end of a sample period (sigma q / sqrt(6) per angle
-  // difference, over 1 / rate_hz).
-  const auto ticks = s.info.attributes.find("ticks_per_revolution");
   const bool skid = kind_ == "skid_steer";
-  Noise wheel = StatedNoise(rec_name_, s.info, {"wheel_radps", "sigma_radps"}, skid ? 0.3 : 0.15,
-                            skid ? "skid-steer wheel speeds are a loose measure of the body's motion (0.3 rad/s)"
-                                 : "0.15 rad/s, as configs/indoor_diffdrive_tracking.yaml");
-  if (wheel.origin.rfind("default", 0) == 0 && ticks != s.info.attributes.end() && ticks->second > 0.0 &&
-      s.info.rate_hz > 0.0) {
-    wheel = {2.0 * kPi / ticks->second * s.info.rate_hz / std::sqrt(6.0),
-             "quantization of " + Where(s.info.name + ".attributes.ticks_per_revolution") + " = " +
-                 Number(ticks->second) + " over 1 / rate_hz = 1 / " + Number(s.info.rate_hz) +
-                 " s: 2 pi / ticks * rate_hz / sqrt(6)"};
-  }
-  AddNoise(&n, "wheel_radps", wheel);
+  AddNoise(&n, "wheel_radps", WheelRateNoise(s));
   const double slack = skid ? 0.1 : 0.02;
   const std::string slack_why = skid ? "default: a skid-steer platform slides sideways as it turns"
                                      : "default: the casters and soft contacts let O move a little (0.02 m/s)";
@@ -340,14 +333,32 @@ Status Builder::AddWheels(const Stream& s) {
   return AddWheelGeometry(s, model, name);
 }
 
-// The radius (free) and the yaw lever arm (fixed) of a wheel model from the platform geometry.
-Status Builder::AddWheelGeometry(const Stream& s, const std::string& model, const std::string& name) {
+// Wheel-rate noise: the stated one, else one tick of quantization on each end of a sample period (sigma q / sqrt(6)
+// per angle difference, over 1 / rate_hz) when the angles were counted in ticks, else a default.
+Noise Builder::WheelRateNoise(const Stream& s) const {
+  const auto ticks = s.info.attributes.find("ticks_per_revolution");
+  const bool skid = kind_ == "skid_steer";
+  Noise wheel = StatedNoise(rec_name_, s.info, {"wheel_radps", "sigma_radps"}, skid ? 0.3 : 0.15,
+                            skid ? "skid-steer wheel speeds are a loose measure of the body's motion (0.3 rad/s)"
+                                 : "0.15 rad/s, as configs/indoor_diffdrive_tracking.yaml");
+  // ticks_per_revolution 1 states revolutions (a log of fractional wheel turns), not counted ticks: no quantization.
+  if (wheel.origin.rfind("default", 0) == 0 && ticks != s.info.attributes.end() && ticks->second > 1.0 &&
+      s.info.rate_hz > 0.0) {
+    wheel = {2.0 * kPi / ticks->second * s.info.rate_hz / std::sqrt(6.0),
+             "quantization of " + Where(s.info.name + ".attributes.ticks_per_revolution") + " = " +
+                 Number(ticks->second) + " over 1 / rate_hz = 1 / " + Number(s.info.rate_hz) +
+                 " s: 2 pi / ticks * rate_hz / sqrt(6)"};
+  }
+  return wheel;
+}
+
+// The nominal wheel radius from the platform geometry: wheel_radius_m, else the mean of wheel_radius_<column>_m.
+Result<double> Builder::WheelRadius(const Stream& s, const std::string& model, std::string* origin) const {
   const std::map<std::string, double>& g = rec_.platform.geometry;
-  std::string origin;
   double radius = 0.0;
   if (g.count("wheel_radius_m")) {
     radius = g.at("wheel_radius_m");
-    origin = "from " + Where("platform.geometry.wheel_radius_m");
+    *origin = "from " + Where("platform.geometry.wheel_radius_m");
   } else {
     std::vector<std::string> keys;
     for (const std::string& column : s.info.columns) {
@@ -361,12 +372,21 @@ Status Builder::AddWheelGeometry(const Stream& s, const std::string& model, cons
                            "/recording.yaml: platform.geometry has no wheel_radius_m (nor "
                            "wheel_radius_<wheel>_m for every column of '" +
                            s.info.name + "') for the " + model + " model");
-    origin = "mean of " + Where("platform.geometry");
-    for (const std::string& key : keys) origin += " " + key;
+    *origin = "mean of " + Where("platform.geometry");
+    for (const std::string& key : keys) *origin += " " + key;
   }
   if (!(radius > 0.0))
     return Status::Error(rec_name_ + "/recording.yaml: platform.geometry: wheel radius must be positive");
-  Parameter(name + ".radius", {radius}, origin, true, "free: the odometry's scale, self-calibrated", 1);
+  return radius;
+}
+
+// The radius (free) and the yaw lever arm (fixed) of a wheel model from the platform geometry.
+Status Builder::AddWheelGeometry(const Stream& s, const std::string& model, const std::string& name) {
+  const std::map<std::string, double>& g = rec_.platform.geometry;
+  std::string origin;
+  const Result<double> radius = WheelRadius(s, model, &origin);
+  if (!radius.ok()) return radius.status();
+  Parameter(name + ".radius", {radius.value()}, origin, true, "free: the odometry's scale, self-calibrated", 1);
   // The yaw lever arm's slot and the geometry keys it is read from: the first of the alternatives, or their sum.
   struct YawLever {
     std::string slot;
@@ -378,6 +398,8 @@ Status Builder::AddWheelGeometry(const Stream& s, const std::string& model, cons
       model == "omni3_drive" ? YawLever{"distance", {"wheel_distance_m"}, false, "wheel_distance_m"}
       : model == "mecanum_drive"
           ? YawLever{"lx_plus_ly", {"half_length_m", "half_width_m"}, true, "half_length_m and half_width_m"}
+      : model == "omni4_drive"
+          ? YawLever{"wheelbase_plus_track", {"wheelbase_m", "track_m"}, true, "wheelbase_m and track_m"}
           : YawLever{"baseline", {"baseline_m", "track_m"}, false, "baseline_m or track_m"};
   double value = 0.0;
   std::string used;
@@ -394,6 +416,53 @@ Status Builder::AddWheelGeometry(const Stream& s, const std::string& model, cons
   const std::string slot = lever.slot;
   Parameter(name + "." + slot, {value}, "from " + Where("platform.geometry." + used), false,
             "fixed: the yaw lever arm is believed (with one free radius it trades with the yaw reference's scale)", 1);
+  return Status::Ok();
+}
+
+// The tricycle: the steered, driven front wheel's angle and its steering angle. The radius and the steering offset
+// free, the wheel-to-axle distance believed (on a drive of nearly constant steering it trades with the offset).
+Status Builder::AddTricycle(const Stream& s) {
+  const Stream* steering = nullptr;
+  for (const Stream& t : rec_.streams)
+    if (t.info.type == StreamType::kSteering && !steering) steering = &t;
+  if (!steering || s.info.columns.size() != 1 || s.info.units != "rad")
+    return Status::Error(rec_name_ + ": stream '" + s.info.name +
+                         "': the tricycle_drive model of platform kind 'tricycle' needs one wheel angle column in rad "
+                         "and a steering stream");
+  const auto axle = rec_.platform.geometry.find("wheel_to_axle_m");
+  if (axle == rec_.platform.geometry.end() || !(axle->second > 0.0))
+    return Status::Error(rec_name_ +
+                         "/recording.yaml: platform.geometry has no positive wheel_to_axle_m for the tricycle_drive "
+                         "model");
+  std::string origin;
+  const Result<double> radius = WheelRadius(s, "tricycle_drive", &origin);
+  if (!radius.ok()) return radius.status();
+  const std::string name = UniqueName(s.info.name);
+  Node n = StreamNode(name, "the master: the front wheel's angle and its steering create the poses", "tricycle_drive",
+                      "platform kind 'tricycle' (" + kind_origin_ + ")", s);
+  used_.insert(steering);
+  n.children.back() = {
+      "source",
+      "wheel: the recording's '" + s.info.name + "' (rad), steering: its '" + steering->info.name + "'",
+      "{wheel: " + Name(s.info.name) + ", steering: " + Name(steering->info.name) + "}",
+      {}};
+  AddNoise(&n, "wheel_radps", WheelRateNoise(s));
+  AddNoise(&n, "steering_rad", StatedNoise(rec_name_, steering->info, {"sigma_rad"}, 0.01, "0.01 rad"));
+  const std::string slack_why = "default: the rear wheels' soft contacts let O move a little (0.02 m/s)";
+  AddNoise(&n, "lateral_mps", {0.02, slack_why});
+  AddNoise(&n, "vertical_mps", {0.02, slack_why});
+  AddNoise(&n, "tilt_radps", {0.1, "default: roll and pitch rates of a chassis rocking on its wheels (0.1 rad/s)"});
+  streams_.push_back(n);
+  master_ = &s;
+  master_name_ = name;
+  Parameter(name + ".radius", {radius.value()}, origin, true, "free: the odometry's scale, self-calibrated", 1);
+  Parameter(name + ".wheel_to_axle", {axle->second}, "from " + Where("platform.geometry.wheel_to_axle_m"), false,
+            "fixed: the wheel-to-axle distance is believed (it trades with the steering offset on steady turns)", 1);
+  const auto offset = rec_.platform.geometry.find("steering_offset_rad");
+  const bool stated = offset != rec_.platform.geometry.end();
+  Parameter(name + ".steering_offset", {stated ? offset->second : 0.0},
+            stated ? "from " + Where("platform.geometry.steering_offset_rad") : "default: no steering offset [rad]",
+            true, "free: the steering sensor's zero, self-calibrated", 1);
   return Status::Ok();
 }
 
