@@ -295,10 +295,11 @@ Status Builder::ChooseMaster() {
   const std::string wheels = left_out_.empty() ? std::string()
                                                : " (" + left_out_.front().substr(0, left_out_.front().find(' ')) +
                                                      ": no wheel model for platform kind '" + kind_ + "')";
-  return Status::Error(rec_name_ +
-                       ": no stream can make the poses: the master needs wheel_encoders of platform kind "
-                       "differential_drive, skid_steer, omni3, mecanum or ackermann (--platform KIND)" +
-                       wheels + ", odometry, visual_odometry, scan_matching or an imu");
+  return Status::Error(
+      rec_name_ +
+      ": no stream can make the poses: the master needs wheel_encoders of platform kind "
+      "differential_drive, skid_steer, omni3, omni4, mecanum, tricycle or ackermann (--platform KIND)" +
+      wheels + ", odometry, visual_odometry, scan_matching or an imu");
 }
 
 Status Builder::AddWheels(const Stream& s) {
