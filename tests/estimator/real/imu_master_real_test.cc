@@ -73,13 +73,14 @@ TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedT
   options.platform = {"skid_steer", {{"wheel_radius_m", 0.1651}, {"baseline_m", 0.555}}};
   options.q_body_imu = Eigen::Quaterniond(std::sqrt(0.5), std::sqrt(0.5), 0.0, 0.0);
   options.wheels_from_odometry = true;
+  options.topics = {{"/imu/data", "imu"}, {"/husky_velocity_controller/odom", "odometry"}, {"/fix", "gps"}};
   auto rec = importers::ImportRosbag(bag, options);
   ASSERT_TRUE(rec.ok()) << rec.status().message();
-  // The IMU + GPS recording: the wheel odometry (and the wheels derived from it) dropped.
+  // The IMU + GPS recording: the wheel odometry (its twist, its pose and the wheels derived from it) dropped.
   recording::Recording imu_gps = rec.value();
   imu_gps.streams.erase(
       std::remove_if(imu_gps.streams.begin(), imu_gps.streams.end(),
-                     [](const recording::Stream& s) { return s.info.name == "odometry" || s.info.name == "wheels"; }),
+                     [](const recording::Stream& s) { return s.info.name != "imu" && s.info.name != "gps"; }),
       imu_gps.streams.end());
   ASSERT_EQ(imu_gps.streams.size(), 2u);
 
