@@ -369,7 +369,9 @@ TEST_P(ImportRos2TypesTest, EveryTypeFromARos2Bag) {
   const auto stream = [&](const std::string& name, StreamType type) {
     const Stream* s = rec.Find(name);
     EXPECT_NE(s, nullptr) << name;
-    if (s) EXPECT_EQ(s->info.type, type) << name;
+    if (s) {
+      EXPECT_EQ(s->info.type, type) << name;
+    }
     return s;
   };
   const Stream* imu = stream("imu", StreamType::kImu);
