@@ -156,6 +156,8 @@ class Builder {
   Status AddWheelGeometry(const Stream& s, const std::string& model, const std::string& param_prefix);
   Status AddAckermann(const Stream& s);
   Status AddTricycle(const Stream& s);
+  const Stream* FirstSteering() const;
+  Result<double> PositiveGeometry(const std::string& key, const std::string& model) const;
   Noise WheelRateNoise(const Stream& s) const;
   Result<double> WheelRadius(const Stream& s, const std::string& model, std::string* origin) const;
   void AddVelocity(const Stream& s, bool master);
@@ -420,21 +422,32 @@ Status Builder::AddWheelGeometry(const Stream& s, const std::string& model, cons
   return Status::Ok();
 }
 
+// The recording's first steering stream, or null.
+const Stream* Builder::FirstSteering() const {
+  for (const Stream& t : rec_.streams)
+    if (t.info.type == StreamType::kSteering) return &t;
+  return nullptr;
+}
+
+// A positive platform geometry value the model needs.
+Result<double> Builder::PositiveGeometry(const std::string& key, const std::string& model) const {
+  const auto it = rec_.platform.geometry.find(key);
+  if (it == rec_.platform.geometry.end() || !(it->second > 0.0))
+    return Status::Error(rec_name_ + "/recording.yaml: platform.geometry has no positive " + key + " for the " + model +
+                         " model");
+  return it->second;
+}
+
 // The tricycle: the steered, driven front wheel's angle and its steering angle. The radius and the steering offset
 // free, the wheel-to-axle distance believed (on a drive of nearly constant steering it trades with the offset).
 Status Builder::AddTricycle(const Stream& s) {
-  const Stream* steering = nullptr;
-  for (const Stream& t : rec_.streams)
-    if (t.info.type == StreamType::kSteering && !steering) steering = &t;
+  const Stream* steering = FirstSteering();
   if (!steering || s.info.columns.size() != 1 || s.info.units != "rad")
     return Status::Error(rec_name_ + ": stream '" + s.info.name +
                          "': the tricycle_drive model of platform kind 'tricycle' needs one wheel angle column in rad "
                          "and a steering stream");
-  const auto axle = rec_.platform.geometry.find("wheel_to_axle_m");
-  if (axle == rec_.platform.geometry.end() || !(axle->second > 0.0))
-    return Status::Error(rec_name_ +
-                         "/recording.yaml: platform.geometry has no positive wheel_to_axle_m for the tricycle_drive "
-                         "model");
+  const Result<double> axle = PositiveGeometry("wheel_to_axle_m", "tricycle_drive");
+  if (!axle.ok()) return axle.status();
   std::string origin;
   const Result<double> radius = WheelRadius(s, "tricycle_drive", &origin);
   if (!radius.ok()) return radius.status();
@@ -457,7 +470,7 @@ Status Builder::AddTricycle(const Stream& s) {
   master_ = &s;
   master_name_ = name;
   Parameter(name + ".radius", {radius.value()}, origin, true, "free: the odometry's scale, self-calibrated", 1);
-  Parameter(name + ".wheel_to_axle", {axle->second}, "from " + Where("platform.geometry.wheel_to_axle_m"), false,
+  Parameter(name + ".wheel_to_axle", {axle.value()}, "from " + Where("platform.geometry.wheel_to_axle_m"), false,
             "fixed: the wheel-to-axle distance is believed (it trades with the steering offset on steady turns)", 1);
   const auto offset = rec_.platform.geometry.find("steering_offset_rad");
   const bool stated = offset != rec_.platform.geometry.end();
@@ -468,18 +481,13 @@ Status Builder::AddTricycle(const Stream& s) {
 }
 
 Status Builder::AddAckermann(const Stream& s) {
-  const Stream* steering = nullptr;
-  for (const Stream& t : rec_.streams)
-    if (t.info.type == StreamType::kSteering && !steering) steering = &t;
+  const Stream* steering = FirstSteering();
   if (!steering || s.info.units != "m/s")
     return Status::Error(rec_name_ + ": stream '" + s.info.name +
                          "': the ackermann model of platform kind 'ackermann' needs the wheel speed in m/s and a "
                          "steering stream");
-  const auto wheelbase = rec_.platform.geometry.find("wheelbase_m");
-  if (wheelbase == rec_.platform.geometry.end() || !(wheelbase->second > 0.0))
-    return Status::Error(rec_name_ +
-                         "/recording.yaml: platform.geometry has no positive wheelbase_m for the "
-                         "ackermann model");
+  const Result<double> wheelbase = PositiveGeometry("wheelbase_m", "ackermann");
+  if (!wheelbase.ok()) return wheelbase.status();
   const std::string name = UniqueName(s.info.name);
   Node n = StreamNode(name, "the master: the rear wheel speed and the steering angle create the poses", "ackermann",
                       "platform kind 'ackermann' (" + kind_origin_ + ")", s);
@@ -495,11 +503,11 @@ Status Builder::AddAckermann(const Stream& s) {
   AddNoise(&n, "vertical_mps", {0.1, "default: eq. 15's no vertical motion on a suspended vehicle (0.1 m/s)"});
   n.children.push_back({"options", "the wheelbase", "", {}});
   n.children.back().children.push_back(
-      {"wheelbase_m", "from " + Where("platform.geometry.wheelbase_m"), Number(wheelbase->second), {}});
+      {"wheelbase_m", "from " + Where("platform.geometry.wheelbase_m"), Number(wheelbase.value()), {}});
   streams_.push_back(n);
   master_ = &s;
   master_name_ = name;
-  Parameter(name + ".kv_over_L", {1.0 / wheelbase->second}, "1 / platform.geometry.wheelbase_m (k_v = 1)", true,
+  Parameter(name + ".kv_over_L", {1.0 / wheelbase.value()}, "1 / platform.geometry.wheelbase_m (k_v = 1)", true,
             "free: the speed scale over the wheelbase, self-calibrated", 1);
   Parameter(name + ".k_theta", {1.0}, "default: the steering sensor's gain 1", true,
             "free: the steering gain, self-calibrated", 1);
