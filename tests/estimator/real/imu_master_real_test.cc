@@ -190,6 +190,17 @@ TEST(ImuMasterRealTest, XioMagnetometerCalibrationAgainstTheEllipsoidFit) {
   ASSERT_TRUE(fit.ok()) << fit.status().message();
   std::cout << (fit.value().constrained ? "ellipsoid-specific fit (the general quadric is no ellipsoid)\n"
                                         : "general quadric fit\n");
+  // How well the log determines the fit: the two halves of the log fitted apart (a device held z up covers a cap of
+  // the ellipsoid, and a cap fits many ellipsoids).
+  const auto half = static_cast<std::ptrdiff_t>(raw.size() / 2);
+  for (const auto& [name, part] : {std::pair{"first", std::vector<Eigen::Vector3d>(raw.begin(), raw.begin() + half)},
+                                   std::pair{"second", std::vector<Eigen::Vector3d>(raw.begin() + half, raw.end())}}) {
+    const auto half_fit = eval::FitEllipsoid(part, eval::EllipsoidFitMethod::kEllipsoidSpecific);
+    if (half_fit.ok()) {
+      std::cout << "ellipsoid-specific fit of the " << name << " half: centre [" << half_fit.value().centre.transpose()
+                << "] uT, radius " << half_fit.value().radius << " uT\n";
+    }
+  }
   double sum_sin_dip = 0.0;
   for (std::size_t i = 0; i < raw.size(); ++i) {
     const Eigen::Vector3d h = fit.value().correction * (raw[i] - fit.value().centre);
