@@ -12,6 +12,7 @@
 
 #include "recording/recording.h"
 #include "tests/recording/temp_dir.h"
+#include "tests/support/real_data.h"
 
 namespace roamlab {
 namespace {
@@ -19,7 +20,6 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 std::string Source(const std::string& relative) { return std::string(ROAMLAB_SOURCE_DIR) + "/" + relative; }
-std::string Shared(const std::string& relative) { return std::string(ROAMLAB_SHARED_DIR) + "/" + relative; }
 
 using testing::CommandRun;
 
@@ -230,7 +230,8 @@ TEST(InitCliTest, PlatformOverridesTheRecordingsKind) {
 // The OptiOdom differential drive: init's configuration calibrates the radius as configs/real's hand-written one
 // (the same free parameter; the noise differs), within their uncertainty.
 TEST(InitCliTest, OptiOdomRadiusAgreesWithTheHandWrittenNominal) {
-  const std::string run_csv = Shared("data/optiodom/data/diff/circular/231220200146/231220200146_run-01.csv");
+  const std::string run_csv =
+      ::roamlab::testing::RealData("optiodom/data/diff/circular/231220200146/231220200146_run-01.csv");
   if (!std::filesystem::exists(run_csv)) GTEST_SKIP() << "OptiOdom data not found: " << run_csv;
   testing::TempDir dir;
   CommandRun run = Roamlab("import optiodom " + run_csv + " --out " + dir.File("rec") + " --quiet", dir);
@@ -256,10 +257,10 @@ TEST(InitCliTest, OptiOdomRadiusAgreesWithTheHandWrittenNominal) {
 // finds it on this robot).
 TEST(InitCliTest, OptiOdomTricycleAndOmni4Calibrate) {
   const std::vector<std::pair<std::string, std::string>> runs = {
-      {"data/optiodom/data/tricyc/circular/140120211415/140120211415_run-01.csv", "tricycle_drive"},
-      {"data/optiodom/data/omni4/circular", "omni4_drive"}};
+      {"optiodom/data/tricyc/circular/140120211415/140120211415_run-01.csv", "tricycle_drive"},
+      {"optiodom/data/omni4/circular", "omni4_drive"}};
   for (const auto& [path, model] : runs) {
-    std::string run_csv = Shared(path);
+    std::string run_csv = ::roamlab::testing::RealData(path);
     if (std::filesystem::is_directory(run_csv)) {
       for (const auto& entry : std::filesystem::recursive_directory_iterator(run_csv)) {
         if (entry.path().filename().string().find("_run-01.csv") != std::string::npos) {
@@ -295,7 +296,7 @@ TEST(InitCliTest, OptiOdomTricycleAndOmni4Calibrate) {
 // information twice; a dead-reckoned pose is no reference) and said so; the configuration loads and binds (init
 // validates it against the recording before writing).
 TEST(InitCliTest, HuskyLeavesOutTheOdometryItsWheelsCameFrom) {
-  const std::string bag = Shared("data/husky_test1/test1.bag");
+  const std::string bag = ::roamlab::testing::RealData("husky_test1/test1.bag");
   if (!std::filesystem::exists(bag)) GTEST_SKIP() << "Husky bag not found: " << bag;
   testing::TempDir dir;
   CommandRun run =

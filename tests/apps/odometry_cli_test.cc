@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/recording/temp_dir.h"
+#include "tests/support/real_data.h"
 
 namespace roamlab {
 namespace {
@@ -146,7 +147,7 @@ TEST_F(OdometryCliTest, MalformedOptiOdomFileGivesOneLineAndExitCode2) {
 
 // The real data: one differential-drive run imports with its metadata and ground truth.
 TEST_F(OdometryCliTest, ImportsARealOptiOdomRun) {
-  const fs::path set = fs::path(ROAMLAB_SHARED_DIR) / "data/optiodom/data/diff/circular/231220200121";
+  const fs::path set = fs::path(::roamlab::testing::RealData("optiodom/data/diff/circular/231220200121"));
   if (!fs::exists(set)) GTEST_SKIP() << "OptiOdom data not found at " << set << " (../shared/data absent)";
   const CommandRun r = Roamlab("import optiodom " + (set / "231220200121_run-01.csv").string() + " --out " +
                                    (dir_ / "rec").string() + " --quiet",

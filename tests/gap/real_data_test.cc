@@ -1,4 +1,4 @@
-// The diagnosis on real recordings (ROAMLAB_SHARED_DIR/data, skipped when absent), where nothing labels the effects:
+// The diagnosis on real recordings (tests/support/real_data.h, skipped when absent), where nothing labels the effects:
 // OptiOdom's differential drive (unequal wheel diameters, a wider effective track) and the Husky bag (skid-steer yaw
 // mismatch). The data README's reference values come from a "quick least-squares look", not from ground truth; the
 // OptiOdom test checks the diagnosis against an independent least-squares fit on the same run instead (YawRatio).
@@ -14,11 +14,12 @@
 #include "gap/diagnose.h"
 #include "importers/optiodom.h"
 #include "importers/rosbag.h"
+#include "tests/support/real_data.h"
 
 namespace roamlab::gap {
 namespace {
 
-const std::string kData = std::string(ROAMLAB_SHARED_DIR) + "/data";
+const std::string kData = ::roamlab::testing::RealDataDir();
 // A Dec-2020 square set: straight legs and turns in place separate the wheel ratio from the track (a circle at
 // constant curvature does not: there the ratio trades against the track and the time offset).
 const std::string kSet = kData + "/optiodom/data/diff/square/231220200029/231220200029";

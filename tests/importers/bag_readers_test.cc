@@ -20,6 +20,7 @@
 #include "importers/internal/bag.h"
 #include "tests/recording/temp_dir.h"
 #include "tests/support/bag_writers.h"
+#include "tests/support/real_data.h"
 
 namespace roamlab::importers::internal {
 namespace {
@@ -322,7 +323,7 @@ TEST(AnyBag, DispatchesByContentAndRefusesOtherFiles) {
   EXPECT_THAT(Rosbag2Error(dir.File("missing.bag")), HasSubstr(dir.File("missing.bag") + ": cannot open"));
 }
 
-std::string SharedFile(const std::string& relative) { return std::string(ROAMLAB_SHARED_DIR) + "/data/" + relative; }
+std::string SharedFile(const std::string& relative) { return ::roamlab::testing::RealData(relative); }
 
 TEST(RealBags, Rosbag2SqliteCarBag) {
   const std::string path = SharedFile("ros2/av1tenth_car/bag2_deadreck_data");

@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/support/real_data.h"
+
 namespace roamlab::importers {
 namespace {
 
@@ -57,7 +59,7 @@ const Stream& Get(const Recording& rec, const std::string& name) {
 // --- The real log: x-io Technologies Fusion example (100 Hz IMU, slower magnetometer repeated on every row).
 
 TEST_F(CsvImportTest, XioImuMagnetometerLog) {
-  const std::string csv = std::string(ROAMLAB_SHARED_DIR) + "/data/xio_imu_mag/sensor_data.csv";
+  const std::string csv = ::roamlab::testing::RealData("xio_imu_mag/sensor_data.csv");
   if (!fs::exists(csv)) GTEST_SKIP() << "the x-io log is absent: " << csv;
   const std::string mapping = std::string(ROAMLAB_SOURCE_DIR) + "/configs/import/xio_imu_mag.yaml";
   CsvImportReport report;

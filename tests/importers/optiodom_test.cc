@@ -10,6 +10,7 @@
 
 #include "recording/wheel_kinematics.h"
 #include "tests/recording/temp_dir.h"
+#include "tests/support/real_data.h"
 
 namespace roamlab::importers {
 namespace {
@@ -21,7 +22,7 @@ using ::roamlab::testing::TempDir;
 using ::roamlab::testing::WriteFile;
 using ::testing::HasSubstr;
 
-const std::string kData = std::string(ROAMLAB_SHARED_DIR) + "/data/optiodom/data";
+const std::string kData = ::roamlab::testing::RealData("optiodom/data");
 
 // Writes <dir>/set_metadata.csv and <dir>/set_run-01.csv; returns the import's result.
 Result<Recording> ImportWritten(const TempDir& dir, const std::string& metadata, const std::string& run) {

@@ -15,6 +15,7 @@
 #include "tests/recording/temp_dir.h"
 #include "tests/support/bag_writers.h"
 #include "tests/support/message_writer.h"
+#include "tests/support/real_data.h"
 
 namespace roamlab::importers {
 namespace {
@@ -606,7 +607,7 @@ TEST(ImportRosbagTypesTest, JointVelocitiesAndUnknownJoints) {
 
 // The real Husky bag (data/husky_test1 of the shared data directory): counts, span, rates and the IMU's clock offset.
 TEST(ImportRosbagRealTest, HuskyTest1) {
-  const std::string path = std::string(ROAMLAB_SHARED_DIR) + "/data/husky_test1/test1.bag";
+  const std::string path = ::roamlab::testing::RealData("husky_test1/test1.bag");
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "real data absent: " << path;
   RosbagImportReport report;
   Result<Recording> rec = ImportRosbag(path, {}, &report);
@@ -640,7 +641,7 @@ TEST(ImportRosbagRealTest, HuskyTest1) {
 
 // A real rosbag2 (SQLite, CDR) bag of a 1/10-scale car (data/ros2/av1tenth_car of the shared data directory).
 TEST(ImportRosbagRealTest, Av1tenthRosbag2) {
-  const std::string path = std::string(ROAMLAB_SHARED_DIR) + "/data/ros2/av1tenth_car/bag2_deadreck_data";
+  const std::string path = ::roamlab::testing::RealData("ros2/av1tenth_car/bag2_deadreck_data");
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "real data absent: " << path;
   RosbagImportReport report;
   RosbagImportOptions options;
@@ -677,7 +678,7 @@ TEST(ImportRosbagRealTest, Av1tenthRosbag2) {
 // The MCAP format fixture (data/ros2/rosbags_fixture): every supported type decoded from CDR, with the fixture's
 // values.
 TEST(ImportRosbagRealTest, McapFixtureEveryType) {
-  const std::string path = std::string(ROAMLAB_SHARED_DIR) + "/data/ros2/rosbags_fixture/test_bag_mcap";
+  const std::string path = ::roamlab::testing::RealData("ros2/rosbags_fixture/test_bag_mcap");
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "data absent: " << path;
   RosbagImportReport report;
   RosbagImportOptions options;

@@ -19,11 +19,12 @@
 #include "eval/ellipsoid_fit.h"
 #include "importers/csv.h"
 #include "importers/rosbag.h"
+#include "tests/support/real_data.h"
 
 namespace roamlab::estimator {
 namespace {
 
-const std::string kData = std::string(ROAMLAB_SHARED_DIR) + "/data";
+const std::string kData = ::roamlab::testing::RealDataDir();
 const std::string kConfigs = std::string(ROAMLAB_SOURCE_DIR) + "/configs/real/";
 
 std::map<std::string, Eigen::VectorXd> Values(const CalibrationResult& r) {
