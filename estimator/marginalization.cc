@@ -12,6 +12,7 @@
 
 #include "estimator/geometry.h"
 #include "estimator/internal/linearization.h"
+#include "estimator/internal/so3_jacobians.h"
 #include "estimator/solver.h"
 
 namespace roamlab::estimator {
@@ -20,15 +21,6 @@ namespace {
 // Margin of the rank decision over the Schur complement's rounding (n eps max|H|): the eigenvalues of rounding alone
 // stay well below that bound.
 constexpr double kRoundingFloor = 10.0;
-
-// Inverse right Jacobian of SO(3): d Log(Exp(phi) Exp(d)) / dd at d = 0.
-Eigen::Matrix3d InverseRightJacobian(const Eigen::Vector3d& phi) {
-  const double theta = phi.norm();
-  const Eigen::Matrix3d K = Skew<double>(phi);
-  if (theta < 1e-6) return Eigen::Matrix3d::Identity() + 0.5 * K + K * K / 12.0;
-  const double c = 1.0 / (theta * theta) - (1.0 + std::cos(theta)) / (2.0 * theta * std::sin(theta));
-  return Eigen::Matrix3d::Identity() + 0.5 * K + c * K * K;
-}
 
 // J (r x n) and r0 with J^T J = H and J^T r0 = g for a positive semi-definite H (g in its range), keeping the
 // directions of the eigenvalues above `floor` (the others carry no information, or only rounding: see Marginalize).
@@ -176,10 +168,11 @@ bool LinearPriorFactor::Evaluate(const double* const* values, double* error, dou
       Eigen::Map<Eigen::MatrixXd> J_i(jacobians[i], m, d);
       const int o = offsets_[i];
       if (manifolds_[i].kind() == ManifoldKind::kQuaternion) {
-        J_i.noalias() = J_.middleCols<3>(o) * InverseRightJacobian(delta.segment<3>(o));
+        J_i.noalias() = J_.middleCols<3>(o) * internal::InverseRightJacobianSO3(delta.segment<3>(o));
       } else if (manifolds_[i].kind() == ManifoldKind::kPose) {
         J_i.leftCols<3>() = J_.middleCols<3>(o);
-        J_i.rightCols<3>().noalias() = J_.middleCols<3>(o + 3) * InverseRightJacobian(delta.segment<3>(o + 3));
+        J_i.rightCols<3>().noalias() =
+            J_.middleCols<3>(o + 3) * internal::InverseRightJacobianSO3(delta.segment<3>(o + 3));
       } else {
         J_i = J_.middleCols(o, d);
       }
