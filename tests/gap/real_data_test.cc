@@ -14,6 +14,7 @@
 #include "gap/diagnose.h"
 #include "importers/optiodom.h"
 #include "importers/rosbag.h"
+#include "tests/support/husky_bag.h"
 #include "tests/support/real_data.h"
 
 namespace roamlab::gap {
@@ -192,12 +193,7 @@ double HeadingRatioInTurns(const recording::Recording& rec) {
 TEST(RealDataTest, HuskySkidSteerYawMismatch) {
   const std::string bag = kData + "/husky_test1/test1.bag";
   if (!std::filesystem::exists(bag)) GTEST_SKIP() << "real data absent: " << bag;
-  importers::RosbagImportOptions options;
-  options.platform = {"skid_steer", {{"wheel_radius_m", 0.1651}, {"baseline_m", 0.555}}};
-  options.q_body_imu = Eigen::Quaterniond(std::sqrt(0.5), std::sqrt(0.5), 0.0, 0.0);
-  options.wheels_from_odometry = true;
-  options.topics = {{"/imu/data", "imu"}, {"/husky_velocity_controller/odom", "odometry"}, {"/fix", "gps"}};
-  auto rec = importers::ImportRosbag(bag, options);
+  auto rec = importers::ImportRosbag(bag, ::roamlab::testing::HuskyImportOptions());
   ASSERT_TRUE(rec.ok()) << rec.status().message();
   auto config = estimator::LoadEstimatorConfig(std::string(ROAMLAB_SOURCE_DIR) + "/configs/real/husky_nominal.yaml");
   ASSERT_TRUE(config.ok()) << config.status().message();

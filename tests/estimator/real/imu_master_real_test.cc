@@ -19,6 +19,7 @@
 #include "eval/ellipsoid_fit.h"
 #include "importers/csv.h"
 #include "importers/rosbag.h"
+#include "tests/support/husky_bag.h"
 #include "tests/support/real_data.h"
 
 namespace roamlab::estimator {
@@ -70,12 +71,7 @@ Result<TrackingResult> CalibrateAndTrack(const std::string& config_file, const r
 TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedTrack) {
   const std::string bag = kData + "/husky_test1/test1.bag";
   if (!std::filesystem::exists(bag)) GTEST_SKIP() << "real data absent: " << bag;
-  importers::RosbagImportOptions options;
-  options.platform = {"skid_steer", {{"wheel_radius_m", 0.1651}, {"baseline_m", 0.555}}};
-  options.q_body_imu = Eigen::Quaterniond(std::sqrt(0.5), std::sqrt(0.5), 0.0, 0.0);
-  options.wheels_from_odometry = true;
-  options.topics = {{"/imu/data", "imu"}, {"/husky_velocity_controller/odom", "odometry"}, {"/fix", "gps"}};
-  auto rec = importers::ImportRosbag(bag, options);
+  auto rec = importers::ImportRosbag(bag, ::roamlab::testing::HuskyImportOptions());
   ASSERT_TRUE(rec.ok()) << rec.status().message();
   // The IMU + GPS recording: the wheel odometry (its twist, its pose and the wheels derived from it) dropped.
   recording::Recording imu_gps = rec.value();
