@@ -212,11 +212,56 @@ TEST_F(EvaluateTest, WithoutGnuplotMetricsAreStillWritten) {
   EXPECT_FALSE(fs::exists(out_dir() + "/trajectory.png"));
 }
 
-TEST_F(EvaluateTest, MissingGroundTruthIsAClearError) {
+// Real data: no ground truth, so the estimate is compared with the GPS fixes, moved to the antenna by the calibrated
+// lever arm (0.6, 0, 0.2) m. At t = 0 (yaw 0) the estimate's antenna is at (0.3 + 0.6, 0.4, 0.2), the fix at the
+// origin.
+TEST_F(EvaluateTest, WithoutGroundTruthTheGpsFixesAreTheReference) {
   WriteGpsCase();
   fs::remove(rec("ground_truth.tum"));
-  EXPECT_EQ(EvaluateError(Options()),
-            rec("ground_truth.tum") + ": missing; evaluation needs the ground-truth trajectory");
+  const Result<Evaluation> r = Evaluate(Options());
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  const json& m = r.value().metrics;
+  EXPECT_EQ(m["reference"]["kind"], "stream");
+  EXPECT_EQ(m["reference"]["stream"], "gps");
+  EXPECT_EQ(m["reference"]["orientation"], false);
+  EXPECT_THAT(m["reference"]["lever_arm_source"].get<std::string>(), StartsWith("calibration ("));
+  EXPECT_EQ(m["association"]["matched"], 2);
+  EXPECT_NEAR(r.value().error_world[0].x(), 0.9, 1e-6);
+  EXPECT_NEAR(r.value().error_world[0].y(), 0.4, 1e-6);
+  EXPECT_NEAR(r.value().error_world[0].z(), 0.2, 1e-6);
+  EXPECT_TRUE(m["ate_rot_deg"].is_null());
+  EXPECT_TRUE(m["rpe"].contains("skipped"));
+  EXPECT_EQ(r.value().reference_label, "GPS fixes (gps)");
+  EXPECT_TRUE(r.value().fixes.empty());  // the reference stream is not drawn twice
+  // Without the calibration the lever arm is ignored, and says so.
+  fs::remove(est("calibration.json"));
+  const Result<Evaluation> ignored = Evaluate(Options());
+  ASSERT_TRUE(ignored.ok()) << ignored.status().message();
+  EXPECT_EQ(ignored.value().metrics["reference"]["lever_arm_source"], "none: ignored");
+  EXPECT_NEAR(ignored.value().error_world[0].x(), 0.3, 1e-6);
+  // The figure exists now.
+  const Result<WrittenEvaluation> w = WriteEvaluation(ignored.value(), out_dir());
+  ASSERT_TRUE(w.ok()) << w.status().message();
+  EXPECT_TRUE(fs::exists(out_dir() + "/trajectory.gp"));
+  EXPECT_THAT(ReadFile(out_dir() + "/trajectory.gp"), HasSubstr("title \"GPS fixes (gps)\""));
+  // A stream that cannot be a reference, and one that does not exist.
+  EvaluateOptions imu = Options();
+  imu.reference_stream = "imu";
+  EXPECT_THAT(EvaluateError(imu), HasSubstr("no stream 'imu'"));
+}
+
+TEST_F(EvaluateTest, MissingGroundTruthWithoutAbsoluteSensorIsAClearError) {
+  fs::create_directories(rec_dir());
+  fs::create_directories(est_dir());
+  WriteFile(rec("recording.yaml"), kImuYaml);
+  WriteFile(rec("imu.csv"), kImuCsv);
+  ASSERT_TRUE(WriteTum(Truth(), est("trajectory.tum")).ok());
+  EXPECT_EQ(EvaluateError(Options()), rec("ground_truth.tum") +
+                                          ": missing, and the recording has no gps, position or pose stream to "
+                                          "compare with");
+  EvaluateOptions imu = Options();
+  imu.reference_stream = "imu";
+  EXPECT_THAT(EvaluateError(imu), HasSubstr("stream 'imu' is of type imu; a reference stream must be gps"));
 }
 
 TEST_F(EvaluateTest, BadInputsNameTheFile) {
