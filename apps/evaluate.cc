@@ -70,7 +70,7 @@ void PrintSummary(const json& m) {
                 Format(m["nees"]["fraction_in_band"], "%.3f").c_str(),
                 FormatArray(m["nees"]["band_single_run"], "%.3f").c_str());
   }
-  if (m.contains("parameters")) {
+  if (m.contains("parameters") && !m["parameters"].empty()) {
     std::printf("%-22s %-34s %-34s %-28s %s\n", "parameter", "truth", "estimate", "error", "error/std");
     for (const auto& [name, p] : m["parameters"].items()) {
       std::string error = FormatArray(p["error"], "%.3g");
