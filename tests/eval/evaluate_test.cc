@@ -250,6 +250,41 @@ TEST_F(EvaluateTest, WithoutGroundTruthTheGpsFixesAreTheReference) {
   EXPECT_THAT(EvaluateError(imu), HasSubstr("no stream 'imu'"));
 }
 
+// A pose stream (motion capture of a marker body mounted 0.5 m ahead, turned 90 deg about z) as the reference: the
+// estimate, moved to the marker by the mounting, matches it exactly, orientation included.
+TEST_F(EvaluateTest, APoseStreamIsAReferenceThroughItsMounting) {
+  fs::create_directories(rec_dir());
+  fs::create_directories(est_dir());
+  WriteFile(rec("recording.yaml"),
+            std::string(kImuYaml) +
+                "  - name: mocap\n"
+                "    type: pose\n"
+                "    rate_hz: 20\n"
+                "    mounting: {p_body_sensor_m: [0.5, 0, 0], q_body_sensor_wxyz: [0.7071067811865476, "
+                "0, 0, 0.7071067811865476]}\n");
+  WriteFile(rec("imu.csv"), kImuCsv);
+  const Eigen::Quaterniond q_body_sensor(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()));
+  std::string mocap = "t,x,y,z,qx,qy,qz,qw\n";
+  for (const StampedPose& pose : Truth()) {
+    const Eigen::Vector3d p = pose.p_world_body + pose.q_world_body * Eigen::Vector3d(0.5, 0.0, 0.0);
+    const Eigen::Quaterniond q = pose.q_world_body * q_body_sensor;
+    char row[256];
+    std::snprintf(row, sizeof row, "%s,%.12f,%.12f,%.12f,%.12f,%.12f,%.12f,%.12f\n", FormatSeconds(pose.t).c_str(),
+                  p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w());
+    mocap += row;
+  }
+  WriteFile(rec("mocap.csv"), mocap);
+  ASSERT_TRUE(WriteTum(Truth(), est("trajectory.tum")).ok());
+  const Result<Evaluation> r = Evaluate(Options());  // no ground truth: the first absolute stream, mocap
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  const json& m = r.value().metrics;
+  EXPECT_EQ(m["reference"]["stream"], "mocap");
+  EXPECT_EQ(m["reference"]["lever_arm_source"], "mounting in recording.yaml");
+  EXPECT_LT(m["ate_m"].get<double>(), 1e-9);
+  EXPECT_LT(m["ate_rot_deg"].get<double>(), 1e-6);
+  EXPECT_LT(m["rpe_trans_m"].get<double>(), 1e-9);
+}
+
 TEST_F(EvaluateTest, MissingGroundTruthWithoutAbsoluteSensorIsAClearError) {
   fs::create_directories(rec_dir());
   fs::create_directories(est_dir());
