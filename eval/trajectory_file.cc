@@ -147,7 +147,8 @@ Result<TrajectoryFile> ReadLines(const std::string& path, const std::vector<Line
     Status s = format == TrajectoryFormat::kKitti ? KittiPose(Split(lines[k].text, false), where, &pose)
                                                   : EurocPose(Split(lines[k].text, true), where, &pose);
     if (!s.ok()) return s;
-    if (format == TrajectoryFormat::kKitti) pose.t = Time::FromNanoseconds(1000000000LL * file.poses.size());
+    if (format == TrajectoryFormat::kKitti)
+      pose.t = Time::FromNanoseconds(1000000000LL * static_cast<std::int64_t>(file.poses.size()));
     if (!file.poses.empty() && pose.t <= file.poses.back().t)
       return Status::Error(where + ": " + TimeOrderProblem(file.poses.back().t, pose.t));
     file.poses.push_back(pose);
