@@ -21,12 +21,13 @@ bool IsDirectory(const std::string& path) {
   return fs::is_directory(path, ec);
 }
 
-// The last component of a path, trailing separators ignored.
+// The last component of a path, trailing separators ignored; "estimate" when there is none usable as a directory name
+// ("/", ".", "..").
 std::string BaseName(const std::string& path) {
   fs::path p = fs::path(path).lexically_normal();
   if (p.filename().empty()) p = p.parent_path();
   const std::string name = p.filename().string();
-  return name.empty() || name == "." ? path : name;
+  return name.empty() || name == "." || name == ".." || name == "/" ? "estimate" : name;
 }
 
 // Reads one optional input: absent is fine, present but broken is an error.

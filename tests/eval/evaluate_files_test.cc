@@ -204,6 +204,28 @@ TEST_F(EvaluateFilesTest, KittiFilesArePairedByIndex) {
   EXPECT_LT(e.metrics["ate_m"].get<double>(), 1e-5);
 }
 
+TEST_F(EvaluateFilesTest, EurocReferenceAgainstATumEstimate) {
+  const Trajectory drive = Drive();
+  std::string csv = "#timestamp [ns],p_RS_R_x [m],p_RS_R_y [m],p_RS_R_z [m],q_RS_w [],q_RS_x [],q_RS_y [],q_RS_z []\n";
+  for (const StampedPose& p : drive) {
+    char row[256];
+    std::snprintf(row, sizeof row, "%lld,%.12f,%.12f,%.12f,%.12f,%.12f,%.12f,%.12f\n",
+                  static_cast<long long>(p.t.nanoseconds()), p.p_world_body.x(), p.p_world_body.y(), p.p_world_body.z(),
+                  p.q_world_body.w(), p.q_world_body.x(), p.q_world_body.y(), p.q_world_body.z());
+    csv += row;
+  }
+  WriteFile(File("data.csv"), csv);
+  Trajectory estimate = drive;
+  for (StampedPose& p : estimate) p.p_world_body.y() += 0.25;
+  ASSERT_TRUE(WriteTum(estimate, File("est.tum")).ok());
+  const Evaluation e = MustEvaluate(Options("data.csv", "est.tum"));
+  EXPECT_EQ(e.metrics["reference"]["format"], "euroc");
+  EXPECT_EQ(e.metrics["association"]["matched"], 601);
+  EXPECT_NEAR(e.metrics["ate_m"].get<double>(), 0.25, 1e-9);
+  EXPECT_NEAR(e.metrics["ate_axes"]["y"]["mean_m"].get<double>(), 0.25, 1e-9);
+  EXPECT_LT(e.metrics["ate_rot_deg"].get<double>(), 1e-6);
+}
+
 TEST_F(EvaluateFilesTest, SeveralEstimatesGiveOneTableAndOverlaidFigures) {
   const Trajectory drive = Drive();
   Trajectory good = drive, bad = drive;
