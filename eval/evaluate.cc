@@ -136,7 +136,10 @@ Result<MatchedTrajectories> Associate(const Inputs& in, const EvaluateOptions& o
     char tolerance[96];
     std::snprintf(tolerance, sizeof tolerance, "%g s (time offset %g s)", options.max_time_difference_s,
                   options.time_offset_s);
-    return Status::Error(in.trajectory_path + ": no pose within " + tolerance + " of a pose of " + in.reference_path);
+    return Status::Error(in.trajectory_path + ": no pose within " + tolerance + " of a pose of " + in.reference_path +
+                         " (estimate " + FormatSeconds(in.estimate.front().t) + " to " +
+                         FormatSeconds(in.estimate.back().t) + " s, reference " +
+                         FormatSeconds(in.reference.front().t) + " to " + FormatSeconds(in.reference.back().t) + " s)");
   }
   (*m)["association"] = {{"by", by_index ? "index" : "time"},
                          {"estimate_poses", association.estimate_size},
