@@ -47,6 +47,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -81,7 +82,7 @@ struct EvaluateOptions {
   double max_time_difference_s = 0.01;                      // association tolerance [s], >= 0
   double time_offset_s = 0.0;                               // added to the estimate's stamps before the association [s]
   double rpe_delta_s = 1.0;                                 // RPE by step: time spanned by the pose pairs [s], > 0
-  double rpe_distance_m = 10.0;  // RPE by distance: segment length along the ground truth [m], > 0
+  double rpe_distance_m = 10.0;  // RPE by distance: segment length along the reference [m], > 0
   double nees_t0_s = 0.0;        // poses in the first t0 seconds are left out of the NEES in-band fraction
 
   // Empty when usable, otherwise what is wrong.
