@@ -105,7 +105,7 @@ Eigen::MatrixXd WhiteNoiseCovariance(const TwinFitRows& rows);
 TwinCovariance WhiteNoiseCovarianceMethod();
 
 struct TwinEffect {
-  EffectEstimate estimate;   // name (the candidate's label), dof, parameters, std, lr, p, Delta BIC, held-out drop
+  EffectEstimate estimate;    // name (the candidate's label), dof, parameters, std, lr, p, Delta BIC, held-out drop
   sim::EffectOptions effect;  // as the simulator applies it (time shifts in whole physics steps)
   double chi2_before = 0.0;   // training part: with the effects kept before it
   double chi2_after = 0.0;    // with it

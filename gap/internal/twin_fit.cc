@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <limits>
 #include <thread>
@@ -28,20 +30,20 @@ int Wheels(const std::string& kind) {
 
 std::vector<TwinCandidate> Library(const sim::Scenario& nominal, double max_shift_s) {
   std::vector<TwinCandidate> all;
-  all.push_back({"wheel_radius_asymmetry", "wheel_radius_asymmetry", {}, {P("ratio_right_left", 1, 2e-3, 0.8, 1.2)}});
-  all.push_back({"track_width_error", "track_width_error", {}, {P("track_error_m", 0, 2e-3, -0.1, 0.1)}});
+  all.push_back({"wheel_radius_asymmetry", "wheel_radius_asymmetry", {}, {P("ratio_right_left", 1, 0.01, 0.8, 1.2)}});
+  all.push_back({"track_width_error", "track_width_error", {}, {P("track_error_m", 0, 0.01, -0.1, 0.1)}});
   const int wheels = Wheels(nominal.robot.kind);
   for (int w = 0; w < wheels; ++w)
     all.push_back({"axle_misalignment wheel " + std::to_string(w),
                    "axle_misalignment",
                    {{"wheel", w}},
-                   {P("yaw_deg", 0, 0.2, -20, 20)}});
+                   {P("yaw_deg", 0, 1.0, -20, 20)}});
   if (nominal.robot.kind == "ackermann")
-    all.push_back({"axle_misalignment", "axle_misalignment", {}, {P("yaw_deg", 0, 0.05, -5, 5)}});
+    all.push_back({"axle_misalignment", "axle_misalignment", {}, {P("yaw_deg", 0, 0.25, -5, 5)}});
   all.push_back({"gyro_scale_error",
                  "gyro_scale_error",
                  {},
-                 {P("scale_x", 1, 2e-3, 0.5, 1.5), P("scale_y", 1, 2e-3, 0.5, 1.5), P("scale_z", 1, 2e-3, 0.5, 1.5)}});
+                 {P("scale_x", 1, 0.01, 0.5, 1.5), P("scale_y", 1, 0.01, 0.5, 1.5), P("scale_z", 1, 0.01, 0.5, 1.5)}});
   all.push_back(
       {"gyro_bias_drift",
        "gyro_bias_drift",
@@ -51,7 +53,7 @@ std::vector<TwinCandidate> Library(const sim::Scenario& nominal, double max_shif
                  "magnetometer_motor_interference",
                  {},
                  {P("b_per_nm_x", 0, 1e-4, -1, 1), P("b_per_nm_y", 0, 1e-4, -1, 1), P("b_per_nm_z", 0, 1e-4, -1, 1)}});
-  all.push_back({"steering_offset", "steering_offset", {}, {P("offset_rad", 0, 1e-3, -0.5, 0.5)}});
+  all.push_back({"steering_offset", "steering_offset", {}, {P("offset_rad", 0, 5e-3, -0.5, 0.5)}});
   all.push_back({"lateral_slip", "lateral_slip", {}, {P("contact_time_scale", 1, 0.05, 1, 4)}});
   TwinCandidate latency{"gps_latency", "gps_latency", {}, {P("latency_s", 0, 0, 0, std::min(1.0, max_shift_s))}};
   latency.time_shift = true;
@@ -172,6 +174,8 @@ Result<CandidateOutcome> FitLeastSquares(const TwinCandidate& c, const Eigen::Ve
       auto run = evaluator->Run({EffectAt(c, trial)});
       if (!run[0].ok()) return Status::Error(c.label + ": a trial twin: " + run[0].status().message());
       const double chi2 = SumOfSquares(Masked(run[0].value(), out.residuals));
+      std::fprintf(stderr, "TRACE %s it %d lambda %g theta %.8g chi2 %.3f -> %.3f\n", c.label.c_str(), out.iterations,
+                   lambda, trial[0], out.chi2, chi2);
       if (chi2 >= out.chi2) continue;
       decrease = out.chi2 - chi2;
       out.theta = trial;
