@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <limits>
 #include <thread>
@@ -174,8 +172,6 @@ Result<CandidateOutcome> FitLeastSquares(const TwinCandidate& c, const Eigen::Ve
       auto run = evaluator->Run({EffectAt(c, trial)});
       if (!run[0].ok()) return Status::Error(c.label + ": a trial twin: " + run[0].status().message());
       const double chi2 = SumOfSquares(Masked(run[0].value(), out.residuals));
-      std::fprintf(stderr, "TRACE %s it %d lambda %g theta %.8g chi2 %.3f -> %.3f\n", c.label.c_str(), out.iterations,
-                   lambda, trial[0], out.chi2, chi2);
       if (chi2 >= out.chi2) continue;
       decrease = out.chi2 - chi2;
       out.theta = trial;
