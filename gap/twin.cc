@@ -168,14 +168,23 @@ Result<TwinEffect> Diagnoser::Fit(const TwinCandidate& c, const State& state, do
 }
 
 // Fits the pool on top of `state`, scores them and keeps the first that passes (its held-out run becomes the new
-// state). Returns whether one was kept.
+// state). A candidate whose twin fails is dropped with the reason. Returns whether one was kept.
 Result<bool> Diagnoser::Round(int round, const std::vector<TwinCandidate>& pool, double step_s, State* state,
                               std::vector<TwinEffect>* scored) {
   for (const TwinCandidate& c : pool) {
     Progress("round " + std::to_string(round + 1) + ": fitting " + c.label);
     auto e = Fit(c, *state, step_s, round > 0);
-    if (!e.ok()) return e.status();
-    scored->push_back(std::move(e).value());
+    if (e.ok()) {
+      scored->push_back(std::move(e).value());
+      continue;
+    }
+    // A twin that fails with the candidate (a parameter that throws the robot off the terrain) drops the candidate.
+    TwinEffect failed;
+    failed.estimate.name = c.label;
+    failed.estimate.dof = static_cast<int>(c.free.size());
+    failed.estimate.delta_bic = std::numeric_limits<double>::infinity();
+    failed.estimate.decision = "not fitted: " + e.status().message();
+    scored->push_back(failed);
   }
   std::sort(scored->begin(), scored->end(),
             [](const TwinEffect& a, const TwinEffect& b) { return a.estimate.delta_bic < b.estimate.delta_bic; });
@@ -189,7 +198,10 @@ Result<bool> Diagnoser::Round(int round, const std::vector<TwinCandidate>& pool,
     sim::Scenario full = state->full;
     full.effects.push_back(e.effect);
     auto twin = RunFull(full);
-    if (!twin.ok()) return Status::Error(x.name + ": the patched twin: " + twin.status().message());
+    if (!twin.ok()) {
+      x.decision = "the patched twin of the whole recording failed: " + twin.status().message();
+      continue;
+    }
     TwinComparison heldout = CompareTwin(real_, twin.value(), train_end_.seconds(), last_.seconds(), options_.drift);
     x.evaluated_heldout = true;
     x.heldout_improvement = state->heldout.chi2 > 0.0 ? 1.0 - heldout.chi2 / state->heldout.chi2 : 0.0;

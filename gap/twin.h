@@ -54,6 +54,16 @@ using TwinRunner = std::function<Result<recording::Recording>(const sim::Scenari
 // Runs `patched` without noise with sim::Simulate: the twin of a recording of the scenario's own drive.
 TwinRunner PlainSimulationRunner();
 
+// Whether `twin` follows the drive of `real`: for each wheel stream in both (wheel_encoders, steering), the change of
+// every column over consecutive kDriveWindowS windows of their common stamps, real against twin: relative RMS
+// difference ||d_real - d_twin|| / ||d_real|| below kMaxDriveMismatch. Empty when it does; otherwise why not (the
+// stream and the relative difference, or that no wheel stream can tell). The plain simulation is the twin only of a
+// recording of the scenario's own drive: a hidden effect changes the wheels' motion by little (they are servoed to
+// the same set-points), another drive by a good part of its size.
+inline constexpr double kDriveWindowS = 1.0;
+inline constexpr double kMaxDriveMismatch = 0.05;
+std::string DriveMismatch(const recording::Recording& real, const recording::Recording& twin);
+
 // An absolute stream's drift over fixed windows: the twin's pose aligned to the real one at each window's start and
 // the error at its end. A pose stream aligns exactly at the start sample (position and heading error); a gps or
 // position stream by the planar rigid transform (yaw about the vertical and translation) that best fits the first

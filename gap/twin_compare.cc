@@ -145,6 +145,42 @@ TwinComparison CompareTwin(const recording::Recording& real, const recording::Re
   return out;
 }
 
+std::string DriveMismatch(const recording::Recording& real, const recording::Recording& twin) {
+  bool compared = false;
+  for (const Stream& r : real.streams) {
+    if (r.info.type != StreamType::kWheelEncoders && r.info.type != StreamType::kSteering) continue;
+    const Stream* s = twin.Find(r.info.name);
+    if (!s || s->info.type != r.info.type || s->values.cols() != r.values.cols() || r.t.empty()) continue;
+    // The changes over consecutive kDriveWindowS windows of the samples both have.
+    double difference = 0.0, size = 0.0;
+    std::optional<std::pair<std::size_t, std::size_t>> start;
+    std::size_t j = 0;
+    for (std::size_t i = 0; i < r.t.size(); ++i) {
+      while (j < s->t.size() && s->t[j] < r.t[i]) ++j;
+      if (j == s->t.size()) break;
+      if (s->t[j] != r.t[i]) continue;
+      if (start && SecondsBetween(r.t[start->first], r.t[i]) < kDriveWindowS) continue;
+      if (start) {
+        const auto change = [](const Stream& x, std::size_t from, std::size_t to) -> Eigen::VectorXd {
+          return (x.values.row(static_cast<Eigen::Index>(to)) - x.values.row(static_cast<Eigen::Index>(from)))
+              .transpose();
+        };
+        const Eigen::VectorXd dr = change(r, start->first, i), ds = change(*s, start->second, j);
+        difference += (dr - ds).squaredNorm();
+        size += dr.squaredNorm();
+      }
+      start = {i, j};
+    }
+    if (!(size > 0.0)) continue;
+    compared = true;
+    const double relative = std::sqrt(difference / size);
+    if (!(relative < kMaxDriveMismatch))
+      return r.info.name + ": the twin's wheel motion differs from the recorded one by " + std::to_string(relative) +
+             " of its size";
+  }
+  return compared ? std::string() : "no wheel stream (wheel_encoders, steering) in both to compare the drive";
+}
+
 Eigen::MatrixXd WhiteNoiseCovariance(const TwinFitRows& rows) {
   const Eigen::MatrixXd H = rows.jacobian.transpose() * rows.jacobian;
   return H.completeOrthogonalDecomposition().pseudoInverse();

@@ -106,5 +106,21 @@ TEST(TwinTest, AHiddenImuTimeOffsetIsRecoveredOnTheStepGrid) {
   EXPECT_NEAR(d.effects.front().effect.parameters.at("offset_s"), kOffsetS, 1e-9);  // applied in whole steps
 }
 
+TEST(TwinTest, ThePlainSimulationIsTheTwinOfTheScenariosOwnDriveOnly) {
+  sim::Scenario nominal = Nominal();
+  const recording::Recording twin = PlainSimulationRunner()(nominal).value();
+  for (const sim::EffectOptions& hidden :
+       std::vector<sim::EffectOptions>{{"wheel_radius_asymmetry", {{"ratio_right_left", 1.05}}},
+                                       {"track_width_error", {{"track_error_m", 0.05}}}}) {
+    sim::Scenario real = Nominal();
+    real.effects = {hidden};
+    EXPECT_EQ(DriveMismatch(testing::SimulatedWithSeed(real, 21).recording, twin), "") << hidden.name;
+  }
+  sim::Scenario other = Nominal();
+  other.driver.angular_radps = sim::Profile::Constant(0.2);  // another drive: the same speeds, another turn rate
+  const std::string mismatch = DriveMismatch(testing::SimulatedWithSeed(other, 21).recording, twin);
+  EXPECT_NE(mismatch.find("wheel_encoders"), std::string::npos) << mismatch;
+}
+
 }  // namespace
 }  // namespace roamlab::gap
