@@ -22,8 +22,10 @@
 //   4. name: each candidate is scored by its chi-square drop LR on the training part (~ chi2(k) under "no effect"),
 //      p = 1 - F_chi2(k)(LR) and Delta BIC = -LR + k ln n (gap/internal/decide.h, Score); in order of Delta BIC the
 //      first with p < alpha, Delta BIC < max_delta_bic and a held-out chi-square drop (the twin run over the whole
-//      recording, compared on the rest) above min_heldout_improvement is kept; then the candidates that passed p in
-//      the first round are fitted again on top of the kept ones, up to max_effects;
+//      recording, compared on the rest) above min_heldout_improvement is kept (a candidate whose twin fails is dropped
+//      with the reason); then the candidates that passed p in the first round are tried again on top of the kept
+//      ones, each fitted only when a score test passes alpha (internal/twin_fit.h PredictedDrop: the Gauss-Newton
+//      step's predicted drop from its neutral values, one Jacobian), up to max_effects;
 //   5. show: on the held-out part, the nominal twin's and the patched twin's residual RMS per stream and drift.
 // Verdict: "named" (some effect kept), "unknown" (no effect kept, and some component inconsistent with the stated
 // noise), "none". `unexplained` lists the components still inconsistent on the held-out part with the patch.

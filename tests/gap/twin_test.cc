@@ -1,6 +1,7 @@
 // The diagnosis against the twin (gap/twin.h) on short seeded differential-drive cases: a "real" recording simulated
 // with noise and a hidden effect is diagnosed against the noise-free simulation of the nominal scenario (the twin of a
 // recording of the scenario's own drive). A GPS at 10 Hz with 5 mm noise stands in for motion capture.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -92,6 +93,14 @@ TEST(TwinTest, NoHiddenEffectNamesNone) {
   const TwinDiagnosis d = Diagnosed({}, 13);
   EXPECT_EQ(d.verdict, "none");
   EXPECT_TRUE(d.effects.empty());
+  // Every candidate the diff drive with IMU and GPS supports was fitted and scored.
+  const std::vector<std::string> names = TwinCandidateNames(Nominal());
+  EXPECT_EQ(names.size(), 8u);  // wheel ratio, track, two axles, gyro scale and bias, IMU offset, GPS latency
+  ASSERT_EQ(d.candidates.size(), names.size());
+  for (const TwinEffect& e : d.candidates) {
+    EXPECT_NE(std::find(names.begin(), names.end(), e.estimate.name), names.end()) << e.estimate.name;
+    EXPECT_FALSE(e.estimate.decision.empty()) << e.estimate.name;
+  }
   for (const LocatedComponent& c : d.located) EXPECT_FALSE(c.inconsistent) << c.stream << "/" << c.component;
 }
 
