@@ -80,6 +80,16 @@ TEST(TwinTest, AHiddenWheelRadiusAsymmetryIsNamedAndTheHeldOutDriftShrinks) {
   const SimulatedStreamFit& nominal = d.heldout_before.streams.at("gyroscope");
   EXPECT_GT(nominal.rms * nominal.rms, 1.0 + 5.0 * std::sqrt(2.0 / (3.0 * nominal.samples)));
   EXPECT_TRUE(TwinDiagnosisJson(d).at("effects").size() == d.effects.size());
+  // Located: the gyroscope's yaw axis (the IMU is aligned with the body), with intervals and the motion it follows.
+  bool located = false;
+  for (const LocatedComponent& c : d.located) {
+    if (c.stream != "gyroscope" || c.component != 2) continue;
+    located = c.inconsistent && !c.intervals.empty() && !c.correlates.empty();
+    if (!c.correlates.empty())
+      std::printf("  gyroscope z located: chi2/dof %.2f, %zu intervals, follows %s (rho %.2f)\n", c.chi2_per_dof,
+                  c.intervals.size(), c.correlates[0].condition.c_str(), c.correlates[0].rho);
+  }
+  EXPECT_TRUE(located);
 }
 
 TEST(TwinTest, AHiddenTrackWidthErrorIsNamedAndTheHeldOutDriftShrinks) {
