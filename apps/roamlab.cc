@@ -172,6 +172,9 @@ void AddDiagnose(CLI::App* app, Commands* commands) {
                     "Time-shift search range [s] of gps_latency, imu_time_offset and pose_time_offset (default 0.5; "
                     "below 1/12 of the recording's span)");
     dia->add_flag("--no-plots", args->no_plots, "No figures");
+    dia->add_flag("--replay", args->replay,
+                  "Also diagnose against the scenario's noise-free twin into OUT/twin.json (a recording of the "
+                  "scenario's own drive only)");
     dia->add_flag("--quiet", args->quiet, "No progress and no summary");
     return dia;
   });
