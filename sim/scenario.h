@@ -189,11 +189,11 @@
 //                                           # baseline / distance / lx_plus_ly follow the moved wheels' yaw lever arms.
 //   driver:
 //     lateral_mps: <profile>                # sideways speed v_y [m/s] (default 0; only for omni3 and mecanum)
-// wheel_encoders has one column per wheel: omni3 "wheel_0" "wheel_1" "wheel_2", mecanum "front_left" "front_right"
-// "rear_left" "rear_right". Platform geometry: omni3 wheel_radius_m, wheel_distance_m (L); mecanum wheel_radius_m,
-// half_length_m, half_width_m. truth.yaml: odometer.radius_<i> for every wheel, and odometer.distance (omni3) or
-// odometer.lx_plus_ly (mecanum), the names of the omni3_drive and mecanum_drive estimator models; the radii are the
-// rollers' envelope (the true mean rolling radius is a little smaller: the axle dips between rollers).
+// wheel_encoders has one column per wheel: omni3 "wheel_0" "wheel_1" "wheel_2", mecanum and skid_steer "front_left"
+// "front_right" "rear_left" "rear_right". Platform geometry: omni3 wheel_radius_m, wheel_distance_m (L); mecanum
+// wheel_radius_m, half_length_m, half_width_m. truth.yaml: odometer.radius_<i> for every wheel, and odometer.distance
+// (omni3) or odometer.lx_plus_ly (mecanum), the names of the omni3_drive and mecanum_drive estimator models; the radii
+// are the rollers' envelope (the true mean rolling radius is a little smaller: the axle dips between rollers).
 //
 // Real robots (scenarios/real/, docs/scenarios.md "Real robots"): a simulated recording that reads like an imported
 // one names its encoder columns and geometry keys as the importer does:

@@ -7,9 +7,11 @@
 // real one are compared through them.
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -22,8 +24,10 @@
 #include "importers/rosbag.h"
 #include "recording/recording.h"
 #include "recording/wheel_kinematics.h"
+#include "sim/mujoco_model.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
+#include "sim/wheeled_robot.h"
 #include "tests/support/husky_bag.h"
 #include "tests/support/real_data.h"
 
@@ -266,6 +270,37 @@ TEST(RealModelsTest, DocumentedLayoutsAreTheRealImports) {
   ASSERT_TRUE(husky.ok()) << husky.status().message();
   const Eigen::Quaterniond q_real = real_husky.value().Find("imu")->info.mounting->q_body_sensor;
   EXPECT_GT(std::abs(q_real.dot(husky.value().sensors.imu->misalignment.normalized())), 1.0 - 1e-12);
+}
+
+// The rows the driver uses, measured on each model (sim/wheeled_robot.h), are those recording::NominalWheelKinematics
+// reads off the simulated recording's geometry keys for its encoder columns: the sign conventions agree.
+TEST(RealModelsTest, RecordedGeometryGivesTheModelsWheelRows) {
+  for (const std::string file : {"optiodom_diff", "optiodom_omni3", "husky"}) {
+    Result<Scenario> scenario = LoadScenario(Source("scenarios/real/" + file + ".yaml"));
+    ASSERT_TRUE(scenario.ok()) << scenario.status().message();
+    std::ifstream in(scenario.value().robot.model_file);
+    std::stringstream xml;
+    xml << in.rdbuf();
+    auto model = LoadModelFromString(xml.str(), file);
+    ASSERT_TRUE(model.ok()) << model.status().message();
+    auto robot = WheeledRobot::Bind(model.value().get(), scenario.value().robot.kind, file);
+    ASSERT_TRUE(robot.ok()) << robot.status().message();
+    const Simulation sim = SimulateReal("scenarios/real/" + file + ".yaml", 0.5);
+    const recording::Stream* enc = nullptr;
+    for (const recording::Stream& st : sim.recording.streams)
+      if (st.info.type == recording::StreamType::kWheelEncoders) enc = &st;
+    ASSERT_NE(enc, nullptr) << file;
+    auto nominal = recording::NominalWheelKinematics(sim.recording.platform, enc->info.columns);
+    ASSERT_TRUE(nominal.ok()) << nominal.status().message();
+    const std::vector<EncoderColumn>& columns = scenario.value().robot.encoder_columns;
+    ASSERT_EQ(static_cast<int>(columns.size()), nominal.value().wheels()) << file;
+    for (std::size_t k = 0; k < columns.size(); ++k) {
+      const Eigen::RowVector3d measured = robot.value().J_rates_twist().row(columns[k].wheel);
+      const Eigen::RowVector3d stated = nominal.value().J_rates_twist.row(static_cast<Eigen::Index>(k));
+      EXPECT_LT((measured - stated).cwiseAbs().maxCoeff(), 1e-4)
+          << file << " column " << columns[k].name << ": measured " << measured << ", stated " << stated;
+    }
+  }
 }
 
 // --- (b) the nominal wheel kinematics dead-reckon the simulated truth ---------------------------------------------
