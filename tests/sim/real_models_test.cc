@@ -303,6 +303,33 @@ TEST(RealModelsTest, RecordedGeometryGivesTheModelsWheelRows) {
   }
 }
 
+// What only the bound model can tell is refused when the simulator is created, in one line naming the key.
+TEST(RealModelsTest, NamingThatDoesNotFitTheModelIsRefused) {
+  Result<Scenario> omni3 = LoadScenario(Source("scenarios/real/optiodom_omni3.yaml"));
+  ASSERT_TRUE(omni3.ok()) << omni3.status().message();
+  const auto refused = [](Scenario s, const std::string& key, const std::string& problem) {
+    auto sim = Simulator::Create(s);
+    ASSERT_FALSE(sim.ok()) << key;
+    const std::string& message = sim.status().message();
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    EXPECT_NE(message.find(key), std::string::npos) << message;
+    EXPECT_NE(message.find(problem), std::string::npos) << message;
+  };
+  Scenario s = omni3.value();
+  s.robot.encoder_columns[2].wheel = 3;
+  refused(s, "robot.encoder_columns[2].wheel", "wheels 0 to 2");
+  s = omni3.value();
+  s.robot.encoder_columns.pop_back();
+  refused(s, "robot.geometry_keys", "every wheel");
+  // The OptiOdom layout (-60, 60, 180 deg, clockwise) is not what the nominal omni3 keys describe.
+  s = omni3.value();
+  s.robot.per_wheel_geometry = false;
+  refused(s, "robot.geometry_keys", "use per_wheel");
+  s = omni3.value();
+  s.robot.stated_geometry["wheel_distance_m"] = 0.2;
+  refused(s, "robot.geometry.wheel_distance_m", "measured on the model");
+}
+
 // --- (b) the nominal wheel kinematics dead-reckon the simulated truth ---------------------------------------------
 // Bounds: the encoders count whole ticks (2 pi / 2796.8 rad: 0.09 mm of rim travel, 1 mrad of heading on the 0.2 m
 // track), and the tires roll on a soft contact whose deflection shortens the rolling radius (under 1 % of the 42 mm
