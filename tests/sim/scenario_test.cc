@@ -184,7 +184,7 @@ TEST_F(ScenarioErrorTest, EncoderColumnsAndGeometryKeysAreParsedAndChecked) {
   ExpectError(LoadIndoorWith(kind, kind + "  geometry: {gear_ratio: many}\n"), "gear_ratio",
               "robot.geometry.gear_ratio", "expected a finite number");
   ExpectError(LoadIndoorWith("ticks_per_revolution: 2048", "ticks_per_revolution: 2048\n    name: \"wheel/s\""),
-              "ticks_per_revolution", "sensors.wheel_encoders.name", "letters, digits and _");
+              "wheel/s", "sensors.wheel_encoders.name", "letters, digits and _");
   // Ticks per revolution need not be whole (64 motor ticks through a 43.7:1 gearbox).
   EXPECT_EQ(LoadIndoorWith("ticks_per_revolution: 2048", "ticks_per_revolution: 2796.8"), "");
 }
