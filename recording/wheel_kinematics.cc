@@ -77,21 +77,38 @@ Status ColumnRadius(const Platform& platform, const std::string& column, double*
   return PositiveKey(platform, FirstPresent(platform, {"wheel_radius_" + column + "_m", "wheel_radius_m"}), out);
 }
 
-// differential_drive and skid_steer: one row per side, columns `left` and `right` in the given order.
+// The side of a differential_drive or skid_steer encoder column: -1 left (`left`, `*_left`), +1 right, 0 neither.
+double Side(const std::string& column) {
+  const auto ends = [&column](const std::string& suffix) {
+    return column.size() >= suffix.size() && column.compare(column.size() - suffix.size(), suffix.size(), suffix) == 0;
+  };
+  if (column == "left" || ends("_left")) return -1.0;
+  if (column == "right" || ends("_right")) return 1.0;
+  return 0.0;
+}
+
+// differential_drive and skid_steer: the row of each column's side (`left` and `right`, or a skid steer's
+// front_left ... rear_right), in the given order.
 Result<WheelKinematics> TwoSides(const Platform& platform, const std::vector<std::string>& columns) {
   const std::vector<std::string> names = columns.empty() ? std::vector<std::string>{"left", "right"} : columns;
-  const bool sides =
-      names.size() == 2 && ((names[0] == "left" && names[1] == "right") || (names[0] == "right" && names[1] == "left"));
-  if (!sides) return Status::Error("platform " + platform.kind + ": the encoder columns must be left and right");
+  const bool two = platform.kind == "differential_drive";
+  bool named = !two || names.size() == 2, left = false, right = false;
+  for (const std::string& c : names) {
+    named = named && Side(c) != 0.0 && (!two || c == "left" || c == "right");
+    left = left || Side(c) < 0.0;
+    right = right || Side(c) > 0.0;
+  }
+  if (!named || !left || !right)
+    return Status::Error("platform " + platform.kind + ": the encoder columns must be left and right" +
+                         (platform.kind == "skid_steer" ? " (or front_left, front_right, rear_left, rear_right)" : ""));
   double baseline = 0.0;
   if (Status s = PositiveKey(platform, FirstPresent(platform, {"baseline_m", "track_m"}), &baseline); !s.ok()) return s;
   WheelKinematics k;
-  k.J_rates_twist.resize(2, 3);
-  for (int i = 0; i < 2; ++i) {
+  k.J_rates_twist.resize(static_cast<Eigen::Index>(names.size()), 3);
+  for (std::size_t i = 0; i < names.size(); ++i) {
     double r = 0.0;
     if (Status s = ColumnRadius(platform, columns.empty() ? std::string() : names[i], &r); !s.ok()) return s;
-    const double side = names[i] == "left" ? -1.0 : 1.0;
-    k.J_rates_twist.row(i) << 1.0 / r, 0.0, side * 0.5 * baseline / r;
+    k.J_rates_twist.row(static_cast<Eigen::Index>(i)) << 1.0 / r, 0.0, Side(names[i]) * 0.5 * baseline / r;
   }
   k.holonomic = false;
   return k;

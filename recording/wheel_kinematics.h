@@ -11,7 +11,8 @@
 //   differential_drive   geometry: wheel_radius_m, baseline_m (distance between the wheel contact points)
 //                        wheels: 0 = left at (0, +B/2), 1 = right at (0, -B/2), both rolling along +x:
 //                        omega_left = (v_x - omega_z B/2) / r,  omega_right = (v_x + omega_z B/2) / r
-//   skid_steer           the same rows, one per side (a side's wheels turn together): wheels 0 = left, 1 = right. B
+//   skid_steer           the same rows, one per side (a side's wheels turn together): wheels 0 = left, 1 = right
+//                        (with the encoder columns: `left`, `right`, or one per wheel front_left ... rear_right). B
 //                        is the nominal track; turning, the tires scrub sideways, so the body turns slower than
 //                        these rows say (the effective track is wider than B)
 //   omni3                geometry: wheel_radius_m, wheel_distance_m (L, from O to each wheel's contact point)

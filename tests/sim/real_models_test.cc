@@ -330,6 +330,30 @@ TEST(RealModelsTest, NamingThatDoesNotFitTheModelIsRefused) {
   refused(s, "robot.geometry.wheel_distance_m", "measured on the model");
 }
 
+// A skid steer without robot.encoder_columns records every wheel (front_left ... rear_right); the nominal kinematics
+// read each column's side from its name, and the four rows are the driver's.
+TEST(RealModelsTest, SkidSteerWithAnEncoderPerWheel) {
+  Result<Scenario> husky = LoadScenario(Source("scenarios/real/husky.yaml"));
+  ASSERT_TRUE(husky.ok()) << husky.status().message();
+  husky.value().robot.encoder_columns.clear();
+  husky.value().duration_s = 0.5;
+  Result<Simulation> sim = Simulate(husky.value());
+  ASSERT_TRUE(sim.ok()) << sim.status().message();
+  const recording::Stream* wheels = sim.value().recording.Find("wheels");
+  ASSERT_NE(wheels, nullptr);
+  EXPECT_EQ(wheels->info.columns, (std::vector<std::string>{"front_left", "front_right", "rear_left", "rear_right"}));
+  auto nominal = recording::NominalWheelKinematics(sim.value().recording.platform, wheels->info.columns);
+  ASSERT_TRUE(nominal.ok()) << nominal.status().message();
+  const double r = 0.1651, half_track = 0.555 / 2.0;
+  Eigen::MatrixXd expected(4, 3);
+  expected << 1 / r, 0, -half_track / r, 1 / r, 0, half_track / r, 1 / r, 0, -half_track / r, 1 / r, 0, half_track / r;
+  EXPECT_LT((nominal.value().J_rates_twist - expected).cwiseAbs().maxCoeff(), 1e-4) << nominal.value().J_rates_twist;
+  // A differential drive needs exactly its two columns.
+  recording::Platform diff = sim.value().recording.platform;
+  diff.kind = "differential_drive";
+  EXPECT_FALSE(recording::NominalWheelKinematics(diff, wheels->info.columns).ok());
+}
+
 // --- (b) the nominal wheel kinematics dead-reckon the simulated truth ---------------------------------------------
 // Bounds: the encoders count whole ticks (2 pi / 2796.8 rad: 0.09 mm of rim travel, 1 mrad of heading on the 0.2 m
 // track), and the tires roll on a soft contact whose deflection shortens the rolling radius (under 1 % of the 42 mm
