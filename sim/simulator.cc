@@ -92,7 +92,11 @@ class Simulator::Impl {
               {"track_m", Micrometres(vehicle_.rear_track_m())},
               {"wheel_radius_m", Micrometres(vehicle_.wheel_radius_m())}};
     std::map<std::string, double> geometry;
-    for (const auto& [key, value] : wheeled_.PlatformGeometry()) geometry[key] = Micrometres(value);
+    const std::map<std::string, double> measured =
+        scenario_.robot.per_wheel_geometry ? wheeled_.PerWheelGeometry(WheelNames()) : wheeled_.PlatformGeometry();
+    // Angles to the microradian, directions exact (+-1): the same rounding.
+    for (const auto& [key, value] : measured) geometry[key] = Micrometres(value);
+    for (const auto& [key, value] : scenario_.robot.stated_geometry) geometry[key] = value;
     return geometry;
   }
   double VehicleMassKg() const { return ackermann_ ? vehicle_.mass_kg() : 0.0; }
@@ -183,6 +187,7 @@ class Simulator::Impl {
       }
       if (Status st = wheeled_.MoveWheels(model_.get(), scenario_.robot.wheel_offset, where_); !st.ok()) return st;
       if (Status st = wheeled_.Deform(model_.get(), TireDeformations(scenario_), where_); !st.ok()) return st;
+      if (Status st = BindEncoderColumns(); !st.ok()) return st;
       odom_site_ = wheeled_.odom_site();
       if (scenario_.sensors.laser && wheeled_.laser_site() < 0)
         return Status::Error(model_where_ + ": sensors.laser needs a site 'laser' on the robot");
@@ -194,6 +199,42 @@ class Simulator::Impl {
     }
 
     return Status::Ok();
+  }
+
+  // The encoder stream's columns (robot.encoder_columns, else every wheel under the kind's names) and the checks of
+  // robot.geometry_keys and robot.geometry against the bound model.
+  Status BindEncoderColumns() {
+    const RobotOptions& robot = scenario_.robot;
+    const int wheels = static_cast<int>(wheeled_.wheels().size());
+    encoder_columns_.clear();
+    if (robot.encoder_columns.empty()) {
+      const std::vector<std::string> names = wheeled_.EncoderColumns();
+      for (int i = 0; i < wheels; ++i) encoder_columns_.push_back({i, names[static_cast<std::size_t>(i)]});
+    }
+    for (std::size_t k = 0; k < robot.encoder_columns.size(); ++k) {
+      if (robot.encoder_columns[k].wheel >= wheels)
+        return Status::Error(where_ + ": robot.encoder_columns[" + std::to_string(k) + "].wheel: the " + robot.kind +
+                             " robot has wheels 0 to " + std::to_string(wheels - 1));
+      encoder_columns_.push_back(robot.encoder_columns[k]);
+    }
+    if (robot.per_wheel_geometry && static_cast<int>(encoder_columns_.size()) != wheels)
+      return Status::Error(where_ + ": robot.geometry_keys: per_wheel needs every wheel in robot.encoder_columns");
+    if (!robot.per_wheel_geometry && !wheeled_.NominalLayout())
+      return Status::Error(where_ + ": robot.geometry_keys: the " + robot.kind +
+                           " model's wheels are off the layout the nominal keys describe: use per_wheel");
+    const std::map<std::string, double> measured =
+        robot.per_wheel_geometry ? wheeled_.PerWheelGeometry(WheelNames()) : wheeled_.PlatformGeometry();
+    for (const auto& [key, value] : robot.stated_geometry)
+      if (measured.count(key) > 0)
+        return Status::Error(where_ + ": robot.geometry." + key + ": measured on the model; it cannot be stated");
+    return Status::Ok();
+  }
+
+  // The encoder column name of each wheel ("" for a wheel without an encoder).
+  std::vector<std::string> WheelNames() const {
+    std::vector<std::string> names(wheeled_.wheels().size());
+    for (const EncoderColumn& c : encoder_columns_) names[static_cast<std::size_t>(c.wheel)] = c.name;
+    return names;
   }
 
   // The physics step, the duration, the lead-in and every stream's clock (every period a whole number of steps).
@@ -230,6 +271,9 @@ class Simulator::Impl {
     }
     if (sensors.gps) {
       if (Status s = clock(sensors.gps->rate_hz, "sensors.gps.rate_hz", &gps_clock_); !s.ok()) return s;
+    }
+    if (sensors.mocap) {
+      if (Status s = clock(sensors.mocap->rate_hz, "sensors.mocap.rate_hz", &mocap_clock_); !s.ok()) return s;
     }
     if (sensors.odometer) {
       if (Status s = clock(sensors.odometer->rate_hz, "sensors.odometer.rate_hz", &odometer_clock_); !s.ok()) return s;
@@ -274,9 +318,17 @@ class Simulator::Impl {
       gps_stream_.info.mounting = recording::Mounting{};
       gps_stream_.info.noise = {{"sigma_m", sensors.gps->sigma_m}};
     }
+    if (sensors.mocap) {
+      mocap_stream_ = MakeStream("mocap", StreamType::kPose, sensors.mocap->rate_hz,
+                                 {"x", "y", "z", "qx", "qy", "qz", "qw"}, "m", mocap_clock_);
+      mocap_stream_.info.noise = {{"position_m", sensors.mocap->position_sigma_m},
+                                  {"orientation_rad", sensors.mocap->orientation_sigma_rad}};
+    }
     if (sensors.wheel_encoders) {
-      encoder_stream_ = MakeStream("wheel_encoders", StreamType::kWheelEncoders, sensors.wheel_encoders->rate_hz,
-                                   wheeled_.EncoderColumns(), "rad", encoder_clock_);
+      std::vector<std::string> columns;
+      for (const EncoderColumn& c : encoder_columns_) columns.push_back(c.name);
+      encoder_stream_ = MakeStream(sensors.wheel_encoders->name, StreamType::kWheelEncoders,
+                                   sensors.wheel_encoders->rate_hz, columns, "rad", encoder_clock_);
       encoder_stream_.info.attributes = {{"ticks_per_revolution", sensors.wheel_encoders->ticks_per_revolution}};
     }
     if (sensors.laser) {
@@ -445,7 +497,8 @@ class Simulator::Impl {
 
   bool AnyDue(std::int64_t t_ns) const {
     return truth_clock_.Due(t_ns) || imu_clock_.Due(t_ns) || mag_clock_.Due(t_ns) || gps_clock_.Due(t_ns) ||
-           odometer_clock_.Due(t_ns) || encoder_clock_.Due(t_ns) || laser_clock_.Due(t_ns) || CameraDue(t_ns);
+           mocap_clock_.Due(t_ns) || odometer_clock_.Due(t_ns) || encoder_clock_.Due(t_ns) || laser_clock_.Due(t_ns) ||
+           CameraDue(t_ns);
   }
 
   // Camera frame k is due at the first step at or after k / rate_hz (rounded to the nanosecond, not accumulated):
@@ -522,17 +575,21 @@ class Simulator::Impl {
       local_->Reverse(antenna.x(), antenna.y(), antenna.z(), latitude, longitude, altitude);
       gps_stream_.values.row(gps_clock_.Row(t_ns)) << latitude, longitude, altitude;
     }
+    if (mocap_clock_.Due(t_ns)) SampleMocap(body, t_ns);
     if (encoder_clock_.Due(t_ns)) {
       // Cumulative angle since t = 0, truncated to whole ticks (an incremental encoder's count).
       const double tick_rad = 2.0 * kPi / sensors.wheel_encoders->ticks_per_revolution;
-      const int wheels = static_cast<int>(wheeled_.wheels().size());
+      const int columns = static_cast<int>(encoder_columns_.size());
       if (t_ns == 0) {
         encoder_zero_rad_.clear();
-        for (int i = 0; i < wheels; ++i) encoder_zero_rad_.push_back(wheeled_.WheelAngle(data_.get(), i));
+        for (const EncoderColumn& c : encoder_columns_)
+          encoder_zero_rad_.push_back(wheeled_.WheelAngle(data_.get(), c.wheel));
       }
-      for (int i = 0; i < wheels; ++i) {
-        const double angle = wheeled_.WheelAngle(data_.get(), i) - encoder_zero_rad_[static_cast<std::size_t>(i)];
-        encoder_stream_.values(encoder_clock_.Row(t_ns), i) = std::floor(angle / tick_rad) * tick_rad;
+      for (int k = 0; k < columns; ++k) {
+        const auto column = static_cast<std::size_t>(k);
+        const double angle =
+            wheeled_.WheelAngle(data_.get(), encoder_columns_[column].wheel) - encoder_zero_rad_[column];
+        encoder_stream_.values(encoder_clock_.Row(t_ns), k) = std::floor(angle / tick_rad) * tick_rad;
       }
     }
     if (laser_clock_.Due(t_ns)) SampleLaser(t_ns);
@@ -557,6 +614,22 @@ class Simulator::Impl {
       steering_stream_.values(odometer_clock_.Row(t_ns), 0) = z_theta;
     }
     return Status::Ok();
+  }
+
+  // One motion-capture pose of O: position noise per axis, the orientation turned by a small rotation vector; the
+  // quaternion's sign kept continuous.
+  void SampleMocap(const FrameKinematics& body, std::int64_t t_ns) {
+    const MocapOptions& o = *scenario_.sensors.mocap;
+    const Eigen::Vector3d p = body.p_world_body + mocap_position_noise_.Draw3(o.position_sigma_m);
+    const Eigen::Vector3d turn = mocap_orientation_noise_.Draw3(o.orientation_sigma_rad);
+    Eigen::Quaterniond q = body.q_world_body;
+    if (turn.norm() > 0.0) q = q * Eigen::Quaterniond(Eigen::AngleAxisd(turn.norm(), turn.normalized()));
+    const Eigen::Index row = mocap_clock_.Row(t_ns);
+    if (row > 0) {
+      const Eigen::Vector4d previous = mocap_stream_.values.row(row - 1).tail<4>().transpose();
+      if (previous.dot(q.coeffs()) < 0.0) q.coeffs() = -q.coeffs();
+    }
+    mocap_stream_.values.row(row) << p.transpose(), q.x(), q.y(), q.z(), q.w();
   }
 
   // One laser scan: ray casts plus range noise, stored when the scenario asks; the scan matcher's stream takes it
@@ -621,6 +694,7 @@ class Simulator::Impl {
     if (sensors.imu) rec.streams.push_back(std::move(imu_stream_));
     if (sensors.magnetometer) rec.streams.push_back(std::move(mag_stream_));
     if (sensors.gps) rec.streams.push_back(std::move(gps_stream_));
+    if (sensors.mocap) rec.streams.push_back(std::move(mocap_stream_));
     if (sensors.odometer) {
       rec.streams.push_back(std::move(wheel_stream_));
       rec.streams.push_back(std::move(steering_stream_));
@@ -676,7 +750,8 @@ class Simulator::Impl {
   std::unique_ptr<SimulatedCamera> camera_;
   recording::Mounting camera_mounting_;
   std::int64_t next_camera_frame_ = 0;
-  std::vector<double> encoder_zero_rad_;
+  std::vector<EncoderColumn> encoder_columns_;  // the wheel_encoders stream's columns
+  std::vector<double> encoder_zero_rad_;        // per column
   std::optional<SpeedController> controller_;
   std::optional<GeographicLib::LocalCartesian> local_;
   ImuCalibration imu_;
@@ -702,7 +777,7 @@ class Simulator::Impl {
   std::int64_t lead_in_ns_ = 0;
   std::int64_t loop_end_ns_ = 0;  // end_ns_, or later when a sample is taken after the recording's end
   std::int64_t t_ns_ = 0;         // the current time, for messages
-  Clock truth_clock_, imu_clock_, mag_clock_, gps_clock_, odometer_clock_, encoder_clock_, laser_clock_;
+  Clock truth_clock_, imu_clock_, mag_clock_, gps_clock_, mocap_clock_, odometer_clock_, encoder_clock_, laser_clock_;
 
   NoiseStream gyro_noise_{seed_, NoiseSource::kGyro, options_.noise};
   NoiseStream accel_noise_{seed_, NoiseSource::kAccel, options_.noise};
@@ -711,11 +786,13 @@ class Simulator::Impl {
   NoiseStream speed_noise_{seed_, NoiseSource::kSpeed, options_.noise};
   NoiseStream steering_noise_{seed_, NoiseSource::kSteering, options_.noise};
   NoiseStream laser_noise_{seed_, NoiseSource::kLaserRange, options_.noise};
+  NoiseStream mocap_position_noise_{seed_, NoiseSource::kMocapPosition, options_.noise};
+  NoiseStream mocap_orientation_noise_{seed_, NoiseSource::kMocapOrientation, options_.noise};
   NoiseStream gyro_bias_noise_{seed_, NoiseSource::kGyroBiasWalk};  // an effect, not sensor noise: always on
   NoiseStream multipath_noise_{seed_, NoiseSource::kGpsMultipath};  // likewise
 
-  recording::Stream imu_stream_, mag_stream_, gps_stream_, wheel_stream_, steering_stream_, encoder_stream_,
-      laser_scan_stream_;
+  recording::Stream imu_stream_, mag_stream_, gps_stream_, mocap_stream_, wheel_stream_, steering_stream_,
+      encoder_stream_, laser_scan_stream_;
   Trajectory truth_;
   double min_height_ = 1e300;
   double max_height_ = -1e300;
