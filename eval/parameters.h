@@ -35,9 +35,9 @@ std::optional<ParameterKind> ParameterKindFromManifold(const std::string& manifo
 
 struct ParameterEstimate {
   ParameterKind kind = ParameterKind::kVector;
-  std::vector<double> estimate;  // ambient values (4 for S3, 7 for SE3)
-  std::vector<double> std;       // tangent standard deviations (3 for S3, 6 for SE3); NaN = unknown; may be empty
-  std::string observability;     // the estimator's verdict ("observable", "weak", "unobservable"); "" = unknown
+  std::vector<double> estimate;    // ambient values (4 for S3, 7 for SE3)
+  std::vector<double> std;         // tangent standard deviations (3 for S3, 6 for SE3); NaN = unknown; may be empty
+  std::string observability = "";  // the estimator's verdict ("observable", "weak", "unobservable"); "" = unknown
 };
 
 struct ParameterComparison {

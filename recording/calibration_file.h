@@ -24,10 +24,10 @@
 namespace roamlab::recording {
 
 struct CalibratedParameter {
-  std::vector<double> estimate;  // ambient values
-  std::vector<double> std;       // tangent standard deviations; NaN where null; empty when absent
-  std::string manifold;          // "R<n>", "S3" or "SE3" as written; "" when absent
-  std::string observability;     // "observable", "weak" or "unobservable" as written; "" when absent
+  std::vector<double> estimate;    // ambient values
+  std::vector<double> std;         // tangent standard deviations; NaN where null; empty when absent
+  std::string manifold;            // "R<n>", "S3" or "SE3" as written; "" when absent
+  std::string observability = "";  // "observable", "weak" or "unobservable" as written; "" when absent
 };
 
 // The parameters' joint marginal information, tangent coordinates stacked in the order of `parameters`.
