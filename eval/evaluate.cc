@@ -410,6 +410,9 @@ Status WriteMetrics(const json& metrics, const std::string& out_dir, WrittenEval
   return Status::Ok();
 }
 
+// The report's note when the figures were not asked for.
+const char kPlotsOff[] = "Figures not drawn (plots off).";
+
 // Runs gnuplot on each figure, or notes that it is missing.
 Status DrawFigures(const std::string& out_dir, const std::vector<PlotFiles>& figures, WrittenEvaluation* written) {
   if (!GnuplotAvailable()) {
@@ -511,12 +514,10 @@ Result<WrittenEvaluation> WriteEvaluation(const Evaluation& evaluation, const st
   if (Status s = WriteMetrics(evaluation.metrics, out_dir, &written); !s.ok()) return s;
   if (plots) {
     if (Status s = DrawEvaluationFigures(evaluation, out_dir, &written); !s.ok()) return s;
-  } else {
-    written.note = "figures not drawn (plots off)";
   }
   written.report_path = Join(out_dir, "report.html");
-  if (Status s = WriteEvaluationReport({evaluation.estimate_name, evaluation.metrics, written.images}, written.note,
-                                       written.report_path);
+  if (Status s = WriteEvaluationReport({evaluation.estimate_name, evaluation.metrics, written.images},
+                                       plots ? written.note : kPlotsOff, written.report_path);
       !s.ok())
     return s;
   return written;
@@ -544,7 +545,9 @@ Result<WrittenEvaluation> WriteComparison(const std::vector<Evaluation>& evaluat
     if (Status s = DrawComparisonFigures(evaluations, out_dir, &written); !s.ok()) return s;
   }
   written.report_path = Join(out_dir, "report.html");
-  if (Status s = WriteComparisonReport(reported, written.images, written.note, written.report_path); !s.ok()) return s;
+  if (Status s = WriteComparisonReport(reported, written.images, plots ? written.note : kPlotsOff, written.report_path);
+      !s.ok())
+    return s;
   return written;
 }
 
