@@ -21,7 +21,7 @@ int RunDiagnose(const DiagnoseArgs& args) {
     summary << "; " << e.name;
     for (const auto& [k, v] : e.parameters) summary << " " << k << " = " << v;
   }
-  std::cout << summary.str() << " (" << args.out << "/report.md)" << std::endl;
+  std::cout << summary.str() << " (" << args.out << "/report.html)" << std::endl;
   return 0;
 }
 

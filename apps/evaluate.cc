@@ -160,7 +160,7 @@ int RunEvaluate(const EvaluateArgs& args) {
       PrintSummary(evaluations.front().metrics);
     else
       PrintTable(evaluations);
-    std::printf("wrote %s", written.value().metrics_path.c_str());
+    std::printf("wrote %s, %s", written.value().report_path.c_str(), written.value().metrics_path.c_str());
     for (const std::string& image : written.value().images) std::printf(", %s", image.c_str());
     std::printf("\n");
   }

@@ -17,7 +17,8 @@ int RunRegress(const RegressArgs& args) {
   std::fputs(regress::ResultsTable(result).c_str(), stdout);
   if (!outcome.ok()) return Exit(nullptr, "regress", outcome);
   if (args.update_baseline) std::printf("baseline written to %s\n", reports.baseline_dir.c_str());
-  std::printf("wrote %s, %s\n", reports.results_json.c_str(), reports.junit_xml.c_str());
+  std::printf("wrote %s, %s, %s\n", reports.results_json.c_str(), reports.junit_xml.c_str(),
+              reports.report_html.c_str());
   return result.Passed() ? 0 : 1;
 }
 

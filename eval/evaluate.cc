@@ -13,6 +13,7 @@
 #include "common/check.h"
 #include "common/json.h"
 #include "eval/internal/evaluate_inputs.h"
+#include "eval/report.h"
 #include "eval/visual_odometry.h"
 #include "recording/truth.h"
 #include "recording/wheel_kinematics.h"
@@ -409,6 +410,9 @@ Status WriteMetrics(const json& metrics, const std::string& out_dir, WrittenEval
   return Status::Ok();
 }
 
+// The report's note when the figures were not asked for.
+const char kPlotsOff[] = "Figures not drawn (plots off).";
+
 // Runs gnuplot on each figure, or notes that it is missing.
 Status DrawFigures(const std::string& out_dir, const std::vector<PlotFiles>& figures, WrittenEvaluation* written) {
   if (!GnuplotAvailable()) {
@@ -433,14 +437,8 @@ json TableRow(const Evaluation& e) {
           {"matched", m["association"]["matched"]}};
 }
 
-}  // namespace
-
-Result<WrittenEvaluation> WriteEvaluation(const Evaluation& evaluation, const std::string& out_dir, bool plots) {
-  WrittenEvaluation written;
-  // metrics.json first: it must exist whatever happens to the figures.
-  if (Status s = WriteMetrics(evaluation.metrics, out_dir, &written); !s.ok()) return s;
-  if (!plots) return written;
-
+// The figures of one evaluation: data, scripts and, with gnuplot, the PNGs.
+Status DrawEvaluationFigures(const Evaluation& evaluation, const std::string& out_dir, WrittenEvaluation* written) {
   // Figures: data and scripts, then gnuplot.
   std::vector<PlotFiles> figures;
   const std::string alignment = AlignmentKindName(evaluation.alignment);
@@ -479,28 +477,12 @@ Result<WrittenEvaluation> WriteEvaluation(const Evaluation& evaluation, const st
     if (!velocity.ok()) return velocity.status();
     figures.push_back(velocity.value());
   }
-  if (Status s = DrawFigures(out_dir, figures, &written); !s.ok()) return s;
-  return written;
+  return DrawFigures(out_dir, figures, written);
 }
 
-Result<WrittenEvaluation> WriteComparison(const std::vector<Evaluation>& evaluations, const std::string& out_dir,
-                                          bool plots) {
-  ROAMLAB_CHECK(!evaluations.empty(), "a comparison needs an evaluation");
-  json m = {{"reference", evaluations.front().metrics["reference"]}, {"table", json::array()}};
-  for (const Evaluation& e : evaluations) {
-    ROAMLAB_CHECK(!m["estimates"].contains(e.estimate_name), "estimate names repeat: " << e.estimate_name);
-    m["table"].push_back(TableRow(e));
-    m["estimates"][e.estimate_name] = e.metrics;
-  }
-  WrittenEvaluation written;
-  if (Status s = WriteMetrics(m, out_dir, &written); !s.ok()) return s;
-  for (const Evaluation& e : evaluations) {
-    const Result<WrittenEvaluation> one = WriteEvaluation(e, Join(out_dir, e.estimate_name), plots);
-    if (!one.ok()) return one.status();
-    if (!one.value().note.empty()) written.note = one.value().note;
-  }
-  if (!plots) return written;
-
+// The overlaid figures of a comparison.
+Status DrawComparisonFigures(const std::vector<Evaluation>& evaluations, const std::string& out_dir,
+                             WrittenEvaluation* written) {
   const Evaluation& first = evaluations.front();
   std::vector<PlottedTrajectory> estimates;
   std::vector<ErrorSeries> series;
@@ -521,7 +503,51 @@ Result<WrittenEvaluation> WriteComparison(const std::vector<Evaluation>& evaluat
       out_dir, "Absolute error against " + first.reference_label + " after alignment", first.t_origin, series);
   if (!errors.ok()) return errors.status();
   figures.push_back(errors.value());
-  if (Status s = DrawFigures(out_dir, figures, &written); !s.ok()) return s;
+  return DrawFigures(out_dir, figures, written);
+}
+
+}  // namespace
+
+Result<WrittenEvaluation> WriteEvaluation(const Evaluation& evaluation, const std::string& out_dir, bool plots) {
+  WrittenEvaluation written;
+  // metrics.json first: it must exist whatever happens to the figures.
+  if (Status s = WriteMetrics(evaluation.metrics, out_dir, &written); !s.ok()) return s;
+  if (plots) {
+    if (Status s = DrawEvaluationFigures(evaluation, out_dir, &written); !s.ok()) return s;
+  }
+  written.report_path = Join(out_dir, "report.html");
+  if (Status s = WriteEvaluationReport({evaluation.estimate_name, evaluation.metrics, written.images},
+                                       plots ? written.note : kPlotsOff, written.report_path);
+      !s.ok())
+    return s;
+  return written;
+}
+
+Result<WrittenEvaluation> WriteComparison(const std::vector<Evaluation>& evaluations, const std::string& out_dir,
+                                          bool plots) {
+  ROAMLAB_CHECK(!evaluations.empty(), "a comparison needs an evaluation");
+  json m = {{"reference", evaluations.front().metrics["reference"]}, {"table", json::array()}};
+  for (const Evaluation& e : evaluations) {
+    ROAMLAB_CHECK(!m["estimates"].contains(e.estimate_name), "estimate names repeat: " << e.estimate_name);
+    m["table"].push_back(TableRow(e));
+    m["estimates"][e.estimate_name] = e.metrics;
+  }
+  WrittenEvaluation written;
+  if (Status s = WriteMetrics(m, out_dir, &written); !s.ok()) return s;
+  std::vector<ReportedEvaluation> reported;
+  for (const Evaluation& e : evaluations) {
+    const Result<WrittenEvaluation> one = WriteEvaluation(e, Join(out_dir, e.estimate_name), plots);
+    if (!one.ok()) return one.status();
+    if (!one.value().note.empty()) written.note = one.value().note;
+    reported.push_back({e.estimate_name, e.metrics, one.value().images});
+  }
+  if (plots) {
+    if (Status s = DrawComparisonFigures(evaluations, out_dir, &written); !s.ok()) return s;
+  }
+  written.report_path = Join(out_dir, "report.html");
+  if (Status s = WriteComparisonReport(reported, written.images, plots ? written.note : kPlotsOff, written.report_path);
+      !s.ok())
+    return s;
   return written;
 }
 

@@ -131,19 +131,21 @@ Result<Evaluation> Evaluate(const EvaluateOptions& options);
 
 struct WrittenEvaluation {
   std::string metrics_path;         // OUT/metrics.json
+  std::string report_path;          // OUT/report.html (eval/report.h)
   std::vector<std::string> images;  // PNGs drawn
   std::string note;                 // one line when the figures could not be drawn (gnuplot missing), else empty
 };
 
 // Writes OUT/metrics.json, then the figures' data and scripts (trajectory, position_error, and nees when there is a
 // covariance) and draws them with gnuplot when it is installed (otherwise `note` says so; metrics.json is written
-// anyway). Errors: the output cannot be written, or gnuplot fails.
+// anyway), then OUT/report.html with the figures embedded. Errors: the output cannot be written, or gnuplot fails.
 Result<WrittenEvaluation> WriteEvaluation(const Evaluation& evaluation, const std::string& out_dir, bool plots = true);
 
 // Several estimates against the same reference: OUT/metrics.json = {"reference": ..., "table": [{"name", "ate_m",
 // "ate_rot_deg", "rpe_trans_m", "rpe_rot_deg", "matched"}], "estimates": {NAME: metrics of the estimate}}, the
 // overlaid top view trajectory.png and ate_over_time.png (position error norm and rotation error of every estimate
-// against time), and each estimate's own evaluation in OUT/NAME/. Names must be unique (CHECK).
+// against time), OUT/report.html (the table, the overlaid figures, then every estimate's tables and figures) and each
+// estimate's own evaluation in OUT/NAME/. Names must be unique (CHECK).
 Result<WrittenEvaluation> WriteComparison(const std::vector<Evaluation>& evaluations, const std::string& out_dir,
                                           bool plots = true);
 

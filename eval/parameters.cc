@@ -130,6 +130,7 @@ Result<ParameterComparison> CompareParameter(const std::string& name, const std:
   row.truth = truth;
   row.estimate = estimate.estimate;
   row.std = estimate.std.empty() ? std::vector<double>(tangent, kNaN) : estimate.std;
+  row.observability = estimate.observability;
   row.angle_error_deg = kNaN;
   // Error in the tangent space the std refers to.
   switch (estimate.kind) {
@@ -182,6 +183,7 @@ Result<std::map<std::string, ParameterEstimate>> ReadCalibrationEstimates(const 
     ParameterEstimate p;
     p.estimate = read.estimate;
     p.std = read.std;
+    p.observability = read.observability;
     const std::string manifold = read.manifold.empty() ? "R" + std::to_string(p.estimate.size()) : read.manifold;
     const std::optional<ParameterKind> kind = ParameterKindFromManifold(manifold);
     if (!kind)
@@ -207,6 +209,7 @@ json ParameterTableJson(const std::vector<ParameterComparison>& rows) {
     } else {
       entry["manifold"] = "R" + std::to_string(row.estimate.size());
     }
+    if (!row.observability.empty()) entry["observability"] = row.observability;
     table[row.name] = entry;
   }
   return table;

@@ -35,8 +35,9 @@ std::optional<ParameterKind> ParameterKindFromManifold(const std::string& manifo
 
 struct ParameterEstimate {
   ParameterKind kind = ParameterKind::kVector;
-  std::vector<double> estimate;  // ambient values (4 for S3, 7 for SE3)
-  std::vector<double> std;       // tangent standard deviations (3 for S3, 6 for SE3); NaN = unknown; may be empty
+  std::vector<double> estimate;    // ambient values (4 for S3, 7 for SE3)
+  std::vector<double> std;         // tangent standard deviations (3 for S3, 6 for SE3); NaN = unknown; may be empty
+  std::string observability = "";  // the estimator's verdict ("observable", "weak", "unobservable"); "" = unknown
 };
 
 struct ParameterComparison {
@@ -49,6 +50,7 @@ struct ParameterComparison {
   std::vector<double> error_over_std;   // tangent size
   double angle_error_deg = 0.0;         // rotations only (NaN for kVector)
   std::vector<double> component_error;  // rotations only: ambient size (empty for kVector)
+  std::string observability;            // as in the estimate; "" = unknown
 };
 
 // Compares one parameter. Errors (bad data, naming the parameter): sizes that do not fit the kind (vector: truth,
@@ -63,12 +65,13 @@ Result<std::vector<ParameterComparison>> CompareParameters(const std::map<std::s
                                                            const std::map<std::string, ParameterEstimate>& estimates,
                                                            std::vector<std::string>* without_truth = nullptr);
 
-// Reads parameters.NAME.{estimate, std, manifold} from a calibration.json written by `roamlab calibrate` (std entries
-// may be null: unknown; a missing manifold means "R<n>"). Errors name the file and the parameter.
+// Reads parameters.NAME.{estimate, std, manifold, observability} from a calibration.json written by `roamlab calibrate`
+// (std entries may be null: unknown; a missing manifold means "R<n>"). Errors name the file and the parameter.
 Result<std::map<std::string, ParameterEstimate>> ReadCalibrationEstimates(const std::string& path);
 
 // {NAME: {"truth": [...], "estimate": [...], "std": [...], "error": [...], "error_over_std": [...], "manifold": "..",
-//         rotations also "angle_error_deg": x, "component_error": [...]}}; NaN as null.
+//         "observability": ".." when known, rotations also "angle_error_deg": x, "component_error": [...]}}; NaN as
+//         null.
 nlohmann::json ParameterTableJson(const std::vector<ParameterComparison>& rows);
 
 }  // namespace roamlab::eval

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -13,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/html.h"
 #include "estimator/calibration.h"
 #include "estimator/calibration_io.h"
 #include "estimator/config.h"
@@ -218,9 +220,42 @@ std::vector<RunResult> RunAll(const MonteCarloOptions& options, const Shared& sh
   return results;
 }
 
+std::string Format(double x, const char* format = "%.4g") {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, format, x);
+  return buffer;
+}
+
+// OUT/report.html: the in-band fraction first, the summary and per-run tables, the NEES figure (when drawn).
+// Returns "" or why it could not be written, as " (...)".
+std::string WriteReport(const MonteCarloOptions& options, const eval::MonteCarloNees& nees,
+                        const std::vector<RunResult>& results, const std::string& plot_note) {
+  html::Page page("Monte-Carlo consistency: " + options.scenario);
+  page.Paragraph("Average position NEES over " + std::to_string(options.runs) + " runs in the " +
+                     Format(100.0 * (1.0 - nees.alpha), "%.0f") + " % band [" + Format(nees.band.lo, "%.3f") + ", " +
+                     Format(nees.band.hi, "%.3f") + "] for " + Format(100.0 * nees.fraction_in_band, "%.1f") +
+                     " % of the time steps after " + Format(options.t0_s, "%.1f") + " s",
+                 "headline");
+  page.Paragraph("Scenario " + options.scenario + ", configuration " + options.config +
+                 (options.calibration.empty() ? "" : ", calibration " + options.calibration) + ".");
+  page.Heading(2, "Runs");
+  html::Table runs{{"seed", "ATE [m]", "mean NEES (3 when consistent)", "tracking [s]"}, {}};
+  for (int i = 0; i < options.runs; ++i)
+    runs.rows.push_back({std::to_string(options.seed_base + i), Format(results[i].nees.ate_m),
+                         Format(results[i].nees.mean_nees), Format(results[i].track_seconds, "%.2f")});
+  page.AddTable(runs);
+  page.Heading(2, "Figures");
+  if (!plot_note.empty())
+    page.Paragraph("No figure" + plot_note, "note");
+  else if (Status s = page.AddImage(options.out + "/nees.png", "Average position NEES with its band"); !s.ok())
+    page.Paragraph(s.message(), "note");
+  const Status written = page.Write(options.out + "/report.html");
+  return written.ok() ? "" : " (" + written.message() + ")";
+}
+
 // OUT/nees.json, OUT/runs.json and OUT/nees.png; returns the plot note.
-std::string WriteOutputs(const MonteCarloOptions& options, const eval::MonteCarloNees& nees,
-                         const std::vector<RunResult>& results) {
+std::string WriteData(const MonteCarloOptions& options, const eval::MonteCarloNees& nees,
+                      const std::vector<RunResult>& results) {
   std::ofstream(options.out + "/nees.json") << eval::NeesJson(nees).dump(2) << "\n";
   nlohmann::json runs = nlohmann::json::array();
   for (int i = 0; i < options.runs; ++i)
@@ -234,6 +269,13 @@ std::string WriteOutputs(const MonteCarloOptions& options, const eval::MonteCarl
       eval::WriteNeesPlot(options.out, "Average position NEES over " + std::to_string(options.runs) + " runs", nees);
   const Status drawn = plot.ok() ? eval::RunGnuplot(options.out, plot.value().script) : plot.status();
   return drawn.ok() ? "" : " (plot failed: " + drawn.message() + ")";
+}
+
+// OUT/nees.json, OUT/runs.json, OUT/nees.png and OUT/report.html; returns the notes of what was not written.
+std::string WriteOutputs(const MonteCarloOptions& options, const eval::MonteCarloNees& nees,
+                         const std::vector<RunResult>& results) {
+  const std::string note = WriteData(options, nees, results);
+  return note + WriteReport(options, nees, results, note);
 }
 
 }  // namespace

@@ -35,20 +35,20 @@ struct MonteCarloOptions {
 
 struct MonteCarloSummary {
   eval::MonteCarloNees nees;
-  std::string plot_note;  // "" or why OUT/nees.png was not drawn, as " (...)"
+  std::string plot_note;  // "" or why OUT/nees.png (or OUT/report.html) was not written, as " (...)"
 };
 
 // Simulates `runs` noise realizations of the scenario (the terrain and the drive stay the same), tracks each online,
 // computes the position NEES (eq. 16) of every pose against the truth, and writes OUT/nees.json
-// ({"runs", "dof", "band", "t", "mean_nees", "fraction_in_band", ...}), OUT/runs.json (per-run ATE and mean NEES) and
-// OUT/nees.png. Runs are spread over `jobs` threads; results do not depend on the number of jobs.
-// Calibration (the configuration's tracking.calibrate, when no calibration file is given): by default one
-// calibration of the scenario simulated with its own noise seed, shared by every run (the seed's protocol). Its error
-// is then one draw common to all runs, so the average NEES tests that draw as much as the tracker (the band assumes
-// independent runs). With calibrate_each_run, run i also simulates a calibration drive of its own (noise seed
-// seed_base + kCalibrationSeedOffset + i), calibrates it (warm-started at the shared calibration, a single stage with
-// every parameter free: the same minimum, fewer iterations) and tracks with those values under that calibration's
-// prior: every random input of the run is its own.
+// ({"runs", "dof", "band", "t", "mean_nees", "fraction_in_band", ...}), OUT/runs.json (per-run ATE and mean NEES),
+// OUT/nees.png and OUT/report.html (the in-band fraction, the per-run table and the figure on one page). Runs are
+// spread over `jobs` threads; results do not depend on the number of jobs. Calibration (the configuration's
+// tracking.calibrate, when no calibration file is given): by default one calibration of the scenario simulated with its
+// own noise seed, shared by every run (the seed's protocol). Its error is then one draw common to all runs, so the
+// average NEES tests that draw as much as the tracker (the band assumes independent runs). With calibrate_each_run, run
+// i also simulates a calibration drive of its own (noise seed seed_base + kCalibrationSeedOffset + i), calibrates it
+// (warm-started at the shared calibration, a single stage with every parameter free: the same minimum, fewer
+// iterations) and tracks with those values under that calibration's prior: every random input of the run is its own.
 Outcome RunMonteCarlo(const MonteCarloOptions& options, MonteCarloSummary* summary = nullptr);
 
 }  // namespace roamlab::experiment

@@ -6,6 +6,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "common/html.h"
 #include "common/json.h"
 #include "eval/plots.h"
 
@@ -157,28 +158,153 @@ json SimulationJson(const SimulationComparison& c) {
           {"not_simulated", c.not_simulated.empty() ? json(nullptr) : json(c.not_simulated)}};
 }
 
-// The report's section on the re-simulation (gap/resimulate.h) against the recording's held-out part.
-void SimulationSection(const SimulationComparison& c, std::ostringstream& r) {
-  r << "\n## The simulation against the recording (held-out part, after t = " << Fixed(c.from_s, 4)
-    << " s)\n\nThe nominal scenario simulated again without noise, as believed and with the accepted effects "
-       "applied (scenario_patch.yaml), compared sample by sample with the recording: RMS of recorded minus "
-       "simulated in units of each stream's stated noise (1 = noise only; meaningful for a recording of the "
-       "scenario's drive), and of its 1 s means (the systematic part).\n\n| stream | RMS as believed | RMS with the "
-       "effects | change | 1 s RMS as believed | 1 s RMS with the effects |\n|---|---|---|---|---|---|\n";
+// A table in Markdown (cells as they are: the tables hold no '|').
+std::string MarkdownTable(const html::Table& table) {
+  std::string out = "|";
+  for (const std::string& h : table.header) out += " " + h + " |";
+  out += "\n|";
+  for (std::size_t i = 0; i < table.header.size(); ++i) out += "---|";
+  out += "\n";
+  for (const std::vector<std::string>& row : table.rows) {
+    out += "|";
+    for (const std::string& cell : row) out += " " + cell + " |";
+    out += "\n";
+  }
+  return out;
+}
+
+// The re-simulation (gap/resimulate.h) against the recording's held-out part.
+const char kSimulationText[] =
+    "The nominal scenario simulated again without noise, as believed and with the accepted effects applied "
+    "(scenario_patch.yaml), compared sample by sample with the recording: RMS of recorded minus simulated in units of "
+    "each stream's stated noise (1 = noise only; meaningful for a recording of the scenario's drive), and of its 1 s "
+    "means (the systematic part).";
+
+html::Table SimulationTable(const SimulationComparison& c) {
+  html::Table t{{"stream", "RMS as believed", "RMS with the effects", "change", "1 s RMS as believed",
+                 "1 s RMS with the effects"},
+                {}};
   for (const auto& [name, b] : c.before) {
     const auto a = c.after.find(name);
-    r << "| " << name << " | " << Fixed(b.rms, 4) << " | ";
     if (a == c.after.end()) {
-      r << "- | - | " << Fixed(b.rms_1s, 4) << " | - |\n";
+      t.rows.push_back({name, Fixed(b.rms, 4), "-", "-", Fixed(b.rms_1s, 4), "-"});
       continue;
     }
-    r << Fixed(a->second.rms, 4) << " | "
-      << (b.rms > 0.0 ? Fixed(100.0 * (a->second.rms / b.rms - 1.0), 3) + " %" : std::string("-")) << " | "
-      << Fixed(b.rms_1s, 4) << " | " << Fixed(a->second.rms_1s, 4) << " |\n";
+    t.rows.push_back({name, Fixed(b.rms, 4), Fixed(a->second.rms, 4),
+                      b.rms > 0.0 ? Fixed(100.0 * (a->second.rms / b.rms - 1.0), 3) + " %" : std::string("-"),
+                      Fixed(b.rms_1s, 4), Fixed(a->second.rms_1s, 4)});
   }
-  for (const std::string& l : c.left_out) r << "\nNot compared: " << l << ".";
-  if (!c.not_simulated.empty()) r << "\nThe effects could not be simulated: " << c.not_simulated << ".";
-  r << "\n";
+  return t;
+}
+
+// The notes under the simulation table.
+std::vector<std::string> SimulationNotes(const SimulationComparison& c) {
+  std::vector<std::string> notes;
+  for (const std::string& l : c.left_out) notes.push_back("Not compared: " + l + ".");
+  if (!c.not_simulated.empty()) notes.push_back("The effects could not be simulated: " + c.not_simulated + ".");
+  return notes;
+}
+
+// The verdict's lines: each accepted effect, or what stays unexplained, or that every stream is consistent.
+std::vector<std::string> VerdictLines(const Diagnosis& d, bool baseline) {
+  std::vector<std::string> lines;
+  if (d.verdict == "named") {
+    for (const EffectEstimate& e : d.effects) {
+      std::string line = e.name + ":";
+      for (const auto& [k, v] : e.parameters) {
+        const auto s = e.std.find(k);
+        line += " " + k + " = " + Fixed(v, 4);
+        if (s != e.std.end() && std::isfinite(s->second)) line += " +- " + Fixed(s->second, 2);
+      }
+      line += " (likelihood ratio " + Fixed(e.lr, 4) + ", p = " + Fixed(e.lr_pvalue, 3) + ", Delta BIC " +
+              Fixed(e.delta_bic, 4) + ", held-out chi2 " + Fixed(100.0 * e.heldout_improvement, 3) + " % lower)";
+      lines.push_back(line);
+    }
+  } else if (d.verdict == "unknown") {
+    lines.push_back("No effect of the library explains it; what stays inconsistent:");
+    for (const std::string& u : d.unexplained) lines.push_back(u);
+  } else {
+    lines.push_back(std::string("Every stream is as consistent as the nominal model is on a nominal simulation") +
+                    (baseline ? "" : " (no baseline: levels compared with 1)") + ".");
+  }
+  return lines;
+}
+
+html::Table LocatedTable(const Diagnosis& d) {
+  html::Table t{{"stream[component]", "chi2/dof", "nominal level", "inconsistent", "intervals [s]",
+                 "strongest condition (rho, lag)"},
+                {}};
+  for (const LocatedComponent& lc : d.located) {
+    std::string intervals;
+    for (std::size_t i = 0; i < lc.intervals.size() && i < 3; ++i)
+      intervals += (i ? ", " : "") + Fixed(lc.intervals[i].first, 3) + "-" + Fixed(lc.intervals[i].second, 3);
+    if (lc.intervals.size() > 3) intervals += " (+" + std::to_string(lc.intervals.size() - 3) + ")";
+    std::string condition;
+    if (!lc.correlates.empty())
+      condition = lc.correlates.front().condition + " (" + Fixed(lc.correlates.front().rho, 2) + ", " +
+                  Fixed(lc.correlates.front().lag_s, 6) + " s)";
+    t.rows.push_back({lc.stream + "[" + std::to_string(lc.component) + "]", Fixed(lc.chi2_per_dof, 3),
+                      Fixed(lc.expected_chi2_per_dof, 3), lc.inconsistent ? "yes" : "no", intervals, condition});
+  }
+  return t;
+}
+
+html::Table CandidatesTable(const Diagnosis& d) {
+  html::Table t{{"effect", "parameters", "LR", "chi2 drop / on baseline", "p", "Delta BIC", "held-out",
+                 "share of the held-out mismatch", "decision"},
+                {}};
+  for (const EffectEstimate& e : d.candidates) {
+    std::string parameters;
+    for (const auto& [k, v] : e.parameters) parameters += k + " = " + Fixed(v, 4) + " ";
+    t.rows.push_back({e.name, parameters, Fixed(e.lr, 4), Fixed(e.lr_raw, 4) + " / " + Fixed(e.baseline_lr, 4),
+                      Fixed(e.lr_pvalue, 3), Fixed(e.delta_bic, 4),
+                      e.evaluated_heldout ? Fixed(100.0 * e.heldout_improvement, 3) + " %" : std::string("-"),
+                      e.evaluated_heldout ? Fixed(e.explained_share, 3) : std::string("-"), e.decision});
+  }
+  return t;
+}
+
+html::Table HeldoutTable(const Diagnosis& d) {
+  html::Table t{
+      {"stream", "RMS before", "RMS after", "1 s RMS before", "1 s RMS after", "chi2/dof before", "chi2/dof after"},
+      {}};
+  for (const auto& [name, b] : d.before) {
+    const auto a = d.after.count(name) ? d.after.at(name) : b;
+    t.rows.push_back({name, Fixed(b.rms, 4), Fixed(a.rms, 4), Fixed(b.rms_1s, 4), Fixed(a.rms_1s, 4),
+                      Fixed(b.chi2_per_dof, 4), Fixed(a.chi2_per_dof, 4)});
+  }
+  return t;
+}
+
+const char kHeldoutText[] =
+    "Whitened residuals: RMS per sample, RMS of their 1 s means (the systematic part) and chi2/dof.";
+
+// report.html: the verdict first, the tables, then the figures embedded.
+Status WriteReportHtml(const Diagnosis& d, const ReportInputs& in, const std::vector<std::string>& images,
+                       const std::string& note, const std::string& dir) {
+  html::Page page("Reality-gap diagnosis");
+  page.Paragraph("Verdict: " + d.verdict, d.verdict == "none" ? "verdict-pass" : "verdict-fail");
+  for (const std::string& line : VerdictLines(d, in.baseline != nullptr)) page.Paragraph(line, "headline");
+  page.Paragraph("Recording " + in.recording + " against the nominal scenario " + in.model + "; " +
+                 std::to_string(d.fits) + " calibrations in " + Fixed(d.seconds, 3) + " s.");
+  page.Heading(2, "Fit on the held-out part (after t = " + Fixed(d.train_end_s, 4) + " s), before and after");
+  page.Paragraph(kHeldoutText);
+  page.AddTable(HeldoutTable(d));
+  page.Heading(2, "Candidates (fitted on the first part)");
+  page.AddTable(CandidatesTable(d));
+  page.Heading(2, "Where (whole run, nominal self-calibration)");
+  page.AddTable(LocatedTable(d));
+  if (in.simulation) {
+    page.Heading(2, "The simulation against the recording (held-out part)");
+    page.Paragraph(kSimulationText);
+    page.AddTable(SimulationTable(*in.simulation));
+    for (const std::string& line : SimulationNotes(*in.simulation)) page.Paragraph(line, "note");
+  }
+  page.Heading(2, "Figures");
+  if (images.empty()) page.Paragraph(note.empty() ? "No figures were drawn." : note, "note");
+  for (const std::string& image : images)
+    if (Status s = page.AddImage(dir + "/" + image, image); !s.ok()) return s;
+  return page.Write(dir + "/report.html");
 }
 
 }  // namespace
@@ -188,58 +314,23 @@ std::string ReportMarkdown(const Diagnosis& d, const std::string& recording, con
   std::ostringstream r;
   r << "# Reality-gap diagnosis\n\nRecording `" << recording << "` against the nominal scenario `" << scenario
     << "`.\n\n## Verdict: **" << d.verdict << "**\n\n";
-  if (d.verdict == "named") {
-    for (const EffectEstimate& e : d.effects) {
-      r << "- **" << e.name << "**:";
-      for (const auto& [k, v] : e.parameters) {
-        const auto s = e.std.find(k);
-        r << " " << k << " = " << Fixed(v, 4);
-        if (s != e.std.end() && std::isfinite(s->second)) r << " +- " << Fixed(s->second, 2);
-      }
-      r << " (likelihood ratio " << Fixed(e.lr, 4) << ", p = " << Fixed(e.lr_pvalue, 3) << ", Delta BIC "
-        << Fixed(e.delta_bic, 4) << ", held-out chi2 " << Fixed(100.0 * e.heldout_improvement, 3) << " % lower)\n";
-    }
-  } else if (d.verdict == "unknown") {
-    r << "No effect of the library explains it; what stays inconsistent:\n";
-    for (const std::string& u : d.unexplained) r << "- " << u << "\n";
-  } else {
-    r << "Every stream is as consistent as the nominal model is on a nominal simulation"
-      << (baseline ? "" : " (no baseline: levels compared with 1)") << ".\n";
+  const std::vector<std::string> verdict = VerdictLines(d, baseline);
+  for (std::size_t i = 0; i < verdict.size(); ++i)
+    r << (d.verdict == "named" || (d.verdict == "unknown" && i > 0) ? "- " : "") << verdict[i] << "\n";
+  r << "\n## Where (whole run, nominal self-calibration)\n\n" << MarkdownTable(LocatedTable(d));
+  r << "\n## Candidates (fitted on the first part, up to t = " << Fixed(d.train_end_s, 4) << " s)\n\n"
+    << MarkdownTable(CandidatesTable(d));
+  r << "\n## Fit on the held-out part (parameters fixed at the training values)\n\n"
+    << kHeldoutText << "\n\n"
+    << MarkdownTable(HeldoutTable(d));
+  if (simulation) {
+    r << "\n## The simulation against the recording (held-out part, after t = " << Fixed(simulation->from_s, 4)
+      << " s)\n\n"
+      << kSimulationText << "\n\n"
+      << MarkdownTable(SimulationTable(*simulation));
+    for (const std::string& note : SimulationNotes(*simulation)) r << "\n" << note;
+    r << "\n";
   }
-  r << "\n## Where (whole run, nominal self-calibration)\n\n| stream[component] | chi2/dof | nominal level | "
-       "inconsistent | intervals [s] | strongest condition (rho, lag) |\n|---|---|---|---|---|---|\n";
-  for (const LocatedComponent& lc : d.located) {
-    r << "| " << lc.stream << "[" << lc.component << "] | " << Fixed(lc.chi2_per_dof, 3) << " | "
-      << Fixed(lc.expected_chi2_per_dof, 3) << " | " << (lc.inconsistent ? "**yes**" : "no") << " | ";
-    for (std::size_t i = 0; i < lc.intervals.size() && i < 3; ++i)
-      r << (i ? ", " : "") << Fixed(lc.intervals[i].first, 3) << "-" << Fixed(lc.intervals[i].second, 3);
-    if (lc.intervals.size() > 3) r << " (+" << lc.intervals.size() - 3 << ")";
-    r << " | ";
-    if (!lc.correlates.empty())
-      r << lc.correlates.front().condition << " (" << Fixed(lc.correlates.front().rho, 2) << ", "
-        << lc.correlates.front().lag_s << " s)";
-    r << " |\n";
-  }
-  r << "\n## Candidates (fitted on the first part, up to t = " << Fixed(d.train_end_s, 4)
-    << " s)\n\n| effect | parameters | LR | chi2 drop / on baseline | p | Delta BIC | held-out | share of the held-out "
-       "mismatch | decision |\n|---|---|---|---|---|---|---|---|---|\n";
-  for (const EffectEstimate& e : d.candidates) {
-    r << "| " << e.name << " | ";
-    for (const auto& [k, v] : e.parameters) r << k << " = " << Fixed(v, 4) << " ";
-    r << "| " << Fixed(e.lr, 4) << " | " << Fixed(e.lr_raw, 4) << " / " << Fixed(e.baseline_lr, 4) << " | "
-      << Fixed(e.lr_pvalue, 3) << " | " << Fixed(e.delta_bic, 4) << " | "
-      << (e.evaluated_heldout ? Fixed(100.0 * e.heldout_improvement, 3) + " %" : std::string("-")) << " | "
-      << (e.evaluated_heldout ? Fixed(e.explained_share, 3) : std::string("-")) << " | " << e.decision << " |\n";
-  }
-  r << "\n## Fit on the held-out part (parameters fixed at the training values)\n\nWhitened residuals: RMS per "
-       "sample, RMS of their 1 s means (the systematic part) and chi2/dof.\n\n| stream | RMS before | RMS after | "
-       "1 s RMS before | 1 s RMS after | chi2/dof before | chi2/dof after |\n|---|---|---|---|---|---|---|\n";
-  for (const auto& [name, b] : d.before) {
-    const auto a = d.after.count(name) ? d.after.at(name) : b;
-    r << "| " << name << " | " << Fixed(b.rms, 4) << " | " << Fixed(a.rms, 4) << " | " << Fixed(b.rms_1s, 4) << " | "
-      << Fixed(a.rms_1s, 4) << " | " << Fixed(b.chi2_per_dof, 4) << " | " << Fixed(a.chi2_per_dof, 4) << " |\n";
-  }
-  if (simulation) SimulationSection(*simulation, r);
   r << "\n";
   for (const std::string& image : images) r << "![" << image << "](" << image << ")\n\n";
   r << d.fits << " calibrations in " << Fixed(d.seconds, 3) << " s.\n";
@@ -332,7 +423,8 @@ Status WriteReport(const Diagnosis& d, const ReportInputs& in, const std::string
   const std::vector<std::string> images = in.plots ? WritePlots(d, dir, &note) : std::vector<std::string>{};
   if (!note.empty() && in.progress) in.progress(note);
   const std::string report = ReportMarkdown(d, in.recording, in.model, in.baseline != nullptr, in.simulation, images);
-  return WriteText(dir + "/report.md", report);
+  if (Status s = WriteText(dir + "/report.md", report); !s.ok()) return s;
+  return WriteReportHtml(d, in, images, note, dir);
 }
 
 }  // namespace roamlab::gap

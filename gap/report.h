@@ -1,7 +1,8 @@
 // What `roamlab diagnose` writes about a diagnosis (gap/diagnose.h): DIR/gap.json (docs/commands.md, `roamlab
-// diagnose`), DIR/report.md, DIR/scenario_patch.yaml (the accepted effects in a scenario's `effects:` form),
-// DIR/estimator_patch.yaml (the same as estimator parameters and stream time shifts) and PNG figures with their
-// gnuplot scripts.
+// diagnose`), DIR/report.md, DIR/report.html (the same, self-contained: verdict first, then the held-out fit before and
+// after, the candidates, where, the re-simulation, and the figures embedded), DIR/scenario_patch.yaml (the accepted
+// effects in a scenario's `effects:` form), DIR/estimator_patch.yaml (the same as estimator parameters and stream time
+// shifts) and PNG figures with their gnuplot scripts.
 #pragma once
 
 #include <cstdint>
@@ -43,7 +44,8 @@ struct ReportInputs {
   std::function<void(const std::string&)> progress;  // receives a note when no figure can be drawn
 };
 
-// Writes gap.json, scenario_patch.yaml, estimator_patch.yaml, the figures and report.md into `dir` (which exists).
+// Writes gap.json, scenario_patch.yaml, estimator_patch.yaml, the figures, report.md and report.html into `dir` (which
+// exists).
 // Errors: a file cannot be written.
 Status WriteReport(const Diagnosis& d, const ReportInputs& in, const std::string& dir);
 

@@ -38,6 +38,10 @@ Result<CalibratedParameter> ReadParameter(const json& node, const std::string& w
     if (!node["manifold"].is_string()) return Status::Error(where + ": 'manifold' must be a string");
     p.manifold = node["manifold"].get<std::string>();
   }
+  if (node.contains("observability")) {
+    if (!node["observability"].is_string()) return Status::Error(where + ": 'observability' must be a string");
+    p.observability = node["observability"].get<std::string>();
+  }
   return p;
 }
 

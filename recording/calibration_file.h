@@ -9,7 +9,7 @@
 //
 // estimate is ambient (quaternions [w, x, y, z]; SE3 [x, y, z, w, x, y, z]), std and the information matrix are
 // tangent; a non-finite number is written as null. Only parameters.NAME.estimate is required; the reader ignores the
-// keys it does not use (correlations, solver, measurements, paths, observability).
+// keys it does not use (correlations, solver, measurements, paths, component_observability).
 #pragma once
 
 #include <map>
@@ -24,9 +24,10 @@
 namespace roamlab::recording {
 
 struct CalibratedParameter {
-  std::vector<double> estimate;  // ambient values
-  std::vector<double> std;       // tangent standard deviations; NaN where null; empty when absent
-  std::string manifold;          // "R<n>", "S3" or "SE3" as written; "" when absent
+  std::vector<double> estimate;    // ambient values
+  std::vector<double> std;         // tangent standard deviations; NaN where null; empty when absent
+  std::string manifold;            // "R<n>", "S3" or "SE3" as written; "" when absent
+  std::string observability = "";  // "observable", "weak" or "unobservable" as written; "" when absent
 };
 
 // The parameters' joint marginal information, tangent coordinates stacked in the order of `parameters`.

@@ -277,6 +277,10 @@ Outcome RunSuite(const RunOptions& options, SuiteResult* result, RunReports* rep
   junit << JunitXml(*result);
   if (!results || !junit)
     return Outcome::Failed(Status::Error((results ? reports->junit_xml : reports->results_json) + ": cannot write"));
+  reports->report_html = options.out + "/report.html";
+  std::ofstream page(reports->report_html);
+  page << ResultsHtml(*result);
+  if (!page) return Outcome::Failed(Status::Error(reports->report_html + ": cannot write"));
   return Outcome::Ok();
 }
 

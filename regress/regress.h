@@ -1,5 +1,5 @@
 // Runs a regression suite (regress/suite.h): each selected case in OUT/cases/NAME, the cases in parallel, then every
-// check against its bound; writes OUT/results.json and OUT/junit.xml (regress/report.h).
+// check against its bound; writes OUT/results.json, OUT/junit.xml and OUT/report.html (regress/report.h).
 #pragma once
 
 #include <functional>
@@ -27,6 +27,7 @@ struct RunReports {
   std::string baseline_dir;  // where the baseline was read (and, with update_baseline, written)
   std::string results_json;
   std::string junit_xml;
+  std::string report_html;
 };
 
 // Runs the suite; `result` receives the results (also when the reports cannot be written). Bad input (a suite or

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "common/html.h"
+
 namespace roamlab::regress {
 namespace {
 
@@ -60,6 +62,19 @@ int Total(const SuiteResult& result) {
   int n = 0;
   for (const CaseResult& c : result.cases) n += static_cast<int>(c.checks.size());
   return n;
+}
+
+// "N checks: ... (C cases, S s)".
+std::string SummaryLine(const SuiteResult& result) {
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "%d checks: %d passed, %d failed, %d errors, %d open targets not met, %d open targets met, %d skipped "
+                "(%zu cases, %.1f s)",
+                Total(result), result.Count(CheckResult::Outcome::kPassed) - OpenMet(result),
+                result.Count(CheckResult::Outcome::kFailed), result.Count(CheckResult::Outcome::kError),
+                result.Count(CheckResult::Outcome::kOpen), OpenMet(result),
+                result.Count(CheckResult::Outcome::kSkipped), result.cases.size(), result.seconds);
+  return line;
 }
 
 json Optional(std::optional<double> x) { return x ? json(*x) : json(nullptr); }
@@ -121,14 +136,7 @@ std::string ResultsTable(const SuiteResult& result) {
   for (const CaseResult& c : result.cases)
     for (const CheckResult& k : c.checks)
       if (k.outcome == CheckResult::Outcome::kOpen) out += c.name + " " + k.metric + ": " + k.message + "\n";
-  std::snprintf(line, sizeof line,
-                "%d checks: %d passed, %d failed, %d errors, %d open targets not met, %d open targets met, %d skipped "
-                "(%zu cases, %.1f s)\n",
-                Total(result), result.Count(CheckResult::Outcome::kPassed) - OpenMet(result),
-                result.Count(CheckResult::Outcome::kFailed), result.Count(CheckResult::Outcome::kError),
-                result.Count(CheckResult::Outcome::kOpen), OpenMet(result),
-                result.Count(CheckResult::Outcome::kSkipped), result.cases.size(), result.seconds);
-  return out + line;
+  return out + SummaryLine(result) + "\n";
 }
 
 json ResultsJson(const SuiteResult& result) {
@@ -227,6 +235,28 @@ std::string JunitXml(const SuiteResult& result) {
     }
   xml += "  </testsuite>\n</testsuites>\n";
   return xml;
+}
+
+std::string ResultsHtml(const SuiteResult& result) {
+  html::Page page("Regression suite " + result.name);
+  page.Paragraph((result.Passed() ? "PASSED: " : "FAILED: ") + SummaryLine(result),
+                 result.Passed() ? "verdict-pass" : "verdict-fail");
+  page.Paragraph("Suite " + result.file + ".");
+  for (const CaseResult& c : result.cases) {
+    if (!c.error.empty()) page.Paragraph("case " + c.name + ": error: " + c.error, "verdict-fail");
+    if (!c.skipped.empty()) page.Paragraph("case " + c.name + ": skipped: " + c.skipped, "note");
+  }
+  page.Heading(2, "Checks");
+  html::Table table{{"case", "mode", "metric", "value", "bound", "threshold", "baseline", "result", "message"}, {}};
+  for (const CaseResult& c : result.cases)
+    for (const CheckResult& k : c.checks)
+      table.rows.push_back({c.name, c.mode, k.metric, ValueText(k), k.bound, Format(k.threshold), Format(k.baseline),
+                            k.outcome == CheckResult::Outcome::kPassed && !k.open.empty()
+                                ? "MET (open: remove the marker)"
+                                : OutcomeName(k.outcome),
+                            k.message});
+  page.AddTable(table);
+  return page.Document();
 }
 
 }  // namespace roamlab::regress

@@ -1,7 +1,7 @@
-// Results of a regression run and the three ways they are reported: a table for people, results.json for tools, and
-// JUnit XML for CI systems (one <testcase classname="CASE" name="METRIC"> per check: <failure> when it fails,
-// <error> when its value could not be read, <skipped> for an open target that does not hold (message: value, bound
-// and reason) and for the checks of a case skipped for absent data).
+// Results of a regression run and the four ways they are reported: a table for people, report.html (common/html.h)
+// for people in a browser, results.json for tools, and JUnit XML for CI systems (one <testcase classname="CASE"
+// name="METRIC"> per check: <failure> when it fails, <error> when its value could not be read, <skipped> for an open
+// target that does not hold (message: value, bound and reason) and for the checks of a case skipped for absent data).
 #pragma once
 
 #include <optional>
@@ -52,6 +52,9 @@ std::string FailureMessage(const CheckResult& check);
 std::string ResultsTable(const SuiteResult& result);
 nlohmann::json ResultsJson(const SuiteResult& result);
 std::string JunitXml(const SuiteResult& result);
+// report.html: one self-contained page, the verdict and the counts first, case errors and skips, then every check
+// (case, mode, metric, value, bound, threshold, baseline, result, message).
+std::string ResultsHtml(const SuiteResult& result);
 
 // `text` with &, <, >, " and ' escaped for XML, and characters XML 1.0 does not allow replaced by '?'.
 std::string XmlEscape(const std::string& text);

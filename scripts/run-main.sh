@@ -12,7 +12,7 @@ rm -rf "$out" && mkdir -p "$out"
 "$roamlab" calibrate "$out/recording" --config configs/atv_calibration.yaml --out "$out/calibration"
 "$roamlab" track "$out/recording" --config configs/atv_tracking.yaml \
   --calibration "$out/calibration/calibration.json" --out "$out/tracking"
-"$roamlab" evaluate --estimate "$out/calibration" --recording "$out/recording" --out "$out/report/calibration"
-"$roamlab" evaluate --estimate "$out/tracking" --recording "$out/recording" --out "$out/report/tracking"
-echo "report: $out/report/calibration/metrics.json (parameter table), $out/report/tracking/metrics.json (ATE, RPE,"
-echo "        NEES) and the figures beside them (trajectory.png, position_error.png)"
+"$roamlab" evaluate --estimate "$out/calibration" --estimate "$out/tracking" --recording "$out/recording" \
+  --out "$out/report"
+echo "report: $out/report/report.html (headline numbers, the calibration's parameter table, ATE, RPE, NEES and the"
+echo "        figures, all in one page); metrics.json and each estimate's own evaluation in $out/report/{calibration,tracking}"

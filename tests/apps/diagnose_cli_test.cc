@@ -15,6 +15,7 @@
 
 #include "eval/plots.h"
 #include "tests/recording/temp_dir.h"
+#include "tests/support/html_check.h"
 
 namespace roamlab {
 namespace {
@@ -74,6 +75,23 @@ TEST(DiagnoseCliTest, NeverOpensTruthYamlAndWritesGapJson) {
     const std::string report = testing::ReadFile(dir.File("out/report.md"));
     EXPECT_NE(report.find("![heldout_fit.png]"), std::string::npos) << report;
     EXPECT_GT(std::filesystem::file_size(dir.File("out/heldout_fit.png")), 0u);
+  }
+  // report.html: well-formed, the verdict first, the held-out fit before/after and the candidates, figures embedded.
+  const std::string page = testing::ReadFile(dir.File("out/report.html"));
+  const testing::HtmlSummary html = testing::CheckHtml(page);
+  ASSERT_EQ(html.error, "");
+  EXPECT_LT(page.find("Verdict: " + verdict), page.find("<table>"));
+  ASSERT_GE(html.table_headers.size(), 3u);
+  EXPECT_EQ(html.table_headers[0].front(), "stream");
+  EXPECT_EQ(html.table_headers[0].back(), "chi2/dof after");
+  EXPECT_EQ(html.table_headers[1].front(), "effect");
+  EXPECT_EQ(html.table_headers[2].front(), "stream[component]");
+  if (eval::GnuplotAvailable()) {
+    ASSERT_FALSE(html.image_sources.empty());
+    for (const std::string& src : html.image_sources) {
+      ASSERT_EQ(src.rfind("data:image/png;base64,", 0), 0u);
+      EXPECT_TRUE(testing::DecodeBase64(src.substr(22)).has_value());
+    }
   }
   // The re-simulation as believed sees the hidden offset in the steering stream: 0.03 rad on a sensor of 0.014 rad
   // noise is a whitened RMS of sqrt(1 + (0.03 / 0.014)^2) = 2.36 (over 200 samples: +-0.05).

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/recording/temp_dir.h"
+#include "tests/support/html_check.h"
 
 #include "recording/recording.h"
 #include "recording/trajectory.h"
@@ -124,6 +125,15 @@ TEST_F(CliTest, MonteCarloCalibratesOnceWhenTheConfigSaysHow) {
   const nlohmann::json nees = nlohmann::json::parse(nin);
   EXPECT_EQ(nees["runs"], 2);
   EXPECT_GT(nees["mean_nees"].size(), 100u);
+  // report.html: the headline, one row per run, the NEES figure embedded when gnuplot drew it.
+  std::ifstream hin(dir_ / "mc" / "report.html");
+  const std::string page((std::istreambuf_iterator<char>(hin)), std::istreambuf_iterator<char>());
+  const testing::HtmlSummary html = testing::CheckHtml(page);
+  ASSERT_EQ(html.error, "");
+  EXPECT_NE(page.find("class=\"headline\">Average position NEES over 2 runs"), std::string::npos);
+  ASSERT_EQ(html.table_headers.size(), 1u);
+  EXPECT_EQ(html.table_headers[0].front(), "seed");
+  EXPECT_EQ(html.image_sources.size(), std::filesystem::exists(dir_ / "mc" / "nees.png") ? 1u : 0u);
 }
 
 TEST_F(CliTest, BadInputGivesOneLineAndNonZeroExit) {

@@ -11,6 +11,7 @@
 
 #include "eval/evaluate.h"
 #include "tests/recording/temp_dir.h"
+#include "tests/support/html_check.h"
 
 namespace roamlab::eval {
 namespace {
@@ -260,6 +261,21 @@ TEST_F(EvaluateFilesTest, SeveralEstimatesGiveOneTableAndOverlaidFigures) {
     EXPECT_EQ(w.value().images.size(), 2u);
     for (const std::string& image : w.value().images) EXPECT_GT(fs::file_size(image), 1000u) << image;
   }
+  // One page: the comparison table first, then each estimate's tables; the overlaid figures and each estimate's own
+  // (trajectory and position error: no covariance) embedded.
+  const std::string page = ReadFile(w.value().report_path);
+  const testing::HtmlSummary html = testing::CheckHtml(page);
+  ASSERT_EQ(html.error, "");
+  ASSERT_FALSE(html.table_headers.empty());
+  EXPECT_THAT(html.table_headers[0], ::testing::ElementsAre("estimate", "matched", "ATE [m]", "ATE [deg]", "RPE [m]",
+                                                            "RPE [deg]", "NEES mean", "alignment"));
+  EXPECT_LT(page.find("<h2>Estimate good</h2>"), page.find("<h2>Estimate bad.tum</h2>"));
+  EXPECT_THAT(page, HasSubstr("<td>bad.tum</td><td>"));
+  if (GnuplotAvailable()) {
+    EXPECT_EQ(html.image_sources.size(), 2u + 2u + 2u);
+  }
+  for (const std::string& src : html.image_sources)
+    EXPECT_TRUE(testing::DecodeBase64(src.substr(src.find(',') + 1)).has_value());
 }
 
 TEST_F(EvaluateFilesTest, BadInputsNameTheFile) {

@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include "tests/recording/temp_dir.h"
+#include "tests/support/html_check.h"
 
 namespace roamlab::eval {
 namespace {
@@ -194,6 +195,43 @@ TEST_F(EvaluateTest, WritesMetricsJsonAndFigures) {
     EXPECT_TRUE(w.value().note.empty());
     EXPECT_EQ(w.value().images.size(), 3u);
     for (const std::string& image : w.value().images) EXPECT_GT(fs::file_size(image), 1000u) << image;
+  }
+}
+
+// report.html: well-formed, the headline first, the tables with their headers (the parameter table with the
+// estimator's observability), and every drawn figure embedded as a PNG data: URI.
+TEST_F(EvaluateTest, WritesAWellFormedReportWithTablesAndEmbeddedFigures) {
+  WriteGpsCase();
+  json calibration = json::parse(ReadFile(est("calibration.json")));
+  calibration["parameters"]["gps.lever_arm"]["observability"] = "weak";
+  WriteFile(est("calibration.json"), calibration.dump());
+  const Result<Evaluation> r = Evaluate(Options());
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_EQ(r.value().metrics["parameters"]["gps.lever_arm"]["observability"], "weak");
+  const Result<WrittenEvaluation> w = WriteEvaluation(r.value(), out_dir());
+  ASSERT_TRUE(w.ok()) << w.status().message();
+  ASSERT_EQ(w.value().report_path, out_dir() + "/report.html");
+  const std::string document = ReadFile(w.value().report_path);
+  const testing::HtmlSummary html = testing::CheckHtml(document);
+  ASSERT_EQ(html.error, "");
+  EXPECT_LT(document.find("class=\"headline\">ATE 0.5 m"), document.find("<table>"));
+  std::vector<std::string> first_headers;
+  for (const auto& headers : html.table_headers) first_headers.push_back(headers.empty() ? "" : headers.front());
+  EXPECT_THAT(first_headers,
+              ::testing::ElementsAre("item", "parameter", "error", "position error [m]", "pairs", "mean"));
+  EXPECT_THAT(html.table_headers[1], ::testing::ElementsAre("parameter", "manifold", "truth", "estimate", "std",
+                                                            "error", "error / std", "observability"));
+  EXPECT_THAT(document, HasSubstr("<td>weak</td>"));
+  EXPECT_THAT(document, HasSubstr("1 of 2 parameters within 3 std of the truth"));
+  ASSERT_EQ(html.image_sources.size(), w.value().images.size());
+  if (GnuplotAvailable()) {
+    EXPECT_EQ(html.image_sources.size(), 3u);
+  }
+  for (const std::string& src : html.image_sources) {
+    ASSERT_THAT(src, StartsWith("data:image/png;base64,"));
+    const std::optional<std::string> png = testing::DecodeBase64(src.substr(22));
+    ASSERT_TRUE(png.has_value());
+    EXPECT_EQ(png->substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
   }
 }
 

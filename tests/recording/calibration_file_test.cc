@@ -30,9 +30,11 @@ TEST(CalibrationFileTest, ReadsParametersAndInformationWithNulls) {
   ASSERT_EQ(lever.std.size(), 3u);
   EXPECT_TRUE(std::isnan(lever.std[2]));
   EXPECT_EQ(lever.manifold, "R3");
+  EXPECT_EQ(lever.observability, "weak");
   const CalibratedParameter& k = file.value().parameters.at("k");
   EXPECT_TRUE(k.std.empty());
   EXPECT_TRUE(k.manifold.empty());
+  EXPECT_TRUE(k.observability.empty());
   ASSERT_TRUE(file.value().information.has_value());
   EXPECT_EQ(file.value().information->parameters, (std::vector<std::string>{"gps.lever_arm", "k"}));
   EXPECT_EQ(file.value().information->matrix(3, 3), 2.0);
@@ -66,6 +68,8 @@ TEST(CalibrationFileTest, BadFilesNameTheFileAndTheProblem) {
               HasSubstr("parameter 'a': 'std' must be an array of numbers or nulls"));
   EXPECT_THAT(message(R"({"parameters": {"a": {"estimate": [1], "manifold": 3}}})"),
               HasSubstr("parameter 'a': 'manifold' must be a string"));
+  EXPECT_THAT(message(R"({"parameters": {"a": {"estimate": [1], "observability": 1}}})"),
+              HasSubstr("parameter 'a': 'observability' must be a string"));
   EXPECT_THAT(message(R"({"parameters": {}, "information": {"parameters": [1], "matrix": [[1]]}})"),
               HasSubstr("information.parameters must be names"));
   EXPECT_THAT(message(R"({"parameters": {}, "information": {"parameters": ["a"], "matrix": [[1, 2]]}})"),

@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/support/html_check.h"
+
 namespace roamlab::regress {
 namespace {
 
@@ -256,6 +258,20 @@ TEST(ResultsTest, CountsAndTableShowEveryCheck) {
   EXPECT_TRUE(ok.Passed());
   ok.cases[0].error = "late failure";
   EXPECT_FALSE(ok.Passed());
+}
+
+// report.html: well-formed, the verdict first, one row per check with the markup of names escaped.
+TEST(ResultsTest, HtmlReportHasTheVerdictFirstAndEveryCheck) {
+  const std::string page = ResultsHtml(Example());
+  const testing::HtmlSummary html = testing::CheckHtml(page);
+  ASSERT_EQ(html.error, "") << page;
+  EXPECT_LT(page.find("class=\"verdict-fail\">FAILED: 3 checks: 1 passed, 1 failed, 1 errors"), page.find("<table>"));
+  ASSERT_EQ(html.table_headers.size(), 1u);
+  EXPECT_EQ(html.table_headers[0].front(), "case");
+  EXPECT_EQ(html.table_headers[0].back(), "message");
+  EXPECT_EQ(Occurrences(page, "<tr><td>"), 3u);
+  EXPECT_NE(page.find("<td>atv&amp;calibration</td>"), std::string::npos);
+  EXPECT_NE(page.find("case broken: error: roamlab track: rec/&lt;gps&gt;.csv"), std::string::npos);
 }
 
 }  // namespace
