@@ -8,6 +8,8 @@
 #include <set>
 #include <sstream>
 
+#include "common/yaml_keys.h"
+
 namespace roamlab::sim::internal {
 namespace {
 
@@ -47,6 +49,7 @@ YamlReader::YamlReader(std::string path) : path_(std::move(path)) {
   content << file.rdbuf();
   try {
     root_ = YAML::Load(content.str());
+    if (const std::string problem = DuplicateKeyProblem(root_); !problem.empty()) error_ = path_ + ":" + problem;
   } catch (const YAML::Exception& e) {
     error_ = e.mark.is_null() ? path_ + ": " + e.msg
                               : path_ + ":" + std::to_string(e.mark.line + 1) + ":" +
