@@ -28,6 +28,7 @@ struct Inputs {
   estimator::EstimatorConfig config;
   recording::Recording recording;
 };
+
 // "[a, b] s" of a stream's first and last stamps.
 std::string Span(const recording::Stream& stream) {
   return "[" + FormatSeconds(stream.t.front()) + ", " + FormatSeconds(stream.t.back()) + "] s";

@@ -47,6 +47,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <set>
@@ -86,15 +87,17 @@ constexpr double kMaxLeverArmM = 1e3;
 constexpr double kMaxGeometry = 1e6;
 constexpr double kMaxNoiseOrAttribute = 1e9;
 
-// "<path>:<line>: <what>.<key>: <value> is beyond the physical range (|value| <= <limit>)" for the first value of
+// "<path>:<line>: <what>: <key> <value> is beyond the physical range (|value| <= <limit>)" for the first value of
 // `values` beyond `limit`; ok otherwise.
 Status CheckMagnitudes(const std::map<std::string, double>& values, double limit, const std::string& path,
                        const YAML::Node& node, const std::string& what) {
   for (const auto& [key, value] : values) {
     if (std::abs(value) > limit) {
-      return ErrorAt(path, node,
-                     what + "." + key + ": " + FormatShortest(value) +
-                         " is beyond the physical range (|value| <= " + FormatShortest(limit) + ")");
+      char bound[16];
+      std::snprintf(bound, sizeof(bound), "%g", limit);
+      return ErrorAt(
+          path, node,
+          what + ": " + key + " " + FormatShortest(value) + " is beyond the physical range (|value| <= " + bound + ")");
     }
   }
   return Status::Ok();

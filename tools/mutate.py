@@ -51,9 +51,19 @@ def optiodom_run():
 NUMBER = re.compile(r"(?<![\w.])-?\d+(\.\d+)?([eE][-+]?\d+)?(?![\w.])")
 
 
+def numbers_outside_comments(text):
+    """The numbers of `text` that are not inside a '#' comment (a YAML comment; CSV text has none)."""
+    out = []
+    for m in NUMBER.finditer(text):
+        line_start = text.rfind("\n", 0, m.start()) + 1
+        if "#" not in text[line_start:m.start()]:
+            out.append(m)
+    return out
+
+
 def replace_number(value):
     def op(text, rng):
-        matches = list(NUMBER.finditer(text))
+        matches = numbers_outside_comments(text)
         if not matches:
             return None
         m = rng.choice(matches)
@@ -62,7 +72,7 @@ def replace_number(value):
 
 
 def scale_number(text, rng):
-    matches = list(NUMBER.finditer(text))
+    matches = numbers_outside_comments(text)
     if not matches:
         return None
     m = rng.choice(matches)
@@ -347,6 +357,9 @@ class Seeds:
         self.estimator = os.path.join(REPO, "configs", "atv_calibration.yaml")
         with open(os.path.join(REPO, "scenarios", "indoor_diffdrive_slip.yaml")) as f:
             scenario = re.sub(r"^duration_s: .*$", "duration_s: 1.0", f.read(), flags=re.M)
+        # Model paths absolute (the mutant lives elsewhere); IMU and encoders only (no rendering, no laser).
+        scenario = scenario.replace("../models/", os.path.join(REPO, "models") + "/")
+        scenario = scenario[:scenario.index("  laser:")] + scenario[scenario.index("effects:"):]
         self.scenario = self.write("scenario.yaml", scenario)
         self.optiodom_run = self.write("set_run-01.csv", optiodom_run())
         self.optiodom_metadata = self.write("set_metadata.csv", OPTIODOM_METADATA)

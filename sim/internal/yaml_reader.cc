@@ -125,6 +125,10 @@ void YamlReader::NodeNumber(const YAML::Node& node, const std::string& key, doub
     Fail(node, key, "expected a finite number, got " + Describe(node));
     return;
   }
+  if (std::abs(value) > kMaxScenarioNumber) {
+    Fail(node, key, node.Scalar() + " is beyond any physical value (|value| <= 1e9)");
+    return;
+  }
   *out = value;
 }
 

@@ -428,10 +428,11 @@ TEST(RecordingYamlTest, ValuesOutsideThePhysicalRange) {
   TempDir dir;
   WriteFixture(
       dir, Replace(kYaml, "    rate_hz: 100\n", "    rate_hz: 100\n    mounting: {p_body_sensor_m: [9.2e18, 0, 0]}\n"));
-  EXPECT_THAT(ReadError(dir), AllOf(HasSubstr("recording.yaml:13:"), HasSubstr("p_body_sensor_m of stream 'imu'"),
+  EXPECT_THAT(ReadError(dir), AllOf(HasSubstr("recording.yaml:12:"), HasSubstr("p_body_sensor_m of stream 'imu'"),
                                     HasSubstr("physical range")));
   WriteFixture(dir, Replace(kYaml, "    rate_hz: 100\n", "    rate_hz: 100\n    noise: {sigma_radps: 1e300}\n"));
-  EXPECT_THAT(ReadError(dir), AllOf(HasSubstr("recording.yaml:13:"), HasSubstr("sigma_radps"), HasSubstr("range")));
+  EXPECT_THAT(ReadError(dir),
+              AllOf(HasSubstr("recording.yaml:12:"), HasSubstr("sigma_radps 1e+300"), HasSubstr("(|value| <= 1e+09)")));
   WriteFixture(dir, Replace(kYaml, "rate_hz: 100", "rate_hz: 1e300"));
   EXPECT_THAT(ReadError(dir), AllOf(HasSubstr("recording.yaml:"), HasSubstr("at most 1e6")));
   WriteFixture(dir, Replace(kYaml, "rate_hz: 5\n", "rate_hz: 5\n    rate_hz: 6\n"));
