@@ -38,6 +38,9 @@ class MessageReader {
 
   const std::string& problem() const { return problem_; }
   bool ok() const { return problem_.empty(); }
+  // Bytes after the last field read; a CDR message may end in up to 3 bytes of padding.
+  std::size_t unread() const { return cursor_.remaining(); }
+  std::size_t allowed_padding() const { return cdr_ ? 3 : 0; }
 
   template <typename T>
   T Get() {
@@ -255,6 +258,11 @@ Result<RosMessage> DecodeRosMessage(const std::string& type, std::string_view da
   message.header = in.Header();
   message.body = entry->decode(&in);
   if (!in.ok()) return Status::Error(in.problem());
+  // Bytes left after the last field: a length or count changed inside the message shifted every field after it.
+  if (in.unread() > in.allowed_padding()) {
+    return Status::Error(std::to_string(in.unread()) +
+                         " bytes follow the message's last field (a length inside the message does not match it)");
+  }
   return message;
 }
 

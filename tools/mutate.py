@@ -6,7 +6,8 @@ scenario and estimator YAML, an OptiOdom run with its metadata and a CSV log wit
 Each mutant is one operator applied to one seed file; the command runs with a timeout and its outcome is classified:
 
   clean      exit 2, one line on stderr (warnings aside) that names the mutated file
-  unclean    refused, but with exit 1, several lines, or a line that does not name the file
+  unclean    refused, but with exit 1 for clearly bad data, several lines, or a line that does not name the file
+  failure    exit 1 with one line after a neutral mutation: a run-time failure (the solver diverged), not bad input
   accepted   exit 0 after a neutral mutation (a change the data may legitimately carry)
   silent     exit 0 after a mutation that makes the data clearly bad (duplicate key, truncated row, NaN, absurd
              magnitude, undeclared name, ...): a silent acceptance
@@ -315,6 +316,9 @@ STREAM_OPS = [
     ("value scaled", scale_number, False),
     ("byte garbage", insert_garbage, False),
 ]
+# The CSV importer skips a repeated time and counts it (docs/import-csv.md); a shift moves every stream of the file.
+CSV_LOG_OPS = [op for op in STREAM_OPS if op[0] not in ("row duplicated", "times shifted +1e6 s")] + [
+    ("row duplicated (counted skip)", csv_duplicate_row(), False)]
 OPTIODOM_RUN_OPS = [
     ("time -> 9.3e9", csv_time("9300000000", False), True),
     ("time -> 1e300", csv_time("1e300", False), True),
@@ -328,11 +332,25 @@ OPTIODOM_RUN_OPS = [
     ("truncated", truncate_anywhere, False),
     ("garbage inserted", insert_garbage, False),
 ]
+def metadata_value(value, keys):
+    """The value of one of `keys` (the keys the importer reads; N, L, ... are accepted and not used)."""
+    def op(text, rng):
+        lines = text.split("\n")
+        rows = [i for i, l in enumerate(lines) if l.split(",")[0] in keys]
+        i = rng.choice(rows)
+        cells = lines[i].split(",")
+        cells[1] = value
+        lines[i] = ",".join(cells)
+        return "\n".join(lines)
+    return op
+
+
+USED_KEYS = ("ngear", "encRes", "Li", "Di", "Thi")
 OPTIODOM_METADATA_OPS = [
     ("key line duplicated", csv_duplicate_row(False), True),
-    ("value -> 9.2e18", csv_value("9.2e18", False), True),
-    ("value -> nan", csv_value("nan", False), True),
-    ("value -> -1", csv_value("-1", False), True),
+    ("value -> 9.2e18", metadata_value("9.2e18", USED_KEYS), True),
+    ("value -> nan", metadata_value("nan", USED_KEYS), True),
+    ("value -> -1", metadata_value("-1", USED_KEYS[:4]), True),
     ("key typo", lambda t, r: re.sub(r"^encRes", "encres", t, flags=re.M), True),
     ("line deleted", delete_line, False),
     ("value scaled", scale_number, False),
@@ -392,6 +410,8 @@ def classify(code, err, names, bad):
     lines = [l for l in lines if not re.match(r"^(calibrate|simulate|track): ", l)]  # progress lines
     if code == 2 and len(lines) == 1 and any(n in lines[0] for n in names):
         return "clean"
+    if code == 1 and len(lines) == 1 and not bad:
+        return "failure"
     return "unclean"
 
 
@@ -491,10 +511,10 @@ class Campaign:
                     [os.path.basename(path)])
 
         self.text_kind("CSV import mapping", YAML_OPS, s.csv_map, csv_import)
-        self.text_kind("CSV import log", STREAM_OPS[:10], s.csv_log, csv_import)
+        self.text_kind("CSV import log", CSV_LOG_OPS, s.csv_log, csv_import)
 
     def table(self):
-        columns = ["clean", "unclean", "accepted", "silent", "crash", "hang"]
+        columns = ["clean", "unclean", "failure", "accepted", "silent", "crash", "hang"]
         lines = ["| input kind | mutants | " + " | ".join(columns) + " |",
                  "|---|---|" + "---|" * len(columns)]
         totals = {c: 0 for c in columns}

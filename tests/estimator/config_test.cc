@@ -82,8 +82,7 @@ TEST(ConfigTest, RefusesUndeclaredParameterNames) {
 
 TEST(ConfigTest, RefusesDuplicateKeys) {
   const std::string good = testing::AtvConfigYaml({});
-  ExpectError(Replace(good, "master: odometer", "master: odometer
-master: gps"), "est.yaml:2: duplicate key 'master'");
+  ExpectError(Replace(good, "master: odometer", "master: odometer\nmaster: gps"), "est.yaml:2: duplicate key 'master'");
   ExpectError(Replace(good, "noise: {sigma_m: 0.33}", "noise: {sigma_m: 0.33, sigma_m: 3.3}"),
               "duplicate key 'sigma_m'");
 }
