@@ -63,7 +63,15 @@ class MessageReader {
       return "";
     }
     std::string_view s = cursor_.Bytes(n);
-    if (cdr_ && !s.empty() && s.back() == '\0') s.remove_suffix(1);
+    if (cdr_ && !s.empty()) {
+      // A CDR string counts its one terminating NUL: a length that does not end on it (or takes in padding after it)
+      // was changed.
+      if (s.back() != '\0' || s.substr(0, s.size() - 1).find('\0') != std::string_view::npos) {
+        Fail("a string of " + std::to_string(n) + " bytes does not end with its one NUL terminator");
+        return "";
+      }
+      s.remove_suffix(1);
+    }
     return std::string(s);
   }
   // A sequence's count, refused when `count` elements of at least `min_bytes` each cannot fit in the rest.
