@@ -42,6 +42,7 @@ void PrintCalibration(const estimator::CalibrationResult& r, const std::string& 
 int RunCalibrate(const CalibrateArgs& args) {
   experiment::CalibrateRequest request = args;
   if (!args.quiet) request.progress = [](const std::string& line) { std::cerr << "calibrate: " << line << "\n"; };
+  request.warning = [](const std::string& line) { std::cerr << "roamlab calibrate: warning: " << line << "\n"; };
   estimator::CalibrationResult result;
   const experiment::Outcome outcome = experiment::CalibrateToDirectory(request, &result);
   if (!outcome.ok()) return Exit(args.err, "calibrate", outcome);
@@ -53,6 +54,7 @@ int RunTrack(const TrackArgs& args) {
   experiment::TrackRequest request = args;
   if (!args.quiet)
     request.progress = [](double f) { std::cerr << "\rtrack: " << static_cast<int>(100 * f) << "%" << std::flush; };
+  request.warning = [](const std::string& line) { std::cerr << "roamlab track: warning: " << line << "\n"; };
   estimator::TrackingResult r;
   const experiment::Outcome outcome = experiment::TrackToDirectory(request, &r);
   // The progress line ends once tracking ran (bad input stops before it).

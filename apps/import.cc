@@ -19,6 +19,7 @@ constexpr const char* kCommand = "import";
 // 1: the recording could not be written).
 int Written(const Result<recording::Recording>& rec, const std::string& out) {
   if (!rec.ok()) return BadInput(nullptr, kCommand, rec.status().message());
+  if (Status s = experiment::MakeOutputDirectory(out); !s.ok()) return BadInput(nullptr, kCommand, s.message());
   if (Status s = recording::WriteRecording(rec.value(), out); !s.ok()) return Failure(nullptr, kCommand, s.message());
   return 0;
 }

@@ -3,10 +3,14 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <map>
 #include <set>
 #include <sstream>
 
 #include <yaml-cpp/yaml.h>
+
+#include "common/yaml_keys.h"
 
 namespace roamlab::estimator {
 namespace {
@@ -192,6 +196,11 @@ class ConfigError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Every number of the configuration is at most this in magnitude; standard deviations lie in [kMinSigma, kMaxSigma].
+constexpr double kMaxMagnitude = 1e9;
+constexpr double kMinSigma = 1e-9;
+constexpr double kMaxSigma = 1e6;
+
 class Parser {
  public:
   explicit Parser(std::string file) : file_(std::move(file)) {}
@@ -212,12 +221,19 @@ class Parser {
     }
   }
 
-  double Number(const YAML::Node& node, const std::string& what) const {
+  // A finite number of magnitude at most kMaxMagnitude; with `allow_inf`, +Inf too (prior_sigma's "no prior").
+  double Number(const YAML::Node& node, const std::string& what, bool allow_inf = false) const {
+    double value = 0.0;
     try {
-      return node.as<double>();
+      value = node.as<double>();
     } catch (const YAML::Exception&) {
       Fail(node, what + " must be a number");
     }
+    if (allow_inf && value == std::numeric_limits<double>::infinity()) return value;
+    if (!std::isfinite(value)) Fail(node, what + " must be a finite number, not '" + node.Scalar() + "'");
+    if (std::abs(value) > kMaxMagnitude)
+      Fail(node, what + ": " + node.Scalar() + " is beyond the physical range (|value| <= 1e9)");
+    return value;
   }
 
   std::string String(const YAML::Node& node, const std::string& what) const {
@@ -225,12 +241,20 @@ class Parser {
     return node.as<std::string>();
   }
 
-  std::vector<double> Numbers(const YAML::Node& node, const std::string& what) const {
+  std::vector<double> Numbers(const YAML::Node& node, const std::string& what, bool allow_inf = false) const {
     std::vector<double> out;
-    if (node.IsScalar()) return {Number(node, what)};
+    if (node.IsScalar()) return {Number(node, what, allow_inf)};
     if (!node.IsSequence()) Fail(node, what + " must be a number or a list of numbers");
-    for (const auto& item : node) out.push_back(Number(item, what));
+    for (const auto& item : node) out.push_back(Number(item, what, allow_inf));
     return out;
+  }
+
+  // A standard deviation in [kMinSigma, kMaxSigma] (its square, the variance, stays a normal double).
+  double Sigma(const YAML::Node& node, const std::string& what) const {
+    const double sigma = Number(node, what);
+    if (!(sigma >= kMinSigma && sigma <= kMaxSigma))
+      Fail(node, what + ": " + node.Scalar() + " is outside the accepted range [1e-9, 1e6] of a standard deviation");
+    return sigma;
   }
 
   // A process setting of a 3-vector parameter: one number for every component, or a list of three.
@@ -307,9 +331,10 @@ class Parser {
     }
     if (n["free"]) p.free = Bool(n["free"], "parameters." + name + ".free");
     if (n["prior_sigma"]) {
-      const std::vector<double> v = Numbers(n["prior_sigma"], "parameters." + name + ".prior_sigma");
+      const std::vector<double> v = Numbers(n["prior_sigma"], "parameters." + name + ".prior_sigma", true);
       for (double sigma : v)
-        if (!(sigma > 0.0)) Fail(n["prior_sigma"], "parameter '" + name + "': prior_sigma must be positive (or .inf)");
+        if (!(sigma >= kMinSigma))
+          Fail(n["prior_sigma"], "parameter '" + name + "': prior_sigma must be at least 1e-9 (or .inf)");
       p.prior_sigma = Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<int>(v.size()));
     }
     if (n["process"]) {
@@ -329,7 +354,8 @@ class Parser {
       if (p.process.type != ProcessConfig::Type::kConstant) {
         if (!pr["sigma"]) Fail(pr, "parameter '" + name + "': process needs sigma");
         p.process.sigma = PerComponent(pr["sigma"], "parameters." + name + ".process.sigma");
-        if (!(p.process.sigma.array() > 0).all()) Fail(pr, "parameter '" + name + "': process sigma must be positive");
+        if (!(p.process.sigma.array() >= kMinSigma).all() || !(p.process.sigma.array() <= kMaxSigma).all())
+          Fail(pr, "parameter '" + name + "': process sigma must be in [1e-9, 1e6]");
       }
       if (pr["interval_s"]) {
         if (p.process.type == ProcessConfig::Type::kConstant)
@@ -371,9 +397,7 @@ class Parser {
     CheckKeys(n["noise"], {spec->noise_keys.begin(), spec->noise_keys.end()}, where + " noise");
     for (const std::string& key : spec->noise_keys) {
       if (!n["noise"][key]) Fail(n["noise"], where + ": noise needs '" + key + "'");
-      const double sigma = Number(n["noise"][key], where + ".noise." + key);
-      if (!(sigma > 0.0)) Fail(n["noise"][key], where + ": noise '" + key + "' must be positive");
-      s.noise[key] = sigma;
+      s.noise[key] = Sigma(n["noise"][key], where + ".noise." + key);
     }
 
     if (n["parameters"]) {
@@ -409,6 +433,25 @@ class Parser {
     return s;
   }
 
+  // A name a stream's `parameters:` maps a slot to must be declared under `parameters:`, be shared by several slots,
+  // or be a default name "<stream>.<slot>" of a configured stream: a name used once and declared nowhere is a typo
+  // that would silently give the slot a parameter of its own at the model default.
+  void CheckParameterNames(const YAML::Node& root, const EstimatorConfig& c) const {
+    std::map<std::string, int> uses;
+    std::set<std::string> defaults;
+    for (const auto& [stream, sc] : c.streams) {
+      for (const auto& [slot, pname] : sc.parameters) ++uses[pname];
+      for (const SlotSpec& slot : FindModelSpec(sc.model)->slots) defaults.insert(stream + "." + slot.name);
+    }
+    for (const auto& [stream, sc] : c.streams)
+      for (const auto& [slot, pname] : sc.parameters) {
+        if (c.parameters.count(pname) > 0 || uses[pname] > 1 || defaults.count(pname) > 0) continue;
+        Fail(root["streams"][stream]["parameters"][slot],
+             "stream '" + stream + "': slot '" + slot + "' names parameter '" + pname +
+                 "', which no parameters: entry declares and no other slot shares (a typo?)");
+      }
+  }
+
   // The IMU master's checks and its poses key (PosesConfig).
   void ParseImuMaster(const YAML::Node& root, EstimatorConfig* c) const {
     const bool imu_master = c->streams.at(c->master).model == "gyroscope";
@@ -431,8 +474,8 @@ class Parser {
     }
     if (n["position_sigma_m"]) {
       c->poses.position_sigma_m = Number(n["position_sigma_m"], "poses.position_sigma_m");
-      if (!(c->poses.position_sigma_m > 0.0) || !std::isfinite(c->poses.position_sigma_m))
-        Fail(n["position_sigma_m"], "poses.position_sigma_m must be a positive number of metres");
+      if (!(c->poses.position_sigma_m >= kMinSigma && c->poses.position_sigma_m <= kMaxSigma))
+        Fail(n["position_sigma_m"], "poses.position_sigma_m must be a number of metres in [1e-9, 1e6]");
     }
   }
 
@@ -472,6 +515,7 @@ class Parser {
         c.parameters[name] = ParseParameter(name, kv.second);
       }
     }
+    CheckParameterNames(root, c);
     if (root["stages"]) {
       for (const auto& stage : root["stages"]) {
         std::vector<std::string> names;
@@ -491,6 +535,8 @@ class Parser {
 Result<EstimatorConfig> ParseEstimatorConfig(const std::string& yaml_text, const std::string& source_name) {
   try {
     const YAML::Node root = YAML::Load(yaml_text);
+    if (const std::string problem = DuplicateKeyProblem(root); !problem.empty())
+      return Status::Error(source_name + ":" + problem);
     Parser parser(source_name);
     if (!root.IsMap()) return Status::Error(source_name + ": the configuration must be a YAML mapping");
     return parser.Parse(root);

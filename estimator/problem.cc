@@ -651,6 +651,8 @@ std::optional<Eigen::Quaterniond> ProblemBuilder::AlignImuToMotion() {
     if (s.config.model == "accelerometer" && accel == nullptr) accel = &s;
   }
   if (gyro == nullptr || accel == nullptr || gyro->slot_parameters[0] != accel->slot_parameters[0]) return std::nullopt;
+  // An empty stream (read with a warning) has no sample to align with.
+  if (gyro->primary->t.empty() || accel->primary->t.empty()) return std::nullopt;
   const std::string& name = gyro->slot_parameters[0];
   const auto config = im.parameter_config.find(name);
   if (config == im.parameter_config.end() || !config->second.free || IsTimeVarying(name)) return std::nullopt;

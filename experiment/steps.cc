@@ -1,14 +1,18 @@
 #include "experiment/steps.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <set>
 #include <utility>
+#include <vector>
 
 #include <Eigen/Core>
 
 #include "estimator/calibration_io.h"
 #include "estimator/config.h"
+#include "estimator/problem.h"
 #include "estimator/tracking_io.h"
 #include "importers/optiodom.h"
 #include "recording/recording.h"
@@ -24,7 +28,48 @@ struct Inputs {
   estimator::EstimatorConfig config;
   recording::Recording recording;
 };
-Result<Inputs> LoadInputs(const std::string& config_path, const std::string& recording_dir) {
+
+// "[a, b] s" of a stream's first and last stamps.
+std::string Span(const recording::Stream& stream) {
+  return "[" + FormatSeconds(stream.t.front()) + ", " + FormatSeconds(stream.t.back()) + "] s";
+}
+
+// Each configured source stream against the master's time span: an empty stream and one with samples outside the span
+// are warnings naming it (with the count), a stream with no sample inside the span is an error (it would leave its
+// parameters to the priors alone while the run claims to have used it).
+Status CheckCoverage(const estimator::EstimatorConfig& config, const recording::Recording& rec,
+                     const std::string& recording_dir, std::vector<std::string>* warnings) {
+  const std::string& master_source = config.streams.at(config.master).sources.begin()->second;
+  const recording::Stream* master = rec.Find(master_source);
+  const std::string csv = recording_dir + "/" + master_source + ".csv";
+  if (master == nullptr || master->t.size() < 2)
+    return Status::Error(csv + ": the master stream '" + master_source + "' has fewer than two samples");
+  std::set<std::string> sources;
+  for (const auto& [name, stream] : config.streams)
+    for (const auto& [role, source] : stream.sources) sources.insert(source);
+  for (const std::string& source : sources) {
+    const recording::Stream& stream = *rec.Find(source);
+    const std::string path = recording_dir + "/" + source + ".csv";
+    if (stream.t.empty()) {
+      warnings->push_back(path + ": stream '" + source + "' is empty; it contributes nothing");
+      continue;
+    }
+    const auto inside = std::count_if(stream.t.begin(), stream.t.end(),
+                                      [&](Time t) { return t >= master->t.front() && t <= master->t.back(); });
+    const std::string which =
+        "of stream '" + source + "' " + Span(stream) + " within the master '" + master_source + "' " + Span(*master);
+    if (inside == 0) return Status::Error(path + ": no sample " + which + ": the streams do not overlap in time");
+    const std::size_t outside = stream.t.size() - static_cast<std::size_t>(inside);
+    if (outside > 0) {
+      warnings->push_back(path + ": " + std::to_string(outside) + " of " + std::to_string(stream.t.size()) +
+                          " samples lie outside the master's span (" + which + "); they are not used");
+    }
+  }
+  return Status::Ok();
+}
+
+Result<Inputs> LoadInputs(const std::string& config_path, const std::string& recording_dir,
+                          std::vector<std::string>* warnings) {
   auto config = estimator::LoadEstimatorConfig(config_path);
   if (!config.ok()) return config.status();
   recording::ReadOptions read;
@@ -33,6 +78,11 @@ Result<Inputs> LoadInputs(const std::string& config_path, const std::string& rec
     for (const auto& [role, source] : stream.sources) read.required_streams.push_back(source);
   auto rec = recording::ReadRecording(recording_dir, read);
   if (!rec.ok()) return rec.status();
+  // The configuration against the recording (stream types, parameter sizes and names, stages): bad input, found
+  // before any work.
+  auto builder = estimator::ProblemBuilder::Create(config.value(), rec.value());
+  if (!builder.ok()) return builder.status();
+  if (Status s = CheckCoverage(config.value(), rec.value(), recording_dir, warnings); !s.ok()) return s;
   return Inputs{std::move(config).value(), std::move(rec).value()};
 }
 
@@ -48,6 +98,7 @@ Status MakeOutputDirectory(const std::string& dir) {
 Outcome SimulateToDirectory(const SimulateRequest& request, sim::Simulation* simulation) {
   auto scenario = sim::LoadScenario(request.scenario);
   if (!scenario.ok()) return Outcome::BadInput(scenario.status());
+  if (Status dir = MakeOutputDirectory(request.out); !dir.ok()) return Outcome::BadInput(dir);
   sim::SimulateOptions options;
   options.seed = request.seed;
   options.image_directory = request.out;
@@ -66,10 +117,13 @@ Outcome SimulateToDirectory(const SimulateRequest& request, sim::Simulation* sim
 }
 
 Outcome CalibrateToDirectory(const CalibrateRequest& request, estimator::CalibrationResult* result) {
-  auto inputs = LoadInputs(request.config, request.recording);
+  std::vector<std::string> warnings;
+  auto inputs = LoadInputs(request.config, request.recording, &warnings);
   if (!inputs.ok()) return Outcome::BadInput(inputs.status());
   const Status dir = MakeOutputDirectory(request.out);
   if (!dir.ok()) return Outcome::BadInput(dir);
+  if (request.warning)
+    for (const std::string& w : warnings) request.warning(w);
 
   estimator::CalibrationOptions options;
   options.progress = request.progress;
@@ -84,8 +138,11 @@ Outcome CalibrateToDirectory(const CalibrateRequest& request, estimator::Calibra
 }
 
 Outcome TrackToDirectory(const TrackRequest& request, estimator::TrackingResult* result) {
-  auto inputs = LoadInputs(request.config, request.recording);
+  std::vector<std::string> warnings;
+  auto inputs = LoadInputs(request.config, request.recording, &warnings);
   if (!inputs.ok()) return Outcome::BadInput(inputs.status());
+  if (request.warning)
+    for (const std::string& w : warnings) request.warning(w);
   estimator::EstimatorConfig& config = inputs.value().config;
   if (request.no_time_budget) config.tracking.time_budget_s = std::numeric_limits<double>::infinity();
   std::map<std::string, Eigen::VectorXd> calibration;
@@ -116,6 +173,7 @@ Outcome ImportOptiOdomToDirectory(const std::string& run_csv, const std::string&
         Status::Error(run_csv + ": cannot find the metadata file (expected <set>_run-NN.csv; use --metadata)"));
   Result<recording::Recording> rec = importers::ImportOptiOdom(run_csv, metadata_path);
   if (!rec.ok()) return Outcome::BadInput(rec.status());
+  if (Status dir = MakeOutputDirectory(out); !dir.ok()) return Outcome::BadInput(dir);
   if (Status s = recording::WriteRecording(rec.value(), out); !s.ok()) return Outcome::Failed(s);
   if (imported) *imported = std::move(rec).value();
   return Outcome::Ok();

@@ -50,6 +50,9 @@ struct CalibrateRequest {
   std::string config;
   std::string out;                                        // receives calibration.json and trajectory.tum
   std::function<void(const std::string& line)> progress;  // optional
+  // Optional: receives each warning about the inputs, one line naming the file (an empty stream, samples outside the
+  // master's span). A source stream with no sample within the master's span is bad input.
+  std::function<void(const std::string& line)> warning;
 };
 // Offline self-calibration of the recording (estimator/calibration.h). `result` (optional) receives it.
 Outcome CalibrateToDirectory(const CalibrateRequest& request, estimator::CalibrationResult* result = nullptr);
@@ -60,7 +63,8 @@ struct TrackRequest {
   std::string calibration;      // optional calibration.json: its values (and prior) for tracking
   std::string out;              // receives trajectory.tum, covariance.csv and summary.json (estimator/tracking_io.h)
   bool no_time_budget = false;  // ignore tracking.time_budget_s: results that do not depend on the machine's speed
-  std::function<void(double fraction)> progress;  // optional
+  std::function<void(double fraction)> progress;         // optional
+  std::function<void(const std::string& line)> warning;  // optional, as CalibrateRequest::warning
 };
 // Online fixed-lag tracking of the recording (estimator/tracking.h). `result` (optional) receives it.
 Outcome TrackToDirectory(const TrackRequest& request, estimator::TrackingResult* result = nullptr);

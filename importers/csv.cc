@@ -265,6 +265,8 @@ Status FileReader::ReadRow(std::int64_t line, bool truncated) {
     return Status::Error(At(line) + (truncated ? "truncated last line: " : "") + std::to_string(cells_.size()) +
                          " cells, expected " + std::to_string(names_.size()));
   }
+  // A writer ends every line: a last line without its end was cut short, and a number cut short reads as another.
+  if (truncated) return Status::Error(At(line) + "truncated last line: no line end (a number may be cut short)");
   std::int64_t t_ns = 0;
   bool skip = false;
   const std::string_view time_cell = cells_[static_cast<std::size_t>(time_column_)];

@@ -38,6 +38,9 @@ class MessageReader {
 
   const std::string& problem() const { return problem_; }
   bool ok() const { return problem_.empty(); }
+  // Bytes after the last field read; a CDR message may end in up to 3 bytes of padding.
+  std::size_t unread() const { return cursor_.remaining(); }
+  std::size_t allowed_padding() const { return cdr_ ? 3 : 0; }
 
   template <typename T>
   T Get() {
@@ -60,7 +63,15 @@ class MessageReader {
       return "";
     }
     std::string_view s = cursor_.Bytes(n);
-    if (cdr_ && !s.empty() && s.back() == '\0') s.remove_suffix(1);
+    if (cdr_ && !s.empty()) {
+      // A CDR string counts its one terminating NUL: a length that does not end on it (or takes in padding after it)
+      // was changed.
+      if (s.back() != '\0' || s.substr(0, s.size() - 1).find('\0') != std::string_view::npos) {
+        Fail("a string of " + std::to_string(n) + " bytes does not end with its one NUL terminator");
+        return "";
+      }
+      s.remove_suffix(1);
+    }
     return std::string(s);
   }
   // A sequence's count, refused when `count` elements of at least `min_bytes` each cannot fit in the rest.
@@ -255,6 +266,11 @@ Result<RosMessage> DecodeRosMessage(const std::string& type, std::string_view da
   message.header = in.Header();
   message.body = entry->decode(&in);
   if (!in.ok()) return Status::Error(in.problem());
+  // Bytes left after the last field: a length or count changed inside the message shifted every field after it.
+  if (in.unread() > in.allowed_padding()) {
+    return Status::Error(std::to_string(in.unread()) +
+                         " bytes follow the message's last field (a length inside the message does not match it)");
+  }
   return message;
 }
 

@@ -18,6 +18,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "common/yaml_keys.h"
 #include "importers/internal/bag.h"
 #include "importers/internal/mcap_reader.h"
 #include "importers/internal/rosbag2_topics.h"
@@ -46,6 +47,7 @@ std::string Scalar(const YAML::Node& map, const char* key) {
 std::string ReadMetadata(const std::string& path, Metadata* out) {
   try {
     const YAML::Node root = YAML::LoadFile(path);
+    if (const std::string problem = DuplicateKeyProblem(root); !problem.empty()) return path + ":" + problem;
     const YAML::Node info = root.IsMap() ? root["rosbag2_bagfile_information"] : YAML::Node();
     if (!info || !info.IsMap())
       return path + ": no 'rosbag2_bagfile_information' mapping (not a rosbag2 metadata.yaml)";

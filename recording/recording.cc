@@ -47,6 +47,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <set>
@@ -80,13 +81,36 @@ Status ErrorAt(const std::string& path, const YAML::Node& node, const std::strin
   return Status::Error(Where(path, node) + ": " + problem);
 }
 
+// The physical ranges of recording.yaml's numbers (documented in docs/recording-format.md).
+constexpr double kMaxRateHz = 1e6;
+constexpr double kMaxLeverArmM = 1e3;
+constexpr double kMaxGeometry = 1e6;
+constexpr double kMaxNoiseOrAttribute = 1e9;
+
+// "<path>:<line>: <what>: <key> <value> is beyond the physical range (|value| <= <limit>)" for the first value of
+// `values` beyond `limit`; ok otherwise.
+Status CheckMagnitudes(const std::map<std::string, double>& values, double limit, const std::string& path,
+                       const YAML::Node& node, const std::string& what) {
+  for (const auto& [key, value] : values) {
+    if (std::abs(value) > limit) {
+      char bound[16];
+      std::snprintf(bound, sizeof(bound), "%g", limit);
+      return ErrorAt(
+          path, node,
+          what + ": " + key + " " + FormatShortest(value) + " is beyond the physical range (|value| <= " + bound + ")");
+    }
+  }
+  return Status::Ok();
+}
+
 Status ParsePlatform(const YAML::Node& node, const std::string& path, Platform* platform) {
   if (Status s = CheckKeys(node, path, "platform", {"kind", "geometry"}); !s.ok()) return s;
   if (Status s = RequireKey(node, "kind", path, "platform"); !s.ok()) return s;
   if (Status s = ReadString(node["kind"], path, "platform.kind", &platform->kind); !s.ok()) return s;
   if (platform->kind.empty()) return ErrorAt(path, node["kind"], "platform.kind is empty");
   if (!node["geometry"]) return Status::Ok();
-  return ReadNumberMap(node["geometry"], path, "platform.geometry", &platform->geometry);
+  if (Status s = ReadNumberMap(node["geometry"], path, "platform.geometry", &platform->geometry); !s.ok()) return s;
+  return CheckMagnitudes(platform->geometry, kMaxGeometry, path, node["geometry"], "platform.geometry");
 }
 
 Status ParseOrigin(const YAML::Node& node, const std::string& path, GeodeticOrigin* origin) {
@@ -174,6 +198,10 @@ Status ParseMounting(const YAML::Node& node, const std::string& path, const std:
       return s;
     }
     mounting->p_body_sensor = Eigen::Vector3d(values[0], values[1], values[2]);
+    if (!(mounting->p_body_sensor.cwiseAbs().maxCoeff() <= kMaxLeverArmM)) {
+      return ErrorAt(path, node["p_body_sensor_m"],
+                     "p_body_sensor_m of " + context + " is beyond the physical range (|component| <= 1000 m)");
+    }
   }
   if (node["q_body_sensor_wxyz"]) {
     const YAML::Node q = node["q_body_sensor_wxyz"];
@@ -232,7 +260,9 @@ Status ParseStreamEntry(const YAML::Node& node, const std::string& path, std::si
   if (!type) return ErrorAt(path, node["type"], "unknown stream type '" + type_name + "' for " + context);
   info.type = *type;
   if (Status s = ReadNumber(node["rate_hz"], path, "rate_hz of " + context, &info.rate_hz); !s.ok()) return s;
-  if (!(info.rate_hz > 0.0)) return ErrorAt(path, node["rate_hz"], "rate_hz of " + context + " must be positive");
+  if (!(info.rate_hz > 0.0 && info.rate_hz <= kMaxRateHz)) {
+    return ErrorAt(path, node["rate_hz"], "rate_hz of " + context + " must be positive and at most 1e6");
+  }
   // Columns, mounting, noise, attributes.
   if (Status s = ParseColumns(node, path, context, &info); !s.ok()) return s;
   if (node["mounting"]) {
@@ -241,10 +271,14 @@ Status ParseStreamEntry(const YAML::Node& node, const std::string& path, std::si
   }
   if (node["noise"]) {
     if (Status s = ReadNumberMap(node["noise"], path, "noise of " + context, &info.noise); !s.ok()) return s;
+    const std::string what = "noise of " + context;
+    if (Status s = CheckMagnitudes(info.noise, kMaxNoiseOrAttribute, path, node["noise"], what); !s.ok()) return s;
   }
   if (node["attributes"]) {
     const YAML::Node attributes = node["attributes"];
     if (Status s = ReadNumberMap(attributes, path, "attributes of " + context, &info.attributes); !s.ok()) return s;
+    const std::string what = "attributes of " + context;
+    if (Status s = CheckMagnitudes(info.attributes, kMaxNoiseOrAttribute, path, attributes, what); !s.ok()) return s;
     const std::string problem = IntrinsicsProblem(info);
     if (!problem.empty()) return ErrorAt(path, attributes, context + ": " + problem);
   }

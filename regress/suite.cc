@@ -9,6 +9,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "common/yaml_keys.h"
 #include "estimator/calibration_io.h"
 #include "estimator/config.h"
 #include "regress/modes.h"
@@ -719,6 +720,8 @@ Result<Suite> LoadSuite(const std::string& path) {
   } catch (const YAML::Exception& e) {
     return Status::Error(path + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML: " + e.msg);
   }
+  if (const std::string problem = DuplicateKeyProblem(root); !problem.empty())
+    return Status::Error(path + ":" + problem);
   const Context ctx{path, ""};
   if (!root.IsMap()) return Status::Error(path + ": the suite must be a map with 'cases'");
   for (const auto& entry : root) {

@@ -48,7 +48,7 @@ bool ParseCellNumber(std::string_view cell, double* value) {
   if (cell.empty()) return false;
   const char* end = cell.data() + cell.size();
   const std::from_chars_result result = std::from_chars(cell.data(), end, *value);
-  return result.ec == std::errc() && result.ptr == end && std::isfinite(*value);
+  return result.ec == std::errc() && result.ptr == end && std::isfinite(*value) && std::abs(*value) <= 1e15;
 }
 
 bool ParseTimeNs(std::string_view cell, int exponent, std::int64_t* ns) {

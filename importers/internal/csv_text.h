@@ -14,7 +14,8 @@ namespace roamlab::importers::internal {
 // Each cell is trimmed of spaces, tabs and a carriage return, and of one pair of surrounding double quotes.
 void SplitCells(std::string_view line, const CsvFormat& format, std::vector<std::string_view>* cells);
 
-// A whole cell as a finite number (a leading '+' accepted); false for anything else, including NaN and Inf.
+// A whole cell as a finite number of magnitude at most 1e15, the recording format's limit (a leading '+' accepted);
+// false for anything else, including NaN, Inf and 1e308.
 bool ParseCellNumber(std::string_view cell, double* value);
 
 // A decimal time stamp in units of 10^-exponent s (exponent 0, 3, 6 or 9) into integer nanoseconds, exactly for

@@ -1,6 +1,7 @@
 #include "recording/internal/stream_csv.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "recording/internal/text_io.h"
 
@@ -81,6 +82,7 @@ Status ParseStreamCsv(std::string_view content, const std::string& path, const s
                       bool text_column, CsvColumns* out) {
   // Trailing blank lines (and the final newline) are allowed: cut them off before walking the lines.
   const std::size_t last = content.find_last_not_of(" \t\r\n");
+  const bool ends_with_line_end = last != std::string_view::npos && content.find('\n', last) != std::string_view::npos;
   content = last == std::string_view::npos ? std::string_view() : content.substr(0, last + 1);
   const std::string header = HeaderLine(columns);
   if (content.empty()) return Status::Error(path + ":1: empty file, expected header '" + header + "'");
@@ -127,8 +129,19 @@ Status ParseStreamCsv(std::string_view content, const std::string& path, const s
       double value = 0.0;
       const NumberParse result = ParseNumber(cells[c + 1], &value);
       if (result != NumberParse::kOk) return LineError(path, n, CellProblem(result, columns[c], cells[c + 1]));
+      if (std::abs(value) > kMaxCellMagnitude) {
+        return LineError(path, n,
+                         "column '" + columns[c] + "': " + FormatShortest(value) +
+                             " is beyond any physical value (|value| <= 1e15)");
+      }
       buffer.push_back(value);
     }
+  }
+
+  // A writer ends every row with a line end: a last row without one was cut short, and a number cut short still
+  // reads as a (wrong) number.
+  if (!out->t.empty() && !ends_with_line_end) {
+    return LineError(path, lines.line_number(), "the last row has no line end: the file looks truncated");
   }
 
   // Row-major buffer -> column-major matrix.

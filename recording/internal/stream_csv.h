@@ -3,8 +3,10 @@
 //   t,<column 1>,<column 2>,...         header, line 1
 //   12.000000001,0.5,-0.25,...          one row per sample: time in seconds, then one number per column
 //
-// Time is parsed exactly (roamlab::ParseSeconds) and must increase strictly; numbers must be finite. A text stream
-// (camera) has a single text column instead of numbers. Trailing blank lines are allowed, others are not.
+// Time is parsed exactly (roamlab::ParseSeconds) and must increase strictly; numbers must be finite and at most
+// kMaxCellMagnitude in magnitude. A text stream (camera) has a single text column instead of numbers. Trailing blank
+// lines are allowed, others are not. Every row ends with a line end ("\n" or "\r\n"): a last row without one is refused
+// as truncated (a number cut short, "0.12" of "0.125", would otherwise read as a valid value).
 #pragma once
 
 #include <string>
@@ -17,6 +19,10 @@
 #include "common/time.h"
 
 namespace roamlab::recording::internal {
+
+// Numeric cells are at most this in magnitude (any unit of the format: m, rad, s, ticks, m^2, ...); a larger value is
+// a corrupted file, not a measurement.
+inline constexpr double kMaxCellMagnitude = 1e15;
 
 // The content of one stream file in memory.
 struct CsvColumns {

@@ -4,7 +4,10 @@
 #include <cmath>
 #include <set>
 
+#include <Eigen/Eigenvalues>
+
 #include "recording/internal/laser_scan.h"
+#include "recording/internal/text_io.h"
 
 namespace roamlab::recording::internal {
 
@@ -92,14 +95,29 @@ std::string CovarianceProblem(const Stream& stream) {
   if (!CarriesCovariance(stream.info)) return "";
   const Eigen::Index fixed = static_cast<Eigen::Index>(FixedColumns(stream.info.type).size());
   const std::vector<std::string>& names = CovarianceColumns(stream.info.type);
+  const Eigen::Index n = stream.info.type == StreamType::kGps ? 3 : 6;
+  Eigen::MatrixXd covariance(n, n);
   for (Eigen::Index row = 0; row < stream.values.rows(); ++row) {
-    // The diagonal of an n x n upper triangle stored row by row: 6x6 entries 0, 6, 11, 15, 18, 20; 3x3: 0, 3, 5.
-    const Eigen::Index n = stream.info.type == StreamType::kGps ? 3 : 6;
+    // The upper triangle stored row by row: 6x6 diagonal entries 0, 6, 11, 15, 18, 20; 3x3: 0, 3, 5.
     Eigen::Index index = 0;
-    for (Eigen::Index k = 0; k < n; index += n - k, ++k) {
-      if (stream.values(row, fixed + index) < 0.0) {
-        return std::to_string(row + 2) + ": " + names[static_cast<std::size_t>(index)] + " is negative";
+    for (Eigen::Index i = 0; i < n; ++i) {
+      for (Eigen::Index j = i; j < n; ++j, ++index) {
+        const double value = stream.values(row, fixed + index);
+        const std::string& name = names[static_cast<std::size_t>(index)];
+        if (i == j && value < 0.0) return std::to_string(row + 2) + ": " + name + " is negative";
+        if (std::abs(value) > kMaxCovarianceEntry) {
+          return std::to_string(row + 2) + ": " + name + " " + FormatShortest(value) +
+                 " is beyond the physical range (|entry| <= 1e12)";
+        }
+        covariance(i, j) = covariance(j, i) = value;
       }
+    }
+    // Positive semi-definite to rounding (an all-zero covariance, "unknown", is allowed).
+    const double scale = std::max(1.0, covariance.diagonal().maxCoeff());
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(covariance, Eigen::EigenvaluesOnly);
+    if (eigen.eigenvalues().minCoeff() < -1e-9 * scale) {
+      return std::to_string(row + 2) + ": the covariance is not positive semi-definite (smallest eigenvalue " +
+             FormatShortest(eigen.eigenvalues().minCoeff()) + ")";
     }
   }
   return "";

@@ -45,7 +45,11 @@ bool CarriesCovariance(const StreamInfo& info);
 // Camera intrinsics in the attributes of camera and visual_odometry streams: all six or none; "" when fine.
 std::string IntrinsicsProblem(const StreamInfo& info);
 
-// Problem with the covariance columns of a stream's values (a negative diagonal entry) as "<line>: <problem>" for the
+// Entries of a covariance column are at most this in magnitude [m^2, (m/s)^2, (rad/s)^2, ...].
+inline constexpr double kMaxCovarianceEntry = 1e12;
+
+// Problem with the covariance columns of a stream's values (a negative diagonal entry, an entry beyond
+// kMaxCovarianceEntry, a matrix that is not positive semi-definite to rounding) as "<line>: <problem>" for the
 // first bad row, or "" when fine. Row i is on line i + 2 of its file (after the header).
 std::string CovarianceProblem(const Stream& stream);
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <set>
 
+#include "common/yaml_keys.h"
 #include "recording/internal/text_io.h"
 
 namespace roamlab::recording::internal {
@@ -31,6 +32,9 @@ Status LoadYamlFile(const std::string& path, YAML::Node* root) {
   if (Status status = ReadTextFile(path, &content); !status.ok()) return status;
   try {
     *root = YAML::Load(content);
+    if (const std::string problem = DuplicateKeyProblem(*root); !problem.empty()) {
+      return Status::Error(path + ":" + problem);
+    }
   } catch (const YAML::Exception& e) {
     if (e.mark.is_null()) return Status::Error(path + ": " + e.msg);
     return Status::Error(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) + ": " +

@@ -8,6 +8,8 @@
 #include <set>
 #include <sstream>
 
+#include "common/yaml_keys.h"
+
 namespace roamlab::sim::internal {
 namespace {
 
@@ -47,6 +49,7 @@ YamlReader::YamlReader(std::string path) : path_(std::move(path)) {
   content << file.rdbuf();
   try {
     root_ = YAML::Load(content.str());
+    if (const std::string problem = DuplicateKeyProblem(root_); !problem.empty()) error_ = path_ + ":" + problem;
   } catch (const YAML::Exception& e) {
     error_ = e.mark.is_null() ? path_ + ": " + e.msg
                               : path_ + ":" + std::to_string(e.mark.line + 1) + ":" +
@@ -120,6 +123,10 @@ void YamlReader::NodeNumber(const YAML::Node& node, const std::string& key, doub
   double value = 0.0;
   if (!node.IsScalar() || !ParseFinite(node.Scalar(), &value)) {
     Fail(node, key, "expected a finite number, got " + Describe(node));
+    return;
+  }
+  if (std::abs(value) > kMaxScenarioNumber) {
+    Fail(node, key, node.Scalar() + " is beyond any physical value (|value| <= 1e9)");
     return;
   }
   *out = value;

@@ -20,6 +20,9 @@
 
 namespace roamlab::sim::internal {
 
+// Every number of a scenario is at most this in magnitude (seeds, read as integers, aside).
+inline constexpr double kMaxScenarioNumber = 1e9;
+
 class YamlReader {
  public:
   // Parses `path`. A missing file or a syntax error is reported through status().

@@ -37,10 +37,54 @@ TEST(ConfigTest, RejectsUnknownKeysModelsAndMissingNoise) {
   ExpectError(Replace(good, "model: gps", "model: galileo"), "unknown model 'galileo'");
   ExpectError(Replace(good, "noise: {sigma_m: 0.33}", "noise: {sigma: 0.33}"), "unknown key 'sigma'");
   ExpectError(Replace(good, "noise: {sigma_m: 0.33}", "noise: {}"), "noise needs 'sigma_m'");
-  ExpectError(Replace(good, "noise: {sigma_m: 0.33}", "noise: {sigma_m: -1}"), "must be positive");
+  ExpectError(Replace(good, "noise: {sigma_m: 0.33}", "noise: {sigma_m: -1}"), "range [1e-9, 1e6] of a standard");
   ExpectError(Replace(good, "master: odometer", "master: gps"), "must use an odometric model");
   ExpectError(Replace(good, "free: false}", "free: maybe}"), "must be true or false");
   ExpectError(Replace(good, "method: levenberg_marquardt", "method: newton"), "solver.method");
+}
+
+// Noise and values are range-checked at load, naming the file, line and key: a sigma whose square underflows would
+// otherwise reach the graph as a singular covariance.
+TEST(ConfigTest, RefusesNoiseAndValuesOutsideThePhysicalRange) {
+  const std::string good = testing::AtvConfigYaml({"gps.lever_arm"});
+  ExpectError(Replace(good, "noise: {sigma_m: 0.33}", "noise: {sigma_m: 1e-300}"),
+              "noise.sigma_m: 1e-300 is outside the accepted range");
+  ExpectError(Replace(good, "noise: {sigma_m: 0.33}", "noise: {sigma_m: 1e300}"), "noise.sigma_m: 1e300 is beyond");
+  ExpectError(Replace(good, "noise: {sigma_m: 0.33}", "noise: {sigma_m: .nan}"), "must be a finite number");
+  ExpectError(Replace(good, "noise: {sigma_m: 0.33}", "noise: {sigma_m: .inf}"), "must be a finite number");
+  ExpectError(Replace(good, "{value: [0, 0, 0], free: true}", "{value: [9.2e18, 0, 0], free: true}"),
+              "gps.lever_arm.value: 9.2e18 is beyond the physical range");
+  ExpectError(Replace(good, "{value: [0, 0, 0], free: true}", "{value: [.nan, 0, 0], free: true}"),
+              "must be a finite number");
+  // prior_sigma keeps .inf ("no prior on this component").
+  const auto config = ParseEstimatorConfig(
+      Replace(good, "{value: [0, 0, 0], free: true}", "{value: [0, 0, 0], free: true, prior_sigma: [.inf, .inf, 0.5]}"),
+      "est.yaml");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+}
+
+// A slot mapped to a parameter nobody declares or shares is a typo: refused instead of silently running a different
+// model.
+TEST(ConfigTest, RefusesUndeclaredParameterNames) {
+  const std::string good = testing::AtvConfigYaml({});
+  const std::string gyro = "parameters: {misalignment: imu.misalignment, time_offset_s: imu.time_offset_s}}";
+  ExpectError(Replace(good, gyro, "parameters: {misalignment: imu.misalignmnet, time_offset_s: imu.time_offset_s}}"),
+              "names parameter 'imu.misalignmnet', which no parameters: entry declares");
+  ExpectError(Replace(good, gyro, "parameters: {misalignment: nan, time_offset_s: imu.time_offset_s}}"),
+              "names parameter 'nan'");
+  // The default name and a name shared by several slots stay accepted.
+  EXPECT_TRUE(
+      ParseEstimatorConfig(
+          Replace(good, gyro, "parameters: {misalignment: gyroscope.misalignment, time_offset_s: imu.time_offset_s}}"),
+          "est.yaml")
+          .ok());
+}
+
+TEST(ConfigTest, RefusesDuplicateKeys) {
+  const std::string good = testing::AtvConfigYaml({});
+  ExpectError(Replace(good, "master: odometer", "master: odometer\nmaster: gps"), "est.yaml:2: duplicate key 'master'");
+  ExpectError(Replace(good, "noise: {sigma_m: 0.33}", "noise: {sigma_m: 0.33, sigma_m: 3.3}"),
+              "duplicate key 'sigma_m'");
 }
 
 // A time-varying parameter's process: one sigma and tau for all three components, or one per component.
@@ -64,7 +108,8 @@ TEST(ConfigTest, ProcessSigmaAndTauAreOneNumberOrOnePerComponent) {
       config.value().parameters.at("odometer.disturbance").process.sigma.isApprox(Eigen::Vector3d::Constant(1.0e-4)));
   ExpectError(parameter("{type: gauss_markov, sigma: [0.006, 0.002], tau_s: 1.0}"), "a list of 3 numbers");
   ExpectError(parameter("{type: gauss_markov, sigma: 0.01, tau_s: [0.7, -1.2, 1.8]}"), "tau_s must be positive");
-  ExpectError(parameter("{type: gauss_markov, sigma: [0.01, 0, 0.01], tau_s: 1.0}"), "sigma must be positive");
+  ExpectError(parameter("{type: gauss_markov, sigma: [0.01, 0, 0.01], tau_s: 1.0}"),
+              "process sigma must be in [1e-9, 1e6]");
 }
 
 // The spacing of a process's instances: absent means one per pose; given, a positive number of seconds, and only for a
@@ -88,7 +133,7 @@ TEST(ConfigTest, ProcessIntervalIsAPositiveNumberOfSeconds) {
   const std::string positive = "process.interval_s must be a positive number of seconds";
   ExpectError(parameter("{type: gauss_markov, sigma: 0.01, tau_s: 1.0, interval_s: 0}"), positive);
   ExpectError(parameter("{type: gauss_markov, sigma: 0.01, tau_s: 1.0, interval_s: -0.1}"), positive);
-  ExpectError(parameter("{type: gauss_markov, sigma: 0.01, tau_s: 1.0, interval_s: .nan}"), positive);
+  ExpectError(parameter("{type: gauss_markov, sigma: 0.01, tau_s: 1.0, interval_s: .nan}"), "must be a finite number");
   ExpectError(parameter("{type: gauss_markov, sigma: 0.01, tau_s: 1.0, interval_s: soon}"), "must be a number");
   ExpectError(parameter("{type: constant, interval_s: 0.1}"), "interval_s needs a random_walk or gauss_markov");
 }
@@ -111,12 +156,12 @@ TEST(ConfigTest, MagnetometerTakesTheSpecificForceInput) {
 // tracking.calibrate names a calibration configuration relative to the file that names it.
 TEST(ConfigTest, TrackingCalibrateIsRelativeToTheConfigFile) {
   const std::string good = testing::AtvConfigYaml({});
-  const std::string with = Replace(good, "master: odometer", "master: odometer\ntracking: {calibrate: cal.yaml}");
+  const std::string with = Replace(good, "tracking: {", "tracking: {calibrate: cal.yaml, ");
   const auto config = ParseEstimatorConfig(with, "configs/est.yaml");
   ASSERT_TRUE(config.ok()) << config.status().message();
   EXPECT_EQ(config.value().tracking.calibrate, "configs/cal.yaml");
   EXPECT_EQ(ParseEstimatorConfig(good, "est.yaml").value().tracking.calibrate, "");
-  ExpectError(Replace(good, "master: odometer", "master: odometer\ntracking: {calibrate: ''}"),
+  ExpectError(Replace(good, "tracking: {", "tracking: {calibrate: '', "),
               "tracking.calibrate must name a configuration file");
 }
 

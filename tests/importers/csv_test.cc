@@ -424,6 +424,9 @@ TEST_F(CsvImportTest, BadFilesGiveOneLineNamingFileAndRow) {
   EXPECT_EQ(ImportError(binary, mapping), binary + ": binary file (NUL byte at offset 9), expected CSV text");
   const std::string truncated = Write("truncated.csv", "t,x\n0,1\n0.1,2\n0.2");
   EXPECT_EQ(ImportError(truncated, mapping), truncated + ":4: truncated last line: 1 cells, expected 2");
+  // All its cells but no line end: "2.5" may be "2.57" cut short.
+  const std::string cut = Write("cut.csv", "t,x\n0,1\n0.1,2\n0.2,2.5");
+  EXPECT_EQ(ImportError(cut, mapping), cut + ":4: truncated last line: no line end (a number may be cut short)");
   const std::string short_row = Write("short.csv", "t,x\n0,1\n0.1\n0.2,3\n");
   EXPECT_EQ(ImportError(short_row, mapping), short_row + ":3: 1 cells, expected 2");
   const std::string backwards = Write("backwards.csv", "t,x\n0,1\n0.2,2\n0.1,3\n");

@@ -172,6 +172,26 @@ TEST_P(RosMessagesTest, OverLongCountsAreRefused) {
   EXPECT_THAT(m.status().message(), HasSubstr("a string of 4000000000 bytes runs past the message"));
 }
 
+// A string-length prefix changed inside the message (longer or shorter than the string) misaligns every field after
+// it: the decoder refuses the message (it runs past the end, or leaves bytes unread) instead of importing shifted
+// values.
+TEST_P(RosMessagesTest, ChangedStringLengthPrefixIsRefused) {
+  const std::string bytes = testing::ImuMessage(GetParam(), 100, 250000000, 0.7);
+  // The frame_id length: after seq, sec, nsec (ROS 1) or the 4-byte encapsulation, sec, nsec (CDR).
+  const std::size_t at = 12;
+  const std::uint32_t declared = GetParam() == Wire::kCdrBig
+                                     ? (static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[at + 3])))
+                                     : static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[at]));
+  ASSERT_EQ(declared, GetParam() == Wire::kRos1 ? 8u : 9u);  // "imu_link" (CDR counts the NUL)
+  for (std::uint32_t length = 0; length < 40; ++length) {
+    if (length == declared) continue;
+    std::string changed = bytes;
+    changed[GetParam() == Wire::kCdrBig ? at + 3 : at] = static_cast<char>(length);
+    Result<RosMessage> m = DecodeRosMessage("sensor_msgs/Imu", changed, EncodingOf(GetParam()));
+    EXPECT_FALSE(m.ok()) << "frame_id length " << length << " instead of " << declared << " was accepted";
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Wires, RosMessagesTest, ::testing::Values(Wire::kRos1, Wire::kCdrLittle, Wire::kCdrBig),
                          [](const ::testing::TestParamInfo<Wire>& info) {
                            return info.param == Wire::kRos1        ? std::string("Ros1")

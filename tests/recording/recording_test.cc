@@ -402,6 +402,43 @@ TEST(RecordingCsvTest, BlankLineInTheMiddle) {
   EXPECT_THAT(ReadError(dir), AllOf(HasSubstr("imu.csv:3:"), HasSubstr("blank line")));
 }
 
+// A file cut inside its last number ("9.8" of "9.81") without a line end is refused as truncated, with its line.
+TEST(RecordingCsvTest, LastRowWithoutLineEndIsTruncated) {
+  TempDir dir;
+  WriteFixture(dir, kYaml, kGpsCsv, "t,wx,wy,wz,ax,ay,az\n0.00,0,0,0.1,0,0,9.81\n0.01,0,0,0.1,0,0,9.8");
+  EXPECT_THAT(ReadError(dir), AllOf(HasSubstr("imu.csv:3:"), HasSubstr("no line end"), HasSubstr("truncated")));
+  // With its line end (and blank lines after it) the same rows read.
+  WriteFixture(dir, kYaml, kGpsCsv, "t,wx,wy,wz,ax,ay,az\n0.00,0,0,0.1,0,0,9.81\n0.01,0,0,0.1,0,0,9.8\r\n\n");
+  EXPECT_TRUE(ReadRecording(dir.path()).ok());
+  // A header alone needs none: there is no row to cut.
+  WriteFixture(dir, kYaml, kGpsCsv, "t,wx,wy,wz,ax,ay,az");
+  EXPECT_TRUE(ReadRecording(dir.path()).ok());
+}
+
+// Stamps past +-9e9 s would overflow the int64 nanoseconds; values past 1e15 are corruption, not measurements.
+TEST(RecordingCsvTest, StampsAndValuesOutsideTheRange) {
+  TempDir dir;
+  WriteFixture(dir, kYaml, kGpsCsv, Replace(kImuCsv, "0.02,", "9223372036.900000000,"));
+  EXPECT_THAT(ReadError(dir), AllOf(HasSubstr("imu.csv:4:"), HasSubstr("not a time")));
+  WriteFixture(dir, kYaml, kGpsCsv, Replace(kImuCsv, "0.02,0,0,0.1", "0.02,0,0,4.75e301"));
+  EXPECT_THAT(ReadError(dir), AllOf(HasSubstr("imu.csv:4:"), HasSubstr("column 'wz'"), HasSubstr("beyond")));
+}
+
+TEST(RecordingYamlTest, ValuesOutsideThePhysicalRange) {
+  TempDir dir;
+  WriteFixture(
+      dir, Replace(kYaml, "    rate_hz: 100\n", "    rate_hz: 100\n    mounting: {p_body_sensor_m: [9.2e18, 0, 0]}\n"));
+  EXPECT_THAT(ReadError(dir), AllOf(HasSubstr("recording.yaml:12:"), HasSubstr("p_body_sensor_m of stream 'imu'"),
+                                    HasSubstr("physical range")));
+  WriteFixture(dir, Replace(kYaml, "    rate_hz: 100\n", "    rate_hz: 100\n    noise: {sigma_radps: 1e300}\n"));
+  EXPECT_THAT(ReadError(dir),
+              AllOf(HasSubstr("recording.yaml:12:"), HasSubstr("sigma_radps 1e+300"), HasSubstr("(|value| <= 1e+09)")));
+  WriteFixture(dir, Replace(kYaml, "rate_hz: 100", "rate_hz: 1e300"));
+  EXPECT_THAT(ReadError(dir), AllOf(HasSubstr("recording.yaml:"), HasSubstr("at most 1e6")));
+  WriteFixture(dir, Replace(kYaml, "rate_hz: 5\n", "rate_hz: 5\n    rate_hz: 6\n"));
+  EXPECT_THAT(ReadError(dir), AllOf(HasSubstr("recording.yaml:"), HasSubstr("duplicate key 'rate_hz'")));
+}
+
 TEST(RecordingCsvTest, MissingFile) {
   TempDir dir;
   WriteFixture(dir);
@@ -579,6 +616,29 @@ TEST(RecordingCovarianceTest, NegativeVarianceIsRefusedWithItsLine) {
   EXPECT_THAT(ReadError(dir), AllOf(HasSubstr("vo.csv:3:"), HasSubstr("cov_vy_vy is negative")));
   recording.streams[0].values(1, 12) = -1.0;
   EXPECT_THAT(WriteError(recording, dir), AllOf(HasSubstr("row 3"), HasSubstr("cov_vy_vy is negative")));
+}
+
+// A covariance that is not positive semi-definite (|cov_vx_vy| above sqrt(cov_vx_vx cov_vy_vy)), or with an entry
+// beyond 1e12, would reach the estimator as a noise model it cannot factor: refused with its line.
+TEST(RecordingCovarianceTest, NotPositiveSemiDefiniteOrHugeIsRefused) {
+  TempDir dir;
+  Recording recording = MakeVisualOdometryRecording();
+  recording.streams[0].values(1, 7) = 1e308;  // cov_vx_vy
+  EXPECT_THAT(WriteError(recording, dir), HasSubstr("beyond the physical range"));
+  recording = MakeVisualOdometryRecording();
+  const double vx = recording.streams[0].values(1, 6), vy = recording.streams[0].values(1, 12);
+  recording.streams[0].values(1, 7) = 2.0 * std::sqrt(vx * vy) + 1.0;  // cov_vx_vy
+  EXPECT_THAT(WriteError(recording, dir), HasSubstr("not positive semi-definite"));
+  recording = MakeVisualOdometryRecording();
+  ASSERT_TRUE(WriteRecording(recording, dir.path()).ok());
+  std::string csv = ReadFile(dir.File("vo.csv"));
+  // Line 3, cov_vx_vy (column 8 after t): a large off-diagonal.
+  const std::size_t line3 = csv.find('\n', csv.find('\n') + 1) + 1;
+  std::size_t at = line3;
+  for (int comma = 0; comma < 8; ++comma) at = csv.find(',', at) + 1;
+  csv.replace(at, csv.find(',', at) - at, "1e6");
+  WriteFile(dir.File("vo.csv"), csv);
+  EXPECT_THAT(ReadError(dir), AllOf(HasSubstr("vo.csv:3:"), HasSubstr("not positive semi-definite")));
 }
 
 TEST(RecordingCovarianceTest, IntrinsicsAreAllOrNoneAndSane) {
