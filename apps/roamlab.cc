@@ -59,6 +59,10 @@ void AddCalibrate(CLI::App* app, Commands* commands) {
     cal->add_option("recording", args->recording, "Recording directory (recording.yaml + CSV streams)")->required();
     cal->add_option("--config", args->config, "Estimator configuration (EST.yaml)")->required();
     cal->add_option("--out", args->out, "Output directory: calibration.json, trajectory.tum")->required();
+    cal->add_option("--std", args->std_method,
+                    "Which standard deviation is `std`: white (inverse information), hac (Newey-West, autocorrelated "
+                    "residuals) or auto (hac on imported recordings, white on simulated ones; default)")
+        ->check(CLI::IsMember({"auto", "white", "hac"}));
     cal->add_flag("--quiet", args->quiet, "No progress and no summary");
     return cal;
   });

@@ -49,6 +49,7 @@ struct CalibrateRequest {
   std::string recording;
   std::string config;
   std::string out;                                        // receives calibration.json and trajectory.tum
+  std::string std_method = "auto";                        // auto | white | hac (estimator/calibration.h)
   std::function<void(const std::string& line)> progress;  // optional
 };
 // Offline self-calibration of the recording (estimator/calibration.h). `result` (optional) receives it.

@@ -34,10 +34,15 @@ std::map<std::string, Eigen::VectorXd> Values(const CalibrationResult& r) {
   return out;
 }
 
+// Each parameter with its white and HAC standard deviations (`std` is the HAC one on an imported recording).
 void Print(const CalibrationResult& r) {
   for (const ParameterEstimate& p : r.parameters) {
-    std::cout << "  " << p.name << " = [" << p.estimate.transpose() << "] +- [" << p.std.transpose() << "]\n";
+    std::cout << "  " << p.name << " = [" << p.estimate.transpose() << "] +- white [" << p.std_white.transpose()
+              << "], hac [" << p.std_hac.transpose() << "]\n";
   }
+  std::cout << "  (std: " << r.std_method << "; HAC lags:";
+  for (const auto& [stream, lag] : r.hac_lags) std::cout << " " << stream << " " << lag;
+  std::cout << ")\n";
 }
 
 // A run's track of the GPS antenna (the pose moved by the calibrated lever arm) with its position covariance.
