@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <limits>
+#include <map>
 #include <unordered_set>
 
 #include <Eigen/CholmodSupport>
@@ -68,6 +70,10 @@ Result<Eigen::MatrixXd> SolveOthers(Eigen::SparseMatrix<double> Hxx, const Eigen
   }
   return Eigen::MatrixXd(llt.solve(Hxp));
 }
+
+// AnalyzeAutocorrelation: the truncation lag in units of the last correlated lag, and the lags sampled per window.
+constexpr int kLagsPerCorrelatedWindow = 3;
+constexpr int kSampledLags = 16;
 
 // One active factor's contribution to the HAC sums: its stamp, whitened residual and a_t = E^T H~ g_t (the influence
 // before the multiplication by the white covariance, see ComputeHacCovariance).
@@ -163,21 +169,33 @@ ResidualAutocorrelation AnalyzeAutocorrelation(const std::vector<Eigen::VectorXd
     for (int t = 0; t + lag < n; ++t) c += r.col(t).dot(r.col(t + lag));
     return c / c0;
   };
+  // Windows of lags [2^j, 2^(j+1)): the last whose mean autocorrelation reaches 2 / sqrt(n) sets the lag. A window's
+  // mean is taken over at most kSampledLags lags spread over it (the autocorrelation is smooth at long lags), so
+  // that a long recording costs O(n log n); the integrated time interpolates linearly between the sampled lags.
   const double threshold = 2.0 / std::sqrt(static_cast<double>(n));
-  const int max_lag = n / 2;
-  std::vector<double> correlations;
-  for (int lag = 1; lag <= max_lag; ++lag) {
-    correlations.push_back(rho(lag));
-    if (correlations.back() < threshold) {
-      out.lag = std::min(2 * lag, max_lag);
-      break;
-    }
+  const int max_lag = n / 4;
+  std::map<int, double> sampled = {{0, 1.0}};
+  int last_end = 0;
+  for (int begin = 1; begin <= max_lag; begin *= 2) {
+    const int end = std::min(2 * begin, max_lag + 1);  // exclusive
+    const int step = std::max(1, (end - begin) / kSampledLags);
+    double mean = 0.0;
+    int count = 0;
+    for (int lag = begin; lag < end; lag += step, ++count) mean += sampled[lag] = rho(lag);
+    if (mean / count >= threshold) last_end = end - 1;
   }
-  if (correlations.size() == static_cast<std::size_t>(max_lag)) out.lag = max_lag;
-  for (int lag = static_cast<int>(correlations.size()) + 1; lag <= out.lag; ++lag) correlations.push_back(rho(lag));
+  out.lag = std::min(kLagsPerCorrelatedWindow * last_end, max_lag);
+  if (out.lag > 0 && !sampled.count(out.lag)) sampled[out.lag] = rho(out.lag);
   double sum = 1.0;
-  for (int lag = 1; lag <= out.lag; ++lag)
-    sum += 2.0 * (1.0 - static_cast<double>(lag) / (out.lag + 1)) * correlations[lag - 1];
+  auto upper = sampled.begin();
+  for (int lag = 1; lag <= out.lag; ++lag) {
+    while (upper->first < lag) ++upper;
+    const auto lower = std::prev(upper);
+    const double f =
+        upper->first == lag ? 1.0 : static_cast<double>(lag - lower->first) / (upper->first - lower->first);
+    const double correlation = (1.0 - f) * lower->second + f * upper->second;
+    sum += 2.0 * (1.0 - static_cast<double>(lag) / (out.lag + 1)) * correlation;
+  }
   out.integrated_time = std::max(1.0, sum);
   return out;
 }

@@ -76,14 +76,18 @@ ObservabilityAnalysis AnalyzeObservability(const Eigen::MatrixXd& information, c
 // the variables' block is formed: X = H^-1 E (E selects the variables; their block of X is `white_covariance`, the
 // white marginal covariance, pseudo-inverse on the observable subspace, so that unobservable directions stay zero),
 // the influence u_t = X^T g_t, and Cov = the Bartlett-weighted sum of u_t u_{t+l}^T. L_s is AnalyzeAutocorrelation's
-// lag of the stream's active factors' residuals: the Bartlett weights fade the lags near L, and at twice the
-// crossing they keep about 85% of a first-order Gauss-Markov residual's long-run variance (at the crossing, 70%).
+// lag of the stream's active factors' residuals: the Bartlett weights fade the lags near L, and at 3 times the last
+// correlated lag they keep most of a first-order Gauss-Markov residual's long-run variance (about 1 - 1 / (L / tau)).
 // With white residuals L_s is 0 to 2 and Cov is the white covariance rescaled by the residuals' actual spread.
-// The autocorrelation of one stream's whitened residual vectors in time order (demeaned, summed over components): the
-// HAC truncation lag L (twice the first lag at which it falls below 2 / sqrt(n), at most n / 2; 0 for fewer than 4
-// rows or rows of mixed dimensions) and the integrated autocorrelation time 1 + 2 sum_{l=1..L} (1 - l / (L + 1))
-// rho(l), at least 1: the factor by which the variance of a mean over the stream exceeds the white one, used to
-// inflate variances that assume white residuals (the diagnosis's time shifts, gap/diagnose.h).
+// The autocorrelation rho(l) of one stream's whitened residual vectors in time order (demeaned, summed over
+// components), read over windows of lags [2^j, 2^(j+1)) up to n / 4: the HAC truncation lag L is 3 times the last lag
+// of the last window whose mean autocorrelation reaches 2 / sqrt(n) (0 when none does, for fewer than 4 rows or rows
+// of mixed dimensions). The last correlated window, not the first lag below the threshold: a residual is often a mix
+// of a white part whose differencing makes rho(1) negative (encoder ticks) and a slow part of a small share whose
+// correlation lasts (a drifting gyroscope), and the slow part is what dominates a parameter's spread. The integrated
+// autocorrelation time 1 + 2 sum_{l=1..L} (1 - l / (L + 1)) rho(l), at least 1, is the factor by which the variance of
+// a mean over the stream exceeds the white one, used to inflate variances that assume white residuals (the
+// diagnosis's time shifts, gap/diagnose.h).
 struct ResidualAutocorrelation {
   int lag = 0;
   double integrated_time = 1.0;
