@@ -24,7 +24,7 @@ namespace {
 
 constexpr int kCases = 20;
 constexpr double kCorrelationS = 0.5;  // the gyroscope noise's correlation time
-constexpr double kDurationS = 30.0;
+constexpr double kDurationS = 60.0;
 
 // One fit's estimate and white and HAC std of a scalar component.
 struct Component {
