@@ -335,7 +335,7 @@ Status EstimateParameters(const CalibrationOptions& options, const std::vector<s
     p.std_hac = p.std_white;
     for (int c = 0; c < dim; ++c)
       if (std::isfinite(p.std_white[c])) p.std_hac[c] = std::sqrt(hac_covariance(offsets[i] + c, offsets[i] + c));
-    p.std = hac ? p.std_hac : p.std_white;
+    p.std = hac ? p.std_hac.cwiseMax(p.std_white) : p.std_white;
     for (int c = 0; c < dim; ++c) {
       const Observability o = analysis.observability[offsets[i] + c];
       p.components.push_back(o);

@@ -9,7 +9,9 @@
 // configured one). `std` is the chosen one (CalibrationOptions::std_method): by default the HAC one for imported
 // (real) recordings, whose residuals are autocorrelated (vibration, slow biases, multipath) so that the white one
 // understates the spread many times, and the white one for simulated recordings, whose noise is the configured white
-// noise unless the scenario colours it. Both are kept.
+// noise unless the scenario colours it. The HAC `std` is never below the white one: the HAC sees only the residuals,
+// and residuals smaller than the configured noise are often errors the poses absorbed (an IMU-driven track follows the
+// GPS fixes' slow errors), not a sensor better than stated. Both are kept as computed.
 #pragma once
 
 #include <functional>
@@ -31,10 +33,10 @@ namespace roamlab::estimator {
 struct ParameterEstimate {
   std::string name;
   Manifold manifold = Manifold::Euclidean(0);
-  Eigen::VectorXd estimate;                                  // ambient: quaternions [w, x, y, z], matrices row-major
-  Eigen::VectorXd std;                                       // tangent; NaN where unobservable; the chosen method's
-  Eigen::VectorXd std_white;                                 // from the marginal information (white residuals)
-  Eigen::VectorXd std_hac;                                   // HAC (Newey-West); NaN where unobservable
+  Eigen::VectorXd estimate;   // ambient: quaternions [w, x, y, z], matrices row-major
+  Eigen::VectorXd std;        // tangent; NaN where unobservable; white, or (hac) the larger of std_white and std_hac
+  Eigen::VectorXd std_white;  // from the marginal information (white residuals)
+  Eigen::VectorXd std_hac;    // HAC (Newey-West); NaN where unobservable
   std::vector<Observability> components;                     // per tangent component
   Observability observability = Observability::kObservable;  // the worst component
 };

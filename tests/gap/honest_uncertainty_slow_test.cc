@@ -71,7 +71,8 @@ std::pair<Component, Component> Fit(const estimator::EstimatorConfig& config, co
   if (print_lags)
     for (const auto& [stream, lag] : result.value().hac_lags)
       std::printf("  HAC lag of %s: %d rows\n", stream.c_str(), lag);
-  return {{s->estimate[2], s->std_white[2], s->std_hac[2]}, {o->estimate[0], o->std_white[0], o->std_hac[0]}};
+  // (std with the HAC method: the larger of std_white and std_hac.)
+  return {{s->estimate[2], s->std_white[2], s->std[2]}, {o->estimate[0], o->std_white[0], o->std[0]}};
 }
 
 sim::Simulation Simulate(const sim::Scenario& scenario, std::uint64_t seed) {
