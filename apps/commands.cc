@@ -33,8 +33,8 @@ void PrintCalibration(const estimator::CalibrationResult& r, const std::string& 
                 Values(p.estimate, "%.5g", false).c_str(), Values(p.std, "%.2g", true).c_str());
   for (const auto& c : r.correlations)
     std::printf("strongly correlated: %s ~ %s (rho %.3f)\n", c.a.c_str(), c.b.c_str(), c.rho);
-  std::printf("cost %.6g -> %.6g in %d iterations, %.2f s; wrote %s\n", r.initial_cost, r.final_cost, r.iterations,
-              r.seconds, json_path.c_str());
+  std::printf("std: %s; cost %.6g -> %.6g in %d iterations, %.2f s; wrote %s\n", r.std_method.c_str(), r.initial_cost,
+              r.final_cost, r.iterations, r.seconds, json_path.c_str());
 }
 
 }  // namespace

@@ -59,6 +59,10 @@ void AddCalibrate(CLI::App* app, Commands* commands) {
     cal->add_option("recording", args->recording, "Recording directory (recording.yaml + CSV streams)")->required();
     cal->add_option("--config", args->config, "Estimator configuration (EST.yaml)")->required();
     cal->add_option("--out", args->out, "Output directory: calibration.json, trajectory.tum")->required();
+    cal->add_option("--std", args->std_method,
+                    "Which standard deviation is `std`: white (inverse information), hac (Newey-West, autocorrelated "
+                    "residuals) or auto (hac on imported recordings, white on simulated ones; default)")
+        ->check(CLI::IsMember({"auto", "white", "hac"}));
     cal->add_flag("--quiet", args->quiet, "No progress and no summary");
     return cal;
   });
@@ -171,6 +175,10 @@ void AddDiagnose(CLI::App* app, Commands* commands) {
     dia->add_option("--max-shift", args->max_shift_s,
                     "Time-shift search range [s] of gps_latency, imu_time_offset and pose_time_offset (default 0.5; "
                     "below 1/12 of the recording's span)");
+    dia->add_option("--std", args->std_method,
+                    "The effects' standard deviations: white, hac (autocorrelated residuals) or auto (hac on imported "
+                    "recordings, white on simulated ones; default)")
+        ->check(CLI::IsMember({"auto", "white", "hac"}));
     dia->add_flag("--no-plots", args->no_plots, "No figures");
     dia->add_flag("--replay", args->replay,
                   "Also diagnose against the scenario's noise-free twin into OUT/twin.json (a recording of the "

@@ -285,7 +285,8 @@ Result<StageSummary> SolveStage(const EstimatorConfig& config, const Calibration
 // The estimate of every parameter free in some stage, with its standard deviations, observability and correlations
 // from their joint marginal information at the final estimate (when options.analyze_observability).
 Status EstimateParameters(const CalibrationOptions& options, const std::vector<std::vector<std::string>>& stages,
-                          ProblemBuilder* builder_ptr, SolverWorkspace* workspace, CalibrationResult* result) {
+                          bool hac, ProblemBuilder* builder_ptr, SolverWorkspace* workspace,
+                          CalibrationResult* result) {
   ProblemBuilder& builder = *builder_ptr;
   std::set<std::string> ever_free;
   for (const auto& st : stages) ever_free.insert(st.begin(), st.end());
@@ -298,6 +299,7 @@ Status EstimateParameters(const CalibrationOptions& options, const std::vector<s
     names.push_back(name);
   }
   ObservabilityAnalysis analysis;
+  Eigen::MatrixXd hac_covariance;
   std::vector<int> offsets;
   if (!ids.empty() && options.analyze_observability) {
     const auto analysis_start = std::chrono::steady_clock::now();
@@ -306,6 +308,10 @@ Status EstimateParameters(const CalibrationOptions& options, const std::vector<s
     analysis = AnalyzeObservability(info.value().information, info.value().conditional, options.observability);
     offsets = info.value().offsets;
     result->information = info.value().information;
+    auto sandwich = ComputeHacCovariance(builder.graph(), ids, analysis.covariance);
+    if (!sandwich.ok()) return sandwich.status();
+    hac_covariance = std::move(sandwich.value().covariance);
+    result->hac_lags = std::move(sandwich.value().lags);
     Say(options,
         "observability analysis: " +
             std::to_string(std::chrono::duration<double>(std::chrono::steady_clock::now() - analysis_start).count()) +
@@ -320,11 +326,16 @@ Status EstimateParameters(const CalibrationOptions& options, const std::vector<s
     const int dim = v.manifold.tangent_dim();
     if (!options.analyze_observability) {
       p.std = Eigen::VectorXd::Constant(dim, std::numeric_limits<double>::quiet_NaN());
+      p.std_white = p.std_hac = p.std;
       p.components.assign(dim, Observability::kObservable);
       result->parameters.push_back(std::move(p));
       continue;
     }
-    p.std = analysis.std.segment(offsets[i], dim);
+    p.std_white = analysis.std.segment(offsets[i], dim);
+    p.std_hac = p.std_white;
+    for (int c = 0; c < dim; ++c)
+      if (std::isfinite(p.std_white[c])) p.std_hac[c] = std::sqrt(hac_covariance(offsets[i] + c, offsets[i] + c));
+    p.std = hac ? p.std_hac.cwiseMax(p.std_white) : p.std_white;
     for (int c = 0; c < dim; ++c) {
       const Observability o = analysis.observability[offsets[i] + c];
       p.components.push_back(o);
@@ -366,6 +377,11 @@ void KeepResiduals(const ProblemBuilder& builder, CalibrationResult* result) {
 
 }  // namespace
 
+bool UsesHac(CalibrationOptions::StdMethod method, const recording::Recording& recording) {
+  return method == CalibrationOptions::StdMethod::kHac ||
+         (method == CalibrationOptions::StdMethod::kAuto && recording.provenance.source == "imported");
+}
+
 Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recording::Recording& recording,
                                     const CalibrationOptions& options) {
   const auto start = std::chrono::steady_clock::now();
@@ -399,7 +415,9 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
   result.initial_cost = result.stages.front().solver.initial_cost;
   result.final_cost = result.stages.back().solver.final_cost;
 
-  const Status estimated = EstimateParameters(options, stages, &builder, workspace.get(), &result);
+  const bool hac = UsesHac(options.std_method, recording);
+  result.std_method = hac ? "hac" : "white";
+  const Status estimated = EstimateParameters(options, stages, hac, &builder, workspace.get(), &result);
   if (!estimated.ok()) return estimated;
   if (options.keep_residuals) KeepResiduals(builder, &result);
   result.counts = builder.counts();

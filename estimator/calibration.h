@@ -2,6 +2,16 @@
 // free, optionally in stages (each stage frees its list and holds the other parameters at their current values, as
 // in the seed's two-set procedure), followed by chi-square gating of gross outliers and the observability analysis of
 // every parameter that was free in some stage, on the joint Hessian at the final estimate.
+//
+// Standard deviations. Two are computed: the white one (the inverse of the marginal information, right when the
+// residuals are the configured white noise) and the HAC one (ComputeHacCovariance, covariance.h: a Newey-West sandwich
+// over each stream's residuals in time order, right when they are autocorrelated or their spread is not the
+// configured one). `std` is the chosen one (CalibrationOptions::std_method): by default the HAC one for imported
+// (real) recordings, whose residuals are autocorrelated (vibration, slow biases, multipath) so that the white one
+// understates the spread many times, and the white one for simulated recordings, whose noise is the configured white
+// noise unless the scenario colours it. The HAC `std` is never below the white one: the HAC sees only the residuals,
+// and residuals smaller than the configured noise are often errors the poses absorbed (an IMU-driven track follows the
+// GPS fixes' slow errors), not a sensor better than stated. Both are kept as computed.
 #pragma once
 
 #include <functional>
@@ -23,8 +33,10 @@ namespace roamlab::estimator {
 struct ParameterEstimate {
   std::string name;
   Manifold manifold = Manifold::Euclidean(0);
-  Eigen::VectorXd estimate;                                  // ambient: quaternions [w, x, y, z], matrices row-major
-  Eigen::VectorXd std;                                       // tangent; NaN where unobservable
+  Eigen::VectorXd estimate;   // ambient: quaternions [w, x, y, z], matrices row-major
+  Eigen::VectorXd std;        // tangent; NaN where unobservable; white, or (hac) the larger of std_white and std_hac
+  Eigen::VectorXd std_white;  // from the marginal information (white residuals)
+  Eigen::VectorXd std_hac;    // HAC (Newey-West); NaN where unobservable
   std::vector<Observability> components;                     // per tangent component
   Observability observability = Observability::kObservable;  // the worst component
 };
@@ -59,6 +71,8 @@ struct CalibrationResult {
   std::map<std::string, StreamCounts> counts;
   Trajectory trajectory;                       // the smoothed trajectory of the final estimate
   std::vector<MeasurementResidual> residuals;  // with CalibrationOptions::keep_residuals, in factor id order
+  std::string std_method;                      // "white" or "hac": which one ParameterEstimate::std is
+  std::map<std::string, int> hac_lags;         // the HAC's truncation lag per stream (factor rows)
   double seconds = 0.0;
   // Totals over the stages.
   int iterations = 0;
@@ -77,10 +91,16 @@ struct CalibrationOptions {
   // motion replaces the configured values. Null: dead reckoning, then both alignments.
   const Trajectory* initial_trajectory = nullptr;
   bool analyze_observability = true;  // false: no marginal covariance (parameters get NaN std)
+  // Which standard deviation is `std`: kAuto is kHac for imported recordings, kWhite for simulated ones.
+  enum class StdMethod { kAuto, kWhite, kHac };
+  StdMethod std_method = StdMethod::kAuto;
 };
 
 Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recording::Recording& recording,
                                     const CalibrationOptions& options = {});
+
+// Whether `method` resolves to the HAC standard deviation for `recording` (kAuto: when it is imported).
+bool UsesHac(CalibrationOptions::StdMethod method, const recording::Recording& recording);
 
 // Options of one gating pass (GateOutliers) beyond testing each factor alone.
 struct GateOptions {

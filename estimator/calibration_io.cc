@@ -23,6 +23,8 @@ json ParametersJson(const std::vector<ParameterEstimate>& parameters) {
     for (auto o : p.components) components.push_back(ObservabilityName(o));
     params[p.name] = {{"estimate", NumberArray(p.estimate)},
                       {"std", NumberArray(p.std)},
+                      {"std_white", NumberArray(p.std_white)},
+                      {"std_hac", NumberArray(p.std_hac)},
                       {"observability", ObservabilityName(p.observability)},
                       {"component_observability", components},
                       {"manifold", p.manifold.Name()}};
@@ -62,6 +64,8 @@ Status WriteCalibrationFile(const CalibrationResult& result, const std::string& 
   json correlations = json::array();
   for (const auto& c : result.correlations) correlations.push_back({{"a", c.a}, {"b", c.b}, {"rho", c.rho}});
   const json out = {{"parameters", ParametersJson(result.parameters)},
+                    {"std_method", result.std_method},
+                    {"hac_lags", result.hac_lags},
                     {"information", InformationJson(names, result.information)},
                     {"correlations", correlations},
                     {"solver", SolverJson(result)},

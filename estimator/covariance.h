@@ -17,6 +17,8 @@
 // against the IMU misalignment, eq. 10) show |rho| near 1 even when exactly dependent.
 #pragma once
 
+#include <map>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -64,5 +66,42 @@ struct ObservabilityAnalysis {
 // information.diagonal() when the information involves no other variables.
 ObservabilityAnalysis AnalyzeObservability(const Eigen::MatrixXd& information, const Eigen::VectorXd& conditional,
                                            const ObservabilityOptions& options = {});
+
+// Heteroscedasticity-and-autocorrelation-consistent (HAC, Newey-West) covariance of the given variables: what their
+// spread is when the residuals are not the white noise the information matrix assumes (vibration, slow biases,
+// multipath make real residuals autocorrelated, and the white covariance then understates the spread many times).
+// With H = J^T W J at the estimate and g_t = J_t^T W r_t the score of factor t (whitened, loss-weighted), the sandwich
+//   Cov = H^-1 M H^-1,  M = sum_s sum_{|l| <= L_s} (1 - |l| / (L_s + 1)) sum_t g_t g_{t+l}^T
+// sums the lags within each stream s, its active factors in time order (streams independent of each other). Only
+// the variables' block is formed: X = H^-1 E (E selects the variables; their block of X is `white_covariance`, the
+// white marginal covariance, pseudo-inverse on the observable subspace, so that unobservable directions stay zero),
+// the influence u_t = X^T g_t, and Cov = the Bartlett-weighted sum of u_t u_{t+l}^T. L_s is AnalyzeAutocorrelation's
+// lag of the stream's active factors' residuals: the Bartlett weights fade the lags near L, and at 3 times the last
+// correlated lag they keep most of a first-order Gauss-Markov residual's long-run variance (about 1 - 1 / (L / tau)).
+// With white residuals L_s is 0 to 2 and Cov is the white covariance rescaled by the residuals' actual spread.
+// The autocorrelation rho(l) of one stream's whitened residual vectors in time order (demeaned, summed over
+// components), read over windows of lags [2^j, 2^(j+1)) up to n / 4: the HAC truncation lag L is 3 times the last lag
+// of the last window whose mean autocorrelation reaches 2 / sqrt(n) (0 when none does, for fewer than 4 rows or rows
+// of mixed dimensions). The last correlated window, not the first lag below the threshold: a residual is often a mix
+// of a white part whose differencing makes rho(1) negative (encoder ticks) and a slow part of a small share whose
+// correlation lasts (a drifting gyroscope), and the slow part is what dominates a parameter's spread. The integrated
+// autocorrelation time 1 + 2 sum_{l=1..L} (1 - l / (L + 1)) rho(l), at least 1, is the factor by which the variance of
+// a mean over the stream exceeds the white one, used to inflate variances that assume white residuals (the
+// diagnosis's time shifts, gap/diagnose.h).
+struct ResidualAutocorrelation {
+  int lag = 0;
+  double integrated_time = 1.0;
+};
+ResidualAutocorrelation AnalyzeAutocorrelation(const std::vector<Eigen::VectorXd>& residuals);
+
+struct HacCovariance {
+  Eigen::MatrixXd covariance;       // tangent coordinates, the variables stacked in order
+  std::map<std::string, int> lags;  // per stream: L_s (factor rows)
+};
+
+// `white_covariance`: the variables' white marginal covariance (ObservabilityAnalysis::covariance of their
+// MarginalInformation). Fails as ComputeMarginalInformation does.
+Result<HacCovariance> ComputeHacCovariance(const Graph& graph, const std::vector<VariableId>& variables,
+                                           const Eigen::MatrixXd& white_covariance);
 
 }  // namespace roamlab::estimator

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "estimator/calibration.h"
 #include "estimator/config.h"
 #include "experiment/init.h"
 #include "gap/nominal_config.h"
@@ -152,6 +153,9 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
   gap::DiagnoseOptions options;
   options.progress = [&](const std::string& line) { say("  " + line); };
   if (request.max_shift_s) options.max_shift_s = *request.max_shift_s;
+  using Method = estimator::CalibrationOptions::StdMethod;
+  if (request.std_method == "white") options.std_method = Method::kWhite;
+  if (request.std_method == "hac") options.std_method = Method::kHac;
 
   gap::Baseline baseline;
   if (!request.no_baseline) {

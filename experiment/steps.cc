@@ -127,6 +127,9 @@ Outcome CalibrateToDirectory(const CalibrateRequest& request, estimator::Calibra
 
   estimator::CalibrationOptions options;
   options.progress = request.progress;
+  using Method = estimator::CalibrationOptions::StdMethod;
+  if (request.std_method == "white") options.std_method = Method::kWhite;
+  if (request.std_method == "hac") options.std_method = Method::kHac;
   auto calibrated = estimator::Calibrate(inputs.value().config, inputs.value().recording, options);
   if (!calibrated.ok()) return Outcome::Failed(calibrated.status());
   const estimator::CalibrationResult& r = calibrated.value();

@@ -49,6 +49,7 @@ struct CalibrateRequest {
   std::string recording;
   std::string config;
   std::string out;                                        // receives calibration.json and trajectory.tum
+  std::string std_method = "auto";                        // auto | white | hac (estimator/calibration.h)
   std::function<void(const std::string& line)> progress;  // optional
   // Optional: receives each warning about the inputs, one line naming the file (an empty stream, samples outside the
   // master's span). A source stream with no sample within the master's span is bad input.

@@ -167,7 +167,9 @@ int NearestPoint(const std::map<int, SearchPoint>& points, int k) {
   return nearest;
 }
 
-Result<FitOutcome> TrainingFits::Run(const FitSpec& spec) const {
+Result<FitOutcome> TrainingFits::Run(const FitSpec& spec_in) const {
+  FitSpec spec = spec_in;
+  spec.std_method = std_method;
   auto fit = Fit(nominal, train, spec);
   ++*fits;
   return fit;

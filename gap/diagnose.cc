@@ -180,8 +180,9 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
   if (!parts.ok()) return parts.status();
   out.train_end_s = parts.value().split_s;
   const internal::TrainingFits fits{
-      nominal,   parts.value().train, internal::MasterPeriod(nominal, recording), options.max_shift_s,
-      &out.fits, options.progress};
+      nominal,          parts.value().train, internal::MasterPeriod(nominal, recording), options.max_shift_s, &out.fits,
+      options.progress, options.std_method};
+  out.std_method = estimator::UsesHac(options.std_method, recording) ? "hac" : "white";
   std::vector<internal::Candidate> library = internal::Library(nominal);
 
   // 1. Replay: the nominal self-calibration of the whole recording, with its residuals.

@@ -12,7 +12,12 @@
 //      the time_offset_s the gyroscope and accelerometer share, started from a profile over it), or a time shift of
 //      a stream found by a 1-D search on the master period's grid with a parabola through the best points (its
 //      curvature gives the standard deviation; GPS latency, an absolute pose stream's offset, and an IMU offset
-//      beyond the first-order model's range; internal/time_shift.h). Statistic (internal/decide.h, Score): without a
+//      beyond the first-order model's range; internal/time_shift.h). Standard deviations (DiagnoseOptions::std_method,
+//      HAC by default on imported recordings, whose residuals are autocorrelated so that the white chi-square
+//      curvature understates a fitted parameter's spread many times): a freed slot's from the estimator's HAC
+//      covariance (estimator/covariance.h); a time shift's is the parabola's times sqrt(tau), tau the integrated
+//      autocorrelation time of the shifted streams' residuals at the chosen shift (AnalyzeAutocorrelation; the
+//      largest over those streams). Statistic (internal/decide.h, Score): without a
 //      baseline the chi-square drop LR = chi2_nominal - chi2_effect ~ chi2(k) (cost = chi2 / 2, estimator/solver.h);
 //      with one, the nominal model is not exact on MuJoCo data and already moves each candidate's parameters on the
 //      nominal simulation, so H0 is "the parameters take the baseline's values" and LR is its Wald form with both
@@ -106,6 +111,7 @@ struct Diagnosis {
   std::map<std::string, double> stream_shifts_s;
   int fits = 0;  // calibrations run
   double seconds = 0.0;
+  std::string std_method;  // "white" or "hac": how the effects' standard deviations were computed
 };
 
 inline constexpr double kDefaultMinExplainedShare = 0.25;
@@ -125,6 +131,9 @@ struct DiagnoseOptions {
   bool heldout_all_candidates = false;
   int max_effects = 3;       // 0: score the candidates only (learning a baseline)
   double max_shift_s = 0.5;  // time-shift search range and the margin cut from shifted streams
+  // The effects' standard deviations: white, or HAC (freed slots: the estimator's HAC covariance; time shifts: the
+  // parabola's inflated by the shifted streams' integrated autocorrelation time); kAuto: HAC on imported recordings.
+  estimator::CalibrationOptions::StdMethod std_method = estimator::CalibrationOptions::StdMethod::kAuto;
   std::function<void(const std::string&)> progress;
 };
 

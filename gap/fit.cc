@@ -97,6 +97,7 @@ Result<FitOutcome> Fit(const EstimatorConfig& nominal, const Recording& recordin
   estimator::CalibrationOptions options;
   options.keep_residuals = spec.keep_residuals;
   options.analyze_observability = spec.observability;
+  options.std_method = spec.std_method;
   options.initial_trajectory = spec.initial;
   auto result = estimator::Calibrate(config, Shifted(recording, spec.shift_s), options);
   if (!result.ok()) return result.status();

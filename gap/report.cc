@@ -411,6 +411,7 @@ json DiagnosisJson(const Diagnosis& d, const Baseline* baseline, std::uint64_t b
           {"components", components},
           {"baseline", base},
           {"simulation", simulation ? SimulationJson(*simulation) : json(nullptr)},
+          {"std_method", d.std_method},
           {"run", {{"fits", d.fits}, {"seconds", d.seconds}}}};
 }
 

@@ -9,6 +9,8 @@
 
 #include <Eigen/Dense>
 
+#include "estimator/covariance.h"
+
 namespace roamlab::gap::internal {
 namespace {
 
@@ -18,6 +20,27 @@ namespace {
 // (1 / sqrt(a) grid steps: cost = chi2 / 2 has second derivative a) and the vertex's own spread from the jitter
 // (delta method on the fitted a, b).
 constexpr int kHalfWindow = 3;
+
+// The largest integrated autocorrelation time (estimator/covariance.h AnalyzeAutocorrelation) of the active residuals
+// of the configured streams that read one of `c`'s shifted recording streams, each in time order; 1 without any.
+double ShiftedAutocorrelationTime(const TrainingFits& fits, const Candidate& c,
+                                  const std::vector<estimator::MeasurementResidual>& residuals) {
+  double tau = 1.0;
+  for (const auto& [name, stream] : fits.nominal.streams) {
+    const bool shifted = std::any_of(stream.sources.begin(), stream.sources.end(), [&](const auto& source) {
+      return std::find(c.shifted.begin(), c.shifted.end(), source.second) != c.shifted.end();
+    });
+    if (!shifted) continue;
+    std::vector<const estimator::MeasurementResidual*> rows;
+    for (const estimator::MeasurementResidual& r : residuals)
+      if (r.active && r.stream == name) rows.push_back(&r);
+    std::stable_sort(rows.begin(), rows.end(), [](const auto* x, const auto* y) { return x->t < y->t; });
+    std::vector<Eigen::VectorXd> series;
+    for (const estimator::MeasurementResidual* r : rows) series.push_back(r->whitened);
+    tau = std::max(tau, estimator::AnalyzeAutocorrelation(series).integrated_time);
+  }
+  return tau;
+}
 
 // The training part's chi-square with `c`'s streams shifted by k * period (|k| <= k_max, the time-shift range),
 // fitted on demand, each fit warm-started from the nearest shift fitted so far (the poses follow the shifted stream,
@@ -163,8 +186,11 @@ Result<CandidateFit> FitTimeShift(const TrainingFits& fits, const Candidate& c, 
   // would lose that much of their own drop.
   FitSpec spec = fits.WarmFrom(base, grid.At(best).values, &grid.At(best).trajectory);
   spec.shift_s = cf.next.shift_s;
+  const bool hac = estimator::UsesHac(fits.std_method, fits.train);
+  spec.keep_residuals = hac;
   auto fit = fits.Run(spec);
   if (!fit.ok()) return fit.status();
+  if (hac) e.std[c.shift_parameter] = stdev * std::sqrt(ShiftedAutocorrelationTime(fits, c, fit.value().residuals));
   cf.next.train_values = fit.value().values;
   cf.next.train_trajectory = fit.value().trajectory;
   cf.next.train_chi2 = fit.value().chi2;

@@ -1,15 +1,17 @@
 // calibration.json: the file `roamlab calibrate` writes (estimator/calibration_io.h), read by tracking (track,
 // montecarlo, the regression suite, the benchmark) and by evaluation (the parameter table). One reader for all.
 //
-//   {"parameters": {NAME: {"estimate": [...], "std": [...], "observability": "...",
-//                          "component_observability": [...], "manifold": "..."}},
+//   {"parameters": {NAME: {"estimate": [...], "std": [...], "std_white": [...], "std_hac": [...],
+//                          "observability": "...", "component_observability": [...], "manifold": "..."}},
+//    "std_method": "white|hac", "hac_lags": {STREAM: L},
 //    "information": {"parameters": [NAME, ...], "matrix": [[...], ...]},
 //    "correlations": [{"a", "b", "rho"}], "solver": {...}, "measurements": {STREAM: {...}},
 //    "recording": PATH, "config": PATH}
 //
 // estimate is ambient (quaternions [w, x, y, z]; SE3 [x, y, z, w, x, y, z]), std and the information matrix are
 // tangent; a non-finite number is written as null. Only parameters.NAME.estimate is required; the reader ignores the
-// keys it does not use (correlations, solver, measurements, paths, component_observability).
+// keys it does not use (correlations, solver, measurements, paths, component_observability, std_white, std_hac:
+// `std` is the chosen one of the two, std_method says which).
 #pragma once
 
 #include <map>

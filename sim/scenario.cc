@@ -334,10 +334,13 @@ void ReadSensors(YamlReader& r, const YAML::Node& node, Scenario* s) {
     ImuOptions& imu = s->sensors.imu.emplace();
     const YAML::Node n = node["imu"];
     const std::string k = "sensors.imu";
-    if (section(n, k, {"rate_hz", "gyro_sigma_radps", "accel_sigma_mps2", "misalignment", "lever_arm_m"})) {
+    if (section(n, k,
+                {"rate_hz", "gyro_sigma_radps", "accel_sigma_mps2", "misalignment", "lever_arm_m",
+                 "noise_correlation_s"})) {
       r.Number(n, k, "rate_hz", &imu.rate_hz);
       r.Number(n, k, "gyro_sigma_radps", &imu.gyro_sigma_radps);
       r.Number(n, k, "accel_sigma_mps2", &imu.accel_sigma_mps2);
+      r.Number(n, k, "noise_correlation_s", &imu.noise_correlation_s);
       std::vector<double> q, lever;
       r.Numbers(n, k, "misalignment", 4, &q);
       if (r.ok() && !q.empty()) imu.misalignment = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
@@ -349,9 +352,10 @@ void ReadSensors(YamlReader& r, const YAML::Node& node, Scenario* s) {
     MagnetometerOptions& mag = s->sensors.magnetometer.emplace();
     const YAML::Node n = node["magnetometer"];
     const std::string k = "sensors.magnetometer";
-    if (section(n, k, {"rate_hz", "sigma", "A", "b", "field_world"})) {
+    if (section(n, k, {"rate_hz", "sigma", "A", "b", "field_world", "noise_correlation_s"})) {
       r.Number(n, k, "rate_hz", &mag.rate_hz);
       r.Number(n, k, "sigma", &mag.sigma);
+      r.Number(n, k, "noise_correlation_s", &mag.noise_correlation_s);
       std::vector<double> A, b, field;
       r.Numbers(n, k, "A", 9, &A);
       if (r.ok() && !A.empty()) mag.A = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(A.data());
@@ -365,9 +369,10 @@ void ReadSensors(YamlReader& r, const YAML::Node& node, Scenario* s) {
     GpsOptions& gps = s->sensors.gps.emplace();
     const YAML::Node n = node["gps"];
     const std::string k = "sensors.gps";
-    if (section(n, k, {"rate_hz", "sigma_m", "lever_arm_m"})) {
+    if (section(n, k, {"rate_hz", "sigma_m", "lever_arm_m", "noise_correlation_s"})) {
       r.Number(n, k, "rate_hz", &gps.rate_hz);
       r.Number(n, k, "sigma_m", &gps.sigma_m);
+      r.Number(n, k, "noise_correlation_s", &gps.noise_correlation_s);
       std::vector<double> lever;
       r.Numbers(n, k, "lever_arm_m", 3, &lever);
       if (r.ok() && !lever.empty()) gps.lever_arm_m = ToVector3(lever);
@@ -387,13 +392,16 @@ void ReadSensors(YamlReader& r, const YAML::Node& node, Scenario* s) {
     OdometerOptions& odo = s->sensors.odometer.emplace();
     const YAML::Node n = node["odometer"];
     const std::string k = "sensors.odometer";
-    if (section(n, k, {"rate_hz", "speed_sigma_mps", "steering_sigma_rad", "kv_over_L", "k_theta", "k_gamma"})) {
+    if (section(n, k,
+                {"rate_hz", "speed_sigma_mps", "steering_sigma_rad", "kv_over_L", "k_theta", "k_gamma",
+                 "noise_correlation_s"})) {
       r.Number(n, k, "rate_hz", &odo.rate_hz);
       r.Number(n, k, "speed_sigma_mps", &odo.speed_sigma_mps);
       r.Number(n, k, "steering_sigma_rad", &odo.steering_sigma_rad);
       r.Number(n, k, "kv_over_L", &odo.kv_over_L);
       r.Number(n, k, "k_theta", &odo.k_theta);
       r.Number(n, k, "k_gamma", &odo.k_gamma);
+      r.Number(n, k, "noise_correlation_s", &odo.noise_correlation_s);
     }
   }
 }

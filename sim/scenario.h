@@ -45,6 +45,12 @@
 //   effects: []                             # hidden physical effects, each {name: ..., parameters: {...}}; written
 //                                           # to truth.yaml only (the recording does not say they are there)
 //
+// Coloured sensor noise: `noise_correlation_s` [s] in imu (gyro and accel), magnetometer, gps and odometer (both
+// readings), in [0, 3600], default 0 (white), makes that sensor's noise a first-order Gauss-Markov process per axis
+// with the same stationary sigma: e(k+1) = a e(k) + sigma sqrt(1 - a^2) n, a = exp(-period / noise_correlation_s),
+// e(0) ~ N(0, sigma^2) (sim/noise.h GaussMarkovNoise). At 0 the sensor draws exactly the white noise it draws without
+// the key.
+//
 // Effects. Each lives where it physically belongs; parameters not given take the default shown,
 // unknown names or parameters are errors. The sensor effects apply to any robot with the sensor (the IMU and GPS
 // synthesis is shared); steering_offset and magnetometer_motor_interference to Ackermann robots only:
@@ -273,6 +279,7 @@ struct ImuOptions {
   double accel_sigma_mps2 = 0.067;
   Eigen::Quaterniond misalignment{0.938, 0.104, 0.313, 0.104};  // q_body_imu, normalized by the loader
   Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();
+  double noise_correlation_s = 0.0;  // Gauss-Markov correlation time of the gyro and accel noise; 0: white
 };
 
 struct MagnetometerOptions {
@@ -284,12 +291,14 @@ struct MagnetometerOptions {
                           .finished();
   Eigen::Vector3d b{-0.008, -0.007, -0.040};
   Eigen::Vector3d field_world{0.0, 0.5, -0.8660254037844386};
+  double noise_correlation_s = 0.0;  // Gauss-Markov correlation time of the noise; 0: white
 };
 
 struct GpsOptions {
   double rate_hz = 5.0;
   double sigma_m = 0.33;
   Eigen::Vector3d lever_arm_m{0.57, -0.46, 0.32};
+  double noise_correlation_s = 0.0;  // Gauss-Markov correlation time of the fix noise; 0: white
 };
 
 // Motion capture: the pose of O in W (noise: position per axis, orientation a rotation vector per axis).
@@ -306,6 +315,7 @@ struct OdometerOptions {
   double kv_over_L = 0.8;             // 1/m, > 0
   double k_theta = 1.0;               // nonzero
   double k_gamma = 0.0;               // rad
+  double noise_correlation_s = 0.0;   // Gauss-Markov correlation time of both readings' noise; 0: white
 };
 
 struct WheelEncoderOptions {

@@ -192,6 +192,10 @@ std::optional<P> WheelChangesProblem(const Scenario& s) {
   return std::nullopt;
 }
 
+// A sensor noise's Gauss-Markov correlation time [s]: 0 (white) or up to an hour.
+bool CorrelationTime(double seconds) { return seconds >= 0.0 && seconds <= 3600.0; }
+constexpr const char* kCorrelationRange = "must be in [0, 3600] s (0: white noise)";
+
 // The IMU, magnetometer and GPS.
 std::optional<P> InertialAndGpsProblem(const Scenario& s) {
   if (const auto& imu = s.sensors.imu) {
@@ -202,6 +206,7 @@ std::optional<P> InertialAndGpsProblem(const Scenario& s) {
     if (!(imu->misalignment.coeffs().allFinite() && norm > 0.5 && norm < 2.0))
       return P{"sensors.imu.misalignment", "must be a quaternion [w, x, y, z] near unit norm"};
     if (!imu->lever_arm_m.allFinite()) return P{"sensors.imu.lever_arm_m", "must be finite"};
+    if (!CorrelationTime(imu->noise_correlation_s)) return P{"sensors.imu.noise_correlation_s", kCorrelationRange};
   }
   if (const auto& mag = s.sensors.magnetometer) {
     if (!s.sensors.imu) return P{"sensors.magnetometer", "needs sensors.imu (it shares the IMU's frame)"};
@@ -211,6 +216,8 @@ std::optional<P> InertialAndGpsProblem(const Scenario& s) {
     if (!mag->b.allFinite()) return P{"sensors.magnetometer.b", "must be finite"};
     if (!(mag->field_world.allFinite() && mag->field_world.norm() > 0.0))
       return P{"sensors.magnetometer.field_world", "must be finite and nonzero"};
+    if (!CorrelationTime(mag->noise_correlation_s))
+      return P{"sensors.magnetometer.noise_correlation_s", kCorrelationRange};
   }
   if (const auto& mocap = s.sensors.mocap) {
     if (!Positive(mocap->rate_hz)) return P{"sensors.mocap.rate_hz", "must be > 0"};
@@ -221,6 +228,7 @@ std::optional<P> InertialAndGpsProblem(const Scenario& s) {
     if (!Positive(gps->rate_hz)) return P{"sensors.gps.rate_hz", "must be > 0"};
     if (!NonNegative(gps->sigma_m)) return P{"sensors.gps.sigma_m", "must be >= 0"};
     if (!gps->lever_arm_m.allFinite()) return P{"sensors.gps.lever_arm_m", "must be finite"};
+    if (!CorrelationTime(gps->noise_correlation_s)) return P{"sensors.gps.noise_correlation_s", kCorrelationRange};
   }
   return std::nullopt;
 }
@@ -265,6 +273,7 @@ std::optional<P> OdometrySensorsProblem(const Scenario& s) {
     if (!Positive(odo->kv_over_L)) return P{"sensors.odometer.kv_over_L", "must be > 0"};
     if (!(Finite(odo->k_theta) && odo->k_theta != 0.0)) return P{"sensors.odometer.k_theta", "must be nonzero"};
     if (!Finite(odo->k_gamma)) return P{"sensors.odometer.k_gamma", "must be finite"};
+    if (!CorrelationTime(odo->noise_correlation_s)) return P{"sensors.odometer.noise_correlation_s", kCorrelationRange};
   }
 
   return std::nullopt;

@@ -261,6 +261,8 @@ class Simulator::Impl {
       if (Status s = clock(sensors.imu->rate_hz, "sensors.imu.rate_hz", &imu_clock_); !s.ok()) return s;
       imu_.q_body_imu = sensors.imu->misalignment.normalized();
       imu_.p_body_imu = sensors.imu->lever_arm_m;
+      gyro_noise_.SetCorrelation(sensors.imu->noise_correlation_s, 1e-9 * static_cast<double>(imu_clock_.period_ns));
+      accel_noise_.SetCorrelation(sensors.imu->noise_correlation_s, 1e-9 * static_cast<double>(imu_clock_.period_ns));
     }
     if (sensors.magnetometer) {
       if (Status s = clock(sensors.magnetometer->rate_hz, "sensors.magnetometer.rate_hz", &mag_clock_); !s.ok())
@@ -268,15 +270,21 @@ class Simulator::Impl {
       magnetometer_.A = sensors.magnetometer->A;
       magnetometer_.b = sensors.magnetometer->b;
       magnetometer_.field_world = sensors.magnetometer->field_world;
+      mag_noise_.SetCorrelation(sensors.magnetometer->noise_correlation_s,
+                                1e-9 * static_cast<double>(mag_clock_.period_ns));
     }
     if (sensors.gps) {
       if (Status s = clock(sensors.gps->rate_hz, "sensors.gps.rate_hz", &gps_clock_); !s.ok()) return s;
+      gps_noise_.SetCorrelation(sensors.gps->noise_correlation_s, 1e-9 * static_cast<double>(gps_clock_.period_ns));
     }
     if (sensors.mocap) {
       if (Status s = clock(sensors.mocap->rate_hz, "sensors.mocap.rate_hz", &mocap_clock_); !s.ok()) return s;
     }
     if (sensors.odometer) {
       if (Status s = clock(sensors.odometer->rate_hz, "sensors.odometer.rate_hz", &odometer_clock_); !s.ok()) return s;
+      const double period_s = 1e-9 * static_cast<double>(odometer_clock_.period_ns);
+      speed_noise_.SetCorrelation(sensors.odometer->noise_correlation_s, period_s);
+      steering_noise_.SetCorrelation(sensors.odometer->noise_correlation_s, period_s);
     }
     if (sensors.wheel_encoders) {
       if (Status s = clock(sensors.wheel_encoders->rate_hz, "sensors.wheel_encoders.rate_hz", &encoder_clock_); !s.ok())
@@ -779,12 +787,12 @@ class Simulator::Impl {
   std::int64_t t_ns_ = 0;         // the current time, for messages
   Clock truth_clock_, imu_clock_, mag_clock_, gps_clock_, mocap_clock_, odometer_clock_, encoder_clock_, laser_clock_;
 
-  NoiseStream gyro_noise_{seed_, NoiseSource::kGyro, options_.noise};
-  NoiseStream accel_noise_{seed_, NoiseSource::kAccel, options_.noise};
-  NoiseStream mag_noise_{seed_, NoiseSource::kMagnetometer, options_.noise};
-  NoiseStream gps_noise_{seed_, NoiseSource::kGps, options_.noise};
-  NoiseStream speed_noise_{seed_, NoiseSource::kSpeed, options_.noise};
-  NoiseStream steering_noise_{seed_, NoiseSource::kSteering, options_.noise};
+  GaussMarkovNoise gyro_noise_{seed_, NoiseSource::kGyro, options_.noise};
+  GaussMarkovNoise accel_noise_{seed_, NoiseSource::kAccel, options_.noise};
+  GaussMarkovNoise mag_noise_{seed_, NoiseSource::kMagnetometer, options_.noise};
+  GaussMarkovNoise gps_noise_{seed_, NoiseSource::kGps, options_.noise};
+  GaussMarkovNoise speed_noise_{seed_, NoiseSource::kSpeed, options_.noise};
+  GaussMarkovNoise steering_noise_{seed_, NoiseSource::kSteering, options_.noise};
   NoiseStream laser_noise_{seed_, NoiseSource::kLaserRange, options_.noise};
   NoiseStream mocap_position_noise_{seed_, NoiseSource::kMocapPosition, options_.noise};
   NoiseStream mocap_orientation_noise_{seed_, NoiseSource::kMocapOrientation, options_.noise};

@@ -60,6 +60,7 @@ struct TrainingFits {
   double margin_s = 0.0;  // the time-shift range (DiagnoseOptions::max_shift_s)
   int* fits = nullptr;    // incremented by every fit
   std::function<void(const std::string&)> progress;
+  estimator::CalibrationOptions::StdMethod std_method = estimator::CalibrationOptions::StdMethod::kAuto;
 
   // Fits the training part as `spec` says, counting the fit.
   Result<FitOutcome> Run(const FitSpec& spec) const;

@@ -32,6 +32,7 @@ struct FitSpec {
   std::map<std::string, double> shift_s;          // recording stream -> seconds subtracted from its stamps
   bool keep_residuals = false;
   bool observability = false;
+  estimator::CalibrationOptions::StdMethod std_method = estimator::CalibrationOptions::StdMethod::kAuto;
   const Trajectory* initial = nullptr;  // warm-start poses (estimator/calibration.h)
 };
 

@@ -1,9 +1,11 @@
 #include "estimator/covariance.h"
 
 #include <cmath>
+#include <random>
 
 #include <gtest/gtest.h>
 
+#include "estimator/marginalization.h"
 #include "estimator/solver.h"
 #include "tests/estimator/solver_testing.h"
 
@@ -60,6 +62,74 @@ TEST(ObservabilityTest, ComponentWhoseInformationIsAlmostAllSharedIsUnobservable
   a = AnalyzeObservability(marginal, conditional);
   EXPECT_EQ(a.observability[1], Observability::kWeak);
   EXPECT_NEAR(a.std[1], std::sqrt(300.0), 1e-9);
+}
+
+// A scalar x read n times as z_t = 1 + e_t, e a first-order Gauss-Markov series of unit variance and lag-one
+// correlation a, each reading believed white with unit variance (stream "z", stamped 10 ms apart): the white variance
+// of the estimate is 1 / n, its actual one about (1 + a) / (n (1 - a)).
+struct ScalarSeries {
+  Graph graph;
+  VariableId x;
+  ScalarSeries(int n, double a, std::uint32_t seed) {
+    x = graph.AddVariable({"x", Manifold::Euclidean(1), Eigen::VectorXd::Zero(1), false, std::nullopt});
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> normal;
+    double e = normal(rng);
+    for (int t = 0; t < n; ++t) {
+      graph.AddFactor(
+          std::make_unique<LinearPriorFactor>(std::vector<Manifold>{Manifold::Euclidean(1)},
+                                              std::vector<Eigen::VectorXd>{Eigen::VectorXd::Constant(1, 1.0 + e)},
+                                              Eigen::MatrixXd::Identity(1, 1), Eigen::VectorXd::Zero(1)),
+          {x}, Eigen::MatrixXd::Identity(1, 1), Loss::Trivial(), "z", Time::FromNanoseconds(10000000LL * t));
+      e = a * e + std::sqrt(1.0 - a * a) * normal(rng);
+    }
+  }
+  // The HAC variance over the white one at the least-squares estimate.
+  double HacOverWhite() {
+    EXPECT_TRUE(Solve(SolverOptions{}, &graph).usable());
+    const auto info = ComputeMarginalInformation(graph, {x});
+    EXPECT_TRUE(info.ok());
+    const Eigen::MatrixXd white = info.value().information.inverse();
+    const auto hac = ComputeHacCovariance(graph, {x}, white);
+    EXPECT_TRUE(hac.ok()) << hac.status().message();
+    return hac.value().covariance(0, 0) / white(0, 0);
+  }
+};
+
+// With correlation a = 0.9 the actual variance is 19 times the white one. The last window of lags whose mean
+// autocorrelation reaches 2 / sqrt(n) = 0.014 is [16, 32) (mean 0.094; [32, 64) has 0.010, near enough to the
+// threshold that noise may admit it), so L = 93 (or 189): the Bartlett sum keeps 0.90 (0.95) of the long-run variance,
+// with a relative spread of about sqrt(4 L / (3 n)) = 0.08 (0.11). Within 3 of those of either.
+TEST(HacCovarianceTest, InflatesTheWhiteVarianceByTheLongRunVarianceOfCorrelatedResiduals) {
+  constexpr double kA = 0.9;
+  ScalarSeries series(20000, kA, 5);
+  const double ratio = series.HacOverWhite() / ((1.0 + kA) / (1.0 - kA));
+  EXPECT_GT(ratio, 0.90 - 3.0 * 0.08);
+  EXPECT_LT(ratio, 0.95 + 3.0 * 0.11);
+}
+
+// With white residuals of the believed variance the HAC variance is the white one, within the spread of a variance
+// estimate over n = 20000 rows and a lag of a few rows (about sqrt(2 / n) = 0.01 each; 5 of those).
+TEST(HacCovarianceTest, MatchesTheWhiteVarianceOnWhiteResiduals) {
+  ScalarSeries series(20000, 0.0, 6);
+  EXPECT_NEAR(series.HacOverWhite(), 1.0, 0.05);
+}
+
+// AR(1) residuals of correlation a: the integrated autocorrelation time (1 + a) / (1 - a) = 19 for a = 0.9, kept as
+// above.
+TEST(HacCovarianceTest, IntegratedAutocorrelationTimeOfAGaussMarkovSeries) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal;
+  std::vector<Eigen::VectorXd> series;
+  double e = normal(rng);
+  for (int t = 0; t < 20000; ++t) {
+    series.push_back(Eigen::VectorXd::Constant(1, e));
+    e = 0.9 * e + std::sqrt(1.0 - 0.81) * normal(rng);
+  }
+  const ResidualAutocorrelation r = AnalyzeAutocorrelation(series);
+  EXPECT_TRUE(r.lag == 93 || r.lag == 189) << r.lag;
+  EXPECT_GT(r.integrated_time / 19.0, 0.90 - 3.0 * 0.08);
+  EXPECT_LT(r.integrated_time / 19.0, 0.95 + 3.0 * 0.11);
 }
 
 }  // namespace

@@ -2,9 +2,12 @@
 // OptiOdom's differential drive (unequal wheel diameters, a wider effective track) and the Husky bag (skid-steer yaw
 // mismatch). The data README's reference values come from a "quick least-squares look", not from ground truth; the
 // OptiOdom test checks the diagnosis against an independent least-squares fit on the same run instead (YawRatio).
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <Eigen/Dense>
@@ -24,6 +27,29 @@ const std::string kData = ::roamlab::testing::RealDataDir();
 // A Dec-2020 square set: straight legs and turns in place separate the wheel ratio from the track (a circle at
 // constant curvature does not: there the ratio trades against the track and the time offset).
 const std::string kSet = kData + "/optiodom/data/diff/square/231220200029/231220200029";
+
+// The diagnosis with the white standard deviations (the chi-square's curvature), which the significance checks below
+// were made with; the default on an imported recording is the HAC one, which PrintHacStds shows beside them.
+Result<Diagnosis> DiagnoseWhite(const estimator::EstimatorConfig& config, const recording::Recording& rec) {
+  DiagnoseOptions options;
+  options.std_method = estimator::CalibrationOptions::StdMethod::kWhite;
+  return Diagnose(config, rec, options);
+}
+
+// The default diagnosis (HAC standard deviations on an imported recording): the named effects' values and stds.
+void PrintHacStds(const estimator::EstimatorConfig& config, const recording::Recording& rec,
+                  const std::vector<std::string>& names) {
+  auto d = Diagnose(config, rec);
+  ASSERT_TRUE(d.ok()) << d.status().message();
+  EXPECT_EQ(d.value().std_method, "hac");
+  for (const EffectEstimate& e : d.value().candidates) {
+    if (std::find(names.begin(), names.end(), e.name) == names.end()) continue;
+    std::cout << "HAC: " << e.name;
+    for (const auto& [k, v] : e.parameters)
+      std::cout << " " << k << " = " << v << " +- " << (e.std.count(k) ? e.std.at(k) : std::nan(""));
+    std::cout << "\n";
+  }
+}
 
 const EffectEstimate* Find(const Diagnosis& d, const std::string& name) {
   for (const EffectEstimate& e : d.effects)
@@ -90,7 +116,7 @@ TEST(RealDataTest, OptiOdomDifferentialDriveTrackAndWheelRatio) {
   auto config =
       estimator::LoadEstimatorConfig(std::string(ROAMLAB_SOURCE_DIR) + "/configs/real/optiodom_diff_nominal.yaml");
   ASSERT_TRUE(config.ok()) << config.status().message();
-  auto d = Diagnose(config.value(), rec.value());
+  auto d = DiagnoseWhite(config.value(), rec.value());
   ASSERT_TRUE(d.ok()) << d.status().message();
   const Diagnosis& diagnosis = d.value();
   for (const EffectEstimate& e : diagnosis.candidates) {
@@ -120,6 +146,7 @@ TEST(RealDataTest, OptiOdomDifferentialDriveTrackAndWheelRatio) {
             << ", yaw regression " << rho_yaw << "\n";
   EXPECT_NEAR(rho, rho_yaw, 0.002);
   EXPECT_LT(rho, 1.0 - 3.0 * ratio->std.at("ratio_right_left"));
+  PrintHacStds(config.value(), rec.value(), {"track_width_error", "wheel_radius_asymmetry"});
 
   // Other runs of the set: dead reckoning with the geometry calibrated on the training part of run 01 with the
   // accepted effects (the radius re-fitted beside them) against the nominal model calibrated on the same part (one
@@ -197,7 +224,7 @@ TEST(RealDataTest, HuskySkidSteerYawMismatch) {
   ASSERT_TRUE(rec.ok()) << rec.status().message();
   auto config = estimator::LoadEstimatorConfig(std::string(ROAMLAB_SOURCE_DIR) + "/configs/real/husky_nominal.yaml");
   ASSERT_TRUE(config.ok()) << config.status().message();
-  auto d = Diagnose(config.value(), rec.value());
+  auto d = DiagnoseWhite(config.value(), rec.value());
   ASSERT_TRUE(d.ok()) << d.status().message();
   for (const EffectEstimate& e : d.value().candidates) {
     std::cout << e.name;
@@ -229,6 +256,7 @@ TEST(RealDataTest, HuskySkidSteerYawMismatch) {
             << heading_ratio << "\n";
   EXPECT_LT(ratio, 1.0 - 3.0 * ratio_std);
   EXPECT_NEAR(ratio, heading_ratio, 3.0 * ratio_std);
+  PrintHacStds(config.value(), rec.value(), {"imu_time_offset", "track_width_error"});
 }
 
 }  // namespace

@@ -126,6 +126,8 @@ TEST_F(ScenarioErrorTest, BadValues) {
               "flux_capacitor", "effects[0].name", "unknown effect");
   ExpectError(LoadWith("effects: []", "effects: [{name: gps_latency, parameters: {latency_s: 2}}]"), "gps_latency",
               "effects[0].parameters.latency_s", "must be in [0, 1]");
+  ExpectError(LoadWith("sigma_m: 0.33", "sigma_m: 0.33\n    noise_correlation_s: -1"), "noise_correlation_s: -1",
+              "sensors.gps.noise_correlation_s", "must be in [0, 3600] s");
 }
 
 TEST_F(ScenarioErrorTest, WheelOffsetIsParsedAndChecked) {

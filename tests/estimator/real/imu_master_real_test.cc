@@ -7,12 +7,14 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "estimator/calibration.h"
 #include "estimator/config.h"
+#include "estimator/covariance.h"
 #include "estimator/geometry.h"
 #include "estimator/models/enu.h"
 #include "estimator/tracking.h"
@@ -34,9 +36,27 @@ std::map<std::string, Eigen::VectorXd> Values(const CalibrationResult& r) {
   return out;
 }
 
+// Each parameter with its white and HAC standard deviations (`std` is the HAC one on an imported recording).
 void Print(const CalibrationResult& r) {
   for (const ParameterEstimate& p : r.parameters) {
-    std::cout << "  " << p.name << " = [" << p.estimate.transpose() << "] +- [" << p.std.transpose() << "]\n";
+    std::cout << "  " << p.name << " = [" << p.estimate.transpose() << "] +- white [" << p.std_white.transpose()
+              << "], hac [" << p.std_hac.transpose() << "]\n";
+  }
+  std::cout << "  (std: " << r.std_method << "; HAC lags:";
+  for (const auto& [stream, lag] : r.hac_lags) std::cout << " " << stream << " " << lag;
+  std::cout << ")\n";
+  // Each stream's integrated residual autocorrelation time: how many times a white variance understates the spread
+  // of a mean over that stream (what the tracked positions' std, white, would need for the GPS stream).
+  std::map<std::string, std::vector<const MeasurementResidual*>> streams;
+  for (const MeasurementResidual& m : r.residuals)
+    if (m.active) streams[m.stream].push_back(&m);
+  for (auto& [stream, rows] : streams) {
+    std::stable_sort(rows.begin(), rows.end(), [](const auto* x, const auto* y) { return x->t < y->t; });
+    std::vector<Eigen::VectorXd> series;
+    for (const MeasurementResidual* m : rows) series.push_back(m->whitened);
+    const ResidualAutocorrelation a = AnalyzeAutocorrelation(series);
+    std::cout << "  " << stream << ": integrated residual autocorrelation time " << a.integrated_time << " (lag "
+              << a.lag << "), std inflation sqrt = " << std::sqrt(a.integrated_time) << "\n";
   }
 }
 
@@ -62,7 +82,9 @@ Result<TrackingResult> CalibrateAndTrack(const std::string& config_file, const r
                                          CalibrationResult* calibration) {
   auto config = LoadEstimatorConfig(config_file);
   if (!config.ok()) return config.status();
-  auto calibrated = Calibrate(config.value(), rec);
+  CalibrationOptions options;
+  options.keep_residuals = true;
+  auto calibrated = Calibrate(config.value(), rec, options);
   if (!calibrated.ok()) return calibrated.status();
   *calibration = calibrated.value();
   return Track(config.value(), rec, Values(*calibration));
