@@ -249,6 +249,27 @@ class Simulator::Impl {
       scan_geometry_.max_range_m = l.max_range_m;
     }
     if (ackermann_) wheelbase_m_ = Micrometres(vehicle_.wheelbase_m());
+    return ScheduleClocks();
+  }
+
+  // A replay's streams at the recording's stamps (sim/replay_schedule.h).
+  Status ScheduleClocks() {
+    if (!options_.replay) return Status::Ok();
+    const ReplaySchedule& replay = *options_.replay;
+    origin_ns_ = replay.t0.nanoseconds();
+    if (replay.drive.t.empty() || replay.drive.values.rows() != static_cast<Eigen::Index>(replay.drive.t.size()))
+      return Status::Error(where_ + ": the replay has no drive inputs");
+    const std::map<std::string, Clock*> clocks{{"imu", &imu_clock_},           {"magnetometer", &mag_clock_},
+                                               {"gps", &gps_clock_},           {"rear_wheel", &odometer_clock_},
+                                               {"steering", &odometer_clock_}, {"wheel_encoders", &encoder_clock_},
+                                               {"pose", &pose_clock_}};
+    for (const auto& [name, stamps] : replay.stamps) {
+      const auto it = clocks.find(name);
+      if (it == clocks.end()) return Status::Error(where_ + ": the replay schedules an unknown stream '" + name + "'");
+      if (stamps.empty() || stamps.front() < replay.t0)
+        return Status::Error(where_ + ": the replay's stream '" + name + "' has no stamps at or after its start");
+      internal::Schedule(stamps, replay.t0, step_ns_, it->second);
+    }
     return Status::Ok();
   }
 
@@ -264,35 +285,39 @@ class Simulator::Impl {
     }
     if (sensors.magnetometer) {
       mag_stream_ = MakeStream("magnetometer", StreamType::kMagnetometer, sensors.magnetometer->rate_hz,
-                               {"mx", "my", "mz"}, "normalized", mag_clock_);
+                               {"mx", "my", "mz"}, "normalized", mag_clock_, origin());
       mag_stream_.info.mounting = recording::Mounting{};
       mag_stream_.info.noise = {{"sigma_normalized", sensors.magnetometer->sigma}};
     }
     if (sensors.gps) {
       gps_stream_ = MakeStream("gps", StreamType::kGps, sensors.gps->rate_hz, {"latitude", "longitude", "altitude"},
-                               "deg", gps_clock_);
+                               "deg", gps_clock_, origin());
       gps_stream_.info.mounting = recording::Mounting{};
       gps_stream_.info.noise = {{"sigma_m", sensors.gps->sigma_m}};
     }
     if (sensors.wheel_encoders) {
       encoder_stream_ = MakeStream("wheel_encoders", StreamType::kWheelEncoders, sensors.wheel_encoders->rate_hz,
-                                   wheeled_.EncoderColumns(), "rad", encoder_clock_);
+                                   wheeled_.EncoderColumns(), "rad", encoder_clock_, origin());
       encoder_stream_.info.attributes = {{"ticks_per_revolution", sensors.wheel_encoders->ticks_per_revolution}};
     }
     if (sensors.laser) {
       scan_matching_.emplace("scan_matching", sensors.laser->rate_hz);
       if (sensors.laser->store_scans) {
         laser_scan_stream_ = MakeStream("laser_scan", StreamType::kLaserScan, sensors.laser->rate_hz,
-                                        recording::LaserScanColumns(sensors.laser->beams), "rad,m", laser_clock_);
+                                        recording::LaserScanColumns(sensors.laser->beams), "rad,m", laser_clock_, origin());
       }
     }
     if (sensors.odometer) {
       wheel_stream_ = MakeStream("rear_wheel", StreamType::kWheelEncoders, sensors.odometer->rate_hz, {"rear"}, "m/s",
-                                 odometer_clock_);
+                                 odometer_clock_, origin());
       wheel_stream_.info.noise = {{"sigma_mps", sensors.odometer->speed_sigma_mps}};
       steering_stream_ =
-          MakeStream("steering", StreamType::kSteering, sensors.odometer->rate_hz, {"angle"}, "rad", odometer_clock_);
+          MakeStream("steering", StreamType::kSteering, sensors.odometer->rate_hz, {"angle"}, "rad", odometer_clock_, origin());
       steering_stream_.info.noise = {{"sigma_rad", sensors.odometer->steering_sigma_rad}};
+    }
+    if (pose_clock_.scheduled()) {
+      pose_stream_ = MakeStream("pose", StreamType::kPose, 0.0, recording::FixedColumns(StreamType::kPose), "",
+                                pose_clock_, origin());
     }
     local_.emplace(scenario_.origin.latitude_deg, scenario_.origin.longitude_deg, scenario_.origin.altitude_m);
     truth_.reserve(truth_clock_.samples);
@@ -313,6 +338,11 @@ class Simulator::Impl {
   // The set-points at t_ns (Ackermann: speed [m/s], handlebar [rad] and 0; body velocity: v_x [m/s], omega_z
   // [rad/s] and v_y [m/s]): the profiles from t = 0, the lead-in's rest and ramp before.
   std::array<double, 3> SetPoints(std::int64_t t_ns) const {
+    if (options_.replay) {
+      const Eigen::VectorXd u = ReplayInputs(t_ns);
+      if (options_.replay->drive.kind == DriveInputs::Kind::kBodyVelocity) return {u[0], u[2], u[1]};
+      return {u[0], u[1], 0.0};
+    }
     const DriverOptions& driver = scenario_.driver;
     const Profile& first = ackermann_ ? driver.speed_mps : driver.linear_mps;
     const Profile& second = ackermann_ ? driver.handlebar_rad : driver.angular_radps;
@@ -325,6 +355,15 @@ class Simulator::Impl {
     const double phase = static_cast<double>(t_ns + lead_in_ns_) / static_cast<double>(lead_in_ns_);
     const double ramp = std::clamp((phase - kLeadInRestFraction) / (1.0 - kLeadInRestFraction), 0.0, 1.0);
     return {ramp * first.Evaluate(0.0), ramp * second.Evaluate(0.0), ramp * third.Evaluate(0.0)};
+  }
+
+  // A replay's drive inputs at t_ns: the recording's from t = 0, the lead-in's rest and ramp to the first before.
+  Eigen::VectorXd ReplayInputs(std::int64_t t_ns) const {
+    const DriveInputs& drive = options_.replay->drive;
+    if (t_ns >= 0) return drive.At(Time::FromNanoseconds(origin_ns_ + t_ns));
+    const double phase = static_cast<double>(t_ns + lead_in_ns_) / static_cast<double>(lead_in_ns_);
+    const double ramp = std::clamp((phase - kLeadInRestFraction) / (1.0 - kLeadInRestFraction), 0.0, 1.0);
+    return ramp * drive.At(Time::FromNanoseconds(origin_ns_));
   }
 
   // Pose of a robot site in O, measured at the current state (the robot is rigid between them).
@@ -360,6 +399,9 @@ class Simulator::Impl {
     mag_clock_.shift_ns = imu_clock_.shift_ns;  // the magnetometer shares the IMU's clock
     // A sample taken after the end of the drive (negative shift) extends the physics past it.
     loop_end_ns_ = end_ns_ + std::max<std::int64_t>(0, -std::min(imu_clock_.shift_ns, gps_clock_.shift_ns));
+    // A replay's sample nearest a stamp may fall after the end.
+    for (const Clock* c : {&imu_clock_, &mag_clock_, &gps_clock_, &odometer_clock_, &encoder_clock_, &pose_clock_})
+      if (c->scheduled()) loop_end_ns_ = std::max(loop_end_ns_, c->LastSampleNs());
     steering_offset_rad_ = EffectParameter(effects, "steering_offset", "offset_rad", 0.0);
     for (int i = 0; i < 3; ++i) {
       const std::string axis(1, "xyz"[i]);
@@ -402,6 +444,8 @@ class Simulator::Impl {
         const double measured = vehicle_.RearWheelRate(d) * vehicle_.wheel_radius_m();
         drive_torque_nm_ = controller_->Update(first, measured, dt_s);
         vehicle_.Apply(second, drive_torque_nm_, d);
+      } else if (options_.replay && options_.replay->drive.kind == DriveInputs::Kind::kWheelRates) {
+        wheeled_.ApplyWheelRates(ReplayInputs(t_ns_), d);
       } else {
         wheeled_.Apply(first, third, second, d);
       }
@@ -445,7 +489,8 @@ class Simulator::Impl {
 
   bool AnyDue(std::int64_t t_ns) const {
     return truth_clock_.Due(t_ns) || imu_clock_.Due(t_ns) || mag_clock_.Due(t_ns) || gps_clock_.Due(t_ns) ||
-           odometer_clock_.Due(t_ns) || encoder_clock_.Due(t_ns) || laser_clock_.Due(t_ns) || CameraDue(t_ns);
+           odometer_clock_.Due(t_ns) || encoder_clock_.Due(t_ns) || laser_clock_.Due(t_ns) || pose_clock_.Due(t_ns) ||
+           CameraDue(t_ns);
   }
 
   // Camera frame k is due at the first step at or after k / rate_hz (rounded to the nanosecond, not accumulated):
@@ -486,7 +531,7 @@ class Simulator::Impl {
 
     if (truth_clock_.Due(t_ns)) {
       if (Status s = CheckVehicle(body, t_ns); !s.ok()) return s;
-      StampedPose pose{Time::FromNanoseconds(t_ns), body.p_world_body, body.q_world_body};
+      StampedPose pose{Time::FromNanoseconds(origin_ns_ + t_ns), body.p_world_body, body.q_world_body};
       // Keep the quaternion sign continuous so that the TUM file has no jumps.
       if (!truth_.empty() && truth_.back().q_world_body.dot(pose.q_world_body) < 0.0)
         pose.q_world_body.coeffs() = -pose.q_world_body.coeffs();
@@ -526,8 +571,7 @@ class Simulator::Impl {
       // Cumulative angle since t = 0, truncated to whole ticks (an incremental encoder's count).
       const double tick_rad = 2.0 * kPi / sensors.wheel_encoders->ticks_per_revolution;
       const int wheels = static_cast<int>(wheeled_.wheels().size());
-      if (t_ns == 0) {
-        encoder_zero_rad_.clear();
+      if (encoder_zero_rad_.empty()) {  // the first sample: t = 0, or a replay's first stamp
         for (int i = 0; i < wheels; ++i) encoder_zero_rad_.push_back(wheeled_.WheelAngle(data_.get(), i));
       }
       for (int i = 0; i < wheels; ++i) {
@@ -536,6 +580,10 @@ class Simulator::Impl {
       }
     }
     if (laser_clock_.Due(t_ns)) SampleLaser(t_ns);
+    if (pose_clock_.Due(t_ns)) {
+      pose_stream_.values.row(pose_clock_.Row(t_ns)) << body.p_world_body.transpose(), body.q_world_body.x(),
+          body.q_world_body.y(), body.q_world_body.z(), body.q_world_body.w();
+    }
     if (odometer_clock_.Due(t_ns)) {
       const OdometerOptions& odo = *sensors.odometer;
       // tire_growth: the rigid MuJoCo tire rolls at omega = v / r0; a tire of radius r0 (1 + c v^2) turns at
@@ -618,6 +666,13 @@ class Simulator::Impl {
     rec.platform.geometry = PlatformGeometry();
     rec.origin = scenario_.origin;
     rec.provenance = internal::SimulatedProvenance(scenario_, seed_, model_where_, options_.noise);
+    internal::FillRepeatedRows(imu_clock_, &imu_stream_);
+    internal::FillRepeatedRows(mag_clock_, &mag_stream_);
+    internal::FillRepeatedRows(gps_clock_, &gps_stream_);
+    internal::FillRepeatedRows(odometer_clock_, &wheel_stream_);
+    internal::FillRepeatedRows(odometer_clock_, &steering_stream_);
+    internal::FillRepeatedRows(encoder_clock_, &encoder_stream_);
+    internal::FillRepeatedRows(pose_clock_, &pose_stream_);
     if (sensors.imu) rec.streams.push_back(std::move(imu_stream_));
     if (sensors.magnetometer) rec.streams.push_back(std::move(mag_stream_));
     if (sensors.gps) rec.streams.push_back(std::move(gps_stream_));
@@ -626,6 +681,7 @@ class Simulator::Impl {
       rec.streams.push_back(std::move(steering_stream_));
     }
     if (sensors.wheel_encoders) rec.streams.push_back(std::move(encoder_stream_));
+    if (pose_clock_.scheduled()) rec.streams.push_back(std::move(pose_stream_));
     if (sensors.laser) {
       recording::Stream scan_stream = scan_matching_->TakeStream();
       scan_stream.info.mounting = laser_mounting_;
@@ -702,7 +758,9 @@ class Simulator::Impl {
   std::int64_t lead_in_ns_ = 0;
   std::int64_t loop_end_ns_ = 0;  // end_ns_, or later when a sample is taken after the recording's end
   std::int64_t t_ns_ = 0;         // the current time, for messages
-  Clock truth_clock_, imu_clock_, mag_clock_, gps_clock_, odometer_clock_, encoder_clock_, laser_clock_;
+  std::int64_t origin_ns_ = 0;  // the recording time of t = 0 (a replay's t0)
+  Time origin() const { return Time::FromNanoseconds(origin_ns_); }
+  Clock truth_clock_, imu_clock_, mag_clock_, gps_clock_, odometer_clock_, encoder_clock_, laser_clock_, pose_clock_;
 
   NoiseStream gyro_noise_{seed_, NoiseSource::kGyro, options_.noise};
   NoiseStream accel_noise_{seed_, NoiseSource::kAccel, options_.noise};
@@ -715,7 +773,7 @@ class Simulator::Impl {
   NoiseStream multipath_noise_{seed_, NoiseSource::kGpsMultipath};  // likewise
 
   recording::Stream imu_stream_, mag_stream_, gps_stream_, wheel_stream_, steering_stream_, encoder_stream_,
-      laser_scan_stream_;
+      laser_scan_stream_, pose_stream_;
   Trajectory truth_;
   double min_height_ = 1e300;
   double max_height_ = -1e300;
