@@ -1,0 +1,323 @@
+// The replay (sim/replay.h): the twin follows the recorded drive, not the nominal schedule; it holds the recording's
+// streams at the recording's stamps; a recording without drive inputs is refused; the same replay gives the same
+// bytes; and, on a real OptiOdom run when the data is present, how far the nominal twin drifts from motion capture.
+#include "sim/replay.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "importers/optiodom.h"
+#include "recording/truth.h"
+#include "sim/simulator.h"
+#include "sim_testing.h"
+#include "tests/recording/temp_dir.h"
+#include "tests/support/real_data.h"
+
+namespace roamlab::sim {
+namespace {
+
+using recording::Recording;
+using recording::Stream;
+using ::roamlab::Trajectory;
+using ::testing::HasSubstr;
+
+constexpr double kPi = 3.14159265358979323846;
+
+// scenarios/indoor_diffdrive_slip.yaml without laser, camera and room, with a gentle drive of sines (no wheel
+// slip: the encoders tell the drive) over `duration_s`.
+Scenario GentleDiffDrive(double duration_s) {
+  auto loaded = LoadScenario(testing::SourcePath("scenarios/indoor_diffdrive_slip.yaml"));
+  EXPECT_TRUE(loaded.ok()) << loaded.status().message();
+  Scenario s = loaded.value();
+  s.duration_s = duration_s;
+  s.sensors.laser.reset();
+  s.sensors.camera.reset();
+  s.world_model_file.clear();
+  ProfileTerm v;
+  v.type = ProfileTerm::Type::kSine;
+  v.amplitude = 0.3;
+  v.period_s = 6.0;
+  ProfileTerm v0;
+  v0.value = 0.2;
+  ProfileTerm w;
+  w.type = ProfileTerm::Type::kSine;
+  w.amplitude = 0.8;
+  w.period_s = 4.0;
+  w.phase_rad = 0.7;
+  s.driver.linear_mps.terms = {v0, v};
+  s.driver.angular_radps.terms = {w};
+  return s;
+}
+
+// The same robot driven by another schedule.
+Scenario OtherDrive(double duration_s) {
+  Scenario s = GentleDiffDrive(duration_s);
+  ProfileTerm v;
+  v.type = ProfileTerm::Type::kSine;
+  v.amplitude = 0.25;
+  v.period_s = 3.0;
+  ProfileTerm w0;
+  w0.value = -0.6;
+  ProfileTerm w;
+  w.type = ProfileTerm::Type::kSine;
+  w.amplitude = 0.5;
+  w.period_s = 2.5;
+  s.driver.linear_mps.terms = {v};
+  s.driver.angular_radps.terms = {w0, w};
+  return s;
+}
+
+struct TrackError {
+  double max_position_m = 0.0;
+  double max_heading_rad = 0.0;
+};
+
+double Yaw(const Eigen::Quaterniond& q) {
+  const Eigen::Vector3d x = q * Eigen::Vector3d::UnitX();
+  return std::atan2(x.y(), x.x());
+}
+
+double AngleDifference(double a, double b) { return std::remainder(a - b, 2.0 * kPi); }
+
+// Largest planar distance and heading difference between two trajectories at their common stamps.
+TrackError Compare(const Trajectory& a, const Trajectory& b) {
+  TrackError e;
+  std::size_t j = 0;
+  for (const auto& pa : a) {
+    while (j < b.size() && b[j].t < pa.t) ++j;
+    if (j == b.size()) break;
+    if (b[j].t != pa.t) continue;
+    e.max_position_m = std::max(e.max_position_m, (pa.p_world_body - b[j].p_world_body).head<2>().norm());
+    e.max_heading_rad =
+        std::max(e.max_heading_rad, std::abs(AngleDifference(Yaw(pa.q_world_body), Yaw(b[j].q_world_body))));
+  }
+  return e;
+}
+
+// The longest straight distance covered, as the trajectory's scale.
+double Extent(const Trajectory& t) {
+  double extent = 0.0;
+  for (const auto& p : t) extent = std::max(extent, (p.p_world_body - t.front().p_world_body).head<2>().norm());
+  return extent;
+}
+
+Simulation SimulateOk(const Scenario& s) {
+  auto sim = Simulate(s);
+  EXPECT_TRUE(sim.ok()) << sim.status().message();
+  return std::move(sim).value();
+}
+
+Simulation ReplayOk(const Scenario& nominal, const Recording& real, const ReplayOptions& options = {}) {
+  auto twin = Replay(nominal, real, options);
+  EXPECT_TRUE(twin.ok()) << twin.status().message();
+  return std::move(twin).value();
+}
+
+// The bound on the twin's tracking error. The encoders quantize the angle to ticks of 2 pi / 2048 rad; the replay's
+// rates, averaged over 2 kRateHalfWindowS, integrate back to the measured angles, so quantization leaves at most one
+// tick of wheel angle, r * tick = 0.1 mm of travel per wheel (models/diffdrive.xml, r = 0.1 m... measured below).
+// The servo tracks its target with a lag: the replayed wheel follows the measured rate (which already lagged the
+// command) one servo lag later, so the twin's wheels run behind the recorded ones by the servo's lag tau, which
+// shifts each wheel's travel by tau * (the change of its rim speed) and the heading by tau * (the change of the yaw
+// rate). Over this drive the yaw rate moves within +-0.8 rad/s, so the heading error stays below ~tau * 1.6 rad/s;
+// the measured servo lag (wheel rate against its target) is below 20 ms here, giving 0.03 rad, and the position
+// error follows as the heading error times the distance driven plus the travel lag, a few centimetres over 12 s.
+constexpr double kHeadingBoundRad = 0.03;
+constexpr double kPositionBoundPerMetre = 0.03;  // [m] per metre of extent
+
+TEST(ReplayTest, OwnDriveReproducesTheTruth) {
+  const Scenario s = GentleDiffDrive(12.0);
+  const Simulation real = SimulateOk(s);
+  const Simulation twin = ReplayOk(s, real.recording);
+  ASSERT_TRUE(twin.recording.ground_truth.has_value());
+  const TrackError e = Compare(*twin.recording.ground_truth, *real.recording.ground_truth);
+  const double extent = Extent(*real.recording.ground_truth);
+  std::printf("own drive: extent %.2f m, twin error <= %.4f m, %.4f rad; %.1fx real time\n", extent, e.max_position_m,
+              e.max_heading_rad, twin.stats.realtime_factor);
+  EXPECT_GT(extent, 1.0);
+  EXPECT_LT(e.max_heading_rad, kHeadingBoundRad);
+  EXPECT_LT(e.max_position_m, kPositionBoundPerMetre * extent);
+  ASSERT_TRUE(twin.truth.replay.has_value());
+  EXPECT_THAT(twin.truth.replay->drive, HasSubstr("wheel_encoders"));
+}
+
+TEST(ReplayTest, InputsNotTheScheduleDriveTheTwin) {
+  const Scenario nominal = GentleDiffDrive(12.0);
+  const Simulation other = SimulateOk(OtherDrive(12.0));
+  const Simulation own = SimulateOk(nominal);
+  const Simulation twin = ReplayOk(nominal, other.recording);
+  const TrackError follows = Compare(*twin.recording.ground_truth, *other.recording.ground_truth);
+  const TrackError schedule = Compare(*own.recording.ground_truth, *other.recording.ground_truth);
+  const double extent = Extent(*other.recording.ground_truth);
+  std::printf("other drive: twin error <= %.4f m, %.4f rad; the nominal schedule's %.3f m, %.3f rad\n",
+              follows.max_position_m, follows.max_heading_rad, schedule.max_position_m, schedule.max_heading_rad);
+  EXPECT_LT(follows.max_heading_rad, kHeadingBoundRad);
+  EXPECT_LT(follows.max_position_m, kPositionBoundPerMetre * extent);
+  EXPECT_GT(schedule.max_position_m, 10.0 * follows.max_position_m);
+}
+
+TEST(ReplayTest, TwinHoldsTheRecordedStreamsAtTheirStamps) {
+  const Scenario s = GentleDiffDrive(5.0);
+  Simulation real = SimulateOk(s);
+  // Jittered stamps, as a real logger writes them: every other encoder and IMU stamp 3.3 ms late.
+  for (Stream& stream : real.recording.streams)
+    for (std::size_t k = 1; k + 1 < stream.t.size(); k += 2)
+      stream.t[k] = Time::FromNanoseconds(stream.t[k].nanoseconds() + 3'300'000);
+  const Simulation twin = ReplayOk(s, real.recording, {1.0, 4.0, nullptr});
+  ASSERT_EQ(twin.recording.streams.size(), real.recording.streams.size());
+  for (const Stream& r : real.recording.streams) {
+    const Stream* t = twin.recording.Find(r.info.name);
+    ASSERT_NE(t, nullptr) << r.info.name;
+    EXPECT_EQ(t->info.type, r.info.type);
+    EXPECT_EQ(t->info.columns, r.info.columns);
+    std::vector<Time> window;
+    for (Time stamp : r.t)
+      if (stamp >= Time::FromSeconds(1.0) && stamp <= Time::FromSeconds(4.0)) window.push_back(stamp);
+    EXPECT_EQ(t->t, window) << r.info.name;
+  }
+  EXPECT_EQ(twin.recording.ground_truth->front().t, Time::FromSeconds(1.0));
+  // The encoders start at the recorded angle and stay within a few ticks of it.
+  const Stream* recorded = real.recording.Find("wheel_encoders");
+  const Stream* replayed = twin.recording.Find("wheel_encoders");
+  const auto first = static_cast<Eigen::Index>(
+      std::lower_bound(recorded->t.begin(), recorded->t.end(), Time::FromSeconds(1.0)) - recorded->t.begin());
+  EXPECT_EQ(replayed->values.row(0), recorded->values.row(first));
+}
+
+TEST(ReplayTest, RecordingWithoutDriveInputsIsRefused) {
+  const Scenario s = GentleDiffDrive(2.0);
+  Simulation real = SimulateOk(s);
+  std::vector<Stream> imu_only;
+  for (Stream& stream : real.recording.streams)
+    if (stream.info.name == "imu") imu_only.push_back(stream);
+  real.recording.streams = imu_only;
+  const auto twin = Replay(s, real.recording);
+  ASSERT_FALSE(twin.ok());
+  EXPECT_THAT(twin.status().message(), HasSubstr("no drive input"));
+  EXPECT_THAT(twin.status().message(), HasSubstr("wheel_encoders"));
+  EXPECT_EQ(twin.status().message().find('\n'), std::string::npos);
+}
+
+TEST(ReplayTest, RecordedCommandsDriveTheTwin) {
+  const Scenario s = GentleDiffDrive(8.0);
+  const Simulation real = SimulateOk(s);
+  // The schedule's commands at 50 Hz, in an inputs stream, and no encoders.
+  Recording commands = real.recording;
+  commands.streams.erase(std::remove_if(commands.streams.begin(), commands.streams.end(),
+                                        [](const Stream& st) { return st.info.name == "wheel_encoders"; }),
+                         commands.streams.end());
+  Stream inputs;
+  inputs.info.name = "inputs";
+  inputs.info.type = recording::StreamType::kInputs;
+  inputs.info.columns = {"linear_mps", "angular_radps"};
+  inputs.values.resize(401, 2);
+  for (int k = 0; k <= 400; ++k) {
+    const double t = 0.02 * k;
+    inputs.t.push_back(Time::FromNanoseconds(20'000'000LL * k));
+    inputs.values.row(k) << s.driver.linear_mps.Evaluate(t), s.driver.angular_radps.Evaluate(t);
+  }
+  commands.streams.push_back(inputs);
+  const Simulation twin = ReplayOk(s, commands);
+  const TrackError e = Compare(*twin.recording.ground_truth, *real.recording.ground_truth);
+  std::printf("commands at 50 Hz: twin error <= %.4f m, %.4f rad\n", e.max_position_m, e.max_heading_rad);
+  EXPECT_THAT(twin.truth.replay->drive, HasSubstr("inputs"));
+  EXPECT_LT(e.max_heading_rad, kHeadingBoundRad);
+  EXPECT_LT(e.max_position_m, kPositionBoundPerMetre * Extent(*real.recording.ground_truth));
+}
+
+std::string FileBytes(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  std::ostringstream content;
+  content << file.rdbuf();
+  return content.str();
+}
+
+TEST(ReplayTest, SameReplayGivesTheSameBytes) {
+  const Scenario s = GentleDiffDrive(3.0);
+  const Simulation real = SimulateOk(s);
+  ::roamlab::testing::TempDir a, b;
+  for (const auto* dir : {&a, &b}) {
+    const Simulation twin = ReplayOk(s, real.recording);
+    ASSERT_TRUE(recording::WriteRecording(twin.recording, dir->File("twin")).ok());
+    ASSERT_TRUE(recording::WriteTruth(twin.truth, dir->File("twin")).ok());
+  }
+  for (const char* file : {"recording.yaml", "imu.csv", "wheel_encoders.csv", "ground_truth.tum", "truth.yaml"}) {
+    const std::string bytes = FileBytes(a.File(std::string("twin/") + file));
+    EXPECT_FALSE(bytes.empty()) << file;
+    EXPECT_EQ(bytes, FileBytes(b.File(std::string("twin/") + file))) << file;
+  }
+  auto truth = recording::ReadTruth(a.File("twin"));
+  ASSERT_TRUE(truth.ok()) << truth.status().message();
+  ASSERT_TRUE(truth.value().replay.has_value());
+}
+
+TEST(ReplayTest, MatchWheelColumnsBySideForSkidSteer) {
+  auto match = MatchWheelColumns({"right", "left"}, {"front_left", "front_right", "rear_left", "rear_right"});
+  ASSERT_TRUE(match.ok()) << match.status().message();
+  EXPECT_EQ(match.value(), (std::vector<int>{1, 0, 1, 0}));
+  auto exact = MatchWheelColumns({"right", "left"}, {"left", "right"});
+  ASSERT_TRUE(exact.ok());
+  EXPECT_EQ(exact.value(), (std::vector<int>{1, 0}));
+  auto none = MatchWheelColumns({"w1", "w2"}, {"left", "right"});
+  ASSERT_FALSE(none.ok());
+  EXPECT_THAT(none.status().message(), HasSubstr("'left'"));
+}
+
+// The twin's pose stream against the recorded one over windows of `window_s`: the difference of the displacements,
+// each in its own start frame. Returns {mean, max} [m].
+std::pair<double, double> WindowDrift(const Stream& real, const Stream& twin, double window_s) {
+  double sum = 0.0, max = 0.0;
+  int windows = 0;
+  const auto yaw_at = [](const Stream& s, Eigen::Index k) {
+    return Yaw(Eigen::Quaterniond(s.values(k, 6), s.values(k, 3), s.values(k, 4), s.values(k, 5)));
+  };
+  const auto displacement = [&](const Stream& s, Eigen::Index a, Eigen::Index b) {
+    const Eigen::Vector2d d = (s.values.row(b).head<2>() - s.values.row(a).head<2>()).transpose();
+    return Eigen::Rotation2Dd(-yaw_at(s, a)) * d;
+  };
+  const auto n = static_cast<Eigen::Index>(twin.t.size());
+  for (Eigen::Index a = 0, b = 0; a < n; a += 10) {
+    while (b < n && SecondsBetween(twin.t[a], twin.t[b]) < window_s) ++b;
+    if (b == n) break;
+    // The twin's rows are the recording's rows from its first stamp on.
+    const auto offset = std::lower_bound(real.t.begin(), real.t.end(), twin.t[0]) - real.t.begin();
+    const double drift = (displacement(real, a + offset, b + offset) - displacement(twin, a, b)).norm();
+    sum += drift;
+    max = std::max(max, drift);
+    ++windows;
+  }
+  return {windows > 0 ? sum / windows : 0.0, max};
+}
+
+TEST(ReplayTest, RealOptiOdomDiffRunAgainstMotionCapture) {
+  const std::string set = ::roamlab::testing::RealData("optiodom/data/diff/square/231220200029/231220200029");
+  const std::string run = set + "_run-01.csv";
+  if (!std::ifstream(run)) GTEST_SKIP() << "real data absent: " << run;
+  auto real = importers::ImportOptiOdom(run, set + "_metadata.csv");
+  ASSERT_TRUE(real.ok()) << real.status().message();
+  auto nominal = LoadScenario(testing::SourcePath("scenarios/indoor_diffdrive_slip.yaml"));
+  ASSERT_TRUE(nominal.ok());
+  const Simulation twin = ReplayOk(nominal.value(), real.value());
+  const Stream* mocap = real.value().Find("mocap");
+  const Stream* replayed = twin.recording.Find("mocap");
+  ASSERT_NE(replayed, nullptr);
+  EXPECT_EQ(replayed->t, mocap->t);
+  const Eigen::Index last = replayed->values.rows() - 1;
+  const double end_error_m = (replayed->values.row(last).head<2>() - mocap->values.row(last).head<2>()).norm();
+  const auto [mean_10s, max_10s] = WindowDrift(*mocap, *replayed, 10.0);
+  std::printf("OptiOdom diff square run-01 (%.0f s), nominal indoor_diffdrive_slip: end error %.3f m; 10 s drift "
+              "mean %.3f m, max %.3f m; %.1fx real time\n",
+              SecondsBetween(mocap->t.front(), mocap->t.back()), end_error_m, mean_10s, max_10s,
+              twin.stats.realtime_factor);
+  for (const std::string& why : twin.stats.left_out) std::printf("  left out: %s\n", why.c_str());
+  EXPECT_GT(twin.stats.realtime_factor, 0.0);
+}
+
+}  // namespace
+}  // namespace roamlab::sim
