@@ -11,7 +11,10 @@
 
 namespace roamlab::sim {
 
-Eigen::VectorXd DriveInputs::At(Time t_at) const {
+namespace {
+
+// The row of `values` at `t_at` (stamps `t`): held or linear between rows, the first before, the last after.
+Eigen::VectorXd Interpolate(const std::vector<Time>& t, const Eigen::MatrixXd& values, Time t_at, bool hold) {
   const auto after = std::upper_bound(t.begin(), t.end(), t_at);
   if (after == t.begin()) return values.row(0).transpose();
   const auto k = static_cast<Eigen::Index>(after - t.begin()) - 1;
@@ -20,6 +23,11 @@ Eigen::VectorXd DriveInputs::At(Time t_at) const {
                    SecondsBetween(t[static_cast<std::size_t>(k)], t[static_cast<std::size_t>(k) + 1]);
   return ((1.0 - a) * values.row(k) + a * values.row(k + 1)).transpose();
 }
+
+}  // namespace
+
+Eigen::VectorXd DriveInputs::At(Time t_at) const { return Interpolate(t, values, t_at, hold); }
+Eigen::VectorXd DriveInputs::AnglesAt(Time t_at) const { return Interpolate(t, angles_rad, t_at, false); }
 
 namespace {
 
@@ -129,8 +137,11 @@ Found FromWheelEncoders(const Recording& real, const std::string& kind) {
     in.t = s.t;
     in.source = "wheel_encoders stream '" + s.info.name + "'" + (IsAngleEncoder(s) ? " (differentiated)" : "");
     in.values.resize(rates.rows(), static_cast<Eigen::Index>(model.size()));
-    for (std::size_t i = 0; i < model.size(); ++i)
+    if (IsAngleEncoder(s)) in.angles_rad.resize(rates.rows(), static_cast<Eigen::Index>(model.size()));
+    for (std::size_t i = 0; i < model.size(); ++i) {
       in.values.col(static_cast<Eigen::Index>(i)) = rates.col(match.value()[i]);
+      if (IsAngleEncoder(s)) in.angles_rad.col(static_cast<Eigen::Index>(i)) = s.values.col(match.value()[i]);
+    }
     return std::optional<DriveInputs>(std::move(in));
   }
   return std::optional<DriveInputs>();

@@ -1,8 +1,12 @@
 // What a replay (sim/replay.h) hands the simulator in place of the scenario's driver and sensor rates: the drive inputs
 // taken from a recording and the recording's own sample stamps. The simulator keeps one loop; with a schedule
 // (SimulateOptions::replay) its simulation time 0 is the recording time `t0`:
-//   - Drive. From t = 0 on the set-points are the inputs at t0 + t (DriveInputs::At); during the lead-in the robot
-//     rests and then ramps to the first input, as it ramps to the profiles' first values without a schedule.
+//   - Drive. During the lead-in the robot settles at rest on the ground; from t = 0 on the set-points are the inputs
+//     at t0 + t (DriveInputs::At). A recording that starts in motion therefore starts the twin with a step. Measured
+//     wheel angles (DriveInputs::angles_rad) are tracked: each wheel's servo target is its measured rate plus
+//     (measured - twin angle increment since t = 0) / kAngleTrackingS, which removes the velocity servo's
+//     steady-state error (the load torque over its gain: the twin's wheel would otherwise lag the recorded one, which
+//     had already lagged its own command by as much).
 //   - Samples. A scheduled stream's sample stamped s is taken at the physics step nearest s - t0 (half a step at most
 //     away: 1 ms on models/diffdrive.xml, 0.5 ms on models/atv.xml), minus the time shift of an effect
 //     (gps_latency, imu_time_offset); two stamps nearest the same step read the same state. The stream keeps the
@@ -31,10 +35,18 @@ struct DriveInputs {
   Eigen::MatrixXd values;  // one row per t
   bool hold = false;       // true: each row holds until the next (recorded commands); false: linear between rows
   std::string source;      // what the inputs were taken from (stream names), for messages and truth.yaml
+  Eigen::MatrixXd angles_rad;  // kWheelRates from cumulative angles: per row the angle [rad] of each model wheel;
+                               // empty otherwise
 
   // The inputs at recording time `t`: the first row before the first stamp, the last after the last.
   Eigen::VectorXd At(Time t) const;
+  // The wheel angles at `t`, linear between rows (angles_rad must not be empty).
+  Eigen::VectorXd AnglesAt(Time t) const;
 };
+
+// The time constant with which a replay's wheels track the measured wheel angles [s] (well above the velocity
+// servos' own few milliseconds, so the two loops do not fight).
+inline constexpr double kAngleTrackingS = 0.1;
 
 struct ReplaySchedule {
   Time t0;             // the recording time of simulation time 0

@@ -357,13 +357,28 @@ class Simulator::Impl {
     return {ramp * first.Evaluate(0.0), ramp * second.Evaluate(0.0), ramp * third.Evaluate(0.0)};
   }
 
-  // A replay's drive inputs at t_ns: the recording's from t = 0, the lead-in's rest and ramp to the first before.
+  // A replay's drive inputs at t_ns: the recording's from t = 0, rest before (sim/replay_schedule.h).
   Eigen::VectorXd ReplayInputs(std::int64_t t_ns) const {
     const DriveInputs& drive = options_.replay->drive;
-    if (t_ns >= 0) return drive.At(Time::FromNanoseconds(origin_ns_ + t_ns));
-    const double phase = static_cast<double>(t_ns + lead_in_ns_) / static_cast<double>(lead_in_ns_);
-    const double ramp = std::clamp((phase - kLeadInRestFraction) / (1.0 - kLeadInRestFraction), 0.0, 1.0);
-    return ramp * drive.At(Time::FromNanoseconds(origin_ns_));
+    if (t_ns < 0) return Eigen::VectorXd::Zero(drive.values.cols());
+    return drive.At(Time::FromNanoseconds(origin_ns_ + t_ns));
+  }
+
+  // A replay's wheel-rate targets at t_ns: the measured rates, plus the tracking of the measured angles.
+  Eigen::VectorXd ReplayWheelRates(std::int64_t t_ns) {
+    Eigen::VectorXd rates = ReplayInputs(t_ns);
+    const DriveInputs& drive = options_.replay->drive;
+    if (t_ns < 0 || drive.angles_rad.size() == 0) return rates;
+    const auto wheels = static_cast<Eigen::Index>(wheeled_.wheels().size());
+    Eigen::VectorXd twin_angles(wheels);
+    for (Eigen::Index i = 0; i < wheels; ++i) twin_angles[i] = wheeled_.WheelAngle(data_.get(), static_cast<int>(i));
+    if (replay_angles_at_start_.size() == 0) {
+      replay_angles_at_start_ = twin_angles;
+      measured_angles_at_start_ = drive.AnglesAt(Time::FromNanoseconds(origin_ns_));
+    }
+    const Eigen::VectorXd measured =
+        drive.AnglesAt(Time::FromNanoseconds(origin_ns_ + t_ns)) - measured_angles_at_start_;
+    return rates + (measured - (twin_angles - replay_angles_at_start_)) / kAngleTrackingS;
   }
 
   // Pose of a robot site in O, measured at the current state (the robot is rigid between them).
@@ -445,7 +460,7 @@ class Simulator::Impl {
         drive_torque_nm_ = controller_->Update(first, measured, dt_s);
         vehicle_.Apply(second, drive_torque_nm_, d);
       } else if (options_.replay && options_.replay->drive.kind == DriveInputs::Kind::kWheelRates) {
-        wheeled_.ApplyWheelRates(ReplayInputs(t_ns_), d);
+        wheeled_.ApplyWheelRates(ReplayWheelRates(t_ns_), d);
       } else {
         wheeled_.Apply(first, third, second, d);
       }
@@ -759,6 +774,7 @@ class Simulator::Impl {
   std::int64_t loop_end_ns_ = 0;  // end_ns_, or later when a sample is taken after the recording's end
   std::int64_t t_ns_ = 0;         // the current time, for messages
   std::int64_t origin_ns_ = 0;  // the recording time of t = 0 (a replay's t0)
+  Eigen::VectorXd replay_angles_at_start_, measured_angles_at_start_;  // a replay's wheel angles at t = 0
   Time origin() const { return Time::FromNanoseconds(origin_ns_); }
   Clock truth_clock_, imu_clock_, mag_clock_, gps_clock_, odometer_clock_, encoder_clock_, laser_clock_, pose_clock_;
 
