@@ -487,7 +487,7 @@ Result<DriveInputs> DriveInputsFrom(const Recording& real, const Scenario& nomin
                                                          : FromWheelEncoders(real, nominal.robot.kind);
   if (!inputs.ok()) return inputs.status();
   if (!inputs.value())
-    return Status::Error("no drive input: a replay of a " + nominal.robot.kind + " needs " + NeededInputs(ackermann) +
+    return Status::Error("no drive input: a replay of robot kind " + nominal.robot.kind + " needs " + NeededInputs(ackermann) +
                          note);
   return std::move(*inputs.value());
 }

@@ -51,8 +51,8 @@
 namespace roamlab::sim {
 
 inline constexpr double kRateHalfWindowS = 0.05;     // the measured rates' centred averaging window, half width [s]
-inline constexpr double kStartMotionM = 0.5;         // GPS start: the heading of the first displacement this long [m]
-inline constexpr double kStartMotionWindowS = 30.0;  // searched for this long after the start [s]
+inline constexpr double kStartMotionM = 5.0;         // GPS start: the heading of the first displacement this long [m]
+inline constexpr double kStartMotionWindowS = 60.0;  // searched for this long after the start [s]
 
 struct ReplayOptions {
   std::optional<double> from_s, to_s;  // the recording's time [s]

@@ -96,6 +96,18 @@ TrackError Compare(const Trajectory& a, const Trajectory& b) {
   return e;
 }
 
+// `a` moved rigidly (in the plane) so that its first pose is `b`'s: the drive's fidelity apart from the start.
+Trajectory AlignedStart(Trajectory a, const Trajectory& b) {
+  const double turn = AngleDifference(Yaw(b.front().q_world_body), Yaw(a.front().q_world_body));
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(turn, Eigen::Vector3d::UnitZ()));
+  const Eigen::Vector3d p0 = a.front().p_world_body;
+  for (auto& pose : a) {
+    pose.p_world_body = b.front().p_world_body + q * (pose.p_world_body - p0);
+    pose.q_world_body = q * pose.q_world_body;
+  }
+  return a;
+}
+
 // The longest straight distance covered, as the trajectory's scale.
 double Extent(const Trajectory& t) {
   double extent = 0.0;
@@ -302,6 +314,38 @@ std::pair<double, double> WindowDrift(const Stream& real, const Stream& twin, do
     ++windows;
   }
   return {windows > 0 ? sum / windows : 0.0, max};
+}
+
+TEST(ReplayTest, AtvFollowsItsRecordedSpeedAndSteering) {
+  // The recording: from rest, straight for 6 s, then weaving; the nominal scenario: atv_hills.yaml's own schedule.
+  const Scenario nominal = testing::AtvHills(20.0);
+  Scenario s = nominal;
+  ProfileTerm speed = RampTo(3.0);
+  speed.end_s = 4.0;
+  ProfileTerm weave = Sine(0.3, 11.0);
+  weave.windowed = true;
+  weave.window_begin_s = 6.0;
+  weave.window_end_s = 1e9;
+  s.driver.speed_mps.terms = {speed};
+  s.driver.handlebar_rad.terms = {weave};
+  const Simulation real = SimulateOk(s);
+  const Simulation twin = ReplayOk(nominal, real.recording);
+  const Simulation own = SimulateOk(nominal);
+  const Trajectory& truth = *real.recording.ground_truth;
+  const TrackError start = Compare({twin.recording.ground_truth->front()}, {truth.front()});
+  const TrackError e = Compare(AlignedStart(*twin.recording.ground_truth, truth), truth);
+  const TrackError schedule = Compare(*own.recording.ground_truth, truth);
+  std::printf("ATV: extent %.1f m; start from %s off by %.2f m, %.3f rad; drive from there within %.3f m, %.4f rad "
+              "(the nominal schedule's %.1f m); %.1fx real time\n",
+              Extent(truth), twin.truth.replay->start.c_str(), start.max_position_m, start.max_heading_rad,
+              e.max_position_m, e.max_heading_rad, schedule.max_position_m, twin.stats.realtime_factor);
+  EXPECT_THAT(twin.truth.replay->drive, HasSubstr("rear-wheel speed"));
+  EXPECT_THAT(twin.truth.replay->start, HasSubstr("gps"));
+  // The start heading is the chord of the first kStartMotionM of GPS fixes (sigma_m per axis at both ends).
+  const double sigma_m = s.sensors.gps->sigma_m;
+  EXPECT_LT(start.max_heading_rad, 3.0 * std::sqrt(2.0) * sigma_m / kStartMotionM);
+  EXPECT_LT(start.max_position_m, 3.0 * std::sqrt(2.0) * sigma_m + 3.0 * std::sqrt(2.0) * sigma_m / kStartMotionM);
+  EXPECT_LT(e.max_position_m, 0.2 * schedule.max_position_m);
 }
 
 // models/diffdrive.xml with the OptiOdom differential drive's published wheels (diameter 0.084 m, axle track 0.2 m),
