@@ -332,8 +332,8 @@ int RunCommandLine(int argc, char** argv) {
   CLI::App app{"roamlab: mobile-robot pose tracking and sensor self-calibration testbed"};
   app.require_subcommand(1);
   Commands commands;
-  for (const auto add : {AddSimulate, AddReplay, AddCalibrate, AddTrack, AddEvaluate, AddMonteCarlo, AddInit, AddDiagnose,
-                         AddGapBenchmark, AddRegress, AddOdometry, AddImport, AddFrontEnd})
+  for (const auto add : {AddSimulate, AddReplay, AddCalibrate, AddTrack, AddEvaluate, AddMonteCarlo, AddInit,
+                         AddDiagnose, AddGapBenchmark, AddRegress, AddOdometry, AddImport, AddFrontEnd})
     add(&app, &commands);
 
   try {

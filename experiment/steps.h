@@ -1,6 +1,7 @@
 // The steps of the `roamlab` commands that write files, as library calls: simulate a scenario into a recording
-// directory, replay a recording's drive in a scenario's model (its MuJoCo twin), calibrate a recording into calibration.json, track it into trajectory.tum, covariance.csv and
-// summary.json, import an OptiOdom run. The command line, the Monte-Carlo runner and the regression suite call them.
+// directory, replay a recording's drive in a scenario's model (its MuJoCo twin), calibrate a recording into
+// calibration.json, track it into trajectory.tum, covariance.csv and summary.json, import an OptiOdom run. The command
+// line, the Monte-Carlo runner and the regression suite call them.
 #pragma once
 
 #include <cstdint>

@@ -10,7 +10,7 @@
 //   replay:                 a replay's twin (sim/replay.h) only: noise-free, driven by a recording's inputs
 //     noise_free: true
 //     drive: wheel_encoders stream 'wheel_encoders' (differentiated)
-//     start: pose stream 'mocap' 
+//     start: pose stream 'mocap'
 #pragma once
 
 #include <map>

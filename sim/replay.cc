@@ -98,9 +98,9 @@ using Found = Result<std::optional<DriveInputs>>;
 
 // 1. Recorded commands, with the driver's columns.
 Found FromInputsStream(const Recording& real, bool ackermann, std::string* note) {
-  const std::vector<std::string> needed = ackermann ? std::vector<std::string>{"speed_mps", "handlebar_rad"}
-                                                    : std::vector<std::string>{"linear_mps", "lateral_mps",
-                                                                               "angular_radps"};
+  const std::vector<std::string> needed = ackermann
+                                              ? std::vector<std::string>{"speed_mps", "handlebar_rad"}
+                                              : std::vector<std::string>{"linear_mps", "lateral_mps", "angular_radps"};
   for (const Stream& s : real.streams) {
     if (s.info.type != StreamType::kInputs || s.t.empty()) continue;
     std::vector<int> columns;
@@ -188,8 +188,8 @@ std::string NeededInputs(bool ackermann) {
 // The twin's plan: the scenario as replayed, the stamps of each simulated stream, and which recorded stream each
 // simulated one stands for.
 struct TwinStream {
-  std::size_t recorded = 0;  // index in the recording's streams
-  std::string simulated;     // the simulator's stream name
+  std::size_t recorded = 0;   // index in the recording's streams
+  std::string simulated;      // the simulator's stream name
   std::size_t first_row = 0;  // the recorded stream's first row in the window
 };
 struct Plan {
@@ -221,8 +221,8 @@ std::string SimulatedName(const Stream& s, const Recording& real, const Scenario
       return need(ackermann && sensors.odometer.has_value(), "steering", "the nominal scenario has no odometer");
     case StreamType::kWheelEncoders:
       if (ackermann)
-        return need(s.info.units == "m/s" && s.info.columns.size() == 1 && sensors.odometer.has_value(),
-                    "rear_wheel", "not a rear-wheel speed of the nominal scenario's odometer");
+        return need(s.info.units == "m/s" && s.info.columns.size() == 1 && sensors.odometer.has_value(), "rear_wheel",
+                    "not a rear-wheel speed of the nominal scenario's odometer");
       if (!IsAngleEncoder(s)) return need(false, "", "wheel_encoders in " + s.info.units + " are not synthesized");
       return "wheel_encoders";
     default:
@@ -462,7 +462,6 @@ Result<Simulation> Replay(const Scenario& nominal, const Recording& real, const 
   return out;
 }
 
-
 Result<std::vector<int>> MatchWheelColumns(const std::vector<std::string>& recorded_columns,
                                            const std::vector<std::string>& model_columns) {
   std::vector<int> match;
@@ -472,8 +471,8 @@ Result<std::vector<int>> MatchWheelColumns(const std::vector<std::string>& recor
       if (it == recorded_columns.end() && EndsWith(wheel, side))
         it = std::find(recorded_columns.begin(), recorded_columns.end(), side);
     if (it == recorded_columns.end())
-      return Status::Error("no recorded column for the model's wheel '" + wheel + "' (recorded: " +
-                           Join(recorded_columns) + "; model: " + Join(model_columns) + ")");
+      return Status::Error("no recorded column for the model's wheel '" + wheel +
+                           "' (recorded: " + Join(recorded_columns) + "; model: " + Join(model_columns) + ")");
     match.push_back(static_cast<int>(it - recorded_columns.begin()));
   }
   return match;
@@ -483,12 +482,12 @@ Result<DriveInputs> DriveInputsFrom(const Recording& real, const Scenario& nomin
   const bool ackermann = nominal.robot.kind == "ackermann";
   std::string note;
   Found inputs = FromInputsStream(real, ackermann, &note);
-  if (inputs.ok() && !inputs.value()) inputs = ackermann ? FromAckermannOdometer(real, nominal)
-                                                         : FromWheelEncoders(real, nominal.robot.kind);
+  if (inputs.ok() && !inputs.value())
+    inputs = ackermann ? FromAckermannOdometer(real, nominal) : FromWheelEncoders(real, nominal.robot.kind);
   if (!inputs.ok()) return inputs.status();
   if (!inputs.value())
-    return Status::Error("no drive input: a replay of robot kind " + nominal.robot.kind + " needs " + NeededInputs(ackermann) +
-                         note);
+    return Status::Error("no drive input: a replay of robot kind " + nominal.robot.kind + " needs " +
+                         NeededInputs(ackermann) + note);
   return std::move(*inputs.value());
 }
 

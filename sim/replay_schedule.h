@@ -31,10 +31,10 @@ struct DriveInputs {
     kAckermann,     // per row rear-wheel speed [m/s] (the speed controller's set-point) and handlebar angle [rad]
   };
   Kind kind = Kind::kBodyVelocity;
-  std::vector<Time> t;     // recording time, strictly increasing, at least one row
-  Eigen::MatrixXd values;  // one row per t
-  bool hold = false;       // true: each row holds until the next (recorded commands); false: linear between rows
-  std::string source;      // what the inputs were taken from (stream names), for messages and truth.yaml
+  std::vector<Time> t;         // recording time, strictly increasing, at least one row
+  Eigen::MatrixXd values;      // one row per t
+  bool hold = false;           // true: each row holds until the next (recorded commands); false: linear between rows
+  std::string source;          // what the inputs were taken from (stream names), for messages and truth.yaml
   Eigen::MatrixXd angles_rad;  // kWheelRates from cumulative angles: per row the angle [rad] of each model wheel;
                                // empty otherwise
 
@@ -49,7 +49,7 @@ struct DriveInputs {
 inline constexpr double kAngleTrackingS = 0.1;
 
 struct ReplaySchedule {
-  Time t0;             // the recording time of simulation time 0
+  Time t0;  // the recording time of simulation time 0
   DriveInputs drive;
   // Per simulated stream (its name in the simulator: imu, magnetometer, gps, wheel_encoders, rear_wheel, steering):
   // the stamps to sample it at (recording time, strictly increasing, >= t0). A stream of the scenario without an

@@ -257,8 +257,18 @@ class Simulator::Impl {
     if (!options_.replay) return Status::Ok();
     const ReplaySchedule& replay = *options_.replay;
     origin_ns_ = replay.t0.nanoseconds();
-    if (replay.drive.t.empty() || replay.drive.values.rows() != static_cast<Eigen::Index>(replay.drive.t.size()))
+    const DriveInputs& drive = replay.drive;
+    if (drive.t.empty() || drive.values.rows() != static_cast<Eigen::Index>(drive.t.size()))
       return Status::Error(where_ + ": the replay has no drive inputs");
+    using Kind = DriveInputs::Kind;
+    const Eigen::Index columns = drive.kind == Kind::kAckermann ? 2
+                                 : drive.kind == Kind::kBodyVelocity
+                                     ? 3
+                                     : static_cast<Eigen::Index>(wheeled_.wheels().size());
+    if (ackermann_ != (drive.kind == Kind::kAckermann) || drive.values.cols() != columns ||
+        (drive.angles_rad.size() > 0 && drive.angles_rad.rows() != drive.values.rows()) ||
+        (drive.angles_rad.size() > 0 && drive.angles_rad.cols() != columns))
+      return Status::Error(where_ + ": the replay's drive inputs do not fit a robot of kind " + scenario_.robot.kind);
     const std::map<std::string, Clock*> clocks{{"imu", &imu_clock_},           {"magnetometer", &mag_clock_},
                                                {"gps", &gps_clock_},           {"rear_wheel", &odometer_clock_},
                                                {"steering", &odometer_clock_}, {"wheel_encoders", &encoder_clock_},
@@ -303,16 +313,17 @@ class Simulator::Impl {
     if (sensors.laser) {
       scan_matching_.emplace("scan_matching", sensors.laser->rate_hz);
       if (sensors.laser->store_scans) {
-        laser_scan_stream_ = MakeStream("laser_scan", StreamType::kLaserScan, sensors.laser->rate_hz,
-                                        recording::LaserScanColumns(sensors.laser->beams), "rad,m", laser_clock_, origin());
+        laser_scan_stream_ =
+            MakeStream("laser_scan", StreamType::kLaserScan, sensors.laser->rate_hz,
+                       recording::LaserScanColumns(sensors.laser->beams), "rad,m", laser_clock_, origin());
       }
     }
     if (sensors.odometer) {
       wheel_stream_ = MakeStream("rear_wheel", StreamType::kWheelEncoders, sensors.odometer->rate_hz, {"rear"}, "m/s",
                                  odometer_clock_, origin());
       wheel_stream_.info.noise = {{"sigma_mps", sensors.odometer->speed_sigma_mps}};
-      steering_stream_ =
-          MakeStream("steering", StreamType::kSteering, sensors.odometer->rate_hz, {"angle"}, "rad", odometer_clock_, origin());
+      steering_stream_ = MakeStream("steering", StreamType::kSteering, sensors.odometer->rate_hz, {"angle"}, "rad",
+                                    odometer_clock_, origin());
       steering_stream_.info.noise = {{"sigma_rad", sensors.odometer->steering_sigma_rad}};
     }
     if (pose_clock_.scheduled()) {
@@ -339,8 +350,10 @@ class Simulator::Impl {
   // [rad/s] and v_y [m/s]): the profiles from t = 0, the lead-in's rest and ramp before.
   std::array<double, 3> SetPoints(std::int64_t t_ns) const {
     if (options_.replay) {
+      const DriveInputs::Kind kind = options_.replay->drive.kind;
+      if (kind == DriveInputs::Kind::kWheelRates) return {0.0, 0.0, 0.0};  // ReplayWheelRates drives
       const Eigen::VectorXd u = ReplayInputs(t_ns);
-      if (options_.replay->drive.kind == DriveInputs::Kind::kBodyVelocity) return {u[0], u[2], u[1]};
+      if (kind == DriveInputs::Kind::kBodyVelocity) return {u[0], u[2], u[1]};
       return {u[0], u[1], 0.0};
     }
     const DriverOptions& driver = scenario_.driver;
@@ -773,7 +786,7 @@ class Simulator::Impl {
   std::int64_t lead_in_ns_ = 0;
   std::int64_t loop_end_ns_ = 0;  // end_ns_, or later when a sample is taken after the recording's end
   std::int64_t t_ns_ = 0;         // the current time, for messages
-  std::int64_t origin_ns_ = 0;  // the recording time of t = 0 (a replay's t0)
+  std::int64_t origin_ns_ = 0;    // the recording time of t = 0 (a replay's t0)
   Eigen::VectorXd replay_angles_at_start_, measured_angles_at_start_;  // a replay's wheel angles at t = 0
   Time origin() const { return Time::FromNanoseconds(origin_ns_); }
   Clock truth_clock_, imu_clock_, mag_clock_, gps_clock_, odometer_clock_, encoder_clock_, laser_clock_, pose_clock_;

@@ -335,10 +335,11 @@ TEST(ReplayTest, AtvFollowsItsRecordedSpeedAndSteering) {
   const TrackError start = Compare({twin.recording.ground_truth->front()}, {truth.front()});
   const TrackError e = Compare(AlignedStart(*twin.recording.ground_truth, truth), truth);
   const TrackError schedule = Compare(*own.recording.ground_truth, truth);
-  std::printf("ATV: extent %.1f m; start from %s off by %.2f m, %.3f rad; drive from there within %.3f m, %.4f rad "
-              "(the nominal schedule's %.1f m); %.1fx real time\n",
-              Extent(truth), twin.truth.replay->start.c_str(), start.max_position_m, start.max_heading_rad,
-              e.max_position_m, e.max_heading_rad, schedule.max_position_m, twin.stats.realtime_factor);
+  std::printf(
+      "ATV: extent %.1f m; start from %s off by %.2f m, %.3f rad; drive from there within %.3f m, %.4f rad "
+      "(the nominal schedule's %.1f m); %.1fx real time\n",
+      Extent(truth), twin.truth.replay->start.c_str(), start.max_position_m, start.max_heading_rad, e.max_position_m,
+      e.max_heading_rad, schedule.max_position_m, twin.stats.realtime_factor);
   EXPECT_THAT(twin.truth.replay->drive, HasSubstr("rear-wheel speed"));
   EXPECT_THAT(twin.truth.replay->start, HasSubstr("gps"));
   // The start heading is the chord of the first kStartMotionM of GPS fixes (sigma_m per axis at both ends).
@@ -374,10 +375,11 @@ void ReportDrift(const Recording& real, const Scenario& nominal, const std::stri
   const Eigen::Index last = replayed->values.rows() - 1;
   const double end_error_m = (replayed->values.row(last).head<2>() - mocap->values.row(last).head<2>()).norm();
   const auto [mean_10s, max_10s] = WindowDrift(*mocap, *replayed, 10.0);
-  std::printf("OptiOdom diff square run-01 (%.0f s), nominal %s: end error %.3f m; 10 s drift mean %.3f m, max "
-              "%.3f m; %.1fx real time\n",
-              SecondsBetween(mocap->t.front(), mocap->t.back()), label.c_str(), end_error_m, mean_10s, max_10s,
-              twin.stats.realtime_factor);
+  std::printf(
+      "OptiOdom diff square run-01 (%.0f s), nominal %s: end error %.3f m; 10 s drift mean %.3f m, max "
+      "%.3f m; %.1fx real time\n",
+      SecondsBetween(mocap->t.front(), mocap->t.back()), label.c_str(), end_error_m, mean_10s, max_10s,
+      twin.stats.realtime_factor);
   for (const std::string& why : twin.stats.left_out) std::printf("  left out: %s\n", why.c_str());
   EXPECT_GT(twin.stats.realtime_factor, 0.0);
 }
