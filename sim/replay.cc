@@ -147,7 +147,29 @@ Found FromWheelEncoders(const Recording& real, const std::string& kind) {
   return std::optional<DriveInputs>();
 }
 
-// 3. The Ackermann vehicle's rear-wheel speed and steering angle, through the nominal odometer calibration.
+// 3. A wheeled robot's wheel odometry (an odometry stream: the velocity of its frame, in its frame), as O's body
+// velocity through the stream's mounting: v_O = R v_S - omega_O x p, omega_O = R omega_S.
+Found FromOdometry(const Recording& real) {
+  for (const Stream& s : real.streams) {
+    if (s.info.type != StreamType::kOdometry || s.t.empty()) continue;
+    const recording::Mounting m = s.info.mounting.value_or(recording::Mounting{});
+    const Eigen::Matrix3d R = m.q_body_sensor.toRotationMatrix();
+    DriveInputs in;
+    in.kind = DriveInputs::Kind::kBodyVelocity;
+    in.t = s.t;
+    in.source = "odometry stream '" + s.info.name + "'";
+    in.values.resize(s.values.rows(), 3);
+    for (Eigen::Index k = 0; k < s.values.rows(); ++k) {
+      const Eigen::Vector3d omega = R * s.values.row(k).segment<3>(3).transpose();
+      const Eigen::Vector3d v = R * s.values.row(k).head<3>().transpose() - omega.cross(m.p_body_sensor);
+      in.values.row(k) << v.x(), v.y(), omega.z();
+    }
+    return std::optional<DriveInputs>(std::move(in));
+  }
+  return std::optional<DriveInputs>();
+}
+
+// 4. The Ackermann vehicle's rear-wheel speed and steering angle, through the nominal odometer calibration.
 Found FromAckermannOdometer(const Recording& real, const Scenario& nominal) {
   const Stream* speed = nullptr;
   const Stream* steering = nullptr;
@@ -181,8 +203,8 @@ Found FromAckermannOdometer(const Recording& real, const Scenario& nominal) {
 std::string NeededInputs(bool ackermann) {
   return ackermann ? "an inputs stream with columns speed_mps, handlebar_rad, or a rear-wheel speed (wheel_encoders, "
                      "one column, m/s) and a steering stream"
-                   : "an inputs stream with columns linear_mps, angular_radps (lateral_mps optional), or a "
-                     "wheel_encoders stream in rad or rad/s";
+                   : "an inputs stream with columns linear_mps, angular_radps (lateral_mps optional), a "
+                     "wheel_encoders stream in rad or rad/s, or an odometry stream";
 }
 
 // The twin's plan: the scenario as replayed, the stamps of each simulated stream, and which recorded stream each
@@ -217,6 +239,8 @@ std::string SimulatedName(const Stream& s, const Recording& real, const Scenario
       return need(sensors.gps.has_value(), "gps", "the nominal scenario has no gps");
     case StreamType::kPose:
       return "pose";
+    case StreamType::kOdometry:
+      return need(!ackermann, "odometry", "an ackermann vehicle has no wheel odometry in the simulator");
     case StreamType::kSteering:
       return need(ackermann && sensors.odometer.has_value(), "steering", "the nominal scenario has no odometer");
     case StreamType::kWheelEncoders:
@@ -402,6 +426,15 @@ Eigen::MatrixXd TwinValues(const Stream& recorded, const Stream& simulated, cons
       const Eigen::Quaterniond q = q_world_body * m.q_body_sensor;
       out.row(k) << p.transpose(), q.x(), q.y(), q.z(), q.w();
     }
+  } else if (plan.simulated == "odometry") {
+    // O's twist as the stream's frame moves: v_S = R^T (v_O + omega x p), omega_S = R^T omega_O.
+    const recording::Mounting m = recorded.info.mounting.value_or(recording::Mounting{});
+    const Eigen::Matrix3d R_T = m.q_body_sensor.toRotationMatrix().transpose();
+    for (Eigen::Index k = 0; k < n; ++k) {
+      const Eigen::Vector3d v = simulated.values.row(k).head<3>().transpose();
+      const Eigen::Vector3d omega = simulated.values.row(k).segment<3>(3).transpose();
+      out.row(k).head<6>() << (R_T * (v + omega.cross(m.p_body_sensor))).transpose(), (R_T * omega).transpose();
+    }
   } else {
     out.leftCols(simulated.values.cols()) = simulated.values;
   }
@@ -484,6 +517,7 @@ Result<DriveInputs> DriveInputsFrom(const Recording& real, const Scenario& nomin
   Found inputs = FromInputsStream(real, ackermann, &note);
   if (inputs.ok() && !inputs.value())
     inputs = ackermann ? FromAckermannOdometer(real, nominal) : FromWheelEncoders(real, nominal.robot.kind);
+  if (inputs.ok() && !inputs.value() && !ackermann) inputs = FromOdometry(real);
   if (!inputs.ok()) return inputs.status();
   if (!inputs.value())
     return Status::Error("no drive input: a replay of robot kind " + nominal.robot.kind + " needs " +

@@ -12,7 +12,10 @@
 //      at most one tick per 2 kRateHalfWindowS and the integral of the rates stays the measured angle); each model
 //      wheel's velocity servo is set to the rate of the recorded column MatchWheelColumns gives it, linear between
 //      rows.
-//   3. Ackermann: the rear-wheel speed (a one-column wheel_encoders stream in m/s) and the steering angle (a steering
+//   3. Wheeled kinds: an odometry stream (the robot's wheel odometry: the velocity of its frame in its frame), turned
+//      into O's body velocity through the stream's mounting and fed to the driver's inverse kinematics (each wheel's
+//      servo set to the rate the nominal kinematics gives), linear between rows.
+//   4. Ackermann: the rear-wheel speed (a one-column wheel_encoders stream in m/s) and the steering angle (a steering
 //      stream), each averaged over the same window, turned into set-points with the nominal odometer calibration
 //      (sim/sensors.h, eq. 15 inverted: speed = z_v kv_over_L L, handlebar = k_theta z_theta + k_gamma; the
 //      scenario's sensors.odometer or its defaults): the speed controller tracks the measured rear-wheel speed.
@@ -27,10 +30,12 @@
 // mounting and calibration: the nominal belief), wheel_encoders in rad (wheeled kinds; the scenario's encoder
 // resolution, else the recording's ticks_per_revolution when whole, else 2048; a recorded column driven by several
 // model wheels reads their mean; each column starts at the recorded value at the first stamp), the ackermann
-// odometer's rear-wheel speed and steering (when the nominal has an odometer), and one pose stream (the pose of its
-// mounting in W; a gps stream's covariance columns are copied from the recording). Left out, with the reason in
-// SimulationStats::left_out ("<stream>: <reason>"): every other stream (odometry and the other velocity
-// types, position, laser_scan, camera, inputs, a second stream of a kind) and the laser and camera of the scenario
+// odometer's rear-wheel speed and steering (when the nominal has an odometer), one pose stream (the pose of its
+// mounting in W) and, for the wheeled kinds, one odometry stream (the wheel odometry: the twist the nominal kinematics
+// gives for the twin's wheel rates, as the stream's frame moves); a gps or odometry stream's covariance columns are
+// copied from the recording. Left out, with the reason in
+// SimulationStats::left_out ("<stream>: <reason>"): every other stream (visual_odometry, scan_matching,
+// position, laser_scan, camera, inputs, a second stream of a kind) and the laser and camera of the scenario
 // (too slow for a replay; the scenario's static world model is dropped with them, so the robot meets no walls).
 // Noise: every sensor-noise source off (SimulateOptions::noise = false); the scenario's effects are applied, so a
 // patched scenario replays with its effects. truth.yaml's `replay` entry says so (recording/truth.h).

@@ -51,7 +51,8 @@ inline constexpr double kAngleTrackingS = 0.1;
 struct ReplaySchedule {
   Time t0;  // the recording time of simulation time 0
   DriveInputs drive;
-  // Per simulated stream (its name in the simulator: imu, magnetometer, gps, wheel_encoders, rear_wheel, steering):
+  // Per simulated stream (its name in the simulator: imu, magnetometer, gps, wheel_encoders, rear_wheel, steering,
+  // pose, odometry):
   // the stamps to sample it at (recording time, strictly increasing, >= t0). A stream of the scenario without an
   // entry here is not scheduled and keeps its rate (stamps from t0).
   std::map<std::string, std::vector<Time>> stamps;

@@ -272,7 +272,7 @@ class Simulator::Impl {
     const std::map<std::string, Clock*> clocks{{"imu", &imu_clock_},           {"magnetometer", &mag_clock_},
                                                {"gps", &gps_clock_},           {"rear_wheel", &odometer_clock_},
                                                {"steering", &odometer_clock_}, {"wheel_encoders", &encoder_clock_},
-                                               {"pose", &pose_clock_}};
+                                               {"pose", &pose_clock_},         {"odometry", &odometry_clock_}};
     for (const auto& [name, stamps] : replay.stamps) {
       const auto it = clocks.find(name);
       if (it == clocks.end()) return Status::Error(where_ + ": the replay schedules an unknown stream '" + name + "'");
@@ -325,6 +325,11 @@ class Simulator::Impl {
       steering_stream_ = MakeStream("steering", StreamType::kSteering, sensors.odometer->rate_hz, {"angle"}, "rad",
                                     odometer_clock_, origin());
       steering_stream_.info.noise = {{"sigma_rad", sensors.odometer->steering_sigma_rad}};
+    }
+    if (odometry_clock_.scheduled() && !ackermann_) {
+      odometry_stream_ = MakeStream("odometry", StreamType::kOdometry, 0.0,
+                                    recording::FixedColumns(StreamType::kOdometry), "", odometry_clock_, origin());
+      twist_from_rates_ = wheeled_.J_rates_twist().completeOrthogonalDecomposition().pseudoInverse();
     }
     if (pose_clock_.scheduled()) {
       pose_stream_ = MakeStream("pose", StreamType::kPose, 0.0, recording::FixedColumns(StreamType::kPose), "",
@@ -428,7 +433,8 @@ class Simulator::Impl {
     // A sample taken after the end of the drive (negative shift) extends the physics past it.
     loop_end_ns_ = end_ns_ + std::max<std::int64_t>(0, -std::min(imu_clock_.shift_ns, gps_clock_.shift_ns));
     // A replay's sample nearest a stamp may fall after the end.
-    for (const Clock* c : {&imu_clock_, &mag_clock_, &gps_clock_, &odometer_clock_, &encoder_clock_, &pose_clock_})
+    for (const Clock* c :
+         {&imu_clock_, &mag_clock_, &gps_clock_, &odometer_clock_, &encoder_clock_, &pose_clock_, &odometry_clock_})
       if (c->scheduled()) loop_end_ns_ = std::max(loop_end_ns_, c->LastSampleNs());
     steering_offset_rad_ = EffectParameter(effects, "steering_offset", "offset_rad", 0.0);
     for (int i = 0; i < 3; ++i) {
@@ -518,7 +524,7 @@ class Simulator::Impl {
   bool AnyDue(std::int64_t t_ns) const {
     return truth_clock_.Due(t_ns) || imu_clock_.Due(t_ns) || mag_clock_.Due(t_ns) || gps_clock_.Due(t_ns) ||
            odometer_clock_.Due(t_ns) || encoder_clock_.Due(t_ns) || laser_clock_.Due(t_ns) || pose_clock_.Due(t_ns) ||
-           CameraDue(t_ns);
+           odometry_clock_.Due(t_ns) || CameraDue(t_ns);
   }
 
   // Camera frame k is due at the first step at or after k / rate_hz (rounded to the nanosecond, not accumulated):
@@ -612,6 +618,13 @@ class Simulator::Impl {
       pose_stream_.values.row(pose_clock_.Row(t_ns)) << body.p_world_body.transpose(), body.q_world_body.x(),
           body.q_world_body.y(), body.q_world_body.z(), body.q_world_body.w();
     }
+    if (odometry_clock_.Due(t_ns)) {
+      // Wheel odometry: the twist the nominal kinematics gives for the wheels' rates (least squares).
+      Eigen::VectorXd rates(static_cast<Eigen::Index>(wheeled_.wheels().size()));
+      for (Eigen::Index i = 0; i < rates.size(); ++i) rates[i] = wheeled_.WheelRate(data_.get(), static_cast<int>(i));
+      const Eigen::Vector3d twist = twist_from_rates_ * rates;  // v_x, v_y, omega_z
+      odometry_stream_.values.row(odometry_clock_.Row(t_ns)) << twist[0], twist[1], 0.0, 0.0, 0.0, twist[2];
+    }
     if (odometer_clock_.Due(t_ns)) {
       const OdometerOptions& odo = *sensors.odometer;
       // tire_growth: the rigid MuJoCo tire rolls at omega = v / r0; a tire of radius r0 (1 + c v^2) turns at
@@ -701,6 +714,7 @@ class Simulator::Impl {
     internal::FillRepeatedRows(odometer_clock_, &steering_stream_);
     internal::FillRepeatedRows(encoder_clock_, &encoder_stream_);
     internal::FillRepeatedRows(pose_clock_, &pose_stream_);
+    internal::FillRepeatedRows(odometry_clock_, &odometry_stream_);
     if (sensors.imu) rec.streams.push_back(std::move(imu_stream_));
     if (sensors.magnetometer) rec.streams.push_back(std::move(mag_stream_));
     if (sensors.gps) rec.streams.push_back(std::move(gps_stream_));
@@ -710,6 +724,7 @@ class Simulator::Impl {
     }
     if (sensors.wheel_encoders) rec.streams.push_back(std::move(encoder_stream_));
     if (pose_clock_.scheduled()) rec.streams.push_back(std::move(pose_stream_));
+    if (odometry_clock_.scheduled() && !ackermann_) rec.streams.push_back(std::move(odometry_stream_));
     if (sensors.laser) {
       recording::Stream scan_stream = scan_matching_->TakeStream();
       scan_stream.info.mounting = laser_mounting_;
@@ -789,7 +804,9 @@ class Simulator::Impl {
   std::int64_t origin_ns_ = 0;    // the recording time of t = 0 (a replay's t0)
   Eigen::VectorXd replay_angles_at_start_, measured_angles_at_start_;  // a replay's wheel angles at t = 0
   Time origin() const { return Time::FromNanoseconds(origin_ns_); }
-  Clock truth_clock_, imu_clock_, mag_clock_, gps_clock_, odometer_clock_, encoder_clock_, laser_clock_, pose_clock_;
+  Clock truth_clock_, imu_clock_, mag_clock_, gps_clock_, odometer_clock_, encoder_clock_, laser_clock_, pose_clock_,
+      odometry_clock_;
+  Eigen::MatrixXd twist_from_rates_;  // a replay's wheel odometry: 3 x wheels, the least-squares inverse of J
 
   NoiseStream gyro_noise_{seed_, NoiseSource::kGyro, options_.noise};
   NoiseStream accel_noise_{seed_, NoiseSource::kAccel, options_.noise};
@@ -802,7 +819,7 @@ class Simulator::Impl {
   NoiseStream multipath_noise_{seed_, NoiseSource::kGpsMultipath};  // likewise
 
   recording::Stream imu_stream_, mag_stream_, gps_stream_, wheel_stream_, steering_stream_, encoder_stream_,
-      laser_scan_stream_, pose_stream_;
+      laser_scan_stream_, pose_stream_, odometry_stream_;
   Trajectory truth_;
   double min_height_ = 1e300;
   double max_height_ = -1e300;
