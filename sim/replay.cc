@@ -28,6 +28,7 @@ Eigen::VectorXd Interpolate(const std::vector<Time>& t, const Eigen::MatrixXd& v
 
 Eigen::VectorXd DriveInputs::At(Time t_at) const { return Interpolate(t, values, t_at, hold); }
 Eigen::VectorXd DriveInputs::AnglesAt(Time t_at) const { return Interpolate(t, angles_rad, t_at, false); }
+double DriveInputs::TravelAt(Time t_at) const { return Interpolate(t, travel_m, t_at, false)[0]; }
 
 namespace {
 
@@ -197,6 +198,11 @@ Found FromAckermannOdometer(const Recording& real, const Scenario& nominal) {
   angle.t = steering->t;
   angle.values = odometer.k_theta * z_theta.array() + odometer.k_gamma;
   for (Eigen::Index k = 0; k < v.size(); ++k) in.values(k, 1) = angle.At(in.t[static_cast<std::size_t>(k)])[0];
+  in.travel_m = Eigen::VectorXd::Zero(v.size());
+  for (Eigen::Index k = 1; k < v.size(); ++k) {
+    const double dt = SecondsBetween(in.t[static_cast<std::size_t>(k - 1)], in.t[static_cast<std::size_t>(k)]);
+    in.travel_m[k] = in.travel_m[k - 1] + 0.5 * (v[k - 1] + v[k]) * dt;
+  }
   return std::optional<DriveInputs>(std::move(in));
 }
 

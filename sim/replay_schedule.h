@@ -6,7 +6,9 @@
 //     wheel angles (DriveInputs::angles_rad) are tracked: each wheel's servo target is its measured rate plus
 //     (measured - twin angle increment since t = 0) / kAngleTrackingS, which removes the velocity servo's
 //     steady-state error (the load torque over its gain: the twin's wheel would otherwise lag the recorded one, which
-//     had already lagged its own command by as much).
+//     had already lagged its own command by as much). Likewise an Ackermann vehicle's measured travel
+//     (DriveInputs::travel_m): the speed set-point is the measured speed plus (measured - twin travel since t = 0) /
+//     kAngleTrackingS, the twin's travel being its rear-wheel speed integrated.
 //   - Samples. A scheduled stream's sample stamped s is taken at the physics step nearest s - t0 (half a step at most
 //     away: 1 ms on models/diffdrive.xml, 0.5 ms on models/atv.xml), minus the time shift of an effect
 //     (gps_latency, imu_time_offset); two stamps nearest the same step read the same state. The stream keeps the
@@ -37,11 +39,15 @@ struct DriveInputs {
   std::string source;          // what the inputs were taken from (stream names), for messages and truth.yaml
   Eigen::MatrixXd angles_rad;  // kWheelRates from cumulative angles: per row the angle [rad] of each model wheel;
                                // empty otherwise
+  Eigen::VectorXd travel_m;    // kAckermann from measured speeds: per row the rear wheels' travel since the first
+                               // row [m] (the speeds integrated); empty otherwise
 
   // The inputs at recording time `t`: the first row before the first stamp, the last after the last.
   Eigen::VectorXd At(Time t) const;
   // The wheel angles at `t`, linear between rows (angles_rad must not be empty).
   Eigen::VectorXd AnglesAt(Time t) const;
+  // The travel at `t`, linear between rows (travel_m must not be empty).
+  double TravelAt(Time t) const;
 };
 
 // The time constant with which a replay's wheels track the measured wheel angles [s] (well above the velocity

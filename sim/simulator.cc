@@ -267,7 +267,8 @@ class Simulator::Impl {
                                      : static_cast<Eigen::Index>(wheeled_.wheels().size());
     if (ackermann_ != (drive.kind == Kind::kAckermann) || drive.values.cols() != columns ||
         (drive.angles_rad.size() > 0 && drive.angles_rad.rows() != drive.values.rows()) ||
-        (drive.angles_rad.size() > 0 && drive.angles_rad.cols() != columns))
+        (drive.angles_rad.size() > 0 && drive.angles_rad.cols() != columns) ||
+        (drive.travel_m.size() > 0 && drive.travel_m.size() != drive.values.rows()))
       return Status::Error(where_ + ": the replay's drive inputs do not fit a robot of kind " + scenario_.robot.kind);
     const std::map<std::string, Clock*> clocks{{"imu", &imu_clock_},           {"magnetometer", &mag_clock_},
                                                {"gps", &gps_clock_},           {"rear_wheel", &odometer_clock_},
@@ -399,6 +400,18 @@ class Simulator::Impl {
     return rates + (measured - (twin_angles - replay_angles_at_start_)) / kAngleTrackingS;
   }
 
+  // A replay's correction of the Ackermann speed set-point [m/s] that tracks the measured travel; advances the twin's
+  // travel by its rear-wheel speed over the coming step. 0 without a replay of measured speeds.
+  double ReplayTravelCorrection(double rear_speed_mps, double dt_s) {
+    if (!options_.replay || options_.replay->drive.travel_m.size() == 0 || t_ns_ < 0) return 0.0;
+    const DriveInputs& drive = options_.replay->drive;
+    const double measured_m =
+        drive.TravelAt(Time::FromNanoseconds(origin_ns_ + t_ns_)) - drive.TravelAt(Time::FromNanoseconds(origin_ns_));
+    const double correction = (measured_m - replay_travel_m_) / kAngleTrackingS;
+    replay_travel_m_ += rear_speed_mps * dt_s;
+    return correction;
+  }
+
   // Pose of a robot site in O, measured at the current state (the robot is rigid between them).
   recording::Mounting SiteInOdom(int site) const {
     const FrameKinematics odom = ReadSiteKinematics(model_.get(), data_.get(), odom_site_);
@@ -476,7 +489,7 @@ class Simulator::Impl {
       const auto [first, second, third] = SetPoints(t_ns_);
       if (ackermann_) {
         const double measured = vehicle_.RearWheelRate(d) * vehicle_.wheel_radius_m();
-        drive_torque_nm_ = controller_->Update(first, measured, dt_s);
+        drive_torque_nm_ = controller_->Update(first + ReplayTravelCorrection(measured, dt_s), measured, dt_s);
         vehicle_.Apply(second, drive_torque_nm_, d);
       } else if (options_.replay && options_.replay->drive.kind == DriveInputs::Kind::kWheelRates) {
         wheeled_.ApplyWheelRates(ReplayWheelRates(t_ns_), d);
@@ -803,6 +816,7 @@ class Simulator::Impl {
   std::int64_t t_ns_ = 0;         // the current time, for messages
   std::int64_t origin_ns_ = 0;    // the recording time of t = 0 (a replay's t0)
   Eigen::VectorXd replay_angles_at_start_, measured_angles_at_start_;  // a replay's wheel angles at t = 0
+  double replay_travel_m_ = 0.0;                                       // a replay's Ackermann travel since t = 0
   Time origin() const { return Time::FromNanoseconds(origin_ns_); }
   Clock truth_clock_, imu_clock_, mag_clock_, gps_clock_, odometer_clock_, encoder_clock_, laser_clock_, pose_clock_,
       odometry_clock_;
