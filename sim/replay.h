@@ -18,7 +18,8 @@
 //   4. Ackermann: the rear-wheel speed (a one-column wheel_encoders stream in m/s) and the steering angle (a steering
 //      stream), each averaged over the same window, turned into set-points with the nominal odometer calibration
 //      (sim/sensors.h, eq. 15 inverted: speed = z_v kv_over_L L, handlebar = k_theta z_theta + k_gamma; the
-//      scenario's sensors.odometer or its defaults): the speed controller tracks the measured rear-wheel speed.
+//      scenario's sensors.odometer or its defaults): the speed controller tracks the measured rear-wheel speed and
+//      travel (sim/replay_schedule.h).
 // Window: [from, to] in the recording's time [s] (default: the drive inputs' first and last stamps).
 // Start: the first absolute reading at or after `from`: the first pose stream's pose (its mounting taken off, so O's
 // pose); else GPS (or a position stream) with the heading of the first >= kStartMotionM of motion within
