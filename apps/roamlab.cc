@@ -99,18 +99,36 @@ void AddTrack(CLI::App* app, Commands* commands) {
 void AddEvaluate(CLI::App* app, Commands* commands) {
   Add(commands, RunEvaluate, [app](auto* args) {
     CLI::App* evl = app->add_subcommand(
-        "evaluate", "Accuracy (ATE, RPE), consistency (NEES, seed eq. 16) and parameter errors against the truth.");
-    evl->add_option("--estimate", args->estimate,
-                    "Estimate directory: trajectory.tum [, covariance.csv, calibration.json]")
+        "evaluate",
+        "Accuracy (ATE, RPE), consistency (NEES, seed eq. 16) and parameter errors against a reference: the "
+        "recording's truth, a trajectory file (TUM, KITTI, EuRoC) or an absolute sensor stream.");
+    evl->add_option("--estimate", args->estimates,
+                    "Estimate directory (trajectory.tum [, covariance.csv, calibration.json]) or trajectory file; "
+                    "several: one comparison table and plot")
         ->required();
-    evl->add_option("--recording", args->recording, "Recording directory with ground_truth.tum [, truth.yaml]")
-        ->required();
+    evl->add_option("--recording", args->recording, "Recording directory [with ground_truth.tum, truth.yaml]");
+    evl->add_option("--reference", args->reference, "Reference trajectory file (TUM, KITTI poses or EuRoC CSV)");
+    evl->add_option("--reference-stream", args->reference_stream,
+                    "gps, position or pose stream of the recording as the reference (default without ground truth: "
+                    "the first such stream)");
+    evl->add_option("--reference-format", args->reference_format, "tum | kitti | euroc (default: detected)");
+    evl->add_option("--estimate-format", args->estimate_format, "tum | kitti | euroc (default: detected)");
+    evl->add_option("--calibration", args->calibration,
+                    "calibration.json for a reference stream's lever arm and the parameter table");
     evl->add_option("--out", args->out, "Output directory: metrics.json, figures (PNG + gnuplot scripts)")->required();
     evl->add_option("--align", args->align,
-                    "none | se3 | yaw_translation (default: none with gps/position/pose streams, se3 otherwise)");
-    evl->add_option("--max-time-difference", args->max_time_difference_s, "Association tolerance [s] (default 0.01)");
-    evl->add_option("--rpe-delta", args->rpe_delta_s, "RPE pose pairs about this far apart [s] (default 1)");
-    evl->add_option("--rpe-distance", args->rpe_distance_m, "RPE segments along the truth [m] (default 10)");
+                    "none | se3 | sim3 | yaw | origin (default: none with gps/position/pose streams or two plain "
+                    "files, se3 otherwise)");
+    evl->add_option("--align-first", args->align_first, "Align on the first N matched poses (default: all)");
+    evl->add_option("--align-window", args->align_window_s,
+                    "Align on the poses between S and E seconds after the reference's first pose")
+        ->expected(2);
+    evl->add_option("--t-max-diff,--max-time-difference", args->max_time_difference_s,
+                    "Association tolerance [s] (default 0.01)");
+    evl->add_option("--t-offset", args->t_offset_s, "Added to the estimates' stamps before association [s]");
+    evl->add_option("--delta,--rpe-delta", args->rpe_delta_s, "RPE pose pairs about this far apart [s] (default 1)");
+    evl->add_option("--delta-m,--rpe-distance", args->rpe_distance_m,
+                    "RPE segments along the reference [m] (default 10)");
     evl->add_option("--nees-t0", args->nees_t0_s, "Leave the first T0 seconds out of the NEES in-band fraction");
     evl->add_flag("--no-plots", args->no_plots, "Write metrics.json only");
     evl->add_flag("--quiet", args->quiet, "No summary on stdout");
@@ -173,6 +191,9 @@ void AddDiagnose(CLI::App* app, Commands* commands) {
                     "Time-shift search range [s] of gps_latency, imu_time_offset and pose_time_offset (default 0.5; "
                     "below 1/12 of the recording's span)");
     dia->add_flag("--no-plots", args->no_plots, "No figures");
+    dia->add_flag("--replay", args->replay,
+                  "Also diagnose against the scenario's noise-free twin into OUT/twin.json (a recording of the "
+                  "scenario's own drive only)");
     dia->add_flag("--quiet", args->quiet, "No progress and no summary");
     return dia;
   });

@@ -32,12 +32,18 @@ const char* AlignmentKindName(AlignmentKind kind) {
       return "se3";
     case AlignmentKind::kYawTranslation:
       return "yaw_translation";
+    case AlignmentKind::kSim3:
+      return "sim3";
+    case AlignmentKind::kOrigin:
+      return "origin";
   }
   return "none";
 }
 
 std::optional<AlignmentKind> ParseAlignmentKind(const std::string& name) {
-  for (AlignmentKind kind : {AlignmentKind::kNone, AlignmentKind::kSe3, AlignmentKind::kYawTranslation})
+  if (name == "yaw") return AlignmentKind::kYawTranslation;
+  for (AlignmentKind kind : {AlignmentKind::kNone, AlignmentKind::kSe3, AlignmentKind::kYawTranslation,
+                             AlignmentKind::kSim3, AlignmentKind::kOrigin})
     if (name == AlignmentKindName(kind)) return kind;
   return std::nullopt;
 }
@@ -56,18 +62,28 @@ RigidTransform AlignPositions(const std::vector<Eigen::Vector3d>& p_est, const s
                 "alignment needs matched points: " << p_est.size() << " estimate vs " << p_ref.size() << " reference");
   RigidTransform transform;
   if (kind == AlignmentKind::kNone || p_est.empty()) return transform;
+  if (kind == AlignmentKind::kOrigin) {
+    transform.p_ref_est = p_ref.front() - p_est.front();
+    return transform;
+  }
   const Eigen::Vector3d mean_est = Mean(p_est);
   const Eigen::Vector3d mean_ref = Mean(p_ref);
 
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
-  if (kind == AlignmentKind::kSe3) {
+  if (kind == AlignmentKind::kSe3 || kind == AlignmentKind::kSim3) {
     // Cross-covariance of the centred points and its SVD; the sign fix keeps a proper rotation.
     Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-    for (std::size_t i = 0; i < p_est.size(); ++i) h += (p_ref[i] - mean_ref) * (p_est[i] - mean_est).transpose();
+    double spread_est = 0.0;  // sum |a_i|^2
+    for (std::size_t i = 0; i < p_est.size(); ++i) {
+      h += (p_ref[i] - mean_ref) * (p_est[i] - mean_est).transpose();
+      spread_est += (p_est[i] - mean_est).squaredNorm();
+    }
     const Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
     Eigen::Matrix3d s = Eigen::Matrix3d::Identity();
     if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0) s(2, 2) = -1.0;
     rotation = svd.matrixU() * s * svd.matrixV().transpose();
+    if (kind == AlignmentKind::kSim3 && spread_est > 0.0)
+      transform.scale = (svd.singularValues().asDiagonal() * s).trace() / spread_est;
   } else {
     // Yaw maximizing sum b^T Rz(yaw) a: the horizontal dot and cross sums of the centred points.
     double dot = 0.0;
@@ -81,11 +97,18 @@ RigidTransform AlignPositions(const std::vector<Eigen::Vector3d>& p_est, const s
     rotation = Eigen::AngleAxisd(std::atan2(cross, dot), Eigen::Vector3d::UnitZ()).toRotationMatrix();
   }
   transform.q_ref_est = Eigen::Quaterniond(rotation).normalized();
-  transform.p_ref_est = mean_ref - rotation * mean_est;
+  transform.p_ref_est = mean_ref - transform.scale * (rotation * mean_est);
   return transform;
 }
 
 RigidTransform AlignTrajectories(const Trajectory& estimate, const Trajectory& reference, AlignmentKind kind) {
+  ROAMLAB_CHECK(estimate.size() == reference.size(), "alignment needs matched trajectories");
+  if (kind == AlignmentKind::kOrigin && !estimate.empty()) {
+    RigidTransform transform;
+    transform.q_ref_est = (reference.front().q_world_body * estimate.front().q_world_body.conjugate()).normalized();
+    transform.p_ref_est = reference.front().p_world_body - transform.q_ref_est * estimate.front().p_world_body;
+    return transform;
+  }
   return AlignPositions(Positions(estimate), Positions(reference), kind);
 }
 

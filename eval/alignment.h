@@ -11,8 +11,13 @@
 //   kYawTranslation  rotation about the world z axis only, plus a 3-D translation (4 DoF: what remains unobservable
 //                    when gravity fixes roll and pitch):  yaw = atan2(sum a_x b_y - a_y b_x, sum a_x b_x + a_y b_y),
 //                    t = mean(p_ref) - Rz(yaw) mean(p_est).
-// Degenerate inputs (fewer than three non-collinear points for kSe3, no horizontal spread for kYawTranslation) return
-// one of the minimizers; no points give the identity.
+//   kSim3            kSe3 with a scale s (Umeyama 1991): minimizes sum |p_ref_i - (s R p_est_i + t)|^2;
+//                    s = trace(D S) / sum |a_i|^2 with S = diag(1, 1, det(U V^T)), t = mean(p_ref) - s R mean(p_est).
+//                    For monocular or otherwise scale-free estimates.
+//   kOrigin          the first poses made equal: R = R_ref_0 R_est_0^T, t = p_ref_0 - R p_est_0 (orientations are used;
+//                    AlignPositions, which has none, makes the first positions equal with R = I).
+// Degenerate inputs (fewer than three non-collinear points for kSe3/kSim3, no horizontal spread for kYawTranslation)
+// return one of the minimizers; no points give the identity (and scale 1 when the estimate's points do not spread).
 #pragma once
 
 #include <optional>
@@ -26,19 +31,22 @@
 
 namespace roamlab::eval {
 
-enum class AlignmentKind { kNone, kSe3, kYawTranslation };
+enum class AlignmentKind { kNone, kSe3, kYawTranslation, kSim3, kOrigin };
 
-// "none", "se3", "yaw_translation"; ParseAlignmentKind is the inverse (nullopt for anything else).
+// "none", "se3", "yaw_translation", "sim3", "origin"; ParseAlignmentKind is the inverse and also accepts "yaw" for
+// kYawTranslation (nullopt for anything else).
 const char* AlignmentKindName(AlignmentKind kind);
 std::optional<AlignmentKind> ParseAlignmentKind(const std::string& name);
 
-// T_ref_est: maps coordinates in the estimate's world frame into the reference's world frame.
+// T_ref_est: maps coordinates in the estimate's world frame into the reference's world frame (a similarity when
+// scale != 1, which only kSim3 produces).
 struct RigidTransform {
   Eigen::Quaterniond q_ref_est = Eigen::Quaterniond::Identity();
   Eigen::Vector3d p_ref_est = Eigen::Vector3d::Zero();  // [m]
+  double scale = 1.0;                                   // reference metres per estimate unit
 
-  Eigen::Vector3d Apply(const Eigen::Vector3d& p_est) const { return q_ref_est * p_est + p_ref_est; }
-  // The pose of the body in the reference frame: (R p + t, R q). Keeps the stamp.
+  Eigen::Vector3d Apply(const Eigen::Vector3d& p_est) const { return scale * (q_ref_est * p_est) + p_ref_est; }
+  // The pose of the body in the reference frame: (s R p + t, R q). Keeps the stamp.
   StampedPose Apply(const StampedPose& pose_est) const;
 };
 
@@ -46,7 +54,7 @@ struct RigidTransform {
 RigidTransform AlignPositions(const std::vector<Eigen::Vector3d>& p_est, const std::vector<Eigen::Vector3d>& p_ref,
                               AlignmentKind kind);
 
-// Same on the positions of two matched trajectories (same size, CHECK; orientations are not used).
+// Same on two matched trajectories (same size, CHECK); orientations are used by kOrigin only.
 RigidTransform AlignTrajectories(const Trajectory& estimate, const Trajectory& reference, AlignmentKind kind);
 
 // Every pose of `trajectory` mapped through `transform`.

@@ -44,7 +44,7 @@ ErrorStatistics Summarize(const std::vector<double>& errors) {
   s.count = errors.size();
   if (errors.empty()) {
     const double nan = std::numeric_limits<double>::quiet_NaN();
-    s.rmse = s.mean = s.median = s.max = nan;
+    s.rmse = s.mean = s.median = s.std = s.min = s.max = nan;
     return s;
   }
   double sum = 0.0;
@@ -60,22 +60,41 @@ ErrorStatistics Summarize(const std::vector<double>& errors) {
   std::sort(sorted.begin(), sorted.end());
   const std::size_t mid = sorted.size() / 2;
   s.median = sorted.size() % 2 == 1 ? sorted[mid] : 0.5 * (sorted[mid - 1] + sorted[mid]);
+  s.min = sorted.front();
   s.max = sorted.back();
+  double sum_centred = 0.0;
+  for (double e : errors) sum_centred += (e - s.mean) * (e - s.mean);
+  s.std = std::sqrt(sum_centred / n);
   return s;
 }
 
 AbsoluteTrajectoryError ComputeAte(const Trajectory& estimate, const Trajectory& reference, AlignmentKind kind) {
+  return ComputeAte(estimate, reference, kind, AlignTrajectories(estimate, reference, kind));
+}
+
+AbsoluteTrajectoryError ComputeAte(const Trajectory& estimate, const Trajectory& reference, AlignmentKind kind,
+                                   const RigidTransform& alignment) {
   ROAMLAB_CHECK(estimate.size() == reference.size(), "ATE needs matched trajectories");
   AbsoluteTrajectoryError ate;
   ate.alignment_kind = kind;
-  ate.alignment = AlignTrajectories(estimate, reference, kind);
+  ate.alignment = alignment;
   ate.aligned_estimate = TransformTrajectory(ate.alignment, estimate);
+  std::vector<double> axis[3], horizontal, vertical;
   for (std::size_t i = 0; i < estimate.size(); ++i) {
     const Eigen::Vector3d e = ate.aligned_estimate[i].p_world_body - reference[i].p_world_body;
     ate.error_world.push_back(e);
     ate.error_m.push_back(e.norm());
+    ate.rotation_deg.push_back(
+        RotationAngleDeg(reference[i].q_world_body.conjugate() * ate.aligned_estimate[i].q_world_body));
+    for (int a = 0; a < 3; ++a) axis[a].push_back(e[a]);
+    horizontal.push_back(e.head<2>().norm());
+    vertical.push_back(std::abs(e.z()));
   }
   ate.statistics = Summarize(ate.error_m);
+  ate.rotation = Summarize(ate.rotation_deg);
+  for (int a = 0; a < 3; ++a) ate.axis[a] = Summarize(axis[a]);
+  ate.horizontal = Summarize(horizontal);
+  ate.vertical = Summarize(vertical);
   return ate;
 }
 

@@ -67,6 +67,10 @@ std::string TrajectoryData(const std::string& what, Time t_origin, const Traject
   return s.str();
 }
 
+// Line colours of estimates, in order.
+constexpr const char* kSeriesColors[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#17becf"};
+constexpr std::size_t kSeriesColorCount = sizeof kSeriesColors / sizeof kSeriesColors[0];
+
 // A file-name-safe version of a label.
 std::string Slug(const std::string& label) {
   std::string out;
@@ -77,18 +81,27 @@ std::string Slug(const std::string& label) {
 }  // namespace
 
 Result<PlotFiles> WriteTrajectoryPlot(const std::string& directory, const std::string& title, Time t_origin,
-                                      const Trajectory& truth, const Trajectory& estimate,
-                                      const std::string& estimate_label, const std::vector<PositionFixes>& fixes) {
-  PlotFiles files{"trajectory.gp", "trajectory.png", {"trajectory_truth.dat", "trajectory_estimate.dat"}};
-  // Data: truth, estimate, one file per fix stream.
-  if (Status s = WriteText(directory, files.data[0], TrajectoryData("ground truth", t_origin, truth)); !s.ok())
-    return s;
-  if (Status s = WriteText(directory, files.data[1], TrajectoryData(estimate_label, t_origin, estimate)); !s.ok())
+                                      const PlottedTrajectory& reference,
+                                      const std::vector<PlottedTrajectory>& estimates,
+                                      const std::vector<PositionFixes>& fixes) {
+  PlotFiles files{"trajectory.gp", "trajectory.png", {"trajectory_reference.dat"}};
+  // Data: reference, estimates, one file per fix stream.
+  if (Status s = WriteText(directory, files.data[0], TrajectoryData(reference.label, t_origin, reference.poses));
+      !s.ok())
     return s;
   std::ostringstream plot;
-  plot << "plot " << Quote(files.data[0]) << " using 2:3 with lines lw 2.5 lc rgb '#222222' title 'ground truth', \\\n"
-       << "     " << Quote(files.data[1]) << " using 2:3 with lines lw 1.5 lc rgb '#1f77b4' title "
-       << Quote(estimate_label);
+  plot << "plot " << Quote(files.data[0]) << " using 2:3 with lines lw 2.5 lc rgb '#222222' title "
+       << Quote(reference.label);
+  for (std::size_t k = 0; k < estimates.size(); ++k) {
+    const std::string name =
+        k == 0 ? "trajectory_estimate.dat" : "trajectory_estimate_" + std::to_string(k + 1) + ".dat";
+    if (Status s = WriteText(directory, name, TrajectoryData(estimates[k].label, t_origin, estimates[k].poses));
+        !s.ok())
+      return s;
+    files.data.push_back(name);
+    plot << ", \\\n     " << Quote(name) << " using 2:3 with lines lw 1.5 lc rgb '"
+         << kSeriesColors[k % kSeriesColorCount] << "' title " << Quote(estimates[k].label);
+  }
   const char* kFixColors[] = {"#d62728", "#2ca02c", "#9467bd", "#ff7f0e"};
   for (std::size_t k = 0; k < fixes.size(); ++k) {
     const PositionFixes& f = fixes[k];
@@ -104,6 +117,7 @@ Result<PlotFiles> WriteTrajectoryPlot(const std::string& directory, const std::s
     plot << ", \\\n     " << Quote(name) << " using 2:3 with points pt 7 ps 0.6 lc rgb '" << kFixColors[k % 4]
          << "' title " << Quote(f.label);
   }
+  const Trajectory& truth = reference.poses;
   // Script: equal axis scales so that the shape of the path is true, on a canvas shaped like the path.
   Eigen::Vector2d lo = Eigen::Vector2d::Constant(0.0);
   Eigen::Vector2d hi = Eigen::Vector2d::Constant(0.0);
@@ -123,7 +137,7 @@ Result<PlotFiles> WriteTrajectoryPlot(const std::string& directory, const std::s
      << "set size ratio -1\nset grid\n"
      // Legend centred under the x label (with an equal-scale plot `set key below` can overlap the label).
      << "set key at screen 0.5, screen 0.015 center bottom vertical box\n"
-     << "set bmargin " << 4 + 2 * static_cast<int>(2 + fixes.size()) * 4 / 5 << "\n"
+     << "set bmargin " << 4 + 2 * static_cast<int>(1 + estimates.size() + fixes.size()) * 4 / 5 << "\n"
      << plot.str() << "\n";
   if (Status s = WriteText(directory, files.script, gp.str()); !s.ok()) return s;
   return files;
@@ -164,6 +178,44 @@ Result<PlotFiles> WritePositionErrorPlot(const std::string& directory, const std
          << "     ";
     gp << Quote(files.data[0]) << " using 1:" << 2 + a << " with lines lw 1.5 lc rgb '#1f77b4' title '" << kAxes[a]
        << " error'\n";
+  }
+  gp << "unset multiplot\n";
+  if (Status st = WriteText(directory, files.script, gp.str()); !st.ok()) return st;
+  return files;
+}
+
+Result<PlotFiles> WriteErrorOverTimePlot(const std::string& directory, const std::string& title, Time t_origin,
+                                         const std::vector<ErrorSeries>& series) {
+  PlotFiles files{"ate_over_time.gp", "ate_over_time.png", {}};
+  bool rotation = false;
+  for (std::size_t k = 0; k < series.size(); ++k) {
+    const ErrorSeries& e = series[k];
+    ROAMLAB_CHECK(e.t.size() == e.position_m.size() && (e.rotation_deg.empty() || e.rotation_deg.size() == e.t.size()),
+                  "error series '" << e.label << "': sizes differ");
+    rotation = rotation || !e.rotation_deg.empty();
+    std::ostringstream s;
+    s << "# " << e.label << "\n# t_s position_error_m rotation_error_deg\n";
+    for (std::size_t i = 0; i < e.t.size(); ++i)
+      s << Num(SecondsBetween(t_origin, e.t[i])) << ' ' << Num(e.position_m[i]) << ' '
+        << (e.rotation_deg.empty() ? "NaN" : Num(e.rotation_deg[i])) << '\n';
+    files.data.push_back("ate_over_time_" + std::to_string(k + 1) + ".dat");
+    if (Status st = WriteText(directory, files.data.back(), s.str()); !st.ok()) return st;
+  }
+  std::ostringstream gp;
+  gp << "# Redraw: cd into this directory, then: gnuplot " << files.script << "\n"
+     << Terminal(1000, rotation ? 900 : 500) << "set output " << Quote(files.image) << "\n"
+     << "set multiplot layout " << (rotation ? 2 : 1) << ",1 title " << Quote(title) << "\n"
+     << "set grid\nset key top right box opaque\nset xlabel 'time since start [s]'\n";
+  const auto panel = [&](int column, const char* ylabel) {
+    gp << "set ylabel '" << ylabel << "'\nplot ";
+    for (std::size_t k = 0; k < series.size(); ++k)
+      gp << (k ? ", \\\n     " : "") << Quote(files.data[k]) << " using 1:" << column << " with lines lw 1.2 lc rgb '"
+         << kSeriesColors[k % kSeriesColorCount] << "' title " << Quote(series[k].label);
+    gp << "\n";
+  };
+  if (!series.empty()) {
+    panel(2, "position error [m]");
+    if (rotation) panel(3, "rotation error [deg]");
   }
   gp << "unset multiplot\n";
   if (Status st = WriteText(directory, files.script, gp.str()); !st.ok()) return st;

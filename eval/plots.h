@@ -2,8 +2,10 @@
 // (whitespace-separated columns with a '#' header) and a gnuplot script into a directory; the script refers to them by
 // relative names, so `cd DIR && gnuplot NAME.gp` redraws NAME.png after editing either. RunGnuplot runs a script.
 //
-//   trajectory       top view (East, North) of the ground truth, the estimate and absolute fixes (the seed's Fig. 3)
+//   trajectory       top view (East, North) of the reference (ground truth), one or several estimates and absolute
+//                    fixes (the seed's Fig. 3)
 //   position_error   estimate - truth per axis (E, N, U) against time, with the +-3 sigma envelope when known
+//   ate_over_time    position error norm (and rotation error) of several estimates against time
 //   nees             average NEES against time with the chi-square band lines (the seed's Fig. 4)
 //   velocity         forward speed, yaw rate and rotational RPE against time: truth, encoders alone, fused estimate
 //                    (the seed's Fig. 6)
@@ -36,17 +38,37 @@ struct PositionFixes {
   std::vector<Eigen::Vector3d> p_world;  // [m]
 };
 
-// Top view. `estimate` is drawn as given (align it first); `estimate_label` is its legend text. Time columns are
-// seconds since t_origin.
+// A trajectory to draw and its legend text.
+struct PlottedTrajectory {
+  std::string label;
+  Trajectory poses;
+};
+
+// Top view. Estimates are drawn as given (align them first); data files trajectory_reference.dat,
+// trajectory_estimate.dat for the first estimate and trajectory_estimate_<k>.dat (k = 2, 3, ...) for the others, one
+// per fix stream. Time columns are seconds since t_origin.
 Result<PlotFiles> WriteTrajectoryPlot(const std::string& directory, const std::string& title, Time t_origin,
-                                      const Trajectory& truth, const Trajectory& estimate,
-                                      const std::string& estimate_label, const std::vector<PositionFixes>& fixes);
+                                      const PlottedTrajectory& reference,
+                                      const std::vector<PlottedTrajectory>& estimates,
+                                      const std::vector<PositionFixes>& fixes);
 
 // Three stacked panels, East, North, Up. t: one stamp per error; errors [m]; sigma_world: one standard deviation per
 // axis [m] per stamp, or empty for no envelope (sizes CHECKed).
 Result<PlotFiles> WritePositionErrorPlot(const std::string& directory, const std::string& title, Time t_origin,
                                          const std::vector<Time>& t, const std::vector<Eigen::Vector3d>& error_world,
                                          const std::vector<Eigen::Vector3d>& sigma_world);
+
+// One estimate's errors at its matched poses.
+struct ErrorSeries {
+  std::string label;
+  std::vector<Time> t;
+  std::vector<double> position_m;    // |error| per stamp [m]
+  std::vector<double> rotation_deg;  // per stamp [deg], or empty (no rotation panel line)
+};
+// ate_over_time.gp/.png and ate_over_time_<k>.dat (k = 1, 2, ...): the position error of every series against time,
+// and a second panel with the rotation errors when any series has them. Sizes CHECKed.
+Result<PlotFiles> WriteErrorOverTimePlot(const std::string& directory, const std::string& title, Time t_origin,
+                                         const std::vector<ErrorSeries>& series);
 
 // Average NEES and the band [lo, hi] (dashed), with a dotted line at t0_s when it is positive. Files NAME.gp, NAME.dat,
 // NAME.png with NAME = `name`.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include <Eigen/Geometry>
 
@@ -57,15 +58,21 @@ std::vector<StampedTwist> TrajectoryVelocities(const Trajectory& trajectory) {
 }
 
 Result<EncoderOdometry> EncoderOnlyOdometry(const recording::Recording& rec) {
-  Result<recording::WheelKinematics> kinematics = recording::NominalWheelKinematics(rec.platform);
-  if (!kinematics.ok()) return kinematics.status();
+  // The last stream of cumulative angles whose columns the platform's kinematics reads (rows in column order).
   const recording::Stream* encoders = nullptr;
-  for (const recording::Stream& s : rec.streams)
-    if (s.info.type == recording::StreamType::kWheelEncoders && s.info.units == "rad" &&
-        s.values.cols() == kinematics.value().wheels())
+  Result<recording::WheelKinematics> kinematics = Status::Error("no wheel_encoders stream of cumulative angles");
+  for (const recording::Stream& s : rec.streams) {
+    if (s.info.type != recording::StreamType::kWheelEncoders || s.info.units != "rad") continue;
+    Result<recording::WheelKinematics> k = recording::NominalWheelKinematics(rec.platform, s.info.columns);
+    if (k.ok() && s.values.cols() == k.value().wheels()) {
       encoders = &s;
-  if (encoders == nullptr)
-    return Status::Error("no wheel_encoders stream of cumulative angles with one column per wheel");
+      kinematics = std::move(k);
+    } else if (encoders == nullptr) {
+      kinematics = k.ok() ? Status::Error("no wheel_encoders stream of cumulative angles with one column per wheel")
+                          : k.status();
+    }
+  }
+  if (encoders == nullptr) return kinematics.status();
   EncoderOdometry out;
   StampedPose pose{encoders->t.empty() ? Time() : encoders->t.front(), Eigen::Vector3d::Zero(),
                    Eigen::Quaterniond::Identity()};

@@ -39,8 +39,9 @@ struct EncoderOdometry {
   std::vector<StampedTwist> twists;
   Trajectory dead_reckoning;  // from the identity at the first encoder stamp
 };
-// Forward kinematics of the recording's wheel-encoder stream (cumulative angles, rad). Errors: no wheeled platform,
-// no such stream, or a geometry key missing.
+// Forward kinematics of the recording's wheel-encoder stream (cumulative angles, rad), with the platform's nominal
+// kinematics for that stream's columns (recording/wheel_kinematics.h). Errors: no wheeled platform, no such stream,
+// or a geometry key missing.
 Result<EncoderOdometry> EncoderOnlyOdometry(const recording::Recording& recording);
 
 struct VelocityErrors {

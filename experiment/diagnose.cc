@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include "estimator/config.h"
@@ -9,6 +10,7 @@
 #include "gap/nominal_config.h"
 #include "gap/report.h"
 #include "gap/resimulate.h"
+#include "gap/twin.h"
 #include "recording/recording.h"
 #include "sim/scenario.h"
 
@@ -92,6 +94,40 @@ Result<gap::Baseline> NominalBaseline(const DiagnoseRequest& request, const Inpu
   return std::move(learned).value().baseline;
 }
 
+// Whether the scenario's plain noise-free simulation is the recording's twin (a recording of its own drive): bad input
+// otherwise, before anything long runs.
+Outcome CheckTwinDrive(const DiagnoseRequest& request, const Inputs& in) {
+  if (!in.scenario) return Outcome::BadInput(Status::Error("--replay needs --scenario"));
+  sim::Scenario nominal = *in.scenario;
+  nominal.effects.clear();
+  nominal.duration_s = std::max(in.span_s, 1.0);
+  auto twin = gap::PlainSimulationRunner()(nominal);
+  if (!twin.ok()) return Outcome::Failed(Status::Error("the nominal twin: " + twin.status().message()));
+  const std::string mismatch = gap::DriveMismatch(in.recording, twin.value());
+  if (!mismatch.empty())
+    return Outcome::BadInput(Status::Error(request.recording + ": not a recording of " + request.scenario +
+                                           "'s own drive (" + mismatch +
+                                           "); --replay needs the replay of the recorded drive, not available"));
+  return Outcome::Ok();
+}
+
+// The diagnosis against the scenario's twin (its plain noise-free simulation) into out/twin.json.
+Outcome DiagnoseTwinToFile(const DiagnoseRequest& request, const Inputs& in,
+                           const std::function<void(const std::string&)>& say) {
+  say("diagnosing " + request.recording + " against the scenario's twin");
+  gap::TwinDiagnoseOptions options;
+  options.progress = [&](const std::string& line) { say("  " + line); };
+  if (request.max_shift_s) options.max_shift_s = *request.max_shift_s;
+  auto diagnosed = gap::DiagnoseTwin(*in.scenario, in.recording, gap::PlainSimulationRunner(), options);
+  if (!diagnosed.ok()) return Outcome::Failed(Status::Error("twin: " + diagnosed.status().message()));
+  const std::string path = (std::filesystem::path(request.out) / "twin.json").string();
+  std::ofstream out(path);
+  out << gap::TwinDiagnosisJson(diagnosed.value()).dump(2) << "\n";
+  if (!out) return Outcome::Failed(Status::Error(path + ": cannot write"));
+  say("twin: " + diagnosed.value().verdict + " (" + path + ")");
+  return Outcome::Ok();
+}
+
 }  // namespace
 
 Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagnosis) {
@@ -111,6 +147,8 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
   auto inputs = LoadInputs(request);
   if (!inputs.ok()) return Outcome::BadInput(inputs.status());
   const Inputs& in = inputs.value();
+  if (request.replay)
+    if (Outcome checked = CheckTwinDrive(request, in); !checked.ok()) return checked;
   gap::DiagnoseOptions options;
   options.progress = [&](const std::string& line) { say("  " + line); };
   if (request.max_shift_s) options.max_shift_s = *request.max_shift_s;
@@ -146,6 +184,8 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
   report.plots = !request.no_plots;
   report.progress = say;
   if (Status s = gap::WriteReport(d, report, request.out); !s.ok()) return Outcome::Failed(s);
+  if (request.replay)
+    if (Outcome twin = DiagnoseTwinToFile(request, in, say); !twin.ok()) return twin;
   if (diagnosis) *diagnosis = std::move(diagnosed).value();
   return Outcome::Ok();
 }

@@ -8,7 +8,8 @@
 // scenario, the nominal scenario is simulated again without noise, as believed and with the accepted effects, and
 // compared with the recording's held-out part (gap/resimulate.h; gap.json "simulation"). Writes gap.json, report.md,
 // the patches and the figures (gap/report.h). Without a scenario and a configuration, the nominal model is the one
-// `roamlab init` writes (experiment/init.h), saved as out/nominal_config.yaml, and there is no baseline.
+// `roamlab init` writes (experiment/init.h), saved as out/nominal_config.yaml, and there is no baseline. With `replay`,
+// the recording is also diagnosed against the scenario's twin (gap/twin.h) into out/twin.json.
 #pragma once
 
 #include <cstdint>
@@ -35,8 +36,12 @@ struct DiagnoseRequest {
   std::string out;        // output directory
   bool no_baseline = false;
   std::uint64_t baseline_seed = gap::kDefaultBaselineSeed;  // noise seed of the nominal simulation
-  std::optional<double> max_shift_s;                      // the time-shift search range (default gap::DiagnoseOptions')
-  bool no_plots = false;                                  // no figures beside report.md
+  std::optional<double> max_shift_s;  // the time-shift search range (default gap::DiagnoseOptions')
+  bool no_plots = false;              // no figures beside report.md
+  // Also diagnose against the twin (gap/twin.h) and write out/twin.json. The twin is the plain noise-free simulation
+  // of the scenario, so this needs a scenario and a recording of the scenario's own drive (gap::DriveMismatch; bad
+  // input otherwise): the replay of another recorded drive is not available.
+  bool replay = false;
   std::function<void(const std::string& line)> progress;  // optional
 };
 

@@ -210,6 +210,13 @@ Result<EstimatorConfig> NominalAckermannConfig(const sim::Scenario& scenario) {
 }  // namespace
 
 Result<EstimatorConfig> NominalConfig(const sim::Scenario& scenario) {
+  // The wheeled models below read the simulator's nominal geometry keys and its default encoder stream.
+  if (scenario.robot.kind != "ackermann" &&
+      (scenario.robot.per_wheel_geometry || !scenario.robot.encoder_columns.empty() ||
+       (scenario.sensors.wheel_encoders && scenario.sensors.wheel_encoders->name != "wheel_encoders")))
+    return Status::Error(
+        "the nominal configuration needs the simulator's own encoder stream and geometry keys (no "
+        "robot.encoder_columns, robot.geometry_keys: per_wheel or sensors.wheel_encoders.name)");
   if (scenario.robot.kind == "differential_drive") return NominalDiffDriveConfig(scenario);
   if (scenario.robot.kind == "omni3" || scenario.robot.kind == "mecanum") return NominalHolonomicConfig(scenario);
   if (scenario.robot.kind != "ackermann")

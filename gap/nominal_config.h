@@ -21,7 +21,9 @@ namespace roamlab::gap {
 //   - differential_drive, omni3 and mecanum: the wheel encoders (master) with the platform geometry measured on the
 //     robot's model, one radius free for all wheels, the yaw lever arm (baseline, distance, lx_plus_ly) fixed, and
 //     the gyroscope with the IMU misalignment free.
-// Errors: another robot kind, or a master or yaw sensor missing.
+// Errors: another robot kind, a master or yaw sensor missing, or a wheeled scenario that renames its encoder stream or
+// its columns or states per-wheel geometry keys (the real robots' scenarios; the real recordings have their own
+// configurations in configs/real/).
 Result<estimator::EstimatorConfig> NominalConfig(const sim::Scenario& scenario);
 
 }  // namespace roamlab::gap

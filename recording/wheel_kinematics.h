@@ -11,10 +11,19 @@
 //   differential_drive   geometry: wheel_radius_m, baseline_m (distance between the wheel contact points)
 //                        wheels: 0 = left at (0, +B/2), 1 = right at (0, -B/2), both rolling along +x:
 //                        omega_left = (v_x - omega_z B/2) / r,  omega_right = (v_x + omega_z B/2) / r
+//   skid_steer           the same rows, one per side (a side's wheels turn together): wheels 0 = left, 1 = right
+//                        (with the encoder columns: `left`, `right`, or one per wheel front_left ... rear_right). B
+//                        is the nominal track; turning, the tires scrub sideways, so the body turns slower than
+//                        these rows say (the effective track is wider than B)
 //   omni3                geometry: wheel_radius_m, wheel_distance_m (L, from O to each wheel's contact point)
 //                        wheel i at alpha_i = 60, 180, 300 deg from x, rolling along the counter-clockwise tangent
 //                        d_i = (-sin alpha_i, cos alpha_i) (omni rollers absorb the radial component):
 //                        omega_i = (-sin alpha_i v_x + cos alpha_i v_y + L omega_z) / r
+// Per-wheel keys (the OptiOdom importer's, importers/optiodom.h), read when the encoder columns are given: radius
+// wheel_radius_<column>_m (else wheel_radius_m); differential_drive and skid_steer: columns `left` and `right` in any
+// order, the track baseline_m (else track_m); omni3: wheel_angle_<column>_rad (alpha of that wheel) and
+// wheel_direction_<column> (+1: a positive rotation pushes the body along the counter-clockwise tangent, as above;
+// -1: along the clockwise one), omega_i = s_i (-sin alpha_i v_x + cos alpha_i v_y + L omega_z) / r_i.
 //   mecanum              geometry: wheel_radius_m, half_length_m (lx), half_width_m (ly); wheels 0-3 front left,
 //                        front right, rear left, rear right at (+-lx, +-ly), rolling along +x, 45 deg rollers in the
 //                        X layout (models/mecanum.xml): with K = lx + ly
@@ -32,6 +41,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -51,8 +61,12 @@ struct WheelKinematics {
 
 // Whether the platform kind is one of the wheeled kinds above.
 bool IsWheeledPlatform(const std::string& kind);
-// The nominal kinematics; errors name the missing or bad geometry key (without a file: the caller adds it).
+// The nominal kinematics, rows in the wheel order above; errors name the missing or bad geometry key (without a file:
+// the caller adds it).
 Result<WheelKinematics> NominalWheelKinematics(const Platform& platform);
+// The same with rows in the order of `columns` (the wheel_encoders stream's column names), reading the per-wheel keys
+// above when present; empty columns: as NominalWheelKinematics(platform).
+Result<WheelKinematics> NominalWheelKinematics(const Platform& platform, const std::vector<std::string>& columns);
 
 // The rows above for given geometry (n x 3): omni3 with per-wheel radii r_i and distance L; mecanum with per-wheel
 // radii and K = lx + ly. Shared with the estimator's error models, which take the geometry as parameters.

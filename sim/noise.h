@@ -21,6 +21,8 @@ enum class NoiseSource : std::uint32_t {
   kLaserRange = 6,
   kGyroBiasWalk = 7,  // the gyro_bias_drift effect's random walk
   kGpsMultipath = 8,  // the gps_multipath effect's Gauss-Markov error
+  kMocapPosition = 9,
+  kMocapOrientation = 10,
 };
 
 class NoiseStream {

@@ -124,12 +124,21 @@ Found FromInputsStream(const Recording& real, bool ackermann, std::string* note)
   return std::optional<DriveInputs>();
 }
 
+// The name of each model wheel, in wheel index order: its robot.encoder_columns name, else the kind's.
+std::vector<std::string> ModelWheelNames(const RobotOptions& robot) {
+  std::vector<std::string> names = WheeledRobot::EncoderColumns(robot.kind);
+  for (const EncoderColumn& c : robot.encoder_columns)
+    if (c.wheel >= 0 && static_cast<std::size_t>(c.wheel) < names.size())
+      names[static_cast<std::size_t>(c.wheel)] = c.name;
+  return names;
+}
+
 // 2. Measured wheel speeds of a wheeled robot.
-Found FromWheelEncoders(const Recording& real, const std::string& kind) {
+Found FromWheelEncoders(const Recording& real, const RobotOptions& robot) {
   for (const Stream& s : real.streams) {
     if (s.info.type != StreamType::kWheelEncoders || s.t.size() < 2) continue;
     if (!IsAngleEncoder(s) && s.info.units != "rad/s") continue;
-    const std::vector<std::string> model = WheeledRobot::EncoderColumns(kind);
+    const std::vector<std::string> model = ModelWheelNames(robot);
     auto match = MatchWheelColumns(s.info.columns, model);
     if (!match.ok()) return Status::Error("wheel_encoders stream '" + s.info.name + "': " + match.status().message());
     const Eigen::MatrixXd rates = IsAngleEncoder(s) ? WindowRates(s) : s.values;
@@ -244,7 +253,7 @@ std::string SimulatedName(const Stream& s, const Recording& real, const Scenario
       if (!real.origin) return need(false, "", "the recording has no origin");
       return need(sensors.gps.has_value(), "gps", "the nominal scenario has no gps");
     case StreamType::kPose:
-      return "pose";
+      return "mocap";
     case StreamType::kOdometry:
       return need(!ackermann, "odometry", "an ackermann vehicle has no wheel odometry in the simulator");
     case StreamType::kSteering:
@@ -261,16 +270,29 @@ std::string SimulatedName(const Stream& s, const Recording& real, const Scenario
   }
 }
 
-// Each recorded column of a wheel_encoders stream must be driven by a model wheel: the model wheels of each column.
-Result<std::vector<std::vector<int>>> WheelsOfColumns(const Stream& s, const std::string& kind) {
-  auto match = MatchWheelColumns(s.info.columns, WheeledRobot::EncoderColumns(kind));
+// Each recorded column of a wheel_encoders stream must be driven by a model wheel that the simulator's encoder stream
+// reads (its columns: robot.encoder_columns, else every wheel in index order): per recorded column, those simulated
+// columns.
+Result<std::vector<std::vector<Eigen::Index>>> SimulatedColumnsOf(const Stream& s, const RobotOptions& robot) {
+  const std::vector<std::string> names = ModelWheelNames(robot);
+  auto match = MatchWheelColumns(s.info.columns, names);
   if (!match.ok()) return match.status();
-  std::vector<std::vector<int>> wheels(s.info.columns.size());
+  std::vector<Eigen::Index> column_of_wheel(names.size(), -1);
+  if (robot.encoder_columns.empty()) {
+    for (std::size_t i = 0; i < names.size(); ++i) column_of_wheel[i] = static_cast<Eigen::Index>(i);
+  }
+  for (std::size_t k = 0; k < robot.encoder_columns.size(); ++k) {
+    const int wheel = robot.encoder_columns[k].wheel;
+    if (wheel >= 0 && static_cast<std::size_t>(wheel) < names.size())
+      column_of_wheel[static_cast<std::size_t>(wheel)] = static_cast<Eigen::Index>(k);
+  }
+  std::vector<std::vector<Eigen::Index>> columns(s.info.columns.size());
   for (std::size_t i = 0; i < match.value().size(); ++i)
-    wheels[static_cast<std::size_t>(match.value()[i])].push_back(static_cast<int>(i));
-  for (std::size_t j = 0; j < wheels.size(); ++j)
-    if (wheels[j].empty()) return Status::Error("column '" + s.info.columns[j] + "' drives no model wheel");
-  return wheels;
+    if (column_of_wheel[i] >= 0) columns[static_cast<std::size_t>(match.value()[i])].push_back(column_of_wheel[i]);
+  for (std::size_t j = 0; j < columns.size(); ++j)
+    if (columns[j].empty())
+      return Status::Error("column '" + s.info.columns[j] + "' drives no model wheel the scenario's encoders read");
+  return columns;
 }
 
 // Which recorded streams the twin holds, at which stamps, and the scenario's sensors for them.
@@ -282,7 +304,7 @@ Plan PlanTwin(const Scenario& nominal, const Recording& real, Time from, Time to
     std::string why;
     std::string name = SimulatedName(s, real, nominal, &why);
     if (name == "wheel_encoders") {
-      if (auto wheels = WheelsOfColumns(s, nominal.robot.kind); !wheels.ok()) {
+      if (auto wheels = SimulatedColumnsOf(s, nominal.robot); !wheels.ok()) {
         why = wheels.status().message();
         name.clear();
       }
@@ -326,6 +348,12 @@ void FitSensors(const Recording& real, Plan* plan) {
   if (!has("gps")) sensors.gps.reset();
   if (!has("rear_wheel") && !has("steering")) sensors.odometer.reset();
   if (!has("wheel_encoders")) sensors.wheel_encoders.reset();
+  if (!has("mocap")) sensors.mocap.reset();
+  if (has("mocap") && !sensors.mocap) {  // the rate is the schedule's; one that fits the physics step
+    MocapOptions mocap;
+    mocap.rate_hz = plan->scenario.ground_truth_rate_hz;
+    sensors.mocap = mocap;
+  }
   if (has("wheel_encoders") && !sensors.wheel_encoders) {
     WheelEncoderOptions encoders;
     encoders.ticks_per_revolution = kDefaultTicksPerRevolution;
@@ -411,19 +439,19 @@ StartPose StartOf(const Recording& real, const Scenario& nominal, Time from) {
 
 // The twin's values of one planned stream from the simulated one, in the recorded stream's layout.
 Eigen::MatrixXd TwinValues(const Stream& recorded, const Stream& simulated, const TwinStream& plan,
-                           const std::string& kind) {
+                           const RobotOptions& robot) {
   const Eigen::Index n = simulated.values.rows();
   const auto first = static_cast<Eigen::Index>(plan.first_row);
   Eigen::MatrixXd out = recorded.values.middleRows(first, n);  // extra columns (a fix's covariance) as recorded
   if (plan.simulated == "wheel_encoders") {
-    const auto wheels = WheelsOfColumns(recorded, kind).value();
-    for (std::size_t j = 0; j < wheels.size(); ++j) {
+    const auto columns = SimulatedColumnsOf(recorded, robot).value();  // checked by PlanTwin
+    for (std::size_t j = 0; j < columns.size(); ++j) {
       Eigen::VectorXd sum = Eigen::VectorXd::Zero(n);
-      for (int i : wheels[j]) sum += simulated.values.col(i);
+      for (Eigen::Index i : columns[j]) sum += simulated.values.col(i);
       const auto c = static_cast<Eigen::Index>(j);
-      out.col(c) = sum / static_cast<double>(wheels[j].size()) + Eigen::VectorXd::Constant(n, out(0, c));
+      out.col(c) = sum / static_cast<double>(columns[j].size()) + Eigen::VectorXd::Constant(n, out(0, c));
     }
-  } else if (plan.simulated == "pose") {
+  } else if (plan.simulated == "mocap") {
     const recording::Mounting m = recorded.info.mounting.value_or(recording::Mounting{});
     for (Eigen::Index k = 0; k < n; ++k) {
       const Eigen::Quaterniond q_world_body(simulated.values(k, 6), simulated.values(k, 3), simulated.values(k, 4),
@@ -452,11 +480,12 @@ void AssembleTwin(const Recording& real, const Plan& plan, Simulation* sim) {
   std::vector<Stream> twin;
   for (const TwinStream& t : plan.streams) {
     const Stream& recorded = real.streams[t.recorded];
-    const Stream* simulated = sim->recording.Find(t.simulated);
+    const bool encoders = t.simulated == "wheel_encoders";  // the scenario names its encoder stream
+    const Stream* simulated = sim->recording.Find(encoders ? plan.scenario.sensors.wheel_encoders->name : t.simulated);
     Stream s;
     s.info = recorded.info;
     s.t = simulated->t;
-    s.values = TwinValues(recorded, *simulated, t, plan.scenario.robot.kind);
+    s.values = TwinValues(recorded, *simulated, t, plan.scenario.robot);
     twin.push_back(std::move(s));
   }
   sim->recording.streams = std::move(twin);
@@ -522,7 +551,7 @@ Result<DriveInputs> DriveInputsFrom(const Recording& real, const Scenario& nomin
   std::string note;
   Found inputs = FromInputsStream(real, ackermann, &note);
   if (inputs.ok() && !inputs.value())
-    inputs = ackermann ? FromAckermannOdometer(real, nominal) : FromWheelEncoders(real, nominal.robot.kind);
+    inputs = ackermann ? FromAckermannOdometer(real, nominal) : FromWheelEncoders(real, nominal.robot);
   if (inputs.ok() && !inputs.value() && !ackermann) inputs = FromOdometry(real);
   if (!inputs.ok()) return inputs.status();
   if (!inputs.value())

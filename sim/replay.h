@@ -29,12 +29,14 @@
 // noise and attributes and its stamps within [from, to] (the physics step nearest each stamp,
 // sim/replay_schedule.h): imu, magnetometer and gps (when the nominal scenario has the sensor; the scenario's
 // mounting and calibration: the nominal belief), wheel_encoders in rad (wheeled kinds; the scenario's encoder
-// resolution, else the recording's ticks_per_revolution when whole, else 2048; a recorded column driven by several
-// model wheels reads their mean; each column starts at the recorded value at the first stamp), the ackermann
-// odometer's rear-wheel speed and steering (when the nominal has an odometer), one pose stream (the pose of its
-// mounting in W) and, for the wheeled kinds, one odometry stream (the wheel odometry: the twist the nominal kinematics
-// gives for the twin's wheel rates, as the stream's frame moves); a gps or odometry stream's covariance columns are
-// copied from the recording. Left out, with the reason in
+// columns read the model wheels, robot.encoder_columns, and each recorded column is matched to them by
+// MatchWheelColumns; the scenario's encoder resolution, else the recording's ticks_per_revolution when whole, else
+// 2048; a recorded column driven by several model wheels reads their mean; each column starts at the recorded value at
+// the first stamp), the ackermann odometer's rear-wheel speed and steering (when the nominal has an odometer), one pose
+// stream (the first of the recording; the simulator's motion capture sampled at its stamps, a scenario without
+// sensors.mocap given one: the pose of the stream's mounting in W) and, for the wheeled kinds, one odometry stream (the
+// wheel odometry: the twist the nominal kinematics gives for the twin's wheel rates, as the stream's frame moves); a
+// gps or odometry stream's covariance columns are copied from the recording. Left out, with the reason in
 // SimulationStats::left_out ("<stream>: <reason>"): every other stream (visual_odometry, scan_matching,
 // position, laser_scan, camera, inputs, a second stream of a kind) and the laser and camera of the scenario
 // (too slow for a replay; the scenario's static world model is dropped with them, so the robot meets no walls).
@@ -65,7 +67,8 @@ struct ReplayOptions {
   std::function<void(double)> progress;
 };
 
-// For each model wheel (`model_columns`, WheeledRobot::EncoderColumns), the index of the recorded column that drives
+// For each model wheel (`model_columns`, in wheel index order: its name in the scenario's robot.encoder_columns, else
+// WheeledRobot::EncoderColumns of the kind), the index of the recorded column that drives
 // it: the column of the same name; else, for a model wheel whose name ends in "left" or "right" (front_left,
 // rear_right), a recorded column named "left" or "right" (a two-column recording of a four-wheel skid steer drives
 // both wheels of a side alike). Errors (one line): a model wheel without a recorded column, naming both lists.

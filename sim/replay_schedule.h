@@ -28,7 +28,7 @@ namespace roamlab::sim {
 struct DriveInputs {
   enum class Kind {
     kBodyVelocity,  // per row v_x [m/s], v_y [m/s], omega_z [rad/s] of O: the wheeled robots' body-velocity driver
-    kWheelRates,    // per row one rate [rad/s] per wheel of the model (WheeledRobot::EncoderColumns order): each
+    kWheelRates,    // per row one rate [rad/s] per wheel of the model (wheel index order, sim/replay.h): each
                     // wheel's velocity servo set to it
     kAckermann,     // per row rear-wheel speed [m/s] (the speed controller's set-point) and handlebar angle [rad]
   };
@@ -57,8 +57,8 @@ inline constexpr double kAngleTrackingS = 0.1;
 struct ReplaySchedule {
   Time t0;  // the recording time of simulation time 0
   DriveInputs drive;
-  // Per simulated stream (its name in the simulator: imu, magnetometer, gps, wheel_encoders, rear_wheel, steering,
-  // pose, odometry):
+  // Per simulated stream (its role in the simulator: imu, magnetometer, gps, wheel_encoders (the scenario's encoder
+  // stream, whatever its name), rear_wheel, steering, mocap, odometry):
   // the stamps to sample it at (recording time, strictly increasing, >= t0). A stream of the scenario without an
   // entry here is not scheduled and keeps its rate (stamps from t0).
   std::map<std::string, std::vector<Time>> stamps;

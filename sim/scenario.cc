@@ -103,10 +103,51 @@ void ReadProfile(YamlReader& r, const YAML::Node& map, const std::string& parent
   }
 }
 
+// robot.encoder_columns, geometry_keys and geometry: how the recording names the wheels and the geometry.
+void ReadRobotNaming(YamlReader& r, const YAML::Node& node, Scenario* s) {
+  if (node["encoder_columns"]) {
+    const YAML::Node list = node["encoder_columns"];
+    const std::string k = "robot.encoder_columns";
+    r.Remember(k, list);
+    if (!list.IsSequence()) return r.Fail(list, k, "expected a list of {wheel, name}");
+    for (std::size_t i = 0; i < list.size() && r.ok(); ++i) {
+      const std::string ki = k + "[" + std::to_string(i) + "]";
+      r.CheckKeys(list[i], ki, {"wheel", "name"});
+      if (!r.Require(list[i], ki, "wheel") || !r.Require(list[i], ki, "name")) return;
+      std::int64_t wheel = 0;
+      EncoderColumn c;
+      r.Integer(list[i], ki, "wheel", &wheel);
+      r.String(list[i], ki, "name", &c.name);
+      c.wheel = static_cast<int>(std::clamp<std::int64_t>(wheel, -1, 64));
+      s->robot.encoder_columns.push_back(c);
+    }
+  }
+  if (node["geometry_keys"]) {
+    std::string keys;
+    r.String(node, "robot", "geometry_keys", &keys);
+    if (r.ok() && keys != "nominal" && keys != "per_wheel")
+      return r.Fail(node["geometry_keys"], "robot.geometry_keys", "expected nominal or per_wheel, got '" + keys + "'");
+    s->robot.per_wheel_geometry = keys == "per_wheel";
+  }
+  if (node["geometry"]) {
+    const YAML::Node map = node["geometry"];
+    r.Remember("robot.geometry", map);
+    if (!map.IsMap()) return r.Fail(map, "robot.geometry", "expected a map of key: number");
+    for (const auto& item : map) {
+      const std::string key = item.first.as<std::string>("");
+      double value = 0.0;
+      r.Number(map, "robot.geometry", key, &value);
+      if (!r.ok()) return;
+      s->robot.stated_geometry[key] = value;
+    }
+  }
+}
+
 void ReadRobot(YamlReader& r, const YAML::Node& node, const std::string& scenario_dir, Scenario* s) {
   const std::string key = "robot";
   r.CheckKeys(node, key,
-              {"kind", "model", "start", "speed_controller", "wheel_mounting", "wheel_deformation", "wheel_offset"});
+              {"kind", "model", "start", "speed_controller", "wheel_mounting", "wheel_deformation", "wheel_offset",
+               "encoder_columns", "geometry_keys", "geometry"});
   if (!r.Require(node, key, "kind") || !r.Require(node, key, "model")) return;
   r.String(node, key, "kind", &s->robot.kind);
   std::string model;
@@ -203,6 +244,7 @@ void ReadRobot(YamlReader& r, const YAML::Node& node, const std::string& scenari
           {static_cast<int>(std::clamp<std::int64_t>(wheel, -1, 64)), Eigen::Vector2d(offset[0], offset[1])});
     }
   }
+  ReadRobotNaming(r, node, s);
 }
 
 void ReadWorld(YamlReader& r, const YAML::Node& node, const std::string& scenario_dir, Scenario* s) {
@@ -279,7 +321,8 @@ void ReadDriver(YamlReader& r, const YAML::Node& node, Scenario* s) {
 }
 
 void ReadSensors(YamlReader& r, const YAML::Node& node, Scenario* s) {
-  r.CheckKeys(node, "sensors", {"imu", "magnetometer", "gps", "odometer", "wheel_encoders", "laser", "camera"});
+  r.CheckKeys(node, "sensors",
+              {"imu", "magnetometer", "gps", "odometer", "wheel_encoders", "laser", "camera", "mocap"});
   if (!r.ok()) return;
   // A present key with an empty value ("imu:" or "imu: {}") is a sensor with all defaults.
   const auto section = [&r](const YAML::Node& n, const std::string& k, std::initializer_list<std::string_view> keys) {
@@ -330,6 +373,16 @@ void ReadSensors(YamlReader& r, const YAML::Node& node, Scenario* s) {
       if (r.ok() && !lever.empty()) gps.lever_arm_m = ToVector3(lever);
     }
   }
+  if (node["mocap"]) {
+    MocapOptions& mocap = s->sensors.mocap.emplace();
+    const YAML::Node n = node["mocap"];
+    const std::string k = "sensors.mocap";
+    if (section(n, k, {"rate_hz", "position_sigma_m", "orientation_sigma_rad"})) {
+      r.Number(n, k, "rate_hz", &mocap.rate_hz);
+      r.Number(n, k, "position_sigma_m", &mocap.position_sigma_m);
+      r.Number(n, k, "orientation_sigma_rad", &mocap.orientation_sigma_rad);
+    }
+  }
   if (node["odometer"]) {
     OdometerOptions& odo = s->sensors.odometer.emplace();
     const YAML::Node n = node["odometer"];
@@ -350,7 +403,8 @@ void ReadIndoorSensors(YamlReader& r, const YAML::Node& node, Scenario* s) {
     WheelEncoderOptions& enc = s->sensors.wheel_encoders.emplace();
     const YAML::Node n = node["wheel_encoders"];
     const std::string k = "sensors.wheel_encoders";
-    r.CheckKeys(n, k, {"rate_hz", "ticks_per_revolution"});
+    r.CheckKeys(n, k, {"name", "rate_hz", "ticks_per_revolution"});
+    r.String(n, k, "name", &enc.name);
     r.Number(n, k, "rate_hz", &enc.rate_hz);
     r.Number(n, k, "ticks_per_revolution", &enc.ticks_per_revolution);
   } else if (node["wheel_encoders"]) {

@@ -35,6 +35,11 @@
 //                    A: [0.87, -0.02, -0.02, 0.0, 0.88, 0.0, -0.02, -0.04, 0.85],   # row-major
 //                    b: [-0.008, -0.007, -0.040], field_world: [0.0, 0.5, -0.8660254037844386]}
 //     gps: {rate_hz: 5, sigma_m: 0.33, lever_arm_m: [0.57, -0.46, 0.32]}
+//     mocap: {rate_hz: 20, position_sigma_m: 0.001, orientation_sigma_rad: 0.005}   # motion capture: stream mocap
+//                                           # (type pose, columns x y z qx qy qz qw: O's pose in W, the position
+//                                           # with Gaussian noise per axis, the orientation turned by a Gaussian
+//                                           # rotation vector; noise position_m, orientation_rad, as the OptiOdom
+//                                           # importer states its motion capture)
 //     odometer: {rate_hz: 100, speed_sigma_mps: 0.033, steering_sigma_rad: 0.014,     # ackermann: eq. 15
 //                kv_over_L: 0.8, k_theta: 1.0, k_gamma: 0.0}
 //   effects: []                             # hidden physical effects, each {name: ..., parameters: {...}}; written
@@ -184,11 +189,32 @@
 //                                           # baseline / distance / lx_plus_ly follow the moved wheels' yaw lever arms.
 //   driver:
 //     lateral_mps: <profile>                # sideways speed v_y [m/s] (default 0; only for omni3 and mecanum)
-// wheel_encoders has one column per wheel: omni3 "wheel_0" "wheel_1" "wheel_2", mecanum "front_left" "front_right"
-// "rear_left" "rear_right". Platform geometry: omni3 wheel_radius_m, wheel_distance_m (L); mecanum wheel_radius_m,
-// half_length_m, half_width_m. truth.yaml: odometer.radius_<i> for every wheel, and odometer.distance (omni3) or
-// odometer.lx_plus_ly (mecanum), the names of the omni3_drive and mecanum_drive estimator models; the radii are the
-// rollers' envelope (the true mean rolling radius is a little smaller: the axle dips between rollers).
+// wheel_encoders has one column per wheel: omni3 "wheel_0" "wheel_1" "wheel_2", mecanum and skid_steer "front_left"
+// "front_right" "rear_left" "rear_right". Platform geometry: omni3 wheel_radius_m, wheel_distance_m (L); mecanum
+// wheel_radius_m, half_length_m, half_width_m. truth.yaml: odometer.radius_<i> for every wheel, and odometer.distance
+// (omni3) or odometer.lx_plus_ly (mecanum), the names of the omni3_drive and mecanum_drive estimator models; the radii
+// are the rollers' envelope (the true mean rolling radius is a little smaller: the axle dips between rollers).
+//
+// Real robots (scenarios/real/, docs/scenarios.md "Real robots"): a simulated recording that reads like an imported
+// one names its encoder columns and geometry keys as the importer does:
+//   robot:
+//     kind: skid_steer                      # 4 wheels front_left, front_right, rear_left, rear_right
+//     (models/husky.xml),
+//                                           # driven as a differential drive of the two sides; geometry wheel_radius_m,
+//                                           # baseline_m (the distance between the left and right contact lines)
+//     encoder_columns: [{wheel: 1, name: right}, {wheel: 0, name: left}]   # optional: the wheel_encoders columns in
+//                                           # this order, column `name` the angle of wheel_<wheel>; wheels left out
+//                                           # have no encoder (a skid steer's rear wheels, geared to the front ones).
+//                                           # Default: every wheel, under the names above
+//     geometry_keys: per_wheel              # nominal (default: the keys above) | per_wheel: the per-wheel keys of
+//                                           # recording/wheel_kinematics.h (wheel_radius_<column>_m; differential_drive
+//                                           # and skid_steer track_m; omni3 wheel_distance_m, wheel_angle_<column>_rad,
+//                                           # wheel_direction_<column>); needs every wheel in encoder_columns. An omni3
+//                                           # model off the 60/180/300 deg counter-clockwise layout needs per_wheel
+//     geometry: {gear_ratio: 43.7}          # optional: keys stated as given (not measured on the model); a key the
+//                                           # model's geometry has is an error
+//   sensors:
+//     wheel_encoders: {name: wheels, ...}   # the stream's name (default wheel_encoders)
 // Physical effects go in `effects`. Each is a new key or value, so existing scenarios keep their meaning.
 #pragma once
 
@@ -210,6 +236,12 @@
 
 namespace roamlab::sim {
 
+// One column of the wheel_encoders stream: the angle of wheel `wheel` (the model's wheel_<wheel>) under `name`.
+struct EncoderColumn {
+  int wheel = 0;
+  std::string name;
+};
+
 struct RobotOptions {
   std::string kind = "ackermann";
   std::string model_file;  // path as resolved (relative to the scenario file's directory, or absolute)
@@ -220,6 +252,9 @@ struct RobotOptions {
   std::vector<WheelMountingChange> wheel_mounting;  // wheeled robots: wheels turned off their nominal mounting
   std::vector<WheelDeformation> wheel_deformation;  // wheeled robots with sphere tires: deformed tires
   std::vector<WheelOffset> wheel_offset;            // wheeled robots: wheels moved off their nominal positions
+  std::vector<EncoderColumn> encoder_columns;       // wheeled robots: the encoder stream's columns; empty: the kind's
+  bool per_wheel_geometry = false;                  // geometry_keys: per_wheel
+  std::map<std::string, double> stated_geometry;    // robot.geometry: keys stated as given, beside the measured ones
 };
 
 struct DriverOptions {
@@ -257,6 +292,13 @@ struct GpsOptions {
   Eigen::Vector3d lever_arm_m{0.57, -0.46, 0.32};
 };
 
+// Motion capture: the pose of O in W (noise: position per axis, orientation a rotation vector per axis).
+struct MocapOptions {
+  double rate_hz = 20.0;
+  double position_sigma_m = 0.001;
+  double orientation_sigma_rad = 0.005;
+};
+
 struct OdometerOptions {
   double rate_hz = 100.0;
   double speed_sigma_mps = 0.033;     // on z_v
@@ -267,8 +309,9 @@ struct OdometerOptions {
 };
 
 struct WheelEncoderOptions {
+  std::string name = "wheel_encoders";  // the stream's name
   double rate_hz = 100.0;
-  double ticks_per_revolution = 2048.0;  // > 0, whole number
+  double ticks_per_revolution = 2048.0;  // > 0 (motor ticks times a gear ratio need not be whole)
 };
 
 struct LaserOptions {
@@ -292,6 +335,7 @@ struct SensorOptions {
   std::optional<ImuOptions> imu;
   std::optional<MagnetometerOptions> magnetometer;
   std::optional<GpsOptions> gps;
+  std::optional<MocapOptions> mocap;
   std::optional<OdometerOptions> odometer;
   std::optional<WheelEncoderOptions> wheel_encoders;
   std::optional<LaserOptions> laser;

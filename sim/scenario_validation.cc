@@ -2,6 +2,7 @@
 #include "sim/scenario.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <set>
 
@@ -41,7 +42,10 @@ std::optional<Scenario::Problem> WheelEffectProblem(const std::vector<EffectOpti
       return P{k + ".parameters.yaw_deg", "must be within +-5 on the ackermann rear axle"};
     return std::nullopt;
   }
-  const int wheels = kind == "differential_drive" ? 2 : kind == "omni3" ? 3 : kind == "mecanum" ? 4 : 0;
+  const int wheels = kind == "differential_drive"                ? 2
+                     : kind == "omni3"                           ? 3
+                     : kind == "mecanum" || kind == "skid_steer" ? 4
+                                                                 : 0;
   if (wheels == 0) return P{k + ".name", name + " is for wheeled indoor robots, not '" + kind + "'"};
   if (name == "wheel_radius_asymmetry") {
     if (kind != "differential_drive") return P{k + ".name", name + " is for differential_drive robots only"};
@@ -88,9 +92,9 @@ std::optional<P> TopLevelProblem(const Scenario& s) {
 std::optional<P> RobotAndDriverProblem(const Scenario& s) {
   const bool ackermann = s.robot.kind == "ackermann";
   const bool holonomic = s.robot.kind == "omni3" || s.robot.kind == "mecanum";
-  if (!ackermann && !holonomic && s.robot.kind != "differential_drive")
-    return P{"robot.kind",
-             "unsupported kind '" + s.robot.kind + "' (supported: ackermann, differential_drive, omni3, mecanum)"};
+  if (!ackermann && !holonomic && s.robot.kind != "differential_drive" && s.robot.kind != "skid_steer")
+    return P{"robot.kind", "unsupported kind '" + s.robot.kind +
+                               "' (supported: ackermann, differential_drive, skid_steer, omni3, mecanum)"};
   if (s.robot.model_file.empty() && s.robot.model_xml.empty()) return P{"robot.model", "missing"};
   if (!s.robot.start_position_m.allFinite()) return P{"robot.start.position_m", "must be finite"};
   if (!Finite(s.robot.start_heading_rad)) return P{"robot.start.heading_deg", "must be finite"};
@@ -121,6 +125,35 @@ std::optional<P> RobotAndDriverProblem(const Scenario& s) {
   return std::nullopt;
 }
 
+bool Identifier(const std::string& name) {
+  if (name.empty()) return false;
+  for (const char c : name)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) return false;
+  return true;
+}
+
+// robot.encoder_columns, geometry_keys and geometry (the wheel indices are checked against the model when bound).
+std::optional<P> RobotNamingProblem(const Scenario& s) {
+  const RobotOptions& r = s.robot;
+  const bool ackermann = r.kind == "ackermann";
+  if (ackermann && !r.encoder_columns.empty()) return P{"robot.encoder_columns", "only for wheeled indoor robots"};
+  for (std::size_t i = 0; i < r.encoder_columns.size(); ++i) {
+    const EncoderColumn& c = r.encoder_columns[i];
+    const std::string k = "robot.encoder_columns[" + std::to_string(i) + "]";
+    if (c.wheel < 0) return P{k + ".wheel", "must be >= 0"};
+    if (!Identifier(c.name)) return P{k + ".name", "must be letters, digits and _"};
+    for (std::size_t j = 0; j < i; ++j) {
+      if (r.encoder_columns[j].wheel == c.wheel) return P{k + ".wheel", "wheel listed twice"};
+      if (r.encoder_columns[j].name == c.name) return P{k + ".name", "name listed twice"};
+    }
+  }
+  if (r.per_wheel_geometry && r.encoder_columns.empty())
+    return P{"robot.geometry_keys", "per_wheel needs robot.encoder_columns (the names of the per-wheel keys)"};
+  for (const auto& [key, value] : r.stated_geometry)
+    if (!Identifier(key) || !Finite(value)) return P{"robot.geometry." + key, "must be a finite number"};
+  return std::nullopt;
+}
+
 // The changes to a wheeled robot's wheels: mounting, deformation, offset.
 std::optional<P> WheelChangesProblem(const Scenario& s) {
   const bool ackermann = s.robot.kind == "ackermann";
@@ -144,6 +177,7 @@ std::optional<P> WheelChangesProblem(const Scenario& s) {
       return P{k + ".ovality_m", "must be in [0, 0.02]"};
   }
 
+  if (auto p = RobotNamingProblem(s)) return p;
   if (ackermann && !s.robot.wheel_offset.empty()) return P{"robot.wheel_offset", "only for wheeled indoor robots"};
   for (std::size_t i = 0; i < s.robot.wheel_offset.size(); ++i) {
     const WheelOffset& o = s.robot.wheel_offset[i];
@@ -178,6 +212,11 @@ std::optional<P> InertialAndGpsProblem(const Scenario& s) {
     if (!(mag->field_world.allFinite() && mag->field_world.norm() > 0.0))
       return P{"sensors.magnetometer.field_world", "must be finite and nonzero"};
   }
+  if (const auto& mocap = s.sensors.mocap) {
+    if (!Positive(mocap->rate_hz)) return P{"sensors.mocap.rate_hz", "must be > 0"};
+    if (!NonNegative(mocap->position_sigma_m)) return P{"sensors.mocap.position_sigma_m", "must be >= 0"};
+    if (!NonNegative(mocap->orientation_sigma_rad)) return P{"sensors.mocap.orientation_sigma_rad", "must be >= 0"};
+  }
   if (const auto& gps = s.sensors.gps) {
     if (!Positive(gps->rate_hz)) return P{"sensors.gps.rate_hz", "must be > 0"};
     if (!NonNegative(gps->sigma_m)) return P{"sensors.gps.sigma_m", "must be >= 0"};
@@ -206,8 +245,8 @@ std::optional<P> OdometrySensorsProblem(const Scenario& s) {
   }
   if (const auto& enc = s.sensors.wheel_encoders) {
     if (!Positive(enc->rate_hz)) return P{"sensors.wheel_encoders.rate_hz", "must be > 0"};
-    if (!(Positive(enc->ticks_per_revolution) && enc->ticks_per_revolution == std::floor(enc->ticks_per_revolution)))
-      return P{"sensors.wheel_encoders.ticks_per_revolution", "must be a positive whole number"};
+    if (!Positive(enc->ticks_per_revolution)) return P{"sensors.wheel_encoders.ticks_per_revolution", "must be > 0"};
+    if (!Identifier(enc->name)) return P{"sensors.wheel_encoders.name", "must be letters, digits and _"};
   }
   if (const auto& laser = s.sensors.laser) {
     if (!Positive(laser->rate_hz)) return P{"sensors.laser.rate_hz", "must be > 0"};

@@ -92,7 +92,11 @@ class Simulator::Impl {
               {"track_m", Micrometres(vehicle_.rear_track_m())},
               {"wheel_radius_m", Micrometres(vehicle_.wheel_radius_m())}};
     std::map<std::string, double> geometry;
-    for (const auto& [key, value] : wheeled_.PlatformGeometry()) geometry[key] = Micrometres(value);
+    const std::map<std::string, double> measured =
+        scenario_.robot.per_wheel_geometry ? wheeled_.PerWheelGeometry(WheelNames()) : wheeled_.PlatformGeometry();
+    // Angles to the microradian, directions exact (+-1): the same rounding.
+    for (const auto& [key, value] : measured) geometry[key] = Micrometres(value);
+    for (const auto& [key, value] : scenario_.robot.stated_geometry) geometry[key] = value;
     return geometry;
   }
   double VehicleMassKg() const { return ackermann_ ? vehicle_.mass_kg() : 0.0; }
@@ -183,6 +187,7 @@ class Simulator::Impl {
       }
       if (Status st = wheeled_.MoveWheels(model_.get(), scenario_.robot.wheel_offset, where_); !st.ok()) return st;
       if (Status st = wheeled_.Deform(model_.get(), TireDeformations(scenario_), where_); !st.ok()) return st;
+      if (Status st = BindEncoderColumns(); !st.ok()) return st;
       odom_site_ = wheeled_.odom_site();
       if (scenario_.sensors.laser && wheeled_.laser_site() < 0)
         return Status::Error(model_where_ + ": sensors.laser needs a site 'laser' on the robot");
@@ -194,6 +199,42 @@ class Simulator::Impl {
     }
 
     return Status::Ok();
+  }
+
+  // The encoder stream's columns (robot.encoder_columns, else every wheel under the kind's names) and the checks of
+  // robot.geometry_keys and robot.geometry against the bound model.
+  Status BindEncoderColumns() {
+    const RobotOptions& robot = scenario_.robot;
+    const int wheels = static_cast<int>(wheeled_.wheels().size());
+    encoder_columns_.clear();
+    if (robot.encoder_columns.empty()) {
+      const std::vector<std::string> names = wheeled_.EncoderColumns();
+      for (int i = 0; i < wheels; ++i) encoder_columns_.push_back({i, names[static_cast<std::size_t>(i)]});
+    }
+    for (std::size_t k = 0; k < robot.encoder_columns.size(); ++k) {
+      if (robot.encoder_columns[k].wheel >= wheels)
+        return Status::Error(where_ + ": robot.encoder_columns[" + std::to_string(k) + "].wheel: the " + robot.kind +
+                             " robot has wheels 0 to " + std::to_string(wheels - 1));
+      encoder_columns_.push_back(robot.encoder_columns[k]);
+    }
+    if (robot.per_wheel_geometry && static_cast<int>(encoder_columns_.size()) != wheels)
+      return Status::Error(where_ + ": robot.geometry_keys: per_wheel needs every wheel in robot.encoder_columns");
+    if (!robot.per_wheel_geometry && !wheeled_.NominalLayout())
+      return Status::Error(where_ + ": robot.geometry_keys: the " + robot.kind +
+                           " model's wheels are off the layout the nominal keys describe: use per_wheel");
+    const std::map<std::string, double> measured =
+        robot.per_wheel_geometry ? wheeled_.PerWheelGeometry(WheelNames()) : wheeled_.PlatformGeometry();
+    for (const auto& [key, value] : robot.stated_geometry)
+      if (measured.count(key) > 0)
+        return Status::Error(where_ + ": robot.geometry." + key + ": measured on the model; it cannot be stated");
+    return Status::Ok();
+  }
+
+  // The encoder column name of each wheel ("" for a wheel without an encoder).
+  std::vector<std::string> WheelNames() const {
+    std::vector<std::string> names(wheeled_.wheels().size());
+    for (const EncoderColumn& c : encoder_columns_) names[static_cast<std::size_t>(c.wheel)] = c.name;
+    return names;
   }
 
   // The physics step, the duration, the lead-in and every stream's clock (every period a whole number of steps).
@@ -230,6 +271,9 @@ class Simulator::Impl {
     }
     if (sensors.gps) {
       if (Status s = clock(sensors.gps->rate_hz, "sensors.gps.rate_hz", &gps_clock_); !s.ok()) return s;
+    }
+    if (sensors.mocap) {
+      if (Status s = clock(sensors.mocap->rate_hz, "sensors.mocap.rate_hz", &mocap_clock_); !s.ok()) return s;
     }
     if (sensors.odometer) {
       if (Status s = clock(sensors.odometer->rate_hz, "sensors.odometer.rate_hz", &odometer_clock_); !s.ok()) return s;
@@ -273,7 +317,7 @@ class Simulator::Impl {
     const std::map<std::string, Clock*> clocks{{"imu", &imu_clock_},           {"magnetometer", &mag_clock_},
                                                {"gps", &gps_clock_},           {"rear_wheel", &odometer_clock_},
                                                {"steering", &odometer_clock_}, {"wheel_encoders", &encoder_clock_},
-                                               {"pose", &pose_clock_},         {"odometry", &odometry_clock_}};
+                                               {"mocap", &mocap_clock_},       {"odometry", &odometry_clock_}};
     for (const auto& [name, stamps] : replay.stamps) {
       const auto it = clocks.find(name);
       if (it == clocks.end()) return Status::Error(where_ + ": the replay schedules an unknown stream '" + name + "'");
@@ -306,9 +350,17 @@ class Simulator::Impl {
       gps_stream_.info.mounting = recording::Mounting{};
       gps_stream_.info.noise = {{"sigma_m", sensors.gps->sigma_m}};
     }
+    if (sensors.mocap) {
+      mocap_stream_ = MakeStream("mocap", StreamType::kPose, sensors.mocap->rate_hz,
+                                 {"x", "y", "z", "qx", "qy", "qz", "qw"}, "m", mocap_clock_, origin());
+      mocap_stream_.info.noise = {{"position_m", sensors.mocap->position_sigma_m},
+                                  {"orientation_rad", sensors.mocap->orientation_sigma_rad}};
+    }
     if (sensors.wheel_encoders) {
-      encoder_stream_ = MakeStream("wheel_encoders", StreamType::kWheelEncoders, sensors.wheel_encoders->rate_hz,
-                                   wheeled_.EncoderColumns(), "rad", encoder_clock_, origin());
+      std::vector<std::string> columns;
+      for (const EncoderColumn& c : encoder_columns_) columns.push_back(c.name);
+      encoder_stream_ = MakeStream(sensors.wheel_encoders->name, StreamType::kWheelEncoders,
+                                   sensors.wheel_encoders->rate_hz, columns, "rad", encoder_clock_, origin());
       encoder_stream_.info.attributes = {{"ticks_per_revolution", sensors.wheel_encoders->ticks_per_revolution}};
     }
     if (sensors.laser) {
@@ -331,10 +383,6 @@ class Simulator::Impl {
       odometry_stream_ = MakeStream("odometry", StreamType::kOdometry, 0.0,
                                     recording::FixedColumns(StreamType::kOdometry), "", odometry_clock_, origin());
       twist_from_rates_ = wheeled_.J_rates_twist().completeOrthogonalDecomposition().pseudoInverse();
-    }
-    if (pose_clock_.scheduled()) {
-      pose_stream_ = MakeStream("pose", StreamType::kPose, 0.0, recording::FixedColumns(StreamType::kPose), "",
-                                pose_clock_, origin());
     }
     local_.emplace(scenario_.origin.latitude_deg, scenario_.origin.longitude_deg, scenario_.origin.altitude_m);
     truth_.reserve(truth_clock_.samples);
@@ -447,7 +495,7 @@ class Simulator::Impl {
     loop_end_ns_ = end_ns_ + std::max<std::int64_t>(0, -std::min(imu_clock_.shift_ns, gps_clock_.shift_ns));
     // A replay's sample nearest a stamp may fall after the end.
     for (const Clock* c :
-         {&imu_clock_, &mag_clock_, &gps_clock_, &odometer_clock_, &encoder_clock_, &pose_clock_, &odometry_clock_})
+         {&imu_clock_, &mag_clock_, &gps_clock_, &mocap_clock_, &odometer_clock_, &encoder_clock_, &odometry_clock_})
       if (c->scheduled()) loop_end_ns_ = std::max(loop_end_ns_, c->LastSampleNs());
     steering_offset_rad_ = EffectParameter(effects, "steering_offset", "offset_rad", 0.0);
     for (int i = 0; i < 3; ++i) {
@@ -536,7 +584,7 @@ class Simulator::Impl {
 
   bool AnyDue(std::int64_t t_ns) const {
     return truth_clock_.Due(t_ns) || imu_clock_.Due(t_ns) || mag_clock_.Due(t_ns) || gps_clock_.Due(t_ns) ||
-           odometer_clock_.Due(t_ns) || encoder_clock_.Due(t_ns) || laser_clock_.Due(t_ns) || pose_clock_.Due(t_ns) ||
+           mocap_clock_.Due(t_ns) || odometer_clock_.Due(t_ns) || encoder_clock_.Due(t_ns) || laser_clock_.Due(t_ns) ||
            odometry_clock_.Due(t_ns) || CameraDue(t_ns);
   }
 
@@ -614,23 +662,23 @@ class Simulator::Impl {
       local_->Reverse(antenna.x(), antenna.y(), antenna.z(), latitude, longitude, altitude);
       gps_stream_.values.row(gps_clock_.Row(t_ns)) << latitude, longitude, altitude;
     }
+    if (mocap_clock_.Due(t_ns)) SampleMocap(body, t_ns);
     if (encoder_clock_.Due(t_ns)) {
       // Cumulative angle since t = 0, truncated to whole ticks (an incremental encoder's count).
       const double tick_rad = 2.0 * kPi / sensors.wheel_encoders->ticks_per_revolution;
-      const int wheels = static_cast<int>(wheeled_.wheels().size());
+      const int columns = static_cast<int>(encoder_columns_.size());
       if (encoder_zero_rad_.empty()) {  // the first sample: t = 0, or a replay's first stamp
-        for (int i = 0; i < wheels; ++i) encoder_zero_rad_.push_back(wheeled_.WheelAngle(data_.get(), i));
+        for (const EncoderColumn& c : encoder_columns_)
+          encoder_zero_rad_.push_back(wheeled_.WheelAngle(data_.get(), c.wheel));
       }
-      for (int i = 0; i < wheels; ++i) {
-        const double angle = wheeled_.WheelAngle(data_.get(), i) - encoder_zero_rad_[static_cast<std::size_t>(i)];
-        encoder_stream_.values(encoder_clock_.Row(t_ns), i) = std::floor(angle / tick_rad) * tick_rad;
+      for (int k = 0; k < columns; ++k) {
+        const auto column = static_cast<std::size_t>(k);
+        const double angle =
+            wheeled_.WheelAngle(data_.get(), encoder_columns_[column].wheel) - encoder_zero_rad_[column];
+        encoder_stream_.values(encoder_clock_.Row(t_ns), k) = std::floor(angle / tick_rad) * tick_rad;
       }
     }
     if (laser_clock_.Due(t_ns)) SampleLaser(t_ns);
-    if (pose_clock_.Due(t_ns)) {
-      pose_stream_.values.row(pose_clock_.Row(t_ns)) << body.p_world_body.transpose(), body.q_world_body.x(),
-          body.q_world_body.y(), body.q_world_body.z(), body.q_world_body.w();
-    }
     if (odometry_clock_.Due(t_ns)) {
       // Wheel odometry: the twist the nominal kinematics gives for the wheels' rates (least squares).
       Eigen::VectorXd rates(static_cast<Eigen::Index>(wheeled_.wheels().size()));
@@ -659,6 +707,22 @@ class Simulator::Impl {
       steering_stream_.values(odometer_clock_.Row(t_ns), 0) = z_theta;
     }
     return Status::Ok();
+  }
+
+  // One motion-capture pose of O: position noise per axis, the orientation turned by a small rotation vector; the
+  // quaternion's sign kept continuous.
+  void SampleMocap(const FrameKinematics& body, std::int64_t t_ns) {
+    const MocapOptions& o = *scenario_.sensors.mocap;
+    const Eigen::Vector3d p = body.p_world_body + mocap_position_noise_.Draw3(o.position_sigma_m);
+    const Eigen::Vector3d turn = mocap_orientation_noise_.Draw3(o.orientation_sigma_rad);
+    Eigen::Quaterniond q = body.q_world_body;
+    if (turn.norm() > 0.0) q = q * Eigen::Quaterniond(Eigen::AngleAxisd(turn.norm(), turn.normalized()));
+    const Eigen::Index row = mocap_clock_.Row(t_ns);
+    if (row > 0) {
+      const Eigen::Vector4d previous = mocap_stream_.values.row(row - 1).tail<4>().transpose();
+      if (previous.dot(q.coeffs()) < 0.0) q.coeffs() = -q.coeffs();
+    }
+    mocap_stream_.values.row(row) << p.transpose(), q.x(), q.y(), q.z(), q.w();
   }
 
   // One laser scan: ray casts plus range noise, stored when the scenario asks; the scan matcher's stream takes it
@@ -726,17 +790,17 @@ class Simulator::Impl {
     internal::FillRepeatedRows(odometer_clock_, &wheel_stream_);
     internal::FillRepeatedRows(odometer_clock_, &steering_stream_);
     internal::FillRepeatedRows(encoder_clock_, &encoder_stream_);
-    internal::FillRepeatedRows(pose_clock_, &pose_stream_);
+    internal::FillRepeatedRows(mocap_clock_, &mocap_stream_);
     internal::FillRepeatedRows(odometry_clock_, &odometry_stream_);
     if (sensors.imu) rec.streams.push_back(std::move(imu_stream_));
     if (sensors.magnetometer) rec.streams.push_back(std::move(mag_stream_));
     if (sensors.gps) rec.streams.push_back(std::move(gps_stream_));
+    if (sensors.mocap) rec.streams.push_back(std::move(mocap_stream_));
     if (sensors.odometer) {
       rec.streams.push_back(std::move(wheel_stream_));
       rec.streams.push_back(std::move(steering_stream_));
     }
     if (sensors.wheel_encoders) rec.streams.push_back(std::move(encoder_stream_));
-    if (pose_clock_.scheduled()) rec.streams.push_back(std::move(pose_stream_));
     if (odometry_clock_.scheduled() && !ackermann_) rec.streams.push_back(std::move(odometry_stream_));
     if (sensors.laser) {
       recording::Stream scan_stream = scan_matching_->TakeStream();
@@ -788,7 +852,8 @@ class Simulator::Impl {
   std::unique_ptr<SimulatedCamera> camera_;
   recording::Mounting camera_mounting_;
   std::int64_t next_camera_frame_ = 0;
-  std::vector<double> encoder_zero_rad_;
+  std::vector<EncoderColumn> encoder_columns_;  // the wheel_encoders stream's columns
+  std::vector<double> encoder_zero_rad_;        // per column
   std::optional<SpeedController> controller_;
   std::optional<GeographicLib::LocalCartesian> local_;
   ImuCalibration imu_;
@@ -818,7 +883,7 @@ class Simulator::Impl {
   Eigen::VectorXd replay_angles_at_start_, measured_angles_at_start_;  // a replay's wheel angles at t = 0
   double replay_travel_m_ = 0.0;                                       // a replay's Ackermann travel since t = 0
   Time origin() const { return Time::FromNanoseconds(origin_ns_); }
-  Clock truth_clock_, imu_clock_, mag_clock_, gps_clock_, odometer_clock_, encoder_clock_, laser_clock_, pose_clock_,
+  Clock truth_clock_, imu_clock_, mag_clock_, gps_clock_, mocap_clock_, odometer_clock_, encoder_clock_, laser_clock_,
       odometry_clock_;
   Eigen::MatrixXd twist_from_rates_;  // a replay's wheel odometry: 3 x wheels, the least-squares inverse of J
 
@@ -829,11 +894,13 @@ class Simulator::Impl {
   NoiseStream speed_noise_{seed_, NoiseSource::kSpeed, options_.noise};
   NoiseStream steering_noise_{seed_, NoiseSource::kSteering, options_.noise};
   NoiseStream laser_noise_{seed_, NoiseSource::kLaserRange, options_.noise};
+  NoiseStream mocap_position_noise_{seed_, NoiseSource::kMocapPosition, options_.noise};
+  NoiseStream mocap_orientation_noise_{seed_, NoiseSource::kMocapOrientation, options_.noise};
   NoiseStream gyro_bias_noise_{seed_, NoiseSource::kGyroBiasWalk};  // an effect, not sensor noise: always on
   NoiseStream multipath_noise_{seed_, NoiseSource::kGpsMultipath};  // likewise
 
-  recording::Stream imu_stream_, mag_stream_, gps_stream_, wheel_stream_, steering_stream_, encoder_stream_,
-      laser_scan_stream_, pose_stream_, odometry_stream_;
+  recording::Stream imu_stream_, mag_stream_, gps_stream_, mocap_stream_, wheel_stream_, steering_stream_,
+      encoder_stream_, laser_scan_stream_, odometry_stream_;
   Trajectory truth_;
   double min_height_ = 1e300;
   double max_height_ = -1e300;

@@ -47,10 +47,10 @@ struct SimulateOptions {
   // The recording directory, where sensors.camera.store_images writes its PNGs (required when it is set).
   std::string image_directory;
   // A replay (sim/replay.h): the drive inputs replace the scenario's driver and the scheduled streams are sampled at
-  // the recording's stamps (sim/replay_schedule.h). The stamps "pose" and "odometry" ask for one more stream each:
-  // `pose` (type pose, O in W) and, for the wheeled kinds, `odometry` (type odometry, O's wheel odometry: the twist
-  // the nominal kinematics gives for the wheels' rates, least squares, in O). The outputs are in recording time
-  // (simulation time + schedule t0).
+  // the recording's stamps (sim/replay_schedule.h). The stamps "mocap" sample the scenario's motion capture (O in W,
+  // the simulator's one pose stream) at the recording's stamps; the stamps "odometry" ask for one more stream, for the
+  // wheeled kinds: `odometry` (type odometry, O's wheel odometry: the twist the nominal kinematics gives for the
+  // wheels' rates, least squares, in O). The outputs are in recording time (simulation time + schedule t0).
   std::shared_ptr<const ReplaySchedule> replay;
 };
 

@@ -12,6 +12,7 @@ namespace {
 std::string ModelOf(const std::string& kind) {
   if (kind == "omni3") return "models/omni3.xml";
   if (kind == "mecanum") return "models/mecanum.xml";
+  if (kind == "skid_steer") return "models/husky.xml";
   return "models/diffdrive.xml";
 }
 
@@ -22,7 +23,7 @@ Status Missing(const std::string& what, const std::string& kind, const std::stri
 int ExpectedWheels(const std::string& kind) {
   if (kind == "differential_drive") return 2;
   if (kind == "omni3") return 3;
-  if (kind == "mecanum") return 4;
+  if (kind == "mecanum" || kind == "skid_steer") return 4;
   return 0;
 }
 
@@ -31,7 +32,6 @@ bool HasRollers(const std::string& kind) { return kind == "omni3" || kind == "me
 // The layout each kind's nominal kinematics assumes (recording/wheel_kinematics.h); empty when the wheels follow it.
 // Tolerances leave room for small mounting changes (WheelMountingChange).
 std::string LayoutProblem(const std::string& kind, const std::vector<WheelGeometry>& w) {
-  constexpr double kPi = 3.14159265358979323846;
   if (kind == "differential_drive") {
     if (!(w[0].p_body_m.y() > 0.0 && w[1].p_body_m.y() < 0.0 && std::abs(w[0].p_body_m.x()) < 0.01 &&
           std::abs(w[1].p_body_m.x()) < 0.01 && w[0].drive_direction.x() > 0.99 && w[1].drive_direction.x() > 0.99))
@@ -40,14 +40,20 @@ std::string LayoutProblem(const std::string& kind, const std::vector<WheelGeomet
   } else if (kind == "omni3") {
     const double distance = w[0].p_body_m.norm();
     for (int i = 0; i < 3; ++i) {
-      const double alpha = (60.0 + 120.0 * i) * kPi / 180.0;
-      const Eigen::Vector2d radial(std::cos(alpha), std::sin(alpha));
-      if ((w[i].p_body_m - distance * radial).norm() > 0.02 ||
-          w[i].drive_direction.dot(Eigen::Vector2d(-radial.y(), radial.x())) < 0.98 ||
+      const Eigen::Vector2d radial = w[i].p_body_m.normalized();
+      if (std::abs(w[i].p_body_m.norm() - distance) > 0.02 ||
+          std::abs(w[i].drive_direction.dot(Eigen::Vector2d(-radial.y(), radial.x()))) < 0.98 ||
           w[i].locked_direction.dot(w[i].drive_direction) < 0.98)
-        return "omni3: wheel_" + std::to_string(i) + " must be at " + std::to_string(60 + 120 * i) +
-               " deg from x at the same distance as wheel_0, its axle towards 'odom', its bottom roller along the "
-               "rolling direction";
+        return "omni3: wheel_" + std::to_string(i) +
+               " must be at the same distance from 'odom' as wheel_0, its axle along the line to 'odom', its bottom "
+               "roller along the rolling direction";
+    }
+  } else if (kind == "skid_steer") {
+    const double sx[4] = {1, 1, -1, -1}, sy[4] = {1, -1, 1, -1};
+    for (int i = 0; i < 4; ++i) {
+      if (!(w[i].p_body_m.x() * sx[i] > 0.0 && w[i].p_body_m.y() * sy[i] > 0.0 && w[i].drive_direction.x() > 0.99))
+        return "skid steer: wheel_" + std::to_string(i) + " must be " + (i < 2 ? "front " : "rear ") +
+               (i % 2 == 0 ? "left" : "right") + " and roll forward about +y";
     }
   } else if (kind == "mecanum") {
     const double sx[4] = {1, 1, -1, -1}, sy[4] = {1, -1, 1, -1};
@@ -260,10 +266,51 @@ Status WheeledRobot::MoveWheels(mjModel* model, const std::vector<WheelOffset>& 
   return Status::Ok();
 }
 
+double WheeledRobot::SideToSideM() const {
+  if (kind_ == "differential_drive") return (wheels_.front().p_body_m - wheels_.back().p_body_m).norm();
+  // skid_steer: the mean lateral positions of the left (0, 2) and right (1, 3) wheels.
+  return 0.5 * (wheels_[0].p_body_m.y() + wheels_[2].p_body_m.y() - wheels_[1].p_body_m.y() - wheels_[3].p_body_m.y());
+}
+
+bool WheeledRobot::NominalLayout() const {
+  if (kind_ != "omni3") return true;
+  constexpr double kPi = 3.14159265358979323846;
+  for (int i = 0; i < 3; ++i) {
+    const WheelGeometry& w = wheels_[static_cast<std::size_t>(i)];
+    const double alpha = (60.0 + 120.0 * i) * kPi / 180.0;
+    const Eigen::Vector2d radial(std::cos(alpha), std::sin(alpha));
+    if ((w.p_body_m - w.p_body_m.norm() * radial).norm() > 0.02 ||
+        w.drive_direction.dot(Eigen::Vector2d(-radial.y(), radial.x())) < 0.98)
+      return false;
+  }
+  return true;
+}
+
+std::map<std::string, double> WheeledRobot::PerWheelGeometry(const std::vector<std::string>& names) const {
+  std::map<std::string, double> g;
+  for (std::size_t i = 0; i < wheels_.size() && i < names.size(); ++i)
+    g["wheel_radius_" + names[i] + "_m"] = wheels_[i].radius_m;
+  if (kind_ == "differential_drive" || kind_ == "skid_steer") {
+    g["track_m"] = SideToSideM();
+  } else if (kind_ == "omni3") {
+    g["wheel_distance_m"] = PlatformGeometry().at("wheel_distance_m");
+    for (std::size_t i = 0; i < wheels_.size() && i < names.size(); ++i) {
+      const Eigen::Vector2d& p = wheels_[i].p_body_m;
+      g["wheel_angle_" + names[i] + "_rad"] = std::atan2(p.y(), p.x());
+      // +1 when a positive rotation pushes the body along the counter-clockwise tangent.
+      g["wheel_direction_" + names[i]] = wheels_[i].drive_direction.dot(Eigen::Vector2d(-p.y(), p.x())) > 0.0 ? 1 : -1;
+    }
+  } else {
+    for (const auto& [key, value] : PlatformGeometry())
+      if (key != "wheel_radius_m") g[key] = value;
+  }
+  return g;
+}
+
 std::map<std::string, double> WheeledRobot::PlatformGeometry() const {
   std::map<std::string, double> g{{"wheel_radius_m", mean_radius_m()}};
-  if (kind_ == "differential_drive") {
-    g["baseline_m"] = (wheels_.front().p_body_m - wheels_.back().p_body_m).norm();
+  if (kind_ == "differential_drive" || kind_ == "skid_steer") {
+    g["baseline_m"] = SideToSideM();
   } else if (kind_ == "omni3") {
     double sum = 0.0;
     for (const WheelGeometry& w : wheels_) sum += w.p_body_m.norm();
@@ -282,7 +329,7 @@ std::map<std::string, double> WheeledRobot::PlatformGeometry() const {
 
 std::vector<std::string> WheeledRobot::EncoderColumns(const std::string& kind) {
   if (kind == "differential_drive") return {"left", "right"};
-  if (kind == "mecanum") return {"front_left", "front_right", "rear_left", "rear_right"};
+  if (kind == "mecanum" || kind == "skid_steer") return {"front_left", "front_right", "rear_left", "rear_right"};
   return {"wheel_0", "wheel_1", "wheel_2"};
 }
 
@@ -309,6 +356,13 @@ std::map<std::string, std::vector<double>> WheeledRobot::TrueOdometerCalibration
     return {{"odometer.radius_left", {wheels_[0].mean_rolling_radius_m}},
             {"odometer.radius_right", {wheels_[1].mean_rolling_radius_m}},
             {"odometer.baseline", {g.at("baseline_m") + track_error_m_ + (lever_change[1] - lever_change[0])}}};
+  // A skid steer's sides as the differential_drive model reads them: the geometric track (the effective one, wider
+  // when the tires scrub, is the physics' and not known here).
+  if (kind_ == "skid_steer")
+    return {{"odometer.radius_left", {0.5 * (wheels_[0].mean_rolling_radius_m + wheels_[2].mean_rolling_radius_m)}},
+            {"odometer.radius_right", {0.5 * (wheels_[1].mean_rolling_radius_m + wheels_[3].mean_rolling_radius_m)}},
+            {"odometer.baseline",
+             {g.at("baseline_m") + 0.5 * (lever_change[1] + lever_change[3] - lever_change[0] - lever_change[2])}}};
   std::map<std::string, std::vector<double>> cal;
   for (std::size_t i = 0; i < wheels_.size(); ++i)
     cal["odometer.radius_" + std::to_string(i)] = {wheels_[i].mean_rolling_radius_m};

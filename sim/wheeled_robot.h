@@ -18,6 +18,12 @@
 //                       O; tire_<i> a sphere or cylinder; roller_<i>_0 the roller under wheel i at qpos0
 //   mecanum             models/mecanum.xml: wheels 0-3 front left, front right, rear left, rear right at (+-lx, +-ly)
 //                       rolling along +x; roller_<i>_0 under wheel i, its axis 45 deg off x and not along p_i
+//   skid_steer          models/husky.xml: wheels 0-3 front left, front right, rear left, rear right, sphere tires
+//                       rolling along +x; the driver's rows are a differential drive's of the two sides (a wheel at
+//                       y_i turns at (v_x - omega_z y_i) / r), and the tires must scrub sideways to turn the body
+// omni3 wheels may sit at any angles (models/optiodom_omni3.xml: -60, 60, 180 deg) and roll either way round: the
+// rows are measured on the model; NominalLayout() says whether they are the 60, 180, 300 deg counter-clockwise
+// layout that the nominal geometry keys (wheel_radius_m, wheel_distance_m) describe.
 #pragma once
 
 #include <map>
@@ -73,7 +79,7 @@ struct WheelOffset {
 class WheeledRobot {
  public:
   // Finds the named elements and measures the wheels at qpos0. `kind` is the robot kind (differential_drive, omni3,
-  // mecanum); errors name `what` (the model file) and the missing element.
+  // mecanum, skid_steer); errors name `what` (the model file) and the missing element.
   static Result<WheeledRobot> Bind(const mjModel* model, const std::string& kind, const std::string& what);
   // Turns wheel bodies of a compiled model (before Bind); errors name `what` and the wheel.
   static Status ChangeMounting(mjModel* model, const std::vector<WheelMountingChange>& changes,
@@ -101,8 +107,17 @@ class WheeledRobot {
   // Wheel rows of the kinematics: n x 3, rates [rad/s] = J [v_x, v_y, omega_z].
   const Eigen::MatrixXd& J_rates_twist() const { return J_rates_twist_; }
   double mean_radius_m() const;
+  // Distance between the left and right contact lines (differential_drive, skid_steer) [m].
+  double SideToSideM() const;
   // The recording's platform geometry (recording/wheel_kinematics.h keys for the kind), measured on the model.
   std::map<std::string, double> PlatformGeometry() const;
+  // The geometry under per-wheel keys (recording/wheel_kinematics.h, the OptiOdom importer's), `names` the encoder
+  // column name of each wheel: wheel_radius_<name>_m; differential_drive and skid_steer track_m; omni3
+  // wheel_distance_m, wheel_angle_<name>_rad, wheel_direction_<name>; mecanum the nominal keys.
+  std::map<std::string, double> PerWheelGeometry(const std::vector<std::string>& names) const;
+  // Whether the wheels follow the layout the kind's nominal geometry keys describe (always, except omni3 wheels off
+  // 60, 180, 300 deg or turning clockwise).
+  bool NominalLayout() const;
   // Encoder column names, one per wheel.
   std::vector<std::string> EncoderColumns() const { return EncoderColumns(kind_); }
   // Those of a kind (differential_drive: left, right; mecanum: front_left, front_right, rear_left, rear_right; omni3:

@@ -1,6 +1,7 @@
 // `roamlab diagnose` end to end on short simulated drives: it never opens the recording's truth.yaml (garbage there
 // changes nothing), writes gap.json with the documented keys, and refuses a recording of another robot kind with one
-// line and exit code 2, as it does a time-shift range the recording cannot hold.
+// line and exit code 2, as it does a time-shift range the recording cannot hold, and --replay a recording of another
+// drive than the scenario's.
 #include <sys/wait.h>
 
 #include <cstdlib>
@@ -115,6 +116,38 @@ TEST(DiagnoseCliTest, RefusesAShiftRangeTheRecordingCannotHold) {
     EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1);
     EXPECT_FALSE(std::ifstream(dir.File("out/gap.json")).good());
   }
+}
+
+// indoor_diffdrive_gap.yaml shortened to 3 s with its turn-rate profile's amplitude `turn_radps`, written to `name`.
+std::string DiffDrive(const testing::TempDir& dir, const std::string& turn_radps, const std::string& name) {
+  std::string text = testing::ReadFile(Source("scenarios/indoor_diffdrive_gap.yaml"));
+  for (const auto& [a, b] : std::vector<std::pair<std::string, std::string>>{
+           {"model: ../models/diffdrive.xml", "model: " + Source("models/diffdrive.xml")},
+           {"duration_s: 30.0", "duration_s: 3.0"},
+           {"amplitude: 0.6, period_s: 11.0", "amplitude: " + turn_radps + ", period_s: 11.0"}}) {
+    const std::size_t at = text.find(a);
+    EXPECT_NE(at, std::string::npos) << a;
+    if (at != std::string::npos) text.replace(at, a.size(), b);
+  }
+  testing::WriteFile(dir.File(name), text);
+  return dir.File(name);
+}
+
+TEST(DiagnoseCliTest, ReplayRefusesARecordingOfAnotherDrive) {
+  testing::TempDir dir;
+  const std::string nominal = DiffDrive(dir, "0.6", "nominal.yaml");
+  const std::string other = DiffDrive(dir, "-0.6", "other.yaml");
+  ASSERT_EQ(Roamlab("simulate " + other + " --out " + dir.File("rec") + " --quiet", dir).exit_code, 0);
+  const CommandRun run = Roamlab("diagnose --real " + dir.File("rec") + " --scenario " + nominal + " --out " +
+                                     dir.File("out") + " --replay --no-baseline",
+                                 dir);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("roamlab diagnose: " + dir.File("rec") + ": not a recording of " + nominal +
+                         "'s own drive (wheel_encoders: the twin's wheel motion differs"),
+            std::string::npos)
+      << run.err;
+  EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1);
+  EXPECT_FALSE(std::ifstream(dir.File("out/gap.json")).good());
 }
 
 }  // namespace

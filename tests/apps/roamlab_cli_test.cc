@@ -17,6 +17,7 @@
 #include "tests/recording/temp_dir.h"
 
 #include "recording/recording.h"
+#include "recording/trajectory.h"
 #include "tests/support/synthetic.h"
 
 namespace roamlab {
@@ -147,9 +148,91 @@ TEST_F(CliTest, EvaluateBadInputGivesOneLineAndExitCodeTwo) {
   EXPECT_EQ(missing.err.rfind("roamlab evaluate: ", 0), 0u) << missing.err;
   EXPECT_EQ(std::count(missing.err.begin(), missing.err.end(), '\n'), 1) << missing.err;
   EXPECT_FALSE(fs::exists(dir_ / "out" / "metrics.json"));
-  const CommandRun align = Roamlab(inputs + " --align sim3", dir_);
+  const CommandRun align = Roamlab(inputs + " --align similarity", dir_);
   EXPECT_EQ(align.exit_code, 2);
-  EXPECT_NE(align.err.find("unknown alignment 'sim3'"), std::string::npos) << align.err;
+  EXPECT_NE(align.err.find("unknown alignment 'similarity'"), std::string::npos) << align.err;
+}
+
+// A simulated recording and an estimate written from its truth with a known error.
+class EvaluateCliTest : public CliTest {
+ protected:
+  void SetUp() override {
+    roamlab::testing::SyntheticOptions options;
+    options.duration_s = 5.0;
+    const recording::Recording rec = roamlab::testing::MakeAtvRecording(options).recording;
+    ASSERT_TRUE(recording::WriteRecording(rec, (dir_ / "rec").string()).ok());
+    Trajectory estimate = *rec.ground_truth;
+    for (std::size_t i = 0; i < estimate.size(); ++i) {
+      const double t = SecondsBetween(estimate.front().t, estimate[i].t);
+      estimate[i].p_world_body += Eigen::Vector3d(0.2 * std::sin(t), 0.1 * t, 0.3);
+      estimate[i].q_world_body =
+          estimate[i].q_world_body * Eigen::Quaterniond(Eigen::AngleAxisd(0.01 * t, Eigen::Vector3d::UnitY()));
+    }
+    fs::create_directories(dir_ / "est");
+    ASSERT_TRUE(WriteTum(estimate, (dir_ / "est" / "trajectory.tum").string()).ok());
+  }
+  nlohmann::json Metrics(const std::string& out) const {
+    std::ifstream in(dir_ / out / "metrics.json");
+    return nlohmann::json::parse(in);
+  }
+  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
+};
+
+// The number: two plain files give the same ATE as the directory form on the same data.
+TEST_F(EvaluateCliTest, PlainFilesGiveTheDirectoryFormsAte) {
+  for (const std::string align : {"", " --align se3", " --align sim3"}) {
+    CommandRun r = Roamlab("evaluate --estimate " + Path("est") + " --recording " + Path("rec") + " --out " +
+                               Path("dir") + align + " --no-plots --quiet",
+                           dir_);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = Roamlab("evaluate --reference " + Path("rec/ground_truth.tum") + " --estimate " + Path("est/trajectory.tum") +
+                    " --out " + Path("files") + align + " --no-plots",
+                dir_);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("ATE rotation"), std::string::npos) << r.out;
+    nlohmann::json d = Metrics("dir"), f = Metrics("files");
+    EXPECT_GT(d["ate_m"].get<double>(), 0.05) << align;  // an error that alignment does not remove
+    for (const char* key : {"ate_m", "ate_rot_deg", "ate_axes", "rpe_trans_m", "rpe_rot_deg", "rpe_distance"})
+      EXPECT_EQ(d[key], f[key]) << key << align;
+    d["alignment"].erase("reason");  // why the default is what it is differs; the alignment itself does not
+    f["alignment"].erase("reason");
+    EXPECT_EQ(d["alignment"], f["alignment"]) << align;
+    EXPECT_EQ(f["reference"]["kind"], "file");
+  }
+}
+
+TEST_F(EvaluateCliTest, SeveralEstimatesGiveOneTable) {
+  const CommandRun r =
+      Roamlab("evaluate --reference " + Path("rec/ground_truth.tum") + " --estimate " + Path("est") + " --estimate " +
+                  Path("est/trajectory.tum") + " --estimate " + Path("est") + " --out " + Path("cmp") + " --no-plots",
+              dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json m = Metrics("cmp");
+  ASSERT_EQ(m["table"].size(), 3u);
+  EXPECT_EQ(m["table"][0]["name"], "est");
+  EXPECT_EQ(m["table"][1]["name"], "trajectory.tum");
+  EXPECT_EQ(m["table"][2]["name"], "est_2");  // a repeated name is made unique
+  EXPECT_EQ(m["table"][0]["ate_m"], m["table"][1]["ate_m"]);
+  EXPECT_NE(r.out.find("estimate"), std::string::npos);
+  EXPECT_NE(r.out.find("est_2"), std::string::npos) << r.out;
+}
+
+TEST_F(EvaluateCliTest, BadPlainFilesGiveOneLineAndExitCodeTwo) {
+  std::ofstream(dir_ / "short.tum") << "0 1 2 3 0 0 0\n";
+  std::ofstream(dir_ / "late.tum") << "1000 1 2 3 0 0 0 1\n";
+  const std::string reference = " --reference " + Path("rec/ground_truth.tum") + " --out " + Path("o");
+  const std::pair<std::string, std::string> cases[] = {
+      {"--estimate " + Path("none.tum") + reference, Path("none.tum") + ": missing"},
+      {"--estimate " + Path("short.tum") + reference, Path("short.tum") + ":1: expected 8 fields"},
+      {"--estimate " + Path("late.tum") + reference, Path("late.tum") + ": no pose within 0.01 s"},
+      {"--estimate " + Path("est") + reference + " --reference-format csv", "--reference-format: unknown format"},
+      {"--estimate " + Path("est") + " --out " + Path("o"), "no reference"}};
+  for (const auto& [args, message] : cases) {
+    const CommandRun r = Roamlab("evaluate " + args, dir_);
+    EXPECT_EQ(r.exit_code, 2) << args;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": " << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+  }
 }
 
 TEST_F(CliTest, HelpDescribesEveryCommand) {

@@ -212,11 +212,91 @@ TEST_F(EvaluateTest, WithoutGnuplotMetricsAreStillWritten) {
   EXPECT_FALSE(fs::exists(out_dir() + "/trajectory.png"));
 }
 
-TEST_F(EvaluateTest, MissingGroundTruthIsAClearError) {
+// Real data: no ground truth, so the estimate is compared with the GPS fixes, moved to the antenna by the calibrated
+// lever arm (0.6, 0, 0.2) m. At t = 0 (yaw 0) the estimate's antenna is at (0.3 + 0.6, 0.4, 0.2), the fix at the
+// origin.
+TEST_F(EvaluateTest, WithoutGroundTruthTheGpsFixesAreTheReference) {
   WriteGpsCase();
   fs::remove(rec("ground_truth.tum"));
-  EXPECT_EQ(EvaluateError(Options()),
-            rec("ground_truth.tum") + ": missing; evaluation needs the ground-truth trajectory");
+  const Result<Evaluation> r = Evaluate(Options());
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  const json& m = r.value().metrics;
+  EXPECT_EQ(m["reference"]["kind"], "stream");
+  EXPECT_EQ(m["reference"]["stream"], "gps");
+  EXPECT_EQ(m["reference"]["orientation"], false);
+  EXPECT_THAT(m["reference"]["lever_arm_source"].get<std::string>(), StartsWith("calibration ("));
+  EXPECT_EQ(m["association"]["matched"], 2);
+  EXPECT_NEAR(r.value().error_world[0].x(), 0.9, 1e-6);
+  EXPECT_NEAR(r.value().error_world[0].y(), 0.4, 1e-6);
+  EXPECT_NEAR(r.value().error_world[0].z(), 0.2, 1e-6);
+  EXPECT_TRUE(m["ate_rot_deg"].is_null());
+  EXPECT_TRUE(m["rpe"].contains("skipped"));
+  EXPECT_EQ(r.value().reference_label, "GPS fixes (gps)");
+  EXPECT_TRUE(r.value().fixes.empty());  // the reference stream is not drawn twice
+  // Without the calibration the lever arm is ignored, and says so.
+  fs::remove(est("calibration.json"));
+  const Result<Evaluation> ignored = Evaluate(Options());
+  ASSERT_TRUE(ignored.ok()) << ignored.status().message();
+  EXPECT_EQ(ignored.value().metrics["reference"]["lever_arm_source"], "none: ignored");
+  EXPECT_NEAR(ignored.value().error_world[0].x(), 0.3, 1e-6);
+  // The figure exists now.
+  const Result<WrittenEvaluation> w = WriteEvaluation(ignored.value(), out_dir());
+  ASSERT_TRUE(w.ok()) << w.status().message();
+  EXPECT_TRUE(fs::exists(out_dir() + "/trajectory.gp"));
+  EXPECT_THAT(ReadFile(out_dir() + "/trajectory.gp"), HasSubstr("title \"GPS fixes (gps)\""));
+  // A stream that cannot be a reference, and one that does not exist.
+  EvaluateOptions imu = Options();
+  imu.reference_stream = "imu";
+  EXPECT_THAT(EvaluateError(imu), HasSubstr("no stream 'imu'"));
+}
+
+// A pose stream (motion capture of a marker body mounted 0.5 m ahead, turned 90 deg about z) as the reference: the
+// estimate, moved to the marker by the mounting, matches it exactly, orientation included.
+TEST_F(EvaluateTest, APoseStreamIsAReferenceThroughItsMounting) {
+  fs::create_directories(rec_dir());
+  fs::create_directories(est_dir());
+  WriteFile(rec("recording.yaml"),
+            std::string(kImuYaml) +
+                "  - name: mocap\n"
+                "    type: pose\n"
+                "    rate_hz: 20\n"
+                "    mounting: {p_body_sensor_m: [0.5, 0, 0], q_body_sensor_wxyz: [0.7071067811865476, "
+                "0, 0, 0.7071067811865476]}\n");
+  WriteFile(rec("imu.csv"), kImuCsv);
+  const Eigen::Quaterniond q_body_sensor(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()));
+  std::string mocap = "t,x,y,z,qx,qy,qz,qw\n";
+  for (const StampedPose& pose : Truth()) {
+    const Eigen::Vector3d p = pose.p_world_body + pose.q_world_body * Eigen::Vector3d(0.5, 0.0, 0.0);
+    const Eigen::Quaterniond q = pose.q_world_body * q_body_sensor;
+    char row[256];
+    std::snprintf(row, sizeof row, "%s,%.12f,%.12f,%.12f,%.12f,%.12f,%.12f,%.12f\n", FormatSeconds(pose.t).c_str(),
+                  p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w());
+    mocap += row;
+  }
+  WriteFile(rec("mocap.csv"), mocap);
+  ASSERT_TRUE(WriteTum(Truth(), est("trajectory.tum")).ok());
+  const Result<Evaluation> r = Evaluate(Options());  // no ground truth: the first absolute stream, mocap
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  const json& m = r.value().metrics;
+  EXPECT_EQ(m["reference"]["stream"], "mocap");
+  EXPECT_EQ(m["reference"]["lever_arm_source"], "mounting in recording.yaml");
+  EXPECT_LT(m["ate_m"].get<double>(), 1e-9);
+  EXPECT_LT(m["ate_rot_deg"].get<double>(), 1e-6);
+  EXPECT_LT(m["rpe_trans_m"].get<double>(), 1e-9);
+}
+
+TEST_F(EvaluateTest, MissingGroundTruthWithoutAbsoluteSensorIsAClearError) {
+  fs::create_directories(rec_dir());
+  fs::create_directories(est_dir());
+  WriteFile(rec("recording.yaml"), kImuYaml);
+  WriteFile(rec("imu.csv"), kImuCsv);
+  ASSERT_TRUE(WriteTum(Truth(), est("trajectory.tum")).ok());
+  EXPECT_EQ(EvaluateError(Options()), rec("ground_truth.tum") +
+                                          ": missing, and the recording has no gps, position or pose stream to "
+                                          "compare with");
+  EvaluateOptions imu = Options();
+  imu.reference_stream = "imu";
+  EXPECT_THAT(EvaluateError(imu), HasSubstr("stream 'imu' is of type imu; a reference stream must be gps"));
 }
 
 TEST_F(EvaluateTest, BadInputsNameTheFile) {

@@ -32,6 +32,8 @@ TEST(MetricsTest, SummarizeComputesRmseMeanMedianMax) {
   EXPECT_DOUBLE_EQ(even.median, 3.5);
   EXPECT_DOUBLE_EQ(even.max, 4.0);
   EXPECT_DOUBLE_EQ(Summarize({5.0, 1.0, 2.0}).median, 2.0);
+  EXPECT_DOUBLE_EQ(even.std, 0.5);
+  EXPECT_DOUBLE_EQ(even.min, 3.0);
   const ErrorStatistics none = Summarize({});
   EXPECT_EQ(none.count, 0u);
   EXPECT_TRUE(std::isnan(none.rmse));
@@ -63,6 +65,29 @@ TEST(MetricsTest, AteWithoutAlignmentEqualsTheOffset) {
   EXPECT_LT((none.error_world[10] - shift.p_ref_est).norm(), 1e-12);
   // Yaw + translation alignment removes a pure shift as well.
   EXPECT_LT(ComputeAte(estimate, reference, AlignmentKind::kYawTranslation).statistics.rmse, 1e-10);
+}
+
+TEST(MetricsTest, AteRotationAndAxesOfAKnownError) {
+  const Trajectory reference = CircleDrive(100, 0.1);
+  Trajectory estimate = reference;
+  // Every pose 2 deg too far about z, and off by (0.3, -0.4, +-1.2) m: the sign of z alternates.
+  for (std::size_t i = 0; i < estimate.size(); ++i) {
+    estimate[i].q_world_body =
+        estimate[i].q_world_body * Eigen::Quaterniond(Eigen::AngleAxisd(2.0 / kDeg, Eigen::Vector3d::UnitZ()));
+    estimate[i].p_world_body += Eigen::Vector3d(0.3, -0.4, i % 2 == 0 ? 1.2 : -1.2);
+  }
+  const AbsoluteTrajectoryError ate = ComputeAte(estimate, reference, AlignmentKind::kNone);
+  EXPECT_NEAR(ate.rotation.rmse, 2.0, 1e-9);
+  EXPECT_NEAR(ate.rotation.max, 2.0, 1e-9);
+  EXPECT_NEAR(ate.axis[0].mean, 0.3, 1e-12);
+  EXPECT_NEAR(ate.axis[1].rmse, 0.4, 1e-12);
+  EXPECT_NEAR(ate.axis[2].rmse, 1.2, 1e-12);
+  EXPECT_NEAR(ate.axis[2].mean, 0.0, 1e-12);
+  EXPECT_NEAR(ate.axis[2].std, 1.2, 1e-12);
+  EXPECT_NEAR(ate.axis[2].min, -1.2, 1e-12);
+  EXPECT_NEAR(ate.horizontal.rmse, 0.5, 1e-12);
+  EXPECT_NEAR(ate.vertical.mean, 1.2, 1e-12);
+  EXPECT_NEAR(ate.statistics.rmse, std::sqrt(0.25 + 1.44), 1e-12);
 }
 
 TEST(MetricsTest, ConstantDriftGivesItsPerStepRpe) {

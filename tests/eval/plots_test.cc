@@ -57,8 +57,8 @@ TEST(PlotsTest, TrajectoryPlotWritesDataAndAScriptThatReadsThem) {
   TempDir dir;
   PositionFixes gps{
       "gps", "GPS fixes (gps)", {Time::FromSeconds(0.0), Time::FromSeconds(0.2)}, {{0.1, 0.0, 0.0}, {2.0, 1.1, 0.0}}};
-  const Result<PlotFiles> files =
-      WriteTrajectoryPlot(dir.path(), "Trajectory", Time(), Line(10), Line(10), "estimate", {gps});
+  const Result<PlotFiles> files = WriteTrajectoryPlot(dir.path(), "Trajectory", Time(), {"ground truth", Line(10)},
+                                                      {{"estimate", Line(10)}}, {gps});
   ASSERT_TRUE(files.ok()) << files.status().message();
   ASSERT_EQ(files.value().data.size(), 3u);
   const std::string script = ReadFile(dir.File(files.value().script));
@@ -100,7 +100,8 @@ TEST(PlotsTest, NeesPlotShowsTheBand) {
 TEST(PlotsTest, GnuplotDrawsThePngs) {
   if (!GnuplotAvailable()) GTEST_SKIP() << "gnuplot not installed";
   TempDir dir;
-  const Result<PlotFiles> files = WriteTrajectoryPlot(dir.path(), "T", Time(), Line(10), Line(10), "estimate", {});
+  const Result<PlotFiles> files =
+      WriteTrajectoryPlot(dir.path(), "T", Time(), {"ground truth", Line(10)}, {{"estimate", Line(10)}}, {});
   ASSERT_TRUE(files.ok());
   ASSERT_TRUE(RunGnuplot(dir.path(), files.value().script).ok());
   EXPECT_TRUE(IsPng(dir.File("trajectory.png")));

@@ -157,6 +157,38 @@ TEST_F(ScenarioErrorTest, WheelOffsetIsParsedAndChecked) {
   EXPECT_EQ(atv.Validate()->key, "robot.wheel_offset");
 }
 
+TEST_F(ScenarioErrorTest, EncoderColumnsAndGeometryKeysAreParsedAndChecked) {
+  const std::string kind = "kind: differential_drive\n";
+  const std::string columns = "  encoder_columns: [{wheel: 1, name: right}, {wheel: 0, name: left}]\n";
+  EXPECT_EQ(LoadIndoorWith(kind, kind + columns + "  geometry_keys: per_wheel\n  geometry: {gear_ratio: 43.7}\n"), "");
+  auto loaded = LoadScenario(path_);
+  ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+  const RobotOptions& robot = loaded.value().robot;
+  ASSERT_EQ(robot.encoder_columns.size(), 2u);
+  EXPECT_EQ(robot.encoder_columns[0].wheel, 1);
+  EXPECT_EQ(robot.encoder_columns[0].name, "right");
+  EXPECT_TRUE(robot.per_wheel_geometry);
+  EXPECT_EQ(robot.stated_geometry.at("gear_ratio"), 43.7);
+  ExpectError(LoadIndoorWith(kind, kind + "  encoder_columns: [{wheel: 0, name: a}, {wheel: 0, name: b}]\n"),
+              "encoder_columns", "robot.encoder_columns[1].wheel", "wheel listed twice");
+  ExpectError(LoadIndoorWith(kind, kind + "  encoder_columns: [{wheel: 0, name: a}, {wheel: 1, name: a}]\n"),
+              "encoder_columns", "robot.encoder_columns[1].name", "name listed twice");
+  ExpectError(LoadIndoorWith(kind, kind + "  encoder_columns: [{wheel: 0, name: \"a b\"}]\n"), "encoder_columns",
+              "robot.encoder_columns[0].name", "letters, digits and _");
+  ExpectError(LoadIndoorWith(kind, kind + "  encoder_columns: [{wheel: 0}]\n"), "encoder_columns",
+              "robot.encoder_columns[0].name", "missing required key");
+  ExpectError(LoadIndoorWith(kind, kind + "  geometry_keys: all\n"), "geometry_keys", "robot.geometry_keys",
+              "nominal or per_wheel");
+  ExpectError(LoadIndoorWith(kind, kind + "  geometry_keys: per_wheel\n"), "geometry_keys", "robot.geometry_keys",
+              "needs robot.encoder_columns");
+  ExpectError(LoadIndoorWith(kind, kind + "  geometry: {gear_ratio: many}\n"), "gear_ratio",
+              "robot.geometry.gear_ratio", "expected a finite number");
+  ExpectError(LoadIndoorWith("ticks_per_revolution: 2048", "ticks_per_revolution: 2048\n    name: \"wheel/s\""),
+              "wheel/s", "sensors.wheel_encoders.name", "letters, digits and _");
+  // Ticks per revolution need not be whole (64 motor ticks through a 43.7:1 gearbox).
+  EXPECT_EQ(LoadIndoorWith("ticks_per_revolution: 2048", "ticks_per_revolution: 2796.8"), "");
+}
+
 TEST_F(ScenarioErrorTest, MissingFilesAndKeys) {
   ExpectError(LoadWith("model: " + testing::SourcePath("models/atv.xml"), "model: no_such_robot.xml"),
               "no_such_robot.xml", "robot.model", "no such file 'no_such_robot.xml'");

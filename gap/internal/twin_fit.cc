@@ -1,0 +1,330 @@
+#include "gap/internal/twin_fit.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <thread>
+
+namespace roamlab::gap::internal {
+namespace {
+
+constexpr double kMinDecrease = 0.1;
+constexpr double kMinRelativeDecrease = 1e-5;
+constexpr int kMaxTries = 4;
+
+TwinParameter P(const std::string& name, double neutral, double step, double lo, double hi) {
+  return {name, neutral, step, lo, hi};
+}
+
+// The wheels a kind's axle_misalignment takes (0: the Ackermann rear axle, no wheel index).
+int Wheels(const std::string& kind) {
+  if (kind == "differential_drive") return 2;
+  if (kind == "omni3") return 3;
+  if (kind == "mecanum") return 4;
+  return 0;
+}
+
+std::vector<TwinCandidate> Library(const sim::Scenario& nominal, double max_shift_s) {
+  std::vector<TwinCandidate> all;
+  all.push_back({"wheel_radius_asymmetry", "wheel_radius_asymmetry", {}, {P("ratio_right_left", 1, 0.01, 0.8, 1.2)}});
+  all.push_back({"track_width_error", "track_width_error", {}, {P("track_error_m", 0, 0.01, -0.1, 0.1)}});
+  const int wheels = Wheels(nominal.robot.kind);
+  for (int w = 0; w < wheels; ++w)
+    all.push_back({"axle_misalignment wheel " + std::to_string(w),
+                   "axle_misalignment",
+                   {{"wheel", w}},
+                   {P("yaw_deg", 0, 1.0, -20, 20)}});
+  if (nominal.robot.kind == "ackermann")
+    all.push_back({"axle_misalignment", "axle_misalignment", {}, {P("yaw_deg", 0, 0.25, -5, 5)}});
+  all.push_back({"gyro_scale_error",
+                 "gyro_scale_error",
+                 {},
+                 {P("scale_x", 1, 0.01, 0.5, 1.5), P("scale_y", 1, 0.01, 0.5, 1.5), P("scale_z", 1, 0.01, 0.5, 1.5)}});
+  all.push_back(
+      {"gyro_bias_drift",
+       "gyro_bias_drift",
+       {},
+       {P("initial_x", 0, 1e-3, -0.5, 0.5), P("initial_y", 0, 1e-3, -0.5, 0.5), P("initial_z", 0, 1e-3, -0.5, 0.5)}});
+  all.push_back({"magnetometer_motor_interference",
+                 "magnetometer_motor_interference",
+                 {},
+                 {P("b_per_nm_x", 0, 1e-4, -1, 1), P("b_per_nm_y", 0, 1e-4, -1, 1), P("b_per_nm_z", 0, 1e-4, -1, 1)}});
+  all.push_back({"steering_offset", "steering_offset", {}, {P("offset_rad", 0, 5e-3, -0.5, 0.5)}});
+  all.push_back({"lateral_slip", "lateral_slip", {}, {P("contact_time_scale", 1, 0.05, 1, 4)}});
+  TwinCandidate latency{"gps_latency", "gps_latency", {}, {P("latency_s", 0, 0, 0, std::min(1.0, max_shift_s))}};
+  latency.time_shift = true;
+  all.push_back(latency);
+  const double imu_range = std::min(0.5, max_shift_s);
+  TwinCandidate offset{"imu_time_offset", "imu_time_offset", {}, {P("offset_s", 0, 0, -imu_range, imu_range)}};
+  offset.time_shift = true;
+  all.push_back(offset);
+  return all;
+}
+
+// Entries finite in `center`; elsewhere 0.
+Eigen::VectorXd Masked(const Eigen::VectorXd& r, const Eigen::VectorXd& center) {
+  Eigen::VectorXd out = r;
+  for (Eigen::Index i = 0; i < r.size(); ++i)
+    if (!std::isfinite(r[i]) || !std::isfinite(center[i])) out[i] = 0.0;
+  return out;
+}
+
+// The fit's rows: the finite entries of `center` and the Jacobian's rows there.
+TwinFitRows Rows(const Layout& layout, const Eigen::VectorXd& center, const Eigen::MatrixXd& jacobian) {
+  TwinFitRows rows;
+  std::vector<Eigen::Index> keep;
+  for (const Series& s : layout.series)
+    for (std::size_t i = 0; i < s.rows.size(); ++i)
+      for (int c = 0; c < s.components(); ++c) {
+        const Eigen::Index k = s.offset + static_cast<Eigen::Index>(i) * s.components() + c;
+        if (!std::isfinite(center[k])) continue;
+        keep.push_back(k);
+        rows.t.push_back(s.t[i]);
+        rows.series.push_back(s.name);
+      }
+  rows.residuals.resize(static_cast<Eigen::Index>(keep.size()));
+  rows.jacobian.resize(static_cast<Eigen::Index>(keep.size()), jacobian.cols());
+  for (std::size_t j = 0; j < keep.size(); ++j) {
+    rows.residuals[static_cast<Eigen::Index>(j)] = center[keep[j]];
+    rows.jacobian.row(static_cast<Eigen::Index>(j)) = jacobian.row(keep[j]);
+  }
+  return rows;
+}
+
+Eigen::VectorXd Clamp(const TwinCandidate& c, Eigen::VectorXd theta) {
+  for (std::size_t j = 0; j < c.free.size(); ++j) {
+    const Eigen::Index k = static_cast<Eigen::Index>(j);
+    theta[k] = std::clamp(theta[k], c.free[j].lo, c.free[j].hi);
+  }
+  return theta;
+}
+
+// The Jacobian of the residuals by the parameters at `theta` (residuals `center`): central differences when 2k runs
+// fit in the threads, else forward (backward at the upper bound; one-sided at either bound).
+Result<Eigen::MatrixXd> Jacobian(const TwinCandidate& c, const Eigen::VectorXd& theta, const Eigen::VectorXd& center,
+                                 int threads, TwinEvaluator* evaluator) {
+  const int k = static_cast<int>(c.free.size());
+  const bool central = 2 * k <= std::max(2, threads);
+  std::vector<sim::EffectOptions> runs;
+  std::vector<std::pair<double, double>> deltas;  // per parameter: the + and - steps taken (0: none)
+  for (int j = 0; j < k; ++j) {
+    const TwinParameter& p = c.free[static_cast<std::size_t>(j)];
+    double plus = theta[j] + p.step <= p.hi ? p.step : 0.0;
+    double minus = (central || plus == 0.0) && theta[j] - p.step >= p.lo ? p.step : 0.0;
+    if (plus == 0.0 && minus == 0.0) return Status::Error(c.label + ": " + p.name + "'s range is narrower than a step");
+    for (const double d : {plus, -minus}) {
+      if (d == 0.0) continue;
+      Eigen::VectorXd at = theta;
+      at[j] += d;
+      runs.push_back(EffectAt(c, at));
+    }
+    deltas.push_back({plus, minus});
+  }
+  const std::vector<Result<Eigen::VectorXd>> r = evaluator->Run(runs);
+  for (const auto& x : r)
+    if (!x.ok()) return Status::Error(c.label + ": a perturbed twin: " + x.status().message());
+  Eigen::MatrixXd J(center.size(), k);
+  std::size_t next = 0;
+  for (int j = 0; j < k; ++j) {
+    const auto [plus, minus] = deltas[static_cast<std::size_t>(j)];
+    const Eigen::VectorXd hi = plus > 0.0 ? Masked(r[next++].value(), center) : Masked(center, center);
+    const Eigen::VectorXd lo = minus > 0.0 ? Masked(r[next++].value(), center) : Masked(center, center);
+    J.col(j) = (hi - lo) / (plus + minus);
+  }
+  return J;
+}
+
+// Levenberg-Marquardt from the neutral values, the parameters scaled by their steps. Stops when the Gauss-Newton step
+// predicts, or the step taken makes, a decrease below kMinDecrease + kMinRelativeDecrease chi2 (a tenth of the
+// chi-square unit that moves a parameter by one standard deviation, so at most a third of it away), after
+// max_iterations, or when kMaxTries dampings do not decrease the cost.
+Result<CandidateOutcome> FitLeastSquares(const TwinCandidate& c, const Eigen::VectorXd& base, TwinEvaluator* evaluator,
+                                         const FitSettings& settings) {
+  const int k = static_cast<int>(c.free.size());
+  CandidateOutcome out;
+  out.theta.resize(k);
+  Eigen::VectorXd scale(k);
+  for (int j = 0; j < k; ++j) {
+    out.theta[j] = c.free[static_cast<std::size_t>(j)].neutral;
+    scale[j] = c.free[static_cast<std::size_t>(j)].step;
+  }
+  out.residuals = base;
+  out.chi2 = SumOfSquares(base);
+  double lambda = 1e-3;
+  Eigen::MatrixXd J;
+  for (out.iterations = 0; out.iterations < settings.max_iterations; ++out.iterations) {
+    auto jacobian = Jacobian(c, out.theta, out.residuals, settings.threads, evaluator);
+    if (!jacobian.ok()) return jacobian.status();
+    J = jacobian.value();
+    const Eigen::MatrixXd Js = J * scale.asDiagonal();
+    const Eigen::VectorXd r = Masked(out.residuals, out.residuals);
+    const Eigen::MatrixXd H = Js.transpose() * Js;
+    const Eigen::VectorXd g = Js.transpose() * r;
+    const double enough = kMinDecrease + kMinRelativeDecrease * out.chi2;
+    if (-g.dot(H.completeOrthogonalDecomposition().solve(-g)) < enough) break;
+    double decrease = 0.0;
+    for (int tries = 0; tries < kMaxTries && decrease <= 0.0; ++tries, lambda *= 10.0) {
+      Eigen::MatrixXd A = H;
+      A.diagonal() += lambda * H.diagonal().cwiseMax(1e-12);
+      const Eigen::VectorXd trial = Clamp(c, out.theta + scale.cwiseProduct(A.ldlt().solve(-g)));
+      auto run = evaluator->Run({EffectAt(c, trial)});
+      if (!run[0].ok()) return Status::Error(c.label + ": a trial twin: " + run[0].status().message());
+      const double chi2 = SumOfSquares(Masked(run[0].value(), out.residuals));
+      if (chi2 >= out.chi2) continue;
+      decrease = out.chi2 - chi2;
+      out.theta = trial;
+      out.residuals = run[0].value();
+      out.chi2 = chi2;
+      lambda = std::max(1e-7, lambda / 100.0);
+    }
+    if (decrease < enough) break;
+  }
+  out.effect = EffectAt(c, out.theta);
+  out.covariance = settings.covariance->compute(Rows(evaluator->layout(), out.residuals, J));
+  return out;
+}
+
+// The time shift on the step grid: the chi-square at a coarse grid of 9 points over the range, then halving the
+// spacing about the best until neighbouring steps; the value is the vertex of the parabola through the best step and
+// its neighbours (within half a step of it), the covariance from the residuals' central difference there.
+Result<CandidateOutcome> SearchTimeShift(const TwinCandidate& c, const Eigen::VectorXd& base, TwinEvaluator* evaluator,
+                                         const FitSettings& settings) {
+  const TwinParameter& p = c.free.front();
+  const double step = settings.physics_step_s;
+  const long lo = static_cast<long>(std::ceil(p.lo / step - 1e-9)),
+             hi = static_cast<long>(std::floor(p.hi / step + 1e-9));
+  std::map<long, Eigen::VectorXd> r;
+  std::map<long, double> chi2;
+  r[0] = base;
+  chi2[0] = SumOfSquares(base);
+  const auto evaluate = [&](std::vector<long> shifts) -> Status {
+    std::vector<long> todo;
+    for (long s : shifts)
+      if (s >= lo && s <= hi && !r.count(s) && std::find(todo.begin(), todo.end(), s) == todo.end()) todo.push_back(s);
+    std::vector<sim::EffectOptions> runs;
+    for (long s : todo) runs.push_back(EffectAt(c, Eigen::VectorXd::Constant(1, static_cast<double>(s) * step)));
+    const auto out = evaluator->Run(runs);
+    for (std::size_t i = 0; i < todo.size(); ++i) {
+      if (!out[i].ok()) return Status::Error(c.label + ": a shifted twin: " + out[i].status().message());
+      r[todo[i]] = out[i].value();
+      chi2[todo[i]] = SumOfSquares(Masked(out[i].value(), base));
+    }
+    return Status::Ok();
+  };
+  const auto best = [&] {
+    return std::min_element(chi2.begin(), chi2.end(), [](const auto& a, const auto& b) { return a.second < b.second; })
+        ->first;
+  };
+  std::vector<long> coarse;
+  for (int i = 0; i <= 8; ++i) coarse.push_back(lo + static_cast<long>(std::lround((hi - lo) * i / 8.0)));
+  if (Status s = evaluate(coarse); !s.ok()) return s;
+  long spacing = std::max(1L, (hi - lo) / 8);
+  int rounds = 0;
+  for (long b = best();; b = best(), ++rounds) {
+    spacing = std::max(1L, spacing / 2);
+    if (Status s = evaluate({b - spacing, b + spacing}); !s.ok()) return s;
+    if (spacing == 1 && best() == b) break;
+  }
+  const long b = best();
+  CandidateOutcome out;
+  out.iterations = rounds;
+  out.residuals = r[b];
+  out.chi2 = chi2[b];
+  out.effect = EffectAt(c, Eigen::VectorXd::Constant(1, static_cast<double>(b) * step));
+  double vertex = 0.0;
+  if (r.count(b - 1) && r.count(b + 1)) {
+    const double curvature = chi2[b - 1] - 2.0 * chi2[b] + chi2[b + 1];
+    if (curvature > 0.0) vertex = std::clamp(0.5 * (chi2[b - 1] - chi2[b + 1]) / curvature, -0.5, 0.5);
+  }
+  out.theta = Eigen::VectorXd::Constant(1, (static_cast<double>(b) + vertex) * step);
+  const long up = r.count(b + 1) ? b + 1 : b, down = r.count(b - 1) ? b - 1 : b;
+  Eigen::MatrixXd J(base.size(), 1);
+  J.col(0) =
+      up > down
+          ? Eigen::VectorXd((Masked(r[up], r[b]) - Masked(r[down], r[b])) / (static_cast<double>(up - down) * step))
+          : Eigen::VectorXd::Zero(base.size());
+  out.covariance = settings.covariance->compute(Rows(evaluator->layout(), r[b], J));
+  return out;
+}
+
+}  // namespace
+
+std::vector<TwinCandidate> TwinCandidates(const sim::Scenario& nominal, double max_shift_s) {
+  std::vector<TwinCandidate> out;
+  for (const TwinCandidate& c : Library(nominal, max_shift_s)) {
+    sim::Scenario trial = nominal;
+    trial.effects.clear();
+    Eigen::VectorXd theta(static_cast<Eigen::Index>(c.free.size()));
+    for (std::size_t j = 0; j < c.free.size(); ++j)
+      theta[static_cast<Eigen::Index>(j)] = std::clamp(c.free[j].neutral + 0.01, c.free[j].lo, c.free[j].hi);
+    trial.effects.push_back(EffectAt(c, theta));
+    if (!trial.Validate()) out.push_back(c);
+  }
+  return out;
+}
+
+sim::EffectOptions EffectAt(const TwinCandidate& c, const Eigen::VectorXd& theta) {
+  sim::EffectOptions e;
+  e.name = c.effect;
+  e.parameters = c.fixed;
+  for (std::size_t j = 0; j < c.free.size(); ++j) e.parameters[c.free[j].name] = theta[static_cast<Eigen::Index>(j)];
+  return e;
+}
+
+void ParallelFor(int n, int threads, const std::function<void(int)>& fn) {
+  std::atomic<int> next{0};
+  const auto worker = [&] {
+    for (int i = next++; i < n; i = next++) fn(i);
+  };
+  std::vector<std::thread> pool;
+  for (int k = 1; k < std::min(std::max(1, threads), n); ++k) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+}
+
+std::vector<Result<Eigen::VectorXd>> TwinEvaluator::Run(const std::vector<sim::EffectOptions>& extra) {
+  std::vector<Result<Eigen::VectorXd>> out(extra.size(), Result<Eigen::VectorXd>(Status::Error("not run")));
+  ParallelFor(static_cast<int>(extra.size()), threads_, [&](int i) {
+    sim::Scenario patched = base_;
+    patched.effects.push_back(extra[static_cast<std::size_t>(i)]);
+    try {
+      auto twin = runner_(patched);
+      out[static_cast<std::size_t>(i)] =
+          twin.ok() ? Result<Eigen::VectorXd>(WhitenedResiduals(layout_, real_, twin.value())) : twin.status();
+    } catch (const std::exception& e) {
+      out[static_cast<std::size_t>(i)] = Status::Error(std::string("the twin runner failed: ") + e.what());
+    }
+  });
+  runs_ += static_cast<int>(extra.size());
+  return out;
+}
+
+Result<double> PredictedDrop(const TwinCandidate& c, const Eigen::VectorXd& base, TwinEvaluator* evaluator,
+                             const FitSettings& settings) {
+  Eigen::VectorXd theta(static_cast<Eigen::Index>(c.free.size()));
+  for (std::size_t j = 0; j < c.free.size(); ++j) theta[static_cast<Eigen::Index>(j)] = c.free[j].neutral;
+  if (c.time_shift) {
+    const double shift_s = c.free.front().hi > 0.0 ? settings.physics_step_s : -settings.physics_step_s;
+    theta[0] = shift_s;
+    auto r = evaluator->Run({EffectAt(c, theta)});
+    if (!r[0].ok()) return Status::Error(c.label + ": a shifted twin: " + r[0].status().message());
+    const Eigen::VectorXd d = (Masked(r[0].value(), base) - Masked(base, base)) / shift_s;
+    const Eigen::VectorXd b = Masked(base, base);
+    return d.squaredNorm() > 0.0 ? std::pow(d.dot(b), 2) / d.squaredNorm() : 0.0;
+  }
+  auto J = Jacobian(c, theta, base, settings.threads, evaluator);
+  if (!J.ok()) return J.status();
+  const Eigen::VectorXd g = J.value().transpose() * Masked(base, base);
+  const Eigen::MatrixXd H = J.value().transpose() * J.value();
+  return g.dot(H.completeOrthogonalDecomposition().solve(g));
+}
+
+Result<CandidateOutcome> FitCandidate(const TwinCandidate& c, const Eigen::VectorXd& base, TwinEvaluator* evaluator,
+                                      const FitSettings& settings) {
+  if (c.time_shift) return SearchTimeShift(c, base, evaluator, settings);
+  return FitLeastSquares(c, base, evaluator, settings);
+}
+
+}  // namespace roamlab::gap::internal

@@ -1,0 +1,88 @@
+// The twin diagnosis's fit of one candidate effect by running the twin again (gap/twin.h, step 3): the library of
+// the simulator's effects as candidates, the parallel evaluation of perturbed twin runs, Levenberg-Marquardt over a
+// candidate's parameters and the time-shift search on the physics step grid.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/status.h"
+#include "gap/internal/twin_residuals.h"
+#include "gap/twin.h"
+#include "sim/scenario.h"
+
+namespace roamlab::gap::internal {
+
+struct TwinParameter {
+  std::string name;  // as the simulator's effect (sim/scenario.h)
+  double neutral = 0.0;
+  double step = 0.0;  // finite-difference step, and the scale of the parameter in the solve
+  double lo = 0.0, hi = 0.0;
+};
+
+struct TwinCandidate {
+  std::string label;   // the effect's name, with the wheel for axle_misalignment ("axle_misalignment wheel 1")
+  std::string effect;  // the simulator's effect
+  std::map<std::string, double> fixed;  // labels, not fitted (axle_misalignment's wheel)
+  std::vector<TwinParameter> free;
+  bool time_shift = false;  // one parameter on the physics step grid, searched
+};
+
+// The candidates `nominal` supports (its sensors and robot kind; the scenario validates with each).
+std::vector<TwinCandidate> TwinCandidates(const sim::Scenario& nominal, double max_shift_s);
+
+// The effect of `c` at parameter values `theta` (in c.free's order).
+sim::EffectOptions EffectAt(const TwinCandidate& c, const Eigen::VectorXd& theta);
+
+// Runs the twin of patched scenarios (the base with one more effect each), in parallel, and returns the whitened
+// training residuals of each (layout's entries; NaN where the twin has no sample).
+class TwinEvaluator {
+ public:
+  TwinEvaluator(const sim::Scenario& base, const recording::Recording& real, const TwinRunner& runner,
+                const Layout& layout, int threads)
+      : base_(base), real_(real), runner_(runner), layout_(layout), threads_(threads) {}
+  std::vector<Result<Eigen::VectorXd>> Run(const std::vector<sim::EffectOptions>& extra);
+  int runs() const { return runs_; }
+  const Layout& layout() const { return layout_; }
+
+ private:
+  const sim::Scenario& base_;
+  const recording::Recording& real_;
+  const TwinRunner& runner_;
+  const Layout& layout_;
+  int threads_;
+  int runs_ = 0;
+};
+
+struct CandidateOutcome {
+  Eigen::VectorXd theta;       // fitted (time shifts: the parabola's vertex, sub-step)
+  Eigen::MatrixXd covariance;  // of theta
+  sim::EffectOptions effect;   // as applied (time shifts in whole steps)
+  double chi2 = 0.0;           // training part, at `effect`
+  Eigen::VectorXd residuals;   // training part, at `effect`
+  int iterations = 0;
+};
+
+struct FitSettings {
+  int max_iterations = 8;
+  double physics_step_s = 0.001;
+  int threads = 2;
+  const TwinCovariance* covariance = nullptr;
+};
+
+// Fits `c` starting at its neutral values, whose residuals (the base twin's) are `base`.
+Result<CandidateOutcome> FitCandidate(const TwinCandidate& c, const Eigen::VectorXd& base, TwinEvaluator* evaluator,
+                                      const FitSettings& settings);
+
+// The score test's chi-square drop: the Gauss-Newton step's predicted decrease from the neutral values, g^T H^+ g
+// with the Jacobian there (a time shift: by one step from zero); ~ chi2(k) when the candidate is absent.
+Result<double> PredictedDrop(const TwinCandidate& c, const Eigen::VectorXd& base, TwinEvaluator* evaluator,
+                             const FitSettings& settings);
+
+// Runs fn(0..n-1) on up to `threads` threads.
+void ParallelFor(int n, int threads, const std::function<void(int)>& fn);
+
+}  // namespace roamlab::gap::internal

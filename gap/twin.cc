@@ -1,0 +1,315 @@
+#include "gap/twin.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <set>
+
+#include "common/chi_square.h"
+#include "eval/velocity.h"
+#include "gap/internal/decide.h"
+#include "gap/internal/twin_fit.h"
+#include "gap/internal/twin_residuals.h"
+#include "recording/wheel_kinematics.h"
+#include "sim/simulator.h"
+
+namespace roamlab::gap {
+namespace {
+
+using internal::Layout;
+using internal::TwinCandidate;
+
+// Locate's inconsistency ratio, against the stated noise.
+constexpr double kInconsistencyRatio = 1.3;
+
+// The whitened residuals as Locate takes them: one per series and sample (finite entries only).
+std::vector<estimator::MeasurementResidual> MeasurementResiduals(const Layout& layout, const Eigen::VectorXd& w) {
+  std::vector<estimator::MeasurementResidual> out;
+  for (const internal::Series& s : layout.series) {
+    const int n = s.components();
+    for (std::size_t i = 0; i < s.rows.size(); ++i) {
+      const Eigen::VectorXd r = w.segment(s.offset + static_cast<Eigen::Index>(i) * n, n);
+      if (r.allFinite()) out.push_back({s.name, s.t[i], r, true});
+    }
+  }
+  return out;
+}
+
+// The motion conditions from the real recording's own streams: a pose stream's poses, else the wheel encoders' dead
+// reckoning (nominal geometry), else none.
+Conditions RealConditions(const recording::Recording& real) {
+  Trajectory poses;
+  for (const recording::Stream& s : real.streams) {
+    if (s.info.type != recording::StreamType::kPose || s.values.cols() < 7 || s.t.size() < 3) continue;
+    for (std::size_t i = 0; i < s.t.size(); ++i) {
+      const auto v = s.values.row(static_cast<Eigen::Index>(i));
+      poses.push_back({s.t[i], Eigen::Vector3d(v[0], v[1], v[2]), Eigen::Quaterniond(v[6], v[3], v[4], v[5])});
+      poses.back().q_world_body.normalize();
+    }
+    break;
+  }
+  if (poses.empty() && recording::IsWheeledPlatform(real.platform.kind)) {
+    auto odometry = eval::EncoderOnlyOdometry(real);
+    if (odometry.ok()) poses = odometry.value().dead_reckoning;
+  }
+  if (poses.size() < 3) return {};
+  return ComputeConditions(poses, real);
+}
+
+std::map<std::string, double> Values(const TwinCandidate& c, const Eigen::VectorXd& theta) {
+  std::map<std::string, double> out = c.fixed;
+  for (std::size_t j = 0; j < c.free.size(); ++j) out[c.free[j].name] = theta[static_cast<Eigen::Index>(j)];
+  return out;
+}
+
+// What one round judges the candidates against: the effects kept so far.
+struct State {
+  sim::Scenario train, full;  // nominal + kept effects; over the training part, over the whole recording
+  Eigen::VectorXd residuals;  // training part
+  double chi2 = 0.0;
+  TwinComparison heldout;
+  recording::Recording twin;  // the whole recording's twin
+};
+
+class Diagnoser {
+ public:
+  Diagnoser(const sim::Scenario& nominal, const recording::Recording& real, const TwinRunner& runner,
+            const TwinDiagnoseOptions& options)
+      : nominal_(nominal), real_(real), runner_(runner), options_(options) {}
+  Result<TwinDiagnosis> Run();
+
+ private:
+  void Progress(const std::string& what) const {
+    if (options_.progress) options_.progress(what);
+  }
+  Status Span();
+  Result<recording::Recording> RunFull(const sim::Scenario& s) {
+    ++runs_;
+    return runner_(s);
+  }
+  // screen: fitted only when the score test (PredictedDrop) passes alpha.
+  Result<TwinEffect> Fit(const TwinCandidate& c, const State& state, double step_s, bool screen);
+  Result<bool> Round(int round, const std::vector<TwinCandidate>& pool, double step_s, State* state,
+                     std::vector<TwinEffect>* scored);
+  void Finish(const State& state);
+
+  const sim::Scenario& nominal_;
+  const recording::Recording& real_;
+  const TwinRunner& runner_;
+  const TwinDiagnoseOptions& options_;
+  TwinDiagnosis out_;
+  Time first_, last_, train_end_;
+  Layout train_layout_;
+  int measurements_ = 0;
+  int runs_ = 0;
+};
+
+Status Diagnoser::Span() {
+  first_ = Time::FromNanoseconds(std::numeric_limits<std::int64_t>::max());
+  last_ = Time::FromNanoseconds(std::numeric_limits<std::int64_t>::min());
+  for (const recording::Stream& s : real_.streams) {
+    if (s.t.empty()) continue;
+    first_ = std::min(first_, s.t.front());
+    last_ = std::max(last_, s.t.back());
+  }
+  if (last_ <= first_) return Status::Error("the recording has no span of samples to compare");
+  if (!(options_.train_fraction > 0.0 && options_.train_fraction < 1.0))
+    return Status::Error("the training fraction must be in (0, 1)");
+  train_end_ = Time::FromSeconds(first_.seconds() + options_.train_fraction * SecondsBetween(first_, last_));
+  out_.train_end_s = train_end_.seconds();
+  train_layout_ = internal::MakeLayout(real_, first_, train_end_);
+  if (train_layout_.size == 0) return Status::Error("the recording has no stream with a stated noise to compare");
+  return Status::Ok();
+}
+
+Result<TwinEffect> Diagnoser::Fit(const TwinCandidate& c, const State& state, double step_s, bool screen) {
+  internal::TwinEvaluator evaluator(state.train, real_, runner_, train_layout_, options_.threads);
+  internal::FitSettings settings;
+  settings.max_iterations = options_.max_iterations;
+  settings.physics_step_s = step_s;
+  settings.threads = options_.threads;
+  settings.covariance = &options_.covariance;
+  if (screen) {
+    auto drop = internal::PredictedDrop(c, state.residuals, &evaluator, settings);
+    runs_ += evaluator.runs();
+    if (!drop.ok()) return drop.status();
+    if (!(1.0 - ChiSquareCdf(drop.value(), static_cast<double>(c.free.size())) < options_.alpha)) {
+      TwinEffect e;
+      e.runs = evaluator.runs();
+      e.chi2_before = e.chi2_after = state.chi2;
+      e.estimate.name = c.label;
+      e.estimate.dof = static_cast<int>(c.free.size());
+      e.estimate.lr_raw = drop.value();
+      internal::Score(nullptr, measurements_, &e.estimate);
+      e.estimate.decision = "not significant by the score test (not fitted)";
+      return e;
+    }
+  }
+  auto fit = internal::FitCandidate(c, state.residuals, &evaluator, settings);
+  runs_ += evaluator.runs();
+  if (!fit.ok()) return fit.status();
+  TwinEffect e;
+  e.effect = fit.value().effect;
+  e.chi2_before = state.chi2;
+  e.chi2_after = fit.value().chi2;
+  e.iterations = fit.value().iterations;
+  e.runs = evaluator.runs();
+  e.estimate.name = c.label;
+  e.estimate.dof = static_cast<int>(c.free.size());
+  e.estimate.parameters = Values(c, fit.value().theta);
+  for (std::size_t j = 0; j < c.free.size(); ++j) {
+    const Eigen::Index k = static_cast<Eigen::Index>(j);
+    e.estimate.std[c.free[j].name] = std::sqrt(std::max(0.0, fit.value().covariance(k, k)));
+  }
+  e.estimate.lr_raw = state.chi2 - fit.value().chi2;
+  internal::Score(nullptr, measurements_, &e.estimate);
+  return e;
+}
+
+// Fits the pool on top of `state`, scores them and keeps the first that passes (its held-out run becomes the new
+// state). A candidate whose twin fails is dropped with the reason. Returns whether one was kept.
+Result<bool> Diagnoser::Round(int round, const std::vector<TwinCandidate>& pool, double step_s, State* state,
+                              std::vector<TwinEffect>* scored) {
+  for (const TwinCandidate& c : pool) {
+    Progress("round " + std::to_string(round + 1) + ": fitting " + c.label);
+    auto e = Fit(c, *state, step_s, round > 0);
+    if (e.ok()) {
+      scored->push_back(std::move(e).value());
+      continue;
+    }
+    // A twin that fails with the candidate (a parameter that throws the robot off the terrain) drops the candidate.
+    TwinEffect failed;
+    failed.estimate.name = c.label;
+    failed.estimate.dof = static_cast<int>(c.free.size());
+    failed.estimate.delta_bic = std::numeric_limits<double>::infinity();
+    failed.estimate.decision = "not fitted: " + e.status().message();
+    scored->push_back(failed);
+  }
+  std::sort(scored->begin(), scored->end(),
+            [](const TwinEffect& a, const TwinEffect& b) { return a.estimate.delta_bic < b.estimate.delta_bic; });
+  for (TwinEffect& e : *scored) {
+    EffectEstimate& x = e.estimate;
+    if (!(x.lr_pvalue < options_.alpha) || !(x.delta_bic < options_.max_delta_bic)) {
+      if (!x.decision.empty()) continue;
+      x.decision = x.lr_pvalue < options_.alpha ? "Delta BIC not below the threshold" : "p not below alpha";
+      continue;
+    }
+    sim::Scenario full = state->full;
+    full.effects.push_back(e.effect);
+    auto twin = RunFull(full);
+    if (!twin.ok()) {
+      x.decision = "the patched twin of the whole recording failed: " + twin.status().message();
+      continue;
+    }
+    TwinComparison heldout = CompareTwin(real_, twin.value(), train_end_.seconds(), last_.seconds(), options_.drift);
+    x.evaluated_heldout = true;
+    x.heldout_improvement = state->heldout.chi2 > 0.0 ? 1.0 - heldout.chi2 / state->heldout.chi2 : 0.0;
+    if (!(x.heldout_improvement > options_.min_heldout_improvement)) {
+      x.decision = "the held-out chi-square does not drop";
+      continue;
+    }
+    x.accepted = true;
+    x.decision = "accepted";
+    state->train.effects.push_back(e.effect);
+    state->full = full;
+    state->chi2 = e.chi2_after;
+    state->heldout = std::move(heldout);
+    state->twin = std::move(twin).value();
+    state->residuals = internal::WhitenedResiduals(train_layout_, real_, state->twin);
+    out_.effects.push_back(e);
+    for (TwinEffect& other : *scored) {
+      EffectEstimate& y = other.estimate;
+      if (!y.decision.empty()) continue;
+      y.decision = !(y.lr_pvalue < options_.alpha)           ? "p not below alpha"
+                   : !(y.delta_bic < options_.max_delta_bic) ? "Delta BIC not below the threshold"
+                                                             : "not tried: a candidate before it was kept";
+    }
+    return true;
+  }
+  return false;
+}
+
+// The held-out figures with the patch, the unexplained components and the verdict.
+void Diagnoser::Finish(const State& state) {
+  out_.heldout_after = state.heldout;
+  for (const TwinEffect& e : out_.effects) out_.patch.push_back(e.effect);
+  const Layout heldout = internal::MakeLayout(real_, train_end_, last_);
+  const auto statistics =
+      ComponentStatistics(MeasurementResiduals(heldout, internal::WhitenedResiduals(heldout, real_, state.twin)));
+  for (const auto& [key, level] : statistics)
+    if (Inconsistent(level, 1.0, kInconsistencyRatio)) out_.unexplained.push_back(key);
+  const bool inconsistent =
+      std::any_of(out_.located.begin(), out_.located.end(), [](const LocatedComponent& c) { return c.inconsistent; });
+  out_.verdict = !out_.effects.empty() ? "named" : inconsistent ? "unknown" : "none";
+}
+
+Result<TwinDiagnosis> Diagnoser::Run() {
+  const auto start = std::chrono::steady_clock::now();
+  if (Status s = Span(); !s.ok()) return s;
+  out_.replayed = options_.replayed;
+  out_.covariance_method = options_.covariance.method;
+  State state;
+  state.full = nominal_;
+  state.full.effects.clear();
+  state.full.duration_s = std::max(last_.seconds(), 1.0);
+  state.train = state.full;
+  state.train.duration_s = std::min(state.full.duration_s, train_end_.seconds() + 0.05);
+  auto simulator = sim::Simulator::Create(state.full, {});
+  if (!simulator.ok()) return Status::Error("the nominal scenario: " + simulator.status().message());
+  const double step_s = simulator.value()->PhysicsStepS();
+
+  Progress("nominal twin");
+  auto twin = RunFull(state.full);
+  if (!twin.ok()) return Status::Error("the nominal twin: " + twin.status().message());
+  state.twin = std::move(twin).value();
+  out_.whole_run = CompareTwin(real_, state.twin, first_.seconds(), last_.seconds(), options_.drift);
+  state.heldout = CompareTwin(real_, state.twin, train_end_.seconds(), last_.seconds(), options_.drift);
+  out_.heldout_before = state.heldout;
+  const Layout whole = internal::MakeLayout(real_, first_, last_);
+  out_.located = Locate(MeasurementResiduals(whole, internal::WhitenedResiduals(whole, real_, state.twin)),
+                        RealConditions(real_), {});
+  state.residuals = internal::WhitenedResiduals(train_layout_, real_, state.twin);
+  state.chi2 = internal::SumOfSquares(state.residuals, &measurements_);
+
+  std::vector<TwinCandidate> pool;
+  for (const TwinCandidate& c : internal::TwinCandidates(nominal_, options_.max_shift_s))
+    if (options_.candidates.empty() ||
+        std::find(options_.candidates.begin(), options_.candidates.end(), c.label) != options_.candidates.end())
+      pool.push_back(c);
+  for (int round = 0; round < options_.max_effects && !pool.empty(); ++round) {
+    std::vector<TwinEffect> scored;
+    auto kept = Round(round, pool, step_s, &state, &scored);
+    if (!kept.ok()) return kept.status();
+    if (round == 0) out_.candidates = scored;
+    if (!kept.value()) break;
+    // The next round: the candidates that passed the likelihood-ratio test in the first, other than the kept effects.
+    std::set<std::string> passed, kept_effects;
+    for (const TwinEffect& e : out_.candidates)
+      if (e.estimate.lr_pvalue < options_.alpha) passed.insert(e.estimate.name);
+    for (const TwinEffect& e : out_.effects) kept_effects.insert(e.effect.name);
+    std::vector<TwinCandidate> next;
+    for (const TwinCandidate& c : pool)
+      if (passed.count(c.label) && !kept_effects.count(c.effect)) next.push_back(c);
+    pool = next;
+  }
+  Finish(state);
+  out_.runs = runs_;
+  out_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out_;
+}
+
+}  // namespace
+
+std::vector<std::string> TwinCandidateNames(const sim::Scenario& nominal) {
+  std::vector<std::string> out;
+  for (const TwinCandidate& c : internal::TwinCandidates(nominal, 0.5)) out.push_back(c.label);
+  return out;
+}
+
+Result<TwinDiagnosis> DiagnoseTwin(const sim::Scenario& nominal, const recording::Recording& real,
+                                   const TwinRunner& runner, const TwinDiagnoseOptions& options) {
+  return Diagnoser(nominal, real, runner, options).Run();
+}
+
+}  // namespace roamlab::gap

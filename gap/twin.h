@@ -1,0 +1,172 @@
+// The diagnosis of a recording against its MuJoCo twin: the nominal scenario run so that it follows the recording
+// (a TwinRunner: the replay of the recorded drive, or for a recording of the scenario's own drive the plain
+// simulation without noise), compared stream by stream with the real recording, and the simulator's own effects
+// (sim/scenario.h) fitted by running the twin again with them.
+//
+//   1. compare: per stream and component the residual real - twin matched by stamp and whitened by the recording's
+//      stated noise (gap/internal/twin_residuals.h); RMS per stream and component; for an absolute stream (gps,
+//      position, pose) the drift over fixed windows (TwinDrift);
+//   2. locate: Locate (gap/locate.h) on the nominal twin's whitened residuals of the whole run, against the stated
+//      noise (level 1), with the conditions computed from the real recording's own streams: the poses of a pose
+//      stream (motion capture) when there is one, else the wheel encoders' dead reckoning with the nominal geometry
+//      (eval/velocity.h), else none;
+//   3. fit: each candidate effect the scenario supports (TwinCandidateNames) is fitted on the training part (the
+//      first train_fraction of the recording) with the effects kept so far applied: Levenberg-Marquardt over its
+//      parameters on cost = the sum of squared whitened residuals, the Jacobian by finite differences of perturbed
+//      twin runs executed in parallel (central when 2k runs fit in the threads, else forward). Time shifts
+//      (gps_latency latency_s, imu_time_offset offset_s) are whole physics steps in the simulator: a 1-D search on
+//      the step grid, coarse to fine, then a parabola through the best step and its neighbours for the value.
+//      The parameters' covariance comes from the residuals' Jacobian at the fit (TwinFitRows) through
+//      TwinDiagnoseOptions::covariance: by default WhiteNoiseCovariance, the Gauss-Newton curvature (J^T J)^-1,
+//      which assumes independent residuals and understates the spread of autocorrelated ones (real recordings);
+//   4. name: each candidate is scored by its chi-square drop LR on the training part (~ chi2(k) under "no effect"),
+//      p = 1 - F_chi2(k)(LR) and Delta BIC = -LR + k ln n (gap/internal/decide.h, Score); in order of Delta BIC the
+//      first with p < alpha, Delta BIC < max_delta_bic and a held-out chi-square drop (the twin run over the whole
+//      recording, compared on the rest) above min_heldout_improvement is kept (a candidate whose twin fails is dropped
+//      with the reason); then the candidates that passed p in the first round are tried again on top of the kept
+//      ones, each fitted only when a score test passes alpha (internal/twin_fit.h PredictedDrop: the Gauss-Newton
+//      step's predicted drop from its neutral values, one Jacobian), up to max_effects;
+//   5. show: on the held-out part, the nominal twin's and the patched twin's residual RMS per stream and drift.
+// Verdict: "named" (some effect kept), "unknown" (no effect kept, and some component inconsistent with the stated
+// noise), "none". `unexplained` lists the components still inconsistent on the held-out part with the patch.
+// The runner must be thread-safe (a Simulator of its own per call); it may stop the twin at the patched scenario's
+// duration_s (the fit's runs cover the training part only). The diagnosis never reads truth.yaml.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include "common/status.h"
+#include "gap/diagnose.h"
+#include "gap/locate.h"
+#include "gap/resimulate.h"
+#include "recording/recording.h"
+#include "sim/scenario.h"
+
+namespace roamlab::gap {
+
+// The twin of `real` for a patched scenario (the nominal one with effects): the same streams at the same stamps.
+using TwinRunner = std::function<Result<recording::Recording>(const sim::Scenario& patched)>;
+
+// Runs `patched` without noise with sim::Simulate: the twin of a recording of the scenario's own drive.
+TwinRunner PlainSimulationRunner();
+
+// Whether `twin` follows the drive of `real`: for each wheel stream in both (wheel_encoders, steering), the change of
+// every column over consecutive kDriveWindowS windows of their common stamps, real against twin: relative RMS
+// difference ||d_real - d_twin|| / ||d_real|| below kMaxDriveMismatch. Empty when it does; otherwise why not (the
+// stream and the relative difference, or that no wheel stream can tell). The plain simulation is the twin only of a
+// recording of the scenario's own drive: a hidden effect changes the wheels' motion by little (they are servoed to
+// the same set-points), another drive by a good part of its size.
+inline constexpr double kDriveWindowS = 1.0;
+inline constexpr double kMaxDriveMismatch = 0.05;
+std::string DriveMismatch(const recording::Recording& real, const recording::Recording& twin);
+
+// An absolute stream's drift over fixed windows: the twin's pose aligned to the real one at each window's start and
+// the error at its end. A pose stream aligns exactly at the start sample (position and heading error); a gps or
+// position stream by the planar rigid transform (yaw about the vertical and translation) that best fits the first
+// align_s of the window, or by translation alone when the real track moves less than 0.1 m there (position error
+// only; heading_measured false).
+struct TwinDrift {
+  std::string stream;
+  double window_s = 0.0;
+  int windows = 0;
+  double mean_position_m = 0.0, max_position_m = 0.0;
+  bool heading_measured = false;
+  double mean_heading_rad = 0.0, max_heading_rad = 0.0;
+};
+
+struct DriftOptions {
+  double window_s = 10.0;
+  double stride_s = 1.0;  // windows start every stride_s
+  double align_s = 2.0;   // position-only streams: the span the alignment fits
+};
+
+// The twin against the real recording over [from_s, to_s].
+struct TwinComparison {
+  double from_s = 0.0, to_s = 0.0;
+  std::map<std::string, SimulatedStreamFit> streams;  // an imu as "gyroscope" and "accelerometer"
+  std::map<std::string, TwinDrift> drift;             // absolute streams with a window inside the span
+  std::vector<std::string> left_out;                  // "stream: reason"
+  double chi2 = 0.0;                                  // sum of squared whitened residuals
+  int residuals = 0;                                  // scalar residuals compared
+};
+TwinComparison CompareTwin(const recording::Recording& real, const recording::Recording& twin, double from_s,
+                           double to_s, const DriftOptions& drift = {});
+
+// The rows of a fit at its solution: the whitened residuals (finite entries only) and their derivatives by the
+// parameters (one column each, in the fitted units), with each row's stamp and series (stream name): what a
+// covariance that accounts for autocorrelation needs (effective sample size, block bootstrap over time).
+struct TwinFitRows {
+  Eigen::MatrixXd jacobian;
+  Eigen::VectorXd residuals;
+  std::vector<Time> t;
+  std::vector<std::string> series;
+};
+// The parameters' covariance from the rows, and the name of the method (written with the results).
+struct TwinCovariance {
+  std::string method;
+  std::function<Eigen::MatrixXd(const TwinFitRows&)> compute;
+};
+// (J^T J)^-1, pseudo-inverse over the directions the rows see: independent unit-variance residuals.
+Eigen::MatrixXd WhiteNoiseCovariance(const TwinFitRows& rows);
+TwinCovariance WhiteNoiseCovarianceMethod();
+
+struct TwinEffect {
+  EffectEstimate estimate;    // name (the candidate's label), dof, parameters, std, lr, p, Delta BIC, held-out drop
+  sim::EffectOptions effect;  // as the simulator applies it (time shifts in whole physics steps)
+  double chi2_before = 0.0;   // training part: with the effects kept before it
+  double chi2_after = 0.0;    // with it
+  int iterations = 0;
+  int runs = 0;  // twin runs spent on the fit
+};
+
+struct TwinDiagnosis {
+  std::string verdict;  // named | unknown | none
+  bool replayed = false;
+  std::string covariance_method;
+  double train_end_s = 0.0;
+  std::vector<LocatedComponent> located;  // the nominal twin, whole run
+  std::vector<TwinEffect> candidates;     // the first round, best Delta BIC first
+  std::vector<TwinEffect> effects;        // kept, in order
+  std::vector<std::string> unexplained;   // "stream/component" inconsistent on the held-out part with the patch
+  TwinComparison whole_run;               // the nominal twin
+  TwinComparison heldout_before, heldout_after;
+  std::vector<sim::EffectOptions> patch;  // the kept effects as the simulator takes them
+  int runs = 0;
+  double seconds = 0.0;
+};
+
+struct TwinDiagnoseOptions {
+  double train_fraction = 2.0 / 3.0;
+  double alpha = 1e-3;
+  double max_delta_bic = 0.0;
+  double min_heldout_improvement = 0.0;
+  int max_effects = 2;
+  double max_shift_s = 0.5;  // time-shift search range
+  int threads = 2;           // twin runs in parallel
+  int max_iterations = 8;    // Levenberg-Marquardt
+  bool replayed = false;     // the runner replays the recorded drive (written with the results)
+  DriftOptions drift;
+  TwinCovariance covariance = WhiteNoiseCovarianceMethod();
+  std::vector<std::string> candidates;  // empty: every one the scenario supports
+  std::function<void(const std::string&)> progress;
+};
+
+// The candidate effects of the twin: labels (an effect name, with the wheel for axle_misalignment: "axle_misalignment
+// wheel 1") that `nominal` supports.
+std::vector<std::string> TwinCandidateNames(const sim::Scenario& nominal);
+
+// Errors: the nominal twin fails, or the recording has nothing to compare.
+Result<TwinDiagnosis> DiagnoseTwin(const sim::Scenario& nominal, const recording::Recording& real,
+                                   const TwinRunner& runner, const TwinDiagnoseOptions& options = {});
+
+// {"replayed", "verdict", "covariance", "train_end_s", "located", "candidates", "effects", "unexplained",
+// "heldout": {"before", "after"}, "whole_run", "patch", "runs", "seconds"}: gap.json's "simulation" section.
+nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d);
+
+}  // namespace roamlab::gap

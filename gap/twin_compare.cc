@@ -1,0 +1,203 @@
+// The twin against the real recording (gap/twin.h): residual statistics, drift over windows, the white-noise
+// covariance and the plain-simulation runner.
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include <Eigen/Geometry>
+
+#include "estimator/models/enu.h"
+#include "gap/internal/twin_residuals.h"
+#include "gap/twin.h"
+#include "sim/simulator.h"
+
+namespace roamlab::gap {
+namespace {
+
+using recording::Stream;
+using recording::StreamType;
+
+// An absolute stream's samples matched by stamp in both recordings.
+struct Track {
+  std::vector<double> t_s;
+  std::vector<Eigen::Vector3d> real, twin;
+  std::vector<Eigen::Quaterniond> q_real, q_twin;  // pose streams only
+};
+
+Track Matched(const Stream& r, const Stream& s, Time from, Time to, const std::optional<recording::GeodeticOrigin>& o) {
+  Track track;
+  std::optional<estimator::EnuConverter> enu;
+  if (o) enu.emplace(*o);
+  const auto position = [&](const Stream& x, std::size_t row) {
+    const Eigen::Vector3d v = x.values.row(static_cast<Eigen::Index>(row)).head(3).transpose();
+    return x.info.type == StreamType::kGps ? Eigen::Vector3d(enu->ToEnu(v[0], v[1], v[2])) : v;
+  };
+  const auto attitude = [](const Stream& x, std::size_t row) {
+    const auto v = x.values.row(static_cast<Eigen::Index>(row));
+    return Eigen::Quaterniond(v[6], v[3], v[4], v[5]).normalized();
+  };
+  const bool pose = r.info.type == StreamType::kPose;
+  std::size_t j = 0;
+  for (std::size_t i = 0; i < r.t.size(); ++i) {
+    if (r.t[i] < from || to < r.t[i]) continue;
+    while (j < s.t.size() && s.t[j] < r.t[i]) ++j;
+    if (j == s.t.size()) break;
+    if (s.t[j] != r.t[i]) continue;
+    track.t_s.push_back(r.t[i].seconds());
+    track.real.push_back(position(r, i));
+    track.twin.push_back(position(s, j));
+    if (pose) {
+      track.q_real.push_back(attitude(r, i));
+      track.q_twin.push_back(attitude(s, j));
+    }
+  }
+  return track;
+}
+
+double Yaw(const Eigen::Quaterniond& q) {
+  const Eigen::Vector3d x = q * Eigen::Vector3d::UnitX();
+  return std::atan2(x.y(), x.x());
+}
+
+// The planar rigid transform (yaw, then translation) of twin positions onto real ones over samples [a, b], or the
+// translation at `a` alone when the real track moves less than 0.1 m there.
+std::pair<Eigen::Matrix3d, Eigen::Vector3d> PlanarAlignment(const Track& k, std::size_t a, std::size_t b) {
+  Eigen::Vector3d cr = Eigen::Vector3d::Zero(), ct = Eigen::Vector3d::Zero();
+  for (std::size_t i = a; i <= b; ++i) {
+    cr += k.real[i];
+    ct += k.twin[i];
+  }
+  cr /= static_cast<double>(b - a + 1);
+  ct /= static_cast<double>(b - a + 1);
+  double extent = 0.0, sxx = 0.0, sxy = 0.0;
+  for (std::size_t i = a; i <= b; ++i) {
+    const Eigen::Vector2d r = (k.real[i] - cr).head<2>(), t = (k.twin[i] - ct).head<2>();
+    extent = std::max(extent, r.norm());
+    sxx += t.dot(r);
+    sxy += t.x() * r.y() - t.y() * r.x();
+  }
+  if (extent < 0.1) return {Eigen::Matrix3d::Identity(), k.real[a] - k.twin[a]};
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(std::atan2(sxy, sxx), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return {R, cr - R * ct};
+}
+
+std::optional<TwinDrift> Drift(const Stream& r, const Stream& s, Time from, Time to,
+                               const std::optional<recording::GeodeticOrigin>& origin, const DriftOptions& options) {
+  const Track k = Matched(r, s, from, to, origin);
+  TwinDrift d;
+  d.stream = r.info.name;
+  d.window_s = options.window_s;
+  d.heading_measured = r.info.type == StreamType::kPose;
+  if (k.t_s.size() < 2 || options.window_s <= 0.0 || options.stride_s <= 0.0) return std::nullopt;
+  std::size_t a = 0;
+  for (double w0 = k.t_s.front(); w0 + options.window_s <= k.t_s.back() + 1e-9; w0 += options.stride_s) {
+    while (a < k.t_s.size() && k.t_s[a] < w0) ++a;
+    std::size_t b = a;
+    while (b + 1 < k.t_s.size() && k.t_s[b + 1] <= w0 + options.window_s + 1e-9) ++b;
+    if (b <= a || k.t_s[b] - k.t_s[a] < 0.9 * options.window_s) continue;
+    double position = 0.0, heading = 0.0;
+    if (d.heading_measured) {
+      const Eigen::Quaterniond R = k.q_real[a] * k.q_twin[a].conjugate();
+      position = (R * (k.twin[b] - k.twin[a]) + k.real[a] - k.real[b]).norm();
+      heading = std::abs(std::remainder(Yaw(R * k.q_twin[b]) - Yaw(k.q_real[b]), 2.0 * M_PI));
+    } else {
+      std::size_t e = a;
+      while (e + 1 < b && k.t_s[e + 1] <= k.t_s[a] + options.align_s) ++e;
+      const auto [R, p] = PlanarAlignment(k, a, e);
+      position = (R * k.twin[b] + p - k.real[b]).norm();
+    }
+    ++d.windows;
+    d.mean_position_m += position;
+    d.max_position_m = std::max(d.max_position_m, position);
+    d.mean_heading_rad += heading;
+    d.max_heading_rad = std::max(d.max_heading_rad, heading);
+  }
+  if (d.windows == 0) return std::nullopt;
+  d.mean_position_m /= d.windows;
+  d.mean_heading_rad /= d.windows;
+  return d;
+}
+
+}  // namespace
+
+TwinComparison CompareTwin(const recording::Recording& real, const recording::Recording& twin, double from_s,
+                           double to_s, const DriftOptions& drift) {
+  TwinComparison out;
+  out.from_s = from_s;
+  out.to_s = to_s;
+  const Time from = Time::FromSeconds(from_s), to = Time::FromSeconds(to_s);
+  const internal::Layout layout = internal::MakeLayout(real, from, to);
+  std::vector<std::string> missing;
+  const Eigen::VectorXd whitened = internal::WhitenedResiduals(layout, real, twin, &missing);
+  out.streams = internal::SeriesFits(layout, whitened);
+  out.chi2 = internal::SumOfSquares(whitened, &out.residuals);
+  out.left_out = layout.left_out;
+  out.left_out.insert(out.left_out.end(), missing.begin(), missing.end());
+  for (const Stream& r : real.streams) {
+    const bool absolute =
+        r.info.type == StreamType::kPose || r.info.type == StreamType::kPosition || r.info.type == StreamType::kGps;
+    const Stream* s = twin.Find(r.info.name);
+    if (!absolute || !s || s->info.type != r.info.type || r.values.cols() < (r.info.type == StreamType::kPose ? 7 : 3))
+      continue;
+    if (r.info.type == StreamType::kGps && !real.origin) continue;
+    if (auto d = Drift(r, *s, from, to, real.origin, drift)) out.drift[r.info.name] = *d;
+  }
+  return out;
+}
+
+std::string DriveMismatch(const recording::Recording& real, const recording::Recording& twin) {
+  bool compared = false;
+  for (const Stream& r : real.streams) {
+    if (r.info.type != StreamType::kWheelEncoders && r.info.type != StreamType::kSteering) continue;
+    const Stream* s = twin.Find(r.info.name);
+    if (!s || s->info.type != r.info.type || s->values.cols() != r.values.cols() || r.t.empty()) continue;
+    // The changes over consecutive kDriveWindowS windows of the samples both have.
+    double difference = 0.0, size = 0.0;
+    std::optional<std::pair<std::size_t, std::size_t>> start;
+    std::size_t j = 0;
+    for (std::size_t i = 0; i < r.t.size(); ++i) {
+      while (j < s->t.size() && s->t[j] < r.t[i]) ++j;
+      if (j == s->t.size()) break;
+      if (s->t[j] != r.t[i]) continue;
+      if (start && SecondsBetween(r.t[start->first], r.t[i]) < kDriveWindowS) continue;
+      if (start) {
+        const auto change = [](const Stream& x, std::size_t from, std::size_t to) -> Eigen::VectorXd {
+          return (x.values.row(static_cast<Eigen::Index>(to)) - x.values.row(static_cast<Eigen::Index>(from)))
+              .transpose();
+        };
+        const Eigen::VectorXd dr = change(r, start->first, i), ds = change(*s, start->second, j);
+        difference += (dr - ds).squaredNorm();
+        size += dr.squaredNorm();
+      }
+      start = {i, j};
+    }
+    if (!(size > 0.0)) continue;
+    compared = true;
+    const double relative = std::sqrt(difference / size);
+    if (!(relative < kMaxDriveMismatch))
+      return r.info.name + ": the twin's wheel motion differs from the recorded one by " + std::to_string(relative) +
+             " of its size";
+  }
+  return compared ? std::string() : "no wheel stream (wheel_encoders, steering) in both to compare the drive";
+}
+
+Eigen::MatrixXd WhiteNoiseCovariance(const TwinFitRows& rows) {
+  const Eigen::MatrixXd H = rows.jacobian.transpose() * rows.jacobian;
+  return H.completeOrthogonalDecomposition().pseudoInverse();
+}
+
+TwinCovariance WhiteNoiseCovarianceMethod() {
+  return {"white-noise Gauss-Newton curvature (J^T J)^-1: independent residuals assumed", WhiteNoiseCovariance};
+}
+
+TwinRunner PlainSimulationRunner() {
+  return [](const sim::Scenario& patched) -> Result<recording::Recording> {
+    sim::SimulateOptions options;
+    options.noise = false;
+    auto simulation = sim::Simulate(patched, options);
+    if (!simulation.ok()) return simulation.status();
+    return std::move(simulation.value().recording);
+  };
+}
+
+}  // namespace roamlab::gap

@@ -1,0 +1,100 @@
+// TwinDiagnosisJson (gap/twin.h).
+#include "common/json.h"
+#include "gap/twin.h"
+
+namespace roamlab::gap {
+namespace {
+
+nlohmann::json StreamsJson(const std::map<std::string, SimulatedStreamFit>& streams) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [name, f] : streams)
+    out[name] = {{"rms", Number(f.rms)},
+                 {"rms_1s", Number(f.rms_1s)},
+                 {"component_rms", NumberArray(f.component_rms)},
+                 {"samples", f.samples}};
+  return out;
+}
+
+nlohmann::json ComparisonJson(const TwinComparison& c) {
+  nlohmann::json drift = nlohmann::json::object();
+  for (const auto& [name, d] : c.drift) {
+    drift[name] = {{"window_s", d.window_s},
+                   {"windows", d.windows},
+                   {"mean_position_m", Number(d.mean_position_m)},
+                   {"max_position_m", Number(d.max_position_m)}};
+    if (d.heading_measured) {
+      drift[name]["mean_heading_rad"] = Number(d.mean_heading_rad);
+      drift[name]["max_heading_rad"] = Number(d.max_heading_rad);
+    }
+  }
+  return {{"from_s", c.from_s},
+          {"to_s", c.to_s},
+          {"chi2", Number(c.chi2)},
+          {"residuals", c.residuals},
+          {"streams", StreamsJson(c.streams)},
+          {"drift", drift},
+          {"left_out", c.left_out}};
+}
+
+nlohmann::json EffectJson(const TwinEffect& e) {
+  const EffectEstimate& x = e.estimate;
+  nlohmann::json parameters = nlohmann::json::object(), std = nlohmann::json::object(),
+                 applied = nlohmann::json::object();
+  for (const auto& [name, value] : x.parameters) parameters[name] = Number(value);
+  for (const auto& [name, value] : x.std) std[name] = Number(value);
+  for (const auto& [name, value] : e.effect.parameters) applied[name] = Number(value);
+  return {{"name", x.name},
+          {"effect", {{"name", e.effect.name}, {"parameters", applied}}},
+          {"dof", x.dof},
+          {"parameters", parameters},
+          {"std", std},
+          {"chi2_before", Number(e.chi2_before)},
+          {"chi2_after", Number(e.chi2_after)},
+          {"lr", Number(x.lr)},
+          {"p", Number(x.lr_pvalue)},
+          {"delta_bic", Number(x.delta_bic)},
+          {"heldout_improvement", x.evaluated_heldout ? Number(x.heldout_improvement) : nlohmann::json()},
+          {"accepted", x.accepted},
+          {"decision", x.decision},
+          {"iterations", e.iterations},
+          {"runs", e.runs}};
+}
+
+}  // namespace
+
+nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d) {
+  nlohmann::json located = nlohmann::json::array();
+  for (const LocatedComponent& c : d.located) {
+    nlohmann::json intervals = nlohmann::json::array(), correlates = nlohmann::json::array();
+    for (const auto& [t0, t1] : c.intervals) intervals.push_back({t0, t1});
+    for (const Correlate& k : c.correlates)
+      correlates.push_back({{"condition", k.condition}, {"rho", Number(k.rho)}, {"lag_s", k.lag_s}});
+    located.push_back({{"stream", c.stream},
+                       {"component", c.component},
+                       {"count", c.count},
+                       {"chi2_per_dof", Number(c.chi2_per_dof)},
+                       {"inconsistent", c.inconsistent},
+                       {"intervals", intervals},
+                       {"correlates", correlates}});
+  }
+  nlohmann::json candidates = nlohmann::json::array(), effects = nlohmann::json::array(),
+                 patch = nlohmann::json::array();
+  for (const TwinEffect& e : d.candidates) candidates.push_back(EffectJson(e));
+  for (const TwinEffect& e : d.effects) effects.push_back(EffectJson(e));
+  for (const sim::EffectOptions& e : d.patch) patch.push_back({{"name", e.name}, {"parameters", e.parameters}});
+  return {{"replayed", d.replayed},
+          {"verdict", d.verdict},
+          {"covariance", d.covariance_method},
+          {"train_end_s", d.train_end_s},
+          {"located", located},
+          {"candidates", candidates},
+          {"effects", effects},
+          {"unexplained", d.unexplained},
+          {"heldout", {{"before", ComparisonJson(d.heldout_before)}, {"after", ComparisonJson(d.heldout_after)}}},
+          {"whole_run", ComparisonJson(d.whole_run)},
+          {"patch", patch},
+          {"runs", d.runs},
+          {"seconds", d.seconds}};
+}
+
+}  // namespace roamlab::gap

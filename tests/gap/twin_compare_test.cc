@@ -1,0 +1,95 @@
+// The twin against the real recording on constructed tracks (gap/twin.h, CompareTwin): the whitened residuals and the
+// drift over windows, which a rigid motion of the whole twin does not change and a velocity error grows linearly.
+#include <cmath>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <Eigen/Geometry>
+
+#include "gap/twin.h"
+
+namespace roamlab::gap {
+namespace {
+
+using recording::Stream;
+using recording::StreamType;
+
+constexpr double kRateHz = 10.0;
+constexpr double kDurationS = 30.0;
+
+// A pose (or position) stream along a circle of speed 1 m/s and yaw rate 0.2 rad/s, moved by `yaw` about the vertical
+// and `offset`, with `velocity_error_mps` added along x over time.
+Stream Track(StreamType type, double yaw, const Eigen::Vector3d& offset, double velocity_error_mps) {
+  Stream s;
+  s.info.name = "mocap";
+  s.info.type = type;
+  s.info.rate_hz = kRateHz;
+  s.info.columns = type == StreamType::kPose ? std::vector<std::string>{"x", "y", "z", "qx", "qy", "qz", "qw"}
+                                             : std::vector<std::string>{"x", "y", "z"};
+  s.info.noise = {{"sigma_m", 0.01}};
+  const int n = static_cast<int>(kDurationS * kRateHz) + 1;
+  s.values.resize(n, static_cast<Eigen::Index>(s.info.columns.size()));
+  const Eigen::AngleAxisd R(yaw, Eigen::Vector3d::UnitZ());
+  for (int i = 0; i < n; ++i) {
+    const double t = i / kRateHz;
+    s.t.push_back(Time::FromSeconds(t));
+    const double heading = 0.2 * t;
+    const Eigen::Vector3d p(5.0 * std::sin(heading) + velocity_error_mps * t, 5.0 * (1.0 - std::cos(heading)), 0.0);
+    s.values.row(i).head(3) = (R * p + offset).transpose();
+    if (type != StreamType::kPose) continue;
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(yaw + heading, Eigen::Vector3d::UnitZ()));
+    s.values.row(i).tail(4) << q.x(), q.y(), q.z(), q.w();
+  }
+  return s;
+}
+
+recording::Recording With(Stream s) {
+  recording::Recording r;
+  r.platform.kind = "differential_drive";
+  r.streams.push_back(std::move(s));
+  return r;
+}
+
+TEST(TwinCompareTest, ARigidlyMovedTwinHasNoDrift) {
+  for (const StreamType type : {StreamType::kPose, StreamType::kPosition}) {
+    const recording::Recording real = With(Track(type, 0.0, Eigen::Vector3d::Zero(), 0.0));
+    const recording::Recording twin = With(Track(type, 0.7, Eigen::Vector3d(3.0, -2.0, 0.5), 0.0));
+    const TwinComparison c = CompareTwin(real, twin, 0.0, kDurationS);
+    ASSERT_TRUE(c.drift.count("mocap"));
+    const TwinDrift& d = c.drift.at("mocap");
+    EXPECT_EQ(d.windows, 21);  // starts every second from 0 to 20 s
+    EXPECT_LT(d.max_position_m, 1e-9);
+    EXPECT_EQ(d.heading_measured, type == StreamType::kPose);
+    EXPECT_LT(d.max_heading_rad, 1e-9);
+    // The residuals are not aligned: the offset shows in the whitened RMS.
+    EXPECT_GT(c.streams.at("mocap").rms, 100.0);
+  }
+}
+
+TEST(TwinCompareTest, AVelocityErrorDriftsByItsSizeTimesTheWindow) {
+  const recording::Recording real = With(Track(StreamType::kPose, 0.0, Eigen::Vector3d::Zero(), 0.0));
+  const recording::Recording twin = With(Track(StreamType::kPose, 0.0, Eigen::Vector3d::Zero(), 0.01));
+  const TwinComparison c = CompareTwin(real, twin, 0.0, kDurationS);
+  const TwinDrift& d = c.drift.at("mocap");
+  EXPECT_NEAR(d.mean_position_m, 0.1, 1e-9);  // 0.01 m/s over 10 s, whatever the heading at the start
+  EXPECT_NEAR(d.max_position_m, 0.1, 1e-9);
+  EXPECT_LT(d.max_heading_rad, 1e-9);
+  // The residual grows as 0.01 t m in units of 0.01 m: RMS of t over [0, 30] s is 30 / sqrt(3), on x alone.
+  const SimulatedStreamFit& fit = c.streams.at("mocap");
+  EXPECT_NEAR(fit.component_rms[0], 30.0 / std::sqrt(3.0), 0.2);
+  EXPECT_LT(fit.component_rms[1], 1e-6);
+  EXPECT_EQ(fit.samples, 301);
+}
+
+TEST(TwinCompareTest, TheWhiteNoiseCovarianceIsTheInverseCurvature) {
+  TwinFitRows rows;
+  rows.jacobian = Eigen::MatrixXd::Zero(4, 2);
+  rows.jacobian.col(0) << 1, 1, 1, 1;  // four residuals see the first parameter with unit weight
+  rows.residuals = Eigen::VectorXd::Zero(4);
+  const Eigen::MatrixXd cov = WhiteNoiseCovariance(rows);
+  EXPECT_NEAR(cov(0, 0), 0.25, 1e-12);
+  EXPECT_NEAR(cov(1, 1), 0.0, 1e-12);  // unseen: no information, and no variance claimed either
+}
+
+}  // namespace
+}  // namespace roamlab::gap

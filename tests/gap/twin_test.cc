@@ -1,0 +1,145 @@
+// The diagnosis against the twin (gap/twin.h) on short seeded differential-drive cases: a "real" recording simulated
+// with noise and a hidden effect is diagnosed against the noise-free simulation of the nominal scenario (the twin of a
+// recording of the scenario's own drive). A GPS at 10 Hz with 5 mm noise stands in for motion capture.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "gap/twin.h"
+#include "sim/simulator.h"
+#include "tests/gap/gap_testing.h"
+
+namespace roamlab::gap {
+namespace {
+
+sim::Scenario Nominal() {
+  auto s = sim::LoadScenario(std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/indoor_diffdrive_gap.yaml");
+  EXPECT_TRUE(s.ok()) << s.status().message();
+  sim::Scenario scenario = s.value();
+  scenario.duration_s = 30.0;
+  sim::GpsOptions gps;
+  gps.rate_hz = 10.0;
+  gps.sigma_m = 0.005;
+  gps.lever_arm_m.setZero();
+  scenario.sensors.gps = gps;
+  return scenario;
+}
+
+// The nominal scenario with `hidden` simulated with noise seed `seed` and diagnosed against its twin.
+TwinDiagnosis Diagnosed(const std::vector<sim::EffectOptions>& hidden, std::uint64_t seed) {
+  sim::Scenario real = Nominal();
+  real.effects = hidden;
+  const recording::Recording recording = testing::SimulatedWithSeed(real, seed).recording;
+  const auto start = std::chrono::steady_clock::now();
+  auto d = DiagnoseTwin(Nominal(), recording, PlainSimulationRunner());
+  EXPECT_TRUE(d.ok()) << d.status().message();
+  if (!d.ok()) return {};
+  std::printf("diagnosed in %.1f s wall, %d twin runs; verdict %s\n",
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), d.value().runs,
+              d.value().verdict.c_str());
+  for (const TwinEffect& e : d.value().effects)
+    for (const auto& [name, value] : e.estimate.std)
+      std::printf("  %s %s = %.6g +- %.3g\n", e.estimate.name.c_str(), name.c_str(), e.estimate.parameters.at(name),
+                  value);
+  return d.value();
+}
+
+// The held-out 10 s drift of the gps track, before and after the patch.
+std::pair<double, double> HeldoutDrift(const TwinDiagnosis& d) {
+  EXPECT_TRUE(d.heldout_before.drift.count("gps") && d.heldout_after.drift.count("gps"));
+  if (!d.heldout_before.drift.count("gps") || !d.heldout_after.drift.count("gps")) return {0.0, 0.0};
+  const double before = d.heldout_before.drift.at("gps").mean_position_m;
+  const double after = d.heldout_after.drift.at("gps").mean_position_m;
+  std::printf("  held-out 10 s drift %.3f m -> %.3f m\n", before, after);
+  return {before, after};
+}
+
+// The first kept effect is `name`, with `parameter` within 3 of its standard deviations of `hidden`.
+void ExpectNamed(const TwinDiagnosis& d, const std::string& name, const std::string& parameter, double hidden) {
+  EXPECT_EQ(d.verdict, "named");
+  ASSERT_FALSE(d.effects.empty());
+  const EffectEstimate& e = d.effects.front().estimate;
+  EXPECT_EQ(e.name, name);
+  ASSERT_TRUE(e.parameters.count(parameter) && e.std.count(parameter)) << e.name;
+  EXPECT_GT(e.std.at(parameter), 0.0);
+  EXPECT_NEAR(e.parameters.at(parameter), hidden, 3.0 * e.std.at(parameter));
+}
+
+TEST(TwinTest, AHiddenWheelRadiusAsymmetryIsNamedAndTheHeldOutDriftShrinks) {
+  const TwinDiagnosis d = Diagnosed({{"wheel_radius_asymmetry", {{"ratio_right_left", 1.02}}}}, 11);
+  ExpectNamed(d, "wheel_radius_asymmetry", "ratio_right_left", 1.02);
+  const auto [before, after] = HeldoutDrift(d);
+  EXPECT_LT(after, 0.5 * before);
+  // The patched twin leaves the gyroscope at the stated noise: RMS^2 within 5 of chi2's relative deviations.
+  const SimulatedStreamFit& gyro = d.heldout_after.streams.at("gyroscope");
+  EXPECT_NEAR(gyro.rms * gyro.rms, 1.0, 5.0 * std::sqrt(2.0 / (3.0 * gyro.samples)));
+  const SimulatedStreamFit& nominal = d.heldout_before.streams.at("gyroscope");
+  EXPECT_GT(nominal.rms * nominal.rms, 1.0 + 5.0 * std::sqrt(2.0 / (3.0 * nominal.samples)));
+  EXPECT_TRUE(TwinDiagnosisJson(d).at("effects").size() == d.effects.size());
+  // Located: the gyroscope's yaw axis (the IMU is aligned with the body), with intervals and the motion it follows.
+  bool located = false;
+  for (const LocatedComponent& c : d.located) {
+    if (c.stream != "gyroscope" || c.component != 2) continue;
+    located = c.inconsistent && !c.intervals.empty() && !c.correlates.empty();
+    if (!c.correlates.empty())
+      std::printf("  gyroscope z located: chi2/dof %.2f, %zu intervals, follows %s (rho %.2f)\n", c.chi2_per_dof,
+                  c.intervals.size(), c.correlates[0].condition.c_str(), c.correlates[0].rho);
+  }
+  EXPECT_TRUE(located);
+}
+
+TEST(TwinTest, AHiddenTrackWidthErrorIsNamedAndTheHeldOutDriftShrinks) {
+  const TwinDiagnosis d = Diagnosed({{"track_width_error", {{"track_error_m", 0.02}}}}, 12);
+  ExpectNamed(d, "track_width_error", "track_error_m", 0.02);
+  const auto [before, after] = HeldoutDrift(d);
+  EXPECT_LT(after, 0.5 * before);
+}
+
+TEST(TwinTest, NoHiddenEffectNamesNone) {
+  const TwinDiagnosis d = Diagnosed({}, 13);
+  EXPECT_EQ(d.verdict, "none");
+  EXPECT_TRUE(d.effects.empty());
+  // Every candidate the diff drive with IMU and GPS supports was fitted and scored.
+  const std::vector<std::string> names = TwinCandidateNames(Nominal());
+  EXPECT_EQ(names.size(), 8u);  // wheel ratio, track, two axles, gyro scale and bias, IMU offset, GPS latency
+  ASSERT_EQ(d.candidates.size(), names.size());
+  for (const TwinEffect& e : d.candidates) {
+    EXPECT_NE(std::find(names.begin(), names.end(), e.estimate.name), names.end()) << e.estimate.name;
+    EXPECT_FALSE(e.estimate.decision.empty()) << e.estimate.name;
+  }
+  for (const LocatedComponent& c : d.located) EXPECT_FALSE(c.inconsistent) << c.stream << "/" << c.component;
+}
+
+TEST(TwinTest, AHiddenImuTimeOffsetIsRecoveredOnTheStepGrid) {
+  constexpr double kOffsetS = 0.03;  // 15 physics steps of models/diffdrive.xml
+  const TwinDiagnosis d = Diagnosed({{"imu_time_offset", {{"offset_s", kOffsetS}}}}, 14);
+  ASSERT_FALSE(d.effects.empty());
+  const EffectEstimate& e = d.effects.front().estimate;
+  EXPECT_EQ(e.name, "imu_time_offset");
+  ASSERT_TRUE(e.std.count("offset_s"));
+  EXPECT_NEAR(e.parameters.at("offset_s"), kOffsetS, std::max(0.002, 3.0 * e.std.at("offset_s")));
+  EXPECT_NEAR(d.effects.front().effect.parameters.at("offset_s"), kOffsetS, 1e-9);  // applied in whole steps
+}
+
+TEST(TwinTest, ThePlainSimulationIsTheTwinOfTheScenariosOwnDriveOnly) {
+  sim::Scenario nominal = Nominal();
+  const recording::Recording twin = PlainSimulationRunner()(nominal).value();
+  for (const sim::EffectOptions& hidden :
+       std::vector<sim::EffectOptions>{{"wheel_radius_asymmetry", {{"ratio_right_left", 1.05}}},
+                                       {"track_width_error", {{"track_error_m", 0.05}}}}) {
+    sim::Scenario real = Nominal();
+    real.effects = {hidden};
+    EXPECT_EQ(DriveMismatch(testing::SimulatedWithSeed(real, 21).recording, twin), "") << hidden.name;
+  }
+  sim::Scenario other = Nominal();
+  other.driver.angular_radps = sim::Profile::Constant(0.2);  // another drive: the same speeds, another turn rate
+  const std::string mismatch = DriveMismatch(testing::SimulatedWithSeed(other, 21).recording, twin);
+  EXPECT_NE(mismatch.find("wheel_encoders"), std::string::npos) << mismatch;
+}
+
+}  // namespace
+}  // namespace roamlab::gap
