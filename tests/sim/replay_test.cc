@@ -8,6 +8,10 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -393,53 +397,61 @@ TEST(ReplayTest, AtvFollowsItsRecordedSpeedAndSteering) {
   EXPECT_LT(e.max_position_m, 0.2 * schedule.max_position_m);
 }
 
-// models/diffdrive.xml with the OptiOdom differential drive's published wheels (diameter 0.084 m, axle track 0.2 m),
-// casters lowered to keep the chassis level: the nominal geometry the recording states.
-std::string OptiOdomLikeDiffDrive() {
-  std::string xml = testing::ReadText(testing::SourcePath("models/diffdrive.xml"));
-  const auto replace = [&xml](const std::string& from, const std::string& to) {
-    const std::size_t at = xml.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    if (at != std::string::npos) xml.replace(at, from.size(), to);
-  };
-  replace("<geom type=\"sphere\" size=\"0.075\"", "<geom type=\"sphere\" size=\"0.042\"");
-  replace("name=\"wheel_left\" pos=\"0 0.2 0\"", "name=\"wheel_left\" pos=\"0 0.1 0\"");
-  replace("name=\"wheel_right\" pos=\"0 -0.2 0\"", "name=\"wheel_right\" pos=\"0 -0.1 0\"");
-  replace("name=\"caster_front\" pos=\"0.2 0 -0.045\"", "name=\"caster_front\" pos=\"0.12 0 -0.012\"");
-  replace("name=\"caster_rear\" pos=\"-0.2 0 -0.045\"", "name=\"caster_rear\" pos=\"-0.12 0 -0.012\"");
-  return xml;
-}
+// The bound on the OptiOdom differential drive twin's mean 10 s drift against motion capture [m]: measured 1.0 to
+// 1.2 cm on the three runs below, where the twin of indoor_diffdrive_slip's model drifts 0.7 to 0.9 m.
+constexpr double kRealDiffTwinDriftM = 0.05;
 
-void ReportDrift(const Recording& real, const Scenario& nominal, const std::string& label) {
+struct Drift {
+  double end_m = 0.0, mean_10s_m = 0.0, max_10s_m = 0.0;
+};
+
+// The twin of `real` under `nominal` against the recorded motion capture: the end error and the 10 s drift.
+Drift ReportDrift(const Recording& real, const Scenario& nominal, const std::string& label) {
   const Simulation twin = ReplayOk(nominal, real);
   const Stream* mocap = real.Find("mocap");
   const Stream* replayed = twin.recording.Find("mocap");
-  ASSERT_NE(replayed, nullptr);
-  EXPECT_EQ(replayed->t, mocap->t);
+  EXPECT_NE(mocap, nullptr);
+  EXPECT_NE(replayed, nullptr);
+  if (mocap == nullptr || replayed == nullptr) return {};
+  EXPECT_EQ(replayed->t.front(), *std::lower_bound(mocap->t.begin(), mocap->t.end(), replayed->t.front()));
   const Eigen::Index last = replayed->values.rows() - 1;
-  const double end_error_m = (replayed->values.row(last).head<2>() - mocap->values.row(last).head<2>()).norm();
-  const auto [mean_10s, max_10s] = WindowDrift(*mocap, *replayed, 10.0);
-  std::printf(
-      "OptiOdom diff square run-01 (%.0f s), nominal %s: end error %.3f m; 10 s drift mean %.3f m, max "
-      "%.3f m; %.1fx real time\n",
-      SecondsBetween(mocap->t.front(), mocap->t.back()), label.c_str(), end_error_m, mean_10s, max_10s,
-      twin.stats.realtime_factor);
-  for (const std::string& why : twin.stats.left_out) std::printf("  left out: %s\n", why.c_str());
-  EXPECT_GT(twin.stats.realtime_factor, 0.0);
+  const auto offset = std::lower_bound(mocap->t.begin(), mocap->t.end(), replayed->t.front()) - mocap->t.begin();
+  Drift d;
+  d.end_m = (replayed->values.row(last).head<2>() - mocap->values.row(last + offset).head<2>()).norm();
+  std::tie(d.mean_10s_m, d.max_10s_m) = WindowDrift(*mocap, *replayed, 10.0);
+  std::printf("%s (%.0f s), nominal %s: end error %.3f m; 10 s drift mean %.3f m, max %.3f m; %.1fx real time\n",
+              label.c_str(), SecondsBetween(replayed->t.front(), replayed->t.back()), nominal.name.c_str(), d.end_m,
+              d.mean_10s_m, d.max_10s_m, twin.stats.realtime_factor);
+  return d;
 }
 
-TEST(ReplayTest, RealOptiOdomDiffRunAgainstMotionCapture) {
-  const std::string set = ::roamlab::testing::RealData("optiodom/data/diff/square/231220200029/231220200029");
-  const std::string run = set + "_run-01.csv";
-  if (!std::ifstream(run)) GTEST_SKIP() << "real data absent: " << run;
-  auto real = importers::ImportOptiOdom(run, set + "_metadata.csv");
-  ASSERT_TRUE(real.ok()) << real.status().message();
-  auto nominal = LoadScenario(testing::SourcePath("scenarios/indoor_diffdrive_slip.yaml"));
-  ASSERT_TRUE(nominal.ok());
-  ReportDrift(real.value(), nominal.value(), "indoor_diffdrive_slip (r 0.075 m, B 0.4 m)");
-  Scenario optiodom_like = nominal.value();
-  optiodom_like.robot.model_xml = OptiOdomLikeDiffDrive();
-  ReportDrift(real.value(), optiodom_like, "indoor_diffdrive_slip with the published wheels (r 0.042 m, B 0.2 m)");
+// The OptiOdom differential drive's twin (scenarios/real/optiodom_diff.yaml: its published wheels and encoders) follows
+// the motion capture of square, circular and Ivanjko-test runs far closer than a twin of another robot's nominal
+// model (indoor_diffdrive_slip: wheel radius 0.075 m, track 0.4 m, against 0.042 m and 0.2 m) driven by the same
+// encoder readings: its 10 s drift is the real robot's unmodelled slip and geometry error, a few centimetres.
+TEST(ReplayTest, RealOptiOdomDiffTwinFollowsMotionCapture) {
+  const std::vector<std::pair<std::string, std::string>> runs = {
+      {"optiodom/data/diff/square/231220200029/231220200029", "square"},
+      {"optiodom/data/diff/circular/231220200121/231220200121", "circular"},
+      {"optiodom/data/diff/ivanjko/231220200057/231220200057", "ivanjko"}};
+  auto real_model = LoadScenario(testing::SourcePath("scenarios/real/optiodom_diff.yaml"));
+  auto other_robot = LoadScenario(testing::SourcePath("scenarios/indoor_diffdrive_slip.yaml"));
+  ASSERT_TRUE(real_model.ok()) << real_model.status().message();
+  ASSERT_TRUE(other_robot.ok()) << other_robot.status().message();
+  int replayed = 0;
+  for (const auto& [set_path, label] : runs) {
+    const std::string set = ::roamlab::testing::RealData(set_path);
+    const std::string run = set + "_run-01.csv";
+    if (!std::ifstream(run)) continue;
+    auto real = importers::ImportOptiOdom(run, set + "_metadata.csv");
+    ASSERT_TRUE(real.ok()) << real.status().message();
+    const Drift own = ReportDrift(real.value(), real_model.value(), "OptiOdom diff " + label + " run-01");
+    const Drift other = ReportDrift(real.value(), other_robot.value(), "OptiOdom diff " + label + " run-01");
+    EXPECT_LT(own.mean_10s_m, kRealDiffTwinDriftM) << label;
+    EXPECT_LT(own.mean_10s_m, 0.1 * other.mean_10s_m) << label;
+    ++replayed;
+  }
+  if (replayed == 0) GTEST_SKIP() << "real data absent: " << ::roamlab::testing::RealData("optiodom/data/diff");
 }
 
 }  // namespace
