@@ -397,6 +397,37 @@ TEST(ReplayTest, AtvFollowsItsRecordedSpeedAndSteering) {
   EXPECT_LT(e.max_position_m, 0.2 * schedule.max_position_m);
 }
 
+// The scenario names and orders the encoder columns (optiodom_diff.yaml: right = wheel 1, then left = wheel 0): the
+// twin's encoder stream keeps the recording's name and columns and each column follows its own wheel, and motion
+// capture is the twin's one pose stream.
+TEST(ReplayTest, ScenarioEncoderColumnsReadTheirOwnWheels) {
+  auto loaded = LoadScenario(testing::SourcePath("scenarios/real/optiodom_diff.yaml"));
+  ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+  Scenario s = loaded.value();
+  s.duration_s = 12.0;
+  const Simulation real = SimulateOk(s);
+  const Simulation twin = ReplayOk(s, real.recording);
+  const Stream* recorded = real.recording.Find("wheel_encoders");
+  const Stream* replayed = twin.recording.Find("wheel_encoders");
+  ASSERT_NE(recorded, nullptr);
+  ASSERT_NE(replayed, nullptr);
+  EXPECT_EQ(replayed->info.columns, (std::vector<std::string>{"right", "left"}));
+  EXPECT_EQ(replayed->t, recorded->t);
+  int pose_streams = 0;
+  for (const Stream& stream : twin.recording.streams) pose_streams += stream.info.type == recording::StreamType::kPose;
+  EXPECT_EQ(pose_streams, 1);
+  EXPECT_NE(twin.recording.Find("mocap"), nullptr);
+  const auto max_difference = [&](Eigen::Index twin_column, Eigen::Index recorded_column) {
+    return (replayed->values.col(twin_column) - recorded->values.col(recorded_column)).cwiseAbs().maxCoeff();
+  };
+  const double matched = std::max(max_difference(0, 0), max_difference(1, 1));
+  const double swapped = std::min(max_difference(0, 1), max_difference(1, 0));
+  std::printf("encoder columns right, left: twin within %.4f rad of its own column, %.2f rad of the other\n", matched,
+              swapped);
+  // The twin's wheels track the measured angles (kAngleTrackingS): a few ticks of 2 pi / 2796.8 rad and the lag.
+  EXPECT_LT(matched, 0.1 * swapped);
+}
+
 // The bound on the OptiOdom differential drive twin's mean 10 s drift against motion capture [m]: measured 1.0 to
 // 1.2 cm on the three runs below, where the twin of indoor_diffdrive_slip's model drifts 0.7 to 0.9 m.
 constexpr double kRealDiffTwinDriftM = 0.05;
