@@ -52,6 +52,25 @@ void AddSimulate(CLI::App* app, Commands* commands) {
                        }});
 }
 
+void AddReplay(CLI::App* app, Commands* commands) {
+  auto args = std::make_shared<ReplayArgs>();
+  auto from = std::make_shared<double>(0.0);
+  auto to = std::make_shared<double>(0.0);
+  CLI::App* rep = app->add_subcommand(
+      "replay", "Drive a scenario's MuJoCo model with a recording's own inputs: the recording's noise-free twin.");
+  rep->add_option("recording", args->recording, "Recording directory whose drive is replayed")->required();
+  rep->add_option("--scenario", args->scenario, "Nominal scenario (NOMINAL.yaml): the model and sensors")->required();
+  rep->add_option("--out", args->out, "Output directory: the twin recording")->required();
+  CLI::Option* from_option = rep->add_option("--from", *from, "Start of the window, recording time [s]");
+  CLI::Option* to_option = rep->add_option("--to", *to, "End of the window, recording time [s]");
+  rep->add_flag("--quiet", args->quiet, "No progress and no summary");
+  commands->push_back({rep, [args, from, to, from_option, to_option] {
+                         if (from_option->count() > 0) args->from_s = *from;
+                         if (to_option->count() > 0) args->to_s = *to;
+                         return RunReplay(*args);
+                       }});
+}
+
 void AddCalibrate(CLI::App* app, Commands* commands) {
   Add(commands, RunCalibrate, [app](auto* args) {
     CLI::App* cal = app->add_subcommand(
@@ -342,8 +361,8 @@ int RunCommandLine(int argc, char** argv) {
   CLI::App app{"roamlab: mobile-robot pose tracking and sensor self-calibration testbed"};
   app.require_subcommand(1);
   Commands commands;
-  for (const auto add : {AddSimulate, AddCalibrate, AddTrack, AddEvaluate, AddMonteCarlo, AddInit, AddDiagnose,
-                         AddGapBenchmark, AddRegress, AddOdometry, AddImport, AddFrontEnd})
+  for (const auto add : {AddSimulate, AddReplay, AddCalibrate, AddTrack, AddEvaluate, AddMonteCarlo, AddInit,
+                         AddDiagnose, AddGapBenchmark, AddRegress, AddOdometry, AddImport, AddFrontEnd})
     add(&app, &commands);
 
   try {

@@ -34,7 +34,36 @@ void PrintSummary(const sim::Simulation& s, const std::string& out) {
               static_cast<unsigned long long>(*s.recording.provenance.seed), s.recording.streams.size());
 }
 
+// The replay's summary: speed, the twin's streams and those left out.
+void PrintReplaySummary(const sim::Simulation& s, const std::string& out) {
+  const sim::SimulationStats& st = s.stats;
+  for (const std::string& warning : st.warnings) std::cerr << "replay: MuJoCo warning: " << warning << "\n";
+  std::printf("replayed %.1f s (%ld steps) in %.2f s: %.1fx real time\n", st.simulated_s, st.physics_steps, st.wall_s,
+              st.realtime_factor);
+  if (s.truth.replay)
+    std::printf("drive: %s; start: %s; %.1f m\n", s.truth.replay->drive.c_str(), s.truth.replay->start.c_str(),
+                st.distance_m);
+  for (const std::string& why : st.left_out) std::printf("left out: %s\n", why.c_str());
+  std::printf("wrote %s: %zu streams, ground_truth.tum, truth.yaml (noise-free twin)\n", out.c_str(),
+              s.recording.streams.size());
+}
+
 }  // namespace
+
+int RunReplay(const ReplayArgs& args) {
+  experiment::ReplayRequest request = args;
+  if (!args.quiet) {
+    request.progress = [](double fraction) {
+      std::cerr << "\rreplay: " << static_cast<int>(100.0 * fraction) << "%" << std::flush;
+    };
+  }
+  sim::Simulation simulation;
+  const experiment::Outcome outcome = experiment::ReplayToDirectory(request, &simulation);
+  if (!args.quiet && !outcome.bad_input) std::cerr << "\n";
+  if (!outcome.ok()) return Exit(args.err, "replay", outcome);
+  if (!args.quiet) PrintReplaySummary(simulation, args.out);
+  return 0;
+}
 
 int RunSimulate(const SimulateArgs& args) {
   experiment::SimulateRequest request = args;

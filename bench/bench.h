@@ -77,6 +77,7 @@ Result<Json> RunChild(const std::string& self, std::vector<std::string> args, co
 int BenchSimulation(const Context& ctx, Json* j, recording::Recording* recording);  // 1, 1b, 1c
 void BenchCgp(Json* j);                                                             // 1d
 int BenchIndoorCamera(const Context& ctx, Json* j);                                 // 1e
+int BenchReplay(const Context& ctx, const recording::Recording& atv, Json* j);      // 1f
 int BenchCeresPeer(const Context& ctx, const recording::Recording& rec, Json* j,
                    TrackingCalibration* peer);  // 2-3
 int CalibrateForTracking(const Context& ctx, const recording::Recording& rec, TrackingCalibration* calibrated,

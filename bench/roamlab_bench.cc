@@ -4,7 +4,8 @@
 //
 //   roamlab_bench [--quick] [--json OUT.json]
 //
-// 1. Simulation of scenarios/atv_hills.yaml with every sensor (multiple of real time).
+// 1. Simulation of scenarios/atv_hills.yaml with every sensor (multiple of real time); 1f: replays of that recording
+//    and of indoor differential-drive and omni recordings (sim/replay.h, multiple of real time).
 // 2. Offline calibration of that recording by roamlab and by the Ceres peer (bench/ceres_peer.h) on the same graph:
 //    one stage with every parameter of configs/atv_calibration.yaml free, from the same aligned initial values,
 //    no gating; final costs (both evaluated by roamlab's objective) and parameters compared; time ratio (each solver's
@@ -103,6 +104,7 @@ int RunSteps(const Context& ctx, Json* j) {
   if (int code = BenchSimulation(ctx, j, &rec)) return code;
   BenchCgp(j);
   if (int code = BenchIndoorCamera(ctx, j)) return code;
+  if (int code = BenchReplay(ctx, rec, j)) return code;
   TrackingCalibration peer, calibrated;
   if (int code = BenchCeresPeer(ctx, rec, j, &peer)) return code;
   std::string calibration_json;

@@ -13,6 +13,7 @@
 #include "frontend/visual_odometry.h"
 #include "sim/mujoco_model.h"
 #include "sim/render.h"
+#include "sim/replay.h"
 #include "sim/simulator.h"
 
 namespace roamlab::bench {
@@ -128,6 +129,39 @@ int BenchSimulation(const Context& ctx, Json* j, recording::Recording* recording
           size.c_str(), factor, factor, r["vo_ms_per_pair"].get<double>(), r["render_ms_per_frame"].get<double>(),
           r["failures"].get<int>(), r["pairs"].get<int>());
     }
+  }
+  return 0;
+}
+
+int BenchReplay(const Context& ctx, const recording::Recording& atv, Json* j) {
+  // 1f. Replay (sim/replay.h): the ATV recording of step 1 replayed from its rear-wheel speed and steering in the
+  // same scenario (target >= 5x), and recordings of scenarios/indoor_diffdrive_slip.yaml and indoor_omni_slip.yaml
+  // (IMU and encoders: no laser) replayed from their encoders (targets >= 20x and >= 5x); wall and CPU time on one
+  // thread.
+  const auto replay = [j](const sim::Scenario& nominal, const recording::Recording& rec, const std::string& name,
+                          double target) {
+    const std::clock_t cpu = std::clock();
+    auto twin = sim::Replay(nominal, rec);
+    const double cpu_s = static_cast<double>(std::clock() - cpu) / CLOCKS_PER_SEC;
+    if (!twin.ok()) return Fail(twin.status().message());
+    const double factor = twin.value().stats.realtime_factor;
+    (*j)["replay_realtime_factor"][name] = factor;
+    const std::string target_text = std::to_string(static_cast<int>(target)) + "x";
+    Say("  replay, %-26s %8.1fx real time    target >= %-8s ratio %.2f   (CPU time: %.1fx)\n", name.c_str(), factor,
+        target_text.c_str(), factor / target, twin.value().stats.simulated_s / cpu_s);
+    return 0;
+  };
+  if (int code = replay(ctx.scenario, atv, "atv_hills", 5.0)) return code;
+  for (const auto& [name, target] : {std::pair<std::string, double>{"indoor_diffdrive_slip", 20.0},
+                                     std::pair<std::string, double>{"indoor_omni_slip", 5.0}}) {
+    auto indoor = sim::LoadScenario(ctx.root + "/scenarios/" + name + ".yaml");
+    if (!indoor.ok()) return Fail(indoor.status().message());
+    indoor.value().sensors.camera.reset();
+    indoor.value().sensors.laser.reset();
+    indoor.value().duration_s = ctx.sizes.indoor_s;
+    auto recorded = sim::Simulate(indoor.value());
+    if (!recorded.ok()) return Fail(recorded.status().message());
+    if (int code = replay(indoor.value(), recorded.value().recording, name, target)) return code;
   }
   return 0;
 }

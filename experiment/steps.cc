@@ -5,6 +5,7 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <sstream>
 #include <utility>
 #include <vector>
 
@@ -18,6 +19,7 @@
 #include "recording/recording.h"
 #include "recording/trajectory.h"
 #include "recording/truth.h"
+#include "sim/replay.h"
 #include "sim/scenario.h"
 
 namespace roamlab::experiment {
@@ -109,6 +111,38 @@ Outcome SimulateToDirectory(const SimulateRequest& request, sim::Simulation* sim
   if (!run.ok()) return Outcome::Failed(run.status());
 
   // The recording and its truth.
+  Status status = recording::WriteRecording(run.value().recording, request.out);
+  if (status.ok()) status = recording::WriteTruth(run.value().truth, request.out);
+  if (!status.ok()) return Outcome::Failed(status);
+  if (simulation) *simulation = std::move(run).value();
+  return Outcome::Ok();
+}
+
+Outcome ReplayToDirectory(const ReplayRequest& request, sim::Simulation* simulation) {
+  auto scenario = sim::LoadScenario(request.scenario);
+  if (!scenario.ok()) return Outcome::BadInput(scenario.status());
+  if (auto nominal = sim::NominalPlatformGeometry(scenario.value()); !nominal.ok())
+    return Outcome::BadInput(nominal.status());
+  auto real = recording::ReadRecording(request.recording);
+  if (!real.ok()) return Outcome::BadInput(real.status());
+  auto inputs = sim::DriveInputsFrom(real.value(), scenario.value());
+  if (!inputs.ok()) return Outcome::BadInput(Status::Error(request.recording + ": " + inputs.status().message()));
+  const double first_s = inputs.value().t.front().seconds(), last_s = inputs.value().t.back().seconds();
+  const double from_s = request.from_s.value_or(first_s), to_s = request.to_s.value_or(last_s);
+  if (!(from_s < to_s) || from_s >= last_s || to_s <= first_s) {
+    std::ostringstream message;
+    message << request.recording << ": the window [" << from_s << ", " << to_s
+            << "] s is empty or outside the drive inputs' span [" << first_s << ", " << last_s << "] s";
+    return Outcome::BadInput(Status::Error(message.str()));
+  }
+  if (Status dir = MakeOutputDirectory(request.out); !dir.ok()) return Outcome::BadInput(dir);
+
+  sim::ReplayOptions options;
+  options.from_s = request.from_s;
+  options.to_s = request.to_s;
+  options.progress = request.progress;
+  auto run = sim::Replay(scenario.value(), real.value(), options);
+  if (!run.ok()) return Outcome::Failed(Status::Error(request.recording + ": " + run.status().message()));
   Status status = recording::WriteRecording(run.value().recording, request.out);
   if (status.ok()) status = recording::WriteTruth(run.value().truth, request.out);
   if (!status.ok()) return Outcome::Failed(status);

@@ -1,6 +1,7 @@
 // The steps of the `roamlab` commands that write files, as library calls: simulate a scenario into a recording
-// directory, calibrate a recording into calibration.json, track it into trajectory.tum, covariance.csv and
-// summary.json, import an OptiOdom run. The command line, the Monte-Carlo runner and the regression suite call them.
+// directory, replay a recording's drive in a scenario's model (its MuJoCo twin), calibrate a recording into
+// calibration.json, track it into trajectory.tum, covariance.csv and summary.json, import an OptiOdom run. The command
+// line, the Monte-Carlo runner and the regression suite call them.
 #pragma once
 
 #include <cstdint>
@@ -44,6 +45,19 @@ struct SimulateRequest {
 // bad input; a simulation that fails or a recording that cannot be written is a failure. `simulation` (optional)
 // receives the run.
 Outcome SimulateToDirectory(const SimulateRequest& request, sim::Simulation* simulation = nullptr);
+
+struct ReplayRequest {
+  std::string recording;                          // REC, the recording whose drive is replayed
+  std::string scenario;                           // NOMINAL.yaml
+  std::string out;                                // the twin's recording directory
+  std::optional<double> from_s, to_s;             // the window, in the recording's time [s]
+  std::function<void(double fraction)> progress;  // optional
+};
+// Replays the recording's drive in the nominal scenario's model (sim/replay.h) and writes the twin with
+// ground_truth.tum and truth.yaml. A recording or scenario that does not load, a recording without drive inputs, an
+// empty window are bad input; a replay that fails or a twin that cannot be written is a failure. `simulation`
+// (optional) receives the run.
+Outcome ReplayToDirectory(const ReplayRequest& request, sim::Simulation* simulation = nullptr);
 
 struct CalibrateRequest {
   std::string recording;

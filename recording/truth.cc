@@ -64,6 +64,20 @@ Status ParseEffects(const YAML::Node& node, const std::string& path, std::vector
   return Status::Ok();
 }
 
+// replay: {noise_free: true, drive: ..., start: ...}.
+Status ParseReplay(const YAML::Node& node, const std::string& path, std::optional<ReplayNote>* out) {
+  if (Status status = CheckKeys(node, path, "replay", {"noise_free", "drive", "start"}); !status.ok()) return status;
+  ReplayNote note;
+  if (node["drive"]) {
+    if (Status status = ReadString(node["drive"], path, "replay.drive", &note.drive); !status.ok()) return status;
+  }
+  if (node["start"]) {
+    if (Status status = ReadString(node["start"], path, "replay.start", &note.start); !status.ok()) return status;
+  }
+  *out = note;
+  return Status::Ok();
+}
+
 // Refuses what ReadTruth would refuse: empty or non-finite values, effects without a name.
 Status ValidateForWrite(const Truth& truth, const std::string& path) {
   for (const auto& [name, values] : truth.calibration) {
@@ -110,7 +124,15 @@ std::string EmitTruth(const Truth& truth) {
     internal::EmitNumberMap(effect.parameters, &out);
     out << YAML::EndMap;
   }
-  out << YAML::EndSeq << YAML::EndMap;
+  out << YAML::EndSeq;
+  if (truth.replay) {
+    out << YAML::Key << "replay" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "noise_free" << YAML::Value << true;
+    out << YAML::Key << "drive" << YAML::Value << truth.replay->drive;
+    out << YAML::Key << "start" << YAML::Value << truth.replay->start;
+    out << YAML::EndMap;
+  }
+  out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }
 
@@ -123,12 +145,16 @@ Result<Truth> ReadTruth(const std::string& directory) {
   // An empty file is an empty truth; anything else must be a mapping with known keys.
   Truth truth;
   if (root.IsNull()) return truth;
-  if (Status status = CheckKeys(root, path, "the top level", {"calibration", "effects"}); !status.ok()) return status;
+  if (Status status = CheckKeys(root, path, "the top level", {"calibration", "effects", "replay"}); !status.ok())
+    return status;
   if (root["calibration"]) {
     if (Status status = ParseCalibration(root["calibration"], path, &truth.calibration); !status.ok()) return status;
   }
   if (root["effects"]) {
     if (Status status = ParseEffects(root["effects"], path, &truth.effects); !status.ok()) return status;
+  }
+  if (root["replay"]) {
+    if (Status status = ParseReplay(root["replay"], path, &truth.replay); !status.ok()) return status;
   }
   return truth;
 }

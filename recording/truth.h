@@ -7,9 +7,14 @@
 //   effects:                hidden physical effects, each with its parameters
 //     - name: gps_latency
 //       parameters: {latency_s: 0.12}
+//   replay:                 a replay's twin (sim/replay.h) only: noise-free, driven by a recording's inputs
+//     noise_free: true
+//     drive: wheel_encoders stream 'wheel_encoders' (differentiated)
+//     start: pose stream 'mocap'
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,9 +27,16 @@ struct Effect {
   std::map<std::string, double> parameters;
 };
 
+// A replay's twin: every sensor-noise source off; the drive and the start taken from the recording.
+struct ReplayNote {
+  std::string drive;  // the recorded streams the inputs came from
+  std::string start;  // where the start pose came from
+};
+
 struct Truth {
   std::map<std::string, std::vector<double>> calibration;
   std::vector<Effect> effects;
+  std::optional<ReplayNote> replay;
 };
 
 Result<Truth> ReadTruth(const std::string& directory);

@@ -301,6 +301,38 @@ class Simulator::Impl {
       scan_geometry_.max_range_m = l.max_range_m;
     }
     if (ackermann_) wheelbase_m_ = Micrometres(vehicle_.wheelbase_m());
+    return ScheduleClocks();
+  }
+
+  // A replay's streams at the recording's stamps (sim/replay_schedule.h).
+  Status ScheduleClocks() {
+    if (!options_.replay) return Status::Ok();
+    const ReplaySchedule& replay = *options_.replay;
+    origin_ns_ = replay.t0.nanoseconds();
+    const DriveInputs& drive = replay.drive;
+    if (drive.t.empty() || drive.values.rows() != static_cast<Eigen::Index>(drive.t.size()))
+      return Status::Error(where_ + ": the replay has no drive inputs");
+    using Kind = DriveInputs::Kind;
+    const Eigen::Index columns = drive.kind == Kind::kAckermann ? 2
+                                 : drive.kind == Kind::kBodyVelocity
+                                     ? 3
+                                     : static_cast<Eigen::Index>(wheeled_.wheels().size());
+    if (ackermann_ != (drive.kind == Kind::kAckermann) || drive.values.cols() != columns ||
+        (drive.angles_rad.size() > 0 && drive.angles_rad.rows() != drive.values.rows()) ||
+        (drive.angles_rad.size() > 0 && drive.angles_rad.cols() != columns) ||
+        (drive.travel_m.size() > 0 && drive.travel_m.size() != drive.values.rows()))
+      return Status::Error(where_ + ": the replay's drive inputs do not fit a robot of kind " + scenario_.robot.kind);
+    const std::map<std::string, Clock*> clocks{{"imu", &imu_clock_},           {"magnetometer", &mag_clock_},
+                                               {"gps", &gps_clock_},           {"rear_wheel", &odometer_clock_},
+                                               {"steering", &odometer_clock_}, {"wheel_encoders", &encoder_clock_},
+                                               {"mocap", &mocap_clock_},       {"odometry", &odometry_clock_}};
+    for (const auto& [name, stamps] : replay.stamps) {
+      const auto it = clocks.find(name);
+      if (it == clocks.end()) return Status::Error(where_ + ": the replay schedules an unknown stream '" + name + "'");
+      if (stamps.empty() || stamps.front() < replay.t0)
+        return Status::Error(where_ + ": the replay's stream '" + name + "' has no stamps at or after its start");
+      internal::Schedule(stamps, replay.t0, step_ns_, it->second);
+    }
     return Status::Ok();
   }
 
@@ -316,19 +348,19 @@ class Simulator::Impl {
     }
     if (sensors.magnetometer) {
       mag_stream_ = MakeStream("magnetometer", StreamType::kMagnetometer, sensors.magnetometer->rate_hz,
-                               {"mx", "my", "mz"}, "normalized", mag_clock_);
+                               {"mx", "my", "mz"}, "normalized", mag_clock_, origin());
       mag_stream_.info.mounting = recording::Mounting{};
       mag_stream_.info.noise = {{"sigma_normalized", sensors.magnetometer->sigma}};
     }
     if (sensors.gps) {
       gps_stream_ = MakeStream("gps", StreamType::kGps, sensors.gps->rate_hz, {"latitude", "longitude", "altitude"},
-                               "deg", gps_clock_);
+                               "deg", gps_clock_, origin());
       gps_stream_.info.mounting = recording::Mounting{};
       gps_stream_.info.noise = {{"sigma_m", sensors.gps->sigma_m}};
     }
     if (sensors.mocap) {
       mocap_stream_ = MakeStream("mocap", StreamType::kPose, sensors.mocap->rate_hz,
-                                 {"x", "y", "z", "qx", "qy", "qz", "qw"}, "m", mocap_clock_);
+                                 {"x", "y", "z", "qx", "qy", "qz", "qw"}, "m", mocap_clock_, origin());
       mocap_stream_.info.noise = {{"position_m", sensors.mocap->position_sigma_m},
                                   {"orientation_rad", sensors.mocap->orientation_sigma_rad}};
     }
@@ -336,23 +368,29 @@ class Simulator::Impl {
       std::vector<std::string> columns;
       for (const EncoderColumn& c : encoder_columns_) columns.push_back(c.name);
       encoder_stream_ = MakeStream(sensors.wheel_encoders->name, StreamType::kWheelEncoders,
-                                   sensors.wheel_encoders->rate_hz, columns, "rad", encoder_clock_);
+                                   sensors.wheel_encoders->rate_hz, columns, "rad", encoder_clock_, origin());
       encoder_stream_.info.attributes = {{"ticks_per_revolution", sensors.wheel_encoders->ticks_per_revolution}};
     }
     if (sensors.laser) {
       scan_matching_.emplace("scan_matching", sensors.laser->rate_hz);
       if (sensors.laser->store_scans) {
-        laser_scan_stream_ = MakeStream("laser_scan", StreamType::kLaserScan, sensors.laser->rate_hz,
-                                        recording::LaserScanColumns(sensors.laser->beams), "rad,m", laser_clock_);
+        laser_scan_stream_ =
+            MakeStream("laser_scan", StreamType::kLaserScan, sensors.laser->rate_hz,
+                       recording::LaserScanColumns(sensors.laser->beams), "rad,m", laser_clock_, origin());
       }
     }
     if (sensors.odometer) {
       wheel_stream_ = MakeStream("rear_wheel", StreamType::kWheelEncoders, sensors.odometer->rate_hz, {"rear"}, "m/s",
-                                 odometer_clock_);
+                                 odometer_clock_, origin());
       wheel_stream_.info.noise = {{"sigma_mps", sensors.odometer->speed_sigma_mps}};
-      steering_stream_ =
-          MakeStream("steering", StreamType::kSteering, sensors.odometer->rate_hz, {"angle"}, "rad", odometer_clock_);
+      steering_stream_ = MakeStream("steering", StreamType::kSteering, sensors.odometer->rate_hz, {"angle"}, "rad",
+                                    odometer_clock_, origin());
       steering_stream_.info.noise = {{"sigma_rad", sensors.odometer->steering_sigma_rad}};
+    }
+    if (odometry_clock_.scheduled() && !ackermann_) {
+      odometry_stream_ = MakeStream("odometry", StreamType::kOdometry, 0.0,
+                                    recording::FixedColumns(StreamType::kOdometry), "", odometry_clock_, origin());
+      twist_from_rates_ = wheeled_.J_rates_twist().completeOrthogonalDecomposition().pseudoInverse();
     }
     local_.emplace(scenario_.origin.latitude_deg, scenario_.origin.longitude_deg, scenario_.origin.altitude_m);
     truth_.reserve(truth_clock_.samples);
@@ -373,6 +411,13 @@ class Simulator::Impl {
   // The set-points at t_ns (Ackermann: speed [m/s], handlebar [rad] and 0; body velocity: v_x [m/s], omega_z
   // [rad/s] and v_y [m/s]): the profiles from t = 0, the lead-in's rest and ramp before.
   std::array<double, 3> SetPoints(std::int64_t t_ns) const {
+    if (options_.replay) {
+      const DriveInputs::Kind kind = options_.replay->drive.kind;
+      if (kind == DriveInputs::Kind::kWheelRates) return {0.0, 0.0, 0.0};  // ReplayWheelRates drives
+      const Eigen::VectorXd u = ReplayInputs(t_ns);
+      if (kind == DriveInputs::Kind::kBodyVelocity) return {u[0], u[2], u[1]};
+      return {u[0], u[1], 0.0};
+    }
     const DriverOptions& driver = scenario_.driver;
     const Profile& first = ackermann_ ? driver.speed_mps : driver.linear_mps;
     const Profile& second = ackermann_ ? driver.handlebar_rad : driver.angular_radps;
@@ -385,6 +430,42 @@ class Simulator::Impl {
     const double phase = static_cast<double>(t_ns + lead_in_ns_) / static_cast<double>(lead_in_ns_);
     const double ramp = std::clamp((phase - kLeadInRestFraction) / (1.0 - kLeadInRestFraction), 0.0, 1.0);
     return {ramp * first.Evaluate(0.0), ramp * second.Evaluate(0.0), ramp * third.Evaluate(0.0)};
+  }
+
+  // A replay's drive inputs at t_ns: the recording's from t = 0, rest before (sim/replay_schedule.h).
+  Eigen::VectorXd ReplayInputs(std::int64_t t_ns) const {
+    const DriveInputs& drive = options_.replay->drive;
+    if (t_ns < 0) return Eigen::VectorXd::Zero(drive.values.cols());
+    return drive.At(Time::FromNanoseconds(origin_ns_ + t_ns));
+  }
+
+  // A replay's wheel-rate targets at t_ns: the measured rates, plus the tracking of the measured angles.
+  Eigen::VectorXd ReplayWheelRates(std::int64_t t_ns) {
+    Eigen::VectorXd rates = ReplayInputs(t_ns);
+    const DriveInputs& drive = options_.replay->drive;
+    if (t_ns < 0 || drive.angles_rad.size() == 0) return rates;
+    const auto wheels = static_cast<Eigen::Index>(wheeled_.wheels().size());
+    Eigen::VectorXd twin_angles(wheels);
+    for (Eigen::Index i = 0; i < wheels; ++i) twin_angles[i] = wheeled_.WheelAngle(data_.get(), static_cast<int>(i));
+    if (replay_angles_at_start_.size() == 0) {
+      replay_angles_at_start_ = twin_angles;
+      measured_angles_at_start_ = drive.AnglesAt(Time::FromNanoseconds(origin_ns_));
+    }
+    const Eigen::VectorXd measured =
+        drive.AnglesAt(Time::FromNanoseconds(origin_ns_ + t_ns)) - measured_angles_at_start_;
+    return rates + (measured - (twin_angles - replay_angles_at_start_)) / kAngleTrackingS;
+  }
+
+  // A replay's correction of the Ackermann speed set-point [m/s] that tracks the measured travel; advances the twin's
+  // travel by its rear-wheel speed over the coming step. 0 without a replay of measured speeds.
+  double ReplayTravelCorrection(double rear_speed_mps, double dt_s) {
+    if (!options_.replay || options_.replay->drive.travel_m.size() == 0 || t_ns_ < 0) return 0.0;
+    const DriveInputs& drive = options_.replay->drive;
+    const double measured_m =
+        drive.TravelAt(Time::FromNanoseconds(origin_ns_ + t_ns_)) - drive.TravelAt(Time::FromNanoseconds(origin_ns_));
+    const double correction = (measured_m - replay_travel_m_) / kAngleTrackingS;
+    replay_travel_m_ += rear_speed_mps * dt_s;
+    return correction;
   }
 
   // Pose of a robot site in O, measured at the current state (the robot is rigid between them).
@@ -420,6 +501,10 @@ class Simulator::Impl {
     mag_clock_.shift_ns = imu_clock_.shift_ns;  // the magnetometer shares the IMU's clock
     // A sample taken after the end of the drive (negative shift) extends the physics past it.
     loop_end_ns_ = end_ns_ + std::max<std::int64_t>(0, -std::min(imu_clock_.shift_ns, gps_clock_.shift_ns));
+    // A replay's sample nearest a stamp may fall after the end.
+    for (const Clock* c :
+         {&imu_clock_, &mag_clock_, &gps_clock_, &mocap_clock_, &odometer_clock_, &encoder_clock_, &odometry_clock_})
+      if (c->scheduled()) loop_end_ns_ = std::max(loop_end_ns_, c->LastSampleNs());
     steering_offset_rad_ = EffectParameter(effects, "steering_offset", "offset_rad", 0.0);
     for (int i = 0; i < 3; ++i) {
       const std::string axis(1, "xyz"[i]);
@@ -460,8 +545,10 @@ class Simulator::Impl {
       const auto [first, second, third] = SetPoints(t_ns_);
       if (ackermann_) {
         const double measured = vehicle_.RearWheelRate(d) * vehicle_.wheel_radius_m();
-        drive_torque_nm_ = controller_->Update(first, measured, dt_s);
+        drive_torque_nm_ = controller_->Update(first + ReplayTravelCorrection(measured, dt_s), measured, dt_s);
         vehicle_.Apply(second, drive_torque_nm_, d);
+      } else if (options_.replay && options_.replay->drive.kind == DriveInputs::Kind::kWheelRates) {
+        wheeled_.ApplyWheelRates(ReplayWheelRates(t_ns_), d);
       } else {
         wheeled_.Apply(first, third, second, d);
       }
@@ -506,7 +593,7 @@ class Simulator::Impl {
   bool AnyDue(std::int64_t t_ns) const {
     return truth_clock_.Due(t_ns) || imu_clock_.Due(t_ns) || mag_clock_.Due(t_ns) || gps_clock_.Due(t_ns) ||
            mocap_clock_.Due(t_ns) || odometer_clock_.Due(t_ns) || encoder_clock_.Due(t_ns) || laser_clock_.Due(t_ns) ||
-           CameraDue(t_ns);
+           odometry_clock_.Due(t_ns) || CameraDue(t_ns);
   }
 
   // Camera frame k is due at the first step at or after k / rate_hz (rounded to the nanosecond, not accumulated):
@@ -547,7 +634,7 @@ class Simulator::Impl {
 
     if (truth_clock_.Due(t_ns)) {
       if (Status s = CheckVehicle(body, t_ns); !s.ok()) return s;
-      StampedPose pose{Time::FromNanoseconds(t_ns), body.p_world_body, body.q_world_body};
+      StampedPose pose{Time::FromNanoseconds(origin_ns_ + t_ns), body.p_world_body, body.q_world_body};
       // Keep the quaternion sign continuous so that the TUM file has no jumps.
       if (!truth_.empty() && truth_.back().q_world_body.dot(pose.q_world_body) < 0.0)
         pose.q_world_body.coeffs() = -pose.q_world_body.coeffs();
@@ -588,8 +675,7 @@ class Simulator::Impl {
       // Cumulative angle since t = 0, truncated to whole ticks (an incremental encoder's count).
       const double tick_rad = 2.0 * kPi / sensors.wheel_encoders->ticks_per_revolution;
       const int columns = static_cast<int>(encoder_columns_.size());
-      if (t_ns == 0) {
-        encoder_zero_rad_.clear();
+      if (encoder_zero_rad_.empty()) {  // the first sample: t = 0, or a replay's first stamp
         for (const EncoderColumn& c : encoder_columns_)
           encoder_zero_rad_.push_back(wheeled_.WheelAngle(data_.get(), c.wheel));
       }
@@ -601,6 +687,13 @@ class Simulator::Impl {
       }
     }
     if (laser_clock_.Due(t_ns)) SampleLaser(t_ns);
+    if (odometry_clock_.Due(t_ns)) {
+      // Wheel odometry: the twist the nominal kinematics gives for the wheels' rates (least squares).
+      Eigen::VectorXd rates(static_cast<Eigen::Index>(wheeled_.wheels().size()));
+      for (Eigen::Index i = 0; i < rates.size(); ++i) rates[i] = wheeled_.WheelRate(data_.get(), static_cast<int>(i));
+      const Eigen::Vector3d twist = twist_from_rates_ * rates;  // v_x, v_y, omega_z
+      odometry_stream_.values.row(odometry_clock_.Row(t_ns)) << twist[0], twist[1], 0.0, 0.0, 0.0, twist[2];
+    }
     if (odometer_clock_.Due(t_ns)) {
       const OdometerOptions& odo = *sensors.odometer;
       // tire_growth: the rigid MuJoCo tire rolls at omega = v / r0; a tire of radius r0 (1 + c v^2) turns at
@@ -699,6 +792,14 @@ class Simulator::Impl {
     rec.platform.geometry = PlatformGeometry();
     rec.origin = scenario_.origin;
     rec.provenance = internal::SimulatedProvenance(scenario_, seed_, model_where_, options_.noise);
+    internal::FillRepeatedRows(imu_clock_, &imu_stream_);
+    internal::FillRepeatedRows(mag_clock_, &mag_stream_);
+    internal::FillRepeatedRows(gps_clock_, &gps_stream_);
+    internal::FillRepeatedRows(odometer_clock_, &wheel_stream_);
+    internal::FillRepeatedRows(odometer_clock_, &steering_stream_);
+    internal::FillRepeatedRows(encoder_clock_, &encoder_stream_);
+    internal::FillRepeatedRows(mocap_clock_, &mocap_stream_);
+    internal::FillRepeatedRows(odometry_clock_, &odometry_stream_);
     if (sensors.imu) rec.streams.push_back(std::move(imu_stream_));
     if (sensors.magnetometer) rec.streams.push_back(std::move(mag_stream_));
     if (sensors.gps) rec.streams.push_back(std::move(gps_stream_));
@@ -708,6 +809,7 @@ class Simulator::Impl {
       rec.streams.push_back(std::move(steering_stream_));
     }
     if (sensors.wheel_encoders) rec.streams.push_back(std::move(encoder_stream_));
+    if (odometry_clock_.scheduled() && !ackermann_) rec.streams.push_back(std::move(odometry_stream_));
     if (sensors.laser) {
       recording::Stream scan_stream = scan_matching_->TakeStream();
       scan_stream.info.mounting = laser_mounting_;
@@ -785,7 +887,13 @@ class Simulator::Impl {
   std::int64_t lead_in_ns_ = 0;
   std::int64_t loop_end_ns_ = 0;  // end_ns_, or later when a sample is taken after the recording's end
   std::int64_t t_ns_ = 0;         // the current time, for messages
-  Clock truth_clock_, imu_clock_, mag_clock_, gps_clock_, mocap_clock_, odometer_clock_, encoder_clock_, laser_clock_;
+  std::int64_t origin_ns_ = 0;    // the recording time of t = 0 (a replay's t0)
+  Eigen::VectorXd replay_angles_at_start_, measured_angles_at_start_;  // a replay's wheel angles at t = 0
+  double replay_travel_m_ = 0.0;                                       // a replay's Ackermann travel since t = 0
+  Time origin() const { return Time::FromNanoseconds(origin_ns_); }
+  Clock truth_clock_, imu_clock_, mag_clock_, gps_clock_, mocap_clock_, odometer_clock_, encoder_clock_, laser_clock_,
+      odometry_clock_;
+  Eigen::MatrixXd twist_from_rates_;  // a replay's wheel odometry: 3 x wheels, the least-squares inverse of J
 
   GaussMarkovNoise gyro_noise_{seed_, NoiseSource::kGyro, options_.noise};
   GaussMarkovNoise accel_noise_{seed_, NoiseSource::kAccel, options_.noise};
@@ -800,7 +908,7 @@ class Simulator::Impl {
   NoiseStream multipath_noise_{seed_, NoiseSource::kGpsMultipath};  // likewise
 
   recording::Stream imu_stream_, mag_stream_, gps_stream_, mocap_stream_, wheel_stream_, steering_stream_,
-      encoder_stream_, laser_scan_stream_;
+      encoder_stream_, laser_scan_stream_, odometry_stream_;
   Trajectory truth_;
   double min_height_ = 1e300;
   double max_height_ = -1e300;

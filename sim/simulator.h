@@ -31,6 +31,7 @@
 #include "frontend/visual_odometry.h"
 #include "recording/recording.h"
 #include "recording/truth.h"
+#include "sim/replay_schedule.h"
 #include "sim/scenario.h"
 
 namespace roamlab::sim {
@@ -45,6 +46,12 @@ struct SimulateOptions {
   std::function<void(Time t, const mjModel* model, const mjData* data)> observer;
   // The recording directory, where sensors.camera.store_images writes its PNGs (required when it is set).
   std::string image_directory;
+  // A replay (sim/replay.h): the drive inputs replace the scenario's driver and the scheduled streams are sampled at
+  // the recording's stamps (sim/replay_schedule.h). The stamps "mocap" sample the scenario's motion capture (O in W,
+  // the simulator's one pose stream) at the recording's stamps; the stamps "odometry" ask for one more stream, for the
+  // wheeled kinds: `odometry` (type odometry, O's wheel odometry: the twist the nominal kinematics gives for the
+  // wheels' rates, least squares, in O). The outputs are in recording time (simulation time + schedule t0).
+  std::shared_ptr<const ReplaySchedule> replay;
 };
 
 struct SimulationStats {
@@ -64,6 +71,8 @@ struct SimulationStats {
   std::optional<frontend::VoCounters> visual_odometry;  // sensors.camera: frames, pairs, estimates, failures by reason
   double camera_height_m = 0.0;       // sensors.camera: the floor height the VO uses (measured at rest)
   std::vector<std::string> warnings;  // MuJoCo warnings, if any
+  std::vector<std::string> left_out;  // a replay (sim/replay.h): the recorded streams the twin does not hold,
+                                      // "<stream>: <reason>"
 };
 
 struct Simulation {

@@ -327,9 +327,9 @@ std::map<std::string, double> WheeledRobot::PlatformGeometry() const {
   return g;
 }
 
-std::vector<std::string> WheeledRobot::EncoderColumns() const {
-  if (kind_ == "differential_drive") return {"left", "right"};
-  if (kind_ == "mecanum" || kind_ == "skid_steer") return {"front_left", "front_right", "rear_left", "rear_right"};
+std::vector<std::string> WheeledRobot::EncoderColumns(const std::string& kind) {
+  if (kind == "differential_drive") return {"left", "right"};
+  if (kind == "mecanum" || kind == "skid_steer") return {"front_left", "front_right", "rear_left", "rear_right"};
   return {"wheel_0", "wheel_1", "wheel_2"};
 }
 
@@ -405,6 +405,11 @@ void WheeledRobot::Place(const mjModel* model, mjData* data, double x, double y,
 void WheeledRobot::Apply(double v_x_mps, double v_y_mps, double omega_z_radps, mjData* data) const {
   const Eigen::VectorXd rates = J_rates_twist_ * Eigen::Vector3d(v_x_mps, v_y_mps, omega_z_radps);
   for (std::size_t i = 0; i < actuators_.size(); ++i) data->ctrl[actuators_[i]] = rates[static_cast<int>(i)];
+}
+
+void WheeledRobot::ApplyWheelRates(const Eigen::VectorXd& rates_radps, mjData* data) const {
+  for (std::size_t i = 0; i < actuators_.size() && static_cast<Eigen::Index>(i) < rates_radps.size(); ++i)
+    data->ctrl[actuators_[i]] = rates_radps[static_cast<Eigen::Index>(i)];
 }
 
 }  // namespace roamlab::sim

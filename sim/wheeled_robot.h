@@ -119,7 +119,10 @@ class WheeledRobot {
   // 60, 180, 300 deg or turning clockwise).
   bool NominalLayout() const;
   // Encoder column names, one per wheel.
-  std::vector<std::string> EncoderColumns() const;
+  std::vector<std::string> EncoderColumns() const { return EncoderColumns(kind_); }
+  // Those of a kind (differential_drive: left, right; mecanum: front_left, front_right, rear_left, rear_right; omni3:
+  // wheel_0, wheel_1, wheel_2).
+  static std::vector<std::string> EncoderColumns(const std::string& kind);
   // The true odometer geometry under the names of the kind's estimator model (odometer.<slot>).
   std::map<std::string, std::vector<double>> TrueOdometerCalibration() const;
 
@@ -128,6 +131,9 @@ class WheeledRobot {
   void Place(const mjModel* model, mjData* data, double x, double y, double yaw_rad, double clearance_m) const;
   // Wheel-speed servo targets [rad/s] for the body-velocity set-points.
   void Apply(double v_x_mps, double v_y_mps, double omega_z_radps, mjData* data) const;
+  // Each wheel's velocity servo set to its own rate [rad/s] (one per wheel, EncoderColumns order): a replay of
+  // measured wheel speeds.
+  void ApplyWheelRates(const Eigen::VectorXd& rates_radps, mjData* data) const;
   // Cumulative angle [rad] and rate [rad/s] of wheel i relative to the chassis.
   double WheelAngle(const mjData* data, int i) const { return data->qpos[wheel_qpos_[i]]; }
   double WheelRate(const mjData* data, int i) const { return data->qvel[wheel_dof_[i]]; }

@@ -1,5 +1,6 @@
 // `roamlab simulate` end to end: a short drive writes a recording that reads back, --seed is honoured, and a bad
-// scenario gives exit code 2 with one line naming the file, the line and the key.
+// scenario gives exit code 2 with one line naming the file, the line and the key. `roamlab replay` of that recording
+// writes its twin; a recording without drive inputs or an empty window gives exit code 2 with one line.
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -72,6 +73,47 @@ TEST(SimulateCliTest, BadScenarioIsOneLineAndExitCode2) {
   const CommandRun missing = Roamlab("simulate " + dir.File("none.yaml") + " --out " + dir.File("rec"), dir);
   EXPECT_EQ(missing.exit_code, 2);
   EXPECT_NE(missing.err.find("none.yaml: cannot open file"), std::string::npos) << missing.err;
+}
+
+TEST(SimulateCliTest, ReplayWritesTheTwinAndRefusesBadInput) {
+  roamlab::testing::TempDir dir;
+  const std::string scenario = WriteScenario(dir);
+  ASSERT_EQ(Roamlab("simulate " + scenario + " --out " + dir.File("rec") + " --quiet", dir).exit_code, 0);
+  const CommandRun run =
+      Roamlab("replay " + dir.File("rec") + " --scenario " + scenario + " --out " + dir.File("twin"), dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("x real time"), std::string::npos) << run.out;
+  auto twin = recording::ReadRecording(dir.File("twin"));
+  ASSERT_TRUE(twin.ok()) << twin.status().message();
+  auto rec = recording::ReadRecording(dir.File("rec"));
+  ASSERT_TRUE(rec.ok());
+  for (const auto& stream : rec.value().streams) {
+    const recording::Stream* replayed = twin.value().Find(stream.info.name);
+    ASSERT_NE(replayed, nullptr) << stream.info.name;
+    EXPECT_EQ(replayed->t, stream.t) << stream.info.name;
+  }
+  auto truth = recording::ReadTruth(dir.File("twin"));
+  ASSERT_TRUE(truth.ok()) << truth.status().message();
+  EXPECT_TRUE(truth.value().replay.has_value());
+
+  const CommandRun window = Roamlab(
+      "replay " + dir.File("rec") + " --scenario " + scenario + " --out " + dir.File("w") + " --from 1.5 --to 1", dir);
+  EXPECT_EQ(window.exit_code, 2);
+  EXPECT_NE(window.err.find("window"), std::string::npos) << window.err;
+  EXPECT_EQ(std::count(window.err.begin(), window.err.end(), '\n'), 1) << window.err;
+
+  std::filesystem::remove(dir.File("rec/rear_wheel.csv"));
+  std::string yaml = sim::testing::ReadText(dir.File("rec/recording.yaml"));
+  const std::size_t at = yaml.find("  - name: rear_wheel");
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t next = yaml.find("  - name:", at + 1);
+  yaml.erase(at, next == std::string::npos ? std::string::npos : next - at);
+  roamlab::testing::WriteFile(dir.File("rec/recording.yaml"), yaml);
+  const CommandRun none =
+      Roamlab("replay " + dir.File("rec") + " --scenario " + scenario + " --out " + dir.File("none"), dir);
+  EXPECT_EQ(none.exit_code, 2) << none.err;
+  EXPECT_NE(none.err.find("no drive input"), std::string::npos) << none.err;
+  EXPECT_EQ(std::count(none.err.begin(), none.err.end(), '\n'), 1) << none.err;
 }
 
 }  // namespace
