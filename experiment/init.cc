@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 
 #include "estimator/problem.h"
+#include "recording/odometry_pose.h"
 
 namespace roamlab::experiment {
 namespace {
@@ -620,17 +621,6 @@ void Builder::AddPose(const Stream& s) {
   MountingParameters(name, s, true, false, "fixed: the reference's mounting frames the calibration", 0);
 }
 
-// The odometry stream a pose stream is the pose of (rosbag's nav_msgs/Odometry gives <name> and <name>_pose), or
-// nullptr.
-const Stream* PosedOdometry(const Recording& rec, const Stream& pose) {
-  const std::string& name = pose.info.name;
-  const std::string suffix = "_pose";
-  if (name.size() <= suffix.size() || name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
-    return nullptr;
-  const Stream* odometry = rec.Find(name.substr(0, name.size() - suffix.size()));
-  return odometry && odometry->info.type == StreamType::kOdometry ? odometry : nullptr;
-}
-
 // The streams beside the master, and those left out with their reason.
 void Builder::AddOthers() {
   const bool derived_wheels = master_ && master_->info.attributes.count("derived_from_odometry") &&
@@ -663,7 +653,7 @@ void Builder::AddOthers() {
         AddGps(s);
         break;
       case StreamType::kPose:
-        if (const Stream* odometry = PosedOdometry(rec_, s)) {
+        if (const Stream* odometry = recording::PosedOdometry(rec_, s)) {
           LeaveOut(s, "the pose of the odometry '" + odometry->info.name +
                           "' (an importer's <odometry>_pose): dead-reckoned in its parent frame, not an absolute "
                           "reference");

@@ -7,6 +7,7 @@
 
 #include <GeographicLib/LocalCartesian.hpp>
 
+#include "recording/odometry_pose.h"
 #include "sim/wheeled_robot.h"
 
 namespace roamlab::sim {
@@ -253,7 +254,8 @@ std::string SimulatedName(const Stream& s, const Recording& real, const Scenario
       if (!real.origin) return need(false, "", "the recording has no origin");
       return need(sensors.gps.has_value(), "gps", "the nominal scenario has no gps");
     case StreamType::kPose:
-      return "mocap";
+      return need(recording::PosedOdometry(real, s) == nullptr, "mocap",
+                  "the pose of an odometry stream, dead-reckoned in its parent frame");
     case StreamType::kOdometry:
       return need(!ackermann, "odometry", "an ackermann vehicle has no wheel odometry in the simulator");
     case StreamType::kSteering:
@@ -382,7 +384,8 @@ struct StartPose {
 
 std::optional<StartPose> StartFromPose(const Recording& real, Time from) {
   for (const Stream& s : real.streams) {
-    if (s.info.type != StreamType::kPose) continue;
+    // An odometry's own pose is dead-reckoned in its parent frame: not where the robot is.
+    if (s.info.type != StreamType::kPose || recording::PosedOdometry(real, s)) continue;
     const auto row = std::lower_bound(s.t.begin(), s.t.end(), from);
     if (row == s.t.end()) continue;
     const Eigen::Index k = row - s.t.begin();

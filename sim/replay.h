@@ -22,27 +22,29 @@
 //      travel (sim/replay_schedule.h).
 // Window: [from, to] in the recording's time [s] (default: the drive inputs' first and last stamps).
 // Start: the first absolute reading at or after `from`: the first pose stream's pose (its mounting taken off, so O's
-// pose); else GPS (or a position stream) with the heading of the first >= kStartMotionM of motion within
-// kStartMotionWindowS (the lever arm taken off); else the scenario's start. The robot is placed there on the ground
-// and the scenario's lead-in runs (rest, then a ramp to the first inputs) before the first sample.
+// pose; an odometry's `<name>_pose`, recording/odometry_pose.h, is not one); else GPS (or a position stream) with the
+// heading of the first >= kStartMotionM of motion within kStartMotionWindowS (the lever arm taken off); else the
+// scenario's start. The robot is placed there on the ground and the scenario's lead-in runs (rest, then a ramp to the
+// first inputs) before the first sample.
+//
 // Twin streams: each recorded stream the simulator synthesizes keeps its name, type, columns, units, rate, mounting,
-// noise and attributes and its stamps within [from, to] (the physics step nearest each stamp,
-// sim/replay_schedule.h): imu, magnetometer and gps (when the nominal scenario has the sensor; the scenario's
-// mounting and calibration: the nominal belief), wheel_encoders in rad (wheeled kinds; the scenario's encoder
-// columns read the model wheels, robot.encoder_columns, and each recorded column is matched to them by
-// MatchWheelColumns; the scenario's encoder resolution, else the recording's ticks_per_revolution when whole, else
-// 2048; a recorded column driven by several model wheels reads their mean; each column starts at the recorded value at
-// the first stamp), the ackermann odometer's rear-wheel speed and steering (when the nominal has an odometer), one pose
-// stream (the first of the recording; the simulator's motion capture sampled at its stamps, a scenario without
-// sensors.mocap given one: the pose of the stream's mounting in W) and, for the wheeled kinds, one odometry stream (the
-// wheel odometry: the twist the nominal kinematics gives for the twin's wheel rates, as the stream's frame moves); a
-// gps or odometry stream's covariance columns are copied from the recording. Left out, with the reason in
-// SimulationStats::left_out ("<stream>: <reason>"): every other stream (visual_odometry, scan_matching,
-// position, laser_scan, camera, inputs, a second stream of a kind) and the laser and camera of the scenario
-// (too slow for a replay; the scenario's static world model is dropped with them, so the robot meets no walls).
-// Noise: every sensor-noise source off (SimulateOptions::noise = false); the scenario's effects are applied, so a
-// patched scenario replays with its effects. truth.yaml's `replay` entry says so (recording/truth.h).
-// Same scenario and recording give the same twin, byte for byte once written.
+// noise and attributes and its stamps within [from, to] (the physics step nearest each stamp, sim/replay_schedule.h):
+// imu, magnetometer and gps (when the nominal scenario has the sensor; the scenario's mounting and calibration: the
+// nominal belief), wheel_encoders in rad (wheeled kinds; the scenario's encoder columns read the model wheels,
+// robot.encoder_columns, and each recorded column is matched to them by MatchWheelColumns; the scenario's encoder
+// resolution, else the recording's ticks_per_revolution when whole, else 2048; a recorded column driven by several
+// model wheels reads their mean; each column starts at the recorded value at the first stamp), the ackermann odometer's
+// rear-wheel speed and steering (when the nominal has an odometer), one pose stream (the first of the recording that is
+// not an odometry's pose; the simulator's motion capture sampled at its stamps, a scenario without sensors.mocap given
+// one: the pose of the stream's mounting in W) and, for the wheeled kinds, one odometry stream (the wheel odometry: the
+// twist the nominal kinematics gives for the twin's wheel rates, as the stream's frame moves); a gps or odometry
+// stream's covariance columns are copied from the recording. Left out, with the reason in SimulationStats::left_out
+// ("<stream>: <reason>"): every other stream (visual_odometry, scan_matching, position, laser_scan, camera, inputs, a
+// second stream of a kind) and the laser and camera of the scenario (too slow for a replay; the scenario's static world
+// model is dropped with them, so the robot meets no walls). Noise: every sensor-noise source off
+// (SimulateOptions::noise = false); the scenario's effects are applied, so a patched scenario replays with its effects.
+// truth.yaml's `replay` entry says so (recording/truth.h). Same scenario and recording give the same twin, byte for
+// byte once written.
 #pragma once
 
 #include <functional>
