@@ -1,12 +1,27 @@
 #include "common/time.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <limits>
 
 namespace roamlab {
 
-Time Time::FromSeconds(double seconds) { return Time(static_cast<std::int64_t>(std::llround(seconds * 1e9))); }
+namespace {
+
+constexpr std::int64_t kMaxWholeSeconds = 9000000000;
+
+}  // namespace
+
+Time Time::FromSeconds(double seconds) {
+  if (std::isnan(seconds)) return Time();
+  const double clamped = std::clamp(seconds, -kMaxSeconds, kMaxSeconds);
+  return Time(static_cast<std::int64_t>(std::llround(clamped * 1e9)));
+}
+
+std::optional<Time> Time::FromSecondsChecked(double seconds) {
+  if (!std::isfinite(seconds) || std::abs(seconds) > kMaxSeconds) return std::nullopt;
+  return FromSeconds(seconds);
+}
 
 std::optional<Time> ParseSeconds(std::string_view text) {
   if (text.empty() || text.size() > 64) return std::nullopt;
@@ -20,8 +35,8 @@ std::optional<Time> ParseSeconds(std::string_view text) {
   std::int64_t whole = 0;
   std::size_t whole_digits = 0;
   for (; i < text.size() && text[i] >= '0' && text[i] <= '9'; ++i, ++whole_digits) {
-    if (whole > (std::numeric_limits<std::int64_t>::max() / 10 - 9) / 1000000000) return std::nullopt;
     whole = whole * 10 + (text[i] - '0');
+    if (whole > kMaxWholeSeconds) return std::nullopt;
   }
   std::int64_t frac = 0;
   std::size_t frac_digits = 0;
@@ -38,24 +53,24 @@ std::optional<Time> ParseSeconds(std::string_view text) {
   }
   if (i == text.size() && whole_digits + frac_digits > 0) {
     for (std::size_t k = frac_digits; k < 9; ++k) frac *= 10;
-    std::int64_t ns = whole * 1000000000 + frac + (round_up ? 1 : 0);
+    const std::int64_t ns = whole * 1000000000 + frac + (round_up ? 1 : 0);
+    if (ns > kMaxWholeSeconds * 1000000000) return std::nullopt;
     return Time::FromNanoseconds(negative ? -ns : ns);
   }
   // Scientific notation or anything else strtod accepts as a finite number.
   std::string copy(text);
   char* end = nullptr;
   const double value = std::strtod(copy.c_str(), &end);
-  if (end != copy.c_str() + copy.size() || !std::isfinite(value) || std::abs(value) > 9e9) return std::nullopt;
-  return Time::FromSeconds(value);
+  if (end != copy.c_str() + copy.size()) return std::nullopt;
+  return Time::FromSecondsChecked(value);
 }
 
 std::string FormatSeconds(Time t) {
-  std::int64_t ns = t.nanoseconds();
-  std::string sign;
-  if (ns < 0) {
-    sign = "-";
-    ns = -ns;
-  }
+  // The magnitude in unsigned arithmetic: -INT64_MIN does not fit an int64.
+  const std::int64_t signed_ns = t.nanoseconds();
+  const std::string sign = signed_ns < 0 ? "-" : "";
+  const std::uint64_t ns =
+      signed_ns < 0 ? ~static_cast<std::uint64_t>(signed_ns) + 1 : static_cast<std::uint64_t>(signed_ns);
   std::string frac = std::to_string(ns % 1000000000);
   frac.insert(0, 9 - frac.size(), '0');
   return sign + std::to_string(ns / 1000000000) + "." + frac;

@@ -75,6 +75,15 @@ const TypeShape* FindType(const std::string& type) {
   return nullptr;
 }
 
+// The largest magnitude of each numeric metadata key: gear ratio, encoder ticks per motor revolution, distances and
+// diameters [m], steering offset [rad].
+double Limit(const std::string& key) {
+  if (key == "ngear") return 1e4;
+  if (key == "encRes") return 1e7;
+  if (key == "Thi") return 3.15;
+  return 100.0;  // Li, Di
+}
+
 // The numbers of one metadata row (cells after the key); Thi may be zero or negative, the other keys must be positive.
 Result<std::vector<double>> RowNumbers(const std::string& path, std::size_t line, const std::string& key,
                                        const std::vector<std::string>& cells) {
@@ -85,6 +94,10 @@ Result<std::vector<double>> RowNumbers(const std::string& path, std::size_t line
     if (!number || (key != "Thi" && !(value > 0.0))) {
       return Status::Error(At(path, line) + key + ": '" + cells[c] + "' is not a " +
                            (key == "Thi" ? "finite" : "positive") + " number");
+    }
+    if (std::abs(value) > Limit(key)) {
+      return Status::Error(At(path, line) + key + ": " + cells[c] + " is outside the physical range (|value| <= " +
+                           recording::internal::FormatShortest(Limit(key)) + ")");
     }
     values.push_back(value);
   }
@@ -125,6 +138,7 @@ Result<Metadata> ReadMetadata(const std::string& path) {
   if (Status s = recording::internal::ReadTextFile(path, &content); !s.ok()) return s;
   static const std::set<std::string> kIgnored = {"N", "L", "imarkers", "gt_ti", "gt_tf", "odo_ti", "odo_tf"};
   std::map<std::string, std::vector<double>> numbers;
+  std::set<std::string> seen;
   Metadata meta;
   const std::vector<std::string> lines = Lines(content);
   for (std::size_t i = 0; i < lines.size(); ++i) {
@@ -132,6 +146,7 @@ Result<Metadata> ReadMetadata(const std::string& path) {
     std::vector<std::string> cells = SplitCells(lines[i]);
     const std::string key = cells.front();
     while (!cells.empty() && cells.back().empty()) cells.pop_back();  // trailing empty cells
+    if (!seen.insert(key).second) return Status::Error(At(path, i) + "duplicate key '" + key + "'");
     if (key == "type") {
       meta.type = cells.size() > 1 ? cells[1] : "";
       continue;
@@ -179,7 +194,9 @@ Result<Run> ReadRun(const std::string& run_csv, std::size_t readings, const std:
                              "' is not a finite number");
       }
     }
-    const Time time = Time::FromSeconds(row[0]);
+    const std::optional<Time> stamp = Time::FromSecondsChecked(row[0]);
+    if (!stamp) return Status::Error(At(run_csv, i) + "time " + cells[0] + " s is outside +-9e9 s");
+    const Time time = *stamp;
     if (!run.t.empty() && time <= run.t.back()) {
       return Status::Error(At(run_csv, i) + recording::internal::TimeOrderProblem(run.t.back(), time));
     }

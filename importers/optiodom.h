@@ -12,7 +12,10 @@
 //                          front wheel to rear axle), Di [m] (wheel diameters in column order: 2 diff, 3 omni3, 4
 //                          omni4, 1 tricyc), Thi (tricyc: the steering offset [rad], any sign; required; empty
 //                          for the others); N, L, imarkers, gt_ti, gt_tf, odo_ti, odo_tf are accepted and not
-//                          used; other keys, a wrong number of Li or Di values, or a missing key are errors
+//                          used; other keys, a key given twice, a wrong number of Li or Di values, a missing key or a
+//                          value outside its range (ngear <= 1e4, encRes <= 1e7, Li and Di <= 100 m, |Thi| <= 3.15
+//                          rad) are errors naming the file and line; a run's time beyond +-9e9 s is an error naming
+//                          the row
 // The recording written (recording.h):
 //   platform.kind        differential_drive | omni3 | omni4 | tricycle
 //   platform.geometry    gear_ratio, encoder_ticks_per_motor_revolution, wheel_radius_<wheel>_m (Di / 2), and

@@ -1,5 +1,8 @@
 #include "common/time.h"
 
+#include <cstdint>
+#include <limits>
+
 #include <gtest/gtest.h>
 
 namespace roamlab {
@@ -32,6 +35,36 @@ TEST(TimeTest, FormatRoundTrips) {
   for (const char* text : {"0.000000000", "12.000000001", "-1.500000000", "1431705823.123456789"}) {
     EXPECT_EQ(FormatSeconds(*ParseSeconds(text)), text);
   }
+}
+
+TEST(TimeTest, RefusesStampsBeyondTheRange) {
+  // 9.22e9 s would overflow int64 nanoseconds; the reader refuses anything past kMaxSeconds.
+  EXPECT_FALSE(ParseSeconds("9223372036.854775808").has_value());
+  EXPECT_FALSE(ParseSeconds("9223372039.999999999").has_value());
+  EXPECT_FALSE(ParseSeconds("-9300000000").has_value());
+  EXPECT_FALSE(ParseSeconds("9.3e9").has_value());
+  EXPECT_FALSE(ParseSeconds("99999999999999999999").has_value());
+  EXPECT_EQ(ParseSeconds("9000000000.000000000")->nanoseconds(), 9000000000000000000);
+  EXPECT_EQ(ParseSeconds("-9000000000")->nanoseconds(), -9000000000000000000);
+  EXPECT_FALSE(ParseSeconds("9000000000.000000001").has_value());
+}
+
+TEST(TimeTest, CheckedConversionRefusesWhatDoesNotFit) {
+  EXPECT_FALSE(Time::FromSecondsChecked(9.3e9).has_value());
+  EXPECT_FALSE(Time::FromSecondsChecked(-1e300).has_value());
+  EXPECT_FALSE(Time::FromSecondsChecked(std::numeric_limits<double>::quiet_NaN()).has_value());
+  EXPECT_FALSE(Time::FromSecondsChecked(std::numeric_limits<double>::infinity()).has_value());
+  EXPECT_EQ(Time::FromSecondsChecked(1.5)->nanoseconds(), 1500000000);
+  // The unchecked conversion saturates instead of overflowing.
+  EXPECT_EQ(Time::FromSeconds(1e300).seconds(), kMaxSeconds);
+  EXPECT_EQ(Time::FromSeconds(-1e300).seconds(), -kMaxSeconds);
+  EXPECT_EQ(Time::FromSeconds(std::numeric_limits<double>::quiet_NaN()).nanoseconds(), 0);
+}
+
+TEST(TimeTest, FormatsEveryInt64) {
+  EXPECT_EQ(FormatSeconds(Time::FromNanoseconds(std::numeric_limits<std::int64_t>::min())), "-9223372036.854775808");
+  EXPECT_EQ(FormatSeconds(Time::FromNanoseconds(std::numeric_limits<std::int64_t>::max())), "9223372036.854775807");
+  EXPECT_EQ(FormatSeconds(Time::FromNanoseconds(-1)), "-0.000000001");
 }
 
 }  // namespace
