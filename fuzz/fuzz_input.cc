@@ -14,8 +14,8 @@ constexpr std::string_view kSeparator = "\n%%%% ";
 bool SafeName(const std::string& name) {
   if (name.empty() || name.size() > 64 || name[0] == '.') return false;
   for (const char c : name) {
-    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
-                    c == '-' || c == '.';
+    const bool ok =
+        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' || c == '.';
     if (!ok) return false;
   }
   return true;
@@ -45,8 +45,8 @@ std::vector<InputFile> SplitInput(const std::uint8_t* data, std::size_t size, co
     if (separator == std::string_view::npos) break;
     const std::size_t name_begin = separator + kSeparator.size();
     const std::size_t line_end = text.find('\n', name_begin);
-    name = std::string(text.substr(name_begin, line_end == std::string_view::npos ? std::string_view::npos
-                                                                                  : line_end - name_begin));
+    name = std::string(
+        text.substr(name_begin, line_end == std::string_view::npos ? std::string_view::npos : line_end - name_begin));
     if (line_end == std::string_view::npos) break;
     start = line_end + 1;
   }

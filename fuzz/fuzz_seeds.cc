@@ -1,6 +1,6 @@
 // Writes the synthetic part of the fuzzers' seed corpora: small bags of every supported message type in each container
-// (tests/support/bag_writers.h, message_writer.h), a simulated recording (tests/support/synthetic.h) packed as the
-// recording harness reads it (fuzz_input.h), and small OptiOdom and CSV inputs.
+// (tests/support/bag_writers.h, message_writer.h) and small OptiOdom and CSV inputs (fuzz_input.h). scripts/fuzz.sh
+// adds simulated recordings, the repository's YAML files and excerpts of real recordings.
 //
 //   fuzz_seeds CORPUS_DIR      writes CORPUS_DIR/<harness>/<seed> (the folders are created)
 #include <cstdint>
@@ -12,10 +12,8 @@
 #include <vector>
 
 #include "fuzz/fuzz_input.h"
-#include "recording/recording.h"
 #include "tests/support/bag_writers.h"
 #include "tests/support/message_writer.h"
-#include "tests/support/synthetic.h"
 
 namespace roamlab::fuzz {
 namespace {
@@ -128,33 +126,6 @@ void WriteDb3s(const fs::path& dir, const fs::path& scratch) {
   }
 }
 
-// The first `rows` lines of `text`.
-std::string Head(const std::string& text, int rows) {
-  std::size_t end = 0;
-  for (int k = 0; k < rows && end != std::string::npos; ++k) {
-    end = text.find('\n', end);
-    if (end != std::string::npos) ++end;
-  }
-  return end == std::string::npos ? text : text.substr(0, end);
-}
-
-// A simulated recording (10 s), written, then packed with each file cut to its first 12 lines.
-void WriteRecordingSeeds(const fs::path& dir, const fs::path& scratch) {
-  testing::SyntheticOptions options;
-  options.duration_s = 10.0;
-  const testing::SyntheticRecording synthetic = testing::MakeAtvRecording(options);
-  const fs::path rec = scratch / "rec";
-  if (!recording::WriteRecording(synthetic.recording, rec.string()).ok()) std::exit(1);
-  std::string packed = ReadAll(rec / "recording.yaml");
-  std::string first_stream;
-  for (const auto& entry : fs::directory_iterator(rec)) {
-    const std::string name = entry.path().filename().string();
-    if (name == "recording.yaml") continue;
-    packed += "%%%% " + name + "\n" + Head(ReadAll(entry.path()), 12);
-  }
-  Write(dir / "simulated_atv", packed);
-}
-
 void WriteTextSeeds(const fs::path& root) {
   Write(root / "optiodom_fuzz" / "diff",
         "0,0,0,0,0,0\n0.05,0.001,0,0.01,40,38\n0.1,0.002,0.0005,0.02,41,39\n"
@@ -190,7 +161,6 @@ int main(int argc, char** argv) {
   roamlab::fuzz::WriteRos1Bags(root / "ros1_bag_fuzz");
   roamlab::fuzz::WriteMcaps(root / "mcap_fuzz");
   roamlab::fuzz::WriteDb3s(root / "rosbag2_fuzz", scratch);
-  roamlab::fuzz::WriteRecordingSeeds(root / "recording_fuzz", scratch);
   roamlab::fuzz::WriteTextSeeds(root);
   fs::remove_all(scratch);
   return 0;

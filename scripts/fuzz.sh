@@ -7,6 +7,8 @@
 #   FUZZERS        the harnesses to run (space-separated), default all
 #   JOBS           build parallelism, default the number of cores
 #   ROAMLAB_DATA_DIR  real recordings to cut small seed excerpts from (default ../shared/data; skipped when absent)
+#   ROAMLAB        the command line that simulates the recording seeds (default build/apps/roamlab, the Release build
+#                  of scripts/setup.sh; skipped when absent)
 # The seeds are written to BUILD_DIR/fuzz/seeds/<harness>, what the fuzzers add to BUILD_DIR/fuzz/corpus/<harness>,
 # crash reproducers to BUILD_DIR/fuzz/artifacts/. Exits 1 when a harness finds a crash, a leak or a timeout.
 set -euo pipefail
@@ -35,9 +37,25 @@ mkdir -p "$seeds/scenario_fuzz" "$seeds/estimator_config_fuzz" "$seeds/regress_s
 cp scenarios/*.yaml "$seeds/scenario_fuzz/"
 cp configs/*.yaml "$seeds/estimator_config_fuzz/"
 cp regression/suite.yaml "$seeds/regress_suite_fuzz/"
+# Simulated recordings, each file cut to its first 12 lines, packed as recording_fuzz reads them.
+roamlab=${ROAMLAB:-build/apps/roamlab}
+if [ -x "$roamlab" ]; then
+  mkdir -p "$seeds/recording_fuzz"
+  for scenario in atv_hills indoor_diffdrive_slip; do
+    rec="$work/simulated/$scenario"
+    rm -rf "$rec"
+    "$roamlab" simulate "scenarios/$scenario.yaml" --out "$rec" --quiet
+    { cat "$rec/recording.yaml"
+      for file in "$rec"/*.csv "$rec"/ground_truth.tum; do
+        printf '%%%%%%%% %s\n' "$(basename "$file")"; head -n 12 "$file"
+      done; } >"$seeds/recording_fuzz/$scenario"
+  done
+fi
 # Small excerpts of real recordings, when present: the head of each file (never kept in the repository).
 if [ -d "$data_dir" ]; then
-  for meta in $(find "$data_dir/optiodom" -name '*_metadata.csv' 2>/dev/null | sort | head -n 12); do
+  for meta in $(for robot in diff omni3 omni4 tricyc; do
+                  find "$data_dir/optiodom/data/$robot" -name '*_metadata.csv' 2>/dev/null | sort | head -n 3
+                done); do
     run=${meta%_metadata.csv}_run-01.csv
     [ -f "$run" ] || continue
     { head -n 40 "$run"; printf '%%%%%%%% set_metadata.csv\n'; cat "$meta"; } >"$seeds/optiodom_fuzz/$(basename "$run")"
