@@ -47,6 +47,7 @@ if [ -x "$roamlab" ]; then
     "$roamlab" simulate "scenarios/$scenario.yaml" --out "$rec" --quiet
     { cat "$rec/recording.yaml"
       for file in "$rec"/*.csv "$rec"/ground_truth.tum; do
+        [ -f "$file" ] || continue
         printf '%%%%%%%% %s\n' "$(basename "$file")"; head -n 12 "$file"
       done; } >"$seeds/recording_fuzz/$scenario"
   done
@@ -60,7 +61,10 @@ if [ -d "$data_dir" ]; then
     [ -f "$run" ] || continue
     { head -n 40 "$run"; printf '%%%%%%%% set_metadata.csv\n'; cat "$meta"; } >"$seeds/optiodom_fuzz/$(basename "$run")"
   done
-  [ -f "$data_dir/husky_test1/test1.bag" ] && head -c 65536 "$data_dir/husky_test1/test1.bag" >"$seeds/ros1_bag_fuzz/husky"
+  husky="$data_dir/husky_test1/test1.bag"
+  [ -f "$husky" ] && head -c 65536 "$husky" >"$seeds/ros1_bag_fuzz/husky"
+  mcap="$data_dir/ros2/rosbags_fixture/test_bag_mcap/test_bag_mcap.mcap"
+  [ -f "$mcap" ] && head -c 65536 "$mcap" >"$seeds/mcap_fuzz/fixture"
   xio="$data_dir/xio_imu_mag/sensor_data.csv"
   if [ -f "$xio" ]; then
     { printf 'time: {column: 0, unit: s}\ncsv: {header: true}\nstreams:\n'
