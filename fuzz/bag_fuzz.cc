@@ -7,9 +7,9 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string path = roamlab::fuzz::ScratchDirectory() + "/input" ROAMLAB_FUZZ_BAG_EXTENSION;
   roamlab::fuzz::WriteBytes(path, std::string_view(reinterpret_cast<const char*>(data), size));
-  (void)roamlab::importers::ListRosbag(path);
+  roamlab::fuzz::ExpectOneLineError(roamlab::importers::ListRosbag(path));
   roamlab::importers::RosbagImportOptions options;
   roamlab::importers::RosbagImportReport report;
-  (void)roamlab::importers::ImportRosbag(path, options, &report);
+  roamlab::fuzz::ExpectOneLineError(roamlab::importers::ImportRosbag(path, options, &report));
   return 0;
 }

@@ -12,6 +12,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (file.name != "mapping.yaml") csv_files.push_back(directory + "/" + file.name);
   }
   roamlab::importers::CsvImportReport report;
-  (void)roamlab::importers::ImportCsv(csv_files, directory + "/mapping.yaml", &report);
+  roamlab::fuzz::ExpectOneLineError(roamlab::importers::ImportCsv(csv_files, directory + "/mapping.yaml", &report));
   return 0;
 }

@@ -13,6 +13,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -38,5 +40,17 @@ void ResetScratch(const std::vector<InputFile>& files, const std::string& subdir
 
 // Writes `bytes` to `path` (truncating).
 void WriteBytes(const std::string& path, std::string_view bytes);
+
+// The project's rule for bad input: one line naming the file and the problem. Aborts (a finding) when `result` is an
+// error whose message is empty or spans several lines.
+template <typename ResultT>
+void ExpectOneLineError(const ResultT& result) {
+  if (result.ok()) return;
+  const std::string& message = result.status().message();
+  if (message.empty() || message.find('\n') != std::string::npos) {
+    std::fprintf(stderr, "error message not one line: '%s'\n", message.c_str());
+    std::abort();
+  }
+}
 
 }  // namespace roamlab::fuzz

@@ -6,6 +6,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   roamlab::fuzz::ResetScratch(roamlab::fuzz::SplitInput(data, size, "set_run-01.csv"));
   const std::string directory = roamlab::fuzz::ScratchDirectory();
-  (void)roamlab::importers::ImportOptiOdom(directory + "/set_run-01.csv", directory + "/set_metadata.csv");
+  roamlab::fuzz::ExpectOneLineError(
+      roamlab::importers::ImportOptiOdom(directory + "/set_run-01.csv", directory + "/set_metadata.csv"));
   return 0;
 }

@@ -5,6 +5,6 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   roamlab::fuzz::ResetScratch(roamlab::fuzz::SplitInput(data, size, "recording.yaml"), "rec");
-  (void)roamlab::recording::ReadRecording(roamlab::fuzz::ScratchDirectory() + "/rec");
+  roamlab::fuzz::ExpectOneLineError(roamlab::recording::ReadRecording(roamlab::fuzz::ScratchDirectory() + "/rec"));
   return 0;
 }

@@ -9,6 +9,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                                                                   {"configs", ROAMLAB_SOURCE_DIR "/configs"},
                                                                   {"models", ROAMLAB_SOURCE_DIR "/models"}});
   roamlab::fuzz::ResetScratch(roamlab::fuzz::SplitInput(data, size, "suite.yaml"), "regression");
-  (void)roamlab::regress::LoadSuite(directory + "/regression/suite.yaml");
+  roamlab::fuzz::ExpectOneLineError(roamlab::regress::LoadSuite(directory + "/regression/suite.yaml"));
   return 0;
 }

@@ -7,6 +7,6 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string& directory = roamlab::fuzz::ScratchDirectory({{"models", ROAMLAB_SOURCE_DIR "/models"}});
   roamlab::fuzz::ResetScratch(roamlab::fuzz::SplitInput(data, size, "scenario.yaml"), "scenarios");
-  (void)roamlab::sim::LoadScenario(directory + "/scenarios/scenario.yaml");
+  roamlab::fuzz::ExpectOneLineError(roamlab::sim::LoadScenario(directory + "/scenarios/scenario.yaml"));
   return 0;
 }
