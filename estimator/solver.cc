@@ -72,7 +72,8 @@ std::vector<VariableId> FreeVariableOrder(const Graph& graph) {
       stamped.push_back({v.stamp->nanoseconds(), 1, id, v.fixed});
       continue;
     }
-    const auto same = std::find_if(newest.begin(), newest.end(), [&](const auto& n) { return *n.first == v.name; });
+    const std::string& name = v.name;  // a structured binding cannot be captured in C++17
+    const auto same = std::find_if(newest.begin(), newest.end(), [&](const auto& n) { return *n.first == name; });
     if (same != newest.end()) {
       stamped[same->second].key = v.stamp->nanoseconds();
       same->second = stamped.size();

@@ -10,7 +10,7 @@ packages=(
   libeigen3-dev libsuitesparse-dev libgeographiclib-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   libmujoco-dev libqhull-dev libgl-dev libopengl-dev libegl-dev libegl-mesa0 libgl1-mesa-dri
   libopencv-dev libgtest-dev libgmock-dev gnuplot-nox libceres-dev libbz2-dev
-  libsqlite3-dev libzstd-dev liblz4-dev
+  libsqlite3-dev libzstd-dev liblz4-dev clang libclang-rt-dev
 )
 
 missing=()

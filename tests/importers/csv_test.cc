@@ -475,5 +475,13 @@ TEST_F(CsvImportTest, BadMappingsNameTheKey) {
             map + ":2: stream 'x' reads file 1 but 1 input file(s) were given");
 }
 
+// Found by csv_fuzz: yaml-cpp names the character it cannot read, here a line break, in its message.
+TEST_F(CsvImportTest, UnreadableMappingIsOneLineNamingTheMapping) {
+  const std::string csv = Write("a.csv", "t,x\n0,1\n");
+  const std::string error = ImportError(csv, std::string("\xff\0\n", 3));
+  EXPECT_EQ(error.rfind((dir_ / "map.yaml").string() + ":", 0), 0u) << error;
+  EXPECT_EQ(error.find('\n'), std::string::npos) << error;
+}
+
 }  // namespace
 }  // namespace roamlab::importers

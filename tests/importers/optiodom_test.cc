@@ -97,7 +97,8 @@ TEST(OptiOdomImportTest, BadMetadataIsOneLineNamingTheFileAndTheProblem) {
       {"type,omni5\nngear,1\nencRes,1\nLi,0.2\nDi,0.06\n", run4, "type 'omni5' is not supported"},
       {kTricycleMetadata, run4, "8 columns, expected 6 (t, x, y, theta, front wheel ticks, steering angle)"},
       // A key given twice: the last no longer wins silently.
-      {"type,tricyc\nngear,1\nencRes,1600\nLi,0.15\nDi,0.065\nThi,0\nLi,0.3\n", run_tricycle, ":7: duplicate key 'Li'"},
+      {"type,tricyc\nngear,1\nencRes,1600\nLi,0.15\nDi,0.065\nThi,0\nLi,0.3\n", run_tricycle,
+       ":7: duplicate key 'Li'"},
       {"type,tricyc\ntype,diff\nngear,1\nencRes,1600\nLi,0.15\nDi,0.065\nThi,0\n", run_tricycle,
        ":2: duplicate key 'type'"},
       {"type,tricyc\nngear,1\nencRes,1600\nLi,9.2e18\nDi,0.065\nThi,0\n", run_tricycle,

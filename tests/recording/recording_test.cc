@@ -663,5 +663,14 @@ TEST(RecordingCovarianceTest, OtherColumnsStillMustMatch) {
   EXPECT_THAT(WriteError(recording, dir), HasSubstr("optionally followed by the 21 covariance columns"));
 }
 
+// Found by recording_fuzz's kind of input (csv_fuzz on a YAML file): the parser's message quotes a line break.
+TEST(RecordingTest, UnreadableRecordingYamlIsOneLineNamingTheFile) {
+  TempDir dir;
+  WriteFile(dir.File("recording.yaml"), std::string("\xff\0\n", 3));
+  const std::string error = ReadError(dir);
+  EXPECT_THAT(error, HasSubstr(dir.File("recording.yaml")));
+  EXPECT_EQ(error.find('\n'), std::string::npos) << error;
+}
+
 }  // namespace
 }  // namespace roamlab::recording

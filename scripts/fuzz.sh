@@ -1,0 +1,98 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer harnesses (fuzz/; clang, AddressSanitizer + UndefinedBehaviorSanitizer) into BUILD_DIR, writes
+# their seed corpora and runs each harness, one after another, for FUZZ_SECONDS (docs/reliability.md).
+#   BUILD_DIR      default build-asan (shared with scripts/sanitize.sh)
+#   FUZZ_SECONDS   time per harness, default 30 (-max_total_time)
+#   FUZZ_RUNS      when set: this many executions per harness instead of a time (-runs)
+#   FUZZERS        the harnesses to run (space-separated), default all
+#   JOBS           build parallelism, default the number of cores
+#   ROAMLAB_DATA_DIR  real recordings to cut small seed excerpts from (default ../shared/data; skipped when absent)
+#   ROAMLAB        the command line that simulates the recording seeds (default build/apps/roamlab, the Release build
+#                  of scripts/setup.sh; skipped when absent)
+# The seeds are written to BUILD_DIR/fuzz/seeds/<harness>, what the fuzzers add to BUILD_DIR/fuzz/corpus/<harness>,
+# crash reproducers to BUILD_DIR/fuzz/artifacts/. Exits 1 when a harness finds a crash, a leak or a timeout.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+build_dir=${BUILD_DIR:-build-asan}
+seconds=${FUZZ_SECONDS:-30}
+all=(recording_fuzz ros1_bag_fuzz mcap_fuzz rosbag2_fuzz optiodom_fuzz csv_fuzz scenario_fuzz estimator_config_fuzz
+     regress_suite_fuzz)
+read -r -a fuzzers <<<"${FUZZERS:-${all[*]}}"
+data_dir=${ROAMLAB_DATA_DIR:-../shared/data}
+
+command -v clang++ >/dev/null || { echo "roamlab fuzz: clang++ not found (scripts/setup.sh installs clang)" >&2; exit 1; }
+start=$(date +%s)
+CC=clang CXX=clang++ cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DROAMLAB_SANITIZE=ON \
+  -DROAMLAB_FUZZ=ON >/dev/null
+cmake --build "$build_dir" -j "${JOBS:-$(nproc)}" --target fuzz_seeds "${fuzzers[@]}"
+built=$(date +%s)
+
+work="$build_dir/fuzz"
+seeds="$work/seeds"
+rm -rf "$seeds"
+mkdir -p "$seeds" "$work/artifacts"
+"$build_dir/fuzz/fuzz_seeds" "$seeds"
+mkdir -p "$seeds/scenario_fuzz" "$seeds/estimator_config_fuzz" "$seeds/regress_suite_fuzz"
+cp scenarios/*.yaml "$seeds/scenario_fuzz/"
+cp configs/*.yaml "$seeds/estimator_config_fuzz/"
+cp regression/suite.yaml "$seeds/regress_suite_fuzz/"
+# Simulated recordings, each file cut to its first 12 lines, packed as recording_fuzz reads them.
+roamlab=${ROAMLAB:-build/apps/roamlab}
+if [ -x "$roamlab" ]; then
+  mkdir -p "$seeds/recording_fuzz"
+  for scenario in atv_hills indoor_diffdrive_slip; do
+    rec="$work/simulated/$scenario"
+    rm -rf "$rec"
+    "$roamlab" simulate "scenarios/$scenario.yaml" --out "$rec" --quiet
+    { cat "$rec/recording.yaml"
+      for file in "$rec"/*.csv "$rec"/ground_truth.tum; do
+        [ -f "$file" ] || continue
+        printf '%%%%%%%% %s\n' "$(basename "$file")"; head -n 12 "$file"
+      done; } >"$seeds/recording_fuzz/$scenario"
+  done
+fi
+# Small excerpts of real recordings, when present: the head of each file (never kept in the repository).
+if [ -d "$data_dir" ]; then
+  for meta in $(for robot in diff omni3 omni4 tricyc; do
+                  find "$data_dir/optiodom/data/$robot" -name '*_metadata.csv' 2>/dev/null | sort | head -n 3
+                done); do
+    run=${meta%_metadata.csv}_run-01.csv
+    [ -f "$run" ] || continue
+    { head -n 40 "$run"; printf '%%%%%%%% set_metadata.csv\n'; cat "$meta"; } >"$seeds/optiodom_fuzz/$(basename "$run")"
+  done
+  husky="$data_dir/husky_test1/test1.bag"
+  [ -f "$husky" ] && head -c 65536 "$husky" >"$seeds/ros1_bag_fuzz/husky"
+  mcap="$data_dir/ros2/rosbags_fixture/test_bag_mcap/test_bag_mcap.mcap"
+  [ -f "$mcap" ] && head -c 65536 "$mcap" >"$seeds/mcap_fuzz/fixture"
+  xio="$data_dir/xio_imu_mag/sensor_data.csv"
+  if [ -f "$xio" ]; then
+    { printf 'time: {column: 0, unit: s}\ncsv: {header: true}\nstreams:\n'
+      printf '  imu: {type: imu, columns: [1, 2, 3, 4, 5, 6], units: [deg/s, deg/s, deg/s, g, g, g]}\n'
+      printf '  magnetometer: {type: magnetometer, columns: [7, 8, 9], units: uT}\n'
+      printf '%%%%%%%% a.csv\n'; head -n 40 "$xio"; } >"$seeds/csv_fuzz/xio"
+  fi
+fi
+
+failed=()
+for f in "${fuzzers[@]}"; do
+  mkdir -p "$work/corpus/$f"
+  limit=(-max_total_time="$seconds")
+  [ -n "${FUZZ_RUNS:-}" ] && limit=(-runs="$FUZZ_RUNS")
+  log="$work/$f.log"
+  if "$build_dir/fuzz/$f" "${limit[@]}" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+      -artifact_prefix="$work/artifacts/$f-" "$work/corpus/$f" "$seeds/$f" >"$log" 2>&1; then
+    status=ok
+  else
+    status=FAILED
+    failed+=("$f")
+    tail -n 40 "$log" >&2
+  fi
+  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo "?")
+  echo "roamlab fuzz: $f: $status, $runs executions (log $log)"
+done
+echo "roamlab fuzz: build $((built - start)) s, total $(($(date +%s) - start)) s"
+if ((${#failed[@]})); then
+  echo "roamlab fuzz: failed: ${failed[*]} (reproducers in $work/artifacts)" >&2
+  exit 1
+fi

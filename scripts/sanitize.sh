@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Builds the libraries and the tests of the parsers, the recording and the estimator core with AddressSanitizer and
+# UndefinedBehaviorSanitizer (clang; any finding fails the test) into BUILD_DIR and runs them (none of them carries the
+# ctest label slow). The build is shared with scripts/fuzz.sh. docs/reliability.md gives the times.
+#   BUILD_DIR  default build-asan
+#   TESTS      the test binaries (space-separated), default the list below
+#   JOBS       build and test parallelism, default the number of cores
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+build_dir=${BUILD_DIR:-build-asan}
+default_tests=(common_test recording_test importers_test estimator_test regress_suite_test)
+read -r -a tests <<<"${TESTS:-${default_tests[*]}}"
+jobs=${JOBS:-$(nproc)}
+
+command -v clang++ >/dev/null || { echo "roamlab sanitize: clang++ not found (scripts/setup.sh installs clang)" >&2; exit 1; }
+start=$(date +%s)
+CC=clang CXX=clang++ cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DROAMLAB_SANITIZE=ON \
+  -DROAMLAB_FUZZ=ON >/dev/null
+cmake --build "$build_dir" -j "$jobs" --target "${tests[@]}"
+built=$(date +%s)
+# Leaks are errors; a finding stops the test with its report (ASAN_OPTIONS / UBSAN_OPTIONS).
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:strict_string_checks=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+failed=()
+for t in "${tests[@]}"; do
+  binary=$(find "$build_dir/tests" -type f -name "$t" | head -n 1)
+  t0=$(date +%s)
+  if "$binary" --gtest_brief=1 >"$build_dir/$t.sanitize.log" 2>&1; then status=ok; else status=FAILED; failed+=("$t"); fi
+  [ "$status" = ok ] || tail -n 60 "$build_dir/$t.sanitize.log" >&2
+  echo "roamlab sanitize: $t: $status in $(($(date +%s) - t0)) s (log $build_dir/$t.sanitize.log)"
+done
+echo "roamlab sanitize: build $((built - start)) s, tests $(($(date +%s) - built)) s"
+if ((${#failed[@]})); then
+  echo "roamlab sanitize: failed: ${failed[*]}" >&2
+  exit 1
+fi
