@@ -200,8 +200,8 @@ void AddDiagnose(CLI::App* app, Commands* commands) {
         ->check(CLI::IsMember({"auto", "white", "hac"}));
     dia->add_flag("--no-plots", args->no_plots, "No figures");
     dia->add_flag("--replay", args->replay,
-                  "Also diagnose against the scenario's noise-free twin into OUT/twin.json (a recording of the "
-                  "scenario's own drive only)");
+                  "Also diagnose against the scenario's noise-free twin into OUT/twin.json (its simulation of the "
+                  "scenario's own drive, else its replay of the recorded drive)");
     dia->add_flag("--quiet", args->quiet, "No progress and no summary");
     return dia;
   });

@@ -13,6 +13,7 @@
 #include "gap/resimulate.h"
 #include "gap/twin.h"
 #include "recording/recording.h"
+#include "sim/replay.h"
 #include "sim/scenario.h"
 
 namespace roamlab::experiment {
@@ -95,31 +96,34 @@ Result<gap::Baseline> NominalBaseline(const DiagnoseRequest& request, const Inpu
   return std::move(learned).value().baseline;
 }
 
-// Whether the scenario's plain noise-free simulation is the recording's twin (a recording of its own drive): bad input
-// otherwise, before anything long runs.
-Outcome CheckTwinDrive(const DiagnoseRequest& request, const Inputs& in) {
-  if (!in.scenario) return Outcome::BadInput(Status::Error("--replay needs --scenario"));
+// The twin's runner: the scenario's plain noise-free simulation when the recording is of its own drive (detected by
+// gap::DriveMismatch), else the replay of the recorded drive (sim/replay.h; bad input when the recording has no drive
+// inputs). `replayed` says which.
+Result<gap::TwinRunner> ChooseTwinRunner(const DiagnoseRequest& request, const Inputs& in, bool* replayed,
+                                         const std::function<void(const std::string&)>& say) {
+  if (!in.scenario) return Status::Error("--replay needs --scenario");
   sim::Scenario nominal = *in.scenario;
   nominal.effects.clear();
   nominal.duration_s = std::max(in.span_s, 1.0);
   auto twin = gap::PlainSimulationRunner()(nominal);
-  if (!twin.ok()) return Outcome::Failed(Status::Error("the nominal twin: " + twin.status().message()));
-  const std::string mismatch = gap::DriveMismatch(in.recording, twin.value());
-  if (!mismatch.empty())
-    return Outcome::BadInput(Status::Error(request.recording + ": not a recording of " + request.scenario +
-                                           "'s own drive (" + mismatch +
-                                           "); --replay needs the replay of the recorded drive, not available"));
-  return Outcome::Ok();
+  const std::string mismatch = twin.ok() ? gap::DriveMismatch(in.recording, twin.value()) : twin.status().message();
+  *replayed = !mismatch.empty();
+  if (!*replayed) return gap::PlainSimulationRunner();
+  if (auto inputs = sim::DriveInputsFrom(in.recording, *in.scenario); !inputs.ok())
+    return Status::Error(request.recording + ": " + inputs.status().message());
+  say("not a recording of the scenario's own drive (" + mismatch + "): the twin replays the recorded drive");
+  return gap::ReplayRunner(in.recording);
 }
 
-// The diagnosis against the scenario's twin (its plain noise-free simulation) into out/twin.json.
-Outcome DiagnoseTwinToFile(const DiagnoseRequest& request, const Inputs& in,
-                           const std::function<void(const std::string&)>& say) {
-  say("diagnosing " + request.recording + " against the scenario's twin");
+// The diagnosis against the scenario's twin (runner: ChooseTwinRunner) into out/twin.json.
+Outcome DiagnoseTwinToFile(const DiagnoseRequest& request, const Inputs& in, const gap::TwinRunner& runner,
+                           bool replayed, const std::function<void(const std::string&)>& say) {
+  say("diagnosing " + request.recording + " against the scenario's twin" + (replayed ? " (replayed)" : ""));
   gap::TwinDiagnoseOptions options;
+  options.replayed = replayed;
   options.progress = [&](const std::string& line) { say("  " + line); };
   if (request.max_shift_s) options.max_shift_s = *request.max_shift_s;
-  auto diagnosed = gap::DiagnoseTwin(*in.scenario, in.recording, gap::PlainSimulationRunner(), options);
+  auto diagnosed = gap::DiagnoseTwin(*in.scenario, in.recording, runner, options);
   if (!diagnosed.ok()) return Outcome::Failed(Status::Error("twin: " + diagnosed.status().message()));
   const std::string path = (std::filesystem::path(request.out) / "twin.json").string();
   std::ofstream out(path);
@@ -148,8 +152,13 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
   auto inputs = LoadInputs(request);
   if (!inputs.ok()) return Outcome::BadInput(inputs.status());
   const Inputs& in = inputs.value();
-  if (request.replay)
-    if (Outcome checked = CheckTwinDrive(request, in); !checked.ok()) return checked;
+  gap::TwinRunner twin_runner;
+  bool replayed = false;
+  if (request.replay) {
+    auto runner = ChooseTwinRunner(request, in, &replayed, say);
+    if (!runner.ok()) return Outcome::BadInput(runner.status());
+    twin_runner = std::move(runner).value();
+  }
   gap::DiagnoseOptions options;
   options.progress = [&](const std::string& line) { say("  " + line); };
   if (request.max_shift_s) options.max_shift_s = *request.max_shift_s;
@@ -189,7 +198,7 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
   report.progress = say;
   if (Status s = gap::WriteReport(d, report, request.out); !s.ok()) return Outcome::Failed(s);
   if (request.replay)
-    if (Outcome twin = DiagnoseTwinToFile(request, in, say); !twin.ok()) return twin;
+    if (Outcome twin = DiagnoseTwinToFile(request, in, twin_runner, replayed, say); !twin.ok()) return twin;
   if (diagnosis) *diagnosis = std::move(diagnosed).value();
   return Outcome::Ok();
 }

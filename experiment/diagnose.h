@@ -39,9 +39,9 @@ struct DiagnoseRequest {
   std::optional<double> max_shift_s;  // the time-shift search range (default gap::DiagnoseOptions')
   std::string std_method = "auto";    // the effects' std: auto | white | hac (gap/diagnose.h)
   bool no_plots = false;              // no figures beside report.md
-  // Also diagnose against the twin (gap/twin.h) and write out/twin.json. The twin is the plain noise-free simulation
-  // of the scenario, so this needs a scenario and a recording of the scenario's own drive (gap::DriveMismatch; bad
-  // input otherwise): the replay of another recorded drive is not available.
+  // Also diagnose against the twin (gap/twin.h) and write out/twin.json. Needs a scenario. The twin is the plain
+  // noise-free simulation of the scenario for a recording of its own drive (gap::DriveMismatch), else the replay of
+  // the recorded drive (sim/replay.h; bad input when the recording has no drive inputs).
   bool replay = false;
   std::function<void(const std::string& line)> progress;  // optional
 };

@@ -55,6 +55,9 @@ using TwinRunner = std::function<Result<recording::Recording>(const sim::Scenari
 
 // Runs `patched` without noise with sim::Simulate: the twin of a recording of the scenario's own drive.
 TwinRunner PlainSimulationRunner();
+// Replays `patched` with the drive inputs of `real` (sim/replay.h) up to the recording time patched.duration_s: the
+// twin of any recording with drive inputs. Keeps its own copy of the recording.
+TwinRunner ReplayRunner(const recording::Recording& real);
 
 // Whether `twin` follows the drive of `real`: for each wheel stream in both (wheel_encoders, steering), the change of
 // every column over consecutive kDriveWindowS windows of their common stamps, real against twin: relative RMS

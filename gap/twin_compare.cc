@@ -2,6 +2,7 @@
 // covariance and the plain-simulation runner.
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <optional>
 
 #include <Eigen/Geometry>
@@ -9,6 +10,7 @@
 #include "estimator/models/enu.h"
 #include "gap/internal/twin_residuals.h"
 #include "gap/twin.h"
+#include "sim/replay.h"
 #include "sim/simulator.h"
 
 namespace roamlab::gap {
@@ -197,6 +199,17 @@ TwinRunner PlainSimulationRunner() {
     auto simulation = sim::Simulate(patched, options);
     if (!simulation.ok()) return simulation.status();
     return std::move(simulation.value().recording);
+  };
+}
+
+TwinRunner ReplayRunner(const recording::Recording& real) {
+  auto recorded = std::make_shared<const recording::Recording>(real);
+  return [recorded](const sim::Scenario& patched) -> Result<recording::Recording> {
+    sim::ReplayOptions options;
+    options.to_s = patched.duration_s;
+    auto replayed = sim::Replay(patched, *recorded, options);
+    if (!replayed.ok()) return replayed.status();
+    return std::move(replayed.value().recording);
   };
 }
 
