@@ -136,12 +136,14 @@ TEST(DiagnoseCliTest, RefusesAShiftRangeTheRecordingCannotHold) {
   }
 }
 
-// indoor_diffdrive_gap.yaml shortened to 3 s with its turn-rate profile's amplitude `turn_radps`, written to `name`.
-std::string DiffDrive(const testing::TempDir& dir, const std::string& turn_radps, const std::string& name) {
+// indoor_diffdrive_gap.yaml shortened to `duration_s` with its turn-rate profile's amplitude `turn_radps`, written to
+// `name`.
+std::string DiffDrive(const testing::TempDir& dir, const std::string& turn_radps, const std::string& name,
+                      const std::string& duration_s = "3.0") {
   std::string text = testing::ReadFile(Source("scenarios/indoor_diffdrive_gap.yaml"));
   for (const auto& [a, b] : std::vector<std::pair<std::string, std::string>>{
            {"model: ../models/diffdrive.xml", "model: " + Source("models/diffdrive.xml")},
-           {"duration_s: 30.0", "duration_s: 3.0"},
+           {"duration_s: 30.0", "duration_s: " + duration_s},
            {"amplitude: 0.6, period_s: 11.0", "amplitude: " + turn_radps + ", period_s: 11.0"}}) {
     const std::size_t at = text.find(a);
     EXPECT_NE(at, std::string::npos) << a;
@@ -153,8 +155,9 @@ std::string DiffDrive(const testing::TempDir& dir, const std::string& turn_radps
 
 TEST(DiagnoseCliTest, ReplayReplaysARecordingOfAnotherDrive) {
   testing::TempDir dir;
-  const std::string nominal = DiffDrive(dir, "0.6", "nominal.yaml");
-  const std::string other = DiffDrive(dir, "-0.6", "other.yaml");
+  // Long enough for the estimator's held-out part.
+  const std::string nominal = DiffDrive(dir, "0.6", "nominal.yaml", "9.0");
+  const std::string other = DiffDrive(dir, "-0.6", "other.yaml", "9.0");
   ASSERT_EQ(Roamlab("simulate " + other + " --out " + dir.File("rec") + " --quiet", dir).exit_code, 0);
   const CommandRun run = Roamlab("diagnose --real " + dir.File("rec") + " --scenario " + nominal + " --out " +
                                      dir.File("out") + " --replay --no-baseline",
