@@ -90,8 +90,11 @@ std::vector<double> ColumnSigmas(const recording::StreamInfo& info) {
     }
     case StreamType::kGps:
     case StreamType::kPosition:
-    case StreamType::kPose:
       return repeat(Noise(info, "sigma_m"), 3);
+    case StreamType::kPose:
+      // x and y only: the height of a pose is that of the stream's reference point, which motion capture of a planar
+      // robot does not state (an imported OptiOdom run writes 0).
+      return repeat(Noise(info, "position_m") > 0.0 ? Noise(info, "position_m") : Noise(info, "sigma_m"), 2);
     case StreamType::kOdometry:
     case StreamType::kVisualOdometry:
     case StreamType::kScanMatching: {

@@ -3,11 +3,11 @@
 //
 // A stream is compared when the recording states its noise (recording.yaml `noise`): the imu's gyro_sigma_radps and
 // accel_sigma_mps2 (compared as two series, "gyroscope" and "accelerometer"), sigma_m of a gps fix per ENU axis and
-// of a position or pose stream's x y z, sigma_mps and sigma_radps of the velocity streams, a wheel encoder's tick /
-// sqrt(12) (cumulative angles in rad with ticks_per_revolution) or its one stated sigma, and the one stated sigma of
-// the other single-noise streams (gyroscope, accelerometer, magnetometer, steering). A gps fix is compared in the
-// real recording's ENU frame (its origin). A sample of the real recording is matched by its exact stamp; a twin
-// without that stamp leaves the entry NaN.
+// of a position stream's x y z, position_m (or sigma_m) of a pose stream's x y (not its height), sigma_mps and
+// sigma_radps of the velocity streams, a wheel encoder's tick / sqrt(12) (cumulative angles in rad with
+// ticks_per_revolution) or its one stated sigma, and the one stated sigma of the other single-noise streams (gyroscope,
+// accelerometer, magnetometer, steering). A gps fix is compared in the real recording's ENU frame (its origin). A
+// sample of the real recording is matched by its exact stamp; a twin without that stamp leaves the entry NaN.
 #pragma once
 
 #include <map>
