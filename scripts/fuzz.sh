@@ -6,7 +6,8 @@
 #   FUZZ_RUNS      when set: this many executions per harness instead of a time (-runs)
 #   FUZZERS        the harnesses to run (space-separated), default all
 #   JOBS           build parallelism, default the number of cores
-#   ROAMLAB_DATA_DIR  real recordings to cut small seed excerpts from (default ../shared/data; skipped when absent)
+#   ROAMLAB_DATA_DIR  real recordings to cut small seed excerpts from (default: the data directory the tests read,
+#                     ROAMLAB_SHARED_DIR/data in tests/CMakeLists.txt; skipped when absent)
 #   ROAMLAB        the command line that simulates the recording seeds (default build/apps/roamlab, the Release build
 #                  of scripts/setup.sh; skipped when absent)
 # The seeds are written to BUILD_DIR/fuzz/seeds/<harness>, what the fuzzers add to BUILD_DIR/fuzz/corpus/<harness>,
