@@ -14,7 +14,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/atomic_file.h"
 #include "common/html.h"
+#include "common/json.h"
 #include "estimator/calibration.h"
 #include "estimator/calibration_io.h"
 #include "estimator/config.h"
@@ -25,9 +27,10 @@
 #include "sim/simulator.h"
 
 namespace roamlab::experiment {
-namespace {
 
 using Values = std::map<std::string, Eigen::VectorXd>;
+
+namespace {
 
 struct RunResult {
   eval::RunNees nees;
@@ -134,9 +137,11 @@ Outcome CalibrateOnce(const MonteCarloOptions& options, std::uint64_t seed, cons
   return outcome;
 }
 
+}  // namespace
+
 // What every run shares: the scenario, the tracking configuration and calibration, and (calibrate_each_run) the warm
 // calibration configuration each run calibrates its own drive with.
-struct Shared {
+struct MonteCarloShared {
   sim::Scenario scenario;
   estimator::EstimatorConfig config;
   Values calibration;
@@ -145,8 +150,10 @@ struct Shared {
   estimator::EstimatorConfig warm;
 };
 
+namespace {
+
 // The inputs every run shares, read (and, with tracking.calibrate, calibrated once) before any run.
-Outcome Prepare(const MonteCarloOptions& options, Shared* shared) {
+Outcome Prepare(const MonteCarloOptions& options, MonteCarloShared* shared) {
   auto scenario = sim::LoadScenario(options.scenario);
   if (!scenario.ok()) return Outcome::BadInput(scenario.status());
   shared->scenario = std::move(scenario).value();
@@ -161,8 +168,14 @@ Outcome Prepare(const MonteCarloOptions& options, Shared* shared) {
   const std::string& calibrate = shared->config.tracking.calibrate;
   std::string calibration_file = options.calibration;
   if (calibration_file.empty() && !calibrate.empty()) {
-    const Outcome once = CalibrateOnce(options, shared->scenario.seed, calibrate, &calibration_file);
-    if (!once.ok()) return once;
+    const std::string earlier = options.out + "/calibration/calibration.json";
+    if (options.resume && std::filesystem::exists(earlier)) {
+      calibration_file = earlier;
+      if (options.log) options.log("resuming with the calibration of the earlier call (" + earlier + ")");
+    } else if (const Outcome once = CalibrateOnce(options, shared->scenario.seed, calibrate, &calibration_file);
+               !once.ok()) {
+      return once;
+    }
   }
   if (!calibration_file.empty()) {
     auto values = estimator::ReadCalibrationValues(calibration_file);
@@ -185,7 +198,7 @@ Outcome Prepare(const MonteCarloOptions& options, Shared* shared) {
 }
 
 // Run i: with its own calibration (per_run) or the shared one.
-RunResult RunOne(const MonteCarloOptions& options, const Shared& shared, int i) {
+RunResult RunOne(const MonteCarloOptions& options, const MonteCarloShared& shared, int i) {
   if (!shared.per_run)
     return OneRun(shared.scenario, shared.config, shared.calibration, shared.tracking, options.seed_base + i);
   auto own = CalibrateRun(shared.scenario, shared.warm, shared.config.tracking.calibration_prior,
@@ -198,26 +211,98 @@ RunResult RunOne(const MonteCarloOptions& options, const Shared& shared, int i) 
   return OneRun(shared.scenario, shared.config, own.value().values, own.value().options, options.seed_base + i);
 }
 
-// The runs spread over worker threads; each writes only its own slot, so the result does not depend on scheduling.
-std::vector<RunResult> RunAll(const MonteCarloOptions& options, const Shared& shared) {
+// Run i's result file content (MonteCarloRunFile).
+nlohmann::json RunJson(int i, std::uint64_t seed, const RunResult& r) {
+  nlohmann::json t = nlohmann::json::array();
+  for (Time time : r.nees.t) t.push_back(time.nanoseconds());
+  return {{"run", i},
+          {"seed", seed},
+          {"ate_m", Number(r.nees.ate_m)},
+          {"mean_nees", Number(r.nees.mean_nees)},
+          {"track_seconds", r.track_seconds},
+          {"t_ns", t},
+          {"nees", NumberArray(r.nees.nees)}};
+}
+
+// j[key], or null when j has no such key (operator[] on a const object must not be asked for a missing key).
+const nlohmann::json& Field(const nlohmann::json& j, const char* key) {
+  static const nlohmann::json kNull;
+  const auto it = j.find(key);
+  return it == j.end() ? kNull : *it;
+}
+
+// A number of a run file, null read as NaN (Number writes what is not finite as null).
+bool ReadNumber(const nlohmann::json& value, double* out) {
+  if (value.is_null()) {
+    *out = std::numeric_limits<double>::quiet_NaN();
+    return true;
+  }
+  if (!value.is_number()) return false;
+  *out = value.get<double>();
+  return true;
+}
+
+// The numbers of a run file's "t_ns" and "nees" arrays, of equal length; false when malformed.
+bool ReadSeries(const nlohmann::json& j, eval::RunNees* nees) {
+  const nlohmann::json& t = Field(j, "t_ns");
+  const nlohmann::json& values = Field(j, "nees");
+  if (!t.is_array() || !values.is_array() || t.size() != values.size()) return false;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    double value = 0.0;
+    if (!t[k].is_number_integer() || !ReadNumber(values[k], &value)) return false;
+    nees->t.push_back(Time::FromNanoseconds(t[k].get<std::int64_t>()));
+    nees->nees.push_back(value);
+  }
+  return true;
+}
+
+// Reads run i's result file; an error names the file and what is wrong with it.
+Result<RunResult> ReadRun(const std::string& path, int i, std::uint64_t seed) {
+  if (!std::filesystem::exists(path))
+    return Status::Error(path + ": missing: run " + std::to_string(i) + " has no result (--resume runs it)");
+  Result<std::string> text = ReadWholeFile(path);
+  if (!text.ok()) return text.status();
+  const nlohmann::json j = nlohmann::json::parse(text.value(), nullptr, false);
+  RunResult r;
+  const bool ok = j.is_object() && Field(j, "run").is_number_integer() && Field(j, "run").get<std::int64_t>() == i &&
+                  Field(j, "seed").is_number_unsigned() && Field(j, "seed").get<std::uint64_t>() == seed &&
+                  ReadNumber(Field(j, "ate_m"), &r.nees.ate_m) &&
+                  ReadNumber(Field(j, "mean_nees"), &r.nees.mean_nees) && Field(j, "track_seconds").is_number() &&
+                  ReadSeries(j, &r.nees);
+  if (!ok)
+    return Status::Error(path + ": not the result file of run " + std::to_string(i) + " with seed " +
+                         std::to_string(seed) + " (malformed or of another call; delete it to run it again)");
+  r.track_seconds = Field(j, "track_seconds").get<double>();
+  return r;
+}
+
+// Runs `todo` spread over worker threads, each writing its own result file, so the result does not depend on
+// scheduling. A failed run does not stop the others; the outcome names the first (lowest) failed run.
+Outcome RunAll(const MonteCarloOptions& options, const MonteCarloShared& shared, const std::vector<int>& todo) {
+  const int n = static_cast<int>(todo.size());
   const int jobs = options.jobs > 0 ? options.jobs : std::max(1u, std::thread::hardware_concurrency());
-  std::vector<RunResult> results(options.runs);
+  std::vector<Outcome> outcomes(todo.size());
   std::atomic<int> next{0}, done{0};
   std::mutex print;
   const auto worker = [&] {
-    for (int i = next++; i < options.runs; i = next++) {
-      results[i] = RunOne(options, shared, i);
+    for (int k = next++; k < n; k = next++) {
+      outcomes[k] = RunMonteCarloRun(options, shared, todo[k]);
       const int finished = ++done;
       if (options.progress) {
         std::lock_guard<std::mutex> lock(print);
-        options.progress(finished, options.runs);
+        options.progress(finished, n);
       }
     }
   };
   std::vector<std::thread> threads;
-  for (int k = 0; k < std::min(jobs, options.runs); ++k) threads.emplace_back(worker);
+  for (int k = 0; k < std::min(jobs, n); ++k) threads.emplace_back(worker);
   for (auto& th : threads) th.join();
-  return results;
+  const auto failed = std::count_if(outcomes.begin(), outcomes.end(), [](const Outcome& o) { return !o.ok(); });
+  for (const Outcome& o : outcomes)
+    if (!o.ok())
+      return Outcome::Failed(Status::Error(std::to_string(failed) + " of " + std::to_string(n) +
+                                           " runs failed; first: " + o.status.message()));
+  return Outcome::Ok();
 }
 
 std::string Format(double x, const char* format = "%.4g") {
@@ -286,23 +371,67 @@ std::string MonteCarloOptions::Validate() const {
   return "";
 }
 
-Outcome RunMonteCarlo(const MonteCarloOptions& options, MonteCarloSummary* summary) {
+std::string MonteCarloRunFile(const std::string& out, int i) {
+  char name[32];
+  std::snprintf(name, sizeof name, "/runs/%06d.json", i);
+  return out + name;
+}
+
+Outcome PrepareMonteCarlo(const MonteCarloOptions& options, std::shared_ptr<const MonteCarloShared>* shared) {
   if (const std::string problem = options.Validate(); !problem.empty())
     return Outcome::BadInput(Status::Error(problem));
-  Shared shared;
-  if (Outcome prepared = Prepare(options, &shared); !prepared.ok()) return prepared;
+  auto prepared = std::make_shared<MonteCarloShared>();
+  if (Outcome outcome = Prepare(options, prepared.get()); !outcome.ok()) return outcome;
+  if (const Status dir = MakeOutputDirectory(options.out + "/runs"); !dir.ok()) return Outcome::BadInput(dir);
+  *shared = std::move(prepared);
+  return Outcome::Ok();
+}
 
-  const std::vector<RunResult> results = RunAll(options, shared);
+Outcome RunMonteCarloRun(const MonteCarloOptions& options, const MonteCarloShared& shared, int i) {
+  const RunResult r = RunOne(options, shared, i);
+  if (!r.error.empty()) return Outcome::Failed(Status::Error("run " + std::to_string(i) + ", " + r.error));
+  const Status written =
+      WriteFileAtomically(MonteCarloRunFile(options.out, i), RunJson(i, options.seed_base + i, r).dump() + "\n");
+  return written.ok() ? Outcome::Ok() : Outcome::Failed(written);
+}
+
+std::vector<int> MissingMonteCarloRuns(const MonteCarloOptions& options) {
+  std::vector<int> missing;
+  for (int i = 0; i < options.runs; ++i)
+    if (!std::filesystem::exists(MonteCarloRunFile(options.out, i))) missing.push_back(i);
+  return missing;
+}
+
+Outcome AggregateMonteCarlo(const MonteCarloOptions& options, MonteCarloSummary* summary) {
+  std::vector<RunResult> results;
   std::vector<eval::RunNees> runs;
-  for (const RunResult& r : results) {
-    if (!r.error.empty()) return Outcome::Failed(Status::Error(r.error));
-    runs.push_back(r.nees);
+  for (int i = 0; i < options.runs; ++i) {
+    Result<RunResult> r = ReadRun(MonteCarloRunFile(options.out, i), i, options.seed_base + i);
+    if (!r.ok()) return Outcome::Failed(r.status());
+    runs.push_back(r.value().nees);
+    results.push_back(std::move(r).value());
   }
   Result<eval::MonteCarloNees> nees = eval::AggregateRunNees(runs, options.t0_s);
   if (!nees.ok()) return Outcome::Failed(nees.status());
   const std::string plot_note = WriteOutputs(options, nees.value(), results);
   if (summary) *summary = {std::move(nees).value(), plot_note};
   return Outcome::Ok();
+}
+
+Outcome RunMonteCarlo(const MonteCarloOptions& options, MonteCarloSummary* summary) {
+  std::shared_ptr<const MonteCarloShared> shared;
+  if (Outcome prepared = PrepareMonteCarlo(options, &shared); !prepared.ok()) return prepared;
+  std::vector<int> todo;
+  if (options.resume) {
+    todo = MissingMonteCarloRuns(options);
+    if (options.log)
+      options.log(std::to_string(options.runs - static_cast<int>(todo.size())) + " of " + std::to_string(options.runs) +
+                  " runs already have their result file");
+  } else {
+    for (int i = 0; i < options.runs; ++i) todo.push_back(i);
+  }
+  if (Outcome ran = RunAll(options, *shared, todo); !ran.ok()) return ran;
+  return AggregateMonteCarlo(options, summary);
 }
 
 }  // namespace roamlab::experiment

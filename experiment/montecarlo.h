@@ -3,7 +3,9 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "eval/nees.h"
 #include "experiment/steps.h"
@@ -26,6 +28,10 @@ struct MonteCarloOptions {
   // With tracking.calibrate and no calibration file: one calibration per run on its own calibration drive instead of
   // one shared by every run (the seed's protocol; see RunMonteCarlo).
   bool calibrate_each_run = false;
+  // Runs whose result file (MonteCarloRunFile) exists are not run again, and the shared calibration an earlier call
+  // wrote to OUT/calibration/calibration.json is read instead of calibrating again: the summary is the one an
+  // uninterrupted call writes.
+  bool resume = false;
   std::function<void(const std::string& line)> log;      // optional: what is being done, one line at a time
   std::function<void(int finished, int runs)> progress;  // optional: after each run
 
@@ -38,11 +44,31 @@ struct MonteCarloSummary {
   std::string plot_note;  // "" or why OUT/nees.png (or OUT/report.html) was not written, as " (...)"
 };
 
+// Run i's result file, OUT/runs/NNNNNN.json (six digits): {"run", "seed", "ate_m", "mean_nees", "track_seconds",
+// "t_ns": [...], "nees": [...]} (a NEES that is not finite as null), written under a temporary name and renamed.
+std::string MonteCarloRunFile(const std::string& out, int i);
+
+// The inputs every run shares: scenario, configurations and calibration.
+struct MonteCarloShared;
+
+// Reads the shared inputs and, with tracking.calibrate and no calibration file, calibrates once into OUT/calibration
+// (with `resume`, reads the calibration an earlier call wrote there when it exists).
+Outcome PrepareMonteCarlo(const MonteCarloOptions& options, std::shared_ptr<const MonteCarloShared>* shared);
+// Runs run i (0 <= i < runs) and writes its result file; a failed run writes none. Safe to call from several threads.
+Outcome RunMonteCarloRun(const MonteCarloOptions& options, const MonteCarloShared& shared, int i);
+// The runs in [0, runs) whose result file does not exist, in increasing order.
+std::vector<int> MissingMonteCarloRuns(const MonteCarloOptions& options);
+// Reads every run's result file and writes the summaries (nees.json, runs.json, nees.png, report.html): the same
+// bytes whichever process or host ran each run. A missing or malformed result file is an error naming it.
+Outcome AggregateMonteCarlo(const MonteCarloOptions& options, MonteCarloSummary* summary = nullptr);
+
 // Simulates `runs` noise realizations of the scenario (the terrain and the drive stay the same), tracks each online,
-// computes the position NEES (eq. 16) of every pose against the truth, and writes OUT/nees.json
+// computes the position NEES (eq. 16) of every pose against the truth, writes each run's result file and from them
+// OUT/nees.json
 // ({"runs", "dof", "band", "t", "mean_nees", "fraction_in_band", ...}), OUT/runs.json (per-run ATE and mean NEES),
 // OUT/nees.png and OUT/report.html (the in-band fraction, the per-run table and the figure on one page). Runs are
-// spread over `jobs` threads; results do not depend on the number of jobs. Calibration (the configuration's
+// spread over `jobs` threads; results do not depend on the number of jobs. A run that fails does not stop the others;
+// the call then fails naming the first failed run and writes no summary. Calibration (the configuration's
 // tracking.calibrate, when no calibration file is given): by default one calibration of the scenario simulated with its
 // own noise seed, shared by every run (the seed's protocol). Its error is then one draw common to all runs, so the
 // average NEES tests that draw as much as the tracker (the band assumes independent runs). With calibrate_each_run, run
