@@ -1,14 +1,17 @@
 #include "apps/montecarlo.h"
 
-#include <cstdio>
 #include <iostream>
 
 #include "apps/cli.h"
+#include "batch/slurm.h"
+#include "batch/work.h"
 #include "experiment/montecarlo.h"
 
 namespace roamlab::apps {
+namespace {
 
-int RunMonteCarlo(const MonteCarloArgs& args) {
+// The local backend: the runs on this host's threads, with a progress bar.
+int RunLocally(const MonteCarloArgs& args, batch::Work& work) {
   experiment::MonteCarloOptions options = args;
   bool bar = false;
   if (!args.quiet) {
@@ -20,17 +23,25 @@ int RunMonteCarlo(const MonteCarloArgs& args) {
       bar = true;
     };
   }
+  (void)batch::WriteLocalBatchFile(work, "running", "");
   experiment::MonteCarloSummary summary;
   const experiment::Outcome outcome = experiment::RunMonteCarlo(options, &summary);
   if (bar) std::cerr << "\n";
+  const std::string headline = outcome.ok() ? batch::MonteCarloHeadline(args, summary) : outcome.status.message();
+  if (!outcome.bad_input) (void)batch::WriteLocalBatchFile(work, outcome.ok() ? "done" : "failed", headline);
   if (!outcome.ok()) return Exit(args.err, "montecarlo", outcome);
-  if (args.quiet) return 0;
-  const eval::MonteCarloNees& nees = summary.nees;
-  std::printf(
-      "%d runs: mean NEES in the 95%% band [%.3f, %.3f] for %.1f%% of the time steps after %.1f s; wrote %s%s\n",
-      args.runs, nees.band.lo, nees.band.hi, 100.0 * nees.fraction_in_band, args.t0_s,
-      (args.out + "/nees.json").c_str(), summary.plot_note.c_str());
+  if (!args.quiet) std::cout << headline << "\n";
   return 0;
+}
+
+}  // namespace
+
+int RunMonteCarlo(const MonteCarloArgs& args) {
+  if (const std::string problem = args.Validate(); !problem.empty()) return BadInput(args.err, "montecarlo", problem);
+  const std::unique_ptr<batch::Work> work = batch::MonteCarloWork(args);
+  if (args.backend.backend == "slurm")
+    return SubmitBatch(*work, args.backend, args.resume, args.quiet, args.err, "montecarlo");
+  return RunLocally(args, *work);
 }
 
 }  // namespace roamlab::apps

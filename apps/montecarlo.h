@@ -3,18 +3,20 @@
 
 #include <iosfwd>
 
+#include "apps/batch.h"
 #include "experiment/montecarlo.h"
 
 namespace roamlab::apps {
 
 // The runner's options (without log and progress, which the command sets).
 struct MonteCarloArgs : experiment::MonteCarloOptions {
+  BackendArgs backend;
   bool quiet = false;           // no progress bar and no summary
   std::ostream* err = nullptr;  // receives the one-line error; nullptr: stderr
 };
 
-// Runs experiment::RunMonteCarlo and prints a progress bar and a one-line summary. Exit code 0; 2 on bad input; 1
-// when a run fails.
+// Runs experiment::RunMonteCarlo and prints a progress bar and a one-line summary (local backend), or submits it to
+// Slurm (batch/slurm.h). Exit code 0; 2 on bad input; 1 when a run fails.
 int RunMonteCarlo(const MonteCarloArgs& args);
 
 }  // namespace roamlab::apps

@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "apps/batch.h"
 #include "apps/commands.h"
 #include "apps/diagnose.h"
 #include "apps/evaluate.h"
@@ -140,6 +141,23 @@ void AddEvaluate(CLI::App* app, Commands* commands) {
   });
 }
 
+// --backend and the Slurm options of a batch command (apps/batch.h, batch/slurm.h).
+void AddBackendOptions(CLI::App* app, BackendArgs* b) {
+  app->add_option("--backend", b->backend, "local (this host's threads; default) | slurm (one job array)")
+      ->check(CLI::IsMember({"local", "slurm"}));
+  app->add_option("--partition", b->slurm.partition, "slurm: sbatch --partition (default: the cluster's)");
+  app->add_option("--time", b->slurm.time, "slurm: time limit of each task, sbatch --time (e.g. 10:00 or 1-00)");
+  app->add_option("--array-parallelism", b->slurm.array_parallelism,
+                  "slurm: at most N tasks at once (--array=...%N; default no limit)");
+  app->add_option("--runs-per-task", b->slurm.runs_per_task, "slurm: runs each array task runs in turn (default 1)");
+  app->add_option("--retries", b->slurm.retries,
+                  "slurm: times the runs of a failed, timed-out or cancelled task are submitted again (default 1)");
+  app->add_option("--sbatch-arg", b->slurm.sbatch_args,
+                  "slurm: one more sbatch argument for every job, as one word (repeatable): --sbatch-arg=--qos=long")
+      ->allow_extra_args(false);
+  app->add_flag("--wait", b->slurm.wait, "slurm: return once the summary is written (default: after submitting)");
+}
+
 void AddMonteCarlo(CLI::App* app, Commands* commands) {
   Add(commands, RunMonteCarlo, [app](auto* args) {
     CLI::App* mc = app->add_subcommand(
@@ -159,6 +177,7 @@ void AddMonteCarlo(CLI::App* app, Commands* commands) {
     mc->add_flag("--resume", args->resume, "Run only the runs whose result file OUT/runs/NNNNNN.json is missing");
     mc->add_option("--out", args->out, "Output directory: nees.json, runs.json, nees.png, runs/")->required();
     mc->add_flag("--quiet", args->quiet, "No progress bar and no summary");
+    AddBackendOptions(mc, &args->backend);
     return mc;
   });
 }
@@ -359,13 +378,37 @@ void AddFrontEnd(CLI::App* app, Commands* commands) {
   });
 }
 
+// `batch status`, and `batch task` and `batch aggregate`, which the Slurm backend's jobs run.
+void AddBatch(CLI::App* app, Commands* commands) {
+  CLI::App* bat =
+      app->add_subcommand("batch", "Batches of runs (montecarlo, sweep): status, and the Slurm jobs' steps.");
+  bat->require_subcommand(1);
+  Add(commands, RunBatchStatus, [bat](auto* args) {
+    CLI::App* sta = bat->add_subcommand("status", "Runs done, pending or running and failed (with their task logs).");
+    sta->add_option("out", args->out, "The batch's output directory")->required();
+    return sta;
+  });
+  Add(commands, RunBatchTask, [bat](auto* args) {
+    CLI::App* tsk = bat->add_subcommand("task", "Run one Slurm array task's block of runs (the array's job script).");
+    tsk->add_option("out", args->out, "The batch's output directory")->required();
+    tsk->add_option("--index", args->index, "The array task index (SLURM_ARRAY_TASK_ID)")->required();
+    return tsk;
+  });
+  Add(commands, RunBatchAggregate, [bat](auto* args) {
+    CLI::App* agg = bat->add_subcommand(
+        "aggregate", "Submit missing runs again while retries remain, else write the summary (the aggregation job).");
+    agg->add_option("out", args->out, "The batch's output directory")->required();
+    return agg;
+  });
+}
+
 // Registers every command, parses the command line and runs the command it names; the process exit code.
 int RunCommandLine(int argc, char** argv) {
   CLI::App app{"roamlab: mobile-robot pose tracking and sensor self-calibration testbed"};
   app.require_subcommand(1);
   Commands commands;
   for (const auto add : {AddSimulate, AddReplay, AddCalibrate, AddTrack, AddEvaluate, AddMonteCarlo, AddInit,
-                         AddDiagnose, AddGapBenchmark, AddRegress, AddOdometry, AddImport, AddFrontEnd})
+                         AddDiagnose, AddGapBenchmark, AddRegress, AddOdometry, AddImport, AddFrontEnd, AddBatch})
     add(&app, &commands);
 
   try {

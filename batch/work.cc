@@ -1,0 +1,123 @@
+#include "batch/work.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <type_traits>
+#include <utility>
+
+namespace roamlab::batch {
+namespace {
+
+using experiment::Outcome;
+using nlohmann::json;
+
+class MonteCarlo : public Work {
+ public:
+  explicit MonteCarlo(experiment::MonteCarloOptions options) : options_(std::move(options)) {
+    options_.log = nullptr;
+    options_.progress = nullptr;
+  }
+  std::string kind() const override { return "montecarlo"; }
+  int runs() const override { return options_.runs; }
+  const std::string& out() const override { return options_.out; }
+  json ToJson() const override {
+    return {{"kind", kind()},
+            {"scenario", options_.scenario},
+            {"config", options_.config},
+            {"calibration", options_.calibration},
+            {"out", options_.out},
+            {"runs", options_.runs},
+            {"seed_base", options_.seed_base},
+            {"t0_s", options_.t0_s},
+            {"no_time_budget", options_.no_time_budget},
+            {"calibrate_each_run", options_.calibrate_each_run}};
+  }
+  Outcome Prepare(bool resume) override {
+    experiment::MonteCarloOptions options = options_;
+    options.resume = resume;
+    return experiment::PrepareMonteCarlo(options, &shared_);
+  }
+  bool Done(int i) const override { return std::filesystem::exists(experiment::MonteCarloRunFile(options_.out, i)); }
+  Outcome Run(int i) override { return experiment::RunMonteCarloRun(options_, *shared_, i); }
+  Outcome Aggregate(std::string* headline) override {
+    experiment::MonteCarloSummary summary;
+    const Outcome outcome = experiment::AggregateMonteCarlo(options_, &summary);
+    if (outcome.ok()) *headline = MonteCarloHeadline(options_, summary);
+    return outcome;
+  }
+  std::string RunName(int i) const override {
+    return "run " + std::to_string(i) + " (seed " + std::to_string(options_.seed_base + i) + ")";
+  }
+  Status Clear() override {
+    for (int i = 0; i < options_.runs; ++i) {
+      const std::string file = experiment::MonteCarloRunFile(options_.out, i);
+      std::error_code ec;
+      std::filesystem::remove(file, ec);
+      if (ec) return Status::Error(file + ": cannot remove the earlier result file");
+    }
+    return Status::Ok();
+  }
+
+ private:
+  experiment::MonteCarloOptions options_;
+  std::shared_ptr<const experiment::MonteCarloShared> shared_;
+};
+
+// json[key] read into *value when it has the value's type; false otherwise.
+template <typename T>
+bool Read(const json& j, const char* key, T* value) {
+  const auto it = j.find(key);
+  if (it == j.end()) return false;
+  if constexpr (std::is_same_v<T, bool>) {
+    if (!it->is_boolean()) return false;
+  } else if constexpr (std::is_same_v<T, std::string>) {
+    if (!it->is_string()) return false;
+  } else if constexpr (std::is_floating_point_v<T>) {
+    if (!it->is_number()) return false;
+  } else if constexpr (std::is_unsigned_v<T>) {
+    if (!it->is_number_unsigned()) return false;
+  } else {
+    if (!it->is_number_integer()) return false;
+  }
+  *value = it->get<T>();
+  return true;
+}
+
+Result<experiment::MonteCarloOptions> MonteCarloFromJson(const json& j) {
+  experiment::MonteCarloOptions o;
+  const bool ok = Read(j, "scenario", &o.scenario) && Read(j, "config", &o.config) &&
+                  Read(j, "calibration", &o.calibration) && Read(j, "out", &o.out) && Read(j, "runs", &o.runs) &&
+                  Read(j, "seed_base", &o.seed_base) && Read(j, "t0_s", &o.t0_s) &&
+                  Read(j, "no_time_budget", &o.no_time_budget) && Read(j, "calibrate_each_run", &o.calibrate_each_run);
+  if (!ok) return Status::Error("the montecarlo work lacks a key or has one of the wrong type");
+  return o;
+}
+
+}  // namespace
+
+std::string MonteCarloHeadline(const experiment::MonteCarloOptions& options,
+                               const experiment::MonteCarloSummary& summary) {
+  const eval::MonteCarloNees& nees = summary.nees;
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "%d runs: mean NEES in the 95%% band [%.3f, %.3f] for %.1f%% of the time steps after %.1f s; wrote ",
+                options.runs, nees.band.lo, nees.band.hi, 100.0 * nees.fraction_in_band, options.t0_s);
+  return line + options.out + "/nees.json" + summary.plot_note;
+}
+
+std::unique_ptr<Work> MonteCarloWork(experiment::MonteCarloOptions options) {
+  return std::make_unique<MonteCarlo>(std::move(options));
+}
+
+Result<std::unique_ptr<Work>> WorkFromJson(const json& j) {
+  const std::string kind =
+      j.is_object() && j.contains("kind") && j["kind"].is_string() ? j["kind"].get<std::string>() : std::string();
+  if (kind == "montecarlo") {
+    auto options = MonteCarloFromJson(j);
+    if (!options.ok()) return options.status();
+    return MonteCarloWork(std::move(options).value());
+  }
+  return Status::Error("unknown work kind '" + kind + "'");
+}
+
+}  // namespace roamlab::batch
