@@ -369,7 +369,9 @@ int AggregateSlurm(const std::string& out, std::ostream& out_stream, std::ostrea
 Result<BatchStatus> ReadBatchStatus(const std::string& out) {
   auto batch = ReadBatch(out);
   if (!batch.ok()) return batch.status();
-  auto work = WorkFromJson(batch.value()["work"]);
+  nlohmann::json described = batch.value()["work"];
+  described["out"] = out;  // the directory as named here (it may have been moved or copied)
+  auto work = WorkFromJson(described);
   if (!work.ok()) return Status::Error(BatchFile(out) + ": " + work.status().message());
   BatchStatus status;
   status.kind = work.value()->kind();

@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
-# Sets up (scripts/setup.sh) and runs the default test suite, then the quick subset of the regression suite
+# Sets up (scripts/setup.sh) and runs the default test suite, then the cluster tests against a one-node Slurm
+# (scripts/local-slurm.sh, started and stopped here), then the quick subset of the regression suite
 # (regression/suite.yaml, results in BUILD_DIR/regress/). Slow tests carry the ctest label "slow" and are left out
-# unless ROAMLAB_SLOW_TESTS=1; ROAMLAB_FULL_REGRESSION=1 runs every regression case.
+# unless ROAMLAB_SLOW_TESTS=1; ROAMLAB_FULL_REGRESSION=1 runs every regression case. The cluster tests carry the label
+# "slurm"; ROAMLAB_SLURM_TESTS=0 leaves them out (they need root to start the daemons).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 build_dir=${BUILD_DIR:-build}
-exclude=(-LE slow)
-[ "${ROAMLAB_SLOW_TESTS:-0}" = "1" ] && exclude=()
+exclude=(-LE 'slow|slurm')
+[ "${ROAMLAB_SLOW_TESTS:-0}" = "1" ] && exclude=(-LE slurm)
 junit="$(cd "$build_dir" && pwd)/ctest-junit.xml"
 ctest --test-dir "$build_dir" --output-on-failure -j "${JOBS:-$(nproc)}" "${exclude[@]}" --output-junit "$junit"
 # A GoogleTest suite whose SetUpTestSuite fails reports its tests as skipped, which ctest counts as passing; the test
@@ -15,6 +17,14 @@ ctest --test-dir "$build_dir" --output-on-failure -j "${JOBS:-$(nproc)}" "${excl
 if grep -q 'FAILED TEST SUITE' "$junit"; then
   echo "roamlab tests: a test suite's set-up failed and its tests were reported skipped; see $junit" >&2
   exit 1
+fi
+if [ "${ROAMLAB_SLURM_TESTS:-1}" = "1" ]; then
+  export LOCAL_SLURM_DIR=${LOCAL_SLURM_DIR:-$(cd "$build_dir" && pwd)/local-slurm}
+  bash scripts/local-slurm.sh start
+  trap 'bash scripts/local-slurm.sh stop' EXIT
+  eval "$(bash scripts/local-slurm.sh env)"
+  # One at a time: the node's cores run the tasks.
+  ctest --test-dir "$build_dir" --output-on-failure -L slurm --output-junit "$(cd "$build_dir" && pwd)/ctest-slurm-junit.xml"
 fi
 regress=(--quick)
 [ "${ROAMLAB_FULL_REGRESSION:-0}" = "1" ] && regress=()

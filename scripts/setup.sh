@@ -11,6 +11,7 @@ packages=(
   libmujoco-dev libqhull-dev libgl-dev libopengl-dev libegl-dev libegl-mesa0 libgl1-mesa-dri
   libopencv-dev libgtest-dev libgmock-dev gnuplot-nox libceres-dev libbz2-dev
   libsqlite3-dev libzstd-dev liblz4-dev clang libclang-rt-dev
+  slurm-wlm munge
 )
 
 missing=()

@@ -11,9 +11,9 @@
 #include <gtest/gtest.h>
 
 #include "recording/recording.h"
-#include "tests/support/message_writer.h"
-#include "tests/support/bag_writers.h"
 #include "tests/recording/temp_dir.h"
+#include "tests/support/bag_writers.h"
+#include "tests/support/message_writer.h"
 
 namespace roamlab {
 namespace {
