@@ -19,6 +19,7 @@
 #include "apps/odometry.h"
 #include "apps/regress.h"
 #include "apps/simulate.h"
+#include "apps/sweep.h"
 
 namespace roamlab::apps {
 namespace {
@@ -378,6 +379,21 @@ void AddFrontEnd(CLI::App* app, Commands* commands) {
   });
 }
 
+void AddSweep(CLI::App* app, Commands* commands) {
+  Add(commands, RunSweep, [app](auto* args) {
+    CLI::App* swp = app->add_subcommand(
+        "sweep", "Monte-Carlo points over scenario and estimator keys (a grid or a list) x N seeds: table and plots.");
+    swp->add_option("sweep", args->sweep, "Sweep file (SWEEP.yaml)")->required();
+    swp->add_option("--out", args->out, "Output directory: sweep.json, table.csv, plots/, report.html, points/NNN/")
+        ->required();
+    swp->add_option("--jobs", args->jobs, "local: parallel runs of a point (default: one per core)");
+    swp->add_flag("--resume", args->resume, "Run only the runs whose result file is missing");
+    swp->add_flag("--quiet", args->quiet, "No progress lines and no summary");
+    AddBackendOptions(swp, &args->backend);
+    return swp;
+  });
+}
+
 // `batch status`, and `batch task` and `batch aggregate`, which the Slurm backend's jobs run.
 void AddBatch(CLI::App* app, Commands* commands) {
   CLI::App* bat =
@@ -407,8 +423,9 @@ int RunCommandLine(int argc, char** argv) {
   CLI::App app{"roamlab: mobile-robot pose tracking and sensor self-calibration testbed"};
   app.require_subcommand(1);
   Commands commands;
-  for (const auto add : {AddSimulate, AddReplay, AddCalibrate, AddTrack, AddEvaluate, AddMonteCarlo, AddInit,
-                         AddDiagnose, AddGapBenchmark, AddRegress, AddOdometry, AddImport, AddFrontEnd, AddBatch})
+  for (const auto add :
+       {AddSimulate, AddReplay, AddCalibrate, AddTrack, AddEvaluate, AddMonteCarlo, AddInit, AddDiagnose,
+        AddGapBenchmark, AddRegress, AddOdometry, AddImport, AddFrontEnd, AddSweep, AddBatch})
     add(&app, &commands);
 
   try {

@@ -1,5 +1,8 @@
 #include "batch/work.h"
 
+#include "experiment/sweep.h"
+
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <type_traits>
@@ -63,6 +66,60 @@ class MonteCarlo : public Work {
   std::shared_ptr<const experiment::MonteCarloShared> shared_;
 };
 
+// Run r of a sweep is run r % seeds of point r / seeds.
+class Sweep : public Work {
+ public:
+  explicit Sweep(experiment::SweepPlan plan) : plan_(std::move(plan)), seeds_(plan_.montecarlo.runs) {
+    plan_.montecarlo.log = nullptr;
+    plan_.montecarlo.progress = nullptr;
+  }
+  std::string kind() const override { return "sweep"; }
+  int runs() const override { return static_cast<int>(plan_.values.size()) * seeds_; }
+  const std::string& out() const override { return plan_.out; }
+  json ToJson() const override {
+    return {{"kind", kind()},
+            {"out", plan_.out},
+            {"keys", plan_.keys},
+            {"values", plan_.values},
+            {"montecarlo", MonteCarlo(plan_.montecarlo).ToJson()}};
+  }
+  Outcome Prepare(bool resume) override {
+    shared_.assign(plan_.values.size(), nullptr);
+    for (std::size_t p = 0; p < plan_.values.size(); ++p) {
+      experiment::MonteCarloOptions options = Point(static_cast<int>(p));
+      options.resume = resume;
+      if (Outcome o = experiment::PrepareMonteCarlo(options, &shared_[p]); !o.ok()) return o;
+    }
+    return Outcome::Ok();
+  }
+  bool Done(int r) const override {
+    return std::filesystem::exists(experiment::MonteCarloRunFile(Point(r / seeds_).out, r % seeds_));
+  }
+  Outcome Run(int r) override {
+    return experiment::RunMonteCarloRun(Point(r / seeds_), *shared_[r / seeds_], r % seeds_);
+  }
+  Outcome Aggregate(std::string* headline) override {
+    for (int p = 0; p < static_cast<int>(plan_.values.size()); ++p)
+      if (Outcome o = experiment::AggregateMonteCarlo(Point(p)); !o.ok()) return o;
+    return experiment::WriteSweepSummary(plan_, headline);
+  }
+  std::string RunName(int r) const override {
+    return "point " + std::to_string(r / seeds_) + " run " + std::to_string(r % seeds_) + " (seed " +
+           std::to_string(plan_.montecarlo.seed_base + r % seeds_) + ")";
+  }
+  Status Clear() override {
+    for (int p = 0; p < static_cast<int>(plan_.values.size()); ++p)
+      if (Status s = MonteCarlo(Point(p)).Clear(); !s.ok()) return s;
+    return Status::Ok();
+  }
+
+ private:
+  experiment::MonteCarloOptions Point(int p) const { return experiment::SweepPointOptions(plan_, p); }
+  experiment::SweepPlan plan_;
+  int seeds_;
+  std::vector<std::shared_ptr<const experiment::MonteCarloShared>> shared_;
+};
+
 // json[key] read into *value when it has the value's type; false otherwise.
 template <typename T>
 bool Read(const json& j, const char* key, T* value) {
@@ -93,6 +150,30 @@ Result<experiment::MonteCarloOptions> MonteCarloFromJson(const json& j) {
   return o;
 }
 
+// A sweep's plan from its ToJson: the points' keys and values and the Monte-Carlo template.
+Result<experiment::SweepPlan> SweepFromJson(const json& j) {
+  experiment::SweepPlan plan;
+  const auto montecarlo = j.find("montecarlo");
+  if (montecarlo == j.end()) return Status::Error("the sweep work has no montecarlo");
+  auto options = MonteCarloFromJson(*montecarlo);
+  if (!options.ok()) return options.status();
+  plan.montecarlo = std::move(options).value();
+  const auto keys = j.find("keys"), values = j.find("values");
+  const auto strings = [](const json& v) {
+    return v.is_array() && std::all_of(v.begin(), v.end(), [](const json& e) { return e.is_string(); });
+  };
+  if (!Read(j, "out", &plan.out) || keys == j.end() || !strings(*keys) || values == j.end() || !values->is_array())
+    return Status::Error("the sweep work lacks out, keys or values");
+  plan.keys = keys->get<std::vector<std::string>>();
+  for (const json& point : *values) {
+    if (!strings(point) || point.size() != plan.keys.size())
+      return Status::Error("the sweep work has a point without a value per key");
+    plan.values.push_back(point.get<std::vector<std::string>>());
+  }
+  if (plan.values.empty() || plan.montecarlo.runs < 1) return Status::Error("the sweep work has no runs");
+  return plan;
+}
+
 }  // namespace
 
 std::string MonteCarloHeadline(const experiment::MonteCarloOptions& options,
@@ -105,6 +186,8 @@ std::string MonteCarloHeadline(const experiment::MonteCarloOptions& options,
   return line + options.out + "/nees.json" + summary.plot_note;
 }
 
+std::unique_ptr<Work> SweepWork(experiment::SweepPlan plan) { return std::make_unique<Sweep>(std::move(plan)); }
+
 std::unique_ptr<Work> MonteCarloWork(experiment::MonteCarloOptions options) {
   return std::make_unique<MonteCarlo>(std::move(options));
 }
@@ -112,6 +195,11 @@ std::unique_ptr<Work> MonteCarloWork(experiment::MonteCarloOptions options) {
 Result<std::unique_ptr<Work>> WorkFromJson(const json& j) {
   const std::string kind =
       j.is_object() && j.contains("kind") && j["kind"].is_string() ? j["kind"].get<std::string>() : std::string();
+  if (kind == "sweep") {
+    auto plan = SweepFromJson(j);
+    if (!plan.ok()) return plan.status();
+    return SweepWork(std::move(plan).value());
+  }
   if (kind == "montecarlo") {
     auto options = MonteCarloFromJson(j);
     if (!options.ok()) return options.status();

@@ -13,6 +13,7 @@
 #include "common/status.h"
 #include "experiment/montecarlo.h"
 #include "experiment/steps.h"
+#include "experiment/sweep.h"
 
 namespace roamlab::batch {
 
@@ -45,6 +46,10 @@ std::string MonteCarloHeadline(const experiment::MonteCarloOptions& options,
 
 // The Monte-Carlo of experiment/montecarlo.h as batch work (log, progress and jobs are not used).
 std::unique_ptr<Work> MonteCarloWork(experiment::MonteCarloOptions options);
+
+// A sweep (experiment/sweep.h) as batch work: run r is run r % seeds of point r / seeds. The points' files must have
+// been written (experiment::WriteSweepPoints) before Prepare.
+std::unique_ptr<Work> SweepWork(experiment::SweepPlan plan);
 
 // The work ToJson described; an error names what is missing.
 Result<std::unique_ptr<Work>> WorkFromJson(const nlohmann::json& json);

@@ -21,6 +21,8 @@
 #include "estimator/calibration_io.h"
 #include "estimator/config.h"
 #include "estimator/tracking.h"
+#include "eval/association.h"
+#include "eval/metrics.h"
 #include "eval/montecarlo.h"
 #include "eval/plots.h"
 #include "sim/scenario.h"
@@ -34,9 +36,20 @@ namespace {
 
 struct RunResult {
   eval::RunNees nees;
+  double rpe_m = 0.0;  // translation RMSE of the relative pose error over pose pairs about 1 s apart [m]
   double track_seconds = 0.0;
   std::string error;  // empty when the run succeeded
 };
+
+// The translation RMSE [m] of the RPE over pose pairs about 1 s apart, on the poses with a truth pose at the same
+// stamp; NaN when there is no such pair.
+double RpeOverOneSecond(const Trajectory& estimate, const Trajectory& truth) {
+  const eval::MatchedTrajectories matched =
+      eval::SelectMatched(estimate, truth, eval::AssociateByTime(estimate, truth, eval::AssociationOptions{}));
+  if (matched.estimate.size() < 2) return std::numeric_limits<double>::quiet_NaN();
+  const std::size_t step = eval::StepForDuration(matched.reference, 1.0);
+  return eval::RpeByStep(matched.estimate, matched.reference, step).translation.rmse;
+}
 
 // One realization: simulate, track, NEES of every tracked pose against the ground truth at the same time stamp.
 RunResult OneRun(const sim::Scenario& scenario, const estimator::EstimatorConfig& config, const Values& calibration,
@@ -61,6 +74,7 @@ RunResult OneRun(const sim::Scenario& scenario, const estimator::EstimatorConfig
     r.error = "seed " + std::to_string(seed) + ": no tracked pose has a ground-truth pose at the same time";
     return r;
   }
+  r.rpe_m = RpeOverOneSecond(tr.trajectory, *rec.ground_truth);
   r.track_seconds = tr.total_seconds;
   return r;
 }
@@ -219,6 +233,7 @@ nlohmann::json RunJson(int i, std::uint64_t seed, const RunResult& r) {
           {"seed", seed},
           {"ate_m", Number(r.nees.ate_m)},
           {"mean_nees", Number(r.nees.mean_nees)},
+          {"rpe_m", Number(r.rpe_m)},
           {"track_seconds", r.track_seconds},
           {"t_ns", t},
           {"nees", NumberArray(r.nees.nees)}};
@@ -267,7 +282,7 @@ Result<RunResult> ReadRun(const std::string& path, int i, std::uint64_t seed) {
   const bool ok = j.is_object() && Field(j, "run").is_number_integer() && Field(j, "run").get<std::int64_t>() == i &&
                   Field(j, "seed").is_number_unsigned() && Field(j, "seed").get<std::uint64_t>() == seed &&
                   ReadNumber(Field(j, "ate_m"), &r.nees.ate_m) &&
-                  ReadNumber(Field(j, "mean_nees"), &r.nees.mean_nees) && Field(j, "track_seconds").is_number() &&
+                  ReadNumber(Field(j, "mean_nees"), &r.nees.mean_nees) && ReadNumber(Field(j, "rpe_m"), &r.rpe_m) && Field(j, "track_seconds").is_number() &&
                   ReadSeries(j, &r.nees);
   if (!ok)
     return Status::Error(path + ": not the result file of run " + std::to_string(i) + " with seed " +
@@ -346,7 +361,8 @@ std::string WriteData(const MonteCarloOptions& options, const eval::MonteCarloNe
   for (int i = 0; i < options.runs; ++i)
     runs.push_back({{"seed", options.seed_base + i},
                     {"ate_m", results[i].nees.ate_m},
-                    {"mean_nees", results[i].nees.mean_nees},
+                    {"mean_nees", Number(results[i].nees.mean_nees)},
+                    {"rpe_m", Number(results[i].rpe_m)},
                     {"track_seconds", results[i].track_seconds}});
   std::ofstream(options.out + "/runs.json") << nlohmann::json{{"runs", runs}}.dump(2) << "\n";
   if (!eval::GnuplotAvailable()) return " (gnuplot not found: no nees.png)";

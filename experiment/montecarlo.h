@@ -44,7 +44,8 @@ struct MonteCarloSummary {
   std::string plot_note;  // "" or why OUT/nees.png (or OUT/report.html) was not written, as " (...)"
 };
 
-// Run i's result file, OUT/runs/NNNNNN.json (six digits): {"run", "seed", "ate_m", "mean_nees", "track_seconds",
+// Run i's result file, OUT/runs/NNNNNN.json (six digits): {"run", "seed", "ate_m", "mean_nees", "rpe_m" (translation
+// RMSE of the RPE over pose pairs about 1 s apart [m]), "track_seconds",
 // "t_ns": [...], "nees": [...]} (a NEES that is not finite as null), written under a temporary name and renamed.
 std::string MonteCarloRunFile(const std::string& out, int i);
 
@@ -65,7 +66,8 @@ Outcome AggregateMonteCarlo(const MonteCarloOptions& options, MonteCarloSummary*
 // Simulates `runs` noise realizations of the scenario (the terrain and the drive stay the same), tracks each online,
 // computes the position NEES (eq. 16) of every pose against the truth, writes each run's result file and from them
 // OUT/nees.json
-// ({"runs", "dof", "band", "t", "mean_nees", "fraction_in_band", ...}), OUT/runs.json (per-run ATE and mean NEES),
+// ({"runs", "dof", "band", "t", "mean_nees", "fraction_in_band", ...}), OUT/runs.json (per-run ATE, mean NEES, RPE
+// and tracking time),
 // OUT/nees.png and OUT/report.html (the in-band fraction, the per-run table and the figure on one page). Runs are
 // spread over `jobs` threads; results do not depend on the number of jobs. A run that fails does not stop the others;
 // the call then fails naming the first failed run and writes no summary. Calibration (the configuration's
