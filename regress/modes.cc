@@ -111,9 +111,11 @@ json NeesSchema() {
           {"t0_s", "number"}, {"t", "numbers"},  {"mean_nees", "numbers"}, {"fraction_in_band", "number"}};
 }
 json RunsSchema() {
-  return {
-      {"runs",
-       json::array({{{"seed", "number"}, {"ate_m", "number"}, {"mean_nees", "number"}, {"track_seconds", "timing"}}})}};
+  return {{"runs", json::array({{{"seed", "number"},
+                                 {"ate_m", "number"},
+                                 {"mean_nees", "number"},
+                                 {"rpe_m", "number"},
+                                 {"track_seconds", "timing"}}})}};
 }
 
 // A failed step's error as the command would print it: "roamlab COMMAND: message" (Outcome::step names an inner
