@@ -249,6 +249,8 @@ void AddGapBenchmark(CLI::App* app, Commands* commands) {
                     "Nominal differential-drive scenario (default scenarios/indoor_diffdrive_gap.yaml)");
     gbm->add_option("--mecanum", args->mecanum_scenario,
                     "Nominal mecanum scenario (default scenarios/indoor_mecanum_gap.yaml)");
+    gbm->add_flag("--resume", args->resume,
+                  "Read back the cases whose NNN/case.json exists instead of running them again");
     gbm->add_option("--out", args->out, "Output directory: score.json, calibration/NNN, cases/NNN")->required();
     gbm->add_flag("--quiet", args->quiet, "No progress");
     return gbm;

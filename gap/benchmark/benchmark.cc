@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <filesystem>
 #include <functional>
 #include <iomanip>
 #include <map>
@@ -13,6 +14,7 @@
 #include <thread>
 #include <tuple>
 
+#include "common/atomic_file.h"
 #include "gap/learn_baseline.h"
 
 namespace roamlab::gap::benchmark {
@@ -65,9 +67,18 @@ Status RunParallel(int n, int jobs, const std::string& label, std::ostream* prog
 }
 
 // Draws and runs one phase's cases (stratified: kinds by CalibrationKind; else blind); results in draw order.
+// The case a finished earlier call wrote to dir/case.json; an error names the file when it does not read back.
+Result<CaseResult> ReadCase(const std::string& dir) {
+  const Result<std::string> text = ReadWholeFile(dir + "/case.json");
+  if (!text.ok()) return text.status();
+  auto c = CaseFromRow(json::parse(text.value(), nullptr, false));
+  if (!c.ok()) return Status::Error(dir + "/case.json: " + c.status().message() + " (delete it to run the case again)");
+  return c;
+}
+
 Result<std::vector<CaseResult>> RunPhase(const std::vector<Platform>& platforms, int n, std::uint64_t draw_seed,
                                          std::uint64_t noise_seed0, bool stratified, const std::string& dir,
-                                         const CaseSetup& setup, const std::string& label, int jobs,
+                                         const CaseSetup& setup, const std::string& label, int jobs, bool resume,
                                          std::ostream* progress) {
   std::mt19937_64 rng(draw_seed);
   std::vector<Draw> draws;
@@ -78,8 +89,11 @@ Result<std::vector<CaseResult>> RunPhase(const std::vector<Platform>& platforms,
     std::ostringstream id;
     id << std::setw(3) << std::setfill('0') << i;
     const Draw& draw = draws[static_cast<std::size_t>(i)];
-    auto c = RunCase(platforms[static_cast<std::size_t>(draw.platform)], draw,
-                     noise_seed0 + static_cast<std::uint64_t>(i), id.str(), dir + "/" + id.str(), setup);
+    const std::string case_dir = dir + "/" + id.str();
+    auto c = resume && std::filesystem::exists(case_dir + "/case.json")
+                 ? ReadCase(case_dir)
+                 : RunCase(platforms[static_cast<std::size_t>(draw.platform)], draw,
+                           noise_seed0 + static_cast<std::uint64_t>(i), id.str(), case_dir, setup);
     if (!c.ok()) return Status::Error(label + " case " + id.str() + ": " + c.status().message());
     results[static_cast<std::size_t>(i)] = c.value();
     return CaseLine(c.value());
@@ -120,7 +134,7 @@ Result<Calibration> Calibrate(const BenchmarkOptions& options, const std::vector
   const CaseSetup loose{Loosest(), true};
   const std::uint64_t calibration_seed = options.seed * 1000 + kMaxCases;
   auto cases = RunPhase(platforms, options.calibration_cases, calibration_seed, calibration_seed, true,
-                        options.out + "/calibration", loose, "calibration", options.jobs, progress);
+                        options.out + "/calibration", loose, "calibration", options.jobs, options.resume, progress);
   if (!cases.ok()) return cases.status();
   Calibration out;
   json grid;
@@ -181,7 +195,7 @@ Result<json> RunBenchmark(const BenchmarkOptions& options, std::vector<Platform>
   // 2. The scored cases, diagnosed with the chosen thresholds.
   const auto scored_start = std::chrono::steady_clock::now();
   auto scored = RunPhase(platforms, options.cases, options.seed, options.seed * 1000, false, options.out + "/cases",
-                         {calibration.value().chosen, false}, "scored", options.jobs, progress);
+                         {calibration.value().chosen, false}, "scored", options.jobs, options.resume, progress);
   if (!scored.ok()) return scored.status();
   json rows = json::array();
   for (CaseResult& c : scored.value()) {

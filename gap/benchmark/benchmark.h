@@ -40,6 +40,9 @@ struct BenchmarkOptions {
   std::string diffdrive_scenario = "scenarios/indoor_diffdrive_gap.yaml";
   std::string mecanum_scenario = "scenarios/indoor_mecanum_gap.yaml";
   std::string out;  // output directory (exists)
+  // Cases whose OUT/.../NNN/case.json exists are read back instead of run again (case.json is written last, under a
+  // temporary name then renamed); score.json is then the uninterrupted call's but for the timings.
+  bool resume = false;
 };
 
 // The three platforms (atv, diffdrive, mecanum), in that order. Errors name the scenario file.

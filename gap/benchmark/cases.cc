@@ -1,5 +1,7 @@
 #include "gap/benchmark/cases.h"
 
+#include "common/atomic_file.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -341,7 +343,9 @@ Result<CaseResult> RunCase(const Platform& platform, const Draw& draw, std::uint
   RecordDiagnosis(b.diagnosis, &c);
   if (Status s = ScoreFromTruth(platform, draw, simulated.value(), rec_dir, b, &c); !s.ok()) return s;
   c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::ofstream(dir + "/case.json") << CaseRow(c).dump(2) << "\n";
+  // Written last, under a temporary name then renamed: a case.json marks a finished case (BenchmarkOptions::resume).
+  if (Status written = WriteFileAtomically(dir + "/case.json", CaseRow(c).dump(2) + "\n"); !written.ok())
+    return written;
   return c;
 }
 

@@ -362,4 +362,94 @@ json CaseRow(const CaseResult& c) {
           {"seconds", c.seconds}};
 }
 
+namespace {
+
+// Readers of a case row that never throw: each answers false when the key is missing or of another type. A null
+// number reads as NaN (Number writes what is not finite as null).
+bool Get(const json& j, const char* key, std::string* out) {
+  const auto it = j.find(key);
+  if (it == j.end() || !it->is_string()) return false;
+  *out = it->get<std::string>();
+  return true;
+}
+bool Get(const json& j, const char* key, double* out) {
+  const auto it = j.find(key);
+  if (it == j.end() || !(it->is_number() || it->is_null())) return false;
+  *out = it->is_null() ? std::numeric_limits<double>::quiet_NaN() : it->get<double>();
+  return true;
+}
+bool Get(const json& j, const char* key, std::vector<std::string>* out) {
+  const auto it = j.find(key);
+  if (it == j.end() || !it->is_array()) return false;
+  for (const json& e : *it) {
+    if (!e.is_string()) return false;
+    out->push_back(e.get<std::string>());
+  }
+  return true;
+}
+// An optional number: *has false when null.
+bool GetOptional(const json& j, const char* key, double* out, bool* has) {
+  const auto it = j.find(key);
+  if (it == j.end() || !(it->is_number() || it->is_null())) return false;
+  *has = it->is_number();
+  if (*has) *out = it->get<double>();
+  return true;
+}
+
+bool ReadCandidate(const json& j, CandidateStats* s) {
+  const auto evaluated = j.find("evaluated_heldout");
+  const auto stds = j.find("std");
+  if (!j.is_object() || evaluated == j.end() || !evaluated->is_boolean() || stds == j.end() || !stds->is_object())
+    return false;
+  s->evaluated_heldout = evaluated->get<bool>();
+  for (const auto& [key, value] : stds->items()) {
+    if (!value.is_number() && !value.is_null()) return false;
+    s->std[key] = value.is_null() ? std::numeric_limits<double>::quiet_NaN() : value.get<double>();
+  }
+  return Get(j, "name", &s->name) && Get(j, "lr_pvalue", &s->lr_pvalue) && Get(j, "delta_bic", &s->delta_bic) &&
+         Get(j, "heldout_improvement", &s->heldout_improvement) && Get(j, "explained_share", &s->explained_share);
+}
+
+// The held-out and re-simulation figures of a case row.
+bool ReadFits(const json& j, CaseResult* c) {
+  bool has_after = false, has_1s = false, has_1s_after = false, sim_after = false, sim_1s = false, sim_1s_after = false;
+  const auto stream = j.find("resimulated_stream");
+  if (stream == j.end() || !(stream->is_string() || stream->is_null())) return false;
+  c->has_sim_rms = stream->is_string();
+  if (c->has_sim_rms) c->sim_stream = stream->get<std::string>();
+  bool has_sim_before = false;
+  return GetOptional(j, "heldout_rms_before", &c->rms_before, &c->has_rms) &&
+         GetOptional(j, "heldout_rms_after", &c->rms_after, &has_after) &&
+         GetOptional(j, "heldout_rms_1s_before", &c->rms_1s_before, &has_1s) &&
+         GetOptional(j, "heldout_rms_1s_after", &c->rms_1s_after, &has_1s_after) &&
+         GetOptional(j, "resimulated_rms_before", &c->sim_rms_before, &has_sim_before) &&
+         GetOptional(j, "resimulated_rms_after", &c->sim_rms_after, &sim_after) &&
+         GetOptional(j, "resimulated_rms_1s_before", &c->sim_rms_1s_before, &sim_1s) &&
+         GetOptional(j, "resimulated_rms_1s_after", &c->sim_rms_1s_after, &sim_1s_after);
+}
+
+}  // namespace
+
+Result<CaseResult> CaseFromRow(const json& j) {
+  CaseResult c;
+  const auto truth = j.is_object() ? j.find("truth") : j.end();
+  const auto candidates = j.is_object() ? j.find("candidates") : j.end();
+  bool ok = truth != j.end() && truth->is_object() && candidates != j.end() && candidates->is_array();
+  double noise_ratio = -1.0;
+  bool has_noise_ratio = false;
+  ok = ok && Get(j, "case", &c.id) && Get(j, "platform", &c.platform) && Get(j, "kind", &c.kind) &&
+       Get(*truth, "name", &c.truth_name) && Get(*truth, "parameter", &c.truth_parameter) &&
+       Get(*truth, "value", &c.truth_value) && GetOptional(j, "noise_ratio", &noise_ratio, &has_noise_ratio) &&
+       Get(j, "verdict", &c.verdict) && Get(j, "named", &c.named) && Get(j, "ranked", &c.ranked) &&
+       GetOptional(j, "estimate", &c.estimate, &c.has_estimate) && ReadFits(j, &c) && Get(j, "seconds", &c.seconds);
+  if (!ok) return Status::Error("not a case row as CaseRow writes it");
+  c.noise_ratio = has_noise_ratio ? noise_ratio : -1.0;
+  for (const json& candidate : *candidates) {
+    CandidateStats s;
+    if (!ReadCandidate(candidate, &s)) return Status::Error("a candidate is not as CaseRow writes it");
+    c.candidates.push_back(std::move(s));
+  }
+  return c;
+}
+
 }  // namespace roamlab::gap::benchmark

@@ -22,6 +22,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/status.h"
 #include "gap/diagnose.h"
 #include "recording/trajectory.h"
 
@@ -134,7 +135,10 @@ double RearCorneringCompliance(const Trajectory& truth);
 // The benchmark's figures over the scored cases, with the targets and whether each is met.
 nlohmann::json Summarize(const std::vector<CaseResult>& cases, double min_noise_ratio = 3.0);
 
-// One case as a row of score.json's table.
+// One case as a row of score.json's table (and of its case.json).
 nlohmann::json CaseRow(const CaseResult& c);
+// The case a row describes, as CaseRow wrote it: every field read back exactly. An error when a key is missing or of
+// another type.
+Result<CaseResult> CaseFromRow(const nlohmann::json& row);
 
 }  // namespace roamlab::gap::benchmark
