@@ -307,3 +307,51 @@ TEST(GapBenchmarkScore, SummarizesTheBenchmarksFigures) {
 
 }  // namespace
 }  // namespace roamlab::gap::benchmark
+
+namespace roamlab::gap::benchmark {
+namespace {
+
+// case.json is what --resume reads back: every field the score uses comes back exactly, through a text round trip.
+TEST(GapBenchmarkScore, CaseRowReadsBackExactly) {
+  CaseResult c = Case("effect", "gps_latency", {Candidate("gps_latency", 1.0 / 3.0, -12.25, 0.1)});
+  c.candidates[0].std = {{"latency_s", 0.0123456789}, {"unknown", std::nan("")}};
+  c.candidates.push_back(Candidate("steering_offset", 0.5, 2.0, 0.0, false));
+  c.id = "007";
+  c.platform = "atv";
+  c.truth_parameter = "latency_s";
+  c.truth_value = 0.1 + 0.2;
+  c.noise_ratio = 4.5;
+  c.verdict = "named";
+  c.named = {"gps_latency"};
+  c.ranked = {"gps_latency", "steering_offset"};
+  c.estimate = 0.29999;
+  c.has_estimate = true;
+  c.rms_before = 2.5;
+  c.rms_after = 1.0 / 7.0;
+  c.rms_1s_before = 1.5;
+  c.rms_1s_after = 0.25;
+  c.has_rms = true;
+  c.seconds = 12.5;
+  const nlohmann::json row = nlohmann::json::parse(CaseRow(c).dump(2));
+  const Result<CaseResult> back = CaseFromRow(row);
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(CaseRow(back.value()).dump(), CaseRow(c).dump());
+  EXPECT_EQ(back.value().truth_value, c.truth_value);
+  EXPECT_FALSE(back.value().has_sim_rms);
+  EXPECT_TRUE(std::isnan(back.value().candidates[0].std.at("unknown")));
+  EXPECT_TRUE(std::isnan(back.value().candidates[0].explained_share));
+
+  // A missing key or one of another type is an error, never an exception.
+  for (const char* key : {"case", "truth", "candidates", "estimate", "seconds"}) {
+    nlohmann::json damaged = row;
+    damaged.erase(key);
+    EXPECT_FALSE(CaseFromRow(damaged).ok()) << key;
+    damaged[key] = nlohmann::json::object();
+    EXPECT_FALSE(CaseFromRow(damaged).ok()) << key;
+  }
+  EXPECT_FALSE(CaseFromRow(nlohmann::json::array()).ok());
+  EXPECT_FALSE(CaseFromRow(nlohmann::json()).ok());
+}
+
+}  // namespace
+}  // namespace roamlab::gap::benchmark
