@@ -21,7 +21,10 @@ int RunBatchStatus(const BatchArgs& args) {
   const batch::BatchStatus& s = status.value();
   std::cout << s.kind << " (" << s.backend << " backend), " << s.runs << " runs: " << s.done << " done, " << s.queued
             << " pending or running, " << s.failed.size() << " failed; state " << s.state << "\n";
-  for (const std::string& line : s.failed) std::cout << "failed: " << line << "\n";
+  // While the batch is submitted, the aggregation job submits such runs again as long as retries remain.
+  const std::string label =
+      s.backend == "slurm" && s.state == "submitted" ? "failed (retried while retries remain): " : "failed: ";
+  for (const std::string& line : s.failed) std::cout << label << line << "\n";
   if (!s.message.empty()) std::cout << s.message << "\n";
   return s.failed.empty() && s.state != "failed" ? 0 : 1;
 }

@@ -312,7 +312,7 @@ int RunSlurmTask(const std::string& out, int index, std::ostream& err) {
     err << "roamlab batch task: --index " << index << " is outside the batch's " << work->runs() << " runs\n";
     return 2;
   }
-  if (Outcome prepared = work->Prepare(true); !prepared.ok()) {
+  if (Outcome prepared = work->PrepareRuns(first, last); !prepared.ok()) {
     err << "roamlab batch task: " << prepared.status.message() << "\n";
     return prepared.bad_input ? 2 : 1;
   }

@@ -83,14 +83,10 @@ class Sweep : public Work {
             {"values", plan_.values},
             {"montecarlo", MonteCarlo(plan_.montecarlo).ToJson()}};
   }
-  Outcome Prepare(bool resume) override {
-    shared_.assign(plan_.values.size(), nullptr);
-    for (std::size_t p = 0; p < plan_.values.size(); ++p) {
-      experiment::MonteCarloOptions options = Point(static_cast<int>(p));
-      options.resume = resume;
-      if (Outcome o = experiment::PrepareMonteCarlo(options, &shared_[p]); !o.ok()) return o;
-    }
-    return Outcome::Ok();
+  Outcome Prepare(bool resume) override { return PreparePoints(0, static_cast<int>(plan_.values.size()), resume); }
+  // Only the points of runs [first, last): a task of a large sweep reads no other point's inputs.
+  Outcome PrepareRuns(int first, int last) override {
+    return PreparePoints(first / seeds_, (last - 1) / seeds_ + 1, true);
   }
   bool Done(int r) const override {
     return std::filesystem::exists(experiment::MonteCarloRunFile(Point(r / seeds_).out, r % seeds_));
@@ -115,6 +111,16 @@ class Sweep : public Work {
 
  private:
   experiment::MonteCarloOptions Point(int p) const { return experiment::SweepPointOptions(plan_, p); }
+  // Points [first, last) prepared; the others stay unprepared (Run must not be asked for their runs).
+  Outcome PreparePoints(int first, int last, bool resume) {
+    shared_.assign(plan_.values.size(), nullptr);
+    for (int p = first; p < last; ++p) {
+      experiment::MonteCarloOptions options = Point(p);
+      options.resume = resume;
+      if (Outcome o = experiment::PrepareMonteCarlo(options, &shared_[p]); !o.ok()) return o;
+    }
+    return Outcome::Ok();
+  }
   experiment::SweepPlan plan_;
   int seeds_;
   std::vector<std::shared_ptr<const experiment::MonteCarloShared>> shared_;

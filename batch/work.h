@@ -28,6 +28,12 @@ class Work {
   // Reads what every run shares and computes what is computed once (montecarlo's shared calibration); with `resume`,
   // reuses what an earlier call computed.
   virtual experiment::Outcome Prepare(bool resume) = 0;
+  // What a Slurm task running runs [first, last) needs of Prepare(true) (by default all of it).
+  virtual experiment::Outcome PrepareRuns(int first, int last) {
+    (void)first;
+    (void)last;
+    return Prepare(true);
+  }
   // Whether run i's result file exists.
   virtual bool Done(int i) const = 0;
   // Runs run i and writes its result file (after Prepare).

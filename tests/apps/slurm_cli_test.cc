@@ -1,9 +1,10 @@
 // The Slurm backend on a running cluster (scripts/local-slurm.sh start, SLURM_CONF exported; ctest label "slurm"):
 // an 8-run ATV Monte-Carlo through Slurm gives the local backend's nees.json byte for byte; a task killed midway is
 // submitted again by the aggregation job; --resume after a cancelled array submits only the missing runs and ends
-// with the same bytes.
+// with the same bytes; a sweep through Slurm gives the local table.
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
 
@@ -142,6 +143,29 @@ TEST_F(SlurmTest, ResumeAfterCancelSubmitsOnlyTheMissingRuns) {
   EXPECT_NE(resumed.err.find("submitted " + std::to_string(8 - done) + " runs"), std::string::npos) << resumed.err;
   EXPECT_EQ(SlurpFile(out / "runs" / "000000.json"), run0) << "run 0 was run again";
   ExpectSameSummary(out);
+}
+
+TEST_F(SlurmTest, SweepGivesTheLocalTable) {
+  const std::string scenario = testing::WriteShortAtvScenario(dir_, "4.0");
+  ASSERT_FALSE(scenario.empty());
+  std::ofstream(dir_ / "sweep.yaml") << "scenario: " << scenario << "\nconfig: " << ROAMLAB_SOURCE_DIR
+                                     << "/configs/atv_tracking.yaml\nseeds: 2\nt0_s: 1\nno_time_budget: true\n"
+                                     << "grid:\n  config.tracking.window: [20, 40]\n";
+  const testing::CommandRun local = Roamlab("sweep sweep.yaml --out sweep_local --jobs 2 --quiet", dir_);
+  ASSERT_EQ(local.exit_code, 0) << local.err;
+  const testing::CommandRun slurm =
+      Roamlab("sweep sweep.yaml --out sweep_slurm --backend slurm --runs-per-task 2 --wait --quiet", dir_);
+  ASSERT_EQ(slurm.exit_code, 0) << slurm.err;
+  for (const char* point : {"000", "001"}) {
+    const fs::path nees = fs::path("points") / point / "nees.json";
+    EXPECT_EQ(SlurpFile(dir_ / "sweep_slurm" / nees), SlurpFile(dir_ / "sweep_local" / nees)) << point;
+  }
+  // The table but for the tracking times.
+  nlohmann::json a = ReadJson(dir_ / "sweep_local" / "sweep.json"), b = ReadJson(dir_ / "sweep_slurm" / "sweep.json");
+  ASSERT_EQ(a["points"].size(), 2u);
+  for (nlohmann::json* sweep : {&a, &b})
+    for (nlohmann::json& point : (*sweep)["points"]) point.erase("track_seconds");
+  EXPECT_EQ(a, b);
 }
 
 }  // namespace
