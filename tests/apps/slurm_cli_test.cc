@@ -1,7 +1,7 @@
 // The Slurm backend on a running cluster (scripts/local-slurm.sh start, SLURM_CONF exported; ctest label "slurm"):
-// an 8-run ATV Monte-Carlo through Slurm gives the local backend's nees.json byte for byte; a task killed midway is
-// submitted again by the aggregation job; --resume after a cancelled array submits only the missing runs and ends
-// with the same bytes; a sweep through Slurm gives the local table.
+// an 8-run ATV Monte-Carlo (a 4 s drive) through Slurm gives the local backend's nees.json byte for byte; a task killed
+// midway is submitted again by the aggregation job; --resume after a cancelled array submits only the missing runs and
+// ends with the same bytes; a sweep through Slurm gives the local table.
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -25,7 +25,7 @@ using testing::SlurpFile;
 
 class SlurmTest : public ::testing::Test {
  protected:
-  // The cluster answers, and the local backend's 8-run Monte-Carlo of a 6 s drive is the reference.
+  // The cluster answers, and the local backend's 8-run Monte-Carlo of a 4 s drive is the reference.
   static void SetUpTestSuite() {
     temp_ = new testing::TempDir;
     const fs::path dir = temp_->path();
@@ -33,7 +33,7 @@ class SlurmTest : public ::testing::Test {
     ASSERT_EQ(sinfo.exit_code, 0) << "no Slurm cluster answers (start one with `bash scripts/local-slurm.sh start` "
                                      "and export SLURM_CONF, or leave these tests out with ctest -LE slurm): "
                                   << sinfo.err;
-    const std::string scenario = testing::WriteShortAtvScenario(dir, "6.0");
+    const std::string scenario = testing::WriteShortAtvScenario(dir, "4.0");
     ASSERT_FALSE(scenario.empty());
     montecarlo_ = scenario + " --config " + std::string(ROAMLAB_SOURCE_DIR) +
                   "/configs/atv_tracking.yaml --runs 8 --t0 1 --no-time-budget --quiet";
