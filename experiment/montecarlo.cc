@@ -282,8 +282,8 @@ Result<RunResult> ReadRun(const std::string& path, int i, std::uint64_t seed) {
   const bool ok = j.is_object() && Field(j, "run").is_number_integer() && Field(j, "run").get<std::int64_t>() == i &&
                   Field(j, "seed").is_number_unsigned() && Field(j, "seed").get<std::uint64_t>() == seed &&
                   ReadNumber(Field(j, "ate_m"), &r.nees.ate_m) &&
-                  ReadNumber(Field(j, "mean_nees"), &r.nees.mean_nees) && ReadNumber(Field(j, "rpe_m"), &r.rpe_m) && Field(j, "track_seconds").is_number() &&
-                  ReadSeries(j, &r.nees);
+                  ReadNumber(Field(j, "mean_nees"), &r.nees.mean_nees) && ReadNumber(Field(j, "rpe_m"), &r.rpe_m) &&
+                  Field(j, "track_seconds").is_number() && ReadSeries(j, &r.nees);
   if (!ok)
     return Status::Error(path + ": not the result file of run " + std::to_string(i) + " with seed " +
                          std::to_string(seed) + " (malformed or of another call; delete it to run it again)");

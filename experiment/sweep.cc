@@ -310,8 +310,9 @@ Result<std::string> WritePlot(const SweepPlan& plan, const json& rows, std::size
     ++index;
   }
   std::string script = "set terminal pngcairo size 800,500 noenhanced font 'sans,11'\nset output '" + name +
-                       ".png'\nset grid\nset offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\nset key outside below\nset xlabel " + GnuplotString(plan.keys[k]) +
-                       "\nset ylabel " + GnuplotString(metric.label) + "\n";
+                       ".png'\nset grid\nset offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\nset key outside "
+                       "below\nset xlabel " +
+                       GnuplotString(plan.keys[k]) + "\nset ylabel " + GnuplotString(metric.label) + "\n";
   if (!numeric) {
     script += "set xtics (";
     for (std::size_t d = 0; d < distinct.size(); ++d)

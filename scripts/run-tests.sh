@@ -24,7 +24,12 @@ if [ "${ROAMLAB_SLURM_TESTS:-1}" = "1" ]; then
   trap 'bash scripts/local-slurm.sh stop' EXIT
   eval "$(bash scripts/local-slurm.sh env)"
   # One at a time: the node's cores run the tasks.
-  ctest --test-dir "$build_dir" --output-on-failure -L slurm --output-junit "$(cd "$build_dir" && pwd)/ctest-slurm-junit.xml"
+  slurm_junit="$(cd "$build_dir" && pwd)/ctest-slurm-junit.xml"
+  ctest --test-dir "$build_dir" --output-on-failure -L slurm --output-junit "$slurm_junit"
+  if grep -q 'FAILED TEST SUITE' "$slurm_junit"; then
+    echo "roamlab tests: the cluster tests' set-up failed; see $slurm_junit" >&2
+    exit 1
+  fi
 fi
 regress=(--quick)
 [ "${ROAMLAB_FULL_REGRESSION:-0}" = "1" ] && regress=()
