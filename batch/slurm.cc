@@ -176,9 +176,10 @@ std::set<std::pair<std::string, int>> QueuedTasks(const json& batch) {
   return queued;
 }
 
-// Whether Slurm still lists the job (pending or running).
+// Whether Slurm still lists the job as pending or running (a cancelled or completing job does not count).
 bool Queued(const std::string& job) {
-  auto ran = internal::RunProcess({"squeue", "-h", "-j", job, "-o", "%i"});
+  auto ran =
+      internal::RunProcess({"squeue", "-h", "-j", job, "-t", "PENDING,CONFIGURING,RUNNING,SUSPENDED", "-o", "%i"});
   return ran.ok() && ran.value().exit_code == 0 && !ran.value().out.empty();
 }
 
@@ -253,6 +254,21 @@ int ReportFailed(json* batch, const std::string& out, const Work& work, const st
   return 1;
 }
 
+// An error when OUT holds a Slurm batch whose last aggregation job Slurm still lists: a second batch would write the
+// same result files.
+Status StillRunning(const std::string& out) {
+  if (!fs::exists(BatchFile(out))) return Status::Ok();
+  auto batch = ReadBatch(out);
+  if (!batch.ok() || batch.value()["backend"] != "slurm" || batch.value()["state"] != "submitted" ||
+      batch.value()["submissions"].empty())
+    return Status::Ok();
+  const json& last = batch.value()["submissions"].back();
+  const std::string aggregate = last["aggregate_job"].get<std::string>();
+  if (!Queued(aggregate)) return Status::Ok();
+  return Status::Error(out + ": its batch is still running (array job " + last["array_job"].get<std::string>() +
+                       ", aggregation job " + aggregate + "); wait for it or scancel both");
+}
+
 }  // namespace
 
 std::string SlurmOptions::Validate() const {
@@ -267,6 +283,7 @@ std::string SlurmOptions::Validate() const {
 Outcome SubmitToSlurm(Work& work, const SlurmOptions& options, bool resume, std::ostream& log, std::string* headline) {
   if (const std::string problem = options.Validate(); !problem.empty())
     return Outcome::BadInput(Status::Error(problem));
+  if (Status busy = StillRunning(work.out()); !busy.ok()) return Outcome::BadInput(busy);
   if (Status made = experiment::MakeOutputDirectory(BatchDir(work.out()) + "/logs"); !made.ok())
     return Outcome::BadInput(made);
   if (!resume)
