@@ -4,7 +4,6 @@
 #include <atomic>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -14,7 +13,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/atomic_file.h"
 #include "common/html.h"
+#include "common/interrupt.h"
 #include "estimator/calibration.h"
 #include "estimator/calibration_io.h"
 #include "estimator/config.h"
@@ -205,7 +206,7 @@ std::vector<RunResult> RunAll(const MonteCarloOptions& options, const Shared& sh
   std::atomic<int> next{0}, done{0};
   std::mutex print;
   const auto worker = [&] {
-    for (int i = next++; i < options.runs; i = next++) {
+    for (int i = next++; i < options.runs && !InterruptRequested(); i = next++) {
       results[i] = RunOne(options, shared, i);
       const int finished = ++done;
       if (options.progress) {
@@ -256,14 +257,16 @@ std::string WriteReport(const MonteCarloOptions& options, const eval::MonteCarlo
 // OUT/nees.json, OUT/runs.json and OUT/nees.png; returns the plot note.
 std::string WriteData(const MonteCarloOptions& options, const eval::MonteCarloNees& nees,
                       const std::vector<RunResult>& results) {
-  std::ofstream(options.out + "/nees.json") << eval::NeesJson(nees).dump(2) << "\n";
+  if (Status s = WriteFileAtomic(options.out + "/nees.json", eval::NeesJson(nees).dump(2) + "\n"); !s.ok())
+    return " (" + s.message() + ")";
   nlohmann::json runs = nlohmann::json::array();
   for (int i = 0; i < options.runs; ++i)
     runs.push_back({{"seed", options.seed_base + i},
                     {"ate_m", results[i].nees.ate_m},
                     {"mean_nees", results[i].nees.mean_nees},
                     {"track_seconds", results[i].track_seconds}});
-  std::ofstream(options.out + "/runs.json") << nlohmann::json{{"runs", runs}}.dump(2) << "\n";
+  if (Status s = WriteFileAtomic(options.out + "/runs.json", nlohmann::json{{"runs", runs}}.dump(2) + "\n"); !s.ok())
+    return " (" + s.message() + ")";
   if (!eval::GnuplotAvailable()) return " (gnuplot not found: no nees.png)";
   auto plot =
       eval::WriteNeesPlot(options.out, "Average position NEES over " + std::to_string(options.runs) + " runs", nees);
@@ -293,6 +296,7 @@ Outcome RunMonteCarlo(const MonteCarloOptions& options, MonteCarloSummary* summa
   if (Outcome prepared = Prepare(options, &shared); !prepared.ok()) return prepared;
 
   const std::vector<RunResult> results = RunAll(options, shared);
+  if (InterruptRequested()) return Outcome::Failed(InterruptedError());
   std::vector<eval::RunNees> runs;
   for (const RunResult& r : results) {
     if (!r.error.empty()) return Outcome::Failed(Status::Error(r.error));
