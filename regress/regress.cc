@@ -88,7 +88,11 @@ Status WriteCaseRecord(const std::string& out_dir, const CaseResult& r) {
   }
   const json record = {{"name", r.name},       {"mode", r.mode},       {"error", r.error},
                        {"skipped", r.skipped}, {"seconds", r.seconds}, {"checks", checks}};
-  return WriteFileAtomic(CaseDirectory(out_dir, r.name) + "/" + kCaseRecord, record.dump(1) + "\n");
+  const std::string dir = CaseDirectory(out_dir, r.name);
+  std::error_code ec;
+  fs::create_directories(dir, ec);  // a skipped case has none yet
+  if (ec) return Status::Error(dir + ": cannot create the case directory: " + ec.message());
+  return WriteFileAtomic(dir + "/" + kCaseRecord, record.dump(1) + "\n");
 }
 
 std::optional<double> ReadOptionalNumber(const json& value) {
