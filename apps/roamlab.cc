@@ -372,10 +372,10 @@ const std::set<std::string> kInputOptions = {"recording", "real",  "scenario", "
 const std::set<std::string> kInterruptible = {"simulate",   "replay",   "calibrate",     "track",
                                               "montecarlo", "diagnose", "gap-benchmark", "regress"};
 
-// "import csv" for a subcommand of a group, "calibrate" for a command.
+// The name a command's error lines carry: the group's ("import", "odometry") for a subcommand of a group.
 std::string CommandName(const CLI::App& app) {
   const CLI::App* parent = app.get_parent();
-  return parent && parent->get_parent() ? parent->get_name() + " " + app.get_name() : app.get_name();
+  return parent && parent->get_parent() ? parent->get_name() : app.get_name();
 }
 
 // The problem with the command's --out against its inputs (apps/output_check.h), "" when there is none.

@@ -134,14 +134,18 @@ Outcome DiagnoseTwinToFile(const DiagnoseRequest& request, const Inputs& in, con
 }
 
 // The outputs of an earlier diagnosis in OUT that this one does not write: twin.json without --replay, the figures
-// with --no-plots, roamlab init's nominal configuration when a scenario or configuration is given.
+// with --no-plots, roamlab init's nominal configuration when a scenario or another configuration is given.
 Status RemoveStaleOutputs(const DiagnoseRequest& given, const std::string& out) {
   std::vector<std::string> stale;
   if (!given.replay) stale.push_back("twin.json");
   if (given.no_plots)
     for (const char* stem : {"residual_vs_condition", "heldout_fit"})
       for (const char* extension : {".dat", ".gp", ".png"}) stale.push_back(std::string(stem) + extension);
-  if (!given.scenario.empty() || !given.config.empty()) stale.push_back(kInitConfigFile);
+  // roamlab init's configuration of an earlier run, unless it is the --config given now.
+  const std::filesystem::path init_config = std::filesystem::path(out) / kInitConfigFile;
+  std::error_code ec;
+  const bool given_config = !given.config.empty() && std::filesystem::equivalent(given.config, init_config, ec);
+  if ((!given.scenario.empty() || !given.config.empty()) && !given_config) stale.push_back(kInitConfigFile);
   for (const std::string& file : stale)
     if (Status s = RemoveStaleFile((std::filesystem::path(out) / file).string()); !s.ok()) return s;
   return Status::Ok();

@@ -202,7 +202,7 @@ TEST_F(InterruptCliTest, OutEqualToOrInsideAnInputIsRefused) {
                               Path("map.yaml") + " --out " + dir_->path(),
                           dir_->path());
   EXPECT_EQ(import.exit_code, 2) << import.err;
-  EXPECT_NE(import.err.find("roamlab import csv: --out " + dir_->path() + " is the directory of the input file"),
+  EXPECT_NE(import.err.find("roamlab import: --out " + dir_->path() + " is the directory of the input file"),
             std::string::npos)
       << import.err;
 
