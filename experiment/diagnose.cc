@@ -133,20 +133,19 @@ Outcome DiagnoseTwinToFile(const DiagnoseRequest& request, const Inputs& in, con
   return Outcome::Ok();
 }
 
-// The outputs of an earlier diagnosis in OUT that this one does not write: twin.json without --replay, the figures
-// with --no-plots, roamlab init's nominal configuration when a scenario or another configuration is given.
-Status RemoveStaleOutputs(const DiagnoseRequest& given, const std::string& out) {
-  std::vector<std::string> stale;
-  if (!given.replay) stale.push_back("twin.json");
-  if (given.no_plots)
-    for (const char* stem : {"residual_vs_condition", "heldout_fit"})
-      for (const char* extension : {".dat", ".gp", ".png"}) stale.push_back(std::string(stem) + extension);
-  // roamlab init's configuration of an earlier run, unless it is the --config given now.
+// The outputs of an earlier diagnosis in OUT, removed before this one starts so that an interrupted run leaves no mix
+// of two runs: the report files, twin.json, the figures, and roamlab init's nominal configuration unless this run
+// writes it (no scenario, no configuration) or reads it (it is the --config given).
+Status RemoveEarlierOutputs(const DiagnoseRequest& given, const std::string& out) {
+  std::vector<std::string> earlier = {"gap.json",  "scenario_patch.yaml", "estimator_patch.yaml",
+                                      "report.md", "report.html",         "twin.json"};
+  for (const char* stem : {"residual_vs_condition", "heldout_fit"})
+    for (const char* extension : {".dat", ".gp", ".png", ".log"}) earlier.push_back(std::string(stem) + extension);
   const std::filesystem::path init_config = std::filesystem::path(out) / kInitConfigFile;
   std::error_code ec;
   const bool given_config = !given.config.empty() && std::filesystem::equivalent(given.config, init_config, ec);
-  if ((!given.scenario.empty() || !given.config.empty()) && !given_config) stale.push_back(kInitConfigFile);
-  for (const std::string& file : stale)
+  if ((!given.scenario.empty() || !given.config.empty()) && !given_config) earlier.push_back(kInitConfigFile);
+  for (const std::string& file : earlier)
     if (Status s = RemoveStaleFile((std::filesystem::path(out) / file).string()); !s.ok()) return s;
   return Status::Ok();
 }
@@ -177,7 +176,7 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
     if (!runner.ok()) return Outcome::BadInput(runner.status());
     twin_runner = std::move(runner).value();
   }
-  if (Status s = RemoveStaleOutputs(given, request.out); !s.ok()) return Outcome::Failed(s);
+  if (Status s = RemoveEarlierOutputs(given, request.out); !s.ok()) return Outcome::Failed(s);
   IncompleteMarker marker(request.out);
   if (Status s = marker.Start(); !s.ok()) return Outcome::Failed(s);
   const auto failed = [&marker](const Status& status) {

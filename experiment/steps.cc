@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <initializer_list>
 #include <limits>
 #include <map>
 #include <set>
@@ -11,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include "common/atomic_file.h"
 #include "common/interrupt.h"
 #include "estimator/calibration_io.h"
 #include "estimator/config.h"
@@ -89,6 +91,14 @@ Result<Inputs> LoadInputs(const std::string& config_path, const std::string& rec
   return Inputs{std::move(config).value(), std::move(rec).value()};
 }
 
+// The files an earlier run of the same command left in `dir`, removed before this one starts: an interrupted run then
+// leaves the marker and no result of another run beside it.
+Status RemoveEarlierOutputs(const std::string& dir, std::initializer_list<const char*> files) {
+  for (const char* file : files)
+    if (Status s = RemoveStaleFile(dir + "/" + file); !s.ok()) return s;
+  return Status::Ok();
+}
+
 // A failure after the marker was written: its message goes into the marker.
 Outcome Failed(const Status& status, IncompleteMarker* marker) {
   marker->SetMessage(status.message());
@@ -165,6 +175,8 @@ Outcome CalibrateToDirectory(const CalibrateRequest& request, estimator::Calibra
   if (!dir.ok()) return Outcome::BadInput(dir);
   if (request.warning)
     for (const std::string& w : warnings) request.warning(w);
+  if (Status s = RemoveEarlierOutputs(request.out, {"calibration.json", "trajectory.tum"}); !s.ok())
+    return Outcome::Failed(s);
   IncompleteMarker marker(request.out);
   if (Status s = marker.Start(); !s.ok()) return Outcome::Failed(s);
 
@@ -206,6 +218,8 @@ Outcome TrackToDirectory(const TrackRequest& request, estimator::TrackingResult*
   if (!options.ok()) return Outcome::BadInput(options.status());
   const Status dir = MakeOutputDirectory(request.out);
   if (!dir.ok()) return Outcome::BadInput(dir);
+  if (Status s = RemoveEarlierOutputs(request.out, {"trajectory.tum", "covariance.csv", "summary.json"}); !s.ok())
+    return Outcome::Failed(s);
   IncompleteMarker marker(request.out);
   if (Status s = marker.Start(); !s.ok()) return Outcome::Failed(s);
 

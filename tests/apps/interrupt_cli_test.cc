@@ -158,7 +158,10 @@ TEST_F(InterruptCliTest, RegressStopsOnSigintAndResumesToTheSameBytes) {
 }
 
 TEST_F(InterruptCliTest, CalibrateStopsOnSigtermWithoutPartialFiles) {
+  // An earlier run's result: removed when this run starts, so that the interrupted directory holds no result.
   const std::string out = Path("calibrate_cut");
+  fs::create_directories(out);
+  testing::WriteFile(out + "/calibration.json", "{}\n");
   const pid_t pid = Start({"calibrate", Path("long_rec"), "--config", Path("cal.yaml"), "--out", out}, dir_->path());
   ASSERT_TRUE(WaitFor(out + "/INCOMPLETE", 120));
   std::this_thread::sleep_for(std::chrono::milliseconds(500));  // into the solver
