@@ -57,8 +57,8 @@ int RunTrack(const TrackArgs& args) {
   request.warning = [](const std::string& line) { std::cerr << "roamlab track: warning: " << line << "\n"; };
   estimator::TrackingResult r;
   const experiment::Outcome outcome = experiment::TrackToDirectory(request, &r);
-  // The progress line ends once tracking ran (bad input stops before it).
-  if (!args.quiet && !outcome.bad_input) std::cerr << "\rtrack: 100%\n";
+  // The progress line ends once tracking ran (bad input stops before it), at 100 % unless it stopped early.
+  if (!args.quiet && !outcome.bad_input) std::cerr << (outcome.ok() ? "\rtrack: 100%\n" : "\n");
   if (!outcome.ok()) return Exit(args.err, "track", outcome);
   if (args.quiet) return 0;
   std::printf("tracked %zu poses, %d updates (mean %.2f ms, max %.2f ms), %d rejected, %.1fx real time; wrote %s\n",

@@ -1,11 +1,11 @@
 #include "apps/gap_benchmark.h"
 
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 
 #include "apps/cli.h"
+#include "common/atomic_file.h"
 
 namespace roamlab::apps {
 
@@ -25,9 +25,8 @@ int RunGapBenchmark(const GapBenchmarkArgs& args) {
 
   auto score = benchmark::RunBenchmark(args, std::move(platforms).value(), args.quiet ? nullptr : &std::cout);
   if (!score.ok()) return Failure(args.err, "gap-benchmark", score.status().message());
-  std::ofstream out(args.out + "/score.json");
-  out << score.value().dump(2) << "\n";
-  if (!out) return Failure(args.err, "gap-benchmark", args.out + "/score.json: cannot write");
+  if (Status s = WriteFileAtomic(args.out + "/score.json", score.value().dump(2) + "\n"); !s.ok())
+    return Failure(args.err, "gap-benchmark", s.message());
   if (!args.quiet) {
     std::cout << "figures: " << score.value()["figures"].dump() << "\n"
               << "total " << std::fixed << std::setprecision(0) << score.value()["seconds"]["total"].get<double>()

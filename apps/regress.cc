@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "apps/cli.h"
+#include "common/interrupt.h"
 #include "regress/regress.h"
 
 namespace roamlab::apps {
@@ -13,7 +14,8 @@ int RunRegress(const RegressArgs& args) {
   regress::SuiteResult result;
   regress::RunReports reports;
   const experiment::Outcome outcome = regress::RunSuite(options, &result, &reports);
-  if (!outcome.ok() && outcome.bad_input) return Exit(nullptr, "regress", outcome);
+  // Bad input stops before any case; an interrupted run has not applied its bounds: no table for either.
+  if (!outcome.ok() && (outcome.bad_input || InterruptRequested())) return Exit(nullptr, "regress", outcome);
   std::fputs(regress::ResultsTable(result).c_str(), stdout);
   if (!outcome.ok()) return Exit(nullptr, "regress", outcome);
   if (args.update_baseline) std::printf("baseline written to %s\n", reports.baseline_dir.c_str());

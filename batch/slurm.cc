@@ -25,7 +25,7 @@ std::string BatchDir(const std::string& out) { return out + "/batch"; }
 std::string BatchFile(const std::string& out) { return BatchDir(out) + "/batch.json"; }
 
 Status WriteBatch(const std::string& out, const json& batch) {
-  return WriteFileAtomically(BatchFile(out), batch.dump(2) + "\n");
+  return WriteFileAtomic(BatchFile(out), batch.dump(2) + "\n");
 }
 
 // Whether j[key] exists and passes `is`.
@@ -89,10 +89,10 @@ Status WriteScripts(const std::string& out, const std::string& roamlab) {
   const std::string dir = ShellQuote(fs::absolute(out).string());
   const std::string exe = ShellQuote(roamlab);
   const std::string header = "#!/bin/sh\n# Written by roamlab (batch/slurm.h).\n";
-  Status s = WriteFileAtomically(BatchDir(out) + "/task.sh",
+  Status s = WriteFileAtomic(BatchDir(out) + "/task.sh",
                                  header + "exec " + exe + " batch task " + dir + " --index \"$SLURM_ARRAY_TASK_ID\"\n");
   if (!s.ok()) return s;
-  return WriteFileAtomically(BatchDir(out) + "/aggregate.sh",
+  return WriteFileAtomic(BatchDir(out) + "/aggregate.sh",
                              header + "exec " + exe + " batch aggregate " + dir + "\n");
 }
 
@@ -246,7 +246,7 @@ int ReportFailed(json* batch, const std::string& out, const Work& work, const st
                               " runs have no result after " + std::to_string((*batch)["submissions"].size()) +
                               " submissions; first: " + work.RunName(missing.front()) + ", log " +
                               TaskLog(*batch, out, missing.front()) + " (" + BatchDir(out) + "/failed.json)";
-  (void)WriteFileAtomically(BatchDir(out) + "/failed.json", json{{"failed", failed}}.dump(2) + "\n");
+  (void)WriteFileAtomic(BatchDir(out) + "/failed.json", json{{"failed", failed}}.dump(2) + "\n");
   (*batch)["state"] = "failed";
   (*batch)["message"] = message;
   (void)WriteBatch(out, *batch);

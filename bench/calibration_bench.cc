@@ -1,7 +1,7 @@
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <optional>
 #include <string>
@@ -11,6 +11,7 @@
 
 #include "bench/bench.h"
 #include "bench/ceres_peer.h"
+#include "common/atomic_file.h"
 #include "estimator/calibration.h"
 #include "estimator/calibration_io.h"
 #include "estimator/covariance.h"
@@ -182,7 +183,10 @@ int ChildCalibrate(const std::string& rec_dir, const std::string& config_path, c
                   {"final_cost", result.value().final_cost},
                   {"peak_rss_kb", StatusKb("VmHWM")},
                   {"poses", result.value().trajectory.size()}};
-  std::ofstream(out_path) << j.dump(2) << "\n";
+  if (const Status s = WriteFileAtomic(out_path, j.dump(2) + "\n"); !s.ok()) {
+    std::fprintf(stderr, "%s\n", s.message().c_str());
+    return 1;
+  }
   return 0;
 }
 

@@ -30,13 +30,13 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <string>
 #include <thread>
 
 #include <unistd.h>
 
 #include "bench/bench.h"
+#include "common/atomic_file.h"
 #include "estimator/config.h"
 #include "recording/recording.h"
 #include "sim/scenario.h"
@@ -136,6 +136,10 @@ int main(int argc, char** argv) {
   bench::Say("roamlab_bench on %u cores%s\n", std::thread::hardware_concurrency(), quick ? " (--quick)" : "");
   if (int code = bench::RunSteps(ctx, &j)) return code;
   std::filesystem::remove_all(ctx.tmp);
-  if (!json_path.empty()) std::ofstream(json_path) << j.dump(2) << "\n";
+  if (!json_path.empty())
+    if (const Status s = WriteFileAtomic(json_path, j.dump(2) + "\n"); !s.ok()) {
+      std::fprintf(stderr, "roamlab_bench: %s\n", s.message().c_str());
+      return 1;
+    }
   return 0;
 }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "bench/bench.h"
+#include "common/atomic_file.h"
 #include "estimator/calibration_io.h"
 #include "estimator/tracking.h"
 #include "experiment/montecarlo.h"
@@ -89,7 +90,10 @@ int ChildTrack(const std::string& rec_dir, const std::string& config_path, const
                   {"rss_end_kb", StatusKb("VmRSS")},
                   {"rss_every_10_min", rss_samples},
                   {"peak_rss_kb", StatusKb("VmHWM")}};
-  std::ofstream(out_path) << j.dump(2) << "\n";
+  if (const Status s = WriteFileAtomic(out_path, j.dump(2) + "\n"); !s.ok()) {
+    std::fprintf(stderr, "%s\n", s.message().c_str());
+    return 1;
+  }
   return 0;
 }
 
@@ -191,7 +195,7 @@ int BenchMonteCarlo(const Context& ctx, const std::string& calibration_json, Jso
     text.replace(at_model, model.size(), "model: " + ctx.root + "/models/");
     text.replace(text.find(duration), duration.size(), "\nduration_s: " + std::to_string(ctx.sizes.montecarlo_drive_s));
     montecarlo_scenario = (ctx.tmp / "atv_short.yaml").string();
-    std::ofstream(montecarlo_scenario) << text;
+    if (const Status s = WriteFileAtomic(montecarlo_scenario, text); !s.ok()) return Fail(s.message());
   }
   for (int jobs : {1, 2}) {
     experiment::MonteCarloOptions mc;

@@ -5,6 +5,8 @@
 #include <iterator>
 #include <sstream>
 
+#include "common/atomic_file.h"
+
 namespace roamlab::html {
 namespace {
 
@@ -102,13 +104,6 @@ std::string Page::Document() const {
          "</body>\n</html>\n";
 }
 
-Status Page::Write(const std::string& path) const {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) return Status::Error(path + ": cannot write");
-  out << Document();
-  out.close();
-  if (!out) return Status::Error(path + ": write failed");
-  return Status::Ok();
-}
+Status Page::Write(const std::string& path) const { return WriteFileAtomic(path, Document()); }
 
 }  // namespace roamlab::html

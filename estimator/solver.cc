@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "common/interrupt.h"
 #include "estimator/internal/normal_equations.h"
 
 namespace roamlab::estimator {
@@ -199,6 +200,11 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
   double nu = 2.0;
   summary.termination = Termination::kMaxIterations;
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
+    if (InterruptRequested()) {
+      summary.termination = Termination::kFailure;  // not usable: the values are those of an unfinished solve
+      summary.message = InterruptedError().message() + " at iteration " + std::to_string(iteration);
+      break;
+    }
     if (elapsed() > options.time_budget_s) {
       summary.termination = Termination::kTimeBudget;
       break;

@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "common/check.h"
+#include "common/interrupt.h"
 #include "estimator/calibration.h"
 #include "estimator/covariance.h"
 #include "estimator/geometry.h"
@@ -223,6 +224,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
     builder.Add(m);
     if (builder.stream_names()[m.stream] != master || builder.poses().size() == poses_before) continue;
     poses_before = builder.poses().size();
+    if (InterruptRequested()) return InterruptedError();
     if (options.progress && i % 1000 == 0) options.progress(static_cast<double>(i) / measurements.size());
 
     // Initialization: buffer, then align and solve the first stretch in one batch.

@@ -1,10 +1,11 @@
 #include "estimator/tracking_io.h"
 
 #include <cstdio>
-#include <fstream>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
+#include "common/atomic_file.h"
 #include "common/time.h"
 #include "estimator/internal/json_io.h"
 #include "recording/trajectory.h"
@@ -13,20 +14,18 @@ namespace roamlab::estimator {
 namespace {
 
 Status WriteCovariance(const TrackingResult& r, const std::string& path) {
-  std::ofstream cov(path);
-  cov << "t,xx,xy,xz,yx,yy,yz,zx,zy,zz\n";
+  std::string cov = "t,xx,xy,xz,yx,yy,yz,zx,zy,zz\n";
   char buf[64];
   for (std::size_t i = 0; i < r.trajectory.size(); ++i) {
-    cov << FormatSeconds(r.trajectory[i].t);
+    cov += FormatSeconds(r.trajectory[i].t);
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) {
         std::snprintf(buf, sizeof buf, ",%.17g", r.position_covariance[i](a, b));
-        cov << buf;
+        cov += buf;
       }
-    cov << "\n";
+    cov += "\n";
   }
-  if (!cov) return Status::Error(path + ": write failed");
-  return Status::Ok();
+  return WriteFileAtomic(path, cov);
 }
 
 }  // namespace

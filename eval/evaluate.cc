@@ -3,13 +3,13 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <optional>
 
 #include <GeographicLib/LocalCartesian.hpp>
 
+#include "common/atomic_file.h"
 #include "common/check.h"
 #include "common/json.h"
 #include "eval/internal/evaluate_inputs.h"
@@ -402,12 +402,7 @@ Status WriteMetrics(const json& metrics, const std::string& out_dir, WrittenEval
   fs::create_directories(out_dir, ec);
   if (ec) return Status::Error(out_dir + ": cannot create the output directory: " + ec.message());
   written->metrics_path = Join(out_dir, "metrics.json");
-  std::ofstream out(written->metrics_path);
-  if (!out) return Status::Error(written->metrics_path + ": cannot write");
-  out << metrics.dump(2) << "\n";
-  out.close();
-  if (!out) return Status::Error(written->metrics_path + ": write failed");
-  return Status::Ok();
+  return WriteFileAtomic(written->metrics_path, metrics.dump(2) + "\n");
 }
 
 // The report's note when the figures were not asked for.

@@ -15,6 +15,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/atomic_file.h"
 #include "common/check.h"
 
 namespace roamlab::eval {
@@ -50,11 +51,7 @@ std::string Terminal(int width, int height) {
 
 Status WriteText(const std::string& directory, const std::string& name, const std::string& text) {
   const std::string path = (fs::path(directory) / name).string();
-  std::ofstream out(path, std::ios::binary);
-  if (!out) return Status::Error(path + ": cannot write");
-  out << text;
-  out.close();
-  return out ? Status::Ok() : Status::Error(path + ": write failed");
+  return WriteFileAtomic(path, text);
 }
 
 // "t x y z" rows of a trajectory, t in seconds since t_origin.

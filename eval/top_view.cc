@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <utility>
 
 #include <Eigen/Geometry>
 
+#include "common/atomic_file.h"
 #include "eval/plots.h"
 
 namespace roamlab::eval {
@@ -64,9 +64,7 @@ Status WriteTopViewFigure(const std::string& dir, const std::string& name, const
   }
   gp << "\n";
   for (const auto& [file, text] : {std::pair{name + ".dat", data.str()}, std::pair{name + ".gp", gp.str()}}) {
-    std::ofstream out(fs::path(dir) / file);
-    out << text;
-    if (!out) return Status::Error((fs::path(dir) / file).string() + ": cannot write");
+    if (Status s = WriteFileAtomic((fs::path(dir) / file).string(), text); !s.ok()) return s;
   }
   return RunGnuplot(dir, name + ".gp");
 }

@@ -2,9 +2,10 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 
+#include "common/atomic_file.h"
+#include "common/interrupt.h"
 #include "estimator/calibration.h"
 #include "estimator/config.h"
 #include "experiment/init.h"
@@ -126,11 +127,27 @@ Outcome DiagnoseTwinToFile(const DiagnoseRequest& request, const Inputs& in, con
   auto diagnosed = gap::DiagnoseTwin(*in.scenario, in.recording, runner, options);
   if (!diagnosed.ok()) return Outcome::Failed(Status::Error("twin: " + diagnosed.status().message()));
   const std::string path = (std::filesystem::path(request.out) / "twin.json").string();
-  std::ofstream out(path);
-  out << gap::TwinDiagnosisJson(diagnosed.value()).dump(2) << "\n";
-  if (!out) return Outcome::Failed(Status::Error(path + ": cannot write"));
+  if (Status s = WriteFileAtomic(path, gap::TwinDiagnosisJson(diagnosed.value()).dump(2) + "\n"); !s.ok())
+    return Outcome::Failed(s);
   say("twin: " + diagnosed.value().verdict + " (" + path + ")");
   return Outcome::Ok();
+}
+
+// The outputs of an earlier diagnosis in OUT, removed before this one starts so that an interrupted run leaves no mix
+// of two runs: the report files, twin.json, the figures, and roamlab init's nominal configuration unless this run
+// writes it (no scenario, no configuration) or reads it (it is the --config given).
+Status RemoveEarlierOutputs(const DiagnoseRequest& given, const std::string& out) {
+  std::vector<std::string> earlier = {"gap.json",  "scenario_patch.yaml", "estimator_patch.yaml",
+                                      "report.md", "report.html",         "twin.json"};
+  for (const char* stem : {"residual_vs_condition", "heldout_fit"})
+    for (const char* extension : {".dat", ".gp", ".png", ".log"}) earlier.push_back(std::string(stem) + extension);
+  const std::filesystem::path init_config = std::filesystem::path(out) / kInitConfigFile;
+  std::error_code ec;
+  const bool given_config = !given.config.empty() && std::filesystem::equivalent(given.config, init_config, ec);
+  if ((!given.scenario.empty() || !given.config.empty()) && !given_config) earlier.push_back(kInitConfigFile);
+  for (const std::string& file : earlier)
+    if (Status s = RemoveStaleFile((std::filesystem::path(out) / file).string()); !s.ok()) return s;
+  return Status::Ok();
 }
 
 }  // namespace
@@ -159,6 +176,13 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
     if (!runner.ok()) return Outcome::BadInput(runner.status());
     twin_runner = std::move(runner).value();
   }
+  if (Status s = RemoveEarlierOutputs(given, request.out); !s.ok()) return Outcome::Failed(s);
+  IncompleteMarker marker(request.out);
+  if (Status s = marker.Start(); !s.ok()) return Outcome::Failed(s);
+  const auto failed = [&marker](const Status& status) {
+    marker.SetMessage(status.message());
+    return Outcome::Failed(status);
+  };
   gap::DiagnoseOptions options;
   options.progress = [&](const std::string& line) { say("  " + line); };
   if (request.max_shift_s) options.max_shift_s = *request.max_shift_s;
@@ -169,23 +193,26 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
   gap::Baseline baseline;
   if (!request.no_baseline) {
     auto learned = NominalBaseline(request, in, options);
-    if (!learned.ok()) return Outcome::Failed(learned.status());
+    if (!learned.ok()) return failed(learned.status());
     baseline = std::move(learned).value();
     options.baseline = &baseline;
+    (void)marker.AddDone("the nominal baseline learned");
   }
 
   say("diagnosing " + request.recording);
   auto diagnosed = gap::Diagnose(in.config, in.recording, options);
-  if (!diagnosed.ok()) return Outcome::Failed(diagnosed.status());
+  if (!diagnosed.ok()) return failed(diagnosed.status());
   const gap::Diagnosis& d = diagnosed.value();
+  (void)marker.AddDone("the diagnosis");
 
   // The simulation again, as believed and with the accepted effects, against the recording's held-out part.
   std::optional<gap::SimulationComparison> simulation;
   if (in.scenario) {
     say("re-simulating the nominal scenario without noise, as believed and with the accepted effects");
     auto compared = gap::CompareWithSimulation(*in.scenario, d.effects, in.recording, d.train_end_s);
-    if (!compared.ok()) return Outcome::Failed(Status::Error("re-simulation: " + compared.status().message()));
+    if (!compared.ok()) return failed(Status::Error("re-simulation: " + compared.status().message()));
     simulation = std::move(compared).value();
+    (void)marker.AddDone("the re-simulation");
   }
 
   gap::ReportInputs report;
@@ -196,9 +223,12 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
   report.simulation = simulation ? &*simulation : nullptr;
   report.plots = !request.no_plots;
   report.progress = say;
-  if (Status s = gap::WriteReport(d, report, request.out); !s.ok()) return Outcome::Failed(s);
+  if (Status s = gap::WriteReport(d, report, request.out); !s.ok()) return failed(s);
+  (void)marker.AddDone("gap.json, the patches and the report");
   if (request.replay)
-    if (Outcome twin = DiagnoseTwinToFile(request, in, twin_runner, replayed, say); !twin.ok()) return twin;
+    if (Outcome twin = DiagnoseTwinToFile(request, in, twin_runner, replayed, say); !twin.ok())
+      return failed(twin.status);
+  if (Status s = marker.Complete(); !s.ok()) return Outcome::Failed(s);
   if (diagnosis) *diagnosis = std::move(diagnosed).value();
   return Outcome::Ok();
 }

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
@@ -12,6 +11,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/atomic_file.h"
 #include "estimator/problem.h"
 #include "recording/odometry_pose.h"
 
@@ -777,10 +777,7 @@ Outcome InitToFile(const InitRequest& request, InitConfig* result) {
   const std::filesystem::path out(request.out);
   if (out.has_parent_path())
     if (Status s = MakeOutputDirectory(out.parent_path().string()); !s.ok()) return Outcome::BadInput(s);
-  std::ofstream file(request.out, std::ios::binary | std::ios::trunc);
-  file << config.value().yaml;
-  file.close();
-  if (!file) return Outcome::Failed(Status::Error(request.out + ": cannot write"));
+  if (Status s = WriteFileAtomic(request.out, config.value().yaml); !s.ok()) return Outcome::Failed(s);
   config.value().config.source_file = request.out;
   if (result) *result = std::move(config).value();
   return Outcome::Ok();

@@ -4,7 +4,6 @@
 #include <atomic>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -17,6 +16,7 @@
 #include "common/atomic_file.h"
 #include "common/html.h"
 #include "common/json.h"
+#include "common/interrupt.h"
 #include "estimator/calibration.h"
 #include "estimator/calibration_io.h"
 #include "estimator/config.h"
@@ -300,7 +300,7 @@ Outcome RunAll(const MonteCarloOptions& options, const MonteCarloShared& shared,
   std::atomic<int> next{0}, done{0};
   std::mutex print;
   const auto worker = [&] {
-    for (int k = next++; k < n; k = next++) {
+    for (int k = next++; k < n && !InterruptRequested(); k = next++) {
       outcomes[k] = RunMonteCarloRun(options, shared, todo[k]);
       const int finished = ++done;
       if (options.progress) {
@@ -356,7 +356,8 @@ std::string WriteReport(const MonteCarloOptions& options, const eval::MonteCarlo
 // OUT/nees.json, OUT/runs.json and OUT/nees.png; returns the plot note.
 std::string WriteData(const MonteCarloOptions& options, const eval::MonteCarloNees& nees,
                       const std::vector<RunResult>& results) {
-  std::ofstream(options.out + "/nees.json") << eval::NeesJson(nees).dump(2) << "\n";
+  if (Status s = WriteFileAtomic(options.out + "/nees.json", eval::NeesJson(nees).dump(2) + "\n"); !s.ok())
+    return " (" + s.message() + ")";
   nlohmann::json runs = nlohmann::json::array();
   for (int i = 0; i < options.runs; ++i)
     runs.push_back({{"seed", options.seed_base + i},
@@ -364,7 +365,8 @@ std::string WriteData(const MonteCarloOptions& options, const eval::MonteCarloNe
                     {"mean_nees", Number(results[i].nees.mean_nees)},
                     {"rpe_m", Number(results[i].rpe_m)},
                     {"track_seconds", results[i].track_seconds}});
-  std::ofstream(options.out + "/runs.json") << nlohmann::json{{"runs", runs}}.dump(2) << "\n";
+  if (Status s = WriteFileAtomic(options.out + "/runs.json", nlohmann::json{{"runs", runs}}.dump(2) + "\n"); !s.ok())
+    return " (" + s.message() + ")";
   if (!eval::GnuplotAvailable()) return " (gnuplot not found: no nees.png)";
   auto plot =
       eval::WriteNeesPlot(options.out, "Average position NEES over " + std::to_string(options.runs) + " runs", nees);
@@ -407,7 +409,7 @@ Outcome RunMonteCarloRun(const MonteCarloOptions& options, const MonteCarloShare
   const RunResult r = RunOne(options, shared, i);
   if (!r.error.empty()) return Outcome::Failed(Status::Error("run " + std::to_string(i) + ", " + r.error));
   const Status written =
-      WriteFileAtomically(MonteCarloRunFile(options.out, i), RunJson(i, options.seed_base + i, r).dump() + "\n");
+      WriteFileAtomic(MonteCarloRunFile(options.out, i), RunJson(i, options.seed_base + i, r).dump() + "\n");
   return written.ok() ? Outcome::Ok() : Outcome::Failed(written);
 }
 
@@ -447,6 +449,7 @@ Outcome RunMonteCarlo(const MonteCarloOptions& options, MonteCarloSummary* summa
     for (int i = 0; i < options.runs; ++i) todo.push_back(i);
   }
   if (Outcome ran = RunAll(options, *shared, todo); !ran.ok()) return ran;
+  if (InterruptRequested()) return Outcome::Failed(InterruptedError());
   return AggregateMonteCarlo(options, summary);
 }
 

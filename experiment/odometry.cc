@@ -6,11 +6,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <numeric>
 #include <random>
 #include <sstream>
 
+#include "common/atomic_file.h"
 #include "estimator/odometry/gaussian_process.h"
 #include "estimator/odometry/parametric.h"
 #include "estimator/odometry/robust_linear.h"
@@ -339,9 +339,7 @@ Outcome EvaluateOdometry(const OdometryEvaluateOptions& options, json* table) {
     if (Outcome o = EvaluateRecording(options, models, r, plots, &pooled, &per_recording); !o.ok()) return o;
   const json pooled_table = PooledTable(options, models, pooled, per_recording);
   const std::string path = (fs::path(options.out) / "table.json").string();
-  std::ofstream out(path);
-  out << pooled_table.dump(2) << "\n";
-  if (!out) return Failed(path + ": cannot write");
+  if (Status s = WriteFileAtomic(path, pooled_table.dump(2) + "\n"); !s.ok()) return Failed(s.message());
   if (table) *table = pooled_table;
   return Outcome::Ok();
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <initializer_list>
 #include <limits>
 #include <map>
 #include <set>
@@ -11,6 +12,8 @@
 
 #include <Eigen/Core>
 
+#include "common/atomic_file.h"
+#include "common/interrupt.h"
 #include "estimator/calibration_io.h"
 #include "estimator/config.h"
 #include "estimator/problem.h"
@@ -88,6 +91,20 @@ Result<Inputs> LoadInputs(const std::string& config_path, const std::string& rec
   return Inputs{std::move(config).value(), std::move(rec).value()};
 }
 
+// The files an earlier run of the same command left in `dir`, removed before this one starts: an interrupted run then
+// leaves the marker and no result of another run beside it.
+Status RemoveEarlierOutputs(const std::string& dir, std::initializer_list<const char*> files) {
+  for (const char* file : files)
+    if (Status s = RemoveStaleFile(dir + "/" + file); !s.ok()) return s;
+  return Status::Ok();
+}
+
+// A failure after the marker was written: its message goes into the marker.
+Outcome Failed(const Status& status, IncompleteMarker* marker) {
+  marker->SetMessage(status.message());
+  return Outcome::Failed(status);
+}
+
 }  // namespace
 
 Status MakeOutputDirectory(const std::string& dir) {
@@ -158,18 +175,27 @@ Outcome CalibrateToDirectory(const CalibrateRequest& request, estimator::Calibra
   if (!dir.ok()) return Outcome::BadInput(dir);
   if (request.warning)
     for (const std::string& w : warnings) request.warning(w);
+  if (Status s = RemoveEarlierOutputs(request.out, {"calibration.json", "trajectory.tum"}); !s.ok())
+    return Outcome::Failed(s);
+  IncompleteMarker marker(request.out);
+  if (Status s = marker.Start(); !s.ok()) return Outcome::Failed(s);
 
   estimator::CalibrationOptions options;
-  options.progress = request.progress;
+  // Each line of progress (stages solved, measurements gated) is what was done when the run stops early.
+  options.progress = [&](const std::string& line) {
+    (void)marker.AddDone(line);
+    if (request.progress) request.progress(line);
+  };
   using Method = estimator::CalibrationOptions::StdMethod;
   if (request.std_method == "white") options.std_method = Method::kWhite;
   if (request.std_method == "hac") options.std_method = Method::kHac;
   auto calibrated = estimator::Calibrate(inputs.value().config, inputs.value().recording, options);
-  if (!calibrated.ok()) return Outcome::Failed(calibrated.status());
+  if (!calibrated.ok()) return Failed(calibrated.status(), &marker);
   const estimator::CalibrationResult& r = calibrated.value();
   Status st = estimator::WriteCalibrationFile(r, request.recording, request.config, request.out + "/calibration.json");
   if (st.ok()) st = WriteTum(r.trajectory, request.out + "/trajectory.tum");
-  if (!st.ok()) return Outcome::Failed(st);
+  if (st.ok()) st = marker.Complete();
+  if (!st.ok()) return Failed(st, &marker);
   if (result) *result = std::move(calibrated).value();
   return Outcome::Ok();
 }
@@ -192,12 +218,17 @@ Outcome TrackToDirectory(const TrackRequest& request, estimator::TrackingResult*
   if (!options.ok()) return Outcome::BadInput(options.status());
   const Status dir = MakeOutputDirectory(request.out);
   if (!dir.ok()) return Outcome::BadInput(dir);
+  if (Status s = RemoveEarlierOutputs(request.out, {"trajectory.tum", "covariance.csv", "summary.json"}); !s.ok())
+    return Outcome::Failed(s);
+  IncompleteMarker marker(request.out);
+  if (Status s = marker.Start(); !s.ok()) return Outcome::Failed(s);
 
   options.value().progress = request.progress;
   auto tracked = estimator::Track(config, inputs.value().recording, calibration, options.value());
-  if (!tracked.ok()) return Outcome::Failed(tracked.status());
-  const Status st = estimator::WriteTrackingFiles(tracked.value(), config.tracking.window, request.out);
-  if (!st.ok()) return Outcome::Failed(st);
+  if (!tracked.ok()) return Failed(tracked.status(), &marker);
+  Status st = estimator::WriteTrackingFiles(tracked.value(), config.tracking.window, request.out);
+  if (st.ok()) st = marker.Complete();
+  if (!st.ok()) return Failed(st, &marker);
   if (result) *result = std::move(tracked).value();
   return Outcome::Ok();
 }

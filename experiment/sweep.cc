@@ -320,8 +320,8 @@ Result<std::string> WritePlot(const SweepPlan& plan, const json& rows, std::size
     script += ")\nset xrange [-0.5:" + std::to_string(distinct.size() - 0.5) + "]\n";
   }
   const std::string dir = plan.out + "/plots";
-  if (Status s = WriteFileAtomically(dir + "/" + name + ".dat", dat); !s.ok()) return s;
-  if (Status s = WriteFileAtomically(dir + "/" + name + ".gp", script + plot + "\n"); !s.ok()) return s;
+  if (Status s = WriteFileAtomic(dir + "/" + name + ".dat", dat); !s.ok()) return s;
+  if (Status s = WriteFileAtomic(dir + "/" + name + ".gp", script + plot + "\n"); !s.ok()) return s;
   return name;
 }
 
@@ -405,8 +405,8 @@ Status WriteSweepPoints(const SweepPlan& plan) {
     MakeAbsolute(c, "tracking", "calibrate", fs::path(plan.montecarlo.config).parent_path());
     const MonteCarloOptions options = SweepPointOptions(plan, p);
     if (Status made = MakeOutputDirectory(options.out); !made.ok()) return made;
-    if (Status w = WriteFileAtomically(options.scenario, Emit(s)); !w.ok()) return w;
-    if (Status w = WriteFileAtomically(options.config, Emit(c)); !w.ok()) return w;
+    if (Status w = WriteFileAtomic(options.scenario, Emit(s)); !w.ok()) return w;
+    if (Status w = WriteFileAtomic(options.config, Emit(c)); !w.ok()) return w;
   }
   return Status::Ok();
 }
@@ -429,9 +429,9 @@ Outcome WriteSweepSummary(const SweepPlan& plan, std::string* headline) {
     rows.push_back(std::move(row).value());
   }
   const json sweep = {{"keys", plan.keys}, {"seeds", plan.montecarlo.runs}, {"points", rows}};
-  if (Status s = WriteFileAtomically(plan.out + "/sweep.json", sweep.dump(2) + "\n"); !s.ok())
+  if (Status s = WriteFileAtomic(plan.out + "/sweep.json", sweep.dump(2) + "\n"); !s.ok())
     return Outcome::Failed(s);
-  if (Status s = WriteFileAtomically(plan.out + "/table.csv", TableCsv(plan, rows)); !s.ok()) return Outcome::Failed(s);
+  if (Status s = WriteFileAtomic(plan.out + "/table.csv", TableCsv(plan, rows)); !s.ok()) return Outcome::Failed(s);
   std::string note;
   WriteReport(plan, rows, WritePlots(plan, rows, &note));
   *headline = std::to_string(rows.size()) + " points x " + std::to_string(plan.montecarlo.runs) + " seeds; wrote " +

@@ -1,6 +1,8 @@
 #include "frontend/recording_front_end.h"
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <system_error>
 #include <utility>
 #include <vector>
@@ -8,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/atomic_file.h"
 #include "frontend/laser_scan.h"
 #include "frontend/scan_matching_stream.h"
 #include "frontend/visual_odometry_stream.h"
@@ -110,29 +113,33 @@ Result<FrontEndResult> ScanMatchingOfScans(const recording::Stream& laser, const
   return result;
 }
 
-// Copies `relative` from one recording directory to the other.
+// Copies `relative` from one recording directory to the other (written atomically).
 Status CopyFile(const std::string& from_directory, const std::string& to_directory, const std::string& relative) {
   const fs::path from = fs::path(from_directory) / relative;
   const fs::path to = fs::path(to_directory) / relative;
   std::error_code error;
   fs::create_directories(to.parent_path(), error);
-  if (!error) fs::copy_file(from, to, fs::copy_options::overwrite_existing, error);
-  if (error) return Status::Error(to.string() + ": cannot copy from " + from.string() + ": " + error.message());
-  return Status::Ok();
+  if (error) return Status::Error(to.string() + ": cannot create its directory: " + error.message());
+  std::ifstream in(from, std::ios::binary);
+  const std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in && !in.eof()) return Status::Error(from.string() + ": cannot read (copying it to " + to.string() + ")");
+  return WriteFileAtomic(to.string(), content);
 }
 
-// The files of the input recording that WriteRecording does not write: camera frames and truth.yaml.
-Status CopyUnwrittenFiles(const recording::Recording& recording, const std::string& input_directory,
-                          const std::string& output_directory) {
-  std::error_code error;
-  if (fs::exists(output_directory, error) && fs::equivalent(input_directory, output_directory, error)) {
-    return Status::Ok();
-  }
+// The camera frames of the input recording, which WriteRecording does not write.
+Status CopyFrames(const recording::Recording& recording, const std::string& input_directory,
+                  const std::string& output_directory) {
   for (const recording::Stream& stream : recording.streams) {
     for (const std::string& frame : stream.text) {
       if (Status s = CopyFile(input_directory, output_directory, frame); !s.ok()) return s;
     }
   }
+  return Status::Ok();
+}
+
+// truth.yaml, after WriteRecording (which removes an earlier recording's).
+Status CopyTruth(const std::string& input_directory, const std::string& output_directory) {
+  std::error_code error;
   if (!fs::exists(fs::path(input_directory) / "truth.yaml", error)) return Status::Ok();
   return CopyFile(input_directory, output_directory, "truth.yaml");
 }
@@ -173,8 +180,9 @@ Result<FrontEndResult> RunFrontEnd(const std::string& input_directory, const std
     replaced = true;
   }
   if (!replaced) recording.streams.push_back(stream);
-  if (Status s = CopyUnwrittenFiles(recording, input_directory, output_directory); !s.ok()) return s;
+  if (Status s = CopyFrames(recording, input_directory, output_directory); !s.ok()) return s;
   if (Status s = recording::WriteRecording(recording, output_directory); !s.ok()) return s;
+  if (Status s = CopyTruth(input_directory, output_directory); !s.ok()) return s;
   return derived;
 }
 

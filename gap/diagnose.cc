@@ -4,6 +4,7 @@
 #include <chrono>
 #include <set>
 
+#include "common/interrupt.h"
 #include "gap/internal/candidate_fit.h"
 #include "gap/internal/decide.h"
 #include "gap/internal/effect_library.h"
@@ -97,6 +98,7 @@ std::vector<CandidateFit> FitRound(const internal::TrainingFits& fits, const std
                                    std::vector<EffectEstimate>* failed) {
   std::vector<CandidateFit> out;
   for (const internal::Candidate& c : library) {
+    if (InterruptRequested()) break;  // Diagnose() reports it
     if (accepted.count(c.name) || dropped->count(c.name)) continue;
     fits.Say("candidate " + c.name + (round > 0 ? " (on top of the accepted effects)" : ""));
     auto cf = internal::FitCandidate(fits, c, state);
@@ -199,6 +201,7 @@ Result<Diagnosis> Diagnose(const EstimatorConfig& nominal_in, const Recording& r
   auto nominal_state = NominalState(fits, &heldout, &out);
   if (!nominal_state.ok()) return nominal_state.status();
   const State state = NameEffects(fits, library, options, &heldout, nominal_state.value(), &out);
+  if (InterruptRequested()) return InterruptedError();
 
   // 4. Model: the accepted effects' training fit, as parameters and stream time shifts.
   out.training_parameters_after = state.train_values;

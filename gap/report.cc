@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <iomanip>
 #include <sstream>
 
+#include "common/atomic_file.h"
 #include "common/html.h"
 #include "common/json.h"
 #include "eval/plots.h"
@@ -92,7 +92,7 @@ std::vector<std::string> WritePlots(const Diagnosis& d, const std::string& dir, 
     const Correlate& c = lc->correlates.front();
     const auto column = std::find(d.conditions.names.begin(), d.conditions.names.end(), c.condition);
     const int ci = static_cast<int>(column - d.conditions.names.begin());
-    std::ofstream data(dir + "/residual_vs_condition.dat");
+    std::ostringstream data;
     data << "# " << c.condition << " (at t + " << c.lag_s << " s)  whitened residual of " << lc->stream << "["
          << lc->component << "]\n";
     for (const estimator::MeasurementResidual& r : d.residuals) {
@@ -100,41 +100,35 @@ std::vector<std::string> WritePlots(const Diagnosis& d, const std::string& dir, 
       const Time t = Time::FromNanoseconds(r.t.nanoseconds() + std::llround(c.lag_s * 1e9));
       data << d.conditions.At(ci, t) << " " << r.whitened[lc->component] << "\n";
     }
-    data.close();  // gnuplot reads it below: every line on disk first
-    std::ofstream gp(dir + "/residual_vs_condition.gp");
+    std::ostringstream gp;
     gp << "set terminal pngcairo size 800,500 noenhanced\nset output 'residual_vs_condition.png'\n"
        << "set title \"" << lc->stream << "[" << lc->component << "]: chi2/dof " << Fixed(lc->chi2_per_dof, 3)
        << " (nominal " << Fixed(lc->expected_chi2_per_dof, 3) << "), rho " << Fixed(c.rho, 2) << "\"\n"
        << "set xlabel '" << c.condition << " at t + " << c.lag_s << " s'\nset ylabel 'whitened residual'\n"
        << "set grid\nplot 'residual_vs_condition.dat' using 1:2 with dots lc rgb '#1f77b4' notitle\n";
-    gp.close();
-    if (eval::RunGnuplot(dir, "residual_vs_condition.gp").ok()) images.push_back("residual_vs_condition.png");
+    if (WriteFileAtomic(dir + "/residual_vs_condition.dat", data.str()).ok() &&
+        WriteFileAtomic(dir + "/residual_vs_condition.gp", gp.str()).ok() &&
+        eval::RunGnuplot(dir, "residual_vs_condition.gp").ok())
+      images.push_back("residual_vs_condition.png");
   }
   {
-    std::ofstream data(dir + "/heldout_fit.dat");
+    std::ostringstream data;
     data << "# stream  chi2_per_dof_before  chi2_per_dof_after (held-out part)\n";
     for (const auto& [name, before] : d.before) {
       const auto after = d.after.find(name);
       data << name << " " << before.chi2_per_dof << " "
            << (after != d.after.end() ? after->second.chi2_per_dof : before.chi2_per_dof) << "\n";
     }
-    data.close();
-    std::ofstream gp(dir + "/heldout_fit.gp");
+    std::ostringstream gp;
     gp << "set terminal pngcairo size 800,450 noenhanced\nset output 'heldout_fit.png'\n"
        << "set title 'held-out part (after t = " << Fixed(d.train_end_s, 4) << " s): chi2/dof per stream'\n"
        << "set style data histograms\nset style fill solid 0.8\nset yrange [0:*]\nset grid y\nset ylabel 'chi2/dof'\n"
        << "plot 'heldout_fit.dat' using 2:xtic(1) title 'nominal', '' using 3 title 'with the accepted effects'\n";
-    gp.close();
-    if (eval::RunGnuplot(dir, "heldout_fit.gp").ok()) images.push_back("heldout_fit.png");
+    if (WriteFileAtomic(dir + "/heldout_fit.dat", data.str()).ok() &&
+        WriteFileAtomic(dir + "/heldout_fit.gp", gp.str()).ok() && eval::RunGnuplot(dir, "heldout_fit.gp").ok())
+      images.push_back("heldout_fit.png");
   }
   return images;
-}
-
-Status WriteText(const std::string& path, const std::string& text) {
-  std::ofstream out(path);
-  if (!out) return Status::Error(path + ": cannot write");
-  out << text;
-  return out ? Status::Ok() : Status::Error(path + ": write failed");
 }
 
 json SimulationJson(const SimulationComparison& c) {
@@ -417,14 +411,14 @@ json DiagnosisJson(const Diagnosis& d, const Baseline* baseline, std::uint64_t b
 
 Status WriteReport(const Diagnosis& d, const ReportInputs& in, const std::string& dir) {
   const json gap_json = DiagnosisJson(d, in.baseline, in.baseline_seed, in.simulation);
-  if (Status s = WriteText(dir + "/gap.json", gap_json.dump(2) + "\n"); !s.ok()) return s;
-  if (Status s = WriteText(dir + "/scenario_patch.yaml", ScenarioPatch(d, in.simulation)); !s.ok()) return s;
-  if (Status s = WriteText(dir + "/estimator_patch.yaml", EstimatorPatch(d)); !s.ok()) return s;
+  if (Status s = WriteFileAtomic(dir + "/gap.json", gap_json.dump(2) + "\n"); !s.ok()) return s;
+  if (Status s = WriteFileAtomic(dir + "/scenario_patch.yaml", ScenarioPatch(d, in.simulation)); !s.ok()) return s;
+  if (Status s = WriteFileAtomic(dir + "/estimator_patch.yaml", EstimatorPatch(d)); !s.ok()) return s;
   std::string note;
   const std::vector<std::string> images = in.plots ? WritePlots(d, dir, &note) : std::vector<std::string>{};
   if (!note.empty() && in.progress) in.progress(note);
   const std::string report = ReportMarkdown(d, in.recording, in.model, in.baseline != nullptr, in.simulation, images);
-  if (Status s = WriteText(dir + "/report.md", report); !s.ok()) return s;
+  if (Status s = WriteFileAtomic(dir + "/report.md", report); !s.ok()) return s;
   return WriteReportHtml(d, in, images, note, dir);
 }
 

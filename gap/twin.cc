@@ -7,6 +7,7 @@
 #include <set>
 
 #include "common/chi_square.h"
+#include "common/interrupt.h"
 #include "eval/velocity.h"
 #include "gap/internal/decide.h"
 #include "gap/internal/twin_fit.h"
@@ -172,6 +173,7 @@ Result<TwinEffect> Diagnoser::Fit(const TwinCandidate& c, const State& state, do
 Result<bool> Diagnoser::Round(int round, const std::vector<TwinCandidate>& pool, double step_s, State* state,
                               std::vector<TwinEffect>* scored) {
   for (const TwinCandidate& c : pool) {
+    if (InterruptRequested()) return InterruptedError();
     Progress("round " + std::to_string(round + 1) + ": fitting " + c.label);
     auto e = Fit(c, *state, step_s, round > 0);
     if (e.ok()) {

@@ -5,11 +5,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <set>
 #include <sstream>
 #include <variant>
 
+#include "common/atomic_file.h"
 #include "importers/internal/bag.h"
 #include "importers/internal/ros_messages.h"
 
@@ -561,9 +561,8 @@ Status WriteCameraFrames(const std::vector<CameraFrame>& frames, const std::stri
     const std::filesystem::path path = std::filesystem::path(directory) / f.file;
     std::error_code ec;
     std::filesystem::create_directories(path.parent_path(), ec);
-    std::ofstream out(path, std::ios::binary);
-    out.write(f.bytes.data(), static_cast<std::streamsize>(f.bytes.size()));
-    if (!out) return Status::Error(path.string() + ": cannot write the camera frame");
+    if (ec) return Status::Error(path.parent_path().string() + ": cannot create the frame directory: " + ec.message());
+    if (Status s = WriteFileAtomic(path.string(), std::string_view(f.bytes.data(), f.bytes.size())); !s.ok()) return s;
   }
   return Status::Ok();
 }

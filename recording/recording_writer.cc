@@ -10,6 +10,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "common/atomic_file.h"
 #include "recording/internal/laser_scan.h"
 #include "recording/internal/stream_csv.h"
 #include "recording/internal/stream_types.h"
@@ -219,6 +220,39 @@ std::string EmitRecordingYaml(const Recording& recording) {
   return std::string(out.c_str()) + "\n";
 }
 
+// The stream CSVs named by the recording.yaml that DIR holds, read leniently: a missing or unreadable file names none.
+// Only plain names count (no path separator, not starting with a dot).
+std::vector<std::string> EarlierStreamFiles(const fs::path& dir) {
+  std::vector<std::string> files;
+  try {
+    const YAML::Node root = YAML::LoadFile((dir / kYamlFile).string());
+    if (!root.IsMap() || !root["streams"] || !root["streams"].IsSequence()) return files;
+    for (const YAML::Node& stream : root["streams"]) {
+      if (!stream.IsMap() || !stream["name"] || !stream["name"].IsScalar()) continue;
+      const std::string name = stream["name"].Scalar();
+      if (!name.empty() && name[0] != '.' && name.find('/') == std::string::npos) files.push_back(name + ".csv");
+    }
+  } catch (const YAML::Exception&) {
+    files.clear();
+  }
+  return files;
+}
+
+// An earlier recording in DIR: its recording.yaml is removed first (until the new one is written last, the directory
+// does not read as a recording), then its stream CSVs that the new recording does not write, and its truth.yaml
+// (WriteTruth writes the new recording's after this). Other files are left alone.
+Status RemoveEarlierRecording(const Recording& recording, const fs::path& dir) {
+  const std::vector<std::string> earlier = EarlierStreamFiles(dir);
+  std::set<std::string> written;
+  for (const Stream& stream : recording.streams) written.insert(stream.info.name + ".csv");
+  std::vector<std::string> stale = {kYamlFile, kTruthYamlFile};
+  for (const std::string& file : earlier)
+    if (!written.count(file)) stale.push_back(file);
+  for (const std::string& file : stale)
+    if (Status s = RemoveStaleFile((dir / file).string()); !s.ok()) return s;
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status WriteRecording(const Recording& recording, const std::string& directory) {
@@ -228,6 +262,7 @@ Status WriteRecording(const Recording& recording, const std::string& directory) 
   std::error_code error;
   fs::create_directories(dir, error);
   if (error) return Status::Error(directory + ": cannot create directory: " + error.message());
+  if (Status s = RemoveEarlierRecording(recording, dir); !s.ok()) return s;
   // Stream files.
   for (const Stream& stream : recording.streams) {
     const std::string path = (dir / (stream.info.name + ".csv")).string();
@@ -235,7 +270,7 @@ Status WriteRecording(const Recording& recording, const std::string& directory) 
     const Eigen::MatrixXd no_values(static_cast<Eigen::Index>(stream.t.size()), 0);
     const std::string text = internal::FormatStreamCsv(
         WrittenColumns(stream.info), stream.t, camera ? no_values : stream.values, camera ? &stream.text : nullptr);
-    if (Status s = internal::WriteTextFile(path, text); !s.ok()) return s;
+    if (Status s = WriteFileAtomic(path, text); !s.ok()) return s;
   }
   // Ground truth; a stale file from an earlier recording in the same directory is removed.
   const fs::path ground_truth_path = dir / kGroundTruthFile;
@@ -246,7 +281,7 @@ Status WriteRecording(const Recording& recording, const std::string& directory) 
     if (error) return Status::Error(ground_truth_path.string() + ": cannot remove stale file: " + error.message());
   }
   // recording.yaml last: an interrupted write leaves a directory that does not read as a recording.
-  return internal::WriteTextFile((dir / kYamlFile).string(), EmitRecordingYaml(recording));
+  return WriteFileAtomic((dir / kYamlFile).string(), EmitRecordingYaml(recording));
 }
 
 }  // namespace roamlab::recording

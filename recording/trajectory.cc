@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string_view>
 
+#include "common/atomic_file.h"
 #include "recording/internal/text_io.h"
 
 namespace roamlab {
@@ -16,7 +17,6 @@ using recording::internal::ParseNumber;
 using recording::internal::ReadTextFile;
 using recording::internal::TimeOrderProblem;
 using recording::internal::Trim;
-using recording::internal::WriteTextFile;
 
 constexpr std::array<const char*, 8> kTumFields = {"t", "x", "y", "z", "qx", "qy", "qz", "qw"};
 
@@ -114,7 +114,7 @@ Status WriteTum(const Trajectory& trajectory, const std::string& path) {
     }
     out += '\n';
   }
-  return WriteTextFile(path, out);
+  return WriteFileAtomic(path, out);
 }
 
 }  // namespace roamlab

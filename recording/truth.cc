@@ -7,6 +7,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "common/atomic_file.h"
+#include "recording/internal/stream_types.h"
 #include "recording/internal/text_io.h"
 #include "recording/internal/yaml_util.h"
 
@@ -20,8 +22,6 @@ using internal::ReadNumberList;
 using internal::ReadNumberMap;
 using internal::ReadString;
 using internal::RequireKey;
-
-constexpr const char* kTruthFile = "truth.yaml";
 
 // calibration: {name: number | [numbers]}; a single number is read as a vector of size one.
 Status ParseCalibration(const YAML::Node& node, const std::string& path,
@@ -139,7 +139,7 @@ std::string EmitTruth(const Truth& truth) {
 }  // namespace
 
 Result<Truth> ReadTruth(const std::string& directory) {
-  const std::string path = (fs::path(directory) / kTruthFile).string();
+  const std::string path = (fs::path(directory) / internal::kTruthYamlFile).string();
   YAML::Node root;
   if (Status status = internal::LoadYamlFile(path, &root); !status.ok()) return status;
   // An empty file is an empty truth; anything else must be a mapping with known keys.
@@ -160,13 +160,13 @@ Result<Truth> ReadTruth(const std::string& directory) {
 }
 
 Status WriteTruth(const Truth& truth, const std::string& directory) {
-  const std::string path = (fs::path(directory) / kTruthFile).string();
+  const std::string path = (fs::path(directory) / internal::kTruthYamlFile).string();
   if (Status status = ValidateForWrite(truth, path); !status.ok()) return status;
   // The directory may not exist yet (truth is written beside a fresh recording).
   std::error_code error;
   fs::create_directories(directory, error);
   if (error) return Status::Error(directory + ": cannot create directory: " + error.message());
-  return internal::WriteTextFile(path, EmitTruth(truth));
+  return WriteFileAtomic(path, EmitTruth(truth));
 }
 
 }  // namespace roamlab::recording

@@ -1,5 +1,9 @@
 // Runs a regression suite (regress/suite.h): each selected case in OUT/cases/NAME, the cases in parallel, then every
-// check against its bound; writes OUT/results.json, OUT/junit.xml and OUT/report.html (regress/report.h).
+// check against its bound; writes OUT/results.json, OUT/junit.xml, OUT/timings.json and OUT/report.html
+// (regress/report.h), each atomically. A finished case leaves its record, OUT/cases/NAME/case_result.json. The reports
+// of an earlier run and the directories of cases not selected are removed first. OUT/INCOMPLETE (common/interrupt.h)
+// lists the finished cases while the run goes on; after SIGINT or SIGTERM no further case starts, a case the signal
+// stopped is removed, the marker stays and the outcome is a failure naming the interruption; `resume` continues.
 #pragma once
 
 #include <functional>
@@ -18,6 +22,9 @@ struct RunOptions {
   int jobs = 0;                  // cases (and montecarlo runs) in parallel; 0 = one per core
   std::string filter;            // glob on case names (fnmatch); "" = all
   bool quick = false;            // only the cases marked `quick: true`
+  // Continue an interrupted run in `out`: a case whose record (cases/NAME/case_result.json) matches its definition is
+  // taken from it, the others run. The reports are the same bytes as an uninterrupted run's.
+  bool resume = false;
   // Optional: one line per finished case ("regress [3/9] NAME (MODE): ran in 12.5 s").
   std::function<void(const std::string& line)> progress;
 };

@@ -50,7 +50,11 @@ struct SuiteResult {
 std::string FailureMessage(const CheckResult& check);
 
 std::string ResultsTable(const SuiteResult& result);
+// results.json and junit.xml hold no wall time: the same cases give the same bytes, also when a run interrupted and
+// resumed (`regress --resume`) gathers them. The times go to timings.json (TimingsJson) and the table.
 nlohmann::json ResultsJson(const SuiteResult& result);
+// timings.json: {"seconds": the run's wall time, "cases": {NAME: seconds}} (a resumed case keeps its first run's).
+nlohmann::json TimingsJson(const SuiteResult& result);
 std::string JunitXml(const SuiteResult& result);
 // report.html: one self-contained page, the verdict and the counts first, case errors and skips, then every check
 // (case, mode, metric, value, bound, threshold, baseline, result, message).

@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/atomic_file.h"
 #include "sim/mujoco_model.h"
 
 namespace roamlab::sim {
@@ -122,13 +123,16 @@ Result<std::optional<frontend::VoEstimate>> SimulatedCamera::Observe(Time t, mjD
     const std::string relative = s.options.stream_name + "/" + name;
     const std::string path = (fs::path(s.options.image_directory) / relative).string();
     cv::cvtColor(s.rgb, s.bgr, cv::COLOR_RGB2BGR);
-    bool written = false;
+    std::vector<unsigned char> png;
+    bool encoded = false;
     try {
-      written = cv::imwrite(path, s.bgr);
+      encoded = cv::imencode(".png", s.bgr, png);
     } catch (const cv::Exception&) {
-      written = false;
+      encoded = false;
     }
-    if (!written) return Status::Error(path + ": cannot write the camera image");
+    if (!encoded) return Status::Error(path + ": cannot encode the camera image");
+    const std::string_view bytes(reinterpret_cast<const char*>(png.data()), png.size());
+    if (Status written = WriteFileAtomic(path, bytes); !written.ok()) return written;
     s.image_t.push_back(t);
     s.image_names.push_back(relative);
   }

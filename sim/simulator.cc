@@ -11,6 +11,7 @@
 #include <GeographicLib/LocalCartesian.hpp>
 
 #include "common/check.h"
+#include "common/interrupt.h"
 #include "frontend/laser_scan.h"
 #include "frontend/scan_matching_stream.h"
 #include "sim/ackermann.h"
@@ -575,6 +576,7 @@ class Simulator::Impl {
       // One physics step.
       mj_step(m, d);
       ++done;
+      if (InterruptRequested()) return InterruptedError();
       if (d->warning[mjWARN_BADQACC].number > 0) {
         return Status::Error(model_where_ + ": the simulation diverged at t = " + FormatTime(t_ns_) +
                              " (MuJoCo: bad acceleration)");

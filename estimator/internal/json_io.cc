@@ -1,17 +1,12 @@
 #include "estimator/internal/json_io.h"
 
-#include <fstream>
+#include "common/atomic_file.h"
 
 namespace roamlab::estimator::internal {
 
 using nlohmann::json;
 
-Status WriteJson(const json& j, const std::string& path) {
-  std::ofstream out(path);
-  if (!out) return Status::Error(path + ": cannot write");
-  out << j.dump(2) << "\n";
-  return out ? Status::Ok() : Status::Error(path + ": write failed");
-}
+Status WriteJson(const json& j, const std::string& path) { return WriteFileAtomic(path, j.dump(2) + "\n"); }
 
 json CountsJson(const std::map<std::string, StreamCounts>& counts) {
   json j = json::object();

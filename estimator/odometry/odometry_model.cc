@@ -4,6 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/atomic_file.h"
+
 namespace roamlab::estimator::odometry {
 namespace {
 
@@ -114,10 +116,7 @@ Status SaveOdometryModel(const OdometryModel& model, const std::string& path) {
     j["kinematics"] = {
         {"J", MatrixRows(k.J)}, {"radius_m", VectorJson(k.radius_m)}, {"sensor_pose", VectorJson(k.sensor_pose)}};
   }
-  std::ofstream out(path);
-  if (!out) return Status::Error(path + ": cannot write");
-  out << j.dump(1) << "\n";
-  return out ? Status::Ok() : Status::Error(path + ": write failed");
+  return WriteFileAtomic(path, j.dump(1) + "\n");
 }
 
 Result<OdometryModel> LoadOdometryModel(const std::string& path) {

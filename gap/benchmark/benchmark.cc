@@ -15,6 +15,7 @@
 #include <tuple>
 
 #include "common/atomic_file.h"
+#include "common/interrupt.h"
 #include "gap/learn_baseline.h"
 
 namespace roamlab::gap::benchmark {
@@ -46,7 +47,7 @@ Status RunParallel(int n, int jobs, const std::string& label, std::ostream* prog
     for (int i = next++; i < n; i = next++) {
       {
         std::lock_guard<std::mutex> lock(mutex);
-        if (!first_error.ok()) return;
+        if (!first_error.ok() || InterruptRequested()) return;
       }
       Result<std::string> line = fn(i);
       std::lock_guard<std::mutex> lock(mutex);
@@ -63,6 +64,7 @@ Status RunParallel(int n, int jobs, const std::string& label, std::ostream* prog
   for (int k = 0; k < std::max(1, std::min(jobs, n)); ++k) threads.emplace_back(worker);
   for (std::thread& t : threads) t.join();
   if (progress) *progress << "\n";
+  if (first_error.ok() && InterruptRequested()) return InterruptedError();
   return first_error;
 }
 

@@ -6,12 +6,12 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <sstream>
 
 #include <Eigen/Core>
 
+#include "common/atomic_file.h"
 #include "gap/learn_baseline.h"
 #include "gap/nominal_config.h"
 #include "gap/report.h"
@@ -334,8 +334,8 @@ Result<CaseResult> RunCase(const Platform& platform, const Draw& draw, std::uint
   auto blind = DiagnoseBlind(platform, rec_dir, setup);
   if (!blind.ok()) return blind.status();
   const BlindDiagnosis& b = blind.value();
-  std::ofstream(dir + "/gap.json")
-      << DiagnosisJson(b.diagnosis, &platform.baseline, kDefaultBaselineSeed, &b.simulation).dump(2) << "\n";
+  const nlohmann::json gap = DiagnosisJson(b.diagnosis, &platform.baseline, kDefaultBaselineSeed, &b.simulation);
+  if (Status s = WriteFileAtomic(dir + "/gap.json", gap.dump(2) + "\n"); !s.ok()) return s;
   CaseResult c;
   c.id = id;
   c.platform = platform.name;
@@ -344,7 +344,7 @@ Result<CaseResult> RunCase(const Platform& platform, const Draw& draw, std::uint
   if (Status s = ScoreFromTruth(platform, draw, simulated.value(), rec_dir, b, &c); !s.ok()) return s;
   c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // Written last, under a temporary name then renamed: a case.json marks a finished case (BenchmarkOptions::resume).
-  if (Status written = WriteFileAtomically(dir + "/case.json", CaseRow(c).dump(2) + "\n"); !written.ok())
+  if (Status written = WriteFileAtomic(dir + "/case.json", CaseRow(c).dump(2) + "\n"); !written.ok())
     return written;
   return c;
 }

@@ -14,6 +14,7 @@ namespace roamlab::recording::internal {
 
 inline constexpr const char* kYamlFile = "recording.yaml";
 inline constexpr const char* kGroundTruthFile = "ground_truth.tum";
+inline constexpr const char* kTruthYamlFile = "truth.yaml";
 inline constexpr double kPi = 3.14159265358979323846;
 inline constexpr double kDegree = kPi / 180.0;       // rad per degree
 inline constexpr double kStandardGravity = 9.80665;  // m/s^2 per g

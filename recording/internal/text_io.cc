@@ -30,15 +30,6 @@ Status ReadTextFile(const std::string& path, std::string* content) {
   return Status::Ok();
 }
 
-Status WriteTextFile(const std::string& path, const std::string& content) {
-  FilePtr file(std::fopen(path.c_str(), "wb"));
-  if (!file) return Status::Error(path + ": cannot create file");
-  const bool written = std::fwrite(content.data(), 1, content.size(), file.get()) == content.size();
-  const bool closed = std::fclose(file.release()) == 0;
-  if (!written || !closed) return Status::Error(path + ": write error");
-  return Status::Ok();
-}
-
 std::string_view Trim(std::string_view text) {
   while (!text.empty() && IsBlank(text.front())) text.remove_prefix(1);
   while (!text.empty() && IsBlank(text.back())) text.remove_suffix(1);

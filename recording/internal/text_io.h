@@ -15,9 +15,6 @@ namespace roamlab::recording::internal {
 // Reads the whole file into `content`. Error: "<path>: cannot open file" (or read error).
 Status ReadTextFile(const std::string& path, std::string* content);
 
-// Writes `content` to `path` (binary mode, replacing the file).
-Status WriteTextFile(const std::string& path, const std::string& content);
-
 // Outcome of parsing one number cell.
 enum class NumberParse { kOk, kNotANumber, kNaN, kInf };
 

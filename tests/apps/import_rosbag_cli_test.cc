@@ -100,8 +100,9 @@ TEST_F(ImportRosbagCliTest, ListTopicAndOdometryTopic) {
 }
 
 TEST_F(ImportRosbagCliTest, BadInputIsOneLineAndExitTwo) {
+  fs::create_directories(dir_ / "not_a_bag");
   for (const std::string& args :
-       {"import rosbag " + dir_.string() + " --out " + (dir_ / "rec").string(),  // a directory, no rosbag2 bag
+       {"import rosbag " + (dir_ / "not_a_bag").string() + " --out " + (dir_ / "rec").string(),  // no rosbag2 bag
         "import rosbag " + (dir_ / "none.bag").string() + " --out " + (dir_ / "rec").string(),
         "import rosbag " + bag_ + " --topic /imu --out " + (dir_ / "rec").string(),
         "import rosbag " + bag_ + " --topic /nothing=x --out " + (dir_ / "rec").string(), "import rosbag " + bag_}) {

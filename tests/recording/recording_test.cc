@@ -336,6 +336,33 @@ TEST(RecordingTest, GroundTruthIsOptional) {
   EXPECT_FALSE(ReadRecording(dir.path()).value().ground_truth.has_value());
 }
 
+// A recording written over an earlier one: the stream CSVs the earlier recording.yaml names and the new recording
+// does not have are removed, with its truth.yaml; files that are not the earlier recording's stay. No temporary file
+// is left.
+TEST(RecordingTest, RewriteRemovesTheEarlierRecordingsStaleFiles) {
+  TempDir dir;
+  const Recording full = MakeFullRecording();
+  ASSERT_GE(full.streams.size(), 2u);
+  ASSERT_TRUE(WriteRecording(full, dir.path()).ok());
+  WriteFile(dir.File("truth.yaml"), "calibration: {}\n");
+  WriteFile(dir.File("notes.csv"), "not a stream of the recording\n");
+  const std::string dropped = full.streams.back().info.name + ".csv";
+  ASSERT_TRUE(std::filesystem::exists(dir.File(dropped)));
+
+  Recording fewer = full;
+  fewer.streams.pop_back();
+  ASSERT_TRUE(WriteRecording(fewer, dir.path()).ok());
+  EXPECT_FALSE(std::filesystem::exists(dir.File(dropped)));
+  EXPECT_FALSE(std::filesystem::exists(dir.File("truth.yaml")));
+  EXPECT_EQ(ReadFile(dir.File("notes.csv")), "not a stream of the recording\n");
+  for (const Stream& stream : fewer.streams) EXPECT_TRUE(std::filesystem::exists(dir.File(stream.info.name + ".csv")));
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path()))
+    EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();
+  const Result<Recording> read = ReadRecording(dir.path());
+  ASSERT_TRUE(read.ok()) << read.status().message();
+  EXPECT_EQ(read.value().streams.size(), fewer.streams.size());
+}
+
 TEST(RecordingTest, NeverOpensTruthYaml) {
   TempDir dir;
   WriteFixture(dir);

@@ -368,5 +368,45 @@ TEST_F(RegressTest, OutputSchemasMatchWhatTheCommandsWrite) {
   EXPECT_EQ(missing, (std::set<std::string>{"metrics.parameters", "metrics.velocity"}));
 }
 
+// --resume takes a finished case from its record only while the record matches the case: a changed bound runs it
+// again. Without --resume every case runs.
+TEST_F(RegressTest, ResumeReadsMatchingRecordsOnly) {
+  const std::string path = dir_->File("suite_resume.yaml");
+  const auto suite = [&](const std::string& bound) {
+    testing::WriteFile(path,
+                       "cases:\n  - name: synthetic_track\n    mode: track\n    recording: rec\n"
+                       "    config: good.yaml\n    checks:\n      - {metric: summary.poses, bound: \"" +
+                           bound + "\"}\n");
+  };
+  const auto run = [&](bool resume, std::string* lines) {
+    RunOptions args;
+    args.suite = path;
+    args.out = dir_->File("out_resume");
+    args.jobs = 1;
+    args.resume = resume;
+    args.progress = [lines](const std::string& line) { *lines += line + "\n"; };
+    return RunRegress(args);
+  };
+  suite(">= 100");
+  std::string lines;
+  ASSERT_EQ(run(false, &lines), 0);
+  EXPECT_NE(lines.find("synthetic_track (track): ran"), std::string::npos) << lines;
+  const std::string first = testing::ReadFile(dir_->File("out_resume/results.json"));
+  ASSERT_TRUE(fs::exists(dir_->File("out_resume/cases/synthetic_track/case_result.json")));
+
+  lines.clear();
+  ASSERT_EQ(run(true, &lines), 0);
+  EXPECT_NE(lines.find("synthetic_track (track): resumed"), std::string::npos) << lines;
+  EXPECT_EQ(testing::ReadFile(dir_->File("out_resume/results.json")), first);
+
+  suite(">= 101");
+  lines.clear();
+  ASSERT_EQ(run(true, &lines), 0);
+  EXPECT_NE(lines.find("synthetic_track (track): ran"), std::string::npos) << lines;
+  lines.clear();
+  ASSERT_EQ(run(false, &lines), 0);
+  EXPECT_NE(lines.find("synthetic_track (track): ran"), std::string::npos) << lines;
+}
+
 }  // namespace
 }  // namespace roamlab::regress
