@@ -137,7 +137,7 @@ int main(int argc, char** argv) {
   if (int code = bench::RunSteps(ctx, &j)) return code;
   std::filesystem::remove_all(ctx.tmp);
   if (!json_path.empty())
-    if (const Status s = WriteFileAtomic(json_path, j.dump(2) + "\n"); !s.ok()) {
+    if (const roamlab::Status s = roamlab::WriteFileAtomic(json_path, j.dump(2) + "\n"); !s.ok()) {
       std::fprintf(stderr, "roamlab_bench: %s\n", s.message().c_str());
       return 1;
     }
