@@ -182,13 +182,14 @@ Result<CandidateOutcome> FitLeastSquares(const TwinCandidate& c, const Eigen::Ve
     if (decrease < enough) break;
   }
   out.effect = EffectAt(c, out.theta);
-  out.covariance = settings.covariance->compute(Rows(evaluator->layout(), out.residuals, J));
+  out.covariance = ComputeTwinCovariance(Rows(evaluator->layout(), out.residuals, J));
   return out;
 }
 
 // The time shift on the step grid: the chi-square at a coarse grid of 9 points over the range, then halving the
 // spacing about the best until neighbouring steps; the value is the vertex of the parabola through the best step and
-// its neighbours (within half a step of it), the covariance from the residuals' central difference there.
+// its neighbours (within half a step of it), the covariance from the residuals' central difference there
+// (FitCandidate).
 Result<CandidateOutcome> SearchTimeShift(const TwinCandidate& c, const Eigen::VectorXd& base, TwinEvaluator* evaluator,
                                          const FitSettings& settings) {
   const TwinParameter& p = c.free.front();
@@ -245,7 +246,8 @@ Result<CandidateOutcome> SearchTimeShift(const TwinCandidate& c, const Eigen::Ve
       up > down
           ? Eigen::VectorXd((Masked(r[up], r[b]) - Masked(r[down], r[b])) / (static_cast<double>(up - down) * step))
           : Eigen::VectorXd::Zero(base.size());
-  out.covariance = settings.covariance->compute(Rows(evaluator->layout(), r[b], J));
+  const Eigen::VectorXd at_vertex = r[b] + J.col(0) * (vertex * step);
+  out.covariance = ComputeTwinCovariance(Rows(evaluator->layout(), at_vertex, J));
   return out;
 }
 

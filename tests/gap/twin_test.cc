@@ -43,8 +43,8 @@ TwinDiagnosis Diagnosed(const std::vector<sim::EffectOptions>& hidden, std::uint
               d.value().verdict.c_str());
   for (const TwinEffect& e : d.value().effects)
     for (const auto& [name, value] : e.estimate.std)
-      std::printf("  %s %s = %.6g +- %.3g\n", e.estimate.name.c_str(), name.c_str(), e.estimate.parameters.at(name),
-                  value);
+      std::printf("  %s %s = %.6g +- %.3g (white %.3g, hac %.3g)\n", e.estimate.name.c_str(), name.c_str(),
+                  e.estimate.parameters.at(name), value, e.std_white.at(name), e.std_hac.at(name));
   return d.value();
 }
 
