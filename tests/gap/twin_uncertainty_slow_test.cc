@@ -80,7 +80,10 @@ void Score(const std::vector<TwinEffect>& fits, const std::string& name, const s
     std::printf("  %-18s truth %+.5f error %+.6f std white %.6f hac %.6f (HAC lags:", c->label.c_str(), truth, error,
                 white, hac);
     for (const auto& [series, lag] : e.hac_lags) std::printf(" %s %d", series.c_str(), lag);
-    std::printf(")\n");
+    std::printf(")");
+    for (const auto& [other, value] : e.estimate.parameters)
+      if (other != parameter) std::printf(" %s %.4f", other.c_str(), value);
+    std::printf("\n");
     return;
   }
   ADD_FAILURE() << name << " was not fitted";
