@@ -223,8 +223,8 @@ void AddDiagnose(CLI::App* app, Commands* commands) {
                     "Time-shift search range [s] of gps_latency, imu_time_offset and pose_time_offset (default 0.5; "
                     "below 1/12 of the recording's span)");
     dia->add_option("--std", args->std_method,
-                    "The effects' standard deviations: white, hac (autocorrelated residuals) or auto (hac on imported "
-                    "recordings, white on simulated ones; default)")
+                    "The effects' standard deviations, also the twin's with --replay: white, hac (autocorrelated "
+                    "residuals) or auto (hac on imported recordings, white on simulated ones; default)")
         ->check(CLI::IsMember({"auto", "white", "hac"}));
     dia->add_flag("--no-plots", args->no_plots, "No figures");
     dia->add_flag("--replay", args->replay,

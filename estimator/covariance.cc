@@ -91,29 +91,11 @@ std::vector<Eigen::VectorXd> Residuals(const std::vector<Score>& rows) {
   return out;
 }
 
-// sum_{|l| <= L} (1 - |l| / (L + 1)) sum_t a_t a_{t+l}^T over one stream's rows in time order: b_t = the
-// Bartlett-weighted sum of the a around t (a triangle is two boxes of length L + 1 convolved), then sum_t a_t b_t^T.
-Eigen::MatrixXd BartlettSum(const std::vector<Score>& rows, int lag) {
-  const int n = static_cast<int>(rows.size());
-  const int k = static_cast<int>(rows.front().a.size());
-  Eigen::MatrixXd a(k, n);
-  for (int t = 0; t < n; ++t) a.col(t) = rows[t].a;
-  Eigen::MatrixXd box(k, n);  // box_t = sum_{j=0..L} a_{t-j}
-  Eigen::VectorXd running = Eigen::VectorXd::Zero(k);
-  for (int t = 0; t < n; ++t) {
-    running += a.col(t);
-    if (t - lag - 1 >= 0) running -= a.col(t - lag - 1);
-    box.col(t) = running;
-  }
-  Eigen::MatrixXd b(k, n);  // b_t = sum_{j=0..L} box_{t+j} / (L + 1)
-  running.setZero();
-  for (int t = n - 1; t >= 0; --t) {
-    running += box.col(t);
-    if (t + lag + 1 < n) running -= box.col(t + lag + 1);
-    b.col(t) = running / static_cast<double>(lag + 1);
-  }
-  const Eigen::MatrixXd m = a * b.transpose();
-  return 0.5 * (m + m.transpose());
+// The influences of one stream's rows in time order, one column each.
+Eigen::MatrixXd Influences(const std::vector<Score>& rows) {
+  Eigen::MatrixXd a(rows.front().a.size(), static_cast<Eigen::Index>(rows.size()));
+  for (std::size_t t = 0; t < rows.size(); ++t) a.col(static_cast<Eigen::Index>(t)) = rows[t].a;
+  return a;
 }
 
 }  // namespace
@@ -149,6 +131,29 @@ Result<MarginalInformation> ComputeMarginalInformation(const Graph& graph, const
   result.information = Hpp - Hxp.transpose() * Y.value();
   result.information = 0.5 * (result.information + result.information.transpose()).eval();
   return result;
+}
+
+// b_t = the Bartlett-weighted sum of the a around t (a triangle is two boxes of length L + 1 convolved), then
+// sum_t a_t b_t^T.
+Eigen::MatrixXd BartlettSum(const Eigen::MatrixXd& a, int lag) {
+  const Eigen::Index n = a.cols(), k = a.rows();
+  lag = std::max(0, lag);
+  Eigen::MatrixXd box(k, n);  // box_t = sum_{j=0..L} a_{t-j}
+  Eigen::VectorXd running = Eigen::VectorXd::Zero(k);
+  for (Eigen::Index t = 0; t < n; ++t) {
+    running += a.col(t);
+    if (t - lag - 1 >= 0) running -= a.col(t - lag - 1);
+    box.col(t) = running;
+  }
+  Eigen::MatrixXd b(k, n);  // b_t = sum_{j=0..L} box_{t+j} / (L + 1)
+  running.setZero();
+  for (Eigen::Index t = n - 1; t >= 0; --t) {
+    running += box.col(t);
+    if (t + lag + 1 < n) running -= box.col(t + lag + 1);
+    b.col(t) = running / static_cast<double>(lag + 1);
+  }
+  const Eigen::MatrixXd m = a * b.transpose();
+  return 0.5 * (m + m.transpose());
 }
 
 ResidualAutocorrelation AnalyzeAutocorrelation(const std::vector<Eigen::VectorXd>& residuals) {
@@ -243,7 +248,7 @@ Result<HacCovariance> ComputeHacCovariance(const Graph& graph, const std::vector
     std::stable_sort(rows.begin(), rows.end(), [](const Score& x, const Score& y) { return x.t_ns < y.t_ns; });
     const int lag = AnalyzeAutocorrelation(Residuals(rows)).lag;
     out.lags[name] = lag;
-    M += BartlettSum(rows, lag);
+    M += BartlettSum(Influences(rows), lag);
   }
   out.covariance = white_covariance * M * white_covariance;
   out.covariance = 0.5 * (out.covariance + out.covariance.transpose()).eval();

@@ -94,6 +94,11 @@ struct ResidualAutocorrelation {
 };
 ResidualAutocorrelation AnalyzeAutocorrelation(const std::vector<Eigen::VectorXd>& residuals);
 
+// The middle of the sandwich over one stream's rows in time order, column t of `a` (k x n) the score or influence of
+// row t: sum_{|l| <= L} (1 - |l| / (L + 1)) sum_t a_t a_{t+l}^T, symmetric, in O(n k^2). Also what a fit outside the
+// graph (the twin diagnosis, gap/twin.h) sums its residuals' scores with.
+Eigen::MatrixXd BartlettSum(const Eigen::MatrixXd& a, int lag);
+
 struct HacCovariance {
   Eigen::MatrixXd covariance;       // tangent coordinates, the variables stacked in order
   std::map<std::string, int> lags;  // per stream: L_s (factor rows)

@@ -20,6 +20,13 @@
 namespace roamlab::experiment {
 namespace {
 
+using StdMethod = estimator::CalibrationOptions::StdMethod;
+
+// --std: auto | white | hac.
+StdMethod ParseStdMethod(const std::string& method) {
+  return method == "white" ? StdMethod::kWhite : method == "hac" ? StdMethod::kHac : StdMethod::kAuto;
+}
+
 std::string Fixed(double x, int digits) {
   std::ostringstream s;
   s.precision(digits);
@@ -122,6 +129,7 @@ Outcome DiagnoseTwinToFile(const DiagnoseRequest& request, const Inputs& in, con
   say("diagnosing " + request.recording + " against the scenario's twin" + (replayed ? " (replayed)" : ""));
   gap::TwinDiagnoseOptions options;
   options.replayed = replayed;
+  options.std_method = ParseStdMethod(request.std_method);
   options.progress = [&](const std::string& line) { say("  " + line); };
   if (request.max_shift_s) options.max_shift_s = *request.max_shift_s;
   auto diagnosed = gap::DiagnoseTwin(*in.scenario, in.recording, runner, options);
@@ -129,7 +137,7 @@ Outcome DiagnoseTwinToFile(const DiagnoseRequest& request, const Inputs& in, con
   const std::string path = (std::filesystem::path(request.out) / "twin.json").string();
   if (Status s = WriteFileAtomic(path, gap::TwinDiagnosisJson(diagnosed.value()).dump(2) + "\n"); !s.ok())
     return Outcome::Failed(s);
-  say("twin: " + diagnosed.value().verdict + " (" + path + ")");
+  say("twin: " + diagnosed.value().verdict + ", std " + diagnosed.value().std_method + " (" + path + ")");
   return Outcome::Ok();
 }
 
@@ -186,9 +194,7 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
   gap::DiagnoseOptions options;
   options.progress = [&](const std::string& line) { say("  " + line); };
   if (request.max_shift_s) options.max_shift_s = *request.max_shift_s;
-  using Method = estimator::CalibrationOptions::StdMethod;
-  if (request.std_method == "white") options.std_method = Method::kWhite;
-  if (request.std_method == "hac") options.std_method = Method::kHac;
+  options.std_method = ParseStdMethod(request.std_method);
 
   gap::Baseline baseline;
   if (!request.no_baseline) {

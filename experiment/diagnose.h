@@ -37,7 +37,7 @@ struct DiagnoseRequest {
   bool no_baseline = false;
   std::uint64_t baseline_seed = gap::kDefaultBaselineSeed;  // noise seed of the nominal simulation
   std::optional<double> max_shift_s;  // the time-shift search range (default gap::DiagnoseOptions')
-  std::string std_method = "auto";    // the effects' std: auto | white | hac (gap/diagnose.h)
+  std::string std_method = "auto";    // the effects' std: auto | white | hac (gap/diagnose.h, gap/twin.h)
   bool no_plots = false;              // no figures beside report.md
   // Also diagnose against the twin (gap/twin.h) and write out/twin.json. Needs a scenario. The twin is the plain
   // noise-free simulation of the scenario for a recording of its own drive (gap::DriveMismatch), else the replay of

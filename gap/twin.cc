@@ -104,6 +104,7 @@ class Diagnoser {
   Layout train_layout_;
   int measurements_ = 0;
   int runs_ = 0;
+  bool hac_ = false;  // the std reported is the HAC one
 };
 
 Status Diagnoser::Span() {
@@ -130,7 +131,6 @@ Result<TwinEffect> Diagnoser::Fit(const TwinCandidate& c, const State& state, do
   settings.max_iterations = options_.max_iterations;
   settings.physics_step_s = step_s;
   settings.threads = options_.threads;
-  settings.covariance = &options_.covariance;
   if (screen) {
     auto drop = internal::PredictedDrop(c, state.residuals, &evaluator, settings);
     runs_ += evaluator.runs();
@@ -159,10 +159,15 @@ Result<TwinEffect> Diagnoser::Fit(const TwinCandidate& c, const State& state, do
   e.estimate.name = c.label;
   e.estimate.dof = static_cast<int>(c.free.size());
   e.estimate.parameters = Values(c, fit.value().theta);
+  const TwinCovariance& covariance = fit.value().covariance;
   for (std::size_t j = 0; j < c.free.size(); ++j) {
     const Eigen::Index k = static_cast<Eigen::Index>(j);
-    e.estimate.std[c.free[j].name] = std::sqrt(std::max(0.0, fit.value().covariance(k, k)));
+    const std::string& name = c.free[j].name;
+    e.std_white[name] = std::sqrt(std::max(0.0, covariance.white(k, k)));
+    e.std_hac[name] = std::sqrt(std::max(0.0, covariance.hac(k, k)));
+    e.estimate.std[name] = hac_ ? std::max(e.std_white[name], e.std_hac[name]) : e.std_white[name];
   }
+  e.hac_lags = covariance.lags;
   e.estimate.lr_raw = state.chi2 - fit.value().chi2;
   internal::Score(nullptr, measurements_, &e.estimate);
   return e;
@@ -250,7 +255,8 @@ Result<TwinDiagnosis> Diagnoser::Run() {
   const auto start = std::chrono::steady_clock::now();
   if (Status s = Span(); !s.ok()) return s;
   out_.replayed = options_.replayed;
-  out_.covariance_method = options_.covariance.method;
+  hac_ = estimator::UsesHac(options_.std_method, real_);
+  out_.std_method = hac_ ? "hac" : "white";
   State state;
   state.full = nominal_;
   state.full.effects.clear();

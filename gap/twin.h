@@ -16,9 +16,11 @@
 //      twin runs executed in parallel (central when 2k runs fit in the threads, else forward). Time shifts
 //      (gps_latency latency_s, imu_time_offset offset_s) are whole physics steps in the simulator: a 1-D search on
 //      the step grid, coarse to fine, then a parabola through the best step and its neighbours for the value.
-//      The parameters' covariance comes from the residuals' Jacobian at the fit (TwinFitRows) through
-//      TwinDiagnoseOptions::covariance: by default WhiteNoiseCovariance, the Gauss-Newton curvature (J^T J)^-1,
-//      which assumes independent residuals and understates the spread of autocorrelated ones (real recordings);
+//      The parameters' covariance comes from the residuals' Jacobian at the fit (TwinFitRows, TwinCovariance): the
+//      white-noise curvature (J^T J)^-1, which assumes independent residuals and understates the spread of
+//      autocorrelated ones (real recordings, coloured sensor noise), and the HAC (Newey-West) sandwich around it,
+//      which does not; TwinDiagnoseOptions::std_method chooses the one reported as the std (auto: HAC on an imported
+//      recording, white on a simulated one, as the estimator's calibration chooses; estimator/calibration.h UsesHac);
 //   4. name: each candidate is scored by its chi-square drop LR on the training part (~ chi2(k) under "no effect"),
 //      p = 1 - F_chi2(k)(LR) and Delta BIC = -LR + k ln n (gap/internal/decide.h, Score); in order of Delta BIC the
 //      first with p < alpha, Delta BIC < max_delta_bic and a held-out chi-square drop (the twin run over the whole
@@ -42,6 +44,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/status.h"
+#include "estimator/calibration.h"
 #include "gap/diagnose.h"
 #include "gap/locate.h"
 #include "gap/resimulate.h"
@@ -102,28 +105,34 @@ TwinComparison CompareTwin(const recording::Recording& real, const recording::Re
                            double to_s, const DriftOptions& drift = {});
 
 // The rows of a fit at its solution: the whitened residuals (finite entries only) and their derivatives by the
-// parameters (one column each, in the fitted units), with each row's stamp and series (stream name): what a
-// covariance that accounts for autocorrelation needs (effective sample size, block bootstrap over time).
+// parameters (one column each, in the fitted units), with each row's stamp and series (stream name), the rows of one
+// series in time order.
 struct TwinFitRows {
   Eigen::MatrixXd jacobian;
   Eigen::VectorXd residuals;
   std::vector<Time> t;
   std::vector<std::string> series;
 };
-// The parameters' covariance from the rows, and the name of the method (written with the results).
+// The parameters' covariances from the rows:
+//   white: (J^T J)^-1, pseudo-inverse over the directions the rows see: independent unit-variance residuals;
+//   hac:   the Newey-West sandwich white M white with the estimator's weights and bandwidth (estimator/covariance.h):
+//          the rows of one series and stamp form one residual vector r_t and one score g_t = J_t^T r_t, and M sums
+//          within each series the Bartlett-weighted products g_t g_{t+l}^T up to the series' lag L_s
+//          (AnalyzeAutocorrelation of its residual vectors); series independent of each other. With white residuals
+//          it is the white covariance rescaled by the residuals' actual spread.
 struct TwinCovariance {
-  std::string method;
-  std::function<Eigen::MatrixXd(const TwinFitRows&)> compute;
+  Eigen::MatrixXd white, hac;
+  std::map<std::string, int> lags;  // per series: L_s (samples)
 };
-// (J^T J)^-1, pseudo-inverse over the directions the rows see: independent unit-variance residuals.
-Eigen::MatrixXd WhiteNoiseCovariance(const TwinFitRows& rows);
-TwinCovariance WhiteNoiseCovarianceMethod();
+TwinCovariance ComputeTwinCovariance(const TwinFitRows& rows);
 
 struct TwinEffect {
-  EffectEstimate estimate;    // name (the candidate's label), dof, parameters, std, lr, p, Delta BIC, held-out drop
-  sim::EffectOptions effect;  // as the simulator applies it (time shifts in whole physics steps)
-  double chi2_before = 0.0;   // training part: with the effects kept before it
-  double chi2_after = 0.0;    // with it
+  EffectEstimate estimate;  // name (the candidate's label), dof, parameters, std, lr, p, Delta BIC, held-out drop
+  std::map<std::string, double> std_white, std_hac;  // per parameter; estimate.std is the chosen one (std_method)
+  std::map<std::string, int> hac_lags;               // per series: the HAC lag (samples)
+  sim::EffectOptions effect;                         // as the simulator applies it (time shifts in whole physics steps)
+  double chi2_before = 0.0;                          // training part: with the effects kept before it
+  double chi2_after = 0.0;                           // with it
   int iterations = 0;
   int runs = 0;  // twin runs spent on the fit
 };
@@ -131,7 +140,7 @@ struct TwinEffect {
 struct TwinDiagnosis {
   std::string verdict;  // named | unknown | none
   bool replayed = false;
-  std::string covariance_method;
+  std::string std_method;  // "white" or "hac": which of each effect's std_white and std_hac is its std
   double train_end_s = 0.0;
   std::vector<LocatedComponent> located;  // the nominal twin, whole run
   std::vector<TwinEffect> candidates;     // the first round, best Delta BIC first
@@ -155,7 +164,9 @@ struct TwinDiagnoseOptions {
   int max_iterations = 8;    // Levenberg-Marquardt
   bool replayed = false;     // the runner replays the recorded drive (written with the results)
   DriftOptions drift;
-  TwinCovariance covariance = WhiteNoiseCovarianceMethod();
+  // The std reported: white, hac (the larger of std_white and std_hac, as the estimator's calibration reports), or
+  // auto (hac on an imported recording, white on a simulated one).
+  estimator::CalibrationOptions::StdMethod std_method = estimator::CalibrationOptions::StdMethod::kAuto;
   std::vector<std::string> candidates;  // empty: every one the scenario supports
   std::function<void(const std::string&)> progress;
 };
@@ -168,7 +179,7 @@ std::vector<std::string> TwinCandidateNames(const sim::Scenario& nominal);
 Result<TwinDiagnosis> DiagnoseTwin(const sim::Scenario& nominal, const recording::Recording& real,
                                    const TwinRunner& runner, const TwinDiagnoseOptions& options = {});
 
-// {"replayed", "verdict", "covariance", "train_end_s", "located", "candidates", "effects", "unexplained",
+// {"replayed", "verdict", "std_method", "train_end_s", "located", "candidates", "effects", "unexplained",
 // "heldout": {"before", "after"}, "whole_run", "patch", "runs", "seconds"}: gap.json's "simulation" section.
 nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d);
 

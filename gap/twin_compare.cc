@@ -1,5 +1,5 @@
 // The twin against the real recording (gap/twin.h): residual statistics, drift over windows, the white-noise
-// covariance and the plain-simulation runner.
+// and HAC covariances and the runners.
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 
+#include "estimator/covariance.h"
 #include "estimator/models/enu.h"
 #include "gap/internal/twin_residuals.h"
 #include "gap/twin.h"
@@ -183,13 +184,41 @@ std::string DriveMismatch(const recording::Recording& real, const recording::Rec
   return compared ? std::string() : "no wheel stream (wheel_encoders, steering) in both to compare the drive";
 }
 
-Eigen::MatrixXd WhiteNoiseCovariance(const TwinFitRows& rows) {
-  const Eigen::MatrixXd H = rows.jacobian.transpose() * rows.jacobian;
-  return H.completeOrthogonalDecomposition().pseudoInverse();
-}
-
-TwinCovariance WhiteNoiseCovarianceMethod() {
-  return {"white-noise Gauss-Newton curvature (J^T J)^-1: independent residuals assumed", WhiteNoiseCovariance};
+TwinCovariance ComputeTwinCovariance(const TwinFitRows& rows) {
+  TwinCovariance out;
+  const Eigen::Index k = rows.jacobian.cols();
+  out.white = (rows.jacobian.transpose() * rows.jacobian).completeOrthogonalDecomposition().pseudoInverse();
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(k, k);
+  // Per series (its rows in time order, those of one stamp together): residual vectors and scores per stamp.
+  for (std::size_t begin = 0; begin < rows.series.size();) {
+    std::size_t end = begin;
+    while (end < rows.series.size() && rows.series[end] == rows.series[begin]) ++end;
+    std::vector<Eigen::VectorXd> residuals;
+    std::vector<Eigen::VectorXd> scores;
+    for (std::size_t i = begin; i < end;) {
+      std::size_t j = i;
+      while (j < end && rows.t[j] == rows.t[i]) ++j;
+      const Eigen::Index first = static_cast<Eigen::Index>(i), n = static_cast<Eigen::Index>(j - i);
+      residuals.push_back(rows.residuals.segment(first, n));
+      scores.push_back(rows.jacobian.middleRows(first, n).transpose() * rows.residuals.segment(first, n));
+      i = j;
+    }
+    Eigen::MatrixXd g(k, static_cast<Eigen::Index>(scores.size()));
+    for (std::size_t t = 0; t < scores.size(); ++t) g.col(static_cast<Eigen::Index>(t)) = scores[t];
+    // The lag from the stamps with every component (a stamp the twin misses a component of is left out of it).
+    Eigen::Index dimension = 0;
+    for (const Eigen::VectorXd& r : residuals) dimension = std::max(dimension, r.size());
+    residuals.erase(std::remove_if(residuals.begin(), residuals.end(),
+                                   [&](const Eigen::VectorXd& r) { return r.size() != dimension; }),
+                    residuals.end());
+    const int lag = estimator::AnalyzeAutocorrelation(residuals).lag;
+    out.lags[rows.series[begin]] = lag;
+    M += estimator::BartlettSum(g, lag);
+    begin = end;
+  }
+  out.hac = out.white * M * out.white;
+  out.hac = 0.5 * (out.hac + out.hac.transpose()).eval();
+  return out;
 }
 
 TwinRunner PlainSimulationRunner() {

@@ -38,16 +38,22 @@ nlohmann::json ComparisonJson(const TwinComparison& c) {
 
 nlohmann::json EffectJson(const TwinEffect& e) {
   const EffectEstimate& x = e.estimate;
-  nlohmann::json parameters = nlohmann::json::object(), std = nlohmann::json::object(),
-                 applied = nlohmann::json::object();
+  nlohmann::json parameters = nlohmann::json::object(), applied = nlohmann::json::object();
   for (const auto& [name, value] : x.parameters) parameters[name] = Number(value);
-  for (const auto& [name, value] : x.std) std[name] = Number(value);
+  const auto numbers = [](const std::map<std::string, double>& values) {
+    nlohmann::json out = nlohmann::json::object();
+    for (const auto& [name, value] : values) out[name] = Number(value);
+    return out;
+  };
   for (const auto& [name, value] : e.effect.parameters) applied[name] = Number(value);
   return {{"name", x.name},
           {"effect", {{"name", e.effect.name}, {"parameters", applied}}},
           {"dof", x.dof},
           {"parameters", parameters},
-          {"std", std},
+          {"std", numbers(x.std)},
+          {"std_white", numbers(e.std_white)},
+          {"std_hac", numbers(e.std_hac)},
+          {"hac_lags", e.hac_lags},
           {"chi2_before", Number(e.chi2_before)},
           {"chi2_after", Number(e.chi2_after)},
           {"lr", Number(x.lr)},
@@ -84,7 +90,7 @@ nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d) {
   for (const sim::EffectOptions& e : d.patch) patch.push_back({{"name", e.name}, {"parameters", e.parameters}});
   return {{"replayed", d.replayed},
           {"verdict", d.verdict},
-          {"covariance", d.covariance_method},
+          {"std_method", d.std_method},
           {"train_end_s", d.train_end_s},
           {"located", located},
           {"candidates", candidates},

@@ -495,6 +495,20 @@ void AssembleTwin(const Recording& real, const Plan& plan, Simulation* sim) {
   sim->stats.left_out = plan.left_out;
 }
 
+// The readings of the drive divided by the scenario's odometry_scale_error scale: the true drive of a robot whose
+// odometry reads that many times its motion.
+void UndoOdometryScale(const Scenario& scenario, DriveInputs* in) {
+  const double scale = EffectParameter(scenario.effects, "odometry_scale_error", "scale", 1.0);
+  if (scale == 1.0) return;
+  if (in->kind == DriveInputs::Kind::kAckermann) {
+    in->values.col(0) /= scale;  // the speed, not the steering
+  } else {
+    in->values /= scale;
+  }
+  in->angles_rad /= scale;
+  in->travel_m /= scale;
+}
+
 }  // namespace
 
 Result<Simulation> Replay(const Scenario& nominal, const Recording& real, const ReplayOptions& options) {
@@ -553,6 +567,7 @@ Result<DriveInputs> DriveInputsFrom(const Recording& real, const Scenario& nomin
   const bool ackermann = nominal.robot.kind == "ackermann";
   std::string note;
   Found inputs = FromInputsStream(real, ackermann, &note);
+  const bool commands = inputs.ok() && inputs.value();
   if (inputs.ok() && !inputs.value())
     inputs = ackermann ? FromAckermannOdometer(real, nominal) : FromWheelEncoders(real, nominal.robot);
   if (inputs.ok() && !inputs.value() && !ackermann) inputs = FromOdometry(real);
@@ -560,6 +575,7 @@ Result<DriveInputs> DriveInputsFrom(const Recording& real, const Scenario& nomin
   if (!inputs.value())
     return Status::Error("no drive input: a replay of robot kind " + nominal.robot.kind + " needs " +
                          NeededInputs(ackermann) + note);
+  if (!commands) UndoOdometryScale(nominal, &*inputs.value());
   return std::move(*inputs.value());
 }
 

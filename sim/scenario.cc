@@ -502,6 +502,7 @@ const std::map<std::string, std::map<std::string, double>>& KnownEffects() {
       {"track_width_error", {{"track_error_m", 0.0}}},
       {"wheel_deformation", {{"wheel", 0.0}, {"ovality_m", 0.0}}},
       {"axle_misalignment", {{"wheel", 0.0}, {"yaw_deg", 0.0}}},
+      {"odometry_scale_error", {{"scale", 1.0}}},
   };
   return known;
 }

@@ -69,6 +69,15 @@
 //   magnetometer_motor_interference {b_per_nm_x: 0, b_per_nm_y: 0, b_per_nm_z: 0}   a magnetometer bias (sensor
 //                                          frame, normalized field units) proportional to the rear drive torque
 //                                          per wheel [N m] applied at the sample instant (motor current)
+//   odometry_scale_error {scale: 1}       the odometry reads `scale` times the true motion, scale in [0.5, 1.5] (a
+//                                          drive-scale error: a wrong gear ratio or encoder resolution, a controller's
+//                                          mis-scaled speeds): each wheel encoder's cumulative angle before the tick
+//                                          quantization, the wheel odometry's twist, the Ackermann rear-wheel speed
+//                                          before its noise; needs sensors.wheel_encoders or sensors.odometer. A
+//                                          replay (sim/replay.h) divides the drive it takes from these readings by
+//                                          `scale`, so that its twin drives the true motion (recorded commands are not
+//                                          divided). A candidate of the twin diagnosis (gap/twin.h), not of the
+//                                          estimator-side one (there a wheel radius absorbs it)
 // Out-of-library effects (none of the diagnosis's candidates models them; gap-benchmark's decoys):
 //   accelerometer_scale_error {scale_x: 1, scale_y: 1, scale_z: 1}   per-axis gain of the accelerometer in its own
 //                                          frame, each in [0.5, 1.5] (eq. 13's k_s, which the nominal models fix at 1)

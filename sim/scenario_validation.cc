@@ -344,6 +344,12 @@ std::optional<P> EffectsProblem(const Scenario& s) {
       const double scale = EffectParameter(s.effects, e.name, "contact_time_scale", 1.0);
       if (!(scale >= 1.0 && scale <= 4.0)) return P{k + ".parameters.contact_time_scale", "must be in [1, 4]"};
     }
+    if (e.name == "odometry_scale_error") {
+      if (!s.sensors.wheel_encoders && !s.sensors.odometer)
+        return P{k + ".name", "odometry_scale_error needs sensors.wheel_encoders or sensors.odometer"};
+      const double scale = EffectParameter(s.effects, e.name, "scale", 1.0);
+      if (!(scale >= 0.5 && scale <= 1.5)) return P{k + ".parameters.scale", "must be in [0.5, 1.5]"};
+    }
     if (e.name == "steering_offset" && !s.sensors.odometer)
       return P{k + ".name", "steering_offset needs sensors.odometer"};
     if (e.name == "magnetometer_motor_interference" && !s.sensors.magnetometer)

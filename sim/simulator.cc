@@ -522,6 +522,7 @@ class Simulator::Impl {
     tire_growth_per_mps2_ = EffectParameter(effects, "tire_growth", "growth_per_mps2", 0.0);
     slip_per_mps2_ = EffectParameter(effects, "longitudinal_slip", "slip_per_mps2", 0.0);
     slope_slip_per_mps2_ = EffectParameter(effects, "slope_slip", "slip_per_mps2", 0.0);
+    odometry_scale_ = EffectParameter(effects, "odometry_scale_error", "scale", 1.0);
     for (const EffectOptions& e : effects) {
       recording::Effect truth{e.name, KnownEffects().at(e.name)};
       for (const auto& [name, value] : e.parameters) truth.parameters[name] = value;
@@ -674,7 +675,8 @@ class Simulator::Impl {
     }
     if (mocap_clock_.Due(t_ns)) SampleMocap(body, t_ns);
     if (encoder_clock_.Due(t_ns)) {
-      // Cumulative angle since t = 0, truncated to whole ticks (an incremental encoder's count).
+      // Cumulative angle since t = 0 (times odometry_scale_error's scale), truncated to whole ticks (an incremental
+      // encoder's count).
       const double tick_rad = 2.0 * kPi / sensors.wheel_encoders->ticks_per_revolution;
       const int columns = static_cast<int>(encoder_columns_.size());
       if (encoder_zero_rad_.empty()) {  // the first sample: t = 0, or a replay's first stamp
@@ -683,17 +685,18 @@ class Simulator::Impl {
       }
       for (int k = 0; k < columns; ++k) {
         const auto column = static_cast<std::size_t>(k);
-        const double angle =
-            wheeled_.WheelAngle(data_.get(), encoder_columns_[column].wheel) - encoder_zero_rad_[column];
+        const double angle = odometry_scale_ * (wheeled_.WheelAngle(data_.get(), encoder_columns_[column].wheel) -
+                                                encoder_zero_rad_[column]);
         encoder_stream_.values(encoder_clock_.Row(t_ns), k) = std::floor(angle / tick_rad) * tick_rad;
       }
     }
     if (laser_clock_.Due(t_ns)) SampleLaser(t_ns);
     if (odometry_clock_.Due(t_ns)) {
-      // Wheel odometry: the twist the nominal kinematics gives for the wheels' rates (least squares).
+      // Wheel odometry: the twist the nominal kinematics gives for the wheels' rates (least squares), times
+      // odometry_scale_error's scale.
       Eigen::VectorXd rates(static_cast<Eigen::Index>(wheeled_.wheels().size()));
       for (Eigen::Index i = 0; i < rates.size(); ++i) rates[i] = wheeled_.WheelRate(data_.get(), static_cast<int>(i));
-      const Eigen::Vector3d twist = twist_from_rates_ * rates;  // v_x, v_y, omega_z
+      const Eigen::Vector3d twist = odometry_scale_ * (twist_from_rates_ * rates);  // v_x, v_y, omega_z
       odometry_stream_.values.row(odometry_clock_.Row(t_ns)) << twist[0], twist[1], 0.0, 0.0, 0.0, twist[2];
     }
     if (odometer_clock_.Due(t_ns)) {
@@ -701,15 +704,16 @@ class Simulator::Impl {
       // tire_growth: the rigid MuJoCo tire rolls at omega = v / r0; a tire of radius r0 (1 + c v^2) turns at
       // omega / (1 + c v^2) at the same ground speed v = r0 omega. longitudinal_slip and slope_slip: the driven tire
       // turns faster than it rolls by 1 + s_f f_x + s_p g sin(pitch) (f_x: O's true forward specific force; pitch:
-      // O's forward axis above the horizontal).
+      // O's forward axis above the horizontal). odometry_scale_error: the speed reads its scale times that.
       const double omega_radps = vehicle_.RearWheelRate(data_.get());
       const double v_mps = omega_radps * vehicle_.wheel_radius_m();
       const double g_mps2 = Eigen::Map<const Eigen::Vector3d>(model_->opt.gravity).norm();
       const double slip = 1.0 + slip_per_mps2_ * body.specific_force_body.x() +
                           slope_slip_per_mps2_ * g_mps2 * (body.q_world_body * Eigen::Vector3d::UnitX()).z();
-      const double z_v = SpeedReading(slip * omega_radps / (1.0 + tire_growth_per_mps2_ * v_mps * v_mps),
-                                      vehicle_.wheel_radius_m(), odo.kv_over_L, wheelbase_m_) +
-                         speed_noise_.Draw(odo.speed_sigma_mps);
+      const double z_v =
+          odometry_scale_ * SpeedReading(slip * omega_radps / (1.0 + tire_growth_per_mps2_ * v_mps * v_mps),
+                                         vehicle_.wheel_radius_m(), odo.kv_over_L, wheelbase_m_) +
+          speed_noise_.Draw(odo.speed_sigma_mps);
       const double z_theta =
           SteeringReading(vehicle_.SteeringAngle(data_.get()), odo.k_theta, odo.k_gamma + steering_offset_rad_) +
           steering_noise_.Draw(odo.steering_sigma_rad);
@@ -883,6 +887,7 @@ class Simulator::Impl {
   double tire_growth_per_mps2_ = 0.0;                      // tire_growth's c [s^2/m^2]
   double slip_per_mps2_ = 0.0;                             // longitudinal_slip's s_f [s^2/m]
   double slope_slip_per_mps2_ = 0.0;                       // slope_slip's s_p [s^2/m]
+  double odometry_scale_ = 1.0;                            // odometry_scale_error: the odometry reads this times true
 
   std::int64_t step_ns_ = 0;
   std::int64_t end_ns_ = 0;

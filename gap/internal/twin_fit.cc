@@ -30,6 +30,7 @@ std::vector<TwinCandidate> Library(const sim::Scenario& nominal, double max_shif
   std::vector<TwinCandidate> all;
   all.push_back({"wheel_radius_asymmetry", "wheel_radius_asymmetry", {}, {P("ratio_right_left", 1, 0.01, 0.8, 1.2)}});
   all.push_back({"track_width_error", "track_width_error", {}, {P("track_error_m", 0, 0.01, -0.1, 0.1)}});
+  all.push_back({"odometry_scale_error", "odometry_scale_error", {}, {P("scale", 1, 0.01, 0.5, 1.5)}});
   const int wheels = Wheels(nominal.robot.kind);
   for (int w = 0; w < wheels; ++w)
     all.push_back({"axle_misalignment wheel " + std::to_string(w),
@@ -182,13 +183,14 @@ Result<CandidateOutcome> FitLeastSquares(const TwinCandidate& c, const Eigen::Ve
     if (decrease < enough) break;
   }
   out.effect = EffectAt(c, out.theta);
-  out.covariance = settings.covariance->compute(Rows(evaluator->layout(), out.residuals, J));
+  out.covariance = ComputeTwinCovariance(Rows(evaluator->layout(), out.residuals, J));
   return out;
 }
 
 // The time shift on the step grid: the chi-square at a coarse grid of 9 points over the range, then halving the
 // spacing about the best until neighbouring steps; the value is the vertex of the parabola through the best step and
-// its neighbours (within half a step of it), the covariance from the residuals' central difference there.
+// its neighbours (within half a step of it), the covariance from the residuals' central difference there
+// (FitCandidate).
 Result<CandidateOutcome> SearchTimeShift(const TwinCandidate& c, const Eigen::VectorXd& base, TwinEvaluator* evaluator,
                                          const FitSettings& settings) {
   const TwinParameter& p = c.free.front();
@@ -245,7 +247,8 @@ Result<CandidateOutcome> SearchTimeShift(const TwinCandidate& c, const Eigen::Ve
       up > down
           ? Eigen::VectorXd((Masked(r[up], r[b]) - Masked(r[down], r[b])) / (static_cast<double>(up - down) * step))
           : Eigen::VectorXd::Zero(base.size());
-  out.covariance = settings.covariance->compute(Rows(evaluator->layout(), r[b], J));
+  const Eigen::VectorXd at_vertex = r[b] + J.col(0) * (vertex * step);
+  out.covariance = ComputeTwinCovariance(Rows(evaluator->layout(), at_vertex, J));
   return out;
 }
 

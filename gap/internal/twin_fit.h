@@ -58,11 +58,11 @@ class TwinEvaluator {
 };
 
 struct CandidateOutcome {
-  Eigen::VectorXd theta;       // fitted (time shifts: the parabola's vertex, sub-step)
-  Eigen::MatrixXd covariance;  // of theta
-  sim::EffectOptions effect;   // as applied (time shifts in whole steps)
-  double chi2 = 0.0;           // training part, at `effect`
-  Eigen::VectorXd residuals;   // training part, at `effect`
+  Eigen::VectorXd theta;      // fitted (time shifts: the parabola's vertex, sub-step)
+  TwinCovariance covariance;  // of theta, white and HAC (gap/twin.h)
+  sim::EffectOptions effect;  // as applied (time shifts in whole steps)
+  double chi2 = 0.0;          // training part, at `effect`
+  Eigen::VectorXd residuals;  // training part, at `effect`
   int iterations = 0;
 };
 
@@ -70,10 +70,12 @@ struct FitSettings {
   int max_iterations = 8;
   double physics_step_s = 0.001;
   int threads = 2;
-  const TwinCovariance* covariance = nullptr;
 };
 
-// Fits `c` starting at its neutral values, whose residuals (the base twin's) are `base`.
+// Fits `c` starting at its neutral values, whose residuals (the base twin's) are `base`. The covariance from the rows
+// at the fit (ComputeTwinCovariance): a least-squares fit's residuals and last Jacobian; a time shift's residuals at
+// the best step moved to the parabola's vertex to first order, r_b + J (theta - b step), with J the central difference
+// over the neighbouring steps.
 Result<CandidateOutcome> FitCandidate(const TwinCandidate& c, const Eigen::VectorXd& base, TwinEvaluator* evaluator,
                                       const FitSettings& settings);
 

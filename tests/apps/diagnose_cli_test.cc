@@ -168,6 +168,16 @@ TEST(DiagnoseCliTest, ReplayReplaysARecordingOfAnotherDrive) {
   ASSERT_TRUE(in.good());
   const nlohmann::json twin = nlohmann::json::parse(in);
   EXPECT_TRUE(twin.at("replayed").get<bool>());
+  // --std auto on a simulated recording: the white std is reported, the HAC one beside it.
+  EXPECT_EQ(twin.at("std_method"), "white");
+  ASSERT_FALSE(twin.at("candidates").empty());
+  for (const nlohmann::json& c : twin.at("candidates")) {
+    if (!c.contains("std") || c.at("std").empty()) continue;  // a candidate that was not fitted
+    for (const auto& [name, value] : c.at("std").items()) {
+      EXPECT_EQ(value, c.at("std_white").at(name)) << c.at("name");
+      EXPECT_TRUE(c.at("std_hac").contains(name)) << c.at("name");
+    }
+  }
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
-// The diagnosis on real recordings (tests/support/real_data.h, skipped when absent), where nothing labels the effects:
+// The diagnosis on real recordings (tests/support/real_data.h, skipped when absent), where nothing labels the effects,
+// with the standard deviations `roamlab diagnose` reports by default (HAC on an imported recording):
 // OptiOdom's differential drive (unequal wheel diameters, a wider effective track) and the Husky bag (skid-steer yaw
 // mismatch). The data README's reference values come from a "quick least-squares look", not from ground truth; the
 // OptiOdom test checks the diagnosis against an independent least-squares fit on the same run instead (YawRatio).
@@ -28,27 +29,14 @@ const std::string kData = ::roamlab::testing::RealDataDir();
 // constant curvature does not: there the ratio trades against the track and the time offset).
 const std::string kSet = kData + "/optiodom/data/diff/square/231220200029/231220200029";
 
-// The diagnosis with the white standard deviations (the chi-square's curvature), which the significance checks below
-// were made with; the default on an imported recording is the HAC one, which PrintHacStds shows beside them.
-Result<Diagnosis> DiagnoseWhite(const estimator::EstimatorConfig& config, const recording::Recording& rec) {
-  DiagnoseOptions options;
-  options.std_method = estimator::CalibrationOptions::StdMethod::kWhite;
-  return Diagnose(config, rec, options);
-}
-
-// The default diagnosis (HAC standard deviations on an imported recording): the named effects' values and stds.
-void PrintHacStds(const estimator::EstimatorConfig& config, const recording::Recording& rec,
-                  const std::vector<std::string>& names) {
+// The diagnosis as `roamlab diagnose` runs it by default: on an imported recording the effects' standard deviations are
+// the HAC ones (autocorrelated residuals), against which the significance checks below are made.
+Result<Diagnosis> DiagnoseDefault(const estimator::EstimatorConfig& config, const recording::Recording& rec) {
   auto d = Diagnose(config, rec);
-  ASSERT_TRUE(d.ok()) << d.status().message();
-  EXPECT_EQ(d.value().std_method, "hac");
-  for (const EffectEstimate& e : d.value().candidates) {
-    if (std::find(names.begin(), names.end(), e.name) == names.end()) continue;
-    std::cout << "HAC: " << e.name;
-    for (const auto& [k, v] : e.parameters)
-      std::cout << " " << k << " = " << v << " +- " << (e.std.count(k) ? e.std.at(k) : std::nan(""));
-    std::cout << "\n";
+  if (d.ok()) {
+    EXPECT_EQ(d.value().std_method, "hac");
   }
+  return d;
 }
 
 const EffectEstimate* Find(const Diagnosis& d, const std::string& name) {
@@ -116,7 +104,7 @@ TEST(RealDataTest, OptiOdomDifferentialDriveTrackAndWheelRatio) {
   auto config =
       estimator::LoadEstimatorConfig(std::string(ROAMLAB_SOURCE_DIR) + "/configs/real/optiodom_diff_nominal.yaml");
   ASSERT_TRUE(config.ok()) << config.status().message();
-  auto d = DiagnoseWhite(config.value(), rec.value());
+  auto d = DiagnoseDefault(config.value(), rec.value());
   ASSERT_TRUE(d.ok()) << d.status().message();
   const Diagnosis& diagnosis = d.value();
   for (const EffectEstimate& e : diagnosis.candidates) {
@@ -135,8 +123,10 @@ TEST(RealDataTest, OptiOdomDifferentialDriveTrackAndWheelRatio) {
   // The effective track: wider than the nominal 0.2 m; the data README's look says about 0.2027 m.
   const double b_eff = 0.2 + track->parameters.at("track_error_m");
   std::cout << "effective track " << b_eff << " m +- " << track->std.at("track_error_m") << "\n";
-  EXPECT_GT(track->parameters.at("track_error_m"), 3.0 * track->std.at("track_error_m"));
+  // With the HAC std (1.7 mm; the white one is 0.19 mm) the track error of this one run is about one std from zero:
+  // not significant on its own, but its 2-sigma interval holds the dataset's value.
   EXPECT_NEAR(b_eff, 0.2027, 0.002);
+  EXPECT_NEAR(b_eff, 0.2027, 2.0 * track->std.at("track_error_m"));
   // The wheel ratio against the independent yaw regression on the same run. The data README's 0.983-0.989 is not
   // what the yaw says (about 0.998 on every Dec-2020 square run): it comes from the forward displacement in turns in
   // place, which a millimetre's offset of the motion-capture frame from the axle centre explains as well.
@@ -144,9 +134,10 @@ TEST(RealDataTest, OptiOdomDifferentialDriveTrackAndWheelRatio) {
   const double rho_yaw = YawRatio(rec.value());
   std::cout << "wheel ratio R/L: diagnosis " << rho << " +- " << ratio->std.at("ratio_right_left")
             << ", yaw regression " << rho_yaw << "\n";
+  // With the HAC std (0.0008; the white one is 0.0004) the ratio is about 2 std below 1, not 3: the claim is the
+  // agreement with the independent regression within its 2-sigma interval.
   EXPECT_NEAR(rho, rho_yaw, 0.002);
-  EXPECT_LT(rho, 1.0 - 3.0 * ratio->std.at("ratio_right_left"));
-  PrintHacStds(config.value(), rec.value(), {"track_width_error", "wheel_radius_asymmetry"});
+  EXPECT_NEAR(rho, rho_yaw, 2.0 * ratio->std.at("ratio_right_left"));
 
   // Other runs of the set: dead reckoning with the geometry calibrated on the training part of run 01 with the
   // accepted effects (the radius re-fitted beside them) against the nominal model calibrated on the same part (one
@@ -224,7 +215,7 @@ TEST(RealDataTest, HuskySkidSteerYawMismatch) {
   ASSERT_TRUE(rec.ok()) << rec.status().message();
   auto config = estimator::LoadEstimatorConfig(std::string(ROAMLAB_SOURCE_DIR) + "/configs/real/husky_nominal.yaml");
   ASSERT_TRUE(config.ok()) << config.status().message();
-  auto d = DiagnoseWhite(config.value(), rec.value());
+  auto d = DiagnoseDefault(config.value(), rec.value());
   ASSERT_TRUE(d.ok()) << d.status().message();
   for (const EffectEstimate& e : d.value().candidates) {
     std::cout << e.name;
@@ -241,10 +232,12 @@ TEST(RealDataTest, HuskySkidSteerYawMismatch) {
   EXPECT_NE(d.value().verdict, "none");
   EXPECT_EQ(d.value().effects.size(), 2u);
   // The wheel odometry reaches the bag late against the IMU (its velocities are a rolling mean in the controller):
-  // the IMU's stamps move later to meet it, a negative offset.
+  // the IMU's stamps move later to meet it, a negative offset. Its HAC std (0.19 s; the white one 0.036 s) leaves the
+  // estimate (-0.25 s) about 1.3 std from zero: named (by its chi-square drop and the held-out part), but not
+  // significant by its std alone, so only the sign is claimed.
   const EffectEstimate* offset = Find(d.value(), "imu_time_offset");
   ASSERT_NE(offset, nullptr);
-  EXPECT_LT(offset->parameters.at("offset_s"), -3.0 * offset->std.at("offset_s"));
+  EXPECT_LT(offset->parameters.at("offset_s"), 0.0);
   // The skid-steer yaw mismatch: wheel speeds converted with the nominal track turn the odometry slower than the
   // robot turns, so the effective track is narrower: B_eff / B_nominal = omega_odometry / omega_gyro.
   const EffectEstimate* track = Find(d.value(), "track_width_error");
@@ -256,7 +249,6 @@ TEST(RealDataTest, HuskySkidSteerYawMismatch) {
             << heading_ratio << "\n";
   EXPECT_LT(ratio, 1.0 - 3.0 * ratio_std);
   EXPECT_NEAR(ratio, heading_ratio, 3.0 * ratio_std);
-  PrintHacStds(config.value(), rec.value(), {"imu_time_offset", "track_width_error"});
 }
 
 }  // namespace

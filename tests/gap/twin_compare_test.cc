@@ -1,6 +1,8 @@
 // The twin against the real recording on constructed tracks (gap/twin.h, CompareTwin): the whitened residuals and the
 // drift over windows, which a rigid motion of the whole twin does not change and a velocity error grows linearly.
 #include <cmath>
+#include <cstdio>
+#include <random>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -86,9 +88,51 @@ TEST(TwinCompareTest, TheWhiteNoiseCovarianceIsTheInverseCurvature) {
   rows.jacobian = Eigen::MatrixXd::Zero(4, 2);
   rows.jacobian.col(0) << 1, 1, 1, 1;  // four residuals see the first parameter with unit weight
   rows.residuals = Eigen::VectorXd::Zero(4);
-  const Eigen::MatrixXd cov = WhiteNoiseCovariance(rows);
+  for (int i = 0; i < 4; ++i) {
+    rows.t.push_back(Time::FromSeconds(i));
+    rows.series.push_back("s");
+  }
+  const Eigen::MatrixXd cov = ComputeTwinCovariance(rows).white;
   EXPECT_NEAR(cov(0, 0), 0.25, 1e-12);
   EXPECT_NEAR(cov(1, 1), 0.0, 1e-12);  // unseen: no information, and no variance claimed either
+}
+
+// The mean of a first-order Gauss-Markov series e(k+1) = a e(k) + sqrt(1 - a^2) n fitted as one parameter (the
+// residuals at the fit: the series less its mean; two components per stamp, one series): the HAC variance over the
+// white one is the Bartlett-weighted sum of the autocorrelation up to the lag chosen, 1 + 2 sum_l (1 - l / (L + 1))
+// a^l (the long-run factor (1 + a) / (1 - a) less the weights' bias), within 4 of the Newey-West estimate's relative
+// standard deviations sqrt(4 L / (3 n)); white residuals (a = 0) leave it at 1.
+TEST(TwinCompareTest, TheHacCovarianceCountsTheResidualsAutocorrelation) {
+  constexpr int kStamps = 20000;
+  for (const double a : {0.0, 0.9}) {
+    std::mt19937_64 draws(17);
+    std::normal_distribution<double> normal;
+    TwinFitRows rows;
+    rows.jacobian = Eigen::MatrixXd::Ones(2 * kStamps, 1);
+    rows.residuals.resize(2 * kStamps);
+    Eigen::Vector2d e(normal(draws), normal(draws));
+    for (int k = 0; k < kStamps; ++k) {
+      rows.residuals.segment<2>(2 * k) = e;
+      e = a * e + std::sqrt(1.0 - a * a) * Eigen::Vector2d(normal(draws), normal(draws));
+      for (int c = 0; c < 2; ++c) {
+        rows.t.push_back(Time::FromSeconds(0.01 * k));
+        rows.series.push_back("gyroscope");
+      }
+    }
+    rows.residuals.array() -= rows.residuals.mean();
+    const TwinCovariance cov = ComputeTwinCovariance(rows);
+    const int lag = cov.lags.at("gyroscope");
+    double expected = 1.0;
+    for (int l = 1; l <= lag; ++l) expected += 2.0 * (1.0 - l / (lag + 1.0)) * std::pow(a, l);
+    const double ratio = cov.hac(0, 0) / cov.white(0, 0);
+    const double spread = std::sqrt(4.0 * std::max(lag, 1) / (3.0 * kStamps));
+    std::printf("a %.1f: lag %d, HAC / white variance %.3f, expected %.3f (long-run %.3f)\n", a, lag, ratio, expected,
+                (1.0 + a) / (1.0 - a));
+    EXPECT_NEAR(ratio / expected, 1.0, 4.0 * spread) << "a = " << a;
+    if (a > 0.0) {
+      EXPECT_GT(lag, 20);  // several correlation times (1 / -ln a = 9.5 stamps)
+    }
+  }
 }
 
 }  // namespace

@@ -183,6 +183,52 @@ TEST(ReplayTest, InputsNotTheScheduleDriveTheTwin) {
   EXPECT_GT(schedule.max_position_m, 10.0 * follows.max_position_m);
 }
 
+// odometry_scale_error: the encoders read 3 % more than the wheels turn (the motion is the same). A replay of the
+// patched scenario takes the encoders' drive over the scale and drives the true motion, its encoders reading what was
+// recorded; the nominal one drives 3 % too far.
+TEST(ReplayTest, AnOdometryScaleErrorIsUndoneByTheReplay) {
+  constexpr double kScale = 1.03;
+  const Scenario nominal = GentleDiffDrive(12.0);
+  Scenario patched = nominal;
+  patched.effects = {{"odometry_scale_error", {{"scale", kScale}}}};
+  const Simulation plain = SimulateOk(nominal);
+  const Simulation real = SimulateOk(patched);
+  const Stream& a = *plain.recording.Find("wheel_encoders");
+  const Stream& b = *real.recording.Find("wheel_encoders");
+  const double tick_rad = 2.0 * kPi / a.info.attributes.at("ticks_per_revolution");
+  for (Eigen::Index c = 0; c < 2; ++c)
+    EXPECT_NEAR(b.values.col(c).tail(1)[0], kScale * a.values.col(c).tail(1)[0], 2.0 * kScale * tick_rad);
+  const double extent = Extent(*real.recording.ground_truth);
+  const TrackError same = Compare(*plain.recording.ground_truth, *real.recording.ground_truth);
+  EXPECT_LT(same.max_position_m, 1e-9);  // the motion itself is unchanged
+
+  const Simulation twin = ReplayOk(patched, real.recording);
+  const TrackError follows = Compare(*twin.recording.ground_truth, *real.recording.ground_truth);
+  const Simulation unpatched = ReplayOk(nominal, real.recording);
+  const TrackError off = Compare(*unpatched.recording.ground_truth, *real.recording.ground_truth);
+  std::printf(
+      "odometry scale %.2f: patched twin error <= %.4f m, %.4f rad; unpatched %.3f m, %.3f rad (extent %.2f m)\n",
+      kScale, follows.max_position_m, follows.max_heading_rad, off.max_position_m, off.max_heading_rad, extent);
+  const Bound bound = EncoderBound(real.recording, extent);
+  EXPECT_LT(follows.max_heading_rad, bound.heading_rad);
+  EXPECT_LT(follows.max_position_m, bound.position_m);
+  EXPECT_GT(off.max_position_m, 0.5 * (kScale - 1.0) * extent);
+  const Stream& recorded = *twin.recording.Find("wheel_encoders");
+  for (Eigen::Index c = 0; c < 2; ++c)
+    EXPECT_NEAR(recorded.values.col(c).tail(1)[0], b.values.col(c).tail(1)[0], 4.0 * kScale * tick_rad);
+
+  // Validation: the scale's range, and a robot without an odometry to scale.
+  patched.effects = {{"odometry_scale_error", {{"scale", 2.0}}}};
+  auto problem = patched.Validate();
+  ASSERT_TRUE(problem.has_value());
+  EXPECT_EQ(problem->key + ": " + problem->message, "effects[0].parameters.scale: must be in [0.5, 1.5]");
+  patched.effects = {{"odometry_scale_error", {}}};
+  patched.sensors.wheel_encoders.reset();
+  problem = patched.Validate();
+  ASSERT_TRUE(problem.has_value());
+  EXPECT_EQ(problem->message, "odometry_scale_error needs sensors.wheel_encoders or sensors.odometer");
+}
+
 TEST(ReplayTest, TwinHoldsTheRecordedStreamsAtTheirStamps) {
   const Scenario s = GentleDiffDrive(5.0);
   Simulation real = SimulateOk(s);
