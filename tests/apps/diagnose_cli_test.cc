@@ -206,7 +206,8 @@ TEST(DiagnoseCliTest, HeldOutShowsTheTwinsPatchOnARecordingOfAnotherDrive) {
               dir)
           .exit_code,
       0);
-  const std::string common = "diagnose --real " + dir.File("rec") + " --scenario " + nominal + " --no-baseline ";
+  const std::string common = "diagnose --real " + dir.File("rec") + " --scenario " + nominal + " --config " +
+                             Source("configs/real/optiodom_diff_nominal.yaml") + " --no-baseline ";
   const CommandRun refused = Roamlab(common + "--out " + dir.File("bad") + " --held-out " + dir.File("held"), dir);
   EXPECT_EQ(refused.exit_code, 2);
   EXPECT_NE(refused.err.find("--held-out needs --replay"), std::string::npos) << refused.err;
@@ -225,9 +226,10 @@ TEST(DiagnoseCliTest, HeldOutShowsTheTwinsPatchOnARecordingOfAnotherDrive) {
   EXPECT_TRUE(held.at("replayed").get<bool>());
   const double before = held.at("before").at("drift").at("mocap").at("mean_position_m").get<double>();
   const double after = held.at("after").at("drift").at("mocap").at("mean_position_m").get<double>();
-  // 3 % of the 1 m a 10 s window travels, against the replay's few millimetres.
+  // 3 % of the 1 m a 10 s window travels, against a floor of a few millimetres: the windows align on one motion
+  // capture sample, whose 5 mrad heading noise moves the end of a 1 m window by about 4 mm.
   EXPECT_GT(before, 0.015);
-  EXPECT_LT(after, 0.25 * before) << before << " -> " << after;
+  EXPECT_LT(after, 0.5 * before) << before << " -> " << after << "; patch " << twin.at("patch").dump();
   EXPECT_LT(held.at("after").at("chi2").get<double>(), held.at("before").at("chi2").get<double>());
   std::ifstream gap_in(dir.File("out/gap.json"));
   const nlohmann::json gap = nlohmann::json::parse(gap_in);
