@@ -19,7 +19,7 @@ namespace {
 
 const std::string kDiff = ::roamlab::testing::RealDataDir() + "/optiodom/data/diff/";
 
-Result<recording::Recording> Run(const std::string& set_path, const std::string& run) {
+Result<recording::Recording> ImportRun(const std::string& set_path, const std::string& run) {
   return importers::ImportOptiOdom(set_path + "_run-" + run + ".csv", set_path + "_metadata.csv");
 }
 
@@ -28,8 +28,8 @@ TEST(TwinRealTest, SquareRunPatchLowersTheCircularRunsDrift) {
   const std::string circular = kDiff + "circular/231220200121/231220200121";
   if (!std::filesystem::exists(square + "_metadata.csv") || !std::filesystem::exists(circular + "_metadata.csv"))
     GTEST_SKIP() << "real data absent: " << square << ", " << circular;
-  auto train = Run(square, "01");
-  auto held = Run(circular, "01");
+  auto train = ImportRun(square, "01");
+  auto held = ImportRun(circular, "01");
   ASSERT_TRUE(train.ok()) << train.status().message();
   ASSERT_TRUE(held.ok()) << held.status().message();
   auto nominal = sim::LoadScenario(std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/real/optiodom_diff.yaml");
