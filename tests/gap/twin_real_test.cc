@@ -11,7 +11,9 @@
 
 #include "gap/twin.h"
 #include "importers/optiodom.h"
+#include "recording/recording.h"
 #include "sim/scenario.h"
+#include "tests/recording/temp_dir.h"
 #include "tests/support/real_data.h"
 
 namespace roamlab::gap {
@@ -19,8 +21,16 @@ namespace {
 
 const std::string kDiff = ::roamlab::testing::RealDataDir() + "/optiodom/data/diff/";
 
-Result<recording::Recording> ImportRun(const std::string& set_path, const std::string& run) {
-  return importers::ImportOptiOdom(set_path + "_run-" + run + ".csv", set_path + "_metadata.csv");
+// The run imported and read back from a recording directory, as `roamlab import optiodom` and `roamlab diagnose` do.
+Result<recording::Recording> ImportRun(const std::string& set_path, const std::string& run,
+                                       const ::roamlab::testing::TempDir& dir) {
+  auto imported = importers::ImportOptiOdom(set_path + "_run-" + run + ".csv", set_path + "_metadata.csv");
+  if (!imported.ok()) return imported.status();
+  const std::string path = dir.File(std::filesystem::path(set_path).filename().string() + "_" + run);
+  if (Status s = recording::WriteRecording(imported.value(), path); !s.ok()) return s;
+  recording::ReadOptions read;
+  read.load_ground_truth = false;
+  return recording::ReadRecording(path, read);
 }
 
 TEST(TwinRealTest, SquareRunPatchLowersTheCircularRunsDrift) {
@@ -28,8 +38,9 @@ TEST(TwinRealTest, SquareRunPatchLowersTheCircularRunsDrift) {
   const std::string circular = kDiff + "circular/231220200121/231220200121";
   if (!std::filesystem::exists(square + "_metadata.csv") || !std::filesystem::exists(circular + "_metadata.csv"))
     GTEST_SKIP() << "real data absent: " << square << ", " << circular;
-  auto train = ImportRun(square, "01");
-  auto held = ImportRun(circular, "01");
+  ::roamlab::testing::TempDir dir;
+  auto train = ImportRun(square, "01", dir);
+  auto held = ImportRun(circular, "01", dir);
   ASSERT_TRUE(train.ok()) << train.status().message();
   ASSERT_TRUE(held.ok()) << held.status().message();
   auto nominal = sim::LoadScenario(std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/real/optiodom_diff.yaml");
