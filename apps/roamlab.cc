@@ -230,6 +230,9 @@ void AddDiagnose(CLI::App* app, Commands* commands) {
     dia->add_flag("--replay", args->replay,
                   "Also diagnose against the scenario's noise-free twin into OUT/twin.json (its simulation of the "
                   "scenario's own drive, else its replay of the recorded drive)");
+    dia->add_option("--held-out", args->held_out,
+                    "With --replay: other recordings of the same robot (held out of the twin's fit) on which the "
+                    "twin's patch is shown (twin.json heldout_runs)");
     dia->add_flag("--quiet", args->quiet, "No progress and no summary");
     return dia;
   });

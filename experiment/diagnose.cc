@@ -104,28 +104,62 @@ Result<gap::Baseline> NominalBaseline(const DiagnoseRequest& request, const Inpu
   return std::move(learned).value().baseline;
 }
 
-// The twin's runner: the scenario's plain noise-free simulation when the recording is of its own drive (detected by
-// gap::DriveMismatch), else the replay of the recorded drive (sim/replay.h; bad input when the recording has no drive
-// inputs). `replayed` says which.
-Result<gap::TwinRunner> ChooseTwinRunner(const DiagnoseRequest& request, const Inputs& in, bool* replayed,
+// The twin's runner of `rec` (read from `path`): the scenario's plain noise-free simulation when the recording is of
+// its own drive (detected by gap::DriveMismatch), else the replay of the recorded drive (sim/replay.h; bad input when
+// the recording has no drive inputs). `replayed` says which.
+Result<gap::TwinRunner> ChooseTwinRunner(const sim::Scenario& scenario, const recording::Recording& rec,
+                                         const std::string& path, bool* replayed,
                                          const std::function<void(const std::string&)>& say) {
-  if (!in.scenario) return Status::Error("--replay needs --scenario");
-  sim::Scenario nominal = *in.scenario;
+  double span_s = 0.0;
+  for (const recording::Stream& s : rec.streams)
+    if (!s.t.empty()) span_s = std::max(span_s, s.t.back().seconds());
+  sim::Scenario nominal = scenario;
   nominal.effects.clear();
-  nominal.duration_s = std::max(in.span_s, 1.0);
+  nominal.duration_s = std::max(span_s, 1.0);
   auto twin = gap::PlainSimulationRunner()(nominal);
-  const std::string mismatch = twin.ok() ? gap::DriveMismatch(in.recording, twin.value()) : twin.status().message();
+  const std::string mismatch = twin.ok() ? gap::DriveMismatch(rec, twin.value()) : twin.status().message();
   *replayed = !mismatch.empty();
   if (!*replayed) return gap::PlainSimulationRunner();
-  if (auto inputs = sim::DriveInputsFrom(in.recording, *in.scenario); !inputs.ok())
-    return Status::Error(request.recording + ": " + inputs.status().message());
-  say("not a recording of the scenario's own drive (" + mismatch + "): the twin replays the recorded drive");
-  return gap::ReplayRunner(in.recording);
+  if (auto inputs = sim::DriveInputsFrom(rec, scenario); !inputs.ok())
+    return Status::Error(path + ": " + inputs.status().message());
+  say(path + ": not a recording of the scenario's own drive (" + mismatch + "): the twin replays the recorded drive");
+  return gap::ReplayRunner(rec);
 }
 
-// The diagnosis against the scenario's twin (runner: ChooseTwinRunner) into out/twin.json.
+// A held-out recording with its twin's runner; errors are bad input.
+struct HeldOut {
+  std::string path;
+  recording::Recording recording;
+  gap::TwinRunner runner;
+  bool replayed = false;
+};
+Result<std::vector<HeldOut>> LoadHeldOut(const DiagnoseRequest& request, const sim::Scenario& scenario,
+                                         const std::function<void(const std::string&)>& say) {
+  std::vector<HeldOut> out;
+  for (const std::string& path : request.held_out) {
+    recording::ReadOptions read;
+    read.load_ground_truth = false;
+    auto rec = recording::ReadRecording(path, read);
+    if (!rec.ok()) return rec.status();
+    if (rec.value().platform.kind != scenario.robot.kind)
+      return Status::Error(path + ": platform kind '" + rec.value().platform.kind +
+                           "' does not match the robot kind '" + scenario.robot.kind + "' of " + request.scenario);
+    HeldOut h{path, std::move(rec).value(), {}, false};
+    auto runner = ChooseTwinRunner(scenario, h.recording, path, &h.replayed, say);
+    if (!runner.ok()) return runner.status();
+    h.runner = std::move(runner).value();
+    out.push_back(std::move(h));
+  }
+  return out;
+}
+
+std::string Millimetres(double m) { return Fixed(1e3 * m, 3) + " mm"; }
+
+// The diagnosis against the scenario's twin (runner: ChooseTwinRunner), its patch shown on the held-out recordings,
+// into out/twin.json; `json` receives what was written.
 Outcome DiagnoseTwinToFile(const DiagnoseRequest& request, const Inputs& in, const gap::TwinRunner& runner,
-                           bool replayed, const std::function<void(const std::string&)>& say) {
+                           bool replayed, const std::vector<HeldOut>& held_out, nlohmann::json* json,
+                           const std::function<void(const std::string&)>& say) {
   say("diagnosing " + request.recording + " against the scenario's twin" + (replayed ? " (replayed)" : ""));
   gap::TwinDiagnoseOptions options;
   options.replayed = replayed;
@@ -134,10 +168,23 @@ Outcome DiagnoseTwinToFile(const DiagnoseRequest& request, const Inputs& in, con
   if (request.max_shift_s) options.max_shift_s = *request.max_shift_s;
   auto diagnosed = gap::DiagnoseTwin(*in.scenario, in.recording, runner, options);
   if (!diagnosed.ok()) return Outcome::Failed(Status::Error("twin: " + diagnosed.status().message()));
+  gap::TwinDiagnosis& d = diagnosed.value();
+  for (const HeldOut& h : held_out) {
+    auto shown = gap::ShowOnHeldOut(*in.scenario, d.patch, h.recording, h.runner, options.drift, options.threads);
+    if (!shown.ok())
+      return Outcome::Failed(Status::Error("twin, held out " + h.path + ": " + shown.status().message()));
+    shown.value().recording = h.path;
+    shown.value().replayed = h.replayed;
+    for (const auto& [stream, before] : shown.value().before.drift)
+      if (const auto after = shown.value().after.drift.find(stream); after != shown.value().after.drift.end())
+        say("twin, held out " + h.path + ": " + stream + " " + Fixed(before.window_s, 3) + " s drift " +
+            Millimetres(before.mean_position_m) + " -> " + Millimetres(after->second.mean_position_m));
+    d.heldout_runs.push_back(std::move(shown).value());
+  }
   const std::string path = (std::filesystem::path(request.out) / "twin.json").string();
-  if (Status s = WriteFileAtomic(path, gap::TwinDiagnosisJson(diagnosed.value()).dump(2) + "\n"); !s.ok())
-    return Outcome::Failed(s);
-  say("twin: " + diagnosed.value().verdict + ", std " + diagnosed.value().std_method + " (" + path + ")");
+  *json = gap::TwinDiagnosisJson(d);
+  if (Status s = WriteFileAtomic(path, json->dump(2) + "\n"); !s.ok()) return Outcome::Failed(s);
+  say("twin: " + d.verdict + ", std " + d.std_method + " (" + path + ")");
   return Outcome::Ok();
 }
 
@@ -179,10 +226,17 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
   const Inputs& in = inputs.value();
   gap::TwinRunner twin_runner;
   bool replayed = false;
+  std::vector<HeldOut> held_out;
+  if (!request.held_out.empty() && !request.replay)
+    return Outcome::BadInput(Status::Error("--held-out needs --replay"));
   if (request.replay) {
-    auto runner = ChooseTwinRunner(request, in, &replayed, say);
+    if (!in.scenario) return Outcome::BadInput(Status::Error("--replay needs --scenario"));
+    auto runner = ChooseTwinRunner(*in.scenario, in.recording, request.recording, &replayed, say);
     if (!runner.ok()) return Outcome::BadInput(runner.status());
     twin_runner = std::move(runner).value();
+    auto loaded = LoadHeldOut(request, *in.scenario, say);
+    if (!loaded.ok()) return Outcome::BadInput(loaded.status());
+    held_out = std::move(loaded).value();
   }
   if (Status s = RemoveEarlierOutputs(given, request.out); !s.ok()) return Outcome::Failed(s);
   IncompleteMarker marker(request.out);
@@ -221,6 +275,11 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
     (void)marker.AddDone("the re-simulation");
   }
 
+  nlohmann::json twin_json;
+  if (request.replay)
+    if (Outcome twin = DiagnoseTwinToFile(request, in, twin_runner, replayed, held_out, &twin_json, say); !twin.ok())
+      return failed(twin.status);
+
   gap::ReportInputs report;
   report.recording = request.recording;
   report.model = request.scenario.empty() ? request.config : request.scenario;
@@ -228,12 +287,10 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
   report.baseline_seed = request.baseline_seed;
   report.simulation = simulation ? &*simulation : nullptr;
   report.plots = !request.no_plots;
+  report.twin = request.replay ? &twin_json : nullptr;
   report.progress = say;
   if (Status s = gap::WriteReport(d, report, request.out); !s.ok()) return failed(s);
   (void)marker.AddDone("gap.json, the patches and the report");
-  if (request.replay)
-    if (Outcome twin = DiagnoseTwinToFile(request, in, twin_runner, replayed, say); !twin.ok())
-      return failed(twin.status);
   if (Status s = marker.Complete(); !s.ok()) return Outcome::Failed(s);
   if (diagnosis) *diagnosis = std::move(diagnosed).value();
   return Outcome::Ok();

@@ -9,13 +9,15 @@
 // compared with the recording's held-out part (gap/resimulate.h; gap.json "simulation"). Writes gap.json, report.md,
 // the patches and the figures (gap/report.h). Without a scenario and a configuration, the nominal model is the one
 // `roamlab init` writes (experiment/init.h), saved as out/nominal_config.yaml, and there is no baseline. With `replay`,
-// the recording is also diagnosed against the scenario's twin (gap/twin.h) into out/twin.json.
+// the recording is also diagnosed against the scenario's twin (gap/twin.h) into out/twin.json (also gap.json's
+// "twin"), and the twin's patch is shown on the held-out recordings.
 #pragma once
 
 #include <cstdint>
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "experiment/steps.h"
 #include "gap/diagnose.h"
@@ -43,6 +45,10 @@ struct DiagnoseRequest {
   // noise-free simulation of the scenario for a recording of its own drive (gap::DriveMismatch), else the replay of
   // the recorded drive (sim/replay.h; bad input when the recording has no drive inputs).
   bool replay = false;
+  // Recordings held out of the twin's fit (other runs of the same robot; needs replay): the patch fitted on
+  // `recording` is shown on each (gap::ShowOnHeldOut; twin.json's heldout_runs). Each is read like `recording` and
+  // must have its platform kind and drive inputs.
+  std::vector<std::string> held_out;
   std::function<void(const std::string& line)> progress;  // optional
 };
 

@@ -410,7 +410,8 @@ json DiagnosisJson(const Diagnosis& d, const Baseline* baseline, std::uint64_t b
 }
 
 Status WriteReport(const Diagnosis& d, const ReportInputs& in, const std::string& dir) {
-  const json gap_json = DiagnosisJson(d, in.baseline, in.baseline_seed, in.simulation);
+  json gap_json = DiagnosisJson(d, in.baseline, in.baseline_seed, in.simulation);
+  gap_json["twin"] = in.twin ? *in.twin : json();
   if (Status s = WriteFileAtomic(dir + "/gap.json", gap_json.dump(2) + "\n"); !s.ok()) return s;
   if (Status s = WriteFileAtomic(dir + "/scenario_patch.yaml", ScenarioPatch(d, in.simulation)); !s.ok()) return s;
   if (Status s = WriteFileAtomic(dir + "/estimator_patch.yaml", EstimatorPatch(d)); !s.ok()) return s;

@@ -40,7 +40,8 @@ struct ReportInputs {
   const Baseline* baseline = nullptr;  // null: diagnosed without one
   std::uint64_t baseline_seed = 0;
   const SimulationComparison* simulation = nullptr;  // null: no re-simulation
-  bool plots = true;                                 // write the figures (when gnuplot is installed)
+  const nlohmann::json* twin = nullptr;  // the diagnosis against the twin (twin.json), gap.json's "twin"; null: none
+  bool plots = true;                     // write the figures (when gnuplot is installed)
   std::function<void(const std::string&)> progress;  // receives a note when no figure can be drawn
 };
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <set>
 
@@ -312,6 +313,39 @@ Result<TwinDiagnosis> Diagnoser::Run() {
 std::vector<std::string> TwinCandidateNames(const sim::Scenario& nominal) {
   std::vector<std::string> out;
   for (const TwinCandidate& c : internal::TwinCandidates(nominal, 0.5)) out.push_back(c.label);
+  return out;
+}
+
+Result<TwinHeldOutRun> ShowOnHeldOut(const sim::Scenario& nominal, const std::vector<sim::EffectOptions>& patch,
+                                     const recording::Recording& held, const TwinRunner& runner,
+                                     const DriftOptions& drift, int threads) {
+  Time first = Time::FromNanoseconds(std::numeric_limits<std::int64_t>::max());
+  Time last = Time::FromNanoseconds(std::numeric_limits<std::int64_t>::min());
+  for (const recording::Stream& s : held.streams) {
+    if (s.t.empty()) continue;
+    first = std::min(first, s.t.front());
+    last = std::max(last, s.t.back());
+  }
+  if (last <= first) return Status::Error("the held-out recording has no span of samples to compare");
+  std::vector<sim::Scenario> scenarios(2, nominal);
+  scenarios[0].effects.clear();
+  scenarios[1].effects = patch;
+  for (sim::Scenario& s : scenarios) s.duration_s = std::max(last.seconds(), 1.0);
+  std::vector<Result<recording::Recording>> twins(2, Result<recording::Recording>(Status::Error("not run")));
+  internal::ParallelFor(2, threads, [&](int i) {
+    try {
+      twins[static_cast<std::size_t>(i)] = runner(scenarios[static_cast<std::size_t>(i)]);
+    } catch (const std::exception& e) {
+      twins[static_cast<std::size_t>(i)] = Status::Error(std::string("the twin runner failed: ") + e.what());
+    }
+  });
+  for (std::size_t i = 0; i < twins.size(); ++i)
+    if (!twins[i].ok())
+      return Status::Error(std::string(i == 0 ? "the nominal" : "the patched") +
+                           " twin: " + twins[i].status().message());
+  TwinHeldOutRun out;
+  out.before = CompareTwin(held, twins[0].value(), first.seconds(), last.seconds(), drift);
+  out.after = CompareTwin(held, twins[1].value(), first.seconds(), last.seconds(), drift);
   return out;
 }
 

@@ -137,6 +137,14 @@ struct TwinEffect {
   int runs = 0;  // twin runs spent on the fit
 };
 
+// A recording held out of the fit (another run of the same robot): the nominal twin and the patched twin (the patch
+// fitted on the diagnosed recording) compared with it over its whole span.
+struct TwinHeldOutRun {
+  std::string recording;  // as named by the caller (its path)
+  bool replayed = false;  // the runner replays its drive
+  TwinComparison before, after;
+};
+
 struct TwinDiagnosis {
   std::string verdict;  // named | unknown | none
   bool replayed = false;
@@ -148,7 +156,8 @@ struct TwinDiagnosis {
   std::vector<std::string> unexplained;   // "stream/component" inconsistent on the held-out part with the patch
   TwinComparison whole_run;               // the nominal twin
   TwinComparison heldout_before, heldout_after;
-  std::vector<sim::EffectOptions> patch;  // the kept effects as the simulator takes them
+  std::vector<sim::EffectOptions> patch;     // the kept effects as the simulator takes them
+  std::vector<TwinHeldOutRun> heldout_runs;  // ShowOnHeldOut's, filled by the caller
   int runs = 0;
   double seconds = 0.0;
 };
@@ -179,8 +188,16 @@ std::vector<std::string> TwinCandidateNames(const sim::Scenario& nominal);
 Result<TwinDiagnosis> DiagnoseTwin(const sim::Scenario& nominal, const recording::Recording& real,
                                    const TwinRunner& runner, const TwinDiagnoseOptions& options = {});
 
+// The patch shown on a held-out recording: its twin with `runner` (the twin of `held`) for the nominal scenario (its
+// effects removed) and for the nominal one with `patch`, both up to held's last stamp, run in parallel on `threads`,
+// each compared with `held` over its span. Errors: a twin fails, or `held` has no span of samples.
+Result<TwinHeldOutRun> ShowOnHeldOut(const sim::Scenario& nominal, const std::vector<sim::EffectOptions>& patch,
+                                     const recording::Recording& held, const TwinRunner& runner,
+                                     const DriftOptions& drift = {}, int threads = 2);
+
 // {"replayed", "verdict", "std_method", "train_end_s", "located", "candidates", "effects", "unexplained",
-// "heldout": {"before", "after"}, "whole_run", "patch", "runs", "seconds"}: gap.json's "simulation" section.
+// "heldout": {"before", "after"}, "whole_run", "patch",
+// "heldout_runs": [{"recording", "replayed", "before", "after"}], "runs", "seconds"}: gap.json's "simulation" section.
 nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d);
 
 }  // namespace roamlab::gap

@@ -88,6 +88,12 @@ nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d) {
   for (const TwinEffect& e : d.candidates) candidates.push_back(EffectJson(e));
   for (const TwinEffect& e : d.effects) effects.push_back(EffectJson(e));
   for (const sim::EffectOptions& e : d.patch) patch.push_back({{"name", e.name}, {"parameters", e.parameters}});
+  nlohmann::json heldout_runs = nlohmann::json::array();
+  for (const TwinHeldOutRun& h : d.heldout_runs)
+    heldout_runs.push_back({{"recording", h.recording},
+                            {"replayed", h.replayed},
+                            {"before", ComparisonJson(h.before)},
+                            {"after", ComparisonJson(h.after)}});
   return {{"replayed", d.replayed},
           {"verdict", d.verdict},
           {"std_method", d.std_method},
@@ -99,6 +105,7 @@ nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d) {
           {"heldout", {{"before", ComparisonJson(d.heldout_before)}, {"after", ComparisonJson(d.heldout_after)}}},
           {"whole_run", ComparisonJson(d.whole_run)},
           {"patch", patch},
+          {"heldout_runs", heldout_runs},
           {"runs", d.runs},
           {"seconds", d.seconds}};
 }

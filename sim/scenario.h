@@ -115,6 +115,11 @@
 //                                          ratio rho = r_R / r_L in [0.8, 1.2] (WheelDeformation.radius_scale);
 //                                          driving straight at equal wheel rates omega it turns at
 //                                          r_L omega (rho - 1) / B
+//   wheel_radius_scale {scale: 1}         differential_drive, skid_steer, omni3, mecanum: every wheel's radius times
+//                                          scale in [0.8, 1.2] (WheelDeformation.radius_scale; a roller wheel's
+//                                          rollers moved radially, WheeledRobot::ScaleRollerWheel; worn or inflated
+//                                          tires, a wrong stated diameter): the robot travels scale times the
+//                                          distance its encoders' nominal radius says, and turns scale times as fast
 //   track_width_error {track_error_m: 0}   differential_drive, mecanum: the wheel bodies moved apart along O's y by
 //                                          track_error_m in [-0.1, 0.1] m, half on each side (a turn at a given wheel-
 //                                          rate difference is B_nom / B_true of the nominal one); truth: baseline +

@@ -27,8 +27,8 @@ std::optional<Scenario::Problem> ProfileProblem(const Profile& profile, const st
 std::optional<Scenario::Problem> WheelEffectProblem(const std::vector<EffectOptions>& effects, const std::string& name,
                                                     const std::string& kind, const std::string& k) {
   using P = Scenario::Problem;
-  const bool wheel_effect = name == "wheel_radius_asymmetry" || name == "track_width_error" ||
-                            name == "wheel_deformation" || name == "axle_misalignment";
+  const bool wheel_effect = name == "wheel_radius_asymmetry" || name == "wheel_radius_scale" ||
+                            name == "track_width_error" || name == "wheel_deformation" || name == "axle_misalignment";
   if (!wheel_effect) return std::nullopt;
   if (kind == "ackermann" && name == "axle_misalignment") {
     // The Ackermann vehicle's rear axle (both rear wheels: a thrust angle); the front wheels are steered, and their
@@ -51,6 +51,12 @@ std::optional<Scenario::Problem> WheelEffectProblem(const std::vector<EffectOpti
     if (kind != "differential_drive") return P{k + ".name", name + " is for differential_drive robots only"};
     const double ratio = EffectParameter(effects, name, "ratio_right_left", 1.0);
     if (!(ratio >= 0.8 && ratio <= 1.2)) return P{k + ".parameters.ratio_right_left", "must be in [0.8, 1.2]"};
+  }
+  if (name == "wheel_radius_scale") {
+    if (kind != "differential_drive" && kind != "skid_steer" && kind != "omni3" && kind != "mecanum")
+      return P{k + ".name", name + " is for differential_drive, skid_steer, omni3 and mecanum robots"};
+    const double scale = EffectParameter(effects, name, "scale", 1.0);
+    if (!(scale >= 0.8 && scale <= 1.2)) return P{k + ".parameters.scale", "must be in [0.8, 1.2]"};
   }
   if (name == "track_width_error") {
     if (kind != "differential_drive" && kind != "mecanum")

@@ -187,6 +187,10 @@ Status WheeledRobot::Deform(mjModel* model, const std::vector<WheelDeformation>&
       return Status::Error(what + ": " + name + ": the " + kind_ + " robot has " + std::to_string(wheels_.size()) +
                            " wheels");
     const int tire = tires_[static_cast<std::size_t>(d.wheel)];
+    if (HasRollers(kind_) && d.ovality_m == 0.0 && !d.keep_mean_radius) {
+      if (Status s = ScaleRollerWheel(model, d.wheel, d.radius_scale, what + ": " + name); !s.ok()) return s;
+      continue;
+    }
     if (model->geom_type[tire] != mjGEOM_SPHERE)
       return Status::Error(what + ": " + name + ": only sphere tires can be deformed");
     // Mean rolling radius of an ellipse of semi-axes a >= b: its perimeter / 2 pi (Ramanujan's second
@@ -227,6 +231,30 @@ Status WheeledRobot::Deform(mjModel* model, const std::vector<WheelDeformation>&
     model->geom_quat[4 * tire + 3] = q.z();
     wheels_[static_cast<std::size_t>(d.wheel)].mean_rolling_radius_m = mean_radius(a, r);
   }
+  return Status::Ok();
+}
+
+Status WheeledRobot::ScaleRollerWheel(mjModel* model, int wheel, double radius_scale, const std::string& what) {
+  const int tire = tires_[static_cast<std::size_t>(wheel)];
+  const double r0 = model->geom_size[3 * tire], r = r0 * radius_scale;
+  const std::string prefix = "roller_" + std::to_string(wheel) + "_";
+  int rollers = 0;
+  for (int body = IdOf(model, mjOBJ_BODY, prefix + "0"); body >= 0;
+       body = IdOf(model, mjOBJ_BODY, prefix + std::to_string(++rollers))) {
+    // The roller's centre sits at r0 - its radius from the hub; moved radially so that its rim reaches r.
+    const int geom = model->body_geomadr[body];
+    if (model->body_geomnum[body] < 1 || model->geom_type[geom] != mjGEOM_SPHERE)
+      return Status::Error(what + ": " + prefix + std::to_string(rollers) + ": needs a sphere roller geom");
+    const double roller_m = model->geom_size[3 * geom];
+    if (!(r > roller_m) || !(r0 > roller_m))
+      return Status::Error(what + ": the wheel's radius must stay above its rollers' radius");
+    for (int k = 0; k < 3; ++k) model->body_pos[3 * body + k] *= (r - roller_m) / (r0 - roller_m);
+  }
+  if (rollers == 0) return Status::Error(what + ": no roller bodies '" + prefix + "<k>'");
+  // As a sphere tire's: the hub moved along z by the radius change, so that the chassis keeps its height.
+  model->body_pos[3 * model->geom_bodyid[tire] + 2] += r - r0;
+  model->geom_size[3 * tire] = r;
+  wheels_[static_cast<std::size_t>(wheel)].mean_rolling_radius_m = r;
   return Status::Ok();
 }
 

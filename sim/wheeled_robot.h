@@ -89,6 +89,9 @@ class WheeledRobot {
   // mean_rolling_radius_m (the true odometer radius) but neither the platform geometry nor the driver's kinematics.
   // Errors name `what` and the wheel.
   Status Deform(mjModel* model, const std::vector<WheelDeformation>& deformations, const std::string& what);
+  // A roller wheel (omni3, mecanum) of another size: its rollers moved radially so that their envelope's radius is
+  // radius_scale times the nominal (Deform's radius_scale on a roller wheel; ovality needs sphere tires).
+  Status ScaleRollerWheel(mjModel* model, int wheel, double radius_scale, const std::string& what);
 
   // Moves the wheels of the bound model apart by track_error_m (< 0: together), half on each side, along O's y axis
   // (a track wider or narrower than designed); differential_drive and mecanum, whose wheel bodies are children of the

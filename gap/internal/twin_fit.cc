@@ -29,6 +29,7 @@ int Wheels(const std::string& kind) {
 std::vector<TwinCandidate> Library(const sim::Scenario& nominal, double max_shift_s) {
   std::vector<TwinCandidate> all;
   all.push_back({"wheel_radius_asymmetry", "wheel_radius_asymmetry", {}, {P("ratio_right_left", 1, 0.01, 0.8, 1.2)}});
+  all.push_back({"wheel_radius_scale", "wheel_radius_scale", {}, {P("scale", 1, 0.01, 0.8, 1.2)}});
   all.push_back({"track_width_error", "track_width_error", {}, {P("track_error_m", 0, 0.01, -0.1, 0.1)}});
   all.push_back({"odometry_scale_error", "odometry_scale_error", {}, {P("scale", 1, 0.01, 0.5, 1.5)}});
   const int wheels = Wheels(nominal.robot.kind);

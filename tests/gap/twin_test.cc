@@ -105,8 +105,8 @@ TEST(TwinTest, NoHiddenEffectNamesNone) {
   EXPECT_TRUE(d.effects.empty());
   // Every candidate the diff drive with IMU and GPS supports was fitted and scored.
   const std::vector<std::string> names = TwinCandidateNames(Nominal());
-  // wheel ratio, track, odometry scale, two axles, gyro scale and bias, IMU offset, GPS latency
-  EXPECT_EQ(names.size(), 9u);
+  // wheel ratio, radius scale, track, odometry scale, two axles, gyro scale and bias, IMU offset, GPS latency
+  EXPECT_EQ(names.size(), 10u);
   ASSERT_EQ(d.candidates.size(), names.size());
   for (const TwinEffect& e : d.candidates) {
     EXPECT_NE(std::find(names.begin(), names.end(), e.estimate.name), names.end()) << e.estimate.name;

@@ -117,6 +117,51 @@ TEST_F(WheelEffectsTest, RadiusAsymmetryCurvesAStraightDriveAsTheRatioPredicts) 
   EXPECT_EQ(sim.truth.effects[0].parameters.at("ratio_right_left"), rho);
 }
 
+// Every tire's radius times s: the yaw rate per unit of wheel-rate difference, r s / B, is s times the nominal one;
+// the platform geometry stays nominal and the true radii are s r.
+TEST_F(WheelEffectsTest, RadiusScaleScalesTheYawRatePerWheelRateDifference) {
+  const double scale = 1.05;
+  const Simulation sim = Simulated(DiffDrive(0.2, 0.8, {{"wheel_radius_scale", {{"scale", scale}}}}));
+  const double r = turning_->recording.platform.geometry.at("wheel_radius_m");
+  const Rates nominal = MeanRates(*turning_), with = MeanRates(sim);
+  const double k_nominal = nominal.yaw_radps / (nominal.right_radps - nominal.left_radps);
+  const double k_with = with.yaw_radps / (with.right_radps - with.left_radps);
+  EXPECT_NEAR(k_with / k_nominal, scale, 0.01) << "k " << k_nominal << " -> " << k_with;
+  ExpectNominalPlatform(sim, *turning_);
+  const auto& cal = sim.truth.calibration;
+  EXPECT_NEAR(cal.at("odometer.radius_left")[0], scale * r, 1e-6);
+  EXPECT_NEAR(cal.at("odometer.radius_right")[0], scale * r, 1e-6);
+  const auto problem = DiffDrive(0.2, 0.0, {{"wheel_radius_scale", {{"scale", 0.7}}}}).Validate();
+  ASSERT_TRUE(problem);
+  EXPECT_EQ(problem->key + ": " + problem->message, "effects[0].parameters.scale: must be in [0.8, 1.2]");
+}
+
+// Roller wheels (the OptiOdom omni3 model) of a radius 5 % large: at the same wheel rates (the driver does not know)
+// the robot drives 5 % further; the true radii follow.
+TEST(WheelRadiusScaleTest, ScaledRollerWheelsCarryTheOmniFurther) {
+  auto loaded = LoadScenario(testing::SourcePath("scenarios/real/optiodom_omni3.yaml"));
+  ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+  Scenario s = loaded.value();
+  s.duration_s = 4.0;
+  s.driver.linear_mps = Profile::Constant(0.15);
+  s.driver.lateral_mps = Profile::Constant(0.0);
+  s.driver.angular_radps = Profile::Constant(0.0);
+  const double scale = 1.05;
+  const Simulation nominal = Simulated(s);
+  s.effects = {{"wheel_radius_scale", {{"scale", scale}}}};
+  const Simulation scaled = Simulated(s);
+  const auto travel = [](const Simulation& sim) {
+    const Trajectory& truth = *sim.recording.ground_truth;
+    std::size_t a = 0;
+    while (a + 1 < truth.size() && truth[a].t.seconds() < kSettledS) ++a;
+    return (truth.back().p_world_body - truth[a].p_world_body).head<2>().norm();
+  };
+  EXPECT_GT(travel(nominal), 0.3);
+  EXPECT_NEAR(travel(scaled) / travel(nominal), scale, 0.01) << travel(nominal) << " -> " << travel(scaled);
+  EXPECT_NEAR(scaled.truth.calibration.at("odometer.radius_0")[0],
+              scale * nominal.truth.calibration.at("odometer.radius_0")[0], 1e-9);
+}
+
 // The yaw rate per unit of wheel-rate difference is r / B: B_nom / B_true of the nominal one.
 TEST_F(WheelEffectsTest, TrackWidthErrorScalesTheYawRatePerWheelRateDifference) {
   const double error_m = 0.04;
