@@ -74,6 +74,11 @@ struct StreamCounts {
   int rejected = 0;  // switched off by the chi-square gate
   int too_late = 0;  // older than the oldest pose in the graph
   int outside = 0;   // no pose around its time stamp (before the first or after the last master sample)
+  // What the input checks found in the stream's primary source (recording/stream_health.h), counted, not removed
+  // (but duplicates, which the reader drops):
+  int duplicates = 0;  // rows identical to the one before, dropped by the recording reader
+  int gaps = 0;        // gaps longer than recording::kGapPeriods periods (an outage, a clock jump)
+  int frozen = 0;      // rows repeating the first row of a frozen run
 };
 
 struct StreamBinding;  // a configured stream bound to its recording data (problem.cc)

@@ -7,6 +7,7 @@
 
 #include "estimator/internal/problem_impl.h"
 #include "estimator/marginalization.h"
+#include "recording/stream_health.h"
 
 namespace roamlab::estimator {
 
@@ -400,7 +401,12 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
   Impl& im = *builder->impl_;
   for (std::size_t i = 0; i < im.streams.size(); ++i) {
     builder->stream_names_.push_back(im.streams[i].name);
-    builder->counts_[im.streams[i].name];
+    StreamCounts& counts = builder->counts_[im.streams[i].name];
+    const recording::Stream& primary = *im.streams[i].primary;
+    const recording::StreamHealth health = recording::CheckStreamHealth(primary);
+    counts.duplicates = static_cast<int>(primary.duplicate_rows_dropped);
+    counts.gaps = static_cast<int>(health.gaps.size());
+    counts.frozen = health.FrozenRepeats();
     if (im.streams[i].name == config.master) im.master = static_cast<int>(i);
     if (im.streams[i].config.model == "gps" || im.streams[i].config.model == "absolute_pose")
       builder->has_absolute_sensor_ = true;
