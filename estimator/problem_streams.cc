@@ -16,6 +16,16 @@ using recording::StreamType;
 
 namespace {
 
+// Per row of `stream`: whether it repeats the first row of one of `health`'s frozen runs.
+std::vector<bool> FrozenRows(const recording::Stream& stream, const recording::StreamHealth& health) {
+  std::vector<bool> frozen(stream.t.size(), false);
+  for (const recording::FrozenRun& run : health.frozen) {
+    const auto first = std::lower_bound(stream.t.begin(), stream.t.end(), run.first) - stream.t.begin();
+    for (auto row = first + 1; row < first + run.rows; ++row) frozen[static_cast<std::size_t>(row)] = true;
+  }
+  return frozen;
+}
+
 Attachment AttachmentOf(const std::string& model, bool master) {
   if (master) return Attachment::kMaster;
   if (model == "relative_motion") return Attachment::kInterval;
@@ -407,6 +417,7 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
     counts.duplicates = static_cast<int>(primary.duplicate_rows_dropped);
     counts.gaps = static_cast<int>(health.gaps.size());
     counts.frozen = health.FrozenRepeats();
+    im.streams[i].frozen = FrozenRows(primary, health);
     if (im.streams[i].name == config.master) im.master = static_cast<int>(i);
     if (im.streams[i].config.model == "gps" || im.streams[i].config.model == "absolute_pose")
       builder->has_absolute_sensor_ = true;

@@ -67,7 +67,7 @@ void HealthWarnings(const recording::Stream& stream, const std::string& path, Ti
   for (const recording::FrozenRun& run : health.frozen) {
     warnings->push_back(path + ": " + name + " repeats one reading on " + std::to_string(run.rows) + " rows over [" +
                         FormatSeconds(run.first) + ", " + FormatSeconds(run.last) +
-                        "] s: the sensor looks frozen (the rows are used; the gate judges them)");
+                        "] s: the sensor looks frozen; the rows after the first are not used");
   }
 }
 

@@ -1,7 +1,7 @@
 // Checks of a stream's timing and values that no single row shows: gaps (an outage or a clock that jumped) and runs
 // of identical rows (a frozen sensor), and the dropping of identical repeated rows (duplicated messages) from a stream
-// built in memory. The estimator counts what they find per stream (estimator/problem.h StreamCounts) and the
-// calibrate and track commands print a warning for each.
+// built in memory. The estimator counts what they find per stream (estimator/problem.h StreamCounts) and leaves a
+// frozen run's repeated rows out; the calibrate and track commands print a warning for each finding.
 //
 //   gap      two consecutive stamps further apart than kGapPeriods nominal periods (info.rate_hz; none without a rate)
 //   frozen   at least kFrozenMinRows consecutive rows with every value identical, spanning at least kFrozenMinSeconds,
