@@ -22,6 +22,7 @@ void PrintSummary(const sim::Simulation& s, const std::string& out) {
       "side slip <= %.2f m/s, wheel slip <= %.2f m/s\n",
       st.distance_m, st.max_abs_pitch_rad * kDegPerRad, st.max_abs_roll_rad * kDegPerRad, st.path_height_range_m,
       st.terrain_relief_m, st.max_lateral_speed_mps, st.max_wheel_slip_mps);
+  for (const std::string& fault : st.faults) std::printf("fault: %s\n", fault.c_str());
   if (st.failed_scan_matches > 0) std::printf("scan matcher: %d scan pairs not matched\n", st.failed_scan_matches);
   if (const auto& vo = st.visual_odometry) {
     std::printf(

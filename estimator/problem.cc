@@ -80,7 +80,9 @@ std::vector<MeasurementRef> ProblemBuilder::Measurements() const {
   std::vector<MeasurementRef> out;
   for (std::size_t i = 0; i < impl_->streams.size(); ++i) {
     const recording::Stream& s = *impl_->streams[i].primary;
-    for (std::size_t r = 0; r < s.t.size(); ++r) out.push_back({s.t[r], static_cast<int>(i), static_cast<int>(r)});
+    const std::vector<bool>& frozen = impl_->streams[i].frozen;
+    for (std::size_t r = 0; r < s.t.size(); ++r)
+      if (frozen.empty() || !frozen[r]) out.push_back({s.t[r], static_cast<int>(i), static_cast<int>(r)});
   }
   const int master = impl_->master;
   std::stable_sort(out.begin(), out.end(), [master](const MeasurementRef& a, const MeasurementRef& b) {

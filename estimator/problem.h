@@ -74,6 +74,10 @@ struct StreamCounts {
   int rejected = 0;  // switched off by the chi-square gate
   int too_late = 0;  // older than the oldest pose in the graph
   int outside = 0;   // no pose around its time stamp (before the first or after the last master sample)
+  // What the input checks found in the stream's primary source (recording/stream_health.h):
+  int duplicates = 0;  // rows identical to the one before, dropped by the recording reader
+  int gaps = 0;        // gaps longer than recording::kGapPeriods periods (an outage, a clock jump)
+  int frozen = 0;      // rows repeating the first row of a frozen run (a stuck sensor), left out of Measurements()
 };
 
 struct StreamBinding;  // a configured stream bound to its recording data (problem.cc)
@@ -86,7 +90,8 @@ class ProblemBuilder {
                                                         const recording::Recording& recording);
   ~ProblemBuilder();
 
-  // Every sample of every configured stream, in time order (ties: master first, then stream order).
+  // Every sample of every configured stream, in time order (ties: master first, then stream order), but for the rows
+  // of a frozen sensor (StreamCounts::frozen).
   std::vector<MeasurementRef> Measurements() const;
 
   // Adds one measurement; see the class comment.

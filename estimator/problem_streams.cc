@@ -7,6 +7,7 @@
 
 #include "estimator/internal/problem_impl.h"
 #include "estimator/marginalization.h"
+#include "recording/stream_health.h"
 
 namespace roamlab::estimator {
 
@@ -14,6 +15,16 @@ using internal::Attachment;
 using recording::StreamType;
 
 namespace {
+
+// Per row of `stream`: whether it repeats the first row of one of `health`'s frozen runs.
+std::vector<bool> FrozenRows(const recording::Stream& stream, const recording::StreamHealth& health) {
+  std::vector<bool> frozen(stream.t.size(), false);
+  for (const recording::FrozenRun& run : health.frozen) {
+    const auto first = std::lower_bound(stream.t.begin(), stream.t.end(), run.first) - stream.t.begin();
+    for (auto row = first + 1; row < first + run.rows; ++row) frozen[static_cast<std::size_t>(row)] = true;
+  }
+  return frozen;
+}
 
 Attachment AttachmentOf(const std::string& model, bool master) {
   if (master) return Attachment::kMaster;
@@ -400,7 +411,13 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
   Impl& im = *builder->impl_;
   for (std::size_t i = 0; i < im.streams.size(); ++i) {
     builder->stream_names_.push_back(im.streams[i].name);
-    builder->counts_[im.streams[i].name];
+    StreamCounts& counts = builder->counts_[im.streams[i].name];
+    const recording::Stream& primary = *im.streams[i].primary;
+    const recording::StreamHealth health = recording::CheckStreamHealth(primary);
+    counts.duplicates = static_cast<int>(primary.duplicate_rows_dropped);
+    counts.gaps = static_cast<int>(health.gaps.size());
+    counts.frozen = health.FrozenRepeats();
+    im.streams[i].frozen = FrozenRows(primary, health);
     if (im.streams[i].name == config.master) im.master = static_cast<int>(i);
     if (im.streams[i].config.model == "gps" || im.streams[i].config.model == "absolute_pose")
       builder->has_absolute_sensor_ = true;

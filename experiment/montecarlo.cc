@@ -25,6 +25,7 @@
 #include "eval/metrics.h"
 #include "eval/montecarlo.h"
 #include "eval/plots.h"
+#include "recording/stream_health.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
 
@@ -62,7 +63,8 @@ RunResult OneRun(const sim::Scenario& scenario, const estimator::EstimatorConfig
     r.error = "seed " + std::to_string(seed) + ": " + simulation.status().message();
     return r;
   }
-  const recording::Recording& rec = simulation.value().recording;
+  recording::Recording& rec = simulation.value().recording;
+  recording::DropDuplicateRows(&rec);  // as the reader does for a recording on disk (a duplicates fault)
   auto tracked = estimator::Track(config, rec, calibration, tracking_options);
   if (!tracked.ok()) {
     r.error = "seed " + std::to_string(seed) + ": " + tracked.status().message();
@@ -94,6 +96,7 @@ Result<RunCalibration> CalibrateRun(const sim::Scenario& scenario, const estimat
   auto simulation = sim::Simulate(scenario, sim_options);
   if (!simulation.ok())
     return Status::Error("calibration seed " + std::to_string(seed) + ": " + simulation.status().message());
+  recording::DropDuplicateRows(&simulation.value().recording);  // as the reader does (a duplicates fault)
   auto calibrated = estimator::Calibrate(warm, simulation.value().recording);
   if (!calibrated.ok())
     return Status::Error("calibration seed " + std::to_string(seed) + ": " + calibrated.status().message());

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <initializer_list>
+#include <iomanip>
 #include <limits>
 #include <map>
 #include <set>
@@ -20,6 +21,7 @@
 #include "estimator/tracking_io.h"
 #include "importers/optiodom.h"
 #include "recording/recording.h"
+#include "recording/stream_health.h"
 #include "recording/trajectory.h"
 #include "recording/truth.h"
 #include "sim/replay.h"
@@ -37,6 +39,39 @@ struct Inputs {
 // "[a, b] s" of a stream's first and last stamps.
 std::string Span(const recording::Stream& stream) {
   return "[" + FormatSeconds(stream.t.front()) + ", " + FormatSeconds(stream.t.back()) + "] s";
+}
+
+std::string Seconds(double s) {
+  std::ostringstream out;
+  out << std::setprecision(4) << s;
+  return out.str();
+}
+
+// What recording/stream_health.h finds in a source stream, one warning each: duplicated rows dropped by the reader,
+// gaps (with, when the stream also runs past the master's end, the forward clock jump they suggest) and frozen runs.
+void HealthWarnings(const recording::Stream& stream, const std::string& path, Time master_end,
+                    std::vector<std::string>* warnings) {
+  const std::string name = "stream '" + stream.info.name + "'";
+  if (stream.duplicate_rows_dropped > 0) {
+    warnings->push_back(path + ": " + std::to_string(stream.duplicate_rows_dropped) +
+                        " rows repeat the row before them (duplicated messages); dropped");
+  }
+  const recording::StreamHealth health = recording::CheckStreamHealth(stream);
+  const double past_end_s = std::max(0.0, SecondsBetween(master_end, stream.t.back()));
+  for (const recording::StreamGap& gap : health.gaps) {
+    std::string line = path + ": " + name + " has a gap of " + Seconds(gap.length_s) + " s after " +
+                       FormatSeconds(gap.after) + " s (an outage, or its clock jumped)";
+    if (past_end_s > 0.0)
+      line += "; it also runs " + Seconds(past_end_s) +
+              " s past the master's end: its clock looks to have jumped "
+              "forward by about that much, so its later samples are stamped late";
+    warnings->push_back(line);
+  }
+  for (const recording::FrozenRun& run : health.frozen) {
+    warnings->push_back(path + ": " + name + " repeats one reading on " + std::to_string(run.rows) + " rows over [" +
+                        FormatSeconds(run.first) + ", " + FormatSeconds(run.last) +
+                        "] s: the sensor looks frozen; the rows after the first are not used");
+  }
 }
 
 // Each configured source stream against the master's time span: an empty stream and one with samples outside the span
@@ -69,6 +104,7 @@ Status CheckCoverage(const estimator::EstimatorConfig& config, const recording::
       warnings->push_back(path + ": " + std::to_string(outside) + " of " + std::to_string(stream.t.size()) +
                           " samples lie outside the master's span (" + which + "); they are not used");
     }
+    HealthWarnings(stream, path, master->t.back(), warnings);
   }
   return Status::Ok();
 }
@@ -117,6 +153,8 @@ Status MakeOutputDirectory(const std::string& dir) {
 Outcome SimulateToDirectory(const SimulateRequest& request, sim::Simulation* simulation) {
   auto scenario = sim::LoadScenario(request.scenario);
   if (!scenario.ok()) return Outcome::BadInput(scenario.status());
+  std::vector<sim::FaultOptions>& faults = scenario.value().faults;
+  faults.insert(faults.end(), request.faults.begin(), request.faults.end());
   if (Status dir = MakeOutputDirectory(request.out); !dir.ok()) return Outcome::BadInput(dir);
   sim::SimulateOptions options;
   options.seed = request.seed;

@@ -8,6 +8,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "common/status.h"
 #include "estimator/calibration.h"
@@ -40,6 +41,7 @@ struct SimulateRequest {
   std::string out;                                // recording directory; also where sensors.camera.store_images writes
   std::optional<std::uint64_t> seed;              // overrides the scenario's noise seed
   std::function<void(double fraction)> progress;  // optional
+  std::vector<sim::FaultOptions> faults;          // applied after the scenario's own (sim/faults.h)
 };
 // Simulates the scenario and writes the recording with ground_truth.tum and truth.yaml. A bad scenario or model is
 // bad input; a simulation that fails or a recording that cannot be written is a failure. `simulation` (optional)

@@ -363,6 +363,7 @@ Status ReadStreamFile(const fs::path& directory, const UnitConversion& conversio
   stream->t = std::move(data.t);
   stream->values = std::move(data.values);
   stream->text = std::move(data.text);
+  stream->duplicate_rows_dropped = data.duplicate_rows;
   ApplyConversion(conversion, &stream->values);
   std::string problem = CovarianceProblem(*stream);
   if (problem.empty()) problem = internal::LaserScanRowsProblem(*stream);

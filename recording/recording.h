@@ -10,6 +10,7 @@
 // The reader converts declared units (deg, deg/s, g, ticks) to the canonical ones; the writer writes canonical units.
 #pragma once
 
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
@@ -110,11 +111,16 @@ struct StreamInfo {
   std::map<std::string, double> attributes;  // type-specific scalars, e.g. "ticks_per_revolution", "fx_px"
 };
 
+// A stream as read is strictly increasing in time. A row identical to the one before it in the file (the same stamp
+// and values: a message delivered twice) is dropped by ReadRecording and counted in duplicate_rows_dropped; a row
+// that repeats a stamp with other values is an error. A stream built in memory may hold such identical rows (the
+// simulator's `duplicates` fault); WriteRecording writes them as they are.
 struct Stream {
   StreamInfo info;
-  std::vector<Time> t;            // strictly increasing
-  Eigen::MatrixXd values;         // rows = samples, columns = info.columns, canonical units
-  std::vector<std::string> text;  // camera only: one file name per row
+  std::vector<Time> t;                      // strictly increasing (but for identical rows, see above)
+  Eigen::MatrixXd values;                   // rows = samples, columns = info.columns, canonical units
+  std::vector<std::string> text;            // camera only: one file name per row
+  std::int64_t duplicate_rows_dropped = 0;  // ReadRecording: rows identical to the previous one, not kept
 };
 
 struct Platform {
@@ -154,9 +160,9 @@ struct ReadOptions {
 };
 
 // Reads and validates REC. Errors name the file, the line (and column or key) and the problem: unknown or missing
-// keys, unknown stream type, unknown units, wrong column count or header, non-numeric cells, NaN/Inf, non-monotonic or
-// duplicate timestamps, missing required streams, missing files, a gps stream without origin.
-// Never opens truth.yaml.
+// keys, unknown stream type, unknown units, wrong column count or header, non-numeric cells, NaN/Inf, timestamps that
+// go backwards or repeat with other values (an identical repeated row is dropped and counted, see Stream), missing
+// required streams, missing files, a gps stream without origin. Never opens truth.yaml.
 Result<Recording> ReadRecording(const std::string& directory, const ReadOptions& options = {});
 
 // Writes REC (creating the directory). Deterministic: the same Recording gives byte-identical files. Values are

@@ -104,9 +104,12 @@ Status ValidateDataForWrite(const Stream& stream, const std::string& prefix) {
     if (problem.empty()) problem = internal::LaserScanRowsProblem(stream);
     if (!problem.empty()) return Status::Error(prefix + "row " + problem);
   }
-  // Time strictly increasing.
+  // Time strictly increasing, but for a row identical to the one before it (a duplicated message; see Stream).
   for (std::size_t i = 1; i < n; ++i) {
-    if (stream.t[i] <= stream.t[i - 1]) {
+    const Eigen::Index row = static_cast<Eigen::Index>(i);
+    const bool identical = stream.t[i] == stream.t[i - 1] && stream.values.row(row) == stream.values.row(row - 1) &&
+                           (stream.text.empty() || stream.text[i] == stream.text[i - 1]);
+    if (stream.t[i] <= stream.t[i - 1] && !identical) {
       return Status::Error(prefix + "sample " + std::to_string(i) + ": " +
                            internal::TimeOrderProblem(stream.t[i - 1], stream.t[i]));
     }

@@ -70,8 +70,14 @@ json MetricsSchema() {
 }
 
 json CountsSchema() {
-  return {
-      {"<stream>", {{"attached", "number"}, {"rejected", "number"}, {"too_late", "number"}, {"outside", "number"}}}};
+  return {{"<stream>",
+           {{"attached", "number"},
+            {"rejected", "number"},
+            {"too_late", "number"},
+            {"outside", "number"},
+            {"duplicates", "number"},
+            {"gaps", "number"},
+            {"frozen", "number"}}}};
 }
 
 // What `roamlab calibrate` writes (estimator/calibration_io.h).
@@ -131,6 +137,7 @@ Result<std::string> Recording(const CaseContext& context) {
   request.scenario = context.c.scenario;
   request.out = context.dir + "/recording";
   request.seed = context.c.seed;
+  request.faults = context.c.faults;
   const experiment::Outcome outcome = experiment::SimulateToDirectory(request);
   if (!outcome.ok()) return Failed("simulate", outcome);
   return request.out;
@@ -365,13 +372,13 @@ Status RunDiagnoseCase(const CaseContext& context) {
 const std::vector<ModeSpec>& Modes() {
   static const std::vector<ModeSpec> modes = {
       {"calibrate",
-       {"scenario", "recording", "seed", "config"},
+       {"scenario", "recording", "seed", "config", "faults"},
        {"scenario|recording", "config"},
        {{"calibration", "calibration/calibration.json", CalibrationSchema()},
         {"metrics", "evaluation/metrics.json", MetricsSchema()}},
        RunCalibrateCase},
       {"track",
-       {"scenario", "recording", "seed", "config", "calibration", "calibrate", "t0_s"},
+       {"scenario", "recording", "seed", "config", "calibration", "calibrate", "t0_s", "faults"},
        {"scenario|recording", "config"},
        {{"summary", "tracking/summary.json", SummarySchema()}, {"metrics", "evaluation/metrics.json", MetricsSchema()}},
        RunTrackCase},

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <set>
 
 #include <yaml-cpp/yaml.h>
@@ -423,6 +424,45 @@ Status LoadEffects(const YAML::Node& effects, const Context& ctx, Case* c) {
   return Status::Ok();
 }
 
+// Sensor faults injected into the simulated recording (calibrate, track): as a scenario's `faults:` (sim/faults.h),
+// checked against the case's scenario (its streams and duration).
+Status LoadFaults(const YAML::Node& faults, const Context& ctx, Case* c) {
+  if (!faults) return Status::Ok();
+  if (!faults.IsSequence()) return ctx.Error(faults, "'faults' is a list of {type: FAULT, stream: NAME, ...}");
+  if (c->scenario.empty()) return ctx.Error(faults, "'faults' need a 'scenario' to simulate");
+  auto scenario = sim::LoadScenario(c->scenario);
+  if (!scenario.ok()) return ctx.Error(faults, scenario.status().message());
+  const std::vector<std::string> streams = scenario.value().StreamNames();
+  for (const YAML::Node& node : faults) {
+    if (!node.IsMap() || !node["type"] || !node["type"].IsScalar() || !node["stream"] || !node["stream"].IsScalar())
+      return ctx.Error(node, "a fault is {type: FAULT, stream: NAME, KEY: value, ...}");
+    sim::FaultOptions fault;
+    fault.type = node["type"].as<std::string>();
+    fault.stream = node["stream"].as<std::string>();
+    const std::vector<std::string>& keys = sim::FaultKeys(fault.type);
+    std::map<std::string, double*> fields = {{"fraction", &fault.fraction}, {"size", &fault.size},
+                                             {"start_s", &fault.start_s},   {"duration_s", &fault.duration_s},
+                                             {"at_s", &fault.at_s},         {"jump_s", &fault.jump_s}};
+    for (const auto& entry : node) {
+      const std::string key = entry.first.as<std::string>();
+      if (key == "type" || key == "stream") continue;
+      if (std::find(keys.begin(), keys.end(), key) == keys.end())
+        return ctx.Error(entry.first, "fault " + fault.type + " has no key " + key);
+      try {
+        *fields.at(key) = entry.second.as<double>();
+      } catch (const YAML::Exception&) {
+        return ctx.Error(entry.second, "fault key " + key + " is not a number");
+      }
+    }
+    for (const std::string& key : keys)
+      if (!node[key]) return ctx.Error(node, "fault " + fault.type + " needs " + key);
+    if (const auto problem = sim::CheckFault(fault, scenario.value().duration_s, streams))
+      return ctx.Error(node, "fault " + problem->key + ": " + problem->message);
+    c->faults.push_back(fault);
+  }
+  return Status::Ok();
+}
+
 // Odometry models (`roamlab odometry learn` options).
 Status LoadOdometryModels(const YAML::Node& models, const Context& ctx, Case* c) {
   if (!models) return Status::Ok();
@@ -528,6 +568,7 @@ Result<Case> LoadCase(const YAML::Node& node, const Context& suite, std::set<std
   Status st = CheckKeys(node, ctx, *mode.value());
   if (st.ok()) st = LoadValues(node, ctx, suite.file, &c);
   if (st.ok()) st = LoadEffects(node["effects"], ctx, &c);
+  if (st.ok()) st = LoadFaults(node["faults"], ctx, &c);
   if (st.ok()) st = LoadOdometryModels(node["models"], ctx, &c);
   Names names;
   if (st.ok()) st = CheckInputs(node, ctx, c, &names);

@@ -12,6 +12,8 @@
 //       scenario: atv_hills.yaml        # simulated with `seed` (default: the scenario's own); or recording: DIR
 //       seed: 1
 //       config: atv_calibration.yaml    # paths are relative to the suite file
+//       faults:                         # calibrate, track: sensor faults injected into the simulated recording,
+//         - {type: outage, stream: gps, start_s: 5, duration_s: 20}   # as a scenario's `faults:` (sim/faults.h)
 //       checks:
 //         - {metric: metrics.parameters.gps.lever_arm.error.norm, bound: "<= 0.10"}
 //         - {metric: metrics.ate_m, bound: "<= 1.10 * baseline"}
@@ -48,6 +50,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/status.h"
+#include "sim/faults.h"
 
 namespace roamlab::regress {
 
@@ -117,6 +120,8 @@ struct Case {
   // noise seed of the nominal simulation (default: the command's).
   std::vector<std::pair<std::string, std::map<std::string, double>>> effects;
   std::optional<std::uint64_t> baseline_seed;
+  // calibrate, track: sensor faults applied to the simulated recording after the scenario's own (sim/faults.h).
+  std::vector<sim::FaultOptions> faults;
   // odometry: training and test inputs (globs relative to `data` when given, else to the suite file: OptiOdom run
   // CSV files, imported; recording directories; scenario YAML files, simulated with `seed`), the models to learn
   // ({model, mean, kernel} of `roamlab odometry learn`) and the key interval.

@@ -482,7 +482,64 @@ void ReadEffects(YamlReader& r, const YAML::Node& node, Scenario* s) {
   }
 }
 
+void ReadFaults(YamlReader& r, const YAML::Node& node, Scenario* s) {
+  r.Remember("faults", node);
+  if (node.IsNull()) return;
+  if (!node.IsSequence()) {
+    r.Fail(node, "faults", "expected a list of faults");
+    return;
+  }
+  for (std::size_t i = 0; i < node.size() && r.ok(); ++i) {
+    const std::string k = "faults[" + std::to_string(i) + "]";
+    FaultOptions fault;
+    if (!r.Require(node[i], k, "type") || !r.Require(node[i], k, "stream")) return;
+    r.String(node[i], k, "type", &fault.type);
+    r.String(node[i], k, "stream", &fault.stream);
+    const std::vector<std::string>& keys = FaultKeys(fault.type);
+    if (keys.empty()) {
+      r.Fail(node[i]["type"], k + ".type",
+             "unknown fault '" + fault.type + "' (outliers, outage, clock_jump, duplicates, freeze)");
+      return;
+    }
+    for (const auto& item : node[i]) {
+      const std::string key = item.first.Scalar();
+      if (key != "type" && key != "stream" && std::find(keys.begin(), keys.end(), key) == keys.end()) {
+        std::string allowed = "type, stream";
+        for (const std::string& name : keys) allowed += ", " + name;
+        r.Fail(item.first, k + "." + key, "unknown key for fault type " + fault.type + " (allowed: " + allowed + ")");
+        return;
+      }
+    }
+    std::map<std::string, double*> fields = {{"fraction", &fault.fraction}, {"size", &fault.size},
+                                             {"start_s", &fault.start_s},   {"duration_s", &fault.duration_s},
+                                             {"at_s", &fault.at_s},         {"jump_s", &fault.jump_s}};
+    for (const std::string& key : keys) {
+      if (r.Require(node[i], k, key)) r.Number(node[i], k, key, fields.at(key));
+    }
+    s->faults.push_back(fault);
+  }
+}
+
 }  // namespace
+
+std::vector<std::string> Scenario::StreamNames() const {
+  std::vector<std::string> names;
+  if (sensors.imu) names.push_back("imu");
+  if (sensors.magnetometer) names.push_back("magnetometer");
+  if (sensors.gps) names.push_back("gps");
+  if (sensors.mocap) names.push_back("mocap");
+  if (sensors.odometer) {
+    names.push_back("rear_wheel");
+    names.push_back("steering");
+  }
+  if (sensors.wheel_encoders) names.push_back(sensors.wheel_encoders->name);
+  if (sensors.laser) {
+    names.push_back("scan_matching");
+    if (sensors.laser->store_scans) names.push_back("laser_scan");
+  }
+  if (sensors.camera) names.push_back("visual_odometry");
+  return names;
+}
 
 const std::map<std::string, std::map<std::string, double>>& KnownEffects() {
   static const std::map<std::string, std::map<std::string, double>> known = {
@@ -528,7 +585,7 @@ Result<Scenario> LoadScenario(const std::string& path) {
   const YAML::Node root = r.root();
   r.CheckKeys(root, "",
               {"name", "duration_s", "seed", "origin", "ground_truth_rate_hz", "robot", "world", "driver", "sensors",
-               "effects"});
+               "effects", "faults"});
   for (const char* required : {"duration_s", "robot", "world", "driver", "sensors"}) r.Require(root, "", required);
   r.String(root, "", "name", &s.name);
   r.Number(root, "", "duration_s", &s.duration_s);
@@ -549,6 +606,7 @@ Result<Scenario> LoadScenario(const std::string& path) {
   if (r.ok()) ReadSensors(r, root["sensors"], &s);
   if (r.ok()) ReadIndoorSensors(r, root["sensors"], &s);
   if (r.ok() && root["effects"]) ReadEffects(r, root["effects"], &s);
+  if (r.ok() && root["faults"]) ReadFaults(r, root["faults"], &s);
   if (!r.ok()) return r.status();
 
   if (const auto problem = s.Validate()) {

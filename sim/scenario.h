@@ -44,6 +44,9 @@
 //                kv_over_L: 0.8, k_theta: 1.0, k_gamma: 0.0}
 //   effects: []                             # hidden physical effects, each {name: ..., parameters: {...}}; written
 //                                           # to truth.yaml only (the recording does not say they are there)
+//   faults: []                              # sensor faults on the written streams, each {type: ..., stream: ...,
+//                                           # ...} (sim/faults.h: outliers, outage, clock_jump, duplicates, freeze);
+//                                           # the ground truth and truth.yaml are untouched; not applied by replay
 //
 // Coloured sensor noise: `noise_correlation_s` [s] in imu (gyro and accel), magnetometer, gps and odometer (both
 // readings), in [0, 3600], default 0 (white), makes that sensor's noise a first-order Gauss-Markov process per axis
@@ -250,6 +253,7 @@
 #include "common/status.h"
 #include "recording/recording.h"
 #include "sim/ackermann.h"
+#include "sim/faults.h"
 #include "sim/profile.h"
 #include "sim/terrain.h"
 #include "sim/wheeled_robot.h"
@@ -391,6 +395,10 @@ struct Scenario {
   DriverOptions driver;
   SensorOptions sensors;
   std::vector<EffectOptions> effects;
+  std::vector<FaultOptions> faults;  // sensor faults applied to the written streams (sim/faults.h)
+
+  // The names of the streams the scenario's sensors write (the `stream` a fault may name).
+  std::vector<std::string> StreamNames() const;
 
   // The first problem, if any: the key path as written in the YAML (e.g. "sensors.gps.rate_hz") and what is wrong.
   // Checks values only; files are checked by LoadScenario and the model by the simulator.

@@ -367,11 +367,21 @@ std::optional<P> EffectsProblem(const Scenario& s) {
   return std::nullopt;
 }
 
+// Faults: each on a stream the sensors write, with values in range (sim/faults.h).
+std::optional<P> FaultsProblem(const Scenario& s) {
+  const std::vector<std::string> streams = s.StreamNames();
+  for (std::size_t i = 0; i < s.faults.size(); ++i) {
+    if (const auto problem = CheckFault(s.faults[i], s.duration_s, streams))
+      return P{"faults[" + std::to_string(i) + "]." + problem->key, problem->message};
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::optional<Scenario::Problem> Scenario::Validate() const {
   for (const auto part : {TopLevelProblem, RobotAndDriverProblem, WheelChangesProblem, InertialAndGpsProblem,
-                          OdometrySensorsProblem, EffectsProblem}) {
+                          OdometrySensorsProblem, EffectsProblem, FaultsProblem}) {
     if (auto problem = part(*this)) return problem;
   }
   return std::nullopt;

@@ -80,6 +80,7 @@ class Simulator::Impl {
       return Status::Error(model_where_ + ": MuJoCo error at t = " + FormatTime(t_ns_) + ": " + OneLine(e.what()));
     }
     Finish();
+    if (!options_.replay) out_.stats.faults = ApplyFaults(scenario_.faults, seed_, &out_.recording);
     out_.stats.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     out_.stats.realtime_factor = out_.stats.wall_s > 0.0 ? out_.stats.simulated_s / out_.stats.wall_s : 0.0;
     out_.stats.warnings = TakeMujocoWarnings();

@@ -12,6 +12,7 @@
 //   4. At every sample instant t_k the state at t_k is completed with mj_forward and mj_rnePostConstraint (so that
 //      accelerations and MuJoCo's own acceleration sensors are current), the kinematics of O are read and every
 //      stream due at t_k is synthesized (sensors.h) and corrupted by its own noise stream (noise.h).
+//   5. The scenario's faults (faults.h) are applied to the recorded streams (not to a replay's).
 // MuJoCo adds no noise and the simulation is single-threaded, so the same scenario and seed give the same recording,
 // byte for byte once written.
 #pragma once
@@ -71,6 +72,7 @@ struct SimulationStats {
   std::optional<frontend::VoCounters> visual_odometry;  // sensors.camera: frames, pairs, estimates, failures by reason
   double camera_height_m = 0.0;       // sensors.camera: the floor height the VO uses (measured at rest)
   std::vector<std::string> warnings;  // MuJoCo warnings, if any
+  std::vector<std::string> faults;    // the scenario's faults, one line each: what they changed (sim/faults.h)
   std::vector<std::string> left_out;  // a replay (sim/replay.h): the recorded streams the twin does not hold,
                                       // "<stream>: <reason>"
 };

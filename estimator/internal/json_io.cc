@@ -11,7 +11,8 @@ Status WriteJson(const json& j, const std::string& path) { return WriteFileAtomi
 json CountsJson(const std::map<std::string, StreamCounts>& counts) {
   json j = json::object();
   for (const auto& [name, c] : counts)
-    j[name] = {{"attached", c.attached}, {"rejected", c.rejected}, {"too_late", c.too_late}, {"outside", c.outside}};
+    j[name] = {{"attached", c.attached},     {"rejected", c.rejected}, {"too_late", c.too_late}, {"outside", c.outside},
+               {"duplicates", c.duplicates}, {"gaps", c.gaps},         {"frozen", c.frozen}};
   return j;
 }
 

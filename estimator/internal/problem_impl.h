@@ -52,6 +52,7 @@ struct StreamBinding {
   int time_offset_slot = -1;
   bool time_offset = false;
   std::deque<MeasurementRef> pending;
+  std::vector<bool> frozen;  // per row of the primary source: repeats the first row of a frozen run (not measured)
 };
 
 // The IMU master's state (problem_imu.cc): the grid of pose times and the gyroscope's integration since the newest

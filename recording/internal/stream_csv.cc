@@ -76,6 +76,12 @@ Status LineError(const std::string& path, int line_number, const std::string& pr
   return Status::Error(path + ":" + std::to_string(line_number) + ": " + problem);
 }
 
+// A row stamped like the previous one with other values: two different readings claim one instant.
+std::string RepeatProblem(Time t) {
+  return "timestamp " + FormatSeconds(t) +
+         " repeats the previous row's with other values (only an identical row, a duplicated message, may repeat)";
+}
+
 }  // namespace
 
 Status ParseStreamCsv(std::string_view content, const std::string& path, const std::vector<std::string>& columns,
@@ -101,6 +107,7 @@ Status ParseStreamCsv(std::string_view content, const std::string& path, const s
   const std::size_t numeric_columns = text_column ? 0 : columns.size();
   std::vector<double> buffer;
   buffer.reserve(row_estimate * numeric_columns);
+  out->duplicate_rows = 0;
   out->t.clear();
   out->t.reserve(row_estimate);
   out->text.clear();
@@ -113,18 +120,25 @@ Status ParseStreamCsv(std::string_view content, const std::string& path, const s
       return LineError(
           path, n, "expected " + std::to_string(expected_cells) + " columns, found " + std::to_string(cells.size()));
     }
-    // Time: exact, strictly increasing.
+    // Time: exact, strictly increasing, but for a row that repeats the previous one (a message delivered twice).
     const std::optional<Time> t = ParseSeconds(Trim(cells[0]));
     if (!t) return LineError(path, n, "column 't': not a time " + Quote(Trim(cells[0])));
-    if (!out->t.empty() && *t <= out->t.back()) return LineError(path, n, TimeOrderProblem(out->t.back(), *t));
-    out->t.push_back(*t);
+    const bool repeat = !out->t.empty() && *t == out->t.back();
+    if (!out->t.empty() && *t < out->t.back()) return LineError(path, n, TimeOrderProblem(out->t.back(), *t));
     // Values: text for a text stream, finite numbers otherwise.
     if (text_column) {
       const std::string_view cell = Trim(cells[1]);
       if (cell.empty()) return LineError(path, n, "column '" + columns[0] + "' is empty");
+      if (repeat && cell != out->text.back()) return LineError(path, n, RepeatProblem(*t));
+      if (repeat) {
+        ++out->duplicate_rows;
+        continue;
+      }
+      out->t.push_back(*t);
       out->text.emplace_back(cell);
       continue;
     }
+    out->t.push_back(*t);
     for (std::size_t c = 0; c < columns.size(); ++c) {
       double value = 0.0;
       const NumberParse result = ParseNumber(cells[c + 1], &value);
@@ -135,6 +149,14 @@ Status ParseStreamCsv(std::string_view content, const std::string& path, const s
                              " is beyond any physical value (|value| <= 1e15)");
       }
       buffer.push_back(value);
+    }
+    if (repeat) {
+      const auto row = buffer.end() - static_cast<std::ptrdiff_t>(numeric_columns);
+      if (!std::equal(row, buffer.end(), row - static_cast<std::ptrdiff_t>(numeric_columns)))
+        return LineError(path, n, RepeatProblem(*t));
+      buffer.erase(row, buffer.end());
+      out->t.pop_back();
+      ++out->duplicate_rows;
     }
   }
 

@@ -35,14 +35,15 @@ TEST(ProblemBuilderTest, OnePosePerMasterSampleAndEveryMeasurementAccountedFor) 
   builder.value()->Finish();
   const std::size_t samples = synthetic.recording.Find("rear_wheel")->t.size();
   EXPECT_EQ(builder.value()->poses().size(), samples);
-  // Attached + outside = samples of the source stream, for every stream: nothing silently dropped.
+  // Attached + outside (+ rows of a frozen sensor) = samples of the source stream, for every stream: nothing silently
+  // dropped.
   const std::map<std::string, std::string> source = {{"odometer", "rear_wheel"},
                                                      {"gyroscope", "imu"},
                                                      {"accelerometer", "imu"},
                                                      {"magnetometer", "magnetometer"},
                                                      {"gps", "gps"}};
   for (const auto& [stream, counts] : builder.value()->counts()) {
-    EXPECT_EQ(counts.attached + counts.outside + counts.too_late + counts.rejected,
+    EXPECT_EQ(counts.attached + counts.outside + counts.too_late + counts.rejected + counts.frozen,
               static_cast<int>(synthetic.recording.Find(source.at(stream))->t.size()))
         << stream;
   }

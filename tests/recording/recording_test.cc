@@ -380,10 +380,28 @@ TEST(RecordingCsvTest, TimestampGoingBackwards) {
   EXPECT_THAT(ReadError(dir), AllOf(HasSubstr("imu.csv:4:"), HasSubstr("goes backwards"), HasSubstr("0.005000000")));
 }
 
-TEST(RecordingCsvTest, DuplicateTimestamp) {
+TEST(RecordingCsvTest, RepeatedStampWithOtherValuesIsRefused) {
   TempDir dir;
-  WriteFixture(dir, kYaml, kGpsCsv, Replace(kImuCsv, "0.02,", "0.010,"));
-  EXPECT_THAT(ReadError(dir), AllOf(HasSubstr("imu.csv:4:"), HasSubstr("duplicate"), HasSubstr("0.010000000")));
+  WriteFixture(dir, kYaml, kGpsCsv, Replace(kImuCsv, "0.02,0,0,0.1", "0.010,0,0,0.2"));
+  EXPECT_THAT(ReadError(dir), AllOf(HasSubstr("imu.csv:4:"), HasSubstr("repeats the previous row's with other values"),
+                                    HasSubstr("0.010000000")));
+}
+
+// A message delivered twice (the same stamp and values) is dropped and counted, not refused and not kept.
+TEST(RecordingCsvTest, IdenticalRepeatedRowsAreDroppedAndCounted) {
+  TempDir dir;
+  WriteFixture(dir, kYaml, kGpsCsv,
+               Replace(kImuCsv, "0.01,0,0,0.1,0,0,9.81\n",
+                       "0.01,0,0,0.1,0,0,9.81\n0.010,0,0,0.1,0,0,9.81\n"
+                       "0.01,0,0,0.1,0,0,9.81\n"));
+  const Result<Recording> rec = ReadRecording(dir.path());
+  ASSERT_TRUE(rec.ok()) << rec.status().message();
+  const Stream& imu = *rec.value().Find("imu");
+  EXPECT_EQ(imu.t.size(), 3u);
+  EXPECT_EQ(imu.values.rows(), 3);
+  EXPECT_EQ(imu.duplicate_rows_dropped, 2);
+  EXPECT_EQ(rec.value().Find("gps")->duplicate_rows_dropped, 0);
+  EXPECT_EQ(imu.t[2], Time::FromNanoseconds(20'000'000));
 }
 
 TEST(RecordingCsvTest, NaN) {
@@ -570,6 +588,16 @@ TEST(RecordingWriteTest, RejectsInvalidRecordings) {
   Recording order = valid;
   order.streams[2].t[4] = order.streams[2].t[3];
   EXPECT_THAT(WriteError(order, dir), AllOf(HasSubstr("sample 4"), HasSubstr("duplicate")));
+  // An identical row (a duplicated message) is written as it is; the reader drops it.
+  Recording twice = valid;
+  twice.streams[2].t[4] = twice.streams[2].t[3];
+  twice.streams[2].values.row(4) = twice.streams[2].values.row(3);
+  if (!twice.streams[2].text.empty()) twice.streams[2].text[4] = twice.streams[2].text[3];
+  ASSERT_TRUE(WriteRecording(twice, dir.path()).ok());
+  const Result<Recording> reread = ReadRecording(dir.path());
+  ASSERT_TRUE(reread.ok()) << reread.status().message();
+  EXPECT_EQ(reread.value().streams[2].duplicate_rows_dropped, 1);
+  EXPECT_EQ(reread.value().streams[2].t.size(), valid.streams[2].t.size() - 1);
 
   Recording nan = valid;
   nan.streams[2].values(0, 0) = std::nan("");

@@ -103,6 +103,28 @@ class ScenarioErrorTest : public ::testing::Test {
   std::string text_;
 };
 
+TEST_F(ScenarioErrorTest, FaultsAreReadAndChecked) {
+  EXPECT_EQ(LoadWith("effects: []",
+                     "effects: []\nfaults:\n  - {type: outage, stream: gps, start_s: 5, duration_s: 20}\n"
+                     "  - {type: clock_jump, stream: imu, at_s: 15, jump_s: 1}"),
+            "");
+  auto loaded = LoadScenario(path_);
+  ASSERT_TRUE(loaded.ok());
+  ASSERT_EQ(loaded.value().faults.size(), 2u);
+  EXPECT_EQ(loaded.value().faults[0].type, "outage");
+  EXPECT_EQ(loaded.value().faults[0].duration_s, 20.0);
+  EXPECT_EQ(loaded.value().faults[1].jump_s, 1.0);
+  ExpectError(
+      LoadWith("effects: []", "effects: []\nfaults:\n  - {type: outage, stream: lidar, start_s: 5, duration_s: 2}"),
+      "type: outage", "faults[0].stream", "no stream 'lidar'");
+  ExpectError(LoadWith("effects: []", "effects: []\nfaults:\n  - {type: outage, stream: gps, start_s: 5, size: 2}"),
+              "start_s: 5, size", "faults[0].size", "unknown key for fault type outage");
+  ExpectError(LoadWith("effects: []", "effects: []\nfaults:\n  - {type: outage, stream: gps, start_s: 5}"),
+              "type: outage", "faults[0].duration_s", "missing");
+  ExpectError(LoadWith("effects: []", "effects: []\nfaults:\n  - {type: clock_jump, stream: gps, at_s: 5, jump_s: -1}"),
+              "type: clock_jump", "faults[0].jump_s", "backward jump");
+}
+
 TEST_F(ScenarioErrorTest, UnchangedCopyLoads) { EXPECT_EQ(LoadWith("name: atv_hills", "name: copy"), ""); }
 
 TEST_F(ScenarioErrorTest, UnknownKeys) {
