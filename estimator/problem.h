@@ -152,6 +152,8 @@ class ProblemBuilder {
   // outside).
   enum class Placement { kAttach, kWait, kOutside };
   Placement PlaceSample(const MeasurementRef& m, const StreamBinding& s, std::size_t* k);
+  // TryAttach for a user model (model_registry.h) at pose index k (PlaceSample's).
+  bool AttachUserSample(const MeasurementRef& m, std::size_t k);
   // TryAttach for relative_motion (the class comment).
   bool TryAttachInterval(const MeasurementRef& m);
   // The noise covariance of one sample: the configured one, plus the row's own when the stream is set to use it.
