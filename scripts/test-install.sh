@@ -4,7 +4,8 @@
 #  2. builds and runs examples/consumer (find_package(roamlab COMPONENTS estimator recording), a user error model
 #     registered by name, a solve) with MuJoCo's and OpenCV's CMake packages disabled, and checks that neither the
 #     estimator's nor the recording's installed target files name them and that the program links neither;
-#  3. builds a program that links every component (find_package(roamlab COMPONENTS <all>));
+#  3. builds a program that links every component (find_package(roamlab COMPONENTS <all>)), after checking that the
+#     same project fails to configure with MuJoCo and OpenCV hidden as in 2;
 #  4. configures a consumer project that finds roamlab with find_package(roamlab) and registers two regression
 #     suites with roamlab_add_regression_suite: one whose checks hold and one with an impossible bound, which ctest
 #     must see fail.
@@ -31,8 +32,10 @@ if grep -rn '#include ".*internal/' "$prefix/include"; then fail "an installed h
 if grep -il 'mujoco\|opencv' "$cmakedir"/roamlab_{common,recording,estimator}Targets*.cmake; then
   fail "the estimator component's targets name MuJoCo or OpenCV"
 fi
+# (--no-warn-unused-cli: that nothing reads the two variables is the point.)
+no_mujoco_opencv=(-DCMAKE_DISABLE_FIND_PACKAGE_mujoco=TRUE -DCMAKE_DISABLE_FIND_PACKAGE_OpenCV=TRUE --no-warn-unused-cli)
 cmake -S examples/consumer -B "$work/example" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release \
-  -DCMAKE_DISABLE_FIND_PACKAGE_mujoco=TRUE -DCMAKE_DISABLE_FIND_PACKAGE_OpenCV=TRUE >/dev/null
+  "${no_mujoco_opencv[@]}" >/dev/null
 cmake --build "$work/example" -j "${JOBS:-$(nproc)}" >/dev/null
 if ldd "$work/example/consumer_example" | grep -i 'mujoco\|opencv'; then fail "consumer_example links MuJoCo or OpenCV"; fi
 "$work/example/consumer_example" "$work/example"
@@ -59,6 +62,10 @@ cat > "$work/all/main.cc" <<'CXX'
 #include "sim/simulator.h"
 int main() { return roamlab::estimator::FindErrorModel("gps") == nullptr ? 1 : 0; }
 CXX
+# The same flags make asking for sim fail: they do hide MuJoCo and OpenCV.
+if cmake -S "$work/all" -B "$work/all/hidden" -DCMAKE_PREFIX_PATH="$prefix" "${no_mujoco_opencv[@]}" >/dev/null 2>&1; then
+  fail "find_package(roamlab COMPONENTS sim ...) succeeded with MuJoCo and OpenCV hidden"
+fi
 cmake -S "$work/all" -B "$work/all/build" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$work/all/build" >/dev/null
 "$work/all/build/all_components" || fail "the program linking every component did not find the gps model"
