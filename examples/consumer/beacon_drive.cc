@@ -18,7 +18,7 @@ Recording SimulateBeaconDrive(const BeaconDriveOptions& o) {
   Recording rec;
   rec.platform.kind = "differential_drive";
   rec.provenance.source = "simulated";
-  rec.provenance.description = "examples/consumer: a circle among three range beacons";
+  rec.provenance.description = "examples/consumer: a slalom among three range beacons";
   Stream odometer;
   odometer.info = {"odometer", StreamType::kOdometry, o.rate_hz, {"vx", "vy", "vz", "wx", "wy", "wz"}, "", {}, {}, {}};
   odometer.values.resize(n, 6);

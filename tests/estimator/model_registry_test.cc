@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -17,7 +18,14 @@ namespace {
 std::string Replace(std::string text, const std::string& from, const std::string& to) {
   const auto pos = text.find(from);
   EXPECT_NE(pos, std::string::npos) << from;
-  return text.replace(pos, from.size(), to);
+  return pos == std::string::npos ? text : text.replace(pos, from.size(), to);
+}
+
+// A beacon's options.beacon_world as BeaconDriveConfig writes it.
+std::string BeaconWorld(const Eigen::Vector3d& p) {
+  std::ostringstream text;
+  text << "beacon_world: [" << p.x() << ", " << p.y() << ", " << p.z() << "]";
+  return text.str();
 }
 
 // The example's range_beacon model (examples/consumer), registered once for every test.
@@ -92,7 +100,9 @@ TEST(ModelRegistryTest, RefusesTakenNamesAndDefinitionsItCannotBuild) {
 TEST_F(RangeBeaconTest, IsUsedByNameFromTheConfiguration) {
   const auto config = ParseEstimatorConfig(beacon::BeaconDriveConfig(drive_), "beacon.yaml");
   ASSERT_TRUE(config.ok()) << config.status().message();
-  EXPECT_EQ(config.value().streams.at("uwb_1").options.at("beacon_world"), (std::vector<double>{0.0, 10.0, 3.0}));
+  const Eigen::Vector3d& beacon = drive_.beacons_world[1];
+  EXPECT_EQ(config.value().streams.at("uwb_1").options.at("beacon_world"),
+            (std::vector<double>{beacon.x(), beacon.y(), beacon.z()}));
   const auto builder = ProblemBuilder::Create(config.value(), rec_);
   ASSERT_TRUE(builder.ok()) << builder.status().message();
   EXPECT_EQ(builder.value()->ResidualDim("uwb_0"), 1);
@@ -107,16 +117,16 @@ TEST_F(RangeBeaconTest, IsUsedByNameFromTheConfiguration) {
 
 TEST_F(RangeBeaconTest, ConfigurationErrorsNameTheFileStreamAndKey) {
   const std::string good = beacon::BeaconDriveConfig(drive_);
+  const std::string first = BeaconWorld(drive_.beacons_world[0]);
   // The parser reads the model's keys from its spec: an option it does not declare is refused.
-  EXPECT_NE(
-      BuildError(Replace(good, "options: {beacon_world:", "options: {beacon:"), rec_).find("unknown key 'beacon'"),
-      std::string::npos);
+  EXPECT_NE(BuildError(Replace(good, "options: {" + first, "options: {beacon:" + first.substr(13)), rec_)
+                .find("unknown key 'beacon'"),
+            std::string::npos);
   // The model's bind checks its options and its recording stream; the builder names the file and stream.
-  EXPECT_NE(BuildError(Replace(good, "    options: {beacon_world: [10, 0, 2]}\n", ""), rec_)
+  EXPECT_NE(BuildError(Replace(good, "    options: {" + first + "}\n", ""), rec_)
                 .find("beacon.yaml: stream 'uwb_0': range_beacon needs options.beacon_world"),
             std::string::npos);
-  EXPECT_NE(BuildError(Replace(good, "beacon_world: [10, 0, 2]", "beacon_world: [10, 0]"), rec_)
-                .find("needs options.beacon_world"),
+  EXPECT_NE(BuildError(Replace(good, first, "beacon_world: [10, 0]"), rec_).find("needs options.beacon_world"),
             std::string::npos);
   EXPECT_NE(BuildError(Replace(good, "source: uwb_0", "source: odometer"), rec_)
                 .find("stream 'uwb_0': recording stream 'odometer' must be an inputs stream"),
