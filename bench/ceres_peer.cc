@@ -18,7 +18,7 @@
 #include "estimator/models/gyroscope.h"
 #include "estimator/models/magnetometer.h"
 
-// The models branch on the value of a scalar through ValueOf (estimator/internal/jet.h); Ceres' jets find this one by
+// The models branch on the value of a scalar through ValueOf (estimator/jet.h); Ceres' jets find this one by
 // argument-dependent lookup.
 namespace ceres {
 template <int N>

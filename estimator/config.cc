@@ -11,183 +11,9 @@
 #include <yaml-cpp/yaml.h>
 
 #include "common/yaml_keys.h"
+#include "estimator/model_registry.h"
 
 namespace roamlab::estimator {
-namespace {
-
-Eigen::VectorXd Vec(std::initializer_list<double> v) {
-  Eigen::VectorXd x(static_cast<int>(v.size()));
-  int i = 0;
-  for (double d : v) x[i++] = d;
-  return x;
-}
-
-SlotSpec ScalarSlot(const std::string& name, double value) { return {name, Manifold::Euclidean(1), Vec({value})}; }
-SlotSpec Vector3Slot(const std::string& name, double fill) {
-  return {name, Manifold::Euclidean(3), Eigen::VectorXd::Constant(3, fill)};
-}
-SlotSpec RotationSlot(const std::string& name) { return {name, Manifold::UnitQuaternion(), Vec({1, 0, 0, 0})}; }
-SlotSpec MatrixSlot(const std::string& name) {
-  return {name, Manifold::Euclidean(9), Vec({1, 0, 0, 0, 1, 0, 0, 0, 1})};
-}
-
-}  // namespace
-
-const std::vector<ModelSpec>& ModelSpecs() {
-  // kv_over_L defaults to NaN: the builder replaces it with 1 / wheelbase (k_v = 1).
-  static const std::vector<ModelSpec> specs = {
-      // slip_per_mps2 and slope_slip_per_mps2: the driven tires' slip per m/s^2 of forward specific force (read from
-      // inputs.specific_force, an imu or accelerometer stream, along options.forward_in_sensor) and of slope g
-      // sin(pitch); disturbance: the speed, lateral and vertical rows' coloured disturbance [m/s], meant to be
-      // time-varying; option front_slip_velocity 1: cornering_front is the front axle's side slip velocity per a_y
-      // [s] instead of an angle (models/ackermann_velocity.h).
-      {"ackermann",
-       {"speed", "steering"},
-       {"speed_mps", "steering_rad", "lateral_mps", "vertical_mps"},
-       {ScalarSlot("kv_over_L", std::numeric_limits<double>::quiet_NaN()), ScalarSlot("k_theta", 1.0),
-        ScalarSlot("k_gamma", 0.0), ScalarSlot("cornering_front", 0.0), ScalarSlot("cornering_rear", 0.0),
-        ScalarSlot("thrust_angle", 0.0), ScalarSlot("slip_per_mps2", 0.0), ScalarSlot("slope_slip_per_mps2", 0.0),
-        Vector3Slot("disturbance", 0.0)},
-       {"wheelbase_m", "speed_column", "contact_height_m", "pitch_lever_m", "forward_in_sensor", "front_slip_velocity"},
-       true,
-       {"specific_force"}},
-      {"ackermann_seed",
-       {"speed", "steering"},
-       {"speed_mps", "steering_rad", "lateral_mps", "vertical_mps", "roll_rate_radps", "pitch_rate_radps"},
-       {ScalarSlot("kv_over_L", std::numeric_limits<double>::quiet_NaN()), ScalarSlot("k_theta", 1.0),
-        ScalarSlot("k_gamma", 0.0)},
-       {"wheelbase_m", "speed_column"},
-       true,
-       {}},
-      // Wheel radii and baseline default to NaN: the builder takes them from the recording's platform geometry.
-      // right_left_ratio multiplies radius_right; deformation_left/right are the tires' second harmonic (a, b) [m]
-      // (models/differential_drive.h).
-      {"differential_drive",
-       {""},
-       {"wheel_radps", "lateral_mps", "vertical_mps", "tilt_radps"},
-       {ScalarSlot("radius_left", std::numeric_limits<double>::quiet_NaN()),
-        ScalarSlot("radius_right", std::numeric_limits<double>::quiet_NaN()),
-        ScalarSlot("baseline", std::numeric_limits<double>::quiet_NaN()),
-        ScalarSlot("right_left_ratio", 1.0),
-        {"deformation_left", Manifold::Euclidean(2), Vec({0.0, 0.0})},
-        {"deformation_right", Manifold::Euclidean(2), Vec({0.0, 0.0})}},
-       {},
-       true,
-       {}},
-      // Omni and mecanum wheel radii and geometry: NaN too, taken from the platform geometry.
-      {"omni3_drive",
-       {""},
-       {"wheel_radps", "vertical_mps", "tilt_radps"},
-       {ScalarSlot("radius_0", std::numeric_limits<double>::quiet_NaN()),
-        ScalarSlot("radius_1", std::numeric_limits<double>::quiet_NaN()),
-        ScalarSlot("radius_2", std::numeric_limits<double>::quiet_NaN()),
-        ScalarSlot("distance", std::numeric_limits<double>::quiet_NaN())},
-       {},
-       true,
-       {}},
-      {"mecanum_drive",
-       {""},
-       {"wheel_radps", "vertical_mps", "tilt_radps"},
-       {ScalarSlot("radius_0", std::numeric_limits<double>::quiet_NaN()),
-        ScalarSlot("radius_1", std::numeric_limits<double>::quiet_NaN()),
-        ScalarSlot("radius_2", std::numeric_limits<double>::quiet_NaN()),
-        ScalarSlot("radius_3", std::numeric_limits<double>::quiet_NaN()),
-        ScalarSlot("lx_plus_ly", std::numeric_limits<double>::quiet_NaN())},
-       {},
-       true,
-       {}},
-      // Four-wheel omni (X layout): radii and the wheelbase + track sum, NaN: from the platform geometry
-      // (models/omni4_drive.h).
-      {"omni4_drive",
-       {""},
-       {"wheel_radps", "vertical_mps", "tilt_radps"},
-       {ScalarSlot("radius_0", std::numeric_limits<double>::quiet_NaN()),
-        ScalarSlot("radius_1", std::numeric_limits<double>::quiet_NaN()),
-        ScalarSlot("radius_2", std::numeric_limits<double>::quiet_NaN()),
-        ScalarSlot("radius_3", std::numeric_limits<double>::quiet_NaN()),
-        ScalarSlot("wheelbase_plus_track", std::numeric_limits<double>::quiet_NaN())},
-       {},
-       true,
-       {}},
-      // Tricycle: the front wheel's encoder and its steering angle; radius and wheel_to_axle NaN (from the platform
-      // geometry), steering_offset from geometry.steering_offset_rad when present, else 0 (models/tricycle_drive.h).
-      {"tricycle_drive",
-       {"wheel", "steering"},
-       {"wheel_radps", "steering_rad", "lateral_mps", "vertical_mps", "tilt_radps"},
-       {ScalarSlot("radius", std::numeric_limits<double>::quiet_NaN()),
-        ScalarSlot("wheel_to_axle", std::numeric_limits<double>::quiet_NaN()), ScalarSlot("steering_offset", 0.0)},
-       {},
-       true,
-       {}},
-      {"odometer",
-       {""},
-       {"linear_mps", "angular_radps"},
-       {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")},
-       {"row_covariance_scale"},
-       true,
-       {}},
-      // The odometer's eqs. 5-8 over the sample's whole interval: see problem.h (relative motion).
-      {"relative_motion",
-       {""},
-       {"linear_mps", "angular_radps"},
-       {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")},
-       {"interval_s", "row_covariance_scale"},
-       false,
-       {}},
-      // time_offset_s: the IMU clock's offset [s], the reading stamped t taken at t - time_offset_s
-      // (models/imu_time_offset.h); share one parameter between the IMU's streams (e.g. imu.time_offset_s).
-      {"gyroscope",
-       {""},
-       {"sigma_radps"},
-       {RotationSlot("misalignment"), Vector3Slot("bias", 0.0), Vector3Slot("scale", 1.0),
-        ScalarSlot("time_offset_s", 0.0)},
-       {},
-       false,
-       {}},
-      {"accelerometer",
-       {""},
-       {"sigma_mps2"},
-       {RotationSlot("misalignment"), Vector3Slot("lever_arm", 0.0), Vector3Slot("bias", 0.0),
-        Vector3Slot("scale", 1.0), ScalarSlot("time_offset_s", 0.0)},
-       {},
-       false,
-       {}},
-      // b_per_drive_nm: the motor interference per N m of drive torque, estimated from the forward specific force read
-      // from inputs.specific_force (an imu or accelerometer stream) times options.drive_nm_per_mps2
-      // (models/magnetometer.h).
-      {"magnetometer",
-       {""},
-       {"sigma"},
-       {RotationSlot("misalignment"), MatrixSlot("A"), Vector3Slot("b", 0.0), Vector3Slot("b_per_drive_nm", 0.0),
-        ScalarSlot("time_offset_s", 0.0)},
-       {"field_world", "drive_nm_per_mps2"},
-       false,
-       {"specific_force"}},
-      {"gps", {""}, {"sigma_m"}, {Vector3Slot("lever_arm", 0.0)}, {}, false, {}},
-      {"absolute_pose",
-       {""},
-       {"position_m", "orientation_rad"},
-       {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")},
-       {},
-       false,
-       {}},
-      {"linear_velocity",
-       {""},
-       {"sigma_mps"},
-       {Vector3Slot("lever_arm", 0.0), RotationSlot("misalignment")},
-       {},
-       false,
-       {}},
-  };
-  return specs;
-}
-
-const ModelSpec* FindModelSpec(const std::string& model) {
-  for (const ModelSpec& spec : ModelSpecs())
-    if (spec.name == model) return &spec;
-  return nullptr;
-}
-
 namespace {
 
 // Errors carry "file:line: message".
@@ -377,7 +203,11 @@ class Parser {
     if (!n["model"]) Fail(n, where + ": missing key 'model'");
     s.model = String(n["model"], where + ".model");
     const ModelSpec* spec = FindModelSpec(s.model);
-    if (spec == nullptr) Fail(n["model"], where + ": unknown model '" + s.model + "'");
+    if (spec == nullptr) {
+      std::string known;
+      for (const std::string& model : ErrorModelNames()) known += (known.empty() ? "" : ", ") + model;
+      Fail(n["model"], where + ": unknown model '" + s.model + "' (registered: " + known + ")");
+    }
 
     // Sources: a stream name, or a role -> stream mapping.
     if (!n["source"]) Fail(n, where + ": missing key 'source'");

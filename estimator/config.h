@@ -37,7 +37,8 @@
 //     - [gps.lever_arm, imu.misalignment]
 //     - [magnetometer.A, magnetometer.b, odometer.kv_over_L, odometer.k_theta, odometer.k_gamma]
 //
-// Models, their noise keys, parameter slots (default value) and options are listed in kModelSpecs (config.cc).
+// Models, their noise keys, parameter slots (default value) and options are listed in the error-model registry
+// (model_registry.h; the built-in models in model_registry.cc), which a program extends with its own models.
 // `odometer` joins the two master poses around its sample's stamp (one master interval: for sources at the master's
 // rate or faster). `relative_motion` reads the same velocity streams, whose rows hold the mean velocity over
 // [t - T/2, t + T/2] stamped at the middle (scan_matching, visual_odometry), and joins the master poses nearest the
@@ -151,8 +152,8 @@ struct ModelSpec {
   bool odometric = false;                // can be the master stream
   std::vector<std::string> input_roles;  // optional extra inputs (StreamConfig::inputs)
 };
+// The spec of a registered model (model_registry.h); nullptr for an unknown name.
 const ModelSpec* FindModelSpec(const std::string& model);
-const std::vector<ModelSpec>& ModelSpecs();
 
 Result<EstimatorConfig> LoadEstimatorConfig(const std::string& path);
 Result<EstimatorConfig> ParseEstimatorConfig(const std::string& yaml_text, const std::string& source_name);

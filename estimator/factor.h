@@ -34,7 +34,7 @@
 #include <utility>
 #include <vector>
 
-#include "estimator/internal/jet.h"
+#include "estimator/jet.h"
 #include "estimator/manifold.h"
 
 namespace roamlab::estimator {

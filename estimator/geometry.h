@@ -22,7 +22,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "estimator/internal/jet.h"
+#include "estimator/jet.h"
 
 namespace roamlab::estimator {
 

@@ -12,7 +12,7 @@
 
 #include "estimator/geometry.h"
 #include "estimator/internal/linearization.h"
-#include "estimator/internal/so3_jacobians.h"
+#include "estimator/so3_jacobians.h"
 #include "estimator/solver.h"
 
 namespace roamlab::estimator {
@@ -168,11 +168,10 @@ bool LinearPriorFactor::Evaluate(const double* const* values, double* error, dou
       Eigen::Map<Eigen::MatrixXd> J_i(jacobians[i], m, d);
       const int o = offsets_[i];
       if (manifolds_[i].kind() == ManifoldKind::kQuaternion) {
-        J_i.noalias() = J_.middleCols<3>(o) * internal::InverseRightJacobianSO3(delta.segment<3>(o));
+        J_i.noalias() = J_.middleCols<3>(o) * InverseRightJacobianSO3(delta.segment<3>(o));
       } else if (manifolds_[i].kind() == ManifoldKind::kPose) {
         J_i.leftCols<3>() = J_.middleCols<3>(o);
-        J_i.rightCols<3>().noalias() =
-            J_.middleCols<3>(o + 3) * internal::InverseRightJacobianSO3(delta.segment<3>(o + 3));
+        J_i.rightCols<3>().noalias() = J_.middleCols<3>(o + 3) * InverseRightJacobianSO3(delta.segment<3>(o + 3));
       } else {
         J_i = J_.middleCols(o, d);
       }

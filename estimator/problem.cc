@@ -5,6 +5,7 @@
 #include <limits>
 #include <set>
 
+#include "common/check.h"
 #include "estimator/factor.h"
 #include "estimator/geometry.h"
 #include "estimator/internal/problem_impl.h"
@@ -64,15 +65,7 @@ int ProblemBuilder::StreamOfFactor(FactorId id) const {
 
 int ProblemBuilder::ResidualDim(const std::string& stream) const {
   for (const StreamBinding& s : impl_->streams)
-    if (s.name == stream) {
-      const std::string& m = s.config.model;
-      if (m == "ackermann") return 4;
-      if (m == "mecanum_drive" || m == "omni4_drive") return 7;
-      return (m == "ackermann_seed" || m == "odometer" || m == "relative_motion" || m == "absolute_pose" ||
-              m == "differential_drive" || m == "omni3_drive" || m == "tricycle_drive")
-                 ? 6
-                 : 3;
-    }
+    if (s.name == stream) return s.definition->residual_dim;
   return 0;
 }
 
@@ -384,6 +377,8 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
       break;
   }
 
+  if (s.user_model) return AttachUserSample(m, k);
+
   // The factor, by model.
   const std::string& model = s.config.model;
   std::unique_ptr<Factor> factor;
@@ -483,6 +478,32 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     orientation_fixes_.push_back({poses_[k].id, slot(1, k), q.normalized()});
   }
   if (s.time_offset) vars.push_back(slot(static_cast<std::size_t>(s.time_offset_slot), k));
+  const FactorId id = graph_.AddFactor(std::move(factor), vars, s.noise_covariance, s.config.loss, s.name, m.t);
+  stream_of_factor_.Add(id, m.stream);
+  ++counts_[s.name].attached;
+  return true;
+}
+
+bool ProblemBuilder::AttachUserSample(const MeasurementRef& m, std::size_t k) {
+  const StreamBinding& s = impl_->streams[m.stream];
+  std::vector<std::size_t> pose_indices = {k};
+  if (s.attachment == Attachment::kPair) pose_indices = {k, k + 1};
+  if (s.attachment == Attachment::kTriple) pose_indices = {k - 1, k, k + 1};
+  ModelSample sample{m.t, s.primary->values.row(m.row), {}};
+  std::vector<VariableId> vars;
+  for (const std::size_t i : pose_indices) {
+    sample.pose_times.push_back(poses_[i].t);
+    vars.push_back(poses_[i].id);
+  }
+  for (const std::string& pname : s.slot_parameters) vars.push_back(ParameterAt(pname, k));
+  std::unique_ptr<Factor> factor = s.user_model->MakeFactor(sample);
+  if (factor == nullptr) {
+    ++counts_[s.name].outside;
+    return true;
+  }
+  ROAMLAB_CHECK(factor->residual_dim() == s.definition->residual_dim,
+                "model " << s.config.model << " of stream '" << s.name << "' made a factor of dimension "
+                         << factor->residual_dim() << ", registered " << s.definition->residual_dim);
   const FactorId id = graph_.AddFactor(std::move(factor), vars, s.noise_covariance, s.config.loss, s.name, m.t);
   stream_of_factor_.Add(id, m.stream);
   ++counts_[s.name].attached;

@@ -5,7 +5,9 @@
 // attaches to the pose(s) nearest its time stamp as soon as they exist: one pose (GPS, magnetometer, absolute pose),
 // the pair of poses whose interval contains it (gyroscope, velocity sensors), or three poses centred on the nearest
 // (accelerometer). Measurements may arrive out of order; one older than the oldest pose still in the graph is
-// counted as too late, never silently dropped.
+// counted as too late, never silently dropped. Which poses a model's samples join, its error's dimension and its
+// noise come from its definition in the error-model registry (model_registry.h); a user model's factors come from
+// its bound model, the built-in models' from this builder.
 //
 // Relative motion (model relative_motion). A sample of a velocity stream stamped at t that stands for the mean
 // velocity over [t_a, t_b] = [t - T/2, t + T/2] (the scan matcher between two scans, the visual odometry between two
@@ -157,6 +159,8 @@ class ProblemBuilder {
   // outside).
   enum class Placement { kAttach, kWait, kOutside };
   Placement PlaceSample(const MeasurementRef& m, const StreamBinding& s, std::size_t* k);
+  // TryAttach for a user model (model_registry.h) at pose index k (PlaceSample's).
+  bool AttachUserSample(const MeasurementRef& m, std::size_t k);
   // TryAttach for relative_motion (the class comment).
   bool TryAttachInterval(const MeasurementRef& m);
   // The noise covariance of one sample: the configured one, plus the row's own when the stream is set to use it.

@@ -26,14 +26,18 @@ std::vector<bool> FrozenRows(const recording::Stream& stream, const recording::S
   return frozen;
 }
 
-Attachment AttachmentOf(const std::string& model, bool master) {
+Attachment AttachmentOf(const ErrorModelDefinition& model, bool master) {
   if (master) return Attachment::kMaster;
-  if (model == "relative_motion") return Attachment::kInterval;
-  if (model == "gyroscope" || model == "linear_velocity" || model == "odometer" || model == "ackermann" ||
-      model == "ackermann_seed" || model == "differential_drive" || model == "omni3_drive" ||
-      model == "mecanum_drive" || model == "omni4_drive" || model == "tricycle_drive")
-    return Attachment::kPair;
-  if (model == "accelerometer") return Attachment::kTriple;
+  switch (model.attachment) {
+    case ModelAttachment::kOnePose:
+      return Attachment::kOnePose;
+    case ModelAttachment::kPair:
+      return Attachment::kPair;
+    case ModelAttachment::kTriple:
+      return Attachment::kTriple;
+    case ModelAttachment::kInterval:
+      return Attachment::kInterval;
+  }
   return Attachment::kOnePose;
 }
 
@@ -58,43 +62,6 @@ Result<bool> BindSpecificForce(const EstimatorConfig& config, const recording::R
     return Error(config, "stream '" + b->name + "': inputs.specific_force '" + it->second + "' is empty");
   b->specific_force_column = b->specific_force->info.type == StreamType::kImu ? 3 : 0;
   return true;
-}
-
-// Noise covariance of the model's noise input, from the configured standard deviations.
-Eigen::MatrixXd NoiseCovariance(const StreamBinding& s) {
-  const auto& n = s.config.noise;
-  Eigen::VectorXd sigma;
-  const std::string& m = s.config.model;
-  if (m == "ackermann") {
-    sigma.resize(4);
-    sigma << n.at("speed_mps"), n.at("steering_rad"), n.at("lateral_mps"), n.at("vertical_mps");
-  } else if (m == "ackermann_seed") {
-    sigma.resize(6);
-    sigma << n.at("speed_mps"), n.at("steering_rad"), n.at("lateral_mps"), n.at("vertical_mps"),
-        n.at("roll_rate_radps"), n.at("pitch_rate_radps");
-  } else if (m == "odometer" || m == "relative_motion") {
-    sigma.resize(6);
-    sigma << Eigen::Vector3d::Constant(n.at("linear_mps")), Eigen::Vector3d::Constant(n.at("angular_radps"));
-  } else if (m == "differential_drive") {
-    sigma.resize(6);
-    sigma << n.at("wheel_radps"), n.at("wheel_radps"), n.at("lateral_mps"), n.at("vertical_mps"), n.at("tilt_radps"),
-        n.at("tilt_radps");
-  } else if (m == "tricycle_drive") {
-    sigma.resize(6);
-    sigma << n.at("wheel_radps"), n.at("steering_rad"), n.at("lateral_mps"), n.at("vertical_mps"), n.at("tilt_radps"),
-        n.at("tilt_radps");
-  } else if (m == "omni3_drive" || m == "mecanum_drive" || m == "omni4_drive") {
-    const int wheels = m == "omni3_drive" ? 3 : 4;
-    sigma.resize(wheels + 3);
-    sigma << Eigen::VectorXd::Constant(wheels, n.at("wheel_radps")), n.at("vertical_mps"), n.at("tilt_radps"),
-        n.at("tilt_radps");
-  } else if (m == "absolute_pose") {
-    sigma.resize(6);
-    sigma << Eigen::Vector3d::Constant(n.at("position_m")), Eigen::Vector3d::Constant(n.at("orientation_rad"));
-  } else {
-    sigma = Eigen::Vector3d::Constant(n.begin()->second);
-  }
-  return sigma.cwiseAbs2().asDiagonal();
 }
 
 // The speed and steering sources of an Ackermann stream, its wheelbase and the options of models/ackermann_velocity.h.
@@ -253,14 +220,24 @@ Result<StreamBinding> BindStream(const EstimatorConfig& config, const recording:
   StreamBinding b;
   b.name = name;
   b.config = sc;
-  b.spec = FindModelSpec(sc.model);
-  b.attachment = AttachmentOf(sc.model, name == config.master);
-  const bool ackermann = sc.model == "ackermann" || sc.model == "ackermann_seed";
-  const std::string primary_role = ackermann ? "speed" : sc.model == "tricycle_drive" ? "wheel" : "";
-  const std::string& source = sc.sources.at(primary_role);
+  b.definition = FindErrorModel(sc.model);
+  if (b.definition == nullptr) return Error(config, "stream '" + name + "': unknown model '" + sc.model + "'");
+  b.spec = &b.definition->spec;
+  b.attachment = AttachmentOf(*b.definition, name == config.master);
+  // The primary source: the first source role (ackermann's speed, tricycle_drive's wheel, "" for one source).
+  const std::string& source = sc.sources.at(b.spec->source_roles.front());
   b.primary = rec.Find(source);
   if (b.primary == nullptr)
     return Error(config, "stream '" + name + "' reads recording stream '" + source + "', which the recording lacks");
+  b.noise_covariance = b.definition->noise_covariance(sc);
+  if (b.definition->bind) {
+    Result<std::unique_ptr<BoundErrorModel>> bound = b.definition->bind({name, sc, rec, *b.primary});
+    if (!bound.ok()) return Error(config, "stream '" + name + "': " + bound.status().message());
+    if (bound.value() == nullptr) return Error(config, "stream '" + name + "': model " + sc.model + " bound nothing");
+    b.user_model = std::move(bound).value();
+    return b;
+  }
+  const bool ackermann = sc.model == "ackermann" || sc.model == "ackermann_seed";
   const StreamType type = b.primary->info.type;
   const std::string bad_type = "stream '" + name + "': recording stream '" + source + "' has type " +
                                recording::StreamTypeName(type) + ", which model " + sc.model + " cannot read";
@@ -269,7 +246,6 @@ Result<StreamBinding> BindStream(const EstimatorConfig& config, const recording:
   if (!bound.ok()) return bound;
   const Status options = BindRowOptions(config, source, &b);
   if (!options.ok()) return options;
-  b.noise_covariance = NoiseCovariance(b);
   return b;
 }
 
@@ -363,6 +339,7 @@ void BindTimeOffsets(const std::map<std::string, ParameterConfig>& parameter_con
                      const std::map<std::string, Eigen::VectorXd>& parameter_initial,
                      std::vector<StreamBinding>* streams) {
   for (StreamBinding& b : *streams) {
+    if (b.user_model) continue;  // a user model's factor takes every slot itself
     for (std::size_t i = 0; i < b.spec->slots.size(); ++i)
       if (b.spec->slots[i].name == "time_offset_s") b.time_offset_slot = static_cast<int>(i);
     if (b.time_offset_slot < 0) continue;
@@ -419,8 +396,7 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
     counts.frozen = health.FrozenRepeats();
     im.streams[i].frozen = FrozenRows(primary, health);
     if (im.streams[i].name == config.master) im.master = static_cast<int>(i);
-    if (im.streams[i].config.model == "gps" || im.streams[i].config.model == "absolute_pose")
-      builder->has_absolute_sensor_ = true;
+    if (im.streams[i].definition->absolute) builder->has_absolute_sensor_ = true;
   }
   if (im.master >= 0 && im.streams[static_cast<std::size_t>(im.master)].config.model == "gyroscope") {
     im.imu.emplace();

@@ -4,6 +4,7 @@
 
 #include <deque>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -11,6 +12,7 @@
 #include <Eigen/Core>
 
 #include "estimator/config.h"
+#include "estimator/model_registry.h"
 #include "estimator/models/ackermann_velocity.h"
 #include "estimator/models/enu.h"
 #include "estimator/problem.h"
@@ -31,6 +33,8 @@ struct StreamBinding {
   std::string name;
   StreamConfig config;
   const ModelSpec* spec = nullptr;
+  const ErrorModelDefinition* definition = nullptr;   // the registered model (spec is its spec)
+  std::shared_ptr<const BoundErrorModel> user_model;  // a user model's bound model (model_registry.h); null: built-in
   internal::Attachment attachment = internal::Attachment::kOnePose;
   const recording::Stream* primary = nullptr;
   const recording::Stream* steering = nullptr;  // ackermann

@@ -36,7 +36,7 @@
 // Variables: poses at t0, t1, t2 (PoseBlock x3), q_body_sensor (QuaternionBlock), S^(O) (Vector3Block), bias
 // (Vector3Block), scale (Vector3Block).
 //
-// Jacobians (Linearize; internal/so3_jacobians.h for Jr^-1, Jl^-1 = (Jr^-1)^T). With f^(O) the specific force in O,
+// Jacobians (Linearize; so3_jacobians.h for Jr^-1, Jl^-1 = (Jr^-1)^T). With f^(O) the specific force in O,
 // D = diag(k_s) R_S^T (so that de = D df^(O)), R1 = R(q1), h = (dt0 + dt1) / 2 and phi_ab = Log(qa^-1 qb):
 //   positions:  df/dp0 = R1^T / (dt0 h),  df/dp1 = -R1^T (1/dt0 + 1/dt1) / h,  df/dp2 = R1^T / (dt1 h)
 //   rotation vectors: dphi_ab/dtheta_a = -Jl^-1(phi_ab)  (Log(Exp(-d) Q)),  dphi_ab/dtheta_b = Jr^-1(phi_ab)
@@ -54,8 +54,8 @@
 #include <Eigen/Core>
 
 #include "estimator/geometry.h"
-#include "estimator/internal/so3_jacobians.h"
 #include "estimator/manifold.h"
+#include "estimator/so3_jacobians.h"
 
 namespace roamlab::estimator {
 
@@ -159,9 +159,9 @@ class AccelerometerError {
       const auto J_e_pose = [&](int i) { return Eigen::Map<Eigen::Matrix<double, 3, 6>>(jacobians[i]); };
       // Jr^-1 of the rotation vectors a pose touches (Jl^-1 is its transpose).
       const bool need01 = wanted(0) || wanted(1), need02 = wanted(0) || wanted(2), need12 = wanted(1) || wanted(2);
-      const Eigen::Matrix3d jr_inv01 = need01 ? internal::InverseRightJacobianSO3(phi01) : Eigen::Matrix3d();
-      const Eigen::Matrix3d jr_inv02 = need02 ? internal::InverseRightJacobianSO3(phi02) : Eigen::Matrix3d();
-      const Eigen::Matrix3d jr_inv12 = need12 ? internal::InverseRightJacobianSO3(phi12) : Eigen::Matrix3d();
+      const Eigen::Matrix3d jr_inv01 = need01 ? InverseRightJacobianSO3(phi01) : Eigen::Matrix3d();
+      const Eigen::Matrix3d jr_inv02 = need02 ? InverseRightJacobianSO3(phi02) : Eigen::Matrix3d();
+      const Eigen::Matrix3d jr_inv12 = need12 ? InverseRightJacobianSO3(phi12) : Eigen::Matrix3d();
       if (wanted(0)) {
         J_e_pose(0).leftCols<3>() = D_R1T / (dt0 * half_span);
         J_e_pose(0).rightCols<3>() = D_K_alpha * jr_inv01.transpose() / dt0 - D_K_omega * jr_inv02.transpose();

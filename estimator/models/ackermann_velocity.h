@@ -90,7 +90,7 @@
 // Variables: pose at t_k, pose at t_k+1 (PoseBlock), kv_over_L, k_theta, k_gamma, c_front, c_rear, alpha, s_f, s_p
 // (ScalarBlock each), w (Vector3Block).
 //
-// Jacobians (Linearize; internal/so3_jacobians.h for Jr, Jr^-1, Jl^-1 = (Jr^-1)^T). VelocitiesBetween computes
+// Jacobians (Linearize; so3_jacobians.h for Jr, Jr^-1, Jl^-1 = (Jr^-1)^T). VelocitiesBetween computes
 // phi = Log(q_k^-1 q_k+1), omega = phi / dt, q_mid = q_k Exp(phi / 2) and v = R_mid^T (p_k+1 - p_k) / dt, so
 //   dphi/dtheta_k = -Jl^-1(phi),  dphi/dtheta_k+1 = Jr^-1(phi),  dv/dp_k = -R_mid^T / dt = -dv/dp_k+1,
 //   dv/dtheta = [v]x eps/dtheta  ((R_mid Exp(eps))^T u = R_mid^T u + [R_mid^T u]x eps), where eps, the right
@@ -117,8 +117,8 @@
 
 #include "common/check.h"
 #include "estimator/geometry.h"
-#include "estimator/internal/so3_jacobians.h"
 #include "estimator/manifold.h"
+#include "estimator/so3_jacobians.h"
 
 namespace roamlab::estimator {
 
@@ -269,8 +269,8 @@ class AckermannVelocityError {
       Eigen::Matrix<double, 4, 3> J_e_eps = J_e_v * Skew<double>(v_odom);
       J_e_eps.row(0) -=
           (v_roll * slip_p * kStandardGravity / k_v) * R_mid.row(2) * Skew<double>(Eigen::Vector3d::UnitX());
-      const Eigen::Matrix3d jr_inv = internal::InverseRightJacobianSO3(phi);
-      const Eigen::Matrix3d half_jr = 0.5 * internal::RightJacobianSO3(phi * 0.5);
+      const Eigen::Matrix3d jr_inv = InverseRightJacobianSO3(phi);
+      const Eigen::Matrix3d half_jr = 0.5 * RightJacobianSO3(phi * 0.5);
       const Eigen::Matrix<double, 4, 3> J_e_dp1 = J_e_v * R_mid_T / dt_s_;
       if (jacobians[0] != nullptr) {
         Eigen::Map<Eigen::Matrix<double, 4, 6>> J_e_pose_k(jacobians[0]);

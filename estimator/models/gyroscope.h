@@ -17,7 +17,7 @@
 // Variables: pose at t(k) (PoseBlock), pose at t(k+1) (PoseBlock), q_body_sensor (QuaternionBlock), bias
 // (Vector3Block), scale (Vector3Block).
 //
-// Jacobians (Linearize; internal/so3_jacobians.h for Jr, Jl^-1), with phi = omega_hat^(O) dt, R_k, R_k+1, R_hat the
+// Jacobians (Linearize; so3_jacobians.h for Jr, Jl^-1), with phi = omega_hat^(O) dt, R_k, R_k+1, R_hat the
 // rotation matrices of q_O^W(t), q_O^W(t+1), q_hat and E = q_hat (q_O^W(t+1))^-1 = Exp(e):
 //   pose k:    E' = q_k Exp(d) Exp(phi) q_k+1^-1 = Exp(R_k d) E            => J_e_theta_k = Jl^-1(e) R_k
 //   pose k+1:  E' = E q_k+1 Exp(-d) q_k+1^-1 = Exp(-R_hat d) E             => J_e_theta_k+1 = -Jl^-1(e) R_hat
@@ -33,8 +33,8 @@
 #include <Eigen/Core>
 
 #include "estimator/geometry.h"
-#include "estimator/internal/so3_jacobians.h"
 #include "estimator/manifold.h"
+#include "estimator/so3_jacobians.h"
 
 namespace roamlab::estimator {
 
@@ -89,7 +89,7 @@ class GyroscopeError {
     if (!wanted(0) && !wanted(1) && !calibration_wanted) return true;
 
     // Orientation blocks.
-    const Eigen::Matrix3d jl_inv_e = internal::InverseRightJacobianSO3(e).transpose();
+    const Eigen::Matrix3d jl_inv_e = InverseRightJacobianSO3(e).transpose();
     const Eigen::Matrix3d R_hat = q_hat.toRotationMatrix();
     if (wanted(0)) {
       Eigen::Map<Eigen::Matrix<double, 3, 6>> J_e_pose_k(jacobians[0]);
@@ -106,7 +106,7 @@ class GyroscopeError {
     // Through the rate: J_e_omega_sensor = M R_S; bias and noise enter as -diag(1 ./ k_s), the scale as
     // -diag(omega^(S) ./ k_s), the misalignment as -[omega^(S)]x.
     const Eigen::Matrix3d J_e_omega_sensor =
-        (dt_s_ * jl_inv_e * R_hat * internal::RightJacobianSO3(phi)) * q_body_sensor.toRotationMatrix();
+        (dt_s_ * jl_inv_e * R_hat * RightJacobianSO3(phi)) * q_body_sensor.toRotationMatrix();
     if (wanted(2)) Eigen::Map<Eigen::Matrix3d>{jacobians[2]} = -J_e_omega_sensor * Skew<double>(omega_sensor);
     const Eigen::Matrix3d J_e_bias = -J_e_omega_sensor * scale.cwiseInverse().asDiagonal();
     if (wanted(3)) Eigen::Map<Eigen::Matrix3d>{jacobians[3]} = J_e_bias;

@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "estimator/internal/so3_jacobians.h"
 #include "estimator/manifold.h"
+#include "estimator/so3_jacobians.h"
 #include "tests/estimator/factor_testing.h"
 #include "tests/estimator/manifold_testing.h"
 
@@ -205,7 +205,7 @@ TEST(GeometryTest, JetDerivativesOfExpAndLogMatchCentralDifferences) {
   }
 }
 
-// The SO(3) Jacobians of internal/so3_jacobians.h against central differences of their defining relations:
+// The SO(3) Jacobians of so3_jacobians.h against central differences of their defining relations:
 //   Log(Exp(phi)^-1 Exp(phi + d)) = Jr(phi) d,  Log(Exp(phi) Exp(d)) - phi = Jr^-1(phi) d,
 //   Log(Exp(phi + d) Exp(phi)^-1) = Jl(phi) d,  Log(Exp(d) Exp(phi)) - phi = Jl^-1(phi) d,
 // and the identities Jl = Jr(-phi) = Jr^T = R(phi) Jr, Jr Jr^-1 = I.
@@ -215,8 +215,8 @@ TEST(GeometryTest, So3JacobiansMatchCentralDifferences) {
     SCOPED_TRACE(::testing::Message() << "angle " << angle);
     const Eigen::Vector3d phi = angle * RandomAxis(&rng);
     const Eigen::Quaterniond R = Exp(phi);
-    const Eigen::Matrix3d Jr = internal::RightJacobianSO3(phi);
-    const Eigen::Matrix3d Jr_inv = internal::InverseRightJacobianSO3(phi);
+    const Eigen::Matrix3d Jr = RightJacobianSO3(phi);
+    const Eigen::Matrix3d Jr_inv = InverseRightJacobianSO3(phi);
     const double h = CentralDifferenceStep();
     const auto right = [&](const Eigen::Vector3d& p) { return Eigen::VectorXd(Log(R.conjugate() * Exp(p))); };
     const auto left = [&](const Eigen::Vector3d& p) { return Eigen::VectorXd(Log(Exp(p) * R.conjugate())); };
@@ -237,7 +237,7 @@ TEST(GeometryTest, So3JacobiansMatchCentralDifferences) {
               CentralDifferenceTolerance(h_log, scale));
     // Identities, to rounding: the entries of Jr and Jr^-1 are at most about 1 + angle^2.
     const double rounding = kRoundingUlps * kEpsilon * (1.0 + angle * angle);
-    EXPECT_LE((internal::RightJacobianSO3(-phi) - Jr.transpose()).lpNorm<Eigen::Infinity>(), rounding);
+    EXPECT_LE((RightJacobianSO3(-phi) - Jr.transpose()).lpNorm<Eigen::Infinity>(), rounding);
     EXPECT_LE((R.toRotationMatrix() * Jr - Jr.transpose()).lpNorm<Eigen::Infinity>(), rounding);
     EXPECT_LE((Jr * Jr_inv - Eigen::Matrix3d::Identity()).lpNorm<Eigen::Infinity>(), rounding);
   }

@@ -1,4 +1,4 @@
-#include "estimator/internal/jet.h"
+#include "estimator/jet.h"
 
 #include <cmath>
 #include <functional>

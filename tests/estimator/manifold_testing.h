@@ -24,7 +24,7 @@
 
 #include <Eigen/Core>
 
-#include "estimator/internal/jet.h"
+#include "estimator/jet.h"
 #include "estimator/manifold.h"
 
 namespace roamlab::estimator::testing {

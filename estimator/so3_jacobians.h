@@ -20,7 +20,7 @@
 
 #include "estimator/geometry.h"
 
-namespace roamlab::estimator::internal {
+namespace roamlab::estimator {
 
 // Below this angle [rad] the coefficients use their Taylor series (truncation error < 1e-15, no cancellation).
 inline constexpr double kSo3SeriesAngle = 1e-3;
@@ -57,4 +57,4 @@ inline Eigen::Matrix3d InverseRightJacobianSO3(const Eigen::Vector3d& phi) {
   return Eigen::Matrix3d::Identity() + 0.5 * phi_x + c * phi_x * phi_x;
 }
 
-}  // namespace roamlab::estimator::internal
+}  // namespace roamlab::estimator
