@@ -2,7 +2,7 @@
 // import_optiodom.h) into a recording directory.
 // `roamlab import rosbag BAG (--out REC | --list) [--topic TOPIC=STREAM ...] [--imu-mounting W X Y Z]
 // [--platform KIND] [--geometry KEY=VALUE ...] [--joints NAME ...] [--joint-velocities] [--wheels-from-odometry
-// [--odometry-topic TOPIC]]`: converts the supported topics of a ROS 1 bag, a rosbag2 directory or an MCAP file
+// [--odometry-topic TOPIC] [--odometry-wheel-separation M]]`: converts the supported topics of a ROS 1 bag, a rosbag2 directory or an MCAP file
 // (importers/rosbag.h) into a recording, printing each imported topic with its message type and every check's
 // warning; --list prints the bag's topics (type, count, rate, span) and imports nothing. The IMU mounting and the
 // platform's nominal geometry, which a bag does not hold, come from the options and go into recording.yaml.
@@ -12,6 +12,7 @@
 // recording cannot be written.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,7 @@ struct ImportRosbagArgs {
   std::vector<std::string> joints;        // JointState joints (empty = the first message's)
   bool joint_velocities = false;          // JointState velocities instead of positions
   std::string odometry_topic;             // the wheels' odometry topic when there are several
+  std::optional<double> odometry_wheel_separation_m;  // the controller's B for the wheels (importers/rosbag.h)
   std::vector<double> imu_mounting_wxyz;  // q_body_imu; empty = identity (no mounting written)
   std::string platform_kind = "unknown";
   std::vector<std::string> geometry;  // "key=value", e.g. "baseline_m=0.555"
