@@ -261,8 +261,8 @@ Result<double> WheeledRobot::ScaleEffectiveTrack(mjModel* model, double ratio, c
   const double shift_m = 0.5 * (std::sqrt(squared_m2) - wheelbase_m);
   std::vector<WheelOffset> offsets;
   for (int i = 0; i < 4; ++i)
-    offsets.push_back({i, Eigen::Vector2d(wheels_[static_cast<std::size_t>(i)].p_body_m.x() > 0.0 ? shift_m : -shift_m,
-                                          0.0)});
+    offsets.push_back(
+        {i, Eigen::Vector2d(wheels_[static_cast<std::size_t>(i)].p_body_m.x() > 0.0 ? shift_m : -shift_m, 0.0)});
   if (Status st = MoveWheels(model, offsets, what); !st.ok()) return st;
   return std::sqrt(squared_m2);
 }
