@@ -31,7 +31,7 @@ std::vector<TwinCandidate> Library(const sim::Scenario& nominal, double max_shif
   all.push_back({"wheel_radius_asymmetry", "wheel_radius_asymmetry", {}, {P("ratio_right_left", 1, 0.01, 0.8, 1.2)}});
   all.push_back({"track_width_error", "track_width_error", {}, {P("track_error_m", 0, 0.01, -0.1, 0.1)}});
   if (nominal.robot.kind == "skid_steer")
-    all.push_back({"skid_steer_track", "skid_steer_track", {}, {P("track_ratio", 1, 0.02, 0.7, 1.5)}});
+    all.push_back({"skid_steer_track", "skid_steer_track", {}, {P("track_ratio", 1, 0.05, 0.7, 1.5)}});
   const int wheels = Wheels(nominal.robot.kind);
   for (int w = 0; w < wheels; ++w)
     all.push_back({"axle_misalignment wheel " + std::to_string(w),
