@@ -46,6 +46,7 @@ int RosbagOptions(const ImportRosbagArgs& args, importers::RosbagImportOptions* 
   options->platform.kind = args.platform_kind;
   options->wheels_from_odometry = args.wheels_from_odometry;
   options->odometry_topic = args.odometry_topic;
+  options->odometry_wheel_separation_m = args.odometry_wheel_separation_m;
   options->joints = args.joints;
   options->joint_velocities = args.joint_velocities;
   for (const std::string& kv : args.geometry) {

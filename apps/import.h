@@ -2,7 +2,8 @@
 // import_optiodom.h) into a recording directory.
 // `roamlab import rosbag BAG (--out REC | --list) [--topic TOPIC=STREAM ...] [--imu-mounting W X Y Z]
 // [--platform KIND] [--geometry KEY=VALUE ...] [--joints NAME ...] [--joint-velocities] [--wheels-from-odometry
-// [--odometry-topic TOPIC]]`: converts the supported topics of a ROS 1 bag, a rosbag2 directory or an MCAP file
+// [--odometry-topic TOPIC] [--odometry-wheel-separation M]]`: converts the supported topics of a ROS 1 bag, a rosbag2
+// directory or an MCAP file
 // (importers/rosbag.h) into a recording, printing each imported topic with its message type and every check's
 // warning; --list prints the bag's topics (type, count, rate, span) and imports nothing. The IMU mounting and the
 // platform's nominal geometry, which a bag does not hold, come from the options and go into recording.yaml.
@@ -12,6 +13,7 @@
 // recording cannot be written.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,6 +40,8 @@ struct ImportRosbagArgs {
   std::vector<std::string> geometry;  // "key=value", e.g. "baseline_m=0.555"
   bool wheels_from_odometry = false;  // also write the `wheels` stream (importers/rosbag.h)
   bool quiet = false;
+  // The wheel separation the odometry's controller divides by, for the wheels (importers/rosbag.h)
+  std::optional<double> odometry_wheel_separation_m;
 };
 int RunImportRosbag(const ImportRosbagArgs& args);
 

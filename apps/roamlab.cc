@@ -360,6 +360,8 @@ void AddImport(CLI::App* app, Commands* commands) {
                          "Also write wheel angles re-expressed from the odometry (needs wheel_radius_m, baseline_m)");
     imp_rosbag->add_option("--odometry-topic", args->odometry_topic,
                            "The odometry topic the wheels come from, when the bag has several");
+    imp_rosbag->add_option("--odometry-wheel-separation", args->odometry_wheel_separation_m,
+                           "The odometry controller's wheel separation [m] for the wheels (default baseline_m)");
     imp_rosbag->add_flag("--quiet", args->quiet, "No summary");
     return imp_rosbag;
   });

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 
 #include "common/atomic_file.h"
@@ -40,7 +41,7 @@ struct Inputs {
   std::optional<sim::Scenario> scenario;
   recording::Recording recording;
   estimator::EstimatorConfig config;
-  double span_s = 0.0;  // the recording's last stamp
+  double span_s = 0.0;  // from the recording's first stamp to its last (stamps may be absolute, e.g. Unix time)
 };
 
 // The nominal model: the configuration given, or the one built from the scenario; every stream it reads present.
@@ -81,8 +82,13 @@ Result<Inputs> LoadInputs(const DiagnoseRequest& request) {
                          "' does not match the robot kind '" + in.scenario->robot.kind + "' of " + request.scenario);
   if (Status s = LoadNominalModel(request, &in); !s.ok()) return s;
   if (Status s = MakeOutputDirectory(request.out); !s.ok()) return s;
-  for (const recording::Stream& s : in.recording.streams)
-    if (!s.t.empty()) in.span_s = std::max(in.span_s, s.t.back().seconds());
+  std::optional<Time> first, last;
+  for (const recording::Stream& s : in.recording.streams) {
+    if (s.t.empty()) continue;
+    if (!first || s.t.front() < *first) first = s.t.front();
+    if (!last || *last < s.t.back()) last = s.t.back();
+  }
+  if (first) in.span_s = SecondsBetween(*first, *last);
   // The held-out third loses twice the range of its position fixes at each end (the diagnosis's slices).
   if (request.max_shift_s && (!(*request.max_shift_s > 0.0) || !(*request.max_shift_s < in.span_s / 12.0)))
     return Status::Error("--max-shift " + Fixed(*request.max_shift_s, 3) + " s: must be above 0 and below " +
@@ -266,8 +272,9 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
   (void)marker.AddDone("the diagnosis");
 
   // The simulation again, as believed and with the accepted effects, against the recording's held-out part.
+  // (A replayed twin replaces it: the scenario's own drive is not the recording's.)
   std::optional<gap::SimulationComparison> simulation;
-  if (in.scenario) {
+  if (in.scenario && !replayed) {
     say("re-simulating the nominal scenario without noise, as believed and with the accepted effects");
     auto compared = gap::CompareWithSimulation(*in.scenario, d.effects, in.recording, d.train_end_s);
     if (!compared.ok()) return failed(Status::Error("re-simulation: " + compared.status().message()));

@@ -261,9 +261,9 @@ Result<TwinDiagnosis> Diagnoser::Run() {
   State state;
   state.full = nominal_;
   state.full.effects.clear();
-  state.full.duration_s = std::max(last_.seconds(), 1.0);
+  state.full.duration_s = std::max(SecondsBetween(first_, last_), 1.0);  // the runners' time since first_
   state.train = state.full;
-  state.train.duration_s = std::min(state.full.duration_s, train_end_.seconds() + 0.05);
+  state.train.duration_s = std::min(state.full.duration_s, SecondsBetween(first_, train_end_) + 0.05);
   auto simulator = sim::Simulator::Create(state.full, {});
   if (!simulator.ok()) return Status::Error("the nominal scenario: " + simulator.status().message());
   const double step_s = simulator.value()->PhysicsStepS();

@@ -32,7 +32,8 @@
 // Verdict: "named" (some effect kept), "unknown" (no effect kept, and some component inconsistent with the stated
 // noise), "none". `unexplained` lists the components still inconsistent on the held-out part with the patch.
 // The runner must be thread-safe (a Simulator of its own per call); it may stop the twin at the patched scenario's
-// duration_s (the fit's runs cover the training part only). The diagnosis never reads truth.yaml.
+// duration_s after the recording's first stamp (the fit's runs cover the training part only). The diagnosis never reads
+// truth.yaml.
 #pragma once
 
 #include <functional>
@@ -58,8 +59,9 @@ using TwinRunner = std::function<Result<recording::Recording>(const sim::Scenari
 
 // Runs `patched` without noise with sim::Simulate: the twin of a recording of the scenario's own drive.
 TwinRunner PlainSimulationRunner();
-// Replays `patched` with the drive inputs of `real` (sim/replay.h) up to the recording time patched.duration_s: the
-// twin of any recording with drive inputs. Keeps its own copy of the recording.
+// Replays `patched` with the drive inputs of `real` (sim/replay.h) up to patched.duration_s after the recording's first
+// stamp (stamps may be absolute, e.g. Unix time): the twin of any recording with drive inputs. Keeps its own copy of
+// the recording.
 TwinRunner ReplayRunner(const recording::Recording& real);
 
 // Whether `twin` follows the drive of `real`: for each wheel stream in both (wheel_encoders, steering), the change of

@@ -233,9 +233,13 @@ TwinRunner PlainSimulationRunner() {
 
 TwinRunner ReplayRunner(const recording::Recording& real) {
   auto recorded = std::make_shared<const recording::Recording>(real);
-  return [recorded](const sim::Scenario& patched) -> Result<recording::Recording> {
+  std::optional<Time> first;
+  for (const recording::Stream& s : real.streams)
+    if (!s.t.empty() && (!first || s.t.front() < *first)) first = s.t.front();
+  const double first_s = first ? first->seconds() : 0.0;
+  return [recorded, first_s](const sim::Scenario& patched) -> Result<recording::Recording> {
     sim::ReplayOptions options;
-    options.to_s = patched.duration_s;
+    options.to_s = first_s + patched.duration_s;
     auto replayed = sim::Replay(patched, *recorded, options);
     if (!replayed.ok()) return replayed.status();
     return std::move(replayed.value().recording);

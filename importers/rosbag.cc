@@ -423,6 +423,9 @@ std::string AddWheels(const RosbagImportOptions& options, const std::map<std::st
   if (r == rec->platform.geometry.end() || b == rec->platform.geometry.end() || !(r->second > 0.0) ||
       !(b->second > 0.0))
     return "wheels from odometry need positive wheel_radius_m and baseline_m in the platform geometry";
+  const double separation_m = options.odometry_wheel_separation_m.value_or(b->second);
+  if (!(std::isfinite(separation_m) && separation_m > 0.0 && separation_m < 1e3))
+    return "the odometry's wheel separation must be a positive number of metres below 1000";
   std::string name;
   if (!options.odometry_topic.empty()) {
     const auto it = odometry_streams.find(options.odometry_topic);
@@ -445,11 +448,12 @@ std::string AddWheels(const RosbagImportOptions& options, const std::map<std::st
   wheels.info.units = "rad";
   wheels.info.rate_hz = odo.info.rate_hz;
   wheels.info.attributes["derived_from_odometry"] = 1.0;
+  wheels.info.attributes["wheel_separation_m"] = separation_m;
   wheels.t = odo.t;
   wheels.values = Eigen::MatrixXd::Zero(odo.values.rows(), 2);
   // Wheel rate of side `side` (-1 left, +1 right) at sample k [rad/s].
   const auto rate = [&](Eigen::Index k, double side) {
-    return (odo.values(k, 0) + side * 0.5 * odo.values(k, 5) * b->second) / r->second;
+    return (odo.values(k, 0) + side * 0.5 * odo.values(k, 5) * separation_m) / r->second;
   };
   for (Eigen::Index k = 1; k < odo.values.rows(); ++k) {
     const double dt = SecondsBetween(odo.t[static_cast<std::size_t>(k - 1)], odo.t[static_cast<std::size_t>(k)]);

@@ -49,10 +49,15 @@
 // when the bag has several odometry streams): a differential-drive / skid-steer controller (ROS
 // diff_drive_controller) computes its twist from the wheel speeds with its nominal geometry, v = r (w_R + w_L) / 2,
 // omega = r (w_R - w_L) / B, so the wheel speeds are recovered exactly by w_L = (v - omega B / 2) / r,
-// w_R = (v + omega B / 2) / r. The importer then also writes stream `wheels` (wheel_encoders, columns left, right,
-// units rad): the cumulative wheel angles, integrated by the trapezoid rule over the odometry stamps, with attribute
-// derived_from_odometry = 1. It re-expresses the odometry (no new measurement) so that the estimator's
-// differential_drive model, with its calibration of radii and effective track, can read it.
+// w_R = (v + omega B / 2) / r, B the controller's wheel separation: odometry_wheel_separation_m when given, else
+// baseline_m. A skid steer's controller divides by an effective separation wider than the geometric one (ROS
+// diff_drive_controller: the wheel_separation, from the robot's URDF or its parameter, times
+// wheel_separation_multiplier; the Clearpath Husky's is 0.5708 m x 1.875 = 1.07 m), so the wheel speeds it measured
+// need that value: with the geometric track the recovered wheel-rate difference is smaller than the real one by the
+// multiplier. The importer then also writes stream `wheels` (wheel_encoders, columns left, right, units rad): the
+// cumulative wheel angles, integrated by the trapezoid rule over the odometry stamps, with attributes
+// derived_from_odometry = 1 and wheel_separation_m = B. It re-expresses the odometry (no new measurement) so that the
+// estimator's differential_drive model, with its calibration of radii and effective track, can read it.
 //
 // Mounting: a bag without /tf does not say how the sensors are mounted, so the IMU's is given by the caller and written
 // into recording.yaml, where the estimator's configuration can read and check it.
@@ -84,6 +89,7 @@ struct RosbagImportOptions {
   bool joint_velocities = false;                            // JointState: velocities [rad/s], not positions [rad]
   bool wheels_from_odometry = false;                        // also write `wheels` (header comment)
   std::string odometry_topic;                               // the wheels' odometry topic when there are several
+  std::optional<double> odometry_wheel_separation_m;        // the controller's B for the wheels (header comment)
 };
 
 // What happened to one topic of the bag.

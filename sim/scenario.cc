@@ -558,6 +558,7 @@ const std::map<std::string, std::map<std::string, double>>& KnownEffects() {
       {"wheel_radius_asymmetry", {{"ratio_right_left", 1.0}}},
       {"wheel_radius_scale", {{"scale", 1.0}}},
       {"track_width_error", {{"track_error_m", 0.0}}},
+      {"skid_steer_track", {{"track_ratio", 1.0}}},
       {"wheel_deformation", {{"wheel", 0.0}, {"ovality_m", 0.0}}},
       {"axle_misalignment", {{"wheel", 0.0}, {"yaw_deg", 0.0}}},
       {"odometry_scale_error", {{"scale", 1.0}}},

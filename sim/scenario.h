@@ -127,6 +127,15 @@
 //                                          track_error_m in [-0.1, 0.1] m, half on each side (a turn at a given wheel-
 //                                          rate difference is B_nom / B_true of the nominal one); truth: baseline +
 //                                          track_error_m (mecanum: lx_plus_ly + track_error_m / 2)
+//   skid_steer_track {track_ratio: 1}     skid_steer: the effective track B_eff, the track of the differential drive
+//                                          that turns as the skid steer does at the same wheel rates, times
+//                                          track_ratio in [0.7, 1.5]. Four equally loaded contacts with isotropic
+//                                          Coulomb friction at (+-L/2, +-B/2) turn with B_eff = B + L^2 / B (models/
+//                                          husky.xml), so the front and rear wheel bodies are moved along O's x to
+//                                          +-L'/2, L'^2 = B (track_ratio (B + L^2 / B) - B): the scrub of a ground
+//                                          whose sideways resistance differs from its rolling one (grass, soil,
+//                                          lugged tires); the platform geometry, the driver and truth's odometer
+//                                          baseline stay nominal (WheeledRobot::MoveWheels)
 //   wheel_deformation {wheel: 0, ovality_m: 0}   differential_drive (sphere tires): the tire of wheel `wheel`
 //                                          made oval by ovality_m in [0, 0.02] m at the same mean rolling radius
 //                                          (WheelDeformation.keep_mean_radius: the rolling radius varies twice per

@@ -28,7 +28,8 @@ std::optional<Scenario::Problem> WheelEffectProblem(const std::vector<EffectOpti
                                                     const std::string& kind, const std::string& k) {
   using P = Scenario::Problem;
   const bool wheel_effect = name == "wheel_radius_asymmetry" || name == "wheel_radius_scale" ||
-                            name == "track_width_error" || name == "wheel_deformation" || name == "axle_misalignment";
+                            name == "track_width_error" || name == "wheel_deformation" || name == "axle_misalignment" ||
+                            name == "skid_steer_track";
   if (!wheel_effect) return std::nullopt;
   if (kind == "ackermann" && name == "axle_misalignment") {
     // The Ackermann vehicle's rear axle (both rear wheels: a thrust angle); the front wheels are steered, and their
@@ -63,6 +64,11 @@ std::optional<Scenario::Problem> WheelEffectProblem(const std::vector<EffectOpti
       return P{k + ".name", name + " is for differential_drive and mecanum robots only"};
     if (!(std::abs(EffectParameter(effects, name, "track_error_m", 0.0)) <= 0.1))
       return P{k + ".parameters.track_error_m", "must be in [-0.1, 0.1] m"};
+  }
+  if (name == "skid_steer_track") {
+    if (kind != "skid_steer") return P{k + ".name", name + " is for skid_steer robots only"};
+    const double ratio = EffectParameter(effects, name, "track_ratio", 1.0);
+    if (!(ratio >= 0.7 && ratio <= 1.5)) return P{k + ".parameters.track_ratio", "must be in [0.7, 1.5]"};
   }
   if (name == "wheel_deformation" || name == "axle_misalignment") {
     const double wheel = EffectParameter(effects, name, "wheel", 0.0);

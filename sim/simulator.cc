@@ -181,6 +181,10 @@ class Simulator::Impl {
         const double error_m = EffectParameter(scenario_.effects, "track_width_error", "track_error_m", 0.0);
         if (Status st = wheeled_.ChangeTrack(model_.get(), error_m, where_); !st.ok()) return st;
       }
+      if (HasEffect(scenario_, "skid_steer_track")) {
+        const double ratio = EffectParameter(scenario_.effects, "skid_steer_track", "track_ratio", 1.0);
+        if (auto moved = wheeled_.ScaleEffectiveTrack(model_.get(), ratio, where_); !moved.ok()) return moved.status();
+      }
       if (HasEffect(scenario_, "axle_misalignment")) {
         WheelMountingChange change;
         change.wheel = static_cast<int>(EffectParameter(scenario_.effects, "axle_misalignment", "wheel", 0.0));

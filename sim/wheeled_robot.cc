@@ -276,6 +276,25 @@ Status WheeledRobot::ChangeTrack(mjModel* model, double track_error_m, const std
   return Status::Ok();
 }
 
+Result<double> WheeledRobot::ScaleEffectiveTrack(mjModel* model, double ratio, const std::string& what) {
+  if (kind_ != "skid_steer") return Status::Error(what + ": an effective track scale needs a skid_steer robot");
+  const double track_m = SideToSideM();
+  const double wheelbase_m =
+      0.5 * (wheels_[0].p_body_m.x() + wheels_[1].p_body_m.x() - wheels_[2].p_body_m.x() - wheels_[3].p_body_m.x());
+  const double effective_m = track_m + wheelbase_m * wheelbase_m / track_m;
+  const double squared_m2 = track_m * (ratio * effective_m - track_m);
+  if (!(track_m > 0.0 && wheelbase_m > 0.0 && squared_m2 > 0.0))
+    return Status::Error(what + ": an effective track of " + std::to_string(ratio * effective_m) +
+                         " m is not reachable with a track of " + std::to_string(track_m) + " m");
+  const double shift_m = 0.5 * (std::sqrt(squared_m2) - wheelbase_m);
+  std::vector<WheelOffset> offsets;
+  for (int i = 0; i < 4; ++i)
+    offsets.push_back(
+        {i, Eigen::Vector2d(wheels_[static_cast<std::size_t>(i)].p_body_m.x() > 0.0 ? shift_m : -shift_m, 0.0)});
+  if (Status st = MoveWheels(model, offsets, what); !st.ok()) return st;
+  return std::sqrt(squared_m2);
+}
+
 Status WheeledRobot::MoveWheels(mjModel* model, const std::vector<WheelOffset>& offsets, const std::string& what) {
   const Eigen::Quaterniond q_root_odom(odom_in_root_quat_[0], odom_in_root_quat_[1], odom_in_root_quat_[2],
                                        odom_in_root_quat_[3]);

@@ -99,6 +99,11 @@ class WheeledRobot {
   // geometry (TrueOdometerCalibration) follows: baseline + track_error_m, lx_plus_ly + track_error_m / 2.
   Status ChangeTrack(mjModel* model, double track_error_m, const std::string& what);
 
+  // skid_steer: scales the effective track B_eff = B + L^2 / B (four Coulomb contacts at (+-L/2, +-B/2)) by `ratio`
+  // (> B / B_eff) by moving the front and rear wheels along O's x to +-L'/2, L'^2 = B (ratio B_eff - B), with
+  // MoveWheels; returns L'. Errors name `what`.
+  Result<double> ScaleEffectiveTrack(mjModel* model, double ratio, const std::string& what);
+
   // Moves wheel bodies of the bound model (see WheelOffset); their bodies must be children of the root body. As
   // Deform, it keeps the platform geometry and the driver's kinematics nominal; the true odometer geometry
   // (TrueOdometerCalibration) follows the moved wheels' yaw lever arms. Errors name `what` and the wheel.

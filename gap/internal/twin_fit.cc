@@ -32,6 +32,8 @@ std::vector<TwinCandidate> Library(const sim::Scenario& nominal, double max_shif
   all.push_back({"wheel_radius_scale", "wheel_radius_scale", {}, {P("scale", 1, 0.01, 0.8, 1.2)}});
   all.push_back({"track_width_error", "track_width_error", {}, {P("track_error_m", 0, 0.01, -0.1, 0.1)}});
   all.push_back({"odometry_scale_error", "odometry_scale_error", {}, {P("scale", 1, 0.01, 0.5, 1.5)}});
+  if (nominal.robot.kind == "skid_steer")
+    all.push_back({"skid_steer_track", "skid_steer_track", {}, {P("track_ratio", 1, 0.05, 0.7, 1.5)}});
   const int wheels = Wheels(nominal.robot.kind);
   for (int w = 0; w < wheels; ++w)
     all.push_back({"axle_misalignment wheel " + std::to_string(w),

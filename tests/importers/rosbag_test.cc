@@ -476,6 +476,19 @@ TEST(ImportRosbagWheelsTest, WheelAnglesInvertTheControllersKinematics) {
   // Twists (1.0, 0.1) then (1.1, 0.2) 0.1 s apart: wheel rates (9.75, 10.25) and (10.5, 11.5) rad/s, trapezoid.
   EXPECT_NEAR(wheels->values(1, 0), 0.05 * (9.75 + 10.5), 1e-12);
   EXPECT_NEAR(wheels->values(1, 1), 0.05 * (10.25 + 11.5), 1e-12);
+  EXPECT_EQ(wheels->info.attributes.at("wheel_separation_m"), 0.5);
+  // A skid steer's controller divides by its effective separation, here 1.0 m: the rate differences double.
+  options.odometry_wheel_separation_m = 1.0;
+  Imported skid = Import(TinyBag("none"), dir, options);
+  ASSERT_TRUE(skid.rec.ok()) << skid.rec.status().message();
+  const Stream* effective = skid.rec.value().Find("wheels");
+  EXPECT_NEAR(effective->values(1, 0), 0.05 * (9.5 + 10.0), 1e-12);
+  EXPECT_NEAR(effective->values(1, 1), 0.05 * (10.5 + 12.0), 1e-12);
+  EXPECT_EQ(effective->info.attributes.at("wheel_separation_m"), 1.0);
+  options.odometry_wheel_separation_m = -1.0;
+  EXPECT_THAT(Import(TinyBag("none"), dir, options).rec.status().message(),
+              HasSubstr("wheel separation must be a positive number"));
+  options.odometry_wheel_separation_m.reset();
   options.platform.geometry.erase("baseline_m");
   EXPECT_THAT(Import(TinyBag("none"), dir, options).rec.status().message(), HasSubstr("baseline_m"));
 }

@@ -414,7 +414,8 @@ double YawRatioInTurns(const eval::EncoderOdometry& odo, const recording::Stream
 }
 
 // A skid steer turns by scrubbing its tires sideways: the body turns slower than the wheel speeds say through the
-// nominal track, by a skid factor k (the effective track is k times the nominal one). Measured here as the ratio of
+// nominal track, by a skid factor k (the effective track is k times the nominal one; Coulomb friction at four equal
+// contacts gives k = 1 + (L / B)^2 within 10 %). Measured here as the ratio of
 // the wheel odometry's heading change to the gyroscope's; with it, the wheel odometry's heading follows the truth
 // within 1 % of the angle turned (the rolling radius on the soft contact) plus 10 mrad (the ticks, and the turns'
 // starts and ends, where the scrub differs from its mean), closer than without it.
@@ -427,12 +428,16 @@ TEST(RealModelsTest, HuskySkidSteerTurnsSlowerThanItsWheels) {
   ASSERT_TRUE(odo.ok()) << odo.status().message();
   const double k = YawRatioInTurns(odo.value(), *rec.Find("imu"), scenario.value().sensors.imu->misalignment);
   const DeadReckoningError e = DeadReckon(rec);
-  std::cout << "husky: simulated yaw-rate ratio wheel-odometry / gyro = " << k
-            << " (the real bag's: about 0.94); effective track " << k * rec.platform.geometry.at("baseline_m")
-            << " m; distance " << e.distance_m << " m, turned " << e.turned_rad << " rad; nominal dead-reckoning "
+  std::cout << "husky: simulated yaw-rate ratio wheel-odometry / gyro = " << k << "; effective track "
+            << k * rec.platform.geometry.at("baseline_m") << " m; distance " << e.distance_m << " m, turned "
+            << e.turned_rad << " rad; nominal dead-reckoning "
             << "error up to " << e.position_m << " m, " << e.heading_rad << " rad\n";
   ASSERT_GT(e.turned_rad, 2.0);
-  EXPECT_GT(k, 1.0);
+  // Four equally loaded Coulomb contacts at (+-L/2, +-B/2) turn with the effective track B + L^2 / B
+  // (models/husky.xml).
+  const double coulomb = 1.0 + (0.512 / 0.555) * (0.512 / 0.555);
+  std::cout << "husky: four-contact Coulomb ratio B_eff / B = " << coulomb << "\n";
+  EXPECT_NEAR(k, coulomb, 0.1 * coulomb);
   // The heading with the effective track: the odometry's yaw rate divided by k.
   recording::Recording effective = rec;
   effective.platform.geometry["baseline_m"] *= k;

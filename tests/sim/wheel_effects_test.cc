@@ -274,6 +274,12 @@ TEST(WheelEffectsValidation, OneLineErrors) {
   EXPECT_EQ(ProblemOf(omni), "effects[0].name: track_width_error is for differential_drive and mecanum robots only");
   omni.effects = {{"wheel_radius_asymmetry", {}}};
   EXPECT_EQ(ProblemOf(omni), "effects[0].name: wheel_radius_asymmetry is for differential_drive robots only");
+  omni.effects = {{"skid_steer_track", {{"track_ratio", 0.9}}}};
+  EXPECT_EQ(ProblemOf(omni), "effects[0].name: skid_steer_track is for skid_steer robots only");
+  Scenario skid = omni;
+  skid.robot.kind = "skid_steer";
+  skid.effects = {{"skid_steer_track", {{"track_ratio", 0.5}}}};
+  EXPECT_EQ(ProblemOf(skid), "effects[0].parameters.track_ratio: must be in [0.7, 1.5]");
 
   Scenario atv = testing::AtvHills(2.0);
   atv.effects = {{"wheel_deformation", {{"ovality_m", 0.001}}}};
