@@ -17,6 +17,7 @@ conf=$dir/slurm.conf
 
 die() {
   echo "local-slurm: $*" >&2
+  [ "${started:-0}" = 1 ] && { started=0; stop >/dev/null 2>&1 || true; }
   exit 1
 }
 
@@ -93,9 +94,11 @@ start() {
   local t0=$SECONDS
   mkdir -p "$dir/state" "$dir/spool"
   write_conf
-  start_munge
-  slurmctld -f "$conf" -i
-  slurmd -f "$conf"
+  # From here a daemon that does not come up stops the others (die), so that no port stays taken.
+  started=1
+  start_munge || die "munged did not start; see $dir/munge/munged.log"
+  slurmctld -f "$conf" -i || die "slurmctld did not start: $(tail -n 3 "$dir/slurmctld.log" 2>/dev/null)"
+  slurmd -f "$conf" || die "slurmd did not start: $(tail -n 3 "$dir/slurmd.log" 2>/dev/null)"
   wait_idle 60
   echo "local-slurm: node idle after $((SECONDS - t0)) s; export SLURM_CONF=$conf"
 }

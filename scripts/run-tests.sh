@@ -3,7 +3,8 @@
 # (scripts/local-slurm.sh, started and stopped here), then the quick subset of the regression suite
 # (regression/suite.yaml, results in BUILD_DIR/regress/). Slow tests carry the ctest label "slow" and are left out
 # unless ROAMLAB_SLOW_TESTS=1; ROAMLAB_FULL_REGRESSION=1 runs every regression case. The cluster tests carry the label
-# "slurm"; ROAMLAB_SLURM_TESTS=0 leaves them out (they need root to start the daemons).
+# "slurm"; they run when the one-node Slurm starts here (root, slurm-wlm and munge), and otherwise are reported
+# as not run; ROAMLAB_SLURM_TESTS=0 leaves them out, ROAMLAB_SLURM_TESTS=1 makes a failed start an error.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -18,9 +19,20 @@ if grep -q 'FAILED TEST SUITE' "$junit"; then
   echo "roamlab tests: a test suite's set-up failed and its tests were reported skipped; see $junit" >&2
   exit 1
 fi
-if [ "${ROAMLAB_SLURM_TESTS:-1}" = "1" ]; then
-  export LOCAL_SLURM_DIR=${LOCAL_SLURM_DIR:-$(cd "$build_dir" && pwd)/local-slurm}
+export LOCAL_SLURM_DIR=${LOCAL_SLURM_DIR:-$(cd "$build_dir" && pwd)/local-slurm}
+slurm_tests=${ROAMLAB_SLURM_TESTS:-auto}
+if [ "$slurm_tests" = "auto" ]; then
+  if bash scripts/local-slurm.sh start; then
+    slurm_tests=1
+  else
+    echo "roamlab tests: the one-node Slurm did not start here; the cluster tests (label slurm) are NOT run" \
+      "(ROAMLAB_SLURM_TESTS=1 makes this an error)" >&2
+    slurm_tests=0
+  fi
+elif [ "$slurm_tests" = "1" ]; then
   bash scripts/local-slurm.sh start
+fi
+if [ "$slurm_tests" = "1" ]; then
   trap 'bash scripts/local-slurm.sh stop' EXIT
   eval "$(bash scripts/local-slurm.sh env)"
   # One at a time: the node's cores run the tasks.
