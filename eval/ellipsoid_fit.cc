@@ -1,6 +1,7 @@
 #include "eval/ellipsoid_fit.h"
 
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
@@ -113,6 +114,31 @@ Result<EllipsoidFit> FitEllipsoid(const std::vector<Eigen::Vector3d>& samples, E
   }
   fit.rms_residual = std::sqrt(sum / n);
   return fit;
+}
+
+Eigen::Matrix3d EllipsoidCentreCovariance(const EllipsoidFit& fit, const std::vector<Eigen::Vector3d>& samples,
+                                          double sigma) {
+  // M's entries scaled by r^2 (about 1 for a near-sphere), so that all nine columns have comparable size.
+  const double r2 = fit.radius * fit.radius;
+  const Eigen::Matrix3d M = fit.correction * fit.correction / r2;
+  Eigen::Matrix<double, 9, 9> information = Eigen::Matrix<double, 9, 9>::Zero();
+  for (const Eigen::Vector3d& z : samples) {
+    const Eigen::Vector3d y = z - fit.centre;
+    const Eigen::Vector3d gradient = M * y;
+    const double norm = gradient.norm();
+    if (!(norm > 0.0)) continue;
+    Eigen::Matrix<double, 9, 1> row;
+    row << -gradient / norm, y.cwiseProduct(y) / (2.0 * norm * r2), y.y() * y.z() / (norm * r2),
+        y.x() * y.z() / (norm * r2), y.x() * y.y() / (norm * r2);
+    information.noalias() += row * row.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> eig(information);
+  const double largest = eig.eigenvalues().maxCoeff();
+  if (!(eig.eigenvalues().minCoeff() > 1e-12 * largest))
+    return Eigen::Matrix3d::Constant(std::numeric_limits<double>::infinity());
+  const Eigen::Matrix<double, 9, 9> covariance =
+      eig.eigenvectors() * eig.eigenvalues().cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
+  return sigma * sigma * covariance.topLeftCorner<3, 3>();
 }
 
 }  // namespace roamlab::eval

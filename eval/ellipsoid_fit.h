@@ -48,6 +48,17 @@ enum class EllipsoidFitMethod { kGeneral, kEllipsoidSpecific };
 Result<EllipsoidFit> FitEllipsoid(const std::vector<Eigen::Vector3d>& samples,
                                   EllipsoidFitMethod method = EllipsoidFitMethod::kGeneral);
 
+// The Cramer-Rao covariance of an ellipsoid's centre [units of z ^2] on the given samples, whatever method fits it: the
+// inverse of the information that samples scattered about `fit`'s ellipsoid (x - b)^T M (x - b) = 1 with white noise
+// of std `sigma` along its normal hold about its nine parameters (b and M's six entries), the centre's block. Each
+// sample's first-order distance from the ellipsoid, d = (sqrt(q) - 1) sqrt(q) / |M y| with y = z - b and
+// q = y^T M y, has the Jacobian -M y / |M y| (the unit normal) in b and y_j y_k / |M y| (diagonal: y_j^2 / (2 |M y|))
+// in M's entries, at q = 1. What limits it is the samples' coverage: on a full sphere of N samples each component's
+// std is sqrt(3 / N) sigma; on a cap, the centre trades off against the shape along the cap's axis. Infinite where the
+// samples leave a direction of the nine undetermined.
+Eigen::Matrix3d EllipsoidCentreCovariance(const EllipsoidFit& fit, const std::vector<Eigen::Vector3d>& samples,
+                                          double sigma);
+
 // (A A^T)^(1/2): the symmetric positive semi-definite factor of A's polar decomposition A = P R.
 Eigen::Matrix3d SymmetricFactor(const Eigen::Matrix3d& A);
 

@@ -90,6 +90,44 @@ TEST(EllipsoidFitTest, EllipsoidSpecificFitIsExactOnNoiseFreeSamples) {
   EXPECT_LT((fit.value().correction - s.distortion.inverse()).cwiseAbs().maxCoeff(), 1e-8);
 }
 
+// The Cramer-Rao covariance of the centre against the spread of the fit's centre over K seeded sample sets: the
+// sample std of K draws has a relative standard error of 1 / sqrt(2 (K - 1)), the tolerance 3 of them. On a cap of
+// the same number of samples the bound is many times wider (the centre trades off against the shape).
+TEST(EllipsoidFitTest, CentreCovarianceMatchesTheSpreadOfFitsAndGrowsOnACap) {
+  const int n = 500, k = 40;
+  const double sigma = 0.5;
+  const Synthetic first = Make(n, sigma, 100);
+  const auto reference = FitEllipsoid(first.samples);
+  ASSERT_TRUE(reference.ok());
+  const Eigen::Vector3d bound = EllipsoidCentreCovariance(reference.value(), first.samples, sigma).diagonal().cwiseSqrt();
+  EXPECT_NEAR(bound.mean(), std::sqrt(3.0 / n) * sigma, 0.2 * std::sqrt(3.0 / n) * sigma);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero(), sum_squared = Eigen::Vector3d::Zero();
+  for (int seed = 0; seed < k; ++seed) {
+    const auto fit = FitEllipsoid(Make(n, sigma, 200 + static_cast<std::uint32_t>(seed)).samples);
+    ASSERT_TRUE(fit.ok());
+    sum += fit.value().centre;
+    sum_squared += fit.value().centre.cwiseProduct(fit.value().centre);
+  }
+  const Eigen::Vector3d spread = ((sum_squared - sum.cwiseProduct(sum) / k) / (k - 1)).cwiseSqrt();
+  const double tolerance = 3.0 / std::sqrt(2.0 * (k - 1));
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(spread[i] / bound[i], 1.0, tolerance) << i;
+
+  // A cap: the directions within 50 degrees of the distorted field's -z.
+  const Synthetic dense = Make(20 * n, sigma, 300);
+  std::vector<Eigen::Vector3d> cap;
+  for (const Eigen::Vector3d& z : dense.samples)
+    if ((dense.distortion.inverse() * (z - dense.centre)).normalized().z() < -std::cos(50.0 * M_PI / 180.0) &&
+        static_cast<int>(cap.size()) < n)
+      cap.push_back(z);
+  ASSERT_EQ(static_cast<int>(cap.size()), n);
+  EllipsoidFit truth;
+  truth.centre = dense.centre;
+  truth.radius = dense.radius;
+  truth.correction = dense.distortion.inverse();
+  const Eigen::Vector3d cap_bound = EllipsoidCentreCovariance(truth, cap, sigma).diagonal().cwiseSqrt();
+  EXPECT_GT(cap_bound.maxCoeff(), 10.0 * bound.maxCoeff());
+}
+
 TEST(EllipsoidFitTest, RefusesTooFewOrFlatSamples) {
   EXPECT_FALSE(FitEllipsoid(std::vector<Eigen::Vector3d>(5, Eigen::Vector3d::Ones())).ok());
   EXPECT_FALSE(FitEllipsoid(std::vector<Eigen::Vector3d>(20, Eigen::Vector3d::Ones())).ok());
