@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <deque>
 #include <limits>
 #include <map>
 #include <set>
@@ -360,6 +361,38 @@ Status EstimateParameters(const CalibrationOptions& options, const std::vector<s
   return Status::Ok();
 }
 
+// Poses per joint marginal covariance in EstimatePoseCovariances: each chunk's solves hold a dense block of the
+// problem's dimension times 6 columns per pose.
+constexpr std::size_t kPoseCovarianceChunk = 40;
+
+// The position covariance of every `every`-th pose, white and HAC, with the parameters that were free in some stage
+// still free (EstimateParameters leaves them so), chunk by chunk.
+Status EstimatePoseCovariances(int every, bool hac, const ProblemBuilder& builder, CalibrationResult* result) {
+  const std::deque<PoseNode>& poses = builder.poses();
+  std::vector<std::size_t> wanted;
+  for (std::size_t i = 0; i < poses.size(); i += static_cast<std::size_t>(every)) wanted.push_back(i);
+  for (std::size_t first = 0; first < wanted.size(); first += kPoseCovarianceChunk) {
+    const std::size_t last = std::min(wanted.size(), first + kPoseCovarianceChunk);
+    std::vector<VariableId> ids;
+    for (std::size_t k = first; k < last; ++k) ids.push_back(poses[wanted[k]].id);
+    auto info = ComputeMarginalInformation(builder.graph(), ids);
+    if (!info.ok()) return info.status();
+    const ObservabilityAnalysis white = AnalyzeObservability(info.value().information, info.value().conditional);
+    auto sandwich = ComputeHacCovariance(builder.graph(), ids, white.covariance);
+    if (!sandwich.ok()) return sandwich.status();
+    for (std::size_t k = first; k < last; ++k) {
+      const int offset = info.value().offsets[k - first];
+      PoseCovariance c;
+      c.pose = wanted[k];
+      c.white = white.covariance.block<3, 3>(offset, offset);
+      c.hac = sandwich.value().covariance.block<3, 3>(offset, offset);
+      c.covariance = hac && c.hac.trace() > c.white.trace() ? c.hac : c.white;
+      result->pose_covariances.push_back(c);
+    }
+  }
+  return Status::Ok();
+}
+
 // Every measurement factor's whitened residual at the final estimate, without the loss weighting.
 void KeepResiduals(const ProblemBuilder& builder, CalibrationResult* result) {
   for (const auto& [id, entry] : builder.graph().factors()) {
@@ -419,6 +452,10 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
   result.std_method = hac ? "hac" : "white";
   const Status estimated = EstimateParameters(options, stages, hac, &builder, workspace.get(), &result);
   if (!estimated.ok()) return estimated;
+  if (options.pose_covariance_every > 0) {
+    const Status poses = EstimatePoseCovariances(options.pose_covariance_every, hac, builder, &result);
+    if (!poses.ok()) return poses;
+  }
   if (options.keep_residuals) KeepResiduals(builder, &result);
   result.counts = builder.counts();
   result.trajectory = ExtractTrajectory(builder);

@@ -61,6 +61,18 @@ struct MeasurementResidual {
   bool active = true;        // false: gated out as an outlier
 };
 
+// The smoothed trajectory's uncertainty at one pose: its world-frame position covariance [m^2] with the calibrated
+// parameters free, white (the marginal covariance) and HAC (the Newey-West sandwich of ComputeHacCovariance, which
+// widens it when the residuals are autocorrelated: a wheel-aided track pulled for tens of seconds by slow GPS errors).
+// `covariance` is the chosen one, as ParameterEstimate::std: white, or (hac) the HAC one unless its trace is below the
+// white one's.
+struct PoseCovariance {
+  std::size_t pose = 0;  // index in CalibrationResult::trajectory
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d white = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d hac = Eigen::Matrix3d::Zero();
+};
+
 struct CalibrationResult {
   std::vector<ParameterEstimate> parameters;
   std::vector<Correlation> correlations;  // pairs of parameters with |rho| >= correlation_threshold
@@ -69,10 +81,11 @@ struct CalibrationResult {
   Eigen::MatrixXd information;
   std::vector<StageSummary> stages;
   std::map<std::string, StreamCounts> counts;
-  Trajectory trajectory;                       // the smoothed trajectory of the final estimate
-  std::vector<MeasurementResidual> residuals;  // with CalibrationOptions::keep_residuals, in factor id order
-  std::string std_method;                      // "white" or "hac": which one ParameterEstimate::std is
-  std::map<std::string, int> hac_lags;         // the HAC's truncation lag per stream (factor rows)
+  Trajectory trajectory;                         // the smoothed trajectory of the final estimate
+  std::vector<PoseCovariance> pose_covariances;  // with CalibrationOptions::pose_covariance_every, in pose order
+  std::vector<MeasurementResidual> residuals;    // with CalibrationOptions::keep_residuals, in factor id order
+  std::string std_method;                        // "white" or "hac": which one ParameterEstimate::std is
+  std::map<std::string, int> hac_lags;           // the HAC's truncation lag per stream (factor rows)
   double seconds = 0.0;
   // Totals over the stages.
   int iterations = 0;
@@ -91,6 +104,9 @@ struct CalibrationOptions {
   // motion replaces the configured values. Null: dead reckoning, then both alignments.
   const Trajectory* initial_trajectory = nullptr;
   bool analyze_observability = true;  // false: no marginal covariance (parameters get NaN std)
+  // > 0: the position covariance of every pose_covariance_every-th pose of the smoothed trajectory, from the first
+  // (CalibrationResult::pose_covariances; two sparse solves per chunk of poses, so thin a long recording out).
+  int pose_covariance_every = 0;
   // Which standard deviation is `std`: kAuto is kHac for imported recordings, kWhite for simulated ones.
   enum class StdMethod { kAuto, kWhite, kHac };
   StdMethod std_method = StdMethod::kAuto;

@@ -99,7 +99,8 @@ TEST(EllipsoidFitTest, CentreCovarianceMatchesTheSpreadOfFitsAndGrowsOnACap) {
   const Synthetic first = Make(n, sigma, 100);
   const auto reference = FitEllipsoid(first.samples);
   ASSERT_TRUE(reference.ok());
-  const Eigen::Vector3d bound = EllipsoidCentreCovariance(reference.value(), first.samples, sigma).diagonal().cwiseSqrt();
+  const Eigen::Vector3d bound =
+      EllipsoidCentreCovariance(reference.value(), first.samples, sigma).diagonal().cwiseSqrt();
   EXPECT_NEAR(bound.mean(), std::sqrt(3.0 / n) * sigma, 0.2 * std::sqrt(3.0 / n) * sigma);
   Eigen::Vector3d sum = Eigen::Vector3d::Zero(), sum_squared = Eigen::Vector3d::Zero();
   for (int seed = 0; seed < k; ++seed) {

@@ -7,7 +7,9 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <map>
+#include <random>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -36,6 +38,21 @@ std::map<std::string, Eigen::VectorXd> Values(const CalibrationResult& r) {
   return out;
 }
 
+// Each stream's active residuals' autocorrelation, in time order.
+std::map<std::string, ResidualAutocorrelation> Autocorrelations(const CalibrationResult& r) {
+  std::map<std::string, std::vector<const MeasurementResidual*>> streams;
+  for (const MeasurementResidual& m : r.residuals)
+    if (m.active) streams[m.stream].push_back(&m);
+  std::map<std::string, ResidualAutocorrelation> out;
+  for (auto& [stream, rows] : streams) {
+    std::stable_sort(rows.begin(), rows.end(), [](const auto* x, const auto* y) { return x->t < y->t; });
+    std::vector<Eigen::VectorXd> series;
+    for (const MeasurementResidual* m : rows) series.push_back(m->whitened);
+    out[stream] = AnalyzeAutocorrelation(series);
+  }
+  return out;
+}
+
 // Each parameter with its white and HAC standard deviations (`std` is the HAC one on an imported recording).
 void Print(const CalibrationResult& r) {
   for (const ParameterEstimate& p : r.parameters) {
@@ -47,17 +64,37 @@ void Print(const CalibrationResult& r) {
   std::cout << ")\n";
   // Each stream's integrated residual autocorrelation time: how many times a white variance understates the spread
   // of a mean over that stream (what the tracked positions' std, white, would need for the GPS stream).
-  std::map<std::string, std::vector<const MeasurementResidual*>> streams;
-  for (const MeasurementResidual& m : r.residuals)
-    if (m.active) streams[m.stream].push_back(&m);
-  for (auto& [stream, rows] : streams) {
-    std::stable_sort(rows.begin(), rows.end(), [](const auto* x, const auto* y) { return x->t < y->t; });
-    std::vector<Eigen::VectorXd> series;
-    for (const MeasurementResidual* m : rows) series.push_back(m->whitened);
-    const ResidualAutocorrelation a = AnalyzeAutocorrelation(series);
+  for (const auto& [stream, a] : Autocorrelations(r)) {
     std::cout << "  " << stream << ": integrated residual autocorrelation time " << a.integrated_time << " (lag "
               << a.lag << "), std inflation sqrt = " << std::sqrt(a.integrated_time) << "\n";
   }
+}
+
+// The spread (std per component) of the ellipsoid fit's centre over `replicates` moving-block bootstrap resamples of
+// `samples` (blocks of `block` consecutive samples drawn with replacement; fixed seed). Resamples whose fit fails are
+// left out and counted on the output.
+Eigen::Vector3d BlockBootstrapCentreStd(const std::vector<Eigen::Vector3d>& samples, std::size_t block,
+                                        int replicates) {
+  std::mt19937 rng(39);
+  std::uniform_int_distribution<std::size_t> start(0, samples.size() - block);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero(), sum_squared = Eigen::Vector3d::Zero();
+  int fitted = 0;
+  for (int r = 0; r < replicates; ++r) {
+    std::vector<Eigen::Vector3d> resample;
+    while (resample.size() < samples.size()) {
+      const std::size_t first = start(rng);
+      resample.insert(resample.end(), samples.begin() + static_cast<std::ptrdiff_t>(first),
+                      samples.begin() + static_cast<std::ptrdiff_t>(first + block));
+    }
+    const auto fit = eval::FitEllipsoid(resample);
+    if (!fit.ok()) continue;
+    sum += fit.value().centre;
+    sum_squared += fit.value().centre.cwiseProduct(fit.value().centre);
+    ++fitted;
+  }
+  std::cout << "block bootstrap: " << fitted << " of " << replicates << " resamples fitted\n";
+  if (fitted < 2) return Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  return ((sum_squared - sum.cwiseProduct(sum) / fitted) / (fitted - 1)).cwiseMax(0.0).cwiseSqrt();
 }
 
 // A run's track of the GPS antenna (the pose moved by the calibrated lever arm) with its position covariance.
@@ -78,18 +115,90 @@ AntennaTrack Antenna(const TrackingResult& track, const Eigen::Vector3d& lever_a
   return out;
 }
 
-Result<TrackingResult> CalibrateAndTrack(const std::string& config_file, const recording::Recording& rec,
-                                         CalibrationResult* calibration) {
+// The smoothed trajectory of a calibration at the poses whose covariance it computed (the antenna at the body
+// origin), with the chosen (white or HAC) covariance, or the white one.
+AntennaTrack Smoothed(const CalibrationResult& calibration, bool white) {
+  AntennaTrack out;
+  for (const PoseCovariance& c : calibration.pose_covariances) {
+    out.t.push_back(calibration.trajectory[c.pose].t);
+    out.p.push_back(calibration.trajectory[c.pose].p_world_body);
+    out.covariance.push_back(white ? c.white : c.covariance);
+  }
+  return out;
+}
+
+// The 3-sigma region of a 2-D Gaussian: the chi-square(2) quantile of 0.9973, -2 ln(0.0027) = 11.83.
+constexpr double kThreeSigma2d = 11.83;
+
+// The fraction of the reference's poses at which `track` (interpolated linearly in time; its nearest pose's
+// covariance) lies inside the combined horizontal 3-sigma region. Both runs read the same GPS, so their errors are
+// positively correlated and the sum of the covariances overstates the difference's: the test is conservative in that.
+double WithinThreeSigma(const AntennaTrack& track, const AntennaTrack& reference, const char* name) {
+  int compared = 0, within = 0;
+  double sum_difference = 0.0, max_difference = 0.0, sum_std_track = 0.0, sum_std_reference = 0.0;
+  for (std::size_t i = 0; i < reference.t.size(); ++i) {
+    const auto after = std::lower_bound(track.t.begin(), track.t.end(), reference.t[i]);
+    if (after == track.t.begin() || after == track.t.end()) continue;
+    const std::size_t j = static_cast<std::size_t>(after - track.t.begin());
+    const double w = SecondsBetween(track.t[j - 1], reference.t[i]) / SecondsBetween(track.t[j - 1], track.t[j]);
+    const Eigen::Vector2d d = (reference.p[i] - ((1.0 - w) * track.p[j - 1] + w * track.p[j])).head<2>();
+    const Eigen::Matrix2d c_track = track.covariance[w < 0.5 ? j - 1 : j].topLeftCorner<2, 2>();
+    const Eigen::Matrix2d c_reference = reference.covariance[i].topLeftCorner<2, 2>();
+    within += d.dot((c_track + c_reference).ldlt().solve(d)) <= kThreeSigma2d ? 1 : 0;
+    ++compared;
+    sum_difference += d.norm();
+    max_difference = std::max(max_difference, d.norm());
+    sum_std_track += std::sqrt(c_track.trace());
+    sum_std_reference += std::sqrt(c_reference.trace());
+  }
+  const double fraction = static_cast<double>(within) / std::max(compared, 1);
+  std::cout << name << ": " << compared << " poses compared; horizontal difference mean " << sum_difference / compared
+            << " m, max " << max_difference << " m; reported horizontal std mean: IMU+GPS " << sum_std_track / compared
+            << " m, wheel-aided " << sum_std_reference / compared << " m; within the 3-sigma region "
+            << 100.0 * fraction << "%\n";
+  return fraction;
+}
+
+// The fraction of the GPS fixes inside a track's horizontal 3-sigma region: its distance from each fix, normalized by
+// its own reported covariance (nearest pose at or after the fix) plus the fix's configured noise (1.2 m per axis in
+// both configurations).
+double AgainstFixes(const recording::Recording& rec, const AntennaTrack& track, const char* name) {
+  const recording::Stream& gps = *rec.Find("gps");
+  const EnuConverter enu(*rec.origin);
+  double sum = 0.0;
+  int n = 0, inside = 0;
+  for (std::size_t r = 0; r < gps.t.size(); ++r) {
+    const auto it = std::lower_bound(track.t.begin(), track.t.end(), gps.t[r]);
+    if (it == track.t.end()) continue;
+    const std::size_t k = static_cast<std::size_t>(it - track.t.begin());
+    const auto row = static_cast<Eigen::Index>(r);
+    const Eigen::Vector3d z = enu.ToEnu(gps.values(row, 0), gps.values(row, 1), gps.values(row, 2));
+    const Eigen::Vector2d d = (track.p[k] - z).head<2>();
+    const Eigen::Matrix2d c = track.covariance[k].topLeftCorner<2, 2>() + 1.2 * 1.2 * Eigen::Matrix2d::Identity();
+    inside += d.dot(c.ldlt().solve(d)) <= kThreeSigma2d ? 1 : 0;
+    sum += d.squaredNorm();
+    ++n;
+  }
+  std::cout << name << " against the GPS fixes: rms horizontal distance " << std::sqrt(sum / n)
+            << " m, within the 3-sigma region " << 100.0 * inside / n << "% of " << n << " fixes\n";
+  return static_cast<double>(inside) / n;
+}
+
+Result<CalibrationResult> CalibrateWith(const std::string& config_file, const recording::Recording& rec,
+                                        int pose_covariance_every) {
   auto config = LoadEstimatorConfig(config_file);
   if (!config.ok()) return config.status();
   CalibrationOptions options;
   options.keep_residuals = true;
-  auto calibrated = Calibrate(config.value(), rec, options);
-  if (!calibrated.ok()) return calibrated.status();
-  *calibration = calibrated.value();
-  return Track(config.value(), rec, Values(*calibration));
+  options.pose_covariance_every = pose_covariance_every;
+  return Calibrate(config.value(), rec, options);
 }
 
+// The IMU + GPS run (configs/real/husky_imu_gps.yaml) tracked with its calibration, against the GPS fixes and against
+// the wheel-odometry-aided calibration's smoothed track (configs/real/husky_nominal.yaml). The reference's
+// covariance is the HAC one: its residuals are autocorrelated over tens of seconds (the skid steer's wheel speeds
+// against a lagged, mis-scaled turn; the fixes' slow errors), and its white covariance understates how far the track
+// strays from the fixes several times.
 TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedTrack) {
   const std::string bag = kData + "/husky_test1/test1.bag";
   if (!std::filesystem::exists(bag)) GTEST_SKIP() << "real data absent: " << bag;
@@ -103,79 +212,51 @@ TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedT
       imu_gps.streams.end());
   ASSERT_EQ(imu_gps.streams.size(), 2u);
 
-  CalibrationResult wheel_calibration, imu_calibration;
-  auto wheel = CalibrateAndTrack(kConfigs + "husky_nominal.yaml", rec.value(), &wheel_calibration);
+  // Every 10th pose of the wheel-aided run (one a second) gets its covariance.
+  auto wheel = CalibrateWith(kConfigs + "husky_nominal.yaml", rec.value(), 10);
   ASSERT_TRUE(wheel.ok()) << wheel.status().message();
-  auto imu = CalibrateAndTrack(kConfigs + "husky_imu_gps.yaml", imu_gps, &imu_calibration);
-  ASSERT_TRUE(imu.ok()) << imu.status().message();
+  auto imu_calibration = CalibrateWith(kConfigs + "husky_imu_gps.yaml", imu_gps, 0);
+  ASSERT_TRUE(imu_calibration.ok()) << imu_calibration.status().message();
   std::cout << "wheel-odometry-aided calibration:\n";
-  Print(wheel_calibration);
+  Print(wheel.value());
   std::cout << "IMU + GPS calibration:\n";
-  Print(imu_calibration);
-  for (const ParameterEstimate& p : imu_calibration.parameters)
+  Print(imu_calibration.value());
+  for (const ParameterEstimate& p : imu_calibration.value().parameters)
     for (int i = 0; i < p.std.size(); ++i) EXPECT_TRUE(std::isfinite(p.std[i])) << p.name << "[" << i << "]";
+  auto config = LoadEstimatorConfig(kConfigs + "husky_imu_gps.yaml");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  auto imu = Track(config.value(), imu_gps, Values(imu_calibration.value()));
+  ASSERT_TRUE(imu.ok()) << imu.status().message();
 
-  // Horizontal antenna positions at the IMU run's poses, the wheel run's interpolated linearly, with each run's
-  // reported covariance (the wheel run's nearest pose's). Both runs read the same GPS, so their errors are positively
-  // correlated and the sum of the covariances overstates the difference's: the test is conservative in that.
-  const AntennaTrack a = Antenna(imu.value(), Values(imu_calibration).at("gps.lever_arm"));
-  const AntennaTrack b = Antenna(wheel.value(), Eigen::Vector3d::Zero());
-  int compared = 0, within = 0;
-  double max_difference = 0.0, sum_difference = 0.0, sum_std_imu = 0.0, sum_std_wheel = 0.0, max_mahalanobis = 0.0;
-  for (std::size_t i = 0; i < a.t.size(); ++i) {
-    const auto after = std::lower_bound(b.t.begin(), b.t.end(), a.t[i]);
-    if (after == b.t.begin() || after == b.t.end()) continue;
-    const std::size_t j = static_cast<std::size_t>(after - b.t.begin());
-    const double w = SecondsBetween(b.t[j - 1], a.t[i]) / SecondsBetween(b.t[j - 1], b.t[j]);
-    const Eigen::Vector2d d = (a.p[i] - ((1.0 - w) * b.p[j - 1] + w * b.p[j])).head<2>();
-    const Eigen::Matrix2d c_imu = a.covariance[i].topLeftCorner<2, 2>();
-    const Eigen::Matrix2d c_wheel = b.covariance[w < 0.5 ? j - 1 : j].topLeftCorner<2, 2>();
-    const double m2 = d.dot((c_imu + c_wheel).ldlt().solve(d));
-    // The 3-sigma region of a 2-D Gaussian: the chi-square(2) quantile of 0.9973, -2 ln(0.0027) = 11.83.
-    within += m2 <= 11.83 ? 1 : 0;
-    ++compared;
-    max_difference = std::max(max_difference, d.norm());
-    max_mahalanobis = std::max(max_mahalanobis, std::sqrt(m2));
-    sum_difference += d.norm();
-    sum_std_imu += std::sqrt(c_imu.trace());
-    sum_std_wheel += std::sqrt(c_wheel.trace());
+  const AntennaTrack track = Antenna(imu.value(), Values(imu_calibration.value()).at("gps.lever_arm"));
+  const AntennaTrack reference = Smoothed(wheel.value(), false);
+  const AntennaTrack reference_white = Smoothed(wheel.value(), true);
+  ASSERT_GT(reference.t.size(), 300u);
+  const double imu_consistent = AgainstFixes(rec.value(), track, "IMU+GPS track");
+  AgainstFixes(rec.value(), reference_white, "wheel-aided smoothed track, white covariance");
+  AgainstFixes(rec.value(), reference, "wheel-aided smoothed track, HAC covariance");
+  WithinThreeSigma(track, reference_white, "IMU+GPS track against the wheel-aided track, white covariance");
+  WithinThreeSigma(track, reference, "IMU+GPS track against the wheel-aided track, HAC");
+  // The HAC covariance of the smoothed positions widens the white one by about the square root of the GPS residuals'
+  // integrated autocorrelation time (the fixes place the stiff wheel-aided track, and their errors are correlated
+  // over tens of seconds): within a factor of 2 of it.
+  double sum_white = 0.0, sum_hac = 0.0;
+  for (const PoseCovariance& c : wheel.value().pose_covariances) {
+    sum_white += std::sqrt(c.white.topLeftCorner<2, 2>().trace());
+    sum_hac += std::sqrt(c.hac.topLeftCorner<2, 2>().trace());
   }
-  ASSERT_GT(compared, 1000);
-  const double fraction = static_cast<double>(within) / compared;
-  std::cout << "Husky: " << compared << " poses compared; horizontal antenna difference mean "
-            << sum_difference / compared << " m, max " << max_difference << " m; reported horizontal std mean: IMU+GPS "
-            << sum_std_imu / compared << " m, wheel-aided " << sum_std_wheel / compared
-            << " m; within the 3-sigma region: " << 100.0 * fraction << "% (max Mahalanobis " << max_mahalanobis
-            << ")\n";
-  // Each run against the GPS fixes it read: the horizontal distance of its antenna from each fix, normalized by its
-  // own reported covariance plus the fix's configured noise (1.2 m per axis in both configurations).
-  const recording::Stream& gps = *rec.value().Find("gps");
-  const EnuConverter enu(*rec.value().origin);
-  const auto against_fixes = [&](const AntennaTrack& track, const char* name) {
-    double sum = 0.0;
-    int n = 0, inside = 0;
-    for (std::size_t r = 0; r < gps.t.size(); ++r) {
-      const auto it = std::lower_bound(track.t.begin(), track.t.end(), gps.t[r]);
-      if (it == track.t.end()) continue;
-      const std::size_t k = static_cast<std::size_t>(it - track.t.begin());
-      const auto row = static_cast<Eigen::Index>(r);
-      const Eigen::Vector3d z = enu.ToEnu(gps.values(row, 0), gps.values(row, 1), gps.values(row, 2));
-      const Eigen::Vector2d d = (track.p[k] - z).head<2>();
-      const Eigen::Matrix2d c = track.covariance[k].topLeftCorner<2, 2>() + 1.2 * 1.2 * Eigen::Matrix2d::Identity();
-      inside += d.dot(c.ldlt().solve(d)) <= 11.83 ? 1 : 0;
-      sum += d.squaredNorm();
-      ++n;
-    }
-    std::cout << name << " track against the GPS fixes: rms horizontal distance " << std::sqrt(sum / n)
-              << " m, within the 3-sigma region " << 100.0 * inside / n << "% of " << n << " fixes\n";
-    return static_cast<double>(inside) / n;
-  };
-  const double imu_consistent = against_fixes(a, "IMU+GPS");
-  against_fixes(b, "wheel-aided");
+  const double inflation = sum_hac / sum_white;
+  const double expected = std::sqrt(Autocorrelations(wheel.value()).at("gps").integrated_time);
+  std::cout << "wheel-aided smoothed positions: horizontal std HAC / white " << inflation << ", sqrt(GPS integrated "
+            << "autocorrelation time) " << expected << "\n";
+  EXPECT_GT(inflation, 0.5 * expected);
+  EXPECT_LT(inflation, 2.0 * expected);
   // The IMU+GPS track is consistent with the fixes: at most the 0.27% a 3-sigma region leaves out, with a margin for
-  // the fixes' correlated errors. The comparison with the wheel-aided track above is reported, not asserted: that run
-  // strays from the same fixes by more than its own reported std allows (its rms distance and fraction printed
-  // here), so the difference measures the reference's inconsistency as much as this track's.
+  // the fixes' correlated errors. The comparison with the wheel-aided track is reported, not asserted: with the HAC
+  // covariance the wheel-aided track is honest against the fixes (the fixes' own 1.2 m dominate that test), but it is
+  // farther from them than the IMU+GPS track is, and the two tracks differ by more than their combined covariances
+  // allow at many poses (docs/results.md): the skid steer's model (its turn's scale and the odometry's lag) is what
+  // the reference lacks.
   EXPECT_GE(imu_consistent, 0.99);
 }
 
@@ -220,6 +301,16 @@ TEST(ImuMasterRealTest, XioMagnetometerCalibrationAgainstTheEllipsoidFit) {
                 << "] uT, radius " << half_fit.value().radius << " uT\n";
     }
   }
+  // How well the log's samples determine any ellipsoid's centre: the Cramer-Rao bound at the fit (white noise of the
+  // fit's rms residual along the normal), and a moving-block bootstrap (blocks of 1 s of samples, which keeps the
+  // samples' correlation in time within each block; 200 replicates, fixed seed).
+  const Eigen::Vector3d bound =
+      eval::EllipsoidCentreCovariance(fit.value(), raw, fit.value().rms_residual).diagonal().cwiseSqrt();
+  const double seconds = SecondsBetween(magnetometer->t.front(), magnetometer->t.back());
+  const auto block = static_cast<std::size_t>(std::ceil(static_cast<double>(raw.size()) / seconds));
+  const Eigen::Vector3d bootstrap = BlockBootstrapCentreStd(raw, block, 200);
+  std::cout << "ellipsoid fit's centre std: Cramer-Rao [" << bound.transpose() << "] uT; block bootstrap (" << block
+            << " samples a block) [" << bootstrap.transpose() << "] uT\n";
   double sum_sin_dip = 0.0;
   for (std::size_t i = 0; i < raw.size(); ++i) {
     const Eigen::Vector3d h = fit.value().correction * (raw[i] - fit.value().centre);
@@ -276,6 +367,18 @@ TEST(ImuMasterRealTest, XioMagnetometerCalibrationAgainstTheEllipsoidFit) {
   // configured magnitude to within twice the configured noise (the radial part of an isotropic noise sigma has rms
   // sigma; uncalibrated, A = I and b = 0, the rms printed above is several times that).
   EXPECT_TRUE(fit.value().constrained);
+  // How far the log is from deciding the comparison: with white noise the samples would pin the centre down to about
+  // the 0.5 uT asked (the Cramer-Rao bound printed above), but the resamples that keep 1 s of the samples' time
+  // correlation spread the fit's centre 4 times that tolerance or more in some component, and the estimator's own
+  // reported (HAC) std of b exceeds the tolerance in every component: the difference of the two is not measurable to
+  // 0.5 uT on this log.
+  constexpr double kTolerance = 0.5;  // uT: the hard-iron agreement asked of the two
+  EXPECT_GT(bootstrap.maxCoeff(), 4.0 * kTolerance);
+  for (const ParameterEstimate& p : result.value().parameters) {
+    if (p.name == "mag.b") {
+      EXPECT_GT(p.std.minCoeff(), kTolerance);
+    }
+  }
   EXPECT_LT(estimator_rms, 2.0 * config.value().streams.at("mag").noise.at("sigma"));
   EXPECT_TRUE(b.allFinite() && A.allFinite());
 }
