@@ -7,18 +7,33 @@
 # Everything (configuration, munge key and socket, state, spool, logs, pid files) lives under LOCAL_SLURM_DIR
 # (default /tmp/roamlab-slurm); nothing under /etc is written. Clients find the cluster through
 # SLURM_CONF=LOCAL_SLURM_DIR/slurm.conf, which `start` prints. Needs root (slurmd starts jobs as their user) and the
-# Debian packages slurm-wlm and munge (scripts/setup.sh installs them). LOCAL_SLURM_PORT (default 6817) is
-# slurmctld's port, slurmd's the next one.
+# Debian packages slurm-wlm and munge (scripts/setup.sh installs them). slurmctld listens on LOCAL_SLURM_PORT, slurmd
+# on the next port; by default the first pair from 6817 on (6817, 6819, ...) where nothing listens yet, so that a second
+# cluster on the same network (another checkout's, or a chroot's on this host) does not clash with the first.
 set -euo pipefail
 
 dir=${LOCAL_SLURM_DIR:-/tmp/roamlab-slurm}
-port=${LOCAL_SLURM_PORT:-6817}
 conf=$dir/slurm.conf
 
 die() {
   echo "local-slurm: $*" >&2
   [ "${started:-0}" = 1 ] && { started=0; stop >/dev/null 2>&1 || true; }
   exit 1
+}
+
+# Whether something listens on 127.0.0.1:$1.
+listening() { (exec 3<>"/dev/tcp/127.0.0.1/$1") 2>/dev/null; }
+
+# Sets `port`: LOCAL_SLURM_PORT, or the first pair of free ports from 6817 on.
+choose_port() {
+  if [ -n "${LOCAL_SLURM_PORT:-}" ]; then
+    port=$LOCAL_SLURM_PORT
+    return 0
+  fi
+  for port in $(seq 6817 2 6915); do
+    listening "$port" || listening $((port + 1)) || return 0
+  done
+  die "no free pair of ports in 6817-6916 (set LOCAL_SLURM_PORT)"
 }
 
 write_conf() {
@@ -62,6 +77,14 @@ KillWait=5
 $node_line NodeAddr=127.0.0.1 State=UNKNOWN
 PartitionName=debug Nodes=$host Default=YES MaxTime=INFINITE State=UP
 EOF
+  # slurmd loads a cgroup plugin even though no plugin above uses cgroups, and its automatic choice fails where no
+  # cgroup file system is mounted on /sys/fs/cgroup (a chroot that bind-mounts /sys alone, as a fresh CI root does);
+  # the cgroup/v1 plugin loads without one.
+  rm -f "$dir/cgroup.conf"
+  case "$(stat -fc %T /sys/fs/cgroup 2>/dev/null)" in
+    tmpfs | cgroup2fs) ;;
+    *) echo "CgroupPlugin=cgroup/v1" >"$dir/cgroup.conf" ;;
+  esac
 }
 
 start_munge() {
@@ -93,6 +116,7 @@ start() {
   fi
   local t0=$SECONDS
   mkdir -p "$dir/state" "$dir/spool"
+  choose_port
   write_conf
   # From here a daemon that does not come up stops the others (die), so that no port stays taken.
   started=1
