@@ -155,7 +155,7 @@ CaseResult RunCase(const Case& c, const std::string& out_dir, int jobs) {
     if (ec) {
       result.error = dir + ": cannot create the case directory: " + ec.message();
     } else {
-      const Status st = mode.run(CaseContext{c, dir, jobs});
+      const Status st = FindModeRunner(c.mode)(CaseContext{c, dir, jobs});
       if (!st.ok()) result.error = st.message();
     }
   }

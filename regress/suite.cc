@@ -13,7 +13,7 @@
 #include "common/yaml_keys.h"
 #include "estimator/calibration_io.h"
 #include "estimator/config.h"
-#include "regress/modes.h"
+#include "regress/mode_specs.h"
 #include "sim/scenario.h"
 
 namespace roamlab::regress {
@@ -21,6 +21,10 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+
+// Bound, time and effect numbers beyond this magnitude are refused as no physical value (as in scenarios).
+constexpr double kMaxSuiteNumber = 1e9;
+bool InRange(double x) { return std::isfinite(x) && std::abs(x) <= kMaxSuiteNumber; }
 
 const char* const kReductions[] = {"norm", "max_abs", "min", "max", "mean"};
 
@@ -328,11 +332,10 @@ Result<const ModeSpec*> LoadNameAndMode(const YAML::Node& node, Context* ctx, st
     return ctx->Error(node["name"], "a case name may only hold letters, digits, '_', '-' and '.'");
   if (!seen->insert(c->name).second) return ctx->Error(node["name"], "a second case of this name");
 
-  if (!node["mode"] || !node["mode"].IsScalar()) return ctx->Error(node, "no 'mode' (" + AvailableModeNames() + ")");
+  if (!node["mode"] || !node["mode"].IsScalar()) return ctx->Error(node, "no 'mode' (" + ModeNames() + ")");
   c->mode = node["mode"].as<std::string>();
   const ModeSpec* mode = FindMode(c->mode);
-  if (!mode) return ctx->Error(node["mode"], "unknown mode '" + c->mode + "' (" + AvailableModeNames() + ")");
-  if (!mode->run) return ctx->Error(node["mode"], "mode " + c->mode + " is not available in this build");
+  if (!mode) return ctx->Error(node["mode"], "unknown mode '" + c->mode + "' (" + ModeNames() + ")");
   return mode;
 }
 
@@ -390,7 +393,9 @@ Status LoadValues(const YAML::Node& node, const Context& ctx, const std::string&
     return ctx.Error(node, std::string("malformed value: ") + e.msg);
   }
   if (node["runs"] && c->runs < 1) return ctx.Error(node["runs"], "runs must be at least 1");
-  if (c->interval_s && !(*c->interval_s > 0.0)) return ctx.Error(node["interval_s"], "interval_s must be positive");
+  if (c->t0_s && !InRange(*c->t0_s)) return ctx.Error(node["t0_s"], "t0_s must be finite, |t0_s| <= 1e9");
+  if (c->interval_s && !(*c->interval_s > 0.0 && InRange(*c->interval_s)))
+    return ctx.Error(node["interval_s"], "interval_s must be positive and at most 1e9");
   return Status::Ok();
 }
 
@@ -418,6 +423,8 @@ Status LoadEffects(const YAML::Node& effects, const Context& ctx, Case* c) {
       } catch (const YAML::Exception&) {
         return ctx.Error(entry.second, "effect parameter " + key + " is not a number");
       }
+      if (!InRange(parameters[key]))
+        return ctx.Error(entry.second, "effect parameter " + key + " is beyond any physical value (|value| <= 1e9)");
     }
     c->effects.emplace_back(name, parameters);
   }
@@ -623,6 +630,7 @@ Result<Bound> ParseBound(const std::string& text) {
   std::optional<double> first = s.Number();
   if (negative && !first) return Status::Error(prefix + "expected a number after '-'");
   if (first && negative) first = -*first;
+  if (first && !InRange(*first)) return Status::Error(prefix + "a number beyond any metric (|value| <= 1e9)");
   if (first && !s.Accept("*")) {
     b.offset = *first;
     if (!s.AtEnd()) return Status::Error(prefix + "unexpected '" + s.Rest() + "' after the number");
@@ -644,6 +652,7 @@ Result<Bound> ParseBound(const std::string& text) {
   if (!plus && !s.Accept("-")) return Status::Error(prefix + "unexpected '" + s.Rest() + "' after '" + reference + "'");
   const std::optional<double> d = s.Number();
   if (!d) return Status::Error(prefix + "expected a number after '" + (plus ? "+" : "-") + "'");
+  if (!InRange(*d)) return Status::Error(prefix + "a number beyond any metric (|value| <= 1e9)");
   b.offset = plus ? *d : -*d;
   if (!s.AtEnd()) return Status::Error(prefix + "unexpected '" + s.Rest() + "' at the end");
   return b;

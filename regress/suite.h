@@ -5,7 +5,7 @@
 //   baseline: regression_baseline       # optional baseline directory, relative to the suite file
 //   cases:
 //     - name: atv_calibration           # [A-Za-z0-9_.-]+, unique: names the case's output and baseline files
-//       mode: calibrate                 # one of the modes of regress/modes.h (its keys are listed there)
+//       mode: calibrate                 # one of the modes of regress/mode_specs.h (its keys are listed there)
 //       quick: true                     # in the quick subset (`--quick`); default false
 //       data: data/optiodom             # optional: a directory the case needs (real data); when it is absent the
 //                                       # case is skipped (reported as skipped with this path, never as passed)
@@ -32,7 +32,8 @@
 //
 // A numeric metric takes a bound: a comparator and a threshold:  CMP [-]NUMBER | CMP [K *] REF [(+|-) D]  with CMP
 // one of <=, <, >=, >; REF is `baseline` (the metric's value stored in the baseline directory) or another numeric
-// metric path of the same case (its value in this run); the threshold is K * REF + D. A string metric (gap.verdict,
+// metric path of the same case (its value in this run); the threshold is K * REF + D. Every number of a bound, like
+// t0_s, interval_s and effect parameters, is finite and within +-1e9. A string metric (gap.verdict,
 // a selected row's name) takes `equals: TEXT` instead (a bound on it, or `equals` on a number, is refused).
 //
 // `open: REASON` marks a target that is known not to be met yet (with the reason): the check is

@@ -6,6 +6,7 @@
 #   FUZZ_RUNS      when set: this many executions per harness instead of a time (-runs)
 #   FUZZERS        the harnesses to run (space-separated), default all
 #   JOBS           build parallelism, default the number of cores
+#   FUZZ_BUILD     0: run the harnesses already built in BUILD_DIR (no configure, no build), default 1
 #   ROAMLAB_DATA_DIR  real recordings to cut small seed excerpts from (default: the data directory the tests read,
 #                     ROAMLAB_SHARED_DIR/data in tests/CMakeLists.txt; skipped when absent)
 #   ROAMLAB        the command line that simulates the recording seeds (default build/apps/roamlab, the Release build
@@ -24,9 +25,11 @@ data_dir=${ROAMLAB_DATA_DIR:-../shared/data}
 
 command -v clang++ >/dev/null || { echo "roamlab fuzz: clang++ not found (scripts/setup.sh installs clang)" >&2; exit 1; }
 start=$(date +%s)
-CC=clang CXX=clang++ cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DROAMLAB_SANITIZE=ON \
-  -DROAMLAB_FUZZ=ON >/dev/null
-cmake --build "$build_dir" -j "${JOBS:-$(nproc)}" --target fuzz_seeds "${fuzzers[@]}"
+if [ "${FUZZ_BUILD:-1}" != 0 ]; then
+  CC=clang CXX=clang++ cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DROAMLAB_SANITIZE=ON \
+    -DROAMLAB_FUZZ=ON >/dev/null
+  cmake --build "$build_dir" -j "${JOBS:-$(nproc)}" --target fuzz_seeds "${fuzzers[@]}"
+fi
 built=$(date +%s)
 
 work="$build_dir/fuzz"
@@ -37,7 +40,7 @@ mkdir -p "$seeds" "$work/artifacts"
 mkdir -p "$seeds/scenario_fuzz" "$seeds/estimator_config_fuzz" "$seeds/regress_suite_fuzz"
 cp scenarios/*.yaml "$seeds/scenario_fuzz/"
 cp configs/*.yaml "$seeds/estimator_config_fuzz/"
-cp regression/suite.yaml "$seeds/regress_suite_fuzz/"
+cp regression/*.yaml "$seeds/regress_suite_fuzz/"
 # Simulated recordings, each file cut to its first 12 lines, packed as recording_fuzz reads them.
 roamlab=${ROAMLAB:-build/apps/roamlab}
 if [ -x "$roamlab" ]; then

@@ -3,7 +3,8 @@
 # UndefinedBehaviorSanitizer (clang; any finding fails the test) into BUILD_DIR and runs them (none of them carries the
 # ctest label slow). The build is shared with scripts/fuzz.sh. docs/reliability.md gives the times.
 #   BUILD_DIR  default build-asan
-#   TESTS      the test binaries (space-separated), default the list below
+#   TESTS      the test binaries (space-separated), default the list below; `fast`: the whole tree, and every ctest
+#              test without the label slow or slurm (the fast suite of scripts/run-tests.sh)
 #   JOBS       build and test parallelism, default the number of cores
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -17,11 +18,22 @@ command -v clang++ >/dev/null || { echo "roamlab sanitize: clang++ not found (sc
 start=$(date +%s)
 CC=clang CXX=clang++ cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DROAMLAB_SANITIZE=ON \
   -DROAMLAB_FUZZ=ON >/dev/null
-cmake --build "$build_dir" -j "$jobs" --target "${tests[@]}"
-built=$(date +%s)
 # Leaks are errors; a finding stops the test with its report (ASAN_OPTIONS / UBSAN_OPTIONS).
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:strict_string_checks=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+if [ "${tests[*]}" = fast ]; then
+  cmake --build "$build_dir" -j "$jobs"
+  built=$(date +%s)
+  status=0
+  ctest --test-dir "$build_dir" -LE 'slow|slurm' -j "$jobs" --output-on-failure \
+    --output-junit "$(cd "$build_dir" && pwd)/sanitize-junit.xml" >"$build_dir/fast.sanitize.log" 2>&1 || status=$?
+  grep -E '^[0-9]+% tests passed|\(Failed\)|\(Timeout\)|Exception' "$build_dir/fast.sanitize.log" || true
+  echo "roamlab sanitize: build $((built - start)) s, tests $(($(date +%s) - built)) s (log $build_dir/fast.sanitize.log)"
+  [ "$status" = 0 ] || { echo "roamlab sanitize: failed (ctest exit $status)" >&2; exit 1; }
+  exit 0
+fi
+cmake --build "$build_dir" -j "$jobs" --target "${tests[@]}"
+built=$(date +%s)
 failed=()
 for t in "${tests[@]}"; do
   binary=$(find "$build_dir/tests" -type f -name "$t" | head -n 1)

@@ -48,13 +48,6 @@ double BicycleEquivalentAngle(double left_rad, double right_rad) {
   return std::atan(2.0 * tl * tr / (tl + tr));
 }
 
-std::string SpeedControllerOptions::Validate() const {
-  if (!(std::isfinite(kp_nm_per_mps) && kp_nm_per_mps > 0.0)) return "kp_nm_per_mps: must be > 0";
-  if (!(std::isfinite(ki_nm_per_m) && ki_nm_per_m >= 0.0)) return "ki_nm_per_m: must be >= 0";
-  if (!(std::isfinite(torque_limit_nm) && torque_limit_nm > 0.0)) return "torque_limit_nm: must be > 0";
-  return "";
-}
-
 double SpeedController::Update(double setpoint_mps, double measured_mps, double dt_s) {
   const double error = setpoint_mps - measured_mps;
   const double limit = options_.torque_limit_nm;

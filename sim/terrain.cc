@@ -11,35 +11,12 @@ namespace roamlab::sim {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr int kMaxSamplesPerSide = 4001;
 constexpr double kBaseThicknessM = 1.0;  // solid ground under the lowest point of the heightfield
 
 // Uniform in [0, 1) from the top 53 bits: the same sequence on every standard library.
 double Uniform(std::mt19937_64& generator) { return static_cast<double>(generator() >> 11) * 0x1.0p-53; }
 
-int SamplesAlong(double size_m, double resolution_m) {
-  return static_cast<int>(std::llround(size_m / resolution_m)) + 1;
-}
-
 }  // namespace
-
-std::string TerrainOptions::Validate() const {
-  const auto finite = [](double x) { return std::isfinite(x); };
-  if (!(finite(friction) && friction > 0.0)) return "friction: must be > 0";
-  if (type == Type::kFlat) return "";
-  if (!(size_m.allFinite() && size_m.minCoeff() > 0.0)) return "size_m: both extents must be > 0";
-  if (!(finite(resolution_m) && resolution_m > 0.0)) return "resolution_m: must be > 0";
-  if (SamplesAlong(size_m.maxCoeff(), resolution_m) > kMaxSamplesPerSide)
-    return "resolution_m: too fine for size_m (at most " + std::to_string(kMaxSamplesPerSide) + " samples per side)";
-  if (SamplesAlong(size_m.minCoeff(), resolution_m) < 3) return "resolution_m: too coarse for size_m";
-  if (!(finite(relief_m) && relief_m > 0.0)) return "relief_m: must be > 0";
-  if (!(finite(min_wavelength_m) && min_wavelength_m > 0.0 && finite(max_wavelength_m) &&
-        max_wavelength_m >= min_wavelength_m))
-    return "wavelength_m: must be [min, max] with 0 < min <= max";
-  if (min_wavelength_m < 4.0 * resolution_m) return "wavelength_m: the minimum must be >= 4 resolution_m";
-  if (waves < 1 || waves > 1000) return "waves: must be in [1, 1000]";
-  return "";
-}
 
 Terrain Terrain::Make(const TerrainOptions& options, const Eigen::Vector2d& zero_at) {
   const std::string problem = options.Validate();
@@ -67,8 +44,8 @@ Terrain Terrain::Make(const TerrainOptions& options, const Eigen::Vector2d& zero
   }
 
   // Sample on the grid, then rescale to [0, 1].
-  terrain.cols_ = SamplesAlong(options.size_m.x(), options.resolution_m);
-  terrain.rows_ = SamplesAlong(options.size_m.y(), options.resolution_m);
+  terrain.cols_ = TerrainSamplesAlong(options.size_m.x(), options.resolution_m);
+  terrain.rows_ = TerrainSamplesAlong(options.size_m.y(), options.resolution_m);
   std::vector<double> height(static_cast<std::size_t>(terrain.rows_) * static_cast<std::size_t>(terrain.cols_));
   for (int r = 0; r < terrain.rows_; ++r) {
     const double y = -0.5 * options.size_m.y() + r * options.size_m.y() / (terrain.rows_ - 1);

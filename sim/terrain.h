@@ -41,6 +41,9 @@ struct TerrainOptions {
   std::string Validate() const;
 };
 
+// Grid samples along an extent of `size_m` at `resolution_m`, both ends included.
+int TerrainSamplesAlong(double size_m, double resolution_m);
+
 // A sampled heightfield (hills) or the flat floor (rows = cols = 0).
 class Terrain {
  public:

@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 """Mutation campaign: every input kind roamlab reads, mutated, run through the command that reads it.
 
-Seeds: a short synthetic recording and a small ROS 1 bag (build/tests/support/make_mutation_seeds), the repository's
-scenario and estimator YAML, an OptiOdom run with its metadata and a CSV log with its import mapping (written here).
+Seeds: a short synthetic recording and a small bag as ROS 1, MCAP and rosbag2 SQLite
+(build/tests/support/make_mutation_seeds), the repository's scenario and estimator YAML, a regression suite of one
+calibration case on the synthetic recording, an OptiOdom run with its metadata and a CSV log with its import mapping
+(written here).
 Each mutant is one operator applied to one seed file; the command runs with a timeout and its outcome is classified:
 
   clean      exit 2, one line on stderr (warnings aside) that names the mutated file
@@ -364,6 +366,33 @@ BAG_OPS = [
 ]
 
 
+def mcap_message_length(data, rng):
+    """Changes the u64 length of one Message record (opcode 0x05; the seed's messages have sequence 7)."""
+    starts = [m.start() for m in re.finditer(b"\x05.{8}[\x01\x02]\x00\x07\x00\x00\x00", data, re.S)]
+    if not starts:
+        return None
+    at = rng.choice(starts) + 1
+    length = int.from_bytes(data[at:at + 8], "little")
+    new = rng.choice([length + 1, length - 1, length + 100, 2 ** 63, 3])
+    return data[:at] + new.to_bytes(8, "little") + data[at + 8:]
+
+
+MCAP_OPS = [
+    ("string length prefix changed", bag_string_length, True),
+    ("record length changed", mcap_message_length, False),
+    ("bytes flipped", byte_flip, False),
+    ("truncated", byte_truncate, False),
+]
+# A rosbag2 SQLite file: the messages are blobs inside the database pages; a flipped byte may hit SQLite's own
+# structure (a corrupt database) or a message.
+DB3_OPS = [
+    ("string length prefix changed", bag_string_length, True),
+    ("bytes flipped", byte_flip, False),
+    ("truncated", byte_truncate, False),
+]
+BINARY_KINDS = ("ROS 1 bag", "ROS 2 MCAP", "ROS 2 SQLite")
+
+
 class Seeds:
     """The seed files of one campaign, written under `root`."""
 
@@ -372,6 +401,8 @@ class Seeds:
         subprocess.run([seeds_tool, root], check=True, stdout=subprocess.DEVNULL)
         self.rec = os.path.join(root, "rec")
         self.bag = os.path.join(root, "seed.bag")
+        self.mcap = os.path.join(root, "seed.mcap")
+        self.db3 = os.path.join(root, "seed.db3")
         self.estimator = os.path.join(REPO, "configs", "atv_calibration.yaml")
         with open(os.path.join(REPO, "scenarios", "indoor_diffdrive_slip.yaml")) as f:
             scenario = re.sub(r"^duration_s: .*$", "duration_s: 1.0", f.read(), flags=re.M)
@@ -383,6 +414,19 @@ class Seeds:
         self.optiodom_metadata = self.write("set_metadata.csv", OPTIODOM_METADATA)
         self.csv_log = self.write("log.csv", CSV_LOG)
         self.csv_map = self.write("map.yaml", CSV_MAP)
+        # One calibration case on the synthetic recording (paths absolute: the mutant lives elsewhere).
+        self.suite = self.write("suite.yaml", (
+            "suite: mutation\n"
+            "cases:\n"
+            "  - name: synthetic_calibration\n"
+            "    mode: calibrate\n"
+            "    recording: %s\n"
+            "    config: %s\n"
+            "    checks:\n"
+            "      - {metric: metrics.ate_m, bound: \"<= 10\"}\n"
+            "      - {metric: metrics.parameters.gps.lever_arm.error.norm, bound: \"<= 2 * metrics.ate_m + 0.5\"}\n"
+            "      - {metric: calibration.measurements.gps.rejected, bound: \"<= 5\", open: \"a reason\"}\n")
+            % (self.rec, self.estimator))
 
     def write(self, name, text):
         path = os.path.join(self.root, name)
@@ -433,7 +477,7 @@ class Campaign:
         """`build(mutant_dir, mutated_path)` copies what the command needs and returns (command, names)."""
         with open(seed_path, "rb") as f:
             original = f.read()
-        binary = kind == "ROS 1 bag"
+        binary = kind in BINARY_KINDS
         for i in range(self.args.per_kind):
             name, op, bad = ops[i % len(ops)]
             mutated = None
@@ -500,8 +544,15 @@ class Campaign:
 
         self.text_kind("OptiOdom run", OPTIODOM_RUN_OPS, s.optiodom_run, optiodom)
         self.text_kind("OptiOdom metadata", OPTIODOM_METADATA_OPS, s.optiodom_metadata, optiodom)
-        self.text_kind("ROS 1 bag", BAG_OPS, s.bag,
-                       lambda d, path: ([roamlab, "import", "rosbag", path, "--out", os.path.join(d, "out"),
+        def import_bag(d, path):
+            return ([roamlab, "import", "rosbag", path, "--out", os.path.join(d, "out"), "--quiet"],
+                    [os.path.basename(path)])
+
+        self.text_kind("ROS 1 bag", BAG_OPS, s.bag, import_bag)
+        self.text_kind("ROS 2 MCAP", MCAP_OPS, s.mcap, import_bag)
+        self.text_kind("ROS 2 SQLite", DB3_OPS, s.db3, import_bag)
+        self.text_kind("regress suite", YAML_OPS, s.suite,
+                       lambda d, path: ([roamlab, "regress", path, "--out", os.path.join(d, "out"), "--jobs", "1",
                                          "--quiet"], [os.path.basename(path)]))
 
         def csv_import(d, path):

@@ -65,7 +65,8 @@ TEST(BoundTest, ComparesStrictlyOrNotAndRejectsNaN) {
 
 TEST(BoundTest, MalformedBoundsSayWhatIsWrong) {
   for (const char* text : {"0.5", "", "<=", "<= abc", "<= 0.5 m", "== 1", "<= baseline *", "<= 2 *", "<= 2 * 3",
-                           "<= baseline + ", "<= baseline * 2", "<= - baseline", "<= nan", "<= inf"}) {
+                           "<= baseline + ", "<= baseline * 2", "<= - baseline", "<= nan", "<= inf", "<= 1e308",
+                           "<= -9.2e18", "<= 2e9 * baseline", "<= baseline + 1.5e9"}) {
     const Result<Bound> b = ParseBound(text);
     ASSERT_FALSE(b.ok()) << "'" << text << "' parsed";
     EXPECT_NE(b.status().message().find(std::string("bound '") + text + "'"), std::string::npos)
@@ -225,6 +226,8 @@ TEST_F(SuiteTest, EachKindOfBadSuiteIsOneLineNamingFileCaseAndProblem) {
       {Diagnose("    effects: [{name: steering_ofset, offset_rad: 0.03}]\n"), "unknown effect 'steering_ofset'"},
       {Diagnose("    effects: [{name: steering_offset, offset: 0.03}]\n"), "has no parameter offset"},
       {Diagnose("    effects: [{name: steering_offset, offset_rad: big}]\n"), "is not a number"},
+      {Diagnose("    effects: [{name: steering_offset, offset_rad: 9.2e18}]\n"), "beyond any physical value"},
+      {CalibrateCase("      - {metric: metrics.ate_m, bound: \"<= 1e308\"}\n"), "beyond any metric"},
       {"  - name: cal\n    mode: calibrate\n    scenario: nowhere.yaml\n    config: " + cal + "\n    checks:\n" + check,
        "missing scenario"},
       {"  - name: cal\n    mode: calibrate\n    recording: no_rec\n    config: " + cal + "\n    checks:\n" + check,
@@ -237,6 +240,9 @@ TEST_F(SuiteTest, EachKindOfBadSuiteIsOneLineNamingFileCaseAndProblem) {
       {"  - name: cal\n    mode: montecarlo\n    scenario: " + hills + "\n    config: " + cal + "\n    checks:\n" +
            check,
        "needs 'runs'"},
+      {"  - name: cal\n    mode: montecarlo\n    scenario: " + hills + "\n    config: " + cal +
+           "\n    runs: 2\n    t0_s: .nan\n    checks:\n      - {metric: nees.fraction_in_band, bound: \">= 0.9\"}\n",
+       "t0_s must be finite"},
       {CalibrateCase(check) + CalibrateCase(check), "a second case of this name"},
   };
   for (const Bad& b : bad) {
