@@ -50,6 +50,10 @@ Status EmitOldest(ProblemBuilder* builder, const CovarianceRequest* known, const
   // The marginal covariance is symmetric; the solves and the inverse above are so only to rounding, which on a badly
   // conditioned window exceeds what a consumer's symmetry check (eval::PositionNees: 1e-9) allows.
   cov = (0.5 * (cov + cov.transpose())).eval();
+  // A covariance that is not finite means the window lost the pose's information (a direction no factor constrains):
+  // a run-time failure, never a value in the output.
+  if (!cov.allFinite() || !p.p_world_body.allFinite())
+    return Status::Error("the position covariance of the pose at t = " + FormatSeconds(node.t) + " is not finite");
   const StampedPose pose{node.t, p.p_world_body, p.q_world_body};
   if (options.on_pose) {
     options.on_pose(pose, cov);
