@@ -175,7 +175,8 @@ class Parser {
         p.process.tau_s = PerComponent(pr["tau_s"], "parameters." + name + ".process.tau_s");
         if (!(p.process.tau_s.array() > 0).all()) Fail(pr, "parameter '" + name + "': tau_s must be positive");
       } else if (type != "constant") {
-        Fail(pr, "parameter '" + name + "': process.type must be constant, random_walk or gauss_markov");
+        Fail(pr, "parameter '" + name + "': process.type must be constant, random_walk or gauss_markov, not '" + type +
+                     "'");
       }
       if (p.process.type != ProcessConfig::Type::kConstant) {
         if (!pr["sigma"]) Fail(pr, "parameter '" + name + "': process needs sigma");
@@ -257,7 +258,7 @@ class Parser {
       } else if (type == "cauchy") {
         s.loss = Loss::Cauchy(scale);
       } else if (type != "none") {
-        Fail(l, where + ": loss type must be none, huber or cauchy");
+        Fail(l, where + ": loss type must be none, huber or cauchy, not '" + type + "'");
       }
     }
     return s;

@@ -115,6 +115,7 @@ void AddNeesTable(const json& m, int level, html::Page* page) {
   const json& nees = At(m, "nees");
   if (!nees.is_object()) return;
   page->Heading(level, "Consistency: position NEES (3 dof, 3 when consistent)");
+  if (nees.contains("warning")) page->Paragraph("Warning: " + Text(At(nees, "warning")), "note");
   page->AddTable(
       {{"mean", "poses", "in the 95 % band", "band (single run)", "without covariance", "left out before t0 [s]"},
        {{Number(At(m, "nees_mean")), Number(At(nees, "poses"), "%.0f"), Number(At(nees, "fraction_in_band"), "%.3f"),

@@ -149,7 +149,7 @@ void ReadRobot(YamlReader& r, const YAML::Node& node, const std::string& scenari
               {"kind", "model", "start", "speed_controller", "wheel_mounting", "wheel_deformation", "wheel_offset",
                "encoder_columns", "geometry_keys", "geometry"});
   if (!r.Require(node, key, "kind") || !r.Require(node, key, "model")) return;
-  r.String(node, key, "kind", &s->robot.kind);
+  r.OneOf(node, key, "kind", {"ackermann", "differential_drive", "skid_steer", "omni3", "mecanum"}, &s->robot.kind);
   std::string model;
   r.String(node, key, "model", &model);
   if (!r.ok()) return;
@@ -302,7 +302,8 @@ void ReadWorld(YamlReader& r, const YAML::Node& node, const std::string& scenari
 void ReadDriver(YamlReader& r, const YAML::Node& node, Scenario* s) {
   const std::string k = "driver";
   if (!r.Require(node, k, "type")) return;
-  r.String(node, k, "type", &s->driver.type);
+  // The type decides the schema of the other keys: an unknown one is refused before they are read.
+  r.OneOf(node, k, "type", {"ackermann", "body_velocity"}, &s->driver.type);
   if (!r.ok()) return;
   if (s->driver.type == "body_velocity") {
     r.CheckKeys(node, k, {"type", "lead_in_s", "linear_mps", "angular_radps", "lateral_mps"});

@@ -201,6 +201,20 @@ void YamlReader::String(const YAML::Node& map, const std::string& parent_key, co
   *out = node.Scalar();
 }
 
+void YamlReader::OneOf(const YAML::Node& map, const std::string& parent_key, const std::string& key,
+                       std::initializer_list<std::string_view> allowed, std::string* out) {
+  std::string value = *out;
+  String(map, parent_key, key, &value);
+  if (!ok() || !map[key]) return;
+  if (std::find(allowed.begin(), allowed.end(), value) != allowed.end()) {
+    *out = value;
+    return;
+  }
+  std::string names;
+  for (std::string_view a : allowed) names += (names.empty() ? "" : ", ") + std::string(a);
+  Fail(map[key], Join(parent_key, key), "unknown value '" + value + "' (allowed: " + names + ")");
+}
+
 void YamlReader::Bool(const YAML::Node& map, const std::string& parent_key, const std::string& key, bool* out) {
   if (!ok() || !map[key]) return;
   const YAML::Node node = map[key];

@@ -47,6 +47,9 @@ class YamlReader {
   void Integer(const YAML::Node& map, const std::string& parent_key, const std::string& key, std::int64_t* out);
   void Unsigned(const YAML::Node& map, const std::string& parent_key, const std::string& key, std::uint64_t* out);
   void String(const YAML::Node& map, const std::string& parent_key, const std::string& key, std::string* out);
+  // A string that must be one of `allowed`; another value fails naming them all.
+  void OneOf(const YAML::Node& map, const std::string& parent_key, const std::string& key,
+             std::initializer_list<std::string_view> allowed, std::string* out);
   // YAML's true / false.
   void Bool(const YAML::Node& map, const std::string& parent_key, const std::string& key, bool* out);
   // A sequence of exactly `size` numbers (any length when size < 0).

@@ -182,6 +182,24 @@ TEST_F(EvaluateTest, WithoutAbsoluteSensorTheRigidOffsetIsAlignedAway) {
   EXPECT_GT(Evaluate(none).value().metrics["ate_m"].get<double>(), 1.0);
 }
 
+TEST_F(EvaluateTest, ANeesWithoutAbsoluteSensorCarriesAWarning) {
+  WriteGpsCase();
+  // With the gps stream the position is observable: no warning.
+  Result<Evaluation> r = Evaluate(Options());
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_FALSE(r.value().metrics["nees"].contains("warning"));
+  // The same estimate and covariance on a recording with an IMU only.
+  fs::remove(rec("gps.csv"));
+  WriteFile(rec("recording.yaml"), kImuYaml);
+  WriteFile(rec("imu.csv"), kImuCsv);
+  r = Evaluate(Options());
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  ASSERT_TRUE(r.value().metrics.contains("nees_mean"));
+  const std::string warning = r.value().metrics["nees"].value("warning", "");
+  EXPECT_NE(warning.find("not observable from " + rec_dir()), std::string::npos) << warning;
+  EXPECT_NE(warning.find("no gps, position or pose stream"), std::string::npos) << warning;
+}
+
 TEST_F(EvaluateTest, WritesMetricsJsonAndFigures) {
   WriteGpsCase();
   const Result<Evaluation> r = Evaluate(Options());

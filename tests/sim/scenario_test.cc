@@ -141,7 +141,11 @@ TEST_F(ScenarioErrorTest, BadValues) {
               "sensors.gps.lever_arm_m", "expected 3 numbers");
   ExpectError(LoadWith("type: hills", "type: mountains"), "type: mountains", "world.terrain.type", "hills or flat");
   ExpectError(LoadWith("relief_m: 4.0", "relief_m: 0"), "relief_m: 0", "world.terrain.relief_m", "must be > 0");
-  ExpectError(LoadWith("kind: ackermann", "kind: hovercraft"), "kind: hovercraft", "robot.kind", "unsupported");
+  ExpectError(LoadWith("kind: ackermann", "kind: hovercraft"), "kind: hovercraft", "robot.kind",
+              "unknown value 'hovercraft' (allowed: ackermann, differential_drive, skid_steer, omni3, mecanum)");
+  // A mistyped driver type is refused as such, not read with another driver's keys.
+  ExpectError(LoadWith("  type: ackermann\n  lead_in_s", "  type: body_velocty\n  lead_in_s"), "type: body_velocty",
+              "driver.type", "unknown value 'body_velocty' (allowed: ackermann, body_velocity)");
   ExpectError(LoadWith("{amplitude: 1.2, period_s: 5.5, phase_rad: 1.5708}", "{amplitude: 1.2, period_s: -5.5}"),
               "period_s: -5.5", "driver.speed_mps[1]", "period_s must be > 0");
   ExpectError(LoadWith("effects: []", "effects: [{name: flux_capacitor, parameters: {gigawatts: 1.21}}]"),
