@@ -74,11 +74,14 @@ inline constexpr double kDriveWindowS = 1.0;
 inline constexpr double kMaxDriveMismatch = 0.05;
 std::string DriveMismatch(const recording::Recording& real, const recording::Recording& twin);
 
-// An absolute stream's drift over fixed windows: the twin's pose aligned to the real one at each window's start and
-// the error at its end. A pose stream aligns exactly at the start sample (position and heading error); a gps or
-// position stream by the planar rigid transform (yaw about the vertical and translation) that best fits the first
-// align_s of the window, or by translation alone when the real track moves less than 0.1 m there (position error
-// only; heading_measured false).
+// An absolute stream's drift over fixed windows: the twin aligned to the real track over the first align_s of each
+// window and the error at the window's last sample. The alignment is the planar rigid transform (yaw about the
+// vertical and translation) that best fits those samples in least squares, positions and a pose stream's headings
+// weighted by their stated noise (position_m or sigma_m, orientation_rad); a stream without stated heading noise
+// whose real track moves less than 0.1 m there is aligned by translation at the window's first sample alone. A fit
+// over align_s rather than one sample keeps the sample's noise out of the drift (a 5 mrad heading error at the start
+// moves the end of a 1 m window by 5 mm). Position error, and for a pose stream the heading error
+// (heading_measured).
 struct TwinDrift {
   std::string stream;
   double window_s = 0.0;
@@ -91,7 +94,7 @@ struct TwinDrift {
 struct DriftOptions {
   double window_s = 10.0;
   double stride_s = 1.0;  // windows start every stride_s
-  double align_s = 2.0;   // position-only streams: the span the alignment fits
+  double align_s = 2.0;   // the span of the window's start the alignment fits
 };
 
 // The twin against the real recording over [from_s, to_s].

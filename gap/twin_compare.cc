@@ -25,7 +25,14 @@ struct Track {
   std::vector<double> t_s;
   std::vector<Eigen::Vector3d> real, twin;
   std::vector<Eigen::Quaterniond> q_real, q_twin;  // pose streams only
+  // The alignment's weights, 1 / sigma^2 of the stated noise: a pose stream's headings weigh 0 when it states none.
+  double position_weight = 1.0, heading_weight = 0.0;
 };
+
+double StatedNoise(const Stream& s, const char* key) {
+  const auto it = s.info.noise.find(key);
+  return it != s.info.noise.end() && it->second > 0.0 ? it->second : 0.0;
+}
 
 Track Matched(const Stream& r, const Stream& s, Time from, Time to, const std::optional<recording::GeodeticOrigin>& o) {
   Track track;
@@ -40,6 +47,12 @@ Track Matched(const Stream& r, const Stream& s, Time from, Time to, const std::o
     return Eigen::Quaterniond(v[6], v[3], v[4], v[5]).normalized();
   };
   const bool pose = r.info.type == StreamType::kPose;
+  if (pose) {
+    const double sigma_m = std::max(StatedNoise(r, "position_m"), StatedNoise(r, "sigma_m"));
+    const double sigma_rad = StatedNoise(r, "orientation_rad");
+    if (sigma_rad > 0.0) track.heading_weight = 1.0 / (sigma_rad * sigma_rad);
+    track.position_weight = sigma_m > 0.0 ? 1.0 / (sigma_m * sigma_m) : sigma_rad > 0.0 ? 0.0 : 1.0;
+  }
   std::size_t j = 0;
   for (std::size_t i = 0; i < r.t.size(); ++i) {
     if (r.t[i] < from || to < r.t[i]) continue;
@@ -62,16 +75,27 @@ double Yaw(const Eigen::Quaterniond& q) {
   return std::atan2(x.y(), x.x());
 }
 
-// The planar rigid transform (yaw, then translation) of twin positions onto real ones over samples [a, b], or the
-// translation at `a` alone when the real track moves less than 0.1 m there.
+// The planar rigid transform (yaw about the vertical, then translation) of the twin onto the real track that best fits
+// samples [a, b] in least squares: positions weighted by position_weight, a pose stream's headings by heading_weight,
+//   cost(yaw, p) = w_p sum |R t_i + p - r_i|^2 + w_h sum (yaw + psi_twin_i - psi_real_i)^2.
+// For the best p (the centroids matched) the positions' cost is w_p rho (yaw - yaw_p)^2 to second order about their
+// own best yaw yaw_p (rho the size of the centred tracks' cross-covariance), the headings' w_h n (yaw - d)^2 about the
+// mean heading difference d: the yaw is their weighted mean. Without heading weight, a real track that moves less
+// than 0.1 m there gives no yaw: the translation at `a` alone.
 std::pair<Eigen::Matrix3d, Eigen::Vector3d> PlanarAlignment(const Track& k, std::size_t a, std::size_t b) {
+  const double n = static_cast<double>(b - a + 1);
   Eigen::Vector3d cr = Eigen::Vector3d::Zero(), ct = Eigen::Vector3d::Zero();
+  double heading_sin = 0.0, heading_cos = 0.0;
   for (std::size_t i = a; i <= b; ++i) {
     cr += k.real[i];
     ct += k.twin[i];
+    if (k.heading_weight <= 0.0) continue;
+    const double d = Yaw(k.q_real[i]) - Yaw(k.q_twin[i]);
+    heading_sin += std::sin(d);
+    heading_cos += std::cos(d);
   }
-  cr /= static_cast<double>(b - a + 1);
-  ct /= static_cast<double>(b - a + 1);
+  cr /= n;
+  ct /= n;
   double extent = 0.0, sxx = 0.0, sxy = 0.0;
   for (std::size_t i = a; i <= b; ++i) {
     const Eigen::Vector2d r = (k.real[i] - cr).head<2>(), t = (k.twin[i] - ct).head<2>();
@@ -79,8 +103,14 @@ std::pair<Eigen::Matrix3d, Eigen::Vector3d> PlanarAlignment(const Track& k, std:
     sxx += t.dot(r);
     sxy += t.x() * r.y() - t.y() * r.x();
   }
-  if (extent < 0.1) return {Eigen::Matrix3d::Identity(), k.real[a] - k.twin[a]};
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(std::atan2(sxy, sxx), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  if (k.heading_weight <= 0.0 && extent < 0.1) return {Eigen::Matrix3d::Identity(), k.real[a] - k.twin[a]};
+  double yaw = std::atan2(sxy, sxx);
+  if (k.heading_weight > 0.0) {
+    const double d = std::atan2(heading_sin, heading_cos);
+    const double positions = k.position_weight * std::hypot(sxx, sxy), headings = k.heading_weight * n;
+    yaw = d + positions / (positions + headings) * std::remainder(yaw - d, 2.0 * M_PI);
+  }
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   return {R, cr - R * ct};
 }
 
@@ -98,17 +128,14 @@ std::optional<TwinDrift> Drift(const Stream& r, const Stream& s, Time from, Time
     std::size_t b = a;
     while (b + 1 < k.t_s.size() && k.t_s[b + 1] <= w0 + options.window_s + 1e-9) ++b;
     if (b <= a || k.t_s[b] - k.t_s[a] < 0.9 * options.window_s) continue;
-    double position = 0.0, heading = 0.0;
-    if (d.heading_measured) {
-      const Eigen::Quaterniond R = k.q_real[a] * k.q_twin[a].conjugate();
-      position = (R * (k.twin[b] - k.twin[a]) + k.real[a] - k.real[b]).norm();
-      heading = std::abs(std::remainder(Yaw(R * k.q_twin[b]) - Yaw(k.q_real[b]), 2.0 * M_PI));
-    } else {
-      std::size_t e = a;
-      while (e + 1 < b && k.t_s[e + 1] <= k.t_s[a] + options.align_s) ++e;
-      const auto [R, p] = PlanarAlignment(k, a, e);
-      position = (R * k.twin[b] + p - k.real[b]).norm();
-    }
+    std::size_t e = a;
+    while (e + 1 < b && k.t_s[e + 1] <= k.t_s[a] + options.align_s + 1e-9) ++e;
+    const auto [R, p] = PlanarAlignment(k, a, e);
+    const double position = (R * k.twin[b] + p - k.real[b]).norm();
+    const double heading =
+        d.heading_measured
+            ? std::abs(std::remainder(Yaw(Eigen::Quaterniond(R) * k.q_twin[b]) - Yaw(k.q_real[b]), 2.0 * M_PI))
+            : 0.0;
     ++d.windows;
     d.mean_position_m += position;
     d.max_position_m = std::max(d.max_position_m, position);

@@ -236,8 +236,8 @@ TEST(DiagnoseCliTest, HeldOutShowsTheTwinsPatchOnARecordingOfAnotherDrive) {
   EXPECT_TRUE(held.at("replayed").get<bool>());
   const double before = held.at("before").at("drift").at("mocap").at("mean_position_m").get<double>();
   const double after = held.at("after").at("drift").at("mocap").at("mean_position_m").get<double>();
-  // 3 % of the 1 m a 10 s window travels, against a floor of a few millimetres: the windows align on one motion
-  // capture sample, whose 5 mrad heading noise moves the end of a 1 m window by about 4 mm.
+  // 3 % of the 1 m a 10 s window travels, against a floor of about a millimetre (the windows align on their first 2 s
+  // of motion capture).
   EXPECT_GT(before, 0.015);
   EXPECT_LT(after, 0.5 * before) << before << " -> " << after << "; patch " << twin.at("patch").dump();
   EXPECT_LT(held.at("after").at("chi2").get<double>(), held.at("before").at("chi2").get<double>());
