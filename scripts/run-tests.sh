@@ -4,8 +4,7 @@
 # (regression/suite.yaml, results in BUILD_DIR/regress/). Slow tests carry the ctest label "slow" and are left out
 # unless ROAMLAB_SLOW_TESTS=1; ROAMLAB_FULL_REGRESSION=1 runs every regression case. The cluster tests carry the label
 # "slurm"; they run when the one-node Slurm starts here (root, slurm-wlm and munge), and otherwise are reported
-# as not run; ROAMLAB_SLURM_TESTS=0 leaves them out, ROAMLAB_SLURM_TESTS=1 makes a failed start an error, and so does
-# CI=true unless ROAMLAB_SLURM_TESTS says otherwise.
+# as not run; ROAMLAB_SLURM_TESTS=0 leaves them out, ROAMLAB_SLURM_TESTS=1 makes a failed start an error.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -21,9 +20,7 @@ if grep -q 'FAILED TEST SUITE' "$junit"; then
   exit 1
 fi
 export LOCAL_SLURM_DIR=${LOCAL_SLURM_DIR:-$(cd "$build_dir" && pwd)/local-slurm}
-slurm_tests=auto
-[ "${CI:-}" = "true" ] && slurm_tests=1
-slurm_tests=${ROAMLAB_SLURM_TESTS:-$slurm_tests}
+slurm_tests=${ROAMLAB_SLURM_TESTS:-auto}
 # A cluster an interrupted earlier call left running in LOCAL_SLURM_DIR is stopped first.
 [ "$slurm_tests" = "0" ] || bash scripts/local-slurm.sh stop >/dev/null
 if [ "$slurm_tests" = "auto" ]; then
