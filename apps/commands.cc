@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "apps/cli.h"
+#include "common/progress.h"
 #include "estimator/calibration.h"
 #include "estimator/covariance.h"
 #include "estimator/tracking_io.h"
@@ -41,7 +42,8 @@ void PrintCalibration(const estimator::CalibrationResult& r, const std::string& 
 
 int RunCalibrate(const CalibrateArgs& args) {
   experiment::CalibrateRequest request = args;
-  if (!args.quiet) request.progress = [](const std::string& line) { std::cerr << "calibrate: " << line << "\n"; };
+  ProgressMeter meter("calibrate", &std::cerr);
+  if (!args.quiet) request.progress = [&meter](const std::string& line) { meter.Note(line); };
   request.warning = [](const std::string& line) { std::cerr << "roamlab calibrate: warning: " << line << "\n"; };
   estimator::CalibrationResult result;
   const experiment::Outcome outcome = experiment::CalibrateToDirectory(request, &result);
@@ -52,13 +54,12 @@ int RunCalibrate(const CalibrateArgs& args) {
 
 int RunTrack(const TrackArgs& args) {
   experiment::TrackRequest request = args;
-  if (!args.quiet)
-    request.progress = [](double f) { std::cerr << "\rtrack: " << static_cast<int>(100 * f) << "%" << std::flush; };
+  ProgressMeter meter("track", &std::cerr);
+  if (!args.quiet) request.progress = [&meter](double fraction) { meter.Update(fraction); };
   request.warning = [](const std::string& line) { std::cerr << "roamlab track: warning: " << line << "\n"; };
   estimator::TrackingResult r;
   const experiment::Outcome outcome = experiment::TrackToDirectory(request, &r);
-  // The progress line ends once tracking ran (bad input stops before it), at 100 % unless it stopped early.
-  if (!args.quiet && !outcome.bad_input) std::cerr << (outcome.ok() ? "\rtrack: 100%\n" : "\n");
+  meter.Finish();
   if (!outcome.ok()) return Exit(args.err, "track", outcome);
   if (args.quiet) return 0;
   std::printf("tracked %zu poses, %d updates (mean %.2f ms, max %.2f ms), %d rejected, %.1fx real time; wrote %s\n",

@@ -4,12 +4,14 @@
 #include <sstream>
 
 #include "apps/cli.h"
+#include "common/progress.h"
 
 namespace roamlab::apps {
 
 int RunDiagnose(const DiagnoseArgs& args) {
   experiment::DiagnoseRequest request = args;
-  if (!args.quiet) request.progress = [](const std::string& line) { std::cout << line << std::endl; };
+  ProgressMeter meter("diagnose", &std::cout);
+  if (!args.quiet) request.progress = [&meter](const std::string& line) { meter.Note(line); };
   gap::Diagnosis d;
   const experiment::Outcome outcome = experiment::DiagnoseToDirectory(request, &d);
   if (!outcome.ok()) return Exit(args.err, "diagnose", outcome);

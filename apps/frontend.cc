@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "apps/cli.h"
+#include "common/progress.h"
 #include "frontend/recording_front_end.h"
 
 namespace roamlab::apps {
@@ -14,8 +15,11 @@ int RunFrontEnd(const FrontEndArgs& args) {
       args.front_end == "scan" ? frontend::FrontEnd::kScanMatching : frontend::FrontEnd::kVisualOdometry;
   options.input_stream = args.input_stream;
   options.output_stream = args.output_stream;
+  ProgressMeter meter("frontend", &std::cerr);
+  if (!args.quiet) options.progress = [&meter](double fraction) { meter.Update(fraction); };
   bool bad_input = true;
   const auto run = frontend::RunFrontEnd(args.recording, args.out, options, &bad_input);
+  meter.Finish();
   if (!run.ok()) return Report(args.err, "frontend", run.status().message(), bad_input ? kBadInputExit : kFailureExit);
   if (args.quiet) return 0;
   const frontend::FrontEndResult& r = run.value();

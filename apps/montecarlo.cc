@@ -5,28 +5,24 @@
 #include "apps/cli.h"
 #include "batch/slurm.h"
 #include "batch/work.h"
+#include "common/progress.h"
 #include "experiment/montecarlo.h"
 
 namespace roamlab::apps {
 namespace {
 
-// The local backend: the runs on this host's threads, with a progress bar.
+// The local backend: the runs on this host's threads, with elapsed time and the time left.
 int RunLocally(const MonteCarloArgs& args, batch::Work& work) {
   experiment::MonteCarloOptions options = args;
-  bool bar = false;
+  ProgressMeter meter("montecarlo", &std::cerr);
   if (!args.quiet) {
-    options.log = [](const std::string& line) { std::cerr << "montecarlo: " << line << "\n"; };
-    options.progress = [&bar](int finished, int runs) {
-      const int width = 40, filled = width * finished / runs;
-      std::cerr << "\rmontecarlo [" << std::string(filled, '#') << std::string(width - filled, ' ') << "] " << finished
-                << "/" << runs << std::flush;
-      bar = true;
-    };
+    options.log = [&meter](const std::string& line) { meter.Note(line); };
+    options.progress = [&meter](int finished, int runs) { meter.Update(finished, runs); };
   }
   (void)batch::WriteLocalBatchFile(work, "running", "");
   experiment::MonteCarloSummary summary;
   const experiment::Outcome outcome = experiment::RunMonteCarlo(options, &summary);
-  if (bar) std::cerr << "\n";
+  meter.Finish();
   const std::string headline = outcome.ok() ? batch::MonteCarloHeadline(args, summary) : outcome.status.message();
   if (!outcome.bad_input) (void)batch::WriteLocalBatchFile(work, outcome.ok() ? "done" : "failed", headline);
   if (!outcome.ok()) return Exit(args.err, "montecarlo", outcome);

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/cli.h"
+#include "common/progress.h"
 #include "experiment/odometry.h"
 
 namespace roamlab::apps {
@@ -40,7 +41,8 @@ void PrintTable(const json& table) {
 
 int RunOdometryLearn(const OdometryLearnArgs& args) {
   experiment::OdometryLearnOptions options = args;
-  if (!args.quiet) options.log = [](const std::string& line) { std::cerr << "odometry learn: " << line << "\n"; };
+  ProgressMeter meter("odometry learn", &std::cerr);
+  if (!args.quiet) options.log = [&meter](const std::string& line) { meter.Note(line); };
   experiment::LearnedOdometry learned;
   const experiment::Outcome outcome = experiment::LearnOdometry(options, &learned);
   if (!outcome.ok()) return Exit(nullptr, "odometry", outcome);

@@ -382,7 +382,7 @@ void AddFrontEnd(CLI::App* app, Commands* commands) {
     fe->add_option("--input", args->input_stream, "Input stream (default: the only camera or laser_scan stream)");
     fe->add_option("--stream", args->output_stream,
                    "Name of the derived stream (default visual_odometry or scan_matching; replaces one of that name)");
-    fe->add_flag("--quiet", args->quiet, "No summary");
+    fe->add_flag("--quiet", args->quiet, "No progress and no summary");
     return fe;
   });
 }

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "apps/cli.h"
+#include "common/progress.h"
 #include "experiment/steps.h"
 
 namespace roamlab::apps {
@@ -53,14 +54,11 @@ void PrintReplaySummary(const sim::Simulation& s, const std::string& out) {
 
 int RunReplay(const ReplayArgs& args) {
   experiment::ReplayRequest request = args;
-  if (!args.quiet) {
-    request.progress = [](double fraction) {
-      std::cerr << "\rreplay: " << static_cast<int>(100.0 * fraction) << "%" << std::flush;
-    };
-  }
+  ProgressMeter meter("replay", &std::cerr);
+  if (!args.quiet) request.progress = [&meter](double fraction) { meter.Update(fraction); };
   sim::Simulation simulation;
   const experiment::Outcome outcome = experiment::ReplayToDirectory(request, &simulation);
-  if (!args.quiet && !outcome.bad_input) std::cerr << "\n";
+  meter.Finish();
   if (!outcome.ok()) return Exit(args.err, "replay", outcome);
   if (!args.quiet) PrintReplaySummary(simulation, args.out);
   return 0;
@@ -68,15 +66,11 @@ int RunReplay(const ReplayArgs& args) {
 
 int RunSimulate(const SimulateArgs& args) {
   experiment::SimulateRequest request = args;
-  if (!args.quiet) {
-    request.progress = [](double fraction) {
-      std::cerr << "\rsimulate: " << static_cast<int>(100.0 * fraction) << "%" << std::flush;
-    };
-  }
+  ProgressMeter meter("simulate", &std::cerr);
+  if (!args.quiet) request.progress = [&meter](double fraction) { meter.Update(fraction); };
   sim::Simulation simulation;
   const experiment::Outcome outcome = experiment::SimulateToDirectory(request, &simulation);
-  // The progress line ends once the simulation ran (bad input stops before it).
-  if (!args.quiet && !outcome.bad_input) std::cerr << "\n";
+  meter.Finish();
   if (!outcome.ok()) return Exit(args.err, "simulate", outcome);
   if (!args.quiet) PrintSummary(simulation, args.out);
   return 0;

@@ -5,6 +5,7 @@
 #include "apps/cli.h"
 #include "batch/slurm.h"
 #include "batch/work.h"
+#include "common/progress.h"
 #include "experiment/sweep.h"
 
 namespace roamlab::apps {
@@ -22,10 +23,17 @@ int RunSweep(const SweepArgs& args) {
   if (Status made = experiment::MakeOutputDirectory(args.out); !made.ok())
     return BadInput(args.err, "sweep", made.message());
   (void)batch::WriteLocalBatchFile(*work, "running", "");
+  ProgressMeter meter("sweep", &std::cerr);
   std::function<void(const std::string&)> log;
-  if (!args.quiet) log = [](const std::string& line) { std::cerr << "sweep: " << line << "\n"; };
+  std::function<void(int, int)> progress;
+  if (!args.quiet) {
+    log = [&meter](const std::string& line) { meter.Note(line); };
+    progress = [&meter](int finished, int runs) { meter.Update(finished, runs); };
+  }
   std::string headline;
-  const experiment::Outcome outcome = experiment::RunSweep(plan.value(), args.resume, args.jobs, log, &headline);
+  const experiment::Outcome outcome =
+      experiment::RunSweep(plan.value(), args.resume, args.jobs, log, progress, &headline);
+  meter.Finish();
   if (!outcome.bad_input)
     (void)batch::WriteLocalBatchFile(*work, outcome.ok() ? "done" : "failed",
                                      outcome.ok() ? headline : outcome.status.message());

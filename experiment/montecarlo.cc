@@ -145,6 +145,8 @@ Outcome CalibrateOnce(const MonteCarloOptions& options, std::uint64_t seed, cons
   calibrate.recording = simulate.out;
   calibrate.config = calibration_config;
   calibrate.out = dir;
+  // The calibration of a long drive takes minutes: its stages are logged as they finish.
+  if (options.log) calibrate.progress = [&options](const std::string& line) { options.log("calibration: " + line); };
   outcome = CalibrateToDirectory(calibrate);
   if (!outcome.ok()) {
     outcome.step = "calibrate";
@@ -312,6 +314,7 @@ Outcome RunAll(const MonteCarloOptions& options, const MonteCarloShared& shared,
       }
     }
   };
+  if (options.progress) options.progress(0, n);
   std::vector<std::thread> threads;
   for (int k = 0; k < std::min(jobs, n); ++k) threads.emplace_back(worker);
   for (auto& th : threads) th.join();

@@ -33,7 +33,7 @@ struct MonteCarloOptions {
   // uninterrupted call writes.
   bool resume = false;
   std::function<void(const std::string& line)> log;      // optional: what is being done, one line at a time
-  std::function<void(int finished, int runs)> progress;  // optional: after each run
+  std::function<void(int finished, int runs)> progress;  // optional: once with 0 before the runs, then after each run
 
   // What is wrong with the options ("--runs must be at least 1"), "" when nothing.
   std::string Validate() const;

@@ -440,17 +440,23 @@ Outcome WriteSweepSummary(const SweepPlan& plan, std::string* headline) {
 }
 
 Outcome RunSweep(const SweepPlan& plan, bool resume, int jobs, const std::function<void(const std::string&)>& log,
-                 std::string* headline) {
+                 const std::function<void(int finished, int runs)>& progress, std::string* headline) {
+  const int points = static_cast<int>(plan.values.size());
   if (Status written = WriteSweepPoints(plan); !written.ok()) return Outcome::BadInput(written);
-  for (int p = 0; p < static_cast<int>(plan.values.size()); ++p) {
+  for (int p = 0; p < points; ++p) {
     MonteCarloOptions options = SweepPointOptions(plan, p);
     options.resume = resume;
     options.jobs = jobs;
+    // Runs over all points; with `resume` the runs a point already has count as finished.
+    if (progress)
+      options.progress = [&progress, runs = options.runs, total = points * options.runs, p](int finished, int todo) {
+        progress(p * runs + runs - todo + finished, total);
+      };
     if (log) {
       std::string values;
       for (std::size_t k = 0; k < plan.keys.size(); ++k)
         values += (k ? ", " : "") + plan.keys[k] + " = " + plan.values[p][k];
-      log("point " + std::to_string(p + 1) + "/" + std::to_string(plan.values.size()) + ": " + values);
+      log("point " + std::to_string(p + 1) + "/" + std::to_string(points) + ": " + values);
     }
     Outcome outcome = RunMonteCarlo(options);
     if (!outcome.ok()) {

@@ -56,8 +56,9 @@ MonteCarloOptions SweepPointOptions(const SweepPlan& plan, int p);
 Outcome WriteSweepSummary(const SweepPlan& plan, std::string* headline);
 
 // The local backend: writes the points' files, runs every point's Monte-Carlo on `jobs` threads (with `resume`, only
-// the runs without a result file), then the summary. `log` (optional) receives a line per point.
+// the runs without a result file), then the summary. `log` (optional) receives a line per point, `progress`
+// (optional) the runs finished over all points after each run.
 Outcome RunSweep(const SweepPlan& plan, bool resume, int jobs, const std::function<void(const std::string&)>& log,
-                 std::string* headline);
+                 const std::function<void(int finished, int runs)>& progress, std::string* headline);
 
 }  // namespace roamlab::experiment

@@ -62,7 +62,8 @@ Status CameraModel(const recording::Stream& camera, const std::string& directory
 
 // Runs the visual odometry over the frames of `camera`.
 Result<FrontEndResult> VisualOdometryOfFrames(const recording::Stream& camera, const std::string& directory,
-                                              const std::string& output_stream) {
+                                              const std::string& output_stream,
+                                              const std::function<void(double)>& progress) {
   PinholeIntrinsics intrinsics;
   VisualOdometryOptions options;
   if (Status s = CameraModel(camera, directory, &intrinsics, &options); !s.ok()) return s;
@@ -84,6 +85,7 @@ Result<FrontEndResult> VisualOdometryOfFrames(const recording::Stream& camera, c
     }
     cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
     vo.ProcessFrame(camera.t[i], gray);
+    if (progress) progress(static_cast<double>(i + 1) / static_cast<double>(camera.t.size()));
   }
   FrontEndResult result;
   result.stream = vo.TakeStream();
@@ -95,7 +97,8 @@ Result<FrontEndResult> VisualOdometryOfFrames(const recording::Stream& camera, c
 
 // Runs the scan matcher over the scans of `laser`.
 Result<FrontEndResult> ScanMatchingOfScans(const recording::Stream& laser, const std::string& directory,
-                                           const std::string& output_stream) {
+                                           const std::string& output_stream,
+                                           const std::function<void(double)>& progress) {
   ScanMatchingStream matching(output_stream, laser.info.rate_hz);
   for (Eigen::Index row = 0; row < laser.values.rows(); ++row) {
     const ScanGeometry geometry = LaserScanGeometry(laser, row);
@@ -104,6 +107,7 @@ Result<FrontEndResult> ScanMatchingOfScans(const recording::Stream& laser, const
                            ": the scan geometry differs from the first scan's");
     }
     matching.AddScan(laser.t[static_cast<std::size_t>(row)], geometry, LaserScanRanges(laser, row));
+    if (progress) progress(static_cast<double>(row + 1) / static_cast<double>(laser.values.rows()));
   }
   FrontEndResult result;
   result.stream = matching.TakeStream();
@@ -158,8 +162,8 @@ Result<FrontEndResult> DeriveStream(const recording::Recording& recording, const
   if (output_stream == input.value()->info.name) {
     return Status::Error(YamlPath(directory) + ": the derived stream would replace its input '" + output_stream + "'");
   }
-  return vo ? VisualOdometryOfFrames(*input.value(), directory, output_stream)
-            : ScanMatchingOfScans(*input.value(), directory, output_stream);
+  return vo ? VisualOdometryOfFrames(*input.value(), directory, output_stream, options.progress)
+            : ScanMatchingOfScans(*input.value(), directory, output_stream, options.progress);
 }
 
 Result<FrontEndResult> RunFrontEnd(const std::string& input_directory, const std::string& output_directory,

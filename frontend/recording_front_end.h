@@ -11,6 +11,7 @@
 //                     scan_matching stream with the laser_scan stream's rate and mounting (scan_matching_stream.h).
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -26,6 +27,7 @@ struct FrontEndOptions {
   FrontEnd front_end = FrontEnd::kVisualOdometry;
   std::string input_stream;   // empty: the recording's only stream of type camera (laser_scan)
   std::string output_stream;  // empty: visual_odometry (scan_matching)
+  std::function<void(double fraction)> progress;  // optional: the fraction of frames (scans) done, after each
 };
 
 struct FrontEndResult {

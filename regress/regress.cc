@@ -20,6 +20,7 @@
 #include "common/atomic_file.h"
 #include "common/check.h"
 #include "common/interrupt.h"
+#include "common/progress.h"
 #include "regress/modes.h"
 #include "regress/suite.h"
 
@@ -274,8 +275,9 @@ std::vector<const Case*> SelectCases(const Suite& suite, const RunOptions& optio
   return cases;
 }
 
-// The progress line of a finished case: "regress [3/9] NAME (MODE): ran in 12.5 s".
-std::string ProgressLine(std::size_t finished, std::size_t total, const CaseResult& r, bool resumed) {
+// The progress line of a finished case, `elapsed_s` after the first started: "regress [3/9] NAME (MODE): ran in
+// 12.5 s, 40s elapsed, about 1m20s left".
+std::string ProgressLine(std::size_t finished, std::size_t total, const CaseResult& r, bool resumed, double elapsed_s) {
   const char* what = resumed              ? "resumed, ran earlier"
                      : !r.error.empty()   ? "error"
                      : !r.skipped.empty() ? "skipped"
@@ -283,7 +285,7 @@ std::string ProgressLine(std::size_t finished, std::size_t total, const CaseResu
   char line[512];
   std::snprintf(line, sizeof line, "regress [%zu/%zu] %s (%s): %s in %.1f s", finished, total, r.name.c_str(),
                 r.mode.c_str(), what, r.seconds);
-  return line;
+  return line + ElapsedAndLeft(elapsed_s, SecondsLeft(elapsed_s, static_cast<double>(finished) / total));
 }
 
 // One case: with `resume`, from its record when that matches; otherwise run and recorded. nullopt when an interrupt
@@ -313,6 +315,7 @@ void RunCases(const std::vector<const Case*>& cases, const RunOptions& options, 
   finished->assign(cases.size(), 0);
   std::atomic<std::size_t> next{0}, done{0};
   std::mutex print;
+  const auto start = std::chrono::steady_clock::now();
   const auto worker = [&] {
     for (std::size_t i = next++; i < cases.size() && !InterruptRequested(); i = next++) {
       bool resumed = false;
@@ -320,7 +323,8 @@ void RunCases(const std::vector<const Case*>& cases, const RunOptions& options, 
       if (!r) continue;
       result->cases[i] = std::move(*r);
       (*finished)[i] = 1;
-      const std::string line = ProgressLine(++done, cases.size(), result->cases[i], resumed);
+      const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const std::string line = ProgressLine(++done, cases.size(), result->cases[i], resumed, elapsed_s);
       std::lock_guard<std::mutex> lock(print);
       // The marker is best effort here: it was written at the start, and says "running" whatever fails now.
       (void)marker->AddDone("case " + cases[i]->name);

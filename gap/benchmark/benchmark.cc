@@ -8,6 +8,7 @@
 #include <iomanip>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <ostream>
 #include <random>
 #include <sstream>
@@ -16,6 +17,7 @@
 
 #include "common/atomic_file.h"
 #include "common/interrupt.h"
+#include "common/progress.h"
 #include "gap/learn_baseline.h"
 
 namespace roamlab::gap::benchmark {
@@ -23,26 +25,17 @@ namespace {
 
 using nlohmann::json;
 
-// Runs fn(0..n-1) on `jobs` threads with a progress bar on `progress` (null: none) and each call's line; the first
-// error stops the rest.
+// Runs fn(0..n-1) on `jobs` threads with progress (common/progress.h) on `progress` (null: none) and each call's
+// line; the first error stops the rest.
 Status RunParallel(int n, int jobs, const std::string& label, std::ostream* progress,
                    const std::function<Result<std::string>(int)>& fn) {
   std::atomic<int> next{0};
   std::mutex mutex;
   int done = 0;
   Status first_error = Status::Ok();
-  const auto start = std::chrono::steady_clock::now();
-  const auto bar = [&] {
-    constexpr int kWidth = 30;
-    const int filled = n > 0 ? kWidth * done / n : kWidth;
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::ostringstream s;
-    s << "\r" << label << " [" << std::string(filled, '#') << std::string(kWidth - filled, '.') << "] " << done << "/"
-      << n << "  " << std::fixed << std::setprecision(0) << elapsed << " s";
-    if (done > 0 && done < n) s << ", about " << elapsed / done * (n - done) << " s left";
-    *progress << s.str() << std::flush;
-  };
-  if (progress) bar();
+  std::optional<ProgressMeter> meter;
+  if (progress) meter.emplace(label, progress);
+  if (meter) meter->Update(0, n);
   const auto worker = [&] {
     for (int i = next++; i < n; i = next++) {
       {
@@ -53,17 +46,16 @@ Status RunParallel(int n, int jobs, const std::string& label, std::ostream* prog
       std::lock_guard<std::mutex> lock(mutex);
       ++done;
       if (!line.ok() && first_error.ok()) first_error = line.status();
-      if (progress) {
-        *progress << "\r" << std::string(100, ' ') << "\r" << (line.ok() ? line.value() : line.status().message())
-                  << "\n";
-        bar();
+      if (meter) {
+        meter->Note(line.ok() ? line.value() : line.status().message());
+        meter->Update(done, n);
       }
     }
   };
   std::vector<std::thread> threads;
   for (int k = 0; k < std::max(1, std::min(jobs, n)); ++k) threads.emplace_back(worker);
   for (std::thread& t : threads) t.join();
-  if (progress) *progress << "\n";
+  if (meter) meter->Finish();
   if (first_error.ok() && InterruptRequested()) return InterruptedError();
   return first_error;
 }

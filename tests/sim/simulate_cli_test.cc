@@ -47,6 +47,9 @@ TEST(SimulateCliTest, WritesARecordingThatReadsBack) {
   const CommandRun run = Roamlab("simulate " + scenario + " --out " + dir.File("rec") + " --seed 9", dir);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.err.find("simulate: 100%"), std::string::npos) << run.err;  // progress
+  // Off a terminal (stderr is a file here): no `\r`, and a line only per 5 % of the simulation time.
+  EXPECT_EQ(run.err.find('\r'), std::string::npos) << run.err;
+  EXPECT_LE(std::count(run.err.begin(), run.err.end(), '\n'), 21) << run.err;
   EXPECT_NE(run.out.find("x real time"), std::string::npos) << run.out;
   auto rec = recording::ReadRecording(dir.File("rec"));
   ASSERT_TRUE(rec.ok()) << rec.status().message();
