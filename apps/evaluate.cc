@@ -155,6 +155,10 @@ int RunEvaluate(const EvaluateArgs& args) {
   if (!written.ok()) return Failure(args.err, "evaluate", written.status().message());
 
   if (!written.value().note.empty()) Report(args.err, "evaluate", written.value().note, 0);
+  // Even with --quiet: a NEES that tests nothing must not pass unnoticed.
+  for (const eval::Evaluation& e : evaluations)
+    if (e.metrics.contains("nees") && e.metrics["nees"].contains("warning"))
+      Report(args.err, "evaluate", "warning: " + e.metrics["nees"]["warning"].get<std::string>(), 0);
   if (!args.quiet) {
     if (evaluations.size() == 1)
       PrintSummary(evaluations.front().metrics);
