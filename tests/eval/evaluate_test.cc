@@ -200,6 +200,23 @@ TEST_F(EvaluateTest, ANeesWithoutAbsoluteSensorCarriesAWarning) {
   EXPECT_NE(warning.find("no gps, position or pose stream"), std::string::npos) << warning;
 }
 
+TEST_F(EvaluateTest, TheCommandPrintsTheNeesWarningAlsoWhenQuiet) {
+  WriteGpsCase();
+  const std::string command = std::string(ROAMLAB_BINARY) + " evaluate --estimate " + est_dir() + " --recording " +
+                              rec_dir() + " --out " + out_dir() + " --no-plots --quiet";
+  testing::CommandRun run = testing::RunCommand(command, dir_.path());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.err.find("warning"), std::string::npos) << run.err;
+  fs::remove(rec("gps.csv"));
+  WriteFile(rec("recording.yaml"), kImuYaml);
+  WriteFile(rec("imu.csv"), kImuCsv);
+  run = testing::RunCommand(command, dir_.path());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.out, "");
+  EXPECT_EQ(run.err.rfind("roamlab evaluate: warning: ", 0), 0u) << run.err;
+  EXPECT_NE(run.err.find("not observable from " + rec_dir()), std::string::npos) << run.err;
+}
+
 TEST_F(EvaluateTest, WritesMetricsJsonAndFigures) {
   WriteGpsCase();
   const Result<Evaluation> r = Evaluate(Options());
