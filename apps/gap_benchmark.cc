@@ -1,11 +1,13 @@
 #include "apps/gap_benchmark.h"
 
-#include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 
 #include "apps/cli.h"
-#include "common/atomic_file.h"
+#include "batch/slurm.h"
+#include "batch/work.h"
+#include "experiment/steps.h"
 
 namespace roamlab::apps {
 
@@ -19,18 +21,23 @@ int RunGapBenchmark(const GapBenchmarkArgs& args) {
   if (args.duration_s < 0.0) return bad("--duration must be positive");
   auto platforms = benchmark::LoadPlatforms(args);
   if (!platforms.ok()) return bad(platforms.status().message());
-  std::error_code ec;
-  std::filesystem::create_directories(args.out, ec);
-  if (ec) return bad(args.out + ": cannot create the output directory");
+  const std::unique_ptr<batch::Work> work = batch::GapBenchmarkWork(args);
+  if (args.backend.backend == "slurm")
+    return SubmitBatch(*work, args.backend, args.resume, args.quiet, args.err, "gap-benchmark");
+  if (Status made = experiment::MakeOutputDirectory(args.out); !made.ok()) return bad(made.message());
 
-  auto score = benchmark::RunBenchmark(args, std::move(platforms).value(), args.quiet ? nullptr : &std::cout);
-  if (!score.ok()) return Failure(args.err, "gap-benchmark", score.status().message());
-  if (Status s = WriteFileAtomic(args.out + "/score.json", score.value().dump(2) + "\n"); !s.ok())
-    return Failure(args.err, "gap-benchmark", s.message());
+  (void)batch::WriteLocalBatchFile(*work, "running", "");
+  auto result = benchmark::RunBenchmark(args, std::move(platforms).value(), args.quiet ? nullptr : &std::cout);
+  Status written = result.ok() ? benchmark::WriteBenchmarkResult(args.out, result.value()) : result.status();
+  (void)batch::WriteLocalBatchFile(*work, written.ok() ? "done" : "failed",
+                                   written.ok() ? args.out + "/score.json" : written.message());
+  if (!written.ok()) return Failure(args.err, "gap-benchmark", written.message());
   if (!args.quiet) {
-    std::cout << "figures: " << score.value()["figures"].dump() << "\n"
-              << "total " << std::fixed << std::setprecision(0) << score.value()["seconds"]["total"].get<double>()
-              << " s (" << args.out << "/score.json)\n";
+    const nlohmann::json& score = result.value().score;
+    std::cout << "figures: " << score["figures"].dump() << "\n"
+              << "total " << std::fixed << std::setprecision(0)
+              << result.value().timings["seconds"]["total"].get<double>() << " s (" << args.out
+              << "/score.json, timings.json)\n";
   }
   return 0;
 }

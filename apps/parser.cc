@@ -253,7 +253,9 @@ void AddGapBenchmark(CLI::App* app, Commands* commands) {
                     "Nominal mecanum scenario (default scenarios/indoor_mecanum_gap.yaml)");
     gbm->add_flag("--resume", args->resume,
                   "Read back the cases whose NNN/case.json exists instead of running them again");
-    gbm->add_option("--out", args->out, "Output directory: score.json, calibration/NNN, cases/NNN")->required();
+    gbm->add_option("--out", args->out, "Output directory: score.json, timings.json, calibration/NNN, cases/NNN")
+        ->required();
+    AddBackendOptions(gbm, &args->backend);
     gbm->add_flag("--quiet", args->quiet, "No progress");
     return gbm;
   });

@@ -48,7 +48,8 @@ bool WellFormedSlurm(const json& batch) {
            v["runs_per_task"].get<std::int64_t>() >= 1 && Has(v, "retries", kInteger) && Has(v, "sbatch_args", strings);
   };
   const auto submission = [](const json& v) {
-    return v.is_object() && Has(v, "array_job", kString) && Has(v, "aggregate_job", kString);
+    return v.is_object() && Has(v, "array_job", kString) && Has(v, "aggregate_job", kString) &&
+           (!v.contains("ready") || v["ready"].is_number_integer());
   };
   const auto submissions = [&](const json& v) { return v.is_array() && std::all_of(v.begin(), v.end(), submission); };
   return Has(batch, "slurm", options) && Has(batch, "submissions", submissions);
@@ -131,8 +132,10 @@ Result<std::string> Sbatch(const json& batch, const std::string& out, std::vecto
   return id;
 }
 
-// One submission: the array over the blocks holding `missing` runs and the aggregation job after it.
-Status SubmitAttempt(json* batch, const std::string& out, const std::string& kind, const std::vector<int>& missing) {
+// One submission: the array over the blocks holding `missing` runs and the aggregation job after it. `ready` is the
+// work's Ready() the missing runs were chosen under (the retries are counted per value).
+Status SubmitAttempt(json* batch, const std::string& out, const std::string& kind, const std::vector<int>& missing,
+                     int ready) {
   const int per_task = (*batch)["slurm"]["runs_per_task"].get<int>();
   std::set<int> block_set;
   for (const int run : missing) block_set.insert(run / per_task);
@@ -148,15 +151,18 @@ Status SubmitAttempt(json* batch, const std::string& out, const std::string& kin
                                "--job-name=roamlab-" + kind + "-aggregate", "--output=" + logs + "/aggregate-%j.log"},
                               "aggregate.sh");
   if (!aggregate_job.ok()) return aggregate_job.status();
-  (*batch)["submissions"].push_back(
-      {{"array_job", array_job.value()}, {"aggregate_job", aggregate_job.value()}, {"blocks", blocks}});
+  (*batch)["submissions"].push_back({{"array_job", array_job.value()},
+                                     {"aggregate_job", aggregate_job.value()},
+                                     {"blocks", blocks},
+                                     {"ready", ready}});
   (*batch)["state"] = "submitted";
   return WriteBatch(out, *batch);
 }
 
+// The runs that can run now and have no result file.
 std::vector<int> MissingRuns(const Work& work) {
   std::vector<int> missing;
-  for (int i = 0; i < work.runs(); ++i)
+  for (int i = 0, ready = work.Ready(); i < ready; ++i)
     if (!work.Done(i)) missing.push_back(i);
   return missing;
 }
@@ -185,10 +191,15 @@ bool Queued(const std::string& job) {
 
 // The log of the last task that ran run `run`.
 std::string TaskLog(const json& batch, const std::string& out, int run) {
-  const int per_task = batch["slurm"]["runs_per_task"].get<int>();
-  if (batch["submissions"].empty()) return "(never submitted)";
-  const std::string job = batch["submissions"].back()["array_job"].get<std::string>();
-  return fs::absolute(BatchDir(out) + "/logs/task-" + job + "-" + std::to_string(run / per_task) + ".log").string();
+  const int block = run / batch["slurm"]["runs_per_task"].get<int>();
+  const json& submissions = batch["submissions"];
+  for (auto s = submissions.rbegin(); s != submissions.rend(); ++s) {
+    const json blocks = s->value("blocks", json::array());
+    if (std::find(blocks.begin(), blocks.end(), block) == blocks.end()) continue;
+    const std::string job = (*s)["array_job"].get<std::string>();
+    return fs::absolute(BatchDir(out) + "/logs/task-" + job + "-" + std::to_string(block) + ".log").string();
+  }
+  return "(never submitted)";
 }
 
 // Polls OUT/batch/batch.json until its state is no longer "submitted"; a failure when the last aggregation job left
@@ -307,7 +318,8 @@ Outcome SubmitToSlurm(Work& work, const SlurmOptions& options, bool resume, std:
     (void)WriteBatch(work.out(), batch);
     return aggregated;
   }
-  if (Status s = SubmitAttempt(&batch, work.out(), work.kind(), missing); !s.ok()) return Outcome::Failed(s);
+  if (Status s = SubmitAttempt(&batch, work.out(), work.kind(), missing, work.Ready()); !s.ok())
+    return Outcome::Failed(s);
   const json& submission = batch["submissions"].back();
   log << "submitted " << missing.size() << " runs as array job " << submission["array_job"].get<std::string>() << " ("
       << submission["blocks"].size() << " tasks), aggregation job " << submission["aggregate_job"].get<std::string>()
@@ -324,10 +336,15 @@ int RunSlurmTask(const std::string& out, int index, std::ostream& err) {
   }
   auto& [batch, work] = loaded.value();
   const int per_task = batch["slurm"]["runs_per_task"].get<int>();
-  const int first = index * per_task, last = std::min(work->runs(), first + per_task);
+  const int first = index * per_task, last = std::min(work->Ready(), first + per_task);
   if (index < 0 || first >= work->runs()) {
     err << "roamlab batch task: --index " << index << " is outside the batch's " << work->runs() << " runs\n";
     return 2;
+  }
+  if (first >= last) {
+    err << "roamlab batch task: runs " << first << " to " << first + per_task - 1
+        << " wait for the earlier runs' results\n";
+    return 1;
   }
   if (Outcome prepared = work->PrepareRuns(first, last); !prepared.ok()) {
     err << "roamlab batch task: " << prepared.status.message() << "\n";
@@ -358,12 +375,15 @@ int AggregateSlurm(const std::string& out, std::ostream& out_stream, std::ostrea
   auto& [batch, work] = loaded.value();
   const std::vector<int> missing = MissingRuns(*work);
   if (!missing.empty()) {
-    const int submissions = static_cast<int>(batch["submissions"].size());
+    // The submissions of the runs ready now: none when earlier runs' results have just made them ready.
+    const int ready = work->Ready();
+    const auto submissions = std::count_if(batch["submissions"].begin(), batch["submissions"].end(),
+                                           [&](const json& s) { return s.value("ready", work->runs()) == ready; });
     if (submissions <= batch["slurm"]["retries"].get<int>()) {
-      const Status s = SubmitAttempt(&batch, out, work->kind(), missing);
+      const Status s = SubmitAttempt(&batch, out, work->kind(), missing, ready);
       if (s.ok()) {
-        out_stream << missing.size() << " runs without a result: submitted again as array job "
-                   << batch["submissions"].back()["array_job"].get<std::string>() << "\n";
+        out_stream << missing.size() << " runs without a result: submitted" << (submissions ? " again" : "")
+                   << " as array job " << batch["submissions"].back()["array_job"].get<std::string>() << "\n";
         return 0;
       }
       err << "roamlab batch aggregate: " << s.message() << "\n";
@@ -399,12 +419,14 @@ Result<BatchStatus> ReadBatchStatus(const std::string& out) {
   const bool slurm = status.backend == "slurm" && batch.value().contains("slurm");
   const auto queued = slurm ? QueuedTasks(batch.value()) : std::set<std::pair<std::string, int>>();
   const int per_task = slurm ? batch.value()["slurm"].value("runs_per_task", 1) : 1;
+  // Runs that wait for earlier runs' results are submitted by the aggregation job once those are done.
+  const int ready = work.value()->Ready();
   for (int i = 0; i < status.runs; ++i) {
     if (work.value()->Done(i)) {
       ++status.done;
       continue;
     }
-    bool in_queue = false;
+    bool in_queue = slurm && i >= ready && status.state == "submitted";
     for (const auto& [job, index] : queued) in_queue = in_queue || index == i / per_task;
     if (in_queue || (!slurm && status.state == "running")) {
       ++status.queued;

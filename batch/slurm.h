@@ -2,11 +2,14 @@
 // [k * runs_per_task, (k + 1) * runs_per_task) that have no result file yet (`roamlab batch task OUT --index k`),
 // and one aggregation job that depends on the array with afterany (`roamlab batch aggregate OUT`). The aggregation
 // job submits the blocks whose runs are still missing again while retries remain (a task that failed, timed out or
-// was cancelled), then writes the summary files from the result files, the same bytes as the local backend; when
-// runs are still missing after the retries it writes OUT/batch/failed.json instead ({"failed": [{"run", "name",
-// "log"}]}) and no summary. OUT must be on a file system every node sees, and the roamlab executable at the same path.
-// OUT/batch/ holds batch.json (the work, the options, each submission's job ids, "state": submitted | done | failed
-// and its message), task.sh, aggregate.sh and logs/ (task-ARRAYJOB-TASK.log, aggregate-JOB.log).
+// was cancelled); when runs that waited for earlier runs' results have become ready (Work::Ready: gap-benchmark's
+// scored cases after its calibration cases), it submits them as the next array, with retries of their own; then it
+// writes the summary files from the result files, the same bytes as the local backend; when runs are still missing
+// after the retries it writes OUT/batch/failed.json instead ({"failed": [{"run", "name", "log"}]}) and no summary.
+// OUT must be on a file system every node sees, and the roamlab executable at the same path. OUT/batch/ holds
+// batch.json (the work, the options, each submission's job ids, blocks and the Ready() it was made under, "state":
+// submitted | done | failed and its message), task.sh, aggregate.sh and logs/ (task-ARRAYJOB-TASK.log,
+// aggregate-JOB.log).
 #pragma once
 
 #include <iosfwd>

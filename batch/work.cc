@@ -126,6 +126,85 @@ class Sweep : public Work {
   std::vector<std::shared_ptr<const experiment::MonteCarloShared>> shared_;
 };
 
+// Run k is case k of the benchmark (gap/benchmark/benchmark.h).
+class GapBenchmark : public Work {
+ public:
+  explicit GapBenchmark(gap::benchmark::BenchmarkOptions options) : options_(std::move(options)) {}
+  std::string kind() const override { return "gap-benchmark"; }
+  int runs() const override { return gap::benchmark::CaseCount(options_); }
+  const std::string& out() const override { return options_.out; }
+  // The scored cases once every calibration case is done.
+  int Ready() const override {
+    for (int k = 0; k < options_.calibration_cases; ++k)
+      if (!Done(k)) return options_.calibration_cases;
+    return runs();
+  }
+  json ToJson() const override {
+    return {{"kind", kind()},
+            {"out", options_.out},
+            {"cases", options_.cases},
+            {"calibration_cases", options_.calibration_cases},
+            {"seed", options_.seed},
+            {"duration_s", options_.duration_s},
+            {"atv", options_.atv_scenario},
+            {"diffdrive", options_.diffdrive_scenario},
+            {"mecanum", options_.mecanum_scenario}};
+  }
+  // The scenarios load and OUT exists; the baselines are learned by each task (they are deterministic).
+  Outcome Prepare(bool resume) override {
+    (void)resume;
+    auto platforms = gap::benchmark::LoadPlatforms(options_);
+    if (!platforms.ok()) return Outcome::BadInput(platforms.status());
+    platforms_ = std::move(platforms).value();
+    if (Status made = experiment::MakeOutputDirectory(options_.out); !made.ok()) return Outcome::BadInput(made);
+    return Outcome::Ok();
+  }
+  // The baselines of the platforms the cases are drawn on, and the thresholds of the scored ones.
+  Outcome PrepareRuns(int first, int last) override {
+    if (Outcome prepared = Prepare(true); !prepared.ok()) return prepared;
+    const Status learned =
+        gap::benchmark::LearnBaselines(&platforms_, gap::benchmark::PlatformsOfCases(options_, first, last));
+    if (!learned.ok()) return Outcome::Failed(learned);
+    if (last <= options_.calibration_cases) return Outcome::Ok();
+    auto thresholds = gap::benchmark::ScoredThresholds(options_);
+    if (!thresholds.ok()) return Outcome::Failed(thresholds.status());
+    thresholds_ = thresholds.value();
+    return Outcome::Ok();
+  }
+  bool Done(int k) const override {
+    return std::filesystem::exists(gap::benchmark::CaseDirectory(options_, k) + "/case.json");
+  }
+  Outcome Run(int k) override {
+    if (Status ran = gap::benchmark::RunOneCase(options_, platforms_, k, thresholds_); !ran.ok())
+      return Outcome::Failed(ran);
+    return Outcome::Ok();
+  }
+  Outcome Aggregate(std::string* headline) override {
+    if (Outcome prepared = Prepare(true); !prepared.ok()) return prepared;
+    auto result = gap::benchmark::ScoreFromCaseFiles(options_, platforms_);
+    if (!result.ok()) return Outcome::Failed(result.status());
+    if (Status s = gap::benchmark::WriteBenchmarkResult(options_.out, result.value()); !s.ok())
+      return Outcome::Failed(s);
+    *headline = "figures: " + result.value().score["figures"].dump() + " (" + options_.out + "/score.json)";
+    return Outcome::Ok();
+  }
+  std::string RunName(int k) const override { return gap::benchmark::CaseName(options_, k); }
+  Status Clear() override {
+    for (int k = 0; k < runs(); ++k) {
+      const std::string file = gap::benchmark::CaseDirectory(options_, k) + "/case.json";
+      std::error_code ec;
+      std::filesystem::remove(file, ec);
+      if (ec) return Status::Error(file + ": cannot remove the earlier result file");
+    }
+    return Status::Ok();
+  }
+
+ private:
+  gap::benchmark::BenchmarkOptions options_;
+  std::vector<gap::benchmark::Platform> platforms_;
+  gap::benchmark::Thresholds thresholds_;
+};
+
 // json[key] read into *value when it has the value's type; false otherwise.
 template <typename T>
 bool Read(const json& j, const char* key, T* value) {
@@ -153,6 +232,18 @@ Result<experiment::MonteCarloOptions> MonteCarloFromJson(const json& j) {
                   Read(j, "seed_base", &o.seed_base) && Read(j, "t0_s", &o.t0_s) &&
                   Read(j, "no_time_budget", &o.no_time_budget) && Read(j, "calibrate_each_run", &o.calibrate_each_run);
   if (!ok) return Status::Error("the montecarlo work lacks a key or has one of the wrong type");
+  return o;
+}
+
+Result<gap::benchmark::BenchmarkOptions> GapBenchmarkFromJson(const json& j) {
+  gap::benchmark::BenchmarkOptions o;
+  const bool ok = Read(j, "out", &o.out) && Read(j, "cases", &o.cases) &&
+                  Read(j, "calibration_cases", &o.calibration_cases) && Read(j, "seed", &o.seed) &&
+                  Read(j, "duration_s", &o.duration_s) && Read(j, "atv", &o.atv_scenario) &&
+                  Read(j, "diffdrive", &o.diffdrive_scenario) && Read(j, "mecanum", &o.mecanum_scenario);
+  const auto in_range = [](int n) { return n >= 1 && n <= gap::benchmark::kMaxCases; };
+  if (!ok || !in_range(o.cases) || !in_range(o.calibration_cases))
+    return Status::Error("the gap-benchmark work lacks a key or has one of the wrong type");
   return o;
 }
 
@@ -194,6 +285,10 @@ std::string MonteCarloHeadline(const experiment::MonteCarloOptions& options,
 
 std::unique_ptr<Work> SweepWork(experiment::SweepPlan plan) { return std::make_unique<Sweep>(std::move(plan)); }
 
+std::unique_ptr<Work> GapBenchmarkWork(gap::benchmark::BenchmarkOptions options) {
+  return std::make_unique<GapBenchmark>(std::move(options));
+}
+
 std::unique_ptr<Work> MonteCarloWork(experiment::MonteCarloOptions options) {
   return std::make_unique<MonteCarlo>(std::move(options));
 }
@@ -205,6 +300,11 @@ Result<std::unique_ptr<Work>> WorkFromJson(const json& j) {
     auto plan = SweepFromJson(j);
     if (!plan.ok()) return plan.status();
     return SweepWork(std::move(plan).value());
+  }
+  if (kind == "gap-benchmark") {
+    auto options = GapBenchmarkFromJson(j);
+    if (!options.ok()) return options.status();
+    return GapBenchmarkWork(std::move(options).value());
   }
   if (kind == "montecarlo") {
     auto options = MonteCarloFromJson(j);

@@ -1,5 +1,6 @@
-// Batch work: runs 0..runs-1 that are independent of each other, each writing its own result file into the output
-// directory (written under a temporary name, then renamed), and a summary aggregated from those files alone. Whoever
+// Batch work: runs 0..runs-1, each writing its own result file into the output directory (written under a temporary
+// name, then renamed), and a summary aggregated from those files alone. Runs are independent of each other, but for
+// runs that need earlier runs' results (Ready). Whoever
 // runs a run (a thread here, a Slurm task on another host) writes the same file, because every run's seed derives
 // from its index; so the summary's bytes do not depend on the backend. A Work is what a Slurm task rebuilds from
 // OUT/batch/batch.json (ToJson, WorkFromJson) to run its block of runs.
@@ -14,14 +15,19 @@
 #include "experiment/montecarlo.h"
 #include "experiment/steps.h"
 #include "experiment/sweep.h"
+#include "gap/benchmark/benchmark.h"
 
 namespace roamlab::batch {
 
 class Work {
  public:
   virtual ~Work() = default;
-  virtual std::string kind() const = 0;  // the command: "montecarlo", "sweep"
+  virtual std::string kind() const = 0;  // the command: "montecarlo", "sweep", "gap-benchmark"
   virtual int runs() const = 0;
+  // Runs [0, Ready()) can run now; the later ones need their results first (gap-benchmark's scored cases need the
+  // thresholds chosen on its calibration cases). Read from the result files: it grows once those runs are done, and
+  // is runs() once every earlier run is.
+  virtual int Ready() const { return runs(); }
   virtual const std::string& out() const = 0;
   // Everything WorkFromJson needs to make the same work again: {"kind": kind(), ...}.
   virtual nlohmann::json ToJson() const = 0;
@@ -56,6 +62,11 @@ std::unique_ptr<Work> MonteCarloWork(experiment::MonteCarloOptions options);
 // A sweep (experiment/sweep.h) as batch work: run r is run r % seeds of point r / seeds. The points' files must have
 // been written (experiment::WriteSweepPoints) before Prepare.
 std::unique_ptr<Work> SweepWork(experiment::SweepPlan plan);
+
+// The gap benchmark (gap/benchmark/benchmark.h) as batch work: run k is case k of the benchmark (the calibration
+// cases, then the scored ones, which are ready once every calibration case is done). A task learns the baselines of
+// the platforms its cases are drawn on. Aggregate writes score.json (the local backend's bytes) and timings.json.
+std::unique_ptr<Work> GapBenchmarkWork(gap::benchmark::BenchmarkOptions options);
 
 // The work ToJson described; an error names what is missing.
 Result<std::unique_ptr<Work>> WorkFromJson(const nlohmann::json& json);

@@ -60,35 +60,87 @@ Status RunParallel(int n, int jobs, const std::string& label, std::ostream* prog
   return first_error;
 }
 
-// Draws and runs one phase's cases (stratified: kinds by CalibrationKind; else blind); results in draw order.
+// One phase of the benchmark: its cases' draws and noise seeds and their directory.
+struct Phase {
+  int n = 0;
+  std::uint64_t draw_seed = 0;
+  std::uint64_t noise_seed0 = 0;  // case i: noise_seed0 + i
+  bool stratified = false;        // kinds by CalibrationKind; else blind
+  std::string dir;
+  std::string label;
+};
+
+Phase CalibrationPhase(const BenchmarkOptions& options) {
+  const std::uint64_t seed = options.seed * 1000 + kMaxCases;
+  return {options.calibration_cases, seed, seed, true, options.out + "/calibration", "calibration"};
+}
+
+Phase ScoredPhase(const BenchmarkOptions& options) {
+  return {options.cases, options.seed, options.seed * 1000, false, options.out + "/cases", "scored"};
+}
+
+// Case k of the benchmark: its phase and index in it.
+std::pair<Phase, int> LocateCase(const BenchmarkOptions& options, int k) {
+  if (k < options.calibration_cases) return {CalibrationPhase(options), k};
+  return {ScoredPhase(options), k - options.calibration_cases};
+}
+
+// All of a phase's draws, drawn first: independent of which cases run where and when.
+std::vector<Draw> PhaseDraws(const Phase& phase) {
+  std::mt19937_64 rng(phase.draw_seed);
+  std::vector<Draw> draws;
+  for (int i = 0; i < phase.n; ++i)
+    draws.push_back(DrawCase(rng, phase.stratified ? CalibrationKind(i) : std::string()));
+  return draws;
+}
+
+std::string CaseId(int i) {
+  std::ostringstream id;
+  id << std::setw(3) << std::setfill('0') << i;
+  return id.str();
+}
+
 // The case a finished earlier call wrote to dir/case.json; an error names the file when it does not read back.
 Result<CaseResult> ReadCase(const std::string& dir) {
   const Result<std::string> text = ReadWholeFile(dir + "/case.json");
-  if (!text.ok()) return text.status();
+  if (!text.ok()) return Status::Error(dir + "/case.json: cannot read (the case has not finished)");
   auto c = CaseFromRow(json::parse(text.value(), nullptr, false));
   if (!c.ok()) return Status::Error(dir + "/case.json: " + c.status().message() + " (delete it to run the case again)");
   return c;
 }
 
-Result<std::vector<CaseResult>> RunPhase(const std::vector<Platform>& platforms, int n, std::uint64_t draw_seed,
-                                         std::uint64_t noise_seed0, bool stratified, const std::string& dir,
-                                         const CaseSetup& setup, const std::string& label, int jobs, bool resume,
-                                         std::ostream* progress) {
-  std::mt19937_64 rng(draw_seed);
-  std::vector<Draw> draws;
-  for (int i = 0; i < n; ++i)  // all drawn first: independent of scheduling
-    draws.push_back(DrawCase(rng, stratified ? CalibrationKind(i) : std::string()));
-  std::vector<CaseResult> results(static_cast<std::size_t>(n));
-  const Status st = RunParallel(n, jobs, label, progress, [&](int i) -> Result<std::string> {
-    std::ostringstream id;
-    id << std::setw(3) << std::setfill('0') << i;
-    const Draw& draw = draws[static_cast<std::size_t>(i)];
-    const std::string case_dir = dir + "/" + id.str();
-    auto c = resume && std::filesystem::exists(case_dir + "/case.json")
-                 ? ReadCase(case_dir)
-                 : RunCase(platforms[static_cast<std::size_t>(draw.platform)], draw,
-                           noise_seed0 + static_cast<std::uint64_t>(i), id.str(), case_dir, setup);
-    if (!c.ok()) return Status::Error(label + " case " + id.str() + ": " + c.status().message());
+// Every case of a phase read back from its case.json.
+Result<std::vector<CaseResult>> ReadPhase(const Phase& phase) {
+  std::vector<CaseResult> cases;
+  for (int i = 0; i < phase.n; ++i) {
+    auto c = ReadCase(phase.dir + "/" + CaseId(i));
+    if (!c.ok()) return c.status();
+    cases.push_back(std::move(c).value());
+  }
+  return cases;
+}
+
+// Runs case i of a phase (or, with `resume`, reads it back when its case.json exists).
+Result<CaseResult> RunPhaseCase(const std::vector<Platform>& platforms, const Phase& phase,
+                                const std::vector<Draw>& draws, int i, const CaseSetup& setup, bool resume) {
+  const Draw& draw = draws[static_cast<std::size_t>(i)];
+  const std::string case_dir = phase.dir + "/" + CaseId(i);
+  auto c = resume && std::filesystem::exists(case_dir + "/case.json")
+               ? ReadCase(case_dir)
+               : RunCase(platforms[static_cast<std::size_t>(draw.platform)], draw,
+                         phase.noise_seed0 + static_cast<std::uint64_t>(i), CaseId(i), case_dir, setup);
+  if (!c.ok()) return Status::Error(phase.label + " case " + CaseId(i) + ": " + c.status().message());
+  return c;
+}
+
+// Runs one phase's cases on `jobs` threads; results in draw order.
+Result<std::vector<CaseResult>> RunPhase(const std::vector<Platform>& platforms, const Phase& phase,
+                                         const CaseSetup& setup, int jobs, bool resume, std::ostream* progress) {
+  const std::vector<Draw> draws = PhaseDraws(phase);
+  std::vector<CaseResult> results(static_cast<std::size_t>(phase.n));
+  const Status st = RunParallel(phase.n, jobs, phase.label, progress, [&](int i) -> Result<std::string> {
+    auto c = RunPhaseCase(platforms, phase, draws, i, setup, resume);
+    if (!c.ok()) return c.status();
     results[static_cast<std::size_t>(i)] = c.value();
     return CaseLine(c.value());
   });
@@ -96,26 +148,35 @@ Result<std::vector<CaseResult>> RunPhase(const std::vector<Platform>& platforms,
   return results;
 }
 
-// Learns each platform's baseline (in parallel) and the ATV's nominal cornering compliance on its truth.
-Status LearnBaselines(std::vector<Platform>* platforms, int jobs, std::ostream* progress) {
-  return RunParallel(static_cast<int>(platforms->size()), jobs, "baselines", progress,
-                     [&](int i) -> Result<std::string> {
-                       Platform& p = (*platforms)[static_cast<std::size_t>(i)];
-                       auto learned = LearnBaseline(p.scenario, p.config);
-                       if (!learned.ok()) return Status::Error(p.name + " " + learned.status().message());
-                       p.baseline = learned.value().baseline;
-                       const auto& truth = learned.value().simulation.recording.ground_truth;
-                       if (p.name == "atv" && truth) p.rear_compliance_s = RearCorneringCompliance(*truth);
-                       return p.name + " baseline learned (noise seed " + std::to_string(kDefaultBaselineSeed) + ")";
-                     });
+// Learns one platform's baseline and the ATV's nominal cornering compliance on its truth; the progress line.
+Result<std::string> LearnPlatformBaseline(Platform* p) {
+  auto learned = LearnBaseline(p->scenario, p->config);
+  if (!learned.ok()) return Status::Error(p->name + " " + learned.status().message());
+  p->baseline = learned.value().baseline;
+  const auto& truth = learned.value().simulation.recording.ground_truth;
+  if (p->name == "atv" && truth) p->rear_compliance_s = RearCorneringCompliance(*truth);
+  return p->name + " baseline learned (noise seed " + std::to_string(kDefaultBaselineSeed) + ")";
 }
 
 double SecondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-// Phase 1: the calibration cases with the loosest thresholds, the thresholds chosen on them and the parameters'
-// noise; score.json's "calibration" and "thresholds".
+// A case's row of score.json: its case.json without the run time (timings.json holds it).
+json ScoreRow(const CaseResult& c) {
+  json row = CaseRow(c);
+  row.erase("seconds");
+  return row;
+}
+
+// The thresholds chosen on the calibration cases, with the benchmark's targets on the effect-free cases imposed on
+// the calibration with the score's rule; `grid` (optional) receives every grid point's counts.
+Thresholds ChooseOnCalibration(const std::vector<CaseResult>& calibration, json* grid) {
+  return ChooseThresholds(calibration, kMaxNoneFalseRate, 1.0 - kMinDecoysUnknown, grid);
+}
+
+// Phase 1's outcome: the thresholds chosen on the calibration cases and the parameters' noise; score.json's
+// "calibration" and "thresholds".
 struct Calibration {
   Thresholds chosen;
   std::map<std::string, std::map<std::string, double>> sigmas;
@@ -123,24 +184,16 @@ struct Calibration {
   json thresholds;
 };
 
-Result<Calibration> Calibrate(const BenchmarkOptions& options, const std::vector<Platform>& platforms,
-                              std::ostream* progress) {
-  const CaseSetup loose{Loosest(), true};
-  const std::uint64_t calibration_seed = options.seed * 1000 + kMaxCases;
-  auto cases = RunPhase(platforms, options.calibration_cases, calibration_seed, calibration_seed, true,
-                        options.out + "/calibration", loose, "calibration", options.jobs, options.resume, progress);
-  if (!cases.ok()) return cases.status();
+Calibration CalibrationFrom(const BenchmarkOptions& options, std::vector<CaseResult> cases) {
   Calibration out;
   json grid;
-  // The benchmark's targets on the effect-free cases, imposed on the calibration with the score's rule.
-  const double max_decoy_false_rate = 1.0 - kMinDecoysUnknown;
-  out.chosen = ChooseThresholds(cases.value(), kMaxNoneFalseRate, max_decoy_false_rate, &grid);
-  out.sigmas = CalibrationSigmas(cases.value());
+  out.chosen = ChooseOnCalibration(cases, &grid);
+  out.sigmas = CalibrationSigmas(cases);
   json rows = json::array();
-  for (CaseResult& c : cases.value()) {
+  for (CaseResult& c : cases) {
     if (c.kind == "effect")
       c.noise_ratio = NoiseRatio(out.sigmas, c.platform, c.truth_name, c.truth_parameter, c.truth_value);
-    json row = CaseRow(c);
+    json row = ScoreRow(c);
     row["replayed_first_round"] = ReplayFirstRound(c.candidates, out.chosen);
     rows.push_back(row);
   }
@@ -148,9 +201,9 @@ Result<Calibration> Calibrate(const BenchmarkOptions& options, const std::vector
   for (const auto& [platform, by_parameter] : out.sigmas)
     for (const auto& [key, sigma] : by_parameter) sigma_json[platform][key] = sigma;
   out.section = {{"cases", rows},
-                 {"draw_and_noise_seed_base", calibration_seed},
+                 {"draw_and_noise_seed_base", CalibrationPhase(options).draw_seed},
                  {"max_none_false_rate", kMaxNoneFalseRate},
-                 {"max_decoy_false_rate", max_decoy_false_rate},
+                 {"max_decoy_false_rate", 1.0 - kMinDecoysUnknown},
                  {"grid", grid},
                  {"noise_sigmas", sigma_json}};
   out.thresholds = {{"alpha", out.chosen.alpha},
@@ -158,6 +211,35 @@ Result<Calibration> Calibrate(const BenchmarkOptions& options, const std::vector
                     {"min_heldout_improvement", out.chosen.min_heldout_improvement},
                     {"min_explained_share", out.chosen.min_explained_share}};
   return out;
+}
+
+// score.json: the figures on the scored cases (their noise ratios from the calibration's sigmas), the thresholds,
+// the calibration and the per-case table; nothing that depends on how or where the cases ran.
+json ScoreJson(const BenchmarkOptions& options, const std::vector<Platform>& platforms,
+               const Calibration& calibration, std::vector<CaseResult> scored) {
+  json rows = json::array();
+  for (CaseResult& c : scored) {
+    if (c.kind == "effect")
+      c.noise_ratio = NoiseRatio(calibration.sigmas, c.platform, c.truth_name, c.truth_parameter, c.truth_value);
+    rows.push_back(ScoreRow(c));
+  }
+  return {{"seed", options.seed},
+          {"duration_s",
+           {{"atv", platforms[0].scenario.duration_s},
+            {"diffdrive", platforms[1].scenario.duration_s},
+            {"mecanum", platforms[2].scenario.duration_s}}},
+          {"figures", Summarize(scored)},
+          {"thresholds", calibration.thresholds},
+          {"calibration", calibration.section},
+          {"cases", rows}};
+}
+
+// timings.json's "cases": each case's run time [s] by its directory under OUT.
+json CaseSeconds(const std::vector<CaseResult>& calibration, const std::vector<CaseResult>& scored) {
+  json seconds = json::object();
+  for (const CaseResult& c : calibration) seconds["calibration/" + c.id] = c.seconds;
+  for (const CaseResult& c : scored) seconds["cases/" + c.id] = c.seconds;
+  return seconds;
 }
 
 }  // namespace
@@ -174,50 +256,106 @@ Result<std::vector<Platform>> LoadPlatforms(const BenchmarkOptions& options) {
   return platforms;
 }
 
-Result<json> RunBenchmark(const BenchmarkOptions& options, std::vector<Platform> platforms, std::ostream* progress) {
+Result<BenchmarkResult> RunBenchmark(const BenchmarkOptions& options, std::vector<Platform> platforms,
+                                     std::ostream* progress) {
+  // The platforms' baselines, in parallel.
   const auto start = std::chrono::steady_clock::now();
-  if (Status s = LearnBaselines(&platforms, options.jobs, progress); !s.ok()) return s;
+  const Status learned =
+      RunParallel(static_cast<int>(platforms.size()), options.jobs, "baselines", progress,
+                  [&](int i) { return LearnPlatformBaseline(&platforms[static_cast<std::size_t>(i)]); });
+  if (!learned.ok()) return learned;
   const double baseline_s = SecondsSince(start);
 
   // 1. Calibration: the loosest thresholds, every passing candidate evaluated on the held-out part.
   const auto calibration_start = std::chrono::steady_clock::now();
-  auto calibration = Calibrate(options, platforms, progress);
-  if (!calibration.ok()) return calibration.status();
+  auto calibration_cases = RunPhase(platforms, CalibrationPhase(options), {Loosest(), true}, options.jobs,
+                                    options.resume, progress);
+  if (!calibration_cases.ok()) return calibration_cases.status();
+  const Calibration calibration = CalibrationFrom(options, calibration_cases.value());
   const double calibration_s = SecondsSince(calibration_start);
-  if (progress) *progress << "thresholds from the calibration cases: " << calibration.value().thresholds.dump() << "\n";
+  if (progress) *progress << "thresholds from the calibration cases: " << calibration.thresholds.dump() << "\n";
 
   // 2. The scored cases, diagnosed with the chosen thresholds.
   const auto scored_start = std::chrono::steady_clock::now();
-  auto scored = RunPhase(platforms, options.cases, options.seed, options.seed * 1000, false, options.out + "/cases",
-                         {calibration.value().chosen, false}, "scored", options.jobs, options.resume, progress);
+  auto scored = RunPhase(platforms, ScoredPhase(options), {calibration.chosen, false}, options.jobs, options.resume,
+                         progress);
   if (!scored.ok()) return scored.status();
-  json rows = json::array();
-  for (CaseResult& c : scored.value()) {
-    if (c.kind == "effect")
-      c.noise_ratio =
-          NoiseRatio(calibration.value().sigmas, c.platform, c.truth_name, c.truth_parameter, c.truth_value);
-    rows.push_back(CaseRow(c));
-  }
   const double scored_s = SecondsSince(scored_start);
   const double total_s = SecondsSince(start);
-  json score = {
-      {"seed", options.seed},
+  json timings = {
       {"jobs", options.jobs},
-      {"duration_s",
-       {{"atv", platforms[0].scenario.duration_s},
-        {"diffdrive", platforms[1].scenario.duration_s},
-        {"mecanum", platforms[2].scenario.duration_s}}},
-      {"figures", Summarize(scored.value())},
-      {"thresholds", calibration.value().thresholds},
-      {"calibration", calibration.value().section},
-      {"cases", rows},
       {"seconds",
        {{"total", total_s},
         {"baselines", baseline_s},
         {"calibration", calibration_s},
         {"scored", scored_s},
-        {"extrapolated_total_for_60_scored_cases", baseline_s + calibration_s + scored_s / options.cases * 60.0}}}};
-  return score;
+        {"extrapolated_total_for_60_scored_cases", baseline_s + calibration_s + scored_s / options.cases * 60.0}}},
+      {"cases", CaseSeconds(calibration_cases.value(), scored.value())}};
+  return BenchmarkResult{ScoreJson(options, platforms, calibration, scored.value()), timings};
+}
+
+Status WriteBenchmarkResult(const std::string& out, const BenchmarkResult& result) {
+  if (Status s = WriteFileAtomic(out + "/score.json", result.score.dump(2) + "\n"); !s.ok()) return s;
+  return WriteFileAtomic(out + "/timings.json", result.timings.dump(2) + "\n");
+}
+
+int CaseCount(const BenchmarkOptions& options) { return options.calibration_cases + options.cases; }
+
+std::string CaseDirectory(const BenchmarkOptions& options, int k) {
+  const auto [phase, i] = LocateCase(options, k);
+  return phase.dir + "/" + CaseId(i);
+}
+
+std::string CaseName(const BenchmarkOptions& options, int k) {
+  const auto [phase, i] = LocateCase(options, k);
+  return phase.label + " case " + CaseId(i) + " (noise seed " +
+         std::to_string(phase.noise_seed0 + static_cast<std::uint64_t>(i)) + ")";
+}
+
+std::vector<int> PlatformsOfCases(const BenchmarkOptions& options, int first, int last) {
+  const std::vector<Draw> calibration = PhaseDraws(CalibrationPhase(options));
+  const std::vector<Draw> scored = PhaseDraws(ScoredPhase(options));
+  std::vector<int> platforms;
+  for (int k = std::max(first, 0); k < std::min(last, CaseCount(options)); ++k) {
+    const Draw& draw = k < options.calibration_cases ? calibration[static_cast<std::size_t>(k)]
+                                                     : scored[static_cast<std::size_t>(k - options.calibration_cases)];
+    if (std::find(platforms.begin(), platforms.end(), draw.platform) == platforms.end())
+      platforms.push_back(draw.platform);
+  }
+  std::sort(platforms.begin(), platforms.end());
+  return platforms;
+}
+
+Status LearnBaselines(std::vector<Platform>* platforms, const std::vector<int>& which) {
+  for (const int p : which) {
+    auto learned = LearnPlatformBaseline(&(*platforms)[static_cast<std::size_t>(p)]);
+    if (!learned.ok()) return learned.status();
+  }
+  return Status::Ok();
+}
+
+Result<Thresholds> ScoredThresholds(const BenchmarkOptions& options) {
+  auto calibration = ReadPhase(CalibrationPhase(options));
+  if (!calibration.ok()) return calibration.status();
+  return ChooseOnCalibration(calibration.value(), nullptr);
+}
+
+Status RunOneCase(const BenchmarkOptions& options, const std::vector<Platform>& platforms, int k,
+                  const Thresholds& scored) {
+  const auto [phase, i] = LocateCase(options, k);
+  const CaseSetup setup = k < options.calibration_cases ? CaseSetup{Loosest(), true} : CaseSetup{scored, false};
+  const Result<CaseResult> c = RunPhaseCase(platforms, phase, PhaseDraws(phase), i, setup, false);
+  return c.ok() ? Status::Ok() : c.status();
+}
+
+Result<BenchmarkResult> ScoreFromCaseFiles(const BenchmarkOptions& options, const std::vector<Platform>& platforms) {
+  auto calibration = ReadPhase(CalibrationPhase(options));
+  if (!calibration.ok()) return calibration.status();
+  auto scored = ReadPhase(ScoredPhase(options));
+  if (!scored.ok()) return scored.status();
+  json timings = {{"cases", CaseSeconds(calibration.value(), scored.value())}};
+  return BenchmarkResult{ScoreJson(options, platforms, CalibrationFrom(options, calibration.value()), scored.value()),
+                         timings};
 }
 
 }  // namespace roamlab::gap::benchmark

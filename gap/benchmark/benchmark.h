@@ -12,8 +12,12 @@
 // Both phases judge a case by one rule (Identified / FalseDiscovery): a none or decoy case that keeps any library
 // effect is a false discovery, whatever the verdict.
 // Writes the recordings in OUT/calibration/NNN/rec and OUT/cases/NNN/rec, each case's row in OUT/.../NNN/case.json and
-// its diagnosis as `roamlab diagnose` writes it in OUT/.../NNN/gap.json; returns score.json's content (figures against
-// the benchmark's targets, thresholds, per-case table, seconds).
+// its diagnosis as `roamlab diagnose` writes it in OUT/.../NNN/gap.json, then OUT/score.json (figures against the
+// benchmark's targets, thresholds, calibration, per-case table: the same bytes for the same options however the cases
+// were run) and OUT/timings.json (how long the parts and each case took).
+// The cases can also be run one by one (a Slurm task each, batch/work.h): case k of the benchmark is calibration case k
+// when k < C, else scored case k - C; a scored case needs every calibration case's case.json (its thresholds are
+// chosen on them); ScoreFromCaseFiles then writes the score from the case.json files alone.
 #pragma once
 
 #include <cstdint>
@@ -41,17 +45,47 @@ struct BenchmarkOptions {
   std::string mecanum_scenario = "scenarios/indoor_mecanum_gap.yaml";
   std::string out;  // output directory (exists)
   // Cases whose OUT/.../NNN/case.json exists are read back instead of run again (case.json is written last, under a
-  // temporary name then renamed); score.json is then the uninterrupted call's but for the timings.
+  // temporary name then renamed); score.json is then the uninterrupted call's.
   bool resume = false;
 };
 
 // The three platforms (atv, diffdrive, mecanum), in that order. Errors name the scenario file.
 Result<std::vector<Platform>> LoadPlatforms(const BenchmarkOptions& options);
 
-// Learns the platforms' baselines, runs the calibration and the scored cases and returns score.json's content.
-// `progress` (null: quiet) receives the progress bars, one line per case and the chosen thresholds. Errors: a case or
-// a baseline failed.
-Result<nlohmann::json> RunBenchmark(const BenchmarkOptions& options, std::vector<Platform> platforms,
-                                    std::ostream* progress);
+// score.json's and timings.json's content.
+struct BenchmarkResult {
+  nlohmann::json score;
+  nlohmann::json timings;
+};
+
+// Learns the platforms' baselines, runs the calibration and the scored cases and returns the score. `progress` (null:
+// quiet) receives the progress bars, one line per case and the chosen thresholds. Errors: a case or a baseline failed.
+Result<BenchmarkResult> RunBenchmark(const BenchmarkOptions& options, std::vector<Platform> platforms,
+                                     std::ostream* progress);
+
+// Writes OUT/score.json and OUT/timings.json.
+Status WriteBenchmarkResult(const std::string& out, const BenchmarkResult& result);
+
+// The cases one by one: C + N of them (calibration then scored), case k's directory (its case.json marks it done),
+// its one-line name, and the platforms (indices into LoadPlatforms') cases [first, last) are drawn on.
+int CaseCount(const BenchmarkOptions& options);
+std::string CaseDirectory(const BenchmarkOptions& options, int k);
+std::string CaseName(const BenchmarkOptions& options, int k);
+std::vector<int> PlatformsOfCases(const BenchmarkOptions& options, int first, int last);
+
+// Learns the baselines of the platforms `which` (the others keep theirs), one after the other.
+Status LearnBaselines(std::vector<Platform>* platforms, const std::vector<int>& which);
+
+// The thresholds the scored cases are diagnosed with, chosen on the calibration cases' case.json files (an error
+// names a missing or unreadable one).
+Result<Thresholds> ScoredThresholds(const BenchmarkOptions& options);
+
+// Runs case k (its platform's baseline learned; `scored` the thresholds of a scored case) and writes its files.
+Status RunOneCase(const BenchmarkOptions& options, const std::vector<Platform>& platforms, int k,
+                  const Thresholds& scored);
+
+// The score from every case's case.json (an error names a missing or unreadable one); the same score.json as
+// RunBenchmark's, and timings.json with each case's seconds only.
+Result<BenchmarkResult> ScoreFromCaseFiles(const BenchmarkOptions& options, const std::vector<Platform>& platforms);
 
 }  // namespace roamlab::gap::benchmark

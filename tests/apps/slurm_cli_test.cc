@@ -1,7 +1,8 @@
 // The Slurm backend on a running cluster (scripts/local-slurm.sh start, SLURM_CONF exported; ctest label "slurm"):
 // an 8-run ATV Monte-Carlo (a 4 s drive) through Slurm gives the local backend's nees.json byte for byte; a task killed
 // midway is submitted again by the aggregation job; --resume after a cancelled array submits only the missing runs and
-// ends with the same bytes; a sweep through Slurm gives the local table.
+// ends with the same bytes; a sweep through Slurm gives the local table; a small gap benchmark through Slurm (the
+// calibration cases' array, then the scored cases') gives the local score.json, also after --resume.
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -22,6 +23,10 @@ using testing::ReadJson;
 using testing::Roamlab;
 using testing::RunCommand;
 using testing::SlurpFile;
+
+// The drive [s] of the gap benchmark's cases: long enough for the diagnosis's held-out part, short enough for the
+// suite's time.
+constexpr char kGapDuration[] = "10";
 
 class SlurmTest : public ::testing::Test {
  protected:
@@ -166,6 +171,46 @@ TEST_F(SlurmTest, SweepGivesTheLocalTable) {
   for (nlohmann::json* sweep : {&a, &b})
     for (nlohmann::json& point : (*sweep)["points"]) point.erase("track_seconds");
   EXPECT_EQ(a, b);
+}
+
+// Two calibration and two scored cases of short drives, two cases a task: one array for the calibration cases, then
+// one for the scored cases (their thresholds are chosen on the calibration cases), submitted by the first aggregation
+// job; score.json is the local backend's byte for byte. Then a scored case's result is removed and --resume runs only
+// its task, leaves the other cases' files untouched and writes the same score.json again.
+TEST_F(SlurmTest, GapBenchmarkGivesTheLocalScore) {
+  const std::string scenarios = std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/";
+  const std::string benchmark = "gap-benchmark --cases 2 --calibration-cases 2 --seed 3 --duration " +
+                                std::string(kGapDuration) + " --quiet --atv " + scenarios + "atv_hills_sines.yaml" +
+                                " --diffdrive " + scenarios + "indoor_diffdrive_gap.yaml --mecanum " + scenarios +
+                                "indoor_mecanum_gap.yaml";
+  const testing::CommandRun local = Roamlab(benchmark + " --jobs 2 --out gap_local", dir_);
+  ASSERT_EQ(local.exit_code, 0) << local.err;
+  const testing::CommandRun slurm =
+      Roamlab(benchmark + " --out gap_slurm --backend slurm --runs-per-task 2 --wait", dir_);
+  ASSERT_EQ(slurm.exit_code, 0) << slurm.err;
+  const fs::path out = dir_ / "gap_slurm";
+  const std::string score = SlurpFile(dir_ / "gap_local" / "score.json");
+  ASSERT_FALSE(score.empty());
+  EXPECT_EQ(SlurpFile(out / "score.json"), score);
+  const nlohmann::json submissions = ReadJson(out / "batch" / "batch.json")["submissions"];
+  ASSERT_EQ(submissions.size(), 2u) << submissions.dump();
+  EXPECT_EQ(submissions[0]["blocks"], nlohmann::json::array({0}));
+  EXPECT_EQ(submissions[0]["ready"], 2);
+  EXPECT_EQ(submissions[1]["blocks"], nlohmann::json::array({1}));
+  EXPECT_EQ(submissions[1]["ready"], 4);
+
+  const std::string calibration0 = SlurpFile(out / "calibration" / "000" / "case.json");
+  fs::remove(out / "cases" / "001" / "case.json");
+  fs::remove(out / "score.json");
+  const testing::CommandRun resumed =
+      Roamlab(benchmark + " --out gap_slurm --backend slurm --runs-per-task 2 --resume --wait", dir_);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+  EXPECT_NE(resumed.err.find("submitted 1 runs as array job"), std::string::npos) << resumed.err;
+  EXPECT_EQ(SlurpFile(out / "calibration" / "000" / "case.json"), calibration0) << "calibration case 0 ran again";
+  EXPECT_EQ(SlurpFile(out / "score.json"), score);
+  const testing::CommandRun status = Roamlab("batch status gap_slurm", dir_);
+  EXPECT_NE(status.out.find("4 runs: 4 done, 0 pending or running, 0 failed; state done"), std::string::npos)
+      << status.out;
 }
 
 }  // namespace
