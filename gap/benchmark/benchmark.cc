@@ -78,14 +78,21 @@ Result<CaseResult> ReadCase(const std::string& dir) {
   return c;
 }
 
+// The salt of the drives' random numbers (DrawDrives), seeded apart from the draws' own.
+constexpr std::uint64_t kDriveSeedSalt = 0x6f74686572ULL;
+
 Result<std::vector<CaseResult>> RunPhase(const std::vector<Platform>& platforms, int n, std::uint64_t draw_seed,
                                          std::uint64_t noise_seed0, bool stratified, const std::string& dir,
-                                         const CaseSetup& setup, const std::string& label, int jobs, bool resume,
-                                         std::ostream* progress) {
+                                         const CaseSetup& setup, const std::string& label,
+                                         const BenchmarkOptions& options, std::ostream* progress) {
   std::mt19937_64 rng(draw_seed);
   std::vector<Draw> draws;
   for (int i = 0; i < n; ++i)  // all drawn first: independent of scheduling
     draws.push_back(DrawCase(rng, stratified ? CalibrationKind(i) : std::string()));
+  std::mt19937_64 drive_rng(draw_seed ^ kDriveSeedSalt);
+  DrawDrives(drive_rng, options.other_drive, &draws);
+  const int jobs = options.jobs;
+  const bool resume = options.resume;
   std::vector<CaseResult> results(static_cast<std::size_t>(n));
   const Status st = RunParallel(n, jobs, label, progress, [&](int i) -> Result<std::string> {
     std::ostringstream id;
@@ -136,7 +143,7 @@ Result<Calibration> Calibrate(const BenchmarkOptions& options, const std::vector
   const CaseSetup loose{Loosest(), true};
   const std::uint64_t calibration_seed = options.seed * 1000 + kMaxCases;
   auto cases = RunPhase(platforms, options.calibration_cases, calibration_seed, calibration_seed, true,
-                        options.out + "/calibration", loose, "calibration", options.jobs, options.resume, progress);
+                        options.out + "/calibration", loose, "calibration", options, progress);
   if (!cases.ok()) return cases.status();
   Calibration out;
   json grid;
@@ -197,7 +204,7 @@ Result<json> RunBenchmark(const BenchmarkOptions& options, std::vector<Platform>
   // 2. The scored cases, diagnosed with the chosen thresholds.
   const auto scored_start = std::chrono::steady_clock::now();
   auto scored = RunPhase(platforms, options.cases, options.seed, options.seed * 1000, false, options.out + "/cases",
-                         {calibration.value().chosen, false}, "scored", options.jobs, options.resume, progress);
+                         {calibration.value().chosen, false}, "scored", options, progress);
   if (!scored.ok()) return scored.status();
   json rows = json::array();
   for (CaseResult& c : scored.value()) {
@@ -211,6 +218,7 @@ Result<json> RunBenchmark(const BenchmarkOptions& options, std::vector<Platform>
   json score = {
       {"seed", options.seed},
       {"jobs", options.jobs},
+      {"other_drive", options.other_drive},
       {"duration_s",
        {{"atv", platforms[0].scenario.duration_s},
         {"diffdrive", platforms[1].scenario.duration_s},
