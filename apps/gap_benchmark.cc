@@ -19,6 +19,7 @@ int RunGapBenchmark(const GapBenchmarkArgs& args) {
     return bad("--cases and --calibration-cases must be in [1, " + std::to_string(benchmark::kMaxCases) + "]");
   if (args.jobs < 1) return bad("--jobs must be >= 1");
   if (args.duration_s < 0.0) return bad("--duration must be positive");
+  if (!(args.other_drive >= 0.0 && args.other_drive <= 1.0)) return bad("--other-drive must be in [0, 1]");
   auto platforms = benchmark::LoadPlatforms(args);
   if (!platforms.ok()) return bad(platforms.status().message());
   const std::unique_ptr<batch::Work> work = batch::GapBenchmarkWork(args);

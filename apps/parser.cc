@@ -221,11 +221,23 @@ void AddDiagnose(CLI::App* app, Commands* commands) {
                     "residuals) or auto (hac on imported recordings, white on simulated ones; default)")
         ->check(CLI::IsMember({"auto", "white", "hac"}));
     dia->add_flag("--no-plots", args->no_plots, "No figures");
-    dia->add_flag("--replay", args->replay,
-                  "Also diagnose against the scenario's noise-free twin into OUT/twin.json (its simulation of the "
-                  "scenario's own drive, else its replay of the recorded drive)");
+    dia->add_flag("--twin", args->twin,
+                  "Also diagnose against the scenario's noise-free twin, the simulator's effects fitted by running it, "
+                  "into OUT/twin.json (the twin: the scenario's own drive for a recording of it, else the replay of "
+                  "the recorded drive)");
+    CLI::Option* replay = dia->add_flag_callback(
+        "--replay",
+        [args] {
+          args->drive = gap::TwinDrive::kReplay;
+          args->twin = true;
+        },
+        "The twin replays the recorded drive, whatever the drive (implies --twin)");
+    CLI::Option* no_replay = dia->add_flag_callback(
+        "--no-replay", [args] { args->drive = gap::TwinDrive::kPlain; },
+        "The twin is the scenario's own drive (its plain simulation), whatever the recording's drive");
+    replay->excludes(no_replay);
     dia->add_option("--held-out", args->held_out,
-                    "With --replay: other recordings of the same robot (held out of the twin's fit) on which the "
+                    "With --twin: other recordings of the same robot (held out of the twin's fit) on which the "
                     "twin's patch is shown (twin.json heldout_runs)");
     dia->add_flag("--quiet", args->quiet, "No progress and no summary");
     return dia;
@@ -245,6 +257,9 @@ void AddGapBenchmark(CLI::App* app, Commands* commands) {
                     "Seed of the draws; scored case i uses noise seed SEED * 1000 + i, calibration case i "
                     "SEED * 1000 + 500 + i (default 1)");
     gbm->add_option("--jobs", args->jobs, "Cases in parallel (default 2)");
+    gbm->add_option("--other-drive", args->other_drive,
+                    "Fraction of the cases whose \"real\" recording is driven by another schedule than the nominal "
+                    "scenario's, so that the re-simulation replays it (default 0.5)");
     gbm->add_option("--duration", args->duration_s, "Drive duration [s] of every case (default: the scenarios')");
     gbm->add_option("--atv", args->atv_scenario, "Nominal ATV scenario (default scenarios/atv_hills_sines.yaml)");
     gbm->add_option("--diffdrive", args->diffdrive_scenario,

@@ -146,6 +146,7 @@ class GapBenchmark : public Work {
             {"calibration_cases", options_.calibration_cases},
             {"seed", options_.seed},
             {"duration_s", options_.duration_s},
+            {"other_drive", options_.other_drive},
             {"atv", options_.atv_scenario},
             {"diffdrive", options_.diffdrive_scenario},
             {"mecanum", options_.mecanum_scenario}};
@@ -239,10 +240,12 @@ Result<gap::benchmark::BenchmarkOptions> GapBenchmarkFromJson(const json& j) {
   gap::benchmark::BenchmarkOptions o;
   const bool ok = Read(j, "out", &o.out) && Read(j, "cases", &o.cases) &&
                   Read(j, "calibration_cases", &o.calibration_cases) && Read(j, "seed", &o.seed) &&
-                  Read(j, "duration_s", &o.duration_s) && Read(j, "atv", &o.atv_scenario) &&
+                  Read(j, "duration_s", &o.duration_s) && Read(j, "other_drive", &o.other_drive) &&
+                  Read(j, "atv", &o.atv_scenario) &&
                   Read(j, "diffdrive", &o.diffdrive_scenario) && Read(j, "mecanum", &o.mecanum_scenario);
   const auto in_range = [](int n) { return n >= 1 && n <= gap::benchmark::kMaxCases; };
-  if (!ok || !in_range(o.cases) || !in_range(o.calibration_cases))
+  const bool fraction = o.other_drive >= 0.0 && o.other_drive <= 1.0;
+  if (!ok || !in_range(o.cases) || !in_range(o.calibration_cases) || !fraction)
     return Status::Error("the gap-benchmark work lacks a key or has one of the wrong type");
   return o;
 }

@@ -39,7 +39,8 @@ bool PlanarPoseAt(const Trajectory& trajectory, Time t, Eigen::Vector3d* x_y_yaw
 }
 
 Status WriteTopViewFigure(const std::string& dir, const std::string& name, const std::string& title,
-                          const std::vector<Eigen::Vector3d>& reference, const std::vector<TopViewSeries>& series) {
+                          const std::vector<Eigen::Vector3d>& reference, const std::vector<TopViewSeries>& series,
+                          const std::string& reference_label) {
   std::ostringstream data;
   data << "# x_ref_m y_ref_m";
   for (const TopViewSeries& e : series) data << "  x_m y_m (" << e.label << ")";
@@ -54,7 +55,7 @@ Status WriteTopViewFigure(const std::string& dir, const std::string& name, const
      << "set terminal pngcairo size 900,900 noenhanced font 'sans,11'\nset output '" << name << ".png'\n"
      << "set title '" << title << "'\nset xlabel 'x [m]'\nset ylabel 'y [m]'\nset size ratio -1\nset grid\n"
      << "set key outside below\n"
-     << "plot '" << name << ".dat' using 1:2 with lines lw 3 lc rgb 'black' title 'reference (ground_truth.tum)'";
+     << "plot '" << name << ".dat' using 1:2 with lines lw 3 lc rgb 'black' title '" << reference_label << "'";
   // Distinct colours, none black (the reference).
   static const char* kColors[] = {"#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd",
                                   "#8c564b", "#e377c2", "#17becf", "#bcbd22", "#7f7f7f"};

@@ -23,8 +23,10 @@ struct TopViewSeries {
   std::vector<Eigen::Vector3d> poses;  // x, y, yaw
 };
 
-// Top view of the reference (black) and every series: NAME.dat, NAME.gp and NAME.png (drawn with gnuplot) in `dir`.
+// Top view of the reference (black, titled `reference_label`) and every series: NAME.dat, NAME.gp and NAME.png (drawn
+// with gnuplot) in `dir`.
 Status WriteTopViewFigure(const std::string& dir, const std::string& name, const std::string& title,
-                          const std::vector<Eigen::Vector3d>& reference, const std::vector<TopViewSeries>& series);
+                          const std::vector<Eigen::Vector3d>& reference, const std::vector<TopViewSeries>& series,
+                          const std::string& reference_label = "reference (ground_truth.tum)");
 
 }  // namespace roamlab::eval

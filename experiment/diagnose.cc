@@ -15,7 +15,6 @@
 #include "gap/resimulate.h"
 #include "gap/twin.h"
 #include "recording/recording.h"
-#include "sim/replay.h"
 #include "sim/scenario.h"
 
 namespace roamlab::experiment {
@@ -110,26 +109,21 @@ Result<gap::Baseline> NominalBaseline(const DiagnoseRequest& request, const Inpu
   return std::move(learned).value().baseline;
 }
 
-// The twin's runner of `rec` (read from `path`): the scenario's plain noise-free simulation when the recording is of
-// its own drive (detected by gap::DriveMismatch), else the replay of the recorded drive (sim/replay.h; bad input when
-// the recording has no drive inputs). `replayed` says which.
-Result<gap::TwinRunner> ChooseTwinRunner(const sim::Scenario& scenario, const recording::Recording& rec,
-                                         const std::string& path, bool* replayed,
-                                         const std::function<void(const std::string&)>& say) {
-  double span_s = 0.0;
-  for (const recording::Stream& s : rec.streams)
-    if (!s.t.empty()) span_s = std::max(span_s, s.t.back().seconds());
-  sim::Scenario nominal = scenario;
-  nominal.effects.clear();
-  nominal.duration_s = std::max(span_s, 1.0);
-  auto twin = gap::PlainSimulationRunner()(nominal);
-  const std::string mismatch = twin.ok() ? gap::DriveMismatch(rec, twin.value()) : twin.status().message();
-  *replayed = !mismatch.empty();
-  if (!*replayed) return gap::PlainSimulationRunner();
-  if (auto inputs = sim::DriveInputsFrom(rec, scenario); !inputs.ok())
-    return Status::Error(path + ": " + inputs.status().message());
-  say(path + ": not a recording of the scenario's own drive (" + mismatch + "): the twin replays the recorded drive");
-  return gap::ReplayRunner(rec);
+// The scenario's twin of `rec` (read from `path`), as `request.drive` says, and its runner; errors are bad input.
+Result<gap::TwinChoice> ChooseTwin(const sim::Scenario& scenario, const recording::Recording& rec,
+                                   const std::string& path, gap::TwinDrive drive,
+                                   const std::function<void(const std::string&)>& say) {
+  auto choice = gap::ChooseTwin(scenario, rec, drive);
+  if (!choice.ok()) return Status::Error(path + ": " + choice.status().message());
+  const gap::TwinChoice& c = choice.value();
+  std::string line = path + ": " + c.reason;
+  if (c.mismatch) line += " (" + c.stream + " differs from the scenario's own drive by " + Fixed(*c.mismatch, 3) + ")";
+  say(line + (c.replayed ? ": the twin replays the recorded drive" : ": the twin is the scenario's own drive"));
+  return choice;
+}
+
+gap::TwinRunner Runner(const gap::TwinChoice& choice, const recording::Recording& rec) {
+  return choice.replayed ? gap::ReplayRunner(rec) : gap::PlainSimulationRunner();
 }
 
 // A held-out recording with its twin's runner; errors are bad input.
@@ -151,9 +145,10 @@ Result<std::vector<HeldOut>> LoadHeldOut(const DiagnoseRequest& request, const s
       return Status::Error(path + ": platform kind '" + rec.value().platform.kind +
                            "' does not match the robot kind '" + scenario.robot.kind + "' of " + request.scenario);
     HeldOut h{path, std::move(rec).value(), {}, false};
-    auto runner = ChooseTwinRunner(scenario, h.recording, path, &h.replayed, say);
-    if (!runner.ok()) return runner.status();
-    h.runner = std::move(runner).value();
+    auto choice = ChooseTwin(scenario, h.recording, path, request.drive, say);
+    if (!choice.ok()) return choice.status();
+    h.runner = Runner(choice.value(), h.recording);
+    h.replayed = choice.value().replayed;
     out.push_back(std::move(h));
   }
   return out;
@@ -161,10 +156,10 @@ Result<std::vector<HeldOut>> LoadHeldOut(const DiagnoseRequest& request, const s
 
 std::string Millimetres(double m) { return Fixed(1e3 * m, 3) + " mm"; }
 
-// The diagnosis against the scenario's twin (runner: ChooseTwinRunner), its patch shown on the held-out recordings,
-// into out/twin.json; `json` receives what was written.
+// The diagnosis against the scenario's twin (runner: ChooseTwin's), its patch shown on the held-out recordings, into
+// out/twin.json; `out` receives it.
 Outcome DiagnoseTwinToFile(const DiagnoseRequest& request, const Inputs& in, const gap::TwinRunner& runner,
-                           bool replayed, const std::vector<HeldOut>& held_out, nlohmann::json* json,
+                           bool replayed, const std::vector<HeldOut>& held_out, gap::TwinDiagnosis* out,
                            const std::function<void(const std::string&)>& say) {
   say("diagnosing " + request.recording + " against the scenario's twin" + (replayed ? " (replayed)" : ""));
   gap::TwinDiagnoseOptions options;
@@ -188,9 +183,9 @@ Outcome DiagnoseTwinToFile(const DiagnoseRequest& request, const Inputs& in, con
     d.heldout_runs.push_back(std::move(shown).value());
   }
   const std::string path = (std::filesystem::path(request.out) / "twin.json").string();
-  *json = gap::TwinDiagnosisJson(d);
-  if (Status s = WriteFileAtomic(path, json->dump(2) + "\n"); !s.ok()) return Outcome::Failed(s);
+  if (Status s = WriteFileAtomic(path, gap::TwinDiagnosisJson(d).dump(2) + "\n"); !s.ok()) return Outcome::Failed(s);
   say("twin: " + d.verdict + ", std " + d.std_method + " (" + path + ")");
+  *out = std::move(d);
   return Outcome::Ok();
 }
 
@@ -200,7 +195,7 @@ Outcome DiagnoseTwinToFile(const DiagnoseRequest& request, const Inputs& in, con
 Status RemoveEarlierOutputs(const DiagnoseRequest& given, const std::string& out) {
   std::vector<std::string> earlier = {"gap.json",  "scenario_patch.yaml", "estimator_patch.yaml",
                                       "report.md", "report.html",         "twin.json"};
-  for (const char* stem : {"residual_vs_condition", "heldout_fit"})
+  for (const char* stem : {"residual_vs_condition", "heldout_fit", "twin_top_view", "twin_residual_vs_condition"})
     for (const char* extension : {".dat", ".gp", ".png", ".log"}) earlier.push_back(std::string(stem) + extension);
   const std::filesystem::path init_config = std::filesystem::path(out) / kInitConfigFile;
   std::error_code ec;
@@ -230,16 +225,16 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
   auto inputs = LoadInputs(request);
   if (!inputs.ok()) return Outcome::BadInput(inputs.status());
   const Inputs& in = inputs.value();
-  gap::TwinRunner twin_runner;
-  bool replayed = false;
+  std::optional<gap::TwinChoice> twin;
   std::vector<HeldOut> held_out;
-  if (!request.held_out.empty() && !request.replay)
-    return Outcome::BadInput(Status::Error("--held-out needs --replay"));
-  if (request.replay) {
-    if (!in.scenario) return Outcome::BadInput(Status::Error("--replay needs --scenario"));
-    auto runner = ChooseTwinRunner(*in.scenario, in.recording, request.recording, &replayed, say);
-    if (!runner.ok()) return Outcome::BadInput(runner.status());
-    twin_runner = std::move(runner).value();
+  if (!request.held_out.empty() && !request.twin)
+    return Outcome::BadInput(Status::Error("--held-out needs --twin (or --replay)"));
+  if ((request.twin || request.drive != gap::TwinDrive::kDetect) && !in.scenario)
+    return Outcome::BadInput(Status::Error("--twin, --replay and --no-replay need --scenario"));
+  if (in.scenario) {
+    auto choice = ChooseTwin(*in.scenario, in.recording, request.recording, request.drive, say);
+    if (!choice.ok()) return Outcome::BadInput(choice.status());
+    twin = std::move(choice).value();
     auto loaded = LoadHeldOut(request, *in.scenario, say);
     if (!loaded.ok()) return Outcome::BadInput(loaded.status());
     held_out = std::move(loaded).value();
@@ -271,21 +266,28 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
   const gap::Diagnosis& d = diagnosed.value();
   (void)marker.AddDone("the diagnosis");
 
-  // The simulation again, as believed and with the accepted effects, against the recording's held-out part.
-  // (A replayed twin replaces it: the scenario's own drive is not the recording's.)
+  std::optional<gap::TwinDiagnosis> twin_diagnosis;
+  if (request.twin) {
+    twin_diagnosis.emplace();
+    if (Outcome fitted = DiagnoseTwinToFile(request, in, Runner(*twin, in.recording), twin->replayed, held_out,
+                                            &*twin_diagnosis, say);
+        !fitted.ok())
+      return failed(fitted.status);
+  }
+
+  // The twin again, as believed and with the accepted effects (the twin's patch when it was fitted), against the
+  // recording's held-out part.
   std::optional<gap::SimulationComparison> simulation;
-  if (in.scenario && !replayed) {
-    say("re-simulating the nominal scenario without noise, as believed and with the accepted effects");
-    auto compared = gap::CompareWithSimulation(*in.scenario, d.effects, in.recording, d.train_end_s);
+  if (in.scenario) {
+    say(std::string("running the scenario's twin without noise (") + (twin->replayed ? "replayed" : "its own drive") +
+        "), as believed and with the accepted effects");
+    auto compared = gap::CompareWithSimulation(
+        *in.scenario, d.effects, in.recording, d.train_end_s, *twin,
+        twin_diagnosis ? std::optional<std::vector<sim::EffectOptions>>(twin_diagnosis->patch) : std::nullopt);
     if (!compared.ok()) return failed(Status::Error("re-simulation: " + compared.status().message()));
     simulation = std::move(compared).value();
     (void)marker.AddDone("the re-simulation");
   }
-
-  nlohmann::json twin_json;
-  if (request.replay)
-    if (Outcome twin = DiagnoseTwinToFile(request, in, twin_runner, replayed, held_out, &twin_json, say); !twin.ok())
-      return failed(twin.status);
 
   gap::ReportInputs report;
   report.recording = request.recording;
@@ -294,7 +296,8 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
   report.baseline_seed = request.baseline_seed;
   report.simulation = simulation ? &*simulation : nullptr;
   report.plots = !request.no_plots;
-  report.twin = request.replay ? &twin_json : nullptr;
+  report.real = &in.recording;
+  report.twin = twin_diagnosis ? &*twin_diagnosis : nullptr;
   report.progress = say;
   if (Status s = gap::WriteReport(d, report, request.out); !s.ok()) return failed(s);
   (void)marker.AddDone("gap.json, the patches and the report");

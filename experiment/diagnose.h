@@ -5,12 +5,13 @@
 // Reads the recording's streams only (never truth.yaml). Unless `no_baseline`, first simulates the nominal scenario
 // (its effects removed, the recording's duration, seed `baseline_seed`) and diagnoses that, to learn the levels and
 // candidate gains the nominal model reaches on MuJoCo data without any hidden effect (gap/learn_baseline.h). With a
-// scenario, the nominal scenario is simulated again without noise, as believed and with the accepted effects, and
-// compared with the recording's held-out part (gap/resimulate.h; gap.json "simulation"). Writes gap.json, report.md,
-// the patches and the figures (gap/report.h). Without a scenario and a configuration, the nominal model is the one
-// `roamlab init` writes (experiment/init.h), saved as out/nominal_config.yaml, and there is no baseline. With `replay`,
-// the recording is also diagnosed against the scenario's twin (gap/twin.h) into out/twin.json (also gap.json's
-// "twin"), and the twin's patch is shown on the held-out recordings.
+// scenario, the scenario's twin of the recording (its plain simulation for a recording of its own drive, else the
+// replay of the recorded drive) is run again without noise, as believed and with the accepted effects, and compared
+// with the recording's held-out part (gap/resimulate.h; gap.json "simulation"). Writes gap.json, report.md, the
+// patches and the figures (gap/report.h). Without a scenario and a configuration, the nominal model is the one
+// `roamlab init` writes (experiment/init.h), saved as out/nominal_config.yaml, and there is no baseline. With `twin`,
+// the recording is also diagnosed against the twin (gap/twin.h) into out/twin.json (gap.json's "simulation" names the
+// file), and the twin's patch is shown on the held-out recordings.
 #pragma once
 
 #include <cstdint>
@@ -22,6 +23,7 @@
 #include "experiment/steps.h"
 #include "gap/diagnose.h"
 #include "gap/learn_baseline.h"
+#include "gap/resimulate.h"
 
 namespace roamlab::experiment {
 
@@ -41,13 +43,16 @@ struct DiagnoseRequest {
   std::optional<double> max_shift_s;  // the time-shift search range (default gap::DiagnoseOptions')
   std::string std_method = "auto";    // the effects' std: auto | white | hac (gap/diagnose.h, gap/twin.h)
   bool no_plots = false;              // no figures beside report.md
-  // Also diagnose against the twin (gap/twin.h) and write out/twin.json. Needs a scenario. The twin is the plain
-  // noise-free simulation of the scenario for a recording of its own drive (gap::DriveMismatch), else the replay of
-  // the recorded drive (sim/replay.h; bad input when the recording has no drive inputs).
-  bool replay = false;
-  // Recordings held out of the twin's fit (other runs of the same robot; needs replay): the patch fitted on
-  // `recording` is shown on each (gap::ShowOnHeldOut; twin.json's heldout_runs). Each is read like `recording` and
-  // must have its platform kind and drive inputs.
+  // The scenario's twin of the recording (gap/resimulate.h ChooseTwin): detected (the plain noise-free simulation for a
+  // recording of the scenario's own drive, else the replay of the recorded drive, sim/replay.h), or forced: kReplay
+  // (bad input when the recording has no drive inputs), kPlain. The re-simulation (gap.json "simulation") runs on it.
+  gap::TwinDrive drive = gap::TwinDrive::kDetect;
+  // Also diagnose against the twin (gap/twin.h), the simulator's effects fitted by running it, into out/twin.json;
+  // the re-simulation then applies the twin's patch. Needs a scenario.
+  bool twin = false;
+  // Recordings held out of the twin's fit (other runs of the same robot; needs twin): the patch fitted on `recording`
+  // is shown on each (gap::ShowOnHeldOut; twin.json's heldout_runs), each on its own twin (chosen as `drive` says).
+  // Each is read like `recording` and must have its platform kind (and drive inputs when replayed).
   std::vector<std::string> held_out;
   std::function<void(const std::string& line)> progress;  // optional
 };

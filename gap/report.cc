@@ -9,6 +9,7 @@
 #include "common/html.h"
 #include "common/json.h"
 #include "eval/plots.h"
+#include "gap/internal/report_twin.h"
 
 namespace roamlab::gap {
 namespace {
@@ -131,7 +132,7 @@ std::vector<std::string> WritePlots(const Diagnosis& d, const std::string& dir, 
   return images;
 }
 
-json SimulationJson(const SimulationComparison& c) {
+json SimulationJson(const SimulationComparison& c, const recording::Recording* real) {
   const auto fits = [](const std::map<std::string, SimulatedStreamFit>& m) {
     json j = json::object();
     for (const auto& [name, f] : m)
@@ -143,11 +144,18 @@ json SimulationJson(const SimulationComparison& c) {
   };
   json effects = json::array();
   for (const sim::EffectOptions& e : c.effects) effects.push_back({{"name", e.name}, {"parameters", e.parameters}});
-  return {{"from_s", c.from_s},
+  return {{"replayed", c.twin.replayed},
+          {"twin",
+           {{"reason", c.twin.reason},
+            {"stream", c.twin.stream.empty() ? json(nullptr) : json(c.twin.stream)},
+            {"drive_mismatch", c.twin.mismatch ? Number(*c.twin.mismatch) : json(nullptr)},
+            {"max_drive_mismatch", kMaxDriveMismatch}}},
+          {"from_s", c.from_s},
           {"duration_s", c.duration_s},
           {"effects", effects},
           {"before", fits(c.before)},
           {"after", fits(c.after)},
+          {"drift", real ? internal::HeldOutDriftJson(internal::TwinHeldOutDrift(c, *real)) : json(nullptr)},
           {"left_out", c.left_out},
           {"not_simulated", c.not_simulated.empty() ? json(nullptr) : json(c.not_simulated)}};
 }
@@ -169,10 +177,11 @@ std::string MarkdownTable(const html::Table& table) {
 
 // The re-simulation (gap/resimulate.h) against the recording's held-out part.
 const char kSimulationText[] =
-    "The nominal scenario simulated again without noise, as believed and with the accepted effects applied "
-    "(scenario_patch.yaml), compared sample by sample with the recording: RMS of recorded minus simulated in units of "
-    "each stream's stated noise (1 = noise only; meaningful for a recording of the scenario's drive), and of its 1 s "
-    "means (the systematic part).";
+    "The scenario's twin of the recording run again without noise, as believed and with the accepted effects applied "
+    "(scenario_patch.yaml; with --twin the twin diagnosis's patch, twin.json), compared sample by sample with the "
+    "recording: RMS of recorded minus twin in units of each stream's stated noise (1 = noise only), and of its 1 s "
+    "means (the systematic part); then the drift of its absolute streams over 10 s windows, each window's twin aligned "
+    "to the recording at its start.";
 
 html::Table SimulationTable(const SimulationComparison& c) {
   html::Table t{{"stream", "RMS as believed", "RMS with the effects", "change", "1 s RMS as believed",
@@ -273,9 +282,36 @@ html::Table HeldoutTable(const Diagnosis& d) {
 const char kHeldoutText[] =
     "Whitened residuals: RMS per sample, RMS of their 1 s means (the systematic part) and chi2/dof.";
 
+// The twin's section: which twin and why, the held-out RMS and drift before and after, the twin diagnosis.
+struct TwinSection {
+  std::string title;
+  std::vector<std::string> lines;  // paragraphs before the tables
+  std::vector<html::Table> tables;
+  std::vector<std::string> notes;
+};
+TwinSection MakeTwinSection(const ReportInputs& in) {
+  const SimulationComparison& c = *in.simulation;
+  TwinSection out;
+  out.title = "The twin against the recording (held-out part, after t = " + Fixed(c.from_s, 4) + " s)";
+  out.lines = {internal::TwinChoiceText(c.twin), kSimulationText};
+  out.tables.push_back(SimulationTable(c));
+  if (in.real) {
+    const internal::HeldOutDrift drift = internal::TwinHeldOutDrift(c, *in.real);
+    if (!drift.before.empty()) out.tables.push_back(internal::DriftTable(drift));
+  }
+  out.notes = SimulationNotes(c);
+  if (in.twin) {
+    const std::vector<std::string> verdict = internal::TwinVerdictLines(*in.twin);
+    out.lines.insert(out.lines.end(), verdict.begin(), verdict.end());
+    out.lines.push_back("The twin diagnosis in full: twin.json.");
+    if (!in.twin->heldout_runs.empty()) out.tables.push_back(internal::HeldOutRunsTable(*in.twin));
+  }
+  return out;
+}
+
 // report.html: the verdict first, the tables, then the figures embedded.
-Status WriteReportHtml(const Diagnosis& d, const ReportInputs& in, const std::vector<std::string>& images,
-                       const std::string& note, const std::string& dir) {
+Status WriteReportHtml(const Diagnosis& d, const ReportInputs& in, const ReportFigures& figures,
+                       const std::string& dir) {
   html::Page page("Reality-gap diagnosis");
   page.Paragraph("Verdict: " + d.verdict, d.verdict == "none" ? "verdict-pass" : "verdict-fail");
   for (const std::string& line : VerdictLines(d, in.baseline != nullptr)) page.Paragraph(line, "headline");
@@ -289,26 +325,29 @@ Status WriteReportHtml(const Diagnosis& d, const ReportInputs& in, const std::ve
   page.Heading(2, "Where (whole run, nominal self-calibration)");
   page.AddTable(LocatedTable(d));
   if (in.simulation) {
-    page.Heading(2, "The simulation against the recording (held-out part)");
-    page.Paragraph(kSimulationText);
-    page.AddTable(SimulationTable(*in.simulation));
-    for (const std::string& line : SimulationNotes(*in.simulation)) page.Paragraph(line, "note");
+    const TwinSection twin = MakeTwinSection(in);
+    page.Heading(2, twin.title);
+    for (const std::string& line : twin.lines) page.Paragraph(line);
+    for (const html::Table& table : twin.tables) page.AddTable(table);
+    for (const std::string& line : twin.notes) page.Paragraph(line, "note");
+    for (const std::string& image : figures.twin_images)
+      if (Status s = page.AddImage(dir + "/" + image, image); !s.ok()) return s;
   }
   page.Heading(2, "Figures");
-  if (images.empty()) page.Paragraph(note.empty() ? "No figures were drawn." : note, "note");
-  for (const std::string& image : images)
+  if (figures.images.empty() && figures.twin_images.empty())
+    page.Paragraph(figures.notes.empty() ? "No figures were drawn." : figures.notes.front(), "note");
+  for (const std::string& image : figures.images)
     if (Status s = page.AddImage(dir + "/" + image, image); !s.ok()) return s;
   return page.Write(dir + "/report.html");
 }
 
 }  // namespace
 
-std::string ReportMarkdown(const Diagnosis& d, const std::string& recording, const std::string& scenario, bool baseline,
-                           const SimulationComparison* simulation, const std::vector<std::string>& images) {
+std::string ReportMarkdown(const Diagnosis& d, const ReportInputs& in, const ReportFigures& figures) {
   std::ostringstream r;
-  r << "# Reality-gap diagnosis\n\nRecording `" << recording << "` against the nominal scenario `" << scenario
+  r << "# Reality-gap diagnosis\n\nRecording `" << in.recording << "` against the nominal scenario `" << in.model
     << "`.\n\n## Verdict: **" << d.verdict << "**\n\n";
-  const std::vector<std::string> verdict = VerdictLines(d, baseline);
+  const std::vector<std::string> verdict = VerdictLines(d, in.baseline != nullptr);
   for (std::size_t i = 0; i < verdict.size(); ++i)
     r << (d.verdict == "named" || (d.verdict == "unknown" && i > 0) ? "- " : "") << verdict[i] << "\n";
   r << "\n## Where (whole run, nominal self-calibration)\n\n" << MarkdownTable(LocatedTable(d));
@@ -317,16 +356,16 @@ std::string ReportMarkdown(const Diagnosis& d, const std::string& recording, con
   r << "\n## Fit on the held-out part (parameters fixed at the training values)\n\n"
     << kHeldoutText << "\n\n"
     << MarkdownTable(HeldoutTable(d));
-  if (simulation) {
-    r << "\n## The simulation against the recording (held-out part, after t = " << Fixed(simulation->from_s, 4)
-      << " s)\n\n"
-      << kSimulationText << "\n\n"
-      << MarkdownTable(SimulationTable(*simulation));
-    for (const std::string& note : SimulationNotes(*simulation)) r << "\n" << note;
-    r << "\n";
+  if (in.simulation) {
+    const TwinSection twin = MakeTwinSection(in);
+    r << "\n## " << twin.title << "\n\n";
+    for (const std::string& line : twin.lines) r << line << "\n\n";
+    for (const html::Table& table : twin.tables) r << MarkdownTable(table) << "\n";
+    for (const std::string& note : twin.notes) r << note << "\n";
+    for (const std::string& image : figures.twin_images) r << "![" << image << "](" << image << ")\n\n";
   }
   r << "\n";
-  for (const std::string& image : images) r << "![" << image << "](" << image << ")\n\n";
+  for (const std::string& image : figures.images) r << "![" << image << "](" << image << ")\n\n";
   r << d.fits << " calibrations in " << Fixed(d.seconds, 3) << " s.\n";
   return r.str();
 }
@@ -340,7 +379,9 @@ std::string ScenarioPatch(const Diagnosis& d, const SimulationComparison* simula
     const EffectEstimate& e = d.effects[i];
     std::map<std::string, double> std;
     sim::EffectOptions effect = SimulatorEffect(e, &std);
-    if (simulation && simulation->effects.size() == d.effects.size()) effect = simulation->effects[i];
+    // As simulated when the re-simulation applied these effects (not the twin diagnosis's patch).
+    if (simulation && simulation->effects.size() == d.effects.size() && simulation->effects[i].name == effect.name)
+      effect = simulation->effects[i];
     y << "  - name: " << e.name << "\n";
     bool same = effect.parameters.size() == e.parameters.size();
     for (const auto& [k, v] : effect.parameters) same = same && e.parameters.count(k);
@@ -376,7 +417,7 @@ std::string EstimatorPatch(const Diagnosis& d) {
 }
 
 json DiagnosisJson(const Diagnosis& d, const Baseline* baseline, std::uint64_t baseline_seed,
-                   const SimulationComparison* simulation) {
+                   const SimulationComparison* simulation, const recording::Recording* real) {
   json located = json::array(), components = json::array(), effects = json::array(), candidates = json::array();
   for (const LocatedComponent& lc : d.located) {
     components.push_back(LocatedJson(lc));
@@ -404,23 +445,29 @@ json DiagnosisJson(const Diagnosis& d, const Baseline* baseline, std::uint64_t b
           {"candidates", candidates},
           {"components", components},
           {"baseline", base},
-          {"simulation", simulation ? SimulationJson(*simulation) : json(nullptr)},
+          {"simulation", simulation ? SimulationJson(*simulation, real) : json(nullptr)},
           {"std_method", d.std_method},
           {"run", {{"fits", d.fits}, {"seconds", d.seconds}}}};
 }
 
 Status WriteReport(const Diagnosis& d, const ReportInputs& in, const std::string& dir) {
-  json gap_json = DiagnosisJson(d, in.baseline, in.baseline_seed, in.simulation);
-  gap_json["twin"] = in.twin ? *in.twin : json();
+  json gap_json = DiagnosisJson(d, in.baseline, in.baseline_seed, in.simulation, in.real);
+  if (in.simulation) gap_json["simulation"]["twin_diagnosis"] = in.twin ? json("twin.json") : json(nullptr);
   if (Status s = WriteFileAtomic(dir + "/gap.json", gap_json.dump(2) + "\n"); !s.ok()) return s;
   if (Status s = WriteFileAtomic(dir + "/scenario_patch.yaml", ScenarioPatch(d, in.simulation)); !s.ok()) return s;
   if (Status s = WriteFileAtomic(dir + "/estimator_patch.yaml", EstimatorPatch(d)); !s.ok()) return s;
-  std::string note;
-  const std::vector<std::string> images = in.plots ? WritePlots(d, dir, &note) : std::vector<std::string>{};
-  if (!note.empty() && in.progress) in.progress(note);
-  const std::string report = ReportMarkdown(d, in.recording, in.model, in.baseline != nullptr, in.simulation, images);
-  if (Status s = WriteFileAtomic(dir + "/report.md", report); !s.ok()) return s;
-  return WriteReportHtml(d, in, images, note, dir);
+  ReportFigures figures;
+  if (in.plots) {
+    std::string note;
+    figures.images = WritePlots(d, dir, &note);
+    if (!note.empty()) figures.notes.push_back(note);
+    if (in.simulation && in.real && eval::GnuplotAvailable())
+      figures.twin_images = internal::WriteTwinFigures(*in.simulation, *in.real, d.conditions, dir, &figures.notes);
+  }
+  if (in.progress)
+    for (const std::string& note : figures.notes) in.progress(note);
+  if (Status s = WriteFileAtomic(dir + "/report.md", ReportMarkdown(d, in, figures)); !s.ok()) return s;
+  return WriteReportHtml(d, in, figures, dir);
 }
 
 }  // namespace roamlab::gap

@@ -8,24 +8,22 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "common/status.h"
 #include "gap/diagnose.h"
 #include "gap/resimulate.h"
+#include "gap/twin.h"
+#include "recording/recording.h"
 
 namespace roamlab::gap {
 
 // The diagnosis as gap.json; `baseline` null: diagnosed without one; `simulation` null: no re-simulation (a robot
-// without a MuJoCo twin).
+// without a MuJoCo twin); `real` (may be null) the recording, for the twins' held-out drift in "simulation".
 nlohmann::json DiagnosisJson(const Diagnosis& d, const Baseline* baseline, std::uint64_t baseline_seed,
-                             const SimulationComparison* simulation);
-
-// report.md: the verdict, where the recording departs from the model, the candidates, the held-out fit before and
-// after, the re-simulation (when given) and the figures in `images`. `recording` and `model` name the inputs.
-std::string ReportMarkdown(const Diagnosis& d, const std::string& recording, const std::string& model, bool baseline,
-                           const SimulationComparison* simulation, const std::vector<std::string>& images);
+                             const SimulationComparison* simulation, const recording::Recording* real = nullptr);
 
 // The accepted effects as the simulator takes them: as simulated when the scenario was simulated again (time shifts
 // in whole physics steps), otherwise converted without the step.
@@ -40,10 +38,24 @@ struct ReportInputs {
   const Baseline* baseline = nullptr;  // null: diagnosed without one
   std::uint64_t baseline_seed = 0;
   const SimulationComparison* simulation = nullptr;  // null: no re-simulation
-  const nlohmann::json* twin = nullptr;  // the diagnosis against the twin (twin.json), gap.json's "twin"; null: none
-  bool plots = true;                     // write the figures (when gnuplot is installed)
+  const recording::Recording* real = nullptr;        // the recording (the twins' drift and figures); null: none
+  // The diagnosis against the twin, written to twin.json by the caller (gap.json's "simulation" names the file and
+  // the report shows its verdict and held-out runs); null: none.
+  const TwinDiagnosis* twin = nullptr;
+  bool plots = true;                                 // write the figures (when gnuplot is installed)
   std::function<void(const std::string&)> progress;  // receives a note when no figure can be drawn
 };
+
+// The figures drawn beside the report: the diagnosis's, the twin's, and why some were not drawn.
+struct ReportFigures {
+  std::vector<std::string> images, twin_images;
+  std::vector<std::string> notes;
+};
+
+// report.md: the verdict, where the recording departs from the model, the candidates, the held-out fit before and
+// after, the twin against the recording (when re-simulated: which twin and why, the held-out RMS and drift before and
+// after, the twin diagnosis's verdict and held-out runs) and the figures.
+std::string ReportMarkdown(const Diagnosis& d, const ReportInputs& in, const ReportFigures& figures);
 
 // Writes gap.json, scenario_patch.yaml, estimator_patch.yaml, the figures, report.md and report.html into `dir` (which
 // exists).

@@ -4,8 +4,11 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 
 #include "gap/internal/twin_residuals.h"
+#include "gap/twin.h"
+#include "sim/replay.h"
 #include "sim/simulator.h"
 
 namespace roamlab::gap {
@@ -30,6 +33,19 @@ std::map<std::string, SimulatedStreamFit> Compare(const recording::Recording& re
     left_out->insert(left_out->end(), missing.begin(), missing.end());
   }
   return internal::SeriesFits(layout, whitened);
+}
+
+// The twin's duration [s] to the recording's last stamp: the plain simulation counts from 0, the replay from the
+// recording's first stamp (stamps may be absolute, e.g. Unix time).
+double TwinDurationS(const recording::Recording& recording, bool replayed) {
+  std::optional<Time> first, last;
+  for (const Stream& s : recording.streams) {
+    if (s.t.empty()) continue;
+    if (!first || s.t.front() < *first) first = s.t.front();
+    if (!last || *last < s.t.back()) last = s.t.back();
+  }
+  if (!first) return 1.0;
+  return std::max(replayed ? SecondsBetween(*first, *last) : last->seconds(), 1.0);
 }
 
 }  // namespace
@@ -57,40 +73,76 @@ sim::EffectOptions SimulatorEffect(const EffectEstimate& effect, std::map<std::s
   return e;
 }
 
+Result<TwinChoice> ChooseTwin(const sim::Scenario& nominal, const recording::Recording& recording, TwinDrive drive) {
+  TwinChoice out;
+  if (drive == TwinDrive::kPlain) {
+    out.reason = "forced: the scenario's own drive";
+    return out;
+  }
+  if (drive == TwinDrive::kReplay) {
+    if (auto inputs = sim::DriveInputsFrom(recording, nominal); !inputs.ok()) return inputs.status();
+    out.replayed = true;
+    out.reason = "forced: the replay of the recorded drive";
+    return out;
+  }
+  sim::Scenario scenario = nominal;
+  scenario.effects.clear();
+  scenario.duration_s = TwinDurationS(recording, false);
+  auto plain = PlainSimulationRunner()(scenario);
+  if (!plain.ok()) return Status::Error("the nominal simulation: " + plain.status().message());
+  const DriveComparison drive_difference = CompareDrive(recording, plain.value());
+  out.stream = drive_difference.stream;
+  if (!drive_difference.stream.empty()) out.mismatch = drive_difference.relative;
+  if (!drive_difference.stream.empty() && drive_difference.relative < kMaxDriveMismatch) {
+    out.reason = "own drive detected";
+    return out;
+  }
+  if (auto inputs = sim::DriveInputsFrom(recording, nominal); !inputs.ok()) {
+    out.reason = "not shown to be the scenario's own drive, but no replay (" + inputs.status().message() + ")";
+    return out;
+  }
+  out.replayed = true;
+  out.reason = "other drive detected";
+  return out;
+}
+
 Result<SimulationComparison> CompareWithSimulation(const sim::Scenario& nominal,
                                                    const std::vector<EffectEstimate>& effects,
-                                                   const recording::Recording& recording, double from_s) {
+                                                   const recording::Recording& recording, double from_s,
+                                                   const TwinChoice& twin,
+                                                   const std::optional<std::vector<sim::EffectOptions>>& patch) {
   if (recording.platform.kind != nominal.robot.kind)
     return Status::Error("the recording's platform kind '" + recording.platform.kind + "' is not the scenario's '" +
                          nominal.robot.kind + "'");
-  double span_s = 0.0;
-  for (const Stream& s : recording.streams)
-    if (!s.t.empty()) span_s = std::max(span_s, s.t.back().seconds());
   SimulationComparison out;
   out.from_s = from_s;
+  out.twin = twin;
   sim::Scenario scenario = nominal;
   scenario.effects.clear();
-  scenario.duration_s = std::max(span_s, 1.0);
+  scenario.duration_s = TwinDurationS(recording, twin.replayed);
   out.duration_s = scenario.duration_s;
-  sim::SimulateOptions options;
-  options.noise = false;
+  const TwinRunner runner = twin.replayed ? ReplayRunner(recording) : PlainSimulationRunner();
   const Time from = Time::FromSeconds(from_s);
-  double step_s = 0.0;
+  auto simulator = sim::Simulator::Create(scenario, {});
+  if (!simulator.ok()) return Status::Error("the nominal scenario: " + simulator.status().message());
+  const double step_s = simulator.value()->PhysicsStepS();
   for (const bool patched : {false, true}) {
     if (patched) {
-      for (const EffectEstimate& e : effects) scenario.effects.push_back(SimulatorEffect(e, nullptr, step_s));
+      if (patch) {
+        scenario.effects = *patch;
+      } else {
+        for (const EffectEstimate& e : effects) scenario.effects.push_back(SimulatorEffect(e, nullptr, step_s));
+      }
       out.effects = scenario.effects;
     }
-    auto simulator = sim::Simulator::Create(scenario, options);
-    if (!patched && simulator.ok()) step_s = simulator.value()->PhysicsStepS();
-    auto simulated = simulator.ok() ? simulator.value()->Run() : Result<sim::Simulation>(simulator.status());
-    if (!simulated.ok() && !patched) return Status::Error("the nominal simulation: " + simulated.status().message());
+    auto simulated = runner(scenario);
+    if (!simulated.ok() && !patched) return Status::Error("the nominal twin: " + simulated.status().message());
     if (!simulated.ok()) {
       out.not_simulated = simulated.status().message();
       break;
     }
-    (patched ? out.after : out.before) =
-        Compare(recording, simulated.value().recording, from, patched ? nullptr : &out.left_out);
+    (patched ? out.after : out.before) = Compare(recording, simulated.value(), from, patched ? nullptr : &out.left_out);
+    (patched ? out.twin_after : out.twin_before) = std::move(simulated).value();
   }
   return out;
 }

@@ -25,19 +25,6 @@ using internal::TwinCandidate;
 // Locate's inconsistency ratio, against the stated noise.
 constexpr double kInconsistencyRatio = 1.3;
 
-// The whitened residuals as Locate takes them: one per series and sample (finite entries only).
-std::vector<estimator::MeasurementResidual> MeasurementResiduals(const Layout& layout, const Eigen::VectorXd& w) {
-  std::vector<estimator::MeasurementResidual> out;
-  for (const internal::Series& s : layout.series) {
-    const int n = s.components();
-    for (std::size_t i = 0; i < s.rows.size(); ++i) {
-      const Eigen::VectorXd r = w.segment(s.offset + static_cast<Eigen::Index>(i) * n, n);
-      if (r.allFinite()) out.push_back({s.name, s.t[i], r, true});
-    }
-  }
-  return out;
-}
-
 // The motion conditions from the real recording's own streams: a pose stream's poses, else the wheel encoders' dead
 // reckoning (nominal geometry), else none.
 Conditions RealConditions(const recording::Recording& real) {
@@ -243,8 +230,8 @@ void Diagnoser::Finish(const State& state) {
   out_.heldout_after = state.heldout;
   for (const TwinEffect& e : out_.effects) out_.patch.push_back(e.effect);
   const Layout heldout = internal::MakeLayout(real_, train_end_, last_);
-  const auto statistics =
-      ComponentStatistics(MeasurementResiduals(heldout, internal::WhitenedResiduals(heldout, real_, state.twin)));
+  const auto statistics = ComponentStatistics(
+      internal::MeasurementResiduals(heldout, internal::WhitenedResiduals(heldout, real_, state.twin)));
   for (const auto& [key, level] : statistics)
     if (Inconsistent(level, 1.0, kInconsistencyRatio)) out_.unexplained.push_back(key);
   const bool inconsistent =
@@ -276,7 +263,7 @@ Result<TwinDiagnosis> Diagnoser::Run() {
   state.heldout = CompareTwin(real_, state.twin, train_end_.seconds(), last_.seconds(), options_.drift);
   out_.heldout_before = state.heldout;
   const Layout whole = internal::MakeLayout(real_, first_, last_);
-  out_.located = Locate(MeasurementResiduals(whole, internal::WhitenedResiduals(whole, real_, state.twin)),
+  out_.located = Locate(internal::MeasurementResiduals(whole, internal::WhitenedResiduals(whole, real_, state.twin)),
                         RealConditions(real_), {});
   state.residuals = internal::WhitenedResiduals(train_layout_, real_, state.twin);
   state.chi2 = internal::SumOfSquares(state.residuals, &measurements_);

@@ -61,17 +61,27 @@ using TwinRunner = std::function<Result<recording::Recording>(const sim::Scenari
 TwinRunner PlainSimulationRunner();
 // Replays `patched` with the drive inputs of `real` (sim/replay.h) up to patched.duration_s after the recording's first
 // stamp (stamps may be absolute, e.g. Unix time): the twin of any recording with drive inputs. Keeps its own copy of
-// the recording.
+// the recording, and the replay's start (sim::ReplayStartOf) found at its first call, so that every run starts alike.
 TwinRunner ReplayRunner(const recording::Recording& real);
 
-// Whether `twin` follows the drive of `real`: for each wheel stream in both (wheel_encoders, steering), the change of
-// every column over consecutive kDriveWindowS windows of their common stamps, real against twin: relative RMS
-// difference ||d_real - d_twin|| / ||d_real|| below kMaxDriveMismatch. Empty when it does; otherwise why not (the
-// stream and the relative difference, or that no wheel stream can tell). The plain simulation is the twin only of a
-// recording of the scenario's own drive: a hidden effect changes the wheels' motion by little (they are servoed to
-// the same set-points), another drive by a good part of its size.
+// How far `twin` is from following the drive of `real`: for each wheel stream in both (wheel_encoders, steering),
+// over consecutive kDriveWindowS windows of their common stamps, the drive of each window (a cumulative wheel angle's
+// change, i.e. its mean rate; the mean of any other reading: a wheel rate or speed, a steering angle), real against
+// twin: the relative RMS difference ||d_real - d_twin - c|| / ||d_real||, c each column's mean difference (a constant
+// offset of a reading, such as a steering offset, is not another drive), each squared sum less the real stream's
+// stated noise variance of the windows' drives; the stream that differs most. Window means keep the readings' noise out
+// of it (a 1 s mean of N samples carries 1/sqrt(N) of a sample's noise). The plain simulation is the twin only of a
+// recording of the scenario's own drive: a hidden effect changes the wheels' motion by little (they are servoed to the
+// same set-points), another drive by a good part of its size.
 inline constexpr double kDriveWindowS = 1.0;
 inline constexpr double kMaxDriveMismatch = 0.05;
+struct DriveComparison {
+  std::string stream;     // empty: no wheel stream in both shows a drive
+  double relative = 0.0;  // its relative difference
+};
+DriveComparison CompareDrive(const recording::Recording& real, const recording::Recording& twin);
+// Empty when `twin` follows the drive of `real` (CompareDrive's difference below kMaxDriveMismatch); otherwise why not
+// (the stream and the relative difference, or that no wheel stream can tell).
 std::string DriveMismatch(const recording::Recording& real, const recording::Recording& twin);
 
 // An absolute stream's drift over fixed windows: the twin aligned to the real track over the first align_s of each
@@ -199,6 +209,9 @@ Result<TwinDiagnosis> DiagnoseTwin(const sim::Scenario& nominal, const recording
 Result<TwinHeldOutRun> ShowOnHeldOut(const sim::Scenario& nominal, const std::vector<sim::EffectOptions>& patch,
                                      const recording::Recording& held, const TwinRunner& runner,
                                      const DriftOptions& drift = {}, int threads = 2);
+
+// Per stream: {"window_s", "windows", "mean_position_m", "max_position_m"[, "mean_heading_rad", "max_heading_rad"]}.
+nlohmann::json TwinDriftJson(const std::map<std::string, TwinDrift>& drift);
 
 // {"replayed", "verdict", "std_method", "train_end_s", "located", "candidates", "effects", "unexplained",
 // "heldout": {"before", "after"}, "whole_run", "patch",

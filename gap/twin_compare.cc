@@ -2,7 +2,9 @@
 // and HAC covariances and the runners.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
+#include <mutex>
 #include <optional>
 
 #include <Eigen/Geometry>
@@ -175,40 +177,99 @@ TwinComparison CompareTwin(const recording::Recording& real, const recording::Re
   return out;
 }
 
-std::string DriveMismatch(const recording::Recording& real, const recording::Recording& twin) {
-  bool compared = false;
+namespace {
+
+// A cumulative wheel angle (wheel_encoders in rad, or without units) changes by the mean rate times the window; any
+// other wheel reading (a rate, a speed, a steering angle) is averaged over it.
+bool Cumulative(const Stream& s) {
+  return s.info.type == StreamType::kWheelEncoders && (s.info.units.empty() || s.info.units == "rad");
+}
+
+// One window's drive of a stream: the first and last sample and the sum of the samples.
+struct DriveWindow {
+  Eigen::VectorXd first, last, sum;
+  int n = 0;
+  void Add(const Eigen::VectorXd& v) {
+    if (n++ == 0) {
+      first = v;
+      sum = Eigen::VectorXd::Zero(v.size());
+    }
+    last = v;
+    sum += v;
+  }
+  Eigen::VectorXd Drive(bool cumulative) const {
+    return cumulative ? Eigen::VectorXd(last - first) : Eigen::VectorXd(sum / n);
+  }
+};
+
+// The relative RMS difference of the drive of `s` (twin) from that of `r` (real) over consecutive kDriveWindowS
+// windows of the stamps both have: per window the change of a cumulative angle (consecutive windows share their
+// boundary sample), else the mean reading; each column's mean difference over the windows taken off (a constant offset
+// of a reading, e.g. a steering offset, is not another drive); relative to the size of the real drive. The real
+// stream's stated noise (ColumnSigmas) is taken out of both sums: a window's change carries twice a sample's variance,
+// its mean 1/n of it. NaN when the real stream shows no drive.
+double RelativeDriveDifference(const Stream& r, const Stream& s) {
+  const bool cumulative = Cumulative(r);
+  double noise_variance = 0.0;  // of one sample, summed over the columns
+  for (const double x : internal::ColumnSigmas(r.info)) noise_variance += x * x;
+  std::vector<Eigen::VectorXd> differences;
+  double size = 0.0, noise = 0.0;
+  DriveWindow wr, ws;
+  Time start;
+  std::size_t j = 0;
+  for (std::size_t i = 0; i < r.t.size(); ++i) {
+    while (j < s.t.size() && s.t[j] < r.t[i]) ++j;
+    if (j == s.t.size()) break;
+    if (s.t[j] != r.t[i]) continue;
+    const Eigen::VectorXd vr = r.values.row(static_cast<Eigen::Index>(i)).transpose();
+    const Eigen::VectorXd vs = s.values.row(static_cast<Eigen::Index>(j)).transpose();
+    if (wr.n > 0 && SecondsBetween(start, r.t[i]) >= kDriveWindowS) {
+      if (cumulative) {
+        wr.Add(vr);
+        ws.Add(vs);
+      }
+      const Eigen::VectorXd dr = wr.Drive(cumulative);
+      differences.push_back(dr - ws.Drive(cumulative));
+      size += dr.squaredNorm();
+      noise += cumulative ? 2.0 * noise_variance : noise_variance / wr.n;
+      wr = DriveWindow();
+      ws = DriveWindow();
+    }
+    if (wr.n == 0) start = r.t[i];
+    wr.Add(vr);
+    ws.Add(vs);
+  }
+  if (differences.empty() || !(size - noise > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  Eigen::VectorXd offset = Eigen::VectorXd::Zero(r.values.cols());
+  for (const Eigen::VectorXd& d : differences) offset += d;
+  offset /= static_cast<double>(differences.size());
+  double difference = 0.0;
+  for (const Eigen::VectorXd& d : differences) difference += (d - offset).squaredNorm();
+  return std::sqrt(std::max(difference - noise, 0.0) / (size - noise));
+}
+
+}  // namespace
+
+DriveComparison CompareDrive(const recording::Recording& real, const recording::Recording& twin) {
+  DriveComparison out;
   for (const Stream& r : real.streams) {
     if (r.info.type != StreamType::kWheelEncoders && r.info.type != StreamType::kSteering) continue;
     const Stream* s = twin.Find(r.info.name);
     if (!s || s->info.type != r.info.type || s->values.cols() != r.values.cols() || r.t.empty()) continue;
-    // The changes over consecutive kDriveWindowS windows of the samples both have.
-    double difference = 0.0, size = 0.0;
-    std::optional<std::pair<std::size_t, std::size_t>> start;
-    std::size_t j = 0;
-    for (std::size_t i = 0; i < r.t.size(); ++i) {
-      while (j < s->t.size() && s->t[j] < r.t[i]) ++j;
-      if (j == s->t.size()) break;
-      if (s->t[j] != r.t[i]) continue;
-      if (start && SecondsBetween(r.t[start->first], r.t[i]) < kDriveWindowS) continue;
-      if (start) {
-        const auto change = [](const Stream& x, std::size_t from, std::size_t to) -> Eigen::VectorXd {
-          return (x.values.row(static_cast<Eigen::Index>(to)) - x.values.row(static_cast<Eigen::Index>(from)))
-              .transpose();
-        };
-        const Eigen::VectorXd dr = change(r, start->first, i), ds = change(*s, start->second, j);
-        difference += (dr - ds).squaredNorm();
-        size += dr.squaredNorm();
-      }
-      start = {i, j};
-    }
-    if (!(size > 0.0)) continue;
-    compared = true;
-    const double relative = std::sqrt(difference / size);
-    if (!(relative < kMaxDriveMismatch))
-      return r.info.name + ": the twin's wheel motion differs from the recorded one by " + std::to_string(relative) +
-             " of its size";
+    const double relative = RelativeDriveDifference(r, *s);
+    if (!std::isfinite(relative) || (!out.stream.empty() && relative <= out.relative)) continue;
+    out.stream = r.info.name;
+    out.relative = relative;
   }
-  return compared ? std::string() : "no wheel stream (wheel_encoders, steering) in both to compare the drive";
+  return out;
+}
+
+std::string DriveMismatch(const recording::Recording& real, const recording::Recording& twin) {
+  const DriveComparison drive = CompareDrive(real, twin);
+  if (drive.stream.empty()) return "no wheel stream (wheel_encoders, steering) in both to compare the drive";
+  if (drive.relative < kMaxDriveMismatch) return "";
+  return drive.stream + ": the twin's wheel motion differs from the recorded one by " + std::to_string(drive.relative) +
+         " of its size";
 }
 
 TwinCovariance ComputeTwinCovariance(const TwinFitRows& rows) {
@@ -264,8 +325,17 @@ TwinRunner ReplayRunner(const recording::Recording& real) {
   for (const recording::Stream& s : real.streams)
     if (!s.t.empty() && (!first || s.t.front() < *first)) first = s.t.front();
   const double first_s = first ? first->seconds() : 0.0;
-  return [recorded, first_s](const sim::Scenario& patched) -> Result<recording::Recording> {
+  // The start, found once (with the first runner call's scenario, its effects removed) and kept for every run.
+  struct Start {
+    std::once_flag once;
+    std::optional<Result<sim::ReplayStart>> found;
+  };
+  auto start = std::make_shared<Start>();
+  return [recorded, first_s, start](const sim::Scenario& patched) -> Result<recording::Recording> {
+    std::call_once(start->once, [&] { start->found = sim::ReplayStartOf(patched, *recorded); });
+    if (!start->found->ok()) return start->found->status();
     sim::ReplayOptions options;
+    options.start = start->found->value();
     options.to_s = first_s + patched.duration_s;
     auto replayed = sim::Replay(patched, *recorded, options);
     if (!replayed.ok()) return replayed.status();

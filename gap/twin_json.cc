@@ -16,23 +16,12 @@ nlohmann::json StreamsJson(const std::map<std::string, SimulatedStreamFit>& stre
 }
 
 nlohmann::json ComparisonJson(const TwinComparison& c) {
-  nlohmann::json drift = nlohmann::json::object();
-  for (const auto& [name, d] : c.drift) {
-    drift[name] = {{"window_s", d.window_s},
-                   {"windows", d.windows},
-                   {"mean_position_m", Number(d.mean_position_m)},
-                   {"max_position_m", Number(d.max_position_m)}};
-    if (d.heading_measured) {
-      drift[name]["mean_heading_rad"] = Number(d.mean_heading_rad);
-      drift[name]["max_heading_rad"] = Number(d.max_heading_rad);
-    }
-  }
   return {{"from_s", c.from_s},
           {"to_s", c.to_s},
           {"chi2", Number(c.chi2)},
           {"residuals", c.residuals},
           {"streams", StreamsJson(c.streams)},
-          {"drift", drift},
+          {"drift", TwinDriftJson(c.drift)},
           {"left_out", c.left_out}};
 }
 
@@ -67,6 +56,21 @@ nlohmann::json EffectJson(const TwinEffect& e) {
 }
 
 }  // namespace
+
+nlohmann::json TwinDriftJson(const std::map<std::string, TwinDrift>& drift) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [name, d] : drift) {
+    out[name] = {{"window_s", d.window_s},
+                 {"windows", d.windows},
+                 {"mean_position_m", Number(d.mean_position_m)},
+                 {"max_position_m", Number(d.max_position_m)}};
+    if (d.heading_measured) {
+      out[name]["mean_heading_rad"] = Number(d.mean_heading_rad);
+      out[name]["max_heading_rad"] = Number(d.max_heading_rad);
+    }
+  }
+  return out;
+}
 
 nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d) {
   nlohmann::json located = nlohmann::json::array();

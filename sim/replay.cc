@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <utility>
 
 #include <GeographicLib/LocalCartesian.hpp>
 
+#include "eval/alignment.h"
 #include "recording/odometry_pose.h"
 #include "sim/wheeled_robot.h"
 
@@ -375,14 +377,7 @@ void FitSensors(const Recording& real, Plan* plan) {
   plan->scenario.world_model_file.clear();
 }
 
-// O's start pose from the first absolute reading at or after `from` (sim/replay.h), and where it came from.
-struct StartPose {
-  Eigen::Vector2d p_m = Eigen::Vector2d::Zero();
-  double yaw_rad = 0.0;
-  std::string source;
-};
-
-std::optional<StartPose> StartFromPose(const Recording& real, Time from) {
+std::optional<ReplayStart> StartFromPose(const Recording& real, Time from) {
   for (const Stream& s : real.streams) {
     // An odometry's own pose is dead-reckoned in its parent frame: not where the robot is.
     if (s.info.type != StreamType::kPose || recording::PosedOdometry(real, s)) continue;
@@ -394,50 +389,85 @@ std::optional<StartPose> StartFromPose(const Recording& real, Time from) {
     const Eigen::Quaterniond q_world_body = q_world_sensor.normalized() * m.q_body_sensor.conjugate();
     const Eigen::Vector3d p = s.values.row(k).head<3>().transpose() - q_world_body * m.p_body_sensor;
     const Eigen::Vector3d x_axis = q_world_body * Eigen::Vector3d::UnitX();
-    return StartPose{p.head<2>(), std::atan2(x_axis.y(), x_axis.x()), "pose stream '" + s.info.name + "'"};
+    return ReplayStart{p.head<2>(), std::atan2(x_axis.y(), x_axis.x()), "pose stream '" + s.info.name + "'"};
   }
   return std::nullopt;
 }
 
 // Positions in W of a gps (through the origin) or position stream.
-std::vector<Eigen::Vector2d> PlanarPositions(const Recording& real, const Stream& s) {
-  std::vector<Eigen::Vector2d> p;
+std::vector<Eigen::Vector3d> Positions(const Recording& real, const Stream& s) {
+  std::vector<Eigen::Vector3d> p;
   std::optional<GeographicLib::LocalCartesian> local;
   if (s.info.type == StreamType::kGps)
     local.emplace(real.origin->latitude_deg, real.origin->longitude_deg, real.origin->altitude_m);
   for (Eigen::Index k = 0; k < s.values.rows(); ++k) {
-    double x = s.values(k, 0), y = s.values(k, 1), z = 0.0;
+    double x = s.values(k, 0), y = s.values(k, 1), z = s.values(k, 2);
     if (local) local->Forward(s.values(k, 0), s.values(k, 1), s.values(k, 2), x, y, z);
-    p.emplace_back(x, y);
+    p.emplace_back(x, y, z);
   }
   return p;
 }
 
-std::optional<StartPose> StartFromPositions(const Recording& real, const Scenario& nominal, Time from) {
+// The first gps (with an origin) or position stream with a sample at or after `from`.
+const Stream* PositionStream(const Recording& real, Time from) {
   for (const Stream& s : real.streams) {
     const bool gps = s.info.type == StreamType::kGps && real.origin;
-    if (!gps && s.info.type != StreamType::kPosition) continue;
-    const auto row = std::lower_bound(s.t.begin(), s.t.end(), from);
-    if (row == s.t.end()) continue;
-    const std::vector<Eigen::Vector2d> p = PlanarPositions(real, s);
-    const std::size_t k0 = static_cast<std::size_t>(row - s.t.begin());
-    for (std::size_t k = k0 + 1; k < p.size() && SecondsBetween(s.t[k0], s.t[k]) <= kStartMotionWindowS; ++k) {
-      const Eigen::Vector2d d = p[k] - p[k0];
-      if (d.norm() < kStartMotionM) continue;
-      const double yaw = std::atan2(d.y(), d.x());
-      Eigen::Vector3d lever = s.info.mounting ? s.info.mounting->p_body_sensor : Eigen::Vector3d::Zero();
-      if (gps && nominal.sensors.gps) lever = nominal.sensors.gps->lever_arm_m;
-      const Eigen::Vector2d lever_world = Eigen::Rotation2Dd(yaw) * lever.head<2>();
-      return StartPose{p[k0] - lever_world, yaw, "the first motion of '" + s.info.name + "'"};
-    }
+    if ((gps || s.info.type == StreamType::kPosition) && s.values.cols() >= 3 && !s.t.empty() && s.t.back() >= from)
+      return &s;
+  }
+  return nullptr;
+}
+
+std::optional<ReplayStart> StartFromPositions(const Recording& real, const Scenario& nominal, const Stream& s,
+                                              Time from) {
+  const auto row = std::lower_bound(s.t.begin(), s.t.end(), from);
+  const std::vector<Eigen::Vector3d> p = Positions(real, s);
+  const std::size_t k0 = static_cast<std::size_t>(row - s.t.begin());
+  for (std::size_t k = k0 + 1; k < p.size() && SecondsBetween(s.t[k0], s.t[k]) <= kStartMotionWindowS; ++k) {
+    const Eigen::Vector2d d = (p[k] - p[k0]).head<2>();
+    if (d.norm() < kStartMotionM) continue;
+    const double yaw = std::atan2(d.y(), d.x());
+    Eigen::Vector3d lever = s.info.mounting ? s.info.mounting->p_body_sensor : Eigen::Vector3d::Zero();
+    if (s.info.type == StreamType::kGps && nominal.sensors.gps) lever = nominal.sensors.gps->lever_arm_m;
+    const Eigen::Vector2d lever_world = Eigen::Rotation2Dd(yaw) * lever.head<2>();
+    return ReplayStart{p[k0].head<2>() - lever_world, yaw, "the first motion of '" + s.info.name + "'"};
   }
   return std::nullopt;
 }
 
-StartPose StartOf(const Recording& real, const Scenario& nominal, Time from) {
-  if (auto pose = StartFromPose(real, from)) return *pose;
-  if (auto pose = StartFromPositions(real, nominal, from)) return *pose;
-  return StartPose{nominal.robot.start_position_m, nominal.robot.start_heading_rad, "the scenario's start"};
+// `start` moved by the planar rigid motion that best fits the track of `s` in `twin` onto the recorded one (matched
+// stamps): a rotation about the vertical and a translation, or a translation alone when the recorded track spans less
+// than kStartAlignMinExtentM; unchanged with fewer than 3 matched samples.
+ReplayStart AlignedStart(const Recording& real, const Stream& s, const Recording& twin, ReplayStart start) {
+  const Stream* t = twin.Find(s.info.name);
+  if (!t) return start;
+  const std::vector<Eigen::Vector3d> real_p = Positions(real, s), twin_p = Positions(real, *t);
+  std::vector<Eigen::Vector3d> a, b;  // twin, recorded
+  for (std::size_t i = 0, j = 0; i < t->t.size(); ++i) {
+    while (j < s.t.size() && s.t[j] < t->t[i]) ++j;
+    if (j == s.t.size()) break;
+    if (s.t[j] != t->t[i]) continue;
+    a.push_back(Eigen::Vector3d(twin_p[i].x(), twin_p[i].y(), 0.0));
+    b.push_back(Eigen::Vector3d(real_p[j].x(), real_p[j].y(), 0.0));
+  }
+  if (a.size() < 3) return start;
+  double extent = 0.0;
+  for (const Eigen::Vector3d& p : b) extent = std::max(extent, (p - b.front()).norm());
+  double yaw = 0.0;
+  Eigen::Vector2d translation = Eigen::Vector2d::Zero();
+  if (extent >= kStartAlignMinExtentM) {
+    const eval::RigidTransform fit = eval::AlignPositions(a, b, eval::AlignmentKind::kYawTranslation);
+    const Eigen::Vector3d x_axis = fit.q_ref_est * Eigen::Vector3d::UnitX();
+    yaw = std::atan2(x_axis.y(), x_axis.x());
+    translation = fit.p_ref_est.head<2>();
+  } else {
+    for (std::size_t i = 0; i < a.size(); ++i) translation += (b[i] - a[i]).head<2>();
+    translation /= static_cast<double>(a.size());
+  }
+  start.p_m = Eigen::Rotation2Dd(yaw) * start.p_m + translation;
+  start.yaw_rad += yaw;
+  start.source += ", aligned on its first " + FormatSeconds(Time::FromSeconds(kStartAlignS)) + " s";
+  return start;
 }
 
 // The twin's values of one planned stream from the simulated one, in the recorded stream's layout.
@@ -524,7 +554,14 @@ Result<Simulation> Replay(const Scenario& nominal, const Recording& real, const 
   }
   Plan plan = PlanTwin(nominal, real, from, to);
   FitSensors(real, &plan);
-  const StartPose start = StartOf(real, nominal, from);
+  ReplayStart start;
+  if (options.start) {
+    start = *options.start;
+  } else {
+    auto found = ReplayStartOf(nominal, real, from.seconds());
+    if (!found.ok()) return found.status();
+    start = found.value();
+  }
   plan.scenario.robot.start_position_m = start.p_m;
   plan.scenario.robot.start_heading_rad = start.yaw_rad;
   plan.scenario.duration_s = SecondsBetween(from, to);
@@ -545,6 +582,29 @@ Result<Simulation> Replay(const Scenario& nominal, const Recording& real, const 
   out.recording.provenance.description += "; the noise-free replay of a recording driven by its " + inputs.source;
   out.truth.replay = recording::ReplayNote{inputs.source, start.source};
   return out;
+}
+
+Result<ReplayStart> ReplayStartOf(const Scenario& nominal, const Recording& real, std::optional<double> from_s) {
+  auto drive = DriveInputsFrom(real, nominal);
+  if (!drive.ok()) return drive.status();
+  const Time from = from_s ? Time::FromSeconds(*from_s) : drive.value().t.front();
+  if (auto pose = StartFromPose(real, from)) return *pose;
+  const Stream* track = PositionStream(real, from);
+  const ReplayStart scenario_start{nominal.robot.start_position_m, nominal.robot.start_heading_rad,
+                                   "the scenario's start"};
+  if (!track) return scenario_start;
+  const ReplayStart start = StartFromPositions(real, nominal, *track, from).value_or(scenario_start);
+  // The refining replay: the nominal scenario as believed over the first kStartAlignS.
+  Scenario base = nominal;
+  base.effects.clear();
+  ReplayOptions first;
+  first.from_s = from.seconds();
+  first.to_s = std::min(from.seconds() + kStartAlignS, drive.value().t.back().seconds());
+  first.start = start;
+  if (!(*first.from_s < *first.to_s)) return start;
+  auto twin = Replay(base, real, first);
+  if (!twin.ok()) return Status::Error("the replay that aligns the start: " + twin.status().message());
+  return AlignedStart(real, *track, twin.value().recording, start);
 }
 
 Result<std::vector<int>> MatchWheelColumns(const std::vector<std::string>& recorded_columns,

@@ -23,11 +23,16 @@
 // The readings among these (2-4, not recorded commands) are divided by the scenario's odometry_scale_error scale
 // (sim/scenario.h): a patched scenario replays the true drive of a robot whose odometry reads that many times it.
 // Window: [from, to] in the recording's time [s] (default: the drive inputs' first and last stamps).
-// Start: the first absolute reading at or after `from`: the first pose stream's pose (its mounting taken off, so O's
-// pose; an odometry's `<name>_pose`, recording/odometry_pose.h, is not one); else GPS (or a position stream) with the
-// heading of the first >= kStartMotionM of motion within kStartMotionWindowS (the lever arm taken off); else the
-// scenario's start. The robot is placed there on the ground and the scenario's lead-in runs (rest, then a ramp to the
-// first inputs) before the first sample.
+// Start (ReplayStartOf): the first absolute reading at or after `from`: the first pose stream's pose (its mounting
+// taken off, so O's pose; an odometry's `<name>_pose`, recording/odometry_pose.h, is not one); else GPS (or a position
+// stream) with the heading of the first >= kStartMotionM of motion within kStartMotionWindowS (the lever arm taken
+// off), or the scenario's start when it does not move that far; with GPS or a position stream the start is then
+// refined: the scenario (its effects removed) is replayed over the first kStartAlignS from it, and the planar rigid
+// motion (a rotation about the vertical and a translation) that best fits that twin's track to the recorded one
+// moves the start (one fix's noise, e.g. 0.33 m on a 5 m baseline, would otherwise turn the heading by about 0.1
+// rad); a translation alone when the recorded track spans less than kStartAlignMinExtentM there. Else the scenario's
+// start. The robot is placed there on the ground and the scenario's lead-in runs (rest, then a ramp to the first
+// inputs) before the first sample.
 //
 // Twin streams: each recorded stream the simulator synthesizes keeps its name, type, columns, units, rate, mounting,
 // noise and attributes and its stamps within [from, to] (the physics step nearest each stamp, sim/replay_schedule.h):
@@ -54,6 +59,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "common/status.h"
 #include "recording/recording.h"
 #include "sim/replay_schedule.h"
@@ -62,14 +69,29 @@
 
 namespace roamlab::sim {
 
-inline constexpr double kRateHalfWindowS = 0.05;     // the measured rates' centred averaging window, half width [s]
-inline constexpr double kStartMotionM = 5.0;         // GPS start: the heading of the first displacement this long [m]
-inline constexpr double kStartMotionWindowS = 60.0;  // searched for this long after the start [s]
+inline constexpr double kRateHalfWindowS = 0.05;      // the measured rates' centred averaging window, half width [s]
+inline constexpr double kStartMotionM = 5.0;          // GPS start: the heading of the first displacement this long [m]
+inline constexpr double kStartMotionWindowS = 60.0;   // searched for this long after the start [s]
+inline constexpr double kStartAlignS = 10.0;          // the refining replay's span [s]
+inline constexpr double kStartAlignMinExtentM = 1.0;  // the recorded track's extent that tells the heading [m]
+
+// O's planar start pose in W and where it came from (truth.yaml's replay note).
+struct ReplayStart {
+  Eigen::Vector2d p_m = Eigen::Vector2d::Zero();
+  double yaw_rad = 0.0;
+  std::string source;
+};
 
 struct ReplayOptions {
   std::optional<double> from_s, to_s;  // the recording's time [s]
+  std::optional<ReplayStart> start;    // default: ReplayStartOf(nominal, real, from_s)
   std::function<void(double)> progress;
 };
+
+// The replay's start for the recording from `from_s` on (default: the drive inputs' first stamp), as described above.
+// Errors: no drive inputs, a refining replay that fails.
+Result<ReplayStart> ReplayStartOf(const Scenario& nominal, const recording::Recording& real,
+                                  std::optional<double> from_s = std::nullopt);
 
 // For each model wheel (`model_columns`, in wheel index order: its name in the scenario's robot.encoder_columns, else
 // WheeledRobot::EncoderColumns of the kind), the index of the recorded column that drives

@@ -66,17 +66,20 @@ struct Phase {
   std::uint64_t draw_seed = 0;
   std::uint64_t noise_seed0 = 0;  // case i: noise_seed0 + i
   bool stratified = false;        // kinds by CalibrationKind; else blind
+  double other_drive = 0.0;       // fraction of the cases driven by another schedule (DrawDrives)
   std::string dir;
   std::string label;
 };
 
 Phase CalibrationPhase(const BenchmarkOptions& options) {
   const std::uint64_t seed = options.seed * 1000 + kMaxCases;
-  return {options.calibration_cases, seed, seed, true, options.out + "/calibration", "calibration"};
+  return {options.calibration_cases, seed, seed, true, options.other_drive, options.out + "/calibration",
+          "calibration"};
 }
 
 Phase ScoredPhase(const BenchmarkOptions& options) {
-  return {options.cases, options.seed, options.seed * 1000, false, options.out + "/cases", "scored"};
+  return {options.cases, options.seed, options.seed * 1000, false, options.other_drive, options.out + "/cases",
+          "scored"};
 }
 
 // Case k of the benchmark: its phase and index in it.
@@ -85,12 +88,17 @@ std::pair<Phase, int> LocateCase(const BenchmarkOptions& options, int k) {
   return {ScoredPhase(options), k - options.calibration_cases};
 }
 
+// The salt of the drives' random numbers (DrawDrives), seeded apart from the draws' own.
+constexpr std::uint64_t kDriveSeedSalt = 0x6f74686572ULL;
+
 // All of a phase's draws, drawn first: independent of which cases run where and when.
 std::vector<Draw> PhaseDraws(const Phase& phase) {
   std::mt19937_64 rng(phase.draw_seed);
   std::vector<Draw> draws;
   for (int i = 0; i < phase.n; ++i)
     draws.push_back(DrawCase(rng, phase.stratified ? CalibrationKind(i) : std::string()));
+  std::mt19937_64 drive_rng(phase.draw_seed ^ kDriveSeedSalt);
+  DrawDrives(drive_rng, phase.other_drive, &draws);
   return draws;
 }
 
@@ -224,6 +232,7 @@ json ScoreJson(const BenchmarkOptions& options, const std::vector<Platform>& pla
     rows.push_back(ScoreRow(c));
   }
   return {{"seed", options.seed},
+          {"other_drive", options.other_drive},
           {"duration_s",
            {{"atv", platforms[0].scenario.duration_s},
             {"diffdrive", platforms[1].scenario.duration_s},

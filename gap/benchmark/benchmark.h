@@ -9,6 +9,10 @@
 //      (alpha, Delta BIC, held-out drop, share of the held-out mismatch explained) are chosen on them
 //      (gap/benchmark/score.h), and so is each candidate parameter's noise (the median reported std);
 //   2. scored: N cases (draws seeded S, noise seeds S * 1000 + i) diagnosed with the chosen thresholds.
+// With BenchmarkOptions::other_drive, a share of the cases of both phases drives its "real" recording by another
+// schedule than the nominal scenario's (Draw::other_drive): the diagnosis (estimator-side) is unchanged, and the
+// re-simulation detects the other drive and replays it (gap/resimulate.h ChooseTwin); score.json's figures give both
+// drives' cases apart ("by_drive").
 // Both phases judge a case by one rule (Identified / FalseDiscovery): a none or decoy case that keeps any library
 // effect is a false discovery, whatever the verdict.
 // Writes the recordings in OUT/calibration/NNN/rec and OUT/cases/NNN/rec, each case's row in OUT/.../NNN/case.json and
@@ -38,7 +42,11 @@ struct BenchmarkOptions {
   int cases = 16;             // scored cases, in [1, kMaxCases]
   int calibration_cases = 8;  // in [1, kMaxCases]
   std::uint64_t seed = 1;
-  int jobs = 2;             // cases run in parallel
+  int jobs = 2;  // cases run in parallel
+  // The fraction of the cases (each phase) whose "real" recording is driven by another schedule (Draw::other_drive):
+  // drawn per case from its own random numbers (seeded by the phase's draw seed), so the cases' other draws do not
+  // depend on it.
+  double other_drive = 0.5;
   double duration_s = 0.0;  // 0: the scenarios' own
   std::string atv_scenario = "scenarios/atv_hills_sines.yaml";
   std::string diffdrive_scenario = "scenarios/indoor_diffdrive_gap.yaml";

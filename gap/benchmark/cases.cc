@@ -165,6 +165,7 @@ Result<sim::Simulation> SimulateCase(const Platform& platform, const Draw& draw,
                                      const std::string& rec_dir) {
   sim::Scenario s = platform.scenario;
   if (draw.kind != "none") s.effects.push_back(draw.effect);
+  if (draw.other_drive) s.driver = OtherDrive(s.driver, draw.drive_seed);
   sim::SimulateOptions options;
   options.seed = noise_seed;
   auto simulated = sim::Simulate(s, options);
@@ -199,7 +200,9 @@ Result<BlindDiagnosis> DiagnoseBlind(const Platform& platform, const std::string
   auto diagnosed = Diagnose(platform.config, rec.value(), options);
   if (!diagnosed.ok()) return Status::Error("diagnosis: " + diagnosed.status().message());
   const Diagnosis& d = diagnosed.value();
-  auto simulation = CompareWithSimulation(platform.scenario, d.effects, rec.value(), d.train_end_s);
+  auto twin = ChooseTwin(platform.scenario, rec.value(), TwinDrive::kDetect);
+  if (!twin.ok()) return Status::Error("re-simulation: " + twin.status().message());
+  auto simulation = CompareWithSimulation(platform.scenario, d.effects, rec.value(), d.train_end_s, twin.value());
   if (!simulation.ok()) return Status::Error("re-simulation: " + simulation.status().message());
   return BlindDiagnosis{std::move(rec).value(), std::move(diagnosed).value(), std::move(simulation).value()};
 }
@@ -323,6 +326,25 @@ Draw DrawCase(std::mt19937_64& rng, const std::string& stratum) {
   return d;
 }
 
+sim::DriverOptions OtherDrive(const sim::DriverOptions& nominal, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> phase(0.0, 2.0 * M_PI);
+  sim::DriverOptions out = nominal;
+  for (sim::Profile* p : {&out.speed_mps, &out.handlebar_rad, &out.linear_mps, &out.angular_radps, &out.lateral_mps})
+    for (sim::ProfileTerm& term : p->terms)
+      if (term.type == sim::ProfileTerm::Type::kSine || term.type == sim::ProfileTerm::Type::kSquare)
+        term.phase_rad += phase(rng);
+  return out;
+}
+
+void DrawDrives(std::mt19937_64& rng, double fraction, std::vector<Draw>* draws) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (Draw& d : *draws) {
+    d.other_drive = u(rng) < fraction;
+    d.drive_seed = rng();
+  }
+}
+
 Result<CaseResult> RunCase(const Platform& platform, const Draw& draw, std::uint64_t noise_seed, const std::string& id,
                            const std::string& dir, const CaseSetup& setup) {
   const auto start = std::chrono::steady_clock::now();
@@ -334,24 +356,27 @@ Result<CaseResult> RunCase(const Platform& platform, const Draw& draw, std::uint
   auto blind = DiagnoseBlind(platform, rec_dir, setup);
   if (!blind.ok()) return blind.status();
   const BlindDiagnosis& b = blind.value();
-  const nlohmann::json gap = DiagnosisJson(b.diagnosis, &platform.baseline, kDefaultBaselineSeed, &b.simulation);
+  const nlohmann::json gap =
+      DiagnosisJson(b.diagnosis, &platform.baseline, kDefaultBaselineSeed, &b.simulation, &b.recording);
   if (Status s = WriteFileAtomic(dir + "/gap.json", gap.dump(2) + "\n"); !s.ok()) return s;
   CaseResult c;
   c.id = id;
   c.platform = platform.name;
   c.kind = draw.kind;
+  c.other_drive = draw.other_drive;
+  c.replayed = b.simulation.twin.replayed;
   RecordDiagnosis(b.diagnosis, &c);
   if (Status s = ScoreFromTruth(platform, draw, simulated.value(), rec_dir, b, &c); !s.ok()) return s;
   c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // Written last, under a temporary name then renamed: a case.json marks a finished case (BenchmarkOptions::resume).
-  if (Status written = WriteFileAtomic(dir + "/case.json", CaseRow(c).dump(2) + "\n"); !written.ok())
-    return written;
+  if (Status written = WriteFileAtomic(dir + "/case.json", CaseRow(c).dump(2) + "\n"); !written.ok()) return written;
   return c;
 }
 
 std::string CaseLine(const CaseResult& c) {
   std::ostringstream s;
   s << c.id << " " << c.platform << " " << c.kind;
+  if (c.other_drive) s << " (other drive" << (c.replayed ? ", replayed" : ", not replayed") << ")";
   if (!c.truth_name.empty()) s << " " << c.truth_name << " " << c.truth_parameter << "=" << c.truth_value;
   if (c.noise_ratio >= 0.0) s << std::setprecision(3) << " (" << c.noise_ratio << "x noise)";
   s << " -> " << c.verdict;

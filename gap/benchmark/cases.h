@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "common/status.h"
 #include "estimator/config.h"
@@ -34,8 +35,19 @@ struct Draw {
   int platform = 0;  // index into the platforms
   std::string kind;  // none | effect | decoy
   sim::EffectOptions effect;
-  std::string parameter;  // the parameter drawn away from neutral
+  std::string parameter;     // the parameter drawn away from neutral
+  bool other_drive = false;  // the "real" recording is driven by OtherDrive(driver, drive_seed)
+  std::uint64_t drive_seed = 0;
 };
+
+// Another drive than `nominal`'s: every sine and square term of its profiles with its phase moved by an angle uniform
+// on [0, 2 pi) (random numbers seeded by `seed`): the same kinds of speeds and turns at the same frequencies, another
+// schedule.
+sim::DriverOptions OtherDrive(const sim::DriverOptions& nominal, std::uint64_t seed);
+
+// Draws which cases drive another schedule: for each of `draws`, from `rng`, a uniform number (below `fraction`:
+// another drive) and the drive's seed, both drawn whatever the fraction.
+void DrawDrives(std::mt19937_64& rng, double fraction, std::vector<Draw>* draws);
 
 // Draws a case: platform 0 is the ATV (half of the cases: its library is the largest), 1 the differential drive and
 // 2 the mecanum robot (a quarter each). Kinds: none 20 %, decoy 15 %, effect 65 %; or `stratum` (none, decoy or

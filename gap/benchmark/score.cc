@@ -282,49 +282,61 @@ json Summarize(const std::vector<CaseResult>& cases, double min_noise_ratio) {
   const json rms_1s = Number(Median(t.rms_1s_named));
   const json sim = Number(Median(t.sim_named));
   const json sim_1s = Number(Median(t.sim_1s_named));
-  return {{"effect_cases", t.effects},
-          {"top1", Fraction(t.top1, t.effects)},
-          {"top3", Fraction(t.top3, t.effects)},
-          {"top1_with_verdict_unknown", t.top1_unknown},
-          {"min_noise_ratio", min_noise_ratio},
-          {"strong_effect_cases", t.strong},
-          {"top1_strong", top1_strong},
-          {"top3_strong", Fraction(t.strong_top3, t.strong)},
-          {"by_effect", per_effect},
-          {"none_cases", t.nones},
-          {"false_discovery_rate", false_rate},
-          {"none_reported_none", Fraction(t.none_none, t.nones)},
-          {"decoy_cases", t.decoys},
-          {"decoys_unknown", unknown_rate},
-          {"decoy_false_discovery_rate", Fraction(t.decoy_false, t.decoys)},
-          {"decoys_unknown_effect_kept_or_not", Fraction(t.decoy_unknown_any, t.decoys)},
-          {"median_parameter_relative_error", rel},
-          {"parameter_errors", t.relative_error.size()},
-          {"median_heldout_rms_reduction", rms},
-          {"median_heldout_rms_reduction_all_effect_cases", Number(Median(t.rms_all))},
-          {"median_heldout_rms_1s_reduction", rms_1s},
-          {"median_heldout_rms_1s_reduction_all_effect_cases", Number(Median(t.rms_1s_all))},
-          {"median_resimulated_rms_reduction", sim},
-          {"median_resimulated_rms_reduction_all_effect_cases", Number(Median(t.sim_all))},
-          {"median_resimulated_rms_1s_reduction", sim_1s},
-          {"median_resimulated_rms_1s_reduction_all_effect_cases", Number(Median(t.sim_1s_all))},
-          {"above_noise",
-           {{"cases", t.sim_above.size()},
-            {"median_resimulated_rms_reduction", Number(Median(t.sim_above))},
-            {"median_heldout_rms_reduction", Number(Median(t.rms_above))}}},
-          {"below_noise",
-           {{"cases", t.sim_below.size()},
-            {"median_resimulated_rms_reduction", Number(Median(t.sim_below))},
-            {"median_heldout_rms_reduction", Number(Median(t.rms_below))}}},
-          {"targets",
-           {{"top1_strong", Target(top1_strong, 0.85, true)},
-            {"false_discovery_rate", Target(false_rate, kMaxNoneFalseRate, false)},
-            {"decoys_unknown", Target(unknown_rate, kMinDecoysUnknown, true)},
-            {"median_parameter_relative_error", Target(rel, 0.15, false)},
-            {"median_heldout_rms_reduction", Target(rms, 0.30, true)},
-            {"median_heldout_rms_1s_reduction", Target(rms_1s, 0.30, true)},
-            {"median_resimulated_rms_reduction", Target(sim, 0.30, true)},
-            {"median_resimulated_rms_1s_reduction", Target(sim_1s, 0.30, true)}}}};
+  json figures = {{"effect_cases", t.effects},
+                  {"top1", Fraction(t.top1, t.effects)},
+                  {"top3", Fraction(t.top3, t.effects)},
+                  {"top1_with_verdict_unknown", t.top1_unknown},
+                  {"min_noise_ratio", min_noise_ratio},
+                  {"strong_effect_cases", t.strong},
+                  {"top1_strong", top1_strong},
+                  {"top3_strong", Fraction(t.strong_top3, t.strong)},
+                  {"by_effect", per_effect},
+                  {"none_cases", t.nones},
+                  {"false_discovery_rate", false_rate},
+                  {"none_reported_none", Fraction(t.none_none, t.nones)},
+                  {"decoy_cases", t.decoys},
+                  {"decoys_unknown", unknown_rate},
+                  {"decoy_false_discovery_rate", Fraction(t.decoy_false, t.decoys)},
+                  {"decoys_unknown_effect_kept_or_not", Fraction(t.decoy_unknown_any, t.decoys)},
+                  {"median_parameter_relative_error", rel},
+                  {"parameter_errors", t.relative_error.size()},
+                  {"median_heldout_rms_reduction", rms},
+                  {"median_heldout_rms_reduction_all_effect_cases", Number(Median(t.rms_all))},
+                  {"median_heldout_rms_1s_reduction", rms_1s},
+                  {"median_heldout_rms_1s_reduction_all_effect_cases", Number(Median(t.rms_1s_all))},
+                  {"median_resimulated_rms_reduction", sim},
+                  {"median_resimulated_rms_reduction_all_effect_cases", Number(Median(t.sim_all))},
+                  {"median_resimulated_rms_1s_reduction", sim_1s},
+                  {"median_resimulated_rms_1s_reduction_all_effect_cases", Number(Median(t.sim_1s_all))},
+                  {"above_noise",
+                   {{"cases", t.sim_above.size()},
+                    {"median_resimulated_rms_reduction", Number(Median(t.sim_above))},
+                    {"median_heldout_rms_reduction", Number(Median(t.rms_above))}}},
+                  {"below_noise",
+                   {{"cases", t.sim_below.size()},
+                    {"median_resimulated_rms_reduction", Number(Median(t.sim_below))},
+                    {"median_heldout_rms_reduction", Number(Median(t.rms_below))}}},
+                  {"targets",
+                   {{"top1_strong", Target(top1_strong, 0.85, true)},
+                    {"false_discovery_rate", Target(false_rate, kMaxNoneFalseRate, false)},
+                    {"decoys_unknown", Target(unknown_rate, kMinDecoysUnknown, true)},
+                    {"median_parameter_relative_error", Target(rel, 0.15, false)},
+                    {"median_heldout_rms_reduction", Target(rms, 0.30, true)},
+                    {"median_heldout_rms_1s_reduction", Target(rms_1s, 0.30, true)},
+                    {"median_resimulated_rms_reduction", Target(sim, 0.30, true)},
+                    {"median_resimulated_rms_1s_reduction", Target(sim_1s, 0.30, true)}}}};
+  std::vector<CaseResult> own, other;
+  for (const CaseResult& c : cases) (c.other_drive ? other : own).push_back(c);
+  if (own.empty() || other.empty()) return figures;
+  const auto replayed = [](const std::vector<CaseResult>& v) {
+    return static_cast<int>(std::count_if(v.begin(), v.end(), [](const CaseResult& c) { return c.replayed; }));
+  };
+  figures["drive"] = {{"own_cases", own.size()},
+                      {"own_replayed", replayed(own)},
+                      {"other_cases", other.size()},
+                      {"other_replayed", replayed(other)}};
+  figures["by_drive"] = {{"own", Summarize(own, min_noise_ratio)}, {"other", Summarize(other, min_noise_ratio)}};
+  return figures;
 }
 
 json CaseRow(const CaseResult& c) {
@@ -359,6 +371,8 @@ json CaseRow(const CaseResult& c) {
           {"resimulated_rms_1s_before", c.has_sim_rms ? json(c.sim_rms_1s_before) : json(nullptr)},
           {"resimulated_rms_1s_after", c.has_sim_rms ? json(c.sim_rms_1s_after) : json(nullptr)},
           {"candidates", candidates},
+          {"other_drive", c.other_drive},
+          {"replayed", c.replayed},
           {"seconds", c.seconds}};
 }
 
@@ -372,6 +386,13 @@ bool Get(const json& j, const char* key, std::string* out) {
   *out = it->get<std::string>();
   return true;
 }
+bool Get(const json& j, const char* key, bool* out) {
+  const auto it = j.find(key);
+  if (it == j.end() || !it->is_boolean()) return false;
+  *out = it->get<bool>();
+  return true;
+}
+
 bool Get(const json& j, const char* key, double* out) {
   const auto it = j.find(key);
   if (it == j.end() || !(it->is_number() || it->is_null())) return false;
@@ -441,7 +462,8 @@ Result<CaseResult> CaseFromRow(const json& j) {
        Get(*truth, "name", &c.truth_name) && Get(*truth, "parameter", &c.truth_parameter) &&
        Get(*truth, "value", &c.truth_value) && GetOptional(j, "noise_ratio", &noise_ratio, &has_noise_ratio) &&
        Get(j, "verdict", &c.verdict) && Get(j, "named", &c.named) && Get(j, "ranked", &c.ranked) &&
-       GetOptional(j, "estimate", &c.estimate, &c.has_estimate) && ReadFits(j, &c) && Get(j, "seconds", &c.seconds);
+       GetOptional(j, "estimate", &c.estimate, &c.has_estimate) && ReadFits(j, &c) &&
+       Get(j, "other_drive", &c.other_drive) && Get(j, "replayed", &c.replayed) && Get(j, "seconds", &c.seconds);
   if (!ok) return Status::Error("not a case row as CaseRow writes it");
   c.noise_ratio = has_noise_ratio ? noise_ratio : -1.0;
   for (const json& candidate : *candidates) {

@@ -71,6 +71,10 @@ struct CaseResult {
   double sim_rms_1s_before = 0.0, sim_rms_1s_after = 0.0;  // of its 1 s means
   bool has_sim_rms = false;
   std::vector<CandidateStats> candidates;  // first round
+  // The "real" recording's drive: the scenario's own schedule, or another one (OtherDrive); and whether the
+  // re-simulation replayed it (gap/resimulate.h ChooseTwin, detected blind).
+  bool other_drive = false;
+  bool replayed = false;
   double seconds = 0.0;
 };
 
@@ -132,7 +136,9 @@ double NoiseRatio(const std::map<std::string, std::map<std::string, double>>& si
 // a_y). NaN with fewer than 10 such pose pairs.
 double RearCorneringCompliance(const Trajectory& truth);
 
-// The benchmark's figures over the scored cases, with the targets and whether each is met.
+// The benchmark's figures over the scored cases, with the targets and whether each is met; with cases of both drives,
+// also "drive": the cases of each whose re-simulation was replayed, and the figures of each drive's cases alone
+// ("by_drive": {"own", "other"}).
 nlohmann::json Summarize(const std::vector<CaseResult>& cases, double min_noise_ratio = 3.0);
 
 // One case as a row of score.json's table (and of its case.json).

@@ -206,4 +206,17 @@ double SumOfSquares(const Eigen::VectorXd& whitened, int* count) {
   return sum;
 }
 
+std::vector<estimator::MeasurementResidual> MeasurementResiduals(const Layout& layout,
+                                                                 const Eigen::VectorXd& whitened) {
+  std::vector<estimator::MeasurementResidual> out;
+  for (const Series& s : layout.series) {
+    const int n = s.components();
+    for (std::size_t i = 0; i < s.rows.size(); ++i) {
+      const Eigen::VectorXd r = whitened.segment(s.offset + static_cast<Eigen::Index>(i) * n, n);
+      if (r.allFinite()) out.push_back({s.name, s.t[i], r, true});
+    }
+  }
+  return out;
+}
+
 }  // namespace roamlab::gap::internal

@@ -18,6 +18,7 @@
 #include <Eigen/Core>
 
 #include "common/time.h"
+#include "estimator/calibration.h"
 #include "gap/resimulate.h"
 #include "recording/recording.h"
 
@@ -57,6 +58,9 @@ Eigen::VectorXd WhitenedResiduals(const Layout& layout, const recording::Recordi
 
 // Per series: RMS over the finite entries, per component, and of the 1 s means (SimulatedStreamFit).
 std::map<std::string, SimulatedStreamFit> SeriesFits(const Layout& layout, const Eigen::VectorXd& whitened);
+
+// The whitened residuals as Locate (gap/locate.h) takes them: one per series and sample (finite entries only).
+std::vector<estimator::MeasurementResidual> MeasurementResiduals(const Layout& layout, const Eigen::VectorXd& whitened);
 
 // The sum of squares of the finite entries and their number.
 double SumOfSquares(const Eigen::VectorXd& whitened, int* count = nullptr);

@@ -1,8 +1,9 @@
 // `roamlab diagnose` end to end on short simulated drives: it never opens the recording's truth.yaml (garbage there
 // changes nothing), writes gap.json with the documented keys, and refuses a recording of another robot kind with one
-// line and exit code 2, as it does a time-shift range the recording cannot hold; --replay diagnoses a recording of
-// another drive than the scenario's against the replay of that drive; --held-out shows the twin's patch on a recording
-// of another drive.
+// line and exit code 2, as it does a time-shift range the recording cannot hold; a recording of another drive than the
+// scenario's is replayed (detected, or forced with --replay; --no-replay forces the plain simulation), gap.json's
+// "simulation" says which and why and report.html shows the twin's figures; --twin diagnoses it against the replay of
+// that drive; --held-out shows the twin's patch on a recording of another drive.
 #include <sys/wait.h>
 
 #include <cstdlib>
@@ -154,16 +155,17 @@ std::string DiffDrive(const testing::TempDir& dir, const std::string& turn_radps
   return dir.File(name);
 }
 
-TEST(DiagnoseCliTest, ReplayReplaysARecordingOfAnotherDrive) {
+TEST(DiagnoseCliTest, TheTwinOfARecordingOfAnotherDriveIsItsReplay) {
   testing::TempDir dir;
   // Long enough for the estimator's held-out part.
   const std::string nominal = DiffDrive(dir, "0.6", "nominal.yaml", "9.0");
   const std::string other = DiffDrive(dir, "-0.6", "other.yaml", "9.0");
   ASSERT_EQ(Roamlab("simulate " + other + " --out " + dir.File("rec") + " --quiet", dir).exit_code, 0);
   const CommandRun run = Roamlab("diagnose --real " + dir.File("rec") + " --scenario " + nominal + " --out " +
-                                     dir.File("out") + " --replay --no-baseline",
+                                     dir.File("out") + " --twin --no-baseline",
                                  dir);
   ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("other drive detected"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("the twin replays the recorded drive"), std::string::npos) << run.out;
   std::ifstream in(dir.File("out/twin.json"));
   ASSERT_TRUE(in.good());
@@ -184,11 +186,11 @@ TEST(DiagnoseCliTest, ReplayReplaysARecordingOfAnotherDrive) {
 // scenarios/real/optiodom_diff.yaml (motion capture: the twin's drift is measured) shortened to `duration_s`, with its
 // turn-rate amplitude `turn_radps` and `effects`, written to `name`.
 std::string OptiOdomDiff(const testing::TempDir& dir, const std::string& turn_radps, const std::string& effects,
-                         const std::string& name) {
+                         const std::string& name, const std::string& duration_s = "12.0") {
   std::string text = testing::ReadFile(Source("scenarios/real/optiodom_diff.yaml"));
   for (const auto& [a, b] : std::vector<std::pair<std::string, std::string>>{
            {"model: ../../models/optiodom_diff.xml", "model: " + Source("models/optiodom_diff.xml")},
-           {"duration_s: 20.0", "duration_s: 12.0"},
+           {"duration_s: 20.0", "duration_s: " + duration_s},
            {"amplitude: 0.14", "amplitude: " + turn_radps},
            {"effects: []", "effects: " + effects}}) {
     const std::size_t at = text.find(a);
@@ -200,8 +202,8 @@ std::string OptiOdomDiff(const testing::TempDir& dir, const std::string& turn_ra
 }
 
 // A wheel radius 3 % large hidden in two drives: the patch fitted on the scenario's own drive is shown on a recording
-// of another drive (replayed), where the patched twin's 10 s drift is well below the nominal twin's; gap.json carries
-// twin.json. A held-out recording without --replay is bad input.
+// of another drive (replayed), where the patched twin's 10 s drift is well below the nominal twin's; gap.json names
+// twin.json. A held-out recording without --twin is bad input.
 TEST(DiagnoseCliTest, HeldOutShowsTheTwinsPatchOnARecordingOfAnotherDrive) {
   testing::TempDir dir;
   const std::string effect = "[{name: wheel_radius_scale, parameters: {scale: 1.03}}]";
@@ -220,10 +222,10 @@ TEST(DiagnoseCliTest, HeldOutShowsTheTwinsPatchOnARecordingOfAnotherDrive) {
                              Source("configs/real/optiodom_diff_nominal.yaml") + " --no-baseline ";
   const CommandRun refused = Roamlab(common + "--out " + dir.File("bad") + " --held-out " + dir.File("held"), dir);
   EXPECT_EQ(refused.exit_code, 2);
-  EXPECT_NE(refused.err.find("--held-out needs --replay"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("--held-out needs --twin"), std::string::npos) << refused.err;
 
   const CommandRun run =
-      Roamlab(common + "--out " + dir.File("out") + " --replay --no-plots --held-out " + dir.File("held"), dir);
+      Roamlab(common + "--out " + dir.File("out") + " --twin --no-plots --held-out " + dir.File("held"), dir);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   std::ifstream in(dir.File("out/twin.json"));
   ASSERT_TRUE(in.good());
@@ -243,7 +245,71 @@ TEST(DiagnoseCliTest, HeldOutShowsTheTwinsPatchOnARecordingOfAnotherDrive) {
   EXPECT_LT(held.at("after").at("chi2").get<double>(), held.at("before").at("chi2").get<double>());
   std::ifstream gap_in(dir.File("out/gap.json"));
   const nlohmann::json gap = nlohmann::json::parse(gap_in);
-  EXPECT_EQ(gap.at("twin").at("heldout_runs").size(), 1u);
+  // gap.json's "simulation" names twin.json rather than copying it, and runs the twin with its patch.
+  EXPECT_FALSE(gap.contains("twin"));
+  EXPECT_EQ(gap.at("simulation").at("twin_diagnosis"), "twin.json");
+  EXPECT_FALSE(gap.at("simulation").at("replayed").get<bool>());
+  EXPECT_EQ(gap.at("simulation").at("effects"), twin.at("patch"));
+}
+
+// A recording of another drive of the OptiOdom differential drive (motion capture): detected and replayed, gap.json's
+// "simulation" says why and gives the twins' held-out drift, and report.html embeds the twin's top view and its
+// residual against a motion condition; --no-replay forces the plain simulation, and --replay with it is refused.
+TEST(DiagnoseCliTest, TheReportShowsTheTwinAgainstTheRecording) {
+  testing::TempDir dir;
+  // 33 s: the held-out third holds two 10 s drift windows.
+  const std::string nominal = OptiOdomDiff(dir, "0.14", "[]", "nominal.yaml", "33.0");
+  const std::string effect = "[{name: wheel_radius_scale, parameters: {scale: 1.03}}]";
+  ASSERT_EQ(Roamlab("simulate " + OptiOdomDiff(dir, "-0.3", effect, "other.yaml", "33.0") + " --out " +
+                        dir.File("rec") + " --quiet",
+                    dir)
+                .exit_code,
+            0);
+  const std::string common = "diagnose --real " + dir.File("rec") + " --scenario " + nominal + " --config " +
+                             Source("configs/real/optiodom_diff_nominal.yaml") + " --no-baseline --quiet ";
+  const auto simulation = [&](const std::string& out) {
+    std::ifstream in(dir.File(out + "/gap.json"));
+    return nlohmann::json::parse(in).at("simulation");
+  };
+  ASSERT_EQ(Roamlab(common + "--out " + dir.File("out"), dir).exit_code, 0);
+  const nlohmann::json detected = simulation("out");
+  EXPECT_TRUE(detected.at("replayed").get<bool>()) << detected.dump();
+  EXPECT_EQ(detected.at("twin").at("reason"), "other drive detected");
+  EXPECT_GT(detected.at("twin").at("drive_mismatch").get<double>(), detected.at("twin").at("max_drive_mismatch"));
+  EXPECT_TRUE(detected.at("twin_diagnosis").is_null());
+  const nlohmann::json& drift = detected.at("drift").at("mocap");
+  // The 3 % larger wheels drive (0.1 m/s) and turn (0.3 rad/s) 3 % more than the nominal twin over the 8 s of each
+  // window after its 2 s alignment: 24 mm and 0.072 rad; at least half of each.
+  EXPECT_GT(drift.at("before").at("mean_position_m").get<double>(), 0.5 * 0.024) << drift.dump();
+  EXPECT_GT(drift.at("before").at("mean_heading_rad").get<double>(), 0.5 * 0.072) << drift.dump();
+  const std::string page = testing::ReadFile(dir.File("out/report.html"));
+  const testing::HtmlSummary html = testing::CheckHtml(page);
+  ASSERT_EQ(html.error, "");
+  EXPECT_NE(page.find("The twin replays the recorded drive"), std::string::npos);
+  if (eval::GnuplotAvailable()) {
+    for (const char* figure : {"twin_top_view.png", "twin_residual_vs_condition.png"}) {
+      const std::size_t at = page.find(std::string("<figcaption>") + figure + "</figcaption>");
+      EXPECT_NE(at, std::string::npos) << figure;
+      EXPECT_GT(std::filesystem::file_size(dir.File(std::string("out/") + figure)), 0u) << figure;
+    }
+    for (const std::string& src : html.image_sources) {
+      ASSERT_EQ(src.rfind("data:image/png;base64,", 0), 0u);
+      EXPECT_TRUE(testing::DecodeBase64(src.substr(22)).has_value());
+    }
+    EXPECT_NE(testing::ReadFile(dir.File("out/report.md")).find("![twin_top_view.png](twin_top_view.png)"),
+              std::string::npos);
+  }
+
+  ASSERT_EQ(Roamlab(common + "--no-plots --no-replay --out " + dir.File("plain"), dir).exit_code, 0);
+  const nlohmann::json plain = simulation("plain");
+  EXPECT_FALSE(plain.at("replayed").get<bool>());
+  EXPECT_EQ(plain.at("twin").at("reason"), "forced: the scenario's own drive");
+  EXPECT_TRUE(plain.at("twin").at("drive_mismatch").is_null());
+  // The plain simulation misses the other drive by far more than its replay does.
+  EXPECT_GT(plain.at("before").at("mocap").at("rms").get<double>(),
+            3.0 * detected.at("before").at("mocap").at("rms").get<double>());
+  const CommandRun both = Roamlab(common + "--replay --no-replay --out " + dir.File("both"), dir);
+  EXPECT_EQ(both.exit_code, 2) << both.err;
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -238,7 +239,7 @@ TEST(ReplayTest, TwinHoldsTheRecordedStreamsAtTheirStamps) {
   for (Stream& stream : real.recording.streams)
     for (std::size_t k = 1; k + 1 < stream.t.size(); k += 2)
       stream.t[k] = Time::FromNanoseconds(stream.t[k].nanoseconds() + 3'300'000);
-  const Simulation twin = ReplayOk(s, real.recording, {1.0, 4.0, nullptr});
+  const Simulation twin = ReplayOk(s, real.recording, {1.0, 4.0, std::nullopt, nullptr});
   ASSERT_EQ(twin.recording.streams.size(), real.recording.streams.size());
   for (const Stream& r : real.recording.streams) {
     const Stream* t = twin.recording.Find(r.info.name);
@@ -438,10 +439,23 @@ TEST(ReplayTest, AtvFollowsItsRecordedSpeedAndSteering) {
       e.max_heading_rad, schedule.max_position_m, twin.stats.realtime_factor);
   EXPECT_THAT(twin.truth.replay->drive, HasSubstr("rear-wheel speed"));
   EXPECT_THAT(twin.truth.replay->start, HasSubstr("gps"));
-  // The start heading is the chord of the first kStartMotionM of GPS fixes (sigma_m per axis at both ends).
+  EXPECT_THAT(twin.truth.replay->start, HasSubstr("aligned"));
+  // The start is the twin's first kStartAlignS fitted onto the N fixes there, spread along the track over L: a line's
+  // direction from N points spread evenly over L has the std sigma sqrt(12 / N) / L, its centre sigma / sqrt(N), and
+  // the start, at one end, moves by the heading error times L / 2 more. 3 stds of each.
   const double sigma_m = s.sensors.gps->sigma_m;
-  EXPECT_LT(start.max_heading_rad, 3.0 * std::sqrt(2.0) * sigma_m / kStartMotionM);
-  EXPECT_LT(start.max_position_m, 3.0 * std::sqrt(2.0) * sigma_m + 3.0 * std::sqrt(2.0) * sigma_m / kStartMotionM);
+  const recording::Stream& gps = *real.recording.Find("gps");
+  const double n = static_cast<double>(
+      std::upper_bound(gps.t.begin(), gps.t.end(), Time::FromSeconds(gps.t.front().seconds() + kStartAlignS)) -
+      gps.t.begin());
+  Trajectory first_span;
+  for (const auto& pose : truth)
+    if (pose.t.seconds() <= gps.t.front().seconds() + kStartAlignS) first_span.push_back(pose);
+  const double length_m = Extent(first_span);
+  const double heading_std = sigma_m * std::sqrt(12.0 / n) / length_m;
+  std::printf("ATV start: %g fixes over %.1f m: heading std %.4f rad\n", n, length_m, heading_std);
+  EXPECT_LT(start.max_heading_rad, 3.0 * heading_std);
+  EXPECT_LT(start.max_position_m, 3.0 * (sigma_m / std::sqrt(n) + heading_std * length_m / 2.0));
   EXPECT_LT(e.max_position_m, 0.2 * schedule.max_position_m);
 }
 

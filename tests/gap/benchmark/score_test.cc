@@ -298,6 +298,23 @@ TEST(GapBenchmarkScore, SummarizesTheBenchmarksFigures) {
   EXPECT_TRUE(f["targets"]["median_parameter_relative_error"]["met"].get<bool>());
   EXPECT_TRUE(f["targets"]["median_heldout_rms_reduction"]["met"].get<bool>());
   EXPECT_EQ(f["by_effect"]["gyro_scale_error"]["top1"], 1);
+  // All of one drive: no split by drive.
+  EXPECT_FALSE(f.contains("by_drive"));
+
+  // The same cases with the right one and two none cases (one a false discovery) of another drive, the right one
+  // replayed: each drive's figures over its own cases.
+  for (std::size_t i : {std::size_t{0}, std::size_t{3}, std::size_t{4}}) cases[i].other_drive = true;
+  cases[0].replayed = true;
+  const nlohmann::json split = Summarize(cases);
+  EXPECT_EQ(split["drive"]["other_cases"], 3);
+  EXPECT_EQ(split["drive"]["other_replayed"], 1);
+  EXPECT_EQ(split["drive"]["own_cases"], 7);
+  EXPECT_EQ(split["drive"]["own_replayed"], 0);
+  EXPECT_DOUBLE_EQ(split["by_drive"]["other"]["top1_strong"].get<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(split["by_drive"]["other"]["false_discovery_rate"].get<double>(), 0.5);
+  EXPECT_DOUBLE_EQ(split["by_drive"]["own"]["top1_strong"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(split["by_drive"]["own"]["false_discovery_rate"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(split["top1_strong"].get<double>(), 0.5);  // the whole's figures unchanged
 
   // Nothing to count: fractions are null and the targets not met.
   const nlohmann::json empty = Summarize({});
@@ -332,17 +349,20 @@ TEST(GapBenchmarkScore, CaseRowReadsBackExactly) {
   c.rms_1s_after = 0.25;
   c.has_rms = true;
   c.seconds = 12.5;
+  c.other_drive = true;
+  c.replayed = true;
   const nlohmann::json row = nlohmann::json::parse(CaseRow(c).dump(2));
   const Result<CaseResult> back = CaseFromRow(row);
   ASSERT_TRUE(back.ok()) << back.status().message();
   EXPECT_EQ(CaseRow(back.value()).dump(), CaseRow(c).dump());
   EXPECT_EQ(back.value().truth_value, c.truth_value);
+  EXPECT_TRUE(back.value().other_drive && back.value().replayed);
   EXPECT_FALSE(back.value().has_sim_rms);
   EXPECT_TRUE(std::isnan(back.value().candidates[0].std.at("unknown")));
   EXPECT_TRUE(std::isnan(back.value().candidates[0].explained_share));
 
   // A missing key or one of another type is an error, never an exception.
-  for (const char* key : {"case", "truth", "candidates", "estimate", "seconds"}) {
+  for (const char* key : {"case", "truth", "candidates", "estimate", "other_drive", "seconds"}) {
     nlohmann::json damaged = row;
     damaged.erase(key);
     EXPECT_FALSE(CaseFromRow(damaged).ok()) << key;
