@@ -7,7 +7,9 @@
 # as not run; ROAMLAB_SLURM_TESTS=0 leaves them out, ROAMLAB_SLURM_TESTS=1 makes a failed start an error.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+t0=$(date +%s)
 bash scripts/setup.sh
+echo "roamlab tests: set-up and build took $(($(date +%s) - t0)) s"
 build_dir=${BUILD_DIR:-build}
 exclude=(-LE 'slow|slurm')
 [ "${ROAMLAB_SLOW_TESTS:-0}" = "1" ] && exclude=(-LE slurm)
