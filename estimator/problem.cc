@@ -360,8 +360,8 @@ void ProblemBuilder::AddMasterSample(const MeasurementRef& m) {
   im.last_master = m;
   TryAttach(odo);
   const std::size_t k = poses_.size() - 2;
-  BridgeGyroscopeGap(im.streams, [&](const std::string& name) { return ParameterAt(name, k); }, poses_[k],
-                     poses_.back(), &graph_);
+  const auto parameter = [&](const std::string& name) { return ParameterAt(name, k); };
+  BridgeGyroscopeGap(im.streams, parameter, poses_[k], poses_.back(), &graph_);
 }
 
 ProblemBuilder::Placement ProblemBuilder::PlaceSample(const MeasurementRef& m, const StreamBinding& s, std::size_t* k) {

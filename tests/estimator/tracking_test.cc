@@ -340,6 +340,30 @@ TEST(TrackingTest, TracksThroughAnImuDropoutWithFiniteConsistentCovariances) {
   EXPECT_GE(inside, static_cast<int>(0.9 * errors.size()));
 }
 
+// Tracking with gross outliers on every 10th steering row (0.5 rad, 35 times the simulated noise): each bends the
+// update's estimate of its pose until the gyroscope's row of the same interval may fail the gate too. The gate must
+// reject the outlier's odometer factor and keep the gyroscope's, so that no pose loses its information.
+TEST(TrackingTest, GatesMasterOutliersWithoutRejectingTheGoodRowsOfTheirPoses) {
+  roamlab::testing::SyntheticOptions options;
+  options.duration_s = 8.0;
+  options.seed = 3;
+  auto synthetic = roamlab::testing::MakeAtvRecording(options);
+  const auto steering = std::find_if(synthetic.recording.streams.begin(), synthetic.recording.streams.end(),
+                                     [](const recording::Stream& s) { return s.info.name == "steering"; });
+  ASSERT_NE(steering, synthetic.recording.streams.end());
+  int outliers = 0;
+  for (Eigen::Index row = 5; row < steering->values.rows(); row += 10, ++outliers)
+    steering->values(row, 0) += row % 20 == 5 ? 0.5 : -0.5;
+  EstimatorConfig config = UnbudgetedConfig();
+  config.gate_probability = 0.99999;
+  auto result = Track(config, synthetic.recording, {});
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_EQ(result.value().counts.at("gyroscope").rejected, 0);
+  EXPECT_LE(result.value().counts.at("odometer").rejected, 2 * outliers);
+  for (std::size_t i = 0; i < result.value().position_covariance.size(); ++i)
+    ASSERT_TRUE(result.value().position_covariance[i].allFinite()) << "pose " << i;
+}
+
 TEST(TrackingTest, CalibrationPriorOfTheWrongSizeIsAnError) {
   CalibratedAtv calibrated = CalibrateOnOtherDrive();
   calibrated.prior.information = Eigen::MatrixXd::Identity(2, 2);
