@@ -261,7 +261,8 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
       initialized = true;
     } else {
       // One update: Gauss-Newton on the window, gating of the measurements attached since the last update, and a
-      // re-solve if anything was gated. The solve also gives the covariance of the pose about to leave the window.
+      // re-solve after each gating pass that switched any. The solve also gives the covariance of the pose about to
+      // leave the window.
       const auto t0 = Clock::now();
       leaving.variables.assign(1, builder.poses().front().id);
       leaving.computed = false;
