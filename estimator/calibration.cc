@@ -54,6 +54,31 @@ void RejectAroundBursts(const std::vector<GateRow>& rows, double margin, std::ve
   }
 }
 
+// An active factor that fails the gate, with its squared error over the quantile of its dimension.
+struct FailingFactor {
+  FactorId id;
+  double excess;
+};
+
+// Of `failing`, those that fail worst at every pose they join (GateOptions::worst_per_pose).
+std::vector<FactorId> WorstPerPose(const std::vector<FailingFactor>& failing, const Graph& graph,
+                                   const std::deque<PoseNode>& poses) {
+  std::set<VariableId> pose_ids;
+  for (const PoseNode& p : poses) pose_ids.insert(p.id);
+  std::map<VariableId, double> worst;
+  for (const FailingFactor& f : failing)
+    for (VariableId v : graph.factor(f.id).variables)
+      if (pose_ids.count(v) > 0) worst[v] = std::max(worst[v], f.excess);
+  std::vector<FactorId> out;
+  for (const FailingFactor& f : failing) {
+    const std::vector<VariableId>& vars = graph.factor(f.id).variables;
+    if (std::all_of(vars.begin(), vars.end(),
+                    [&](VariableId v) { return pose_ids.count(v) == 0 || worst[v] <= f.excess; }))
+      out.push_back(f.id);
+  }
+  return out;
+}
+
 }  // namespace
 
 GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId first,
@@ -72,6 +97,7 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
   std::vector<std::pair<double, int>> failing;  // (ignore_chance_changes) squared norm and dimension of each active
                                                 // factor that fails
+  std::vector<FailingFactor> failing_factors;   // (worst_per_pose)
   const bool bursts = options.burst_margin > 0.0;
   std::vector<std::vector<GateRow>> rows(bursts ? builder->stream_names().size() : 0);  // per stream, in time order
   std::vector<const double*> values;
@@ -106,6 +132,8 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
       failing.push_back({ok ? linearized->squared_norm : kInfinity, dim});
     if (bursts)
       rows[stream->second].push_back({id, entry.active, pass});
+    else if (options.worst_per_pose && !pass && entry.active)
+      failing_factors.push_back({id, ok ? linearized->squared_norm / threshold(dim) : kInfinity});
     else if (pass != entry.active)
       switched.push_back(id);
   }
@@ -117,6 +145,11 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
       for (std::size_t k = 0; k < r.size(); ++k)
         if ((r[k].pass && !reject[k]) != r[k].was_active) switched.push_back(r[k].id);
     }
+    std::sort(switched.begin(), switched.end());
+  }
+  if (!failing_factors.empty()) {
+    const std::vector<FactorId> worst = WorstPerPose(failing_factors, graph, builder->poses());
+    switched.insert(switched.end(), worst.begin(), worst.end());
     std::sort(switched.begin(), switched.end());
   }
   // By chance: no more newly failing factors than the test's false alarms among the tested factors, and none beyond

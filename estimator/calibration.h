@@ -133,6 +133,12 @@ struct GateOptions {
   // test can tell. The factors that fit again are re-admitted all the same (unless they too, with the failing ones,
   // are no more than the false alarms: then nothing switches), and the result is `settled`.
   bool ignore_chance_changes = false;
+  // Reject a failing factor only where it fails worst (its squared error over the quantile) among the failing factors
+  // that share a pose with it; the others stay active for the next pass, after a re-solve without it. A gross outlier
+  // bends the solve's estimate of its poses until the good measurements of the same poses fail too (a steering outlier
+  // against the gyroscope, of comparable weight on the yaw rate): rejected together, they would leave those poses
+  // with nothing to hold them. Not with burst_margin.
+  bool worst_per_pose = false;
 };
 
 // What one gating pass switched.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <set>
 
@@ -40,6 +41,11 @@ namespace {
 // slope's noise, which biases the offset towards zero, falls as n^-1.5, while the line smooths the motion's content
 // above about 0.5 Hz (the header's numbers).
 constexpr double kReadingRateHalfWindow = 0.3;
+
+// The bound on the body's angular rate that bridges a gyroscope gap (BridgeGyroscopeGap) [rad/s], per axis: above
+// what a ground vehicle turns, rolls or pitches at, so that on the axes the master measures (yaw, for an odometer) it
+// adds a few percent of their information at most.
+constexpr double kGapBridgeRateSigma = 3.0;
 
 }  // namespace
 
@@ -168,6 +174,37 @@ Eigen::Vector3d ReadingRate(const recording::Stream& data, int column, int row) 
     stz += dt * (data.values.row(i).segment<3>(column).transpose() - mean_z);
   }
   return stt > 0.0 ? Eigen::Vector3d(stz / stt) : Eigen::Vector3d::Zero();
+}
+
+// Whether the stream has a measured row (not a frozen repeat) stamped in [a, b).
+bool HasRowIn(const StreamBinding& s, Time a, Time b) {
+  const std::vector<Time>& t = s.primary->t;
+  for (auto it = std::lower_bound(t.begin(), t.end(), a); it != t.end() && *it < b; ++it)
+    if (s.frozen.empty() || !s.frozen[static_cast<std::size_t>(it - t.begin())]) return true;
+  return false;
+}
+
+// A master interval that no gyroscope row falls in (a dropout, or a frozen IMU's repeats left out) leaves the relative
+// rotation of its poses to the master's rows, which constrain some of its axes only (an Ackermann or wheel odometer
+// says little about roll and pitch rates): the newest pose would have directions no factor constrains, the update's
+// solve would step along them at the damping's whim, and the gate would then test (and reject) the master's factor
+// where nothing can check it, leaving a pose without information. The gap is bridged by what is known without the
+// gyroscope: the body's rate over the interval is bounded, a zero-rate reading of the gyroscope's own model with the
+// noise kGapBridgeRateSigma, far weaker than the master's rows on the axes they measure. Not a measurement: neither
+// gated nor counted. Exempting the master's factor from the gate instead would leave the solve stepping along the free
+// directions all the same, and knowing when a factor is the only check of a direction takes a marginal covariance per
+// factor and update; the bridge states the one assumption it adds (the body turns slower than a few rad/s).
+void BridgeGyroscopeGap(const std::vector<StreamBinding>& streams,
+                        const std::function<VariableId(const std::string&)>& parameter, const PoseNode& from,
+                        const PoseNode& to, Graph* graph) {
+  for (const StreamBinding& s : streams) {
+    if (s.config.model != "gyroscope" || s.user_model || HasRowIn(s, from.t, to.t)) continue;
+    graph->AddFactor(MakeFactor(GyroscopeError(Eigen::Vector3d::Zero(), SecondsBetween(from.t, to.t))),
+                     {from.id, to.id, parameter(s.slot_parameters[0]), parameter(s.slot_parameters[1]),
+                      parameter(s.slot_parameters[2])},
+                     Eigen::Matrix3d::Identity() * (kGapBridgeRateSigma * kGapBridgeRateSigma), Loss::Trivial(),
+                     s.name + " gap bridge", to.t);
+  }
 }
 
 }  // namespace
@@ -322,6 +359,9 @@ void ProblemBuilder::AddMasterSample(const MeasurementRef& m) {
   CreatePose(m.t, next_value);
   im.last_master = m;
   TryAttach(odo);
+  const std::size_t k = poses_.size() - 2;
+  const auto parameter = [&](const std::string& name) { return ParameterAt(name, k); };
+  BridgeGyroscopeGap(im.streams, parameter, poses_[k], poses_.back(), &graph_);
 }
 
 ProblemBuilder::Placement ProblemBuilder::PlaceSample(const MeasurementRef& m, const StreamBinding& s, std::size_t* k) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <memory>
 
 #include <Eigen/Eigenvalues>
@@ -25,6 +26,21 @@ using Clock = std::chrono::steady_clock;
 constexpr int kPositionDims = 3;
 
 FactorId NextFactorId(const Graph& graph) { return graph.factors().empty() ? 0 : graph.factors().rbegin()->first + 1; }
+
+// Gating passes after a solve, each followed by a re-solve (`solve`, returning its iterations) when it switched any
+// factor: a pass rejects only the factors that fail worst at their poses (GateOptions::worst_per_pose) and re-admits
+// those that fit again once the outliers are out. Returns the re-solves' iterations.
+constexpr int kMaxGatePasses = 5;
+int GateAndResolve(double probability, FactorId first, const SolverWorkspace* last_solve, ProblemBuilder* builder,
+                   const std::function<int()>& solve) {
+  GateOptions options;
+  options.worst_per_pose = true;
+  int iterations = 0;
+  for (int pass = 0;
+       pass < kMaxGatePasses && GateOutliers(probability, builder, first, last_solve, options).switched() > 0; ++pass)
+    iterations += solve();
+  return iterations;
+}
 
 // The oldest pose's estimate and position covariance (marginal of the whole window): from `known` when it holds that
 // pose (a request of poses' positions only, kPositionDims each, computed by a solve or by OldestPoseCovariances),
@@ -239,12 +255,14 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
       builder.AlignToAbsoluteFixes();
       const SolverSummary s = Solve(config.solver, &builder.graph());
       if (!s.usable()) return Status::Error("initialization failed: " + s.message);
-      if (config.gate_probability && GateOutliers(*config.gate_probability, &builder).switched() > 0)
-        Solve(config.solver, &builder.graph());
+      if (config.gate_probability)
+        GateAndResolve(*config.gate_probability, 0, nullptr, &builder,
+                       [&] { return Solve(config.solver, &builder.graph()).iterations; });
       initialized = true;
     } else {
       // One update: Gauss-Newton on the window, gating of the measurements attached since the last update, and a
-      // re-solve if anything was gated. The solve also gives the covariance of the pose about to leave the window.
+      // re-solve after each gating pass that switched any. The solve also gives the covariance of the pose about to
+      // leave the window.
       const auto t0 = Clock::now();
       leaving.variables.assign(1, builder.poses().front().id);
       leaving.computed = false;
@@ -253,14 +271,16 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
       const SolverSummary s = Solve(update_options, &builder.graph(), request, &workspace);
       if (!s.usable()) return Status::Error("update at t = " + FormatSeconds(m.t) + " failed: " + s.message);
       iterations += s.iterations;
-      if (config.gate_probability &&
-          GateOutliers(*config.gate_probability, &builder, first_new_factor, &workspace).switched() > 0) {
+      if (config.gate_probability) {
         // Without a gated measurement the window may not factor (a gated odometer factor leaves the newest pose's
         // position free until the next samples attach), and the Schur complement EmitOldest would fall back to runs
         // through that singular block: keep the leaving pose's covariance from before the gate then.
-        const CovarianceRequest before_gate = leaving;
-        iterations += Solve(update_options, &builder.graph(), request, &workspace).iterations;
-        if (request != nullptr && !leaving.computed && before_gate.computed) leaving = before_gate;
+        iterations += GateAndResolve(*config.gate_probability, first_new_factor, &workspace, &builder, [&] {
+          const CovarianceRequest before_gate = leaving;
+          const int resolve_iterations = Solve(update_options, &builder.graph(), request, &workspace).iterations;
+          if (request != nullptr && !leaving.computed && before_gate.computed) leaving = before_gate;
+          return resolve_iterations;
+        });
       }
       const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
       ++out.updates;

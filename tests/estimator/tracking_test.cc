@@ -292,6 +292,78 @@ TEST(TrackingTest, RelinearizationThresholdStaysCloseToRelinearizingEveryFactor)
   }
 }
 
+// The recording without the rows of `stream` stamped in [start_s, start_s + duration_s) after its first stamp: an
+// outage (a dropout, or a frozen sensor's repeated rows left out).
+void RemoveRows(const std::string& stream, double start_s, double duration_s, recording::Recording* rec) {
+  const auto found = std::find_if(rec->streams.begin(), rec->streams.end(),
+                                  [&](const recording::Stream& s) { return s.info.name == stream; });
+  ASSERT_NE(found, rec->streams.end()) << stream;
+  recording::Stream& s = *found;
+  const Time first = s.t.front();
+  std::vector<Time> t;
+  std::vector<Eigen::Index> kept;
+  for (std::size_t i = 0; i < s.t.size(); ++i) {
+    const double since = SecondsBetween(first, s.t[i]);
+    if (since >= start_s && since < start_s + duration_s) continue;
+    t.push_back(s.t[i]);
+    kept.push_back(static_cast<Eigen::Index>(i));
+  }
+  Eigen::MatrixXd values(static_cast<Eigen::Index>(kept.size()), s.values.cols());
+  for (std::size_t r = 0; r < kept.size(); ++r) values.row(static_cast<Eigen::Index>(r)) = s.values.row(kept[r]);
+  s.t = std::move(t);
+  s.values = std::move(values);
+}
+
+// Tracking through a 2 s IMU dropout with the gate on: no gyroscope or accelerometer sample joins the poses of the
+// gap, whose relative rotation only the other sensors constrain, and the gate tests the odometer's factor of each new
+// pose. Every pose must come out with a finite, positive-definite position covariance, and its error must be
+// consistent with it as on a drive without the gap.
+TEST(TrackingTest, TracksThroughAnImuDropoutWithFiniteConsistentCovariances) {
+  roamlab::testing::SyntheticOptions options;
+  options.duration_s = 8.0;
+  options.seed = 3;
+  auto synthetic = roamlab::testing::MakeAtvRecording(options);
+  RemoveRows("imu", 3.0, 2.0, &synthetic.recording);
+  EstimatorConfig config = UnbudgetedConfig();
+  config.gate_probability = 0.99999;
+  auto result = Track(config, synthetic.recording, {});
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  const auto errors = PositionErrors(result.value(), *synthetic.recording.ground_truth);
+  const double gate = ChiSquareQuantile(0.997, 3);
+  int inside = 0;
+  for (std::size_t i = 0; i < errors.size(); ++i) {
+    const Eigen::Matrix3d& cov = result.value().position_covariance[i];
+    ASSERT_TRUE(cov.allFinite()) << "pose " << i;
+    ASSERT_GT(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvalues().minCoeff(), 0.0) << "pose " << i;
+    inside += errors[i].dot(cov.ldlt().solve(errors[i])) <= gate;
+  }
+  EXPECT_GE(inside, static_cast<int>(0.9 * errors.size()));
+}
+
+// Tracking with gross outliers on every 10th steering row (0.5 rad, 35 times the simulated noise): each bends the
+// update's estimate of its pose until the gyroscope's row of the same interval may fail the gate too. The gate must
+// reject the outlier's odometer factor and keep the gyroscope's, so that no pose loses its information.
+TEST(TrackingTest, GatesMasterOutliersWithoutRejectingTheGoodRowsOfTheirPoses) {
+  roamlab::testing::SyntheticOptions options;
+  options.duration_s = 8.0;
+  options.seed = 3;
+  auto synthetic = roamlab::testing::MakeAtvRecording(options);
+  const auto steering = std::find_if(synthetic.recording.streams.begin(), synthetic.recording.streams.end(),
+                                     [](const recording::Stream& s) { return s.info.name == "steering"; });
+  ASSERT_NE(steering, synthetic.recording.streams.end());
+  int outliers = 0;
+  for (Eigen::Index row = 5; row < steering->values.rows(); row += 10, ++outliers)
+    steering->values(row, 0) += row % 20 == 5 ? 0.5 : -0.5;
+  EstimatorConfig config = UnbudgetedConfig();
+  config.gate_probability = 0.99999;
+  auto result = Track(config, synthetic.recording, {});
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_EQ(result.value().counts.at("gyroscope").rejected, 0);
+  EXPECT_LE(result.value().counts.at("odometer").rejected, 2 * outliers);
+  for (std::size_t i = 0; i < result.value().position_covariance.size(); ++i)
+    ASSERT_TRUE(result.value().position_covariance[i].allFinite()) << "pose " << i;
+}
+
 TEST(TrackingTest, CalibrationPriorOfTheWrongSizeIsAnError) {
   CalibratedAtv calibrated = CalibrateOnOtherDrive();
   calibrated.prior.information = Eigen::MatrixXd::Identity(2, 2);
