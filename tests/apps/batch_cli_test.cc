@@ -9,6 +9,7 @@
 
 #include "tests/apps/batch_fixture.h"
 #include "tests/recording/temp_dir.h"
+#include "tests/support/paths.h"
 
 namespace roamlab {
 namespace {
@@ -26,7 +27,7 @@ class BatchLocalTest : public ::testing::Test {
     const fs::path dir = temp_->path();
     const std::string scenario = testing::WriteShortAtvScenario(dir, "4.0");
     ASSERT_FALSE(scenario.empty());
-    montecarlo_ = scenario + " --config " + std::string(ROAMLAB_SOURCE_DIR) +
+    montecarlo_ = scenario + " --config " + roamlab::testing::SourceDir() +
                   "/configs/atv_tracking.yaml --runs 4 --jobs 2 --t0 1 --no-time-budget --quiet";
     const testing::CommandRun r = Roamlab("montecarlo " + montecarlo_ + " --out ref", dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/recording/temp_dir.h"
+#include "tests/support/paths.h"
 
 namespace roamlab::testing {
 
@@ -30,11 +31,11 @@ inline nlohmann::json ReadJson(const std::filesystem::path& path) {
 // scenarios/atv_hills.yaml shortened to `duration_s`, written to DIR/atv_short.yaml; its path, "" when the scenario
 // did not have the expected lines.
 inline std::string WriteShortAtvScenario(const std::filesystem::path& dir, const std::string& duration_s) {
-  std::string scenario = SlurpFile(std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/atv_hills.yaml");
+  std::string scenario = SlurpFile(roamlab::testing::SourceDir() + "/scenarios/atv_hills.yaml");
   const std::string from = "duration_s: 30.0", model = "../models/atv.xml";
   if (scenario.find(from) == std::string::npos || scenario.find(model) == std::string::npos) return "";
   scenario.replace(scenario.find(from), from.size(), "duration_s: " + duration_s);
-  scenario.replace(scenario.find(model), model.size(), std::string(ROAMLAB_SOURCE_DIR) + "/models/atv.xml");
+  scenario.replace(scenario.find(model), model.size(), roamlab::testing::SourceDir() + "/models/atv.xml");
   const std::string path = (dir / "atv_short.yaml").string();
   std::ofstream(path) << scenario;
   return path;

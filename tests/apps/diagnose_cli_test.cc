@@ -18,11 +18,12 @@
 #include "eval/plots.h"
 #include "tests/recording/temp_dir.h"
 #include "tests/support/html_check.h"
+#include "tests/support/paths.h"
 
 namespace roamlab {
 namespace {
 
-std::string Source(const std::string& relative) { return std::string(ROAMLAB_SOURCE_DIR) + "/" + relative; }
+std::string Source(const std::string& relative) { return roamlab::testing::SourceDir() + "/" + relative; }
 
 using testing::CommandRun;
 

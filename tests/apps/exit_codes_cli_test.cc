@@ -9,6 +9,7 @@
 
 #include "recording/recording.h"
 #include "tests/recording/temp_dir.h"
+#include "tests/support/paths.h"
 #include "tests/support/synthetic.h"
 
 namespace roamlab {
@@ -43,7 +44,7 @@ class ExitCodesTest : public ::testing::Test {
     options.duration_s = 3.0;
     ASSERT_TRUE(recording::WriteRecording(testing::MakeAtvRecording(options).recording, rec_).ok());
     testing::WriteFile(file_, "a regular file\n");
-    config_ = testing::ReadFile(std::string(ROAMLAB_SOURCE_DIR) + "/configs/atv_calibration.yaml");
+    config_ = testing::ReadFile(roamlab::testing::SourceDir() + "/configs/atv_calibration.yaml");
   }
   // Writes `text` as dir/name and returns the path.
   std::string Write(const std::string& name, const std::string& text) {
@@ -108,7 +109,7 @@ TEST_F(ExitCodesTest, EveryCommandRefusesABadInputWithCodeTwo) {
   const std::string missing = (dir_ / "missing.yaml").string();
   const std::string dup = Write("dup.yaml", "name: a\nname: b\n");
   const std::string config = Write("est.yaml", config_);
-  const std::string scenario = std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/indoor_diffdrive_slip.yaml";
+  const std::string scenario = roamlab::testing::SourceDir() + "/scenarios/indoor_diffdrive_slip.yaml";
   ExpectBadInput("simulate " + dup + " --out " + out_, "dup.yaml");
   ExpectBadInput("simulate " + scenario + " --out " + file_ + "/sub", "regular_file");
   ExpectBadInput("calibrate " + rec_ + " --config " + missing + " --out " + out_, "missing.yaml");

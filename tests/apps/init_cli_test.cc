@@ -12,6 +12,7 @@
 
 #include "recording/recording.h"
 #include "tests/recording/temp_dir.h"
+#include "tests/support/paths.h"
 #include "tests/support/real_data.h"
 
 namespace roamlab {
@@ -19,7 +20,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::string Source(const std::string& relative) { return std::string(ROAMLAB_SOURCE_DIR) + "/" + relative; }
+std::string Source(const std::string& relative) { return roamlab::testing::SourceDir() + "/" + relative; }
 
 using testing::CommandRun;
 

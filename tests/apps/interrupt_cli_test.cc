@@ -19,6 +19,7 @@
 #include "recording/recording.h"
 #include "recording/truth.h"
 #include "tests/recording/temp_dir.h"
+#include "tests/support/paths.h"
 #include "tests/support/synthetic.h"
 
 namespace roamlab {
@@ -92,7 +93,7 @@ class InterruptCliTest : public ::testing::Test {
       ASSERT_TRUE(recording::WriteTruth(synthetic.truth, dir_->File(name)).ok());
     }
     testing::WriteFile(dir_->File("cal.yaml"),
-                       testing::ReadFile(std::string(ROAMLAB_SOURCE_DIR) + "/configs/atv_calibration.yaml"));
+                       testing::ReadFile(roamlab::testing::SourceDir() + "/configs/atv_calibration.yaml"));
     std::string suite = "suite: interrupted\ncases:\n";
     for (int i = 0; i < kCases; ++i)
       suite += "  - name: case_" + std::to_string(i) +

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/recording/temp_dir.h"
+#include "tests/support/paths.h"
 
 namespace roamlab {
 namespace {
@@ -27,7 +28,7 @@ TEST(DeformedOdometryTest, TapedWheelLearnedModelsBeatTheNominalModel) {
   testing::TempDir temp;
   const fs::path dir = temp.path();
   for (const std::string role : {"train", "test"}) {
-    const testing::CommandRun r = Roamlab("simulate " + std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/deformed_f1_" +
+    const testing::CommandRun r = Roamlab("simulate " + roamlab::testing::SourceDir() + "/scenarios/deformed_f1_" +
                                               role + ".yaml --out " + (dir / role).string() + " --quiet",
                                           dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;

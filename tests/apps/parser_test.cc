@@ -15,6 +15,7 @@
 #include "apps/parser.h"
 #include "apps/suggest.h"
 #include "tests/recording/temp_dir.h"
+#include "tests/support/paths.h"
 
 namespace roamlab::apps {
 namespace {
@@ -138,7 +139,7 @@ std::string Documentation(const std::map<std::string, std::string>& sections, co
 }
 
 TEST_F(ParserTest, CommandsMdDocumentsEveryOption) {
-  const std::string doc = testing::ReadFile(std::string(ROAMLAB_SOURCE_DIR) + "/docs/commands.md");
+  const std::string doc = testing::ReadFile(roamlab::testing::SourceDir() + "/docs/commands.md");
   ASSERT_FALSE(doc.empty());
   const std::map<std::string, std::string> sections = Sections(doc);
   EXPECT_NE(sections.at("").find("--version"), std::string::npos) << "the introduction lacks roamlab --version";
@@ -199,7 +200,7 @@ TEST(ClosestName, ByEditDistanceOrUniqueStart) {
 TEST_F(ParserTest, TheRecordingIsNamedAlikeInEveryCommand) {
   // Each spelling reaches the command, which then reports the missing recording by its path.
   const std::string missing = (fs::path(dir_.path()) / "norec").string();
-  const std::string config = std::string(ROAMLAB_SOURCE_DIR) + "/configs/atv_calibration.yaml";
+  const std::string config = roamlab::testing::SourceDir() + "/configs/atv_calibration.yaml";
   const std::string out = " --out " + (fs::path(dir_.path()) / "o").string();
   for (const std::string& args :
        {"calibrate " + missing + " --config " + config + out,

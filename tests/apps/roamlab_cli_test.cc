@@ -19,6 +19,7 @@
 
 #include "recording/recording.h"
 #include "recording/trajectory.h"
+#include "tests/support/paths.h"
 #include "tests/support/synthetic.h"
 
 namespace roamlab {
@@ -43,7 +44,7 @@ TEST_F(CliTest, CalibrateAndTrackWriteTheirOutputs) {
   options.duration_s = 5.0;
   ASSERT_TRUE(
       recording::WriteRecording(roamlab::testing::MakeAtvRecording(options).recording, (dir_ / "rec").string()).ok());
-  const std::string config = std::string(ROAMLAB_SOURCE_DIR) + "/configs/atv_calibration.yaml";
+  const std::string config = roamlab::testing::SourceDir() + "/configs/atv_calibration.yaml";
   CommandRun r = Roamlab(
       "calibrate " + (dir_ / "rec").string() + " --config " + config + " --out " + (dir_ / "cal").string() + " --quiet",
       dir_);
@@ -67,7 +68,7 @@ TEST_F(CliTest, CalibrateAndTrackWriteTheirOutputs) {
   EXPECT_EQ(cal["information"]["parameters"].size(), cal["parameters"].size());
   EXPECT_EQ(cal["information"]["matrix"].size(), 21u);
 
-  const std::string track_config = std::string(ROAMLAB_SOURCE_DIR) + "/configs/atv_tracking.yaml";
+  const std::string track_config = roamlab::testing::SourceDir() + "/configs/atv_tracking.yaml";
   r = Roamlab("track " + (dir_ / "rec").string() + " --config " + track_config + " --calibration " +
                   (dir_ / "cal" / "calibration.json").string() + " --out " + (dir_ / "trk").string() + " --quiet",
               dir_);
@@ -99,17 +100,17 @@ TEST_F(CliTest, CalibrateAndTrackWriteTheirOutputs) {
 // montecarlo without --calibration, with tracking.calibrate (configs/atv_tracking.yaml): one offline calibration
 // on the scenario's own noise seed, then the runs track under its prior. A 6 s drive keeps the test short.
 TEST_F(CliTest, MonteCarloCalibratesOnceWhenTheConfigSaysHow) {
-  std::ifstream in(std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/atv_hills.yaml");
+  std::ifstream in(roamlab::testing::SourceDir() + "/scenarios/atv_hills.yaml");
   std::string scenario((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::string from = "duration_s: 30.0";
   ASSERT_NE(scenario.find(from), std::string::npos);
   scenario.replace(scenario.find(from), from.size(), "duration_s: 6.0");
   const std::string model = "../models/atv.xml";  // relative to the scenario's file: made absolute for the copy
   ASSERT_NE(scenario.find(model), std::string::npos);
-  scenario.replace(scenario.find(model), model.size(), std::string(ROAMLAB_SOURCE_DIR) + "/models/atv.xml");
+  scenario.replace(scenario.find(model), model.size(), roamlab::testing::SourceDir() + "/models/atv.xml");
   const std::string short_scenario = (dir_ / "atv_short.yaml").string();
   std::ofstream(short_scenario) << scenario;
-  const std::string config = std::string(ROAMLAB_SOURCE_DIR) + "/configs/atv_tracking.yaml";
+  const std::string config = roamlab::testing::SourceDir() + "/configs/atv_tracking.yaml";
   const CommandRun r = Roamlab("montecarlo " + short_scenario + " --config " + config + " --runs 2 --jobs 1 --t0 1" +
                                    " --out " + (dir_ / "mc").string(),
                                dir_);
@@ -137,7 +138,7 @@ TEST_F(CliTest, MonteCarloCalibratesOnceWhenTheConfigSaysHow) {
 }
 
 TEST_F(CliTest, BadInputGivesOneLineAndNonZeroExit) {
-  const std::string config = std::string(ROAMLAB_SOURCE_DIR) + "/configs/atv_calibration.yaml";
+  const std::string config = roamlab::testing::SourceDir() + "/configs/atv_calibration.yaml";
   for (const std::string& args :
        {"calibrate /nonexistent/rec --config " + config + " --out " + (dir_ / "o").string(),
         "calibrate " + dir_.string() + " --config /nonexistent.yaml --out " + (dir_ / "o").string(),

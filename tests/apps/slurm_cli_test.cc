@@ -14,6 +14,7 @@
 
 #include "tests/apps/batch_fixture.h"
 #include "tests/recording/temp_dir.h"
+#include "tests/support/paths.h"
 
 namespace roamlab {
 namespace {
@@ -40,7 +41,7 @@ class SlurmTest : public ::testing::Test {
                                   << sinfo.err;
     const std::string scenario = testing::WriteShortAtvScenario(dir, "4.0");
     ASSERT_FALSE(scenario.empty());
-    montecarlo_ = scenario + " --config " + std::string(ROAMLAB_SOURCE_DIR) +
+    montecarlo_ = scenario + " --config " + roamlab::testing::SourceDir() +
                   "/configs/atv_tracking.yaml --runs 8 --t0 1 --no-time-budget --quiet";
     const testing::CommandRun r = Roamlab("montecarlo " + montecarlo_ + " --jobs 2 --out local", dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -153,7 +154,7 @@ TEST_F(SlurmTest, ResumeAfterCancelSubmitsOnlyTheMissingRuns) {
 TEST_F(SlurmTest, SweepGivesTheLocalTable) {
   const std::string scenario = testing::WriteShortAtvScenario(dir_, "4.0");
   ASSERT_FALSE(scenario.empty());
-  std::ofstream(dir_ / "sweep.yaml") << "scenario: " << scenario << "\nconfig: " << ROAMLAB_SOURCE_DIR
+  std::ofstream(dir_ / "sweep.yaml") << "scenario: " << scenario << "\nconfig: " << roamlab::testing::SourceDir()
                                      << "/configs/atv_tracking.yaml\nseeds: 2\nt0_s: 1\nno_time_budget: true\n"
                                      << "grid:\n  config.tracking.window: [20, 40]\n";
   const testing::CommandRun local = Roamlab("sweep sweep.yaml --out sweep_local --jobs 2 --quiet", dir_);
@@ -178,7 +179,7 @@ TEST_F(SlurmTest, SweepGivesTheLocalTable) {
 // job; score.json is the local backend's byte for byte. Then a scored case's result is removed and --resume runs only
 // its task, leaves the other cases' files untouched and writes the same score.json again.
 TEST_F(SlurmTest, GapBenchmarkGivesTheLocalScore) {
-  const std::string scenarios = std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/";
+  const std::string scenarios = roamlab::testing::SourceDir() + "/scenarios/";
   // --other-drive 0: no case replays its drive (the batch's mechanics do not depend on it; replays are slow).
   const std::string benchmark = "gap-benchmark --cases 2 --calibration-cases 2 --seed 3 --other-drive 0 --duration " +
                                 std::string(kGapDuration) + " --quiet --atv " + scenarios + "atv_hills_sines.yaml" +

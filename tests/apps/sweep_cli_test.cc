@@ -12,6 +12,7 @@
 
 #include "tests/apps/batch_fixture.h"
 #include "tests/recording/temp_dir.h"
+#include "tests/support/paths.h"
 
 namespace roamlab {
 namespace {
@@ -39,7 +40,7 @@ class SweepTest : public ::testing::Test {
   testing::TempDir temp_;
   fs::path dir_{temp_.path()};
   std::string scenario_ = testing::WriteShortAtvScenario(dir_, "4.0");
-  std::string config_ = std::string(ROAMLAB_SOURCE_DIR) + "/configs/atv_tracking.yaml";
+  std::string config_ = roamlab::testing::SourceDir() + "/configs/atv_tracking.yaml";
 };
 
 TEST_F(SweepTest, GridTableMatchesSingleMonteCarloRuns) {
@@ -67,7 +68,7 @@ TEST_F(SweepTest, GridTableMatchesSingleMonteCarloRuns) {
 
   // Points 1 (sigma 0.2, window 40) and 2 (sigma 0.5, window 20) as single Monte-Carlo runs of files patched here.
   const std::string config = SlurpFile(config_), scenario = SlurpFile(scenario_);
-  const std::string calibrate = std::string(ROAMLAB_SOURCE_DIR) + "/configs/atv_calibration.yaml";
+  const std::string calibrate = roamlab::testing::SourceDir() + "/configs/atv_calibration.yaml";
   for (const auto& [point, sigma, window] : {std::make_tuple(1, "0.2", "40"), std::make_tuple(2, "0.5", "20")}) {
     const std::string name = "point" + std::to_string(point);
     const std::string s = Patched(scenario, "    sigma_m: 0.33", std::string("    sigma_m: ") + sigma, name + ".yaml");

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/recording/temp_dir.h"
+#include "tests/support/paths.h"
 #include "tests/support/real_data.h"
 
 namespace roamlab {
@@ -21,7 +22,7 @@ namespace fs = std::filesystem;
 
 // The tutorial's commands: the indented lines of README.md's "A ten-minute tutorial" section, comments removed.
 std::vector<std::string> TutorialCommands() {
-  const std::string readme = testing::ReadFile(std::string(ROAMLAB_SOURCE_DIR) + "/README.md");
+  const std::string readme = testing::ReadFile(roamlab::testing::SourceDir() + "/README.md");
   const std::size_t begin = readme.find("\n## A ten-minute tutorial\n");
   const std::size_t end = readme.find("\n## ", begin + 1);
   std::istringstream section(readme.substr(begin, end - begin));
@@ -39,7 +40,7 @@ TEST(Tutorial, EveryCommandRuns) {
   ASSERT_GE(commands.size(), 10u) << "README.md's tutorial section was not found";
   testing::TempDir dir;
   for (const char* linked : {"scenarios", "configs", "models"})
-    fs::create_directory_symlink(fs::path(ROAMLAB_SOURCE_DIR) / linked, fs::path(dir.path()) / linked);
+    fs::create_directory_symlink(fs::path(roamlab::testing::SourceDir()) / linked, fs::path(dir.path()) / linked);
   const std::string data = testing::RealData("optiodom/data");
   const bool have_data = fs::is_directory(data);
   const std::string bin = fs::path(ROAMLAB_BINARY).parent_path().string();

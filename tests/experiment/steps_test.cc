@@ -13,6 +13,7 @@
 #include "experiment/montecarlo.h"
 #include "recording/recording.h"
 #include "tests/recording/temp_dir.h"
+#include "tests/support/paths.h"
 #include "tests/support/synthetic.h"
 
 namespace roamlab::experiment {
@@ -21,7 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-std::string Config(const std::string& name) { return std::string(ROAMLAB_SOURCE_DIR) + "/configs/" + name; }
+std::string Config(const std::string& name) { return roamlab::testing::SourceDir() + "/configs/" + name; }
 
 // Calibrating writes calibration.json (read back by the estimator's reader) and trajectory.tum; tracking with it
 // writes its three files.

@@ -14,6 +14,7 @@
 #include "gap/nominal_config.h"
 #include "sim/simulator.h"
 #include "tests/gap/gap_testing.h"
+#include "tests/support/paths.h"
 
 namespace roamlab::gap {
 namespace {
@@ -21,7 +22,7 @@ namespace {
 constexpr std::uint64_t kBaselineSeed = 900001;
 
 sim::Scenario Atv() {
-  auto s = sim::LoadScenario(std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/atv_hills_sines.yaml");
+  auto s = sim::LoadScenario(roamlab::testing::SourceDir() + "/scenarios/atv_hills_sines.yaml");
   EXPECT_TRUE(s.ok()) << s.status().message();
   return s.value();
 }

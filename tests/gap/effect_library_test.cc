@@ -10,12 +10,13 @@
 
 #include "gap/nominal_config.h"
 #include "sim/scenario.h"
+#include "tests/support/paths.h"
 
 namespace roamlab::gap::internal {
 namespace {
 
 estimator::EstimatorConfig Nominal(const std::string& scenario_path) {
-  auto scenario = sim::LoadScenario(std::string(ROAMLAB_SOURCE_DIR) + "/" + scenario_path);
+  auto scenario = sim::LoadScenario(roamlab::testing::SourceDir() + "/" + scenario_path);
   EXPECT_TRUE(scenario.ok()) << scenario.status().message();
   auto config = NominalConfig(scenario.value());
   EXPECT_TRUE(config.ok()) << config.status().message();

@@ -14,6 +14,7 @@
 #include "gap/learn_baseline.h"
 #include "gap/nominal_config.h"
 #include "sim/simulator.h"
+#include "tests/support/paths.h"
 
 namespace roamlab::gap::testing {
 
@@ -34,11 +35,11 @@ struct LearnedNominal {
   Baseline baseline;
 };
 
-// Loads ROAMLAB_SOURCE_DIR/`scenario_path` and learns its baseline; nullptr (with a test failure) when that fails.
+// Loads SourceDir()/`scenario_path` and learns its baseline; nullptr (with a test failure) when that fails.
 // `adjust`, when given, changes the nominal configuration (what the user believes) before the baseline is learned.
 inline std::unique_ptr<LearnedNominal> LearnNominal(
     const std::string& scenario_path, const std::function<void(estimator::EstimatorConfig*)>& adjust = {}) {
-  auto loaded = sim::LoadScenario(std::string(ROAMLAB_SOURCE_DIR) + "/" + scenario_path);
+  auto loaded = sim::LoadScenario(roamlab::testing::SourceDir() + "/" + scenario_path);
   EXPECT_TRUE(loaded.ok()) << loaded.status().message();
   if (!loaded.ok()) return nullptr;
   auto out = std::make_unique<LearnedNominal>();

@@ -18,6 +18,7 @@
 #include "estimator/calibration.h"
 #include "gap/nominal_config.h"
 #include "sim/simulator.h"
+#include "tests/support/paths.h"
 
 namespace roamlab::gap {
 namespace {
@@ -105,7 +106,7 @@ estimator::EstimatorConfig ConfigWithScaleAndOffset(const sim::Scenario& scenari
 }
 
 TEST(HonestUncertaintySlowTest, HacIntervalsCoverHiddenScaleAndClockOffsetUnderColouredNoise) {
-  auto loaded = sim::LoadScenario(std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/indoor_diffdrive_gap.yaml");
+  auto loaded = sim::LoadScenario(roamlab::testing::SourceDir() + "/scenarios/indoor_diffdrive_gap.yaml");
   ASSERT_TRUE(loaded.ok()) << loaded.status().message();
   sim::Scenario scenario = loaded.value();
   scenario.duration_s = kDurationS;

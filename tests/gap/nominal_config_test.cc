@@ -5,11 +5,12 @@
 
 #include "gap/nominal_config.h"
 #include "sim/scenario.h"
+#include "tests/support/paths.h"
 
 namespace roamlab::gap {
 namespace {
 
-std::string Source(const std::string& relative) { return std::string(ROAMLAB_SOURCE_DIR) + "/" + relative; }
+std::string Source(const std::string& relative) { return roamlab::testing::SourceDir() + "/" + relative; }
 
 // The nominal configuration of the scenario at `relative`; none (with a test failure) when either fails.
 std::optional<estimator::EstimatorConfig> NominalOf(const std::string& relative) {

@@ -19,6 +19,7 @@
 #include "importers/optiodom.h"
 #include "importers/rosbag.h"
 #include "tests/support/husky_bag.h"
+#include "tests/support/paths.h"
 #include "tests/support/real_data.h"
 
 namespace roamlab::gap {
@@ -102,7 +103,7 @@ TEST(RealDataTest, OptiOdomDifferentialDriveTrackAndWheelRatio) {
   auto rec = importers::ImportOptiOdom(kSet + "_run-01.csv", kSet + "_metadata.csv");
   ASSERT_TRUE(rec.ok()) << rec.status().message();
   auto config =
-      estimator::LoadEstimatorConfig(std::string(ROAMLAB_SOURCE_DIR) + "/configs/real/optiodom_diff_nominal.yaml");
+      estimator::LoadEstimatorConfig(roamlab::testing::SourceDir() + "/configs/real/optiodom_diff_nominal.yaml");
   ASSERT_TRUE(config.ok()) << config.status().message();
   auto d = DiagnoseDefault(config.value(), rec.value());
   ASSERT_TRUE(d.ok()) << d.status().message();
@@ -213,7 +214,7 @@ TEST(RealDataTest, HuskySkidSteerYawMismatch) {
   if (!std::filesystem::exists(bag)) GTEST_SKIP() << "real data absent: " << bag;
   auto rec = importers::ImportRosbag(bag, ::roamlab::testing::HuskyImportOptions());
   ASSERT_TRUE(rec.ok()) << rec.status().message();
-  auto config = estimator::LoadEstimatorConfig(std::string(ROAMLAB_SOURCE_DIR) + "/configs/real/husky_nominal.yaml");
+  auto config = estimator::LoadEstimatorConfig(roamlab::testing::SourceDir() + "/configs/real/husky_nominal.yaml");
   ASSERT_TRUE(config.ok()) << config.status().message();
   auto d = DiagnoseDefault(config.value(), rec.value());
   ASSERT_TRUE(d.ok()) << d.status().message();

@@ -9,6 +9,7 @@
 #include "gap/resimulate.h"
 #include "sim/simulator.h"
 #include "tests/gap/gap_testing.h"
+#include "tests/support/paths.h"
 
 namespace roamlab::gap {
 namespace {
@@ -16,7 +17,7 @@ namespace {
 constexpr double kDurationS = 8.0;
 
 sim::Scenario ShortAtv() {
-  auto s = sim::LoadScenario(std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/atv_hills_sines.yaml");
+  auto s = sim::LoadScenario(roamlab::testing::SourceDir() + "/scenarios/atv_hills_sines.yaml");
   EXPECT_TRUE(s.ok()) << s.status().message();
   sim::Scenario scenario = s.value();
   scenario.duration_s = kDurationS;

@@ -11,6 +11,7 @@
 #include "gap/resimulate.h"
 #include "gap/twin.h"
 #include "tests/gap/gap_testing.h"
+#include "tests/support/paths.h"
 
 namespace roamlab::gap {
 namespace {
@@ -18,7 +19,7 @@ namespace {
 constexpr double kDurationS = 10.0;
 
 sim::Scenario Load(const std::string& path) {
-  auto s = sim::LoadScenario(std::string(ROAMLAB_SOURCE_DIR) + "/" + path);
+  auto s = sim::LoadScenario(roamlab::testing::SourceDir() + "/" + path);
   EXPECT_TRUE(s.ok()) << s.status().message();
   sim::Scenario scenario = s.value();
   scenario.effects.clear();

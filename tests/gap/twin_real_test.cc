@@ -14,6 +14,7 @@
 #include "recording/recording.h"
 #include "sim/scenario.h"
 #include "tests/recording/temp_dir.h"
+#include "tests/support/paths.h"
 #include "tests/support/real_data.h"
 
 namespace roamlab::gap {
@@ -43,7 +44,7 @@ TEST(TwinRealTest, SquareRunPatchLowersTheCircularRunsDrift) {
   auto held = ImportRun(circular, "01", dir);
   ASSERT_TRUE(train.ok()) << train.status().message();
   ASSERT_TRUE(held.ok()) << held.status().message();
-  auto nominal = sim::LoadScenario(std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/real/optiodom_diff.yaml");
+  auto nominal = sim::LoadScenario(roamlab::testing::SourceDir() + "/scenarios/real/optiodom_diff.yaml");
   ASSERT_TRUE(nominal.ok()) << nominal.status().message();
 
   TwinDiagnoseOptions options;

@@ -12,12 +12,13 @@
 #include "gap/twin.h"
 #include "sim/simulator.h"
 #include "tests/gap/gap_testing.h"
+#include "tests/support/paths.h"
 
 namespace roamlab::gap {
 namespace {
 
 sim::Scenario Nominal() {
-  auto s = sim::LoadScenario(std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/indoor_diffdrive_gap.yaml");
+  auto s = sim::LoadScenario(roamlab::testing::SourceDir() + "/scenarios/indoor_diffdrive_gap.yaml");
   EXPECT_TRUE(s.ok()) << s.status().message();
   sim::Scenario scenario = s.value();
   scenario.duration_s = 30.0;
@@ -106,7 +107,7 @@ TEST(TwinTest, AHiddenTrackWidthErrorIsNamedAndTheHeldOutDriftShrinks) {
 // to small changes (a 0.25 % larger turn command changes the heading after 7 s by up to 2.5 %, either sign), so the
 // twin runs scatter about their trend by more than the white covariance assumes; the printout shows both.
 TEST(TwinTest, AHiddenSkidSteerEffectiveTrackIsNamed) {
-  auto loaded = sim::LoadScenario(std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/real/husky.yaml");
+  auto loaded = sim::LoadScenario(roamlab::testing::SourceDir() + "/scenarios/real/husky.yaml");
   ASSERT_TRUE(loaded.ok()) << loaded.status().message();
   sim::Scenario nominal = loaded.value();
   nominal.duration_s = 24.0;

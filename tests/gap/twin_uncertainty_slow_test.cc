@@ -18,6 +18,7 @@
 #include "gap/twin.h"
 #include "sim/simulator.h"
 #include "tests/gap/gap_testing.h"
+#include "tests/support/paths.h"
 
 namespace roamlab::gap {
 namespace {
@@ -28,7 +29,7 @@ constexpr double kImuCorrelationS = 0.05;  // 5 IMU samples
 constexpr double kGpsCorrelationS = 0.2;   // 2 GPS fixes
 
 sim::Scenario Nominal() {
-  auto s = sim::LoadScenario(std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/indoor_diffdrive_gap.yaml");
+  auto s = sim::LoadScenario(roamlab::testing::SourceDir() + "/scenarios/indoor_diffdrive_gap.yaml");
   EXPECT_TRUE(s.ok()) << s.status().message();
   sim::Scenario scenario = s.value();
   scenario.duration_s = kDurationS;

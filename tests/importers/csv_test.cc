@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/support/paths.h"
 #include "tests/support/real_data.h"
 
 namespace roamlab::importers {
@@ -61,7 +62,7 @@ const Stream& Get(const Recording& rec, const std::string& name) {
 TEST_F(CsvImportTest, XioImuMagnetometerLog) {
   const std::string csv = ::roamlab::testing::RealData("xio_imu_mag/sensor_data.csv");
   if (!fs::exists(csv)) GTEST_SKIP() << "the x-io log is absent: " << csv;
-  const std::string mapping = std::string(ROAMLAB_SOURCE_DIR) + "/configs/import/xio_imu_mag.yaml";
+  const std::string mapping = roamlab::testing::SourceDir() + "/configs/import/xio_imu_mag.yaml";
   CsvImportReport report;
   const Result<Recording> result = ImportCsv({csv}, mapping, &report);
   ASSERT_TRUE(result.ok()) << result.status().message();

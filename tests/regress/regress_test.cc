@@ -19,6 +19,7 @@
 #include "recording/truth.h"
 #include "regress/modes.h"
 #include "tests/recording/temp_dir.h"
+#include "tests/support/paths.h"
 #include "tests/support/synthetic.h"
 
 namespace roamlab::regress {
@@ -37,7 +38,7 @@ int RunRegress(const RunOptions& options) {
   return result.Passed() ? 0 : 1;
 }
 
-std::string Source(const std::string& name) { return std::string(ROAMLAB_SOURCE_DIR) + "/configs/" + name; }
+std::string Source(const std::string& name) { return roamlab::testing::SourceDir() + "/configs/" + name; }
 
 // The ATV tracking configuration with the synthetic drive's calibration (seed Table I, tests/support/synthetic.h)
 // and a noise value replaced: tracking with known parameters (no calibration prior), whose consistency then depends

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/recording/temp_dir.h"
+#include "tests/support/paths.h"
 
 namespace roamlab::regress {
 namespace {
@@ -85,9 +86,9 @@ class SuiteTest : public ::testing::Test {
     return path;
   }
   static std::string Scenario(const std::string& name) {
-    return std::string(ROAMLAB_SOURCE_DIR) + "/scenarios/" + name;
+    return roamlab::testing::SourceDir() + "/scenarios/" + name;
   }
-  static std::string Config(const std::string& name) { return std::string(ROAMLAB_SOURCE_DIR) + "/configs/" + name; }
+  static std::string Config(const std::string& name) { return roamlab::testing::SourceDir() + "/configs/" + name; }
   std::string CalibrateCase(const std::string& checks, const std::string& extra = "") {
     return "  - name: cal\n    mode: calibrate\n    scenario: " + Scenario("atv_hills.yaml") +
            "\n    seed: 3\n    config: " + Config("atv_calibration.yaml") + "\n" + extra + "    checks:\n" + checks;

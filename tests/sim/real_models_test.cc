@@ -29,6 +29,7 @@
 #include "sim/simulator.h"
 #include "sim/wheeled_robot.h"
 #include "tests/support/husky_bag.h"
+#include "tests/support/paths.h"
 #include "tests/support/real_data.h"
 
 namespace roamlab::sim {
@@ -36,7 +37,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::string Source(const std::string& relative) { return std::string(ROAMLAB_SOURCE_DIR) + "/" + relative; }
+std::string Source(const std::string& relative) { return roamlab::testing::SourceDir() + "/" + relative; }
 
 // A stream as the layout comparison sees it.
 struct StreamLayout {

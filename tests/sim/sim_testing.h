@@ -9,10 +9,11 @@
 #include <gtest/gtest.h>
 
 #include "sim/scenario.h"
+#include "tests/support/paths.h"
 
 namespace roamlab::sim::testing {
 
-inline std::string SourcePath(const std::string& relative) { return std::string(ROAMLAB_SOURCE_DIR) + "/" + relative; }
+inline std::string SourcePath(const std::string& relative) { return roamlab::testing::SourceDir() + "/" + relative; }
 
 inline std::string ReadText(const std::string& path) {
   std::ifstream file(path, std::ios::binary);

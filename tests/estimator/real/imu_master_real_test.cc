@@ -24,13 +24,14 @@
 #include "importers/csv.h"
 #include "importers/rosbag.h"
 #include "tests/support/husky_bag.h"
+#include "tests/support/paths.h"
 #include "tests/support/real_data.h"
 
 namespace roamlab::estimator {
 namespace {
 
 const std::string kData = ::roamlab::testing::RealDataDir();
-const std::string kConfigs = std::string(ROAMLAB_SOURCE_DIR) + "/configs/real/";
+const std::string kConfigs = roamlab::testing::SourceDir() + "/configs/real/";
 
 std::map<std::string, Eigen::VectorXd> Values(const CalibrationResult& r) {
   std::map<std::string, Eigen::VectorXd> out;
@@ -267,7 +268,7 @@ TEST(ImuMasterRealTest, XioMagnetometerCalibrationAgainstTheEllipsoidFit) {
   // the magnetometer's repeated values between its own updates collapsed.
   importers::CsvImportReport report;
   auto imported =
-      importers::ImportCsv({csv}, std::string(ROAMLAB_SOURCE_DIR) + "/configs/import/xio_imu_mag.yaml", &report);
+      importers::ImportCsv({csv}, roamlab::testing::SourceDir() + "/configs/import/xio_imu_mag.yaml", &report);
   ASSERT_TRUE(imported.ok()) << imported.status().message();
   const recording::Recording& rec = imported.value();
   const recording::Stream* imu = rec.Find("imu");
