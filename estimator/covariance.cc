@@ -13,6 +13,7 @@
 
 #include "estimator/internal/linearization.h"
 #include "estimator/internal/normal_equations.h"
+#include "estimator/internal/sparse_solve.h"
 #include "estimator/solver.h"
 
 namespace roamlab::estimator {
@@ -56,21 +57,6 @@ Status LinearizeWithVariablesLast(const Graph& graph, const std::vector<Variable
   return Status::Ok();
 }
 
-// Factors Hxx with CHOLMOD (regularized very slightly when a gauge freedom leaves it singular) and returns
-// Hxx^-1 Hxp, or an error.
-Result<Eigen::MatrixXd> SolveOthers(Eigen::SparseMatrix<double> Hxx, const Eigen::MatrixXd& Hxp) {
-  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
-  llt.cholmod().print = 0;
-  llt.compute(Hxx);
-  if (llt.info() != Eigen::Success) {
-    for (int i = 0; i < Hxx.rows(); ++i) Hxx.coeffRef(i, i) += 1e-10 * std::max(1.0, Hxx.coeff(i, i));
-    llt.compute(Hxx);
-    if (llt.info() != Eigen::Success)
-      return Status::Error("the Hessian of the variables being marginalized is singular");
-  }
-  return Eigen::MatrixXd(llt.solve(Hxp));
-}
-
 // AnalyzeAutocorrelation: the truncation lag in units of the last correlated lag, and the lags sampled per window.
 constexpr int kLagsPerCorrelatedWindow = 3;
 constexpr int kSampledLags = 16;
@@ -100,6 +86,21 @@ Eigen::MatrixXd Influences(const std::vector<Score>& rows) {
 
 }  // namespace
 
+namespace internal {
+Result<Eigen::MatrixXd> SolveSparseSpd(Eigen::SparseMatrix<double> H, const Eigen::MatrixXd& rhs) {
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+  llt.cholmod().print = 0;
+  llt.compute(H);
+  if (llt.info() != Eigen::Success) {
+    for (int i = 0; i < H.rows(); ++i) H.coeffRef(i, i) += 1e-10 * std::max(1.0, H.coeff(i, i));
+    llt.compute(H);
+    if (llt.info() != Eigen::Success)
+      return Status::Error("the Hessian of the variables being marginalized is singular");
+  }
+  return Eigen::MatrixXd(llt.solve(rhs));
+}
+}  // namespace internal
+
 Result<MarginalInformation> ComputeMarginalInformation(const Graph& graph, const std::vector<VariableId>& variables,
                                                        SolverWorkspace* workspace) {
   MarginalInformation result;
@@ -126,7 +127,7 @@ Result<MarginalInformation> ComputeMarginalInformation(const Graph& graph, const
   }
 
   const Eigen::MatrixXd Hxp = Eigen::MatrixXd(H.topRightCorner(nx, np));
-  auto Y = SolveOthers(H.topLeftCorner(nx, nx), Hxp);
+  auto Y = internal::SolveSparseSpd(H.topLeftCorner(nx, nx), Hxp);
   if (!Y.ok()) return Y.status();
   result.information = Hpp - Hxp.transpose() * Y.value();
   result.information = 0.5 * (result.information + result.information.transpose()).eval();
@@ -216,7 +217,7 @@ Result<HacCovariance> ComputeHacCovariance(const Graph& graph, const std::vector
   Eigen::MatrixXd Y;
   if (nx > 0) {
     const Eigen::SparseMatrix<double> H = system.hessian_upper().selfadjointView<Eigen::Upper>();
-    auto solved = SolveOthers(H.topLeftCorner(nx, nx), Eigen::MatrixXd(H.topRightCorner(nx, np)));
+    auto solved = internal::SolveSparseSpd(H.topLeftCorner(nx, nx), Eigen::MatrixXd(H.topRightCorner(nx, np)));
     if (!solved.ok()) return solved.status();
     Y = std::move(solved).value();
   }
