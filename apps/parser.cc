@@ -14,6 +14,7 @@
 #include "apps/frontend.h"
 #include "apps/gap_benchmark.h"
 #include "apps/import.h"
+#include "apps/information.h"
 #include "apps/init.h"
 #include "apps/montecarlo.h"
 #include "apps/odometry.h"
@@ -191,6 +192,23 @@ void AddInit(CLI::App* app, Commands* commands) {
                     "ackermann");
     ini->add_flag("--quiet", args->quiet, "No summary");
     return ini;
+  });
+}
+
+void AddInformation(CLI::App* app, Commands* commands) {
+  Add(commands, RunInformation, [app](auto* args) {
+    CLI::App* inf = app->add_subcommand(
+        "information",
+        "The Cramer-Rao bound of every free calibration parameter for a scenario's drive (noise-free, at the truth, "
+        "poses marginalized), its weak and unobservable directions, and where its information comes from: shares by "
+        "stream and by time window.");
+    inf->add_option("scenario", args->scenario, "Scenario file (SCENARIO.yaml), simulated without sensor noise")
+        ->required();
+    inf->add_option("--config", args->config, "Estimator configuration (EST.yaml): free parameters, noise")->required();
+    inf->add_option("--out", args->out, "Output directory: information.json, information.png")->required();
+    inf->add_option("--window", args->window_s, "Length of the time windows of the split [s] (default 1)");
+    inf->add_flag("--quiet", args->quiet, "No progress and no table");
+    return inf;
   });
 }
 
@@ -452,7 +470,7 @@ Commands AddCommands(CLI::App* app) {
   app->require_subcommand(1);
   Commands commands;
   for (const auto add :
-       {AddSimulate, AddReplay, AddCalibrate, AddTrack, AddEvaluate, AddMonteCarlo, AddInit, AddDiagnose,
+       {AddSimulate, AddReplay, AddCalibrate, AddTrack, AddEvaluate, AddMonteCarlo, AddInit, AddInformation, AddDiagnose,
         AddGapBenchmark, AddRegress, AddOdometry, AddImport, AddFrontEnd, AddSweep, AddBatch})
     add(app, &commands);
   return commands;

@@ -319,6 +319,62 @@ bool GnuplotAvailable() {
   return false;
 }
 
+Result<PlotFiles> WriteInformationPlot(const std::string& directory, const std::string& title,
+                                       const InformationPlotData& data) {
+  ROAMLAB_CHECK(data.shares.size() == data.rows.size(), "one share row per label");
+  ROAMLAB_CHECK(data.speed_mps.size() == data.t_s.size() && data.yaw_rate_radps.size() == data.t_s.size() &&
+                data.pitch_deg.size() == data.t_s.size(),
+                "one drive value per sample");
+  PlotFiles files{"information.gp", "information.png", {"information_shares.dat", "information_drive.dat"}};
+  // Shares: one pixel per (window, row), the row index counted down from the top.
+  std::ostringstream shares;
+  shares << "# share of each component's information per window [%]\n# window_middle_s row share_percent\n";
+  std::size_t windows = 0;
+  for (std::size_t r = 0; r < data.rows.size(); ++r) {
+    windows = std::max(windows, data.shares[r].size());
+    for (std::size_t k = 0; k < data.shares[r].size(); ++k)
+      shares << Num((static_cast<double>(k) + 0.5) * data.window_s) << ' ' << r << ' '
+             << Num(100.0 * data.shares[r][k]) << '\n';
+    shares << '\n';
+  }
+  if (Status st = WriteText(directory, files.data[0], shares.str()); !st.ok()) return st;
+  std::ostringstream drive;
+  drive << "# the drive (true poses)\n# t_s speed_mps yaw_rate_radps pitch_deg\n";
+  for (std::size_t i = 0; i < data.t_s.size(); ++i)
+    drive << Num(data.t_s[i]) << ' ' << Num(data.speed_mps[i]) << ' ' << Num(data.yaw_rate_radps[i]) << ' '
+          << Num(data.pitch_deg[i]) << '\n';
+  if (Status st = WriteText(directory, files.data[1], drive.str()); !st.ok()) return st;
+
+  // Script: the heat map over 55 % of the page, the drive's three panels below it, x axes aligned by fixed margins.
+  const double t_end = static_cast<double>(windows) * data.window_s;
+  const int height = 700 + 18 * static_cast<int>(data.rows.size());
+  std::ostringstream gp;
+  gp << "# Redraw: cd into this directory, then: gnuplot " << files.script << "\n"
+     << Terminal(1200, height) << "set output " << Quote(files.image) << "\n"
+     << "set multiplot title " << Quote(title) << "\n"
+     << "set lmargin at screen 0.22\nset rmargin at screen 0.88\nset xrange [0:" << Num(t_end) << "]\n"
+     << "set size 1,0.52\nset origin 0,0.45\nset tmargin at screen 0.95\nset bmargin at screen 0.47\n"
+     << "set yrange [" << Num(static_cast<double>(data.rows.size()) - 0.5) << ":-0.5]\nset ytics (";
+  for (std::size_t r = 0; r < data.rows.size(); ++r) gp << (r ? ", " : "") << Quote(data.rows[r]) << ' ' << r;
+  gp << ") font 'sans,9'\nset format x ''\nset cbrange [0:*]\nset cblabel 'share of the information [%]'\n"
+     << "set palette defined (0 'white', 1 '#9ecae1', 2 '#3182bd', 3 '#08306b')\n"
+     << "plot " << Quote(files.data[0]) << " using 1:2:3 with image notitle\n"
+     << "unset colorbox\nset ytics auto font 'sans,10'\nset autoscale y\nset grid\n";
+  const char* kLabels[] = {"speed [m/s]", "yaw rate [deg/s]", "pitch [deg]"};
+  const char* kColumns[] = {"2", "($3*180/pi)", "4"};
+  for (int panel = 0; panel < 3; ++panel) {
+    const double top = 0.44 - 0.14 * panel;
+    gp << "set tmargin at screen " << Num(top) << "\nset bmargin at screen " << Num(top - 0.12) << "\n"
+       << "set ylabel '" << kLabels[panel] << "'\n";
+    if (panel == 2) gp << "set format x '%g'\nset xlabel 'time since start [s]'\n";
+    gp << "plot " << Quote(files.data[1]) << " using 1:" << kColumns[panel]
+       << " with lines lw 1.5 lc rgb '#1f77b4' notitle\n";
+  }
+  gp << "unset multiplot\n";
+  if (Status st = WriteText(directory, files.script, gp.str()); !st.ok()) return st;
+  return files;
+}
+
 Status RunGnuplot(const std::string& directory, const std::string& script) {
   if (!GnuplotAvailable()) return Status::Error("gnuplot not found on PATH");
   const std::string stem = fs::path(script).stem().string();

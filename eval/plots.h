@@ -92,6 +92,21 @@ Result<PlotFiles> WriteVelocityPlot(const std::string& directory, const std::str
 // True when an executable named gnuplot is on PATH.
 bool GnuplotAvailable();
 
+// What the information figure draws (`roamlab information`, docs/methods-information.md): per row (a parameter
+// component) its share of the information in each time window, and the drive along it.
+struct InformationPlotData {
+  double window_s = 1.0;
+  std::vector<std::string> rows;               // component labels, drawn top to bottom
+  std::vector<std::vector<double>> shares;     // [row][window], NaN where undefined (unobservable)
+  std::vector<double> t_s;                     // drive samples, seconds since the first window's start
+  std::vector<double> speed_mps, yaw_rate_radps, pitch_deg;  // at t_s
+};
+// A heat map of the shares (rows x windows, one colour scale) above three panels: speed [m/s], yaw rate [deg/s] and
+// pitch [deg] on the same time axis. Files information.gp, information_shares.dat, information_drive.dat,
+// information.png. Sizes CHECKed.
+Result<PlotFiles> WriteInformationPlot(const std::string& directory, const std::string& title,
+                                       const InformationPlotData& data);
+
 // Runs `gnuplot SCRIPT` with `directory` as working directory. Its messages go to SCRIPT-without-.gp.log in the
 // directory (removed when empty). Errors: gnuplot missing, not started, or exiting non-zero (with its first message).
 Status RunGnuplot(const std::string& directory, const std::string& script);
