@@ -15,6 +15,8 @@ namespace {
 
 // How many of the windows with the largest shares the table lists.
 constexpr int kTopWindows = 3;
+// The table's "measured by" lists the streams whose measured share is at least this in size.
+constexpr double kMeasuredShown = 0.05;
 
 std::string Format(const char* format, double value) {
   if (!std::isfinite(value)) return "-";
@@ -28,6 +30,14 @@ std::string TruthText(const estimator::InformationParameter& p, int k) {
   if (!p.has_truth) return "(none)";
   if (p.manifold.kind() != estimator::ManifoldKind::kEuclidean) return "-";
   return Format("%.4g", p.truth[k]);
+}
+
+// "gps 100, odometer 12" for the streams whose measured share is at least kMeasuredShown in size.
+std::string MeasuredBy(const estimator::InformationComponent& c) {
+  std::string out;
+  for (const auto& [stream, share] : c.measured_by)
+    if (std::abs(share) >= kMeasuredShown) out += (out.empty() ? "" : ", ") + stream + " " + Format("%.0f", 100 * share);
+  return out.empty() ? "-" : out;
 }
 
 // "12-13 s 9%, 5-6 s 7%, ..." for the windows with the largest shares.
@@ -47,12 +57,13 @@ std::string TopWindows(const estimator::InformationComponent& c, double window_s
 
 void PrintTable(const experiment::InformationRun& run) {
   const estimator::InformationResult& r = run.result;
-  std::printf("Cramer-Rao bound at the truth (noise-free drive, %d poses, %d factors); share of each component's "
-              "information by stream [%%] and its largest windows (%g s)\n\n",
+  std::printf("Cramer-Rao bound at the truth (noise-free drive, %d poses, %d factors); per stream the share of each "
+              "component's CRB variance its noise causes [%%], the streams that measure it (measured share [%%]) and the "
+              "windows (%g s) whose factors carry the largest variance shares\n\n",
               r.poses, r.factors, r.window_s);
   std::printf("| component | truth | CRB std | observability |");
   for (const std::string& s : r.streams) std::printf(" %s |", s.c_str());
-  std::printf(" largest windows |\n|---|---|---|---|");
+  std::printf(" measured by | largest windows |\n|---|---|---|---|---|");
   for (std::size_t s = 0; s < r.streams.size(); ++s) std::printf("---|");
   std::printf("---|\n");
   for (const estimator::InformationParameter& p : r.parameters) {
@@ -64,7 +75,7 @@ void PrintTable(const experiment::InformationRun& run) {
         const auto it = c.by_stream.find(s);
         std::printf(" %s |", Format("%.1f", it == c.by_stream.end() ? 0.0 : 100.0 * it->second).c_str());
       }
-      std::printf(" %s |\n", TopWindows(c, r.window_s).c_str());
+      std::printf(" %s | %s |\n", MeasuredBy(c).c_str(), TopWindows(c, r.window_s).c_str());
     }
   }
   std::printf("\n");

@@ -182,12 +182,14 @@ Result<FisherBlocks> AccumulateFisher(const Graph& graph, const Layout& layout) 
   return out;
 }
 
-// The shares of the header comment: (J_p,f w_i)^T (R_f w_i) summed per stream and window, divided by (I^+)_ii.
+// The shares of the header comment, divided by (I^+)_ii: (J_p,f w_i)^T (R_f w_i) summed per stream (measured_by),
+// |R_f w_i|^2 summed per stream and window.
 Status SplitInformation(const Graph& graph, const Layout& layout, const Eigen::MatrixXd& Y,
                         InformationResult* result) {
   const int np = layout.np;
   const Eigen::MatrixXd& W = result->covariance;
-  std::map<std::string, std::vector<Eigen::VectorXd>> sums;  // stream -> window -> per component
+  std::map<std::string, std::vector<Eigen::VectorXd>> variance;  // stream -> window -> per component
+  std::map<std::string, std::vector<Eigen::VectorXd>> measured;   // stream -> window -> per component
   internal::WhitenedFactor wf;
   FactorRows rows;
   for (const auto& [id, entry] : graph.factors()) {
@@ -196,25 +198,41 @@ Status SplitInformation(const Graph& graph, const Layout& layout, const Eigen::M
       return Status::Error("a factor of '" + entry.stream + "' cannot be evaluated at the truth");
     Eigen::MatrixXd R = rows.Jp;
     for (const auto& [a, Ja] : rows.x_blocks) R.noalias() -= Ja * Y.middleRows(a, Ja.cols());
-    const Eigen::VectorXd contribution = ((rows.Jp * W).cwiseProduct(R * W)).colwise().sum().transpose();
+    const Eigen::MatrixXd RW = R * W;
     const double since = SecondsBetween(result->t0, entry.stamp);
     const int window = std::clamp(static_cast<int>(std::floor(since / result->window_s)), 0, result->windows - 1);
-    std::vector<Eigen::VectorXd>& per_window = sums[entry.stream];
+    std::vector<Eigen::VectorXd>& per_window = variance[entry.stream];
     if (per_window.empty()) per_window.assign(result->windows, Eigen::VectorXd::Zero(np));
-    per_window[window] += contribution;
+    per_window[window] += RW.colwise().squaredNorm().transpose();
+    std::vector<Eigen::VectorXd>& measured_per_window = measured[entry.stream];
+    if (measured_per_window.empty()) measured_per_window.assign(result->windows, Eigen::VectorXd::Zero(np));
+    measured_per_window[window] += ((rows.Jp * W).cwiseProduct(RW)).colwise().sum().transpose();
   }
-  for (const auto& [stream, per_window] : sums) result->streams.push_back(stream);
+  for (const auto& [stream, per_window] : variance) result->streams.push_back(stream);
   for (int i = 0; i < np; ++i) {
     InformationComponent& c = result->components[i];
     const bool observable = std::isfinite(c.crb_std);
-    const double variance = W(i, i);
+    // (I^+)_ii; the variance shares' own total, equal to it but for the solve's rounding, makes them sum to 1 exactly.
+    const double v = observable ? W(i, i) : kNaN;
+    double v_variance = 0.0;
+    for (const auto& [stream, per_window] : variance)
+      for (const Eigen::VectorXd& w : per_window) v_variance += w[i];
+    if (!observable) v_variance = kNaN;
     c.by_window.assign(result->windows, observable ? 0.0 : kNaN);
-    for (const auto& [stream, per_window] : sums) {
+    for (const auto& [stream, per_window] : variance) {
+      std::vector<double>& measured_series = c.measured_by_stream_window[stream];
+      measured_series.assign(result->windows, kNaN);
+      double measured_total = observable ? 0.0 : kNaN;
+      for (int k = 0; k < result->windows && observable; ++k) {
+        measured_series[k] = measured.at(stream)[k][i] / v;
+        measured_total += measured_series[k];
+      }
+      c.measured_by[stream] = measured_total;
       std::vector<double>& series = c.by_stream_window[stream];
       series.assign(result->windows, kNaN);
       double total = observable ? 0.0 : kNaN;
       for (int k = 0; k < result->windows && observable; ++k) {
-        series[k] = per_window[k][i] / variance;
+        series[k] = per_window[k][i] / v_variance;
         total += series[k];
         c.by_window[k] += series[k];
       }

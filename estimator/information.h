@@ -13,16 +13,23 @@
 // Origin. With Y = H_xx^-1 H_xp (the best poses move by -Y per unit change of the parameters), the rows
 //   R_f = J_p,f - J_x,f Y = (P J_p)_f     (factor f's sensitivity to the parameters once the poses follow them; P the
 //                                         projector orthogonal to the columns of J_x)
-// give I = J_p^T P J_p = sum_f J_p,f^T R_f. For component i with w_i = I^+ e_i,
-//   share_f(i) = (J_p,f w_i)^T (R_f w_i) / (I^+)_ii,        sum_f share_f(i) = 1,
-// is the part of component i's information (1 / CRB^2, in the direction of its estimate) that factor f brings: its own
-// sensitivity to the parameter times what of that sensitivity the poses cannot absorb. Additive over any grouping of
-// factors (by stream, by time window of the factor's stamp). Only factors that measure the parameter, or one
-// correlated with it (J_p,f w_i != 0), get a share: a parameter one stream measures gets all of it from that stream
-// (when it does not correlate with another stream's parameters), a window whose rows do not depend on it (a speed
-// scale at standstill) none; the streams that only hold the poses show in how much the poses absorb.
-// A single term is not bound to be positive: where the rest of the drive moves the poses more than a row's own
-// sensitivity, its share is negative (small in practice).
+// split I exactly in two ways, I = sum_f R_f^T R_f = sum_f J_p,f^T R_f. For component i with w_i = I^+ e_i (the
+// direction of its estimate: p_i's estimate moves by w_i^T sum_f R_f^T n_f for whitened noise n), two shares, each
+// summing to 1 over the factors and additive over any grouping of them:
+//   variance share  |R_f w_i|^2 / (I^+)_ii                 the part of the CRB variance that factor f's noise causes:
+//                                                          never negative; split by stream and by time window of the
+//                                                          factor's stamp (by_stream, by_window, by_stream_window).
+//                                                          A stream that only holds the poses gets a share through
+//                                                          them (its noise moves the poses that the parameter's
+//                                                          measurements are compared with).
+//   measured share  (J_p,f w_i)^T (R_f w_i) / (I^+)_ii     the part of the information that factor f's own
+//                                                          sensitivity brings, less what of it the poses absorb: only
+//                                                          the streams that measure the parameter (or one correlated
+//                                                          with it) get one (measured_by,
+//                                                          measured_by_stream_window); a single term is negative
+//                                                          where the rest of the drive moves the poses more than the
+//                                                          row calls for, so that two streams measuring one parameter
+//                                                          with poses between them can show +480 % and -380 %.
 //
 // Directions. N = C^-1/2 I C^-1/2 with C = diag(H_pp) (each component's information were every other variable known)
 // is eigen-decomposed; an eigenvalue lambda is the information along its direction relative to what the components
@@ -61,11 +68,15 @@ struct InformationComponent {
   std::string label;      // e.g. "gps.lever_arm[x]", "magnetometer.A[0,1]", "imu.misalignment[rz]"
   double crb_std = 0.0;   // NaN when unobservable
   Observability observability = Observability::kObservable;
-  // Shares of the CRB variance, NaN when unobservable: by stream (each sums to 1 over the streams), by window and by
-  // stream and window (window k covers [t0 + k window_s, t0 + (k + 1) window_s), t0 the first pose's time).
+  // Variance shares (the header comment), NaN when unobservable: by stream (summing to 1 over the streams), by window
+  // and by stream and window (window k covers [t0 + k window_s, t0 + (k + 1) window_s), t0 the first pose's time;
+  // factors stamped before t0, such as a parameter's prior, count in window 0).
   std::map<std::string, double> by_stream;
   std::vector<double> by_window;
   std::map<std::string, std::vector<double>> by_stream_window;
+  // Measured shares (the header comment) by stream, summing to 1, and by stream and window; NaN when unobservable.
+  std::map<std::string, double> measured_by;
+  std::map<std::string, std::vector<double>> measured_by_stream_window;
 };
 
 struct InformationDirection {

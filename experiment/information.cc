@@ -96,15 +96,21 @@ nlohmann::json InformationJson(const InformationRequest& request, const Informat
     json components = json::array();
     for (int k = 0; k < p.manifold.tangent_dim(); ++k) {
       const estimator::InformationComponent& c = r.components[static_cast<std::size_t>(p.first_component + k)];
-      json by_stream = json::object(), by_stream_window = json::object();
+      json by_stream = json::object(), by_stream_window = json::object(), measured_by = json::object(),
+           measured_by_stream_window = json::object();
+      for (const auto& [stream, shares] : c.measured_by_stream_window)
+        measured_by_stream_window[stream] = NumberArray(shares);
       for (const auto& [stream, share] : c.by_stream) by_stream[stream] = Number(share);
+      for (const auto& [stream, share] : c.measured_by) measured_by[stream] = Number(share);
       for (const auto& [stream, shares] : c.by_stream_window) by_stream_window[stream] = NumberArray(shares);
       components.push_back({{"label", c.label},
                             {"crb_std", Number(c.crb_std)},
                             {"observability", estimator::ObservabilityName(c.observability)},
                             {"by_stream", by_stream},
                             {"by_window", NumberArray(c.by_window)},
-                            {"by_stream_window", by_stream_window}});
+                            {"by_stream_window", by_stream_window},
+                            {"measured_by", measured_by},
+                            {"measured_by_stream_window", measured_by_stream_window}});
     }
     parameters[p.name] = {{"truth", p.has_truth ? NumberArray(p.truth) : json()},
                           {"linearized_at", NumberArray(p.truth)},

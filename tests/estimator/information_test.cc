@@ -61,9 +61,10 @@ TEST(InformationTest, CramerRaoBoundIsTheStdCalibrateReportsOnANoiseFreeRecordin
   EXPECT_EQ(compared, 9);
 }
 
-// The shares split each component's information exactly (they sum to 1 over the streams and over the windows), and
-// only the factors that measure a parameter (or one correlated with it) carry it: the magnetometer's b is measured by
-// the magnetometer alone and does not correlate with the other streams' parameters.
+// Both shares split each component's information exactly (they sum to 1 over the streams, the variance shares also over
+// the windows, and are never negative), and only the factors that measure a parameter (or one correlated with it) get
+// a measured share: the magnetometer's b is measured by the magnetometer alone and does not correlate with the other
+// streams' parameters.
 TEST(InformationTest, SharesAddUpAndAMagnetometerParameterComesFromTheMagnetometerAlone) {
   const auto drive = NoiseFreeDrive(true);
   auto info = AnalyzeInformation(testing::AtvConfig(kFree), drive.recording, drive.truth.calibration,
@@ -71,20 +72,25 @@ TEST(InformationTest, SharesAddUpAndAMagnetometerParameterComesFromTheMagnetomet
   ASSERT_TRUE(info.ok()) << info.status().message();
   EXPECT_EQ(info.value().windows, 12);
   for (const InformationComponent& c : info.value().components) {
-    double by_stream = 0.0;
-    for (const auto& [stream, share] : c.by_stream) by_stream += share;
+    double by_stream = 0.0, measured = 0.0;
+    for (const auto& [stream, share] : c.by_stream) {
+      by_stream += share;
+      EXPECT_GE(share, 0.0) << c.label << " " << stream;
+    }
+    for (const auto& [stream, share] : c.measured_by) measured += share;
     EXPECT_NEAR(by_stream, 1.0, 1e-9) << c.label;
+    EXPECT_NEAR(measured, 1.0, 1e-9) << c.label;
     EXPECT_NEAR(std::accumulate(c.by_window.begin(), c.by_window.end(), 0.0), 1.0, 1e-9) << c.label;
   }
   for (const std::string axis : {"x", "y", "z"}) {
     const InformationComponent& b = Component(info.value(), "magnetometer.b[" + axis + "]");
-    EXPECT_NEAR(b.by_stream.at("magnetometer"), 1.0, 1e-9);
-    EXPECT_NEAR(b.by_stream.at("gps"), 0.0, 1e-9);
-    EXPECT_NEAR(b.by_stream.at("gyroscope"), 0.0, 1e-9);
+    EXPECT_NEAR(b.measured_by.at("magnetometer"), 1.0, 1e-9);
+    EXPECT_NEAR(b.measured_by.at("gps"), 0.0, 1e-9);
+    EXPECT_NEAR(b.measured_by.at("gyroscope"), 0.0, 1e-9);
   }
   // The lever arm is measured by the GPS alone, the gains by the odometer alone.
-  EXPECT_NEAR(Component(info.value(), "gps.lever_arm[x]").by_stream.at("gps"), 1.0, 1e-9);
-  EXPECT_NEAR(Component(info.value(), "odometer.kv_over_L").by_stream.at("odometer"), 1.0, 1e-9);
+  EXPECT_NEAR(Component(info.value(), "gps.lever_arm[x]").measured_by.at("gps"), 1.0, 1e-9);
+  EXPECT_NEAR(Component(info.value(), "odometer.kv_over_L").measured_by.at("odometer"), 1.0, 1e-9);
 }
 
 // On a flat drive the GPS antenna's height cannot be told from the vehicle's: the component has no CRB, and the
