@@ -328,7 +328,7 @@ Result<PlotFiles> WriteInformationPlot(const std::string& directory, const std::
   PlotFiles files{"information.gp", "information.png", {"information_shares.dat", "information_drive.dat"}};
   // Shares: one pixel per (window, row), the row index counted down from the top.
   std::ostringstream shares;
-  shares << "# share of each component's information per window [%]\n# window_middle_s row share_percent\n";
+  shares << "# variance share of each component per window [%]\n# window_middle_s row share_percent\n";
   std::size_t windows = 0;
   for (std::size_t r = 0; r < data.rows.size(); ++r) {
     windows = std::max(windows, data.shares[r].size());
@@ -356,15 +356,15 @@ Result<PlotFiles> WriteInformationPlot(const std::string& directory, const std::
      << "set size 1,0.52\nset origin 0,0.45\nset tmargin at screen 0.95\nset bmargin at screen 0.47\n"
      << "set yrange [" << Num(static_cast<double>(data.rows.size()) - 0.5) << ":-0.5]\nset ytics (";
   for (std::size_t r = 0; r < data.rows.size(); ++r) gp << (r ? ", " : "") << Quote(data.rows[r]) << ' ' << r;
-  gp << ") font 'sans,9'\nset format x ''\nset cbrange [0:*]\nset cblabel 'share of the information [%]'\n"
+  gp << ") font 'sans,9'\nset format x ''\nset cbrange [0:*]\nset cblabel 'variance share [%]'\n"
      << "set palette defined (0 'white', 1 '#9ecae1', 2 '#3182bd', 3 '#08306b')\n"
      << "plot " << Quote(files.data[0]) << " using 1:2:3 with image notitle\n"
      << "unset colorbox\nset ytics auto font 'sans,10'\nset autoscale y\nset grid\n";
   const char* kLabels[] = {"speed [m/s]", "yaw rate [deg/s]", "pitch [deg]"};
   const char* kColumns[] = {"2", "($3*180/pi)", "4"};
   for (int panel = 0; panel < 3; ++panel) {
-    const double top = 0.44 - 0.14 * panel;
-    gp << "set tmargin at screen " << Num(top) << "\nset bmargin at screen " << Num(top - 0.12) << "\n"
+    const double top = 0.44 - 0.135 * panel;
+    gp << "set tmargin at screen " << Num(top) << "\nset bmargin at screen " << Num(top - 0.11) << "\n"
        << "set ylabel '" << kLabels[panel] << "'\n";
     if (panel == 2) gp << "set format x '%g'\nset xlabel 'time since start [s]'\n";
     gp << "plot " << Quote(files.data[1]) << " using 1:" << kColumns[panel]
