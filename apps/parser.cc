@@ -161,7 +161,12 @@ void AddMonteCarlo(CLI::App* app, Commands* commands) {
     CLI::App* mc = app->add_subcommand(
         "montecarlo", "NEES consistency of online tracking over noise realizations (seed 000, Section V, Fig. 4).");
     mc->add_option("scenario", args->scenario, "Scenario file (SCENARIO.yaml)")->required();
-    mc->add_option("--config", args->config, "Estimator configuration for tracking (EST.yaml)")->required();
+    mc->add_option("--config", args->config, "Estimator configuration for tracking (EST.yaml); or --command");
+    mc->add_option("--command", args->command.command,
+                   "An external estimator under test instead of --config: a shell command run on each run's "
+                   "recording, {recording} and {out} replaced by the directories (docs/external-estimator.md)");
+    mc->add_option("--timeout", args->command.timeout_s,
+                   "--command: seconds each run's command may take before it is killed (default 600)");
     mc->add_option("--calibration", args->calibration,
                    "calibration.json whose values tracking uses (default: calibrate once with tracking.calibrate)");
     mc->add_option("--runs", args->runs, "Noise realizations (default 50)");
