@@ -111,8 +111,8 @@ bool WaitUntil(pid_t pid, Clock::time_point deadline, int* status, bool stop_on_
 void KillGroup(pid_t pid) {
   ::kill(-pid, SIGTERM);
   int status = 0;
-  const auto grace = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                        std::chrono::duration<double>(kTerminateGraceS));
+  const auto grace =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kTerminateGraceS));
   if (WaitUntil(pid, grace, &status, false)) {
     ::kill(-pid, SIGKILL);  // what the shell left running
     return;
@@ -215,7 +215,8 @@ Status RunExternalCommand(const ExternalCommand& command, const std::string& rec
 Result<ExternalEstimate> ReadExternalEstimate(const std::string& out_dir) {
   ExternalEstimate estimate;
   const std::string trajectory = (fs::path(out_dir) / "trajectory.tum").string();
-  if (!fs::is_regular_file(trajectory)) return Status::Error(trajectory + ": missing: the estimator wrote no trajectory");
+  if (!fs::is_regular_file(trajectory))
+    return Status::Error(trajectory + ": missing: the estimator wrote no trajectory");
   Result<Trajectory> poses = ReadTum(trajectory);
   if (!poses.ok()) return poses.status();
   if (poses.value().empty()) return Status::Error(trajectory + ": no poses");

@@ -109,9 +109,10 @@ RunResult ExternalRun(const sim::Scenario& scenario, const ExternalCommand& comm
   const auto start = std::chrono::steady_clock::now();
   if (status.ok()) status = RunExternalCommand(command, recording_dir, estimate_dir, run_dir + "/estimator.log");
   r.track_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  Result<ExternalEstimate> estimate = status.ok() ? ReadExternalEstimate(estimate_dir) : Result<ExternalEstimate>(status);
+  Result<ExternalEstimate> estimate =
+      status.ok() ? ReadExternalEstimate(estimate_dir) : Result<ExternalEstimate>(status);
   if (!estimate.ok()) {
-    const bool named = status.ok();  // a reading error does not name the command yet
+    const bool named = status.ok();  // only a reading error does not name the command yet
     r.error = prefix + (named ? "estimator command '" + command.command + "': " : "") + estimate.status().message();
     return r;
   }

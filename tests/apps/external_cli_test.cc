@@ -58,10 +58,9 @@ TEST(ExternalCliTest, MonteCarloScoresTheDeadReckoningAsEvaluateDoes) {
 
 TEST(ExternalCliTest, AFailingCommandFailsTheCallNamingRunAndCommand) {
   testing::TempDir dir;
-  const testing::CommandRun mc =
-      Roamlab("montecarlo " + Example("indoor_diffdrive_mocap.yaml") +
-                  " --command 'echo broken >&2; exit 4' --runs 2 --jobs 1 --out mc --quiet",
-              dir.path());
+  const testing::CommandRun mc = Roamlab("montecarlo " + Example("indoor_diffdrive_mocap.yaml") +
+                                             " --command 'echo broken >&2; exit 4' --runs 2 --jobs 1 --out mc --quiet",
+                                         dir.path());
   EXPECT_EQ(mc.exit_code, 1);
   EXPECT_THAT(mc.err, HasSubstr("2 of 2 runs failed; first: run 0, seed 1000: estimator command 'echo broken >&2; "
                                 "exit 4': exited with status 4"));
@@ -72,9 +71,9 @@ TEST(ExternalCliTest, AFailingCommandFailsTheCallNamingRunAndCommand) {
 TEST(ExternalCliTest, WithoutCovarianceRunsAreScoredWithoutNees) {
   testing::TempDir dir;
   const std::string command = "sh " + Example("dead_reckoning.sh") + " {recording} {out} && rm {out}/covariance.csv";
-  const testing::CommandRun mc = Roamlab(
-      "montecarlo " + Example("indoor_diffdrive_mocap.yaml") + " --command '" + command + "' --runs 2 --out mc",
-      dir.path());
+  const testing::CommandRun mc =
+      Roamlab("montecarlo " + Example("indoor_diffdrive_mocap.yaml") + " --command '" + command + "' --runs 2 --out mc",
+              dir.path());
   ASSERT_EQ(mc.exit_code, 0) << mc.err;
   EXPECT_THAT(mc.out, HasSubstr("no NEES: the estimator wrote no covariance.csv"));
   EXPECT_FALSE(fs::exists(fs::path(dir.path()) / "mc/nees.json"));

@@ -82,8 +82,8 @@ TEST(ExternalTest, RunsInItsWorkingDirectoryWithTheRecordingAndItsOutput) {
 
 TEST(ExternalTest, NonZeroExitNamesTheCommandStatusAndLog) {
   testing::TempDir dir;
-  const Status ran = RunExternalCommand({"echo cannot read the encoders >&2; exit 3", dir.path(), 10.0},
-                                        dir.path(), dir.File("out"), dir.File("estimator.log"));
+  const Status ran = RunExternalCommand({"echo cannot read the encoders >&2; exit 3", dir.path(), 10.0}, dir.path(),
+                                        dir.File("out"), dir.File("estimator.log"));
   ASSERT_FALSE(ran.ok());
   EXPECT_THAT(ran.message(), HasSubstr("estimator command 'echo cannot read the encoders >&2; exit 3'"));
   EXPECT_THAT(ran.message(), HasSubstr("exited with status 3"));
@@ -92,9 +92,8 @@ TEST(ExternalTest, NonZeroExitNamesTheCommandStatusAndLog) {
 
 TEST(ExternalTest, AProgramThatDoesNotExistIsAFailureNotACrash) {
   testing::TempDir dir;
-  const Status ran =
-      RunExternalCommand({"./no_such_program {recording} {out}", dir.path(), 10.0}, dir.path(), dir.File("out"),
-                         dir.File("estimator.log"));
+  const Status ran = RunExternalCommand({"./no_such_program {recording} {out}", dir.path(), 10.0}, dir.path(),
+                                        dir.File("out"), dir.File("estimator.log"));
   ASSERT_FALSE(ran.ok());
   EXPECT_THAT(ran.message(), HasSubstr("status 127 (command not found)"));
 }

@@ -183,7 +183,8 @@ TEST_F(SuiteTest, LoadsExternalCommandCases) {
   const std::string path = WriteSuite("  - name: dr\n    mode: montecarlo\n    scenario: " +
                                       Scenario("atv_hills.yaml") +
                                       "\n    command: \"sh ../dr.sh {recording} {out}\"\n    timeout_s: 30\n"
-                                      "    runs: 2\n    checks:\n      - {metric: runs.runs.ate_m.max, bound: \"<= 1\"}\n");
+                                      "    runs: 2\n    checks:\n"
+                                      "      - {metric: runs.runs.ate_m.max, bound: \"<= 1\"}\n");
   const Result<Suite> suite = LoadSuite(path);
   ASSERT_TRUE(suite.ok()) << suite.status().message();
   const Case& c = suite.value().cases[0];
