@@ -7,7 +7,8 @@
 # Reads the recording's files directly (never the truth): recording.yaml (platform.kind differential_drive,
 # platform.geometry wheel_radius_m and baseline_m, the streams), the wheel_encoders stream (cumulative wheel angles in
 # rad, columns left and right) and the first row of the first pose stream (motion capture), the only absolute
-# information it uses: the start pose. Without a pose stream it starts at the world origin with heading 0.
+# information it uses: the start pose. Without a pose stream it starts at the world origin with heading 0 and writes
+# no covariance (its frame is then its own: the evaluation aligns it to the truth, and a NEES would mean nothing).
 #
 # From there it integrates the wheels (midpoint heading), on a flat floor (z and roll and pitch stay those of the
 # start), and propagates the covariance of (x, y, yaw) with each wheel's travel error of variance
@@ -56,7 +57,7 @@ function read_header(line,    fields, k, n) {
 function write_pose(t,    half) {
   half = yaw / 2
   printf "%s %.17g %.17g %.17g 0 0 %.17g %.17g\n", t, x, y, z, sin(half), cos(half) > trajectory
-  printf "%s,%.17g,%.17g,0,%.17g,%.17g,0,0,0,%.17g\n", t, pxx, pxy, pxy, pyy, var_z > covariance
+  if (start_t != "") printf "%s,%.17g,%.17g,0,%.17g,%.17g,0,0,0,%.17g\n", t, pxx, pxy, pxy, pyy, var_z > covariance
 }
 # One step with wheel travels dl and dr [m]: the pose (midpoint heading) and the covariance, P = F P F^T + G Q G^T.
 function step(dl, dr,    ds, dyaw, mid, c, s, fx, fy, gxl, gxr, gyl, gyr, gt, ql, qr, nxx, nxy, nxt, nyy, nyt) {
@@ -122,7 +123,7 @@ BEGIN {
   read_header(line)
   if (!("left" in column) || !("right" in column)) fail(path ": no columns left and right")
   print "# t x y z qx qy qz qw" > trajectory
-  print "t,xx,xy,xz,yx,yy,yz,zx,zy,zz" > covariance
+  if (start_t != "") print "t,xx,xy,xz,yx,yy,yz,zx,zy,zz" > covariance
   started = 0
   while ((getline line < path) > 0) {
     split(line, f, ",")
