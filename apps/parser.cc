@@ -118,6 +118,9 @@ void AddEvaluate(CLI::App* app, Commands* commands) {
     evl->add_option("--estimate-format", args->estimate_format, "tum | kitti | euroc (default: detected)");
     evl->add_option("--calibration", args->calibration,
                     "calibration.json for a reference stream's lever arm and the parameter table");
+    evl->add_option("--covariance", args->covariance,
+                    "covariance.csv of the estimate's position covariances, for the NEES (default: "
+                    "DIR/covariance.csv of an estimate directory; none for a file)");
     evl->add_option("--out", args->out, "Output directory: metrics.json, figures (PNG + gnuplot scripts)")->required();
     evl->add_option("--align", args->align,
                     "none | se3 | sim3 | yaw | origin (default: none with gps/position/pose streams or two plain "
