@@ -97,29 +97,35 @@ Result<pid_t> Spawn(const std::string& line, const std::string& working_dir, con
   return pid;
 }
 
-// Waits for the child until `deadline`; true when it ended (`status` holds its wait status).
-bool WaitUntil(pid_t pid, Clock::time_point deadline, int* status, bool stop_on_interrupt) {
+// Waits until the child has ended (without reaping it, so that its pid, the process group's id, cannot be reused
+// before the group is killed) or `deadline` passed; true when it ended.
+bool WaitUntil(pid_t pid, Clock::time_point deadline, bool stop_on_interrupt) {
   for (;;) {
-    const pid_t done = ::waitpid(pid, status, WNOHANG);
-    if (done == pid || (done < 0 && errno != EINTR)) return true;
+    siginfo_t info{};
+    const int waited = ::waitid(P_PID, static_cast<id_t>(pid), &info, WEXITED | WNOHANG | WNOWAIT);
+    if ((waited == 0 && info.si_pid == pid) || (waited < 0 && errno != EINTR)) return true;
     if (Clock::now() >= deadline || (stop_on_interrupt && InterruptRequested())) return false;
     std::this_thread::sleep_for(kPollPeriod);
   }
 }
 
-// Ends the child's process group: SIGTERM, then SIGKILL after the grace period; reaps the child.
-void KillGroup(pid_t pid) {
-  ::kill(-pid, SIGTERM);
-  int status = 0;
-  const auto grace =
-      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kTerminateGraceS));
-  if (WaitUntil(pid, grace, &status, false)) {
-    ::kill(-pid, SIGKILL);  // what the shell left running
-    return;
-  }
+// Kills what is left of the child's process group (what the command started and left running) and reaps the
+// child; its wait status.
+int KillGroupAndReap(pid_t pid) {
   ::kill(-pid, SIGKILL);
+  int status = 0;
   while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
+  return status;
+}
+
+// Ends the child's process group: SIGTERM, then SIGKILL after the grace period; reaps the child.
+void TerminateGroup(pid_t pid) {
+  ::kill(-pid, SIGTERM);
+  const auto grace =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kTerminateGraceS));
+  WaitUntil(pid, grace, false);
+  KillGroupAndReap(pid);
 }
 
 // Why the wait status is a failure ("exited with status 3", "was killed by signal 11"), "" for exit status 0.
@@ -196,17 +202,15 @@ Status RunExternalCommand(const ExternalCommand& command, const std::string& rec
   if (!pid.ok()) return Status::Error(name + ": " + pid.status().message());
   const auto deadline =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(command.timeout_s));
-  int status = 0;
-  if (!WaitUntil(pid.value(), deadline, &status, true)) {
-    KillGroup(pid.value());
+  if (!WaitUntil(pid.value(), deadline, true)) {
+    TerminateGroup(pid.value());
     if (InterruptRequested()) return Status::Error(name + ": stopped, " + InterruptedError().message());
     char limit[32];
     std::snprintf(limit, sizeof limit, "%g", command.timeout_s);
     return Status::Error(name + ": killed after the time-out of " + std::string(limit) + " s (output in " + log_file +
                          ")");
   }
-  ::kill(-pid.value(), SIGKILL);  // anything the command left running in its group
-  const std::string failure = Failure(status);
+  const std::string failure = Failure(KillGroupAndReap(pid.value()));
   if (failure.empty()) return Status::Ok();
   const std::string last = LastLine(log_file);
   return Status::Error(name + ": " + failure + " (" + log_file + (last.empty() ? ")" : ": " + last + ")"));

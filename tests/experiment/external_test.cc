@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <thread>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -135,6 +136,25 @@ TEST(ExternalTest, TimeOutKillsTheCommand) {
   EXPECT_THAT(ran.message(), HasSubstr("killed after the time-out of 0.3 s"));
   EXPECT_LT(seconds, 5.0);
   EXPECT_FALSE(fs::exists(dir.File("out/late")));
+}
+
+// What the command leaves running when it exits (a background job in its process group) is killed with it.
+TEST(ExternalTest, WhatTheCommandLeftRunningIsKilled) {
+  testing::TempDir dir;
+  const Status ran = RunExternalCommand({"sleep 30 & echo $! > {out}/pid", dir.path(), 10.0}, dir.path(),
+                                        dir.File("out"), dir.File("estimator.log"));
+  ASSERT_TRUE(ran.ok()) << ran.message();
+  const std::string pid = testing::ReadFile(dir.File("out/pid"));
+  ASSERT_FALSE(pid.empty());
+  // Gone, or a zombie waiting for its new parent to reap it: state Z in /proc/PID/stat.
+  bool ended = false;
+  for (int k = 0; k < 100 && !ended; ++k) {
+    const std::string stat = testing::ReadFile("/proc/" + pid.substr(0, pid.find('\n')) + "/stat");
+    const std::size_t close = stat.rfind(')');
+    ended = stat.empty() || (close != std::string::npos && stat.compare(close + 2, 1, "Z") == 0);
+    if (!ended) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_TRUE(ended) << "pid " << pid;
 }
 
 TEST(ExternalTest, AnInterruptStopsTheCommand) {
