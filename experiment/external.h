@@ -4,7 +4,7 @@
 //   command   a shell command line; "{recording}" and "{out}" in it are replaced by the absolute paths of the
 //             recording directory and of the output directory (each single-quoted for the shell); a command naming
 //             neither gets both appended as two arguments. It runs with /bin/sh -c in `working_dir` (relative paths
-//             in the command are relative to it), standard input /dev/null, standard output and error appended to
+//             in the command are relative to it), standard input /dev/null, standard output and error written to
 //             the log file, in a process group of its own that is killed (SIGTERM, then SIGKILL) when it exceeds
 //             timeout_s or when roamlab is interrupted.
 //   input     the recording directory without ground_truth.tum and truth.yaml: the estimator under test is never
