@@ -223,7 +223,8 @@ struct MonteCarloShared {
 
 namespace {
 
-Outcome PrepareDirectories(const MonteCarloOptions& options) {
+// The output directory (an external estimator's runs share nothing else).
+Outcome PrepareOutput(const MonteCarloOptions& options) {
   if (const Status dir = MakeOutputDirectory(options.out); !dir.ok()) return Outcome::BadInput(dir);
   return Outcome::Ok();
 }
@@ -233,7 +234,7 @@ Outcome Prepare(const MonteCarloOptions& options, MonteCarloShared* shared) {
   auto scenario = sim::LoadScenario(options.scenario);
   if (!scenario.ok()) return Outcome::BadInput(scenario.status());
   shared->scenario = std::move(scenario).value();
-  if (options.external()) return PrepareDirectories(options);
+  if (options.external()) return PrepareOutput(options);
   auto config = estimator::LoadEstimatorConfig(options.config);
   if (!config.ok()) return Outcome::BadInput(config.status());
   shared->config = std::move(config).value();
@@ -441,9 +442,11 @@ Status WriteRunsJson(const MonteCarloOptions& options, const std::vector<RunResu
   return WriteFileAtomic(options.out + "/runs.json", nlohmann::json{{"runs", runs}}.dump(2) + "\n");
 }
 
-// Without covariances: OUT/runs.json, and no nees.json (a stale one is removed); returns the note that says so.
+// Without covariances: OUT/runs.json, and no nees.json, nees.png or report.html (stale ones are removed); returns the
+// note that says so.
 std::string WriteRunsOnly(const MonteCarloOptions& options, const std::vector<RunResult>& results) {
-  if (Status s = RemoveStaleFile(options.out + "/nees.json"); !s.ok()) return " (" + s.message() + ")";
+  for (const char* stale : {"/nees.json", "/nees.png", "/report.html"})
+    if (Status s = RemoveStaleFile(options.out + stale); !s.ok()) return " (" + s.message() + ")";
   if (Status s = WriteRunsJson(options, results); !s.ok()) return " (" + s.message() + ")";
   return " (no NEES: the estimator wrote no covariance.csv)";
 }
