@@ -100,6 +100,9 @@ std::string MakeOptions(const EvaluateArgs& args, eval::EvaluateOptions* options
   options->reference_file = args.reference;
   options->reference_stream = args.reference_stream;
   options->calibration_file = args.calibration;
+  options->covariance_file = args.covariance;
+  if (!args.covariance.empty() && args.estimates.size() > 1)
+    return "--covariance belongs to one estimate: give it with a single --estimate";
   options->max_time_difference_s = args.max_time_difference_s;
   options->time_offset_s = args.t_offset_s;
   options->rpe_delta_s = args.rpe_delta_s;

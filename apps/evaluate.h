@@ -18,6 +18,7 @@ struct EvaluateArgs {
   std::string reference_format;        // "", "tum", "kitti", "euroc"; "" = detected
   std::string estimate_format;         // same, for estimate files
   std::string calibration;             // calibration.json for a stream's lever arm and the parameter table
+  std::string covariance;              // covariance.csv of the (one) estimate: "" = DIR/covariance.csv
   std::string out;                     // output directory: metrics.json, figures
   std::string
       align;  // "", "none", "se3", "sim3", "yaw" ("yaw_translation") or "origin"; "" = eval/evaluate.h's default

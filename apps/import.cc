@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "apps/cli.h"
+#include "common/progress.h"
 #include "experiment/steps.h"
 #include "importers/csv.h"
 #include "importers/rosbag.h"
@@ -119,7 +120,10 @@ int RunImportRosbag(const ImportRosbagArgs& args) {
   importers::RosbagImportOptions options;
   if (const int code = RosbagOptions(args, &options); code != 0) return code;
   importers::RosbagImportReport report;
+  ProgressMeter meter("import", &std::cerr);
+  if (!args.quiet) options.progress = [&meter](double fraction) { meter.Update(fraction); };
   const Result<recording::Recording> rec = importers::ImportRosbag(args.bag, options, &report);
+  meter.Finish();
   if (const int code = Written(rec, args.out); code != 0) return code;
   if (Status s = importers::WriteCameraFrames(report.frames, args.out); !s.ok())
     return Failure(nullptr, kCommand, s.message());

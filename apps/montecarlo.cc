@@ -1,5 +1,6 @@
 #include "apps/montecarlo.h"
 
+#include <filesystem>
 #include <iostream>
 
 #include "apps/cli.h"
@@ -32,7 +33,12 @@ int RunLocally(const MonteCarloArgs& args, batch::Work& work) {
 
 }  // namespace
 
-int RunMonteCarlo(const MonteCarloArgs& args) {
+int RunMonteCarlo(const MonteCarloArgs& given) {
+  // An external command runs where roamlab was started, wherever the runs execute (a Slurm task's directory).
+  MonteCarloArgs args = given;
+  std::error_code ec;
+  if (args.external() && args.command.working_dir.empty())
+    args.command.working_dir = std::filesystem::current_path(ec).string();
   if (const std::string problem = args.Validate(); !problem.empty()) return BadInput(args.err, "montecarlo", problem);
   const std::unique_ptr<batch::Work> work = batch::MonteCarloWork(args);
   if (args.backend.backend == "slurm")

@@ -119,6 +119,9 @@ void AddEvaluate(CLI::App* app, Commands* commands) {
     evl->add_option("--estimate-format", args->estimate_format, "tum | kitti | euroc (default: detected)");
     evl->add_option("--calibration", args->calibration,
                     "calibration.json for a reference stream's lever arm and the parameter table");
+    evl->add_option("--covariance", args->covariance,
+                    "covariance.csv of the estimate's position covariances, for the NEES (default: "
+                    "DIR/covariance.csv of an estimate directory; none for a file)");
     evl->add_option("--out", args->out, "Output directory: metrics.json, figures (PNG + gnuplot scripts)")->required();
     evl->add_option("--align", args->align,
                     "none | se3 | sim3 | yaw | origin (default: none with gps/position/pose streams or two plain "
@@ -162,7 +165,12 @@ void AddMonteCarlo(CLI::App* app, Commands* commands) {
     CLI::App* mc = app->add_subcommand(
         "montecarlo", "NEES consistency of online tracking over noise realizations (seed 000, Section V, Fig. 4).");
     mc->add_option("scenario", args->scenario, "Scenario file (SCENARIO.yaml)")->required();
-    mc->add_option("--config", args->config, "Estimator configuration for tracking (EST.yaml)")->required();
+    mc->add_option("--config", args->config, "Estimator configuration for tracking (EST.yaml); or --command");
+    mc->add_option("--command", args->command.command,
+                   "An external estimator under test instead of --config: a shell command run on each run's "
+                   "recording, {recording} and {out} replaced by the directories (docs/external-estimator.md)");
+    mc->add_option("--timeout", args->command.timeout_s,
+                   "--command: seconds each run's command may take before it is killed (default 600)");
     mc->add_option("--calibration", args->calibration,
                    "calibration.json whose values tracking uses (default: calibrate once with tracking.calibrate)");
     mc->add_option("--runs", args->runs, "Noise realizations (default 50)");

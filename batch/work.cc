@@ -33,7 +33,10 @@ class MonteCarlo : public Work {
             {"seed_base", options_.seed_base},
             {"t0_s", options_.t0_s},
             {"no_time_budget", options_.no_time_budget},
-            {"calibrate_each_run", options_.calibrate_each_run}};
+            {"calibrate_each_run", options_.calibrate_each_run},
+            {"command", options_.command.command},
+            {"command_dir", options_.command.working_dir},
+            {"timeout_s", options_.command.timeout_s}};
   }
   Outcome Prepare(bool resume) override {
     experiment::MonteCarloOptions options = options_;
@@ -232,7 +235,11 @@ Result<experiment::MonteCarloOptions> MonteCarloFromJson(const json& j) {
                   Read(j, "calibration", &o.calibration) && Read(j, "out", &o.out) && Read(j, "runs", &o.runs) &&
                   Read(j, "seed_base", &o.seed_base) && Read(j, "t0_s", &o.t0_s) &&
                   Read(j, "no_time_budget", &o.no_time_budget) && Read(j, "calibrate_each_run", &o.calibrate_each_run);
-  if (!ok) return Status::Error("the montecarlo work lacks a key or has one of the wrong type");
+  // The external estimator's keys: absent in the work of roamlab's own estimator written before they existed.
+  const bool command = !j.contains("command") ||
+                       (Read(j, "command", &o.command.command) && Read(j, "command_dir", &o.command.working_dir) &&
+                        Read(j, "timeout_s", &o.command.timeout_s));
+  if (!ok || !command) return Status::Error("the montecarlo work lacks a key or has one of the wrong type");
   return o;
 }
 
@@ -279,6 +286,8 @@ Result<experiment::SweepPlan> SweepFromJson(const json& j) {
 std::string MonteCarloHeadline(const experiment::MonteCarloOptions& options,
                                const experiment::MonteCarloSummary& summary) {
   const eval::MonteCarloNees& nees = summary.nees;
+  if (!summary.has_nees)
+    return std::to_string(options.runs) + " runs; wrote " + options.out + "/runs.json" + summary.plot_note;
   char line[256];
   std::snprintf(line, sizeof line,
                 "%d runs: mean NEES in the 95%% band [%.3f, %.3f] for %.1f%% of the time steps after %.1f s; wrote ",

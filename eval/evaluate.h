@@ -5,7 +5,8 @@
 //   the estimate   a directory EST with trajectory.tum (required), covariance.csv (3x3 world-frame position covariance
 //                  per pose, optional; `roamlab track` writes it) and calibration.json (estimated parameters,
 //                  optional; `roamlab calibrate` writes it), or a plain trajectory file (eval/trajectory_file.h: TUM,
-//                  KITTI, EuRoC CSV).
+//                  KITTI, EuRoC CSV); covariance_file gives the covariances of either (required then, and a timed
+//                  estimate: rows are matched to poses by stamp).
 //   the reference  in this order: reference_file (a plain trajectory file); REC/ground_truth.tum; the recording's
 //                  stream reference_stream, or without ground truth its first gps, position or pose stream. A gps
 //                  stream is converted to East-North-Up at the recording's origin; gps and position streams carry no
@@ -73,6 +74,8 @@ struct EvaluateOptions {
   std::string reference_stream;                      // a gps, position or pose stream of the recording as the reference
   std::string calibration_file;                      // calibration.json for the lever arm and the parameter table
                                                      // ("": EST/calibration.json when the estimate is a directory)
+  std::string covariance_file;                       // covariance.csv of the estimate's position covariances ("":
+                                                     // EST/covariance.csv of a directory, none for a plain file)
   std::optional<TrajectoryFormat> reference_format;  // nullopt: detected
   std::optional<TrajectoryFormat> estimate_format;   // nullopt: detected (plain files only)
   std::optional<AlignmentKind> alignment;            // nullopt: the default (see the top of this file)

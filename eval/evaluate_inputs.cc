@@ -149,6 +149,15 @@ Status ReadEstimate(const EvaluateOptions& options, Inputs* in) {
     in->estimate_format = TrajectoryFormatName(file.value().format);
   }
   if (in->estimate.empty()) return Status::Error(in->trajectory_path + ": no poses");
+  if (!options.covariance_file.empty()) {
+    if (!in->estimate_timed)
+      return Status::Error(options.covariance_file + ": covariances pair with poses by stamp; " +
+                           in->trajectory_path + " has no time stamps");
+    in->covariance_path = options.covariance_file;
+    Result<std::vector<StampedCovariance>> rows = ReadPositionCovariances(options.covariance_file);
+    if (!rows.ok()) return rows.status();
+    in->covariances = std::move(rows).value();
+  }
   // The time offset, on the covariance rows too (they are matched to the poses by stamp).
   const std::int64_t offset_ns = std::llround(options.time_offset_s * 1e9);
   for (StampedPose& pose : in->estimate) pose.t = Time::FromNanoseconds(pose.t.nanoseconds() + offset_ns);

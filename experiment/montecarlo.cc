@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
@@ -25,6 +26,7 @@
 #include "eval/metrics.h"
 #include "eval/montecarlo.h"
 #include "eval/plots.h"
+#include "recording/recording.h"
 #include "recording/stream_health.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
@@ -37,6 +39,7 @@ namespace {
 
 struct RunResult {
   eval::RunNees nees;
+  bool has_covariance = true;  // false: an external estimator wrote no covariance.csv (nees.nees and mean_nees NaN)
   double rpe_m = 0.0;  // translation RMSE of the relative pose error over pose pairs about 1 s apart [m]
   double track_seconds = 0.0;
   std::string error;  // empty when the run succeeded
@@ -78,6 +81,55 @@ RunResult OneRun(const sim::Scenario& scenario, const estimator::EstimatorConfig
   }
   r.rpe_m = RpeOverOneSecond(tr.trajectory, *rec.ground_truth);
   r.track_seconds = tr.total_seconds;
+  return r;
+}
+
+// Run `seed` of an external estimator (MonteCarloOptions::command) in `run_dir`: simulate, write the recording
+// without the truth, run the command on it, pair its poses with the truth's.
+RunResult ExternalRun(const sim::Scenario& scenario, const ExternalCommand& command, const std::string& run_dir,
+                      std::uint64_t seed) {
+  RunResult r;
+  const std::string prefix = "seed " + std::to_string(seed) + ": ";
+  sim::SimulateOptions sim_options;
+  sim_options.seed = seed;
+  auto simulation = sim::Simulate(scenario, sim_options);
+  if (!simulation.ok()) {
+    r.error = prefix + simulation.status().message();
+    return r;
+  }
+  recording::Recording& rec = simulation.value().recording;
+  const Trajectory truth = *rec.ground_truth;
+  rec.ground_truth.reset();  // the estimator under test never sees the truth
+  const std::string recording_dir = run_dir + "/recording";
+  const std::string estimate_dir = run_dir + "/estimate";
+  std::error_code ec;
+  std::filesystem::remove_all(run_dir, ec);
+  Status status = MakeOutputDirectory(run_dir);
+  if (status.ok()) status = recording::WriteRecording(rec, recording_dir);
+  const auto start = std::chrono::steady_clock::now();
+  if (status.ok()) status = RunExternalCommand(command, recording_dir, estimate_dir, run_dir + "/estimator.log");
+  r.track_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  Result<ExternalEstimate> estimate =
+      status.ok() ? ReadExternalEstimate(estimate_dir) : Result<ExternalEstimate>(status);
+  if (!estimate.ok()) {
+    const bool named = status.ok();  // only a reading error does not name the command yet
+    r.error = prefix + (named ? "estimator command '" + command.command + "': " : "") + estimate.status().message();
+    return r;
+  }
+  const ExternalEstimate& e = estimate.value();
+  r.has_covariance = e.position_covariance_world.has_value();
+  const std::vector<Eigen::Matrix3d> identity(e.trajectory.size(), Eigen::Matrix3d::Identity());
+  r.nees = eval::MatchedNees(e.trajectory, r.has_covariance ? *e.position_covariance_world : identity, truth);
+  if (r.nees.t.empty()) {
+    r.error = prefix + estimate_dir + "/trajectory.tum: no pose has a ground-truth pose at the same time stamp";
+    return r;
+  }
+  if (!r.has_covariance) {
+    r.nees.nees.assign(r.nees.t.size(), std::numeric_limits<double>::quiet_NaN());
+    r.nees.mean_nees = std::numeric_limits<double>::quiet_NaN();
+  }
+  r.rpe_m = RpeOverOneSecond(e.trajectory, truth);
+  std::filesystem::remove_all(recording_dir, ec);
   return r;
 }
 
@@ -171,11 +223,18 @@ struct MonteCarloShared {
 
 namespace {
 
+// The output directory (an external estimator's runs share nothing else).
+Outcome PrepareOutput(const MonteCarloOptions& options) {
+  if (const Status dir = MakeOutputDirectory(options.out); !dir.ok()) return Outcome::BadInput(dir);
+  return Outcome::Ok();
+}
+
 // The inputs every run shares, read (and, with tracking.calibrate, calibrated once) before any run.
 Outcome Prepare(const MonteCarloOptions& options, MonteCarloShared* shared) {
   auto scenario = sim::LoadScenario(options.scenario);
   if (!scenario.ok()) return Outcome::BadInput(scenario.status());
   shared->scenario = std::move(scenario).value();
+  if (options.external()) return PrepareOutput(options);
   auto config = estimator::LoadEstimatorConfig(options.config);
   if (!config.ok()) return Outcome::BadInput(config.status());
   shared->config = std::move(config).value();
@@ -218,6 +277,11 @@ Outcome Prepare(const MonteCarloOptions& options, MonteCarloShared* shared) {
 
 // Run i: with its own calibration (per_run) or the shared one.
 RunResult RunOne(const MonteCarloOptions& options, const MonteCarloShared& shared, int i) {
+  if (options.external()) {
+    const std::string file = MonteCarloRunFile(options.out, i);
+    const std::string run_dir = file.substr(0, file.size() - std::string(".json").size());
+    return ExternalRun(shared.scenario, options.command, run_dir, options.seed_base + i);
+  }
   if (!shared.per_run)
     return OneRun(shared.scenario, shared.config, shared.calibration, shared.tracking, options.seed_base + i);
   auto own = CalibrateRun(shared.scenario, shared.warm, shared.config.tracking.calibration_prior,
@@ -240,6 +304,7 @@ nlohmann::json RunJson(int i, std::uint64_t seed, const RunResult& r) {
           {"mean_nees", Number(r.nees.mean_nees)},
           {"rpe_m", Number(r.rpe_m)},
           {"track_seconds", r.track_seconds},
+          {"covariance", r.has_covariance},
           {"t_ns", t},
           {"nees", NumberArray(r.nees.nees)}};
 }
@@ -293,6 +358,10 @@ Result<RunResult> ReadRun(const std::string& path, int i, std::uint64_t seed) {
     return Status::Error(path + ": not the result file of run " + std::to_string(i) + " with seed " +
                          std::to_string(seed) + " (malformed or of another call; delete it to run it again)");
   r.track_seconds = Field(j, "track_seconds").get<double>();
+  const nlohmann::json& covariance = Field(j, "covariance");
+  if (!covariance.is_null() && !covariance.is_boolean())
+    return Status::Error(path + ": \"covariance\" is not true or false (delete the file to run it again)");
+  r.has_covariance = !covariance.is_boolean() || covariance.get<bool>();
   return r;
 }
 
@@ -342,7 +411,9 @@ std::string WriteReport(const MonteCarloOptions& options, const eval::MonteCarlo
                      Format(nees.band.hi, "%.3f") + "] for " + Format(100.0 * nees.fraction_in_band, "%.1f") +
                      " % of the time steps after " + Format(options.t0_s, "%.1f") + " s",
                  "headline");
-  page.Paragraph("Scenario " + options.scenario + ", configuration " + options.config +
+  page.Paragraph("Scenario " + options.scenario +
+                 (options.external() ? ", estimator command " + options.command.command
+                                     : ", configuration " + options.config) +
                  (options.calibration.empty() ? "" : ", calibration " + options.calibration) + ".");
   page.Heading(2, "Runs");
   html::Table runs{{"seed", "ATE [m]", "mean NEES (3 when consistent)", "tracking [s]"}, {}};
@@ -359,11 +430,8 @@ std::string WriteReport(const MonteCarloOptions& options, const eval::MonteCarlo
   return written.ok() ? "" : " (" + written.message() + ")";
 }
 
-// OUT/nees.json, OUT/runs.json and OUT/nees.png; returns the plot note.
-std::string WriteData(const MonteCarloOptions& options, const eval::MonteCarloNees& nees,
-                      const std::vector<RunResult>& results) {
-  if (Status s = WriteFileAtomic(options.out + "/nees.json", eval::NeesJson(nees).dump(2) + "\n"); !s.ok())
-    return " (" + s.message() + ")";
+// OUT/runs.json: per-run ATE, mean NEES, RPE and tracking time.
+Status WriteRunsJson(const MonteCarloOptions& options, const std::vector<RunResult>& results) {
   nlohmann::json runs = nlohmann::json::array();
   for (int i = 0; i < options.runs; ++i)
     runs.push_back({{"seed", options.seed_base + i},
@@ -371,8 +439,24 @@ std::string WriteData(const MonteCarloOptions& options, const eval::MonteCarloNe
                     {"mean_nees", Number(results[i].nees.mean_nees)},
                     {"rpe_m", Number(results[i].rpe_m)},
                     {"track_seconds", results[i].track_seconds}});
-  if (Status s = WriteFileAtomic(options.out + "/runs.json", nlohmann::json{{"runs", runs}}.dump(2) + "\n"); !s.ok())
+  return WriteFileAtomic(options.out + "/runs.json", nlohmann::json{{"runs", runs}}.dump(2) + "\n");
+}
+
+// Without covariances: OUT/runs.json, and no nees.json, nees.png or report.html (stale ones are removed); returns the
+// note that says so.
+std::string WriteRunsOnly(const MonteCarloOptions& options, const std::vector<RunResult>& results) {
+  for (const char* stale : {"/nees.json", "/nees.png", "/report.html"})
+    if (Status s = RemoveStaleFile(options.out + stale); !s.ok()) return " (" + s.message() + ")";
+  if (Status s = WriteRunsJson(options, results); !s.ok()) return " (" + s.message() + ")";
+  return " (no NEES: the estimator wrote no covariance.csv)";
+}
+
+// OUT/nees.json, OUT/runs.json and OUT/nees.png; returns the plot note.
+std::string WriteData(const MonteCarloOptions& options, const eval::MonteCarloNees& nees,
+                      const std::vector<RunResult>& results) {
+  if (Status s = WriteFileAtomic(options.out + "/nees.json", eval::NeesJson(nees).dump(2) + "\n"); !s.ok())
     return " (" + s.message() + ")";
+  if (Status s = WriteRunsJson(options, results); !s.ok()) return " (" + s.message() + ")";
   if (!eval::GnuplotAvailable()) return " (gnuplot not found: no nees.png)";
   auto plot =
       eval::WriteNeesPlot(options.out, "Average position NEES over " + std::to_string(options.runs) + " runs", nees);
@@ -392,7 +476,12 @@ std::string WriteOutputs(const MonteCarloOptions& options, const eval::MonteCarl
 std::string MonteCarloOptions::Validate() const {
   if (runs < 1) return "--runs must be at least 1";
   if (jobs < 0) return "--jobs must be >= 0";
-  return "";
+  if (config.empty() == command.command.empty())
+    return "give the estimator either as --config (roamlab's) or as --command (an external one)";
+  if (!external()) return "";
+  if (!calibration.empty() || calibrate_each_run)
+    return "--calibration and --calibrate-each-run are for --config; an external estimator calibrates itself";
+  return command.Validate();
 }
 
 std::string MonteCarloRunFile(const std::string& out, int i) {
@@ -435,10 +524,21 @@ Outcome AggregateMonteCarlo(const MonteCarloOptions& options, MonteCarloSummary*
     runs.push_back(r.value().nees);
     results.push_back(std::move(r).value());
   }
+  // All runs with a covariance (NEES) or none (an external estimator that writes none).
+  const auto with = std::count_if(results.begin(), results.end(), [](const RunResult& r) { return r.has_covariance; });
+  if (with == 0) {
+    const std::string note = WriteRunsOnly(options, results);
+    if (summary) *summary = {eval::MonteCarloNees{}, false, note};
+    return Outcome::Ok();
+  }
+  for (int i = 0; i < options.runs; ++i)
+    if (!results[i].has_covariance)
+      return Outcome::Failed(Status::Error(MonteCarloRunFile(options.out, i) + ": run " + std::to_string(i) +
+                                           " has no covariance while other runs have one (no NEES can be averaged)"));
   Result<eval::MonteCarloNees> nees = eval::AggregateRunNees(runs, options.t0_s);
   if (!nees.ok()) return Outcome::Failed(nees.status());
   const std::string plot_note = WriteOutputs(options, nees.value(), results);
-  if (summary) *summary = {std::move(nees).value(), plot_note};
+  if (summary) *summary = {std::move(nees).value(), true, plot_note};
   return Outcome::Ok();
 }
 

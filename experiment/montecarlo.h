@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "eval/nees.h"
+#include "experiment/external.h"
 #include "experiment/steps.h"
 
 namespace roamlab::experiment {
@@ -18,6 +19,11 @@ inline constexpr unsigned long long kCalibrationSeedOffset = 1000000;
 struct MonteCarloOptions {
   std::string scenario;
   std::string config;
+  // Or, instead of `config`, an external estimator under test (experiment/external.h): run i's recording (without
+  // the truth) is written to OUT/runs/NNNNNN/recording, the command writes OUT/runs/NNNNNN/estimate (its output in
+  // OUT/runs/NNNNNN/estimator.log); the recording is removed once the run succeeded. Its poses are paired with the
+  // truth poses of the same stamp; the NEES needs its covariance.csv (all runs or none: without, no NEES).
+  ExternalCommand command;
   std::string calibration;  // optional calibration.json: tracking uses its values
   std::string out;
   int runs = 50;
@@ -37,16 +43,19 @@ struct MonteCarloOptions {
 
   // What is wrong with the options ("--runs must be at least 1"), "" when nothing.
   std::string Validate() const;
+  bool external() const { return !command.command.empty(); }
 };
 
 struct MonteCarloSummary {
   eval::MonteCarloNees nees;
+  bool has_nees = true;  // false when an external estimator wrote no covariance.csv: no nees.json, `nees` unset
   std::string plot_note;  // "" or why OUT/nees.png (or OUT/report.html) was not written, as " (...)"
 };
 
 // Run i's result file, OUT/runs/NNNNNN.json (six digits): {"run", "seed", "ate_m", "mean_nees", "rpe_m" (translation
-// RMSE of the RPE over pose pairs about 1 s apart [m]), "track_seconds",
-// "t_ns": [...], "nees": [...]} (a NEES that is not finite as null), written under a temporary name and renamed.
+// RMSE of the RPE over pose pairs about 1 s apart [m]), "track_seconds" (an external estimator's: its command's wall
+// time), "covariance" (false: no NEES), "t_ns": [...], "nees": [...]} (a NEES that is not finite as null), written
+// under a temporary name and renamed.
 std::string MonteCarloRunFile(const std::string& out, int i);
 
 // The inputs every run shares: scenario, configurations and calibration.

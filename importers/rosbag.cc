@@ -393,13 +393,28 @@ std::string Select(const Bag& bag, const RosbagImportOptions& options, std::map<
   return "";
 }
 
+// Messages decoded of the selected topics' `total`, reported through RosbagImportOptions::progress.
+struct DecodeProgress {
+  const std::function<void(double)>* report = nullptr;
+  std::size_t done = 0;
+  std::size_t total = 0;
+
+  void Advance() {
+    ++done;
+    if (*report && (done % RosbagImportOptions::kProgressMessages == 0 || done == total))
+      (*report)(static_cast<double>(done) / static_cast<double>(total));
+  }
+};
+
 // Decodes one topic's messages into its streams; "" or the refusal naming the message.
-std::string DecodeTopic(const Bag& bag, const std::vector<std::size_t>& messages, TopicWork* w) {
+std::string DecodeTopic(const Bag& bag, const std::vector<std::size_t>& messages, TopicWork* w,
+                        DecodeProgress* progress) {
   for (std::size_t k = 0; k < messages.size(); ++k) {
     const internal::BagMessage& m = bag.messages[messages[k]];
     Result<RosMessage> decoded = internal::DecodeRosMessage(w->topic->type, m.data, w->topic->encoding);
     std::string problem = decoded.ok() ? AddMessage(decoded.value(), m.receive_time, w) : decoded.status().message();
     if (!problem.empty()) return w->topic->name + " message " + std::to_string(k) + " (counting from 0): " + problem;
+    progress->Advance();
   }
   return "";
 }
@@ -471,9 +486,11 @@ std::string BuildStreams(const Bag& bag, const RosbagImportOptions& options,
   for (std::size_t i = 0; i < bag.messages.size(); ++i) per_topic[bag.messages[i].topic].push_back(i);
   std::set<std::string> names;
   std::map<std::string, std::string> odometry_streams;  // topic -> stream
+  DecodeProgress progress{&options.progress, 0, 0};
+  for (const auto& [index, name] : selected) progress.total += per_topic[index].size();
   for (const auto& [index, name] : selected) {
     TopicWork w{&bag.topics[index], &rep->topics[index], &options, BuildsOf(bag.topics[index].type, name), {}, -1};
-    if (std::string problem = DecodeTopic(bag, per_topic[index], &w); !problem.empty()) return problem;
+    if (std::string problem = DecodeTopic(bag, per_topic[index], &w, &progress); !problem.empty()) return problem;
     w.report->decoded = true;
     for (Build& b : w.builds) {
       Stream s;

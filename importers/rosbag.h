@@ -67,6 +67,7 @@
 // an unknown or unsupported selected topic, no supported topic.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -90,6 +91,11 @@ struct RosbagImportOptions {
   bool wheels_from_odometry = false;                        // also write `wheels` (header comment)
   std::string odometry_topic;                               // the wheels' odometry topic when there are several
   std::optional<double> odometry_wheel_separation_m;        // the controller's B for the wheels (header comment)
+  // Optional: the fraction of the selected topics' messages decoded, in (0, 1], every kProgressMessages messages and
+  // at the end (1). Reading the bag's container comes before the first call.
+  std::function<void(double fraction)> progress;
+
+  static constexpr std::size_t kProgressMessages = 1024;
 };
 
 // What happened to one topic of the bag.

@@ -10,6 +10,7 @@
 
 #include "eval/evaluate.h"
 #include "experiment/diagnose.h"
+#include "experiment/external.h"
 #include "experiment/montecarlo.h"
 #include "experiment/odometry.h"
 #include "experiment/steps.h"
@@ -84,11 +85,34 @@ Status RunCalibrateCase(const CaseContext& context) {
   return Evaluate(context, context.dir + "/calibration", recording.value());
 }
 
+// The case's external estimator (Case::command), run in the suite file's directory.
+experiment::ExternalCommand Command(const CaseContext& context) {
+  experiment::ExternalCommand command;
+  command.command = context.c.command;
+  command.working_dir = context.c.command_dir;
+  if (context.c.timeout_s) command.timeout_s = *context.c.timeout_s;
+  return command;
+}
+
+// An external estimator on the recording stripped of its truth (DIR/input): its output in DIR/estimate, checked
+// against the protocol, then evaluated like roamlab's own.
+Status RunExternalTrackCase(const CaseContext& context, const std::string& recording) {
+  const std::string input = context.dir + "/input", estimate = context.dir + "/estimate";
+  Status st = experiment::MakeEstimatorInput(recording, input);
+  const experiment::ExternalCommand command = Command(context);
+  if (st.ok()) st = experiment::RunExternalCommand(command, input, estimate, context.dir + "/estimator.log");
+  if (!st.ok()) return st;
+  const Result<experiment::ExternalEstimate> read = experiment::ReadExternalEstimate(estimate);
+  if (!read.ok()) return Status::Error("estimator command '" + command.command + "': " + read.status().message());
+  return Evaluate(context, estimate, recording);
+}
+
 // Tracking runs without its per-update time budget (tracking.time_budget_s): where an update reaches it, the result
 // would depend on the machine's load, and a regression value must not.
 Status RunTrackCase(const CaseContext& context) {
   const Result<std::string> recording = Recording(context);
   if (!recording.ok()) return recording.status();
+  if (!context.c.command.empty()) return RunExternalTrackCase(context, recording.value());
   const Result<std::string> calibration = CalibrationFile(context, recording.value());
   if (!calibration.ok()) return calibration.status();
   experiment::TrackRequest request;
@@ -114,6 +138,7 @@ Status RunMonteCarloCase(const CaseContext& context) {
   experiment::MonteCarloOptions options;
   options.scenario = context.c.scenario;
   options.config = context.c.config;
+  if (!context.c.command.empty()) options.command = Command(context);
   options.calibration = calibration;
   options.out = context.dir + "/montecarlo";
   options.runs = context.c.runs;

@@ -25,6 +25,8 @@ using nlohmann::json;
 // Bound, time and effect numbers beyond this magnitude are refused as no physical value (as in scenarios).
 constexpr double kMaxSuiteNumber = 1e9;
 bool InRange(double x) { return std::isfinite(x) && std::abs(x) <= kMaxSuiteNumber; }
+// An external command's time limit per run [s] (as experiment/external.h).
+constexpr double kMaxTimeoutS = 1e6;
 
 const char* const kReductions[] = {"norm", "max_abs", "min", "max", "mean"};
 
@@ -362,6 +364,9 @@ Status CheckKeys(const YAML::Node& node, const Context& ctx, const ModeSpec& mod
   }
   if (node["calibration"] && node["calibrate"])
     return ctx.Error(node, "give 'calibration' (a file) or 'calibrate' (a configuration), not both");
+  if (node["command"] && (node["calibration"] || node["calibrate"]))
+    return ctx.Error(node, "'calibration' and 'calibrate' are for 'config'; an external 'command' calibrates itself");
+  if (node["timeout_s"] && !node["command"]) return ctx.Error(node["timeout_s"], "'timeout_s' is for a 'command'");
   return Status::Ok();
 }
 
@@ -375,6 +380,13 @@ Status LoadValues(const YAML::Node& node, const Context& ctx, const std::string&
     if (node["t0_s"]) c->t0_s = node["t0_s"].as<double>();
     if (node["baseline_seed"]) c->baseline_seed = node["baseline_seed"].as<std::uint64_t>();
     if (node["interval_s"]) c->interval_s = node["interval_s"].as<double>();
+    if (node["timeout_s"]) c->timeout_s = node["timeout_s"].as<double>();
+    if (node["command"]) {
+      c->command = node["command"].as<std::string>();
+      std::error_code ec;
+      const fs::path dir = fs::path(suite_file).parent_path();
+      c->command_dir = fs::absolute(dir.empty() ? fs::path(".") : dir, ec).lexically_normal().string();
+    }
     for (auto [key, field] : {std::pair{"scenario", &c->scenario},
                               {"recording", &c->recording},
                               {"config", &c->config},
@@ -396,6 +408,10 @@ Status LoadValues(const YAML::Node& node, const Context& ctx, const std::string&
   if (c->t0_s && !InRange(*c->t0_s)) return ctx.Error(node["t0_s"], "t0_s must be finite, |t0_s| <= 1e9");
   if (c->interval_s && !(*c->interval_s > 0.0 && InRange(*c->interval_s)))
     return ctx.Error(node["interval_s"], "interval_s must be positive and at most 1e9");
+  if (node["command"] && c->command.find_first_not_of(" \t") == std::string::npos)
+    return ctx.Error(node["command"], "the estimator command is empty");
+  if (c->timeout_s && !(*c->timeout_s > 0.0 && *c->timeout_s <= kMaxTimeoutS))
+    return ctx.Error(node["timeout_s"], "timeout_s must be positive and at most 1e6 s");
   return Status::Ok();
 }
 
@@ -587,6 +603,9 @@ Result<Case> LoadCase(const YAML::Node& node, const Context& suite, std::set<std
   for (const YAML::Node& check : checks) {
     Result<Check> k = LoadCheck(check, ctx, *mode.value(), names);
     if (!k.ok()) return k.status();
+    if (!c.command.empty() && k.value().metric.output == "summary")
+      return ctx.Error(check, "metric '" + k.value().metric.text +
+                                  "': an external command writes no summary.json (its case writes metrics)");
     c.checks.push_back(std::move(k).value());
   }
   return c;

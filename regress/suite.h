@@ -12,6 +12,9 @@
 //       scenario: atv_hills.yaml        # simulated with `seed` (default: the scenario's own); or recording: DIR
 //       seed: 1
 //       config: atv_calibration.yaml    # paths are relative to the suite file
+//       command: "../examples/dead_reckoning/dead_reckoning.sh {recording} {out}"   # track, montecarlo: instead of
+//                                       # config, an external estimator under test (experiment/external.h), run
+//                                       # in the suite file's directory; timeout_s: its time limit per run [s]
 //       faults:                         # calibrate, track: sensor faults injected into the simulated recording,
 //         - {type: outage, stream: gps, start_s: 5, duration_s: 20}   # as a scenario's `faults:` (sim/faults.h)
 //       checks:
@@ -112,6 +115,9 @@ struct Case {
   std::string recording;
   std::optional<std::uint64_t> seed;  // noise seed of the simulated recording
   std::string config;
+  std::string command;              // track, montecarlo: an external estimator instead of config,
+  std::string command_dir;          // run in this directory (the suite file's),
+  std::optional<double> timeout_s;  // with this time limit per run [s]
   std::string calibration;         // calibration.json whose values tracking uses
   std::string calibrate;           // or: calibrate first with this configuration, track with its values
   int runs = 0;                    // montecarlo

@@ -64,9 +64,17 @@ TEST_F(ImportRosbagCliTest, SummaryNamesTypesAndWarnsOfChecks) {
   EXPECT_THAT(r.err, HasSubstr("roamlab import: warning: /imu (imu): header stamps are 100 ms earlier than the bag's "
                                "receive times\n"));
   EXPECT_THAT(r.err, HasSubstr("roamlab import: warning: /zero/odom (zero_odom): all values are zero\n"));
+  EXPECT_EQ(r.err.rfind("import: 100%, ", 0), 0u) << r.err;  // the progress (common/progress.h), off a terminal
   Result<recording::Recording> back = recording::ReadRecording(rec);
   ASSERT_TRUE(back.ok()) << back.status().message();
   EXPECT_EQ(back.value().streams.size(), 5u);
+
+  // --quiet: no progress, no summary; the warnings stay.
+  r = Roamlab("import rosbag " + bag_ + " --out " + rec + " --platform skid_steer --quiet", dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "");
+  EXPECT_THAT(r.err, ::testing::Not(HasSubstr("import: 100%")));
+  EXPECT_THAT(r.err, HasSubstr("roamlab import: warning: /zero/odom (zero_odom): all values are zero\n"));
 }
 
 TEST_F(ImportRosbagCliTest, ListTopicAndOdometryTopic) {

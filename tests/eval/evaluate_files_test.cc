@@ -205,6 +205,36 @@ TEST_F(EvaluateFilesTest, KittiFilesArePairedByIndex) {
   EXPECT_LT(e.metrics["ate_m"].get<double>(), 1e-5);
 }
 
+// A plain TUM estimate with its covariances in a file of their own: every pose 0.1 m off in x with a variance of
+// 0.01 m^2 in x gives a NEES of exactly 1 per pose; without the file there is no NEES; an untimed (KITTI) estimate
+// cannot pair covariance rows by stamp.
+TEST_F(EvaluateFilesTest, CovarianceFileGivesAPlainEstimateItsNees) {
+  const Trajectory drive = Drive();
+  Trajectory estimate = drive;
+  std::string rows = "t,xx,xy,xz,yx,yy,yz,zx,zy,zz\n";
+  for (StampedPose& p : estimate) {
+    p.p_world_body.x() += 0.1;
+    rows += FormatSeconds(p.t) + ",0.01,0,0,0,1,0,0,0,1\n";
+  }
+  ASSERT_TRUE(WriteTum(drive, File("gt.tum")).ok());
+  ASSERT_TRUE(WriteTum(estimate, File("est.tum")).ok());
+  WriteFile(File("est_covariance.csv"), rows);
+  EvaluateOptions options = Options("gt.tum", "est.tum");
+  EXPECT_FALSE(MustEvaluate(options).metrics.contains("nees"));
+  options.covariance_file = File("est_covariance.csv");
+  const Evaluation e = MustEvaluate(options);
+  ASSERT_TRUE(e.metrics.contains("nees")) << e.metrics.dump(2);
+  EXPECT_NEAR(e.metrics["nees_mean"].get<double>(), 1.0, 1e-9);
+  EXPECT_EQ(e.metrics["nees"]["poses"], drive.size());
+
+  options.covariance_file = File("absent.csv");
+  EXPECT_THAT(Error(options), StartsWith(File("absent.csv") + ": cannot open"));
+  WriteFile(File("est.kitti"), "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 1 0 1 0 0 0 0 1 0\n");
+  options.estimate_dir = File("est.kitti");
+  options.covariance_file = File("est_covariance.csv");
+  EXPECT_THAT(Error(options), HasSubstr("has no time stamps"));
+}
+
 TEST_F(EvaluateFilesTest, EurocReferenceAgainstATumEstimate) {
   const Trajectory drive = Drive();
   std::string csv = "#timestamp [ns],p_RS_R_x [m],p_RS_R_y [m],p_RS_R_z [m],q_RS_w [],q_RS_x [],q_RS_y [],q_RS_z []\n";

@@ -162,6 +162,30 @@ TEST(ImportRosbagChecksTest, ClockOffsetIsReportedWithItsSign) {
       Contains("/imu/data (imu_data): 1 header stamps jump back from the previous message's (sorted by stamp)"));
 }
 
+// Progress: the fraction of the selected topics' messages decoded, every kProgressMessages messages and at the end;
+// here 2500 IMU messages (the /rosout log is not a selected topic) and one odometry message.
+TEST(ImportRosbagProgressTest, ReportsTheFractionOfMessagesDecoded) {
+  std::string chunk = Connection(0, "/imu", "sensor_msgs/Imu") + Connection(1, "/odom", "nav_msgs/Odometry") +
+                      Connection(2, "/rosout", "rosgraph_msgs/Log");
+  const int imu = 2500;
+  for (int k = 0; k < imu; ++k) {
+    const std::uint32_t sec = 100 + static_cast<std::uint32_t>(k / 100), nsec = 10000000u * (k % 100);
+    chunk += MessageRecord(0, sec, nsec, testing::ImuMessage(kRos1, sec, nsec, 0.001 * k));
+    chunk += MessageRecord(2, sec, nsec, "log text");
+  }
+  chunk += MessageRecord(1, 100, 0,
+                         testing::OdometryMessage(kRos1, 100, 0, "odom", "base_link", {0, 0, 0, 1}, 1.0, 0.0, 0.1));
+  std::vector<double> fractions;
+  RosbagImportOptions options;
+  options.progress = [&fractions](double fraction) { fractions.push_back(fraction); };
+  TempDir dir;
+  Imported in = Import(BagOf(chunk, "none"), dir, options);
+  ASSERT_TRUE(in.rec.ok()) << in.rec.status().message();
+  const double total = imu + 1;
+  EXPECT_THAT(fractions, ::testing::ElementsAre(::testing::DoubleEq(1024 / total), ::testing::DoubleEq(2048 / total),
+                                                ::testing::DoubleEq(1.0)));
+}
+
 // An odometry twist in the parent frame (empty child_frame_id), heading 90 deg: rotated into the body frame, so the
 // parent's vy is the body's vx (and the variances swap); the same twist in the child frame is kept.
 TEST(ImportRosbagOdometryTest, ParentFrameTwistIsRotatedIntoTheBodyFrame) {

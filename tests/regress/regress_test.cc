@@ -10,6 +10,7 @@
 #include <fstream>
 #include <string>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -238,6 +239,70 @@ TEST_F(RegressTest, OpenTargetsAndAbsentDataDoNotFailTheRun) {
                      "cases:\n  - name: synthetic_track\n    mode: track\n    recording: rec\n"
                      "    config: good.yaml\n    checks:\n      - {metric: summary.poses, bound: \"<= 1\"}\n");
   EXPECT_EQ(Run(path, "out_closed", false, 1), 1);
+}
+
+// An external estimator under test (a `command:` instead of `config:`): the dead reckoning of examples/ on its
+// scenario is scored as roamlab's own estimates are, and its ATE is the one `evaluate` computes from its files; a
+// command that fails, writes a malformed trajectory or exceeds its time makes its case an error that results.json and
+// junit.xml name, while the other cases still run.
+TEST_F(RegressTest, ExternalCommandCasesAreScoredAndTheirFailuresNamed) {
+  const std::string source = roamlab::testing::SourceDir();
+  const std::string scenario = source + "/examples/dead_reckoning/indoor_diffdrive_mocap.yaml";
+  const std::string script = source + "/examples/dead_reckoning/dead_reckoning.sh";
+  testing::WriteFile(dir_->File("bad_line.tum"), "0.0 0 0 0 0 0 0 1\n0.01 0 0 0 0 0 0\n");
+  const std::string path = dir_->File("suite_external.yaml");
+  const auto track_case = [&](const std::string& name, const std::string& command, const std::string& extra) {
+    return "  - name: " + name + "\n    mode: track\n    scenario: " + scenario + "\n    seed: 1\n    command: \"" +
+           command + "\"\n" + extra + "    checks:\n      - {metric: metrics.ate_m, bound: \"<= 0.05\"}\n";
+  };
+  testing::WriteFile(path, "cases:\n" + track_case("dead_reckoning", "sh " + script + " {recording} {out}", "") +
+                               track_case("exits_3", "echo no encoders >&2; exit 3", "") +
+                               track_case("malformed", "cp bad_line.tum {out}/trajectory.tum", "") +
+                               track_case("too_slow", "sleep 20; : {out}", "    timeout_s: 0.5\n"));
+  EXPECT_EQ(Run(path, "out_external", false, 2), 1);
+  const json results = ReadJson(dir_->File("out_external/results.json"));
+  ASSERT_EQ(results["cases"].size(), 4u) << results.dump(2);
+  const json& good = results["cases"][0];
+  EXPECT_EQ(good["checks"][0]["result"], "passed") << good.dump(2);
+  const double ate = good["checks"][0]["value"].get<double>();
+  EXPECT_GT(ate, 0.001);  // dead reckoning drifts: not the truth scored against itself
+
+  // The same ATE from `evaluate` on the files the command wrote and the recording the case simulated.
+  eval::EvaluateOptions evaluate;
+  evaluate.estimate_dir = dir_->File("out_external/cases/dead_reckoning/estimate");
+  evaluate.recording_dir = dir_->File("out_external/cases/dead_reckoning/recording");
+  const auto evaluation = eval::Evaluate(evaluate);
+  ASSERT_TRUE(evaluation.ok()) << evaluation.status().message();
+  EXPECT_EQ(evaluation.value().metrics["ate_m"].get<double>(), ate);
+  EXPECT_TRUE(evaluation.value().metrics.contains("nees"));
+  EXPECT_FALSE(fs::exists(dir_->File("out_external/cases/dead_reckoning/input/ground_truth.tum")));
+
+  const auto error = [&](int k) { return results["cases"][k]["error"].get<std::string>(); };
+  EXPECT_THAT(error(1), ::testing::HasSubstr("estimator command 'echo no encoders >&2; exit 3': exited with status 3"));
+  EXPECT_THAT(error(1), ::testing::HasSubstr("estimator.log: no encoders"));
+  EXPECT_THAT(error(2), ::testing::HasSubstr("estimate/trajectory.tum:2"));
+  EXPECT_THAT(error(3), ::testing::HasSubstr("killed after the time-out of 0.5 s"));
+  const std::string junit = testing::ReadFile(dir_->File("out_external/junit.xml"));
+  for (const char* name : {"exits_3", "malformed", "too_slow"})
+    EXPECT_NE(junit.find("<testcase classname=\"" + std::string(name) + "\" name=\"metrics.ate_m\">\n      <error"),
+              std::string::npos)
+        << name << "\n"
+        << junit;
+}
+
+// montecarlo with a command: every run's recording goes to the command, and the runs' ATE and NEES are scored.
+TEST_F(RegressTest, ExternalMonteCarloCase) {
+  const std::string source = roamlab::testing::SourceDir();
+  const std::string path = dir_->File("suite_external_mc.yaml");
+  testing::WriteFile(path, "cases:\n  - name: dead_reckoning_mc\n    mode: montecarlo\n    scenario: " + source +
+                               "/examples/dead_reckoning/indoor_diffdrive_mocap.yaml\n    command: \"sh " + source +
+                               "/examples/dead_reckoning/dead_reckoning.sh\"\n    runs: 2\n    checks:\n"
+                               "      - {metric: runs.runs.ate_m.max, bound: \"<= 0.05\"}\n"
+                               "      - {metric: nees.fraction_in_band, bound: \">= 0\"}\n");
+  EXPECT_EQ(Run(path, "out_external_mc", false, 2), 0);
+  const std::string runs = dir_->File("out_external_mc/cases/dead_reckoning_mc/montecarlo/runs");
+  EXPECT_TRUE(fs::exists(runs + "/000001/estimate/covariance.csv"));
+  EXPECT_FALSE(fs::exists(runs + "/000001/recording"));  // removed once the run succeeded
 }
 
 // A model-free odometry case on synthetic OptiOdom files (a differential drive whose wheel radii and track differ

@@ -178,6 +178,22 @@ TEST_F(SuiteTest, LoadsCasesWithTheirChecks) {
   EXPECT_EQ(mc.checks[2].metric.reduction, "1");
 }
 
+// A case with an external estimator: its command kept as written, run in the suite file's directory.
+TEST_F(SuiteTest, LoadsExternalCommandCases) {
+  const std::string path = WriteSuite("  - name: dr\n    mode: montecarlo\n    scenario: " +
+                                      Scenario("atv_hills.yaml") +
+                                      "\n    command: \"sh ../dr.sh {recording} {out}\"\n    timeout_s: 30\n"
+                                      "    runs: 2\n    checks:\n"
+                                      "      - {metric: runs.runs.ate_m.max, bound: \"<= 1\"}\n");
+  const Result<Suite> suite = LoadSuite(path);
+  ASSERT_TRUE(suite.ok()) << suite.status().message();
+  const Case& c = suite.value().cases[0];
+  EXPECT_EQ(c.command, "sh ../dr.sh {recording} {out}");
+  EXPECT_EQ(c.command_dir, dir_.path());
+  EXPECT_EQ(c.timeout_s, 30.0);
+  EXPECT_TRUE(c.config.empty());
+}
+
 TEST_F(SuiteTest, EachKindOfBadSuiteIsOneLineNamingFileCaseAndProblem) {
   const std::string check = "      - {metric: metrics.ate_m, bound: \"<= 1\"}\n";
   struct Bad {
@@ -185,6 +201,10 @@ TEST_F(SuiteTest, EachKindOfBadSuiteIsOneLineNamingFileCaseAndProblem) {
     std::string problem;
   };
   const std::string hills = Scenario("atv_hills.yaml"), cal = Config("atv_calibration.yaml");
+  const std::string tracking = Config("atv_tracking.yaml");
+  const auto Track = [&](const std::string& estimator, const std::string& checks) {
+    return "  - name: cal\n    mode: track\n    scenario: " + hills + "\n" + estimator + "    checks:\n" + checks;
+  };
   const Bad bad[] = {
       {CalibrateCase("      - {metric: metrics.ate_meters, bound: \"<= 1\"}\n"), "unknown key 'ate_meters'"},
       {CalibrateCase("      - {metric: metrics.parameters.gps.lever_arm.eror.norm, bound: \"<= 1\"}\n"),
@@ -245,6 +265,15 @@ TEST_F(SuiteTest, EachKindOfBadSuiteIsOneLineNamingFileCaseAndProblem) {
            "\n    runs: 2\n    t0_s: .nan\n    checks:\n      - {metric: nees.fraction_in_band, bound: \">= 0.9\"}\n",
        "t0_s must be finite"},
       {CalibrateCase(check) + CalibrateCase(check), "a second case of this name"},
+      {Track("    config: " + tracking + "\n    command: prog\n", check), "exactly one of 'config' and 'command'"},
+      {Track("", check), "exactly one of 'config' and 'command'"},
+      {Track("    command: prog\n    calibrate: " + cal + "\n", check), "an external 'command' calibrates itself"},
+      {Track("    config: " + tracking + "\n    timeout_s: 5\n", check), "'timeout_s' is for a 'command'"},
+      {Track("    command: prog\n    timeout_s: 0\n", check), "timeout_s must be positive"},
+      {Track("    command: \" \"\n", check), "the estimator command is empty"},
+      {Track("    command: prog\n", "      - {metric: summary.poses, bound: \">= 1\"}\n"),
+       "an external command writes no summary.json"},
+      {CalibrateCase(check, "    command: prog\n"), "unknown key 'command' for mode calibrate"},
   };
   for (const Bad& b : bad) {
     const std::string path = WriteSuite(b.cases);
