@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "apps/cli.h"
+#include "apps/consistency.h"
 #include "batch/slurm.h"
 #include "batch/work.h"
 #include "common/progress.h"
@@ -33,6 +34,7 @@ int RunLocally(const MonteCarloArgs& args, batch::Work& work) {
 }  // namespace
 
 int RunMonteCarlo(const MonteCarloArgs& args) {
+  if (args.calibration_consistency) return RunCalibrationConsistency(args);
   if (const std::string problem = args.Validate(); !problem.empty()) return BadInput(args.err, "montecarlo", problem);
   const std::unique_ptr<batch::Work> work = batch::MonteCarloWork(args);
   if (args.backend.backend == "slurm")
