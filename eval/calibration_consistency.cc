@@ -185,8 +185,10 @@ nlohmann::json ConsistencyJson(const std::vector<BlockConsistency>& blocks) {
 std::string ConsistencyTable(const std::vector<BlockConsistency>& blocks) {
   std::ostringstream s;
   if (blocks.empty()) return "";
-  s << "parameter              bias +- s.e.           spread    mean std  spread/std  cover 1s   2s     3s   "
-       "  CRB std   std/CRB\n";
+  char header[192];
+  std::snprintf(header, sizeof header, "%-23s%24s%10s%12s%11s %6s%6s%6s%12s%9s\n", "parameter", "bias +- std error  ",
+                "spread", "mean std", "spread/std", "1s %", "2s %", "3s %", "CRB std", "std/CRB");
+  s << header;
   for (const BlockConsistency& b : blocks)
     for (std::size_t i = 0; i < b.components.size(); ++i) {
       const ComponentConsistency& c = b.components[i];
