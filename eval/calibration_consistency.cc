@@ -111,7 +111,8 @@ nlohmann::json ComponentJson(const ComponentConsistency& c, int index) {
           {"spread_over_std", Number(c.spread_over_std)},
           {"coverage", coverage},
           {"cramer_rao_std", Number(c.cramer_rao_std)},
-          {"efficiency", Number(c.efficiency)}};
+          {"efficiency", Number(c.efficiency)},
+          {"noise_free_error", Number(c.noise_free_error)}};
 }
 
 std::string Format(const char* format, double x) {
@@ -186,8 +187,9 @@ std::string ConsistencyTable(const std::vector<BlockConsistency>& blocks) {
   std::ostringstream s;
   if (blocks.empty()) return "";
   char header[192];
-  std::snprintf(header, sizeof header, "%-23s%24s%10s%12s%11s %6s%6s%6s%12s%9s\n", "parameter", "bias +- std error  ",
-                "spread", "mean std", "spread/std", "1s %", "2s %", "3s %", "CRB std", "std/CRB");
+  std::snprintf(header, sizeof header, "%-23s%24s%10s%12s%11s %6s%6s%6s%12s%9s%14s\n", "parameter",
+                "bias +- std error  ", "spread", "mean std", "spread/std", "1s %", "2s %", "3s %", "CRB std", "std/CRB",
+                "no-noise err");
   s << header;
   for (const BlockConsistency& b : blocks)
     for (std::size_t i = 0; i < b.components.size(); ++i) {
@@ -200,7 +202,8 @@ std::string ConsistencyTable(const std::vector<BlockConsistency>& blocks) {
         << Format("%+10.3e", c.bias) << " +- " << Format("%9.3e", c.bias_standard_error) << (c.biased ? "*" : " ")
         << Format("%10.3e", c.spread) << Format("%12.3e", c.mean_std) << Format("%10.2f", c.spread_over_std) << "  "
         << Percent(c.coverage[0].fraction) << Percent(c.coverage[1].fraction) << Percent(c.coverage[2].fraction)
-        << Format("%12.3e", c.cramer_rao_std) << Format("%9.2f", c.efficiency) << "\n";
+        << Format("%12.3e", c.cramer_rao_std) << Format("%9.2f", c.efficiency)
+        << Format("%+14.3e", c.noise_free_error) << "\n";
     }
   s << "block                  dim  runs  mean NEES  band (" << Format("%.0f", 100.0 * (1.0 - blocks.front().alpha))
     << " %)\n";

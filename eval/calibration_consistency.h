@@ -18,6 +18,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -57,6 +58,9 @@ struct ComponentConsistency {
   std::array<Coverage, 3> coverage;  // k = 1, 2, 3
   double cramer_rao_std = 0.0;       // NaN when not given
   double efficiency = 0.0;           // mean_std / cramer_rao_std
+  // Set by the caller when known: the error of the calibration without noise, what a bias shared by every run comes
+  // from (physics the model misses); NaN when not given.
+  double noise_free_error = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct BlockConsistency {
@@ -83,11 +87,11 @@ BlockConsistency BlockStatistics(const std::string& name, const std::vector<Para
 // [{"name", "runs", "dimension", "nees": {"mean", "band": [lo, hi], "alpha", "in_band", "runs", "per_run": [...]},
 //   "components": [{"index", "bias", "bias_standard_error", "biased", "spread", "mean_std", "spread_over_std",
 //                   "coverage": [{"sigmas", "nominal", "fraction", "confidence": [lo, hi], "consistent"}, x3],
-//                   "cramer_rao_std", "efficiency"}]}]; NaN as null.
+//                   "cramer_rao_std", "efficiency", "noise_free_error"}]}]; NaN as null.
 nlohmann::json ConsistencyJson(const std::vector<BlockConsistency>& blocks);
 
 // The printed table: one row per component (bias +- standard error, spread, mean std, ratio, coverage at 1/2/3
-// sigma, Cramer-Rao std, efficiency), then one row per block (mean NEES and its band).
+// sigma, Cramer-Rao std, efficiency, noise-free error), then one row per block (mean NEES and its band).
 std::string ConsistencyTable(const std::vector<BlockConsistency>& blocks);
 
 }  // namespace roamlab::eval

@@ -34,6 +34,7 @@ struct Shared {
   sim::Scenario scenario;
   estimator::EstimatorConfig config;
   std::map<std::string, Eigen::VectorXd> cramer_rao_std;
+  std::map<std::string, Eigen::VectorXd> noise_free_error;
 };
 
 // One calibrated parameter of one run against its truth.
@@ -278,9 +279,12 @@ Outcome Prepare(const MonteCarloOptions& options, Shared* shared) {
     return Outcome::BadInput(Status::Error(options.config + ": no free parameter to calibrate"));
   if (const Status dir = MakeOutputDirectory(options.out + "/calibrations"); !dir.ok()) return Outcome::BadInput(dir);
   if (options.log) options.log("Cramer-Rao std: calibrating the scenario simulated without noise");
-  auto crb = CramerRaoStd(shared->scenario, shared->config);
+  auto noise_free = CalibrateWithoutNoise(shared->scenario, shared->config);
+  if (!noise_free.ok()) return Outcome::Failed(Status::Error("noise-free calibration: " + noise_free.status().message()));
+  auto crb = CramerRaoStd(noise_free.value());
   if (!crb.ok()) return Outcome::Failed(Status::Error("Cramer-Rao std: " + crb.status().message()));
   shared->cramer_rao_std = std::move(crb).value();
+  shared->noise_free_error = std::move(noise_free.value().error);
   return Outcome::Ok();
 }
 
@@ -296,6 +300,8 @@ Outcome Aggregate(const MonteCarloOptions& options, const Shared& shared, Consis
     if (crb.size() != draws.value()[k].front().error.size())
       return Outcome::Failed(Status::Error(names[k] + ": the Cramer-Rao std has another size than the runs' errors"));
     blocks.push_back(eval::BlockStatistics(names[k], draws.value()[k], crb));
+    const Eigen::VectorXd& noise_free = shared.noise_free_error.at(names[k]);
+    for (Eigen::Index i = 0; i < noise_free.size(); ++i) blocks.back().components[i].noise_free_error = noise_free[i];
   }
   Status written = Status::Ok();
   const std::string note = WriteOutputs(options, blocks, draws.value(), &written);
@@ -306,18 +312,23 @@ Outcome Aggregate(const MonteCarloOptions& options, const Shared& shared, Consis
 
 }  // namespace
 
-Result<std::map<std::string, Eigen::VectorXd>> CramerRaoStd(const sim::Scenario& scenario,
-                                                            const estimator::EstimatorConfig& config) {
+Result<NoiseFreeCalibration> CalibrateWithoutNoise(const sim::Scenario& scenario,
+                                                   const estimator::EstimatorConfig& config) {
   recording::Truth truth;
   auto calibrated = SimulateAndCalibrate(scenario, config, scenario.seed, false, &truth);
   if (!calibrated.ok()) return calibrated.status();
-  std::map<std::string, Eigen::VectorXd> out;
-  for (const estimator::ParameterEstimate& p : calibrated.value().parameters) {
-    if (!truth.calibration.count(p.name))
-      return Status::Error(p.name + ": the scenario's truth has no value for this free parameter");
-    out[p.name] = p.std;
+  auto compared = CompareWithTruth(calibrated.value(), truth);
+  if (!compared.ok()) return compared.status();
+  NoiseFreeCalibration out;
+  for (const RunParameter& p : compared.value()) {
+    out.std[p.name] = p.draw.std;
+    out.error[p.name] = p.draw.error;
   }
   return out;
+}
+
+Result<std::map<std::string, Eigen::VectorXd>> CramerRaoStd(const NoiseFreeCalibration& noise_free) {
+  return noise_free.std;
 }
 
 std::string ConsistencyRunFile(const std::string& out, int i) {

@@ -22,12 +22,19 @@
 
 namespace roamlab::experiment {
 
-// The standard deviation each free parameter's tangent components can reach on the scenario's drive, by name:
-// the std `calibrate` reports on the scenario simulated with every noise source off (the recording at the truth, up
-// to the physics the configuration does not model), the Cramer-Rao bound of the configured noise. One function so
-// that another computation of the bound can replace it.
-Result<std::map<std::string, Eigen::VectorXd>> CramerRaoStd(const sim::Scenario& scenario,
-                                                            const estimator::EstimatorConfig& config);
+// The calibration of the scenario simulated with every noise source off, per free parameter (by name): the std it
+// reports, which is the Cramer-Rao bound of the configured noise, and its error against the truth (tangent), what the
+// physics the configuration does not model leaves: a bias every noisy realization of the same drive shares.
+struct NoiseFreeCalibration {
+  std::map<std::string, Eigen::VectorXd> std;
+  std::map<std::string, Eigen::VectorXd> error;
+};
+Result<NoiseFreeCalibration> CalibrateWithoutNoise(const sim::Scenario& scenario,
+                                                   const estimator::EstimatorConfig& config);
+
+// The standard deviation each free parameter's tangent components can reach on the scenario's drive, by name: the
+// noise-free calibration's std. One function so that another computation of the bound can replace it.
+Result<std::map<std::string, Eigen::VectorXd>> CramerRaoStd(const NoiseFreeCalibration& noise_free);
 
 // Run i's result file, OUT/calibrations/NNNNNN.json (six digits): {"run", "seed", "seconds" (calibration time),
 // "parameters": {NAME: {"manifold", "truth", "estimate", "error" (tangent, eval/parameters.h), "std",
@@ -40,13 +47,14 @@ struct ConsistencySummary {
 };
 
 // Uses options.scenario, config (the calibration configuration), out, runs, jobs, seed_base, resume (runs whose
-// result file exists are not run again), log and progress. Computes the Cramer-Rao std, runs the calibrations over
+// result file exists are not run again), log and progress. Calibrates the noise-free recording (the Cramer-Rao std and
+// each component's noise-free error), runs the calibrations over
 // `jobs` threads (the result does not depend on it), then writes OUT/consistency.json ({"scenario", "config",
 // "runs", "seed_base", "cramer_rao": how the bound was computed, "parameters": eval::ConsistencyJson}) and
 // OUT/consistency.png (the normalized errors error / std of every run per component with the +-2 band, and the
 // coverage of the 1, 2, 3 sigma intervals against their nominal shares). A failed run does not stop the others; the
 // call then fails naming the first and writes no summary. Bad input: a scenario or configuration that does not load,
-// a configuration with no free parameter, a free parameter without a true value.
+// a configuration with no free parameter. A free parameter the scenario's truth has no value for fails the call.
 Outcome RunCalibrationConsistency(const MonteCarloOptions& options, ConsistencySummary* summary = nullptr);
 
 }  // namespace roamlab::experiment

@@ -147,6 +147,8 @@ TEST_F(ConsistencyCliTest, StatisticsAreThoseOfTheRuns) {
   // The Cramer-Rao std of the lever arm is known and the runs report one of the same size (a 6 s drive).
   const nlohmann::json& lever = j["parameters"][0]["components"][0];
   ASSERT_TRUE(lever["cramer_rao_std"].is_number());
+  ASSERT_TRUE(lever["noise_free_error"].is_number());
+  EXPECT_LT(std::abs(lever["noise_free_error"].get<double>()), 3.0 * lever["cramer_rao_std"].get<double>());
   EXPECT_NEAR(lever["efficiency"].get<double>(), 1.0, 0.5);
   if (r.out.find("gnuplot not found") == std::string::npos) {
     EXPECT_TRUE(fs::exists(dir_ / "c" / "consistency.png"));
