@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "apps/cli.h"
+#include "apps/consistency.h"
 #include "batch/slurm.h"
 #include "batch/work.h"
 #include "common/progress.h"
@@ -34,6 +35,7 @@ int RunLocally(const MonteCarloArgs& args, batch::Work& work) {
 }  // namespace
 
 int RunMonteCarlo(const MonteCarloArgs& given) {
+  if (given.calibration_consistency) return RunCalibrationConsistency(given);
   // An external command runs where roamlab was started, wherever the runs execute (a Slurm task's directory).
   MonteCarloArgs args = given;
   std::error_code ec;

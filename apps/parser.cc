@@ -179,6 +179,9 @@ void AddMonteCarlo(CLI::App* app, Commands* commands) {
     mc->add_option("--t0", args->t0_s, "Leave the first T0 seconds out of fraction_in_band (default 2)");
     mc->add_flag("--calibrate-each-run", args->calibrate_each_run,
                  "With tracking.calibrate: each run calibrates a drive of its own instead of sharing one calibration");
+    mc->add_flag("--calibration-consistency", args->calibration_consistency,
+                 "Calibrate each run with --config instead of tracking it: the calibration's std against its errors "
+                 "(consistency.json, consistency.png)");
     mc->add_flag("--no-time-budget", args->no_time_budget,
                  "Ignore tracking.time_budget_s: results that do not depend on the machine's speed or load");
     mc->add_flag("--resume", args->resume, "Run only the runs whose result file OUT/runs/NNNNNN.json is missing");

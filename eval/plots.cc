@@ -304,6 +304,47 @@ Result<PlotFiles> WriteVelocityPlot(const std::string& directory, const std::str
   return files;
 }
 
+Result<PlotFiles> WriteConsistencyPlot(const std::string& directory, const std::string& title,
+                                       const std::vector<NormalizedErrors>& components) {
+  PlotFiles files{"consistency.gp", "consistency.png", {"consistency_errors.dat", "consistency_coverage.dat"}};
+  std::ostringstream errors, coverage, tics;
+  errors << "# component error_over_std (one row per run)\n";
+  coverage << "# component coverage_1sigma_pct coverage_2sigma_pct coverage_3sigma_pct label\n";
+  for (std::size_t c = 0; c < components.size(); ++c) {
+    for (double e : components[c].error_over_std) errors << c << ' ' << Num(e) << '\n';
+    coverage << c;
+    for (double f : components[c].coverage) coverage << ' ' << Num(100.0 * f);
+    coverage << ' ' << components[c].label << '\n';
+    tics << (c == 0 ? "" : ", ") << Quote(components[c].label) << ' ' << c;
+  }
+  if (Status st = WriteText(directory, files.data[0], errors.str()); !st.ok()) return st;
+  if (Status st = WriteText(directory, files.data[1], coverage.str()); !st.ok()) return st;
+
+  const int width = std::max(900, 40 * static_cast<int>(components.size()) + 200);
+  std::ostringstream gp;
+  gp << "# Redraw: cd into this directory, then: gnuplot " << files.script << "\n"
+     << Terminal(width, 900) << "set output " << Quote(files.image) << "\n"
+     << "set multiplot layout 2,1 title " << Quote(title) << "\n"
+     << "set xrange [-0.5:" << Num(components.size() - 0.5) << "]\nset grid ytics\nset key top right box opaque\n"
+     << "set lmargin 10\nset rmargin 3\nset xtics 1\nset format x ''\n"
+     << "set ylabel 'error / reported std'\nset yrange [*<-4:4<*]\n"
+     << "plot " << Quote(files.data[0]) << " using 1:2 with points pt 7 ps 0.6 lc rgb '#1f77b4' title 'runs', \\\n"
+     << "     2 with lines dt 2 lw 1.5 lc rgb '#d62728' title '+-2', \\\n"
+     << "     -2 with lines dt 2 lw 1.5 lc rgb '#d62728' notitle\n"
+     << "set format x '%g'\nset xtics (" << tics.str() << ") rotate by 45 right\n"
+     << "set ylabel 'coverage [%]'\nset yrange [0:130]\nset ytics 0, 20, 100\n"
+     << "set key top center horizontal box opaque\n"
+     << "set boxwidth 0.25\nset style fill solid 0.8 noborder\n"
+     << "plot " << Quote(files.data[1]) << " using ($1-0.27):2 with boxes lc rgb '#9ecae1' title '1 sigma', \\\n"
+     << "     '' using 1:3 with boxes lc rgb '#4292c6' title '2 sigma', \\\n"
+     << "     '' using ($1+0.27):4 with boxes lc rgb '#08519c' title '3 sigma', \\\n"
+     << "     68.27 with lines dt 2 lc rgb '#555555' title 'nominal 68.3, 95.4, 99.7 %', \\\n"
+     << "     95.45 with lines dt 2 lc rgb '#555555' notitle, 99.73 with lines dt 2 lc rgb '#555555' notitle\n"
+     << "unset multiplot\n";
+  if (Status st = WriteText(directory, files.script, gp.str()); !st.ok()) return st;
+  return files;
+}
+
 bool GnuplotAvailable() {
   const char* path = std::getenv("PATH");
   if (!path) return false;

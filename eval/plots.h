@@ -9,8 +9,11 @@
 //   nees             average NEES against time with the chi-square band lines (the seed's Fig. 4)
 //   velocity         forward speed, yaw rate and rotational RPE against time: truth, encoders alone, fused estimate
 //                    (the seed's Fig. 6)
+//   consistency      a calibration's normalized errors over Monte-Carlo runs per parameter component, and the
+//                    coverage of its 1, 2, 3 sigma intervals (eval/calibration_consistency.h)
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -88,6 +91,18 @@ struct VelocityPlotData {
 // velocity.png. Sizes CHECKed.
 Result<PlotFiles> WriteVelocityPlot(const std::string& directory, const std::string& title,
                                     const VelocityPlotData& data);
+
+// One calibrated parameter component over Monte-Carlo runs.
+struct NormalizedErrors {
+  std::string label;                    // "gps.lever_arm[2]" (no spaces)
+  std::vector<double> error_over_std;   // per run; NaN where the std is unknown
+  std::array<double, 3> coverage{};     // share of runs within 1, 2, 3 reported std
+};
+// Two stacked panels over the components: every run's error / std with the +-2 band, and the coverage of the 1, 2, 3
+// sigma intervals [%] as bars beside their nominal shares (68.3, 95.4, 99.7 %). Files consistency.gp,
+// consistency_errors.dat, consistency_coverage.dat, consistency.png.
+Result<PlotFiles> WriteConsistencyPlot(const std::string& directory, const std::string& title,
+                                       const std::vector<NormalizedErrors>& components);
 
 // True when an executable named gnuplot is on PATH.
 bool GnuplotAvailable();

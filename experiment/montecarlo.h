@@ -38,6 +38,9 @@ struct MonteCarloOptions {
   // wrote to OUT/calibration/calibration.json is read instead of calibrating again: the summary is the one an
   // uninterrupted call writes.
   bool resume = false;
+  // Calibrate each run's recording with `config` (a calibration configuration) instead of tracking it, and test the
+  // calibration's reported std against its errors (experiment/consistency.h, RunCalibrationConsistency).
+  bool calibration_consistency = false;
   std::function<void(const std::string& line)> log;      // optional: what is being done, one line at a time
   std::function<void(int finished, int runs)> progress;  // optional: once with 0 before the runs, then after each run
 

@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
@@ -95,6 +96,25 @@ TEST(PlotsTest, NeesPlotShowsTheBand) {
   EXPECT_THAT(script, HasSubstr("lo = 0.2157952"));
   EXPECT_THAT(script, HasSubstr("hi = 9.348403"));
   EXPECT_THAT(script, HasSubstr("set output \"fig4.png\""));
+}
+
+// One data row per run and component, one coverage row per component with its label as a tic; gnuplot draws it.
+TEST(PlotsTest, ConsistencyPlotHasEveryRunAndTheCoverage) {
+  TempDir dir;
+  const std::vector<NormalizedErrors> components = {{"gps.lever_arm[0]", {0.5, -2.5}, {0.5, 0.5, 1.0}},
+                                                    {"odometer.k_theta[0]", {1.0, NAN}, {1.0, 1.0, 1.0}}};
+  const Result<PlotFiles> files = WriteConsistencyPlot(dir.path(), "Calibration errors", components);
+  ASSERT_TRUE(files.ok()) << files.status().message();
+  EXPECT_EQ(ReadFile(dir.File("consistency_errors.dat")),
+            "# component error_over_std (one row per run)\n0 0.5\n0 -2.5\n1 1\n1 NaN\n");
+  EXPECT_THAT(ReadFile(dir.File("consistency_coverage.dat")), HasSubstr("\n0 50 50 100 gps.lever_arm[0]\n"));
+  const std::string script = ReadFile(dir.File("consistency.gp"));
+  EXPECT_THAT(script, HasSubstr("\"odometer.k_theta[0]\" 1"));
+  EXPECT_THAT(script, HasSubstr("2 with lines"));
+  EXPECT_THAT(script, HasSubstr("95.45 with lines"));
+  if (!GnuplotAvailable()) GTEST_SKIP() << "gnuplot not installed";
+  ASSERT_TRUE(RunGnuplot(dir.path(), files.value().script).ok());
+  EXPECT_TRUE(IsPng(dir.File("consistency.png")));
 }
 
 TEST(PlotsTest, GnuplotDrawsThePngs) {

@@ -1,0 +1,354 @@
+#include "experiment/consistency.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <mutex>
+#include <thread>
+#include <utility>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <nlohmann/json.hpp>
+
+#include "common/atomic_file.h"
+#include "common/interrupt.h"
+#include "common/json.h"
+#include "estimator/calibration.h"
+#include "eval/parameters.h"
+#include "eval/plots.h"
+#include "recording/stream_health.h"
+#include "sim/simulator.h"
+
+namespace roamlab::experiment {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr char kCramerRaoMethod[] =
+    "the std calibrate reports on the scenario simulated with every noise source off (the recording at the truth)";
+
+// What every run shares.
+struct Shared {
+  sim::Scenario scenario;
+  estimator::EstimatorConfig config;
+  std::map<std::string, Eigen::VectorXd> cramer_rao_std;
+  std::map<std::string, Eigen::VectorXd> noise_free_error;
+};
+
+// One calibrated parameter of one run against its truth.
+struct RunParameter {
+  std::string name;
+  std::string manifold;
+  std::vector<double> truth, estimate;
+  eval::ParameterDraw draw;
+};
+
+// The joint covariance of the calibrated parameters: the inverse of the joint marginal information, rescaled so that
+// its diagonal is the reported std squared (the correlations are the information's). NaN when the information is
+// singular (a direction the recording does not observe).
+Eigen::MatrixXd ReportedCovariance(const estimator::CalibrationResult& result) {
+  const Eigen::MatrixXd& information = result.information;
+  const Eigen::Index n = information.rows();
+  if (n == 0 || !information.allFinite()) return Eigen::MatrixXd::Constant(n, n, kNaN);
+  const Eigen::LLT<Eigen::MatrixXd> llt(information);
+  if (llt.info() != Eigen::Success) return Eigen::MatrixXd::Constant(n, n, kNaN);
+  const Eigen::MatrixXd covariance = llt.solve(Eigen::MatrixXd::Identity(n, n));
+  Eigen::VectorXd reported(n);
+  Eigen::Index offset = 0;
+  for (const estimator::ParameterEstimate& p : result.parameters) {
+    reported.segment(offset, p.std.size()) = p.std;
+    offset += p.std.size();
+  }
+  if (offset != n) return Eigen::MatrixXd::Constant(n, n, kNaN);
+  const Eigen::VectorXd scale = reported.array() / covariance.diagonal().array().sqrt();
+  return scale.asDiagonal() * covariance * scale.asDiagonal();
+}
+
+// Every calibrated parameter compared with its true value; an error names a parameter without one.
+Result<std::vector<RunParameter>> CompareWithTruth(const estimator::CalibrationResult& result,
+                                                   const recording::Truth& truth) {
+  const Eigen::MatrixXd covariance = ReportedCovariance(result);
+  std::vector<RunParameter> out;
+  Eigen::Index offset = 0;
+  for (const estimator::ParameterEstimate& p : result.parameters) {
+    const Eigen::Index d = p.std.size();
+    const auto true_value = truth.calibration.find(p.name);
+    if (true_value == truth.calibration.end())
+      return Status::Error(p.name + ": the scenario's truth has no value for this free parameter");
+    RunParameter r;
+    r.name = p.name;
+    r.manifold = p.manifold.Name();
+    r.truth = true_value->second;
+    r.estimate.assign(p.estimate.data(), p.estimate.data() + p.estimate.size());
+    eval::ParameterEstimate estimate;
+    estimate.kind = eval::ParameterKindFromManifold(r.manifold).value_or(eval::ParameterKind::kVector);
+    estimate.estimate = r.estimate;
+    estimate.std.assign(p.std.data(), p.std.data() + d);
+    auto compared = eval::CompareParameter(p.name, r.truth, estimate);
+    if (!compared.ok()) return compared.status();
+    r.draw.error = Eigen::Map<const Eigen::VectorXd>(compared.value().error.data(), d);
+    r.draw.std = p.std;
+    r.draw.covariance = covariance.block(offset, offset, d, d);
+    offset += d;
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+// Simulates the scenario (noise off when !noise), calibrates it; `truth` receives the simulation's truth.
+Result<estimator::CalibrationResult> SimulateAndCalibrate(const sim::Scenario& scenario,
+                                                          const estimator::EstimatorConfig& config, std::uint64_t seed,
+                                                          bool noise, recording::Truth* truth) {
+  sim::SimulateOptions sim_options;
+  sim_options.seed = seed;
+  sim_options.noise = noise;
+  auto simulation = sim::Simulate(scenario, sim_options);
+  if (!simulation.ok()) return Status::Error("seed " + std::to_string(seed) + ": " + simulation.status().message());
+  recording::DropDuplicateRows(&simulation.value().recording);  // as the reader does (a duplicates fault)
+  auto calibrated = estimator::Calibrate(config, simulation.value().recording);
+  if (!calibrated.ok()) return Status::Error("seed " + std::to_string(seed) + ": " + calibrated.status().message());
+  *truth = std::move(simulation.value().truth);
+  return calibrated;
+}
+
+nlohmann::json MatrixJson(const Eigen::MatrixXd& m) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (Eigen::Index r = 0; r < m.rows(); ++r) {
+    const Eigen::VectorXd row = m.row(r).transpose();
+    rows.push_back(NumberArray(row));
+  }
+  return rows;
+}
+
+// Run i: simulate with its seed, calibrate, compare with the truth, write its result file.
+Outcome RunOne(const MonteCarloOptions& options, const Shared& shared, int i) {
+  const std::uint64_t seed = options.seed_base + static_cast<std::uint64_t>(i);
+  recording::Truth truth;
+  auto calibrated = SimulateAndCalibrate(shared.scenario, shared.config, seed, true, &truth);
+  if (!calibrated.ok()) return Outcome::Failed(Status::Error("run " + std::to_string(i) + ", " + calibrated.status().message()));
+  auto compared = CompareWithTruth(calibrated.value(), truth);
+  if (!compared.ok()) return Outcome::BadInput(compared.status());
+  nlohmann::json parameters = nlohmann::json::object();
+  for (const RunParameter& p : compared.value())
+    parameters[p.name] = {{"manifold", p.manifold},
+                          {"truth", NumberArray(p.truth)},
+                          {"estimate", NumberArray(p.estimate)},
+                          {"error", NumberArray(p.draw.error)},
+                          {"std", NumberArray(p.draw.std)},
+                          {"covariance", MatrixJson(p.draw.covariance)}};
+  const nlohmann::json j = {
+      {"run", i}, {"seed", seed}, {"seconds", calibrated.value().seconds}, {"parameters", parameters}};
+  const Status written = WriteFileAtomic(ConsistencyRunFile(options.out, i), j.dump() + "\n");
+  return written.ok() ? Outcome::Ok() : Outcome::Failed(written);
+}
+
+// The runs in `todo` over worker threads; the outcome names the first (lowest) failed run.
+Outcome RunAll(const MonteCarloOptions& options, const Shared& shared, const std::vector<int>& todo) {
+  const int n = static_cast<int>(todo.size());
+  const int jobs = options.jobs > 0 ? options.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  std::vector<Outcome> outcomes(todo.size());
+  std::atomic<int> next{0}, done{0};
+  std::mutex print;
+  const auto worker = [&] {
+    for (int k = next++; k < n && !InterruptRequested(); k = next++) {
+      outcomes[k] = RunOne(options, shared, todo[k]);
+      const int finished = ++done;
+      if (options.progress) {
+        std::lock_guard<std::mutex> lock(print);
+        options.progress(finished, n);
+      }
+    }
+  };
+  if (options.progress) options.progress(0, n);
+  std::vector<std::thread> threads;
+  for (int k = 0; k < std::min(jobs, n); ++k) threads.emplace_back(worker);
+  for (auto& th : threads) th.join();
+  const auto failed = std::count_if(outcomes.begin(), outcomes.end(), [](const Outcome& o) { return !o.ok(); });
+  for (const Outcome& o : outcomes)
+    if (!o.ok()) {
+      Outcome first = o;
+      first.status = Status::Error(std::to_string(failed) + " of " + std::to_string(n) + " runs failed; first: " +
+                                   o.status.message());
+      return first;
+    }
+  return Outcome::Ok();
+}
+
+// A number array of a run file (null read as NaN); false when malformed or not of size n.
+bool ReadVector(const nlohmann::json& j, Eigen::Index n, Eigen::VectorXd* out) {
+  if (!j.is_array() || static_cast<Eigen::Index>(j.size()) != n) return false;
+  out->resize(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const nlohmann::json& v = j[static_cast<std::size_t>(k)];
+    if (!v.is_null() && !v.is_number()) return false;
+    (*out)[k] = v.is_null() ? kNaN : v.get<double>();
+  }
+  return true;
+}
+
+// Parameter `name`'s draw in a run file; false when malformed.
+bool ReadDraw(const nlohmann::json& run, const std::string& name, eval::ParameterDraw* draw) {
+  const auto parameters = run.find("parameters");
+  if (parameters == run.end() || !parameters->is_object() || !parameters->contains(name)) return false;
+  const nlohmann::json& p = (*parameters)[name];
+  if (!p.is_object() || !p.contains("error") || !p["error"].is_array()) return false;
+  const Eigen::Index d = static_cast<Eigen::Index>(p["error"].size());
+  if (d == 0 || !ReadVector(p["error"], d, &draw->error) || !p.contains("std") || !ReadVector(p["std"], d, &draw->std))
+    return false;
+  if (!p.contains("covariance") || !p["covariance"].is_array() || static_cast<Eigen::Index>(p["covariance"].size()) != d)
+    return false;
+  draw->covariance.resize(d, d);
+  for (Eigen::Index r = 0; r < d; ++r) {
+    Eigen::VectorXd row;
+    if (!ReadVector(p["covariance"][static_cast<std::size_t>(r)], d, &row)) return false;
+    draw->covariance.row(r) = row.transpose();
+  }
+  return true;
+}
+
+// Every run's draws per parameter (in the order of `names`); an error names the file that is missing or malformed.
+Result<std::vector<std::vector<eval::ParameterDraw>>> ReadDraws(const MonteCarloOptions& options,
+                                                                const std::vector<std::string>& names) {
+  std::vector<std::vector<eval::ParameterDraw>> draws(names.size());
+  for (int i = 0; i < options.runs; ++i) {
+    const std::string path = ConsistencyRunFile(options.out, i);
+    Result<std::string> text = ReadWholeFile(path);
+    if (!text.ok()) return Status::Error(path + ": missing: run " + std::to_string(i) + " has no result");
+    const nlohmann::json run = nlohmann::json::parse(text.value(), nullptr, false);
+    const bool same = run.is_object() && run.contains("seed") && run["seed"].is_number_unsigned() &&
+                      run["seed"].get<std::uint64_t>() == options.seed_base + static_cast<std::uint64_t>(i);
+    for (std::size_t k = 0; k < names.size(); ++k) {
+      eval::ParameterDraw draw;
+      if (!same || !ReadDraw(run, names[k], &draw))
+        return Status::Error(path + ": not the result of run " + std::to_string(i) + " (seed " +
+                             std::to_string(options.seed_base + i) + ") with " + names[k] +
+                             " (malformed or of another call; delete it to run it again)");
+      draws[k].push_back(std::move(draw));
+    }
+  }
+  return draws;
+}
+
+// The normalized errors error / std of every run and the coverage per component, for the figure.
+std::vector<eval::NormalizedErrors> PlotData(const std::vector<eval::BlockConsistency>& blocks,
+                                             const std::vector<std::vector<eval::ParameterDraw>>& draws) {
+  std::vector<eval::NormalizedErrors> out;
+  for (std::size_t b = 0; b < blocks.size(); ++b)
+    for (int i = 0; i < blocks[b].dimension; ++i) {
+      eval::NormalizedErrors c;
+      c.label = blocks[b].name + "[" + std::to_string(i) + "]";
+      for (const eval::ParameterDraw& d : draws[b]) c.error_over_std.push_back(d.error[i] / d.std[i]);
+      for (int k = 0; k < 3; ++k) c.coverage[k] = blocks[b].components[i].coverage[k].fraction;
+      out.push_back(std::move(c));
+    }
+  return out;
+}
+
+// OUT/consistency.json and OUT/consistency.png; returns the plot note.
+std::string WriteOutputs(const MonteCarloOptions& options, const std::vector<eval::BlockConsistency>& blocks,
+                         const std::vector<std::vector<eval::ParameterDraw>>& draws, Status* written) {
+  const nlohmann::json j = {{"scenario", options.scenario},
+                            {"config", options.config},
+                            {"runs", options.runs},
+                            {"seed_base", options.seed_base},
+                            {"cramer_rao", kCramerRaoMethod},
+                            {"parameters", eval::ConsistencyJson(blocks)}};
+  *written = WriteFileAtomic(options.out + "/consistency.json", j.dump(2) + "\n");
+  if (!written->ok()) return "";
+  if (!eval::GnuplotAvailable()) return " (gnuplot not found: no consistency.png)";
+  auto plot = eval::WriteConsistencyPlot(
+      options.out, "Calibration errors over " + std::to_string(options.runs) + " runs", PlotData(blocks, draws));
+  const Status drawn = plot.ok() ? eval::RunGnuplot(options.out, plot.value().script) : plot.status();
+  return drawn.ok() ? "" : " (plot failed: " + drawn.message() + ")";
+}
+
+// Reads the scenario and configuration and computes the Cramer-Rao std.
+Outcome Prepare(const MonteCarloOptions& options, Shared* shared) {
+  if (const std::string problem = options.Validate(); !problem.empty())
+    return Outcome::BadInput(Status::Error(problem));
+  auto scenario = sim::LoadScenario(options.scenario);
+  if (!scenario.ok()) return Outcome::BadInput(scenario.status());
+  shared->scenario = std::move(scenario).value();
+  auto config = estimator::LoadEstimatorConfig(options.config);
+  if (!config.ok()) return Outcome::BadInput(config.status());
+  shared->config = std::move(config).value();
+  const auto& parameters = shared->config.parameters;
+  if (std::none_of(parameters.begin(), parameters.end(), [](const auto& p) { return p.second.free; }))
+    return Outcome::BadInput(Status::Error(options.config + ": no free parameter to calibrate"));
+  if (const Status dir = MakeOutputDirectory(options.out + "/calibrations"); !dir.ok()) return Outcome::BadInput(dir);
+  if (options.log) options.log("Cramer-Rao std: calibrating the scenario simulated without noise");
+  auto noise_free = CalibrateWithoutNoise(shared->scenario, shared->config);
+  if (!noise_free.ok()) return Outcome::Failed(Status::Error("noise-free calibration: " + noise_free.status().message()));
+  auto crb = CramerRaoStd(noise_free.value());
+  if (!crb.ok()) return Outcome::Failed(Status::Error("Cramer-Rao std: " + crb.status().message()));
+  shared->cramer_rao_std = std::move(crb).value();
+  shared->noise_free_error = std::move(noise_free.value().error);
+  return Outcome::Ok();
+}
+
+// The statistics of every parameter from the run files, and the summary files.
+Outcome Aggregate(const MonteCarloOptions& options, const Shared& shared, ConsistencySummary* summary) {
+  std::vector<std::string> names;
+  for (const auto& [name, std] : shared.cramer_rao_std) names.push_back(name);
+  auto draws = ReadDraws(options, names);
+  if (!draws.ok()) return Outcome::Failed(draws.status());
+  std::vector<eval::BlockConsistency> blocks;
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const Eigen::VectorXd& crb = shared.cramer_rao_std.at(names[k]);
+    if (crb.size() != draws.value()[k].front().error.size())
+      return Outcome::Failed(Status::Error(names[k] + ": the Cramer-Rao std has another size than the runs' errors"));
+    blocks.push_back(eval::BlockStatistics(names[k], draws.value()[k], crb));
+    const Eigen::VectorXd& noise_free = shared.noise_free_error.at(names[k]);
+    for (Eigen::Index i = 0; i < noise_free.size(); ++i) blocks.back().components[i].noise_free_error = noise_free[i];
+  }
+  Status written = Status::Ok();
+  const std::string note = WriteOutputs(options, blocks, draws.value(), &written);
+  if (!written.ok()) return Outcome::Failed(written);
+  if (summary) *summary = {std::move(blocks), note};
+  return Outcome::Ok();
+}
+
+}  // namespace
+
+Result<NoiseFreeCalibration> CalibrateWithoutNoise(const sim::Scenario& scenario,
+                                                   const estimator::EstimatorConfig& config) {
+  recording::Truth truth;
+  auto calibrated = SimulateAndCalibrate(scenario, config, scenario.seed, false, &truth);
+  if (!calibrated.ok()) return calibrated.status();
+  auto compared = CompareWithTruth(calibrated.value(), truth);
+  if (!compared.ok()) return compared.status();
+  NoiseFreeCalibration out;
+  for (const RunParameter& p : compared.value()) {
+    out.std[p.name] = p.draw.std;
+    out.error[p.name] = p.draw.error;
+  }
+  return out;
+}
+
+Result<std::map<std::string, Eigen::VectorXd>> CramerRaoStd(const NoiseFreeCalibration& noise_free) {
+  return noise_free.std;
+}
+
+std::string ConsistencyRunFile(const std::string& out, int i) {
+  char name[40];
+  std::snprintf(name, sizeof name, "/calibrations/%06d.json", i);
+  return out + name;
+}
+
+Outcome RunCalibrationConsistency(const MonteCarloOptions& options, ConsistencySummary* summary) {
+  Shared shared;
+  if (Outcome prepared = Prepare(options, &shared); !prepared.ok()) return prepared;
+  std::vector<int> todo;
+  for (int i = 0; i < options.runs; ++i)
+    if (!options.resume || !std::filesystem::exists(ConsistencyRunFile(options.out, i))) todo.push_back(i);
+  if (options.resume && options.log)
+    options.log(std::to_string(options.runs - static_cast<int>(todo.size())) + " of " + std::to_string(options.runs) +
+                " runs already have their result file");
+  if (Outcome ran = RunAll(options, shared, todo); !ran.ok()) return ran;
+  if (InterruptRequested()) return Outcome::Failed(InterruptedError());
+  return Aggregate(options, shared, summary);
+}
+
+}  // namespace roamlab::experiment
