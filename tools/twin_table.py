@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The OptiOdom twin table from scripts/twin_optiodom.sh's outputs (OUT/<day>_<square set>/twin.json).
+"""The OptiOdom twin table from scripts/twin_optiodom.sh's outputs (OUT/<day>_<training set>/twin.json).
 
 Per training run: the effects named (value +- std, and which std), the twin's mean 10 s motion-capture drift on its own
 held-out part and on each held-out run, nominal -> patched (ratio). Per day: every candidate's first-round fit on
