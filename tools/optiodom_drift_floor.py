@@ -5,8 +5,9 @@ the twin, gap/twin.h TwinDrift: 10 s windows every 1 s, each aligned by the nois
 first 2 s, the position error at its end).
 
 Per run (run-01 of each set named): the nominal geometry's drift; the drift with the geometry fitted to that run's own
-windows (an oracle: common radius scale, right/left radius ratio and track, Nelder-Mead on the mean drift), and with
-the geometry so fitted on a training run (the first run named) carried over; the motion capture's distance over the
+windows (an oracle: common radius scale, right/left radius ratio and track, Nelder-Mead on the mean drift), the same
+with a clock shift of the encoders against the motion capture fitted too, and the geometry fitted on a training run
+(the first run named) carried over; the motion capture's distance over the
 encoders' on straight 1 s stretches, its heading change over the encoders' on arcs (1 s stretches with both wheels
 forward, their angles differing by more than 5 %, turning by more than 0.05 rad) and on in-place turns (0.5 s stretches with the wheels turning
 opposite ways), all with the nominal geometry.
@@ -45,8 +46,20 @@ def geometry(p):
     return RADIUS_M * scale * math.sqrt(ratio), RADIUS_M * scale / math.sqrt(ratio), TRACK_M + track_error
 
 
+def shifted(t, values, shift_s):
+    """values (at stamps t) read at t + shift_s, linearly interpolated, held at the ends."""
+    out = []
+    for q in t:
+        q += shift_s
+        i = min(max(bisect.bisect_right(t, q), 1), len(t) - 1)
+        a = min(max((q - t[i - 1]) / (t[i] - t[i - 1]), 0.0), 1.0)
+        out.append(values[i - 1] + a * (values[i] - values[i - 1]))
+    return out
+
+
 def dead_reckon(run, p):
-    r_right, r_left, track = geometry(p)
+    """The pose from the encoder angles with geometry p[:3], the encoders read p[3] s later when given."""
+    r_right, r_left, track = geometry(p[:3])
     x, y, th = [0.0], [0.0], [0.0]
     for i in range(1, len(run["t"])):
         d_right = r_right * (run["right"][i] - run["right"][i - 1])
@@ -56,6 +69,8 @@ def dead_reckon(run, p):
         x.append(x[-1] + ds * math.cos(mid))
         y.append(y[-1] + ds * math.sin(mid))
         th.append(th[-1] + dth)
+    if len(p) > 3:
+        return tuple(shifted(run["t"], v, p[3]) for v in (x, y, th))
     return x, y, th
 
 
@@ -171,20 +186,24 @@ def main(argv):
     nominal = (1.0, 1.0, 0.0)
     oracles = {name: nelder_mead(lambda p, run=run: drift(run, p), nominal, (0.01, 0.003, 0.003))
                for name, run in runs.items()}
+    clocked = {name: nelder_mead(lambda p, run=run: drift(run, p), (*oracles[name][0], 0.0),
+                                 (0.01, 0.003, 0.003, 0.03)) for name, run in runs.items()}
     training = argv[2]
     carried = oracles[training][0]
     print(f"geometry fitted on {training}'s windows: scale {carried[0]:.4f}, R/L {carried[1]:.4f}, "
           f"track {1000 * carried[2]:+.1f} mm")
-    print("| run | nominal 10 s drift | own fit: scale, R/L, track -> drift (ratio) | training run's fit carried "
-          "over (ratio) | straight: distance ratio | arcs: heading ratio | in-place turns: heading ratio |")
-    print("|---|---|---|---|---|---|---|")
+    print("| run | nominal 10 s drift | own fit: scale, R/L, track -> drift (ratio) | own fit with a clock shift "
+          "(ratio) | training run's fit carried over (ratio) | straight: distance ratio | arcs: heading ratio | in-place turns: heading ratio |")
+    print("|---|---|---|---|---|---|---|---|")
     for name, run in runs.items():
         d0 = drift(run, nominal)
         (scale, ratio, track), own = oracles[name]
         over = drift(run, carried)
+        shift_s, with_shift = clocked[name][0][3], clocked[name][1]
         straight, arcs, turns = motion_ratios(run)
         print(f"| {name} | {1000 * d0:.1f} mm | {scale:.4f}, {ratio:.4f}, {1000 * track:+.1f} mm -> "
-              f"{1000 * own:.1f} mm ({own / d0:.2f}) | {1000 * over:.1f} mm ({over / d0:.2f}) | {straight:.4f} | "
+              f"{1000 * own:.1f} mm ({own / d0:.2f}) | {1000 * shift_s:+.0f} ms: {1000 * with_shift:.1f} mm "
+              f"({with_shift / d0:.2f}) | {1000 * over:.1f} mm ({over / d0:.2f}) | {straight:.4f} | "
               f"{arcs:.4f} | {turns:.4f} |")
     return 0
 
