@@ -1,8 +1,9 @@
 // The diagnosis against the replayed twin on real OptiOdom recordings (tests/support/real_data.h, skipped when
 // absent), held out across runs: the patch fitted on a Dec-2020 square run of the differential drive is shown on a
 // circular run of the same day (the twin's 10 s motion-capture drift, nominal against patched). The claim asserted
-// is the one the data supports (docs/results.md): the drift falls by at least a fifth, not to half; the kinematic
-// floor of the drift measure on these runs is close to half of the nominal twin's.
+// is the one the data supports (docs/results.md): the drift falls by at least a fifth, not to half; the robot's
+// effective geometry depends on how it moves, and the best constant geometry for a square run's own windows takes the
+// circular runs' drift only to about 0.55 of the nominal twin's (tools/optiodom_drift_floor.py).
 #include <filesystem>
 #include <iostream>
 #include <string>
