@@ -48,9 +48,9 @@ TwinDiagnosis Diagnosed(const std::vector<sim::EffectOptions>& hidden, std::uint
               d.value().verdict.c_str());
   for (const TwinEffect& e : d.value().candidates)
     for (const auto& [name, value] : e.estimate.parameters)
-      std::printf("  %s %s = %.6g +- %.3g, chi2 drop %.1f, p %.2g: %s\n", e.estimate.name.c_str(), name.c_str(),
-                  value, e.estimate.std.count(name) ? e.estimate.std.at(name) : 0.0, e.estimate.lr_raw,
-                  e.estimate.lr_pvalue, e.estimate.decision.c_str());
+      std::printf("  %s %s = %.6g +- %.3g, chi2 drop %.1f, p %.2g: %s\n", e.estimate.name.c_str(), name.c_str(), value,
+                  e.estimate.std.count(name) ? e.estimate.std.at(name) : 0.0, e.estimate.lr_raw, e.estimate.lr_pvalue,
+                  e.estimate.decision.c_str());
   return d.value();
 }
 

@@ -261,7 +261,7 @@ TEST(PoseTimeOffsetTest, ThePoseStampedTIsThePoseAtTMinusTheOffset) {
   const recording::Stream& c = *early.recording.Find("mocap");
   ASSERT_EQ(a.values.rows(), b.values.rows());
   ASSERT_EQ(a.values.rows(), c.values.rows());  // samples taken after the end: the physics runs on
-  EXPECT_EQ(a.t, b.t);                           // the stamps do not say it
+  EXPECT_EQ(a.t, b.t);                          // the stamps do not say it
   for (Eigen::Index k = 2; k + 3 < a.values.rows(); ++k) {
     EXPECT_NEAR((b.values.row(k) - a.values.row(k - 2)).norm(), 0.0, 1e-9) << k;
     EXPECT_NEAR((c.values.row(k) - a.values.row(k + 3)).norm(), 0.0, 1e-9) << k;
