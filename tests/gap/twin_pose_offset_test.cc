@@ -5,8 +5,8 @@
 // hidden effect and the sensors' noise). The sign is the simulator's: the pose stamped t is O's pose at t - offset_s,
 // so encoders that read behind the motion capture (what the real runs show) are a negative offset. (The replayed twin
 // of such a recording, driven by its quantized encoder angles, is not exact: on the clean drive of seed 42 it drifts
-// enough for wheel_radius_asymmetry to be named, and pose_time_offset alone reads about -10 ms there; see
-// docs/methods-gap.md.)
+// enough for wheel_radius_asymmetry to be named, and pose_time_offset alone reads about -10 ms there;
+// docs/results.md.)
 #include <algorithm>
 #include <chrono>
 #include <cmath>
