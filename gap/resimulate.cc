@@ -64,7 +64,8 @@ sim::EffectOptions SimulatorEffect(const EffectEstimate& effect, std::map<std::s
   }
   const auto known = sim::KnownEffects().find(effect.name);
   if (known == sim::KnownEffects().end()) return e;
-  const bool shift = effect.name == "gps_latency" || effect.name == "imu_time_offset";
+  const bool shift =
+      effect.name == "gps_latency" || effect.name == "imu_time_offset" || effect.name == "pose_time_offset";
   for (const auto& [name, value] : effect.parameters) {
     if (!known->second.count(name)) continue;
     e.parameters[name] = shift && physics_step_s > 0.0 ? std::round(value / physics_step_s) * physics_step_s : value;

@@ -28,8 +28,8 @@ namespace roamlab::gap {
 // An accepted effect as the simulator's scenario effect (sim/scenario.h): the parameters the simulator knows, and
 // lateral_slip's rear cornering compliance as the tires' contact time scale (+0.0203 s per unit above 1, measured on
 // atv_hills_sines.yaml, sim/scenario.h), within the simulator's [1, 4]. With `physics_step_s` > 0 the time shifts
-// (gps_latency, imu_time_offset) are rounded to whole physics steps, as the simulator takes them. `std` gets the
-// parameters' standard deviations in the same units (may be null).
+// (gps_latency, imu_time_offset, pose_time_offset) are rounded to whole physics steps, as the simulator takes them.
+// `std` gets the parameters' standard deviations in the same units (may be null).
 sim::EffectOptions SimulatorEffect(const EffectEstimate& effect, std::map<std::string, double>* std = nullptr,
                                    double physics_step_s = 0.0);
 

@@ -14,8 +14,10 @@
 //      first train_fraction of the recording) with the effects kept so far applied: Levenberg-Marquardt over its
 //      parameters on cost = the sum of squared whitened residuals, the Jacobian by finite differences of perturbed
 //      twin runs executed in parallel (central when 2k runs fit in the threads, else forward). Time shifts
-//      (gps_latency latency_s, imu_time_offset offset_s) are whole physics steps in the simulator: a 1-D search on
-//      the step grid, coarse to fine, then a parabola through the best step and its neighbours for the value.
+//      (gps_latency latency_s, imu_time_offset offset_s, pose_time_offset offset_s: the motion capture's pose stamped
+//      t is O's pose at t - offset_s, so negative is wheel encoders that read behind it) are whole physics steps in
+//      the simulator: a 1-D search on the step grid, coarse to fine, then a parabola through the best step and its
+//      neighbours for the value.
 //      The parameters' covariance comes from the residuals' Jacobian at the fit (TwinFitRows, TwinCovariance): the
 //      white-noise curvature (J^T J)^-1, which assumes independent residuals and understates the spread of
 //      autocorrelated ones (real recordings, coloured sensor noise), and the HAC (Newey-West) sandwich around it,

@@ -1,16 +1,20 @@
 #!/usr/bin/env bash
 # The MuJoCo twin diagnosed against the real OptiOdom recordings: per robot day, the twin's patch is fitted on each
-# square run (`roamlab diagnose --replay`, the default --std auto: HAC on these imported runs) and shown on held-out
-# circular and Ivanjko runs of the same robot (--held-out); tools/twin_table.py then prints the drift table and the
-# within-day spread of the fitted parameters.
-#   bash scripts/twin_optiodom.sh [DATA_DIR] [OUT_DIR]   (DATA_DIR: the OptiOdom dataset's data/ folder; OUT_DIR:
-#                                                          out/twin_optiodom)
+# training run (`roamlab diagnose --replay`, the default --std auto: HAC on these imported runs) and shown on held-out
+# runs of the same robot (--held-out); tools/twin_table.py then prints the drift table and the within-day spread of
+# the fitted parameters. Days: diff_dec (23 Dec 2020: square runs train, circular and Ivanjko runs held out),
+# diff_jun (square runs of 23 Jun 2020 train, circular and Ivanjko runs of 25 Jun held out: two days apart, the
+# dataset has no other runs of 23 Jun), diff_jun25 (25 Jun: circular runs train, another circular and an Ivanjko run
+# held out), omni3 (22 Dec 2020: square runs train, circular runs held out).
+#   bash scripts/twin_optiodom.sh [DATA_DIR] [OUT_DIR]   (DATA_DIR: the OptiOdom dataset's data/ folder, default
+#                                                          $ROAMLAB_DATA_DIR/optiodom/data, else ../shared/data's;
+#                                                          OUT_DIR: out/twin_optiodom)
 # Needs build/apps/roamlab and python3. Ten diagnoses of about 40-70 s of CPU each, on two threads; JOBS (default 1)
 # of them at a time (OUT/<day>_<set>.time: each one's wall and CPU time). ONLY (a regular expression) runs only the
-# days whose names match (diff_dec, diff_jun, omni3).
+# days whose names match (diff_dec, diff_jun, diff_jun25, omni3).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
-data=${1:-$here/../shared/data/optiodom/data}
+data=${1:-${ROAMLAB_DATA_DIR:-$here/../shared/data}/optiodom/data}
 out=${2:-$here/out/twin_optiodom}
 roamlab=$here/build/apps/roamlab
 jobs=${JOBS:-1}
@@ -23,20 +27,21 @@ rec() {  # kind/shape/set: imports run 01 once, prints its recording directory
     "$roamlab" import optiodom "$data/$1/$(basename "$1")_run-01.csv" --out "$dest" --quiet
   echo "$dest"
 }
-diagnose() {  # day, robot (diff, omni3), square set, held-out kind/shape/set...
-  local day=$1 robot=$2 square=$3 dir=$out/$1_$3 held=()
+diagnose() {  # day, robot (diff, omni3), training shape/set, held-out shape/set...
+  local day=$1 robot=$2 set=${3#*/} dir=$out/$1_${3#*/} held=()
+  local training=$3
   shift 3
   [[ -z "$only" || "$day" =~ $only ]] || return 0
   [ -f "$dir/twin.json" ] && return 0
   local train
-  train=$(rec "$robot/square/$square")
+  train=$(rec "$robot/$training")
   for h in "$@"; do held+=("$(rec "$robot/$h")"); done
   local config=$here/configs/real/optiodom_diff_nominal.yaml
   if [ "$robot" = omni3 ]; then
     config=$out/omni3_nominal.yaml
     [ -f "$config" ] || "$roamlab" init "$train" --out "$config" --quiet
   fi
-  /usr/bin/time -f "%e s wall, %U s user + %S s system CPU" -o "$out/${day}_$square.time" \
+  /usr/bin/time -f "%e s wall, %U s user + %S s system CPU" -o "$out/${day}_$set.time" \
     "$roamlab" diagnose --real "$train" --scenario "$here/scenarios/real/optiodom_$robot.yaml" --config "$config" \
     --no-baseline --replay --no-plots --quiet --out "$dir" --held-out "${held[@]}"
 }
@@ -46,13 +51,16 @@ run() {  # diagnose in the background, at most $jobs at a time
   diagnose "$@" &
 }
 for square in 231220200029 231220200040 231220200045 231220200048; do
-  run diff_dec diff "$square" circular/231220200121 circular/231220200134 ivanjko/231220200057
+  run diff_dec diff "square/$square" circular/231220200121 circular/231220200134 ivanjko/231220200057
 done
 for square in 221220201934 221220201953; do
-  run omni3 omni3 "$square" circular/221220201643 circular/221220201701
+  run omni3 omni3 "square/$square" circular/221220201643 circular/221220201701
 done
 for square in 230620202042 230620202144 230620202258 230620202317; do
-  run diff_jun diff "$square" circular/250620202104 ivanjko/250620201618
+  run diff_jun diff "square/$square" circular/250620202104 ivanjko/250620201618
+done
+for circle in 250620202104 250620202236; do
+  run diff_jun25 diff "circular/$circle" circular/250620202119 ivanjko/250620201618
 done
 while [ "$(jobs -rp | wc -l)" -gt 0 ]; do reap; done
 python3 "$here/tools/twin_table.py" "$out"

@@ -11,8 +11,9 @@
 //     kAngleTrackingS, the twin's travel being its rear-wheel speed integrated.
 //   - Samples. A scheduled stream's sample stamped s is taken at the physics step nearest s - t0 (half a step at most
 //     away: 1 ms on models/diffdrive.xml, 0.5 ms on models/atv.xml), minus the time shift of an effect
-//     (gps_latency, imu_time_offset); two stamps nearest the same step read the same state. The stream keeps the
-//     exact stamps s. The ground truth keeps the scenario's rate, stamped t0 + k / ground_truth_rate_hz.
+//     (gps_latency, imu_time_offset, pose_time_offset); two stamps nearest the same step read the same state. The
+//     stream keeps the exact stamps s. The ground truth keeps the scenario's rate, stamped t0 + k /
+//     ground_truth_rate_hz.
 #pragma once
 
 #include <map>

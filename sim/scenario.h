@@ -61,6 +61,12 @@
 //                                          (receiver latency); latency_s in [0, 1], a whole number of physics steps
 //   imu_time_offset {offset_s: 0}          the IMU row stamped t holds the reading taken at t - offset_s (the IMU's
 //                                          clock runs offset_s ahead); |offset_s| <= 0.5, whole physics steps
+//   pose_time_offset {offset_s: 0}         the motion capture's pose stamped t is O's pose at t - offset_s: positive,
+//                                          the pose stream is stamped late against the drive and the other sensors
+//                                          (equivalently, they read offset_s ahead of it); negative, the wheel
+//                                          encoders read |offset_s| behind it. |offset_s| <= 0.5, whole physics
+//                                          steps; needs sensors.mocap (the estimator's time shift of the same name,
+//                                          gap/diagnose.h, means the same: stamps moved to t - offset_s)
 //   steering_offset {offset_rad: 0}        the front wheels' angle when the handlebar sensor reads zero: eq. 15's
 //                                          k_gamma becomes k_gamma + offset_rad
 //   gyro_scale_error {scale_x: 1, scale_y: 1, scale_z: 1}   per-axis gain of the gyroscope in its own frame

@@ -504,9 +504,14 @@ class Simulator::Impl {
                          &imu_clock_.shift_ns);
         !s.ok())
       return s;
+    if (Status s = steps(EffectParameter(effects, "pose_time_offset", "offset_s", 0.0), "pose_time_offset.offset_s",
+                         &mocap_clock_.shift_ns);
+        !s.ok())
+      return s;
     mag_clock_.shift_ns = imu_clock_.shift_ns;  // the magnetometer shares the IMU's clock
     // A sample taken after the end of the drive (negative shift) extends the physics past it.
-    loop_end_ns_ = end_ns_ + std::max<std::int64_t>(0, -std::min(imu_clock_.shift_ns, gps_clock_.shift_ns));
+    loop_end_ns_ = end_ns_ + std::max<std::int64_t>(
+                                 0, -std::min({imu_clock_.shift_ns, gps_clock_.shift_ns, mocap_clock_.shift_ns}));
     // A replay's sample nearest a stamp may fall after the end.
     for (const Clock* c :
          {&imu_clock_, &mag_clock_, &gps_clock_, &mocap_clock_, &odometer_clock_, &encoder_clock_, &odometry_clock_})

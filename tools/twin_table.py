@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The OptiOdom twin table from scripts/twin_optiodom.sh's outputs (OUT/<day>_<square set>/twin.json).
+"""The OptiOdom twin table from scripts/twin_optiodom.sh's outputs (OUT/<day>_<training set>/twin.json).
 
 Per training run: the effects named (value +- std, and which std), the twin's mean 10 s motion-capture drift on its own
 held-out part and on each held-out run, nominal -> patched (ratio). Per day: every candidate's first-round fit on
@@ -51,23 +51,32 @@ def main(out):
         print(f"twin_table.py: {out}: no */twin.json", file=sys.stderr)
         return 2
     days = {}
+    ratios = {}
     print("| day, training run (run-01) | named (value +- std) | own third | held out |")
     print("|---|---|---|---|")
     for path in runs:
-        day, square = path.parent.name.rsplit("_", 1)
+        day, training = path.parent.name.rsplit("_", 1)
         twin = json.loads(path.read_text())
         named = " / ".join(effect_text(e) for e in twin["effects"]) or "(none)"
         own = ratio_text(drift(twin["heldout"]["before"]), drift(twin["heldout"]["after"]))
         held = "; ".join(
             f"{pathlib.Path(h['recording']).name.split('_')[0]}: "
             + ratio_text(drift(h["before"]), drift(h["after"])) for h in twin["heldout_runs"])
-        print(f"| {day}, square {square} | {named} ({twin['std_method']} std) | {own} | {held} |")
+        print(f"| {day}, {training} | {named} ({twin['std_method']} std) | {own} | {held} |")
+        for h in twin["heldout_runs"]:
+            before, after = drift(h["before"]), drift(h["after"])
+            if before and after is not None:
+                ratios.setdefault(day, []).append(after / before)
         day_fits = days.setdefault(day, {"named": {}, "candidates": {}})
         for kind, effects in (("named", twin["effects"]), ("candidates", twin["candidates"])):
             for e in effects:
                 for k, v in e["parameters"].items():
                     if k in e.get("std", {}) and v is not None:
-                        day_fits[kind].setdefault(f"{e['name']} {k}", {})[square] = (v, e["std"][k])
+                        day_fits[kind].setdefault(f"{e['name']} {k}", {})[training] = (v, e["std"][k])
+    for day, values in ratios.items():
+        met = sum(r <= 0.5 for r in values)
+        print(f"\n{day}: held-out drift ratio patched / nominal {min(values):.2f}-{max(values):.2f}; "
+              f"{met} of {len(values)} at most 0.5")
     for day, fits in days.items():
         print(f"\n{day}: normalized spread between the runs |a - b| / sqrt(sa^2 + sb^2)")
         for kind in ("named", "candidates"):

@@ -64,6 +64,11 @@ std::vector<TwinCandidate> Library(const sim::Scenario& nominal, double max_shif
   TwinCandidate offset{"imu_time_offset", "imu_time_offset", {}, {P("offset_s", 0, 0, -imu_range, imu_range)}};
   offset.time_shift = true;
   all.push_back(offset);
+  // The motion capture's clock against the drive (sim/scenario.h pose_time_offset): the pose stamped t is O's pose at
+  // t - offset_s, so a negative value is wheel encoders that read behind the motion capture.
+  TwinCandidate pose{"pose_time_offset", "pose_time_offset", {}, {P("offset_s", 0, 0, -imu_range, imu_range)}};
+  pose.time_shift = true;
+  all.push_back(pose);
   return all;
 }
 

@@ -241,6 +241,40 @@ TEST_F(WheelEffectsTest, GyroScaleErrorAppliesToWheeledRobots) {
   for (Eigen::Index k = 0; k < a.values.rows(); ++k) EXPECT_NEAR(b.values(k, 2), 1.03 * a.values(k, 2), 1e-12);
 }
 
+// The turning drive with motion capture at 100 Hz, so that a shift of whole samples compares row to row.
+Scenario WithMocap(const std::vector<EffectOptions>& effects) {
+  Scenario s = DiffDrive(0.2, 0.8, effects);
+  MocapOptions mocap;
+  mocap.rate_hz = 100.0;
+  s.sensors.mocap = mocap;
+  return s;
+}
+
+// pose_time_offset's sign: positive stamps the motion capture late (the pose stamped t is O's pose at t - offset_s),
+// negative early; the wheel encoders keep their clock.
+TEST(PoseTimeOffsetTest, ThePoseStampedTIsThePoseAtTMinusTheOffset) {
+  const Simulation nominal = Simulated(WithMocap({}));
+  const Simulation late = Simulated(WithMocap({{"pose_time_offset", {{"offset_s", 0.02}}}}));
+  const Simulation early = Simulated(WithMocap({{"pose_time_offset", {{"offset_s", -0.03}}}}));
+  const recording::Stream& a = *nominal.recording.Find("mocap");
+  const recording::Stream& b = *late.recording.Find("mocap");
+  const recording::Stream& c = *early.recording.Find("mocap");
+  ASSERT_EQ(a.values.rows(), b.values.rows());
+  ASSERT_EQ(a.values.rows(), c.values.rows());  // samples taken after the end: the physics runs on
+  EXPECT_EQ(a.t, b.t);                          // the stamps do not say it
+  for (Eigen::Index k = 2; k + 3 < a.values.rows(); ++k) {
+    EXPECT_NEAR((b.values.row(k) - a.values.row(k - 2)).norm(), 0.0, 1e-9) << k;
+    EXPECT_NEAR((c.values.row(k) - a.values.row(k + 3)).norm(), 0.0, 1e-9) << k;
+  }
+  // Moving at 0.2 m/s, 20 ms is 4 mm: the rows differ from the nominal ones at the same stamp.
+  const Eigen::Index mid = a.values.rows() / 2;
+  EXPECT_GT((b.values.row(mid).head<2>() - a.values.row(mid).head<2>()).norm(), 0.003);
+  const recording::Stream& encoders = *late.recording.Find("wheel_encoders");
+  EXPECT_LT((encoders.values - nominal.recording.Find("wheel_encoders")->values).cwiseAbs().maxCoeff(), 1e-9);
+  ASSERT_EQ(late.truth.effects.size(), 1u);
+  EXPECT_EQ(late.truth.effects[0].parameters.at("offset_s"), 0.02);
+}
+
 std::string ProblemOf(Scenario s) {
   const auto p = s.Validate();
   return p ? p->key + ": " + p->message : "";
@@ -267,6 +301,11 @@ TEST(WheelEffectsValidation, OneLineErrors) {
   EXPECT_NE(ProblemOf(s).find("needs sensors.magnetometer"), std::string::npos);
   s.effects = {{"gyro_bias_drift", {{"initial_z", 0.01}}}, {"imu_time_offset", {{"offset_s", 0.01}}}};
   EXPECT_EQ(ProblemOf(s), "");
+  s.effects = {{"pose_time_offset", {{"offset_s", -0.03}}}};
+  EXPECT_EQ(ProblemOf(s), "effects[0].name: pose_time_offset needs sensors.mocap");
+  EXPECT_EQ(ProblemOf(WithMocap({{"pose_time_offset", {{"offset_s", -0.03}}}})), "");
+  EXPECT_EQ(ProblemOf(WithMocap({{"pose_time_offset", {{"offset_s", 0.6}}}})),
+            "effects[0].parameters.offset_s: must be in [-0.5, 0.5]");
 
   Scenario omni = s;
   omni.robot.kind = "omni3";
