@@ -214,7 +214,7 @@ TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedT
   ASSERT_EQ(imu_gps.streams.size(), 2u);
 
   // Every 10th pose of the wheel-aided run (one a second) gets its covariance.
-  auto wheel = CalibrateWith(kConfigs + "husky_nominal.yaml", rec.value(), 10);
+  auto wheel = CalibrateWith(kConfigs + "husky_wheel_aided.yaml", rec.value(), 10);
   ASSERT_TRUE(wheel.ok()) << wheel.status().message();
   auto imu_calibration = CalibrateWith(kConfigs + "husky_imu_gps.yaml", imu_gps, 0);
   ASSERT_TRUE(imu_calibration.ok()) << imu_calibration.status().message();
