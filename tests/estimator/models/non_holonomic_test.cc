@@ -16,7 +16,8 @@ using testing::RandomPoint;
 // ahead of the origin moves sideways by omega_z times the distance.
 TEST(NonHolonomicErrorTest, ZeroAlongTheBodyXAndTheLeverArmsSideSlipInATurn) {
   const double dt = 0.1, v = 1.5, yaw_rate = 0.4;
-  const Pose<double> pose0{Eigen::Vector3d(1.0, 2.0, 0.3), Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()))};
+  const Pose<double> pose0{Eigen::Vector3d(1.0, 2.0, 0.3),
+                           Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()))};
   const Pose<double> pose1 = PredictPose<double>(pose0, Eigen::Vector3d(v, 0, 0), Eigen::Vector3d(0, 0, yaw_rate), dt);
   Eigen::VectorXd x0(7), x1(7);
   PoseToArray(pose0, x0.data());

@@ -195,11 +195,46 @@ Result<CalibrationResult> CalibrateWith(const std::string& config_file, const re
   return Calibrate(config.value(), rec, options);
 }
 
-// The IMU + GPS run (configs/real/husky_imu_gps.yaml) tracked with its calibration, against the GPS fixes and against
-// the wheel-odometry-aided calibration's smoothed track (configs/real/husky_nominal.yaml). The reference's
-// covariance is the HAC one: its residuals are autocorrelated over tens of seconds (the skid steer's wheel speeds
-// against a lagged, mis-scaled turn; the fixes' slow errors), and its white covariance understates how far the track
-// strays from the fixes several times.
+// An IMU + GPS run: its calibration, and its track of the GPS antenna with that calibration.
+struct ImuGpsRun {
+  CalibrationResult calibration;
+  AntennaTrack track;
+};
+
+Result<ImuGpsRun> RunImuGps(const std::string& config_file, const recording::Recording& imu_gps) {
+  auto calibration = CalibrateWith(config_file, imu_gps, 0);
+  if (!calibration.ok()) return calibration.status();
+  auto config = LoadEstimatorConfig(config_file);
+  if (!config.ok()) return config.status();
+  auto track = Track(config.value(), imu_gps, Values(calibration.value()));
+  if (!track.ok()) return track.status();
+  const Eigen::Vector3d lever_arm = Values(calibration.value()).at("gps.lever_arm");
+  return ImuGpsRun{calibration.value(), Antenna(track.value(), lever_arm)};
+}
+
+// The calibrated IMU misalignment's turn from the configured mounting R_x(+90 deg), about the body's axes (the slot's
+// tangent is in the IMU's frame: IMU x = body x, IMU y = body z, IMU z = body -y), in degrees with its std.
+void PrintMisalignment(const CalibrationResult& r) {
+  for (const ParameterEstimate& p : r.parameters) {
+    if (p.name != "imu.misalignment") continue;
+    const Eigen::Quaterniond mounting(std::sqrt(0.5), std::sqrt(0.5), 0.0, 0.0);
+    const Eigen::Quaterniond q(p.estimate[0], p.estimate[1], p.estimate[2], p.estimate[3]);
+    const Eigen::Vector3d delta = QuaternionLog<double>(mounting.conjugate() * q.normalized()) * 180.0 / M_PI;
+    const Eigen::Vector3d std = p.std * 180.0 / M_PI;
+    std::cout << "  IMU misalignment from the mounting: roll " << delta[0] << " +- " << std[0] << " deg, pitch "
+              << -delta[2] << " +- " << std[2] << " deg, yaw " << delta[1] << " +- " << std[1]
+              << " deg (observability roll/pitch/yaw: " << static_cast<int>(p.components[0]) << "/"
+              << static_cast<int>(p.components[2]) << "/" << static_cast<int>(p.components[1])
+              << "; 0 observable, 1 weak, 2 unobservable)\n";
+  }
+}
+
+// The IMU + GPS runs (configs/real/husky_imu_gps.yaml, and husky_imu_gps_nonholonomic.yaml with the vehicle's
+// non-holonomic rows), tracked with their calibrations, against the GPS fixes and against the wheel-odometry-aided
+// calibration's smoothed track (configs/real/husky_wheel_aided.yaml: the skid steer's effective track and the
+// gyroscope's time offset free). The reference's covariance is the HAC one: its residuals are autocorrelated over tens
+// of seconds (the fixes' slow errors, which the stiff wheel-aided track does not follow), and its white covariance
+// understates how far the track strays from the fixes several times.
 TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedTrack) {
   const std::string bag = kData + "/husky_test1/test1.bag";
   if (!std::filesystem::exists(bag)) GTEST_SKIP() << "real data absent: " << bag;
@@ -216,28 +251,34 @@ TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedT
   // Every 10th pose of the wheel-aided run (one a second) gets its covariance.
   auto wheel = CalibrateWith(kConfigs + "husky_wheel_aided.yaml", rec.value(), 10);
   ASSERT_TRUE(wheel.ok()) << wheel.status().message();
-  auto imu_calibration = CalibrateWith(kConfigs + "husky_imu_gps.yaml", imu_gps, 0);
-  ASSERT_TRUE(imu_calibration.ok()) << imu_calibration.status().message();
   std::cout << "wheel-odometry-aided calibration:\n";
   Print(wheel.value());
-  std::cout << "IMU + GPS calibration:\n";
-  Print(imu_calibration.value());
-  for (const ParameterEstimate& p : imu_calibration.value().parameters)
-    for (int i = 0; i < p.std.size(); ++i) EXPECT_TRUE(std::isfinite(p.std[i])) << p.name << "[" << i << "]";
-  auto config = LoadEstimatorConfig(kConfigs + "husky_imu_gps.yaml");
-  ASSERT_TRUE(config.ok()) << config.status().message();
-  auto imu = Track(config.value(), imu_gps, Values(imu_calibration.value()));
-  ASSERT_TRUE(imu.ok()) << imu.status().message();
-
-  const AntennaTrack track = Antenna(imu.value(), Values(imu_calibration.value()).at("gps.lever_arm"));
   const AntennaTrack reference = Smoothed(wheel.value(), false);
   const AntennaTrack reference_white = Smoothed(wheel.value(), true);
   ASSERT_GT(reference.t.size(), 300u);
-  const double imu_consistent = AgainstFixes(rec.value(), track, "IMU+GPS track");
   AgainstFixes(rec.value(), reference_white, "wheel-aided smoothed track, white covariance");
   AgainstFixes(rec.value(), reference, "wheel-aided smoothed track, HAC covariance");
-  WithinThreeSigma(track, reference_white, "IMU+GPS track against the wheel-aided track, white covariance");
-  WithinThreeSigma(track, reference, "IMU+GPS track against the wheel-aided track, HAC");
+
+  auto plain = RunImuGps(kConfigs + "husky_imu_gps.yaml", imu_gps);
+  ASSERT_TRUE(plain.ok()) << plain.status().message();
+  std::cout << "IMU + GPS calibration:\n";
+  Print(plain.value().calibration);
+  for (const ParameterEstimate& p : plain.value().calibration.parameters)
+    for (int i = 0; i < p.std.size(); ++i) EXPECT_TRUE(std::isfinite(p.std[i])) << p.name << "[" << i << "]";
+  const double imu_consistent = AgainstFixes(rec.value(), plain.value().track, "IMU+GPS track");
+  WithinThreeSigma(plain.value().track, reference_white,
+                   "IMU+GPS track against the wheel-aided track, white covariance");
+  WithinThreeSigma(plain.value().track, reference, "IMU+GPS track against the wheel-aided track, HAC");
+
+  auto vehicle = RunImuGps(kConfigs + "husky_imu_gps_nonholonomic.yaml", imu_gps);
+  ASSERT_TRUE(vehicle.ok()) << vehicle.status().message();
+  std::cout << "IMU + GPS + non-holonomic calibration:\n";
+  Print(vehicle.value().calibration);
+  PrintMisalignment(vehicle.value().calibration);
+  AgainstFixes(rec.value(), vehicle.value().track, "IMU+GPS+non-holonomic track");
+  WithinThreeSigma(vehicle.value().track, reference_white,
+                   "IMU+GPS+non-holonomic track against the wheel-aided track, white covariance");
+  WithinThreeSigma(vehicle.value().track, reference, "IMU+GPS+non-holonomic track against the wheel-aided track, HAC");
   // The HAC covariance of the smoothed positions widens the white one by about the square root of the GPS residuals'
   // integrated autocorrelation time (the fixes place the stiff wheel-aided track, and their errors are correlated
   // over tens of seconds): within a factor of 2 of it.
