@@ -381,6 +381,60 @@ TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedT
   EXPECT_LT(std::abs(std::remainder(roll_pitch_yaw[2] + turn.theta, 2.0 * M_PI)), M_PI / 4.0);
 }
 
+// The odometry's lag against the wheel-aided model (configs/real/husky_wheel_aided.yaml, the gyroscope's first-order
+// time offset fixed at 0): the odometry and wheel streams' stamps moved 0.4 s earlier (the lag the yaw rates show,
+// docs/results.md) and the calibration run again. The wheels' rows fit better (their chi-square drops by a fifth: the
+// lag is real), but the smoothed track stays as far from the fixes (its rms distance moves by under 1 %): the lag is
+// not what keeps the wheel-aided track from the fixes.
+TEST(ImuMasterRealTest, HuskyOdometryLagSeenByTheWheelsNotByTheTrack) {
+  const std::string bag = kData + "/husky_test1/test1.bag";
+  if (!std::filesystem::exists(bag)) GTEST_SKIP() << "real data absent: " << bag;
+  auto rec = importers::ImportRosbag(bag, ::roamlab::testing::HuskyImportOptions());
+  ASSERT_TRUE(rec.ok()) << rec.status().message();
+  auto config = LoadEstimatorConfig(kConfigs + "husky_wheel_aided.yaml");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  config.value().parameters.at("imu.time_offset_s").free = false;
+  std::map<double, double> wheels_chi2, rms;
+  for (const double shift_s : {0.0, 0.4}) {
+    recording::Recording shifted = rec.value();
+    for (recording::Stream& s : shifted.streams) {
+      if (s.info.name == "imu" || s.info.name == "gps") continue;
+      for (Time& t : s.t) t = Time::FromNanoseconds(t.nanoseconds() - std::llround(shift_s * 1e9));
+    }
+    CalibrationOptions options;
+    options.keep_residuals = true;
+    auto calibration = Calibrate(config.value(), shifted, options);
+    ASSERT_TRUE(calibration.ok()) << calibration.status().message();
+    for (const MeasurementResidual& m : calibration.value().residuals)
+      if (m.active && m.stream == "wheels") wheels_chi2[shift_s] += m.whitened.squaredNorm();
+    AntennaTrack track;
+    for (const StampedPose& p : calibration.value().trajectory) {
+      track.t.push_back(p.t);
+      track.p.push_back(p.p_world_body);
+      track.covariance.push_back(Eigen::Matrix3d::Zero());
+    }
+    std::cout << "odometry " << shift_s << " s earlier: wheels chi-square " << wheels_chi2[shift_s] << "\n";
+    Print(calibration.value());
+    // The fraction inside is meaningless here (no covariance); the rms distance is what is compared.
+    const recording::Stream& gps = *rec.value().Find("gps");
+    const EnuConverter enu(*rec.value().origin);
+    double sum = 0.0;
+    int n = 0;
+    for (std::size_t r = 0; r < gps.t.size(); ++r) {
+      const auto it = std::lower_bound(track.t.begin(), track.t.end(), gps.t[r]);
+      if (it == track.t.end()) continue;
+      const auto row = static_cast<Eigen::Index>(r);
+      const Eigen::Vector3d z = enu.ToEnu(gps.values(row, 0), gps.values(row, 1), gps.values(row, 2));
+      sum += (track.p[static_cast<std::size_t>(it - track.t.begin())] - z).head<2>().squaredNorm();
+      ++n;
+    }
+    rms[shift_s] = std::sqrt(sum / n);
+    std::cout << "  smoothed track against the fixes: rms horizontal distance " << rms[shift_s] << " m\n";
+  }
+  EXPECT_LT(wheels_chi2[0.4], 0.9 * wheels_chi2[0.0]);
+  EXPECT_LT(std::abs(rms[0.4] - rms[0.0]), 0.01 * rms[0.0]);
+}
+
 TEST(ImuMasterRealTest, XioMagnetometerCalibrationAgainstTheEllipsoidFit) {
   const std::string csv = kData + "/xio_imu_mag/sensor_data.csv";
   if (!std::filesystem::exists(csv)) GTEST_SKIP() << "real data absent: " << csv;
