@@ -23,7 +23,7 @@
 //     parameters: {lever_arm: vehicle.lever_arm}   # optional, default [0, 0, 0]
 // The noise is per row: n rows in one pose interval constrain it sqrt(n) times tighter than one. The slack is the
 // vehicle's side slip and bounce (a skid steer scrubs sideways in turns).
-// Variables: pose at t_k, pose at t_k+1 (PoseBlock), P^(O) (Vector3Block). Analytic Jacobians by the jets (factor.h);
+// Variables: pose at t_k, pose at t_k+1 (PoseBlock), P^(O) (Vector3Block). Jacobians by the jets (factor.h);
 // tests/estimator/models/non_holonomic_test.cc checks them against central differences.
 #pragma once
 

@@ -1,6 +1,7 @@
 // The IMU master on real recordings (skipped when the shared data are absent):
-//  - the Husky bag without its wheel odometry (configs/real/husky_imu_gps.yaml), tracked with its calibration and
-//    compared with the wheel-odometry-aided run (configs/real/husky_nominal.yaml);
+//  - the Husky bag without its wheel odometry (configs/real/husky_imu_gps.yaml, and with the vehicle's non-holonomic
+//    rows: husky_imu_gps_nonholonomic.yaml), tracked with its calibration and compared with the wheel-odometry-aided
+//    run (configs/real/husky_wheel_aided.yaml), and that run with the odometry's stamps moved by its lag;
 //  - the x-io handheld IMU + magnetometer log (configs/real/xio_imu_mag.yaml): the magnetometer's A and b against the
 //    ellipsoid fit of the raw field (eval/ellipsoid_fit.h).
 #include <algorithm>
