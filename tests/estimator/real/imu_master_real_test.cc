@@ -372,7 +372,7 @@ TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedT
   // The IMU misalignment's yaw with the non-holonomic rows: observable, with a finite std, and on the side that the
   // accelerometer's regression on the odometry's acceleration shows (the mounted IMU's x axis at -theta in the body
   // frame): within 45 deg of it, the same quarter turn, where the configured mounting (yaw 0) is a quarter turn off.
-  // Not asserted: the two agree within their stds (docs/results.md: they do not).
+  // Not asserted: their agreement within the regression's std, which its 1 s blocks, correlated in time, leave unknown.
   const HorizontalTurn turn = AccelerometerAgainstOdometry(rec.value(), 0.4);
   std::cout << "accelerometer against the odometry's acceleration (" << turn.blocks << " blocks of 1 s, odometry read "
             << "0.4 s later): turned by " << turn.theta * 180.0 / M_PI << " deg, correlation " << turn.correlation
