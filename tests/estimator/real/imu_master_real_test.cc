@@ -253,6 +253,20 @@ HorizontalTurn AccelerometerAgainstOdometry(const recording::Recording& rec, dou
   return {std::atan2(sin_sum, cos_sum), std::hypot(cos_sum, sin_sum) / std::sqrt(ff * aa), static_cast<int>(f.size())};
 }
 
+// The direction of travel in a trajectory's body frame [rad]: the circular mean, over the poses that moved at least
+// 0.5 m over the 10 poses around them, of the displacement's angle about the body's z.
+double TravelInBody(const Trajectory& trajectory) {
+  double sin_sum = 0.0, cos_sum = 0.0;
+  for (std::size_t i = 5; i + 5 < trajectory.size(); ++i) {
+    const Eigen::Vector3d d = trajectory[i + 5].p_world_body - trajectory[i - 5].p_world_body;
+    if (d.head<2>().norm() < 0.5) continue;
+    const Eigen::Vector3d d_body = trajectory[i].q_world_body.conjugate() * d;
+    sin_sum += std::sin(std::atan2(d_body.y(), d_body.x()));
+    cos_sum += std::cos(std::atan2(d_body.y(), d_body.x()));
+  }
+  return std::atan2(sin_sum, cos_sum);
+}
+
 // An IMU + GPS run: its calibration, and its track of the GPS antenna with that calibration.
 struct ImuGpsRun {
   CalibrationResult calibration;
@@ -337,6 +351,9 @@ TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedT
   ASSERT_NE(misalignment, nullptr);
   const Eigen::Vector3d roll_pitch_yaw = MisalignmentFromMounting(*misalignment);
   const double vehicle_consistent = AgainstFixes(rec.value(), vehicle.value().track, "IMU+GPS+non-holonomic track");
+  std::cout << "direction of travel in the body frame: IMU+GPS "
+            << TravelInBody(plain.value().calibration.trajectory) * 180.0 / M_PI << " deg, IMU+GPS+non-holonomic "
+            << TravelInBody(vehicle.value().calibration.trajectory) * 180.0 / M_PI << " deg\n";
   WithinThreeSigma(vehicle.value().track, reference_white,
                    "IMU+GPS+non-holonomic track against the wheel-aided track, white covariance");
   WithinThreeSigma(vehicle.value().track, reference, "IMU+GPS+non-holonomic track against the wheel-aided track, HAC");
