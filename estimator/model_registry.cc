@@ -6,6 +6,8 @@
 #include <mutex>
 #include <utility>
 
+#include "estimator/models/non_holonomic.h"
+
 namespace roamlab::estimator {
 namespace {
 
@@ -240,6 +242,8 @@ std::vector<ErrorModelDefinition> BuiltInModels() {
     if (!t.noise.empty()) d.noise_covariance = RepeatedNoise(t.noise);
     models.push_back(std::move(d));
   }
+  // Built from its own definition (models/non_holonomic.h): it reads no values, so it binds like a user model.
+  models.push_back(NonHolonomicModel());
   return models;
 }
 

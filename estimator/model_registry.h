@@ -16,7 +16,8 @@
 //     recording stream of the stream's first source role; it checks the stream (type, columns) and reads the options,
 //     and returns the bound model that makes the factor of each sample, or an error message (the builder prefixes
 //     the configuration file and stream name). The built-in models have no bind: the builder (problem.cc) makes their
-//     factors, with what they need beyond a sample (steering, specific force, wheel geometry, time offsets).
+//     factors, with what they need beyond a sample (steering, specific force, wheel geometry, time offsets); except
+//     non_holonomic (models/non_holonomic.h), which needs nothing beyond its poses and binds as a user model does.
 //
 // A bound model's factor joins the sample's poses (oldest first) and then the model's slots in the spec's order, and
 // its error has residual_dim entries and its noise as many components as the noise covariance's size; the graph

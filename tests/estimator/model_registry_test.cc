@@ -59,6 +59,14 @@ TEST(ModelRegistryTest, HoldsTheBuiltInModelsWithTheirTraits) {
   EXPECT_EQ(FindErrorModel("accelerometer")->attachment, ModelAttachment::kTriple);
   EXPECT_EQ(FindErrorModel("relative_motion")->attachment, ModelAttachment::kInterval);
   EXPECT_EQ(FindErrorModel("mecanum_drive")->residual_dim, 7);
+  // The non-holonomic pseudo-measurement reads no values: a built-in model that binds as a user model does.
+  const ErrorModelDefinition* non_holonomic = FindErrorModel("non_holonomic");
+  ASSERT_NE(non_holonomic, nullptr);
+  EXPECT_TRUE(non_holonomic->bind);
+  EXPECT_EQ(non_holonomic->attachment, ModelAttachment::kPair);
+  EXPECT_EQ(non_holonomic->residual_dim, 2);
+  EXPECT_FALSE(non_holonomic->absolute);
+  EXPECT_FALSE(non_holonomic->spec.odometric);
 }
 
 TEST(ModelRegistryTest, BuiltInNoiseCovarianceRepeatsTheKeysInTheModelsOrder) {

@@ -1,16 +1,19 @@
 // The IMU master on real recordings (skipped when the shared data are absent):
-//  - the Husky bag without its wheel odometry (configs/real/husky_imu_gps.yaml), tracked with its calibration and
-//    compared with the wheel-odometry-aided run (configs/real/husky_nominal.yaml);
+//  - the Husky bag without its wheel odometry (configs/real/husky_imu_gps.yaml, and with the vehicle's non-holonomic
+//    rows: husky_imu_gps_nonholonomic.yaml), tracked with its calibration and compared with the wheel-odometry-aided
+//    run (configs/real/husky_wheel_aided.yaml), and that run with the odometry's stamps moved by its lag;
 //  - the x-io handheld IMU + magnetometer log (configs/real/xio_imu_mag.yaml): the magnetometer's A and b against the
 //    ellipsoid fit of the raw field (eval/ellipsoid_fit.h).
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <iostream>
 #include <limits>
 #include <map>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -195,11 +198,114 @@ Result<CalibrationResult> CalibrateWith(const std::string& config_file, const re
   return Calibrate(config.value(), rec, options);
 }
 
-// The IMU + GPS run (configs/real/husky_imu_gps.yaml) tracked with its calibration, against the GPS fixes and against
-// the wheel-odometry-aided calibration's smoothed track (configs/real/husky_nominal.yaml). The reference's
-// covariance is the HAC one: its residuals are autocorrelated over tens of seconds (the skid steer's wheel speeds
-// against a lagged, mis-scaled turn; the fixes' slow errors), and its white covariance understates how far the track
-// strays from the fixes several times.
+// Where the IMU's horizontal axes point, independently of the estimator: the accelerometer's horizontal specific
+// force (turned by the configured mounting) against the odometry's acceleration in the body frame, forward dv/dt
+// and centripetal v omega_z (omega_z the gyroscope's, v the odometry's read `lag_s` later: it lags), both as 1 s
+// means, their means removed; the least-squares turn theta [rad] about the body's z with f = R(theta) a (2-D
+// Procrustes), and the correlation of the two. The mounted IMU's x axis points at -theta in the body frame.
+struct HorizontalTurn {
+  double theta = 0.0;
+  double correlation = 0.0;
+  int blocks = 0;
+};
+
+HorizontalTurn AccelerometerAgainstOdometry(const recording::Recording& rec, double lag_s) {
+  const recording::Stream& imu = *rec.Find("imu");
+  const recording::Stream& odometry = *rec.Find("odometry");
+  const Eigen::Quaterniond mounting(std::sqrt(0.5), std::sqrt(0.5), 0.0, 0.0);
+  const auto speed = [&](Time t) {
+    auto it = std::lower_bound(odometry.t.begin(), odometry.t.end(),
+                               Time::FromNanoseconds(t.nanoseconds() + std::llround(lag_s * 1e9)));
+    if (it == odometry.t.end()) --it;
+    return odometry.values(it - odometry.t.begin(), 0);  // column vx [m/s]
+  };
+  std::vector<Eigen::Vector2d> f, a;
+  constexpr std::int64_t kBlockNs = 1'000'000'000;
+  std::size_t k = 0;
+  for (Time start = imu.t.front(); Time::FromNanoseconds(start.nanoseconds() + kBlockNs) <= imu.t.back();
+       start = Time::FromNanoseconds(start.nanoseconds() + kBlockNs)) {
+    const Time end = Time::FromNanoseconds(start.nanoseconds() + kBlockNs);
+    Eigen::Vector2d f_sum = Eigen::Vector2d::Zero();
+    double centripetal_sum = 0.0;
+    int n = 0;
+    for (; k < imu.t.size() && imu.t[k] < end; ++k, ++n) {
+      const auto row = static_cast<Eigen::Index>(k);
+      f_sum += (mounting * Eigen::Vector3d(imu.values.row(row).segment<3>(3).transpose())).head<2>();
+      centripetal_sum += speed(imu.t[k]) * (mounting * Eigen::Vector3d(imu.values.row(row).head<3>().transpose())).z();
+    }
+    if (n == 0) continue;
+    f.push_back(f_sum / n);
+    a.emplace_back(speed(end) - speed(start), centripetal_sum / n);
+  }
+  Eigen::Vector2d f_mean = Eigen::Vector2d::Zero(), a_mean = Eigen::Vector2d::Zero();
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    f_mean += f[i] / static_cast<double>(f.size());
+    a_mean += a[i] / static_cast<double>(a.size());
+  }
+  double cos_sum = 0.0, sin_sum = 0.0, ff = 0.0, aa = 0.0;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    const Eigen::Vector2d fi = f[i] - f_mean, ai = a[i] - a_mean;
+    cos_sum += ai.dot(fi);
+    sin_sum += ai.x() * fi.y() - ai.y() * fi.x();
+    ff += fi.squaredNorm();
+    aa += ai.squaredNorm();
+  }
+  return {std::atan2(sin_sum, cos_sum), std::hypot(cos_sum, sin_sum) / std::sqrt(ff * aa), static_cast<int>(f.size())};
+}
+
+// The direction of travel in a trajectory's body frame [rad]: the circular mean, over the poses that moved at least
+// 0.5 m over the 10 poses around them, of the displacement's angle about the body's z.
+double TravelInBody(const Trajectory& trajectory) {
+  double sin_sum = 0.0, cos_sum = 0.0;
+  for (std::size_t i = 5; i + 5 < trajectory.size(); ++i) {
+    const Eigen::Vector3d d = trajectory[i + 5].p_world_body - trajectory[i - 5].p_world_body;
+    if (d.head<2>().norm() < 0.5) continue;
+    const Eigen::Vector3d d_body = trajectory[i].q_world_body.conjugate() * d;
+    sin_sum += std::sin(std::atan2(d_body.y(), d_body.x()));
+    cos_sum += std::cos(std::atan2(d_body.y(), d_body.x()));
+  }
+  return std::atan2(sin_sum, cos_sum);
+}
+
+// An IMU + GPS run: its calibration, and its track of the GPS antenna with that calibration.
+struct ImuGpsRun {
+  CalibrationResult calibration;
+  AntennaTrack track;
+};
+
+Result<ImuGpsRun> RunImuGps(const std::string& config_file, const recording::Recording& imu_gps) {
+  auto calibration = CalibrateWith(config_file, imu_gps, 0);
+  if (!calibration.ok()) return calibration.status();
+  auto config = LoadEstimatorConfig(config_file);
+  if (!config.ok()) return config.status();
+  auto track = Track(config.value(), imu_gps, Values(calibration.value()));
+  if (!track.ok()) return track.status();
+  const Eigen::Vector3d lever_arm = Values(calibration.value()).at("gps.lever_arm");
+  return ImuGpsRun{calibration.value(), Antenna(track.value(), lever_arm)};
+}
+
+// The calibrated IMU misalignment's turn from the configured mounting R_x(+90 deg), about the body's axes (the slot's
+// tangent is in the IMU's frame: IMU x = body x, IMU y = body z, IMU z = body -y) [rad], printed in degrees with its
+// std; the yaw's ParameterEstimate component is the second (about the IMU's y).
+Eigen::Vector3d MisalignmentFromMounting(const ParameterEstimate& p) {
+  const Eigen::Quaterniond mounting(std::sqrt(0.5), std::sqrt(0.5), 0.0, 0.0);
+  const Eigen::Quaterniond q(p.estimate[0], p.estimate[1], p.estimate[2], p.estimate[3]);
+  const Eigen::Vector3d delta = QuaternionLog<double>(mounting.conjugate() * q.normalized());
+  const Eigen::Vector3d roll_pitch_yaw(delta[0], -delta[2], delta[1]);
+  const Eigen::Vector3d deg = roll_pitch_yaw * 180.0 / M_PI, std = p.std * 180.0 / M_PI;
+  std::cout << "  IMU misalignment from the mounting: roll " << deg[0] << " +- " << std[0] << " deg, pitch " << deg[1]
+            << " +- " << std[2] << " deg, yaw " << deg[2] << " +- " << std[1]
+            << " deg (roll, pitch, yaw: " << ObservabilityName(p.components[0]) << ", "
+            << ObservabilityName(p.components[2]) << ", " << ObservabilityName(p.components[1]) << ")\n";
+  return roll_pitch_yaw;
+}
+
+// The IMU + GPS runs (configs/real/husky_imu_gps.yaml, and husky_imu_gps_nonholonomic.yaml with the vehicle's
+// non-holonomic rows), tracked with their calibrations, against the GPS fixes and against the wheel-odometry-aided
+// calibration's smoothed track (configs/real/husky_wheel_aided.yaml: the skid steer's effective track and the
+// gyroscope's time offset free). The reference's covariance is the HAC one: its residuals are autocorrelated over tens
+// of seconds (the fixes' slow errors, which the stiff wheel-aided track does not follow), and its white covariance
+// understates how far the track strays from the fixes several times.
 TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedTrack) {
   const std::string bag = kData + "/husky_test1/test1.bag";
   if (!std::filesystem::exists(bag)) GTEST_SKIP() << "real data absent: " << bag;
@@ -214,30 +320,43 @@ TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedT
   ASSERT_EQ(imu_gps.streams.size(), 2u);
 
   // Every 10th pose of the wheel-aided run (one a second) gets its covariance.
-  auto wheel = CalibrateWith(kConfigs + "husky_nominal.yaml", rec.value(), 10);
+  auto wheel = CalibrateWith(kConfigs + "husky_wheel_aided.yaml", rec.value(), 10);
   ASSERT_TRUE(wheel.ok()) << wheel.status().message();
-  auto imu_calibration = CalibrateWith(kConfigs + "husky_imu_gps.yaml", imu_gps, 0);
-  ASSERT_TRUE(imu_calibration.ok()) << imu_calibration.status().message();
   std::cout << "wheel-odometry-aided calibration:\n";
   Print(wheel.value());
-  std::cout << "IMU + GPS calibration:\n";
-  Print(imu_calibration.value());
-  for (const ParameterEstimate& p : imu_calibration.value().parameters)
-    for (int i = 0; i < p.std.size(); ++i) EXPECT_TRUE(std::isfinite(p.std[i])) << p.name << "[" << i << "]";
-  auto config = LoadEstimatorConfig(kConfigs + "husky_imu_gps.yaml");
-  ASSERT_TRUE(config.ok()) << config.status().message();
-  auto imu = Track(config.value(), imu_gps, Values(imu_calibration.value()));
-  ASSERT_TRUE(imu.ok()) << imu.status().message();
-
-  const AntennaTrack track = Antenna(imu.value(), Values(imu_calibration.value()).at("gps.lever_arm"));
   const AntennaTrack reference = Smoothed(wheel.value(), false);
   const AntennaTrack reference_white = Smoothed(wheel.value(), true);
   ASSERT_GT(reference.t.size(), 300u);
-  const double imu_consistent = AgainstFixes(rec.value(), track, "IMU+GPS track");
   AgainstFixes(rec.value(), reference_white, "wheel-aided smoothed track, white covariance");
   AgainstFixes(rec.value(), reference, "wheel-aided smoothed track, HAC covariance");
-  WithinThreeSigma(track, reference_white, "IMU+GPS track against the wheel-aided track, white covariance");
-  WithinThreeSigma(track, reference, "IMU+GPS track against the wheel-aided track, HAC");
+
+  auto plain = RunImuGps(kConfigs + "husky_imu_gps.yaml", imu_gps);
+  ASSERT_TRUE(plain.ok()) << plain.status().message();
+  std::cout << "IMU + GPS calibration:\n";
+  Print(plain.value().calibration);
+  for (const ParameterEstimate& p : plain.value().calibration.parameters)
+    for (int i = 0; i < p.std.size(); ++i) EXPECT_TRUE(std::isfinite(p.std[i])) << p.name << "[" << i << "]";
+  const double imu_consistent = AgainstFixes(rec.value(), plain.value().track, "IMU+GPS track");
+  WithinThreeSigma(plain.value().track, reference_white,
+                   "IMU+GPS track against the wheel-aided track, white covariance");
+  WithinThreeSigma(plain.value().track, reference, "IMU+GPS track against the wheel-aided track, HAC");
+
+  auto vehicle = RunImuGps(kConfigs + "husky_imu_gps_nonholonomic.yaml", imu_gps);
+  ASSERT_TRUE(vehicle.ok()) << vehicle.status().message();
+  std::cout << "IMU + GPS + non-holonomic calibration:\n";
+  Print(vehicle.value().calibration);
+  const ParameterEstimate* misalignment = nullptr;
+  for (const ParameterEstimate& p : vehicle.value().calibration.parameters)
+    if (p.name == "imu.misalignment") misalignment = &p;
+  ASSERT_NE(misalignment, nullptr);
+  const Eigen::Vector3d roll_pitch_yaw = MisalignmentFromMounting(*misalignment);
+  const double vehicle_consistent = AgainstFixes(rec.value(), vehicle.value().track, "IMU+GPS+non-holonomic track");
+  std::cout << "direction of travel in the body frame: IMU+GPS "
+            << TravelInBody(plain.value().calibration.trajectory) * 180.0 / M_PI << " deg, IMU+GPS+non-holonomic "
+            << TravelInBody(vehicle.value().calibration.trajectory) * 180.0 / M_PI << " deg\n";
+  WithinThreeSigma(vehicle.value().track, reference_white,
+                   "IMU+GPS+non-holonomic track against the wheel-aided track, white covariance");
+  WithinThreeSigma(vehicle.value().track, reference, "IMU+GPS+non-holonomic track against the wheel-aided track, HAC");
   // The HAC covariance of the smoothed positions widens the white one by about the square root of the GPS residuals'
   // integrated autocorrelation time (the fixes place the stiff wheel-aided track, and their errors are correlated
   // over tens of seconds): within a factor of 2 of it.
@@ -252,13 +371,86 @@ TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedT
             << "autocorrelation time) " << expected << "\n";
   EXPECT_GT(inflation, 0.5 * expected);
   EXPECT_LT(inflation, 2.0 * expected);
-  // The IMU+GPS track is consistent with the fixes: at most the 0.27% a 3-sigma region leaves out, with a margin for
-  // the fixes' correlated errors. The comparison with the wheel-aided track is reported, not asserted: with the HAC
-  // covariance the wheel-aided track is honest against the fixes (the fixes' own 1.2 m dominate that test), but it is
-  // farther from them than the IMU+GPS track is, and the two tracks differ by more than their combined covariances
-  // allow at many poses (docs/results.md): the skid steer's model (its turn's scale and the odometry's lag) is what
-  // the reference lacks.
+  // Both IMU+GPS tracks are consistent with the fixes: at most the 0.27% a 3-sigma region leaves out, with a margin
+  // for the fixes' correlated errors. The comparison with the wheel-aided track is reported, not asserted: with the
+  // HAC covariance the wheel-aided track is honest against the fixes (the fixes' own 1.2 m dominate that test), but it
+  // is farther from them than the IMU+GPS tracks are, and the tracks differ by more than their combined covariances
+  // allow at about half the poses (docs/results.md). The effective track and the gyroscope's offset, freed, leave the
+  // wheel-aided track where it was: what separates the tracks is how each follows the fixes' slow errors.
   EXPECT_GE(imu_consistent, 0.99);
+  EXPECT_GE(vehicle_consistent, 0.99);
+  // The skid steer turns with an effective track well below the nominal 0.555 m through which its wheel speeds were
+  // recovered from the controller's odometry: more than 3 of its (HAC) std below.
+  for (const ParameterEstimate& p : wheel.value().parameters) {
+    if (p.name == "wheels.baseline") {
+      EXPECT_LT(p.estimate[0] + 3.0 * p.std[0], 0.555);
+    }
+  }
+  // The IMU misalignment's yaw with the non-holonomic rows: observable, with a finite std, and on the side that the
+  // accelerometer's regression on the odometry's acceleration shows (the mounted IMU's x axis at -theta in the body
+  // frame): within 45 deg of it, the same quarter turn, where the configured mounting (yaw 0) is a quarter turn off.
+  // Not asserted: their agreement within the regression's std, which its 1 s blocks, correlated in time, leave unknown.
+  const HorizontalTurn turn = AccelerometerAgainstOdometry(rec.value(), 0.4);
+  std::cout << "accelerometer against the odometry's acceleration (" << turn.blocks << " blocks of 1 s, odometry read "
+            << "0.4 s later): turned by " << turn.theta * 180.0 / M_PI << " deg, correlation " << turn.correlation
+            << "; the mounted IMU's x at " << -turn.theta * 180.0 / M_PI << " deg in the body frame\n";
+  EXPECT_EQ(misalignment->components[1], Observability::kObservable);
+  EXPECT_TRUE(std::isfinite(misalignment->std[1]));
+  EXPECT_LT(std::abs(std::remainder(roll_pitch_yaw[2] + turn.theta, 2.0 * M_PI)), M_PI / 4.0);
+}
+
+// The odometry's lag against the wheel-aided model (configs/real/husky_wheel_aided.yaml, the gyroscope's first-order
+// time offset fixed at 0): the odometry and wheel streams' stamps moved 0.4 s earlier (the lag the yaw rates show,
+// docs/results.md) and the calibration run again. The wheels' rows fit better (their chi-square drops by a fifth: the
+// lag is real), but the smoothed track stays as far from the fixes (its rms distance moves by under 1 %): the lag is
+// not what keeps the wheel-aided track from the fixes.
+TEST(ImuMasterRealTest, HuskyOdometryLagSeenByTheWheelsNotByTheTrack) {
+  const std::string bag = kData + "/husky_test1/test1.bag";
+  if (!std::filesystem::exists(bag)) GTEST_SKIP() << "real data absent: " << bag;
+  auto rec = importers::ImportRosbag(bag, ::roamlab::testing::HuskyImportOptions());
+  ASSERT_TRUE(rec.ok()) << rec.status().message();
+  auto config = LoadEstimatorConfig(kConfigs + "husky_wheel_aided.yaml");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  config.value().parameters.at("imu.time_offset_s").free = false;
+  std::map<double, double> wheels_chi2, rms;
+  for (const double shift_s : {0.0, 0.4}) {
+    recording::Recording shifted = rec.value();
+    for (recording::Stream& s : shifted.streams) {
+      if (s.info.name == "imu" || s.info.name == "gps") continue;
+      for (Time& t : s.t) t = Time::FromNanoseconds(t.nanoseconds() - std::llround(shift_s * 1e9));
+    }
+    CalibrationOptions options;
+    options.keep_residuals = true;
+    auto calibration = Calibrate(config.value(), shifted, options);
+    ASSERT_TRUE(calibration.ok()) << calibration.status().message();
+    for (const MeasurementResidual& m : calibration.value().residuals)
+      if (m.active && m.stream == "wheels") wheels_chi2[shift_s] += m.whitened.squaredNorm();
+    AntennaTrack track;
+    for (const StampedPose& p : calibration.value().trajectory) {
+      track.t.push_back(p.t);
+      track.p.push_back(p.p_world_body);
+      track.covariance.push_back(Eigen::Matrix3d::Zero());
+    }
+    std::cout << "odometry " << shift_s << " s earlier: wheels chi-square " << wheels_chi2[shift_s] << "\n";
+    Print(calibration.value());
+    // The fraction inside is meaningless here (no covariance); the rms distance is what is compared.
+    const recording::Stream& gps = *rec.value().Find("gps");
+    const EnuConverter enu(*rec.value().origin);
+    double sum = 0.0;
+    int n = 0;
+    for (std::size_t r = 0; r < gps.t.size(); ++r) {
+      const auto it = std::lower_bound(track.t.begin(), track.t.end(), gps.t[r]);
+      if (it == track.t.end()) continue;
+      const auto row = static_cast<Eigen::Index>(r);
+      const Eigen::Vector3d z = enu.ToEnu(gps.values(row, 0), gps.values(row, 1), gps.values(row, 2));
+      sum += (track.p[static_cast<std::size_t>(it - track.t.begin())] - z).head<2>().squaredNorm();
+      ++n;
+    }
+    rms[shift_s] = std::sqrt(sum / n);
+    std::cout << "  smoothed track against the fixes: rms horizontal distance " << rms[shift_s] << " m\n";
+  }
+  EXPECT_LT(wheels_chi2[0.4], 0.9 * wheels_chi2[0.0]);
+  EXPECT_LT(std::abs(rms[0.4] - rms[0.0]), 0.01 * rms[0.0]);
 }
 
 TEST(ImuMasterRealTest, XioMagnetometerCalibrationAgainstTheEllipsoidFit) {
