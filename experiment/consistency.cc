@@ -1,12 +1,9 @@
 #include "experiment/consistency.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
-#include <mutex>
-#include <thread>
 #include <utility>
 
 #include <Eigen/Cholesky>
@@ -142,38 +139,6 @@ Outcome RunOne(const MonteCarloOptions& options, const Shared& shared, int i) {
       {"run", i}, {"seed", seed}, {"seconds", calibrated.value().seconds}, {"parameters", parameters}};
   const Status written = WriteFileAtomic(ConsistencyRunFile(options.out, i), j.dump() + "\n");
   return written.ok() ? Outcome::Ok() : Outcome::Failed(written);
-}
-
-// The runs in `todo` over worker threads; the outcome names the first (lowest) failed run.
-Outcome RunAll(const MonteCarloOptions& options, const Shared& shared, const std::vector<int>& todo) {
-  const int n = static_cast<int>(todo.size());
-  const int jobs = options.jobs > 0 ? options.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  std::vector<Outcome> outcomes(todo.size());
-  std::atomic<int> next{0}, done{0};
-  std::mutex print;
-  const auto worker = [&] {
-    for (int k = next++; k < n && !InterruptRequested(); k = next++) {
-      outcomes[k] = RunOne(options, shared, todo[k]);
-      const int finished = ++done;
-      if (options.progress) {
-        std::lock_guard<std::mutex> lock(print);
-        options.progress(finished, n);
-      }
-    }
-  };
-  if (options.progress) options.progress(0, n);
-  std::vector<std::thread> threads;
-  for (int k = 0; k < std::min(jobs, n); ++k) threads.emplace_back(worker);
-  for (auto& th : threads) th.join();
-  const auto failed = std::count_if(outcomes.begin(), outcomes.end(), [](const Outcome& o) { return !o.ok(); });
-  for (const Outcome& o : outcomes)
-    if (!o.ok()) {
-      Outcome first = o;
-      first.status = Status::Error(std::to_string(failed) + " of " + std::to_string(n) + " runs failed; first: " +
-                                   o.status.message());
-      return first;
-    }
-  return Outcome::Ok();
 }
 
 // A number array of a run file (null read as NaN); false when malformed or not of size n.
@@ -346,7 +311,8 @@ Outcome RunCalibrationConsistency(const MonteCarloOptions& options, ConsistencyS
   if (options.resume && options.log)
     options.log(std::to_string(options.runs - static_cast<int>(todo.size())) + " of " + std::to_string(options.runs) +
                 " runs already have their result file");
-  if (Outcome ran = RunAll(options, shared, todo); !ran.ok()) return ran;
+  const auto run = [&](int i) { return RunOne(options, shared, i); };
+  if (Outcome ran = RunSpread(todo, options.jobs, options.progress, run); !ran.ok()) return ran;
   if (InterruptRequested()) return Outcome::Failed(InterruptedError());
   return Aggregate(options, shared, summary);
 }

@@ -365,35 +365,41 @@ Result<RunResult> ReadRun(const std::string& path, int i, std::uint64_t seed) {
   return r;
 }
 
-// Runs `todo` spread over worker threads, each writing its own result file, so the result does not depend on
-// scheduling. A failed run does not stop the others; the outcome names the first (lowest) failed run.
-Outcome RunAll(const MonteCarloOptions& options, const MonteCarloShared& shared, const std::vector<int>& todo) {
+}  // namespace
+
+Outcome RunSpread(const std::vector<int>& todo, int jobs, const std::function<void(int, int)>& progress,
+                  const std::function<Outcome(int)>& run) {
   const int n = static_cast<int>(todo.size());
-  const int jobs = options.jobs > 0 ? options.jobs : std::max(1u, std::thread::hardware_concurrency());
+  if (jobs <= 0) jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::vector<Outcome> outcomes(todo.size());
   std::atomic<int> next{0}, done{0};
   std::mutex print;
   const auto worker = [&] {
     for (int k = next++; k < n && !InterruptRequested(); k = next++) {
-      outcomes[k] = RunMonteCarloRun(options, shared, todo[k]);
+      outcomes[k] = run(todo[k]);
       const int finished = ++done;
-      if (options.progress) {
+      if (progress) {
         std::lock_guard<std::mutex> lock(print);
-        options.progress(finished, n);
+        progress(finished, n);
       }
     }
   };
-  if (options.progress) options.progress(0, n);
+  if (progress) progress(0, n);
   std::vector<std::thread> threads;
   for (int k = 0; k < std::min(jobs, n); ++k) threads.emplace_back(worker);
   for (auto& th : threads) th.join();
   const auto failed = std::count_if(outcomes.begin(), outcomes.end(), [](const Outcome& o) { return !o.ok(); });
   for (const Outcome& o : outcomes)
-    if (!o.ok())
-      return Outcome::Failed(Status::Error(std::to_string(failed) + " of " + std::to_string(n) +
-                                           " runs failed; first: " + o.status.message()));
+    if (!o.ok()) {
+      Outcome first = o;
+      first.status = Status::Error(std::to_string(failed) + " of " + std::to_string(n) + " runs failed; first: " +
+                                   o.status.message());
+      return first;
+    }
   return Outcome::Ok();
 }
+
+namespace {
 
 std::string Format(double x, const char* format = "%.4g") {
   char buffer[64];
@@ -554,7 +560,8 @@ Outcome RunMonteCarlo(const MonteCarloOptions& options, MonteCarloSummary* summa
   } else {
     for (int i = 0; i < options.runs; ++i) todo.push_back(i);
   }
-  if (Outcome ran = RunAll(options, *shared, todo); !ran.ok()) return ran;
+  const auto run = [&](int i) { return RunMonteCarloRun(options, *shared, i); };
+  if (Outcome ran = RunSpread(todo, options.jobs, options.progress, run); !ran.ok()) return ran;
   if (InterruptRequested()) return Outcome::Failed(InterruptedError());
   return AggregateMonteCarlo(options, summary);
 }

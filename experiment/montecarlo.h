@@ -69,6 +69,12 @@ struct MonteCarloShared;
 Outcome PrepareMonteCarlo(const MonteCarloOptions& options, std::shared_ptr<const MonteCarloShared>* shared);
 // Runs run i (0 <= i < runs) and writes its result file; a failed run writes none. Safe to call from several threads.
 Outcome RunMonteCarloRun(const MonteCarloOptions& options, const MonteCarloShared& shared, int i);
+// Runs run(i) for each i of `todo` over `jobs` threads (0: one per core), calling progress(finished, total) once
+// with 0 and after each run; no new run starts once an interrupt is requested (common/interrupt.h). Each run writes
+// its own result, so nothing depends on scheduling. A failed run does not stop the others; the outcome then says how
+// many failed and carries the first (lowest in `todo`) failure.
+Outcome RunSpread(const std::vector<int>& todo, int jobs, const std::function<void(int finished, int total)>& progress,
+                  const std::function<Outcome(int i)>& run);
 // The runs in [0, runs) whose result file does not exist, in increasing order.
 std::vector<int> MissingMonteCarloRuns(const MonteCarloOptions& options);
 // Reads every run's result file and writes the summaries (nees.json, runs.json, nees.png, report.html): the same
