@@ -1,6 +1,7 @@
 #include "estimator/models/gps.h"
 
 #include <cstdint>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -51,7 +52,8 @@ testing::SmallProblem GpsProblem(bool noisy, std::uint32_t seed) {
   testing::AddAnchoredPoses(motion.poses, 0.02, 0.002, noisy, &rng, &problem);
   const VariableId lever_id =
       testing::AddFreeParameter("lever_arm", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), lever_arm, &problem);
-  const VariableId bias_id = problem.graph.AddVariable({"bias", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), true});
+  const VariableId bias_id =
+      problem.graph.AddVariable({"bias", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), true, std::nullopt});
   for (std::size_t k = 0; k < motion.poses.size(); ++k) {
     const Pose<double> T = PoseFromArray(motion.poses[k].data());
     const Eigen::Vector3d z = T.p_world_body + T.q_world_body.toRotationMatrix() * lever_arm +
