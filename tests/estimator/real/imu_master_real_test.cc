@@ -163,12 +163,25 @@ double WithinThreeSigma(const AntennaTrack& track, const AntennaTrack& reference
   return fraction;
 }
 
+// The variance of a fix's error per ENU axis [m^2] as a configuration models it: the white sigma_m squared, plus the
+// stationary variance of the bias's Gauss-Markov process when the bias is one.
+Eigen::Vector3d FixErrorVariance(const EstimatorConfig& config) {
+  const double sigma_m = config.streams.at("gps").noise.at("sigma_m");
+  Eigen::Vector3d variance = Eigen::Vector3d::Constant(sigma_m * sigma_m);
+  const auto bias = config.parameters.find("gps.bias");
+  if (bias != config.parameters.end() && bias->second.process.type == ProcessConfig::Type::kGaussMarkov)
+    variance += bias->second.process.sigma.cwiseAbs2();
+  return variance;
+}
+
 // The fraction of the GPS fixes inside a track's horizontal 3-sigma region: its distance from each fix, normalized by
-// its own reported covariance (nearest pose at or after the fix) plus the fix's configured noise (1.2 m per axis in
-// both configurations).
-double AgainstFixes(const recording::Recording& rec, const AntennaTrack& track, const char* name) {
+// its own reported covariance (nearest pose at or after the fix) plus the fix's error variance as its configuration
+// models it (FixErrorVariance).
+double AgainstFixes(const recording::Recording& rec, const AntennaTrack& track, const Eigen::Vector3d& fix_variance,
+                    const char* name) {
   const recording::Stream& gps = *rec.Find("gps");
   const EnuConverter enu(*rec.origin);
+  const Eigen::Matrix2d fix_covariance = fix_variance.head<2>().asDiagonal();
   double sum = 0.0;
   int n = 0, inside = 0;
   for (std::size_t r = 0; r < gps.t.size(); ++r) {
@@ -178,7 +191,7 @@ double AgainstFixes(const recording::Recording& rec, const AntennaTrack& track, 
     const auto row = static_cast<Eigen::Index>(r);
     const Eigen::Vector3d z = enu.ToEnu(gps.values(row, 0), gps.values(row, 1), gps.values(row, 2));
     const Eigen::Vector2d d = (track.p[k] - z).head<2>();
-    const Eigen::Matrix2d c = track.covariance[k].topLeftCorner<2, 2>() + 1.2 * 1.2 * Eigen::Matrix2d::Identity();
+    const Eigen::Matrix2d c = track.covariance[k].topLeftCorner<2, 2>() + fix_covariance;
     inside += d.dot(c.ldlt().solve(d)) <= kThreeSigma2d ? 1 : 0;
     sum += d.squaredNorm();
     ++n;
@@ -186,6 +199,13 @@ double AgainstFixes(const recording::Recording& rec, const AntennaTrack& track, 
   std::cout << name << " against the GPS fixes: rms horizontal distance " << std::sqrt(sum / n)
             << " m, within the 3-sigma region " << 100.0 * inside / n << "% of " << n << " fixes\n";
   return static_cast<double>(inside) / n;
+}
+
+// FixErrorVariance of a configuration in configs/real/.
+Eigen::Vector3d ConfiguredFixErrorVariance(const std::string& file) {
+  auto config = LoadEstimatorConfig(kConfigs + file);
+  EXPECT_TRUE(config.ok()) << config.status().message();
+  return config.ok() ? FixErrorVariance(config.value()) : Eigen::Vector3d::Constant(NAN);
 }
 
 Result<CalibrationResult> CalibrateWith(const std::string& config_file, const recording::Recording& rec,
@@ -300,6 +320,70 @@ Eigen::Vector3d MisalignmentFromMounting(const ParameterEstimate& p) {
   return roll_pitch_yaw;
 }
 
+// The fixes' slow error read from a run that does not follow it: per ENU axis, the GPS residuals [m] (whitened times
+// the run's white sigma_m) in time order, demeaned, their autocovariance C(l) at lag l fixes. A white part plus a
+// first-order Gauss-Markov part of variance s^2 and correlation time tau gives C(0) = w^2 + s^2 and C(l) = s^2
+// exp(-l dt / tau) for l >= 1, so: s = sqrt(C(1)), w = sqrt(C(0) - C(1)), and tau = (l_e - 1) dt, l_e the first lag
+// at which C(l) falls to C(1) / e (dt the fixes' median spacing).
+struct GpsErrorSplit {
+  Eigen::Vector3d slow_sigma_m;
+  Eigen::Vector3d white_sigma_m;
+  Eigen::Vector3d tau_s;
+};
+
+GpsErrorSplit SplitGpsResiduals(const CalibrationResult& r, double sigma_m) {
+  std::vector<const MeasurementResidual*> rows;
+  for (const MeasurementResidual& m : r.residuals)
+    if (m.active && m.stream == "gps") rows.push_back(&m);
+  std::stable_sort(rows.begin(), rows.end(), [](const auto* x, const auto* y) { return x->t < y->t; });
+  const int n = static_cast<int>(rows.size());
+  Eigen::MatrixXd e(3, n);
+  std::vector<double> spacing_s;
+  for (int t = 0; t < n; ++t) {
+    e.col(t) = sigma_m * rows[static_cast<std::size_t>(t)]->whitened;
+    if (t > 0)
+      spacing_s.push_back(
+          SecondsBetween(rows[static_cast<std::size_t>(t) - 1]->t, rows[static_cast<std::size_t>(t)]->t));
+  }
+  e.colwise() -= e.rowwise().mean();
+  std::nth_element(spacing_s.begin(), spacing_s.begin() + static_cast<std::ptrdiff_t>(spacing_s.size() / 2),
+                   spacing_s.end());
+  const double dt_s = spacing_s[spacing_s.size() / 2];
+  const auto autocovariance = [&](int axis, int lag) {
+    return e.row(axis).head(n - lag).dot(e.row(axis).tail(n - lag)) / n;
+  };
+  GpsErrorSplit out;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double c0 = autocovariance(axis, 0), c1 = autocovariance(axis, 1);
+    out.slow_sigma_m[axis] = std::sqrt(std::max(c1, 0.0));
+    out.white_sigma_m[axis] = std::sqrt(std::max(c0 - c1, 0.0));
+    int lag = 1;
+    while (lag < n / 4 && autocovariance(axis, lag) > c1 / M_E) ++lag;
+    out.tau_s[axis] = (lag - 1) * dt_s;
+  }
+  std::cout << "GPS residuals (" << n << " fixes, " << dt_s << " s apart) split per ENU axis: slow std ["
+            << out.slow_sigma_m.transpose() << "] m, tau [" << out.tau_s.transpose() << "] s, white std ["
+            << out.white_sigma_m.transpose() << "] m\n";
+  return out;
+}
+
+TEST(ImuMasterRealTest, HuskyGpsSlowErrorFromTheWheelAidedResiduals) {
+  const std::string bag = kData + "/husky_test1/test1.bag";
+  if (!std::filesystem::exists(bag)) GTEST_SKIP() << "real data absent: " << bag;
+  auto rec = importers::ImportRosbag(bag, ::roamlab::testing::HuskyImportOptions());
+  ASSERT_TRUE(rec.ok()) << rec.status().message();
+  auto config = LoadEstimatorConfig(kConfigs + "husky_wheel_aided.yaml");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  EstimatorConfig white = config.value();
+  white.parameters.erase("gps.bias");
+  white.streams.at("gps").noise["sigma_m"] = 1.2;
+  CalibrationOptions options;
+  options.keep_residuals = true;
+  auto run = Calibrate(white, rec.value(), options);
+  ASSERT_TRUE(run.ok()) << run.status().message();
+  SplitGpsResiduals(run.value(), 1.2);
+}
+
 // The IMU + GPS runs (configs/real/husky_imu_gps.yaml, and husky_imu_gps_nonholonomic.yaml with the vehicle's
 // non-holonomic rows), tracked with their calibrations, against the GPS fixes and against the wheel-odometry-aided
 // calibration's smoothed track (configs/real/husky_wheel_aided.yaml: the skid steer's effective track and the
@@ -327,8 +411,9 @@ TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedT
   const AntennaTrack reference = Smoothed(wheel.value(), false);
   const AntennaTrack reference_white = Smoothed(wheel.value(), true);
   ASSERT_GT(reference.t.size(), 300u);
-  AgainstFixes(rec.value(), reference_white, "wheel-aided smoothed track, white covariance");
-  AgainstFixes(rec.value(), reference, "wheel-aided smoothed track, HAC covariance");
+  const Eigen::Vector3d wheel_fix_variance = ConfiguredFixErrorVariance("husky_wheel_aided.yaml");
+  AgainstFixes(rec.value(), reference_white, wheel_fix_variance, "wheel-aided smoothed track, white covariance");
+  AgainstFixes(rec.value(), reference, wheel_fix_variance, "wheel-aided smoothed track, HAC covariance");
 
   auto plain = RunImuGps(kConfigs + "husky_imu_gps.yaml", imu_gps);
   ASSERT_TRUE(plain.ok()) << plain.status().message();
@@ -336,7 +421,8 @@ TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedT
   Print(plain.value().calibration);
   for (const ParameterEstimate& p : plain.value().calibration.parameters)
     for (int i = 0; i < p.std.size(); ++i) EXPECT_TRUE(std::isfinite(p.std[i])) << p.name << "[" << i << "]";
-  const double imu_consistent = AgainstFixes(rec.value(), plain.value().track, "IMU+GPS track");
+  const double imu_consistent =
+      AgainstFixes(rec.value(), plain.value().track, ConfiguredFixErrorVariance("husky_imu_gps.yaml"), "IMU+GPS track");
   WithinThreeSigma(plain.value().track, reference_white,
                    "IMU+GPS track against the wheel-aided track, white covariance");
   WithinThreeSigma(plain.value().track, reference, "IMU+GPS track against the wheel-aided track, HAC");
@@ -350,7 +436,9 @@ TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedT
     if (p.name == "imu.misalignment") misalignment = &p;
   ASSERT_NE(misalignment, nullptr);
   const Eigen::Vector3d roll_pitch_yaw = MisalignmentFromMounting(*misalignment);
-  const double vehicle_consistent = AgainstFixes(rec.value(), vehicle.value().track, "IMU+GPS+non-holonomic track");
+  const double vehicle_consistent =
+      AgainstFixes(rec.value(), vehicle.value().track, ConfiguredFixErrorVariance("husky_imu_gps_nonholonomic.yaml"),
+                   "IMU+GPS+non-holonomic track");
   std::cout << "direction of travel in the body frame: IMU+GPS "
             << TravelInBody(plain.value().calibration.trajectory) * 180.0 / M_PI << " deg, IMU+GPS+non-holonomic "
             << TravelInBody(vehicle.value().calibration.trajectory) * 180.0 / M_PI << " deg\n";
