@@ -135,11 +135,14 @@ AntennaTrack Smoothed(const CalibrationResult& calibration, bool white) {
 constexpr double kThreeSigma2d = 11.83;
 
 // The fraction of the reference's poses at which `track` (interpolated linearly in time; its nearest pose's
-// covariance) lies inside the combined horizontal 3-sigma region. Both runs read the same GPS, so their errors are
-// positively correlated and the sum of the covariances overstates the difference's: the test is conservative in that.
+// covariance) lies inside the combined horizontal 3-sigma region; printed with the mean of the normalized squared
+// differences d^T (C_track + C_reference)^-1 d, 2 (the dimension) for consistent and independent errors, below it
+// when the covariances are generous or the errors positively correlated. Both runs read the same GPS, so their errors
+// are positively correlated and the sum of the covariances overstates the difference's: the test is conservative in
+// that.
 double WithinThreeSigma(const AntennaTrack& track, const AntennaTrack& reference, const char* name) {
   int compared = 0, within = 0;
-  double sum_difference = 0.0, max_difference = 0.0, sum_std_track = 0.0, sum_std_reference = 0.0;
+  double sum_difference = 0.0, max_difference = 0.0, sum_std_track = 0.0, sum_std_reference = 0.0, sum_nees = 0.0;
   for (std::size_t i = 0; i < reference.t.size(); ++i) {
     const auto after = std::lower_bound(track.t.begin(), track.t.end(), reference.t[i]);
     if (after == track.t.begin() || after == track.t.end()) continue;
@@ -148,7 +151,9 @@ double WithinThreeSigma(const AntennaTrack& track, const AntennaTrack& reference
     const Eigen::Vector2d d = (reference.p[i] - ((1.0 - w) * track.p[j - 1] + w * track.p[j])).head<2>();
     const Eigen::Matrix2d c_track = track.covariance[w < 0.5 ? j - 1 : j].topLeftCorner<2, 2>();
     const Eigen::Matrix2d c_reference = reference.covariance[i].topLeftCorner<2, 2>();
-    within += d.dot((c_track + c_reference).ldlt().solve(d)) <= kThreeSigma2d ? 1 : 0;
+    const double nees = d.dot((c_track + c_reference).ldlt().solve(d));
+    within += nees <= kThreeSigma2d ? 1 : 0;
+    sum_nees += nees;
     ++compared;
     sum_difference += d.norm();
     max_difference = std::max(max_difference, d.norm());
@@ -159,7 +164,8 @@ double WithinThreeSigma(const AntennaTrack& track, const AntennaTrack& reference
   std::cout << name << ": " << compared << " poses compared; horizontal difference mean " << sum_difference / compared
             << " m, max " << max_difference << " m; reported horizontal std mean: IMU+GPS " << sum_std_track / compared
             << " m, wheel-aided " << sum_std_reference / compared << " m; within the 3-sigma region "
-            << 100.0 * fraction << "%\n";
+            << 100.0 * fraction << "%; mean normalized squared difference " << sum_nees / compared
+            << " (2 for independent errors)\n";
   return fraction;
 }
 
@@ -367,6 +373,8 @@ GpsErrorSplit SplitGpsResiduals(const CalibrationResult& r, double sigma_m) {
   return out;
 }
 
+// The rule's inputs: the wheel-aided run (configs/real/husky_wheel_aided.yaml) with the fixes taken as white (the bias
+// left out, sigma_m 1.2 m, as the configuration read before the bias was modelled).
 TEST(ImuMasterRealTest, HuskyGpsSlowErrorFromTheWheelAidedResiduals) {
   const std::string bag = kData + "/husky_test1/test1.bag";
   if (!std::filesystem::exists(bag)) GTEST_SKIP() << "real data absent: " << bag;
@@ -381,7 +389,20 @@ TEST(ImuMasterRealTest, HuskyGpsSlowErrorFromTheWheelAidedResiduals) {
   options.keep_residuals = true;
   auto run = Calibrate(white, rec.value(), options);
   ASSERT_TRUE(run.ok()) << run.status().message();
-  SplitGpsResiduals(run.value(), 1.2);
+  const GpsErrorSplit split = SplitGpsResiduals(run.value(), 1.2);
+  const double white_rms = std::sqrt(split.white_sigma_m.squaredNorm() / 3.0);
+  // The Husky configurations carry the rule's values, rounded to three digits (within 1 %).
+  for (const char* file : {"husky_wheel_aided.yaml", "husky_imu_gps.yaml", "husky_imu_gps_nonholonomic.yaml"}) {
+    auto c = LoadEstimatorConfig(kConfigs + file);
+    ASSERT_TRUE(c.ok()) << c.status().message();
+    const ProcessConfig& process = c.value().parameters.at("gps.bias").process;
+    EXPECT_EQ(process.type, ProcessConfig::Type::kGaussMarkov) << file;
+    for (int axis = 0; axis < 3; ++axis) {
+      EXPECT_NEAR(process.sigma[axis], split.slow_sigma_m[axis], 0.01 * split.slow_sigma_m[axis]) << file << axis;
+      EXPECT_NEAR(process.tau_s[axis], split.tau_s[axis], 0.01 * split.tau_s[axis]) << file << axis;
+    }
+    EXPECT_NEAR(c.value().streams.at("gps").noise.at("sigma_m"), white_rms, 0.01 * white_rms) << file;
+  }
 }
 
 // The IMU + GPS runs (configs/real/husky_imu_gps.yaml, and husky_imu_gps_nonholonomic.yaml with the vehicle's
@@ -425,7 +446,8 @@ TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedT
       AgainstFixes(rec.value(), plain.value().track, ConfiguredFixErrorVariance("husky_imu_gps.yaml"), "IMU+GPS track");
   WithinThreeSigma(plain.value().track, reference_white,
                    "IMU+GPS track against the wheel-aided track, white covariance");
-  WithinThreeSigma(plain.value().track, reference, "IMU+GPS track against the wheel-aided track, HAC");
+  const double imu_within =
+      WithinThreeSigma(plain.value().track, reference, "IMU+GPS track against the wheel-aided track, HAC");
 
   auto vehicle = RunImuGps(kConfigs + "husky_imu_gps_nonholonomic.yaml", imu_gps);
   ASSERT_TRUE(vehicle.ok()) << vehicle.status().message();
@@ -445,28 +467,26 @@ TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedT
   WithinThreeSigma(vehicle.value().track, reference_white,
                    "IMU+GPS+non-holonomic track against the wheel-aided track, white covariance");
   WithinThreeSigma(vehicle.value().track, reference, "IMU+GPS+non-holonomic track against the wheel-aided track, HAC");
-  // The HAC covariance of the smoothed positions widens the white one by about the square root of the GPS residuals'
-  // integrated autocorrelation time (the fixes place the stiff wheel-aided track, and their errors are correlated
-  // over tens of seconds): within a factor of 2 of it.
+  // With the fixes' slow error modelled (the bias), the wheel-aided run's GPS residuals are white: no lag window of
+  // their autocorrelation reaches 2 / sqrt(n) (AnalyzeAutocorrelation's lag 0 to 2; with the fixes taken as white
+  // they are correlated over 30 fixes, 12 s). The HAC covariance of the smoothed positions still widens the white one
+  // (printed): the wheels' residuals and the bias's process rows stay correlated.
   double sum_white = 0.0, sum_hac = 0.0;
   for (const PoseCovariance& c : wheel.value().pose_covariances) {
     sum_white += std::sqrt(c.white.topLeftCorner<2, 2>().trace());
     sum_hac += std::sqrt(c.hac.topLeftCorner<2, 2>().trace());
   }
-  const double inflation = sum_hac / sum_white;
-  const double expected = std::sqrt(Autocorrelations(wheel.value()).at("gps").integrated_time);
-  std::cout << "wheel-aided smoothed positions: horizontal std HAC / white " << inflation << ", sqrt(GPS integrated "
-            << "autocorrelation time) " << expected << "\n";
-  EXPECT_GT(inflation, 0.5 * expected);
-  EXPECT_LT(inflation, 2.0 * expected);
+  std::cout << "wheel-aided smoothed positions: horizontal std HAC / white " << sum_hac / sum_white << "\n";
+  EXPECT_LE(Autocorrelations(wheel.value()).at("gps").lag, 2);
   // Both IMU+GPS tracks are consistent with the fixes: at most the 0.27% a 3-sigma region leaves out, with a margin
-  // for the fixes' correlated errors. The comparison with the wheel-aided track is reported, not asserted: with the
-  // HAC covariance the wheel-aided track is honest against the fixes (the fixes' own 1.2 m dominate that test), but it
-  // is farther from them than the IMU+GPS tracks are, and the tracks differ by more than their combined covariances
-  // allow at about half the poses (docs/results.md). The effective track and the gyroscope's offset, freed, leave the
-  // wheel-aided track where it was: what separates the tracks is how each follows the fixes' slow errors.
+  // for the fixes' correlated errors.
   EXPECT_GE(imu_consistent, 0.99);
   EXPECT_GE(vehicle_consistent, 0.99);
+  // The IMU+GPS track lies within the combined 3-sigma region of the wheel-aided track's (HAC) at 97 % of the poses or
+  // more: a consistent pair leaves out 0.27 % of independent poses, and below 97 % (with the spread that 395
+  // correlated poses give a fraction) the pair is not consistent. With the fixes taken as white it read 61.8 %: each
+  // track followed the fixes' slow error in its own way, and neither covariance held that error (docs/results.md).
+  EXPECT_GE(imu_within, 0.97);
   // The skid steer turns with an effective track well below the nominal 0.555 m through which its wheel speeds were
   // recovered from the controller's odometry: more than 3 of its (HAC) std below.
   for (const ParameterEstimate& p : wheel.value().parameters) {
