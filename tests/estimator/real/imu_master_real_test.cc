@@ -1,7 +1,8 @@
 // The IMU master on real recordings (skipped when the shared data are absent):
 //  - the Husky bag without its wheel odometry (configs/real/husky_imu_gps.yaml, and with the vehicle's non-holonomic
 //    rows: husky_imu_gps_nonholonomic.yaml), tracked with its calibration and compared with the wheel-odometry-aided
-//    run (configs/real/husky_wheel_aided.yaml), and that run with the odometry's stamps moved by its lag;
+//    run (configs/real/husky_wheel_aided.yaml), and that run with the odometry's stamps moved by its lag; the GPS's
+//    slow error (the configurations' gps.bias process) split from the wheel-aided run's residuals;
 //  - the x-io handheld IMU + magnetometer log (configs/real/xio_imu_mag.yaml): the magnetometer's A and b against the
 //    ellipsoid fit of the raw field (eval/ellipsoid_fit.h).
 #include <algorithm>
@@ -374,7 +375,7 @@ GpsErrorSplit SplitGpsResiduals(const CalibrationResult& r, double sigma_m) {
 }
 
 // The rule's inputs: the wheel-aided run (configs/real/husky_wheel_aided.yaml) with the fixes taken as white (the bias
-// left out, sigma_m 1.2 m, as the configuration read before the bias was modelled).
+// left out, sigma_m 1.2 m: the fixes' whole spread taken as one white error).
 TEST(ImuMasterRealTest, HuskyGpsSlowErrorFromTheWheelAidedResiduals) {
   const std::string bag = kData + "/husky_test1/test1.bag";
   if (!std::filesystem::exists(bag)) GTEST_SKIP() << "real data absent: " << bag;
