@@ -344,6 +344,9 @@ GpsErrorSplit SplitGpsResiduals(const CalibrationResult& r, double sigma_m) {
     if (m.active && m.stream == "gps") rows.push_back(&m);
   std::stable_sort(rows.begin(), rows.end(), [](const auto* x, const auto* y) { return x->t < y->t; });
   const int n = static_cast<int>(rows.size());
+  GpsErrorSplit out;
+  out.slow_sigma_m = out.white_sigma_m = out.tau_s = Eigen::Vector3d::Constant(NAN);
+  if (n < 8) return out;  // too few fixes for a lag window
   Eigen::MatrixXd e(3, n);
   std::vector<double> spacing_s;
   for (int t = 0; t < n; ++t) {
@@ -359,7 +362,6 @@ GpsErrorSplit SplitGpsResiduals(const CalibrationResult& r, double sigma_m) {
   const auto autocovariance = [&](int axis, int lag) {
     return e.row(axis).head(n - lag).dot(e.row(axis).tail(n - lag)) / n;
   };
-  GpsErrorSplit out;
   for (int axis = 0; axis < 3; ++axis) {
     const double c0 = autocovariance(axis, 0), c1 = autocovariance(axis, 1);
     out.slow_sigma_m[axis] = std::sqrt(std::max(c1, 0.0));
