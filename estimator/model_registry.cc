@@ -158,7 +158,8 @@ std::vector<ModelSpec> BuiltInSpecs() {
        {"field_world", "drive_nm_per_mps2"},
        false,
        {"specific_force"}},
-      {"gps", {""}, {"sigma_m"}, {Vector3Slot("lever_arm", 0.0)}, {}, false, {}},
+      // bias: the fixes' slow error in W [m], meant to be a Gauss-Markov process (models/gps.h).
+      {"gps", {""}, {"sigma_m"}, {Vector3Slot("lever_arm", 0.0), Vector3Slot("bias", 0.0)}, {}, false, {}},
       {"absolute_pose",
        {""},
        {"position_m", "orientation_rad"},

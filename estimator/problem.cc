@@ -508,7 +508,7 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     Eigen::Vector3d z = z3();
     if (data.info.type == StreamType::kGps) z = im.enu->ToEnu(z[0], z[1], z[2]);
     factor = MakeFactor(GpsError(z));
-    vars = {poses_[k].id, slot(0, k)};
+    vars = {poses_[k].id, slot(0, k), slot(1, k)};
     absolute_fixes_.emplace_back(poses_[k].id, z);
   } else if (model == "absolute_pose") {
     const Eigen::Quaterniond q(row[6], row[3], row[4], row[5]);

@@ -25,7 +25,7 @@ constexpr double kGridStepS = 1e-3;
 constexpr recording::GeodeticOrigin kOrigin{45.4642, 9.19, 120.0};
 
 // Noise sources; the index is mixed into the seed of each one's generator.
-enum NoiseSource { kGyroNoise = 0, kAccelNoise, kMagNoise, kGpsNoise, kSpeedNoise, kSteeringNoise };
+enum NoiseSource { kGyroNoise = 0, kAccelNoise, kMagNoise, kGpsNoise, kSpeedNoise, kSteeringNoise, kGpsBias };
 
 // One plane sinusoid of the terrain: amplitude * sin(kx x + ky y + phase), amplitude [m], wave numbers [rad/m].
 struct TerrainWave {
@@ -239,9 +239,11 @@ std::string SyntheticOptions::Validate() const {
   require(IsFinite(wheelbase_m) && wheelbase_m > 0.0, "wheelbase_m must be > 0");
   require(gyro_bias_radps.allFinite(), "gyro_bias_radps must be finite");
   require(IsFinite(imu_time_offset_s) && std::abs(imu_time_offset_s) <= 1.0, "imu_time_offset_s must be in [-1, 1]");
-  for (double sigma : {sigma_gps_m, sigma_mag, sigma_acc_mps2, sigma_gyro_radps, sigma_speed_mps, sigma_steering_rad}) {
+  for (double sigma : {sigma_gps_m, sigma_mag, sigma_acc_mps2, sigma_gyro_radps, sigma_speed_mps, sigma_steering_rad,
+                       gps_bias_sigma_m}) {
     require(IsFinite(sigma) && sigma >= 0.0, "noise sigmas must be >= 0");
   }
+  require(IsFinite(gps_bias_tau_s) && gps_bias_tau_s > 0.0, "gps_bias_tau_s must be > 0");
   require(field_world.allFinite() && field_world.norm() > 0.0, "field_world must be finite and nonzero");
   return problems.str();
 }
@@ -273,6 +275,7 @@ SyntheticRecording MakeAtvRecording(const SyntheticOptions& options) {
   NoiseStream gps_noise(options.noise, options.seed, kGpsNoise);
   NoiseStream speed_noise(options.noise, options.seed, kSpeedNoise);
   NoiseStream steering_noise(options.noise, options.seed, kSteeringNoise);
+  NoiseStream gps_bias_noise(options.noise, options.seed, kGpsBias);
 
   // IMU (gyro, specific force) and ground truth at the IMU times.
   recording::Stream imu = MakeStream("imu", recording::StreamType::kImu, options.imu_rate_hz,
@@ -317,10 +320,15 @@ SyntheticRecording MakeAtvRecording(const SyntheticOptions& options) {
   gps.info.mounting = recording::Mounting{};
   gps.info.noise = {{"sigma_m", options.sigma_gps_m}};
   const GeographicLib::LocalCartesian local(kOrigin.latitude_deg, kOrigin.longitude_deg, kOrigin.altitude_m);
+  const double bias_decay = std::exp(-1.0 / (options.gps_rate_hz * options.gps_bias_tau_s));
+  Eigen::Vector3d bias_world = gps_bias_noise.Draw3(options.gps_bias_sigma_m);
   for (std::size_t k = 0; k < gps.t.size(); ++k) {
+    if (k > 0)
+      bias_world = bias_decay * bias_world +
+                   gps_bias_noise.Draw3(options.gps_bias_sigma_m * std::sqrt(1.0 - bias_decay * bias_decay));
     const AtvTruth::Kinematics truth = truth_model.At(gps.t[k].nanoseconds());
-    const Eigen::Vector3d antenna_world =
-        truth.p_world_body + truth.q_world_body * options.gps_lever_arm_m + gps_noise.Draw3(options.sigma_gps_m);
+    const Eigen::Vector3d antenna_world = truth.p_world_body + truth.q_world_body * options.gps_lever_arm_m +
+                                          bias_world + gps_noise.Draw3(options.sigma_gps_m);
     double latitude = 0.0, longitude = 0.0, altitude = 0.0;
     local.Reverse(antenna_world.x(), antenna_world.y(), antenna_world.z(), latitude, longitude, altitude);
     gps.values.row(static_cast<Eigen::Index>(k)) << latitude, longitude, altitude;

@@ -30,11 +30,14 @@
 //   gps           p_world_body + q_world_body gps_lever_arm + eta_p, eta_p ~ N(0, sigma^2 I) in ENU [m], then
 //                 converted to latitude, longitude [deg], altitude [m] with GeographicLib::LocalCartesian at the
 //                 origin (45.4642, 9.19, 120.0)                                                (eq. 9)
+//                 With gps_bias_sigma_m > 0 the fixes carry a slow error on top of eta_p: per ENU axis a first-order
+//                 Gauss-Markov process b(t_k+1) = a b(t_k) + s sqrt(1 - a^2) n, a = exp(-period / gps_bias_tau_s),
+//                 b(t_0) ~ N(0, s^2), s = gps_bias_sigma_m (the receiver's wandering error; models/gps.h's bias).
 //   rear_wheel    z_v = v / k_v + eta_v, k_v = kv_over_L * wheelbase_m [m/s]                  (eq. 15: v = k_v z_v)
 //   steering      z_theta = (delta_eff - k_gamma) / k_theta + eta_theta [rad], with delta_eff = atan(L omega_z / v)
 //                 the steering angle for which eq. 15 gives the body yaw rate exactly (on a slope the body yaw rate
 //                 differs from the planar one, so delta_eff differs slightly from delta(t)).
-// Each noise source (gyro, accel, magnetometer, gps, speed, steering) has its own std::mt19937_64 seeded from
+// Each noise source (gyro, accel, magnetometer, gps, speed, steering, gps bias) has its own std::mt19937_64 seeded from
 // (seed, source index). Sample times are t_k = k * period, period = round(1e9 / rate) ns, from 0 to duration_s
 // inclusive. Same options -> identical SyntheticRecording.
 //
@@ -86,6 +89,10 @@ struct SyntheticOptions {
   double sigma_gyro_radps = 0.033;
   double sigma_speed_mps = 0.033;     // on z_v
   double sigma_steering_rad = 0.014;  // on z_theta
+  // The fixes' slow Gauss-Markov error (header comment): stationary std [m] (>= 0; 0: none) and correlation time [s]
+  // (> 0).
+  double gps_bias_sigma_m = 0.0;
+  double gps_bias_tau_s = 10.0;
 
   Eigen::Vector3d field_world{0.0, 0.5, -0.8660254037844386};  // Earth field in ENU, unit magnitude (dip 60 deg)
 

@@ -362,6 +362,43 @@ TEST(SyntheticTest, SameOptionsGiveIdenticalRecordings) {
   EXPECT_EQ(a.recording.ground_truth->back().p_world_body, c.recording.ground_truth->back().p_world_body);
 }
 
+// The fixes' slow error (gps_bias_sigma_m, gps_bias_tau_s), alone (sigma_gps_m 0): per ENU axis a first-order
+// Gauss-Markov process sampled at the fixes, its lag-1 correlation a = exp(-period / tau) and its stationary std the
+// configured one. Tolerances are five standard errors of an AR(1) sample of n values: sqrt((1 - a^2) / n) for the
+// lag-1 correlation, sigma sqrt((1 + a^2) / (2 n (1 - a^2))) for the standard deviation.
+TEST(SyntheticTest, GpsBiasIsAGaussMarkovProcessOfTheConfiguredStdAndCorrelationTime) {
+  SyntheticOptions options;
+  options.duration_s = 300.0;  // 1501 fixes
+  options.sigma_gps_m = 0.0;
+  options.gps_bias_sigma_m = 1.0;
+  options.gps_bias_tau_s = 1.0;
+  SyntheticOptions noise_free = options;
+  noise_free.noise = false;
+  const SyntheticRecording biased = MakeAtvRecording(options);
+  const SyntheticRecording clean = MakeAtvRecording(noise_free);
+  const estimator::EnuConverter enu(*biased.recording.origin);
+  const recording::Stream& gps_biased = Get(biased.recording, "gps");
+  const recording::Stream& gps_clean = Get(clean.recording, "gps");
+  const Eigen::Index n = gps_biased.values.rows();
+  Eigen::MatrixXd bias(3, n);
+  for (Eigen::Index k = 0; k < n; ++k)
+    bias.col(k) = enu.ToEnu(gps_biased.values(k, 0), gps_biased.values(k, 1), gps_biased.values(k, 2)) -
+                  enu.ToEnu(gps_clean.values(k, 0), gps_clean.values(k, 1), gps_clean.values(k, 2));
+  const double a = std::exp(-0.2 / options.gps_bias_tau_s);
+  const double samples = 3.0 * static_cast<double>(n);
+  double lag1 = 0.0, variance = 0.0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const Eigen::RowVectorXd x = bias.row(axis).array() - bias.row(axis).mean();
+    variance += x.squaredNorm();
+    lag1 += x.head(n - 1).dot(x.tail(n - 1));
+  }
+  EXPECT_NEAR(lag1 / variance, a, 5.0 * std::sqrt((1.0 - a * a) / samples));
+  EXPECT_NEAR(std::sqrt(variance / samples), options.gps_bias_sigma_m,
+              5.0 * options.gps_bias_sigma_m * std::sqrt((1.0 + a * a) / (2.0 * samples * (1.0 - a * a))));
+  options.gps_bias_tau_s = 0.0;
+  EXPECT_NE(options.Validate().find("gps_bias_tau_s"), std::string::npos);
+}
+
 // Noise of one source: the differences noisy - noise-free, stacked.
 struct NoiseSample {
   const char* name;

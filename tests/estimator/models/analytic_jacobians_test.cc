@@ -339,8 +339,9 @@ TEST(AnalyticJacobiansTest, Gps) {
     const Eigen::VectorXd pose = RandomPoint(Manifold::Pose(), &rng, 100.0);
     const Eigen::Vector3d lever = Gaussian3(large ? 10.0 : 0.5, &rng);
     const Pose<double> T = PoseFromArray(pose.data());
-    const Eigen::Vector3d z = T.p_world_body + T.q_world_body * lever + Gaussian3(0.33, &rng);
-    ExpectAnalyticMatchesJets(GpsError(z), {pose, lever}, "point " + std::to_string(point));
+    const Eigen::Vector3d bias = Gaussian3(1.5, &rng);
+    const Eigen::Vector3d z = T.p_world_body + T.q_world_body * lever + bias + Gaussian3(0.33, &rng);
+    ExpectAnalyticMatchesJets(GpsError(z), {pose, lever, bias}, "point " + std::to_string(point));
   }
 }
 

@@ -1,7 +1,8 @@
 // The IMU master on real recordings (skipped when the shared data are absent):
 //  - the Husky bag without its wheel odometry (configs/real/husky_imu_gps.yaml, and with the vehicle's non-holonomic
 //    rows: husky_imu_gps_nonholonomic.yaml), tracked with its calibration and compared with the wheel-odometry-aided
-//    run (configs/real/husky_wheel_aided.yaml), and that run with the odometry's stamps moved by its lag;
+//    run (configs/real/husky_wheel_aided.yaml), and that run with the odometry's stamps moved by its lag; the GPS's
+//    slow error (the configurations' gps.bias process) split from the wheel-aided run's residuals;
 //  - the x-io handheld IMU + magnetometer log (configs/real/xio_imu_mag.yaml): the magnetometer's A and b against the
 //    ellipsoid fit of the raw field (eval/ellipsoid_fit.h).
 #include <algorithm>
@@ -135,11 +136,14 @@ AntennaTrack Smoothed(const CalibrationResult& calibration, bool white) {
 constexpr double kThreeSigma2d = 11.83;
 
 // The fraction of the reference's poses at which `track` (interpolated linearly in time; its nearest pose's
-// covariance) lies inside the combined horizontal 3-sigma region. Both runs read the same GPS, so their errors are
-// positively correlated and the sum of the covariances overstates the difference's: the test is conservative in that.
+// covariance) lies inside the combined horizontal 3-sigma region; printed with the mean of the normalized squared
+// differences d^T (C_track + C_reference)^-1 d, 2 (the dimension) for consistent and independent errors, below it
+// when the covariances are generous or the errors positively correlated. Both runs read the same GPS, so their errors
+// are positively correlated and the sum of the covariances overstates the difference's: the test is conservative in
+// that.
 double WithinThreeSigma(const AntennaTrack& track, const AntennaTrack& reference, const char* name) {
   int compared = 0, within = 0;
-  double sum_difference = 0.0, max_difference = 0.0, sum_std_track = 0.0, sum_std_reference = 0.0;
+  double sum_difference = 0.0, max_difference = 0.0, sum_std_track = 0.0, sum_std_reference = 0.0, sum_nees = 0.0;
   for (std::size_t i = 0; i < reference.t.size(); ++i) {
     const auto after = std::lower_bound(track.t.begin(), track.t.end(), reference.t[i]);
     if (after == track.t.begin() || after == track.t.end()) continue;
@@ -148,7 +152,9 @@ double WithinThreeSigma(const AntennaTrack& track, const AntennaTrack& reference
     const Eigen::Vector2d d = (reference.p[i] - ((1.0 - w) * track.p[j - 1] + w * track.p[j])).head<2>();
     const Eigen::Matrix2d c_track = track.covariance[w < 0.5 ? j - 1 : j].topLeftCorner<2, 2>();
     const Eigen::Matrix2d c_reference = reference.covariance[i].topLeftCorner<2, 2>();
-    within += d.dot((c_track + c_reference).ldlt().solve(d)) <= kThreeSigma2d ? 1 : 0;
+    const double nees = d.dot((c_track + c_reference).ldlt().solve(d));
+    within += nees <= kThreeSigma2d ? 1 : 0;
+    sum_nees += nees;
     ++compared;
     sum_difference += d.norm();
     max_difference = std::max(max_difference, d.norm());
@@ -159,16 +165,30 @@ double WithinThreeSigma(const AntennaTrack& track, const AntennaTrack& reference
   std::cout << name << ": " << compared << " poses compared; horizontal difference mean " << sum_difference / compared
             << " m, max " << max_difference << " m; reported horizontal std mean: IMU+GPS " << sum_std_track / compared
             << " m, wheel-aided " << sum_std_reference / compared << " m; within the 3-sigma region "
-            << 100.0 * fraction << "%\n";
+            << 100.0 * fraction << "%; mean normalized squared difference " << sum_nees / compared
+            << " (2 for independent errors)\n";
   return fraction;
 }
 
+// The variance of a fix's error per ENU axis [m^2] as a configuration models it: the white sigma_m squared, plus the
+// stationary variance of the bias's Gauss-Markov process when the bias is one.
+Eigen::Vector3d FixErrorVariance(const EstimatorConfig& config) {
+  const double sigma_m = config.streams.at("gps").noise.at("sigma_m");
+  Eigen::Vector3d variance = Eigen::Vector3d::Constant(sigma_m * sigma_m);
+  const auto bias = config.parameters.find("gps.bias");
+  if (bias != config.parameters.end() && bias->second.process.type == ProcessConfig::Type::kGaussMarkov)
+    variance += bias->second.process.sigma.cwiseAbs2();
+  return variance;
+}
+
 // The fraction of the GPS fixes inside a track's horizontal 3-sigma region: its distance from each fix, normalized by
-// its own reported covariance (nearest pose at or after the fix) plus the fix's configured noise (1.2 m per axis in
-// both configurations).
-double AgainstFixes(const recording::Recording& rec, const AntennaTrack& track, const char* name) {
+// its own reported covariance (nearest pose at or after the fix) plus the fix's error variance as its configuration
+// models it (FixErrorVariance).
+double AgainstFixes(const recording::Recording& rec, const AntennaTrack& track, const Eigen::Vector3d& fix_variance,
+                    const char* name) {
   const recording::Stream& gps = *rec.Find("gps");
   const EnuConverter enu(*rec.origin);
+  const Eigen::Matrix2d fix_covariance = fix_variance.head<2>().asDiagonal();
   double sum = 0.0;
   int n = 0, inside = 0;
   for (std::size_t r = 0; r < gps.t.size(); ++r) {
@@ -178,7 +198,7 @@ double AgainstFixes(const recording::Recording& rec, const AntennaTrack& track, 
     const auto row = static_cast<Eigen::Index>(r);
     const Eigen::Vector3d z = enu.ToEnu(gps.values(row, 0), gps.values(row, 1), gps.values(row, 2));
     const Eigen::Vector2d d = (track.p[k] - z).head<2>();
-    const Eigen::Matrix2d c = track.covariance[k].topLeftCorner<2, 2>() + 1.2 * 1.2 * Eigen::Matrix2d::Identity();
+    const Eigen::Matrix2d c = track.covariance[k].topLeftCorner<2, 2>() + fix_covariance;
     inside += d.dot(c.ldlt().solve(d)) <= kThreeSigma2d ? 1 : 0;
     sum += d.squaredNorm();
     ++n;
@@ -186,6 +206,13 @@ double AgainstFixes(const recording::Recording& rec, const AntennaTrack& track, 
   std::cout << name << " against the GPS fixes: rms horizontal distance " << std::sqrt(sum / n)
             << " m, within the 3-sigma region " << 100.0 * inside / n << "% of " << n << " fixes\n";
   return static_cast<double>(inside) / n;
+}
+
+// FixErrorVariance of a configuration in configs/real/.
+Eigen::Vector3d ConfiguredFixErrorVariance(const std::string& file) {
+  auto config = LoadEstimatorConfig(kConfigs + file);
+  EXPECT_TRUE(config.ok()) << config.status().message();
+  return config.ok() ? FixErrorVariance(config.value()) : Eigen::Vector3d::Constant(NAN);
 }
 
 Result<CalibrationResult> CalibrateWith(const std::string& config_file, const recording::Recording& rec,
@@ -300,6 +327,87 @@ Eigen::Vector3d MisalignmentFromMounting(const ParameterEstimate& p) {
   return roll_pitch_yaw;
 }
 
+// The fixes' slow error read from a run that does not follow it: per ENU axis, the GPS residuals [m] (whitened times
+// the run's white sigma_m) in time order, demeaned, their autocovariance C(l) at lag l fixes. A white part plus a
+// first-order Gauss-Markov part of variance s^2 and correlation time tau gives C(0) = w^2 + s^2 and C(l) = s^2
+// exp(-l dt / tau) for l >= 1, so: s = sqrt(C(1)), w = sqrt(C(0) - C(1)), and tau = (l_e - 1) dt, l_e the first lag
+// at which C(l) falls to C(1) / e (dt the fixes' median spacing).
+struct GpsErrorSplit {
+  Eigen::Vector3d slow_sigma_m;
+  Eigen::Vector3d white_sigma_m;
+  Eigen::Vector3d tau_s;
+};
+
+GpsErrorSplit SplitGpsResiduals(const CalibrationResult& r, double sigma_m) {
+  std::vector<const MeasurementResidual*> rows;
+  for (const MeasurementResidual& m : r.residuals)
+    if (m.active && m.stream == "gps") rows.push_back(&m);
+  std::stable_sort(rows.begin(), rows.end(), [](const auto* x, const auto* y) { return x->t < y->t; });
+  const int n = static_cast<int>(rows.size());
+  GpsErrorSplit out;
+  out.slow_sigma_m = out.white_sigma_m = out.tau_s = Eigen::Vector3d::Constant(NAN);
+  if (n < 8) return out;  // too few fixes for a lag window
+  Eigen::MatrixXd e(3, n);
+  std::vector<double> spacing_s;
+  for (int t = 0; t < n; ++t) {
+    e.col(t) = sigma_m * rows[static_cast<std::size_t>(t)]->whitened;
+    if (t > 0)
+      spacing_s.push_back(
+          SecondsBetween(rows[static_cast<std::size_t>(t) - 1]->t, rows[static_cast<std::size_t>(t)]->t));
+  }
+  e.colwise() -= e.rowwise().mean();
+  std::nth_element(spacing_s.begin(), spacing_s.begin() + static_cast<std::ptrdiff_t>(spacing_s.size() / 2),
+                   spacing_s.end());
+  const double dt_s = spacing_s[spacing_s.size() / 2];
+  const auto autocovariance = [&](int axis, int lag) {
+    return e.row(axis).head(n - lag).dot(e.row(axis).tail(n - lag)) / n;
+  };
+  for (int axis = 0; axis < 3; ++axis) {
+    const double c0 = autocovariance(axis, 0), c1 = autocovariance(axis, 1);
+    out.slow_sigma_m[axis] = std::sqrt(std::max(c1, 0.0));
+    out.white_sigma_m[axis] = std::sqrt(std::max(c0 - c1, 0.0));
+    int lag = 1;
+    while (lag < n / 4 && autocovariance(axis, lag) > c1 / M_E) ++lag;
+    out.tau_s[axis] = (lag - 1) * dt_s;
+  }
+  std::cout << "GPS residuals (" << n << " fixes, " << dt_s << " s apart) split per ENU axis: slow std ["
+            << out.slow_sigma_m.transpose() << "] m, tau [" << out.tau_s.transpose() << "] s, white std ["
+            << out.white_sigma_m.transpose() << "] m\n";
+  return out;
+}
+
+// The rule's inputs: the wheel-aided run (configs/real/husky_wheel_aided.yaml) with the fixes taken as white (the bias
+// left out, sigma_m 1.2 m: the fixes' whole spread taken as one white error).
+TEST(ImuMasterRealTest, HuskyGpsSlowErrorFromTheWheelAidedResiduals) {
+  const std::string bag = kData + "/husky_test1/test1.bag";
+  if (!std::filesystem::exists(bag)) GTEST_SKIP() << "real data absent: " << bag;
+  auto rec = importers::ImportRosbag(bag, ::roamlab::testing::HuskyImportOptions());
+  ASSERT_TRUE(rec.ok()) << rec.status().message();
+  auto config = LoadEstimatorConfig(kConfigs + "husky_wheel_aided.yaml");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  EstimatorConfig white = config.value();
+  white.parameters.erase("gps.bias");
+  white.streams.at("gps").noise["sigma_m"] = 1.2;
+  CalibrationOptions options;
+  options.keep_residuals = true;
+  auto run = Calibrate(white, rec.value(), options);
+  ASSERT_TRUE(run.ok()) << run.status().message();
+  const GpsErrorSplit split = SplitGpsResiduals(run.value(), 1.2);
+  const double white_rms = std::sqrt(split.white_sigma_m.squaredNorm() / 3.0);
+  // The Husky configurations carry the rule's values, rounded to three digits (within 1 %).
+  for (const char* file : {"husky_wheel_aided.yaml", "husky_imu_gps.yaml", "husky_imu_gps_nonholonomic.yaml"}) {
+    auto c = LoadEstimatorConfig(kConfigs + file);
+    ASSERT_TRUE(c.ok()) << c.status().message();
+    const ProcessConfig& process = c.value().parameters.at("gps.bias").process;
+    EXPECT_EQ(process.type, ProcessConfig::Type::kGaussMarkov) << file;
+    for (int axis = 0; axis < 3; ++axis) {
+      EXPECT_NEAR(process.sigma[axis], split.slow_sigma_m[axis], 0.01 * split.slow_sigma_m[axis]) << file << axis;
+      EXPECT_NEAR(process.tau_s[axis], split.tau_s[axis], 0.01 * split.tau_s[axis]) << file << axis;
+    }
+    EXPECT_NEAR(c.value().streams.at("gps").noise.at("sigma_m"), white_rms, 0.01 * white_rms) << file;
+  }
+}
+
 // The IMU + GPS runs (configs/real/husky_imu_gps.yaml, and husky_imu_gps_nonholonomic.yaml with the vehicle's
 // non-holonomic rows), tracked with their calibrations, against the GPS fixes and against the wheel-odometry-aided
 // calibration's smoothed track (configs/real/husky_wheel_aided.yaml: the skid steer's effective track and the
@@ -327,8 +435,9 @@ TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedT
   const AntennaTrack reference = Smoothed(wheel.value(), false);
   const AntennaTrack reference_white = Smoothed(wheel.value(), true);
   ASSERT_GT(reference.t.size(), 300u);
-  AgainstFixes(rec.value(), reference_white, "wheel-aided smoothed track, white covariance");
-  AgainstFixes(rec.value(), reference, "wheel-aided smoothed track, HAC covariance");
+  const Eigen::Vector3d wheel_fix_variance = ConfiguredFixErrorVariance("husky_wheel_aided.yaml");
+  AgainstFixes(rec.value(), reference_white, wheel_fix_variance, "wheel-aided smoothed track, white covariance");
+  AgainstFixes(rec.value(), reference, wheel_fix_variance, "wheel-aided smoothed track, HAC covariance");
 
   auto plain = RunImuGps(kConfigs + "husky_imu_gps.yaml", imu_gps);
   ASSERT_TRUE(plain.ok()) << plain.status().message();
@@ -336,10 +445,12 @@ TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedT
   Print(plain.value().calibration);
   for (const ParameterEstimate& p : plain.value().calibration.parameters)
     for (int i = 0; i < p.std.size(); ++i) EXPECT_TRUE(std::isfinite(p.std[i])) << p.name << "[" << i << "]";
-  const double imu_consistent = AgainstFixes(rec.value(), plain.value().track, "IMU+GPS track");
+  const double imu_consistent =
+      AgainstFixes(rec.value(), plain.value().track, ConfiguredFixErrorVariance("husky_imu_gps.yaml"), "IMU+GPS track");
   WithinThreeSigma(plain.value().track, reference_white,
                    "IMU+GPS track against the wheel-aided track, white covariance");
-  WithinThreeSigma(plain.value().track, reference, "IMU+GPS track against the wheel-aided track, HAC");
+  const double imu_within =
+      WithinThreeSigma(plain.value().track, reference, "IMU+GPS track against the wheel-aided track, HAC");
 
   auto vehicle = RunImuGps(kConfigs + "husky_imu_gps_nonholonomic.yaml", imu_gps);
   ASSERT_TRUE(vehicle.ok()) << vehicle.status().message();
@@ -350,35 +461,35 @@ TEST(ImuMasterRealTest, HuskyImuGpsTrackAgainstTheFixesAndTheWheelOdometryAidedT
     if (p.name == "imu.misalignment") misalignment = &p;
   ASSERT_NE(misalignment, nullptr);
   const Eigen::Vector3d roll_pitch_yaw = MisalignmentFromMounting(*misalignment);
-  const double vehicle_consistent = AgainstFixes(rec.value(), vehicle.value().track, "IMU+GPS+non-holonomic track");
+  const double vehicle_consistent =
+      AgainstFixes(rec.value(), vehicle.value().track, ConfiguredFixErrorVariance("husky_imu_gps_nonholonomic.yaml"),
+                   "IMU+GPS+non-holonomic track");
   std::cout << "direction of travel in the body frame: IMU+GPS "
             << TravelInBody(plain.value().calibration.trajectory) * 180.0 / M_PI << " deg, IMU+GPS+non-holonomic "
             << TravelInBody(vehicle.value().calibration.trajectory) * 180.0 / M_PI << " deg\n";
   WithinThreeSigma(vehicle.value().track, reference_white,
                    "IMU+GPS+non-holonomic track against the wheel-aided track, white covariance");
   WithinThreeSigma(vehicle.value().track, reference, "IMU+GPS+non-holonomic track against the wheel-aided track, HAC");
-  // The HAC covariance of the smoothed positions widens the white one by about the square root of the GPS residuals'
-  // integrated autocorrelation time (the fixes place the stiff wheel-aided track, and their errors are correlated
-  // over tens of seconds): within a factor of 2 of it.
+  // With the fixes' slow error modelled (the bias), the wheel-aided run's GPS residuals are white: no lag window of
+  // their autocorrelation reaches 2 / sqrt(n) (AnalyzeAutocorrelation's lag 0 to 2; with the fixes taken as white
+  // they are correlated over 30 fixes, 12 s). The HAC covariance of the smoothed positions still widens the white one
+  // (printed): the wheels' residuals and the bias's process rows stay correlated.
   double sum_white = 0.0, sum_hac = 0.0;
   for (const PoseCovariance& c : wheel.value().pose_covariances) {
     sum_white += std::sqrt(c.white.topLeftCorner<2, 2>().trace());
     sum_hac += std::sqrt(c.hac.topLeftCorner<2, 2>().trace());
   }
-  const double inflation = sum_hac / sum_white;
-  const double expected = std::sqrt(Autocorrelations(wheel.value()).at("gps").integrated_time);
-  std::cout << "wheel-aided smoothed positions: horizontal std HAC / white " << inflation << ", sqrt(GPS integrated "
-            << "autocorrelation time) " << expected << "\n";
-  EXPECT_GT(inflation, 0.5 * expected);
-  EXPECT_LT(inflation, 2.0 * expected);
+  std::cout << "wheel-aided smoothed positions: horizontal std HAC / white " << sum_hac / sum_white << "\n";
+  EXPECT_LE(Autocorrelations(wheel.value()).at("gps").lag, 2);
   // Both IMU+GPS tracks are consistent with the fixes: at most the 0.27% a 3-sigma region leaves out, with a margin
-  // for the fixes' correlated errors. The comparison with the wheel-aided track is reported, not asserted: with the
-  // HAC covariance the wheel-aided track is honest against the fixes (the fixes' own 1.2 m dominate that test), but it
-  // is farther from them than the IMU+GPS tracks are, and the tracks differ by more than their combined covariances
-  // allow at about half the poses (docs/results.md). The effective track and the gyroscope's offset, freed, leave the
-  // wheel-aided track where it was: what separates the tracks is how each follows the fixes' slow errors.
+  // for the fixes' correlated errors.
   EXPECT_GE(imu_consistent, 0.99);
   EXPECT_GE(vehicle_consistent, 0.99);
+  // The IMU+GPS track lies within the combined 3-sigma region of the wheel-aided track's (HAC) at 97 % of the poses or
+  // more: a consistent pair leaves out 0.27 % of independent poses, and below 97 % (with the spread that 395
+  // correlated poses give a fraction) the pair is not consistent. With the fixes taken as white it read 61.8 %: each
+  // track followed the fixes' slow error in its own way, and neither covariance held that error (docs/results.md).
+  EXPECT_GE(imu_within, 0.97);
   // The skid steer turns with an effective track well below the nominal 0.555 m through which its wheel speeds were
   // recovered from the controller's odometry: more than 3 of its (HAC) std below.
   for (const ParameterEstimate& p : wheel.value().parameters) {
