@@ -170,7 +170,6 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
     std::swap(result.ignored, result.rejected);
     if (static_cast<double>(switched.size()) <= false_alarms) result.readmitted = 0;
   }
-  result.settled = result.rejected == 0;
   for (FactorId id : switched) {
     FactorEntry& entry = graph.mutable_factor(id);
     if (by_chance && (entry.active || result.readmitted == 0)) continue;
@@ -454,8 +453,8 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
 
   CalibrationResult result;
   double lambda = config.solver.initial_lambda;
-  // The solves' buffers, carried from one solve to the next (a gating round's one-step solve would otherwise allocate
-  // and page in its pattern and envelope again); the observability analysis at the end uses them too. The factors'
+  // The solves' buffers, carried from one solve to the next (a gating round's re-solve would otherwise allocate and
+  // page in its pattern and envelope again); the observability analysis at the end uses them too. The factors'
   // linearizations are not kept (the gate evaluates the errors at the converged point, where no solve linearized
   // them).
   auto workspace = std::make_unique<SolverWorkspace>();
