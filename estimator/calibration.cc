@@ -45,7 +45,9 @@ void RejectAroundBursts(const std::vector<GateRow>& rows, double margin, std::ve
       ++failing;
       newly |= rows[k].was_active;
     }
-    if (newly && failing >= kMinFailing) {
+    // A burst is dense: at least half its rows fail (a skid). Outliers scattered at random (one row in ten) come within
+    // kMaxGapRows of each other all along a stream; as one burst, their margin would take the whole stream out.
+    if (newly && failing >= kMinFailing && 2 * failing >= last - first + 1) {
       const int m = static_cast<int>(margin * (last - first + 1));
       for (int k = std::max(0, first - m); k <= std::min(n - 1, last + m); ++k)
         if (rows[k].pass && rows[k].was_active) (*reject)[k] = 1;
@@ -168,7 +170,6 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
     std::swap(result.ignored, result.rejected);
     if (static_cast<double>(switched.size()) <= false_alarms) result.readmitted = 0;
   }
-  result.settled = result.rejected == 0;
   for (FactorId id : switched) {
     FactorEntry& entry = graph.mutable_factor(id);
     if (by_chance && (entry.active || result.readmitted == 0)) continue;
@@ -258,17 +259,16 @@ Result<StageSummary> SolveStage(const EstimatorConfig& config, const Calibration
   if (!stage.solver.usable()) return Status::Error("stage " + std::to_string(s + 1) + ": " + stage.solver.message);
   // Gate gross outliers at the converged estimate and re-solve without them. Gross outliers bend the estimate and make
   // inliers look bad too: every measurement is re-tested after each re-solve, re-admitting those that fit again, until
-  // the set has settled (at most kMaxGatingRounds rounds; settled: no more newly failing measurements than the test's
-  // own false alarms, GateOutliers). The first round also rejects a burst's neighbours (kBurstMargin). A round that
-  // only re-admits ends the rounds: its measurements fit already.
-  // A round's re-solve is one step: from a converged point with a few measurements switched the problem is all but
-  // quadratic (the damping has come down to a Gauss-Newton step), and that step leaves a small fraction of its decrease
-  // to the next ones, which do not move the next round's test. Once the set is stable the solve runs to convergence.
-  // Each re-solve starts from the last one's damping too (the problem changed by a few measurements).
+  // a round switches nothing (at most kMaxGatingRounds rounds; a round that rejects no more newly failing measurements
+  // than the test's own false alarms rejects none, GateOutliers). The first round also rejects a burst's neighbours
+  // (kBurstMargin).
+  // Each round's re-solve runs to convergence, and a round that only re-admits is followed by another: a round that
+  // switches many rows (a burst's margin, the good rows of poses an outlier bent) moves the estimate far, and rows
+  // tested short of where it leads stay rejected though they fit there (a GPS fix beside a stretch of late ones, a
+  // motion-capture pose beside an outlier). Each re-solve starts from the last one's damping.
   *lambda = stage.solver.final_lambda;
-  const auto resolve = [&](int max_iterations, const std::string& what) -> Status {
+  const auto resolve = [&](const std::string& what) -> Status {
     SolverOptions warm = config.solver;
-    warm.max_iterations = max_iterations;
     if (lm) warm.initial_lambda = std::max(*lambda, std::numeric_limits<double>::epsilon());
     const SolverSummary again = Solve(warm, &builder.graph(), nullptr, workspace);
     *lambda = again.final_lambda;
@@ -283,7 +283,6 @@ Result<StageSummary> SolveStage(const EstimatorConfig& config, const Calibration
     stage.solver.seconds += again.seconds;
     return Status::Ok();
   };
-  bool gated = false;
   for (int round = 0; config.gate_probability && round < kMaxGatingRounds; ++round) {
     // (Not handed the workspace: Levenberg-Marquardt's last point had its cost evaluated, not its linearization.)
     GateOptions gate;
@@ -291,22 +290,12 @@ Result<StageSummary> SolveStage(const EstimatorConfig& config, const Calibration
     gate.ignore_chance_changes = true;
     const GateSwitches changed = GateOutliers(*config.gate_probability, &builder, 0, nullptr, gate);
     if (changed.switched() == 0) break;
-    gated = true;
-    const std::string what = "gating round " + std::to_string(round + 1) + ": " + std::to_string(changed.rejected) +
-                             " measurements rejected, " + std::to_string(changed.readmitted) + " re-admitted" +
-                             (changed.ignored > 0 ? ", " + std::to_string(changed.ignored) + " failing by chance" : "");
-    // Settled (nothing rejected): the re-admitted measurements fit the estimate already, and the solve to
-    // convergence below takes them in; a step and another round would test the same set again.
-    if (changed.settled) {
-      Say(options, "stage " + std::to_string(s + 1) + ": " + what + ", settled");
-      break;
-    }
-    const Status stepped = resolve(1, what + ", one step");
-    if (!stepped.ok()) return stepped;
-  }
-  if (gated) {
-    const Status converged = resolve(config.solver.max_iterations, "gated set re-solved");
-    if (!converged.ok()) return converged;
+    const Status solved =
+        resolve("gating round " + std::to_string(round + 1) + ": " + std::to_string(changed.rejected) +
+                " measurements rejected, " + std::to_string(changed.readmitted) + " re-admitted" +
+                (changed.ignored > 0 ? ", " + std::to_string(changed.ignored) + " failing by chance" : "") +
+                ", re-solved");
+    if (!solved.ok()) return solved;
   }
   for (const auto& [stream, c] : builder.counts()) stage.rejected += c.rejected;
   Say(options, "stage " + std::to_string(s + 1) + "/" + std::to_string(stage_count) + ": cost " +
@@ -464,8 +453,8 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
 
   CalibrationResult result;
   double lambda = config.solver.initial_lambda;
-  // The solves' buffers, carried from one solve to the next (a gating round's one-step solve would otherwise allocate
-  // and page in its pattern and envelope again); the observability analysis at the end uses them too. The factors'
+  // The solves' buffers, carried from one solve to the next (a gating round's re-solve would otherwise allocate and
+  // page in its pattern and envelope again); the observability analysis at the end uses them too. The factors'
   // linearizations are not kept (the gate evaluates the errors at the converged point, where no solve linearized
   // them).
   auto workspace = std::make_unique<SolverWorkspace>();

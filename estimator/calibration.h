@@ -131,7 +131,7 @@ struct GateOptions {
   // expected to be, (1 - probability) of them, and none of them is a gross outlier (beyond the quantile that all N
   // tested factors pass with the test's probability, 1 - (1 - probability) / N each): such a set is as stable as the
   // test can tell. The factors that fit again are re-admitted all the same (unless they too, with the failing ones,
-  // are no more than the false alarms: then nothing switches), and the result is `settled`.
+  // are no more than the false alarms: then nothing switches).
   bool ignore_chance_changes = false;
   // Reject a failing factor only where it fails worst (its squared error over the quantile) among the failing factors
   // that share a pose with it; the others stay active for the next pass, after a re-solve without it. A gross outlier
@@ -146,9 +146,6 @@ struct GateSwitches {
   int rejected = 0;    // active factors switched off
   int readmitted = 0;  // inactive factors switched on again
   int ignored = 0;     // newly failing factors left active as chance would explain them
-  // No factor was rejected (none failed, or only as many as chance explains: GateOptions::ignore_chance_changes): the
-  // set changed at most by factors that fit at the current estimate, and another pass after a re-solve is not needed.
-  bool settled = false;
   int switched() const { return rejected + readmitted; }
 };
 
