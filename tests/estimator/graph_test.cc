@@ -20,8 +20,9 @@ TEST(GraphTest, FactorsWithTheSameNoiseCovarianceShareOneModel) {
   const VariableId pose =
       graph.AddVariable({"pose", Manifold::Pose(), Manifold::Pose().Identity(), false, Time::FromSeconds(0.0)});
   const VariableId lever = graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), true, {}});
+  const VariableId bias = graph.AddVariable({"bias", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), true, {}});
   const auto add = [&](const Eigen::Matrix3d& covariance) {
-    const FactorId id = graph.AddFactor(MakeFactor(GpsError(Eigen::Vector3d::Zero())), {pose, lever}, covariance,
+    const FactorId id = graph.AddFactor(MakeFactor(GpsError(Eigen::Vector3d::Zero())), {pose, lever, bias}, covariance,
                                         Loss::Trivial(), "gps", Time::FromSeconds(0.0));
     return graph.factor(id).noise;
   };
@@ -49,25 +50,27 @@ TEST(GraphDeathTest, NoiseCovarianceThatIsNotPositiveDefiniteIsRefused) {
   const VariableId pose =
       graph.AddVariable({"pose", Manifold::Pose(), Manifold::Pose().Identity(), false, Time::FromSeconds(0.0)});
   const VariableId lever = graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), true, {}});
+  const VariableId bias = graph.AddVariable({"bias", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), true, {}});
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
-  graph.AddFactor(MakeFactor(GpsError(Eigen::Vector3d::Zero())), {pose, lever}, covariance, Loss::Trivial(), "gps",
-                  Time::FromSeconds(0.0));
+  graph.AddFactor(MakeFactor(GpsError(Eigen::Vector3d::Zero())), {pose, lever, bias}, covariance, Loss::Trivial(),
+                  "gps", Time::FromSeconds(0.0));
   covariance(0, 0) = -1.0;
-  EXPECT_DEATH(graph.AddFactor(MakeFactor(GpsError(Eigen::Vector3d::Zero())), {pose, lever}, covariance,
+  EXPECT_DEATH(graph.AddFactor(MakeFactor(GpsError(Eigen::Vector3d::Zero())), {pose, lever, bias}, covariance,
                                Loss::Trivial(), "gps", Time::FromSeconds(0.0)),
                "factor from 'gps': noise covariance is not symmetric positive definite");
 }
 
-// A small graph: a pose and a fixed lever arm, each GPS factor on both.
+// A small graph: a pose, a fixed lever arm and a fixed GPS bias, each GPS factor on all three.
 struct PoseAndLever {
   Graph graph;
   VariableId pose =
       graph.AddVariable({"pose", Manifold::Pose(), Manifold::Pose().Identity(), false, Time::FromSeconds(0.0)});
   VariableId lever = graph.AddVariable({"lever", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), true, {}});
+  VariableId bias = graph.AddVariable({"bias", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), true, {}});
 
   FactorId AddGps(const std::string& stream = "gps") {
-    return graph.AddFactor(MakeFactor(GpsError(Eigen::Vector3d::Zero())), {pose, lever}, Eigen::Matrix3d::Identity(),
-                           Loss::Trivial(), stream, Time::FromSeconds(0.0));
+    return graph.AddFactor(MakeFactor(GpsError(Eigen::Vector3d::Zero())), {pose, lever, bias},
+                           Eigen::Matrix3d::Identity(), Loss::Trivial(), stream, Time::FromSeconds(0.0));
   }
 };
 
@@ -90,7 +93,7 @@ TEST(GraphTest, AddRemoveAndLookUpVariablesAndFactors) {
   EXPECT_LT(a, b);
   EXPECT_LT(b, c);
   EXPECT_EQ(graph.factor(b).stream, "b");
-  EXPECT_EQ(graph.factor(b).variables, (std::vector<VariableId>{g.pose, g.lever}));
+  EXPECT_EQ(graph.factor(b).variables, (std::vector<VariableId>{g.pose, g.lever, g.bias}));
   EXPECT_TRUE(graph.factor(b).active);
   graph.mutable_factor(b).active = false;
   EXPECT_FALSE(graph.factor(b).active);
@@ -110,7 +113,7 @@ TEST(GraphTest, AddRemoveAndLookUpVariablesAndFactors) {
   EXPECT_TRUE(graph.FactorsOf(g.lever).empty());
   graph.RemoveVariable(g.lever);
   EXPECT_FALSE(graph.HasVariable(g.lever));
-  EXPECT_EQ(graph.variables().size(), 1u);
+  EXPECT_EQ(graph.variables().size(), 2u);
   const VariableId e = graph.AddVariable({"e", Manifold::Euclidean(1), Eigen::VectorXd::Zero(1), false, {}});
   EXPECT_GT(e, g.lever);
 }
@@ -123,11 +126,11 @@ TEST(GraphDeathTest, BrokenPreconditionsAbortWithAMessage) {
   EXPECT_DEATH(g.graph.factor(99), "no factor 99");
   EXPECT_DEATH(g.graph.AddVariable({"short", Manifold::Pose(), Eigen::VectorXd::Zero(3), false, {}}),
                "variable 'short' has 3 values for manifold SE3");
-  // The GPS model takes (pose, lever arm): swapped, the manifolds do not match.
-  EXPECT_DEATH(g.graph.AddFactor(MakeFactor(GpsError(Eigen::Vector3d::Zero())), {g.lever, g.pose},
+  // The GPS model takes (pose, lever arm, bias): swapped, the manifolds do not match.
+  EXPECT_DEATH(g.graph.AddFactor(MakeFactor(GpsError(Eigen::Vector3d::Zero())), {g.lever, g.pose, g.bias},
                                  Eigen::Matrix3d::Identity(), Loss::Trivial(), "gps", Time()),
                "factor from 'gps': variable 0 \\('lever'\\) is R3, expected SE3");
-  EXPECT_DEATH(g.graph.AddFactor(MakeFactor(GpsError(Eigen::Vector3d::Zero())), {g.pose, g.lever},
+  EXPECT_DEATH(g.graph.AddFactor(MakeFactor(GpsError(Eigen::Vector3d::Zero())), {g.pose, g.lever, g.bias},
                                  Eigen::Matrix2d::Identity(), Loss::Trivial(), "gps", Time()),
                "noise covariance is 2x2, expected 3");
 }

@@ -18,12 +18,14 @@ MultiAntennaProblem::MultiAntennaProblem(double noise_sigma, std::uint32_t seed)
       {"pose", Manifold::Pose(), Perturb(Manifold::Pose(), truth, 0.3, &rng), false, Time::FromSeconds(0.0)});
   const std::vector<Eigen::Vector3d> levers = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {-1, -1, 0.5}};
   std::normal_distribution<double> noise(0.0, noise_sigma);
+  const VariableId bias =
+      graph.AddVariable({"bias", Manifold::Euclidean(3), Eigen::Vector3d::Zero(), true, std::nullopt});
   for (const Eigen::Vector3d& lever : levers) {
     const VariableId l = graph.AddVariable({"lever", Manifold::Euclidean(3), lever, true, std::nullopt});
     for (int k = 0; k < 20; ++k) {
       const Eigen::Vector3d z =
           T.p_world_body + T.q_world_body * lever + Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
-      graph.AddFactor(MakeFactor(GpsError(z)), {pose, l},
+      graph.AddFactor(MakeFactor(GpsError(z)), {pose, l, bias},
                       Eigen::Matrix3d::Identity() * std::max(noise_sigma * noise_sigma, 1e-6), Loss::Trivial(), "gps",
                       Time::FromSeconds(0.0));
     }
