@@ -238,7 +238,8 @@ void AddDesign(CLI::App* app, Commands* commands) {
                     "NAME=STD: the target std of every tangent component of the free parameter NAME (repeatable; at "
                     "least one)")
         ->required();
-    des->add_option("--duration", args->duration_s, "Recorded duration of the designed drive [s] (default: the scenario's)");
+    des->add_option("--duration", args->duration_s,
+                    "Recorded duration of the designed drive [s] (default: the scenario's)");
     des->add_option("--budget", args->budget, "Drives simulated and analysed (default 60)");
     des->add_option("--speed-range", args->speed_range_mps, "MIN MAX of the speed set-point [m/s] (default 1.5 6)")
         ->expected(2);
@@ -246,7 +247,8 @@ void AddDesign(CLI::App* app, Commands* commands) {
                     "Largest |handlebar| set-point [rad] (default 0.45)");
     des->add_option("--period-range", args->period_range_s, "MIN MAX of the weave's period [s] (default 5 30)")
         ->expected(2);
-    des->add_option("--max-roll", args->limits.max_roll_deg, "Feasible: largest |roll| of the vehicle [deg] (default 25)");
+    des->add_option("--max-roll", args->limits.max_roll_deg,
+                    "Feasible: largest |roll| of the vehicle [deg] (default 25)");
     des->add_option("--max-pitch", args->limits.max_pitch_deg, "Feasible: largest |pitch| [deg] (default 25)");
     des->add_option("--max-side-slip", args->limits.max_side_slip_mps,
                     "Feasible: largest lateral speed of O [m/s] (default 0.3)");
@@ -515,8 +517,8 @@ Commands AddCommands(CLI::App* app) {
   app->require_subcommand(1);
   Commands commands;
   for (const auto add :
-       {AddSimulate, AddReplay, AddCalibrate, AddTrack, AddEvaluate, AddMonteCarlo, AddInit, AddInformation, AddDesign, AddDiagnose,
-        AddGapBenchmark, AddRegress, AddOdometry, AddImport, AddFrontEnd, AddSweep, AddBatch})
+       {AddSimulate, AddReplay, AddCalibrate, AddTrack, AddEvaluate, AddMonteCarlo, AddInit, AddInformation, AddDesign,
+        AddDiagnose, AddGapBenchmark, AddRegress, AddOdometry, AddImport, AddFrontEnd, AddSweep, AddBatch})
     add(app, &commands);
   return commands;
 }

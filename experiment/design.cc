@@ -116,8 +116,10 @@ double MaxLateralAcceleration(const Trajectory& truth) {
 // The first limit the simulated drive exceeds, or empty.
 std::string LimitExceeded(const DesignCandidate& c, const DesignLimits& l) {
   std::ostringstream why;
-  if (c.max_roll_deg > l.max_roll_deg) why << "roll " << c.max_roll_deg << " deg > " << l.max_roll_deg;
-  else if (c.max_pitch_deg > l.max_pitch_deg) why << "pitch " << c.max_pitch_deg << " deg > " << l.max_pitch_deg;
+  if (c.max_roll_deg > l.max_roll_deg)
+    why << "roll " << c.max_roll_deg << " deg > " << l.max_roll_deg;
+  else if (c.max_pitch_deg > l.max_pitch_deg)
+    why << "pitch " << c.max_pitch_deg << " deg > " << l.max_pitch_deg;
   else if (c.max_side_slip_mps > l.max_side_slip_mps)
     why << "side slip " << c.max_side_slip_mps << " m/s > " << l.max_side_slip_mps;
   else if (c.max_lateral_accel_mps2 > l.max_lateral_accel_mps2)
@@ -187,7 +189,9 @@ Result<DesignCandidate> Evaluate(const Problem& p, const DriveDesign& drive, con
 Status Search(const Problem& p, DesignResult* result) {
   const DesignLimits& limits = p.request.limits;
   const int budget = p.request.budget;
-  auto better = [&](int i, int j) { return j < 0 || result->candidates[i].objective < result->candidates[j].objective; };
+  auto better = [&](int i, int j) {
+    return j < 0 || result->candidates[i].objective < result->candidates[j].objective;
+  };
   auto try_drive = [&](const DriveDesign& drive, const std::string& stage) -> Result<bool> {
     for (const DesignCandidate& seen : result->candidates) {  // a rounded drive already tried costs nothing
       const std::array<double, kCoordinates> a = ToCoordinates(seen.drive, limits), b = ToCoordinates(drive, limits);
@@ -262,9 +266,8 @@ std::string DesignedYaml(const DesignRequest& request, const sim::Scenario& scen
   YAML::Node speed(YAML::NodeType::Sequence), handlebar(YAML::NodeType::Sequence);
   speed.push_back(YAML::Node());
   speed[0]["constant"] = d.speed_mean_mps;
-  speed.push_back(TermNode("sine", {{"amplitude", d.speed_swing_mps},
-                                    {"period_s", 0.5 * d.handlebar_period_s},
-                                    {"phase_rad", 0.5 * kPi}}));
+  speed.push_back(TermNode(
+      "sine", {{"amplitude", d.speed_swing_mps}, {"period_s", 0.5 * d.handlebar_period_s}, {"phase_rad", 0.5 * kPi}}));
   handlebar.push_back(YAML::Node());
   handlebar[0]["constant"] = d.handlebar_offset_rad;
   handlebar.push_back(TermNode(
@@ -275,8 +278,8 @@ std::string DesignedYaml(const DesignRequest& request, const sim::Scenario& scen
   std::ostringstream text;
   text << "# Designed by `roamlab design " << request.scenario << " --config " << request.config << "`: of "
        << "the drives v = v0 + dv cos(4 pi t / P), handlebar = d0 + da sin(2 pi t / P), start heading h, the\n"
-       << "# feasible one with the least max CRB std / target (" << best.objective << ", set by " << best.worst
-       << "; " << best.distance_m << " m, roll " << best.max_roll_deg << " deg, pitch " << best.max_pitch_deg
+       << "# feasible one with the least max CRB std / target (" << best.objective << ", set by " << best.worst << "; "
+       << best.distance_m << " m, roll " << best.max_roll_deg << " deg, pitch " << best.max_pitch_deg
        << " deg, side slip " << best.max_side_slip_mps << " m/s, lateral acceleration " << best.max_lateral_accel_mps2
        << " m/s^2). Predicted std (Cramer-Rao, noise-free drive at the truth):\n";
   for (const auto& [label, std] : best.crb_std) {
@@ -376,9 +379,9 @@ Outcome DesignToFile(const DesignRequest& request, DesignResult* result_out) {
     return result.candidates.empty() ? Outcome::BadInput(s) : Outcome::Failed(s);
   }
   if (result.best < 0) {
-    const Outcome failed = Outcome::Failed(Status::Error(
-        "no feasible drive among " + std::to_string(result.candidates.size()) + " (the first: " +
-        result.candidates.front().infeasible + ")"));
+    const Outcome failed =
+        Outcome::Failed(Status::Error("no feasible drive among " + std::to_string(result.candidates.size()) +
+                                      " (the first: " + result.candidates.front().infeasible + ")"));
     if (result_out) *result_out = std::move(result);
     return failed;
   }

@@ -26,11 +26,11 @@ namespace roamlab::experiment {
 // One drive of the family (the header comment).
 struct DriveDesign {
   double speed_mean_mps = 3.5;
-  double speed_swing_mps = 0.0;        // amplitude of the cos(4 pi t / P) term
+  double speed_swing_mps = 0.0;  // amplitude of the cos(4 pi t / P) term
   double handlebar_amplitude_rad = 0.0;
-  double handlebar_period_s = 10.0;    // P
+  double handlebar_period_s = 10.0;  // P
   double handlebar_offset_rad = 0.0;
-  double heading_deg = 0.0;            // start heading, from east counter-clockwise
+  double heading_deg = 0.0;  // start heading, from east counter-clockwise
 };
 
 // The bounds of the family and the feasibility limits.
@@ -42,30 +42,30 @@ struct DesignLimits {
   double max_period_s = 30.0;
   double max_roll_deg = 25.0;  // of O, over the recording
   double max_pitch_deg = 25.0;
-  double max_side_slip_mps = 0.3;         // max |v_y| of O (sim::SimulationStats)
-  double max_lateral_accel_mps2 = 4.4;    // max speed x |yaw rate| of O over 0.1 s steps (0.45 g)
+  double max_side_slip_mps = 0.3;       // max |v_y| of O (sim::SimulationStats)
+  double max_lateral_accel_mps2 = 4.4;  // max speed x |yaw rate| of O over 0.1 s steps (0.45 g)
   // Empty when valid, otherwise "--option: problem".
   std::string Validate() const;
 };
 
 struct DesignRequest {
-  std::string scenario;  // SCENARIO.yaml, driver type ackermann
-  std::string config;    // EST.yaml
-  std::string out;       // DESIGNED.yaml; design.json is written beside it
-  double duration_s = 0.0;  // the designed drive's recorded duration; 0: the scenario's
+  std::string scenario;                   // SCENARIO.yaml, driver type ackermann
+  std::string config;                     // EST.yaml
+  std::string out;                        // DESIGNED.yaml; design.json is written beside it
+  double duration_s = 0.0;                // the designed drive's recorded duration; 0: the scenario's
   std::map<std::string, double> targets;  // free parameter -> target CRB std of each of its tangent components
   DesignLimits limits;
-  int budget = 60;  // drives simulated and analysed, at least 1
+  int budget = 60;                                // drives simulated and analysed, at least 1
   std::function<void(double fraction)> progress;  // optional: the budget's fraction spent
 };
 
 // One drive tried.
 struct DesignCandidate {
   DriveDesign drive;
-  std::string stage;       // "start", "grid" or "pattern"
-  std::string infeasible;  // why the drive is not feasible; empty when feasible
-  double objective = 0.0;  // max CRB std / target; +inf when infeasible
-  std::string worst;       // the component that sets the objective
+  std::string stage;                                    // "start", "grid" or "pattern"
+  std::string infeasible;                               // why the drive is not feasible; empty when feasible
+  double objective = 0.0;                               // max CRB std / target; +inf when infeasible
+  std::string worst;                                    // the component that sets the objective
   std::vector<std::pair<std::string, double>> crb_std;  // per component label (empty when infeasible)
   double max_roll_deg = 0.0, max_pitch_deg = 0.0, max_side_slip_mps = 0.0, max_lateral_accel_mps2 = 0.0;
   double distance_m = 0.0;
