@@ -32,6 +32,9 @@ constexpr double kMaxDurationS = 3600.0;
 constexpr int kCoordinates = 6;
 constexpr double kFirstStep = 0.2;
 constexpr double kLastStep = 0.02;
+// The pattern search's order of the coordinates: the handlebar's amplitude and period first (the steering range
+// excites most parameters), the heading last.
+constexpr std::array<int, kCoordinates> kSearchOrder = {2, 3, 0, 1, 4, 5};
 // The coarse grid: start headings (added to the scenario's) and handlebar offsets (fractions of the room left by the
 // amplitude; 0.5 is none).
 constexpr std::array<double, 4> kGridHeadingsDeg = {0.0, 90.0, 180.0, 270.0};
@@ -224,8 +227,9 @@ Status Search(const Problem& p, DesignResult* result) {
     bool improved = true;
     while (improved && !spent()) {
       improved = false;
-      for (int k = 0; k < kCoordinates && !improved && !spent(); ++k)
+      for (int i = 0; i < kCoordinates && !improved && !spent(); ++i)
         for (double sign : {1.0, -1.0}) {
+          const int k = kSearchOrder[static_cast<std::size_t>(i)];
           if (spent()) break;
           std::array<double, kCoordinates> u = ToCoordinates(result->candidates[result->best].drive, limits);
           u[k] = k == 5 ? std::fmod(u[k] + sign * step + 1.0, 1.0) : std::clamp(u[k] + sign * step, 0.0, 1.0);
