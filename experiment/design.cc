@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <iomanip>
 #include <limits>
 #include <sstream>
 #include <utility>
@@ -280,15 +281,19 @@ std::string DesignedYaml(const DesignRequest& request, const sim::Scenario& scen
   root["driver"]["handlebar_rad"] = handlebar;
 
   std::ostringstream text;
-  text << "# Designed by `roamlab design " << request.scenario << " --config " << request.config << "`: of "
-       << "the drives v = v0 + dv cos(4 pi t / P), handlebar = d0 + da sin(2 pi t / P), start heading h, the\n"
-       << "# feasible one with the least max CRB std / target (" << best.objective << ", set by " << best.worst << "; "
-       << best.distance_m << " m, roll " << best.max_roll_deg << " deg, pitch " << best.max_pitch_deg
-       << " deg, side slip " << best.max_side_slip_mps << " m/s, lateral acceleration " << best.max_lateral_accel_mps2
-       << " m/s^2). Predicted std (Cramer-Rao, noise-free drive at the truth):\n";
+  text << "# Designed by\n#   roamlab design " << request.scenario << " --config " << request.config << " --duration "
+       << scenario.duration_s << " --budget " << request.budget;
+  for (const auto& [name, target] : request.targets) text << " --target " << name << "=" << target;
+  text << std::setprecision(3) << "\n"
+       << "# (limits in design.json): of the drives speed = v0 + dv cos(4 pi t / P),\n"
+       << "# handlebar = d0 + da sin(2 pi t / P), start heading h (driver, robot.start), the feasible one with the "
+          "least max CRB std / target:\n# "
+       << best.objective << ", set by " << best.worst << "; " << best.distance_m << " m; largest roll "
+       << best.max_roll_deg << " deg, pitch " << best.max_pitch_deg << " deg, side slip " << best.max_side_slip_mps
+       << " m/s, lateral acceleration " << best.max_lateral_accel_mps2 << " m/s^2.\n"
+       << "# Predicted std (Cramer-Rao bound of the noise-free drive at its truth) and target:\n";
   for (const auto& [label, std] : best.crb_std) {
-    const auto parameter = label.substr(0, label.find('['));
-    const auto target = request.targets.find(parameter);
+    const auto target = request.targets.find(label.substr(0, label.find('[')));
     text << "#   " << label << ": " << std;
     if (target != request.targets.end()) text << " (target " << target->second << ")";
     text << "\n";
