@@ -27,7 +27,7 @@ TARGETS = {
 
 
 def main():
-    if len(sys.argv) != 2:
+    if len(sys.argv) != 2 or sys.argv[1] in ("-h", "--help"):
         sys.exit(__doc__)
     files = sorted(glob.glob(os.path.join(sys.argv[1], "calibrations", "*.json")))
     if not files:
