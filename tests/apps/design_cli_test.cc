@@ -40,7 +40,7 @@ TEST(DesignCliTest, BadTargetsAndOptionsExitTwoNamingTheProblem) {
     const testing::CommandRun run = Design(options, fs::path(dir.path()));
     EXPECT_EQ(run.exit_code, 2) << options << ": " << run.err;
     EXPECT_NE(run.err.find(message), std::string::npos) << options << ": " << run.err;
-    EXPECT_FALSE(fs::exists(dir.path() / "d.yaml")) << options;
+    EXPECT_FALSE(fs::exists(dir.File("d.yaml"))) << options;
   }
 }
 
