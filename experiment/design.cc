@@ -33,6 +33,8 @@ constexpr double kMaxDurationS = 3600.0;
 constexpr int kCoordinates = 6;
 constexpr double kFirstStep = 0.2;
 constexpr double kLastStep = 0.02;
+// The speed term's phase: a quarter turn (slowest where the handlebar is turned most), as written (10 digits).
+constexpr double kSpeedPhaseRad = 1.570796327;
 // The pattern search's order of the coordinates: the handlebar's amplitude and period first (the steering range
 // excites most parameters), the heading last.
 constexpr std::array<int, kCoordinates> kSearchOrder = {2, 3, 0, 1, 4, 5};
@@ -41,7 +43,15 @@ constexpr std::array<int, kCoordinates> kSearchOrder = {2, 3, 0, 1, 4, 5};
 constexpr std::array<double, 4> kGridHeadingsDeg = {0.0, 90.0, 180.0, 270.0};
 constexpr std::array<double, 3> kGridOffsets = {0.5, 0.25, 0.75};
 
-double Round(double value, double step) { return std::round(value / step) * step; }
+// A number as the designed scenario writes it: the rounded value's shortest form (yaml-cpp would write 17 digits).
+std::string Text(double value) {
+  std::ostringstream out;
+  out << std::setprecision(10) << value;
+  return out.str();
+}
+
+// `value` to a multiple of `step`, as its text reads back, so that the drive analysed is the one written.
+double Round(double value, double step) { return std::stod(Text(std::round(value / step) * step)); }
 
 // The drive as written: values rounded so that the scenario written is the one analysed.
 DriveDesign Rounded(const DriveDesign& d) {
@@ -254,7 +264,7 @@ std::string PathFrom(const std::string& file, const std::string& out) {
 
 YAML::Node TermNode(const char* type, const std::map<std::string, double>& fields) {
   YAML::Node inner;
-  for (const auto& [key, value] : fields) inner[key] = value;
+  for (const auto& [key, value] : fields) inner[key] = Text(value);
   YAML::Node term;
   term[type] = inner;
   return term;
@@ -264,17 +274,18 @@ YAML::Node TermNode(const char* type, const std::map<std::string, double>& field
 std::string DesignedYaml(const DesignRequest& request, const sim::Scenario& scenario, const DesignCandidate& best) {
   YAML::Node root = YAML::LoadFile(request.scenario);
   const DriveDesign& d = best.drive;
-  root["duration_s"] = scenario.duration_s;
+  root["duration_s"] = Text(scenario.duration_s);
   root["robot"]["model"] = PathFrom(scenario.robot.model_file, request.out);
   if (!scenario.world_model_file.empty()) root["world"]["model"] = PathFrom(scenario.world_model_file, request.out);
-  root["robot"]["start"]["heading_deg"] = d.heading_deg;
+  root["robot"]["start"]["heading_deg"] = Text(d.heading_deg);
   YAML::Node speed(YAML::NodeType::Sequence), handlebar(YAML::NodeType::Sequence);
   speed.push_back(YAML::Node());
-  speed[0]["constant"] = d.speed_mean_mps;
+  speed[0]["constant"] = Text(d.speed_mean_mps);
   speed.push_back(TermNode(
-      "sine", {{"amplitude", d.speed_swing_mps}, {"period_s", 0.5 * d.handlebar_period_s}, {"phase_rad", 0.5 * kPi}}));
+      "sine",
+      {{"amplitude", d.speed_swing_mps}, {"period_s", 0.5 * d.handlebar_period_s}, {"phase_rad", kSpeedPhaseRad}}));
   handlebar.push_back(YAML::Node());
-  handlebar[0]["constant"] = d.handlebar_offset_rad;
+  handlebar[0]["constant"] = Text(d.handlebar_offset_rad);
   handlebar.push_back(TermNode(
       "sine", {{"amplitude", d.handlebar_amplitude_rad}, {"period_s", d.handlebar_period_s}, {"phase_rad", 0.0}}));
   root["driver"]["speed_mps"] = speed;
@@ -299,7 +310,6 @@ std::string DesignedYaml(const DesignRequest& request, const sim::Scenario& scen
     text << "\n";
   }
   YAML::Emitter emitter;
-  emitter.SetDoublePrecision(10);
   emitter << root;
   text << emitter.c_str() << "\n";
   return text.str();
@@ -346,7 +356,7 @@ sim::Scenario WithDrive(const sim::Scenario& scenario, const DriveDesign& drive)
   sim::Scenario out = scenario;
   out.robot.start_heading_rad = drive.heading_deg / kDegPerRad;
   out.driver.speed_mps.terms = {Constant(drive.speed_mean_mps),
-                                Sine(drive.speed_swing_mps, 0.5 * drive.handlebar_period_s, 0.5 * kPi)};
+                                Sine(drive.speed_swing_mps, 0.5 * drive.handlebar_period_s, kSpeedPhaseRad)};
   out.driver.handlebar_rad.terms = {Constant(drive.handlebar_offset_rad),
                                     Sine(drive.handlebar_amplitude_rad, drive.handlebar_period_s, 0.0)};
   return out;
