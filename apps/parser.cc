@@ -9,6 +9,7 @@
 #include "apps/batch.h"
 #include "apps/cli.h"
 #include "apps/commands.h"
+#include "apps/design.h"
 #include "apps/diagnose.h"
 #include "apps/evaluate.h"
 #include "apps/frontend.h"
@@ -220,6 +221,41 @@ void AddInformation(CLI::App* app, Commands* commands) {
     inf->add_option("--window", args->window_s, "Length of the time windows of the split [s] (default 1)");
     inf->add_flag("--quiet", args->quiet, "No progress and no table");
     return inf;
+  });
+}
+
+void AddDesign(CLI::App* app, Commands* commands) {
+  Add(commands, RunDesign, [app](auto* args) {
+    CLI::App* des = app->add_subcommand(
+        "design",
+        "Choose the Ackermann drive (speed and handlebar weave, start heading) that minimizes the worst ratio of a "
+        "calibration parameter's Cramer-Rao std to its target, feasible in MuJoCo; write it as a scenario.");
+    des->add_option("scenario", args->scenario, "Scenario file (SCENARIO.yaml) with an ackermann driver")->required();
+    des->add_option("--config", args->config, "Estimator configuration (EST.yaml): free parameters, noise")->required();
+    des->add_option("--out", args->out, "The designed scenario to write (DESIGNED.yaml); design.json beside it")
+        ->required();
+    des->add_option("--target", args->target_texts,
+                    "NAME=STD: the target std of every tangent component of the free parameter NAME (repeatable; at "
+                    "least one)")
+        ->required();
+    des->add_option("--duration", args->duration_s,
+                    "Recorded duration of the designed drive [s] (default: the scenario's)");
+    des->add_option("--budget", args->budget, "Drives simulated and analysed (default 60)");
+    des->add_option("--speed-range", args->speed_range_mps, "MIN MAX of the speed set-point [m/s] (default 1.5 6)")
+        ->expected(2);
+    des->add_option("--max-handlebar", args->limits.max_handlebar_rad,
+                    "Largest |handlebar| set-point [rad] (default 0.45)");
+    des->add_option("--period-range", args->period_range_s, "MIN MAX of the weave's period [s] (default 5 30)")
+        ->expected(2);
+    des->add_option("--max-roll", args->limits.max_roll_deg,
+                    "Feasible: largest |roll| of the vehicle [deg] (default 25)");
+    des->add_option("--max-pitch", args->limits.max_pitch_deg, "Feasible: largest |pitch| [deg] (default 25)");
+    des->add_option("--max-side-slip", args->limits.max_side_slip_mps,
+                    "Feasible: largest lateral speed of O [m/s] (default 0.3)");
+    des->add_option("--max-lateral-accel", args->limits.max_lateral_accel_mps2,
+                    "Feasible: largest speed x yaw rate [m/s^2] (default 4.4, 0.45 g)");
+    des->add_flag("--quiet", args->quiet, "No progress and no table");
+    return des;
   });
 }
 
@@ -481,8 +517,8 @@ Commands AddCommands(CLI::App* app) {
   app->require_subcommand(1);
   Commands commands;
   for (const auto add :
-       {AddSimulate, AddReplay, AddCalibrate, AddTrack, AddEvaluate, AddMonteCarlo, AddInit, AddInformation, AddDiagnose,
-        AddGapBenchmark, AddRegress, AddOdometry, AddImport, AddFrontEnd, AddSweep, AddBatch})
+       {AddSimulate, AddReplay, AddCalibrate, AddTrack, AddEvaluate, AddMonteCarlo, AddInit, AddInformation, AddDesign,
+        AddDiagnose, AddGapBenchmark, AddRegress, AddOdometry, AddImport, AddFrontEnd, AddSweep, AddBatch})
     add(app, &commands);
   return commands;
 }
