@@ -193,7 +193,8 @@ TEST(ProblemBuilderTest, ProcessIntervalSharesOneInstanceAmongItsPoses) {
   int odometer = 0;
   for (const auto& [id, f] : graph.factors()) {
     if (f.stream != "odometer") continue;
-    const auto k = std::find_if(poses.begin(), poses.end(), [&](const PoseNode& p) { return p.id == f.variables[0]; });
+    const VariableId first = f.variables[0];  // a structured binding cannot be captured in C++17
+    const auto k = std::find_if(poses.begin(), poses.end(), [first](const PoseNode& p) { return p.id == first; });
     ASSERT_NE(k, poses.end());
     EXPECT_EQ(f.variables[10], k->instances.at("odometer.disturbance"));
     ++odometer;
