@@ -779,7 +779,9 @@ Result<std::string> ResolveText(const json& output, const MetricPath& path) {
   return w.value().node->get<std::string>();
 }
 
-Result<Suite> LoadSuite(const std::string& path) {
+namespace {
+
+Result<Suite> ReadSuite(const std::string& path) {
   Suite suite;
   suite.file = path;
   if (!fs::is_regular_file(path)) return Status::Error(path + ": cannot open the suite file");
@@ -817,6 +819,19 @@ Result<Suite> LoadSuite(const std::string& path) {
     }
   }
   return suite;
+}
+
+}  // namespace
+
+// Every field is read with its kind checked; a node of another kind that reaches yaml-cpp's conversion anyway (a key
+// that is a map or a list, say) is one line naming the file and the line, not an exception.
+Result<Suite> LoadSuite(const std::string& path) {
+  try {
+    return ReadSuite(path);
+  } catch (const YAML::Exception& e) {
+    const std::string line = e.mark.line >= 0 ? std::to_string(e.mark.line + 1) + ":" : "";
+    return Status::Error(path + ":" + line + " a key or value of the wrong kind (" + e.msg + ")");
+  }
 }
 
 }  // namespace roamlab::regress

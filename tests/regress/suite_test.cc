@@ -85,9 +85,7 @@ class SuiteTest : public ::testing::Test {
     testing::WriteFile(path, "suite: test\ncases:\n" + cases);
     return path;
   }
-  static std::string Scenario(const std::string& name) {
-    return roamlab::testing::SourceDir() + "/scenarios/" + name;
-  }
+  static std::string Scenario(const std::string& name) { return roamlab::testing::SourceDir() + "/scenarios/" + name; }
   static std::string Config(const std::string& name) { return roamlab::testing::SourceDir() + "/configs/" + name; }
   std::string CalibrateCase(const std::string& checks, const std::string& extra = "") {
     return "  - name: cal\n    mode: calibrate\n    scenario: " + Scenario("atv_hills.yaml") +
@@ -180,11 +178,11 @@ TEST_F(SuiteTest, LoadsCasesWithTheirChecks) {
 
 // A case with an external estimator: its command kept as written, run in the suite file's directory.
 TEST_F(SuiteTest, LoadsExternalCommandCases) {
-  const std::string path = WriteSuite("  - name: dr\n    mode: montecarlo\n    scenario: " +
-                                      Scenario("atv_hills.yaml") +
-                                      "\n    command: \"sh ../dr.sh {recording} {out}\"\n    timeout_s: 30\n"
-                                      "    runs: 2\n    checks:\n"
-                                      "      - {metric: runs.runs.ate_m.max, bound: \"<= 1\"}\n");
+  const std::string path =
+      WriteSuite("  - name: dr\n    mode: montecarlo\n    scenario: " + Scenario("atv_hills.yaml") +
+                 "\n    command: \"sh ../dr.sh {recording} {out}\"\n    timeout_s: 30\n"
+                 "    runs: 2\n    checks:\n"
+                 "      - {metric: runs.runs.ate_m.max, bound: \"<= 1\"}\n");
   const Result<Suite> suite = LoadSuite(path);
   ASSERT_TRUE(suite.ok()) << suite.status().message();
   const Case& c = suite.value().cases[0];
@@ -289,12 +287,16 @@ TEST_F(SuiteTest, EachKindOfBadSuiteIsOneLineNamingFileCaseAndProblem) {
 
 TEST_F(SuiteTest, BadSuiteFileOutsideCases) {
   for (const std::string& text : {std::string("cases: []\n"), std::string("suite: x\n"),
-                                  std::string("cases:\n  - {name: a\n"), std::string("cases: 3\nextra: 1\n")}) {
+                                  std::string("cases:\n  - {name: a\n"), std::string("cases: 3\nextra: 1\n"),
+                                  // A key that is a list or a map (the fuzzer's find: an exception escaped).
+                                  std::string("? [suite, x]\n: 1\ncases: []\n"),
+                                  std::string("cases:\n  - name: a\n    ? {mode: track}\n    : 1\n")}) {
     const std::string path = dir_.File("suite.yaml");
     testing::WriteFile(path, text);
     const Result<Suite> suite = LoadSuite(path);
     ASSERT_FALSE(suite.ok()) << text;
     EXPECT_EQ(suite.status().message().rfind(path, 0), 0u) << suite.status().message();
+    EXPECT_EQ(suite.status().message().find('\n'), std::string::npos) << suite.status().message();
   }
   EXPECT_FALSE(LoadSuite(dir_.File("absent.yaml")).ok());
 }
