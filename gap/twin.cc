@@ -123,13 +123,14 @@ Result<TwinEffect> Diagnoser::Fit(const TwinCandidate& c, const State& state, do
     auto drop = internal::PredictedDrop(c, state.residuals, &evaluator, settings);
     runs_ += evaluator.runs();
     if (!drop.ok()) return drop.status();
-    if (!(1.0 - ChiSquareCdf(drop.value(), static_cast<double>(c.free.size())) < options_.alpha)) {
+    const internal::ScoreTest& test = drop.value();
+    if (test.dof == 0 || !(1.0 - ChiSquareCdf(test.drop, static_cast<double>(test.dof)) < options_.alpha)) {
       TwinEffect e;
       e.runs = evaluator.runs();
       e.chi2_before = e.chi2_after = state.chi2;
       e.estimate.name = c.label;
-      e.estimate.dof = static_cast<int>(c.free.size());
-      e.estimate.lr_raw = drop.value();
+      e.estimate.dof = test.dof;
+      e.estimate.lr_raw = test.drop;
       internal::Score(nullptr, measurements_, &e.estimate);
       e.estimate.decision = "not significant by the score test (not fitted)";
       return e;
@@ -145,19 +146,25 @@ Result<TwinEffect> Diagnoser::Fit(const TwinCandidate& c, const State& state, do
   e.iterations = fit.value().iterations;
   e.runs = evaluator.runs();
   e.estimate.name = c.label;
-  e.estimate.dof = static_cast<int>(c.free.size());
   e.estimate.parameters = Values(c, fit.value().theta);
   const TwinCovariance& covariance = fit.value().covariance;
+  Eigen::Index k = 0;  // the informed parameters' index in the covariance
   for (std::size_t j = 0; j < c.free.size(); ++j) {
-    const Eigen::Index k = static_cast<Eigen::Index>(j);
     const std::string& name = c.free[j].name;
+    if (!fit.value().informed[j]) {
+      e.not_informed.push_back(name);
+      continue;
+    }
     e.std_white[name] = std::sqrt(std::max(0.0, covariance.white(k, k)));
     e.std_hac[name] = std::sqrt(std::max(0.0, covariance.hac(k, k)));
     e.estimate.std[name] = hac_ ? std::max(e.std_white[name], e.std_hac[name]) : e.std_white[name];
+    ++k;
   }
+  e.estimate.dof = static_cast<int>(k);
   e.hac_lags = covariance.lags;
   e.estimate.lr_raw = state.chi2 - fit.value().chi2;
   internal::Score(nullptr, measurements_, &e.estimate);
+  if (k == 0) e.estimate.decision = "not fitted: the data informs none of its parameters";
   return e;
 }
 

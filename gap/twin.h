@@ -145,11 +145,16 @@ TwinCovariance ComputeTwinCovariance(const TwinFitRows& rows);
 
 struct TwinEffect {
   EffectEstimate estimate;  // name (the candidate's label), dof, parameters, std, lr, p, Delta BIC, held-out drop
-  std::map<std::string, double> std_white, std_hac;  // per parameter; estimate.std is the chosen one (std_method)
-  std::map<std::string, int> hac_lags;               // per series: the HAC lag (samples)
-  sim::EffectOptions effect;                         // as the simulator applies it (time shifts in whole physics steps)
-  double chi2_before = 0.0;                          // training part: with the effects kept before it
-  double chi2_after = 0.0;                           // with it
+  // Per fitted parameter; estimate.std is the chosen one (std_method).
+  std::map<std::string, double> std_white, std_hac;
+  // Parameters the data does not inform (internal/twin_fit.h FitCandidate: a conditional white std above 5 % of the
+  // parameter's range), held at their neutral values in estimate.parameters and the effect, without a std and not
+  // counted in estimate.dof.
+  std::vector<std::string> not_informed;
+  std::map<std::string, int> hac_lags;  // per series: the HAC lag (samples)
+  sim::EffectOptions effect;            // as the simulator applies it (time shifts in whole physics steps)
+  double chi2_before = 0.0;             // training part: with the effects kept before it
+  double chi2_after = 0.0;              // with it
   int iterations = 0;
   int runs = 0;  // twin runs spent on the fit
 };

@@ -221,6 +221,8 @@ std::vector<std::string> TwinVerdictLines(const TwinDiagnosis& d) {
     for (const auto& [k, v] : e.estimate.parameters) {
       line += " " + k + " = " + Fixed(v, 5);
       if (const auto s = e.estimate.std.find(k); s != e.estimate.std.end()) line += " +- " + Fixed(s->second, 2);
+      if (std::find(e.not_informed.begin(), e.not_informed.end(), k) != e.not_informed.end())
+        line += " (not informed, held)";
     }
     lines.push_back(line + " (training chi2 " + Fixed(e.chi2_before, 5) + " -> " + Fixed(e.chi2_after, 5) + ")");
   }

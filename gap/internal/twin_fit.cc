@@ -13,6 +13,9 @@ namespace {
 constexpr double kMinDecrease = 0.1;
 constexpr double kMinRelativeDecrease = 1e-5;
 constexpr int kMaxTries = 4;
+// A parameter is informed by the data when its conditional white std (the others fitted along) is below this share of
+// its range (hi - lo); others are held at their neutral values.
+constexpr double kMaxInformedStdShare = 0.05;
 
 TwinParameter P(const std::string& name, double neutral, double step, double lo, double hi) {
   return {name, neutral, step, lo, hi};
@@ -70,6 +73,12 @@ std::vector<TwinCandidate> Library(const sim::Scenario& nominal, double max_shif
   pose.time_shift = true;
   all.push_back(pose);
   return all;
+}
+
+Eigen::VectorXd NeutralValues(const TwinCandidate& c) {
+  Eigen::VectorXd theta(static_cast<Eigen::Index>(c.free.size()));
+  for (std::size_t j = 0; j < c.free.size(); ++j) theta[static_cast<Eigen::Index>(j)] = c.free[j].neutral;
+  return theta;
 }
 
 // Entries finite in `center`; elsewhere 0.
@@ -145,12 +154,64 @@ Result<Eigen::MatrixXd> Jacobian(const TwinCandidate& c, const Eigen::VectorXd& 
   return J;
 }
 
+// Which of c.free the Jacobian J (at the neutral values) informs: the parameters in units of their ranges, H = J^T J
+// over the kept ones; the parameter whose conditional std, 1 / sqrt(H_jj - H_jo H_oo^+ H_oj), is largest against
+// kMaxInformedStdShare is dropped (held at its neutral value) and the rest judged again, until every kept one is
+// below it. A zero column (the parameter moves no residual) has no information; of two columns that move the residuals
+// alike one is held.
+std::vector<bool> Informed(const TwinCandidate& c, const Eigen::MatrixXd& J) {
+  const int k = static_cast<int>(c.free.size());
+  Eigen::MatrixXd Jr = J;
+  for (int j = 0; j < k; ++j)
+    Jr.col(j) *= c.free[static_cast<std::size_t>(j)].hi - c.free[static_cast<std::size_t>(j)].lo;
+  const Eigen::MatrixXd H = Jr.transpose() * Jr;
+  std::vector<bool> kept(static_cast<std::size_t>(k), true);
+  for (;;) {
+    int worst = -1;
+    double worst_std = kMaxInformedStdShare;
+    for (int j = 0; j < k; ++j) {
+      if (!kept[static_cast<std::size_t>(j)]) continue;
+      std::vector<int> others;
+      for (int o = 0; o < k; ++o)
+        if (o != j && kept[static_cast<std::size_t>(o)]) others.push_back(o);
+      double information = H(j, j);
+      if (!others.empty()) {
+        const Eigen::MatrixXd Hoo = H(others, others);
+        const Eigen::VectorXd Hoj = H(others, j);
+        information -= Hoj.dot(Hoo.completeOrthogonalDecomposition().solve(Hoj));
+      }
+      const double std_share =
+          information > 0.0 ? 1.0 / std::sqrt(information) : std::numeric_limits<double>::infinity();
+      if (std_share > worst_std) {
+        worst = j;
+        worst_std = std_share;
+      }
+    }
+    if (worst < 0) return kept;
+    kept[static_cast<std::size_t>(worst)] = false;
+  }
+}
+
+// `c` with the parameters not `informed` held at their neutral values (moved to c.fixed).
+TwinCandidate Reduced(const TwinCandidate& c, const std::vector<bool>& informed) {
+  TwinCandidate out = c;
+  out.free.clear();
+  for (std::size_t j = 0; j < c.free.size(); ++j) {
+    if (informed[j])
+      out.free.push_back(c.free[j]);
+    else
+      out.fixed[c.free[j].name] = c.free[j].neutral;
+  }
+  return out;
+}
+
 // Levenberg-Marquardt from the neutral values, the parameters scaled by their steps. Stops when the Gauss-Newton step
 // predicts, or the step taken makes, a decrease below kMinDecrease + kMinRelativeDecrease chi2 (a tenth of the
 // chi-square unit that moves a parameter by one standard deviation, so at most a third of it away), after
 // max_iterations, or when kMaxTries dampings do not decrease the cost.
+// `first_jacobian`, when given, is the Jacobian at the neutral values.
 Result<CandidateOutcome> FitLeastSquares(const TwinCandidate& c, const Eigen::VectorXd& base, TwinEvaluator* evaluator,
-                                         const FitSettings& settings) {
+                                         const FitSettings& settings, const Eigen::MatrixXd* first_jacobian) {
   const int k = static_cast<int>(c.free.size());
   CandidateOutcome out;
   out.theta.resize(k);
@@ -164,9 +225,13 @@ Result<CandidateOutcome> FitLeastSquares(const TwinCandidate& c, const Eigen::Ve
   double lambda = 1e-3;
   Eigen::MatrixXd J;
   for (out.iterations = 0; out.iterations < settings.max_iterations; ++out.iterations) {
-    auto jacobian = Jacobian(c, out.theta, out.residuals, settings.threads, evaluator);
-    if (!jacobian.ok()) return jacobian.status();
-    J = jacobian.value();
+    if (out.iterations == 0 && first_jacobian) {
+      J = *first_jacobian;
+    } else {
+      auto jacobian = Jacobian(c, out.theta, out.residuals, settings.threads, evaluator);
+      if (!jacobian.ok()) return jacobian.status();
+      J = jacobian.value();
+    }
     const Eigen::MatrixXd Js = J * scale.asDiagonal();
     const Eigen::VectorXd r = Masked(out.residuals, out.residuals);
     const Eigen::MatrixXd H = Js.transpose() * Js;
@@ -312,10 +377,9 @@ std::vector<Result<Eigen::VectorXd>> TwinEvaluator::Run(const std::vector<sim::E
   return out;
 }
 
-Result<double> PredictedDrop(const TwinCandidate& c, const Eigen::VectorXd& base, TwinEvaluator* evaluator,
-                             const FitSettings& settings) {
-  Eigen::VectorXd theta(static_cast<Eigen::Index>(c.free.size()));
-  for (std::size_t j = 0; j < c.free.size(); ++j) theta[static_cast<Eigen::Index>(j)] = c.free[j].neutral;
+Result<ScoreTest> PredictedDrop(const TwinCandidate& c, const Eigen::VectorXd& base, TwinEvaluator* evaluator,
+                                const FitSettings& settings) {
+  Eigen::VectorXd theta = NeutralValues(c);
   if (c.time_shift) {
     const double shift_s = c.free.front().hi > 0.0 ? settings.physics_step_s : -settings.physics_step_s;
     theta[0] = shift_s;
@@ -323,19 +387,53 @@ Result<double> PredictedDrop(const TwinCandidate& c, const Eigen::VectorXd& base
     if (!r[0].ok()) return Status::Error(c.label + ": a shifted twin: " + r[0].status().message());
     const Eigen::VectorXd d = (Masked(r[0].value(), base) - Masked(base, base)) / shift_s;
     const Eigen::VectorXd b = Masked(base, base);
-    return d.squaredNorm() > 0.0 ? std::pow(d.dot(b), 2) / d.squaredNorm() : 0.0;
+    return ScoreTest{d.squaredNorm() > 0.0 ? std::pow(d.dot(b), 2) / d.squaredNorm() : 0.0, 1};
   }
   auto J = Jacobian(c, theta, base, settings.threads, evaluator);
   if (!J.ok()) return J.status();
-  const Eigen::VectorXd g = J.value().transpose() * Masked(base, base);
-  const Eigen::MatrixXd H = J.value().transpose() * J.value();
-  return g.dot(H.completeOrthogonalDecomposition().solve(g));
+  const std::vector<bool> informed = Informed(c, J.value());
+  std::vector<int> columns;
+  for (std::size_t j = 0; j < informed.size(); ++j)
+    if (informed[j]) columns.push_back(static_cast<int>(j));
+  const Eigen::MatrixXd Ji = J.value()(Eigen::all, columns);
+  const Eigen::VectorXd g = Ji.transpose() * Masked(base, base);
+  const Eigen::MatrixXd H = Ji.transpose() * Ji;
+  return ScoreTest{columns.empty() ? 0.0 : g.dot(H.completeOrthogonalDecomposition().solve(g)),
+                   static_cast<int>(columns.size())};
 }
 
 Result<CandidateOutcome> FitCandidate(const TwinCandidate& c, const Eigen::VectorXd& base, TwinEvaluator* evaluator,
                                       const FitSettings& settings) {
-  if (c.time_shift) return SearchTimeShift(c, base, evaluator, settings);
-  return FitLeastSquares(c, base, evaluator, settings);
+  if (c.time_shift) {
+    auto out = SearchTimeShift(c, base, evaluator, settings);
+    if (out.ok()) out.value().informed.assign(1, true);
+    return out;
+  }
+  const Eigen::VectorXd neutral = NeutralValues(c);
+  auto J = Jacobian(c, neutral, base, settings.threads, evaluator);
+  if (!J.ok()) return J.status();
+  const std::vector<bool> informed = Informed(c, J.value());
+  const TwinCandidate fitted = Reduced(c, informed);
+  CandidateOutcome out;
+  if (fitted.free.empty()) {  // nothing to fit: the neutral values, the base residuals
+    out.theta = neutral;
+    out.effect = EffectAt(c, neutral);
+    out.residuals = base;
+    out.chi2 = SumOfSquares(base);
+  } else {
+    // The Jacobian at the neutral values is the first iteration's when every parameter is fitted; with fewer, the
+    // reduced candidate's own (central differences when they now fit in the threads).
+    const bool all = fitted.free.size() == c.free.size();
+    auto fit = FitLeastSquares(fitted, base, evaluator, settings, all ? &J.value() : nullptr);
+    if (!fit.ok()) return fit.status();
+    out = std::move(fit).value();
+    Eigen::VectorXd theta = neutral;
+    for (std::size_t j = 0, f = 0; j < c.free.size(); ++j)
+      if (informed[j]) theta[static_cast<Eigen::Index>(j)] = out.theta[static_cast<Eigen::Index>(f++)];
+    out.theta = theta;
+  }
+  out.informed = informed;
+  return out;
 }
 
 }  // namespace roamlab::gap::internal

@@ -58,11 +58,12 @@ class TwinEvaluator {
 };
 
 struct CandidateOutcome {
-  Eigen::VectorXd theta;      // fitted (time shifts: the parabola's vertex, sub-step)
-  TwinCovariance covariance;  // of theta, white and HAC (gap/twin.h)
-  sim::EffectOptions effect;  // as applied (time shifts in whole steps)
-  double chi2 = 0.0;          // training part, at `effect`
-  Eigen::VectorXd residuals;  // training part, at `effect`
+  Eigen::VectorXd theta;       // fitted (time shifts: the parabola's vertex, sub-step); the uninformed at neutral
+  std::vector<bool> informed;  // per parameter (c.free's order): fitted; the others are held at their neutral values
+  TwinCovariance covariance;   // of the informed parameters of theta, in order, white and HAC (gap/twin.h)
+  sim::EffectOptions effect;   // as applied (time shifts in whole steps)
+  double chi2 = 0.0;           // training part, at `effect`
+  Eigen::VectorXd residuals;   // training part, at `effect`
   int iterations = 0;
 };
 
@@ -72,7 +73,10 @@ struct FitSettings {
   int threads = 2;
 };
 
-// Fits `c` starting at its neutral values, whose residuals (the base twin's) are `base`. The covariance from the rows
+// Fits `c` starting at its neutral values, whose residuals (the base twin's) are `base`. Only the parameters the data
+// informs are fitted: from the Jacobian at the neutral values, a parameter whose conditional white std (the others
+// fitted along) exceeds 5 % of its range (hi - lo), such as a gyroscope's x scale on a planar drive, is held at its
+// neutral value, reported as not informed, and the others are fitted without it. The covariance from the rows
 // at the fit (ComputeTwinCovariance): a least-squares fit's residuals and last Jacobian; a time shift's residuals at
 // the best step moved to the parabola's vertex to first order, r_b + J (theta - b step), with J the central difference
 // over the neighbouring steps.
@@ -80,9 +84,14 @@ Result<CandidateOutcome> FitCandidate(const TwinCandidate& c, const Eigen::Vecto
                                       const FitSettings& settings);
 
 // The score test's chi-square drop: the Gauss-Newton step's predicted decrease from the neutral values, g^T H^+ g
-// with the Jacobian there (a time shift: by one step from zero); ~ chi2(k) when the candidate is absent.
-Result<double> PredictedDrop(const TwinCandidate& c, const Eigen::VectorXd& base, TwinEvaluator* evaluator,
-                             const FitSettings& settings);
+// with the Jacobian there over the informed parameters (as FitCandidate; a time shift: by one step from zero);
+// ~ chi2(dof) when the candidate is absent, dof the informed parameters.
+struct ScoreTest {
+  double drop = 0.0;
+  int dof = 0;
+};
+Result<ScoreTest> PredictedDrop(const TwinCandidate& c, const Eigen::VectorXd& base, TwinEvaluator* evaluator,
+                                const FitSettings& settings);
 
 // Runs fn(0..n-1) on up to `threads` threads.
 void ParallelFor(int n, int threads, const std::function<void(int)>& fn);
