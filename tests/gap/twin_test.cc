@@ -188,6 +188,37 @@ TEST(TwinTest, AHiddenOdometryScaleErrorIsRecovered) {
   ExpectNamed(d.value(), "odometry_scale_error", "scale", kScale);
 }
 
+// A planar drive turns about the vertical only: of the gyroscope's scales the data informs z, and x and y (whose
+// readings stay near zero) are held at 1, reported as not informed, without a std and not counted in the dof.
+TEST(TwinTest, TheGyroscopeScalesAPlanarDriveDoesNotInformAreHeld) {
+  constexpr double kScaleZ = 1.02;
+  sim::Scenario nominal = Nominal();
+  nominal.duration_s = 10.0;
+  sim::Scenario real = nominal;
+  real.effects = {{"gyro_scale_error", {{"scale_z", kScaleZ}}}};
+  TwinDiagnoseOptions options;
+  options.candidates = {"gyro_scale_error"};
+  options.max_effects = 1;
+  auto d = DiagnoseTwin(nominal, testing::SimulatedWithSeed(real, 16).recording, PlainSimulationRunner(), options);
+  ASSERT_TRUE(d.ok()) << d.status().message();
+  ASSERT_EQ(d.value().candidates.size(), 1u);
+  const TwinEffect& e = d.value().candidates.front();
+  EXPECT_EQ(e.not_informed, (std::vector<std::string>{"scale_x", "scale_y"}));
+  EXPECT_EQ(e.estimate.dof, 1);
+  for (const std::string name : {"scale_x", "scale_y"}) {
+    ASSERT_TRUE(e.estimate.parameters.count(name)) << name;
+    EXPECT_EQ(e.estimate.parameters.at(name), 1.0) << name;
+    EXPECT_EQ(e.effect.parameters.at(name), 1.0) << name;
+    EXPECT_FALSE(e.estimate.std.count(name) || e.std_white.count(name) || e.std_hac.count(name)) << name;
+  }
+  ASSERT_TRUE(e.estimate.std.count("scale_z"));
+  std::printf("  scale_z = %.5f +- %.5f\n", e.estimate.parameters.at("scale_z"), e.estimate.std.at("scale_z"));
+  EXPECT_NEAR(e.estimate.parameters.at("scale_z"), kScaleZ, 3.0 * e.estimate.std.at("scale_z"));
+  EXPECT_EQ(d.value().verdict, "named");
+  const nlohmann::json json = TwinDiagnosisJson(d.value());
+  EXPECT_EQ(json.at("candidates").at(0).at("not_informed"), nlohmann::json({"scale_x", "scale_y"}));
+}
+
 TEST(TwinTest, ThePlainSimulationIsTheTwinOfTheScenariosOwnDriveOnly) {
   sim::Scenario nominal = Nominal();
   const recording::Recording twin = PlainSimulationRunner()(nominal).value();
