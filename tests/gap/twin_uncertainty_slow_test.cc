@@ -109,6 +109,11 @@ TEST(TwinUncertaintySlowTest, HacIntervalsCoverHiddenTimeShiftAndScalesUnderColo
                {"gps_latency", "gyro_scale_error"}, 300 + static_cast<std::uint64_t>(k));
     Score(sensors, "gps_latency", "latency_s", true_latency_s, &latency);
     Score(sensors, "gyro_scale_error", "scale_z", true_scale, &gyro);
+    // A planar drive informs the gyroscope's z scale only: x and y are held at 1, not fitted.
+    for (const TwinEffect& e : sensors) {
+      if (e.estimate.name != "gyro_scale_error") continue;
+      EXPECT_EQ(e.not_informed, (std::vector<std::string>{"scale_x", "scale_y"})) << "case " << k;
+    }
     const std::vector<TwinEffect> drive = Fitted({{"wheel_radius_asymmetry", {{"ratio_right_left", true_ratio}}}},
                                                  {"wheel_radius_asymmetry"}, 400 + static_cast<std::uint64_t>(k));
     Score(drive, "wheel_radius_asymmetry", "ratio_right_left", true_ratio, &ratio);
@@ -119,14 +124,15 @@ TEST(TwinUncertaintySlowTest, HacIntervalsCoverHiddenTimeShiftAndScalesUnderColo
   for (const Coverage* c : {&latency, &gyro, &ratio})
     std::printf("  %-18s white %2d/%d  hac %2d/%d   RMS error/std: white %.2f, hac %.2f\n", c->label.c_str(), c->white,
                 c->cases, c->hac, c->cases, std::sqrt(c->sum_z2_white / c->cases), std::sqrt(c->sum_z2_hac / c->cases));
-  // Target: at least 90 % of the HAC intervals contain the hidden value, for the time shift and the drive's scale.
+  // Target: at least 90 % of the HAC intervals contain the hidden value (18 of 20), for the time shift and the drive's
+  // scale.
   for (const Coverage* c : {&latency, &ratio}) EXPECT_GE(c->hac, (9 * kCases + 9) / 10) << c->label;
-  // The gyroscope's scale falls short of it (16 of 20): its HAC std is what the Newey-West sum of this noise gives
-  // (about 2.8 times the white one against the long-run factor's 3.2, the Bartlett weights' bias at the chosen lag),
-  // but its errors spread about 1.3 times wider than the noise's long-run variance predicts. The candidate's x and y
-  // scales, which a planar drive does not observe, end at their bounds (0.5 or 1.5) in every case (printed), and the
-  // clamped Levenberg-Marquardt steps leave scale_z off its optimum by more than the noise. Claimed: HAC covers more
-  // than white.
+  // Not met for the gyroscope's z scale on these 20 seeds: 16 of 20. Its fitted errors spread as the Gauss-Markov
+  // noise's long-run variance predicts (over 60 cases of the same draws, seeds 300-359: RMS error 0.0032 against the
+  // white std 0.00098 times the long-run factor 3.17, 0.0031; HAC covers 54 of 60), but the first 20 happen to spread
+  // wider (RMS 0.0039), and the HAC std falls short of the long-run one by about 14 % (mean 0.0027: the Bartlett
+  // weights' truncation at the chosen lag, 21 or 45 samples against a correlation of 5, and the scores' zero sum at the
+  // fit, which takes more off at a longer lag: twice the lag covers 52 of 60). Claimed: HAC covers more than white.
   EXPECT_GT(gyro.hac, gyro.white) << gyro.label;
 }
 
