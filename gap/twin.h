@@ -13,7 +13,9 @@
 //   3. fit: each candidate effect the scenario supports (TwinCandidateNames) is fitted on the training part (the
 //      first train_fraction of the recording) with the effects kept so far applied: Levenberg-Marquardt over its
 //      parameters on cost = the sum of squared whitened residuals, the Jacobian by finite differences of perturbed
-//      twin runs executed in parallel (central when 2k runs fit in the threads, else forward). Time shifts
+//      twin runs executed in parallel (central when 2k runs fit in the threads, else forward), over the parameters the
+//      data informs (a parameter whose conditional white std at the neutral values exceeds 5 % of its range is held at
+//      its neutral value and listed in TwinEffect::not_informed; internal/twin_fit.h FitCandidate). Time shifts
 //      (gps_latency latency_s, imu_time_offset offset_s, pose_time_offset offset_s: the motion capture's pose stamped
 //      t is O's pose at t - offset_s, so negative is wheel encoders that read behind it) are whole physics steps in
 //      the simulator: a 1-D search on the step grid, coarse to fine, then a parabola through the best step and its
