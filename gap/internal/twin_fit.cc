@@ -154,11 +154,25 @@ Result<Eigen::MatrixXd> Jacobian(const TwinCandidate& c, const Eigen::VectorXd& 
   return J;
 }
 
-// Which of c.free the Jacobian J (at the neutral values) informs: the parameters in units of their ranges, H = J^T J
-// over the kept ones; the parameter whose conditional std, 1 / sqrt(H_jj - H_jo H_oo^+ H_oj), is largest against
-// kMaxInformedStdShare is dropped (held at its neutral value) and the rest judged again, until every kept one is
-// below it. A zero column (the parameter moves no residual) has no information; of two columns that move the residuals
-// alike one is held.
+// The std of parameter j from the information H with the other `kept` parameters fitted along:
+// 1 / sqrt(H_jj - H_jo H_oo^+ H_oj); infinite without information.
+double ConditionalStd(const Eigen::MatrixXd& H, const std::vector<bool>& kept, int j) {
+  std::vector<int> others;
+  for (int o = 0; o < static_cast<int>(kept.size()); ++o)
+    if (o != j && kept[static_cast<std::size_t>(o)]) others.push_back(o);
+  double information = H(j, j);
+  if (!others.empty()) {
+    const Eigen::MatrixXd Hoo = H(others, others);
+    const Eigen::VectorXd Hoj = H(others, j);
+    information -= Hoj.dot(Hoo.completeOrthogonalDecomposition().solve(Hoj));
+  }
+  return information > 0.0 ? 1.0 / std::sqrt(information) : std::numeric_limits<double>::infinity();
+}
+
+// Which of c.free the Jacobian J (at the neutral values) informs: with the parameters in units of their ranges
+// (hi - lo) and H = J^T J, the kept parameter of the largest ConditionalStd is held (at its neutral value) while that
+// std exceeds kMaxInformedStdShare, and the rest judged again. A zero column (the parameter moves no residual) has no
+// information; of two columns that move the residuals alike one is held.
 std::vector<bool> Informed(const TwinCandidate& c, const Eigen::MatrixXd& J) {
   const int k = static_cast<int>(c.free.size());
   Eigen::MatrixXd Jr = J;
@@ -171,17 +185,7 @@ std::vector<bool> Informed(const TwinCandidate& c, const Eigen::MatrixXd& J) {
     double worst_std = kMaxInformedStdShare;
     for (int j = 0; j < k; ++j) {
       if (!kept[static_cast<std::size_t>(j)]) continue;
-      std::vector<int> others;
-      for (int o = 0; o < k; ++o)
-        if (o != j && kept[static_cast<std::size_t>(o)]) others.push_back(o);
-      double information = H(j, j);
-      if (!others.empty()) {
-        const Eigen::MatrixXd Hoo = H(others, others);
-        const Eigen::VectorXd Hoj = H(others, j);
-        information -= Hoj.dot(Hoo.completeOrthogonalDecomposition().solve(Hoj));
-      }
-      const double std_share =
-          information > 0.0 ? 1.0 / std::sqrt(information) : std::numeric_limits<double>::infinity();
+      const double std_share = ConditionalStd(H, kept, j);
       if (std_share > worst_std) {
         worst = j;
         worst_std = std_share;
