@@ -291,7 +291,7 @@ Result<DesignLimits> WithRobotDefaults(const DesignLimits& given, const sim::Sce
   if (!envelope.ok()) return envelope.status();
   const sim::DriveEnvelope& e = envelope.value();
   if (e.max_lateral_mps == 0.0 && given.max_lateral_mps > 0.0)
-    return Status::Error("--max-lateral-speed: a " + scenario.robot.kind + " robot has no sideways set-point");
+    return Status::Error("--max-lateral-speed: a robot of kind " + scenario.robot.kind + " has no sideways set-point");
   DesignLimits l = given;
   auto fill = [](double* value, double robot) {
     if (std::isnan(*value)) *value = robot;
