@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "experiment/design.h"
+#include "sim/drive_envelope.h"
 #include "sim/simulator.h"
 #include "tests/recording/temp_dir.h"
 #include "tests/support/paths.h"
@@ -119,6 +120,20 @@ TEST_F(DesignIndoorTest, ASidewaysLimitForADifferentialDriveIsBadInput) {
   outcome = DesignToFile(request_);
   EXPECT_TRUE(outcome.bad_input);
   EXPECT_NE(outcome.status.message().find("--max-yaw-rate"), std::string::npos) << outcome.status.message();
+}
+
+TEST(DriveEnvelopeTest, EachIndoorKindHasItsOwnAndOthersNone) {
+  for (const char* kind : {"ackermann", "differential_drive", "omni3", "mecanum"}) {
+    const auto e = sim::DesignEnvelope(kind);
+    ASSERT_TRUE(e.ok()) << kind;
+    EXPECT_LT(e.value().min_speed_mps, e.value().max_speed_mps) << kind;
+    EXPECT_GT(e.value().max_turn, 0.0) << kind;
+  }
+  EXPECT_EQ(sim::DesignEnvelope("differential_drive").value().max_lateral_mps, 0.0);
+  EXPECT_GT(sim::DesignEnvelope("omni3").value().max_lateral_mps, 0.0);
+  const auto none = sim::DesignEnvelope("tricycle");
+  ASSERT_FALSE(none.ok());
+  EXPECT_NE(none.status().message().find("no drive family for a tricycle"), std::string::npos);
 }
 
 }  // namespace
