@@ -262,8 +262,7 @@ Result<Problem> LoadProblem(const DesignRequest& request) {
   if (!(request.duration_s >= 0.0) || request.duration_s > kMaxDurationS)
     return Status::Error("--duration: must be in (0, 3600]");
   if (request.budget < 1) return Status::Error("--budget: must be >= 1");
-  Problem p{request, std::move(scenario).value(), std::move(config).value(), limits.value(),
-            std::move(family).value()};
+  Problem p{request, std::move(scenario).value(), std::move(config).value(), limits.value(), std::move(family).value()};
   if (request.duration_s > 0.0) p.scenario.duration_s = request.duration_s;
   return p;
 }

@@ -47,12 +47,12 @@ struct DesignLimits {
 Result<DesignLimits> WithRobotDefaults(const DesignLimits& given, const sim::Scenario& scenario);
 
 struct DesignRequest {
-  std::string scenario;                   // SCENARIO.yaml, driver type ackermann or body_velocity
-  std::string config;                     // EST.yaml
-  std::string out;                        // DESIGNED.yaml; design.json is written beside it
-  double duration_s = 0.0;                // the designed drive's recorded duration; 0: the scenario's
-  std::map<std::string, double> targets;  // free parameter -> target CRB std of each of its tangent components
-  DesignLimits limits;                    // NaN entries: the robot's
+  std::string scenario;                           // SCENARIO.yaml, driver type ackermann or body_velocity
+  std::string config;                             // EST.yaml
+  std::string out;                                // DESIGNED.yaml; design.json is written beside it
+  double duration_s = 0.0;                        // the designed drive's recorded duration; 0: the scenario's
+  std::map<std::string, double> targets;          // free parameter -> target CRB std of each of its tangent components
+  DesignLimits limits;                            // NaN entries: the robot's
   int budget = 60;                                // drives simulated and analysed, at least 1
   std::function<void(double fraction)> progress;  // optional: the budget's fraction spent
 };
@@ -84,9 +84,10 @@ struct DesignResult {
 // or robot kind without a family.
 Result<DriveDesign> StartDrive(const sim::Scenario& scenario, const DesignLimits& limits);
 
-// Bad input: a scenario or configuration that does not load, a scenario whose driver or robot has no drive family, a target that
-// is not a free parameter of the configuration or not > 0, no target, invalid limits, a duration or budget out of
-// range, a configuration that does not fit the simulated recording. Failures: no feasible drive, writing the files.
+// Bad input: a scenario or configuration that does not load, a scenario whose driver or robot has no drive family, a
+// target that is not a free parameter of the configuration or not > 0, no target, invalid limits, a duration or budget
+// out of range, a configuration that does not fit the simulated recording. Failures: no feasible drive, writing the
+// files.
 Outcome DesignToFile(const DesignRequest& request, DesignResult* result = nullptr);
 
 // design.json (docs/commands.md): the request, every candidate and the chosen one.

@@ -128,14 +128,18 @@ class AckermannFamily : public DriveFamily {
     const ProfileShape speed = Shape(scenario.driver.speed_mps, 0.0);
     const ProfileShape handlebar = Shape(scenario.driver.handlebar_rad, 10.0);
     DriveDesign d;
-    d.values = {{"speed_mean_mps", speed.constant},         {"speed_swing_mps", speed.amplitude},
-                {"handlebar_amplitude_rad", handlebar.amplitude}, {"handlebar_period_s", handlebar.period_s},
-                {"handlebar_offset_rad", handlebar.constant},  {"heading_deg", scenario.robot.start_heading_rad * kDegPerRad}};
+    d.values = {{"speed_mean_mps", speed.constant},
+                {"speed_swing_mps", speed.amplitude},
+                {"handlebar_amplitude_rad", handlebar.amplitude},
+                {"handlebar_period_s", handlebar.period_s},
+                {"handlebar_offset_rad", handlebar.constant},
+                {"heading_deg", scenario.robot.start_heading_rad * kDegPerRad}};
     return FromCoordinates(ToCoordinates(d));
   }
   std::vector<std::pair<std::string, sim::Profile>> Profiles(const DriveDesign& d) const override {
     const double period_s = d.at("handlebar_period_s");
-    return {{"speed_mps", {{Constant(d.at("speed_mean_mps")), Sine(d.at("speed_swing_mps"), 0.5 * period_s, kSpeedPhaseRad)}}},
+    return {{"speed_mps",
+             {{Constant(d.at("speed_mean_mps")), Sine(d.at("speed_swing_mps"), 0.5 * period_s, kSpeedPhaseRad)}}},
             {"handlebar_rad",
              {{Constant(d.at("handlebar_offset_rad")), Sine(d.at("handlebar_amplitude_rad"), period_s, 0.0)}}}};
   }
@@ -212,20 +216,22 @@ class BodyVelocityFamily : public DriveFamily {
     const ProfileShape yaw = Shape(scenario.driver.angular_radps, l_.min_period_s);
     const ProfileShape lateral = Shape(scenario.driver.lateral_mps, l_.min_period_s);
     DriveDesign d;
-    d.values = {{"linear_mean_mps", linear.constant},      {"linear_swing_mps", linear.amplitude},
-                {"linear_period_s", linear.period_s},      {"yaw_rate_amplitude_radps", yaw.amplitude},
-                {"yaw_rate_period_s", yaw.period_s},       {"yaw_rate_offset_radps", yaw.constant},
+    d.values = {{"linear_mean_mps", linear.constant},         {"linear_swing_mps", linear.amplitude},
+                {"linear_period_s", linear.period_s},         {"yaw_rate_amplitude_radps", yaw.amplitude},
+                {"yaw_rate_period_s", yaw.period_s},          {"yaw_rate_offset_radps", yaw.constant},
                 {"lateral_amplitude_mps", lateral.amplitude}, {"lateral_period_s", lateral.period_s}};
     return FromCoordinates(ToCoordinates(d));
   }
   std::vector<std::pair<std::string, sim::Profile>> Profiles(const DriveDesign& d) const override {
     std::vector<std::pair<std::string, sim::Profile>> out = {
-        {"linear_mps", {{Constant(d.at("linear_mean_mps")), Sine(d.at("linear_swing_mps"), d.at("linear_period_s"), 0.0)}}},
+        {"linear_mps",
+         {{Constant(d.at("linear_mean_mps")), Sine(d.at("linear_swing_mps"), d.at("linear_period_s"), 0.0)}}},
         {"angular_radps",
          {{Constant(d.at("yaw_rate_offset_radps")),
            Sine(d.at("yaw_rate_amplitude_radps"), d.at("yaw_rate_period_s"), 0.0)}}}};
     if (holonomic_)
-      out.push_back({"lateral_mps", {{Sine(d.at("lateral_amplitude_mps"), d.at("lateral_period_s"), kLateralPhaseRad)}}});
+      out.push_back(
+          {"lateral_mps", {{Sine(d.at("lateral_amplitude_mps"), d.at("lateral_period_s"), kLateralPhaseRad)}}});
     return out;
   }
   double HeadingDeg(const sim::Scenario& scenario, const DriveDesign&) const override {
@@ -260,7 +266,8 @@ Result<std::unique_ptr<DriveFamily>> MakeDriveFamily(const sim::Scenario& scenar
     if (!envelope.ok()) return envelope.status();
     return std::unique_ptr<DriveFamily>(new BodyVelocityFamily(limits, envelope.value().max_lateral_mps > 0.0));
   }
-  return Status::Error("driver.type: no drive family for a " + scenario.driver.type + " driver (ackermann, body_velocity)");
+  return Status::Error("driver.type: no drive family for a " + scenario.driver.type +
+                       " driver (ackermann, body_velocity)");
 }
 
 sim::Scenario WithDrive(const DriveFamily& family, const sim::Scenario& scenario, const DriveDesign& drive) {

@@ -119,9 +119,9 @@ TEST(InformationIndoorTest, DifferentialDriveSplitsSumToTheTotal) {
   testing::TempDir dir;
   const InformationRun run = Analyse(DiffDrive(), "indoor_diffdrive_mocap_calibration.yaml", dir);
   EXPECT_EQ(run.result.windows, 6);
-  EXPECT_EQ(Labels(run.result), (std::vector<std::string>{"imu.misalignment[rx]", "imu.misalignment[ry]",
-                                                         "imu.misalignment[rz]", "odometer.baseline",
-                                                         "odometer.radius_left", "odometer.radius_right"}));
+  EXPECT_EQ(Labels(run.result),
+            (std::vector<std::string>{"imu.misalignment[rx]", "imu.misalignment[ry]", "imu.misalignment[rz]",
+                                      "odometer.baseline", "odometer.radius_left", "odometer.radius_right"}));
   ExpectSplitsSumToTheTotal(run.result);
   // The wheel radii and the baseline are read by the encoders: the odometer carries all of their measured share.
   for (const estimator::InformationComponent& c : run.result.components)
@@ -144,10 +144,10 @@ TEST(InformationIndoorTest, MecanumSplitsSumToTheTotal) {
 TEST(InformationIndoorTest, OmniSplitsSumToTheTotal) {
   testing::TempDir dir;
   const InformationRun run = Analyse(Omni(), "indoor_omni_calibration.yaml", dir);
-  EXPECT_EQ(Labels(run.result), (std::vector<std::string>{"imu.misalignment[rx]", "imu.misalignment[ry]",
-                                                         "imu.misalignment[rz]", "odometer.distance",
-                                                         "odometer.radius_0", "odometer.radius_1",
-                                                         "odometer.radius_2"}));
+  EXPECT_EQ(
+      Labels(run.result),
+      (std::vector<std::string>{"imu.misalignment[rx]", "imu.misalignment[ry]", "imu.misalignment[rz]",
+                                "odometer.distance", "odometer.radius_0", "odometer.radius_1", "odometer.radius_2"}));
   ExpectSplitsSumToTheTotal(run.result);
   // The scan matcher is the metric reference of the radii and the distance: its noise carries part of their variance.
   for (const estimator::InformationComponent& c : run.result.components)
