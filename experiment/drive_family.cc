@@ -38,7 +38,7 @@ double OffsetFraction(double offset, double amplitude, double limit) {
 }
 double Offset(double u, double amplitude, double limit) { return (2.0 * u - 1.0) * (limit - amplitude); }
 
-// A swing within the room a mean leaves in [low, high], as u in [0, 1], and back.
+// The room a mean leaves in [low, high] for a swing either way.
 double SwingRoom(double mean, double low, double high) { return std::min(mean - low, high - mean); }
 
 sim::ProfileTerm Constant(double value) {
