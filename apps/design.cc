@@ -41,9 +41,10 @@ void PrintTable(const experiment::DesignRequest& request, const experiment::Desi
   for (const auto& c : result.candidates) feasible += c.infeasible.empty() ? 1 : 0;
   std::printf(
       "%zu drives tried (%d feasible); the best (#%d, %s): %s; %.0f m, roll %.1f deg, pitch %.1f deg, side slip "
-      "%.2f m/s, lateral acceleration %.2f m/s^2\n",
+      "%.2f m/s, lateral acceleration %.2f m/s^2, velocity error %.2f m/s\n",
       result.candidates.size(), feasible, result.best, best.stage.c_str(), result.best_drive.c_str(), best.distance_m,
-      best.max_roll_deg, best.max_pitch_deg, best.max_side_slip_mps, best.max_lateral_accel_mps2);
+      best.max_roll_deg, best.max_pitch_deg, best.max_side_slip_mps, best.max_lateral_accel_mps2,
+      best.max_velocity_error_mps);
   std::printf("objective (max CRB std / target) %.3g, set by %s; start drive's %.3g\n\n", best.objective,
               best.worst.c_str(), result.candidates.front().objective);
   std::printf("| component | predicted std | target | ratio |\n|---|---|---|---|\n");

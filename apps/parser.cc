@@ -267,6 +267,9 @@ void AddDesign(CLI::App* app, Commands* commands) {
                     "omni and mecanum)");
     des->add_option("--max-lateral-accel", args->limits.max_lateral_accel_mps2,
                     "Feasible: largest speed x yaw rate [m/s^2] (default: ATV 4.4, 0.45 g; indoor robots 1)");
+    des->add_option("--max-velocity-error", args->limits.max_velocity_error_mps,
+                    "Feasible, indoor robots: largest |horizontal velocity of O - its set-point| [m/s] (default 0.1: "
+                    "a wall, an obstacle or slip)");
     des->add_flag("--quiet", args->quiet, "No progress and no table");
     return des;
   });

@@ -56,6 +56,41 @@ double MaxLateralAcceleration(const Trajectory& truth) {
   return out;
 }
 
+// The body_velocity drivers' horizontal set-point of O at time t [s] (driver.linear_mps, driver.lateral_mps among the
+// drive's profiles); false for a drive without them (ackermann).
+bool SetPoint(const std::vector<std::pair<std::string, sim::Profile>>& profiles, double t_s, Eigen::Vector2d* v_mps) {
+  bool found = false;
+  *v_mps = Eigen::Vector2d::Zero();
+  for (const auto& [key, profile] : profiles) {
+    if (key == "linear_mps") {
+      (*v_mps)[0] = profile.Evaluate(t_s);
+      found = true;
+    }
+    if (key == "lateral_mps") (*v_mps)[1] = profile.Evaluate(t_s);
+  }
+  return found;
+}
+
+// Largest |horizontal velocity of O in its frame - its set-point| between true poses kLateralStepS apart, stamped at
+// the middle (seconds since the first pose, the recording's t = 0) [m/s]; 0 for a drive without body-velocity
+// set-points.
+double MaxVelocityError(const Trajectory& truth, const std::vector<std::pair<std::string, sim::Profile>>& profiles) {
+  double out = 0.0;
+  Eigen::Vector2d set_point;
+  if (truth.empty() || !SetPoint(profiles, 0.0, &set_point)) return 0.0;
+  std::size_t a = 0;
+  for (std::size_t b = 1; b < truth.size(); ++b) {
+    const double dt = SecondsBetween(truth[a].t, truth[b].t);
+    if (dt < kLateralStepS - 1e-9) continue;
+    const Eigen::Quaterniond middle = truth[a].q_world_body.slerp(0.5, truth[b].q_world_body);
+    const Eigen::Vector3d v_body = middle.conjugate() * (truth[b].p_world_body - truth[a].p_world_body) / dt;
+    SetPoint(profiles, SecondsBetween(truth.front().t, truth[a].t) + 0.5 * dt, &set_point);
+    out = std::max(out, (v_body.head<2>() - set_point).norm());
+    a = b;
+  }
+  return out;
+}
+
 // The first limit the simulated drive exceeds, or empty.
 std::string LimitExceeded(const DesignCandidate& c, const DesignLimits& l) {
   std::ostringstream why;
@@ -67,6 +102,9 @@ std::string LimitExceeded(const DesignCandidate& c, const DesignLimits& l) {
     why << "side slip " << c.max_side_slip_mps << " m/s > " << l.max_side_slip_mps;
   else if (c.max_lateral_accel_mps2 > l.max_lateral_accel_mps2)
     why << "lateral acceleration " << c.max_lateral_accel_mps2 << " m/s^2 > " << l.max_lateral_accel_mps2;
+  else if (c.max_velocity_error_mps > l.max_velocity_error_mps)
+    why << "velocity error " << c.max_velocity_error_mps << " m/s > " << l.max_velocity_error_mps
+        << " (a wall, an obstacle or slip)";
   return why.str();
 }
 
@@ -119,6 +157,7 @@ Result<DesignCandidate> Evaluate(const Problem& p, const DriveDesign& drive, con
   if (!s.recording.ground_truth || s.recording.ground_truth->empty())
     return Status::Error(p.request.scenario + ": the simulation wrote no ground truth");
   c.max_lateral_accel_mps2 = MaxLateralAcceleration(*s.recording.ground_truth);
+  c.max_velocity_error_mps = MaxVelocityError(*s.recording.ground_truth, p.family->Profiles(drive));
   c.infeasible = LimitExceeded(c, p.limits);
   if (c.infeasible.empty()) {
     auto analysed =
@@ -282,6 +321,7 @@ std::string DesignLimits::Validate(const std::string& driver_type) const {
   if (!(max_roll_deg > 0.0) || !(max_pitch_deg > 0.0)) return "--max-roll/--max-pitch: must be > 0";
   if (!(max_side_slip_mps > 0.0)) return "--max-side-slip: must be > 0";
   if (!(max_lateral_accel_mps2 > 0.0)) return "--max-lateral-accel: must be > 0";
+  if (!(max_velocity_error_mps > 0.0)) return "--max-velocity-error: must be > 0";
   return "";
 }
 
@@ -308,6 +348,7 @@ Result<DesignLimits> WithRobotDefaults(const DesignLimits& given, const sim::Sce
   fill(&l.max_pitch_deg, e.max_pitch_deg);
   fill(&l.max_side_slip_mps, e.max_side_slip_mps);
   fill(&l.max_lateral_accel_mps2, e.max_lateral_accel_mps2);
+  fill(&l.max_velocity_error_mps, e.max_velocity_error_mps);
   return l;
 }
 
@@ -370,6 +411,7 @@ nlohmann::json DesignJson(const DesignRequest& request, const DesignResult& resu
                           {"max_pitch_deg", c.max_pitch_deg},
                           {"max_side_slip_mps", c.max_side_slip_mps},
                           {"max_lateral_accel_mps2", c.max_lateral_accel_mps2},
+                          {"max_velocity_error_mps", c.max_velocity_error_mps},
                           {"distance_m", c.distance_m},
                           {"seconds", c.seconds}});
   }
@@ -390,7 +432,8 @@ nlohmann::json DesignJson(const DesignRequest& request, const DesignResult& resu
             {"max_roll_deg", l.max_roll_deg},
             {"max_pitch_deg", l.max_pitch_deg},
             {"max_side_slip_mps", Number(l.max_side_slip_mps)},
-            {"max_lateral_accel_mps2", l.max_lateral_accel_mps2}}},
+            {"max_lateral_accel_mps2", l.max_lateral_accel_mps2},
+            {"max_velocity_error_mps", Number(l.max_velocity_error_mps)}}},
           {"family", result.formula},
           {"budget", request.budget},
           {"best", result.best},

@@ -6,9 +6,9 @@
 // otherwise. The terrain, the start position and the sensors stay the scenario's. The objective of a drive: max over
 // the free parameters' tangent components of CRB std / target (the Cramer-Rao bound of estimator/information.h on the
 // noise-free drive, at its truth). A drive is feasible when it simulates (it neither leaves the terrain nor rolls
-// over) within the roll, pitch, side-slip and lateral-acceleration limits. The search: the scenario's own drive
-// (mapped into the family), the family's coarse grid around it, then a pattern search over the normalized
-// coordinates, within an evaluation budget.
+// over) within the roll, pitch, side-slip, lateral-acceleration and (body velocity) velocity-error limits. The search:
+// the scenario's own drive (mapped into the family), the family's coarse grid around it, then a pattern search over the
+// normalized coordinates, within an evaluation budget.
 #pragma once
 
 #include <functional>
@@ -38,6 +38,7 @@ struct DesignLimits {
   double max_pitch_deg = kRobotDefault;
   double max_side_slip_mps = kRobotDefault;       // max |v_y| of O (sim::SimulationStats)
   double max_lateral_accel_mps2 = kRobotDefault;  // max speed x |yaw rate| of O over 0.1 s steps
+  double max_velocity_error_mps = kRobotDefault;  // max |v of O - set-point| over 0.1 s steps (body_velocity)
   static constexpr double kRobotDefault = std::numeric_limits<double>::quiet_NaN();
   // Empty when valid for a drive of `driver_type` (ackermann: 0 < min speed), otherwise "--option: problem".
   std::string Validate(const std::string& driver_type) const;
@@ -66,6 +67,7 @@ struct DesignCandidate {
   std::string worst;                                    // the component that sets the objective
   std::vector<std::pair<std::string, double>> crb_std;  // per component label (empty when infeasible)
   double max_roll_deg = 0.0, max_pitch_deg = 0.0, max_side_slip_mps = 0.0, max_lateral_accel_mps2 = 0.0;
+  double max_velocity_error_mps = 0.0;  // body_velocity drivers: largest |horizontal v of O - its set-point|
   double distance_m = 0.0;
   double seconds = 0.0;  // wall time of the evaluation
 };

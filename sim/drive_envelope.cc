@@ -20,6 +20,7 @@ DriveEnvelope Indoor(double min_speed_mps, double max_speed_mps, double max_yaw_
   e.max_pitch_deg = 10.0;
   e.max_side_slip_mps = max_lateral_mps > 0.0 ? kInfinity : 0.05;
   e.max_lateral_accel_mps2 = 1.0;
+  e.max_velocity_error_mps = 0.1;
   return e;
 }
 
@@ -37,6 +38,7 @@ Result<DriveEnvelope> DesignEnvelope(const std::string& kind) {
     e.max_pitch_deg = 25.0;
     e.max_side_slip_mps = 0.3;
     e.max_lateral_accel_mps2 = 4.4;
+    e.max_velocity_error_mps = kInfinity;
     return e;
   }
   if (kind == "differential_drive") return Indoor(-0.3, 0.6, 1.2, 0.0);

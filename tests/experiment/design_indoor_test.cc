@@ -80,6 +80,8 @@ TEST_F(DesignIndoorTest, DifferentialDriveDesignBeatsItsStartAndSimulates) {
   EXPECT_EQ(best.worst, "odometer.baseline");
   EXPECT_LT(best.objective, 0.8 * start.objective);
   EXPECT_LE(best.max_lateral_accel_mps2, result.limits.max_lateral_accel_mps2);
+  EXPECT_GT(best.max_velocity_error_mps, 0.0);  // measured: the servos lag their set-points a little
+  EXPECT_LE(best.max_velocity_error_mps, result.limits.max_velocity_error_mps);
 
   // The written scenario reads back as the best drive and simulates in MuJoCo, with noise, within the side-slip limit.
   auto loaded = sim::LoadScenario(request_.out);
@@ -106,6 +108,34 @@ TEST_F(DesignIndoorTest, HolonomicRobotsGetASidewaysTerm) {
   auto loaded = sim::LoadScenario(request_.out);
   ASSERT_TRUE(loaded.ok()) << loaded.status().message();
   EXPECT_FALSE(loaded.value().driver.lateral_mps.terms.empty());
+}
+
+// 12 s of the omni robot at 0.5 m/s straight ahead from the middle of the 8 m room: it meets the east wall after 7 s.
+std::string OmniIntoTheWall() {
+  return "name: wall\nduration_s: 12.0\nseed: 1\nground_truth_rate_hz: 100\nrobot:\n  kind: omni3\n  model: " +
+         roamlab::testing::SourceDir() +
+         "/models/omni3.xml\n  start: {position_m: [0.0, 0.0], heading_deg: 0.0}\n"
+         "world:\n  terrain: {type: flat, friction: 0.6}\n  model: " +
+         roamlab::testing::SourceDir() +
+         "/models/indoor_room.xml\n"
+         "driver:\n  type: body_velocity\n  lead_in_s: 1.0\n  linear_mps: 0.5\n  angular_radps: 0.0\n"
+         "sensors:\n  imu: {rate_hz: 100, gyro_sigma_radps: 0.01, accel_sigma_mps2: 0.05}\n"
+         "  wheel_encoders: {rate_hz: 100, ticks_per_revolution: 2048}\n"
+         "  laser: {rate_hz: 10, beams: 683, fov_deg: 240, min_range_m: 0.02, max_range_m: 4.0, sigma_m: 0.01}\n";
+}
+
+TEST_F(DesignIndoorTest, ADriveIntoAWallIsInfeasible) {
+  Use(OmniIntoTheWall(), "indoor_omni_calibration.yaml");
+  request_.targets = {{"odometer.distance", 1e-3}};
+  request_.budget = 1;
+  DesignResult result;
+  const Outcome outcome = DesignToFile(request_, &result);
+  ASSERT_FALSE(outcome.ok());
+  EXPECT_FALSE(outcome.bad_input) << outcome.status.message();
+  ASSERT_EQ(result.candidates.size(), 1u);
+  EXPECT_NE(result.candidates.front().infeasible.find("velocity error"), std::string::npos)
+      << result.candidates.front().infeasible;
+  EXPECT_GT(result.candidates.front().max_velocity_error_mps, 0.4);  // it stops against the wall
 }
 
 TEST_F(DesignIndoorTest, ASidewaysLimitForADifferentialDriveIsBadInput) {
