@@ -37,16 +37,14 @@ std::string ParseRange(const std::vector<double>& range, const char* option, dou
 
 void PrintTable(const experiment::DesignRequest& request, const experiment::DesignResult& result) {
   const experiment::DesignCandidate& best = result.candidates[static_cast<std::size_t>(result.best)];
-  const experiment::DriveDesign& d = best.drive;
   int feasible = 0;
   for (const auto& c : result.candidates) feasible += c.infeasible.empty() ? 1 : 0;
   std::printf(
-      "%zu drives tried (%d feasible); the best (#%d, %s): speed %.2f + %.2f cos(4 pi t / %.2f) m/s, handlebar "
-      "%.3f + %.3f sin(2 pi t / %.2f) rad, heading %.1f deg; %.0f m, roll %.1f deg, pitch %.1f deg, side slip "
-      "%.2f m/s, lateral acceleration %.2f m/s^2\n",
-      result.candidates.size(), feasible, result.best, best.stage.c_str(), d.speed_mean_mps, d.speed_swing_mps,
-      d.handlebar_period_s, d.handlebar_offset_rad, d.handlebar_amplitude_rad, d.handlebar_period_s, d.heading_deg,
-      best.distance_m, best.max_roll_deg, best.max_pitch_deg, best.max_side_slip_mps, best.max_lateral_accel_mps2);
+      "%zu drives tried (%d feasible); the best (#%d, %s): %s; %.0f m, roll %.1f deg, pitch %.1f deg, side slip "
+      "%.2f m/s, lateral acceleration %.2f m/s^2, velocity error %.2f m/s\n",
+      result.candidates.size(), feasible, result.best, best.stage.c_str(), result.best_drive.c_str(), best.distance_m,
+      best.max_roll_deg, best.max_pitch_deg, best.max_side_slip_mps, best.max_lateral_accel_mps2,
+      best.max_velocity_error_mps);
   std::printf("objective (max CRB std / target) %.3g, set by %s; start drive's %.3g\n\n", best.objective,
               best.worst.c_str(), result.candidates.front().objective);
   std::printf("| component | predicted std | target | ratio |\n|---|---|---|---|\n");

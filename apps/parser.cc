@@ -228,9 +228,12 @@ void AddDesign(CLI::App* app, Commands* commands) {
   Add(commands, RunDesign, [app](auto* args) {
     CLI::App* des = app->add_subcommand(
         "design",
-        "Choose the Ackermann drive (speed and handlebar weave, start heading) that minimizes the worst ratio of a "
-        "calibration parameter's Cramer-Rao std to its target, feasible in MuJoCo; write it as a scenario.");
-    des->add_option("scenario", args->scenario, "Scenario file (SCENARIO.yaml) with an ackermann driver")->required();
+        "Choose the drive (the Ackermann weave and start heading, or an indoor robot's forward, yaw-rate and sideways "
+        "sines) that minimizes the worst ratio of a calibration parameter's Cramer-Rao std to its target, feasible in "
+        "MuJoCo; write it as a scenario. Limits not given are the robot's (docs/commands.md).");
+    des->add_option("scenario", args->scenario,
+                    "Scenario file (SCENARIO.yaml) with an ackermann or body_velocity driver")
+        ->required();
     des->add_option("--config", args->config, "Estimator configuration (EST.yaml): free parameters, noise")->required();
     des->add_option("--out", args->out, "The designed scenario to write (DESIGNED.yaml); design.json beside it")
         ->required();
@@ -241,19 +244,32 @@ void AddDesign(CLI::App* app, Commands* commands) {
     des->add_option("--duration", args->duration_s,
                     "Recorded duration of the designed drive [s] (default: the scenario's)");
     des->add_option("--budget", args->budget, "Drives simulated and analysed (default 60)");
-    des->add_option("--speed-range", args->speed_range_mps, "MIN MAX of the speed set-point [m/s] (default 1.5 6)")
+    des->add_option("--speed-range", args->speed_range_mps,
+                    "MIN MAX of the forward speed set-point [m/s] (default: ATV 1.5 6, differential drive -0.3 0.6, "
+                    "omni -0.5 0.5, mecanum -0.3 0.3)")
         ->expected(2);
     des->add_option("--max-handlebar", args->limits.max_handlebar_rad,
-                    "Largest |handlebar| set-point [rad] (default 0.45)");
-    des->add_option("--period-range", args->period_range_s, "MIN MAX of the weave's period [s] (default 5 30)")
+                    "Ackermann: largest |handlebar| set-point [rad] (default 0.45)");
+    des->add_option("--max-yaw-rate", args->limits.max_yaw_rate_radps,
+                    "Indoor robots: largest |yaw rate| set-point [rad/s] (default: differential drive 1.2, omni 1.5, "
+                    "mecanum 0.6)");
+    des->add_option("--max-lateral-speed", args->limits.max_lateral_mps,
+                    "Omni and mecanum: largest |sideways speed| set-point [m/s] (default: omni 0.4, mecanum 0.3)");
+    des->add_option("--period-range", args->period_range_s,
+                    "MIN MAX of the profiles' periods [s] (default: ATV 5 30, indoor robots 4 20)")
         ->expected(2);
     des->add_option("--max-roll", args->limits.max_roll_deg,
-                    "Feasible: largest |roll| of the vehicle [deg] (default 25)");
-    des->add_option("--max-pitch", args->limits.max_pitch_deg, "Feasible: largest |pitch| [deg] (default 25)");
+                    "Feasible: largest |roll| of the vehicle [deg] (default: ATV 25, indoor robots 10)");
+    des->add_option("--max-pitch", args->limits.max_pitch_deg,
+                    "Feasible: largest |pitch| [deg] (default: ATV 25, indoor robots 10)");
     des->add_option("--max-side-slip", args->limits.max_side_slip_mps,
-                    "Feasible: largest lateral speed of O [m/s] (default 0.3)");
+                    "Feasible: largest lateral speed of O [m/s] (default: ATV 0.3, differential drive 0.05, none for "
+                    "omni and mecanum)");
     des->add_option("--max-lateral-accel", args->limits.max_lateral_accel_mps2,
-                    "Feasible: largest speed x yaw rate [m/s^2] (default 4.4, 0.45 g)");
+                    "Feasible: largest speed x yaw rate [m/s^2] (default: ATV 4.4, 0.45 g; indoor robots 1)");
+    des->add_option("--max-velocity-error", args->limits.max_velocity_error_mps,
+                    "Feasible, indoor robots: largest |horizontal velocity of O - its set-point| [m/s] (default 0.1: "
+                    "a wall, an obstacle or slip)");
     des->add_flag("--quiet", args->quiet, "No progress and no table");
     return des;
   });

@@ -1,7 +1,6 @@
 #include "experiment/design.h"
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -16,6 +15,7 @@
 #include "common/json.h"
 #include "estimator/config.h"
 #include "estimator/information.h"
+#include "sim/drive_envelope.h"
 #include "sim/simulator.h"
 
 namespace roamlab::experiment {
@@ -29,86 +29,15 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr double kLateralStepS = 0.1;
 // The longest designed drive [s].
 constexpr double kMaxDurationS = 3600.0;
-// The normalized coordinates of the family (Coordinates below) and the pattern search's first and last step in them.
-constexpr int kCoordinates = 6;
+// The pattern search's first and last step in the normalized coordinates.
 constexpr double kFirstStep = 0.2;
 constexpr double kLastStep = 0.02;
-// The speed term's phase: a quarter turn (slowest where the handlebar is turned most), as written (10 digits).
-constexpr double kSpeedPhaseRad = 1.570796327;
-// The pattern search's order of the coordinates: the handlebar's amplitude and period first (the steering range
-// excites most parameters), the heading last.
-constexpr std::array<int, kCoordinates> kSearchOrder = {2, 3, 0, 1, 4, 5};
-// The coarse grid: start headings (added to the scenario's) and handlebar offsets (fractions of the room left by the
-// amplitude; 0.5 is none).
-constexpr std::array<double, 4> kGridHeadingsDeg = {0.0, 90.0, 180.0, 270.0};
-constexpr std::array<double, 3> kGridOffsets = {0.5, 0.25, 0.75};
 
 // A number as the designed scenario writes it: the rounded value's shortest form (yaml-cpp would write 17 digits).
 std::string Text(double value) {
   std::ostringstream out;
   out << std::setprecision(10) << value;
   return out.str();
-}
-
-// `value` to a multiple of `step`, as its text reads back, so that the drive analysed is the one written.
-double Round(double value, double step) { return std::stod(Text(std::round(value / step) * step)); }
-
-// The drive as written: values rounded so that the scenario written is the one analysed.
-DriveDesign Rounded(const DriveDesign& d) {
-  DriveDesign r;
-  r.speed_mean_mps = Round(d.speed_mean_mps, 0.01);
-  r.speed_swing_mps = Round(d.speed_swing_mps, 0.01);
-  r.handlebar_amplitude_rad = Round(d.handlebar_amplitude_rad, 0.001);
-  r.handlebar_period_s = Round(d.handlebar_period_s, 0.01);
-  r.handlebar_offset_rad = Round(d.handlebar_offset_rad, 0.001);
-  r.heading_deg = Round(std::fmod(std::fmod(d.heading_deg, 360.0) + 360.0, 360.0), 0.1);
-  return r;
-}
-
-// Normalized coordinates u in [0, 1]^6: mean speed; swing as a fraction of the room the mean leaves; handlebar
-// amplitude; period; offset as a fraction of the room the amplitude leaves (0.5: none); heading over a turn.
-DriveDesign FromCoordinates(const std::array<double, kCoordinates>& u, const DesignLimits& l) {
-  DriveDesign d;
-  d.speed_mean_mps = l.min_speed_mps + u[0] * (l.max_speed_mps - l.min_speed_mps);
-  d.speed_swing_mps = u[1] * std::min(d.speed_mean_mps - l.min_speed_mps, l.max_speed_mps - d.speed_mean_mps);
-  d.handlebar_amplitude_rad = u[2] * l.max_handlebar_rad;
-  d.handlebar_period_s = l.min_period_s + u[3] * (l.max_period_s - l.min_period_s);
-  d.handlebar_offset_rad = (2.0 * u[4] - 1.0) * (l.max_handlebar_rad - d.handlebar_amplitude_rad);
-  d.heading_deg = 360.0 * u[5];
-  return Rounded(d);
-}
-
-double Fraction(double value, double low, double high) {
-  return high > low ? std::clamp((value - low) / (high - low), 0.0, 1.0) : 0.0;
-}
-
-std::array<double, kCoordinates> ToCoordinates(const DriveDesign& d, const DesignLimits& l) {
-  std::array<double, kCoordinates> u{};
-  u[0] = Fraction(d.speed_mean_mps, l.min_speed_mps, l.max_speed_mps);
-  const double mean = l.min_speed_mps + u[0] * (l.max_speed_mps - l.min_speed_mps);
-  u[1] = Fraction(d.speed_swing_mps, 0.0, std::min(mean - l.min_speed_mps, l.max_speed_mps - mean));
-  u[2] = Fraction(d.handlebar_amplitude_rad, 0.0, l.max_handlebar_rad);
-  u[3] = Fraction(d.handlebar_period_s, l.min_period_s, l.max_period_s);
-  const double room = l.max_handlebar_rad - u[2] * l.max_handlebar_rad;
-  u[4] = room > 0.0 ? std::clamp(0.5 + 0.5 * d.handlebar_offset_rad / room, 0.0, 1.0) : 0.5;
-  u[5] = std::fmod(std::fmod(d.heading_deg, 360.0) + 360.0, 360.0) / 360.0;
-  return u;
-}
-
-sim::ProfileTerm Constant(double value) {
-  sim::ProfileTerm t;
-  t.type = sim::ProfileTerm::Type::kConstant;
-  t.value = value;
-  return t;
-}
-
-sim::ProfileTerm Sine(double amplitude, double period_s, double phase_rad) {
-  sim::ProfileTerm t;
-  t.type = sim::ProfileTerm::Type::kSine;
-  t.amplitude = amplitude;
-  t.period_s = period_s;
-  t.phase_rad = phase_rad;
-  return t;
 }
 
 // Largest speed x |yaw rate| of O between true poses kLateralStepS apart [m/s^2].
@@ -127,6 +56,41 @@ double MaxLateralAcceleration(const Trajectory& truth) {
   return out;
 }
 
+// The body_velocity drivers' horizontal set-point of O at time t [s] (driver.linear_mps, driver.lateral_mps among the
+// drive's profiles); false for a drive without them (ackermann).
+bool SetPoint(const std::vector<std::pair<std::string, sim::Profile>>& profiles, double t_s, Eigen::Vector2d* v_mps) {
+  bool found = false;
+  *v_mps = Eigen::Vector2d::Zero();
+  for (const auto& [key, profile] : profiles) {
+    if (key == "linear_mps") {
+      (*v_mps)[0] = profile.Evaluate(t_s);
+      found = true;
+    }
+    if (key == "lateral_mps") (*v_mps)[1] = profile.Evaluate(t_s);
+  }
+  return found;
+}
+
+// Largest |horizontal velocity of O in its frame - its set-point| between true poses kLateralStepS apart, stamped at
+// the middle (seconds since the first pose, the recording's t = 0) [m/s]; 0 for a drive without body-velocity
+// set-points.
+double MaxVelocityError(const Trajectory& truth, const std::vector<std::pair<std::string, sim::Profile>>& profiles) {
+  double out = 0.0;
+  Eigen::Vector2d set_point;
+  if (truth.empty() || !SetPoint(profiles, 0.0, &set_point)) return 0.0;
+  std::size_t a = 0;
+  for (std::size_t b = 1; b < truth.size(); ++b) {
+    const double dt = SecondsBetween(truth[a].t, truth[b].t);
+    if (dt < kLateralStepS - 1e-9) continue;
+    const Eigen::Quaterniond middle = truth[a].q_world_body.slerp(0.5, truth[b].q_world_body);
+    const Eigen::Vector3d v_body = middle.conjugate() * (truth[b].p_world_body - truth[a].p_world_body) / dt;
+    SetPoint(profiles, SecondsBetween(truth.front().t, truth[a].t) + 0.5 * dt, &set_point);
+    out = std::max(out, (v_body.head<2>() - set_point).norm());
+    a = b;
+  }
+  return out;
+}
+
 // The first limit the simulated drive exceeds, or empty.
 std::string LimitExceeded(const DesignCandidate& c, const DesignLimits& l) {
   std::ostringstream why;
@@ -138,6 +102,9 @@ std::string LimitExceeded(const DesignCandidate& c, const DesignLimits& l) {
     why << "side slip " << c.max_side_slip_mps << " m/s > " << l.max_side_slip_mps;
   else if (c.max_lateral_accel_mps2 > l.max_lateral_accel_mps2)
     why << "lateral acceleration " << c.max_lateral_accel_mps2 << " m/s^2 > " << l.max_lateral_accel_mps2;
+  else if (c.max_velocity_error_mps > l.max_velocity_error_mps)
+    why << "velocity error " << c.max_velocity_error_mps << " m/s > " << l.max_velocity_error_mps
+        << " (a wall, an obstacle or slip)";
   return why.str();
 }
 
@@ -146,6 +113,8 @@ struct Problem {
   const DesignRequest& request;
   sim::Scenario scenario;  // with the designed duration
   estimator::EstimatorConfig config;
+  DesignLimits limits;                  // the request's, the robot's where NaN
+  std::unique_ptr<DriveFamily> family;  // the scenario's driver's
 };
 
 // Objective and per-component CRB std of one analysed drive.
@@ -173,7 +142,7 @@ Result<DesignCandidate> Evaluate(const Problem& p, const DriveDesign& drive, con
   c.objective = kInfinity;
   sim::SimulateOptions options;
   options.noise = false;
-  auto simulation = sim::Simulate(WithDrive(p.scenario, drive), options);
+  auto simulation = sim::Simulate(WithDrive(*p.family, p.scenario, drive), options);
   auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count(); };
   if (!simulation.ok()) {
     c.infeasible = simulation.status().message();
@@ -188,7 +157,8 @@ Result<DesignCandidate> Evaluate(const Problem& p, const DriveDesign& drive, con
   if (!s.recording.ground_truth || s.recording.ground_truth->empty())
     return Status::Error(p.request.scenario + ": the simulation wrote no ground truth");
   c.max_lateral_accel_mps2 = MaxLateralAcceleration(*s.recording.ground_truth);
-  c.infeasible = LimitExceeded(c, p.request.limits);
+  c.max_velocity_error_mps = MaxVelocityError(*s.recording.ground_truth, p.family->Profiles(drive));
+  c.infeasible = LimitExceeded(c, p.limits);
   if (c.infeasible.empty()) {
     auto analysed =
         estimator::AnalyzeInformation(p.config, s.recording, s.truth.calibration, *s.recording.ground_truth);
@@ -201,15 +171,14 @@ Result<DesignCandidate> Evaluate(const Problem& p, const DriveDesign& drive, con
 
 // The search of the header comment; fills `result` (candidates in order, the best). Errors as Evaluate's.
 Status Search(const Problem& p, DesignResult* result) {
-  const DesignLimits& limits = p.request.limits;
+  const DriveFamily& family = *p.family;
   const int budget = p.request.budget;
   auto better = [&](int i, int j) {
     return j < 0 || result->candidates[i].objective < result->candidates[j].objective;
   };
   auto try_drive = [&](const DriveDesign& drive, const std::string& stage) -> Result<bool> {
     for (const DesignCandidate& seen : result->candidates) {  // a rounded drive already tried costs nothing
-      const std::array<double, kCoordinates> a = ToCoordinates(seen.drive, limits), b = ToCoordinates(drive, limits);
-      if (a == b) return false;
+      if (family.ToCoordinates(seen.drive) == family.ToCoordinates(drive)) return false;
     }
     auto c = Evaluate(p, drive, stage);
     if (!c.ok()) return c.status();
@@ -222,35 +191,33 @@ Status Search(const Problem& p, DesignResult* result) {
   };
   auto spent = [&] { return static_cast<int>(result->candidates.size()) >= budget; };
 
-  const DriveDesign start = StartDrive(p.scenario, limits);
+  const DriveDesign start = family.StartDrive(p.scenario);
   if (auto r = try_drive(start, "start"); !r.ok()) return r.status();
-  for (double heading : kGridHeadingsDeg)
-    for (double offset : kGridOffsets) {
-      if (spent()) break;
-      std::array<double, kCoordinates> u = ToCoordinates(start, limits);
-      u[4] = offset;
-      u[5] = std::fmod(u[5] + heading / 360.0, 1.0);
-      if (auto r = try_drive(FromCoordinates(u, limits), "grid"); !r.ok()) return r.status();
-    }
+  for (const std::vector<double>& u : family.Grid(family.ToCoordinates(start))) {
+    if (spent()) break;
+    if (auto r = try_drive(family.FromCoordinates(u), "grid"); !r.ok()) return r.status();
+  }
   // Pattern search: from the best, each coordinate up and down by the step; the first improvement is taken; a sweep
-  // without one halves the step. The heading wraps around.
+  // without one halves the step. The family's wrapping coordinate (the heading) wraps around.
   for (double step = kFirstStep; step >= kLastStep && !spent() && result->best >= 0; step /= 2.0) {
     bool improved = true;
     while (improved && !spent()) {
       improved = false;
-      for (int i = 0; i < kCoordinates && !improved && !spent(); ++i)
+      for (int k : family.SearchOrder()) {
+        if (improved || spent()) break;
         for (double sign : {1.0, -1.0}) {
-          const int k = kSearchOrder[static_cast<std::size_t>(i)];
           if (spent()) break;
-          std::array<double, kCoordinates> u = ToCoordinates(result->candidates[result->best].drive, limits);
-          u[k] = k == 5 ? std::fmod(u[k] + sign * step + 1.0, 1.0) : std::clamp(u[k] + sign * step, 0.0, 1.0);
-          auto r = try_drive(FromCoordinates(u, limits), "pattern");
+          std::vector<double> u = family.ToCoordinates(result->candidates[result->best].drive);
+          const double moved = u[k] + sign * step;
+          u[k] = k == family.Wrapping() ? std::fmod(moved + 1.0, 1.0) : std::clamp(moved, 0.0, 1.0);
+          auto r = try_drive(family.FromCoordinates(u), "pattern");
           if (!r.ok()) return r.status();
           if (r.value()) {
             improved = true;
             break;
           }
         }
+      }
     }
   }
   return Status::Ok();
@@ -262,45 +229,42 @@ std::string PathFrom(const std::string& file, const std::string& out) {
   return fs::absolute(file).lexically_normal().lexically_relative(dir).string();
 }
 
-YAML::Node TermNode(const char* type, const std::map<std::string, double>& fields) {
-  YAML::Node inner;
-  for (const auto& [key, value] : fields) inner[key] = Text(value);
-  YAML::Node term;
-  term[type] = inner;
-  return term;
+// A profile's constant and sine terms (the ones a drive family makes) as the scenario writes them.
+YAML::Node ProfileNode(const sim::Profile& profile) {
+  YAML::Node terms(YAML::NodeType::Sequence);
+  for (const sim::ProfileTerm& t : profile.terms) {
+    YAML::Node term;
+    if (t.type == sim::ProfileTerm::Type::kConstant) term["constant"] = Text(t.value);
+    if (t.type == sim::ProfileTerm::Type::kSine) {
+      term["sine"]["amplitude"] = Text(t.amplitude);
+      term["sine"]["period_s"] = Text(t.period_s);
+      term["sine"]["phase_rad"] = Text(t.phase_rad);
+    }
+    terms.push_back(term);
+  }
+  return terms;
 }
 
 // The scenario file with the designed drive, duration and start heading, and its paths made relative to `out`.
-std::string DesignedYaml(const DesignRequest& request, const sim::Scenario& scenario, const DesignCandidate& best) {
+std::string DesignedYaml(const Problem& p, const DesignCandidate& best) {
+  const DesignRequest& request = p.request;
+  const sim::Scenario& scenario = p.scenario;
   YAML::Node root = YAML::LoadFile(request.scenario);
-  const DriveDesign& d = best.drive;
   root["duration_s"] = Text(scenario.duration_s);
   root["robot"]["model"] = PathFrom(scenario.robot.model_file, request.out);
   if (!scenario.world_model_file.empty()) root["world"]["model"] = PathFrom(scenario.world_model_file, request.out);
-  root["robot"]["start"]["heading_deg"] = Text(d.heading_deg);
-  YAML::Node speed(YAML::NodeType::Sequence), handlebar(YAML::NodeType::Sequence);
-  speed.push_back(YAML::Node());
-  speed[0]["constant"] = Text(d.speed_mean_mps);
-  speed.push_back(TermNode(
-      "sine",
-      {{"amplitude", d.speed_swing_mps}, {"period_s", 0.5 * d.handlebar_period_s}, {"phase_rad", kSpeedPhaseRad}}));
-  handlebar.push_back(YAML::Node());
-  handlebar[0]["constant"] = Text(d.handlebar_offset_rad);
-  handlebar.push_back(TermNode(
-      "sine", {{"amplitude", d.handlebar_amplitude_rad}, {"period_s", d.handlebar_period_s}, {"phase_rad", 0.0}}));
-  root["driver"]["speed_mps"] = speed;
-  root["driver"]["handlebar_rad"] = handlebar;
+  root["robot"]["start"]["heading_deg"] = Text(p.family->HeadingDeg(scenario, best.drive));
+  for (const auto& [key, profile] : p.family->Profiles(best.drive)) root["driver"][key] = ProfileNode(profile);
 
   std::ostringstream text;
   text << "# Designed by\n#   roamlab design " << request.scenario << " --config " << request.config << " --duration "
        << scenario.duration_s << " --budget " << request.budget;
   for (const auto& [name, target] : request.targets) text << " --target " << name << "=" << target;
   text << std::setprecision(3) << "\n"
-       << "# (limits in design.json): of the drives speed = v0 + dv cos(4 pi t / P),\n"
-       << "# handlebar = d0 + da sin(2 pi t / P), start heading h (driver, robot.start), the feasible one with the "
-          "least max CRB std / target:\n# "
-       << best.objective << ", set by " << best.worst << "; " << best.distance_m << " m; largest roll "
-       << best.max_roll_deg << " deg, pitch " << best.max_pitch_deg << " deg, side slip " << best.max_side_slip_mps
+       << "# (limits in design.json): of the drives " << p.family->Formula() << "\n"
+       << "# (driver, robot.start), the feasible one with the least max CRB std / target:\n# " << best.objective
+       << ", set by " << best.worst << "; " << best.distance_m << " m; largest roll " << best.max_roll_deg
+       << " deg, pitch " << best.max_pitch_deg << " deg, side slip " << best.max_side_slip_mps
        << " m/s, lateral acceleration " << best.max_lateral_accel_mps2 << " m/s^2.\n"
        << "# Predicted std (Cramer-Rao bound of the noise-free drive at its truth) and target:\n";
   for (const auto& [label, std] : best.crb_std) {
@@ -315,13 +279,16 @@ std::string DesignedYaml(const DesignRequest& request, const sim::Scenario& scen
   return text.str();
 }
 
-// Inputs: the scenario (ackermann driver), the configuration, the targets, the limits, the duration and budget.
+// Inputs: the scenario (a driver with a family), the configuration, the targets, the limits, the duration and budget.
 Result<Problem> LoadProblem(const DesignRequest& request) {
   auto scenario = sim::LoadScenario(request.scenario);
   if (!scenario.ok()) return scenario.status();
-  if (scenario.value().driver.type != "ackermann")
-    return Status::Error(request.scenario + ": driver.type: design needs an ackermann driver, not " +
-                         scenario.value().driver.type);
+  auto limits = WithRobotDefaults(request.limits, scenario.value());
+  if (!limits.ok()) return Status::Error(request.scenario + ": " + limits.status().message());
+  if (const std::string problem = limits.value().Validate(scenario.value().driver.type); !problem.empty())
+    return Status::Error(problem);
+  auto family = MakeDriveFamily(scenario.value(), limits.value());
+  if (!family.ok()) return Status::Error(request.scenario + ": " + family.status().message());
   auto config = estimator::LoadEstimatorConfig(request.config);
   if (!config.ok()) return config.status();
   if (request.targets.empty()) return Status::Error("--target: no target given");
@@ -331,56 +298,66 @@ Result<Problem> LoadProblem(const DesignRequest& request) {
       return Status::Error("--target " + name + ": not a free parameter of " + request.config);
     if (!(target > 0.0) || !std::isfinite(target)) return Status::Error("--target " + name + ": must be > 0");
   }
-  if (const std::string problem = request.limits.Validate(); !problem.empty()) return Status::Error(problem);
   if (!(request.duration_s >= 0.0) || request.duration_s > kMaxDurationS)
     return Status::Error("--duration: must be in (0, 3600]");
   if (request.budget < 1) return Status::Error("--budget: must be >= 1");
-  Problem p{request, std::move(scenario).value(), std::move(config).value()};
+  Problem p{request, std::move(scenario).value(), std::move(config).value(), limits.value(), std::move(family).value()};
   if (request.duration_s > 0.0) p.scenario.duration_s = request.duration_s;
   return p;
 }
 
 }  // namespace
 
-std::string DesignLimits::Validate() const {
-  if (!(min_speed_mps > 0.0) || !(max_speed_mps > min_speed_mps)) return "--speed-range: need 0 < min < max";
-  if (!(max_handlebar_rad > 0.0) || max_handlebar_rad > 1.0) return "--max-handlebar: must be in (0, 1] rad";
+std::string DesignLimits::Validate(const std::string& driver_type) const {
+  if (!(max_speed_mps > min_speed_mps)) return "--speed-range: need min < max";
+  if (driver_type == "ackermann" && !(min_speed_mps > 0.0)) return "--speed-range: an ackermann drive needs 0 < min";
+  if (driver_type == "ackermann" && (!(max_handlebar_rad > 0.0) || max_handlebar_rad > 1.0))
+    return "--max-handlebar: must be in (0, 1] rad";
+  if (driver_type != "ackermann" && (!(max_yaw_rate_radps > 0.0) || !std::isfinite(max_yaw_rate_radps)))
+    return "--max-yaw-rate: must be > 0";
+  if (driver_type != "ackermann" && (!(max_lateral_mps >= 0.0) || !std::isfinite(max_lateral_mps)))
+    return "--max-lateral-speed: must be >= 0";
   if (!(min_period_s > 0.0) || !(max_period_s >= min_period_s)) return "--period-range: need 0 < min <= max";
   if (!(max_roll_deg > 0.0) || !(max_pitch_deg > 0.0)) return "--max-roll/--max-pitch: must be > 0";
   if (!(max_side_slip_mps > 0.0)) return "--max-side-slip: must be > 0";
   if (!(max_lateral_accel_mps2 > 0.0)) return "--max-lateral-accel: must be > 0";
+  if (!(max_velocity_error_mps > 0.0)) return "--max-velocity-error: must be > 0";
   return "";
 }
 
-sim::Scenario WithDrive(const sim::Scenario& scenario, const DriveDesign& drive) {
-  sim::Scenario out = scenario;
-  out.robot.start_heading_rad = drive.heading_deg / kDegPerRad;
-  out.driver.speed_mps.terms = {Constant(drive.speed_mean_mps),
-                                Sine(drive.speed_swing_mps, 0.5 * drive.handlebar_period_s, kSpeedPhaseRad)};
-  out.driver.handlebar_rad.terms = {Constant(drive.handlebar_offset_rad),
-                                    Sine(drive.handlebar_amplitude_rad, drive.handlebar_period_s, 0.0)};
-  return out;
+Result<DesignLimits> WithRobotDefaults(const DesignLimits& given, const sim::Scenario& scenario) {
+  auto envelope = sim::DesignEnvelope(scenario.robot.kind);
+  if (!envelope.ok()) return envelope.status();
+  const sim::DriveEnvelope& e = envelope.value();
+  if (e.max_lateral_mps == 0.0 && given.max_lateral_mps > 0.0)
+    return Status::Error("--max-lateral-speed: a robot of kind " + scenario.robot.kind + " has no sideways set-point");
+  DesignLimits l = given;
+  auto fill = [](double* value, double robot) {
+    if (std::isnan(*value)) *value = robot;
+  };
+  const bool ackermann = scenario.driver.type == "ackermann";
+  fill(&l.min_speed_mps, e.min_speed_mps);
+  fill(&l.max_speed_mps, e.max_speed_mps);
+  // The turn limit of the other driver type stays NaN (unused).
+  if (ackermann) fill(&l.max_handlebar_rad, e.max_turn);
+  if (!ackermann) fill(&l.max_yaw_rate_radps, e.max_turn);
+  fill(&l.max_lateral_mps, e.max_lateral_mps);
+  fill(&l.min_period_s, e.min_period_s);
+  fill(&l.max_period_s, e.max_period_s);
+  fill(&l.max_roll_deg, e.max_roll_deg);
+  fill(&l.max_pitch_deg, e.max_pitch_deg);
+  fill(&l.max_side_slip_mps, e.max_side_slip_mps);
+  fill(&l.max_lateral_accel_mps2, e.max_lateral_accel_mps2);
+  fill(&l.max_velocity_error_mps, e.max_velocity_error_mps);
+  return l;
 }
 
-DriveDesign StartDrive(const sim::Scenario& scenario, const DesignLimits& limits) {
-  DriveDesign d;
-  d.speed_mean_mps = 0.0;
-  bool speed_sine = false, handlebar_sine = false;
-  for (const sim::ProfileTerm& t : scenario.driver.speed_mps.terms) {
-    if (t.type == sim::ProfileTerm::Type::kConstant) d.speed_mean_mps += t.value;
-    if (t.type == sim::ProfileTerm::Type::kSine && !speed_sine) d.speed_swing_mps = std::abs(t.amplitude);
-    speed_sine = speed_sine || t.type == sim::ProfileTerm::Type::kSine;
-  }
-  for (const sim::ProfileTerm& t : scenario.driver.handlebar_rad.terms) {
-    if (t.type == sim::ProfileTerm::Type::kConstant) d.handlebar_offset_rad += t.value;
-    if (t.type == sim::ProfileTerm::Type::kSine && !handlebar_sine) {
-      d.handlebar_amplitude_rad = std::abs(t.amplitude);
-      d.handlebar_period_s = t.period_s;
-    }
-    handlebar_sine = handlebar_sine || t.type == sim::ProfileTerm::Type::kSine;
-  }
-  d.heading_deg = scenario.robot.start_heading_rad * kDegPerRad;
-  return FromCoordinates(ToCoordinates(d, limits), limits);
+Result<DriveDesign> StartDrive(const sim::Scenario& scenario, const DesignLimits& limits) {
+  auto complete = WithRobotDefaults(limits, scenario);
+  if (!complete.ok()) return complete.status();
+  auto family = MakeDriveFamily(scenario, complete.value());
+  if (!family.ok()) return family.status();
+  return family.value()->StartDrive(scenario);
 }
 
 Outcome DesignToFile(const DesignRequest& request, DesignResult* result_out) {
@@ -393,6 +370,8 @@ Outcome DesignToFile(const DesignRequest& request, DesignResult* result_out) {
 
   DesignResult result;
   result.duration_s = p.scenario.duration_s;
+  result.limits = p.limits;
+  result.formula = p.family->Formula();
   if (Status s = Search(p, &result); !s.ok()) {
     // The first drive's analysis failing is the configuration not fitting the recording: bad input.
     return result.candidates.empty() ? Outcome::BadInput(s) : Outcome::Failed(s);
@@ -404,7 +383,9 @@ Outcome DesignToFile(const DesignRequest& request, DesignResult* result_out) {
     if (result_out) *result_out = std::move(result);
     return failed;
   }
-  result.designed_yaml = DesignedYaml(request, p.scenario, result.candidates[static_cast<std::size_t>(result.best)]);
+  const DesignCandidate& best = result.candidates[static_cast<std::size_t>(result.best)];
+  result.designed_yaml = DesignedYaml(p, best);
+  result.best_drive = p.family->Describe(best.drive);
   if (Status s = WriteFileAtomic(request.out, result.designed_yaml); !s.ok()) return Outcome::Failed(s);
   if (Status s = WriteFileAtomic((dir / "design.json").string(), DesignJson(request, result).dump(2) + "\n"); !s.ok())
     return Outcome::Failed(s);
@@ -414,14 +395,7 @@ Outcome DesignToFile(const DesignRequest& request, DesignResult* result_out) {
 
 nlohmann::json DesignJson(const DesignRequest& request, const DesignResult& result) {
   using nlohmann::json;
-  auto drive_json = [](const DriveDesign& d) {
-    return json{{"speed_mean_mps", d.speed_mean_mps},
-                {"speed_swing_mps", d.speed_swing_mps},
-                {"handlebar_amplitude_rad", d.handlebar_amplitude_rad},
-                {"handlebar_period_s", d.handlebar_period_s},
-                {"handlebar_offset_rad", d.handlebar_offset_rad},
-                {"heading_deg", d.heading_deg}};
-  };
+  auto drive_json = [](const DriveDesign& d) { return json(d.values); };
   json candidates = json::array();
   for (const DesignCandidate& c : result.candidates) {
     json crb = json::object();
@@ -437,12 +411,13 @@ nlohmann::json DesignJson(const DesignRequest& request, const DesignResult& resu
                           {"max_pitch_deg", c.max_pitch_deg},
                           {"max_side_slip_mps", c.max_side_slip_mps},
                           {"max_lateral_accel_mps2", c.max_lateral_accel_mps2},
+                          {"max_velocity_error_mps", c.max_velocity_error_mps},
                           {"distance_m", c.distance_m},
                           {"seconds", c.seconds}});
   }
   json targets = json::object();
   for (const auto& [name, std] : request.targets) targets[name] = std;
-  const DesignLimits& l = request.limits;
+  const DesignLimits& l = result.limits;
   return {{"scenario", request.scenario},
           {"config", request.config},
           {"out", request.out},
@@ -450,12 +425,16 @@ nlohmann::json DesignJson(const DesignRequest& request, const DesignResult& resu
           {"targets", targets},
           {"limits",
            {{"speed_range_mps", {l.min_speed_mps, l.max_speed_mps}},
-            {"max_handlebar_rad", l.max_handlebar_rad},
+            {"max_handlebar_rad", Number(l.max_handlebar_rad)},
+            {"max_yaw_rate_radps", Number(l.max_yaw_rate_radps)},
+            {"max_lateral_mps", Number(l.max_lateral_mps)},
             {"period_range_s", {l.min_period_s, l.max_period_s}},
             {"max_roll_deg", l.max_roll_deg},
             {"max_pitch_deg", l.max_pitch_deg},
-            {"max_side_slip_mps", l.max_side_slip_mps},
-            {"max_lateral_accel_mps2", l.max_lateral_accel_mps2}}},
+            {"max_side_slip_mps", Number(l.max_side_slip_mps)},
+            {"max_lateral_accel_mps2", l.max_lateral_accel_mps2},
+            {"max_velocity_error_mps", Number(l.max_velocity_error_mps)}}},
+          {"family", result.formula},
           {"budget", request.budget},
           {"best", result.best},
           {"candidates", candidates}};

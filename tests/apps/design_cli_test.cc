@@ -32,7 +32,9 @@ TEST(DesignCliTest, BadTargetsAndOptionsExitTwoNamingTheProblem) {
       {"--target gps.nonsense=0.1", "--target gps.nonsense: not a free parameter of"},
       {"--target odometer.cornering_rear=0.1", "--target odometer.cornering_rear: not a free parameter of"},
       {"--target odometer.k_theta=-1", "--target odometer.k_theta: must be > 0"},
-      {"--target odometer.k_theta=0.01 --speed-range 4 2", "--speed-range: need 0 < min < max"},
+      {"--target odometer.k_theta=0.01 --speed-range 4 2", "--speed-range: need min < max"},
+      {"--target odometer.k_theta=0.01 --speed-range -1 2", "--speed-range: an ackermann drive needs 0 < min"},
+      {"--target odometer.k_theta=0.01 --max-lateral-speed 0.2", "--max-lateral-speed: a robot of kind ackermann"},
       {"--target odometer.k_theta=0.01 --budget 0", "--budget: must be >= 1"},
       {"--target odometer.k_theta=0.01 --duration -5", "--duration"},
   };
