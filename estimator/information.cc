@@ -149,6 +149,20 @@ bool LinearizeRows(const Graph& graph, const FactorEntry& entry, const Layout& l
   return true;
 }
 
+// Calls visit(entry, rows) for every active factor, linearized at the graph's values.
+template <typename Visit>
+Status ForEachActiveFactor(const Graph& graph, const Layout& layout, Visit visit) {
+  internal::WhitenedFactor wf;
+  FactorRows rows;
+  for (const auto& [id, entry] : graph.factors()) {
+    if (!entry.active) continue;
+    if (!LinearizeRows(graph, entry, layout, &wf, &rows))
+      return Status::Error("a factor of '" + entry.stream + "' cannot be evaluated at the truth");
+    visit(entry, rows);
+  }
+  return Status::Ok();
+}
+
 struct FisherBlocks {
   Eigen::SparseMatrix<double> Hxx;
   Eigen::MatrixXd Hxp, Hpp;
@@ -160,12 +174,7 @@ Result<FisherBlocks> AccumulateFisher(const Graph& graph, const Layout& layout) 
   out.Hxp = Eigen::MatrixXd::Zero(layout.nx, layout.np);
   out.Hpp = Eigen::MatrixXd::Zero(layout.np, layout.np);
   std::vector<Eigen::Triplet<double>> triplets;
-  internal::WhitenedFactor wf;
-  FactorRows rows;
-  for (const auto& [id, entry] : graph.factors()) {
-    if (!entry.active) continue;
-    if (!LinearizeRows(graph, entry, layout, &wf, &rows))
-      return Status::Error("a factor of '" + entry.stream + "' cannot be evaluated at the truth");
+  const Status status = ForEachActiveFactor(graph, layout, [&](const FactorEntry&, const FactorRows& rows) {
     out.Hpp += rows.Jp.transpose() * rows.Jp;
     for (const auto& [a, Ja] : rows.x_blocks) {
       out.Hxp.middleRows(a, Ja.cols()) += Ja.transpose() * rows.Jp;
@@ -176,7 +185,8 @@ Result<FisherBlocks> AccumulateFisher(const Graph& graph, const Layout& layout) 
             if (block(r, c) != 0.0) triplets.emplace_back(a + r, b + c, block(r, c));
       }
     }
-  }
+  });
+  if (!status.ok()) return status;
   out.Hxx.resize(layout.nx, layout.nx);
   out.Hxx.setFromTriplets(triplets.begin(), triplets.end());
   return out;
@@ -190,12 +200,7 @@ Status SplitInformation(const Graph& graph, const Layout& layout, const Eigen::M
   const Eigen::MatrixXd& W = result->covariance;
   std::map<std::string, std::vector<Eigen::VectorXd>> variance;  // stream -> window -> per component
   std::map<std::string, std::vector<Eigen::VectorXd>> measured;   // stream -> window -> per component
-  internal::WhitenedFactor wf;
-  FactorRows rows;
-  for (const auto& [id, entry] : graph.factors()) {
-    if (!entry.active) continue;
-    if (!LinearizeRows(graph, entry, layout, &wf, &rows))
-      return Status::Error("a factor of '" + entry.stream + "' cannot be evaluated at the truth");
+  const Status status = ForEachActiveFactor(graph, layout, [&](const FactorEntry& entry, const FactorRows& rows) {
     Eigen::MatrixXd R = rows.Jp;
     for (const auto& [a, Ja] : rows.x_blocks) R.noalias() -= Ja * Y.middleRows(a, Ja.cols());
     const Eigen::MatrixXd RW = R * W;
@@ -207,7 +212,8 @@ Status SplitInformation(const Graph& graph, const Layout& layout, const Eigen::M
     std::vector<Eigen::VectorXd>& measured_per_window = measured[entry.stream];
     if (measured_per_window.empty()) measured_per_window.assign(result->windows, Eigen::VectorXd::Zero(np));
     measured_per_window[window] += ((rows.Jp * W).cwiseProduct(RW)).colwise().sum().transpose();
-  }
+  });
+  if (!status.ok()) return status;
   for (const auto& [stream, per_window] : variance) result->streams.push_back(stream);
   for (int i = 0; i < np; ++i) {
     InformationComponent& c = result->components[i];
