@@ -157,11 +157,13 @@ TEST(ExternalTest, WhatTheCommandLeftRunningIsKilled) {
   EXPECT_TRUE(ended) << "pid " << pid;
 }
 
+// The command names {out}, so that no paths are appended to sleep's arguments (which would end it at once).
 TEST(ExternalTest, AnInterruptStopsTheCommand) {
   testing::TempDir dir;
   RequestInterrupt(2);
   const Status ran =
-      RunExternalCommand({"sleep 30", dir.path(), 60.0}, dir.path(), dir.File("out"), dir.File("estimator.log"));
+      RunExternalCommand({"sleep 30 && test -d {out}", dir.path(), 60.0}, dir.path(), dir.File("out"),
+                         dir.File("estimator.log"));
   ClearInterrupt();
   ASSERT_FALSE(ran.ok());
   EXPECT_THAT(ran.message(), HasSubstr("interrupted by SIGINT"));
