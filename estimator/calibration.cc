@@ -81,6 +81,62 @@ std::vector<FactorId> WorstPerPose(const std::vector<FailingFactor>& failing, co
   return out;
 }
 
+// One measurement factor as a gating pass tested it.
+struct TestedFactor {
+  FactorId id;
+  int stream;
+  bool active;
+  bool pass;            // within the quantile
+  double squared_norm;  // its whitened squared error (infinite where it could not be evaluated)
+  int dim;
+};
+
+// Runs of at most this many spans of a cumulative wheel stream are bridged: one outlying reading fails the two
+// spans it joins, two consecutive ones three; longer runs are a skid, rejected span by span.
+constexpr std::size_t kMaxBridgedSpans = 4;
+
+// Bridges (ProblemBuilder::BridgeCumulativeRun) each run of 2 to kMaxBridgedSpans consecutive spans of a cumulative
+// wheel stream that fail: tested now and failing, or not tested now (older than the pass's first factor) and rejected
+// before, at least one of them tested now. A reading off by delta makes the span before it delta / dt too fast and the
+// one after it delta / dt too slow; tested alone, each span fails and is rejected, and the poses around the reading
+// lose both. Left out instead, the reading's neighbours still give the mean rate across it, and the gate tests that
+// bridge at the next pass like any factor. Returns the factors bridged; adds the readings left out to *readings.
+std::set<FactorId> BridgeFailingRuns(const std::vector<TestedFactor>& tested, ProblemBuilder* builder, int* readings) {
+  std::map<FactorId, bool> failing_now;  // tested spans: id -> fails
+  for (const TestedFactor& t : tested) failing_now[t.id] = !t.pass;
+  // The unreplaced spans of every cumulative stream, by (stream, first row).
+  std::map<std::pair<int, int>, FactorId> by_row;
+  for (const auto& [id, span] : builder->cumulative_spans())
+    if (!span.bridge && !span.replaced && builder->graph().factors().count(id) > 0)
+      by_row[{span.stream, span.row_begin}] = id;
+  std::set<FactorId> bridged;
+  std::vector<FactorId> run;
+  bool tested_in_run = false;
+  const auto close_run = [&] {
+    if (run.size() >= 2 && run.size() <= kMaxBridgedSpans && tested_in_run && builder->BridgeCumulativeRun(run)) {
+      bridged.insert(run.begin(), run.end());
+      *readings += static_cast<int>(run.size()) - 1;
+    }
+    run.clear();
+    tested_in_run = false;
+  };
+  int last_stream = -1, last_end = -1;
+  for (const auto& [key, id] : by_row) {
+    const auto now = failing_now.find(id);
+    const bool bad = now != failing_now.end() ? now->second : !builder->graph().factor(id).active;
+    const ProblemBuilder::CumulativeSpan& span = builder->cumulative_spans().at(id);
+    if (!bad || key.first != last_stream || key.second != last_end) close_run();
+    if (bad) {
+      run.push_back(id);
+      tested_in_run |= now != failing_now.end();
+    }
+    last_stream = span.stream;
+    last_end = span.row_end;
+  }
+  close_run();
+  return bridged;
+}
+
 }  // namespace
 
 GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId first,
@@ -95,7 +151,7 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
   };
   // One walk over the measurement factors and the graph's factors in id order (a whole recording's 10^5-10^6).
   std::vector<FactorId> switched;
-  long tested = 0;
+  GateSwitches result;
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
   std::vector<std::pair<double, int>> failing;  // (ignore_chance_changes) squared norm and dimension of each active
                                                 // factor that fails
@@ -104,6 +160,8 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
   std::vector<std::vector<GateRow>> rows(bursts ? builder->stream_names().size() : 0);  // per stream, in time order
   std::vector<const double*> values;
   internal::WhitenedFactor wf;  // reused: its buffers keep their size
+  std::vector<TestedFactor> tested_factors;
+  const std::map<FactorId, ProblemBuilder::CumulativeSpan>& spans = builder->cumulative_spans();
   auto factor = graph.factors().lower_bound(first);
   for (auto stream = builder->factor_streams().lower_bound(first); stream != builder->factor_streams().end();
        ++stream) {
@@ -111,6 +169,7 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
     while (factor != graph.factors().end() && factor->first < id) ++factor;
     if (factor == graph.factors().end()) break;
     if (factor->first != id) continue;  // (no longer in the graph)
+    if (const auto span = spans.find(id); span != spans.end() && span->second.replaced) continue;
     const FactorEntry& entry = factor->second;
     const int dim = entry.factor->residual_dim();
     // The solve's linearization (of an active factor, with the Jacobians of its free variables), else the error.
@@ -128,16 +187,21 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
       ok = internal::LinearizeFactorAt(entry, values.data(), 0, &wf);
       linearized = &wf;
     }
-    const bool pass = ok && linearized->squared_norm <= threshold(dim);
-    ++tested;
-    if (options.ignore_chance_changes && !pass && entry.active)
-      failing.push_back({ok ? linearized->squared_norm : kInfinity, dim});
+    tested_factors.push_back({id, stream->second, entry.active, ok && linearized->squared_norm <= threshold(dim),
+                              ok ? linearized->squared_norm : kInfinity, dim});
+  }
+  const int tested = static_cast<int>(tested_factors.size());
+  // A reading of a cumulative wheel stream that fails both spans it joins is left out, not both spans.
+  const std::set<FactorId> bridged = BridgeFailingRuns(tested_factors, builder, &result.bridged);
+  for (const TestedFactor& t : tested_factors) {
+    if (bridged.count(t.id) > 0) continue;
+    if (options.ignore_chance_changes && !t.pass && t.active) failing.push_back({t.squared_norm, t.dim});
     if (bursts)
-      rows[stream->second].push_back({id, entry.active, pass});
-    else if (options.worst_per_pose && !pass && entry.active)
-      failing_factors.push_back({id, ok ? linearized->squared_norm / threshold(dim) : kInfinity});
-    else if (pass != entry.active)
-      switched.push_back(id);
+      rows[t.stream].push_back({t.id, t.active, t.pass});
+    else if (options.worst_per_pose && !t.pass && t.active)
+      failing_factors.push_back({t.id, t.squared_norm / threshold(t.dim)});
+    else if (t.pass != t.active)
+      switched.push_back(t.id);
   }
   if (bursts) {
     std::vector<char> reject;
@@ -158,7 +222,6 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
   // the quantile that all of them pass with the test's probability (1 - (1 - p) / N each): a gross outlier is rejected
   // however few there are. The factors that fit again are re-admitted, unless they and the failing ones together are
   // no more than the false alarms either.
-  GateSwitches result;
   for (FactorId id : switched) (graph.factor(id).active ? result.rejected : result.readmitted) += 1;
   const double false_alarms = static_cast<double>(tested) * (1.0 - probability);
   const bool by_chance =
@@ -293,6 +356,7 @@ Result<StageSummary> SolveStage(const EstimatorConfig& config, const Calibration
     const Status solved =
         resolve("gating round " + std::to_string(round + 1) + ": " + std::to_string(changed.rejected) +
                 " measurements rejected, " + std::to_string(changed.readmitted) + " re-admitted" +
+                (changed.bridged > 0 ? ", " + std::to_string(changed.bridged) + " wheel readings bridged" : "") +
                 (changed.ignored > 0 ? ", " + std::to_string(changed.ignored) + " failing by chance" : "") +
                 ", re-solved");
     if (!solved.ok()) return solved;

@@ -146,7 +146,8 @@ struct GateSwitches {
   int rejected = 0;    // active factors switched off
   int readmitted = 0;  // inactive factors switched on again
   int ignored = 0;     // newly failing factors left active as chance would explain them
-  int switched() const { return rejected + readmitted; }
+  int bridged = 0;     // readings of cumulative wheel streams left out (ProblemBuilder::BridgeCumulativeRun)
+  int switched() const { return rejected + readmitted + bridged; }
 };
 
 // Re-tests the measurement factors with id >= `first` (factor ids grow as factors are added, so `first` selects the
