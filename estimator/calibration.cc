@@ -4,7 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstddef>
 #include <deque>
+#include <functional>
 #include <limits>
 #include <map>
 #include <set>
@@ -91,17 +93,21 @@ struct TestedFactor {
   int dim;
 };
 
-// Runs of at most this many spans of a cumulative wheel stream are bridged: one outlying reading fails the two
-// spans it joins, two consecutive ones three; longer runs are a skid, rejected span by span.
-constexpr std::size_t kMaxBridgedSpans = 4;
+// A bridge leaves out at most this many consecutive readings: one outlying reading fails the two spans it joins, two
+// consecutive ones three spans.
+constexpr std::size_t kMaxBridgedReadings = 3;
 
-// Bridges (ProblemBuilder::BridgeCumulativeRun) each run of 2 to kMaxBridgedSpans consecutive spans of a cumulative
-// wheel stream that fail: tested now and failing, or not tested now (older than the pass's first factor) and rejected
-// before, at least one of them tested now. A reading off by delta makes the span before it delta / dt too fast and the
-// one after it delta / dt too slow; tested alone, each span fails and is rejected, and the poses around the reading
-// lose both. Left out instead, the reading's neighbours still give the mean rate across it, and the gate tests that
-// bridge at the next pass like any factor. Returns the factors bridged; adds the readings left out to *readings.
-std::set<FactorId> BridgeFailingRuns(const std::vector<TestedFactor>& tested, ProblemBuilder* builder, int* readings) {
+// Bridges (ProblemBuilder::BridgeCumulativeRun) over outlying readings of cumulative wheel streams. A reading off by
+// delta makes the span before it delta / dt too fast and the one after it delta / dt too slow; tested alone, each
+// span fails and is rejected, and the poses around the reading lose both. In each run of consecutive failing spans
+// (tested now and failing, or older than the pass's first factor and rejected before; at least one tested now),
+// from its start: the bridge over the fewest readings (1 to kMaxBridgedReadings) that passes the test at the current
+// estimate replaces the spans it covers; its poses are not those the reading bent, so its test is not fooled by the
+// bend. Spans no passing bridge covers (a skid) are left to the gate. Returns the factors bridged; adds the readings
+// left out to *readings.
+std::set<FactorId> BridgeFailingRuns(const std::vector<TestedFactor>& tested,
+                                     const std::function<double(int)>& threshold, ProblemBuilder* builder,
+                                     int* readings) {
   std::map<FactorId, bool> failing_now;  // tested spans: id -> fails
   for (const TestedFactor& t : tested) failing_now[t.id] = !t.pass;
   // The unreplaced spans of every cumulative stream, by (stream, first row).
@@ -110,13 +116,34 @@ std::set<FactorId> BridgeFailingRuns(const std::vector<TestedFactor>& tested, Pr
     if (!span.bridge && !span.replaced && builder->graph().factors().count(id) > 0)
       by_row[{span.stream, span.row_begin}] = id;
   std::set<FactorId> bridged;
+  std::vector<const double*> values;
+  internal::WhitenedFactor wf;
+  const auto passes = [&](const FactorEntry& entry) {
+    values.clear();
+    for (VariableId v : entry.variables) values.push_back(builder->graph().variable(v).value.data());
+    return internal::LinearizeFactorAt(entry, values.data(), 0, &wf) &&
+           wf.squared_norm <= threshold(entry.factor->residual_dim());
+  };
+  const auto bridge_run = [&](const std::vector<FactorId>& run) {
+    for (std::size_t i = 0; i + 1 < run.size();) {
+      std::size_t skipped = 0;
+      for (std::size_t w = 1; w <= kMaxBridgedReadings && i + w < run.size() && skipped == 0; ++w) {
+        const std::vector<FactorId> spans(run.begin() + static_cast<std::ptrdiff_t>(i),
+                                          run.begin() + static_cast<std::ptrdiff_t>(i + w + 1));
+        const std::optional<FactorEntry> candidate = builder->CumulativeBridge(spans);
+        if (candidate && passes(*candidate) && builder->BridgeCumulativeRun(spans)) {
+          bridged.insert(spans.begin(), spans.end());
+          skipped = w;
+        }
+      }
+      *readings += static_cast<int>(skipped);
+      i += skipped > 0 ? skipped + 1 : 1;
+    }
+  };
   std::vector<FactorId> run;
   bool tested_in_run = false;
   const auto close_run = [&] {
-    if (run.size() >= 2 && run.size() <= kMaxBridgedSpans && tested_in_run && builder->BridgeCumulativeRun(run)) {
-      bridged.insert(run.begin(), run.end());
-      *readings += static_cast<int>(run.size()) - 1;
-    }
+    if (run.size() >= 2 && tested_in_run) bridge_run(run);
     run.clear();
     tested_in_run = false;
   };
@@ -124,14 +151,13 @@ std::set<FactorId> BridgeFailingRuns(const std::vector<TestedFactor>& tested, Pr
   for (const auto& [key, id] : by_row) {
     const auto now = failing_now.find(id);
     const bool bad = now != failing_now.end() ? now->second : !builder->graph().factor(id).active;
-    const ProblemBuilder::CumulativeSpan& span = builder->cumulative_spans().at(id);
     if (!bad || key.first != last_stream || key.second != last_end) close_run();
     if (bad) {
       run.push_back(id);
       tested_in_run |= now != failing_now.end();
     }
-    last_stream = span.stream;
-    last_end = span.row_end;
+    last_stream = key.first;
+    last_end = builder->cumulative_spans().at(id).row_end;
   }
   close_run();
   return bridged;
@@ -192,9 +218,20 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
   }
   const int tested = static_cast<int>(tested_factors.size());
   // A reading of a cumulative wheel stream that fails both spans it joins is left out, not both spans.
-  const std::set<FactorId> bridged = BridgeFailingRuns(tested_factors, builder, &result.bridged);
+  const std::set<FactorId> bridged = BridgeFailingRuns(tested_factors, threshold, builder, &result.bridged);
+  // The other measurements of the poses a bridged reading bent wait for the re-solve without it: failing there now,
+  // they would be rejected with it and leave those poses held by nothing, where they stay bent.
+  std::set<VariableId> bent_poses;
+  for (const FactorId id : bridged) {
+    const std::vector<VariableId>& vars = graph.factor(id).variables;
+    bent_poses.insert(vars.begin(), vars.begin() + 2);
+  }
+  const auto at_bent_pose = [&](FactorId id) {
+    const std::vector<VariableId>& vars = graph.factor(id).variables;
+    return std::any_of(vars.begin(), vars.end(), [&](VariableId v) { return bent_poses.count(v) > 0; });
+  };
   for (const TestedFactor& t : tested_factors) {
-    if (bridged.count(t.id) > 0) continue;
+    if (bridged.count(t.id) > 0 || (!t.pass && !bent_poses.empty() && at_bent_pose(t.id))) continue;
     if (options.ignore_chance_changes && !t.pass && t.active) failing.push_back({t.squared_norm, t.dim});
     if (bursts)
       rows[t.stream].push_back({t.id, t.active, t.pass});

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <functional>
 #include <limits>
 #include <set>
+#include <vector>
 
 #include "common/check.h"
 #include "estimator/factor.h"
@@ -46,6 +48,28 @@ constexpr double kReadingRateHalfWindow = 0.3;
 // what a ground vehicle turns, rolls or pitches at, so that on the axes the master measures (yaw, for an odometer) it
 // adds a few percent of their information at most.
 constexpr double kGapBridgeRateSigma = 3.0;
+
+// Which pairs (a_i, b_i) have lengths that agree: |a_i| - |b_i| within kLengthOutlierScale robust standard
+// deviations (1.4826 times the median absolute deviation) of the median difference, or within 1e-9 of it when the
+// spread is nil.
+constexpr double kLengthOutlierScale = 5.0;
+std::vector<bool> ConsistentLengths(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
+  std::vector<double> d(a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) d[i] = a[i].norm() - b[i].norm();
+  const auto median = [](std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+    std::nth_element(v.begin(), mid, v.end());
+    return *mid;
+  };
+  const double centre = median(d);
+  std::vector<double> deviation(d.size());
+  for (std::size_t i = 0; i < d.size(); ++i) deviation[i] = std::abs(d[i] - centre);
+  const double bound = std::max(kLengthOutlierScale * 1.4826 * median(deviation), 1e-9);
+  std::vector<bool> kept(d.size());
+  for (std::size_t i = 0; i < d.size(); ++i) kept[i] = deviation[i] <= bound;
+  return kept;
+}
 
 }  // namespace
 
@@ -533,7 +557,7 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
   return true;
 }
 
-std::optional<FactorId> ProblemBuilder::BridgeCumulativeRun(const std::vector<FactorId>& run) {
+std::optional<FactorEntry> ProblemBuilder::CumulativeBridge(const std::vector<FactorId>& run) const {
   if (run.empty()) return std::nullopt;
   std::vector<const CumulativeSpan*> spans;
   for (std::size_t i = 0; i < run.size(); ++i) {
@@ -547,20 +571,32 @@ std::optional<FactorId> ProblemBuilder::BridgeCumulativeRun(const std::vector<Fa
   }
   const StreamBinding& s = impl_->streams[spans[0]->stream];
   const FactorEntry& first = graph_.factor(run.front());
-  std::vector<VariableId> vars = first.variables;
-  vars[1] = graph_.factor(run.back()).variables[1];
-  const Variable& pose_a = graph_.variable(vars[0]);
-  const Variable& pose_b = graph_.variable(vars[1]);
+  FactorEntry bridge;
+  bridge.variables = first.variables;
+  bridge.variables[1] = graph_.factor(run.back()).variables[1];
+  const Variable& pose_a = graph_.variable(bridge.variables[0]);
+  const Variable& pose_b = graph_.variable(bridge.variables[1]);
   if (!pose_a.stamp || !pose_b.stamp) return std::nullopt;
-  std::unique_ptr<Factor> factor =
-      CumulativeFactor(s, spans.front()->row_begin, spans.back()->row_end, SecondsBetween(*pose_a.stamp, *pose_b.stamp));
-  if (factor == nullptr) return std::nullopt;
-  const CumulativeSpan bridge{spans[0]->stream, spans.front()->row_begin, spans.back()->row_end, true, false};
-  const FactorId id =
-      graph_.AddFactor(std::move(factor), vars, first.noise->covariance, first.loss, s.name, first.stamp);
-  stream_of_factor_.Add(id, bridge.stream);
-  cumulative_spans_[id] = bridge;
-  int& rejected = counts_[s.name].rejected;
+  bridge.factor = CumulativeFactor(s, spans.front()->row_begin, spans.back()->row_end,
+                                   SecondsBetween(*pose_a.stamp, *pose_b.stamp));
+  if (bridge.factor == nullptr) return std::nullopt;
+  bridge.noise = first.noise;
+  bridge.loss = first.loss;
+  bridge.stream = first.stream;
+  bridge.stamp = first.stamp;
+  return bridge;
+}
+
+std::optional<FactorId> ProblemBuilder::BridgeCumulativeRun(const std::vector<FactorId>& run) {
+  std::optional<FactorEntry> bridge = CumulativeBridge(run);
+  if (!bridge) return std::nullopt;
+  const CumulativeSpan& first = cumulative_spans_.at(run.front());
+  const CumulativeSpan span{first.stream, first.row_begin, cumulative_spans_.at(run.back()).row_end, true, false};
+  const FactorId id = graph_.AddFactor(std::move(bridge->factor), bridge->variables, bridge->noise->covariance,
+                                       bridge->loss, bridge->stream, bridge->stamp);
+  stream_of_factor_.Add(id, span.stream);
+  cumulative_spans_[id] = span;
+  int& rejected = counts_[bridge->stream].rejected;
   --rejected;
   for (const FactorId f : run) {
     FactorEntry& entry = graph_.mutable_factor(f);
@@ -773,8 +809,8 @@ std::optional<Eigen::Quaterniond> ProblemBuilder::AlignImuToMotion() {
   const double gyro_weight = 1.0 / gyro->noise_covariance(0, 0);
   const double accel_weight = 1.0 / accel->noise_covariance(0, 0);
   const Eigen::Vector3d g_world(0.0, 0.0, kStandardGravity);
-  Eigen::Matrix3d B = Eigen::Matrix3d::Zero();
-  Eigen::Matrix3d horizontal = Eigen::Matrix3d::Zero();  // spread of the body-frame specific force off its mean axis
+  // Pairs of body-frame vectors from the poses and the IMU's readings at each inner pose.
+  std::vector<Eigen::Vector3d> omega_body, omega_imu, f_body, f_imu;
   for (std::size_t k = 1; k + 1 < poses_.size(); ++k) {
     const Pose<double> a = PoseFromArray(graph_.variable(poses_[k - 1].id).value.data());
     const Pose<double> b = PoseFromArray(graph_.variable(poses_[k].id).value.data());
@@ -783,20 +819,31 @@ std::optional<Eigen::Quaterniond> ProblemBuilder::AlignImuToMotion() {
     const double dt_bc = SecondsBetween(poses_[k].t, poses_[k + 1].t);
     const Eigen::Vector3d accel_world =
         2.0 * ((c.p_world_body - b.p_world_body) / dt_bc - (b.p_world_body - a.p_world_body) / dt_ab) / (dt_ab + dt_bc);
-    const Eigen::Matrix3d R_T = b.q_world_body.toRotationMatrix().transpose();
-    const Eigen::Vector3d f_body = R_T * (accel_world + g_world);
-    const Eigen::Vector3d omega_body =
-        QuaternionLog<double>(a.q_world_body.conjugate() * c.q_world_body) / (dt_ab + dt_bc);
+    f_body.push_back(b.q_world_body.conjugate() * (accel_world + g_world));
+    omega_body.push_back(QuaternionLog<double>(a.q_world_body.conjugate() * c.q_world_body) / (dt_ab + dt_bc));
     const Eigen::RowVectorXd w_row = gyro->primary->values.row(NearestRow(*gyro->primary, poses_[k].t));
     const Eigen::RowVectorXd f_row = accel->primary->values.row(NearestRow(*accel->primary, poses_[k].t));
-    const Eigen::Vector3d omega_imu = w_row.segment<3>(gyro->column).transpose();
-    const Eigen::Vector3d f_imu = f_row.segment<3>(accel->column).transpose();
-    B += gyro_weight * omega_body * omega_imu.transpose() + accel_weight * f_body * f_imu.transpose();
-    const Eigen::Vector2d f_xy = f_body.head<2>();
-    horizontal.topLeftCorner<2, 2>() += f_xy * f_xy.transpose();
+    omega_imu.push_back(w_row.segment<3>(gyro->column).transpose());
+    f_imu.push_back(f_row.segment<3>(accel->column).transpose());
   }
+  // A rotation keeps a vector's length: a pair whose lengths disagree far beyond the spread of the others holds an
+  // outlier (a master reading off by a few ticks puts a spike of tens of m/s^2 into the dead-reckoned acceleration
+  // at its pose) and would turn the fit towards itself. Left out.
+  const std::vector<bool> gyro_kept = ConsistentLengths(omega_body, omega_imu);
+  const std::vector<bool> accel_kept = ConsistentLengths(f_body, f_imu);
+  Eigen::Matrix3d B = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d horizontal = Eigen::Matrix3d::Zero();  // spread of the body-frame specific force off its mean axis
+  double samples = 0.0;
+  for (std::size_t i = 0; i < f_body.size(); ++i) {
+    if (gyro_kept[i]) B += gyro_weight * omega_body[i] * omega_imu[i].transpose();
+    if (!accel_kept[i]) continue;
+    B += accel_weight * f_body[i] * f_imu[i].transpose();
+    const Eigen::Vector2d f_xy = f_body[i].head<2>();
+    horizontal.topLeftCorner<2, 2>() += f_xy * f_xy.transpose();
+    samples += 1.0;
+  }
+  if (samples < 1.0) return std::nullopt;
   // Two axes are needed: gravity, and some horizontal acceleration (forward or sideways) in the body frame.
-  const double samples = static_cast<double>(poses_.size() - 2);
   if (horizontal.trace() / samples < 0.05 * 0.05) return std::nullopt;  // under 0.05 m/s^2 rms
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(B, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d D = Eigen::Matrix3d::Identity();

@@ -139,6 +139,8 @@ class ProblemBuilder {
   // loss) instead, the run's factors switched off and marked replaced. The stream's rejected count grows by the
   // run's active factors less one. Returns the bridge's id; nullopt (nothing changed) when the run does not chain.
   std::optional<FactorId> BridgeCumulativeRun(const std::vector<FactorId>& run);
+  // The factor that BridgeCumulativeRun would add, not added (to test it first).
+  std::optional<FactorEntry> CumulativeBridge(const std::vector<FactorId>& run) const;
 
   // Absolute position fixes (GPS, absolute pose) as (pose, measured position in W), for initial alignment.
   const std::vector<std::pair<VariableId, Eigen::Vector3d>>& absolute_fixes() const { return absolute_fixes_; }
