@@ -104,10 +104,10 @@ constexpr std::size_t kMaxBridgedReadings = 3;
 // from its start: the bridge over the fewest readings (1 to kMaxBridgedReadings) that passes the test at the current
 // estimate replaces the spans it covers; its poses are not those the reading bent, so its test is not fooled by the
 // bend. Spans no passing bridge covers (a skid) are left to the gate. Returns the factors bridged; adds the readings
-// left out to *readings.
+// left out to *readings and each bridged run to *runs.
 std::set<FactorId> BridgeFailingRuns(const std::vector<TestedFactor>& tested,
                                      const std::function<double(int)>& threshold, ProblemBuilder* builder,
-                                     int* readings) {
+                                     int* readings, std::vector<std::vector<FactorId>>* runs) {
   std::map<FactorId, bool> failing_now;  // tested spans: id -> fails
   for (const TestedFactor& t : tested) failing_now[t.id] = !t.pass;
   // The unreplaced spans of every cumulative stream, by (stream, first row).
@@ -133,6 +133,7 @@ std::set<FactorId> BridgeFailingRuns(const std::vector<TestedFactor>& tested,
         const std::optional<FactorEntry> candidate = builder->CumulativeBridge(spans);
         if (candidate && passes(*candidate) && builder->BridgeCumulativeRun(spans)) {
           bridged.insert(spans.begin(), spans.end());
+          runs->push_back(spans);
           skipped = w;
         }
       }
@@ -161,6 +162,28 @@ std::set<FactorId> BridgeFailingRuns(const std::vector<TestedFactor>& tested,
   }
   close_run();
   return bridged;
+}
+
+// The poses inside a bridged run (those of the readings left out), each set between the run's end poses at its time
+// (position linear, rotation along the geodesic): where the bent estimate had them, the left-out reading still pulled
+// them off. Returns them.
+std::vector<VariableId> UnbendBridgedPoses(const std::vector<FactorId>& run, Graph* graph) {
+  const VariableId a_id = graph->factor(run.front()).variables[0];
+  const VariableId b_id = graph->factor(run.back()).variables[1];
+  const Pose<double> a = PoseFromArray(graph->variable(a_id).value.data());
+  const Pose<double> b = PoseFromArray(graph->variable(b_id).value.data());
+  const Time t_a = *graph->variable(a_id).stamp, t_b = *graph->variable(b_id).stamp;
+  std::vector<VariableId> inside;
+  for (std::size_t i = 0; i + 1 < run.size(); ++i) {
+    const VariableId id = graph->factor(run[i]).variables[1];
+    Variable& pose = graph->mutable_variable(id);
+    const double w = SecondsBetween(t_a, *pose.stamp) / SecondsBetween(t_a, t_b);
+    const Pose<double> between{a.p_world_body + w * (b.p_world_body - a.p_world_body),
+                               a.q_world_body.slerp(w, b.q_world_body)};
+    PoseToArray(between, pose.value.data());
+    inside.push_back(id);
+  }
+  return inside;
 }
 
 }  // namespace
@@ -218,7 +241,23 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
   }
   const int tested = static_cast<int>(tested_factors.size());
   // A reading of a cumulative wheel stream that fails both spans it joins is left out, not both spans.
-  const std::set<FactorId> bridged = BridgeFailingRuns(tested_factors, threshold, builder, &result.bridged);
+  std::vector<std::vector<FactorId>> runs;
+  const std::set<FactorId> bridged = BridgeFailingRuns(tested_factors, threshold, builder, &result.bridged, &runs);
+  // The poses of the readings left out go back between their neighbours, and their measurements rejected before (as
+  // that reading bent them) are re-admitted where they fit there.
+  std::set<FactorId> refit;
+  for (const std::vector<FactorId>& run : runs)
+    for (const VariableId pose : UnbendBridgedPoses(run, &graph))
+      for (const FactorId id : graph.FactorsOf(pose)) {
+        const FactorEntry& entry = graph.factor(id);
+        if (entry.active || builder->StreamOfFactor(id) < 0 || bridged.count(id) > 0) continue;
+        if (const auto span = spans.find(id); span != spans.end() && span->second.replaced) continue;
+        values.clear();
+        for (VariableId v : entry.variables) values.push_back(graph.variable(v).value.data());
+        if (internal::LinearizeFactorAt(entry, values.data(), 0, &wf) &&
+            wf.squared_norm <= threshold(entry.factor->residual_dim()))
+          refit.insert(id);
+      }
   // The other measurements of the poses a bridged reading bent wait for the re-solve without it: failing there now,
   // they would be rejected with it and leave those poses held by nothing, where they stay bent.
   std::set<VariableId> bent_poses;
@@ -231,6 +270,7 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
     return std::any_of(vars.begin(), vars.end(), [&](VariableId v) { return bent_poses.count(v) > 0; });
   };
   for (const TestedFactor& t : tested_factors) {
+    if (refit.count(t.id) > 0) continue;
     if (bridged.count(t.id) > 0 || (!t.pass && !bent_poses.empty() && at_bent_pose(t.id))) continue;
     if (options.ignore_chance_changes && !t.pass && t.active) failing.push_back({t.squared_norm, t.dim});
     if (bursts)
@@ -248,6 +288,10 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
       for (std::size_t k = 0; k < r.size(); ++k)
         if ((r[k].pass && !reject[k]) != r[k].was_active) switched.push_back(r[k].id);
     }
+    std::sort(switched.begin(), switched.end());
+  }
+  if (!refit.empty()) {
+    switched.insert(switched.end(), refit.begin(), refit.end());
     std::sort(switched.begin(), switched.end());
   }
   if (!failing_factors.empty()) {
