@@ -419,9 +419,10 @@ TEST(GateOutliersTest, ScatteredOutliersAreNotABurst) {
   EXPECT_EQ(rejected, static_cast<int>(corrupted.size()));
 }
 
-// A differential drive's wheel angles are cumulative: one reading off by 0.05 rad makes the span before it 1 rad/s
-// (50 sigma) too fast and the one after it as much too slow. The gate leaves that one reading out (a bridge over the
-// two spans), not the two spans, and the bridge fits at the next pass.
+// A differential drive's wheel angles are cumulative: one reading off by 0.5 rad makes the span before it 10 rad/s
+// (20 sigma) too fast and the one after it as much too slow, and the motion capture (0.1 mm) holds the pose between
+// them. The gate leaves that one reading out (a bridge over the two spans), not the two spans, and the bridge fits at
+// the next pass.
 TEST(GateOutliersTest, AnOutlyingCumulativeReadingIsBridgedNotItsTwoSpansRejected) {
   constexpr double kRadius = 0.04, kTrack = 0.2, kDt = 0.05;
   constexpr int kSamples = 60, kBad = 30;
@@ -450,7 +451,7 @@ TEST(GateOutliersTest, AnOutlyingCumulativeReadingIsBridgedNotItsTwoSpansRejecte
     p += v * kDt * Eigen::Vector2d(std::cos(yaw + 0.5 * omega * kDt), std::sin(yaw + 0.5 * omega * kDt));
     yaw += omega * kDt;
   }
-  enc.values.row(kBad) += Eigen::RowVector2d(0.05, 0.05);
+  enc.values.row(kBad) += Eigen::RowVector2d(0.5, 0.5);
   rec.streams = {enc, mocap};
   auto config = ParseEstimatorConfig(R"(
 master: wheels
@@ -461,12 +462,12 @@ streams:
   wheels:
     model: differential_drive
     source: wheels
-    noise: {wheel_radps: 0.02, lateral_mps: 0.002, vertical_mps: 0.002, tilt_radps: 0.02}
+    noise: {wheel_radps: 0.5, lateral_mps: 0.002, vertical_mps: 0.002, tilt_radps: 0.02}
     parameters: {radius_left: wheels.radius, radius_right: wheels.radius, baseline: wheels.baseline}
   mocap:
     model: absolute_pose
     source: mocap
-    noise: {position_m: 0.001, orientation_rad: 0.003}
+    noise: {position_m: 0.0001, orientation_rad: 0.001}
 )",
                                      "test config");
   ASSERT_TRUE(config.ok()) << config.status().message();
@@ -489,7 +490,9 @@ streams:
   }
   EXPECT_EQ(bridges, 1);
   for (const auto& [id, entry] : builder->graph().factors()) {
-    if (entry.stream == "mocap") EXPECT_TRUE(entry.active) << "mocap at " << entry.stamp.seconds();
+    if (entry.stream == "mocap") {
+      EXPECT_TRUE(entry.active) << "mocap at " << entry.stamp.seconds();
+    }
   }
   ASSERT_TRUE(Solve(config.value().solver, &builder->graph()).usable());
   EXPECT_EQ(GateOutliers(0.99999, builder.get()).switched(), 0);
