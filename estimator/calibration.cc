@@ -4,7 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstddef>
 #include <deque>
+#include <functional>
 #include <limits>
 #include <map>
 #include <set>
@@ -81,6 +83,109 @@ std::vector<FactorId> WorstPerPose(const std::vector<FailingFactor>& failing, co
   return out;
 }
 
+// One measurement factor as a gating pass tested it.
+struct TestedFactor {
+  FactorId id;
+  int stream;
+  bool active;
+  bool pass;            // within the quantile
+  double squared_norm;  // its whitened squared error (infinite where it could not be evaluated)
+  int dim;
+};
+
+// A bridge leaves out at most this many consecutive readings: one outlying reading fails the two spans it joins, two
+// consecutive ones three spans.
+constexpr std::size_t kMaxBridgedReadings = 3;
+
+// Bridges (ProblemBuilder::BridgeCumulativeRun) over outlying readings of cumulative wheel streams. A reading off by
+// delta makes the span before it delta / dt too fast and the one after it delta / dt too slow; tested alone, each
+// span fails and is rejected, and the poses around the reading lose both. In each run of consecutive failing spans
+// (tested now and failing, or older than the pass's first factor and rejected before; at least one tested now),
+// from its start: the bridge over the fewest readings (1 to kMaxBridgedReadings) that passes the test at the current
+// estimate replaces the spans it covers; its poses are not those the reading bent, so its test is not fooled by the
+// bend. Spans no passing bridge covers (a skid) are left to the gate. Returns the factors bridged; adds the readings
+// left out to *readings and each bridged run to *runs.
+std::set<FactorId> BridgeFailingRuns(const std::vector<TestedFactor>& tested,
+                                     const std::function<double(int)>& threshold, ProblemBuilder* builder,
+                                     int* readings, std::vector<std::vector<FactorId>>* runs) {
+  std::map<FactorId, bool> failing_now;  // tested spans: id -> fails
+  for (const TestedFactor& t : tested) failing_now[t.id] = !t.pass;
+  // The unreplaced spans of every cumulative stream, by (stream, first row).
+  std::map<std::pair<int, int>, FactorId> by_row;
+  for (const auto& [id, span] : builder->cumulative_spans())
+    if (!span.bridge && !span.replaced && builder->graph().factors().count(id) > 0)
+      by_row[{span.stream, span.row_begin}] = id;
+  std::set<FactorId> bridged;
+  std::vector<const double*> values;
+  internal::WhitenedFactor wf;
+  const auto passes = [&](const FactorEntry& entry) {
+    values.clear();
+    for (VariableId v : entry.variables) values.push_back(builder->graph().variable(v).value.data());
+    return internal::LinearizeFactorAt(entry, values.data(), 0, &wf) &&
+           wf.squared_norm <= threshold(entry.factor->residual_dim());
+  };
+  const auto bridge_run = [&](const std::vector<FactorId>& run) {
+    for (std::size_t i = 0; i + 1 < run.size();) {
+      std::size_t skipped = 0;
+      for (std::size_t w = 1; w <= kMaxBridgedReadings && i + w < run.size() && skipped == 0; ++w) {
+        const std::vector<FactorId> spans(run.begin() + static_cast<std::ptrdiff_t>(i),
+                                          run.begin() + static_cast<std::ptrdiff_t>(i + w + 1));
+        const std::optional<FactorEntry> candidate = builder->CumulativeBridge(spans);
+        if (candidate && passes(*candidate) && builder->BridgeCumulativeRun(spans)) {
+          bridged.insert(spans.begin(), spans.end());
+          runs->push_back(spans);
+          skipped = w;
+        }
+      }
+      *readings += static_cast<int>(skipped);
+      i += skipped > 0 ? skipped + 1 : 1;
+    }
+  };
+  std::vector<FactorId> run;
+  bool tested_in_run = false;
+  const auto close_run = [&] {
+    if (run.size() >= 2 && tested_in_run) bridge_run(run);
+    run.clear();
+    tested_in_run = false;
+  };
+  int last_stream = -1, last_end = -1;
+  for (const auto& [key, id] : by_row) {
+    const auto now = failing_now.find(id);
+    const bool bad = now != failing_now.end() ? now->second : !builder->graph().factor(id).active;
+    if (!bad || key.first != last_stream || key.second != last_end) close_run();
+    if (bad) {
+      run.push_back(id);
+      tested_in_run |= now != failing_now.end();
+    }
+    last_stream = key.first;
+    last_end = builder->cumulative_spans().at(id).row_end;
+  }
+  close_run();
+  return bridged;
+}
+
+// The poses inside a bridged run (those of the readings left out), each set between the run's end poses at its time
+// (position linear, rotation along the geodesic): where the bent estimate had them, the left-out reading still pulled
+// them off. Returns them.
+std::vector<VariableId> UnbendBridgedPoses(const std::vector<FactorId>& run, Graph* graph) {
+  const VariableId a_id = graph->factor(run.front()).variables[0];
+  const VariableId b_id = graph->factor(run.back()).variables[1];
+  const Pose<double> a = PoseFromArray(graph->variable(a_id).value.data());
+  const Pose<double> b = PoseFromArray(graph->variable(b_id).value.data());
+  const Time t_a = *graph->variable(a_id).stamp, t_b = *graph->variable(b_id).stamp;
+  std::vector<VariableId> inside;
+  for (std::size_t i = 0; i + 1 < run.size(); ++i) {
+    const VariableId id = graph->factor(run[i]).variables[1];
+    Variable& pose = graph->mutable_variable(id);
+    const double w = SecondsBetween(t_a, *pose.stamp) / SecondsBetween(t_a, t_b);
+    const Pose<double> between{a.p_world_body + w * (b.p_world_body - a.p_world_body),
+                               a.q_world_body.slerp(w, b.q_world_body)};
+    PoseToArray(between, pose.value.data());
+    inside.push_back(id);
+  }
+  return inside;
+}
+
 }  // namespace
 
 GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId first,
@@ -95,7 +200,7 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
   };
   // One walk over the measurement factors and the graph's factors in id order (a whole recording's 10^5-10^6).
   std::vector<FactorId> switched;
-  long tested = 0;
+  GateSwitches result;
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
   std::vector<std::pair<double, int>> failing;  // (ignore_chance_changes) squared norm and dimension of each active
                                                 // factor that fails
@@ -104,6 +209,8 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
   std::vector<std::vector<GateRow>> rows(bursts ? builder->stream_names().size() : 0);  // per stream, in time order
   std::vector<const double*> values;
   internal::WhitenedFactor wf;  // reused: its buffers keep their size
+  std::vector<TestedFactor> tested_factors;
+  const std::map<FactorId, ProblemBuilder::CumulativeSpan>& spans = builder->cumulative_spans();
   auto factor = graph.factors().lower_bound(first);
   for (auto stream = builder->factor_streams().lower_bound(first); stream != builder->factor_streams().end();
        ++stream) {
@@ -111,6 +218,7 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
     while (factor != graph.factors().end() && factor->first < id) ++factor;
     if (factor == graph.factors().end()) break;
     if (factor->first != id) continue;  // (no longer in the graph)
+    if (const auto span = spans.find(id); span != spans.end() && span->second.replaced) continue;
     const FactorEntry& entry = factor->second;
     const int dim = entry.factor->residual_dim();
     // The solve's linearization (of an active factor, with the Jacobians of its free variables), else the error.
@@ -128,16 +236,49 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
       ok = internal::LinearizeFactorAt(entry, values.data(), 0, &wf);
       linearized = &wf;
     }
-    const bool pass = ok && linearized->squared_norm <= threshold(dim);
-    ++tested;
-    if (options.ignore_chance_changes && !pass && entry.active)
-      failing.push_back({ok ? linearized->squared_norm : kInfinity, dim});
+    tested_factors.push_back({id, stream->second, entry.active, ok && linearized->squared_norm <= threshold(dim),
+                              ok ? linearized->squared_norm : kInfinity, dim});
+  }
+  const int tested = static_cast<int>(tested_factors.size());
+  // A reading of a cumulative wheel stream that fails both spans it joins is left out, not both spans.
+  std::vector<std::vector<FactorId>> runs;
+  const std::set<FactorId> bridged = BridgeFailingRuns(tested_factors, threshold, builder, &result.bridged, &runs);
+  // The poses of the readings left out go back between their neighbours, and their measurements rejected before (as
+  // that reading bent them) are re-admitted where they fit there.
+  std::set<FactorId> refit;
+  for (const std::vector<FactorId>& run : runs)
+    for (const VariableId pose : UnbendBridgedPoses(run, &graph))
+      for (const FactorId id : graph.FactorsOf(pose)) {
+        const FactorEntry& entry = graph.factor(id);
+        if (entry.active || builder->StreamOfFactor(id) < 0 || bridged.count(id) > 0) continue;
+        if (const auto span = spans.find(id); span != spans.end() && span->second.replaced) continue;
+        values.clear();
+        for (VariableId v : entry.variables) values.push_back(graph.variable(v).value.data());
+        if (internal::LinearizeFactorAt(entry, values.data(), 0, &wf) &&
+            wf.squared_norm <= threshold(entry.factor->residual_dim()))
+          refit.insert(id);
+      }
+  // The other measurements of the poses a bridged reading bent wait for the re-solve without it: failing there now,
+  // they would be rejected with it and leave those poses held by nothing, where they stay bent.
+  std::set<VariableId> bent_poses;
+  for (const FactorId id : bridged) {
+    const std::vector<VariableId>& vars = graph.factor(id).variables;
+    bent_poses.insert(vars.begin(), vars.begin() + 2);
+  }
+  const auto at_bent_pose = [&](FactorId id) {
+    const std::vector<VariableId>& vars = graph.factor(id).variables;
+    return std::any_of(vars.begin(), vars.end(), [&](VariableId v) { return bent_poses.count(v) > 0; });
+  };
+  for (const TestedFactor& t : tested_factors) {
+    if (refit.count(t.id) > 0) continue;
+    if (bridged.count(t.id) > 0 || (!t.pass && !bent_poses.empty() && at_bent_pose(t.id))) continue;
+    if (options.ignore_chance_changes && !t.pass && t.active) failing.push_back({t.squared_norm, t.dim});
     if (bursts)
-      rows[stream->second].push_back({id, entry.active, pass});
-    else if (options.worst_per_pose && !pass && entry.active)
-      failing_factors.push_back({id, ok ? linearized->squared_norm / threshold(dim) : kInfinity});
-    else if (pass != entry.active)
-      switched.push_back(id);
+      rows[t.stream].push_back({t.id, t.active, t.pass});
+    else if (options.worst_per_pose && !t.pass && t.active)
+      failing_factors.push_back({t.id, t.squared_norm / threshold(t.dim)});
+    else if (t.pass != t.active)
+      switched.push_back(t.id);
   }
   if (bursts) {
     std::vector<char> reject;
@@ -149,6 +290,10 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
     }
     std::sort(switched.begin(), switched.end());
   }
+  if (!refit.empty()) {
+    switched.insert(switched.end(), refit.begin(), refit.end());
+    std::sort(switched.begin(), switched.end());
+  }
   if (!failing_factors.empty()) {
     const std::vector<FactorId> worst = WorstPerPose(failing_factors, graph, builder->poses());
     switched.insert(switched.end(), worst.begin(), worst.end());
@@ -158,7 +303,6 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
   // the quantile that all of them pass with the test's probability (1 - (1 - p) / N each): a gross outlier is rejected
   // however few there are. The factors that fit again are re-admitted, unless they and the failing ones together are
   // no more than the false alarms either.
-  GateSwitches result;
   for (FactorId id : switched) (graph.factor(id).active ? result.rejected : result.readmitted) += 1;
   const double false_alarms = static_cast<double>(tested) * (1.0 - probability);
   const bool by_chance =
@@ -293,6 +437,7 @@ Result<StageSummary> SolveStage(const EstimatorConfig& config, const Calibration
     const Status solved =
         resolve("gating round " + std::to_string(round + 1) + ": " + std::to_string(changed.rejected) +
                 " measurements rejected, " + std::to_string(changed.readmitted) + " re-admitted" +
+                (changed.bridged > 0 ? ", " + std::to_string(changed.bridged) + " wheel readings bridged" : "") +
                 (changed.ignored > 0 ? ", " + std::to_string(changed.ignored) + " failing by chance" : "") +
                 ", re-solved");
     if (!solved.ok()) return solved;

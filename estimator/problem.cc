@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <functional>
 #include <limits>
 #include <set>
+#include <vector>
 
 #include "common/check.h"
 #include "estimator/factor.h"
@@ -46,6 +48,28 @@ constexpr double kReadingRateHalfWindow = 0.3;
 // what a ground vehicle turns, rolls or pitches at, so that on the axes the master measures (yaw, for an odometer) it
 // adds a few percent of their information at most.
 constexpr double kGapBridgeRateSigma = 3.0;
+
+// Which pairs (a_i, b_i) have lengths that agree: |a_i| - |b_i| within kLengthOutlierScale robust standard
+// deviations (1.4826 times the median absolute deviation) of the median difference, or within 1e-9 of it when the
+// spread is nil.
+constexpr double kLengthOutlierScale = 5.0;
+std::vector<bool> ConsistentLengths(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
+  std::vector<double> d(a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) d[i] = a[i].norm() - b[i].norm();
+  const auto median = [](std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+    std::nth_element(v.begin(), mid, v.end());
+    return *mid;
+  };
+  const double centre = median(d);
+  std::vector<double> deviation(d.size());
+  for (std::size_t i = 0; i < d.size(); ++i) deviation[i] = std::abs(d[i] - centre);
+  const double bound = std::max(kLengthOutlierScale * 1.4826 * median(deviation), 1e-9);
+  std::vector<bool> kept(d.size());
+  for (std::size_t i = 0; i < d.size(); ++i) kept[i] = deviation[i] <= bound;
+  return kept;
+}
 
 }  // namespace
 
@@ -104,31 +128,62 @@ double SteeringAt(const recording::Stream& s, Time t) {
   return (1.0 - w) * s.values(i - 1, 0) + w * s.values(i, 0);
 }
 
-// Mean wheel rates [rad/s] over [t_row, t_row+1] from cumulative wheel angles; nullopt for the last row.
-std::optional<Eigen::VectorXd> WheelRates(const recording::Stream& s, int row) {
-  if (row + 1 >= static_cast<int>(s.t.size())) return std::nullopt;
-  const double dt = SecondsBetween(s.t[row], s.t[row + 1]);
-  return Eigen::VectorXd((s.values.row(row + 1) - s.values.row(row)).transpose() / dt);
+// Mean wheel rates [rad/s] over [t_a, t_b] from the cumulative wheel angles of rows a < b; nullopt past the last row.
+std::optional<Eigen::VectorXd> WheelRates(const recording::Stream& s, int row_a, int row_b) {
+  if (row_b >= static_cast<int>(s.t.size())) return std::nullopt;
+  const double dt = SecondsBetween(s.t[row_a], s.t[row_b]);
+  return Eigen::VectorXd((s.values.row(row_b) - s.values.row(row_a)).transpose() / dt);
 }
 
-// A tricycle's steering angle over [t_row, t_row+1] of its wheel stream: the mean of the interval's ends.
-double IntervalSteering(const StreamBinding& s, int row) {
-  return 0.5 * (SteeringAt(*s.steering, s.primary->t[row]) + SteeringAt(*s.steering, s.primary->t[row + 1]));
+// The same over [t_row, t_row+1].
+std::optional<Eigen::VectorXd> WheelRates(const recording::Stream& s, int row) { return WheelRates(s, row, row + 1); }
+
+// A tricycle's steering angle over [t_a, t_b] of its wheel stream: the mean of the interval's ends.
+double IntervalSteering(const StreamBinding& s, int row_a, int row_b) {
+  return 0.5 * (SteeringAt(*s.steering, s.primary->t[row_a]) + SteeringAt(*s.steering, s.primary->t[row_b]));
 }
 
-// A differential drive's (left, right) wheel rates, whatever the order of the stream's columns.
-std::optional<Eigen::VectorXd> LeftRightRates(const StreamBinding& s, int row) {
-  std::optional<Eigen::VectorXd> rates = WheelRates(*s.primary, row);
+// A differential drive's (left, right) wheel rates over [t_a, t_b], whatever the order of the stream's columns.
+std::optional<Eigen::VectorXd> LeftRightRates(const StreamBinding& s, int row_a, int row_b) {
+  std::optional<Eigen::VectorXd> rates = WheelRates(*s.primary, row_a, row_b);
   if (rates && s.right_then_left) std::swap((*rates)[0], (*rates)[1]);
   return rates;
 }
 
-// The (C, S) deformation harmonics of the left and right wheels over [t_row, t_row+1] (models/differential_drive.h).
-std::pair<Eigen::Vector2d, Eigen::Vector2d> LeftRightHarmonics(const StreamBinding& s, int row) {
+// The (C, S) deformation harmonics of the left and right wheels over [t_a, t_b] (models/differential_drive.h).
+std::pair<Eigen::Vector2d, Eigen::Vector2d> LeftRightHarmonics(const StreamBinding& s, int row_a, int row_b) {
   const Eigen::MatrixXd& angles = s.primary->values;
   const int left = s.right_then_left ? 1 : 0, right = 1 - left;
-  return {DifferentialDriveError::DeformationHarmonics(angles(row, left), angles(row + 1, left)),
-          DifferentialDriveError::DeformationHarmonics(angles(row, right), angles(row + 1, right))};
+  return {DifferentialDriveError::DeformationHarmonics(angles(row_a, left), angles(row_b, left)),
+          DifferentialDriveError::DeformationHarmonics(angles(row_a, right), angles(row_b, right))};
+}
+
+// The calibration slots that a cumulative wheel model's factor joins after its two poses (the first n of the
+// stream's slots); 0 for a model whose readings are not cumulative wheel angles.
+std::size_t CumulativeSlotCount(const std::string& model) {
+  if (model == "differential_drive") return 6;
+  if (model == "tricycle_drive") return 3;
+  if (model == "omni3_drive") return 4;
+  if (model == "omni4_drive" || model == "mecanum_drive") return 5;
+  return 0;
+}
+
+// The factor of a cumulative wheel stream between its rows a < b, whose poses are dt_s apart: the mean wheel rates
+// over the span; null past the last row.
+std::unique_ptr<Factor> CumulativeFactor(const StreamBinding& s, int row_a, int row_b, double dt_s) {
+  const std::string& model = s.config.model;
+  if (model == "differential_drive") {
+    const auto rates = LeftRightRates(s, row_a, row_b);
+    if (!rates) return nullptr;
+    const auto [harmonics_left, harmonics_right] = LeftRightHarmonics(s, row_a, row_b);
+    return MakeFactor(DifferentialDriveError((*rates)[0], (*rates)[1], dt_s, harmonics_left, harmonics_right));
+  }
+  const auto rates = WheelRates(*s.primary, row_a, row_b);
+  if (!rates) return nullptr;
+  if (model == "tricycle_drive") return MakeFactor(TricycleDriveError((*rates)[0], IntervalSteering(s, row_a, row_b), dt_s));
+  if (model == "omni3_drive") return MakeFactor(Omni3DriveError(*rates, dt_s));
+  if (model == "omni4_drive") return MakeFactor(Omni4DriveError(*rates, dt_s));
+  return MakeFactor(MecanumDriveError(*rates, dt_s));
 }
 
 // The specific force [m/s^2] of a stream's inputs.specific_force at time t: linear interpolation between the
@@ -323,7 +378,7 @@ void ProblemBuilder::AddMasterSample(const MeasurementRef& m) {
     v_body.x() = kv_over_l * s.wheelbase_m * z_v;
     omega_body.z() = kv_over_l * z_v * std::tan(k_theta * SteeringAt(*s.steering, odo.t) + k_gamma);
   } else if (s.config.model == "differential_drive") {
-    if (const auto rates = LeftRightRates(s, odo.row)) {
+    if (const auto rates = LeftRightRates(s, odo.row, odo.row + 1)) {
       DifferentialDriveError::BodyVelocity((*rates)[0], (*rates)[1], value(0)[0], value(1)[0] * value(3)[0],
                                            value(2)[0], &v_body, &omega_body);
     }
@@ -339,7 +394,7 @@ void ProblemBuilder::AddMasterSample(const MeasurementRef& m) {
     }
   } else if (s.config.model == "tricycle_drive") {
     if (const auto rates = WheelRates(*s.primary, odo.row)) {
-      TricycleDriveError::BodyVelocity((*rates)[0], IntervalSteering(s, odo.row), value(0)[0], value(1)[0], value(2)[0],
+      TricycleDriveError::BodyVelocity((*rates)[0], IntervalSteering(s, odo.row, odo.row + 1), value(0)[0], value(1)[0], value(2)[0],
                                        &v_body, &omega_body);
     }
   } else if (s.config.model == "mecanum_drive") {
@@ -423,6 +478,7 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
   const std::string& model = s.config.model;
   std::unique_ptr<Factor> factor;
   std::vector<VariableId> vars;
+  bool cumulative = false;  // a span of a cumulative wheel master stream (cumulative_spans)
   const double dt = k + 1 < poses_.size() ? SecondsBetween(poses_[k].t, poses_[k + 1].t) : 0.0;
   if (model == "ackermann" || model == "ackermann_seed") {
     const double z_v = row[s.column];
@@ -435,39 +491,15 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
     } else {
       factor = MakeFactor(AckermannOdometerError(z_v, z_theta, s.wheelbase_m, dt));
     }
-  } else if (model == "differential_drive") {
-    const auto rates = LeftRightRates(s, m.row);
-    if (!rates) {
+  } else if (const std::size_t slots = CumulativeSlotCount(model); slots > 0) {
+    factor = CumulativeFactor(s, m.row, m.row + 1, dt);
+    if (factor == nullptr) {
       ++counts_[s.name].outside;
       return true;
     }
-    const auto [harmonics_left, harmonics_right] = LeftRightHarmonics(s, m.row);
-    factor = MakeFactor(DifferentialDriveError((*rates)[0], (*rates)[1], dt, harmonics_left, harmonics_right));
-    vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k), slot(3, k), slot(4, k), slot(5, k)};
-  } else if (model == "tricycle_drive") {
-    const auto rates = WheelRates(data, m.row);
-    if (!rates) {
-      ++counts_[s.name].outside;
-      return true;
-    }
-    factor = MakeFactor(TricycleDriveError((*rates)[0], IntervalSteering(s, m.row), dt));
-    vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k)};
-  } else if (model == "omni3_drive" || model == "mecanum_drive" || model == "omni4_drive") {
-    const auto rates = WheelRates(data, m.row);
-    if (!rates) {
-      ++counts_[s.name].outside;
-      return true;
-    }
-    vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k), slot(2, k), slot(3, k)};
-    if (model == "omni3_drive") {
-      factor = MakeFactor(Omni3DriveError(*rates, dt));
-    } else if (model == "omni4_drive") {
-      factor = MakeFactor(Omni4DriveError(*rates, dt));
-      vars.push_back(slot(4, k));
-    } else {
-      factor = MakeFactor(MecanumDriveError(*rates, dt));
-      vars.push_back(slot(4, k));
-    }
+    vars = {poses_[k].id, poses_[k + 1].id};
+    for (std::size_t i = 0; i < slots; ++i) vars.push_back(slot(i, k));
+    cumulative = s.attachment == Attachment::kMaster;
   } else if (model == "odometer") {
     factor = MakeFactor(OdometerError(row.head<6>().transpose(), dt));
     vars = {poses_[k].id, poses_[k + 1].id, slot(0, k), slot(1, k)};
@@ -520,8 +552,59 @@ bool ProblemBuilder::TryAttach(const MeasurementRef& m) {
   if (s.time_offset) vars.push_back(slot(static_cast<std::size_t>(s.time_offset_slot), k));
   const FactorId id = graph_.AddFactor(std::move(factor), vars, s.noise_covariance, s.config.loss, s.name, m.t);
   stream_of_factor_.Add(id, m.stream);
+  if (cumulative) cumulative_spans_[id] = {m.stream, m.row, m.row + 1, false, false};
   ++counts_[s.name].attached;
   return true;
+}
+
+std::optional<FactorEntry> ProblemBuilder::CumulativeBridge(const std::vector<FactorId>& run) const {
+  if (run.empty()) return std::nullopt;
+  std::vector<const CumulativeSpan*> spans;
+  for (std::size_t i = 0; i < run.size(); ++i) {
+    const auto it = cumulative_spans_.find(run[i]);
+    if (it == cumulative_spans_.end() || it->second.replaced || graph_.factors().count(run[i]) == 0)
+      return std::nullopt;
+    spans.push_back(&it->second);
+    if (i > 0 && (spans[i]->stream != spans[0]->stream || spans[i]->row_begin != spans[i - 1]->row_end ||
+                  graph_.factor(run[i]).variables[0] != graph_.factor(run[i - 1]).variables[1]))
+      return std::nullopt;
+  }
+  const StreamBinding& s = impl_->streams[spans[0]->stream];
+  const FactorEntry& first = graph_.factor(run.front());
+  FactorEntry bridge;
+  bridge.variables = first.variables;
+  bridge.variables[1] = graph_.factor(run.back()).variables[1];
+  const Variable& pose_a = graph_.variable(bridge.variables[0]);
+  const Variable& pose_b = graph_.variable(bridge.variables[1]);
+  if (!pose_a.stamp || !pose_b.stamp) return std::nullopt;
+  bridge.factor = CumulativeFactor(s, spans.front()->row_begin, spans.back()->row_end,
+                                   SecondsBetween(*pose_a.stamp, *pose_b.stamp));
+  if (bridge.factor == nullptr) return std::nullopt;
+  bridge.noise = first.noise;
+  bridge.loss = first.loss;
+  bridge.stream = first.stream;
+  bridge.stamp = first.stamp;
+  return bridge;
+}
+
+std::optional<FactorId> ProblemBuilder::BridgeCumulativeRun(const std::vector<FactorId>& run) {
+  std::optional<FactorEntry> bridge = CumulativeBridge(run);
+  if (!bridge) return std::nullopt;
+  const CumulativeSpan& first = cumulative_spans_.at(run.front());
+  const CumulativeSpan span{first.stream, first.row_begin, cumulative_spans_.at(run.back()).row_end, true, false};
+  const FactorId id = graph_.AddFactor(std::move(bridge->factor), bridge->variables, bridge->noise->covariance,
+                                       bridge->loss, bridge->stream, bridge->stamp);
+  stream_of_factor_.Add(id, span.stream);
+  cumulative_spans_[id] = span;
+  int& rejected = counts_[bridge->stream].rejected;
+  --rejected;
+  for (const FactorId f : run) {
+    FactorEntry& entry = graph_.mutable_factor(f);
+    if (entry.active) ++rejected;
+    entry.active = false;
+    cumulative_spans_[f].replaced = true;
+  }
+  return id;
 }
 
 bool ProblemBuilder::AttachUserSample(const MeasurementRef& m, std::size_t k) {
@@ -626,6 +709,8 @@ void ProblemBuilder::PopOldestPose() {
   // keep every entry.)
   while (!stream_of_factor_.empty() && graph_.factors().count(stream_of_factor_.begin()->first) == 0)
     stream_of_factor_.Erase(stream_of_factor_.begin()->first);
+  for (auto it = cumulative_spans_.begin(); it != cumulative_spans_.end();)
+    it = graph_.factors().count(it->first) == 0 ? cumulative_spans_.erase(it) : std::next(it);
   absolute_fixes_.erase(std::remove_if(absolute_fixes_.begin(), absolute_fixes_.end(),
                                        [this](const auto& fix) { return !graph_.HasVariable(fix.first); }),
                         absolute_fixes_.end());
@@ -724,8 +809,8 @@ std::optional<Eigen::Quaterniond> ProblemBuilder::AlignImuToMotion() {
   const double gyro_weight = 1.0 / gyro->noise_covariance(0, 0);
   const double accel_weight = 1.0 / accel->noise_covariance(0, 0);
   const Eigen::Vector3d g_world(0.0, 0.0, kStandardGravity);
-  Eigen::Matrix3d B = Eigen::Matrix3d::Zero();
-  Eigen::Matrix3d horizontal = Eigen::Matrix3d::Zero();  // spread of the body-frame specific force off its mean axis
+  // Pairs of body-frame vectors from the poses and the IMU's readings at each inner pose.
+  std::vector<Eigen::Vector3d> omega_body, omega_imu, f_body, f_imu;
   for (std::size_t k = 1; k + 1 < poses_.size(); ++k) {
     const Pose<double> a = PoseFromArray(graph_.variable(poses_[k - 1].id).value.data());
     const Pose<double> b = PoseFromArray(graph_.variable(poses_[k].id).value.data());
@@ -734,20 +819,31 @@ std::optional<Eigen::Quaterniond> ProblemBuilder::AlignImuToMotion() {
     const double dt_bc = SecondsBetween(poses_[k].t, poses_[k + 1].t);
     const Eigen::Vector3d accel_world =
         2.0 * ((c.p_world_body - b.p_world_body) / dt_bc - (b.p_world_body - a.p_world_body) / dt_ab) / (dt_ab + dt_bc);
-    const Eigen::Matrix3d R_T = b.q_world_body.toRotationMatrix().transpose();
-    const Eigen::Vector3d f_body = R_T * (accel_world + g_world);
-    const Eigen::Vector3d omega_body =
-        QuaternionLog<double>(a.q_world_body.conjugate() * c.q_world_body) / (dt_ab + dt_bc);
+    f_body.push_back(b.q_world_body.conjugate() * (accel_world + g_world));
+    omega_body.push_back(QuaternionLog<double>(a.q_world_body.conjugate() * c.q_world_body) / (dt_ab + dt_bc));
     const Eigen::RowVectorXd w_row = gyro->primary->values.row(NearestRow(*gyro->primary, poses_[k].t));
     const Eigen::RowVectorXd f_row = accel->primary->values.row(NearestRow(*accel->primary, poses_[k].t));
-    const Eigen::Vector3d omega_imu = w_row.segment<3>(gyro->column).transpose();
-    const Eigen::Vector3d f_imu = f_row.segment<3>(accel->column).transpose();
-    B += gyro_weight * omega_body * omega_imu.transpose() + accel_weight * f_body * f_imu.transpose();
-    const Eigen::Vector2d f_xy = f_body.head<2>();
-    horizontal.topLeftCorner<2, 2>() += f_xy * f_xy.transpose();
+    omega_imu.push_back(w_row.segment<3>(gyro->column).transpose());
+    f_imu.push_back(f_row.segment<3>(accel->column).transpose());
   }
+  // A rotation keeps a vector's length: a pair whose lengths disagree far beyond the spread of the others holds an
+  // outlier (a master reading off by a few ticks puts a spike of tens of m/s^2 into the dead-reckoned acceleration
+  // at its pose) and would turn the fit towards itself. Left out.
+  const std::vector<bool> gyro_kept = ConsistentLengths(omega_body, omega_imu);
+  const std::vector<bool> accel_kept = ConsistentLengths(f_body, f_imu);
+  Eigen::Matrix3d B = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d horizontal = Eigen::Matrix3d::Zero();  // spread of the body-frame specific force off its mean axis
+  double samples = 0.0;
+  for (std::size_t i = 0; i < f_body.size(); ++i) {
+    if (gyro_kept[i]) B += gyro_weight * omega_body[i] * omega_imu[i].transpose();
+    if (!accel_kept[i]) continue;
+    B += accel_weight * f_body[i] * f_imu[i].transpose();
+    const Eigen::Vector2d f_xy = f_body[i].head<2>();
+    horizontal.topLeftCorner<2, 2>() += f_xy * f_xy.transpose();
+    samples += 1.0;
+  }
+  if (samples < 1.0) return std::nullopt;
   // Two axes are needed: gravity, and some horizontal acceleration (forward or sideways) in the body frame.
-  const double samples = static_cast<double>(poses_.size() - 2);
   if (horizontal.trace() / samples < 0.05 * 0.05) return std::nullopt;  // under 0.05 m/s^2 rms
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(B, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d D = Eigen::Matrix3d::Identity();

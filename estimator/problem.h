@@ -121,6 +121,27 @@ class ProblemBuilder {
   // Chi-square dimension of a stream's factors.
   int ResidualDim(const std::string& stream) const;
 
+  // A factor of a cumulative wheel master stream (differential, tricycle, omni and mecanum drives), whose readings
+  // are wheel angles summed since the start: the factor joining the poses of rows row_begin < row_end holds the mean
+  // rates over that span, the difference of the two rows' readings. An outlier in one reading bends both factors
+  // that share it, in opposite directions; a bridge over the rows around it (BridgeCumulativeRun) leaves it out.
+  struct CumulativeSpan {
+    int stream = 0;
+    int row_begin = 0;
+    int row_end = 0;
+    bool bridge = false;    // made by BridgeCumulativeRun
+    bool replaced = false;  // switched off for good, in favour of a bridge over it
+  };
+  // By factor id; entries whose factors have left the graph are dropped with their poses (PopOldestPose).
+  const std::map<FactorId, CumulativeSpan>& cumulative_spans() const { return cumulative_spans_; }
+  // Replaces consecutive spans of one stream (each ending at the row and pose where the next begins), as if the
+  // readings of the rows inside had not been recorded: one active factor over the whole span (the run's noise and
+  // loss) instead, the run's factors switched off and marked replaced. The stream's rejected count grows by the
+  // run's active factors less one. Returns the bridge's id; nullopt (nothing changed) when the run does not chain.
+  std::optional<FactorId> BridgeCumulativeRun(const std::vector<FactorId>& run);
+  // The factor that BridgeCumulativeRun would add, not added (to test it first).
+  std::optional<FactorEntry> CumulativeBridge(const std::vector<FactorId>& run) const;
+
   // Absolute position fixes (GPS, absolute pose) as (pose, measured position in W), for initial alignment.
   const std::vector<std::pair<VariableId, Eigen::Vector3d>>& absolute_fixes() const { return absolute_fixes_; }
   bool has_absolute_sensor() const { return has_absolute_sensor_; }
@@ -189,6 +210,7 @@ class ProblemBuilder {
   bool has_absolute_sensor_ = false;
   bool popped_any_ = false;
   IdTable<int> stream_of_factor_;
+  std::map<FactorId, CumulativeSpan> cumulative_spans_;
 };
 
 }  // namespace roamlab::estimator

@@ -419,6 +419,85 @@ TEST(GateOutliersTest, ScatteredOutliersAreNotABurst) {
   EXPECT_EQ(rejected, static_cast<int>(corrupted.size()));
 }
 
+// A differential drive's wheel angles are cumulative: one reading off by 0.5 rad makes the span before it 10 rad/s
+// (20 sigma) too fast and the one after it as much too slow, and the motion capture (0.1 mm) holds the pose between
+// them. The gate leaves that one reading out (a bridge over the two spans), not the two spans, and the bridge fits at
+// the next pass.
+TEST(GateOutliersTest, AnOutlyingCumulativeReadingIsBridgedNotItsTwoSpansRejected) {
+  constexpr double kRadius = 0.04, kTrack = 0.2, kDt = 0.05;
+  constexpr int kSamples = 60, kBad = 30;
+  recording::Recording rec;
+  rec.platform.kind = "differential_drive";
+  recording::Stream enc, mocap;
+  enc.info.name = "wheels";
+  enc.info.type = recording::StreamType::kWheelEncoders;
+  enc.info.columns = {"left", "right"};
+  enc.info.units = "rad";
+  mocap.info.name = "mocap";
+  mocap.info.type = recording::StreamType::kPose;
+  enc.values.resize(kSamples, 2);
+  mocap.values.resize(kSamples, 7);
+  double yaw = 0.3, left = 0.0, right = 0.0;
+  Eigen::Vector2d p(1.0, -2.0);
+  for (int k = 0; k < kSamples; ++k) {
+    enc.t.push_back(Time::FromSeconds(k * kDt));
+    mocap.t.push_back(Time::FromSeconds(k * kDt));
+    enc.values.row(k) << left, right;
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
+    mocap.values.row(k) << p.x(), p.y(), 0.0, q.x(), q.y(), q.z(), q.w();
+    const double v = 0.1, omega = 0.5;
+    left += (v - 0.5 * omega * kTrack) / kRadius * kDt;
+    right += (v + 0.5 * omega * kTrack) / kRadius * kDt;
+    p += v * kDt * Eigen::Vector2d(std::cos(yaw + 0.5 * omega * kDt), std::sin(yaw + 0.5 * omega * kDt));
+    yaw += omega * kDt;
+  }
+  enc.values.row(kBad) += Eigen::RowVector2d(0.5, 0.5);
+  rec.streams = {enc, mocap};
+  auto config = ParseEstimatorConfig(R"(
+master: wheels
+parameters:
+  wheels.radius: {value: [0.04]}
+  wheels.baseline: {value: [0.2]}
+streams:
+  wheels:
+    model: differential_drive
+    source: wheels
+    noise: {wheel_radps: 0.5, lateral_mps: 0.002, vertical_mps: 0.002, tilt_radps: 0.02}
+    parameters: {radius_left: wheels.radius, radius_right: wheels.radius, baseline: wheels.baseline}
+  mocap:
+    model: absolute_pose
+    source: mocap
+    noise: {position_m: 0.0001, orientation_rad: 0.001}
+)",
+                                     "test config");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  const std::unique_ptr<ProblemBuilder> builder = SolvedProblem(config.value(), rec);
+  const GateSwitches first = GateOutliers(0.99999, builder.get());
+  EXPECT_EQ(first.bridged, 1);
+  EXPECT_EQ(first.rejected, 0);
+  EXPECT_EQ(builder->counts().at("wheels").rejected, 1);
+  int bridges = 0;
+  for (const auto& [id, span] : builder->cumulative_spans()) {
+    if (span.bridge) {
+      ++bridges;
+      EXPECT_EQ(span.row_begin, kBad - 1);
+      EXPECT_EQ(span.row_end, kBad + 1);
+      EXPECT_TRUE(builder->graph().factor(id).active);
+    }
+    const bool around_bad = (span.row_begin == kBad - 1 && span.row_end == kBad) ||
+                            (span.row_begin == kBad && span.row_end == kBad + 1);
+    EXPECT_EQ(span.replaced, around_bad);
+  }
+  EXPECT_EQ(bridges, 1);
+  for (const auto& [id, entry] : builder->graph().factors()) {
+    if (entry.stream == "mocap") {
+      EXPECT_TRUE(entry.active) << "mocap at " << entry.stamp.seconds();
+    }
+  }
+  ASSERT_TRUE(Solve(config.value().solver, &builder->graph()).usable());
+  EXPECT_EQ(GateOutliers(0.99999, builder.get()).switched(), 0);
+}
+
 // A pass that rejects nothing (or only as many factors as chance explains) re-admits the factors that fit again; one
 // with a gross outlier rejects it, whatever else it re-admits.
 TEST(GateOutliersTest, APassReadmitsTheRowsThatFitAndRejectsAGrossOutlier) {
