@@ -2,22 +2,28 @@
 # Builds the libraries and the tests of the parsers, the recording and the estimator core with AddressSanitizer and
 # UndefinedBehaviorSanitizer (clang; any finding fails the test) into BUILD_DIR and runs them (none of them carries the
 # ctest label slow). The build is shared with scripts/fuzz.sh. docs/reliability.md gives the times.
-#   BUILD_DIR  default build-asan
+#   BUILD_DIR  default build-asan (shared with scripts/fuzz.sh); with TESTS=fast build-asan-fast, the whole tree
+#              without the fuzzers' coverage instrumentation
 #   TESTS      the test binaries (space-separated), default the list below; `fast`: the whole tree, and every ctest
 #              test without the label slow or slurm (the fast suite of scripts/run-tests.sh)
 #   JOBS       build and test parallelism, default the number of cores
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-build_dir=${BUILD_DIR:-build-asan}
 default_tests=(common_test recording_test importers_test estimator_test regress_suite_test)
 read -r -a tests <<<"${TESTS:-${default_tests[*]}}"
+fuzz=ON
+build_dir=${BUILD_DIR:-build-asan}
+if [ "${tests[*]}" = fast ]; then
+  fuzz=OFF
+  build_dir=${BUILD_DIR:-build-asan-fast}
+fi
 jobs=${JOBS:-$(nproc)}
 
 command -v clang++ >/dev/null || { echo "roamlab sanitize: clang++ not found (scripts/setup.sh installs clang)" >&2; exit 1; }
 start=$(date +%s)
 CC=clang CXX=clang++ cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DROAMLAB_SANITIZE=ON \
-  -DROAMLAB_FUZZ=ON >/dev/null
+  -DROAMLAB_FUZZ="$fuzz" >/dev/null
 # Leaks are errors; a finding stops the test with its report (ASAN_OPTIONS / UBSAN_OPTIONS).
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:strict_string_checks=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
