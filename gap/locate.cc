@@ -214,7 +214,9 @@ std::vector<LocatedComponent> Locate(const std::vector<estimator::MeasurementRes
 
   std::vector<LocatedComponent> out;
   for (const auto& [stream, components] : series) {
-    for (const auto& [component, s] : components) {
+    for (const auto& component_series : components) {
+      const auto& component = component_series.first;
+      const auto& s = component_series.second;  // a reference, not a binding: the lambda below captures it
       LocatedComponent lc;
       lc.stream = stream;
       lc.component = component;
