@@ -424,35 +424,9 @@ TEST(GateOutliersTest, ScatteredOutliersAreNotABurst) {
 // them. The gate leaves that one reading out (a bridge over the two spans), not the two spans, and the bridge fits at
 // the next pass.
 TEST(GateOutliersTest, AnOutlyingCumulativeReadingIsBridgedNotItsTwoSpansRejected) {
-  constexpr double kRadius = 0.04, kTrack = 0.2, kDt = 0.05;
   constexpr int kSamples = 60, kBad = 30;
-  recording::Recording rec;
-  rec.platform.kind = "differential_drive";
-  recording::Stream enc, mocap;
-  enc.info.name = "wheels";
-  enc.info.type = recording::StreamType::kWheelEncoders;
-  enc.info.columns = {"left", "right"};
-  enc.info.units = "rad";
-  mocap.info.name = "mocap";
-  mocap.info.type = recording::StreamType::kPose;
-  enc.values.resize(kSamples, 2);
-  mocap.values.resize(kSamples, 7);
-  double yaw = 0.3, left = 0.0, right = 0.0;
-  Eigen::Vector2d p(1.0, -2.0);
-  for (int k = 0; k < kSamples; ++k) {
-    enc.t.push_back(Time::FromSeconds(k * kDt));
-    mocap.t.push_back(Time::FromSeconds(k * kDt));
-    enc.values.row(k) << left, right;
-    const Eigen::Quaterniond q(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
-    mocap.values.row(k) << p.x(), p.y(), 0.0, q.x(), q.y(), q.z(), q.w();
-    const double v = 0.1, omega = 0.5;
-    left += (v - 0.5 * omega * kTrack) / kRadius * kDt;
-    right += (v + 0.5 * omega * kTrack) / kRadius * kDt;
-    p += v * kDt * Eigen::Vector2d(std::cos(yaw + 0.5 * omega * kDt), std::sin(yaw + 0.5 * omega * kDt));
-    yaw += omega * kDt;
-  }
-  enc.values.row(kBad) += Eigen::RowVector2d(0.5, 0.5);
-  rec.streams = {enc, mocap};
+  recording::Recording rec = testing::DiffDriveArcWithMotionCapture(kSamples, 0.3, Eigen::Vector2d(1.0, -2.0));
+  rec.streams[0].values.row(kBad) += Eigen::RowVector2d(0.5, 0.5);  // the wheels' cumulative angles
   auto config = ParseEstimatorConfig(R"(
 master: wheels
 parameters:

@@ -1,7 +1,10 @@
 #include "tests/estimator/estimation_testing.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
+
+#include <Eigen/Geometry>
 
 #include <gtest/gtest.h>
 
@@ -55,6 +58,36 @@ EstimatorConfig AtvConfig(const std::vector<std::string>& free, int window) {
   auto config = ParseEstimatorConfig(AtvConfigYaml(free, window), "atv_test.yaml");
   EXPECT_TRUE(config.ok()) << config.status().message();
   return config.value();
+}
+
+recording::Recording DiffDriveArcWithMotionCapture(int samples, double yaw0_rad, const Eigen::Vector2d& start_m) {
+  recording::Recording rec;
+  rec.platform.kind = "differential_drive";
+  recording::Stream enc, mocap;
+  enc.info.name = "wheels";
+  enc.info.type = recording::StreamType::kWheelEncoders;
+  enc.info.columns = {"left", "right"};
+  enc.info.units = "rad";
+  mocap.info.name = "mocap";
+  mocap.info.type = recording::StreamType::kPose;
+  enc.values.resize(samples, 2);
+  mocap.values.resize(samples, 7);
+  double yaw = yaw0_rad, left = 0.0, right = 0.0;
+  Eigen::Vector2d p = start_m;
+  const double v = 0.1, omega = 0.5;
+  for (int k = 0; k < samples; ++k) {
+    enc.t.push_back(Time::FromSeconds(k * kArcDt_s));
+    mocap.t.push_back(Time::FromSeconds(k * kArcDt_s));
+    enc.values.row(k) << left, right;
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
+    mocap.values.row(k) << p.x(), p.y(), 0.0, q.x(), q.y(), q.z(), q.w();
+    left += (v - 0.5 * omega * kArcTrack_m) / kArcRadius_m * kArcDt_s;
+    right += (v + 0.5 * omega * kArcTrack_m) / kArcRadius_m * kArcDt_s;
+    p += v * kArcDt_s * Eigen::Vector2d(std::cos(yaw + 0.5 * omega * kArcDt_s), std::sin(yaw + 0.5 * omega * kArcDt_s));
+    yaw += omega * kArcDt_s;
+  }
+  rec.streams = {enc, mocap};
+  return rec;
 }
 
 }  // namespace roamlab::estimator::testing

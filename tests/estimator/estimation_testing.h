@@ -1,11 +1,15 @@
 // Shared pieces of the end-to-end estimator tests: an estimator configuration for the synthetic ATV recording
-// (tests/support/synthetic.h) with selectable free parameters.
+// (tests/support/synthetic.h) with selectable free parameters, and a short differential-drive arc seen by motion
+// capture.
 #pragma once
 
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "estimator/config.h"
+#include "recording/recording.h"
 
 namespace roamlab::estimator::testing {
 
@@ -15,5 +19,11 @@ namespace roamlab::estimator::testing {
 std::string AtvConfigYaml(const std::vector<std::string>& free, int window = 40);
 
 EstimatorConfig AtvConfig(const std::vector<std::string>& free, int window = 40);
+
+// A differential drive (wheel radius kArcRadius_m, track kArcTrack_m) driving 0.1 m/s forward while turning at
+// 0.5 rad/s from yaw0_rad at start_m, sampled every kArcDt_s: its cumulative wheel angles (stream "wheels", rad) and
+// motion-capture poses (stream "mocap"), `samples` of each at the same stamps.
+constexpr double kArcRadius_m = 0.04, kArcTrack_m = 0.2, kArcDt_s = 0.05;
+recording::Recording DiffDriveArcWithMotionCapture(int samples, double yaw0_rad, const Eigen::Vector2d& start_m);
 
 }  // namespace roamlab::estimator::testing

@@ -306,36 +306,9 @@ TEST(ProblemBuilderTest, AckermannFrontSlipVelocityIsChecked) {
 // position-only yaw fit) that starts facing backwards: the measured orientations still turn the dead-reckoned
 // trajectory (which starts at yaw 0) onto the fixes.
 TEST(ProblemBuilderTest, AbsolutePoseOrientationsAlignAShortDeadReckonedStretch) {
-  constexpr double kRadius = 0.04, kTrack = 0.2, kDt = 0.05, kYaw0 = 2.9;
+  constexpr double kYaw0 = 2.9;
   const Eigen::Vector2d start(1.0, -2.0);
-  recording::Recording rec;
-  rec.platform.kind = "differential_drive";
-  recording::Stream enc, mocap;
-  enc.info.name = "wheels";
-  enc.info.type = recording::StreamType::kWheelEncoders;
-  enc.info.columns = {"left", "right"};
-  enc.info.units = "rad";
-  mocap.info.name = "mocap";
-  mocap.info.type = recording::StreamType::kPose;
-  constexpr int kSamples = 60;
-  enc.values.resize(kSamples, 2);
-  mocap.values.resize(kSamples, 7);
-  double yaw = kYaw0, left = 0.0, right = 0.0;
-  Eigen::Vector2d p = start;
-  for (int k = 0; k < kSamples; ++k) {
-    enc.t.push_back(Time::FromSeconds(k * kDt));
-    mocap.t.push_back(Time::FromSeconds(k * kDt));
-    enc.values.row(k) << left, right;
-    const Eigen::Quaterniond q(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
-    mocap.values.row(k) << p.x(), p.y(), 0.0, q.x(), q.y(), q.z(), q.w();
-    // 0.1 m/s forward, turning at 0.5 rad/s: 0.3 m in all.
-    const double v = 0.1, omega = 0.5;
-    left += (v - 0.5 * omega * kTrack) / kRadius * kDt;
-    right += (v + 0.5 * omega * kTrack) / kRadius * kDt;
-    p += v * kDt * Eigen::Vector2d(std::cos(yaw + 0.5 * omega * kDt), std::sin(yaw + 0.5 * omega * kDt));
-    yaw += omega * kDt;
-  }
-  rec.streams = {enc, mocap};
+  const recording::Recording rec = testing::DiffDriveArcWithMotionCapture(60, kYaw0, start);  // 0.3 m in all
   auto config = ParseEstimatorConfig(R"(
 master: wheels
 parameters:
