@@ -6,6 +6,7 @@
 #   FUZZ_RUNS      when set: this many executions per harness instead of a time (-runs)
 #   FUZZERS        the harnesses to run (space-separated), default all
 #   JOBS           build parallelism, default the number of cores
+#   SANITIZE_OPT   optimization level of the build, default -O2 (ROAMLAB_SANITIZE_OPT); -O0 compiles fastest
 #   FUZZ_BUILD     0: run the harnesses already built in BUILD_DIR (no configure, no build), default 1
 #   ROAMLAB_DATA_DIR  real recordings to cut small seed excerpts from (default: the data directory the tests read,
 #                     ROAMLAB_SHARED_DIR/data in tests/CMakeLists.txt; skipped when absent)
@@ -27,7 +28,7 @@ command -v clang++ >/dev/null || { echo "roamlab fuzz: clang++ not found (script
 start=$(date +%s)
 if [ "${FUZZ_BUILD:-1}" != 0 ]; then
   CC=clang CXX=clang++ cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DROAMLAB_SANITIZE=ON \
-    -DROAMLAB_FUZZ=ON >/dev/null
+    -DROAMLAB_SANITIZE_OPT="${SANITIZE_OPT:--O2}" -DROAMLAB_FUZZ=ON >/dev/null
   cmake --build "$build_dir" -j "${JOBS:-$(nproc)}" --target fuzz_seeds "${fuzzers[@]}"
 fi
 built=$(date +%s)

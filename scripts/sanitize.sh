@@ -7,6 +7,7 @@
 #   TESTS      the test binaries (space-separated), default the list below; `fast`: the whole tree, and every ctest
 #              test without the label slow or slurm (the fast suite of scripts/run-tests.sh)
 #   JOBS       build and test parallelism, default the number of cores
+#   SANITIZE_OPT  optimization level of the build, default -O2 (ROAMLAB_SANITIZE_OPT); -O0 compiles fastest
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -23,7 +24,7 @@ jobs=${JOBS:-$(nproc)}
 command -v clang++ >/dev/null || { echo "roamlab sanitize: clang++ not found (scripts/setup.sh installs clang)" >&2; exit 1; }
 start=$(date +%s)
 CC=clang CXX=clang++ cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DROAMLAB_SANITIZE=ON \
-  -DROAMLAB_FUZZ="$fuzz" >/dev/null
+  -DROAMLAB_SANITIZE_OPT="${SANITIZE_OPT:--O2}" -DROAMLAB_FUZZ="$fuzz" >/dev/null
 # Leaks are errors; a finding stops the test with its report (ASAN_OPTIONS / UBSAN_OPTIONS).
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:strict_string_checks=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
