@@ -266,6 +266,7 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
     bent_poses.insert(vars.begin(), vars.begin() + 2);
   }
   const auto at_bent_pose = [&](FactorId id) {
+    if (options.defer_when_bridging) return true;
     const std::vector<VariableId>& vars = graph.factor(id).variables;
     return std::any_of(vars.begin(), vars.end(), [&](VariableId v) { return bent_poses.count(v) > 0; });
   };
@@ -427,15 +428,21 @@ Result<StageSummary> SolveStage(const EstimatorConfig& config, const Calibration
     stage.solver.seconds += again.seconds;
     return Status::Ok();
   };
-  for (int round = 0; config.gate_probability && round < kMaxGatingRounds; ++round) {
+  // Passes that bridge wheel readings reject nothing else (GateOptions::defer_when_bridging) and are not counted as
+  // rounds, up to kMaxGatingRounds of them: the rounds, burst margin first, start at the estimate re-solved without
+  // the readings they left out.
+  int round = 0;
+  for (int pass = 0; config.gate_probability && round < kMaxGatingRounds; ++pass) {
     // (Not handed the workspace: Levenberg-Marquardt's last point had its cost evaluated, not its linearization.)
     GateOptions gate;
     gate.burst_margin = round == 0 ? kBurstMargin : 0.0;
     gate.ignore_chance_changes = true;
+    gate.defer_when_bridging = pass - round < kMaxGatingRounds;
     const GateSwitches changed = GateOutliers(*config.gate_probability, &builder, 0, nullptr, gate);
+    if (changed.bridged == 0 || !gate.defer_when_bridging) ++round;
     if (changed.switched() == 0) break;
     const Status solved =
-        resolve("gating round " + std::to_string(round + 1) + ": " + std::to_string(changed.rejected) +
+        resolve("gating round " + std::to_string(pass + 1) + ": " + std::to_string(changed.rejected) +
                 " measurements rejected, " + std::to_string(changed.readmitted) + " re-admitted" +
                 (changed.bridged > 0 ? ", " + std::to_string(changed.bridged) + " wheel readings bridged" : "") +
                 (changed.ignored > 0 ? ", " + std::to_string(changed.ignored) + " failing by chance" : "") +

@@ -139,6 +139,11 @@ struct GateOptions {
   // against the gyroscope, of comparable weight on the yaw rate): rejected together, they would leave those poses
   // with nothing to hold them. Not with burst_margin.
   bool worst_per_pose = false;
+  // In a pass that bridges wheel readings, reject nothing else: every other failing measurement waits for the
+  // re-solve without the bridged readings. The estimate such readings bent fails the good measurements of many poses
+  // (the IMU's rows and their bursts' margins); rejected with the readings, they leave poses that nothing holds, which
+  // the re-solve moves so far that they never fit again.
+  bool defer_when_bridging = false;
 };
 
 // What one gating pass switched.
