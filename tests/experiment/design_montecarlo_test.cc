@@ -1,9 +1,11 @@
 // A designed drive's predicted std against a Monte-Carlo of it: `roamlab design`'s Cramer-Rao std of a component must
 // be the spread of the calibrations over independent noise realizations of the designed drive, within the sampling
-// spread of a sample standard deviation of N runs. That holds where the configured noise is the simulation's: the
-// IMU's (white, the scenario's sigmas), designed for here; not the wheels' (the encoders' tick truncation, which the
-// configured white rate noise over-states: docs/results.md, the indoor calibration consistency), whose spread may only
-// be smaller than predicted. 10 s of the differential drive with motion capture, a budget of 4 drives, 12 runs.
+// spread of a sample standard deviation of N runs. That holds where the configured noise is the simulation's (white,
+// the scenario's sigmas): the motion capture's and the IMU's, which carry the IMU misalignment designed for here (rx
+// and ry rest mostly on the motion capture's orientation noise: configured at twice the simulated, their spread falls
+// to 0.65 and 0.32 of the prediction and this test fails). Not the wheels': the encoders' tick truncation, which the
+// configured white rate noise over-states (docs/results.md, the indoor calibration consistency), so their spread may
+// only be smaller than predicted. 10 s of the differential drive with motion capture, a budget of 4 drives, 12 runs.
 #include <cmath>
 #include <map>
 #include <string>
@@ -20,7 +22,7 @@ namespace roamlab::experiment {
 namespace {
 
 // configs/indoor_diffdrive_mocap_calibration.yaml with the IMU's noise the scenario's (gyroscope 0.01 rad/s,
-// accelerometer 0.05 m/s^2), and its target on the IMU's misalignment.
+// accelerometer 0.05 m/s^2; the motion capture's is already), and its target on the IMU's misalignment.
 std::string ImuExactConfig() {
   return "master: odometer\n"
          "solver: {method: levenberg_marquardt, max_iterations: 100, function_tolerance: 1.0e-10}\n"
@@ -85,7 +87,7 @@ TEST(DesignMonteCarloTest, PredictedStdIsTheSpreadOfTheDesignedDrivesCalibration
       // by the physics' bias, a small fraction of the parameter (measured: equal to 3 digits).
       EXPECT_NEAR(c.cramer_rao_std / sigma, 1.0, 0.02) << label;
       const double ratio = c.spread / sigma;
-      if (block.name == "imu.misalignment") {  // white noise, modelled as it is simulated
+      if (block.name == "imu.misalignment") {  // white noise, configured as simulated
         ++imu_components;
         EXPECT_GE(ratio, lo) << label << ": spread " << c.spread << " against the predicted " << sigma;
         EXPECT_LE(ratio, hi) << label << ": spread " << c.spread << " against the predicted " << sigma;
