@@ -35,7 +35,7 @@ std::string ParseRange(const std::vector<double>& range, const char* option, dou
   return "";
 }
 
-void PrintTable(const experiment::DesignRequest& request, const experiment::DesignResult& result) {
+void PrintTable(const experiment::DesignResult& result) {
   const experiment::DesignCandidate& best = result.candidates[static_cast<std::size_t>(result.best)];
   int feasible = 0;
   for (const auto& c : result.candidates) feasible += c.infeasible.empty() ? 1 : 0;
@@ -49,8 +49,8 @@ void PrintTable(const experiment::DesignRequest& request, const experiment::Desi
               best.worst.c_str(), result.candidates.front().objective);
   std::printf("| component | predicted std | target | ratio |\n|---|---|---|---|\n");
   for (const auto& [label, std] : best.crb_std) {
-    const auto target = request.targets.find(label.substr(0, label.find('[')));
-    if (target == request.targets.end()) {
+    const auto target = result.targets.find(label.substr(0, label.find('[')));
+    if (target == result.targets.end()) {
       std::printf("| %s | %.3g | - | - |\n", label.c_str(), std);
       continue;
     }
@@ -79,7 +79,7 @@ int RunDesign(const DesignArgs& args) {
   meter.Finish();
   if (!outcome.ok()) return Exit(args.err, "design", outcome);
   if (args.quiet) return 0;
-  PrintTable(request, result);
+  PrintTable(result);
   std::printf("\nwrote %s and design.json beside it\n", args.out.c_str());
   return 0;
 }

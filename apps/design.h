@@ -1,8 +1,9 @@
-// `roamlab design SCENARIO.yaml --config EST.yaml --out DESIGNED.yaml --target NAME=STD ...`: the drive of the
+// `roamlab design SCENARIO.yaml --config EST.yaml --out DESIGNED.yaml [--target NAME=STD ...]`: the drive of the
 // scenario's robot, within its driver's family (experiment/drive_family.h: the Ackermann weave, the indoor robots'
 // body-velocity sines), that minimizes the worst ratio of a parameter's Cramer-Rao std to its target, feasible in
 // MuJoCo (experiment/design.h). Limits not given are the robot's (sim/drive_envelope.h). Writes the designed scenario
-// and design.json beside it; prints the predicted std of every component. Exit codes as the other commands'
+// and design.json beside it; prints the predicted std of every component. The targets are the configuration's
+// target_std entries, each overridden by a --target of the same parameter. Exit codes as the other commands'
 // (apps/cli.h).
 #pragma once
 

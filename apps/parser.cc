@@ -238,9 +238,8 @@ void AddDesign(CLI::App* app, Commands* commands) {
     des->add_option("--out", args->out, "The designed scenario to write (DESIGNED.yaml); design.json beside it")
         ->required();
     des->add_option("--target", args->target_texts,
-                    "NAME=STD: the target std of every tangent component of the free parameter NAME (repeatable; at "
-                    "least one)")
-        ->required();
+                    "NAME=STD: the target std of every tangent component of the free parameter NAME (repeatable; "
+                    "overrides the configuration's target_std of NAME; at least one target in all)");
     des->add_option("--duration", args->duration_s,
                     "Recorded duration of the designed drive [s] (default: the scenario's)");
     des->add_option("--budget", args->budget, "Drives simulated and analysed (default 60)");

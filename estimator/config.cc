@@ -148,8 +148,19 @@ class Parser {
     if (!(t->relinearize_threshold >= 0.0)) Fail(n, "tracking.relinearize_threshold must be >= 0");
   }
 
+  // `roamlab design`'s target for every tangent component of a free parameter: a standard deviation.
+  double TargetStd(const std::string& name, const YAML::Node& node, bool free) const {
+    if (!free) Fail(node, "parameter '" + name + "': target_std is for a free parameter (free: true)");
+    if (!node.IsScalar()) Fail(node, "parameters." + name + ".target_std must be one number (every component's std)");
+    const double target = Number(node, "parameters." + name + ".target_std");
+    if (!(target >= kMinSigma && target <= kMaxSigma))
+      Fail(node, "parameters." + name + ".target_std: " + node.Scalar() +
+                     " is outside the accepted range [1e-9, 1e6] of a standard deviation");
+    return target;
+  }
+
   ParameterConfig ParseParameter(const std::string& name, const YAML::Node& n) const {
-    CheckKeys(n, {"value", "free", "process", "prior_sigma"}, "parameter '" + name + "'");
+    CheckKeys(n, {"value", "free", "process", "prior_sigma", "target_std"}, "parameter '" + name + "'");
     ParameterConfig p;
     if (n["value"]) {
       const std::vector<double> v = Numbers(n["value"], "parameters." + name + ".value");
@@ -163,6 +174,7 @@ class Parser {
           Fail(n["prior_sigma"], "parameter '" + name + "': prior_sigma must be at least 1e-9 (or .inf)");
       p.prior_sigma = Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<int>(v.size()));
     }
+    if (n["target_std"]) p.target_std = TargetStd(name, n["target_std"], p.free);
     if (n["process"]) {
       const YAML::Node& pr = n["process"];
       CheckKeys(pr, {"type", "sigma", "tau_s", "interval_s"}, "parameter '" + name + "' process");

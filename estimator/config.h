@@ -12,6 +12,7 @@
 //              initialization_s: 2.0, relinearize_threshold: 0.0}
 //   parameters:                            # any parameter not listed here keeps its model default and is fixed
 //     gps.lever_arm: {value: [0, 0, 0], free: true}     # optional prior_sigma: [.inf, .inf, 0.5] (ParameterConfig)
+//     odometer.k_theta: {value: 1.0, free: true, target_std: 0.00167}   # `roamlab design`'s target (ParameterConfig)
 //     imu.gyro_bias: {value: [0, 0, 0], free: true, process: {type: random_walk, sigma: 1.0e-4}}
 //     odometer.disturbance: {value: [0, 0, 0], free: true,   # per component: a list of three (Gauss-Markov:
 //                            process: {type: gauss_markov, sigma: [0.01, 0.002, 0.03], tau_s: [0.5, 1.2, 1.8]}}
@@ -82,6 +83,9 @@ struct ParameterConfig {
   // that component): for a component the measurements leave unobservable, e.g. the GPS antenna's height above an IMU
   // master's poses on a planar drive.
   std::optional<Eigen::VectorXd> prior_sigma;
+  // The std `roamlab design` aims at for every tangent component of this free parameter, in its units (the command
+  // line's --target overrides it).
+  std::optional<double> target_std;
 };
 
 struct StreamConfig {

@@ -113,8 +113,9 @@ struct Problem {
   const DesignRequest& request;
   sim::Scenario scenario;  // with the designed duration
   estimator::EstimatorConfig config;
-  DesignLimits limits;                  // the request's, the robot's where NaN
-  std::unique_ptr<DriveFamily> family;  // the scenario's driver's
+  std::map<std::string, double> targets;  // the request's, the configuration's target_std where not given
+  DesignLimits limits;                    // the request's, the robot's where NaN
+  std::unique_ptr<DriveFamily> family;    // the scenario's driver's
 };
 
 // Objective and per-component CRB std of one analysed drive.
@@ -163,7 +164,7 @@ Result<DesignCandidate> Evaluate(const Problem& p, const DriveDesign& drive, con
     auto analysed =
         estimator::AnalyzeInformation(p.config, s.recording, s.truth.calibration, *s.recording.ground_truth);
     if (!analysed.ok()) return Status::Error(p.request.config + ": " + analysed.status().message());
-    Score(analysed.value(), p.request.targets, &c);
+    Score(analysed.value(), p.targets, &c);
   }
   c.seconds = seconds();
   return c;
@@ -259,7 +260,7 @@ std::string DesignedYaml(const Problem& p, const DesignCandidate& best) {
   std::ostringstream text;
   text << "# Designed by\n#   roamlab design " << request.scenario << " --config " << request.config << " --duration "
        << scenario.duration_s << " --budget " << request.budget;
-  for (const auto& [name, target] : request.targets) text << " --target " << name << "=" << target;
+  for (const auto& [name, target] : p.targets) text << " --target " << name << "=" << target;
   text << std::setprecision(3) << "\n"
        << "# (limits in design.json): of the drives " << p.family->Formula() << "\n"
        << "# (driver, robot.start), the feasible one with the least max CRB std / target:\n# " << best.objective
@@ -268,9 +269,9 @@ std::string DesignedYaml(const Problem& p, const DesignCandidate& best) {
        << " m/s, lateral acceleration " << best.max_lateral_accel_mps2 << " m/s^2.\n"
        << "# Predicted std (Cramer-Rao bound of the noise-free drive at its truth) and target:\n";
   for (const auto& [label, std] : best.crb_std) {
-    const auto target = request.targets.find(label.substr(0, label.find('[')));
+    const auto target = p.targets.find(label.substr(0, label.find('[')));
     text << "#   " << label << ": " << std;
-    if (target != request.targets.end()) text << " (target " << target->second << ")";
+    if (target != p.targets.end()) text << " (target " << target->second << ")";
     text << "\n";
   }
   YAML::Emitter emitter;
@@ -291,17 +292,22 @@ Result<Problem> LoadProblem(const DesignRequest& request) {
   if (!family.ok()) return Status::Error(request.scenario + ": " + family.status().message());
   auto config = estimator::LoadEstimatorConfig(request.config);
   if (!config.ok()) return config.status();
-  if (request.targets.empty()) return Status::Error("--target: no target given");
   for (const auto& [name, target] : request.targets) {
     const auto it = config.value().parameters.find(name);
     if (it == config.value().parameters.end() || !it->second.free)
       return Status::Error("--target " + name + ": not a free parameter of " + request.config);
     if (!(target > 0.0) || !std::isfinite(target)) return Status::Error("--target " + name + ": must be > 0");
   }
+  std::map<std::string, double> targets = request.targets;
+  for (const auto& [name, parameter] : config.value().parameters)
+    if (parameter.target_std) targets.emplace(name, *parameter.target_std);  // a given --target stays
+  if (targets.empty())
+    return Status::Error("--target: no target given, and no parameter of " + request.config + " has a target_std");
   if (!(request.duration_s >= 0.0) || request.duration_s > kMaxDurationS)
     return Status::Error("--duration: must be in (0, 3600]");
   if (request.budget < 1) return Status::Error("--budget: must be >= 1");
-  Problem p{request, std::move(scenario).value(), std::move(config).value(), limits.value(), std::move(family).value()};
+  Problem p{request,        std::move(scenario).value(), std::move(config).value(), std::move(targets),
+            limits.value(), std::move(family).value()};
   if (request.duration_s > 0.0) p.scenario.duration_s = request.duration_s;
   return p;
 }
@@ -371,15 +377,19 @@ Outcome DesignToFile(const DesignRequest& request, DesignResult* result_out) {
   DesignResult result;
   result.duration_s = p.scenario.duration_s;
   result.limits = p.limits;
+  result.targets = p.targets;
   result.formula = p.family->Formula();
   if (Status s = Search(p, &result); !s.ok()) {
     // The first drive's analysis failing is the configuration not fitting the recording: bad input.
     return result.candidates.empty() ? Outcome::BadInput(s) : Outcome::Failed(s);
   }
   if (result.best < 0) {
+    const DesignCandidate& first = result.candidates.front();
+    const std::string why =
+        first.infeasible.empty() ? first.worst + " is unobservable on it (its std is not finite)" : first.infeasible;
     const Outcome failed =
-        Outcome::Failed(Status::Error("no feasible drive among " + std::to_string(result.candidates.size()) +
-                                      " (the first: " + result.candidates.front().infeasible + ")"));
+        Outcome::Failed(Status::Error("no feasible drive with a finite objective among " +
+                                      std::to_string(result.candidates.size()) + " (the first: " + why + ")"));
     if (result_out) *result_out = std::move(result);
     return failed;
   }
@@ -416,7 +426,7 @@ nlohmann::json DesignJson(const DesignRequest& request, const DesignResult& resu
                           {"seconds", c.seconds}});
   }
   json targets = json::object();
-  for (const auto& [name, std] : request.targets) targets[name] = std;
+  for (const auto& [name, std] : result.targets) targets[name] = std;
   const DesignLimits& l = result.limits;
   return {{"scenario", request.scenario},
           {"config", request.config},

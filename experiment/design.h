@@ -48,11 +48,13 @@ struct DesignLimits {
 Result<DesignLimits> WithRobotDefaults(const DesignLimits& given, const sim::Scenario& scenario);
 
 struct DesignRequest {
-  std::string scenario;                           // SCENARIO.yaml, driver type ackermann or body_velocity
-  std::string config;                             // EST.yaml
-  std::string out;                                // DESIGNED.yaml; design.json is written beside it
-  double duration_s = 0.0;                        // the designed drive's recorded duration; 0: the scenario's
-  std::map<std::string, double> targets;          // free parameter -> target CRB std of each of its tangent components
+  std::string scenario;     // SCENARIO.yaml, driver type ackermann or body_velocity
+  std::string config;       // EST.yaml
+  std::string out;          // DESIGNED.yaml; design.json is written beside it
+  double duration_s = 0.0;  // the designed drive's recorded duration; 0: the scenario's
+  // Free parameter -> target CRB std of each of its tangent components; joined by the configuration's target_std
+  // entries (estimator/config.h) for the parameters not given here.
+  std::map<std::string, double> targets;
   DesignLimits limits;                            // NaN entries: the robot's
   int budget = 60;                                // drives simulated and analysed, at least 1
   std::function<void(double fraction)> progress;  // optional: the budget's fraction spent
@@ -76,6 +78,7 @@ struct DesignResult {
   std::vector<DesignCandidate> candidates;  // in the order tried
   double duration_s = 0.0;                  // of the designed drive [s]
   DesignLimits limits;                      // those used (the robot's where the request's were NaN)
+  std::map<std::string, double> targets;    // those used (the request's, the configuration's where not given)
   std::string formula;                      // the family's (DriveFamily::Formula)
   std::string best_drive;                   // the best drive in words (DriveFamily::Describe); empty: none
   int best = -1;                            // index of the feasible candidate with the least objective; -1: none
@@ -87,9 +90,9 @@ struct DesignResult {
 Result<DriveDesign> StartDrive(const sim::Scenario& scenario, const DesignLimits& limits);
 
 // Bad input: a scenario or configuration that does not load, a scenario whose driver or robot has no drive family, a
-// target that is not a free parameter of the configuration or not > 0, no target, invalid limits, a duration or budget
-// out of range, a configuration that does not fit the simulated recording. Failures: no feasible drive, writing the
-// files.
+// target that is not a free parameter of the configuration or not > 0, no target (given or in the configuration),
+// invalid limits, a duration or budget out of range, a configuration that does not fit the simulated recording.
+// Failures: no feasible drive, writing the files.
 Outcome DesignToFile(const DesignRequest& request, DesignResult* result = nullptr);
 
 // design.json (docs/commands.md): the request, every candidate and the chosen one.

@@ -1,5 +1,8 @@
 #include "estimator/config.h"
 
+#include <algorithm>
+#include <string>
+
 #include <gtest/gtest.h>
 
 #include "tests/estimator/estimation_testing.h"
@@ -78,6 +81,30 @@ TEST(ConfigTest, RefusesUndeclaredParameterNames) {
           Replace(good, gyro, "parameters: {misalignment: gyroscope.misalignment, time_offset_s: imu.time_offset_s}}"),
           "est.yaml")
           .ok());
+}
+
+// `roamlab design`'s target of a free parameter: one standard deviation for every tangent component. A target on a
+// fixed parameter, a list, zero or an unknown spelling are refused naming the file and the parameter's line.
+TEST(ConfigTest, TargetStdIsOnePositiveStdOfAFreeParameter) {
+  const std::string good = testing::AtvConfigYaml({"gps.lever_arm"});
+  const std::string free_lever_arm = "{value: [0, 0, 0], free: true}";
+  const auto with = [&](const std::string& entry) { return Replace(good, free_lever_arm, entry); };
+  auto config = ParseEstimatorConfig(with("{value: [0, 0, 0], free: true, target_std: 0.033}"), "est.yaml");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  EXPECT_DOUBLE_EQ(config.value().parameters.at("gps.lever_arm").target_std.value(), 0.033);
+  EXPECT_FALSE(config.value().parameters.at("imu.misalignment").target_std.has_value());
+
+  // The lever arm's line, 1-based.
+  const std::string line = std::to_string(
+      1 + std::count(good.begin(), good.begin() + static_cast<std::ptrdiff_t>(good.find(free_lever_arm)), '\n'));
+  const std::string at = "est.yaml:" + line + ": ";
+  ExpectError(with("{value: [0, 0, 0], free: true, target_std: 0}"), at + "parameters.gps.lever_arm.target_std: 0 is");
+  ExpectError(with("{value: [0, 0, 0], free: true, target_std: -0.1}"), "target_std: -0.1 is outside the accepted");
+  ExpectError(with("{value: [0, 0, 0], free: true, target_std: abc}"), "target_std must be a number");
+  ExpectError(with("{value: [0, 0, 0], free: true, target_std: [0.1, 0.1, 0.1]}"), at + "parameters.gps.lever_arm");
+  ExpectError(with("{value: [0, 0, 0], free: false, target_std: 0.033}"),
+              at + "parameter 'gps.lever_arm': target_std is for a free parameter");
+  ExpectError(with("{value: [0, 0, 0], free: true, target: 0.033}"), at + "unknown key 'target'");
 }
 
 TEST(ConfigTest, RefusesDuplicateKeys) {

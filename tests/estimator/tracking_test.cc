@@ -173,7 +173,7 @@ TEST(TrackingTest, TrackingTheGyroBiasComesCloseToKnowingIt) {
   const EstimatorConfig tracked = WithRandomWalkGyroBias(testing::AtvConfig({}, 20));
   EstimatorConfig oracle = tracked;
   oracle.parameters["imu.gyro_bias"] = ParameterConfig{
-      Eigen::VectorXd(Eigen::Vector3d(synthetic.truth.calibration.at("imu.gyro_bias").data())), false, {}, {}};
+      Eigen::VectorXd(Eigen::Vector3d(synthetic.truth.calibration.at("imu.gyro_bias").data())), false, {}, {}, {}};
   const EstimatorConfig ignored = testing::AtvConfig({}, 20);
 
   auto with_oracle = Track(oracle, synthetic.recording, {});

@@ -1,7 +1,10 @@
 // `roamlab design` on the indoor robots: the body-velocity family (experiment/drive_family.h) within the robot's
 // envelope (sim/drive_envelope.h), on short drives with small budgets.
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iterator>
+#include <map>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -9,6 +12,7 @@
 #include "experiment/design.h"
 #include "sim/drive_envelope.h"
 #include "sim/simulator.h"
+#include "tests/experiment/design_testing.h"
 #include "tests/recording/temp_dir.h"
 #include "tests/support/paths.h"
 
@@ -47,7 +51,7 @@ class DesignIndoorTest : public ::testing::Test {
   void Use(const std::string& scenario_text, const std::string& config) {
     std::ofstream(dir_.File("scenario.yaml")) << scenario_text;
     request_.scenario = dir_.File("scenario.yaml");
-    request_.config = roamlab::testing::SourceDir() + "/configs/" + config;
+    request_.config = testing::ConfigWithoutTargets(config, dir_);  // the test's targets only
     request_.out = dir_.File("designed.yaml");
   }
   testing::TempDir dir_;
@@ -92,6 +96,32 @@ TEST_F(DesignIndoorTest, DifferentialDriveDesignBeatsItsStartAndSimulates) {
   auto simulated = sim::Simulate(loaded.value());
   ASSERT_TRUE(simulated.ok()) << simulated.status().message();
   EXPECT_LE(simulated.value().stats.max_lateral_speed_mps, result.limits.max_side_slip_mps);
+}
+
+// No target in the request: the configuration's (configs/indoor_diffdrive_mocap_calibration.yaml: the wheels') are the
+// objective's, and the designed scenario's header repeats them as the equivalent --target options.
+TEST_F(DesignIndoorTest, WithoutTargetsTheConfigurationsAreTheObjectives) {
+  Use(GentleDiffDrive(), "indoor_diffdrive_mocap_calibration.yaml");
+  request_.config = roamlab::testing::SourceDir() + "/configs/indoor_diffdrive_mocap_calibration.yaml";
+  request_.budget = 1;
+  DesignResult result;
+  const Outcome outcome = DesignToFile(request_, &result);
+  ASSERT_TRUE(outcome.ok()) << outcome.status.message();
+  const std::map<std::string, double> expected = {
+      {"odometer.baseline", 3e-4}, {"odometer.radius_left", 2e-5}, {"odometer.radius_right", 2e-5}};
+  EXPECT_EQ(result.targets, expected);
+  const DesignCandidate& start = result.candidates.front();
+  double worst = 0.0;
+  for (const auto& [label, std] : start.crb_std) {
+    const auto target = expected.find(label);
+    if (target != expected.end()) worst = std::max(worst, std / target->second);
+  }
+  EXPECT_TRUE(std::isfinite(worst));
+  EXPECT_DOUBLE_EQ(start.objective, worst);
+  std::ifstream written(request_.out);
+  const std::string header((std::istreambuf_iterator<char>(written)), std::istreambuf_iterator<char>());
+  EXPECT_NE(header.find("--target odometer.baseline=0.0003 --target odometer.radius_left=2e-05"), std::string::npos)
+      << header.substr(0, 400);
 }
 
 TEST_F(DesignIndoorTest, HolonomicRobotsGetASidewaysTerm) {

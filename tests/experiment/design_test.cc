@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "sim/simulator.h"
+#include "tests/experiment/design_testing.h"
 #include "tests/recording/temp_dir.h"
 #include "tests/support/paths.h"
 
@@ -36,7 +37,7 @@ class DesignStepTest : public ::testing::Test {
   void SetUp() override {
     std::ofstream(dir_.File("gentle.yaml")) << GentleScenario();
     request_.scenario = dir_.File("gentle.yaml");
-    request_.config = roamlab::testing::SourceDir() + "/configs/atv_calibration.yaml";
+    request_.config = testing::ConfigWithoutTargets("atv_calibration.yaml", dir_);
     request_.out = dir_.File("designed.yaml");
     request_.targets = {{"odometer.k_theta", 0.002}};
     request_.budget = 16;
@@ -83,6 +84,24 @@ TEST_F(DesignStepTest, ImprovesOnItsStartAndWritesAScenarioThatSimulates) {
   EXPECT_EQ(json["best"], result.best);
   EXPECT_NEAR(json["candidates"][result.best]["crb_std"]["odometer.k_theta"].get<double>(), best.objective * 0.002,
               1e-12);
+}
+
+// The configuration's target_std entries are the targets of the parameters not given in the request: on this short,
+// flat drive the GPS antenna's height is unobservable, and its target, from the configuration, fails the design.
+TEST_F(DesignStepTest, TheConfigurationsTargetsJoinTheGivenOnes) {
+  request_.config = roamlab::testing::SourceDir() + "/configs/atv_calibration.yaml";
+  request_.budget = 1;
+  DesignResult result;
+  const Outcome outcome = DesignToFile(request_, &result);
+  const std::map<std::string, double> expected = {
+      {"gps.lever_arm", 0.033},     {"imu.misalignment", 0.0116},    {"magnetometer.A", 0.0067},
+      {"magnetometer.b", 0.0033},   {"odometer.kv_over_L", 0.00133}, {"odometer.k_theta", 0.002},  // given
+      {"odometer.k_gamma", 0.00167}};
+  EXPECT_EQ(result.targets, expected);
+  ASSERT_FALSE(outcome.ok());
+  EXPECT_FALSE(outcome.bad_input);
+  EXPECT_NE(outcome.status.message().find("gps.lever_arm[z] is unobservable"), std::string::npos)
+      << outcome.status.message();
 }
 
 TEST_F(DesignStepTest, NoFeasibleDriveIsAFailure) {
