@@ -157,6 +157,25 @@ Eigen::MatrixXd BartlettSum(const Eigen::MatrixXd& a, int lag) {
   return 0.5 * (m + m.transpose());
 }
 
+// The bound on a prewhitening coefficient (PrewhitenedBartlettSum).
+constexpr double kMaxPrewhitening = 0.97;
+
+Eigen::MatrixXd PrewhitenedBartlettSum(const Eigen::MatrixXd& a, int lag) {
+  const Eigen::Index n = a.cols(), k = a.rows();
+  if (n < 3) return BartlettSum(a, lag);
+  const Eigen::MatrixXd before = a.leftCols(n - 1), after = a.rightCols(n - 1);
+  Eigen::VectorXd rho = Eigen::VectorXd::Zero(k);
+  for (Eigen::Index i = 0; i < k; ++i) {
+    const double denominator = before.row(i).squaredNorm();
+    if (denominator > 0.0)
+      rho[i] = std::clamp(before.row(i).dot(after.row(i)) / denominator, -kMaxPrewhitening, kMaxPrewhitening);
+  }
+  const Eigen::MatrixXd whitened = after - rho.asDiagonal() * before;
+  const Eigen::VectorXd recolour = (Eigen::VectorXd::Ones(k) - rho).cwiseInverse();
+  return static_cast<double>(n) / static_cast<double>(n - 1) * recolour.asDiagonal() *
+         BartlettSum(whitened, lag) * recolour.asDiagonal();
+}
+
 ResidualAutocorrelation AnalyzeAutocorrelation(const std::vector<Eigen::VectorXd>& residuals) {
   ResidualAutocorrelation out;
   const int n = static_cast<int>(residuals.size());

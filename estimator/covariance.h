@@ -95,9 +95,23 @@ struct ResidualAutocorrelation {
 ResidualAutocorrelation AnalyzeAutocorrelation(const std::vector<Eigen::VectorXd>& residuals);
 
 // The middle of the sandwich over one stream's rows in time order, column t of `a` (k x n) the score or influence of
-// row t: sum_{|l| <= L} (1 - |l| / (L + 1)) sum_t a_t a_{t+l}^T, symmetric, in O(n k^2). Also what a fit outside the
-// graph (the twin diagnosis, gap/twin.h) sums its residuals' scores with.
+// row t: sum_{|l| <= L} (1 - |l| / (L + 1)) sum_t a_t a_{t+l}^T, symmetric, in O(n k^2).
 Eigen::MatrixXd BartlettSum(const Eigen::MatrixXd& a, int lag);
+
+// BartlettSum after first-order prewhitening (Andrews and Monahan 1992, with a diagonal AR(1)): each component i of
+// the a_t is fitted an AR(1) coefficient rho_i = sum_t a_i,t a_i,t-1 / sum_t a_i,t-1^2, bounded to [-0.97, 0.97],
+// D = diag(rho_i); the Bartlett sum is taken of the prewhitened a*_t = a_t - D a_{t-1} (t = 1..n-1) and recoloured:
+//   M = n / (n - 1) (I - D)^-1 BartlettSum(a*, L) (I - D)^-1.
+// Since sum_t a*_t = (I - D) sum_t a_t up to one end term, M estimates the same long-run sum for any D; what D
+// changes is the bias. A Bartlett sum over a strongly autocorrelated series is low for two reasons the prewhitened
+// series mostly escapes: the weights' truncation at L (for a first-order Gauss-Markov series of coefficient phi they
+// keep 1 + 2 sum_{l=1..L} (1 - l / (L + 1)) phi^l of its long-run (1 + phi) / (1 - phi): 78 % at phi = 0.82, L = 21),
+// and the zero sum of scores taken at the fit, which takes more off the longer the series' memory. With white a_t,
+// rho_i is near 0 and M is BartlettSum(a, L). The bound keeps the recolouring (at most (1 - 0.97)^-2 = 1111) from
+// dividing by an estimate of 1 - rho that is mostly noise. Fewer than 3 columns: BartlettSum(a, L). The twin's fit
+// (gap/twin.h) sums its residuals' scores with it; ComputeHacCovariance keeps the plain BartlettSum, its coverage
+// being measured with that (docs/results.md).
+Eigen::MatrixXd PrewhitenedBartlettSum(const Eigen::MatrixXd& a, int lag);
 
 struct HacCovariance {
   Eigen::MatrixXd covariance;       // tangent coordinates, the variables stacked in order

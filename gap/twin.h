@@ -137,8 +137,9 @@ struct TwinFitRows {
 //   hac:   the Newey-West sandwich white M white with the estimator's weights and bandwidth (estimator/covariance.h):
 //          the rows of one series and stamp form one residual vector r_t and one score g_t = J_t^T r_t, and M sums
 //          within each series the Bartlett-weighted products g_t g_{t+l}^T up to the series' lag L_s
-//          (AnalyzeAutocorrelation of its residual vectors); series independent of each other. With white residuals
-//          it is the white covariance rescaled by the residuals' actual spread.
+//          (AnalyzeAutocorrelation of its residual vectors), the scores prewhitened by an AR(1) per parameter and
+//          recoloured (PrewhitenedBartlettSum); series independent of each other. With white residuals it is the
+//          white covariance rescaled by the residuals' actual spread.
 struct TwinCovariance {
   Eigen::MatrixXd white, hac;
   std::map<std::string, int> lags;  // per series: L_s (samples)

@@ -301,7 +301,7 @@ TwinCovariance ComputeTwinCovariance(const TwinFitRows& rows) {
                     residuals.end());
     const int lag = estimator::AnalyzeAutocorrelation(residuals).lag;
     out.lags[rows.series[begin]] = lag;
-    M += estimator::BartlettSum(g, lag);
+    M += estimator::PrewhitenedBartlettSum(g, lag);
     begin = end;
   }
   out.hac = out.white * M * out.white;

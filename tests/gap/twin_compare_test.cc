@@ -128,9 +128,10 @@ TEST(TwinCompareTest, TheWhiteNoiseCovarianceIsTheInverseCurvature) {
 
 // The mean of a first-order Gauss-Markov series e(k+1) = a e(k) + sqrt(1 - a^2) n fitted as one parameter (the
 // residuals at the fit: the series less its mean; two components per stamp, one series): the HAC variance over the
-// white one is the Bartlett-weighted sum of the autocorrelation up to the lag chosen, 1 + 2 sum_l (1 - l / (L + 1))
-// a^l (the long-run factor (1 + a) / (1 - a) less the weights' bias), within 4 of the Newey-West estimate's relative
-// standard deviations sqrt(4 L / (3 n)); white residuals (a = 0) leave it at 1.
+// white one is the long-run factor (1 + a) / (1 - a) (the scores prewhitened by their AR(1) and recoloured, so without
+// the Bartlett weights' bias), within 4 of the estimate's relative standard deviations: sqrt(4 L / (3 n)) of the
+// Bartlett sum over the prewhitened scores and 2 sqrt((1 - a^2) / n) / (1 - a) of the recolouring (1 - rho)^-2;
+// white residuals (a = 0) leave it at 1.
 TEST(TwinCompareTest, TheHacCovarianceCountsTheResidualsAutocorrelation) {
   constexpr int kStamps = 20000;
   for (const double a : {0.0, 0.9}) {
@@ -151,12 +152,12 @@ TEST(TwinCompareTest, TheHacCovarianceCountsTheResidualsAutocorrelation) {
     rows.residuals.array() -= rows.residuals.mean();
     const TwinCovariance cov = ComputeTwinCovariance(rows);
     const int lag = cov.lags.at("gyroscope");
-    double expected = 1.0;
-    for (int l = 1; l <= lag; ++l) expected += 2.0 * (1.0 - l / (lag + 1.0)) * std::pow(a, l);
+    const double expected = (1.0 + a) / (1.0 - a);
     const double ratio = cov.hac(0, 0) / cov.white(0, 0);
-    const double spread = std::sqrt(4.0 * std::max(lag, 1) / (3.0 * kStamps));
-    std::printf("a %.1f: lag %d, HAC / white variance %.3f, expected %.3f (long-run %.3f)\n", a, lag, ratio, expected,
-                (1.0 + a) / (1.0 - a));
+    const double recolouring = 2.0 * std::sqrt((1.0 - a * a) / kStamps) / (1.0 - a);
+    const double spread = std::sqrt(4.0 * std::max(lag, 1) / (3.0 * kStamps) + recolouring * recolouring);
+    std::printf("a %.1f: lag %d, HAC / white variance %.3f, expected (long-run) %.3f +- %.3f\n", a, lag, ratio,
+                expected, spread * expected);
     EXPECT_NEAR(ratio / expected, 1.0, 4.0 * spread) << "a = " << a;
     if (a > 0.0) {
       EXPECT_GT(lag, 20);  // several correlation times (1 / -ln a = 9.5 stamps)
