@@ -257,8 +257,10 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
     bool accept = evaluated && (lm ? (predicted > 0.0 && actual / predicted > 1e-3) : true);
 
     if (!accept) RestoreValues(ws.saved_, free_variables);
-    // A rejected step is shortened along its direction (ShortenedStep) when that lowers the cost, and then counts as
-    // accepted: the damping follows the shortened step's ratio of actual to predicted decrease.
+    // A rejected step is shortened along its direction (ShortenedStep) when that lowers the cost; the damping still
+    // rises as after a rejection, since the model overestimated the decrease (kept or lowered instead, a solve of
+    // indoor_fault_outliers, gross outliers still in, walks the wheel radii from 75 mm to 3-6 mm).
+    bool shortened = false;
     if (lm && evaluated && !accept) {
       double short_cost = 0.0;
       if (auto short_dx = ShortenedStep(&system, *graph, dx, old_cost, new_cost, ws.saved_, free_variables,
@@ -267,7 +269,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
         new_cost = short_cost;
         predicted = system.ModelDecrease(dx);
         actual = old_cost - new_cost;
-        accept = true;
+        accept = shortened = true;
       }
     }
 
@@ -294,7 +296,10 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
       }
       continue;
     }
-    if (lm) {
+    if (lm && shortened) {
+      lambda *= nu;
+      nu *= 2.0;
+    } else if (lm) {
       const double rho = actual / predicted;
       lambda *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
       nu = 2.0;
