@@ -163,7 +163,8 @@ struct SineError {
 TEST(SolverTest, LevenbergMarquardtShortensARejectedStepToTheMinimumAlongIt) {
   // From x = 1.2 the first step (-r / J = -tan(1.2) = -2.57) lands at x = -1.37, where sin is -0.98: rejected. The
   // parabola through the cost at 0 and 1 along it and the slope at 0 has its minimum at t = 0.47 (x = -0.02), which
-  // lowers the cost; the solver takes it instead of raising the damping and re-solving, so no iteration is rejected.
+  // lowers the cost; the solver takes it instead of re-solving with more damping until a step passes, so no iteration
+  // is rejected.
   Graph graph;
   const VariableId x =
       graph.AddVariable({"x", Manifold::Euclidean(1), Eigen::VectorXd::Constant(1, 1.2), false, std::nullopt});
