@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <deque>
 #include <random>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
@@ -144,6 +145,38 @@ TEST(SolverTest, LevenbergMarquardtStartedAtItsMinimumConvergesThere) {
   EXPECT_EQ(summary.initial_cost, 1.0);
   EXPECT_EQ(summary.final_cost, 1.0);
   EXPECT_EQ(graph.variable(x).value[0], 0.0);
+}
+
+// e = sin(x) + eta: along a step from x = 1.2 the cost bends far more than the Gauss-Newton model of its slope there.
+struct SineError {
+  using Blocks = std::tuple<ScalarBlock>;
+  static constexpr int kResidualDim = 1;
+  static constexpr int kNoiseDim = 1;
+  template <typename T>
+  bool operator()(const T* const* x, const T* noise, T* error) const {
+    using std::sin;
+    error[0] = sin(x[0][0]) + noise[0];
+    return true;
+  }
+};
+
+TEST(SolverTest, LevenbergMarquardtShortensARejectedStepToTheMinimumAlongIt) {
+  // From x = 1.2 the first step (-r / J = -tan(1.2) = -2.57) lands at x = -1.37, where sin is -0.98: rejected. The
+  // parabola through the cost at 0 and 1 along it and the slope at 0 has its minimum at t = 0.47 (x = -0.02), which
+  // lowers the cost; the solver takes it instead of re-solving with more damping until a step passes, so no iteration
+  // is rejected.
+  Graph graph;
+  const VariableId x =
+      graph.AddVariable({"x", Manifold::Euclidean(1), Eigen::VectorXd::Constant(1, 1.2), false, std::nullopt});
+  graph.AddFactor(MakeFactor(SineError()), {x}, Eigen::MatrixXd::Identity(1, 1), Loss::Trivial(), "sine", Time());
+  SolverOptions options;
+  options.initial_lambda = 1e-8;
+  const SolverSummary summary = Solve(options, &graph);
+  ASSERT_TRUE(summary.usable()) << summary.message;
+  EXPECT_NE(summary.termination, Termination::kMaxIterations);
+  EXPECT_EQ(summary.cost_history.size(), static_cast<std::size_t>(summary.iterations) + 1);  // all accepted
+  EXPECT_LT(std::abs(summary.cost_history[1] - 0.5 * std::pow(std::sin(-0.02), 2)), 2e-3);
+  EXPECT_LT(std::abs(graph.variable(x).value[0]), 1e-6);
 }
 
 // The solver's order: poses in time; each time-varying instance after the last pose it serves (just before the pose
