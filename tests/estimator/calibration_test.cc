@@ -419,15 +419,9 @@ TEST(GateOutliersTest, ScatteredOutliersAreNotABurst) {
   EXPECT_EQ(rejected, static_cast<int>(corrupted.size()));
 }
 
-// A differential drive's wheel angles are cumulative: one reading off by 0.5 rad makes the span before it 10 rad/s
-// (20 sigma) too fast and the one after it as much too slow, and the motion capture (0.1 mm) holds the pose between
-// them. The gate leaves that one reading out (a bridge over the two spans), not the two spans, and the bridge fits at
-// the next pass.
-TEST(GateOutliersTest, AnOutlyingCumulativeReadingIsBridgedNotItsTwoSpansRejected) {
-  constexpr int kSamples = 60, kBad = 30;
-  recording::Recording rec = testing::DiffDriveArcWithMotionCapture(kSamples, 0.3, Eigen::Vector2d(1.0, -2.0));
-  rec.streams[0].values.row(kBad) += Eigen::RowVector2d(0.5, 0.5);  // the wheels' cumulative angles
-  auto config = ParseEstimatorConfig(R"(
+// The differential drive with motion capture of the bridging tests (DiffDriveArcWithMotionCapture's streams).
+Result<EstimatorConfig> BridgingConfig() {
+  return ParseEstimatorConfig(R"(
 master: wheels
 parameters:
   wheels.radius: {value: [0.04]}
@@ -443,7 +437,18 @@ streams:
     source: mocap
     noise: {position_m: 0.0001, orientation_rad: 0.001}
 )",
-                                     "test config");
+                              "test config");
+}
+
+// A differential drive's wheel angles are cumulative: one reading off by 0.5 rad makes the span before it 10 rad/s
+// (20 sigma) too fast and the one after it as much too slow, and the motion capture (0.1 mm) holds the pose between
+// them. The gate leaves that one reading out (a bridge over the two spans), not the two spans, and the bridge fits at
+// the next pass.
+TEST(GateOutliersTest, AnOutlyingCumulativeReadingIsBridgedNotItsTwoSpansRejected) {
+  constexpr int kSamples = 60, kBad = 30;
+  recording::Recording rec = testing::DiffDriveArcWithMotionCapture(kSamples, 0.3, Eigen::Vector2d(1.0, -2.0));
+  rec.streams[0].values.row(kBad) += Eigen::RowVector2d(0.5, 0.5);  // the wheels' cumulative angles
+  const auto config = BridgingConfig();
   ASSERT_TRUE(config.ok()) << config.status().message();
   const std::unique_ptr<ProblemBuilder> builder = SolvedProblem(config.value(), rec);
   const GateSwitches first = GateOutliers(0.99999, builder.get());
@@ -481,23 +486,7 @@ TEST(GateOutliersTest, APassThatBridgesDefersTheOtherRejections) {
   recording::Recording rec = testing::DiffDriveArcWithMotionCapture(kSamples, 0.3, Eigen::Vector2d(1.0, -2.0));
   rec.streams[0].values.row(kBad) += Eigen::RowVector2d(0.5, 0.5);  // the wheels' cumulative angles
   rec.streams[1].values(kMocapOutlier, 1) += 0.05;
-  auto config = ParseEstimatorConfig(R"(
-master: wheels
-parameters:
-  wheels.radius: {value: [0.04]}
-  wheels.baseline: {value: [0.2]}
-streams:
-  wheels:
-    model: differential_drive
-    source: wheels
-    noise: {wheel_radps: 0.5, lateral_mps: 0.002, vertical_mps: 0.002, tilt_radps: 0.02}
-    parameters: {radius_left: wheels.radius, radius_right: wheels.radius, baseline: wheels.baseline}
-  mocap:
-    model: absolute_pose
-    source: mocap
-    noise: {position_m: 0.0001, orientation_rad: 0.001}
-)",
-                                     "test config");
+  const auto config = BridgingConfig();
   ASSERT_TRUE(config.ok()) << config.status().message();
   const std::unique_ptr<ProblemBuilder> at_once = SolvedProblem(config.value(), rec);
   const GateSwitches together = GateOutliers(0.99999, at_once.get());
