@@ -258,8 +258,8 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
 
     if (!accept) RestoreValues(ws.saved_, free_variables);
     // A rejected step is shortened along its direction (ShortenedStep) when that lowers the cost; the damping still
-    // rises as after a rejection, since the model overestimated the decrease (kept or lowered instead, a solve of
-    // indoor_fault_outliers, gross outliers still in, walks the wheel radii from 75 mm to 3-6 mm).
+    // rises as after a rejection, since the model overestimated the decrease (kept or lowered instead, a solve with
+    // gross outliers still in can walk weak parameters far off in the steps the model misjudges).
     bool shortened = false;
     if (lm && evaluated && !accept) {
       double short_cost = 0.0;

@@ -161,10 +161,9 @@ LongRunShares ShareOfLongRunSum(int series, int n, double a, int lag, std::uint3
 
 // The twin's gyroscope under IMU noise correlated over 0.05 s at 100 Hz (a = exp(-0.2) = 0.82), 667 rows, L = 21:
 // the plain Bartlett sum keeps 1 + 2 sum_{l=1..21} (1 - l / 22) a^l = 78 % of the long-run sum before the zero sum
-// takes its share (measured: 0.72). Prewhitened, the mean is the long-run sum up to the recolouring's first-order
+// takes its share. Prewhitened, the mean is the long-run sum up to the recolouring's first-order
 // biases, each about 5 % (the demeaned AR(1) coefficient's downward bias (1 + 3a) / n, times 2 / (1 - a); the
-// convexity of (1 - rho)^-2, 3 (1 - a^2) / (n (1 - a)^2), upward), so within their sum 0.10 and 3 standard errors
-// (measured: 0.94).
+// convexity of (1 - rho)^-2, 3 (1 - a^2) / (n (1 - a)^2), upward), so within their sum 0.10 and 3 standard errors.
 TEST(HacCovarianceTest, PrewhiteningRemovesTheBartlettSumsBiasOnAGaussMarkovSeries) {
   const LongRunShares s = ShareOfLongRunSum(300, 667, std::exp(-0.2), 21, 11);
   std::printf("share of the long-run sum: plain %.3f +- %.3f, prewhitened %.3f +- %.3f\n", s.plain, s.plain_error,
