@@ -265,14 +265,15 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
     const std::vector<VariableId>& vars = graph.factor(id).variables;
     bent_poses.insert(vars.begin(), vars.begin() + 2);
   }
-  const auto at_bent_pose = [&](FactorId id) {
+  // With defer_when_bridging, every failing measurement of a bridging pass waits, not only those of the bent poses.
+  const auto waits_for_resolve = [&](FactorId id) {
     if (options.defer_when_bridging) return true;
     const std::vector<VariableId>& vars = graph.factor(id).variables;
     return std::any_of(vars.begin(), vars.end(), [&](VariableId v) { return bent_poses.count(v) > 0; });
   };
   for (const TestedFactor& t : tested_factors) {
     if (refit.count(t.id) > 0) continue;
-    if (bridged.count(t.id) > 0 || (!t.pass && !bent_poses.empty() && at_bent_pose(t.id))) continue;
+    if (bridged.count(t.id) > 0 || (!t.pass && !bent_poses.empty() && waits_for_resolve(t.id))) continue;
     if (options.ignore_chance_changes && !t.pass && t.active) failing.push_back({t.squared_norm, t.dim});
     if (bursts)
       rows[t.stream].push_back({t.id, t.active, t.pass});
