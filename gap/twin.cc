@@ -52,6 +52,14 @@ std::map<std::string, double> Values(const TwinCandidate& c, const Eigen::Vector
   return out;
 }
 
+// e's std of parameter `name` from the covariances' diagonal entry k; the reported one is the larger of the white and
+// the HAC std when `hac`, else the white.
+void SetStd(const std::string& name, const TwinCovariance& covariance, Eigen::Index k, bool hac, TwinEffect* e) {
+  e->std_white[name] = std::sqrt(std::max(0.0, covariance.white(k, k)));
+  e->std_hac[name] = std::sqrt(std::max(0.0, covariance.hac(k, k)));
+  e->estimate.std[name] = hac ? std::max(e->std_white[name], e->std_hac[name]) : e->std_white[name];
+}
+
 // What one round judges the candidates against: the effects kept so far.
 struct State {
   sim::Scenario train, full;  // nominal + kept effects; over the training part, over the whole recording
@@ -81,6 +89,7 @@ class Diagnoser {
   Result<TwinEffect> Fit(const TwinCandidate& c, const State& state, double step_s, bool screen);
   Result<bool> Round(int round, const std::vector<TwinCandidate>& pool, double step_s, State* state,
                      std::vector<TwinEffect>* scored);
+  void FitJointly(const State& state, const std::vector<TwinCandidate>& library, double step_s);
   void Finish(const State& state);
 
   const sim::Scenario& nominal_;
@@ -155,10 +164,7 @@ Result<TwinEffect> Diagnoser::Fit(const TwinCandidate& c, const State& state, do
       e.not_informed.push_back(name);
       continue;
     }
-    e.std_white[name] = std::sqrt(std::max(0.0, covariance.white(k, k)));
-    e.std_hac[name] = std::sqrt(std::max(0.0, covariance.hac(k, k)));
-    e.estimate.std[name] = hac_ ? std::max(e.std_white[name], e.std_hac[name]) : e.std_white[name];
-    ++k;
+    SetStd(name, covariance, k++, hac_, &e);
   }
   e.estimate.dof = static_cast<int>(k);
   e.hac_lags = covariance.lags;
@@ -232,6 +238,79 @@ Result<bool> Diagnoser::Round(int round, const std::vector<TwinCandidate>& pool,
   return false;
 }
 
+// Step 5 (gap/twin.h): the kept effects other than time shifts, each over the parameters its round fitted, refitted
+// together from their kept values on the training part, the time shifts held in the base. A joint fit whose twin fails
+// leaves the rounds' figures alone and says why.
+void Diagnoser::FitJointly(const State& state, const std::vector<TwinCandidate>& library, double step_s) {
+  sim::Scenario base = state.train;
+  base.effects.clear();
+  std::vector<TwinCandidate> parts;
+  std::vector<const TwinEffect*> kept;
+  std::vector<double> start;
+  for (const TwinEffect& e : out_.effects) {
+    const auto c = std::find_if(library.begin(), library.end(),
+                                [&](const TwinCandidate& x) { return x.label == e.estimate.name; });
+    if (c == library.end() || c->time_shift) {
+      base.effects.push_back(e.effect);
+      out_.joint.held.push_back(e.estimate.name);
+      continue;
+    }
+    std::vector<bool> informed;
+    for (const internal::TwinParameter& p : c->free)
+      informed.push_back(std::find(e.not_informed.begin(), e.not_informed.end(), p.name) == e.not_informed.end());
+    parts.push_back(internal::Reduced(*c, informed));
+    for (const internal::TwinParameter& p : parts.back().free) start.push_back(e.estimate.parameters.at(p.name));
+    kept.push_back(&e);
+  }
+  if (parts.size() < 2) {
+    out_.joint = {};
+    return;
+  }
+  Progress("joint refit of the kept effects");
+  internal::TwinEvaluator evaluator(base, real_, runner_, train_layout_, options_.threads);
+  internal::FitSettings settings;
+  settings.max_iterations = options_.max_iterations;
+  settings.physics_step_s = step_s;
+  settings.threads = options_.threads;
+  const Eigen::VectorXd theta0 = Eigen::Map<const Eigen::VectorXd>(start.data(), static_cast<Eigen::Index>(start.size()));
+  auto fit = internal::FitJointly(parts, theta0, state.residuals, &evaluator, settings);
+  runs_ += evaluator.runs();
+  out_.joint.runs = evaluator.runs();
+  out_.joint.chi2_before = state.chi2;
+  if (!fit.ok()) {
+    out_.joint.failed = fit.status().message();
+    return;
+  }
+  out_.joint.chi2_after = fit.value().chi2;
+  out_.joint.iterations = fit.value().iterations;
+  const TwinCovariance& covariance = fit.value().covariance;
+  const Eigen::MatrixXd information = covariance.white.completeOrthogonalDecomposition().pseudoInverse();
+  Eigen::Index k = 0;  // the parameter's index in the joint covariance
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    TwinEffect e;
+    e.effect = fit.value().effects[i];
+    e.estimate.name = parts[i].label;
+    const Eigen::Index size = static_cast<Eigen::Index>(parts[i].free.size());
+    e.estimate.parameters = Values(parts[i], fit.value().theta.segment(k, size));
+    e.estimate.dof = static_cast<int>(size);
+    e.estimate.decision = "refitted jointly with the other kept effects: marginal std";
+    const Eigen::MatrixXd conditional =
+        information.block(k, k, size, size).completeOrthogonalDecomposition().pseudoInverse();
+    std::map<std::string, double> conditional_std;
+    for (Eigen::Index j = 0; j < size; ++j)
+      conditional_std[parts[i].free[static_cast<std::size_t>(j)].name] = std::sqrt(std::max(0.0, conditional(j, j)));
+    out_.joint.std_white_conditional.push_back(conditional_std);
+    for (const internal::TwinParameter& p : parts[i].free) SetStd(p.name, covariance, k++, hac_, &e);
+    e.not_informed = kept[i]->not_informed;
+    e.hac_lags = covariance.lags;
+    e.chi2_before = out_.joint.chi2_before;
+    e.chi2_after = out_.joint.chi2_after;
+    e.iterations = out_.joint.iterations;
+    e.runs = out_.joint.runs;
+    out_.joint.effects.push_back(std::move(e));
+  }
+}
+
 // The held-out figures with the patch, the unexplained components and the verdict.
 void Diagnoser::Finish(const State& state) {
   out_.heldout_after = state.heldout;
@@ -275,8 +354,9 @@ Result<TwinDiagnosis> Diagnoser::Run() {
   state.residuals = internal::WhitenedResiduals(train_layout_, real_, state.twin);
   state.chi2 = internal::SumOfSquares(state.residuals, &measurements_);
 
+  const std::vector<TwinCandidate> library = internal::TwinCandidates(nominal_, options_.max_shift_s);
   std::vector<TwinCandidate> pool;
-  for (const TwinCandidate& c : internal::TwinCandidates(nominal_, options_.max_shift_s))
+  for (const TwinCandidate& c : library)
     if (options_.candidates.empty() ||
         std::find(options_.candidates.begin(), options_.candidates.end(), c.label) != options_.candidates.end())
       pool.push_back(c);
@@ -296,6 +376,8 @@ Result<TwinDiagnosis> Diagnoser::Run() {
       if (passed.count(c.label) && !kept_effects.count(c.effect)) next.push_back(c);
     pool = next;
   }
+  if (InterruptRequested()) return InterruptedError();
+  FitJointly(state, library, step_s);
   Finish(state);
   out_.runs = runs_;
   out_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -32,7 +32,12 @@
 //      with the reason); then the candidates that passed p in the first round are tried again on top of the kept
 //      ones, each fitted only when a score test passes alpha (internal/twin_fit.h PredictedDrop: the Gauss-Newton
 //      step's predicted drop from its neutral values, one Jacobian), up to max_effects;
-//   5. show: on the held-out part, the nominal twin's and the patched twin's residual RMS per stream and drift.
+//   5. joint refit: with more than one effect kept, each was fitted on top of the ones before it, held at their values,
+//      so its std is conditional on them; the kept effects' parameters (time shifts held at their values) are fitted
+//      again together, Levenberg-Marquardt from the kept values (internal/twin_fit.h FitJointly), and their joint values
+//      with the marginal std (white and HAC, from the joint covariance) are reported beside the rounds' (TwinJointFit).
+//      It names nothing and leaves the patch and the held-out figures as the rounds kept them;
+//   6. show: on the held-out part, the nominal twin's and the patched twin's residual RMS per stream and drift.
 // Verdict: "named" (some effect kept), "unknown" (no effect kept, and some component inconsistent with the stated
 // noise), "none". `unexplained` lists the components still inconsistent on the held-out part with the patch.
 // The runner must be thread-safe (a Simulator of its own per call); it may stop the twin at the patched scenario's
@@ -162,6 +167,21 @@ struct TwinEffect {
   int runs = 0;  // twin runs spent on the fit
 };
 
+// The kept effects fitted together (step 5): per refitted effect its joint values and marginal std (estimate.name,
+// parameters, std, dof; std_white, std_hac, not_informed and hac_lags as the rounds'); chi2_before is the training
+// chi-square at the rounds' values, chi2_after at the joint ones; iterations and runs are the joint fit's.
+struct TwinJointFit {
+  std::vector<TwinEffect> effects;  // in the kept order
+  // Per effect (effects' order) and parameter: its white std with the other effects held at their joint values (from
+  // the joint information's block of the effect), the std a fit of the effect alone there would report; at most the
+  // marginal std_white, equal to it where the effect does not correlate with the others.
+  std::vector<std::map<std::string, double>> std_white_conditional;
+  std::vector<std::string> held;    // kept effects not refitted (time shifts), at their kept values
+  std::string failed;               // why the joint fit failed (a twin run's error), empty when it did not
+  double chi2_before = 0.0, chi2_after = 0.0;
+  int iterations = 0, runs = 0;
+};
+
 // A recording held out of the fit (another run of the same robot): the nominal twin and the patched twin (the patch
 // fitted on the diagnosed recording) compared with it over its whole span.
 struct TwinHeldOutRun {
@@ -178,6 +198,7 @@ struct TwinDiagnosis {
   std::vector<LocatedComponent> located;  // the nominal twin, whole run
   std::vector<TwinEffect> candidates;     // the first round, best Delta BIC first
   std::vector<TwinEffect> effects;        // kept, in order
+  TwinJointFit joint;                     // empty unless more than one effect is kept and refitted
   std::vector<std::string> unexplained;   // "stream/component" inconsistent on the held-out part with the patch
   TwinComparison whole_run;               // the nominal twin
   TwinComparison heldout_before, heldout_after;
@@ -223,7 +244,8 @@ Result<TwinHeldOutRun> ShowOnHeldOut(const sim::Scenario& nominal, const std::ve
 // Per stream: {"window_s", "windows", "mean_position_m", "max_position_m"[, "mean_heading_rad", "max_heading_rad"]}.
 nlohmann::json TwinDriftJson(const std::map<std::string, TwinDrift>& drift);
 
-// {"replayed", "verdict", "std_method", "train_end_s", "located", "candidates", "effects", "unexplained",
+// {"replayed", "verdict", "std_method", "train_end_s", "located", "candidates", "effects", "joint" (null, or
+// {"effects", "held", "failed", "chi2_before", "chi2_after", "iterations", "runs"}), "unexplained",
 // "heldout": {"before", "after"}, "whole_run", "patch",
 // "heldout_runs": [{"recording", "replayed", "before", "after"}], "runs", "seconds"}: gap.json's "simulation" section.
 nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d);

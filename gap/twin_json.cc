@@ -56,6 +56,27 @@ nlohmann::json EffectJson(const TwinEffect& e) {
           {"runs", e.runs}};
 }
 
+// Null when no joint fit was made; each effect as EffectJson without the naming's scores, with std_white_conditional.
+nlohmann::json JointJson(const TwinJointFit& j) {
+  if (j.effects.empty() && j.failed.empty()) return nullptr;
+  nlohmann::json effects = nlohmann::json::array();
+  for (std::size_t i = 0; i < j.effects.size(); ++i) {
+    nlohmann::json x = EffectJson(j.effects[i]);
+    for (const char* key : {"lr", "p", "delta_bic", "heldout_improvement", "accepted"}) x.erase(key);
+    x["std_white_conditional"] = nlohmann::json::object();
+    if (i < j.std_white_conditional.size())
+      for (const auto& [name, value] : j.std_white_conditional[i]) x["std_white_conditional"][name] = Number(value);
+    effects.push_back(x);
+  }
+  return {{"effects", effects},
+          {"held", j.held},
+          {"failed", j.failed},
+          {"chi2_before", Number(j.chi2_before)},
+          {"chi2_after", Number(j.chi2_after)},
+          {"iterations", j.iterations},
+          {"runs", j.runs}};
+}
+
 }  // namespace
 
 nlohmann::json TwinDriftJson(const std::map<std::string, TwinDrift>& drift) {
@@ -106,6 +127,7 @@ nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d) {
           {"located", located},
           {"candidates", candidates},
           {"effects", effects},
+          {"joint", JointJson(d.joint)},
           {"unexplained", d.unexplained},
           {"heldout", {{"before", ComparisonJson(d.heldout_before)}, {"after", ComparisonJson(d.heldout_after)}}},
           {"whole_run", ComparisonJson(d.whole_run)},

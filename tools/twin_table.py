@@ -1,10 +1,12 @@
 #!/usr/bin/env python3
 """The OptiOdom twin table from scripts/twin_optiodom.sh's outputs (OUT/<day>_<training set>/twin.json).
 
-Per training run: the effects named (value +- std, and which std), the twin's mean 10 s motion-capture drift on its own
-held-out part and on each held-out run, nominal -> patched (ratio). Per day: every candidate's first-round fit on
-each training run (value +- std) and the largest normalized spread |a - b| / sqrt(sa^2 + sb^2) over the pairs of runs,
-for the named effects and for all the candidates.
+Per training run: the effects named (value +- std, and which std; with more than one named, also their joint refit's
+values +- marginal std), the twin's mean 10 s motion-capture drift on its own held-out part and on each held-out run,
+nominal -> patched (ratio). Per day: every candidate's first-round fit on each training run (value +- std) and the
+largest normalized spread |a - b| / sqrt(sa^2 + sb^2) over the pairs of runs, for the named effects as their rounds
+fitted them ("named"), as the joint refit gives them ("joint": the joint values and marginal std where the run names
+more than one effect, else the round's), and for all the candidates.
 
     python3 tools/twin_table.py OUT_DIR
 """
@@ -58,6 +60,9 @@ def main(out):
         day, training = path.parent.name.rsplit("_", 1)
         twin = json.loads(path.read_text())
         named = " / ".join(effect_text(e) for e in twin["effects"]) or "(none)"
+        joint = (twin.get("joint") or {}).get("effects") or []
+        if joint:
+            named += "; joint: " + " / ".join(effect_text(e) for e in joint)
         own = ratio_text(drift(twin["heldout"]["before"]), drift(twin["heldout"]["after"]))
         held = "; ".join(
             f"{pathlib.Path(h['recording']).name.split('_')[0]}: "
@@ -67,8 +72,9 @@ def main(out):
             before, after = drift(h["before"]), drift(h["after"])
             if before and after is not None:
                 ratios.setdefault(day, []).append(after / before)
-        day_fits = days.setdefault(day, {"named": {}, "candidates": {}})
-        for kind, effects in (("named", twin["effects"]), ("candidates", twin["candidates"])):
+        day_fits = days.setdefault(day, {"named": {}, "joint": {}, "candidates": {}})
+        for kind, effects in (("named", twin["effects"]), ("joint", joint or twin["effects"]),
+                              ("candidates", twin["candidates"])):
             for e in effects:
                 for k, v in e["parameters"].items():
                     if k in e.get("std", {}) and v is not None:
@@ -79,7 +85,7 @@ def main(out):
               f"{met} of {len(values)} at most 0.5")
     for day, fits in days.items():
         print(f"\n{day}: normalized spread between the runs |a - b| / sqrt(sa^2 + sb^2)")
-        for kind in ("named", "candidates"):
+        for kind in ("named", "joint", "candidates"):
             for parameter, values in sorted(fits[kind].items()):
                 if len(values) < 2:
                     continue

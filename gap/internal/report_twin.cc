@@ -167,6 +167,18 @@ std::string ResidualVsCondition(const SimulationComparison& c, const recording::
   return "twin_residual_vs_condition.png";
 }
 
+// "name: parameter = value +- std ..." of a fitted effect.
+std::string EffectLine(const TwinEffect& e) {
+  std::string line = e.estimate.name + ":";
+  for (const auto& [k, v] : e.estimate.parameters) {
+    line += " " + k + " = " + Fixed(v, 5);
+    if (const auto s = e.estimate.std.find(k); s != e.estimate.std.end()) line += " +- " + Fixed(s->second, 2);
+    if (std::find(e.not_informed.begin(), e.not_informed.end(), k) != e.not_informed.end())
+      line += " (not informed, held)";
+  }
+  return line;
+}
+
 }  // namespace
 
 HeldOutDrift TwinHeldOutDrift(const SimulationComparison& c, const recording::Recording& real) {
@@ -216,16 +228,16 @@ html::Table DriftTable(const HeldOutDrift& drift) {
 std::vector<std::string> TwinVerdictLines(const TwinDiagnosis& d) {
   std::vector<std::string> lines = {"The twin's verdict: " + d.verdict + " (std " + d.std_method + ", " +
                                     std::to_string(d.runs) + " twin runs in " + Fixed(d.seconds, 3) + " s)."};
-  for (const TwinEffect& e : d.effects) {
-    std::string line = e.estimate.name + ":";
-    for (const auto& [k, v] : e.estimate.parameters) {
-      line += " " + k + " = " + Fixed(v, 5);
-      if (const auto s = e.estimate.std.find(k); s != e.estimate.std.end()) line += " +- " + Fixed(s->second, 2);
-      if (std::find(e.not_informed.begin(), e.not_informed.end(), k) != e.not_informed.end())
-        line += " (not informed, held)";
-    }
-    lines.push_back(line + " (training chi2 " + Fixed(e.chi2_before, 5) + " -> " + Fixed(e.chi2_after, 5) + ")");
-  }
+  for (const TwinEffect& e : d.effects)
+    lines.push_back(EffectLine(e) + " (training chi2 " + Fixed(e.chi2_before, 5) + " -> " + Fixed(e.chi2_after, 5) +
+                    (d.joint.effects.empty() ? ")" : "; std conditional on the effects kept before it)"));
+  if (!d.joint.failed.empty()) lines.push_back("The kept effects' joint refit failed: " + d.joint.failed + ".");
+  if (d.joint.effects.empty()) return lines;
+  std::string held;
+  for (const std::string& h : d.joint.held) held += (held.empty() ? "; held at their values: " : ", ") + h;
+  lines.push_back("Refitted jointly (training chi2 " + Fixed(d.joint.chi2_before, 5) + " -> " +
+                  Fixed(d.joint.chi2_after, 5) + held + "), each std marginal over the others:");
+  for (const TwinEffect& e : d.joint.effects) lines.push_back("joint " + EffectLine(e));
   return lines;
 }
 

@@ -111,38 +111,63 @@ TwinFitRows Rows(const Layout& layout, const Eigen::VectorXd& center, const Eige
   return rows;
 }
 
-Eigen::VectorXd Clamp(const TwinCandidate& c, Eigen::VectorXd theta) {
-  for (std::size_t j = 0; j < c.free.size(); ++j) {
+// Candidates fitted together (one for a single candidate's fit): their free parameters concatenated in order.
+struct Parts {
+  std::vector<TwinCandidate> candidates;
+  std::string label;  // the candidates' labels joined by " + "
+  std::vector<TwinParameter> free;
+
+  explicit Parts(std::vector<TwinCandidate> parts) : candidates(std::move(parts)) {
+    for (const TwinCandidate& c : candidates) {
+      label += (label.empty() ? "" : " + ") + c.label;
+      free.insert(free.end(), c.free.begin(), c.free.end());
+    }
+  }
+  Patch At(const Eigen::VectorXd& theta) const {
+    Patch out;
+    Eigen::Index offset = 0;
+    for (const TwinCandidate& c : candidates) {
+      const Eigen::Index k = static_cast<Eigen::Index>(c.free.size());
+      out.push_back(EffectAt(c, theta.segment(offset, k)));
+      offset += k;
+    }
+    return out;
+  }
+};
+
+Eigen::VectorXd Clamp(const Parts& parts, Eigen::VectorXd theta) {
+  for (std::size_t j = 0; j < parts.free.size(); ++j) {
     const Eigen::Index k = static_cast<Eigen::Index>(j);
-    theta[k] = std::clamp(theta[k], c.free[j].lo, c.free[j].hi);
+    theta[k] = std::clamp(theta[k], parts.free[j].lo, parts.free[j].hi);
   }
   return theta;
 }
 
 // The Jacobian of the residuals by the parameters at `theta` (residuals `center`): central differences when 2k runs
 // fit in the threads, else forward (backward at the upper bound; one-sided at either bound).
-Result<Eigen::MatrixXd> Jacobian(const TwinCandidate& c, const Eigen::VectorXd& theta, const Eigen::VectorXd& center,
+Result<Eigen::MatrixXd> Jacobian(const Parts& parts, const Eigen::VectorXd& theta, const Eigen::VectorXd& center,
                                  int threads, TwinEvaluator* evaluator) {
-  const int k = static_cast<int>(c.free.size());
+  const int k = static_cast<int>(parts.free.size());
   const bool central = 2 * k <= std::max(2, threads);
-  std::vector<sim::EffectOptions> runs;
+  std::vector<Patch> runs;
   std::vector<std::pair<double, double>> deltas;  // per parameter: the + and - steps taken (0: none)
   for (int j = 0; j < k; ++j) {
-    const TwinParameter& p = c.free[static_cast<std::size_t>(j)];
+    const TwinParameter& p = parts.free[static_cast<std::size_t>(j)];
     double plus = theta[j] + p.step <= p.hi ? p.step : 0.0;
     double minus = (central || plus == 0.0) && theta[j] - p.step >= p.lo ? p.step : 0.0;
-    if (plus == 0.0 && minus == 0.0) return Status::Error(c.label + ": " + p.name + "'s range is narrower than a step");
+    if (plus == 0.0 && minus == 0.0)
+      return Status::Error(parts.label + ": " + p.name + "'s range is narrower than a step");
     for (const double d : {plus, -minus}) {
       if (d == 0.0) continue;
       Eigen::VectorXd at = theta;
       at[j] += d;
-      runs.push_back(EffectAt(c, at));
+      runs.push_back(parts.At(at));
     }
     deltas.push_back({plus, minus});
   }
   const std::vector<Result<Eigen::VectorXd>> r = evaluator->Run(runs);
   for (const auto& x : r)
-    if (!x.ok()) return Status::Error(c.label + ": a perturbed twin: " + x.status().message());
+    if (!x.ok()) return Status::Error(parts.label + ": a perturbed twin: " + x.status().message());
   Eigen::MatrixXd J(center.size(), k);
   std::size_t next = 0;
   for (int j = 0; j < k; ++j) {
@@ -196,43 +221,37 @@ std::vector<bool> Informed(const TwinCandidate& c, const Eigen::MatrixXd& J) {
   }
 }
 
-// `c` with the parameters not `informed` held at their neutral values (moved to c.fixed).
-TwinCandidate Reduced(const TwinCandidate& c, const std::vector<bool>& informed) {
-  TwinCandidate out = c;
-  out.free.clear();
-  for (std::size_t j = 0; j < c.free.size(); ++j) {
-    if (informed[j])
-      out.free.push_back(c.free[j]);
-    else
-      out.fixed[c.free[j].name] = c.free[j].neutral;
-  }
-  return out;
-}
+// The outcome of FitLeastSquares.
+struct LeastSquares {
+  Eigen::VectorXd theta;
+  TwinCovariance covariance;
+  double chi2 = 0.0;
+  Eigen::VectorXd residuals;
+  int iterations = 0;
+};
 
-// Levenberg-Marquardt from the neutral values, the parameters scaled by their steps. Stops when the Gauss-Newton step
-// predicts, or the step taken makes, a decrease below kMinDecrease + kMinRelativeDecrease chi2 (a tenth of the
-// chi-square unit that moves a parameter by one standard deviation, so at most a third of it away), after
-// max_iterations, or when kMaxTries dampings do not decrease the cost.
-// `first_jacobian`, when given, is the Jacobian at the neutral values.
-Result<CandidateOutcome> FitLeastSquares(const TwinCandidate& c, const Eigen::VectorXd& base, TwinEvaluator* evaluator,
-                                         const FitSettings& settings, const Eigen::MatrixXd* first_jacobian) {
-  const int k = static_cast<int>(c.free.size());
-  CandidateOutcome out;
-  out.theta.resize(k);
+// Levenberg-Marquardt from `start` (residuals `at_start`), the parameters scaled by their steps. Stops when the
+// Gauss-Newton step predicts, or the step taken makes, a decrease below kMinDecrease + kMinRelativeDecrease chi2 (a
+// tenth of the chi-square unit that moves a parameter by one standard deviation, so at most a third of it away), after
+// max_iterations, or when kMaxTries dampings do not decrease the cost. `first_jacobian`, when given, is the Jacobian at
+// `start`.
+Result<LeastSquares> FitLeastSquares(const Parts& parts, const Eigen::VectorXd& start, const Eigen::VectorXd& at_start,
+                                     TwinEvaluator* evaluator, const FitSettings& settings,
+                                     const Eigen::MatrixXd* first_jacobian) {
+  const int k = static_cast<int>(parts.free.size());
+  LeastSquares out;
+  out.theta = start;
   Eigen::VectorXd scale(k);
-  for (int j = 0; j < k; ++j) {
-    out.theta[j] = c.free[static_cast<std::size_t>(j)].neutral;
-    scale[j] = c.free[static_cast<std::size_t>(j)].step;
-  }
-  out.residuals = base;
-  out.chi2 = SumOfSquares(base);
+  for (int j = 0; j < k; ++j) scale[j] = parts.free[static_cast<std::size_t>(j)].step;
+  out.residuals = at_start;
+  out.chi2 = SumOfSquares(at_start);
   double lambda = 1e-3;
   Eigen::MatrixXd J;
   for (out.iterations = 0; out.iterations < settings.max_iterations; ++out.iterations) {
     if (out.iterations == 0 && first_jacobian) {
       J = *first_jacobian;
     } else {
-      auto jacobian = Jacobian(c, out.theta, out.residuals, settings.threads, evaluator);
+      auto jacobian = Jacobian(parts, out.theta, out.residuals, settings.threads, evaluator);
       if (!jacobian.ok()) return jacobian.status();
       J = jacobian.value();
     }
@@ -246,9 +265,9 @@ Result<CandidateOutcome> FitLeastSquares(const TwinCandidate& c, const Eigen::Ve
     for (int tries = 0; tries < kMaxTries && decrease <= 0.0; ++tries, lambda *= 10.0) {
       Eigen::MatrixXd A = H;
       A.diagonal() += lambda * H.diagonal().cwiseMax(1e-12);
-      const Eigen::VectorXd trial = Clamp(c, out.theta + scale.cwiseProduct(A.ldlt().solve(-g)));
-      auto run = evaluator->Run({EffectAt(c, trial)});
-      if (!run[0].ok()) return Status::Error(c.label + ": a trial twin: " + run[0].status().message());
+      const Eigen::VectorXd trial = Clamp(parts, out.theta + scale.cwiseProduct(A.ldlt().solve(-g)));
+      auto run = evaluator->Run({parts.At(trial)});
+      if (!run[0].ok()) return Status::Error(parts.label + ": a trial twin: " + run[0].status().message());
       const double chi2 = SumOfSquares(Masked(run[0].value(), out.residuals));
       if (chi2 >= out.chi2) continue;
       decrease = out.chi2 - chi2;
@@ -259,7 +278,6 @@ Result<CandidateOutcome> FitLeastSquares(const TwinCandidate& c, const Eigen::Ve
     }
     if (decrease < enough) break;
   }
-  out.effect = EffectAt(c, out.theta);
   out.covariance = ComputeTwinCovariance(Rows(evaluator->layout(), out.residuals, J));
   return out;
 }
@@ -282,8 +300,8 @@ Result<CandidateOutcome> SearchTimeShift(const TwinCandidate& c, const Eigen::Ve
     std::vector<long> todo;
     for (long s : shifts)
       if (s >= lo && s <= hi && !r.count(s) && std::find(todo.begin(), todo.end(), s) == todo.end()) todo.push_back(s);
-    std::vector<sim::EffectOptions> runs;
-    for (long s : todo) runs.push_back(EffectAt(c, Eigen::VectorXd::Constant(1, static_cast<double>(s) * step)));
+    std::vector<Patch> runs;
+    for (long s : todo) runs.push_back({EffectAt(c, Eigen::VectorXd::Constant(1, static_cast<double>(s) * step))});
     const auto out = evaluator->Run(runs);
     for (std::size_t i = 0; i < todo.size(); ++i) {
       if (!out[i].ok()) return Status::Error(c.label + ": a shifted twin: " + out[i].status().message());
@@ -331,6 +349,18 @@ Result<CandidateOutcome> SearchTimeShift(const TwinCandidate& c, const Eigen::Ve
 
 }  // namespace
 
+TwinCandidate Reduced(const TwinCandidate& c, const std::vector<bool>& informed) {
+  TwinCandidate out = c;
+  out.free.clear();
+  for (std::size_t j = 0; j < c.free.size(); ++j) {
+    if (informed[j])
+      out.free.push_back(c.free[j]);
+    else
+      out.fixed[c.free[j].name] = c.free[j].neutral;
+  }
+  return out;
+}
+
 std::vector<TwinCandidate> TwinCandidates(const sim::Scenario& nominal, double max_shift_s) {
   std::vector<TwinCandidate> out;
   for (const TwinCandidate& c : Library(nominal, max_shift_s)) {
@@ -364,11 +394,12 @@ void ParallelFor(int n, int threads, const std::function<void(int)>& fn) {
   for (std::thread& t : pool) t.join();
 }
 
-std::vector<Result<Eigen::VectorXd>> TwinEvaluator::Run(const std::vector<sim::EffectOptions>& extra) {
-  std::vector<Result<Eigen::VectorXd>> out(extra.size(), Result<Eigen::VectorXd>(Status::Error("not run")));
-  ParallelFor(static_cast<int>(extra.size()), threads_, [&](int i) {
+std::vector<Result<Eigen::VectorXd>> TwinEvaluator::Run(const std::vector<Patch>& patches) {
+  std::vector<Result<Eigen::VectorXd>> out(patches.size(), Result<Eigen::VectorXd>(Status::Error("not run")));
+  ParallelFor(static_cast<int>(patches.size()), threads_, [&](int i) {
     sim::Scenario patched = base_;
-    patched.effects.push_back(extra[static_cast<std::size_t>(i)]);
+    const Patch& patch = patches[static_cast<std::size_t>(i)];
+    patched.effects.insert(patched.effects.end(), patch.begin(), patch.end());
     try {
       auto twin = runner_(patched);
       out[static_cast<std::size_t>(i)] =
@@ -377,7 +408,7 @@ std::vector<Result<Eigen::VectorXd>> TwinEvaluator::Run(const std::vector<sim::E
       out[static_cast<std::size_t>(i)] = Status::Error(std::string("the twin runner failed: ") + e.what());
     }
   });
-  runs_ += static_cast<int>(extra.size());
+  runs_ += static_cast<int>(patches.size());
   return out;
 }
 
@@ -387,13 +418,13 @@ Result<ScoreTest> PredictedDrop(const TwinCandidate& c, const Eigen::VectorXd& b
   if (c.time_shift) {
     const double shift_s = c.free.front().hi > 0.0 ? settings.physics_step_s : -settings.physics_step_s;
     theta[0] = shift_s;
-    auto r = evaluator->Run({EffectAt(c, theta)});
+    auto r = evaluator->Run({Patch{EffectAt(c, theta)}});
     if (!r[0].ok()) return Status::Error(c.label + ": a shifted twin: " + r[0].status().message());
     const Eigen::VectorXd d = (Masked(r[0].value(), base) - Masked(base, base)) / shift_s;
     const Eigen::VectorXd b = Masked(base, base);
     return ScoreTest{d.squaredNorm() > 0.0 ? std::pow(d.dot(b), 2) / d.squaredNorm() : 0.0, 1};
   }
-  auto J = Jacobian(c, theta, base, settings.threads, evaluator);
+  auto J = Jacobian(Parts({c}), theta, base, settings.threads, evaluator);
   if (!J.ok()) return J.status();
   const std::vector<bool> informed = Informed(c, J.value());
   std::vector<int> columns;
@@ -414,29 +445,50 @@ Result<CandidateOutcome> FitCandidate(const TwinCandidate& c, const Eigen::Vecto
     return out;
   }
   const Eigen::VectorXd neutral = NeutralValues(c);
-  auto J = Jacobian(c, neutral, base, settings.threads, evaluator);
+  auto J = Jacobian(Parts({c}), neutral, base, settings.threads, evaluator);
   if (!J.ok()) return J.status();
   const std::vector<bool> informed = Informed(c, J.value());
   const TwinCandidate fitted = Reduced(c, informed);
   CandidateOutcome out;
+  out.theta = neutral;
   if (fitted.free.empty()) {  // nothing to fit: the neutral values, the base residuals
-    out.theta = neutral;
-    out.effect = EffectAt(c, neutral);
     out.residuals = base;
     out.chi2 = SumOfSquares(base);
   } else {
     // The Jacobian at the neutral values is the first iteration's when every parameter is fitted; with fewer, the
     // reduced candidate's own (central differences when they now fit in the threads).
     const bool all = fitted.free.size() == c.free.size();
-    auto fit = FitLeastSquares(fitted, base, evaluator, settings, all ? &J.value() : nullptr);
+    auto fit = FitLeastSquares(Parts({fitted}), NeutralValues(fitted), base, evaluator, settings,
+                               all ? &J.value() : nullptr);
     if (!fit.ok()) return fit.status();
-    out = std::move(fit).value();
-    Eigen::VectorXd theta = neutral;
     for (std::size_t j = 0, f = 0; j < c.free.size(); ++j)
-      if (informed[j]) theta[static_cast<Eigen::Index>(j)] = out.theta[static_cast<Eigen::Index>(f++)];
-    out.theta = theta;
+      if (informed[j]) out.theta[static_cast<Eigen::Index>(j)] = fit.value().theta[static_cast<Eigen::Index>(f++)];
+    out.covariance = fit.value().covariance;
+    out.chi2 = fit.value().chi2;
+    out.residuals = fit.value().residuals;
+    out.iterations = fit.value().iterations;
   }
+  out.effect = EffectAt(c, out.theta);
   out.informed = informed;
+  return out;
+}
+
+Result<JointOutcome> FitJointly(const std::vector<TwinCandidate>& parts, const Eigen::VectorXd& start,
+                                const Eigen::VectorXd& at_start, TwinEvaluator* evaluator, const FitSettings& settings) {
+  for (const TwinCandidate& c : parts)
+    if (c.time_shift) return Status::Error(c.label + ": a time shift is not refitted jointly");
+  const Parts joint(parts);
+  if (start.size() != static_cast<Eigen::Index>(joint.free.size()))
+    return Status::Error(joint.label + ": the start has " + std::to_string(start.size()) + " values for " +
+                         std::to_string(joint.free.size()) + " parameters");
+  auto fit = FitLeastSquares(joint, start, at_start, evaluator, settings, nullptr);
+  if (!fit.ok()) return fit.status();
+  JointOutcome out;
+  out.theta = fit.value().theta;
+  out.covariance = fit.value().covariance;
+  out.effects = joint.At(out.theta);
+  out.chi2 = fit.value().chi2;
+  out.iterations = fit.value().iterations;
   return out;
 }
 

@@ -37,14 +37,17 @@ std::vector<TwinCandidate> TwinCandidates(const sim::Scenario& nominal, double m
 // The effect of `c` at parameter values `theta` (in c.free's order).
 sim::EffectOptions EffectAt(const TwinCandidate& c, const Eigen::VectorXd& theta);
 
-// Runs the twin of patched scenarios (the base with one more effect each), in parallel, and returns the whitened
+// The effects one twin run adds to the evaluator's base scenario.
+using Patch = std::vector<sim::EffectOptions>;
+
+// Runs the twin of patched scenarios (the base with a patch's effects each), in parallel, and returns the whitened
 // training residuals of each (layout's entries; NaN where the twin has no sample).
 class TwinEvaluator {
  public:
   TwinEvaluator(const sim::Scenario& base, const recording::Recording& real, const TwinRunner& runner,
                 const Layout& layout, int threads)
       : base_(base), real_(real), runner_(runner), layout_(layout), threads_(threads) {}
-  std::vector<Result<Eigen::VectorXd>> Run(const std::vector<sim::EffectOptions>& extra);
+  std::vector<Result<Eigen::VectorXd>> Run(const std::vector<Patch>& patches);
   int runs() const { return runs_; }
   const Layout& layout() const { return layout_; }
 
@@ -82,6 +85,23 @@ struct FitSettings {
 // over the neighbouring steps.
 Result<CandidateOutcome> FitCandidate(const TwinCandidate& c, const Eigen::VectorXd& base, TwinEvaluator* evaluator,
                                       const FitSettings& settings);
+
+// Kept effects refitted together: Levenberg-Marquardt as FitCandidate over the free parameters of every part at once,
+// concatenated in the parts' order, from `start` (whose residuals are `at_start`), the evaluator's base holding none of
+// the parts. Its covariance is the joint one, so each parameter's std is marginal over the others (a part fitted on
+// top of another frozen one reports a std conditional on it). Time-shift parts are refused.
+struct JointOutcome {
+  Eigen::VectorXd theta;      // concatenated as the parts' free parameters
+  TwinCovariance covariance;  // of theta
+  Patch effects;              // one per part, as applied
+  double chi2 = 0.0;          // training part, at `effects`
+  int iterations = 0;
+};
+Result<JointOutcome> FitJointly(const std::vector<TwinCandidate>& parts, const Eigen::VectorXd& start,
+                                const Eigen::VectorXd& at_start, TwinEvaluator* evaluator, const FitSettings& settings);
+
+// `c` with the parameters not `informed` (c.free's order) held at their neutral values (moved to c.fixed).
+TwinCandidate Reduced(const TwinCandidate& c, const std::vector<bool>& informed);
 
 // The score test's chi-square drop: the Gauss-Newton step's predicted decrease from the neutral values, g^T H^+ g
 // with the Jacobian there over the informed parameters (as FitCandidate; a time shift: by one step from zero);

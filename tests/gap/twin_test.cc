@@ -5,7 +5,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -186,6 +188,53 @@ TEST(TwinTest, AHiddenOdometryScaleErrorIsRecovered) {
                   name.c_str(), e.estimate.parameters.at(name), value, e.std_white.at(name), e.std_hac.at(name),
                   e.chi2_before, e.chi2_after);
   ExpectNamed(d.value(), "odometry_scale_error", "scale", kScale);
+}
+
+// Two hidden effects, the wheel radius ratio and the gyroscope's z scale, diagnosed with those two candidates. The ratio
+// is kept first with the gyroscope at its nominal scale, the scale on top of it with the ratio held, so each round's
+// std is conditional on the other effect; both move the gyroscope's residual (the turn rate the drive makes, read
+// through the scale). The joint refit frees both: each joint std (marginal over the other effect) is at least the
+// std conditional on the other at the same values (from the joint information), and the joint values stay within
+// three of it of the hidden ones. (Each round's own std is taken at the other effect's value of that round, 2 % off
+// for the gyroscope's scale, so it is printed, not compared.)
+TEST(TwinTest, TwoKeptEffectsAreRefittedJointlyWithTheirMarginalStd) {
+  const std::map<std::string, std::pair<std::string, double>> hidden = {
+      {"wheel_radius_asymmetry", {"ratio_right_left", 1.02}}, {"gyro_scale_error", {"scale_z", 1.02}}};
+  sim::Scenario real = Nominal();
+  TwinDiagnoseOptions options;
+  for (const auto& [name, value] : hidden) {
+    real.effects.push_back({name, {{value.first, value.second}}});
+    options.candidates.push_back(name);
+  }
+  auto diagnosed =
+      DiagnoseTwin(Nominal(), testing::SimulatedWithSeed(real, 17).recording, PlainSimulationRunner(), options);
+  ASSERT_TRUE(diagnosed.ok()) << diagnosed.status().message();
+  const TwinDiagnosis& d = diagnosed.value();
+  ASSERT_EQ(d.effects.size(), 2u);
+  ASSERT_EQ(d.joint.effects.size(), 2u) << d.joint.failed;
+  EXPECT_LE(d.joint.chi2_after, d.joint.chi2_before);
+  for (std::size_t i = 0; i < d.effects.size(); ++i) {
+    const TwinEffect& kept = d.effects[i];
+    const TwinEffect& joint = d.joint.effects[i];
+    ASSERT_EQ(joint.estimate.name, kept.estimate.name);
+    ASSERT_TRUE(hidden.count(kept.estimate.name)) << kept.estimate.name;
+    const std::string& parameter = hidden.at(kept.estimate.name).first;
+    const double truth = hidden.at(kept.estimate.name).second;
+    ASSERT_TRUE(joint.std_white.count(parameter) && kept.std_white.count(parameter)) << kept.estimate.name;
+    std::printf("  %s %s: joint %.6g +- %.3g (white %.3g, hac %.3g); its round %.6g +- %.3g (white %.3g, hac %.3g)\n",
+                kept.estimate.name.c_str(), parameter.c_str(), joint.estimate.parameters.at(parameter),
+                joint.estimate.std.at(parameter), joint.std_white.at(parameter), joint.std_hac.at(parameter),
+                kept.estimate.parameters.at(parameter), kept.estimate.std.at(parameter), kept.std_white.at(parameter),
+                kept.std_hac.at(parameter));
+    ASSERT_EQ(d.joint.std_white_conditional.size(), d.joint.effects.size());
+    const double conditional = d.joint.std_white_conditional[i].at(parameter);
+    std::printf("    conditional on the other at the joint values: %.3g\n", conditional);
+    EXPECT_GE(joint.std_white.at(parameter), conditional) << kept.estimate.name;
+    EXPECT_NEAR(joint.estimate.parameters.at(parameter), truth, 3.0 * joint.estimate.std.at(parameter))
+        << kept.estimate.name;
+  }
+  const nlohmann::json json = TwinDiagnosisJson(d);
+  EXPECT_EQ(json.at("joint").at("effects").size(), 2u);
 }
 
 // A planar drive turns about the vertical only: of the gyroscope's scales the data informs z, and x and y (whose
