@@ -139,19 +139,22 @@ Result<MarginalInformation> ComputeMarginalInformation(const Graph& graph, const
 Eigen::MatrixXd BartlettSum(const Eigen::MatrixXd& a, int lag) {
   const Eigen::Index n = a.cols(), k = a.rows();
   lag = std::max(0, lag);
-  Eigen::MatrixXd box(k, n);  // box_t = sum_{j=0..L} a_{t-j}
+  // box_t = sum_{j=0..L} a_{t-j} (rows outside 0..n-1 are zero) for t < n + L: the boxes past the last row still hold
+  // rows, whose products with the last L rows the sum needs.
+  const Eigen::Index boxes = n + lag;
+  Eigen::MatrixXd box(k, boxes);
   Eigen::VectorXd running = Eigen::VectorXd::Zero(k);
-  for (Eigen::Index t = 0; t < n; ++t) {
-    running += a.col(t);
-    if (t - lag - 1 >= 0) running -= a.col(t - lag - 1);
+  for (Eigen::Index t = 0; t < boxes; ++t) {
+    if (t < n) running += a.col(t);
+    if (t - lag - 1 >= 0 && t - lag - 1 < n) running -= a.col(t - lag - 1);
     box.col(t) = running;
   }
   Eigen::MatrixXd b(k, n);  // b_t = sum_{j=0..L} box_{t+j} / (L + 1)
   running.setZero();
-  for (Eigen::Index t = n - 1; t >= 0; --t) {
+  for (Eigen::Index t = boxes - 1; t >= 0; --t) {
     running += box.col(t);
-    if (t + lag + 1 < n) running -= box.col(t + lag + 1);
-    b.col(t) = running / static_cast<double>(lag + 1);
+    if (t + lag + 1 < boxes) running -= box.col(t + lag + 1);
+    if (t < n) b.col(t) = running / static_cast<double>(lag + 1);
   }
   const Eigen::MatrixXd m = a * b.transpose();
   return 0.5 * (m + m.transpose());

@@ -133,6 +133,23 @@ TEST(HacCovarianceTest, IntegratedAutocorrelationTimeOfAGaussMarkovSeries) {
   EXPECT_LT(r.integrated_time / 19.0, 0.95 + 3.0 * 0.11);
 }
 
+// BartlettSum's running boxes give the weighted sum of lagged products itself, the products of the last L rows with
+// each other included, at a lag that is a large share of the rows (as the twin's motion capture reaches) and beyond.
+TEST(HacCovarianceTest, BartlettSumIsTheWeightedSumOfLaggedProducts) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd a(2, 40);
+  for (Eigen::Index t = 0; t < a.cols(); ++t) a.col(t) = Eigen::Vector2d(normal(rng), normal(rng));
+  for (const int lag : {0, 1, 10, 39, 60}) {
+    Eigen::MatrixXd direct = a * a.transpose();
+    for (int l = 1; l <= lag && l < a.cols(); ++l) {
+      const Eigen::MatrixXd c = a.leftCols(a.cols() - l) * a.rightCols(a.cols() - l).transpose();
+      direct += (1.0 - static_cast<double>(l) / (lag + 1)) * (c + c.transpose());
+    }
+    EXPECT_LT((BartlettSum(a, lag) - direct).norm(), 1e-12 * direct.norm()) << "lag " << lag;
+  }
+}
+
 // Sums of `series` first-order Gauss-Markov series of `n` rows, correlation a, unit variance, each demeaned as the
 // scores at a fit sum to zero, over lag L, as shares of the long-run sum n (1 + a) / (1 - a): their mean and standard
 // error, of the plain and of the prewhitened Bartlett sum.
