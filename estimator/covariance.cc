@@ -175,8 +175,8 @@ Eigen::MatrixXd PrewhitenedBartlettSum(const Eigen::MatrixXd& a, int lag) {
   }
   const Eigen::MatrixXd whitened = after - rho.asDiagonal() * before;
   const Eigen::VectorXd recolour = (Eigen::VectorXd::Ones(k) - rho).cwiseInverse();
-  return static_cast<double>(n) / static_cast<double>(n - 1) * recolour.asDiagonal() *
-         BartlettSum(whitened, lag) * recolour.asDiagonal();
+  return static_cast<double>(n) / static_cast<double>(n - 1) * recolour.asDiagonal() * BartlettSum(whitened, lag) *
+         recolour.asDiagonal();
 }
 
 ResidualAutocorrelation AnalyzeAutocorrelation(const std::vector<Eigen::VectorXd>& residuals) {

@@ -272,7 +272,8 @@ void Diagnoser::FitJointly(const State& state, const std::vector<TwinCandidate>&
   settings.max_iterations = options_.max_iterations;
   settings.physics_step_s = step_s;
   settings.threads = options_.threads;
-  const Eigen::VectorXd theta0 = Eigen::Map<const Eigen::VectorXd>(start.data(), static_cast<Eigen::Index>(start.size()));
+  const Eigen::VectorXd theta0 =
+      Eigen::Map<const Eigen::VectorXd>(start.data(), static_cast<Eigen::Index>(start.size()));
   auto fit = internal::FitJointly(parts, theta0, state.residuals, &evaluator, settings);
   runs_ += evaluator.runs();
   out_.joint.runs = evaluator.runs();

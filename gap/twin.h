@@ -34,9 +34,9 @@
 //      step's predicted drop from its neutral values, one Jacobian), up to max_effects;
 //   5. joint refit: with more than one effect kept, each was fitted on top of the ones before it, held at their values,
 //      so its std is conditional on them; the kept effects' parameters (time shifts held at their values) are fitted
-//      again together, Levenberg-Marquardt from the kept values (internal/twin_fit.h FitJointly), and their joint values
-//      with the marginal std (white and HAC, from the joint covariance) are reported beside the rounds' (TwinJointFit).
-//      It names nothing and leaves the patch and the held-out figures as the rounds kept them;
+//      again together, Levenberg-Marquardt from the kept values (internal/twin_fit.h FitJointly), and their joint
+//      values with the marginal std (white and HAC, from the joint covariance) are reported beside the rounds'
+//      (TwinJointFit). It names nothing and leaves the patch and the held-out figures as the rounds kept them;
 //   6. show: on the held-out part, the nominal twin's and the patched twin's residual RMS per stream and drift.
 // Verdict: "named" (some effect kept), "unknown" (no effect kept, and some component inconsistent with the stated
 // noise), "none". `unexplained` lists the components still inconsistent on the held-out part with the patch.
@@ -176,8 +176,8 @@ struct TwinJointFit {
   // the joint information's block of the effect), the std a fit of the effect alone there would report; at most the
   // marginal std_white, equal to it where the effect does not correlate with the others.
   std::vector<std::map<std::string, double>> std_white_conditional;
-  std::vector<std::string> held;    // kept effects not refitted (time shifts), at their kept values
-  std::string failed;               // why the joint fit failed (a twin run's error), empty when it did not
+  std::vector<std::string> held;  // kept effects not refitted (time shifts), at their kept values
+  std::string failed;             // why the joint fit failed (a twin run's error), empty when it did not
   double chi2_before = 0.0, chi2_after = 0.0;
   int iterations = 0, runs = 0;
 };

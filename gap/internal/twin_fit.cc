@@ -458,8 +458,8 @@ Result<CandidateOutcome> FitCandidate(const TwinCandidate& c, const Eigen::Vecto
     // The Jacobian at the neutral values is the first iteration's when every parameter is fitted; with fewer, the
     // reduced candidate's own (central differences when they now fit in the threads).
     const bool all = fitted.free.size() == c.free.size();
-    auto fit = FitLeastSquares(Parts({fitted}), NeutralValues(fitted), base, evaluator, settings,
-                               all ? &J.value() : nullptr);
+    auto fit =
+        FitLeastSquares(Parts({fitted}), NeutralValues(fitted), base, evaluator, settings, all ? &J.value() : nullptr);
     if (!fit.ok()) return fit.status();
     for (std::size_t j = 0, f = 0; j < c.free.size(); ++j)
       if (informed[j]) out.theta[static_cast<Eigen::Index>(j)] = fit.value().theta[static_cast<Eigen::Index>(f++)];
@@ -474,7 +474,8 @@ Result<CandidateOutcome> FitCandidate(const TwinCandidate& c, const Eigen::Vecto
 }
 
 Result<JointOutcome> FitJointly(const std::vector<TwinCandidate>& parts, const Eigen::VectorXd& start,
-                                const Eigen::VectorXd& at_start, TwinEvaluator* evaluator, const FitSettings& settings) {
+                                const Eigen::VectorXd& at_start, TwinEvaluator* evaluator,
+                                const FitSettings& settings) {
   for (const TwinCandidate& c : parts)
     if (c.time_shift) return Status::Error(c.label + ": a time shift is not refitted jointly");
   const Parts joint(parts);

@@ -190,10 +190,10 @@ TEST(TwinTest, AHiddenOdometryScaleErrorIsRecovered) {
   ExpectNamed(d.value(), "odometry_scale_error", "scale", kScale);
 }
 
-// Two hidden effects, the wheel radius ratio and the gyroscope's z scale, diagnosed with those two candidates. The ratio
-// is kept first with the gyroscope at its nominal scale, the scale on top of it with the ratio held, so each round's
-// std is conditional on the other effect; both move the gyroscope's residual (the turn rate the drive makes, read
-// through the scale). The joint refit frees both: each joint std (marginal over the other effect) is at least the
+// Two hidden effects, the wheel radius ratio and the gyroscope's z scale, diagnosed with those two candidates. The
+// ratio is kept first with the gyroscope at its nominal scale, the scale on top of it with the ratio held, so each
+// round's std is conditional on the other effect; both move the gyroscope's residual (the turn rate the drive makes,
+// read through the scale). The joint refit frees both: each joint std (marginal over the other effect) is at least the
 // std conditional on the other at the same values (from the joint information), and the joint values stay within
 // three of it of the hidden ones. (Each round's own std is taken at the other effect's value of that round, 2 % off
 // for the gyroscope's scale, so it is printed, not compared.)
