@@ -316,6 +316,26 @@ struct Context {
   }
 };
 
+// The scenarios and estimator configurations the suite names, each loaded once per suite: the cases of a suite name
+// the same few files again and again.
+class InputFiles {
+ public:
+  const Result<sim::Scenario>& Scenario(const std::string& path) {
+    auto it = scenarios_.find(path);
+    if (it == scenarios_.end()) it = scenarios_.emplace(path, sim::LoadScenario(path)).first;
+    return it->second;
+  }
+  const Result<estimator::EstimatorConfig>& Config(const std::string& path) {
+    auto it = configs_.find(path);
+    if (it == configs_.end()) it = configs_.emplace(path, estimator::LoadEstimatorConfig(path)).first;
+    return it->second;
+  }
+
+ private:
+  std::map<std::string, Result<sim::Scenario>> scenarios_;
+  std::map<std::string, Result<estimator::EstimatorConfig>> configs_;
+};
+
 std::string ResolvePath(const std::string& suite_file, const std::string& path) {
   if (path.empty() || fs::path(path).is_absolute()) return path;
   return (fs::path(suite_file).parent_path() / path).lexically_normal().string();
@@ -449,11 +469,11 @@ Status LoadEffects(const YAML::Node& effects, const Context& ctx, Case* c) {
 
 // Sensor faults injected into the simulated recording (calibrate, track): as a scenario's `faults:` (sim/faults.h),
 // checked against the case's scenario (its streams and duration).
-Status LoadFaults(const YAML::Node& faults, const Context& ctx, Case* c) {
+Status LoadFaults(const YAML::Node& faults, const Context& ctx, InputFiles* inputs, Case* c) {
   if (!faults) return Status::Ok();
   if (!faults.IsSequence()) return ctx.Error(faults, "'faults' is a list of {type: FAULT, stream: NAME, ...}");
   if (c->scenario.empty()) return ctx.Error(faults, "'faults' need a 'scenario' to simulate");
-  auto scenario = sim::LoadScenario(c->scenario);
+  const Result<sim::Scenario>& scenario = inputs->Scenario(c->scenario);
   if (!scenario.ok()) return ctx.Error(faults, scenario.status().message());
   const std::vector<std::string> streams = scenario.value().StreamNames();
   for (const YAML::Node& node : faults) {
@@ -516,22 +536,22 @@ Status LoadOdometryModels(const YAML::Node& models, const Context& ctx, Case* c)
 
 // Inputs exist and load (a case's `data` may be absent: the case is then skipped, and its inputs are not checked);
 // `names` receives the parameter and stream names of the case's configuration.
-Status CheckInputs(const YAML::Node& node, const Context& ctx, const Case& c, Names* names) {
+Status CheckInputs(const YAML::Node& node, const Context& ctx, const Case& c, InputFiles* inputs, Names* names) {
   const bool data_absent = !c.data.empty() && !fs::is_directory(c.data);
   if (!c.scenario.empty()) {
     if (!fs::is_regular_file(c.scenario)) return ctx.Error(node["scenario"], "missing scenario " + c.scenario);
-    const auto scenario = sim::LoadScenario(c.scenario);
+    const Result<sim::Scenario>& scenario = inputs->Scenario(c.scenario);
     if (!scenario.ok()) return ctx.Error(node["scenario"], "bad scenario: " + scenario.status().message());
   }
   if (!c.recording.empty() && !data_absent && !fs::is_regular_file(fs::path(c.recording) / "recording.yaml"))
     return ctx.Error(node["recording"], "missing recording " + c.recording + " (no recording.yaml)");
   if (!c.config.empty()) {
-    const auto config = estimator::LoadEstimatorConfig(c.config);
+    const Result<estimator::EstimatorConfig>& config = inputs->Config(c.config);
     if (!config.ok()) return ctx.Error(node["config"], "bad config: " + config.status().message());
     *names = NamesOf(config.value());
   }
   if (!c.calibrate.empty()) {
-    const auto config = estimator::LoadEstimatorConfig(c.calibrate);
+    const Result<estimator::EstimatorConfig>& config = inputs->Config(c.calibrate);
     if (!config.ok()) return ctx.Error(node["calibrate"], "bad config: " + config.status().message());
   }
   if (!c.calibration.empty()) {
@@ -583,7 +603,7 @@ Result<Check> LoadCheck(const YAML::Node& check, const Context& ctx, const ModeS
 }
 
 // Loads and validates one case; `seen` holds the names of the cases before it.
-Result<Case> LoadCase(const YAML::Node& node, const Context& suite, std::set<std::string>* seen) {
+Result<Case> LoadCase(const YAML::Node& node, const Context& suite, std::set<std::string>* seen, InputFiles* inputs) {
   Context ctx = suite;
   Case c;
   const Result<const ModeSpec*> mode = LoadNameAndMode(node, &ctx, seen, &c);
@@ -591,10 +611,10 @@ Result<Case> LoadCase(const YAML::Node& node, const Context& suite, std::set<std
   Status st = CheckKeys(node, ctx, *mode.value());
   if (st.ok()) st = LoadValues(node, ctx, suite.file, &c);
   if (st.ok()) st = LoadEffects(node["effects"], ctx, &c);
-  if (st.ok()) st = LoadFaults(node["faults"], ctx, &c);
+  if (st.ok()) st = LoadFaults(node["faults"], ctx, inputs, &c);
   if (st.ok()) st = LoadOdometryModels(node["models"], ctx, &c);
   Names names;
-  if (st.ok()) st = CheckInputs(node, ctx, c, &names);
+  if (st.ok()) st = CheckInputs(node, ctx, c, inputs, &names);
   if (!st.ok()) return st;
 
   const YAML::Node checks = node["checks"];
@@ -809,9 +829,10 @@ Result<Suite> ReadSuite(const std::string& path) {
   const YAML::Node cases = root["cases"];
   if (!cases || !cases.IsSequence() || cases.size() == 0) return Status::Error(path + ": no 'cases' (a list of cases)");
   std::set<std::string> seen;
+  InputFiles inputs;
   for (const YAML::Node& node : cases) {
     try {
-      auto c = LoadCase(node, ctx, &seen);
+      auto c = LoadCase(node, ctx, &seen, &inputs);
       if (!c.ok()) return c.status();
       suite.cases.push_back(std::move(c).value());
     } catch (const YAML::Exception& e) {

@@ -148,8 +148,9 @@ struct Suite {
   std::vector<Case> cases;
 };
 
-// Loads and validates the whole suite: keys, modes, inputs (files exist and load), metric paths and bounds. The
-// error is one line "FILE:LINE: case 'NAME': problem" (or "FILE: problem" outside a case).
+// Loads and validates the whole suite: keys, modes, inputs (files exist and load; each scenario and configuration
+// once, however many cases name it), metric paths and bounds. The error is one line "FILE:LINE: case 'NAME': problem"
+// (or "FILE: problem" outside a case).
 Result<Suite> LoadSuite(const std::string& path);
 
 }  // namespace roamlab::regress

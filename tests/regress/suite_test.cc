@@ -176,6 +176,29 @@ TEST_F(SuiteTest, LoadsCasesWithTheirChecks) {
   EXPECT_EQ(mc.checks[2].metric.reduction, "1");
 }
 
+// Cases that name the same scenario and configuration as earlier ones (each file is loaded once per suite): every
+// case's metrics are checked against its own configuration's parameters.
+TEST_F(SuiteTest, EachCaseIsCheckedAgainstItsOwnConfigurationWhenFilesRepeat) {
+  const std::string lever_arm = "      - {metric: metrics.parameters.gps.lever_arm.error.norm, bound: \"<= 0.1\"}\n";
+  const auto Named = [&](const std::string& name, const std::string& config) {
+    return "  - name: " + name + "\n    mode: calibrate\n    scenario: " + Scenario("atv_hills.yaml") +
+           "\n    config: " + Config(config) + "\n    checks:\n" + lever_arm;
+  };
+  const std::string repeated = Named("first", "atv_calibration.yaml") + Named("second", "atv_calibration.yaml");
+  const Result<Suite> suite = LoadSuite(WriteSuite(repeated));
+  ASSERT_TRUE(suite.ok()) << suite.status().message();
+  EXPECT_EQ(suite.value().cases[1].checks[0].metric.keys,
+            (std::vector<std::string>{"parameters", "gps.lever_arm", "error"}));
+
+  // The indoor configuration has no GPS: its case's lever-arm check is refused, after two that hold it.
+  const Result<Suite> mixed =
+      LoadSuite(WriteSuite(repeated + Named("indoor", "indoor_diffdrive_mocap_calibration.yaml")));
+  ASSERT_FALSE(mixed.ok());
+  EXPECT_NE(mixed.status().message().find("case 'indoor'"), std::string::npos) << mixed.status().message();
+  EXPECT_NE(mixed.status().message().find("does not start with a parameter"), std::string::npos)
+      << mixed.status().message();
+}
+
 // A case with an external estimator: its command kept as written, run in the suite file's directory.
 TEST_F(SuiteTest, LoadsExternalCommandCases) {
   const std::string path =
