@@ -215,6 +215,7 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
   for (auto stream = builder->factor_streams().lower_bound(first); stream != builder->factor_streams().end();
        ++stream) {
     const FactorId id = stream->first;
+    if (id >= options.end) break;
     while (factor != graph.factors().end() && factor->first < id) ++factor;
     if (factor == graph.factors().end()) break;
     if (factor->first != id) continue;  // (no longer in the graph)

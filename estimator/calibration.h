@@ -15,6 +15,7 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -144,6 +145,8 @@ struct GateOptions {
   // (the IMU's rows and their bursts' margins); rejected with the readings, they leave poses that nothing holds, which
   // the re-solve moves so far that they never fit again.
   bool defer_when_bridging = false;
+  // Test only the measurement factors with ids below this one (with `first`: a range of them).
+  FactorId end = std::numeric_limits<FactorId>::max();
 };
 
 // What one gating pass switched.
@@ -155,9 +158,9 @@ struct GateSwitches {
   int switched() const { return rejected + readmitted + bridged; }
 };
 
-// Re-tests the measurement factors with id >= `first` (factor ids grow as factors are added, so `first` selects the
-// newest ones): active exactly when the whitened squared error is within the chi-square quantile `probability` of its
-// dimension, but for what `options` add. A run of failing intervals of a cumulative wheel master stream is first
+// Re-tests the measurement factors with `first` <= id < options.end (factor ids grow as factors are added, so `first`
+// selects the newest ones): active exactly when the whitened squared error is within the chi-square quantile
+// `probability` of its dimension, but for what `options` add. A run of failing intervals of a cumulative wheel master stream is first
 // bridged where a bridge over its readings passes (ProblemBuilder::BridgeCumulativeRun; the readings left out count
 // as rejected), the poses of the left-out readings are set between the bridge's ends, their rejected measurements
 // that fit there re-admitted, and the other failing measurements of the bridged poses left as they are until the

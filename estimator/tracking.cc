@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <memory>
 
 #include <Eigen/Eigenvalues>
@@ -27,14 +28,16 @@ constexpr int kPositionDims = 3;
 
 FactorId NextFactorId(const Graph& graph) { return graph.factors().empty() ? 0 : graph.factors().rbegin()->first + 1; }
 
-// Gating passes after a solve, each followed by a re-solve (`solve`, returning its iterations) when it switched any
-// factor: a pass rejects only the factors that fail worst at their poses (GateOptions::worst_per_pose) and re-admits
-// those that fit again once the outliers are out. Returns the re-solves' iterations.
+// Gating passes over the factors with ids in [first, end) after a solve, each followed by a re-solve (`solve`,
+// returning its iterations) when it switched any factor: a pass rejects only the factors that fail worst at their
+// poses (GateOptions::worst_per_pose) and re-admits those that fit again once the outliers are out. Returns the
+// re-solves' iterations.
 constexpr int kMaxGatePasses = 5;
-int GateAndResolve(double probability, FactorId first, const SolverWorkspace* last_solve, ProblemBuilder* builder,
-                   const std::function<int()>& solve) {
+int GateAndResolve(double probability, FactorId first, FactorId end, const SolverWorkspace* last_solve,
+                   ProblemBuilder* builder, const std::function<int()>& solve) {
   GateOptions options;
   options.worst_per_pose = true;
+  options.end = end;
   int iterations = 0;
   for (int pass = 0;
        pass < kMaxGatePasses && GateOutliers(probability, builder, first, last_solve, options).switched() > 0; ++pass)
@@ -190,12 +193,15 @@ SolverOptions UpdateOptions(const EstimatorConfig& config) {
   return update_options;
 }
 
-// Whatever is left in the window at the end (short recordings never leave initialization): solved, and every pose
-// reported, their covariances from one factorization.
-Status EmitFinalWindow(const EstimatorConfig& config, const TrackingOptions& options, ProblemBuilder* builder,
-                       TrackingResult* out) {
+// Whatever is left in the window at the end (short recordings never leave initialization): solved, the factors from
+// `first_ungated` on gated, and every pose reported, their covariances from one factorization.
+Status EmitFinalWindow(const EstimatorConfig& config, FactorId first_ungated, const TrackingOptions& options,
+                       ProblemBuilder* builder, TrackingResult* out) {
   const SolverSummary s = Solve(config.solver, &builder->graph());
   if (!s.usable()) return Status::Error("final window: " + s.message);
+  if (config.gate_probability)
+    GateAndResolve(*config.gate_probability, first_ungated, std::numeric_limits<FactorId>::max(), nullptr, builder,
+                   [&] { return Solve(config.solver, &builder->graph()).iterations; });
   const std::vector<CovarianceRequest> last = OldestPoseCovariances(*builder, builder->poses().size());
   for (std::size_t k = 0; !builder->poses().empty(); ++k) {
     const CovarianceRequest* known = &last[k];
@@ -234,7 +240,10 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
   std::size_t poses_before = 0;
   double update_seconds = 0.0;
   int iterations = 0;
+  // The factors attached since the last update start at first_new_factor; those attached before it and not gated yet
+  // at first_ungated. An update gates the latter (below).
   FactorId first_new_factor = 0;
+  FactorId first_ungated = 0;
   CovarianceRequest leaving;
   leaving.leading_dims = kPositionDims;
   std::vector<double> update_times;
@@ -256,13 +265,21 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
       const SolverSummary s = Solve(config.solver, &builder.graph());
       if (!s.usable()) return Status::Error("initialization failed: " + s.message);
       if (config.gate_probability)
-        GateAndResolve(*config.gate_probability, 0, nullptr, &builder,
+        GateAndResolve(*config.gate_probability, 0, std::numeric_limits<FactorId>::max(), nullptr, &builder,
                        [&] { return Solve(config.solver, &builder.graph()).iterations; });
+      first_new_factor = NextFactorId(builder.graph());
       initialized = true;
     } else {
-      // One update: Gauss-Newton on the window, gating of the measurements attached since the last update, and a
-      // re-solve after each gating pass that switched any. The solve also gives the covariance of the pose about to
-      // leave the window.
+      // One update: Gauss-Newton on the window, gating of the measurements attached at the last update, and a re-solve
+      // after each gating pass that switched any. The solve also gives the covariance of the pose about to leave the
+      // window. A measurement is gated one update after it is attached, once the next master sample's measurements
+      // join its newest pose: until then the master row that predicted the new pose and the IMU rows that tie it to
+      // the poses before are the only measurements of its motion since the last pose, the solve splits a conflict
+      // between them, and which of them fails worst is chance. Rejecting the IMU's row there leaves the pose to an
+      // outlying master row, and the velocity it gives the pose is carried on to the next poses, failing their good
+      // rows. The next sample's rows side with the good ones. A cumulative wheel master (its readings bridged,
+      // GateOutliers) is gated at attachment: its bridges test a reading on both spans it joins.
+      const bool delayed = builder.cumulative_spans().empty();
       const auto t0 = Clock::now();
       leaving.variables.assign(1, builder.poses().front().id);
       leaving.computed = false;
@@ -275,7 +292,9 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
         // Without a gated measurement the window may not factor (a gated odometer factor leaves the newest pose's
         // position free until the next samples attach), and the Schur complement EmitOldest would fall back to runs
         // through that singular block: keep the leaving pose's covariance from before the gate then.
-        iterations += GateAndResolve(*config.gate_probability, first_new_factor, &workspace, &builder, [&] {
+        iterations += GateAndResolve(*config.gate_probability, delayed ? first_ungated : first_new_factor,
+                                     delayed ? first_new_factor : std::numeric_limits<FactorId>::max(), &workspace,
+                                     &builder, [&] {
           const CovarianceRequest before_gate = leaving;
           const int resolve_iterations = Solve(update_options, &builder.graph(), request, &workspace).iterations;
           if (request != nullptr && !leaving.computed && before_gate.computed) leaving = before_gate;
@@ -288,6 +307,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
       update_times.push_back(dt);
       out.max_update_s = std::max(out.max_update_s, dt);
     }
+    first_ungated = first_new_factor;
     first_new_factor = NextFactorId(builder.graph());
     // Poses beyond the window leave it: after an update the one whose covariance the solve computed, after the
     // initial batch every pose beyond the window, their covariances from one factorization.
@@ -305,7 +325,8 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
   }
   builder.Finish();
 
-  const Status final_window = EmitFinalWindow(config, options, &builder, &out);
+  const FactorId first_final = builder.cumulative_spans().empty() ? first_ungated : first_new_factor;
+  const Status final_window = EmitFinalWindow(config, first_final, options, &builder, &out);
   if (!final_window.ok()) return final_window;
   out.mean_update_s = out.updates > 0 ? update_seconds / out.updates : 0.0;
   if (!update_times.empty()) {

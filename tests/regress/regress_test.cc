@@ -115,7 +115,8 @@ class RegressTest : public ::testing::Test {
                            "      - {metric: metrics.nees_mean, bound: \"<= 2 * baseline\"}\n"
                            "      - {metric: metrics.nees_mean, bound: \">= 0.5 * baseline\"}\n"
                            "      - {metric: metrics.nees.fraction_in_band, bound: \">= baseline - 0.1\"}\n"
-                           "      - {metric: summary.poses, bound: \">= 100\"}\n");
+                           "      - {metric: summary.poses, bound: \">= 100\"}\n"
+                           "      - {metric: summary.measurements.odometer.rejected, bound: \"<= baseline + 20\"}\n");
     return path;
   }
 
@@ -136,7 +137,7 @@ TEST_F(RegressTest, BaselineCatchesWrongNoiseLevels) {
   // Baseline with the right configuration; every check then passes against it.
   ASSERT_EQ(Run(Suite("good.yaml"), "out_update", true, 1), 0);
   const json baseline = ReadJson(dir_->File("baseline/synthetic_track.json"));
-  ASSERT_EQ(baseline["values"].size(), 4u) << baseline.dump();
+  ASSERT_EQ(baseline["values"].size(), 5u) << baseline.dump();
 
   // The same suite again with two jobs: the same values, bit for bit.
   ASSERT_EQ(Run(Suite("good.yaml"), "out_again", false, 2), 0);
