@@ -174,7 +174,7 @@ TEST_F(RegressTest, MissingBaselineIsAnErrorNotAPass) {
   args.filter = "synthetic_*";
   EXPECT_EQ(RunRegress(args), 1);
   const json results = ReadJson(dir_->File("out_no_baseline/results.json"));
-  EXPECT_EQ(results["checks"]["errors"], 4);
+  EXPECT_EQ(results["checks"]["errors"], 5);
   EXPECT_EQ(results["checks"]["passed"], 1);
   args.filter = "no_such_case";
   EXPECT_EQ(RunRegress(args), 2);
