@@ -126,17 +126,18 @@ gap::TwinRunner Runner(const gap::TwinChoice& choice, const recording::Recording
   return choice.replayed ? gap::ReplayRunner(rec) : gap::PlainSimulationRunner();
 }
 
-// A held-out recording with its twin's runner; errors are bad input.
+// A held-out or training recording with its twin's runner; errors are bad input.
 struct HeldOut {
   std::string path;
   recording::Recording recording;
   gap::TwinRunner runner;
   bool replayed = false;
 };
-Result<std::vector<HeldOut>> LoadHeldOut(const DiagnoseRequest& request, const sim::Scenario& scenario,
-                                         const std::function<void(const std::string&)>& say) {
+Result<std::vector<HeldOut>> LoadOtherRuns(const DiagnoseRequest& request, const std::vector<std::string>& paths,
+                                           const sim::Scenario& scenario,
+                                           const std::function<void(const std::string&)>& say) {
   std::vector<HeldOut> out;
-  for (const std::string& path : request.held_out) {
+  for (const std::string& path : paths) {
     recording::ReadOptions read;
     read.load_ground_truth = false;
     auto rec = recording::ReadRecording(path, read);
@@ -156,18 +157,22 @@ Result<std::vector<HeldOut>> LoadHeldOut(const DiagnoseRequest& request, const s
 
 std::string Millimetres(double m) { return Fixed(1e3 * m, 3) + " mm"; }
 
-// The diagnosis against the scenario's twin (runner: ChooseTwin's), its patch shown on the held-out recordings, into
-// out/twin.json; `out` receives it.
+// The diagnosis against the scenario's twin (runner: ChooseTwin's), fitted on the recording and the training runs,
+// its patch shown on the held-out recordings, into out/twin.json; `out` receives it.
 Outcome DiagnoseTwinToFile(const DiagnoseRequest& request, const Inputs& in, const gap::TwinRunner& runner,
-                           bool replayed, const std::vector<HeldOut>& held_out, gap::TwinDiagnosis* out,
-                           const std::function<void(const std::string&)>& say) {
-  say("diagnosing " + request.recording + " against the scenario's twin" + (replayed ? " (replayed)" : ""));
+                           bool replayed, const std::vector<HeldOut>& training, const std::vector<HeldOut>& held_out,
+                           gap::TwinDiagnosis* out, const std::function<void(const std::string&)>& say) {
+  say("diagnosing " + request.recording + " against the scenario's twin" + (replayed ? " (replayed)" : "") +
+      (training.empty() ? "" : ", fitted with " + std::to_string(training.size()) + " further training runs"));
   gap::TwinDiagnoseOptions options;
   options.replayed = replayed;
   options.std_method = ParseStdMethod(request.std_method);
   options.progress = [&](const std::string& line) { say("  " + line); };
   if (request.max_shift_s) options.max_shift_s = *request.max_shift_s;
-  auto diagnosed = gap::DiagnoseTwin(*in.scenario, in.recording, runner, options);
+  if (request.max_effects) options.max_effects = *request.max_effects;
+  std::vector<gap::TwinTrainingRun> runs = {{request.recording, &in.recording, runner, replayed}};
+  for (const HeldOut& t : training) runs.push_back({t.path, &t.recording, t.runner, t.replayed});
+  auto diagnosed = gap::DiagnoseTwin(*in.scenario, runs, options);
   if (!diagnosed.ok()) return Outcome::Failed(Status::Error("twin: " + diagnosed.status().message()));
   gap::TwinDiagnosis& d = diagnosed.value();
   for (const HeldOut& h : held_out) {
@@ -226,18 +231,25 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
   if (!inputs.ok()) return Outcome::BadInput(inputs.status());
   const Inputs& in = inputs.value();
   std::optional<gap::TwinChoice> twin;
-  std::vector<HeldOut> held_out;
+  std::vector<HeldOut> held_out, training;
   if (!request.held_out.empty() && !request.twin)
     return Outcome::BadInput(Status::Error("--held-out needs --twin (or --replay)"));
+  if (!request.train_with.empty() && !request.twin)
+    return Outcome::BadInput(Status::Error("--train-with needs --twin (or --replay)"));
+  if (request.max_effects && !(*request.max_effects >= 1))
+    return Outcome::BadInput(Status::Error("--max-effects " + std::to_string(*request.max_effects) + ": must be 1 or more"));
   if ((request.twin || request.drive != gap::TwinDrive::kDetect) && !in.scenario)
     return Outcome::BadInput(Status::Error("--twin, --replay and --no-replay need --scenario"));
   if (in.scenario) {
     auto choice = ChooseTwin(*in.scenario, in.recording, request.recording, request.drive, say);
     if (!choice.ok()) return Outcome::BadInput(choice.status());
     twin = std::move(choice).value();
-    auto loaded = LoadHeldOut(request, *in.scenario, say);
+    auto loaded = LoadOtherRuns(request, request.held_out, *in.scenario, say);
     if (!loaded.ok()) return Outcome::BadInput(loaded.status());
     held_out = std::move(loaded).value();
+    auto trained = LoadOtherRuns(request, request.train_with, *in.scenario, say);
+    if (!trained.ok()) return Outcome::BadInput(trained.status());
+    training = std::move(trained).value();
   }
   if (Status s = RemoveEarlierOutputs(given, request.out); !s.ok()) return Outcome::Failed(s);
   IncompleteMarker marker(request.out);
@@ -269,8 +281,8 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
   std::optional<gap::TwinDiagnosis> twin_diagnosis;
   if (request.twin) {
     twin_diagnosis.emplace();
-    if (Outcome fitted = DiagnoseTwinToFile(request, in, Runner(*twin, in.recording), twin->replayed, held_out,
-                                            &*twin_diagnosis, say);
+    if (Outcome fitted = DiagnoseTwinToFile(request, in, Runner(*twin, in.recording), twin->replayed, training,
+                                            held_out, &*twin_diagnosis, say);
         !fitted.ok())
       return failed(fitted.status);
   }

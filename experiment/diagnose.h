@@ -54,6 +54,10 @@ struct DiagnoseRequest {
   // is shown on each (gap::ShowOnHeldOut; twin.json's heldout_runs), each on its own twin (chosen as `drive` says).
   // Each is read like `recording` and must have its platform kind (and drive inputs when replayed).
   std::vector<std::string> held_out;
+  // Further recordings the twin's patch is fitted on (other runs of the same robot; needs twin), each on its own twin
+  // and checked as `held_out` (gap::DiagnoseTwin's training runs; twin.json's training_runs).
+  std::vector<std::string> train_with;
+  std::optional<int> max_effects;  // the twin's effects kept at most (default gap::TwinDiagnoseOptions')
   std::function<void(const std::string& line)> progress;  // optional
 };
 

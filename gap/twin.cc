@@ -62,18 +62,30 @@ void SetStd(const std::string& name, const TwinCovariance& covariance, Eigen::In
 
 // What one round judges the candidates against: the effects kept so far.
 struct State {
-  sim::Scenario train, full;  // nominal + kept effects; over the training part, over the whole recording
-  Eigen::VectorXd residuals;  // training part
+  std::vector<sim::EffectOptions> effects;  // kept
+  Eigen::VectorXd residuals;                // the runs' training parts (internal::CombinedLayout)
   double chi2 = 0.0;
-  TwinComparison heldout;
-  recording::Recording twin;  // the whole recording's twin
+  std::vector<TwinComparison> heldout;      // per run, its held-out part
+  std::vector<recording::Recording> twins;  // per run, the whole recording's twin
+};
+
+// The runs' held-out chi-square.
+double Chi2(const std::vector<TwinComparison>& heldout) {
+  double sum = 0.0;
+  for (const TwinComparison& c : heldout) sum += c.chi2;
+  return sum;
+}
+
+// A training run's span: its first and last stamps and the end of its training part.
+struct RunSpan {
+  Time first, last, train_end;
+  double whole_s = 0.0, train_s = 0.0;  // the twin's durations since `first`: whole recording, training part
 };
 
 class Diagnoser {
  public:
-  Diagnoser(const sim::Scenario& nominal, const recording::Recording& real, const TwinRunner& runner,
-            const TwinDiagnoseOptions& options)
-      : nominal_(nominal), real_(real), runner_(runner), options_(options) {}
+  Diagnoser(const sim::Scenario& nominal, const std::vector<TwinTrainingRun>& runs, const TwinDiagnoseOptions& options)
+      : nominal_(nominal), runs_in_(runs), real_(*runs.front().real), options_(options) {}
   Result<TwinDiagnosis> Run();
 
  private:
@@ -81,10 +93,16 @@ class Diagnoser {
     if (options_.progress) options_.progress(what);
   }
   Status Span();
-  Result<recording::Recording> RunFull(const sim::Scenario& s) {
-    ++runs_;
-    return runner_(s);
+  // The nominal scenario with `effects`.
+  sim::Scenario Base(const std::vector<sim::EffectOptions>& effects) const {
+    sim::Scenario s = nominal_;
+    s.effects = effects;
+    return s;
   }
+  // Each run's twin of its whole recording with `effects`, in parallel.
+  Result<std::vector<recording::Recording>> RunWhole(const std::vector<sim::EffectOptions>& effects);
+  // Each run's twin compared with its held-out part.
+  std::vector<TwinComparison> HeldOut(const std::vector<recording::Recording>& twins) const;
   // screen: fitted only when the score test (PredictedDrop) passes alpha.
   Result<TwinEffect> Fit(const TwinCandidate& c, const State& state, double step_s, bool screen);
   Result<bool> Round(int round, const std::vector<TwinCandidate>& pool, double step_s, State* state,
@@ -93,37 +111,79 @@ class Diagnoser {
   void Finish(const State& state);
 
   const sim::Scenario& nominal_;
-  const recording::Recording& real_;
-  const TwinRunner& runner_;
+  const std::vector<TwinTrainingRun>& runs_in_;
+  const recording::Recording& real_;  // the diagnosed recording, the first run
   const TwinDiagnoseOptions& options_;
   TwinDiagnosis out_;
-  Time first_, last_, train_end_;
-  Layout train_layout_;
+  std::vector<RunSpan> spans_;               // per run
+  std::vector<internal::FitRun> fit_runs_;  // per run, its training part
   int measurements_ = 0;
   int runs_ = 0;
   bool hac_ = false;  // the std reported is the HAC one
 };
 
 Status Diagnoser::Span() {
-  first_ = Time::FromNanoseconds(std::numeric_limits<std::int64_t>::max());
-  last_ = Time::FromNanoseconds(std::numeric_limits<std::int64_t>::min());
-  for (const recording::Stream& s : real_.streams) {
-    if (s.t.empty()) continue;
-    first_ = std::min(first_, s.t.front());
-    last_ = std::max(last_, s.t.back());
-  }
-  if (last_ <= first_) return Status::Error("the recording has no span of samples to compare");
   if (!(options_.train_fraction > 0.0 && options_.train_fraction < 1.0))
     return Status::Error("the training fraction must be in (0, 1)");
-  train_end_ = Time::FromSeconds(first_.seconds() + options_.train_fraction * SecondsBetween(first_, last_));
-  out_.train_end_s = train_end_.seconds();
-  train_layout_ = internal::MakeLayout(real_, first_, train_end_);
-  if (train_layout_.size == 0) return Status::Error("the recording has no stream with a stated noise to compare");
+  for (const TwinTrainingRun& run : runs_in_) {
+    const std::string name = spans_.empty() ? std::string() : run.recording + ": ";
+    RunSpan span;
+    span.first = Time::FromNanoseconds(std::numeric_limits<std::int64_t>::max());
+    span.last = Time::FromNanoseconds(std::numeric_limits<std::int64_t>::min());
+    for (const recording::Stream& s : run.real->streams) {
+      if (s.t.empty()) continue;
+      span.first = std::min(span.first, s.t.front());
+      span.last = std::max(span.last, s.t.back());
+    }
+    if (span.last <= span.first) return Status::Error(name + "the recording has no span of samples to compare");
+    const double seconds = SecondsBetween(span.first, span.last);
+    span.train_end = Time::FromSeconds(span.first.seconds() + options_.train_fraction * seconds);
+    span.whole_s = std::max(seconds, 1.0);
+    span.train_s = std::min(span.whole_s, SecondsBetween(span.first, span.train_end) + 0.05);
+    internal::FitRun fit{run.recording, run.real, &run.runner, internal::MakeLayout(*run.real, span.first, span.train_end),
+                         span.train_s};
+    if (fit.layout.size == 0) return Status::Error(name + "the recording has no stream with a stated noise to compare");
+    spans_.push_back(span);
+    fit_runs_.push_back(std::move(fit));
+  }
+  out_.train_end_s = spans_.front().train_end.seconds();
   return Status::Ok();
 }
 
+Result<std::vector<recording::Recording>> Diagnoser::RunWhole(const std::vector<sim::EffectOptions>& effects) {
+  const int n = static_cast<int>(runs_in_.size());
+  std::vector<Result<recording::Recording>> twins(runs_in_.size(), Status::Error("not run"));
+  internal::ParallelFor(n, options_.threads, [&](int i) {
+    const std::size_t run = static_cast<std::size_t>(i);
+    sim::Scenario s = Base(effects);
+    s.duration_s = spans_[run].whole_s;
+    try {
+      twins[run] = runs_in_[run].runner(s);
+    } catch (const std::exception& e) {
+      twins[run] = Status::Error(std::string("the twin runner failed: ") + e.what());
+    }
+  });
+  runs_ += n;
+  std::vector<recording::Recording> out;
+  for (std::size_t i = 0; i < twins.size(); ++i) {
+    if (!twins[i].ok())
+      return n == 1 ? twins[i].status() : Status::Error(runs_in_[i].recording + ": " + twins[i].status().message());
+    out.push_back(std::move(twins[i]).value());
+  }
+  return out;
+}
+
+std::vector<TwinComparison> Diagnoser::HeldOut(const std::vector<recording::Recording>& twins) const {
+  std::vector<TwinComparison> out;
+  for (std::size_t i = 0; i < twins.size(); ++i)
+    out.push_back(CompareTwin(*runs_in_[i].real, twins[i], spans_[i].train_end.seconds(), spans_[i].last.seconds(),
+                              options_.drift));
+  return out;
+}
+
 Result<TwinEffect> Diagnoser::Fit(const TwinCandidate& c, const State& state, double step_s, bool screen) {
-  internal::TwinEvaluator evaluator(state.train, real_, runner_, train_layout_, options_.threads);
+  const sim::Scenario base = Base(state.effects);
+  internal::TwinEvaluator evaluator(base, fit_runs_, options_.threads);
   internal::FitSettings settings;
   settings.max_iterations = options_.max_iterations;
   settings.physics_step_s = step_s;
@@ -203,28 +263,27 @@ Result<bool> Diagnoser::Round(int round, const std::vector<TwinCandidate>& pool,
       x.decision = x.lr_pvalue < options_.alpha ? "Delta BIC not below the threshold" : "p not below alpha";
       continue;
     }
-    sim::Scenario full = state->full;
-    full.effects.push_back(e.effect);
-    auto twin = RunFull(full);
-    if (!twin.ok()) {
-      x.decision = "the patched twin of the whole recording failed: " + twin.status().message();
+    std::vector<sim::EffectOptions> effects = state->effects;
+    effects.push_back(e.effect);
+    auto twins = RunWhole(effects);
+    if (!twins.ok()) {
+      x.decision = "the patched twin of the whole recording failed: " + twins.status().message();
       continue;
     }
-    TwinComparison heldout = CompareTwin(real_, twin.value(), train_end_.seconds(), last_.seconds(), options_.drift);
+    std::vector<TwinComparison> heldout = HeldOut(twins.value());
     x.evaluated_heldout = true;
-    x.heldout_improvement = state->heldout.chi2 > 0.0 ? 1.0 - heldout.chi2 / state->heldout.chi2 : 0.0;
+    x.heldout_improvement = Chi2(state->heldout) > 0.0 ? 1.0 - Chi2(heldout) / Chi2(state->heldout) : 0.0;
     if (!(x.heldout_improvement > options_.min_heldout_improvement)) {
       x.decision = "the held-out chi-square does not drop";
       continue;
     }
     x.accepted = true;
     x.decision = "accepted";
-    state->train.effects.push_back(e.effect);
-    state->full = full;
+    state->effects = std::move(effects);
     state->chi2 = e.chi2_after;
     state->heldout = std::move(heldout);
-    state->twin = std::move(twin).value();
-    state->residuals = internal::WhitenedResiduals(train_layout_, real_, state->twin);
+    state->twins = std::move(twins).value();
+    state->residuals = internal::CombinedResiduals(fit_runs_, state->twins);
     out_.effects.push_back(e);
     for (TwinEffect& other : *scored) {
       EffectEstimate& y = other.estimate;
@@ -242,8 +301,7 @@ Result<bool> Diagnoser::Round(int round, const std::vector<TwinCandidate>& pool,
 // together from their kept values on the training part, the time shifts held in the base. A joint fit whose twin fails
 // leaves the rounds' figures alone and says why.
 void Diagnoser::FitJointly(const State& state, const std::vector<TwinCandidate>& library, double step_s) {
-  sim::Scenario base = state.train;
-  base.effects.clear();
+  sim::Scenario base = Base({});
   std::vector<TwinCandidate> parts;
   std::vector<const TwinEffect*> kept;
   std::vector<double> start;
@@ -267,7 +325,7 @@ void Diagnoser::FitJointly(const State& state, const std::vector<TwinCandidate>&
     return;
   }
   Progress("joint refit of the kept effects");
-  internal::TwinEvaluator evaluator(base, real_, runner_, train_layout_, options_.threads);
+  internal::TwinEvaluator evaluator(base, fit_runs_, options_.threads);
   internal::FitSettings settings;
   settings.max_iterations = options_.max_iterations;
   settings.physics_step_s = step_s;
@@ -314,11 +372,13 @@ void Diagnoser::FitJointly(const State& state, const std::vector<TwinCandidate>&
 
 // The held-out figures with the patch, the unexplained components and the verdict.
 void Diagnoser::Finish(const State& state) {
-  out_.heldout_after = state.heldout;
+  out_.heldout_after = state.heldout.front();
+  for (std::size_t i = 1; i < state.heldout.size(); ++i) out_.training_runs[i - 1].heldout_after = state.heldout[i];
   for (const TwinEffect& e : out_.effects) out_.patch.push_back(e.effect);
-  const Layout heldout = internal::MakeLayout(real_, train_end_, last_);
+  const RunSpan& span = spans_.front();
+  const Layout heldout = internal::MakeLayout(real_, span.train_end, span.last);
   const auto statistics = ComponentStatistics(
-      internal::MeasurementResiduals(heldout, internal::WhitenedResiduals(heldout, real_, state.twin)));
+      internal::MeasurementResiduals(heldout, internal::WhitenedResiduals(heldout, real_, state.twins.front())));
   for (const auto& [key, level] : statistics)
     if (Inconsistent(level, 1.0, kInconsistencyRatio)) out_.unexplained.push_back(key);
   const bool inconsistent =
@@ -333,26 +393,28 @@ Result<TwinDiagnosis> Diagnoser::Run() {
   hac_ = estimator::UsesHac(options_.std_method, real_);
   out_.std_method = hac_ ? "hac" : "white";
   State state;
-  state.full = nominal_;
-  state.full.effects.clear();
-  state.full.duration_s = std::max(SecondsBetween(first_, last_), 1.0);  // the runners' time since first_
-  state.train = state.full;
-  state.train.duration_s = std::min(state.full.duration_s, SecondsBetween(first_, train_end_) + 0.05);
-  auto simulator = sim::Simulator::Create(state.full, {});
+  sim::Scenario nominal = Base({});
+  nominal.duration_s = spans_.front().whole_s;  // the runners' time since the first stamp
+  auto simulator = sim::Simulator::Create(nominal, {});
   if (!simulator.ok()) return Status::Error("the nominal scenario: " + simulator.status().message());
   const double step_s = simulator.value()->PhysicsStepS();
 
   Progress("nominal twin");
-  auto twin = RunFull(state.full);
-  if (!twin.ok()) return Status::Error("the nominal twin: " + twin.status().message());
-  state.twin = std::move(twin).value();
-  out_.whole_run = CompareTwin(real_, state.twin, first_.seconds(), last_.seconds(), options_.drift);
-  state.heldout = CompareTwin(real_, state.twin, train_end_.seconds(), last_.seconds(), options_.drift);
-  out_.heldout_before = state.heldout;
-  const Layout whole = internal::MakeLayout(real_, first_, last_);
-  out_.located = Locate(internal::MeasurementResiduals(whole, internal::WhitenedResiduals(whole, real_, state.twin)),
-                        RealConditions(real_), {});
-  state.residuals = internal::WhitenedResiduals(train_layout_, real_, state.twin);
+  auto twins = RunWhole({});
+  if (!twins.ok()) return Status::Error("the nominal twin: " + twins.status().message());
+  state.twins = std::move(twins).value();
+  const RunSpan& span = spans_.front();
+  out_.whole_run = CompareTwin(real_, state.twins.front(), span.first.seconds(), span.last.seconds(), options_.drift);
+  state.heldout = HeldOut(state.twins);
+  out_.heldout_before = state.heldout.front();
+  for (std::size_t i = 1; i < runs_in_.size(); ++i)
+    out_.training_runs.push_back(
+        {runs_in_[i].recording, runs_in_[i].replayed, spans_[i].train_end.seconds(), state.heldout[i], {}});
+  const Layout whole = internal::MakeLayout(real_, span.first, span.last);
+  out_.located = Locate(
+      internal::MeasurementResiduals(whole, internal::WhitenedResiduals(whole, real_, state.twins.front())),
+      RealConditions(real_), {});
+  state.residuals = internal::CombinedResiduals(fit_runs_, state.twins);
   state.chi2 = internal::SumOfSquares(state.residuals, &measurements_);
 
   const std::vector<TwinCandidate> library = internal::TwinCandidates(nominal_, options_.max_shift_s);
@@ -428,7 +490,15 @@ Result<TwinHeldOutRun> ShowOnHeldOut(const sim::Scenario& nominal, const std::ve
 
 Result<TwinDiagnosis> DiagnoseTwin(const sim::Scenario& nominal, const recording::Recording& real,
                                    const TwinRunner& runner, const TwinDiagnoseOptions& options) {
-  return Diagnoser(nominal, real, runner, options).Run();
+  return DiagnoseTwin(nominal, {TwinTrainingRun{"", &real, runner, options.replayed}}, options);
+}
+
+Result<TwinDiagnosis> DiagnoseTwin(const sim::Scenario& nominal, const std::vector<TwinTrainingRun>& runs,
+                                   const TwinDiagnoseOptions& options) {
+  if (runs.empty()) return Status::Error("no recording to diagnose");
+  for (const TwinTrainingRun& run : runs)
+    if (!run.real || !run.runner) return Status::Error(run.recording + ": no recording or no twin runner");
+  return Diagnoser(nominal, runs, options).Run();
 }
 
 }  // namespace roamlab::gap

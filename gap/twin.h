@@ -190,6 +190,24 @@ struct TwinHeldOutRun {
   TwinComparison before, after;
 };
 
+// A recording the patch is fitted on, with its twin's runner: the diagnosed recording, and further runs of the same
+// robot (DiagnoseTwin's training runs).
+struct TwinTrainingRun {
+  std::string recording;  // as named by the caller (its path); prefixes its series' names in a fit on several runs
+  const recording::Recording* real = nullptr;
+  TwinRunner runner;
+  bool replayed = false;  // the runner replays its drive
+};
+
+// A further training run's figures: its training part's end and its held-out part (the last 1 - train_fraction) with
+// the nominal twin and the patched one.
+struct TwinTrainingFigures {
+  std::string recording;
+  bool replayed = false;
+  double train_end_s = 0.0;
+  TwinComparison heldout_before, heldout_after;
+};
+
 struct TwinDiagnosis {
   std::string verdict;  // named | unknown | none
   bool replayed = false;
@@ -204,6 +222,7 @@ struct TwinDiagnosis {
   TwinComparison heldout_before, heldout_after;
   std::vector<sim::EffectOptions> patch;     // the kept effects as the simulator takes them
   std::vector<TwinHeldOutRun> heldout_runs;  // ShowOnHeldOut's, filled by the caller
+  std::vector<TwinTrainingFigures> training_runs;  // the training runs after the diagnosed one
   int runs = 0;
   double seconds = 0.0;
 };
@@ -233,6 +252,14 @@ std::vector<std::string> TwinCandidateNames(const sim::Scenario& nominal);
 // Errors: the nominal twin fails, or the recording has nothing to compare.
 Result<TwinDiagnosis> DiagnoseTwin(const sim::Scenario& nominal, const recording::Recording& real,
                                    const TwinRunner& runner, const TwinDiagnoseOptions& options = {});
+// The diagnosis with the patch fitted on several runs of the same robot, the diagnosed recording first: each run's
+// twin with its own runner; each contributes its first train_fraction to the fit and its last part to the held-out
+// test. The fit's residuals and chi-square, the score test, LR and Delta BIC (n: the runs' training residuals) and the
+// held-out chi-square drop are over the runs together; the HAC covariance treats each run's series as independent
+// series. Locate, whole_run, heldout_before/after and unexplained are the diagnosed recording's; training_runs holds
+// the others' held-out figures. With one run it is the diagnosis above. Errors: as above, naming the run.
+Result<TwinDiagnosis> DiagnoseTwin(const sim::Scenario& nominal, const std::vector<TwinTrainingRun>& runs,
+                                   const TwinDiagnoseOptions& options = {});
 
 // The patch shown on a held-out recording: its twin with `runner` (the twin of `held`) for the nominal scenario (its
 // effects removed) and for the nominal one with `patch`, both up to held's last stamp, run in parallel on `threads`,
@@ -247,7 +274,9 @@ nlohmann::json TwinDriftJson(const std::map<std::string, TwinDrift>& drift);
 // {"replayed", "verdict", "std_method", "train_end_s", "located", "candidates", "effects", "joint" (null, or
 // {"effects", "held", "failed", "chi2_before", "chi2_after", "iterations", "runs"}), "unexplained",
 // "heldout": {"before", "after"}, "whole_run", "patch",
-// "heldout_runs": [{"recording", "replayed", "before", "after"}], "runs", "seconds"}: gap.json's "simulation" section.
+// "heldout_runs": [{"recording", "replayed", "before", "after"}], "runs", "seconds"}, and with further training runs
+// "training_runs": [{"recording", "replayed", "train_end_s", "heldout": {"before", "after"}}]: gap.json's "simulation"
+// section.
 nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d);
 
 }  // namespace roamlab::gap

@@ -120,7 +120,7 @@ nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d) {
                             {"replayed", h.replayed},
                             {"before", ComparisonJson(h.before)},
                             {"after", ComparisonJson(h.after)}});
-  return {{"replayed", d.replayed},
+  nlohmann::json out = {{"replayed", d.replayed},
           {"verdict", d.verdict},
           {"std_method", d.std_method},
           {"train_end_s", d.train_end_s},
@@ -135,6 +135,15 @@ nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d) {
           {"heldout_runs", heldout_runs},
           {"runs", d.runs},
           {"seconds", d.seconds}};
+  if (d.training_runs.empty()) return out;
+  out["training_runs"] = nlohmann::json::array();
+  for (const TwinTrainingFigures& t : d.training_runs)
+    out["training_runs"].push_back(
+        {{"recording", t.recording},
+         {"replayed", t.replayed},
+         {"train_end_s", t.train_end_s},
+         {"heldout", {{"before", ComparisonJson(t.heldout_before)}, {"after", ComparisonJson(t.heldout_after)}}}});
+  return out;
 }
 
 }  // namespace roamlab::gap

@@ -394,21 +394,77 @@ void ParallelFor(int n, int threads, const std::function<void(int)>& fn) {
   for (std::thread& t : pool) t.join();
 }
 
-std::vector<Result<Eigen::VectorXd>> TwinEvaluator::Run(const std::vector<Patch>& patches) {
-  std::vector<Result<Eigen::VectorXd>> out(patches.size(), Result<Eigen::VectorXd>(Status::Error("not run")));
-  ParallelFor(static_cast<int>(patches.size()), threads_, [&](int i) {
-    sim::Scenario patched = base_;
-    const Patch& patch = patches[static_cast<std::size_t>(i)];
-    patched.effects.insert(patched.effects.end(), patch.begin(), patch.end());
-    try {
-      auto twin = runner_(patched);
-      out[static_cast<std::size_t>(i)] =
-          twin.ok() ? Result<Eigen::VectorXd>(WhitenedResiduals(layout_, real_, twin.value())) : twin.status();
-    } catch (const std::exception& e) {
-      out[static_cast<std::size_t>(i)] = Status::Error(std::string("the twin runner failed: ") + e.what());
+Layout CombinedLayout(const std::vector<FitRun>& runs) {
+  if (runs.size() == 1) return runs.front().layout;
+  Layout out;
+  if (!runs.empty()) out.origin = runs.front().layout.origin;
+  for (const FitRun& run : runs) {
+    for (Series s : run.layout.series) {
+      s.name = run.name + ": " + s.name;
+      s.offset += out.size;
+      out.series.push_back(std::move(s));
     }
+    for (const std::string& why : run.layout.left_out) out.left_out.push_back(run.name + ": " + why);
+    out.size += run.layout.size;
+  }
+  return out;
+}
+
+namespace {
+
+// The runs' residual vectors (one per run, in order) concatenated.
+Eigen::VectorXd Concatenated(const std::vector<FitRun>& runs, const std::vector<Eigen::VectorXd>& per_run) {
+  if (per_run.size() == 1) return per_run.front();
+  Eigen::Index size = 0;
+  for (const FitRun& run : runs) size += run.layout.size;
+  Eigen::VectorXd out(size);
+  Eigen::Index offset = 0;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    out.segment(offset, runs[i].layout.size) = per_run[i];
+    offset += runs[i].layout.size;
+  }
+  return out;
+}
+
+}  // namespace
+
+Eigen::VectorXd CombinedResiduals(const std::vector<FitRun>& runs, const std::vector<recording::Recording>& twins) {
+  std::vector<Eigen::VectorXd> per_run;
+  for (std::size_t i = 0; i < runs.size(); ++i)
+    per_run.push_back(WhitenedResiduals(runs[i].layout, *runs[i].real, twins[i]));
+  return Concatenated(runs, per_run);
+}
+
+std::vector<Result<Eigen::VectorXd>> TwinEvaluator::Run(const std::vector<Patch>& patches) {
+  const std::size_t n_runs = runs_of_.size();
+  std::vector<Result<Eigen::VectorXd>> each(patches.size() * n_runs, Result<Eigen::VectorXd>(Status::Error("not run")));
+  ParallelFor(static_cast<int>(each.size()), threads_, [&](int i) {
+    const FitRun& run = runs_of_[static_cast<std::size_t>(i) % n_runs];
+    const Patch& patch = patches[static_cast<std::size_t>(i) / n_runs];
+    sim::Scenario patched = base_;
+    patched.duration_s = run.duration_s;
+    patched.effects.insert(patched.effects.end(), patch.begin(), patch.end());
+    Result<Eigen::VectorXd>& out = each[static_cast<std::size_t>(i)];
+    try {
+      auto twin = (*run.runner)(patched);
+      out = twin.ok() ? Result<Eigen::VectorXd>(WhitenedResiduals(run.layout, *run.real, twin.value())) : twin.status();
+    } catch (const std::exception& e) {
+      out = Status::Error(std::string("the twin runner failed: ") + e.what());
+    }
+    if (!out.ok() && n_runs > 1) out = Status::Error(run.name + ": " + out.status().message());
   });
-  runs_ += static_cast<int>(patches.size());
+  runs_ += static_cast<int>(each.size());
+  std::vector<Result<Eigen::VectorXd>> out(patches.size(), Result<Eigen::VectorXd>(Status::Error("not run")));
+  for (std::size_t p = 0; p < patches.size(); ++p) {
+    const auto first = each.begin() + static_cast<std::ptrdiff_t>(p * n_runs);
+    const auto failed = std::find_if(first, first + static_cast<std::ptrdiff_t>(n_runs),
+                                     [](const Result<Eigen::VectorXd>& r) { return !r.ok(); });
+    std::vector<Eigen::VectorXd> per_run;
+    if (failed == first + static_cast<std::ptrdiff_t>(n_runs))
+      for (auto r = first; r != failed; ++r) per_run.push_back(std::move(*r).value());
+    out[p] = failed != first + static_cast<std::ptrdiff_t>(n_runs) ? failed->status()
+                                                                  : Result<Eigen::VectorXd>(Concatenated(runs_of_, per_run));
+  }
   return out;
 }
 

@@ -40,22 +40,39 @@ sim::EffectOptions EffectAt(const TwinCandidate& c, const Eigen::VectorXd& theta
 // The effects one twin run adds to the evaluator's base scenario.
 using Patch = std::vector<sim::EffectOptions>;
 
-// Runs the twin of patched scenarios (the base with a patch's effects each), in parallel, and returns the whitened
-// training residuals of each (layout's entries; NaN where the twin has no sample).
+// One recording the fit runs the twin of: its real recording, the twin's runner, the layout of its training part and
+// the twin's duration (s after the recording's first stamp).
+struct FitRun {
+  std::string name;  // prefixes its series' names when the fit runs on more than one recording
+  const recording::Recording* real = nullptr;
+  const TwinRunner* runner = nullptr;
+  Layout layout;
+  double duration_s = 0.0;
+};
+
+// The runs' layouts as one residual vector: the series concatenated in the runs' order, their offsets moved, and with
+// more than one run each series' name prefixed "NAME: " so that the HAC covariance (ComputeTwinCovariance) treats
+// each run's series as independent of the others'.
+Layout CombinedLayout(const std::vector<FitRun>& runs);
+
+// The runs' whitened training residuals, concatenated as CombinedLayout, for their twins (one per run, in order).
+Eigen::VectorXd CombinedResiduals(const std::vector<FitRun>& runs, const std::vector<recording::Recording>& twins);
+
+// Runs the twin of patched scenarios (the base with a patch's effects each) for every run, the runs x patches in
+// parallel, and returns the whitened training residuals of each patch (CombinedLayout's entries; NaN where a twin has
+// no sample). A patch fails when any run's twin fails.
 class TwinEvaluator {
  public:
-  TwinEvaluator(const sim::Scenario& base, const recording::Recording& real, const TwinRunner& runner,
-                const Layout& layout, int threads)
-      : base_(base), real_(real), runner_(runner), layout_(layout), threads_(threads) {}
+  TwinEvaluator(const sim::Scenario& base, const std::vector<FitRun>& runs, int threads)
+      : base_(base), runs_of_(runs), layout_(CombinedLayout(runs)), threads_(threads) {}
   std::vector<Result<Eigen::VectorXd>> Run(const std::vector<Patch>& patches);
   int runs() const { return runs_; }
   const Layout& layout() const { return layout_; }
 
  private:
   const sim::Scenario& base_;
-  const recording::Recording& real_;
-  const TwinRunner& runner_;
-  const Layout& layout_;
+  const std::vector<FitRun>& runs_of_;
+  Layout layout_;
   int threads_;
   int runs_ = 0;
 };

@@ -204,7 +204,8 @@ std::string OptiOdomDiff(const testing::TempDir& dir, const std::string& turn_ra
 
 // A wheel radius 3 % large hidden in two drives: the patch fitted on the scenario's own drive is shown on a recording
 // of another drive (replayed), where the patched twin's 10 s drift is well below the nominal twin's; gap.json names
-// twin.json. A held-out recording without --twin is bad input.
+// twin.json. A held-out or training recording without --twin is bad input, and so is a training recording of another
+// robot kind.
 TEST(DiagnoseCliTest, HeldOutShowsTheTwinsPatchOnARecordingOfAnotherDrive) {
   testing::TempDir dir;
   const std::string effect = "[{name: wheel_radius_scale, parameters: {scale: 1.03}}]";
@@ -224,6 +225,20 @@ TEST(DiagnoseCliTest, HeldOutShowsTheTwinsPatchOnARecordingOfAnotherDrive) {
   const CommandRun refused = Roamlab(common + "--out " + dir.File("bad") + " --held-out " + dir.File("held"), dir);
   EXPECT_EQ(refused.exit_code, 2);
   EXPECT_NE(refused.err.find("--held-out needs --twin"), std::string::npos) << refused.err;
+  // A training recording of another robot kind: one line naming it, exit 2, before any diagnosis.
+  ASSERT_EQ(Roamlab("simulate " + Scenario(dir, 1.0, "[]") + " --out " + dir.File("atv") + " --quiet", dir).exit_code,
+            0);
+  const CommandRun other_kind =
+      Roamlab(common + "--out " + dir.File("bad") + " --twin --quiet --train-with " + dir.File("atv"), dir);
+  EXPECT_EQ(other_kind.exit_code, 2);
+  EXPECT_NE(other_kind.err.find(dir.File("atv") + ": platform kind 'ackermann' does not match the robot kind "
+                                                  "'differential_drive'"),
+            std::string::npos)
+      << other_kind.err;
+  EXPECT_EQ(std::count(other_kind.err.begin(), other_kind.err.end(), '\n'), 1);
+  const CommandRun no_twin = Roamlab(common + "--out " + dir.File("bad") + " --train-with " + dir.File("held"), dir);
+  EXPECT_EQ(no_twin.exit_code, 2);
+  EXPECT_NE(no_twin.err.find("--train-with needs --twin"), std::string::npos) << no_twin.err;
 
   const CommandRun run =
       Roamlab(common + "--out " + dir.File("out") + " --twin --no-plots --held-out " + dir.File("held"), dir);
