@@ -1,7 +1,7 @@
 // The twin's patch fitted on several training runs (gap/twin.h DiagnoseTwin with TwinTrainingRun): a hidden wheel
-// radius asymmetry in two seeded 30 s differential-drive recordings of different drives, the scenario's own (its twin
-// the plain simulation) and one turning the other way (its twin the replay of its drive). A GPS at 10 Hz with 5 mm
-// noise stands in for motion capture.
+// radius asymmetry in two seeded 30 s recordings of the OptiOdom differential drive (wheel encoders, motion capture)
+// of different drives, the scenario's own (its twin the plain simulation) and one turning the other way at twice the
+// rate (its twin the replay of its drive).
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -18,16 +18,11 @@ namespace {
 constexpr double kRatio = 1.02;
 
 sim::Scenario Nominal() {
-  auto s = sim::LoadScenario(roamlab::testing::SourceDir() + "/scenarios/indoor_diffdrive_gap.yaml");
+  auto s = sim::LoadScenario(roamlab::testing::SourceDir() + "/scenarios/real/optiodom_diff.yaml");
   EXPECT_TRUE(s.ok()) << s.status().message();
   sim::Scenario scenario = s.value();
   scenario.effects.clear();
   scenario.duration_s = 30.0;
-  sim::GpsOptions gps;
-  gps.rate_hz = 10.0;
-  gps.sigma_m = 0.005;
-  gps.lever_arm_m.setZero();
-  scenario.sensors.gps = gps;
   return scenario;
 }
 
@@ -50,10 +45,10 @@ std::pair<double, double> Ratio(const TwinDiagnosis& d) {
   return {e.parameters.at("ratio_right_left"), e.std.at("ratio_right_left")};
 }
 
-// The mean 10 s drift of a comparison's gps track.
+// The mean 10 s drift of a comparison's motion capture track.
 double Drift(const TwinComparison& c) {
-  EXPECT_TRUE(c.drift.count("gps"));
-  return c.drift.count("gps") ? c.drift.at("gps").mean_position_m : 0.0;
+  EXPECT_TRUE(c.drift.count("mocap"));
+  return c.drift.count("mocap") ? c.drift.at("mocap").mean_position_m : 0.0;
 }
 
 // The ratio fitted on both runs is named and within three of its std of the hidden one, with a smaller std than
@@ -62,7 +57,7 @@ double Drift(const TwinComparison& c) {
 TEST(TwinTrainingRunsTest, AnEffectFittedOnTwoRunsOfDifferentDrivesUsesBoth) {
   const sim::Scenario nominal = Nominal();
   sim::Scenario other = nominal;
-  for (sim::ProfileTerm& term : other.driver.angular_radps.terms) term.amplitude = -term.amplitude;
+  for (sim::ProfileTerm& term : other.driver.angular_radps.terms) term.amplitude = -0.3;
   const recording::Recording own = Real(nominal, 41), turned = Real(other, 42);
   TwinDiagnoseOptions options;
   options.candidates = {"wheel_radius_asymmetry", "wheel_radius_scale"};
@@ -87,7 +82,7 @@ TEST(TwinTrainingRunsTest, AnEffectFittedOnTwoRunsOfDifferentDrivesUsesBoth) {
   EXPECT_GT(d.runs, one.value().runs);
 
   const std::map<std::string, int>& lags = d.effects.front().hac_lags;
-  EXPECT_TRUE(lags.count("own: gps") && lags.count("turned: gps")) << "series: " << lags.size();
+  EXPECT_TRUE(lags.count("own: mocap") && lags.count("turned: mocap")) << "series: " << lags.size();
 
   ASSERT_EQ(d.training_runs.size(), 1u);
   const TwinTrainingFigures& t = d.training_runs.front();
