@@ -5,13 +5,16 @@
 # the fitted parameters. Days: diff_dec (23 Dec 2020: square runs train, circular and Ivanjko runs held out),
 # diff_jun (square runs of 23 Jun 2020 train, circular and Ivanjko runs of 25 Jun held out: two days apart, the
 # dataset has no other runs of 23 Jun), diff_jun25 (25 Jun: circular runs train, another circular and an Ivanjko run
-# held out), omni3 (22 Dec 2020: square runs train, circular runs held out).
+# held out), omni3 (22 Dec 2020: square runs train, circular runs held out), diffset_dec (23 Dec: the patch fitted on a
+# square, a circular and an Ivanjko run together, --train-with, with at most 2 and 3 effects; the other circular,
+# Ivanjko and square runs of the day held out).
 #   bash scripts/twin_optiodom.sh [DATA_DIR] [OUT_DIR]   (DATA_DIR: the OptiOdom dataset's data/ folder, default
 #                                                          $ROAMLAB_DATA_DIR/optiodom/data, else ../shared/data's;
 #                                                          OUT_DIR: out/twin_optiodom)
-# Needs build/apps/roamlab and python3. Ten diagnoses of about 40-70 s of CPU each, on two threads; JOBS (default 1)
-# of them at a time (OUT/<day>_<set>.time: each one's wall and CPU time). ONLY (a regular expression) runs only the
-# days whose names match (diff_dec, diff_jun, diff_jun25, omni3).
+# Needs build/apps/roamlab and python3. Ten diagnoses of about 40-70 s of CPU each and two (diffset_dec) of about
+# 110-160 s, on two threads; JOBS (default 1) of them at a time (OUT/<day>_<set>.time: each one's wall and CPU time).
+# ONLY (a regular expression) runs only the days whose names match (diff_dec, diff_jun, diff_jun25, omni3,
+# diffset_dec).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 data=${1:-${ROAMLAB_DATA_DIR:-$here/../shared/data}/optiodom/data}
@@ -45,6 +48,22 @@ diagnose() {  # day, robot (diff, omni3), training shape/set, held-out shape/set
     "$roamlab" diagnose --real "$train" --scenario "$here/scenarios/real/optiodom_$robot.yaml" --config "$config" \
     --no-baseline --replay --no-plots --quiet --out "$dir" --held-out "${held[@]}"
 }
+diagnose_set() {  # day, robot, max effects, "training shape/set ...", held-out shape/set...
+  local day=$1 robot=$2 n=$3 dir=$out/$1_max$3 held=() with=()
+  local -a training
+  read -ra training <<<"$4"
+  shift 4
+  [[ -z "$only" || "$day" =~ $only ]] || return 0
+  [ -f "$dir/twin.json" ] && return 0
+  local first
+  first=$(rec "$robot/${training[0]}")
+  for t in "${training[@]:1}"; do with+=("$(rec "$robot/$t")"); done
+  for h in "$@"; do held+=("$(rec "$robot/$h")"); done
+  /usr/bin/time -f "%e s wall, %U s user + %S s system CPU" -o "$out/${day}_max$n.time" \
+    "$roamlab" diagnose --real "$first" --train-with "${with[@]}" --max-effects "$n" \
+    --scenario "$here/scenarios/real/optiodom_$robot.yaml" --config "$here/configs/real/optiodom_diff_nominal.yaml" \
+    --no-baseline --replay --no-plots --quiet --out "$dir" --held-out "${held[@]}"
+}
 reap() { wait -n || echo "twin_optiodom.sh: a diagnosis failed (its output above)" >&2; }
 run() {  # diagnose in the background, at most $jobs at a time
   while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do reap; done
@@ -61,6 +80,14 @@ for square in 230620202042 230620202144 230620202258 230620202317; do
 done
 for circle in 250620202104 250620202236; do
   run diff_jun25 diff "circular/$circle" circular/250620202119 ivanjko/250620201618
+done
+for n in 2 3; do
+  set_runs=(diffset_dec diff "$n" "square/231220200029 circular/231220200121 ivanjko/231220200057")
+  for h in circular/2312202001{34,41,46,50,54,57} ivanjko/2312202001{02,04,07} square/2312202000{40,45,48}; do
+    set_runs+=("$h")
+  done
+  while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do reap; done
+  diagnose_set "${set_runs[@]}" &
 done
 while [ "$(jobs -rp | wc -l)" -gt 0 ]; do reap; done
 python3 "$here/tools/twin_table.py" "$out"

@@ -6,7 +6,9 @@ values +- marginal std), the twin's mean 10 s motion-capture drift on its own he
 nominal -> patched (ratio). Per day: every candidate's first-round fit on each training run (value +- std) and the
 largest normalized spread |a - b| / sqrt(sa^2 + sb^2) over the pairs of runs, for the named effects as their rounds
 fitted them ("named"), as the joint refit gives them ("joint": the joint values and marginal std where the run names
-more than one effect, else the round's), and for all the candidates.
+more than one effect, else the round's), and for all the candidates. A diagnosis fitted on a set of training runs
+(`--train-with`, twin.json's training_runs) gives each further training run's own third after the first's, and no
+spread (its runs share one fit).
 
     python3 tools/twin_table.py OUT_DIR
 """
@@ -64,6 +66,9 @@ def main(out):
         if joint:
             named += "; joint: " + " / ".join(effect_text(e) for e in joint)
         own = ratio_text(drift(twin["heldout"]["before"]), drift(twin["heldout"]["after"]))
+        for t in twin.get("training_runs", []):
+            own += (f"; {pathlib.Path(t['recording']).name.split('_')[0]}: "
+                    + ratio_text(drift(t["heldout"]["before"]), drift(t["heldout"]["after"])))
         held = "; ".join(
             f"{pathlib.Path(h['recording']).name.split('_')[0]}: "
             + ratio_text(drift(h["before"]), drift(h["after"])) for h in twin["heldout_runs"])
@@ -72,6 +77,8 @@ def main(out):
             before, after = drift(h["before"]), drift(h["after"])
             if before and after is not None:
                 ratios.setdefault(day, []).append(after / before)
+        if "training_runs" in twin:
+            continue
         day_fits = days.setdefault(day, {"named": {}, "joint": {}, "candidates": {}})
         for kind, effects in (("named", twin["effects"]), ("joint", joint or twin["effects"]),
                               ("candidates", twin["candidates"])):
