@@ -324,6 +324,9 @@ void AddDiagnose(CLI::App* app, Commands* commands) {
                     "own twin, its first 2/3 in the fit and its last 1/3 in the held-out test (twin.json "
                     "training_runs)");
     dia->add_option("--max-effects", args->max_effects, "With --twin: the twin's effects kept at most (default 2)");
+    dia->add_option("--twin-candidates", args->twin_candidates,
+                    "With --twin: the candidate effects the twin diagnosis tries, as twin.json names them (e.g. "
+                    "wheel_radius_scale, 'axle_misalignment wheel 0'; default every one the scenario supports)");
     dia->add_flag("--quiet", args->quiet, "No progress and no summary");
     return dia;
   });

@@ -155,6 +155,18 @@ Result<std::vector<HeldOut>> LoadOtherRuns(const DiagnoseRequest& request, const
   return out;
 }
 
+// Each of `names` a twin candidate `scenario` supports.
+Status CheckTwinCandidates(const std::vector<std::string>& names, const sim::Scenario& scenario) {
+  const std::vector<std::string> known = gap::TwinCandidateNames(scenario);
+  for (const std::string& name : names)
+    if (std::find(known.begin(), known.end(), name) == known.end()) {
+      std::string list;
+      for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
+      return Status::Error("--twin-candidates: '" + name + "' is not a twin candidate of the scenario (" + list + ")");
+    }
+  return Status::Ok();
+}
+
 std::string Millimetres(double m) { return Fixed(1e3 * m, 3) + " mm"; }
 
 // The diagnosis against the scenario's twin (runner: ChooseTwin's), fitted on the recording and the training runs,
@@ -170,6 +182,7 @@ Outcome DiagnoseTwinToFile(const DiagnoseRequest& request, const Inputs& in, con
   options.progress = [&](const std::string& line) { say("  " + line); };
   if (request.max_shift_s) options.max_shift_s = *request.max_shift_s;
   if (request.max_effects) options.max_effects = *request.max_effects;
+  options.candidates = request.twin_candidates;
   std::vector<gap::TwinTrainingRun> runs = {{request.recording, &in.recording, runner, replayed}};
   for (const HeldOut& t : training) runs.push_back({t.path, &t.recording, t.runner, t.replayed});
   auto diagnosed = gap::DiagnoseTwin(*in.scenario, runs, options);
@@ -240,6 +253,10 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
     return Outcome::BadInput(Status::Error("--max-effects " + std::to_string(*request.max_effects) + ": must be 1 or more"));
   if ((request.twin || request.drive != gap::TwinDrive::kDetect) && !in.scenario)
     return Outcome::BadInput(Status::Error("--twin, --replay and --no-replay need --scenario"));
+  if (!request.twin_candidates.empty()) {
+    if (!request.twin) return Outcome::BadInput(Status::Error("--twin-candidates needs --twin (or --replay)"));
+    if (Status s = CheckTwinCandidates(request.twin_candidates, *in.scenario); !s.ok()) return Outcome::BadInput(s);
+  }
   if (in.scenario) {
     auto choice = ChooseTwin(*in.scenario, in.recording, request.recording, request.drive, say);
     if (!choice.ok()) return Outcome::BadInput(choice.status());

@@ -7,12 +7,13 @@ first 2 s, the position error at its end).
 Per run (run-01 of each set named): the nominal geometry's drift; the drift with the geometry fitted to that run's own
 windows (an oracle: common radius scale, right/left radius ratio and track, Nelder-Mead on the mean drift), the same
 with a clock shift of the encoders against the motion capture fitted too, and the geometry fitted on a training run
-(the first run named) carried over; the motion capture's distance over the
+(the first run named; several, comma-separated, fitted together on the mean over them of drift / nominal drift)
+carried over; the motion capture's distance over the
 encoders' on straight 1 s stretches, its heading change over the encoders' on arcs (1 s stretches with both wheels
 forward, their angles differing by more than 5 %, turning by more than 0.05 rad) and on in-place turns (0.5 s stretches with the wheels turning
 opposite ways), all with the nominal geometry.
 
-    python3 tools/optiodom_drift_floor.py DATA_DIR TRAINING_SET OTHER_SET...
+    python3 tools/optiodom_drift_floor.py DATA_DIR TRAINING_SET[,TRAINING_SET...] OTHER_SET...
       (DATA_DIR: the dataset's data/diff folder; a set as shape/name, e.g. square/231220200029)
 """
 import bisect
@@ -177,7 +178,8 @@ def main(argv):
         return 0 if len(argv) > 1 and argv[1] in ("-h", "--help") else 2
     data = pathlib.Path(argv[1])
     runs = {}
-    for name in argv[2:]:
+    training = argv[2].split(",")
+    for name in training + argv[3:]:
         path = data / name / f"{pathlib.Path(name).name}_run-01.csv"
         if not path.is_file():
             print(f"optiodom_drift_floor.py: {path}: no such run", file=sys.stderr)
@@ -188,9 +190,13 @@ def main(argv):
                for name, run in runs.items()}
     clocked = {name: nelder_mead(lambda p, run=run: drift(run, p), (*oracles[name][0], 0.0),
                                  (0.01, 0.003, 0.003, 0.03)) for name, run in runs.items()}
-    training = argv[2]
-    carried = oracles[training][0]
-    print(f"geometry fitted on {training}'s windows: scale {carried[0]:.4f}, R/L {carried[1]:.4f}, "
+    if len(training) == 1:
+        carried = oracles[training[0]][0]
+    else:
+        nominal_drift = {name: drift(runs[name], nominal) for name in training}
+        carried = nelder_mead(lambda p: sum(drift(runs[n], p) / nominal_drift[n] for n in training) / len(training),
+                              nominal, (0.01, 0.003, 0.003))[0]
+    print(f"geometry fitted on {', '.join(training)}'s windows: scale {carried[0]:.4f}, R/L {carried[1]:.4f}, "
           f"track {1000 * carried[2]:+.1f} mm")
     print("| run | nominal 10 s drift | own fit: scale, R/L, track -> drift (ratio) | own fit with a clock shift "
           "(ratio) | training run's fit carried over (ratio) | straight: distance ratio | arcs: heading ratio | in-place turns: heading ratio |")

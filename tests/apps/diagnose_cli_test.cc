@@ -204,8 +204,8 @@ std::string OptiOdomDiff(const testing::TempDir& dir, const std::string& turn_ra
 
 // A wheel radius 3 % large hidden in two drives: the patch fitted on the scenario's own drive is shown on a recording
 // of another drive (replayed), where the patched twin's 10 s drift is well below the nominal twin's; gap.json names
-// twin.json. A held-out or training recording without --twin is bad input, and so is a training recording of another
-// robot kind.
+// twin.json. A held-out or training recording without --twin is bad input, and so are a training recording of another
+// robot kind and a twin candidate the scenario does not support.
 TEST(DiagnoseCliTest, HeldOutShowsTheTwinsPatchOnARecordingOfAnotherDrive) {
   testing::TempDir dir;
   const std::string effect = "[{name: wheel_radius_scale, parameters: {scale: 1.03}}]";
@@ -239,6 +239,11 @@ TEST(DiagnoseCliTest, HeldOutShowsTheTwinsPatchOnARecordingOfAnotherDrive) {
   const CommandRun no_twin = Roamlab(common + "--out " + dir.File("bad") + " --train-with " + dir.File("held"), dir);
   EXPECT_EQ(no_twin.exit_code, 2);
   EXPECT_NE(no_twin.err.find("--train-with needs --twin"), std::string::npos) << no_twin.err;
+  const CommandRun unknown =
+      Roamlab(common + "--out " + dir.File("bad") + " --twin --twin-candidates wheel_radius_scale gyro_scale_error", dir);
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.err.find("'gyro_scale_error' is not a twin candidate of the scenario"), std::string::npos)
+      << unknown.err;
 
   const CommandRun run =
       Roamlab(common + "--out " + dir.File("out") + " --twin --no-plots --held-out " + dir.File("held"), dir);
