@@ -319,10 +319,11 @@ void AddDiagnose(CLI::App* app, Commands* commands) {
     dia->add_option("--held-out", args->held_out,
                     "With --twin: other recordings of the same robot (held out of the twin's fit) on which the "
                     "twin's patch is shown (twin.json heldout_runs)");
-    dia->add_option("--train-with", args->train_with,
-                    "With --twin: other recordings of the same robot the twin's patch is fitted on as well, each on its "
-                    "own twin, its first 2/3 in the fit and its last 1/3 in the held-out test (twin.json "
-                    "training_runs)");
+    dia->add_option(
+        "--train-with", args->train_with,
+        "With --twin: other recordings of the same robot the twin's patch is fitted on as well, each on its "
+        "own twin, its first 2/3 in the fit and its last 1/3 in the held-out test (twin.json "
+        "training_runs)");
     dia->add_option("--max-effects", args->max_effects, "With --twin: the twin's effects kept at most (default 2)");
     dia->add_option("--twin-candidates", args->twin_candidates,
                     "With --twin: the candidate effects the twin diagnosis tries, as twin.json names them (e.g. "

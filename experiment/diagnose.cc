@@ -250,7 +250,8 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
   if (!request.train_with.empty() && !request.twin)
     return Outcome::BadInput(Status::Error("--train-with needs --twin (or --replay)"));
   if (request.max_effects && !(*request.max_effects >= 1))
-    return Outcome::BadInput(Status::Error("--max-effects " + std::to_string(*request.max_effects) + ": must be 1 or more"));
+    return Outcome::BadInput(
+        Status::Error("--max-effects " + std::to_string(*request.max_effects) + ": must be 1 or more"));
   if ((request.twin || request.drive != gap::TwinDrive::kDetect) && !in.scenario)
     return Outcome::BadInput(Status::Error("--twin, --replay and --no-replay need --scenario"));
   if (!request.twin_candidates.empty()) {

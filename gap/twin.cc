@@ -115,7 +115,7 @@ class Diagnoser {
   const recording::Recording& real_;  // the diagnosed recording, the first run
   const TwinDiagnoseOptions& options_;
   TwinDiagnosis out_;
-  std::vector<RunSpan> spans_;               // per run
+  std::vector<RunSpan> spans_;              // per run
   std::vector<internal::FitRun> fit_runs_;  // per run, its training part
   int measurements_ = 0;
   int runs_ = 0;
@@ -140,8 +140,8 @@ Status Diagnoser::Span() {
     span.train_end = Time::FromSeconds(span.first.seconds() + options_.train_fraction * seconds);
     span.whole_s = std::max(seconds, 1.0);
     span.train_s = std::min(span.whole_s, SecondsBetween(span.first, span.train_end) + 0.05);
-    internal::FitRun fit{run.recording, run.real, &run.runner, internal::MakeLayout(*run.real, span.first, span.train_end),
-                         span.train_s};
+    internal::FitRun fit{run.recording, run.real, &run.runner,
+                         internal::MakeLayout(*run.real, span.first, span.train_end), span.train_s};
     if (fit.layout.size == 0) return Status::Error(name + "the recording has no stream with a stated noise to compare");
     spans_.push_back(span);
     fit_runs_.push_back(std::move(fit));
@@ -411,9 +411,9 @@ Result<TwinDiagnosis> Diagnoser::Run() {
     out_.training_runs.push_back(
         {runs_in_[i].recording, runs_in_[i].replayed, spans_[i].train_end.seconds(), state.heldout[i], {}});
   const Layout whole = internal::MakeLayout(real_, span.first, span.last);
-  out_.located = Locate(
-      internal::MeasurementResiduals(whole, internal::WhitenedResiduals(whole, real_, state.twins.front())),
-      RealConditions(real_), {});
+  out_.located =
+      Locate(internal::MeasurementResiduals(whole, internal::WhitenedResiduals(whole, real_, state.twins.front())),
+             RealConditions(real_), {});
   state.residuals = internal::CombinedResiduals(fit_runs_, state.twins);
   state.chi2 = internal::SumOfSquares(state.residuals, &measurements_);
 

@@ -220,8 +220,8 @@ struct TwinDiagnosis {
   std::vector<std::string> unexplained;   // "stream/component" inconsistent on the held-out part with the patch
   TwinComparison whole_run;               // the nominal twin
   TwinComparison heldout_before, heldout_after;
-  std::vector<sim::EffectOptions> patch;     // the kept effects as the simulator takes them
-  std::vector<TwinHeldOutRun> heldout_runs;  // ShowOnHeldOut's, filled by the caller
+  std::vector<sim::EffectOptions> patch;           // the kept effects as the simulator takes them
+  std::vector<TwinHeldOutRun> heldout_runs;        // ShowOnHeldOut's, filled by the caller
   std::vector<TwinTrainingFigures> training_runs;  // the training runs after the diagnosed one
   int runs = 0;
   double seconds = 0.0;

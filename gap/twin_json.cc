@@ -120,21 +120,22 @@ nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d) {
                             {"replayed", h.replayed},
                             {"before", ComparisonJson(h.before)},
                             {"after", ComparisonJson(h.after)}});
-  nlohmann::json out = {{"replayed", d.replayed},
-          {"verdict", d.verdict},
-          {"std_method", d.std_method},
-          {"train_end_s", d.train_end_s},
-          {"located", located},
-          {"candidates", candidates},
-          {"effects", effects},
-          {"joint", JointJson(d.joint)},
-          {"unexplained", d.unexplained},
-          {"heldout", {{"before", ComparisonJson(d.heldout_before)}, {"after", ComparisonJson(d.heldout_after)}}},
-          {"whole_run", ComparisonJson(d.whole_run)},
-          {"patch", patch},
-          {"heldout_runs", heldout_runs},
-          {"runs", d.runs},
-          {"seconds", d.seconds}};
+  nlohmann::json out = {
+      {"replayed", d.replayed},
+      {"verdict", d.verdict},
+      {"std_method", d.std_method},
+      {"train_end_s", d.train_end_s},
+      {"located", located},
+      {"candidates", candidates},
+      {"effects", effects},
+      {"joint", JointJson(d.joint)},
+      {"unexplained", d.unexplained},
+      {"heldout", {{"before", ComparisonJson(d.heldout_before)}, {"after", ComparisonJson(d.heldout_after)}}},
+      {"whole_run", ComparisonJson(d.whole_run)},
+      {"patch", patch},
+      {"heldout_runs", heldout_runs},
+      {"runs", d.runs},
+      {"seconds", d.seconds}};
   if (d.training_runs.empty()) return out;
   out["training_runs"] = nlohmann::json::array();
   for (const TwinTrainingFigures& t : d.training_runs)

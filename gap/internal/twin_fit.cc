@@ -462,8 +462,9 @@ std::vector<Result<Eigen::VectorXd>> TwinEvaluator::Run(const std::vector<Patch>
     std::vector<Eigen::VectorXd> per_run;
     if (failed == first + static_cast<std::ptrdiff_t>(n_runs))
       for (auto r = first; r != failed; ++r) per_run.push_back(std::move(*r).value());
-    out[p] = failed != first + static_cast<std::ptrdiff_t>(n_runs) ? failed->status()
-                                                                  : Result<Eigen::VectorXd>(Concatenated(runs_of_, per_run));
+    out[p] = failed != first + static_cast<std::ptrdiff_t>(n_runs)
+                 ? failed->status()
+                 : Result<Eigen::VectorXd>(Concatenated(runs_of_, per_run));
   }
   return out;
 }

@@ -239,8 +239,8 @@ TEST(DiagnoseCliTest, HeldOutShowsTheTwinsPatchOnARecordingOfAnotherDrive) {
   const CommandRun no_twin = Roamlab(common + "--out " + dir.File("bad") + " --train-with " + dir.File("held"), dir);
   EXPECT_EQ(no_twin.exit_code, 2);
   EXPECT_NE(no_twin.err.find("--train-with needs --twin"), std::string::npos) << no_twin.err;
-  const CommandRun unknown =
-      Roamlab(common + "--out " + dir.File("bad") + " --twin --twin-candidates wheel_radius_scale gyro_scale_error", dir);
+  const CommandRun unknown = Roamlab(
+      common + "--out " + dir.File("bad") + " --twin --twin-candidates wheel_radius_scale gyro_scale_error", dir);
   EXPECT_EQ(unknown.exit_code, 2);
   EXPECT_NE(unknown.err.find("'gyro_scale_error' is not a twin candidate of the scenario"), std::string::npos)
       << unknown.err;

@@ -103,8 +103,8 @@ TEST(TwinTrainingRunsTest, ARunWithoutSamplesIsAnErrorNamingIt) {
     s.t.clear();
     s.values.resize(0, s.values.cols());
   }
-  const auto d = DiagnoseTwin(nominal, {{"own", &own, PlainSimulationRunner(), false},
-                                        {"empty", &empty, PlainSimulationRunner(), false}});
+  const auto d = DiagnoseTwin(
+      nominal, {{"own", &own, PlainSimulationRunner(), false}, {"empty", &empty, PlainSimulationRunner(), false}});
   ASSERT_FALSE(d.ok());
   EXPECT_EQ(d.status().message(), "empty: the recording has no span of samples to compare");
   EXPECT_FALSE(DiagnoseTwin(nominal, std::vector<TwinTrainingRun>{}).ok());
