@@ -103,8 +103,8 @@ constexpr std::size_t kMaxBridgedReadings = 3;
 // (tested now and failing, or older than the pass's first factor and rejected before; at least one of them, or the
 // passing span after them, tested now), bridges over 1 to kMaxBridgedReadings readings that pass the test at the
 // current estimate replace the spans they cover, the narrowest first; their poses are not those the reading bent, so
-// their test is not fooled by the bend. Spans no passing bridge covers (a skid) are left to the gate. Returns the factors bridged; adds the readings
-// left out to *readings and each bridged run to *runs.
+// their test is not fooled by the bend. Spans no passing bridge covers (a skid) are left to the gate. Returns the
+// factors bridged; adds the readings left out to *readings and each bridged run to *runs.
 std::set<FactorId> BridgeFailingRuns(const std::vector<TestedFactor>& tested,
                                      const std::function<double(int)>& threshold, ProblemBuilder* builder,
                                      int* readings, std::vector<std::vector<FactorId>>* runs) {
