@@ -100,11 +100,11 @@ constexpr std::size_t kMaxBridgedReadings = 3;
 // Bridges (ProblemBuilder::BridgeCumulativeRun) over outlying readings of cumulative wheel streams. A reading off by
 // delta makes the span before it delta / dt too fast and the one after it delta / dt too slow; tested alone, each
 // span fails and is rejected, and the poses around the reading lose both. In each run of consecutive failing spans
-// (tested now and failing, or older than the pass's first factor and rejected before; at least one tested now),
-// from its start: the bridge over the fewest readings (1 to kMaxBridgedReadings) that passes the test at the current
-// estimate replaces the spans it covers; its poses are not those the reading bent, so its test is not fooled by the
-// bend. Spans no passing bridge covers (a skid) are left to the gate. Returns the factors bridged; adds the readings
-// left out to *readings and each bridged run to *runs.
+// (tested now and failing, or older than the pass's first factor and rejected before; at least one of them, or the
+// passing span after them, tested now), bridges over 1 to kMaxBridgedReadings readings that pass the test at the
+// current estimate replace the spans they cover, the narrowest first; their poses are not those the reading bent, so
+// their test is not fooled by the bend. Spans no passing bridge covers (a skid) are left to the gate. Returns the
+// factors bridged; adds the readings left out to *readings and each bridged run to *runs.
 std::set<FactorId> BridgeFailingRuns(const std::vector<TestedFactor>& tested,
                                      const std::function<double(int)>& threshold, ProblemBuilder* builder,
                                      int* readings, std::vector<std::vector<FactorId>>* runs) {
@@ -124,38 +124,58 @@ std::set<FactorId> BridgeFailingRuns(const std::vector<TestedFactor>& tested,
     return internal::LinearizeFactorAt(entry, values.data(), 0, &wf) &&
            wf.squared_norm <= threshold(entry.factor->residual_dim());
   };
-  const auto bridge_run = [&](const std::vector<FactorId>& run) {
-    for (std::size_t i = 0; i + 1 < run.size();) {
-      std::size_t skipped = 0;
-      for (std::size_t w = 1; w <= kMaxBridgedReadings && i + w < run.size() && skipped == 0; ++w) {
+  // A span fails when tested now and failing, or not tested now and rejected before.
+  const auto fails = [&](FactorId id) {
+    const auto now = failing_now.find(id);
+    return now != failing_now.end() ? now->second : !builder->graph().factor(id).active;
+  };
+  // The narrowest bridges first, each from every start in turn: a span the reading beside it bent fails too, and a
+  // bridge from it would leave out a good reading with the outlier. In an open run (ending at its stream's newest span,
+  // which may go on), only the starts whose every width is recorded: a narrower bridge from a later start would keep
+  // outlying readings at its ends.
+  const auto bridge_run = [&](const std::vector<FactorId>& run, bool open) {
+    std::vector<char> covered(run.size(), 0);
+    for (std::size_t w = 1; w <= kMaxBridgedReadings; ++w) {
+      for (std::size_t i = 0; i + w < run.size(); ++i) {
+        if (open && i + kMaxBridgedReadings >= run.size()) break;
+        if (std::any_of(covered.begin() + static_cast<std::ptrdiff_t>(i),
+                        covered.begin() + static_cast<std::ptrdiff_t>(i + w + 1), [](char c) { return c != 0; }))
+          continue;
         const std::vector<FactorId> spans(run.begin() + static_cast<std::ptrdiff_t>(i),
                                           run.begin() + static_cast<std::ptrdiff_t>(i + w + 1));
         const std::optional<FactorEntry> candidate = builder->CumulativeBridge(spans);
         if (candidate && passes(*candidate) && builder->BridgeCumulativeRun(spans)) {
           bridged.insert(spans.begin(), spans.end());
           runs->push_back(spans);
-          skipped = w;
+          std::fill(covered.begin() + static_cast<std::ptrdiff_t>(i),
+                    covered.begin() + static_cast<std::ptrdiff_t>(i + w + 1), 1);
+          *readings += static_cast<int>(w);
         }
       }
-      *readings += static_cast<int>(skipped);
-      i += skipped > 0 ? skipped + 1 : 1;
     }
   };
+  int last_stream = -1, last_end = -1;
   std::vector<FactorId> run;
   bool tested_in_run = false;
+  // The last span of each stream.
+  std::map<int, FactorId> newest;
+  for (const auto& [key, id] : by_row) newest[key.first] = id;
   const auto close_run = [&] {
-    if (run.size() >= 2 && tested_in_run) bridge_run(run);
+    const bool open = !run.empty() && newest[last_stream] == run.back();
+    if (run.size() >= 2 && tested_in_run) bridge_run(run, open);
     run.clear();
     tested_in_run = false;
   };
-  int last_stream = -1, last_end = -1;
   for (const auto& [key, id] : by_row) {
-    const auto now = failing_now.find(id);
-    const bool bad = now != failing_now.end() ? now->second : !builder->graph().factor(id).active;
-    if (!bad || key.first != last_stream || key.second != last_end) close_run();
+    const bool bad = fails(id);
+    const bool chained = key.first == last_stream && key.second == last_end;
+    // A span tested now that passes closes the run before it: the run is tested (a start in it that waited for the
+    // span is tried now).
+    if (!bad && chained) tested_in_run |= failing_now.count(id) > 0;
+    if (!bad || !chained) close_run();
     if (bad) {
       run.push_back(id);
-      tested_in_run |= now != failing_now.end();
+      tested_in_run |= failing_now.count(id) > 0;
     }
     last_stream = key.first;
     last_end = builder->cumulative_spans().at(id).row_end;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -43,6 +44,39 @@ int GateAndResolve(double probability, FactorId first, FactorId end, const Solve
        pass < kMaxGatePasses && GateOutliers(probability, builder, first, last_solve, options).switched() > 0; ++pass)
     iterations += solve();
   return iterations;
+}
+
+// Before a solve with a cumulative wheel master: switches off, counted as rejected, the newest pose's spans (those that
+// end at it), when the measurements that tie the newest pose to earlier ones (the IMU's rows) have at least as many
+// residual rows as it has dimensions (not in an IMU gap). The solve then places the newest pose by its motion, and the
+// gate tests the spans there and re-admits those that fit. Otherwise the newest pose is predicted from the newest span
+// itself, which then fits whatever its reading: an outlying reading bends the poses before it through the IMU's rows,
+// failing their good spans, and a bridge over an earlier reading that ends at the newest pose passes at the position
+// the outlier gave it.
+void HoldOutNewestSpans(ProblemBuilder* builder) {
+  Graph& graph = builder->graph();
+  const std::deque<PoseNode>& poses = builder->poses();
+  const auto& spans = builder->cumulative_spans();
+  if (spans.empty()) return;
+  const VariableId newest = poses.back().id;
+  const auto poses_joined = [&](const FactorEntry& entry) {
+    return std::count_if(entry.variables.begin(), entry.variables.end(), [&](VariableId v) {
+      return std::any_of(poses.begin(), poses.end(), [&](const PoseNode& p) { return p.id == v; });
+    });
+  };
+  int motion_rows = 0;
+  for (const FactorId id : graph.FactorsOf(newest)) {
+    const FactorEntry& entry = graph.factor(id);
+    if (entry.active && builder->StreamOfFactor(id) >= 0 && spans.count(id) == 0 && poses_joined(entry) > 1)
+      motion_rows += entry.factor->residual_dim();
+  }
+  if (motion_rows < graph.variable(newest).manifold.tangent_dim()) return;
+  for (const FactorId id : graph.FactorsOf(newest)) {
+    FactorEntry& entry = graph.mutable_factor(id);
+    if (spans.count(id) == 0 || !entry.active) continue;
+    entry.active = false;
+    ++builder->mutable_counts(entry.stream).rejected;
+  }
 }
 
 // The oldest pose's estimate and position covariance (marginal of the whole window): from `known` when it holds that
@@ -262,6 +296,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
           SecondsBetween(builder.poses().front().t, m.t) < config.tracking.initialization_s)
         continue;
       builder.AlignToAbsoluteFixes();
+      if (config.gate_probability) HoldOutNewestSpans(&builder);
       const SolverSummary s = Solve(config.solver, &builder.graph());
       if (!s.usable()) return Status::Error("initialization failed: " + s.message);
       if (config.gate_probability)
@@ -278,9 +313,11 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
       // between them, and which of them fails worst is chance. Rejecting the IMU's row there leaves the pose to an
       // outlying master row, and the velocity it gives the pose is carried on to the next poses, failing their good
       // rows. The next sample's rows side with the good ones. A cumulative wheel master (its readings bridged,
-      // GateOutliers) is gated at attachment: its bridges test a reading on both spans it joins.
+      // GateOutliers) is gated at attachment, with the newest pose's spans held out of the first solve
+      // (HoldOutNewestSpans): its bridges test a reading on both spans it joins.
       const bool delayed = builder.cumulative_spans().empty();
       const auto t0 = Clock::now();
+      if (config.gate_probability) HoldOutNewestSpans(&builder);
       leaving.variables.assign(1, builder.poses().front().id);
       leaving.computed = false;
       CovarianceRequest* request =

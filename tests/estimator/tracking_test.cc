@@ -412,6 +412,48 @@ TEST(TrackingTest, GatesMasterOutliersOnlyOnceTheNextSampleSidesWithTheGoodRows)
     ASSERT_TRUE(result.value().position_covariance[i].allFinite()) << "pose " << i;
 }
 
+// Tracking a differential drive (cumulative wheel angles) under motion capture, with three readings in a row off by
+// 0.5 rad (10 rad/s, 20 sigma, on the spans they end and start), the first and the third on the left wheel backwards
+// and the middle one forwards (all three on the right wheel forwards). Every span from the one before them to the one
+// after them fails; a bridge over the middle reading alone passes (its ends are off by the same angles), one over
+// all three is right. The gate must leave out exactly the three readings, no motion-capture pose, and every pose
+// keep a finite covariance.
+TEST(TrackingTest, LeavesOutExactlyTheOutlyingCumulativeWheelReadings) {
+  recording::Recording rec = testing::DiffDriveArcWithMotionCapture(120, 0.3, Eigen::Vector2d(1.0, -2.0));
+  constexpr int kFirst = 60;
+  rec.streams[0].values.row(kFirst) += Eigen::RowVector2d(-0.5, 0.5);
+  rec.streams[0].values.row(kFirst + 1) += Eigen::RowVector2d(0.5, 0.5);
+  rec.streams[0].values.row(kFirst + 2) += Eigen::RowVector2d(-0.5, 0.5);
+  // Each motion-capture pose 1 us before its wheel reading, so that it has joined the newest pose at the update.
+  for (Time& t : rec.streams[1].t) t = Time::FromNanoseconds(t.nanoseconds() - 1000);
+  const auto config = ParseEstimatorConfig(R"(
+master: wheels
+tracking: {window: 20, max_iterations: 5, improvement_threshold: 1.0e-3, time_budget_s: 1.0e9, initialization_s: 0.5}
+gating: {probability: 0.99999}
+parameters:
+  wheels.radius: {value: [0.04]}
+  wheels.baseline: {value: [0.2]}
+streams:
+  wheels:
+    model: differential_drive
+    source: wheels
+    noise: {wheel_radps: 0.5, lateral_mps: 0.002, vertical_mps: 0.002, tilt_radps: 0.02}
+    parameters: {radius_left: wheels.radius, radius_right: wheels.radius, baseline: wheels.baseline}
+  mocap:
+    model: absolute_pose
+    source: mocap
+    noise: {position_m: 0.0001, orientation_rad: 0.001}
+)",
+                                           "test config");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  auto result = Track(config.value(), rec, {});
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_EQ(result.value().counts.at("wheels").rejected, 3);
+  EXPECT_EQ(result.value().counts.at("mocap").rejected, 0);
+  for (std::size_t i = 0; i < result.value().position_covariance.size(); ++i)
+    ASSERT_TRUE(result.value().position_covariance[i].allFinite()) << "pose " << i;
+}
+
 TEST(TrackingTest, CalibrationPriorOfTheWrongSizeIsAnError) {
   CalibratedAtv calibrated = CalibrateOnOtherDrive();
   calibrated.prior.information = Eigen::MatrixXd::Identity(2, 2);
