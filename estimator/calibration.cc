@@ -407,6 +407,29 @@ Status BuildGraph(const CalibrationOptions& options, ProblemBuilder* builder_ptr
   return Status::Ok();
 }
 
+// The scale of the robust start's Huber loss: the chi-square 95 % quantile of a factor's dimension, in whitened units.
+// Errors within it (19 in 20 good ones) count as in least squares; a gross one pulls with the force of one at the scale.
+constexpr double kRobustStartProbability = 0.95;
+
+// Gives every measurement factor of a stream configured with the trivial loss Huber's loss at the
+// kRobustStartProbability quantile of its dimension (robust), or the trivial loss back (not robust); the streams
+// configured with a robust loss keep theirs. Returns `robust` when some factor took Huber's loss.
+bool UseRobustStartLoss(const EstimatorConfig& config, bool robust, ProblemBuilder* builder) {
+  std::map<int, double> scale;  // by dimension
+  bool any = false;
+  Graph& graph = builder->graph();
+  for (const auto& [id, entry] : graph.factors()) {
+    if (builder->StreamOfFactor(id) < 0) continue;
+    const auto stream = config.streams.find(entry.stream);
+    if (stream == config.streams.end() || stream->second.loss.type != Loss::Type::kTrivial) continue;
+    const int dim = entry.factor->residual_dim();
+    if (scale.count(dim) == 0) scale[dim] = std::sqrt(ChiSquareQuantile(kRobustStartProbability, dim));
+    graph.mutable_factor(id).loss = robust ? Loss::Huber(scale[dim]) : Loss::Trivial();
+    any = true;
+  }
+  return any && robust;
+}
+
 // One stage (stage index s of `stage_count`, its parameters free): a solve, then gating rounds with their re-solves.
 // `lambda` carries Levenberg-Marquardt's damping from solve to solve: the first stage starts from the configured one,
 // as its parameters and the dead-reckoned poses may be far from the minimum; every later solve starts where the last
@@ -422,6 +445,7 @@ Result<StageSummary> SolveStage(const EstimatorConfig& config, const Calibration
   stage.free_parameters = free;
   SolverOptions stage_options = config.solver;
   if (lm) stage_options.initial_lambda = std::max(*lambda, std::numeric_limits<double>::epsilon());
+  bool robust = config.gate_probability && config.gate_robust_start && UseRobustStartLoss(config, true, &builder);
   stage.solver = Solve(stage_options, &builder.graph(), nullptr, workspace);
   if (!stage.solver.usable()) return Status::Error("stage " + std::to_string(s + 1) + ": " + stage.solver.message);
   // Gate gross outliers at the converged estimate and re-solve without them. Gross outliers bend the estimate and make
@@ -462,13 +486,25 @@ Result<StageSummary> SolveStage(const EstimatorConfig& config, const Calibration
     gate.defer_when_bridging = pass - round < kMaxGatingRounds;
     const GateSwitches changed = GateOutliers(*config.gate_probability, &builder, 0, nullptr, gate);
     if (changed.bridged == 0 || !gate.defer_when_bridging) ++round;
-    if (changed.switched() == 0) break;
+    if (changed.switched() == 0 && !robust) break;
+    if (changed.switched() == 0) {
+      // Settled under Huber's loss: least squares on what it kept, tested again by the next pass.
+      robust = UseRobustStartLoss(config, false, &builder);
+      const Status solved = resolve("gate settled under Huber's loss: least squares");
+      if (!solved.ok()) return solved;
+      continue;
+    }
     const Status solved =
         resolve("gating round " + std::to_string(pass + 1) + ": " + std::to_string(changed.rejected) +
                 " measurements rejected, " + std::to_string(changed.readmitted) + " re-admitted" +
                 (changed.bridged > 0 ? ", " + std::to_string(changed.bridged) + " wheel readings bridged" : "") +
                 (changed.ignored > 0 ? ", " + std::to_string(changed.ignored) + " failing by chance" : "") +
                 ", re-solved");
+    if (!solved.ok()) return solved;
+  }
+  if (robust) {
+    UseRobustStartLoss(config, false, &builder);
+    const Status solved = resolve("rounds ended under Huber's loss: least squares");
     if (!solved.ok()) return solved;
   }
   for (const auto& [stream, c] : builder.counts()) stage.rejected += c.rejected;

@@ -333,10 +333,12 @@ class Parser {
     if (root["solver"]) ParseSolver(root["solver"], &c.solver);
     if (root["tracking"]) ParseTracking(root["tracking"], &c.tracking);
     if (root["gating"]) {
-      CheckKeys(root["gating"], {"probability"}, "gating");
+      CheckKeys(root["gating"], {"probability", "robust_start"}, "gating");
       const double p = Number(root["gating"]["probability"], "gating.probability");
       if (!(p > 0.0 && p < 1.0)) Fail(root["gating"], "gating.probability must be in (0, 1)");
       c.gate_probability = p;
+      if (root["gating"]["robust_start"])
+        c.gate_robust_start = Bool(root["gating"]["robust_start"], "gating.robust_start");
     }
     if (!root["streams"].IsMap()) Fail(root["streams"], "streams must be a mapping");
     for (const auto& kv : root["streams"]) {

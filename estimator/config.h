@@ -135,6 +135,9 @@ struct EstimatorConfig {
   PosesConfig poses;  // IMU master only
   SolverOptions solver;
   std::optional<double> gate_probability;
+  // Calibration with the gate on: each stage's solves take Huber's loss (gating.robust_start) until the gate has
+  // settled, then least squares on the measurements it kept (calibration.h, Calibrate).
+  bool gate_robust_start = false;
   TrackingConfig tracking;
   std::map<std::string, ParameterConfig> parameters;
   std::map<std::string, StreamConfig> streams;  // by stream name (ordered: deterministic)
