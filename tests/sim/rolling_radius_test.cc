@@ -3,6 +3,7 @@
 #include "sim/rolling_radius.h"
 
 #include <cmath>
+#include <cstdio>
 
 #include <gtest/gtest.h>
 
@@ -70,6 +71,25 @@ TEST(RollingRadiusTest, RollerWheelsRollBelowTheirEnvelopeByTheAxlesDip) {
       EXPECT_NEAR(envelope_m - rigid_m, 4e-4, 2e-5) << kind << " wheel " << i;
       EXPECT_LT(radii.value()[i], rigid_m) << kind << " wheel " << i;
       EXPECT_GT(radii.value()[i], rigid_m - kContactSinkM) << kind << " wheel " << i;
+      std::printf("%s wheel %zu: %.6f m per rad (envelope %.6f m)\n", kind.c_str(), i, radii.value()[i], envelope_m);
+    }
+  }
+}
+
+// Faster, the rollers' contacts bounce and the wheels' travel per radian spreads; it stays well within the axle's dip
+// of the slow drive's, which is the definition of the truth.
+TEST(RollingRadiusTest, TheTravelPerRadianDependsLittleOnTheSpeed) {
+  for (const auto& [file, kind] : std::vector<std::pair<std::string, std::string>>{{"models/omni3.xml", "omni3"},
+                                                                                   {"models/mecanum.xml", "mecanum"}}) {
+    const FlatWorld world = Compile(file, kind);
+    RollingRadiusDrive fast;
+    fast.speed_mps = 0.4;
+    auto slow_m = MeasureRollingRadii(world.model.get(), world.robot, 0.0, 0.0, 0.3, file);
+    auto fast_m = MeasureRollingRadii(world.model.get(), world.robot, 0.0, 0.0, 0.3, file, fast);
+    ASSERT_TRUE(slow_m.ok() && fast_m.ok());
+    for (std::size_t i = 0; i < slow_m.value().size(); ++i) {
+      EXPECT_NEAR(fast_m.value()[i], slow_m.value()[i], 2e-4) << kind << " wheel " << i;
+      std::printf("%s wheel %zu at 0.4 m/s: %.6f m per rad\n", kind.c_str(), i, fast_m.value()[i]);
     }
   }
 }
