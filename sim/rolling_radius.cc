@@ -120,8 +120,8 @@ class Drive {
       }
       if (!open) return Status::Ok();
     }
-    return Status::Error(what_ + ": measuring the rolling radius: a wheel did not turn " +
-                         "its window within " + std::to_string(limit_s) + " s");
+    return Status::Error(what_ + ": measuring the rolling radius: a wheel did not turn its window within " +
+                         std::to_string(limit_s) + " s");
   }
 
  private:
@@ -132,7 +132,8 @@ class Drive {
     robot_.Apply(v.x(), v.y(), 0.0, data_);
     mj_step(model_, data_);
     if (data_->warning[mjWARN_BADQACC].number > 0)
-      return Status::Error(what_ + ": measuring the rolling radius: the simulation diverged (MuJoCo: bad acceleration)");
+      return Status::Error(what_ +
+                           ": measuring the rolling radius: the simulation diverged (MuJoCo: bad acceleration)");
     mj_kinematics(model_, data_);
     return Status::Ok();
   }
@@ -168,8 +169,8 @@ Result<std::vector<double>> MeasureRollingRadii(const mjModel* model, const Whee
       longest_window_rad = std::max(longest_window_rad, w.window_rad);
       travels.push_back(w);
     }
-    const double window_s = longest_window_rad * robot.wheels()[static_cast<std::size_t>(group.front())].radius_m /
-                            drive.speed_mps;
+    const double window_s =
+        longest_window_rad * robot.wheels()[static_cast<std::size_t>(group.front())].radius_m / drive.speed_mps;
     if (Status s = driver.Run(drive.ramp_s, rest, v); !s.ok()) return s;
     if (Status s = driver.Run(drive.hold_s, v, v); !s.ok()) return s;
     if (Status s = driver.Measure(v, kWindowTimeLimit * window_s, &travels); !s.ok()) return s;

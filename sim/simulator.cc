@@ -212,9 +212,9 @@ class Simulator::Impl {
   // Roller wheels: their true radius is the travel per radian, measured on the changed model from the start pose.
   Status MeasureRollingRadii() {
     if (!wheeled_.HasRollers()) return Status::Ok();
-    auto radii = sim::MeasureRollingRadii(model_.get(), wheeled_, scenario_.robot.start_position_m.x(),
-                                          scenario_.robot.start_position_m.y(), scenario_.robot.start_heading_rad,
-                                          model_where_);
+    auto radii =
+        sim::MeasureRollingRadii(model_.get(), wheeled_, scenario_.robot.start_position_m.x(),
+                                 scenario_.robot.start_position_m.y(), scenario_.robot.start_heading_rad, model_where_);
     if (!radii.ok()) return radii.status();
     wheeled_.SetRollingRadii(radii.value());
     return Status::Ok();

@@ -109,8 +109,8 @@ Result<WheeledRobot> WheeledRobot::Bind(const mjModel* model, const std::string&
         model->actuator_trnid[2 * actuator] != joint)
       return Missing(what, kind, "a velocity actuator 'drive_" + index + "' on joint 'wheel_" + index + "'");
     const int tire = IdOf(model, mjOBJ_GEOM, "tire_" + index);
-    if (tire < 0 ||
-        !(model->geom_type[tire] == mjGEOM_SPHERE || (KindHasRollers(kind) && model->geom_type[tire] == mjGEOM_CYLINDER)))
+    if (tire < 0 || !(model->geom_type[tire] == mjGEOM_SPHERE ||
+                      (KindHasRollers(kind) && model->geom_type[tire] == mjGEOM_CYLINDER)))
       return Missing(
           what, kind,
           std::string("a ") + (KindHasRollers(kind) ? "sphere or cylinder" : "sphere") + " geom 'tire_" + index + "'");
