@@ -231,7 +231,8 @@
 // "front_right" "rear_left" "rear_right". Platform geometry: omni3 wheel_radius_m, wheel_distance_m (L); mecanum
 // wheel_radius_m, half_length_m, half_width_m. truth.yaml: odometer.radius_<i> for every wheel, and odometer.distance
 // (omni3) or odometer.lx_plus_ly (mecanum), the names of the omni3_drive and mecanum_drive estimator models; the radii
-// are the rollers' envelope (the true mean rolling radius is a little smaller: the axle dips between rollers).
+// are each wheel's travel per radian, measured on the physics (sim/rolling_radius.h: below the rollers' envelope, the
+// axle dips between rollers), and odometer.radius_envelope_<i> the envelope.
 //
 // Real robots (scenarios/real/, docs/scenarios.md "Real robots"): a simulated recording that reads like an imported
 // one names its encoder columns and geometry keys as the importer does:

@@ -21,6 +21,7 @@
 #include "sim/laser.h"
 #include "sim/mujoco_model.h"
 #include "sim/noise.h"
+#include "sim/rolling_radius.h"
 #include "sim/sensors.h"
 #include "sim/simulated_camera.h"
 #include "sim/terrain.h"
@@ -193,6 +194,7 @@ class Simulator::Impl {
       }
       if (Status st = wheeled_.MoveWheels(model_.get(), scenario_.robot.wheel_offset, where_); !st.ok()) return st;
       if (Status st = wheeled_.Deform(model_.get(), TireDeformations(scenario_), where_); !st.ok()) return st;
+      if (Status st = MeasureRollingRadii(); !st.ok()) return st;
       if (Status st = BindEncoderColumns(); !st.ok()) return st;
       odom_site_ = wheeled_.odom_site();
       if (scenario_.sensors.laser && wheeled_.laser_site() < 0)
@@ -204,6 +206,17 @@ class Simulator::Impl {
         return Status::Error(where_ + ": sensors.camera.store_images: no recording directory to store images in");
     }
 
+    return Status::Ok();
+  }
+
+  // Roller wheels: their true radius is the travel per radian, measured on the changed model from the start pose.
+  Status MeasureRollingRadii() {
+    if (!wheeled_.HasRollers()) return Status::Ok();
+    auto radii =
+        sim::MeasureRollingRadii(model_.get(), wheeled_, scenario_.robot.start_position_m.x(),
+                                 scenario_.robot.start_position_m.y(), scenario_.robot.start_heading_rad, model_where_);
+    if (!radii.ok()) return radii.status();
+    wheeled_.SetRollingRadii(radii.value());
     return Status::Ok();
   }
 

@@ -27,7 +27,7 @@ int ExpectedWheels(const std::string& kind) {
   return 0;
 }
 
-bool HasRollers(const std::string& kind) { return kind == "omni3" || kind == "mecanum"; }
+bool KindHasRollers(const std::string& kind) { return kind == "omni3" || kind == "mecanum"; }
 
 // The layout each kind's nominal kinematics assumes (recording/wheel_kinematics.h); empty when the wheels follow it.
 // Tolerances leave room for small mounting changes (WheelMountingChange).
@@ -109,11 +109,11 @@ Result<WheeledRobot> WheeledRobot::Bind(const mjModel* model, const std::string&
         model->actuator_trnid[2 * actuator] != joint)
       return Missing(what, kind, "a velocity actuator 'drive_" + index + "' on joint 'wheel_" + index + "'");
     const int tire = IdOf(model, mjOBJ_GEOM, "tire_" + index);
-    if (tire < 0 ||
-        !(model->geom_type[tire] == mjGEOM_SPHERE || (HasRollers(kind) && model->geom_type[tire] == mjGEOM_CYLINDER)))
+    if (tire < 0 || !(model->geom_type[tire] == mjGEOM_SPHERE ||
+                      (KindHasRollers(kind) && model->geom_type[tire] == mjGEOM_CYLINDER)))
       return Missing(
           what, kind,
-          std::string("a ") + (HasRollers(kind) ? "sphere or cylinder" : "sphere") + " geom 'tire_" + index + "'");
+          std::string("a ") + (KindHasRollers(kind) ? "sphere or cylinder" : "sphere") + " geom 'tire_" + index + "'");
     r.wheel_qpos_.push_back(model->jnt_qposadr[joint]);
     r.wheel_dof_.push_back(model->jnt_dofadr[joint]);
     r.actuators_.push_back(actuator);
@@ -131,7 +131,8 @@ Result<WheeledRobot> WheeledRobot::Bind(const mjModel* model, const std::string&
     w.locked_direction = w.drive_direction;
     w.radius_m = model->geom_size[3 * tire];
     w.mean_rolling_radius_m = w.radius_m;
-    if (HasRollers(kind)) {
+    if (KindHasRollers(kind)) {
+      w.envelope_radius_m = w.radius_m;
       // The roller under the wheel: its hinge axis, seen from above, is the locked direction u.
       const int roller = IdOf(model, mjOBJ_JOINT, "roller_" + index + "_0");
       if (roller < 0 || model->jnt_type[roller] != mjJNT_HINGE)
@@ -187,7 +188,7 @@ Status WheeledRobot::Deform(mjModel* model, const std::vector<WheelDeformation>&
       return Status::Error(what + ": " + name + ": the " + kind_ + " robot has " + std::to_string(wheels_.size()) +
                            " wheels");
     const int tire = tires_[static_cast<std::size_t>(d.wheel)];
-    if (HasRollers(kind_) && d.ovality_m == 0.0 && !d.keep_mean_radius) {
+    if (KindHasRollers(kind_) && d.ovality_m == 0.0 && !d.keep_mean_radius) {
       if (Status s = ScaleRollerWheel(model, d.wheel, d.radius_scale, what + ": " + name); !s.ok()) return s;
       continue;
     }
@@ -255,7 +256,14 @@ Status WheeledRobot::ScaleRollerWheel(mjModel* model, int wheel, double radius_s
   model->body_pos[3 * model->geom_bodyid[tire] + 2] += r - r0;
   model->geom_size[3 * tire] = r;
   wheels_[static_cast<std::size_t>(wheel)].mean_rolling_radius_m = r;
+  wheels_[static_cast<std::size_t>(wheel)].envelope_radius_m = r;
   return Status::Ok();
+}
+
+bool WheeledRobot::HasRollers() const { return KindHasRollers(kind_); }
+
+void WheeledRobot::SetRollingRadii(const std::vector<double>& radii_m) {
+  for (std::size_t i = 0; i < wheels_.size() && i < radii_m.size(); ++i) wheels_[i].mean_rolling_radius_m = radii_m[i];
 }
 
 Status WheeledRobot::ChangeTrack(mjModel* model, double track_error_m, const std::string& what) {
@@ -411,8 +419,10 @@ std::map<std::string, std::vector<double>> WheeledRobot::TrueOdometerCalibration
             {"odometer.baseline",
              {g.at("baseline_m") + 0.5 * (lever_change[1] + lever_change[3] - lever_change[0] - lever_change[2])}}};
   std::map<std::string, std::vector<double>> cal;
-  for (std::size_t i = 0; i < wheels_.size(); ++i)
+  for (std::size_t i = 0; i < wheels_.size(); ++i) {
     cal["odometer.radius_" + std::to_string(i)] = {wheels_[i].mean_rolling_radius_m};
+    cal["odometer.radius_envelope_" + std::to_string(i)] = {wheels_[i].envelope_radius_m};
+  }
   if (kind_ == "omni3") {
     cal["odometer.distance"] = {g.at("wheel_distance_m") + change_of_mean_abs_lever_m};
   } else {

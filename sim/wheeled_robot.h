@@ -42,7 +42,10 @@ struct WheelGeometry {
   Eigen::Vector2d drive_direction = Eigen::Vector2d::UnitX();
   Eigen::Vector2d locked_direction = Eigen::Vector2d::UnitX();  // u: unit, the direction the wheel cannot slide in
   double radius_m = 0.0;                                        // nominal rolling radius (the tire as modelled)
-  double mean_rolling_radius_m = 0.0;  // travel per revolution / 2 pi (radius_m unless deformed)
+  // Travel per radian: a tire's radius_m unless deformed; a roller wheel's as SetRollingRadii measured it (below its
+  // envelope: sim/rolling_radius.h), its envelope until then.
+  double mean_rolling_radius_m = 0.0;
+  double envelope_radius_m = 0.0;  // roller wheels: the rollers' envelope (radius_m unless scaled); tires: 0
 };
 
 // A change of one wheel's mounting, applied to the compiled model before binding (the wheel turns about its centre):
@@ -92,6 +95,10 @@ class WheeledRobot {
   // A roller wheel (omni3, mecanum) of another size: its rollers moved radially so that their envelope's radius is
   // radius_scale times the nominal (Deform's radius_scale on a roller wheel; ovality needs sphere tires).
   Status ScaleRollerWheel(mjModel* model, int wheel, double radius_scale, const std::string& what);
+  // Whether the wheels are roller wheels (omni3, mecanum), whose true radius is measured (sim/rolling_radius.h).
+  bool HasRollers() const;
+  // Each wheel's travel per radian [m] (EncoderColumns order), measured on the physics: the true odometer radii.
+  void SetRollingRadii(const std::vector<double>& radii_m);
 
   // Moves the wheels of the bound model apart by track_error_m (< 0: together), half on each side, along O's y axis
   // (a track wider or narrower than designed); differential_drive and mecanum, whose wheel bodies are children of the
@@ -131,7 +138,8 @@ class WheeledRobot {
   // Those of a kind (differential_drive: left, right; mecanum: front_left, front_right, rear_left, rear_right; omni3:
   // wheel_0, wheel_1, wheel_2).
   static std::vector<std::string> EncoderColumns(const std::string& kind);
-  // The true odometer geometry under the names of the kind's estimator model (odometer.<slot>).
+  // The true odometer geometry under the names of the kind's estimator model (odometer.<slot>); roller wheels also
+  // odometer.radius_envelope_<i>, the rollers' envelope, which no estimator parameter has.
   std::map<std::string, std::vector<double>> TrueOdometerCalibration() const;
 
   // Puts the robot at rest on the flat floor (z = 0) with O above (x, y), heading yaw_rad, the tires clearance_m

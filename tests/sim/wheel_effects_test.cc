@@ -137,7 +137,9 @@ TEST_F(WheelEffectsTest, RadiusScaleScalesTheYawRatePerWheelRateDifference) {
 }
 
 // Roller wheels (the OptiOdom omni3 model) of a radius 5 % large: at the same wheel rates (the driver does not know)
-// the robot drives 5 % further; the true radii follow.
+// the robot drives 5 % further; the true radii follow: the envelope exactly, the travel per radian within the change
+// of the axle's dip between rollers ((scale - 1) rho (1 - sin(x) / x), rho the roller's radius, a micrometre here)
+// and the measurement's scatter (a few micrometres).
 TEST(WheelRadiusScaleTest, ScaledRollerWheelsCarryTheOmniFurther) {
   auto loaded = LoadScenario(testing::SourcePath("scenarios/real/optiodom_omni3.yaml"));
   ASSERT_TRUE(loaded.ok()) << loaded.status().message();
@@ -158,8 +160,10 @@ TEST(WheelRadiusScaleTest, ScaledRollerWheelsCarryTheOmniFurther) {
   };
   EXPECT_GT(travel(nominal), 0.3);
   EXPECT_NEAR(travel(scaled) / travel(nominal), scale, 0.01) << travel(nominal) << " -> " << travel(scaled);
+  EXPECT_NEAR(scaled.truth.calibration.at("odometer.radius_envelope_0")[0],
+              scale * nominal.truth.calibration.at("odometer.radius_envelope_0")[0], 1e-9);
   EXPECT_NEAR(scaled.truth.calibration.at("odometer.radius_0")[0],
-              scale * nominal.truth.calibration.at("odometer.radius_0")[0], 1e-9);
+              scale * nominal.truth.calibration.at("odometer.radius_0")[0], 2e-5);
 }
 
 // The yaw rate per unit of wheel-rate difference is r / B: B_nom / B_true of the nominal one.

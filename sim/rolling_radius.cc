@@ -1,0 +1,183 @@
+#include "sim/rolling_radius.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "sim/mujoco_model.h"
+
+namespace roamlab::sim {
+namespace {
+
+constexpr double kTwoPi = 6.28318530717958647692;
+constexpr double kPlacementClearanceM = 0.01;
+// The drive's time limit for a measurement window, in multiples of the time the window takes at the set speed.
+constexpr double kWindowTimeLimit = 5.0;
+
+// A copy of `model` whose world geoms other than the ground do not collide with the robot.
+ModelPtr FloorOnlyCopy(const mjModel* model) {
+  ModelPtr copy(mj_copyModel(nullptr, model));
+  const int ground = IdOf(copy.get(), mjOBJ_GEOM, "terrain");
+  for (int g = 0; g < copy->ngeom; ++g) {
+    if (copy->geom_bodyid[g] != 0 || g == ground) continue;
+    copy->geom_contype[g] = 0;
+    copy->geom_conaffinity[g] = 0;
+  }
+  return copy;
+}
+
+// The angle [rad] over which wheel i is measured: `pitches` roller pitches, or one revolution without rollers.
+double WindowRad(const mjModel* model, int wheel, int pitches) {
+  const std::string prefix = "roller_" + std::to_string(wheel) + "_";
+  int rollers = 0;
+  while (IdOf(model, mjOBJ_BODY, prefix + std::to_string(rollers)) >= 0) ++rollers;
+  return rollers == 0 ? kTwoPi : pitches * kTwoPi / rollers;
+}
+
+// Groups of wheels that share a rolling direction (in O).
+std::vector<std::vector<int>> DirectionGroups(const WheeledRobot& robot) {
+  std::vector<std::vector<int>> groups;
+  const std::vector<WheelGeometry>& wheels = robot.wheels();
+  for (int i = 0; i < static_cast<int>(wheels.size()); ++i) {
+    const auto same = [&](const std::vector<int>& g) {
+      return wheels[static_cast<std::size_t>(g.front())].drive_direction.dot(
+                 wheels[static_cast<std::size_t>(i)].drive_direction) > 0.999;
+    };
+    const auto found = std::find_if(groups.begin(), groups.end(), same);
+    if (found == groups.end()) {
+      groups.push_back({i});
+    } else {
+      found->push_back(i);
+    }
+  }
+  return groups;
+}
+
+// One wheel's measurement: its hub's travel along its rolling direction and its rotation since the window opened.
+struct WheelTravel {
+  int joint = -1;
+  double window_rad = 0.0;
+  double start_angle_rad = 0.0;
+  Eigen::Vector3d last_hub_world = Eigen::Vector3d::Zero();
+  double travel_m = 0.0;
+  double radius_m = 0.0;  // set when the window closes
+};
+
+// The rolling direction in the world, d = a x e_z (a: the hinge axis), of the wheel on `joint`.
+Eigen::Vector3d RollingDirectionWorld(const mjData* data, int joint) {
+  const Eigen::Vector3d axis(data->xaxis + 3 * joint);
+  return axis.cross(Eigen::Vector3d::UnitZ()).normalized();
+}
+
+Eigen::Vector3d HubWorld(const mjModel* model, const mjData* data, int joint) {
+  return Eigen::Vector3d(data->xpos + 3 * model->jnt_bodyid[joint]);
+}
+
+class Drive {
+ public:
+  Drive(const mjModel* model, mjData* data, const WheeledRobot& robot, const std::string& what)
+      : model_(model), data_(data), robot_(robot), what_(what) {}
+
+  // Steps for duration_s with the body velocity set-point ramping from `from` to `to` (in O).
+  Status Run(double duration_s, const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
+    const long steps = std::lround(duration_s / model_->opt.timestep);
+    for (long k = 0; k < steps; ++k) {
+      const Eigen::Vector2d v = from + (to - from) * (static_cast<double>(k + 1) / static_cast<double>(steps));
+      if (Status s = Step(v); !s.ok()) return s;
+    }
+    return Status::Ok();
+  }
+
+  // Steps at the set-point v until every wheel in `travels` has turned its window.
+  Status Measure(const Eigen::Vector2d& v, double limit_s, std::vector<WheelTravel>* travels) {
+    for (WheelTravel& w : *travels) {
+      w.start_angle_rad = data_->qpos[model_->jnt_qposadr[w.joint]];
+      w.last_hub_world = HubWorld(model_, data_, w.joint);
+    }
+    const long limit_steps = std::lround(limit_s / model_->opt.timestep);
+    for (long k = 0; k < limit_steps; ++k) {
+      std::vector<double> turned_before;
+      for (const WheelTravel& w : *travels) turned_before.push_back(Turned(w));
+      if (Status s = Step(v); !s.ok()) return s;
+      bool open = false;
+      for (std::size_t i = 0; i < travels->size(); ++i) {
+        WheelTravel& w = (*travels)[i];
+        if (w.radius_m > 0.0) continue;
+        const Eigen::Vector3d hub = HubWorld(model_, data_, w.joint);
+        const double step_m = (hub - w.last_hub_world).dot(RollingDirectionWorld(data_, w.joint));
+        w.last_hub_world = hub;
+        const double turned = Turned(w);
+        if (turned < w.window_rad) {
+          w.travel_m += step_m;
+          open = true;
+          continue;
+        }
+        // The window closes within this step: its share of the step's travel, linear in the rotation.
+        const double share = (w.window_rad - turned_before[i]) / (turned - turned_before[i]);
+        w.radius_m = (w.travel_m + share * step_m) / w.window_rad;
+      }
+      if (!open) return Status::Ok();
+    }
+    return Status::Error(what_ + ": measuring the rolling radius: a wheel did not turn its window within " +
+                         std::to_string(limit_s) + " s");
+  }
+
+ private:
+  double Turned(const WheelTravel& w) const { return data_->qpos[model_->jnt_qposadr[w.joint]] - w.start_angle_rad; }
+
+  // One physics step at the set-point v (in O), then the positions for the new state.
+  Status Step(const Eigen::Vector2d& v) {
+    robot_.Apply(v.x(), v.y(), 0.0, data_);
+    mj_step(model_, data_);
+    if (data_->warning[mjWARN_BADQACC].number > 0)
+      return Status::Error(what_ +
+                           ": measuring the rolling radius: the simulation diverged (MuJoCo: bad acceleration)");
+    mj_kinematics(model_, data_);
+    return Status::Ok();
+  }
+
+  const mjModel* model_;
+  mjData* data_;
+  const WheeledRobot& robot_;
+  const std::string& what_;
+};
+
+}  // namespace
+
+Result<std::vector<double>> MeasureRollingRadii(const mjModel* model, const WheeledRobot& robot, double x, double y,
+                                                double yaw_rad, const std::string& what,
+                                                const RollingRadiusDrive& drive) {
+  const ModelPtr floor_only = FloorOnlyCopy(model);
+  const mjModel* m = floor_only.get();
+  DataPtr data = MakeData(m);
+  robot.Place(m, data.get(), x, y, yaw_rad, kPlacementClearanceM);
+  Drive driver(m, data.get(), robot, what);
+  const Eigen::Vector2d rest = Eigen::Vector2d::Zero();
+  if (Status s = driver.Run(drive.settle_s, rest, rest); !s.ok()) return s;
+
+  std::vector<double> radii(robot.wheels().size(), 0.0);
+  for (const std::vector<int>& group : DirectionGroups(robot)) {
+    const Eigen::Vector2d v = drive.speed_mps * robot.wheels()[static_cast<std::size_t>(group.front())].drive_direction;
+    std::vector<WheelTravel> travels;
+    double longest_window_rad = 0.0;
+    for (int i : group) {
+      WheelTravel w;
+      w.joint = IdOf(m, mjOBJ_JOINT, "wheel_" + std::to_string(i));
+      w.window_rad = WindowRad(m, i, drive.pitches);
+      longest_window_rad = std::max(longest_window_rad, w.window_rad);
+      travels.push_back(w);
+    }
+    const double window_s =
+        longest_window_rad * robot.wheels()[static_cast<std::size_t>(group.front())].radius_m / drive.speed_mps;
+    if (Status s = driver.Run(drive.ramp_s, rest, v); !s.ok()) return s;
+    if (Status s = driver.Run(drive.hold_s, v, v); !s.ok()) return s;
+    if (Status s = driver.Measure(v, kWindowTimeLimit * window_s, &travels); !s.ok()) return s;
+    if (Status s = driver.Run(drive.ramp_s, v, rest); !s.ok()) return s;
+    for (std::size_t k = 0; k < group.size(); ++k) radii[static_cast<std::size_t>(group[k])] = travels[k].radius_m;
+  }
+  return radii;
+}
+
+}  // namespace roamlab::sim

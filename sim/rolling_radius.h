@@ -1,0 +1,44 @@
+// The effective rolling radius of a robot's wheels, measured on its physics without the estimator.
+//
+// The wheel models' radius r turns a wheel's spin rate into its contact's speed (v = r omega). A roller wheel (omni3,
+// mecanum) rests on the roller under it: a sphere of radius rho whose centre is c from the hub, so the hub is
+// rho + c cos(phi) above the floor at wheel angle phi from that roller's bottom position, and it advances that much
+// per radian of the wheel. Between two of the N rollers the axle dips, and the travel per radian over a pitch 2 pi / N
+// is rho + c sin(pi / N) / (pi / N), below the rollers' envelope rho + c; the soft contact's penetration under the
+// robot's weight lowers it further. That travel per radian, not the envelope, is the truth of r.
+//
+// MeasureRollingRadii drives a copy of the bound model: placed at rest on the floor (every world geom but the ground,
+// `terrain`, out of contact, so that walls cannot stop it), settled, then for each rolling direction in turn a slow
+// straight drive along it, ramped up and held at constant speed; over a whole number of roller pitches (one
+// revolution for a tire) the wheel's hub travel along its rolling direction divided by its rotation. The speed is
+// low enough for the rollers to keep their contact (faster, the roller contacts' bouncing makes the travel per
+// radian differ between wheels by a tenth of a millimetre).
+// Driven along its own rolling direction, a wheel's rollers do not turn and nothing asks it to slip. Deterministic:
+// the same model and start give the same radii.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <mujoco/mujoco.h>
+
+#include "common/status.h"
+#include "sim/wheeled_robot.h"
+
+namespace roamlab::sim {
+
+struct RollingRadiusDrive {
+  double speed_mps = 0.2;  // body speed along the rolling direction
+  double settle_s = 0.5;   // at rest after placing
+  double ramp_s = 0.3;     // speed ramp of each direction's drive
+  double hold_s = 0.3;     // at constant speed before the measurement
+  int pitches = 4;         // roller pitches measured over (a tire: one revolution)
+};
+
+// The travel per radian [m] of each wheel of `robot` (bound to `model`), started at (x, y) heading yaw_rad. Errors
+// name `what` (a wheel that does not turn its window within the time the drive allows, a diverged simulation).
+Result<std::vector<double>> MeasureRollingRadii(const mjModel* model, const WheeledRobot& robot, double x, double y,
+                                                double yaw_rad, const std::string& what,
+                                                const RollingRadiusDrive& drive = {});
+
+}  // namespace roamlab::sim
