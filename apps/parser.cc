@@ -274,6 +274,36 @@ void AddDesign(CLI::App* app, Commands* commands) {
   });
 }
 
+// diagnose's options of the twin: the simulator's effects fitted by running it.
+void AddTwinOptions(CLI::App* dia, DiagnoseArgs* args) {
+  dia->add_flag("--twin", args->twin,
+                "Also diagnose against the scenario's noise-free twin, the simulator's effects fitted by running it, "
+                "into OUT/twin.json (the twin: the scenario's own drive for a recording of it, else the replay of "
+                "the recorded drive)");
+  CLI::Option* replay = dia->add_flag_callback(
+      "--replay",
+      [args] {
+        args->drive = gap::TwinDrive::kReplay;
+        args->twin = true;
+      },
+      "The twin replays the recorded drive, whatever the drive (implies --twin)");
+  CLI::Option* no_replay = dia->add_flag_callback(
+      "--no-replay", [args] { args->drive = gap::TwinDrive::kPlain; },
+      "The twin is the scenario's own drive (its plain simulation), whatever the recording's drive");
+  replay->excludes(no_replay);
+  dia->add_option("--held-out", args->held_out,
+                  "With --twin: other recordings of the same robot (held out of the twin's fit) on which the "
+                  "twin's patch is shown (twin.json heldout_runs)");
+  dia->add_option("--train-with", args->train_with,
+                  "With --twin: other recordings of the same robot the twin's patch is fitted on as well, each on its "
+                  "own twin, its first 2/3 in the fit and its last 1/3 in the held-out test (twin.json "
+                  "training_runs)");
+  dia->add_option("--max-effects", args->max_effects, "With --twin: the twin's effects kept at most (default 2)");
+  dia->add_option("--twin-candidates", args->twin_candidates,
+                  "With --twin: the candidate effects the twin diagnosis tries, as twin.json names them (e.g. "
+                  "wheel_radius_scale, 'axle_misalignment wheel 0'; default every one the scenario supports)");
+}
+
 void AddDiagnose(CLI::App* app, Commands* commands) {
   Add(commands, RunDiagnose, [app](auto* args) {
     CLI::App* dia = app->add_subcommand(
@@ -301,33 +331,7 @@ void AddDiagnose(CLI::App* app, Commands* commands) {
                     "residuals) or auto (hac on imported recordings, white on simulated ones; default)")
         ->check(CLI::IsMember({"auto", "white", "hac"}));
     dia->add_flag("--no-plots", args->no_plots, "No figures");
-    dia->add_flag("--twin", args->twin,
-                  "Also diagnose against the scenario's noise-free twin, the simulator's effects fitted by running it, "
-                  "into OUT/twin.json (the twin: the scenario's own drive for a recording of it, else the replay of "
-                  "the recorded drive)");
-    CLI::Option* replay = dia->add_flag_callback(
-        "--replay",
-        [args] {
-          args->drive = gap::TwinDrive::kReplay;
-          args->twin = true;
-        },
-        "The twin replays the recorded drive, whatever the drive (implies --twin)");
-    CLI::Option* no_replay = dia->add_flag_callback(
-        "--no-replay", [args] { args->drive = gap::TwinDrive::kPlain; },
-        "The twin is the scenario's own drive (its plain simulation), whatever the recording's drive");
-    replay->excludes(no_replay);
-    dia->add_option("--held-out", args->held_out,
-                    "With --twin: other recordings of the same robot (held out of the twin's fit) on which the "
-                    "twin's patch is shown (twin.json heldout_runs)");
-    dia->add_option(
-        "--train-with", args->train_with,
-        "With --twin: other recordings of the same robot the twin's patch is fitted on as well, each on its "
-        "own twin, its first 2/3 in the fit and its last 1/3 in the held-out test (twin.json "
-        "training_runs)");
-    dia->add_option("--max-effects", args->max_effects, "With --twin: the twin's effects kept at most (default 2)");
-    dia->add_option("--twin-candidates", args->twin_candidates,
-                    "With --twin: the candidate effects the twin diagnosis tries, as twin.json names them (e.g. "
-                    "wheel_radius_scale, 'axle_misalignment wheel 0'; default every one the scenario supports)");
+    AddTwinOptions(dia, args);
     dia->add_flag("--quiet", args->quiet, "No progress and no summary");
     return dia;
   });

@@ -285,19 +285,25 @@ std::unique_ptr<ProblemBuilder> SolvedProblem(const EstimatorConfig& config, con
   return builder;
 }
 
-TEST(CalibrationTest, GatingRejectsGrossGpsOutliers) {
+// The 8 s synthetic ATV drive with three GPS fixes (rows 10, 20, 30) moved by about 50 m (0.0005 deg of latitude).
+recording::Recording AtvWithGrossGpsOutliers() {
   roamlab::testing::SyntheticOptions options;
   options.duration_s = 8.0;
   auto synthetic = roamlab::testing::MakeAtvRecording(options);
-  // Corrupt three GPS fixes by about 50 m (0.0005 deg of latitude).
   recording::Stream* gps = FindStream(&synthetic.recording, "gps");
-  ASSERT_NE(gps, nullptr);
-  for (int row : {10, 20, 30}) gps->values(row, 0) += 0.0005;
+  EXPECT_NE(gps, nullptr);
+  if (gps != nullptr)
+    for (int row : {10, 20, 30}) gps->values(row, 0) += 0.0005;
+  return synthetic.recording;
+}
+
+TEST(CalibrationTest, GatingRejectsGrossGpsOutliers) {
+  const recording::Recording recording = AtvWithGrossGpsOutliers();
   // A robust loss keeps the outliers from bending the first solution; the gate then switches them off.
   EstimatorConfig config = testing::AtvConfig({"gps.lever_arm"});
   config.streams["gps"].loss = Loss::Cauchy(3.0);
   config.gate_probability = 0.99999;
-  auto result = Calibrate(config, synthetic.recording);
+  auto result = Calibrate(config, recording);
   ASSERT_TRUE(result.ok()) << result.status().message();
   EXPECT_EQ(result.value().counts.at("gps").rejected, 3);
   const ParameterEstimate& lever = Find(result.value(), "gps.lever_arm");
@@ -423,17 +429,12 @@ TEST(GateOutliersTest, ScatteredOutliersAreNotABurst) {
 // the gate, tested there, rejects good fixes with them. gating.robust_start solves under Huber's loss until the gate
 // has settled: it rejects the three alone, and the lever arm ends within 3.5 reported std, as with the Cauchy loss.
 TEST(CalibrationTest, RobustStartRejectsExactlyTheGrossGpsOutliersWithoutAConfiguredLoss) {
-  roamlab::testing::SyntheticOptions options;
-  options.duration_s = 8.0;
-  auto synthetic = roamlab::testing::MakeAtvRecording(options);
-  recording::Stream* gps = FindStream(&synthetic.recording, "gps");
-  ASSERT_NE(gps, nullptr);
-  for (int row : {10, 20, 30}) gps->values(row, 0) += 0.0005;
+  const recording::Recording recording = AtvWithGrossGpsOutliers();
   EstimatorConfig config = testing::AtvConfig({"gps.lever_arm"});
   config.gate_probability = 0.99999;
   for (const bool robust_start : {false, true}) {
     config.gate_robust_start = robust_start;
-    auto result = Calibrate(config, synthetic.recording);
+    auto result = Calibrate(config, recording);
     ASSERT_TRUE(result.ok()) << result.status().message();
     const int rejected = result.value().counts.at("gps").rejected;
     if (!robust_start) {
@@ -447,25 +448,7 @@ TEST(CalibrationTest, RobustStartRejectsExactlyTheGrossGpsOutliersWithoutAConfig
 }
 
 // The differential drive with motion capture of the bridging tests (DiffDriveArcWithMotionCapture's streams).
-Result<EstimatorConfig> BridgingConfig() {
-  return ParseEstimatorConfig(R"(
-master: wheels
-parameters:
-  wheels.radius: {value: [0.04]}
-  wheels.baseline: {value: [0.2]}
-streams:
-  wheels:
-    model: differential_drive
-    source: wheels
-    noise: {wheel_radps: 0.5, lateral_mps: 0.002, vertical_mps: 0.002, tilt_radps: 0.02}
-    parameters: {radius_left: wheels.radius, radius_right: wheels.radius, baseline: wheels.baseline}
-  mocap:
-    model: absolute_pose
-    source: mocap
-    noise: {position_m: 0.0001, orientation_rad: 0.001}
-)",
-                              "test config");
-}
+Result<EstimatorConfig> BridgingConfig() { return ParseEstimatorConfig(testing::ArcConfigYaml({}), "test config"); }
 
 // A differential drive's wheel angles are cumulative: one reading off by 0.5 rad makes the span before it 10 rad/s
 // (20 sigma) too fast and the one after it as much too slow, and the motion capture (0.1 mm) holds the pose between
@@ -490,8 +473,8 @@ TEST(GateOutliersTest, AnOutlyingCumulativeReadingIsBridgedNotItsTwoSpansRejecte
       EXPECT_EQ(span.row_end, kBad + 1);
       EXPECT_TRUE(builder->graph().factor(id).active);
     }
-    const bool around_bad = (span.row_begin == kBad - 1 && span.row_end == kBad) ||
-                            (span.row_begin == kBad && span.row_end == kBad + 1);
+    const bool around_bad =
+        (span.row_begin == kBad - 1 && span.row_end == kBad) || (span.row_begin == kBad && span.row_end == kBad + 1);
     EXPECT_EQ(span.replaced, around_bad);
   }
   EXPECT_EQ(bridges, 1);

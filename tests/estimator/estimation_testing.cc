@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <sstream>
 
 #include <Eigen/Geometry>
 
@@ -88,6 +89,26 @@ recording::Recording DiffDriveArcWithMotionCapture(int samples, double yaw0_rad,
   }
   rec.streams = {enc, mocap};
   return rec;
+}
+
+std::string ArcConfigYaml(const ArcNoise& noise, const std::string& sections) {
+  std::ostringstream yaml;
+  yaml << "master: wheels\n"
+       << sections << "parameters:\n"
+       << "  wheels.radius: {value: [" << kArcRadius_m << "]}\n"
+       << "  wheels.baseline: {value: [" << kArcTrack_m << "]}\n"
+       << "streams:\n"
+       << "  wheels:\n"
+       << "    model: differential_drive\n"
+       << "    source: wheels\n"
+       << "    noise: {wheel_radps: " << noise.wheel_radps << ", lateral_mps: 0.002, vertical_mps: 0.002, "
+       << "tilt_radps: 0.02}\n"
+       << "    parameters: {radius_left: wheels.radius, radius_right: wheels.radius, baseline: wheels.baseline}\n"
+       << "  mocap:\n"
+       << "    model: absolute_pose\n"
+       << "    source: mocap\n"
+       << "    noise: {position_m: " << noise.position_m << ", orientation_rad: " << noise.orientation_rad << "}\n";
+  return yaml.str();
 }
 
 }  // namespace roamlab::estimator::testing

@@ -26,4 +26,17 @@ EstimatorConfig AtvConfig(const std::vector<std::string>& free, int window = 40)
 constexpr double kArcRadius_m = 0.04, kArcTrack_m = 0.2, kArcDt_s = 0.05;
 recording::Recording DiffDriveArcWithMotionCapture(int samples, double yaw0_rad, const Eigen::Vector2d& start_m);
 
+// The noise of ArcConfigYaml's streams: the wheel rate (rad/s) and the motion capture's position (m) and orientation
+// (rad).
+struct ArcNoise {
+  double wheel_radps = 0.5;
+  double position_m = 0.0001;
+  double orientation_rad = 0.001;
+};
+
+// An estimator configuration for DiffDriveArcWithMotionCapture's streams: the wheels as the differential-drive master
+// (one free radius for both wheels and a free baseline, starting at the arc's true values) and the motion capture as
+// absolute poses. `sections` is further top-level YAML (tracking, gating), each line ending in a newline.
+std::string ArcConfigYaml(const ArcNoise& noise, const std::string& sections = "");
+
 }  // namespace roamlab::estimator::testing

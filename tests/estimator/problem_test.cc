@@ -309,23 +309,7 @@ TEST(ProblemBuilderTest, AbsolutePoseOrientationsAlignAShortDeadReckonedStretch)
   constexpr double kYaw0 = 2.9;
   const Eigen::Vector2d start(1.0, -2.0);
   const recording::Recording rec = testing::DiffDriveArcWithMotionCapture(60, kYaw0, start);  // 0.3 m in all
-  auto config = ParseEstimatorConfig(R"(
-master: wheels
-parameters:
-  wheels.radius: {value: [0.04]}
-  wheels.baseline: {value: [0.2]}
-streams:
-  wheels:
-    model: differential_drive
-    source: wheels
-    noise: {wheel_radps: 0.02, lateral_mps: 0.002, vertical_mps: 0.002, tilt_radps: 0.02}
-    parameters: {radius_left: wheels.radius, radius_right: wheels.radius, baseline: wheels.baseline}
-  mocap:
-    model: absolute_pose
-    source: mocap
-    noise: {position_m: 0.001, orientation_rad: 0.003}
-)",
-                                     "test config");
+  auto config = ParseEstimatorConfig(testing::ArcConfigYaml({0.02, 0.001, 0.003}), "test config");
   ASSERT_TRUE(config.ok()) << config.status().message();
   auto builder = ProblemBuilder::Create(config.value(), rec);
   ASSERT_TRUE(builder.ok()) << builder.status().message();

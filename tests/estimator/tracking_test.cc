@@ -426,25 +426,12 @@ TEST(TrackingTest, LeavesOutExactlyTheOutlyingCumulativeWheelReadings) {
   rec.streams[0].values.row(kFirst + 2) += Eigen::RowVector2d(-0.5, 0.5);
   // Each motion-capture pose 1 us before its wheel reading, so that it has joined the newest pose at the update.
   for (Time& t : rec.streams[1].t) t = Time::FromNanoseconds(t.nanoseconds() - 1000);
-  const auto config = ParseEstimatorConfig(R"(
-master: wheels
-tracking: {window: 20, max_iterations: 5, improvement_threshold: 1.0e-3, time_budget_s: 1.0e9, initialization_s: 0.5}
-gating: {probability: 0.99999}
-parameters:
-  wheels.radius: {value: [0.04]}
-  wheels.baseline: {value: [0.2]}
-streams:
-  wheels:
-    model: differential_drive
-    source: wheels
-    noise: {wheel_radps: 0.5, lateral_mps: 0.002, vertical_mps: 0.002, tilt_radps: 0.02}
-    parameters: {radius_left: wheels.radius, radius_right: wheels.radius, baseline: wheels.baseline}
-  mocap:
-    model: absolute_pose
-    source: mocap
-    noise: {position_m: 0.0001, orientation_rad: 0.001}
-)",
-                                           "test config");
+  const auto config = ParseEstimatorConfig(
+      testing::ArcConfigYaml({},
+                             "tracking: {window: 20, max_iterations: 5, improvement_threshold: 1.0e-3, "
+                             "time_budget_s: 1.0e9, initialization_s: 0.5}\n"
+                             "gating: {probability: 0.99999}\n"),
+      "test config");
   ASSERT_TRUE(config.ok()) << config.status().message();
   auto result = Track(config.value(), rec, {});
   ASSERT_TRUE(result.ok()) << result.status().message();
