@@ -525,13 +525,16 @@ void AssembleTwin(const Recording& real, const Plan& plan, Simulation* sim) {
   sim->stats.left_out = plan.left_out;
 }
 
-// The readings of the drive divided by the scenario's odometry_scale_error scale: the true drive of a robot whose
-// odometry reads that many times its motion.
-void UndoOdometryScale(const Scenario& scenario, DriveInputs* in) {
+// The drive taken from readings, through the scenario's effects on those readings back to the true drive: divided by
+// odometry_scale_error's scale (the odometry reads that many times the motion), and an Ackermann vehicle's front
+// wheels turned steering_offset's offset further than the nominal calibration reads the steering sensor. The drive
+// tires' slip (longitudinal_slip, slope_slip) depends on the twin's own traction: the simulator undoes it as it
+// drives (sim/replay_schedule.h).
+void UndoReadingEffects(const Scenario& scenario, DriveInputs* in) {
   const double scale = EffectParameter(scenario.effects, "odometry_scale_error", "scale", 1.0);
-  if (scale == 1.0) return;
   if (in->kind == DriveInputs::Kind::kAckermann) {
-    in->values.col(0) /= scale;  // the speed, not the steering
+    in->values.col(0) /= scale;
+    in->values.col(1).array() += EffectParameter(scenario.effects, "steering_offset", "offset_rad", 0.0);
   } else {
     in->values /= scale;
   }
@@ -635,7 +638,7 @@ Result<DriveInputs> DriveInputsFrom(const Recording& real, const Scenario& nomin
   if (!inputs.value())
     return Status::Error("no drive input: a replay of robot kind " + nominal.robot.kind + " needs " +
                          NeededInputs(ackermann) + note);
-  if (!commands) UndoOdometryScale(nominal, &*inputs.value());
+  if (!commands) UndoReadingEffects(nominal, &*inputs.value());
   return std::move(*inputs.value());
 }
 

@@ -20,8 +20,11 @@
 //      (sim/sensors.h, eq. 15 inverted: speed = z_v kv_over_L L, handlebar = k_theta z_theta + k_gamma; the
 //      scenario's sensors.odometer or its defaults): the speed controller tracks the measured rear-wheel speed and
 //      travel (sim/replay_schedule.h).
-// The readings among these (2-4, not recorded commands) are divided by the scenario's odometry_scale_error scale
-// (sim/scenario.h): a patched scenario replays the true drive of a robot whose odometry reads that many times it.
+// The readings among these (2-4, not recorded commands) are taken back through the scenario's effects on them
+// (sim/scenario.h), so that a patched scenario replays the true drive and its readings are the recorded ones: divided
+// by odometry_scale_error's scale; an Ackermann handlebar plus steering_offset's offset; an Ackermann speed divided by
+// the drive tires' slip factor of longitudinal_slip and slope_slip, at the twin's own traction as it drives
+// (sim/replay_schedule.h).
 // Window: [from, to] in the recording's time [s] (default: the drive inputs' first and last stamps).
 // Start (ReplayStartOf): the first absolute reading at or after `from`: the first pose stream's pose (its mounting
 // taken off, so O's pose; an odometry's `<name>_pose`, recording/odometry_pose.h, is not one); else GPS (or a position

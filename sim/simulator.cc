@@ -487,6 +487,13 @@ class Simulator::Impl {
     return correction;
   }
 
+  // What the rear-wheel speed sensor reads per unit of the twin's rear-wheel speed (the drive tires' slip and growth at
+  // the last odometer sample) in a replay of measured speeds, whose set-points are readings; 1 otherwise.
+  double ReplaySpeedReadingFactor() const {
+    if (!options_.replay || options_.replay->drive.travel_m.size() == 0) return 1.0;
+    return speed_reading_factor_;
+  }
+
   // Pose of a robot site in O, measured at the current state (the robot is rigid between them).
   recording::Mounting SiteInOdom(int site) const {
     const FrameKinematics odom = ReadSiteKinematics(model_.get(), data_.get(), odom_site_);
@@ -570,7 +577,8 @@ class Simulator::Impl {
       const auto [first, second, third] = SetPoints(t_ns_);
       if (ackermann_) {
         const double measured = vehicle_.RearWheelRate(d) * vehicle_.wheel_radius_m();
-        drive_torque_nm_ = controller_->Update(first + ReplayTravelCorrection(measured, dt_s), measured, dt_s);
+        const double correction = ReplayTravelCorrection(ReplaySpeedReadingFactor() * measured, dt_s);
+        drive_torque_nm_ = controller_->Update(first + correction, measured, dt_s);
         vehicle_.Apply(second, drive_torque_nm_, d);
       } else if (options_.replay && options_.replay->drive.kind == DriveInputs::Kind::kWheelRates) {
         wheeled_.ApplyWheelRates(ReplayWheelRates(t_ns_), d);
@@ -733,6 +741,7 @@ class Simulator::Impl {
       const double g_mps2 = Eigen::Map<const Eigen::Vector3d>(model_->opt.gravity).norm();
       const double slip = 1.0 + slip_per_mps2_ * body.specific_force_body.x() +
                           slope_slip_per_mps2_ * g_mps2 * (body.q_world_body * Eigen::Vector3d::UnitX()).z();
+      speed_reading_factor_ = slip / (1.0 + tire_growth_per_mps2_ * v_mps * v_mps);
       const double z_v =
           odometry_scale_ * SpeedReading(slip * omega_radps / (1.0 + tire_growth_per_mps2_ * v_mps * v_mps),
                                          vehicle_.wheel_radius_m(), odo.kv_over_L, wheelbase_m_) +
@@ -910,6 +919,7 @@ class Simulator::Impl {
   double tire_growth_per_mps2_ = 0.0;                      // tire_growth's c [s^2/m^2]
   double slip_per_mps2_ = 0.0;                             // longitudinal_slip's s_f [s^2/m]
   double slope_slip_per_mps2_ = 0.0;                       // slope_slip's s_p [s^2/m]
+  double speed_reading_factor_ = 1.0;                      // the speed sensor's slip and growth at its last sample
   double odometry_scale_ = 1.0;                            // odometry_scale_error: the odometry reads this times true
 
   std::int64_t step_ns_ = 0;

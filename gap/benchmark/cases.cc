@@ -35,14 +35,18 @@ std::string AffectedStream(const std::string& effect) {
 // effects in their sensor; physical ones (the drive is open-loop: the same commands) where the changed motion shows:
 // the ATV's path and the mecanum robot's (track_width_error, drawn on it only) in their GPS fixes, the differential
 // drive's turn rate in its gyroscope (it has no GPS). Not the mecanum robot's IMU: its rollers shake the body, and
-// any change of the physics draws another shaking, which stays several times the noise with the effect fitted.
-std::string SimulatedStream(const std::string& effect) {
+// any change of the physics draws another shaking, which stays several times the noise with the effect fitted. A
+// replay drives by the steering and rear-wheel readings and reproduces them whatever the patch (sim/replay.h takes
+// the patch's effects on them back to the drive): the effects on those readings show in the path, in the GPS fixes.
+std::string SimulatedStream(const std::string& effect, bool replayed) {
   if (effect == "gps_latency" || effect == "lateral_slip" || effect == "axle_misalignment" ||
       effect == "track_width_error")
     return "gps";
   if (effect == "magnetometer_motor_interference") return "magnetometer";
+  const bool drive_reading = effect == "steering_offset" || effect == "longitudinal_slip" || effect == "slope_slip";
+  if (drive_reading && replayed) return "gps";
   if (effect == "steering_offset") return "steering";
-  if (effect == "longitudinal_slip" || effect == "slope_slip") return "rear_wheel";
+  if (drive_reading) return "rear_wheel";
   return "gyroscope";
 }
 
@@ -238,7 +242,7 @@ void ScoreEffect(const BlindDiagnosis& blind, CaseResult* c) {
     c->rms_1s_after = d.after.at(stream).rms_1s;
     c->has_rms = true;
   }
-  c->sim_stream = SimulatedStream(c->truth_name);
+  c->sim_stream = SimulatedStream(c->truth_name, blind.simulation.twin.replayed);
   const auto before = blind.simulation.before.find(c->sim_stream);
   const auto after = blind.simulation.after.find(c->sim_stream);
   if (before != blind.simulation.before.end() && after != blind.simulation.after.end()) {

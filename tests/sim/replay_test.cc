@@ -413,9 +413,8 @@ std::pair<double, double> WindowDrift(const Stream& real, const Stream& twin, do
   return {windows > 0 ? sum / windows : 0.0, max};
 }
 
-TEST(ReplayTest, AtvFollowsItsRecordedSpeedAndSteering) {
-  // The recording: from rest, straight for 6 s, then weaving; the nominal scenario: atv_hills.yaml's own schedule.
-  const Scenario nominal = testing::AtvHills(20.0);
+// `nominal` driven from rest: straight for 6 s, then weaving.
+Scenario AtvFromRest(const Scenario& nominal) {
   Scenario s = nominal;
   ProfileTerm speed = RampTo(3.0);
   speed.end_s = 4.0;
@@ -425,6 +424,13 @@ TEST(ReplayTest, AtvFollowsItsRecordedSpeedAndSteering) {
   weave.window_end_s = 1e9;
   s.driver.speed_mps.terms = {speed};
   s.driver.handlebar_rad.terms = {weave};
+  return s;
+}
+
+TEST(ReplayTest, AtvFollowsItsRecordedSpeedAndSteering) {
+  // The recording: AtvFromRest; the nominal scenario: atv_hills.yaml's own schedule.
+  const Scenario nominal = testing::AtvHills(20.0);
+  const Scenario s = AtvFromRest(nominal);
   const Simulation real = SimulateOk(s);
   const Simulation twin = ReplayOk(nominal, real.recording);
   const Simulation own = SimulateOk(nominal);
@@ -457,6 +463,55 @@ TEST(ReplayTest, AtvFollowsItsRecordedSpeedAndSteering) {
   EXPECT_LT(start.max_heading_rad, 3.0 * heading_std);
   EXPECT_LT(start.max_position_m, 3.0 * (sigma_m / std::sqrt(n) + heading_std * length_m / 2.0));
   EXPECT_LT(e.max_position_m, 0.2 * schedule.max_position_m);
+}
+
+// Mean and RMS of a one-column stream's differences from another with the same stamps.
+struct Difference {
+  double mean = 0.0;
+  double rms = 0.0;
+};
+Difference Differ(const Stream& a, const Stream& b) {
+  const Eigen::ArrayXd d = a.values.col(0).array() - b.values.col(0).array();
+  return {d.mean(), std::sqrt(d.square().mean())};
+}
+
+// The ATV's speed and steering readings carry a steering offset and the drive tires' slip under traction. A replay of
+// the patched scenario takes both back to the drive: its front wheels turn by the offset more than the nominal
+// calibration reads, its rear wheels slower by the slip than the sensor reads; so its readings are the recorded ones,
+// and its path the recording's. The nominal replay drives the readings as they are.
+TEST(ReplayTest, ReadingEffectsOfTheAtvDriveAreTakenBackToTheDrive) {
+  constexpr double kOffsetRad = 0.03, kSlipPerMps2 = 0.1;
+  const Scenario nominal = AtvFromRest(testing::AtvHills(20.0));
+  Scenario patched = nominal;
+  patched.effects = {{"steering_offset", {{"offset_rad", kOffsetRad}}},
+                     {"longitudinal_slip", {{"slip_per_mps2", kSlipPerMps2}}}};
+  const Simulation real = SimulateOk(patched);
+  const Trajectory& truth = *real.recording.ground_truth;
+  const Simulation twin = ReplayOk(patched, real.recording);
+  const Simulation unpatched = ReplayOk(nominal, real.recording);
+  const TrackError follows = Compare(AlignedStart(*twin.recording.ground_truth, truth), truth);
+  const TrackError off = Compare(AlignedStart(*unpatched.recording.ground_truth, truth), truth);
+  const Simulation clean = SimulateOk(nominal);
+  const TrackError base =
+      Compare(AlignedStart(*ReplayOk(nominal, clean.recording).recording.ground_truth, *clean.recording.ground_truth),
+              *clean.recording.ground_truth);
+  const Difference steer = Differ(*twin.recording.Find("steering"), *real.recording.Find("steering"));
+  const Difference steer_off = Differ(*unpatched.recording.Find("steering"), *real.recording.Find("steering"));
+  const Difference speed = Differ(*twin.recording.Find("rear_wheel"), *real.recording.Find("rear_wheel"));
+  const Difference speed_off = Differ(*unpatched.recording.Find("rear_wheel"), *real.recording.Find("rear_wheel"));
+  std::printf(
+      "ATV steering offset %.2f rad, slip %.2f s^2/m over %.1f m: patched twin within %.3f m, %.4f rad (nominal "
+      "%.3f m, %.4f rad; the effect-free drive's replay %.3f m, %.4f rad); steering reading mean %+.5f rms %.5f "
+      "(nominal %+.5f, %.5f); speed reading mean %+.4f rms %.4f (nominal %+.4f, %.4f)\n",
+      kOffsetRad, kSlipPerMps2, Extent(truth), follows.max_position_m, follows.max_heading_rad, off.max_position_m,
+      off.max_heading_rad, base.max_position_m, base.max_heading_rad, steer.mean, steer.rms, steer_off.mean,
+      steer_off.rms, speed.mean, speed.rms, speed_off.mean, speed_off.rms);
+  // The patched twin follows the recorded path within a tenth of the nominal twin's error.
+  EXPECT_LT(follows.max_position_m, 0.1 * off.max_position_m);
+  EXPECT_LT(follows.max_heading_rad, 0.1 * off.max_heading_rad);
+  // Its readings are the recorded ones, as closely as the nominal twin's, which drives them as they are.
+  EXPECT_LT(steer.rms, 1.2 * steer_off.rms);
+  EXPECT_LT(speed.rms, 1.2 * speed_off.rms);
 }
 
 // The scenario names and orders the encoder columns (optiodom_diff.yaml: right = wheel 1, then left = wheel 0): the
