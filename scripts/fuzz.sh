@@ -42,6 +42,15 @@ mkdir -p "$seeds/scenario_fuzz" "$seeds/estimator_config_fuzz" "$seeds/regress_s
 cp scenarios/*.yaml "$seeds/scenario_fuzz/"
 cp configs/*.yaml "$seeds/estimator_config_fuzz/"
 cp regression/*.yaml "$seeds/regress_suite_fuzz/"
+# Each case of the repository's suites as a suite of its own, without the comment lines: every case fits in the
+# harness's -max_len below.
+for suite in regression/*.yaml; do
+  awk -v out="$seeds/regress_suite_fuzz/$(basename "$suite" .yaml)" '
+    /^[[:space:]]*#/ { next }
+    /^  - name:/ { n++; file = sprintf("%s_case%02d.yaml", out, n); printf "%s", head > file }
+    n == 0 { head = head $0 "\n"; next }
+    { print > file }' "$suite"
+done
 # Simulated recordings, each file cut to its first 12 lines, packed as recording_fuzz reads them.
 roamlab=${ROAMLAB:-build/apps/roamlab}
 if [ -x "$roamlab" ]; then
@@ -79,11 +88,19 @@ if [ -d "$data_dir" ]; then
   fi
 fi
 
+# Allocation and free stacks of a report are cut to the allocating call: the system libraries (yaml-cpp, bzip2, ...)
+# have no frame pointers, so AddressSanitizer's fast unwinder reads their stack as frames, each stack a new entry of
+# its stack depot, which never shrinks (docs/reliability.md). A reproducer run alone gives the whole stacks.
+export ASAN_OPTIONS=${ASAN_OPTIONS:-malloc_context_size=2}
+# The longest input per harness where the default (the largest seed) is more than the harness needs: a suite's cases
+# are loaded one after the other, and 4 KB hold two or three of them.
+declare -A max_len=([regress_suite_fuzz]=4096)
 failed=()
 for f in "${fuzzers[@]}"; do
   mkdir -p "$work/corpus/$f"
   limit=(-max_total_time="$seconds")
   [ -n "${FUZZ_RUNS:-}" ] && limit=(-runs="$FUZZ_RUNS")
+  [ -n "${max_len[$f]:-}" ] && limit+=(-max_len="${max_len[$f]}")
   log="$work/$f.log"
   if "$build_dir/fuzz/$f" "${limit[@]}" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
       -artifact_prefix="$work/artifacts/$f-" "$work/corpus/$f" "$seeds/$f" >"$log" 2>&1; then
