@@ -8,6 +8,7 @@
 #   JOBS           build parallelism, default the number of cores
 #   SANITIZE_OPT   optimization level of the build, default -O2 (ROAMLAB_SANITIZE_OPT); -O0 compiles fastest
 #   FUZZ_BUILD     0: run the harnesses already built in BUILD_DIR (no configure, no build), default 1
+#   ASAN_OPTIONS   default malloc_context_size=2 (below)
 #   ROAMLAB_DATA_DIR  real recordings to cut small seed excerpts from (default: the data directory the tests read,
 #                     ROAMLAB_SHARED_DIR/data in tests/CMakeLists.txt; skipped when absent)
 #   ROAMLAB        the command line that simulates the recording seeds (default build/apps/roamlab, the Release build
@@ -33,6 +34,10 @@ if [ "${FUZZ_BUILD:-1}" != 0 ]; then
 fi
 built=$(date +%s)
 
+# The longest input per harness where the default (the largest seed) is more than the harness needs: a suite's cases
+# are loaded one after the other, and 4 KB hold two or three of them.
+declare -A max_len=([regress_suite_fuzz]=4096)
+
 work="$build_dir/fuzz"
 seeds="$work/seeds"
 rm -rf "$seeds"
@@ -42,6 +47,19 @@ mkdir -p "$seeds/scenario_fuzz" "$seeds/estimator_config_fuzz" "$seeds/regress_s
 cp scenarios/*.yaml "$seeds/scenario_fuzz/"
 cp configs/*.yaml "$seeds/estimator_config_fuzz/"
 cp regression/*.yaml "$seeds/regress_suite_fuzz/"
+# Each case of the repository's suites as a suite of its own, without the comment lines: every case fits in the
+# harness's -max_len below.
+for suite in regression/*.yaml; do
+  awk -v out="$seeds/regress_suite_fuzz/$(basename "$suite" .yaml)" '
+    /^[[:space:]]*#/ { next }
+    /^  - name:/ { n++; file = sprintf("%s_case%02d.yaml", out, n); printf "%s", head > file }
+    n == 0 { head = head $0 "\n"; next }
+    { print > file }' "$suite"
+done
+for seed in "$seeds"/regress_suite_fuzz/*_case*.yaml; do
+  [ "$(wc -c <"$seed")" -le "${max_len[regress_suite_fuzz]}" ] ||
+    echo "roamlab fuzz: the seed $seed is longer than -max_len=${max_len[regress_suite_fuzz]} (cut)" >&2
+done
 # Simulated recordings, each file cut to its first 12 lines, packed as recording_fuzz reads them.
 roamlab=${ROAMLAB:-build/apps/roamlab}
 if [ -x "$roamlab" ]; then
@@ -79,11 +97,16 @@ if [ -d "$data_dir" ]; then
   fi
 fi
 
+# Allocation and free stacks of a report are cut to the allocating call: the system libraries (yaml-cpp, bzip2, ...)
+# have no frame pointers, so AddressSanitizer's fast unwinder reads their stack as frames, each stack a new entry of
+# its stack depot, which never shrinks (docs/reliability.md). A reproducer run alone gives the whole stacks.
+export ASAN_OPTIONS=${ASAN_OPTIONS:-malloc_context_size=2}
 failed=()
 for f in "${fuzzers[@]}"; do
   mkdir -p "$work/corpus/$f"
   limit=(-max_total_time="$seconds")
   [ -n "${FUZZ_RUNS:-}" ] && limit=(-runs="$FUZZ_RUNS")
+  [ -n "${max_len[$f]:-}" ] && limit+=(-max_len="${max_len[$f]}")
   log="$work/$f.log"
   if "$build_dir/fuzz/$f" "${limit[@]}" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
       -artifact_prefix="$work/artifacts/$f-" "$work/corpus/$f" "$seeds/$f" >"$log" 2>&1; then
