@@ -3,21 +3,29 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <deque>
 #include <functional>
 #include <limits>
+#include <map>
 #include <memory>
+#include <set>
+#include <string>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
 #include "common/check.h"
+#include "common/chi_square.h"
 #include "common/interrupt.h"
 #include "estimator/calibration.h"
 #include "estimator/covariance.h"
 #include "estimator/geometry.h"
+#include "estimator/internal/linearization.h"
 #include "estimator/internal/normal_equations.h"
 #include "estimator/marginalization.h"
 #include "estimator/solver.h"
+#include "recording/stream_health.h"
 
 namespace roamlab::estimator {
 namespace {
@@ -77,6 +85,119 @@ void HoldOutNewestSpans(ProblemBuilder* builder) {
     entry.active = false;
     ++builder->mutable_counts(entry.stream).rejected;
   }
+}
+
+// The measurement factors of `streams` attached since `first` that hold one pose alone (every other variable they join
+// fixed): absolute measurements (a motion-capture pose, a GPS fix). The master stream's are not among them.
+std::vector<FactorId> NewAbsoluteFactors(const ProblemBuilder& builder, FactorId first, const std::string& master,
+                                         const std::set<std::string>& streams) {
+  const Graph& graph = builder.graph();
+  std::vector<FactorId> out;
+  for (auto it = graph.factors().lower_bound(first); it != graph.factors().end(); ++it) {
+    const FactorEntry& entry = it->second;
+    const int stream = builder.StreamOfFactor(it->first);
+    if (stream < 0 || builder.stream_names()[stream] == master || !entry.active || streams.count(entry.stream) == 0)
+      continue;
+    int free_poses = 0, free_other = 0;
+    for (VariableId v : entry.variables) {
+      if (graph.variable(v).fixed) continue;
+      const bool pose = std::any_of(builder.poses().begin(), builder.poses().end(),
+                                    [&](const PoseNode& p) { return p.id == v; });
+      (pose ? free_poses : free_other) += 1;
+    }
+    if (free_poses == 1 && free_other == 0) out.push_back(it->first);
+  }
+  return out;
+}
+
+// Per configured stream with a single recording source, the stamps at which that source's rows resume after a gap (an
+// outage, or its clock jumped forward: recording::CheckStreamHealth).
+std::map<std::string, std::vector<Time>> GapResumes(const EstimatorConfig& config, const recording::Recording& rec) {
+  std::map<std::string, std::vector<Time>> out;
+  for (const auto& [name, stream] : config.streams) {
+    if (stream.sources.size() != 1) continue;
+    for (const recording::Stream& source : rec.streams) {
+      if (source.info.name != stream.sources.begin()->second) continue;
+      for (const recording::StreamGap& gap : recording::CheckStreamHealth(source).gaps)
+        out[name].push_back(Time::FromNanoseconds(gap.after.nanoseconds() + std::llround(gap.length_s * 1e9)));
+    }
+  }
+  return out;
+}
+
+// Adds to `unconfirmed` the streams whose rows resume after a gap within a millisecond of the newest pose or before it
+// (a row is attached at the master sample at or after its stamp); `resumes` loses each gap so passed.
+void MarkStreamsAfterGaps(Time newest, std::map<std::string, std::vector<Time>>* resumes,
+                          std::set<std::string>* unconfirmed) {
+  constexpr std::int64_t kSlackNs = 1000000;
+  const Time reach = Time::FromNanoseconds(newest.nanoseconds() + kSlackNs);
+  for (auto& [name, stamps] : *resumes) {
+    const auto passed = std::upper_bound(stamps.begin(), stamps.end(), reach);
+    if (passed == stamps.begin()) continue;
+    stamps.erase(stamps.begin(), passed);
+    unconfirmed->insert(name);
+  }
+}
+
+// Switches `factors` off, counted as rejected, for the update's first solve.
+void HoldOut(const std::vector<FactorId>& factors, ProblemBuilder* builder) {
+  for (const FactorId id : factors) {
+    builder->graph().mutable_factor(id).active = false;
+    ++builder->mutable_counts(builder->graph().factor(id).stream).rejected;
+  }
+}
+
+// Whether the absolute factor `entry` (its one free variable the pose `pose`) fails the innovation test described at
+// ReadmitConsistentAbsolute. A pose whose marginal covariance cannot be had (nothing else holds it) has nothing to
+// test the factor against: it does not fail.
+bool InnovationFails(double probability, const FactorEntry& entry, VariableId pose,
+                     const std::vector<const double*>& values, const Graph& graph, internal::WhitenedFactor* wf) {
+  const std::size_t column = static_cast<std::size_t>(
+      std::find(entry.variables.begin(), entry.variables.end(), pose) - entry.variables.begin());
+  if (!internal::LinearizeFactorAt(entry, values.data(), std::uint64_t{1} << column, wf)) return false;
+  const auto info = ComputeMarginalInformation(graph, {pose});
+  if (!info.ok()) return false;
+  const Eigen::LDLT<Eigen::MatrixXd> information(info.value().information);
+  if (information.info() != Eigen::Success || !information.isPositive() ||
+      information.vectorD().minCoeff() <= 0.0)
+    return false;
+  // (A robust loss scales the whitened error and Jacobian alike: the test takes them before it.)
+  const double unweight = wf->residual.norm() > 0.0 ? std::sqrt(wf->squared_norm) / wf->residual.norm() : 1.0;
+  const Eigen::VectorXd r = unweight * wf->residual;
+  const Eigen::MatrixXd J = unweight * wf->jacobians[column];
+  const Eigen::MatrixXd innovation =
+      Eigen::MatrixXd::Identity(J.rows(), J.rows()) + J * information.solve(J.transpose());
+  return !(r.dot(innovation.ldlt().solve(r)) <= ChiSquareQuantile(probability, entry.factor->residual_dim()));
+}
+
+// Re-admits each held-out absolute factor whose innovation passes the chi-square quantile `probability` of its
+// dimension: its whitened error r at the estimate solved without it, against I + J P J^T (J its whitened Jacobian in
+// its pose, P the pose's marginal covariance in the window). Tested after a solve that includes it, the error of an
+// absolute measurement shrinks by the window's uncertainty against its noise: where dead reckoning has left the pose
+// centimetres uncertain, a millimetre measurement pulls the window onto itself and then fits, whatever it says (a
+// motion-capture pose stamped a second late). Adds the streams of those it re-admitted to *consistent; returns how
+// many it re-admitted.
+int ReadmitConsistentAbsolute(double probability, const std::vector<FactorId>& held, ProblemBuilder* builder,
+                              std::set<std::string>* consistent) {
+  Graph& graph = builder->graph();
+  int readmitted = 0;
+  std::vector<const double*> values;
+  internal::WhitenedFactor wf;
+  for (const FactorId id : held) {
+    FactorEntry& entry = graph.mutable_factor(id);
+    VariableId pose = 0;
+    values.clear();
+    for (const VariableId v : entry.variables) {
+      values.push_back(graph.variable(v).value.data());
+      if (!graph.variable(v).fixed) pose = v;
+    }
+    if (InnovationFails(probability, entry, pose, values, graph, &wf)) continue;
+    entry.active = true;
+    --builder->mutable_counts(entry.stream).rejected;
+    consistent->insert(entry.stream);
+    ++readmitted;
+  }
+  return readmitted;
 }
 
 // The oldest pose's estimate and position covariance (marginal of the whole window): from `known` when it holds that
@@ -282,6 +403,8 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
   leaving.leading_dims = kPositionDims;
   std::vector<double> update_times;
   SolverWorkspace workspace;  // the window's pattern repeats from one update to the next
+  std::map<std::string, std::vector<Time>> gap_resumes = GapResumes(config, recording);
+  std::set<std::string> after_gap;  // absolute streams past a gap, none of their rows since found consistent
   for (std::size_t i = 0; i < measurements.size(); ++i) {
     const MeasurementRef& m = measurements[i];
     builder.Add(m);
@@ -318,6 +441,14 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
       const bool delayed = builder.cumulative_spans().empty();
       const auto t0 = Clock::now();
       if (config.gate_probability) HoldOutNewestSpans(&builder);
+      // After a gap in an absolute stream (an outage, or its clock jumped: every later row stamped late), its rows
+      // attached now are held out of the first solve and tested on their innovation there (ReadmitConsistentAbsolute)
+      // until one passes; those that pass go back in for a re-solve, and the gate below tests them again.
+      MarkStreamsAfterGaps(builder.poses().back().t, &gap_resumes, &after_gap);
+      const std::vector<FactorId> held = config.gate_probability && !after_gap.empty()
+                                             ? NewAbsoluteFactors(builder, first_new_factor, master, after_gap)
+                                             : std::vector<FactorId>();
+      HoldOut(held, &builder);
       leaving.variables.assign(1, builder.poses().front().id);
       leaving.computed = false;
       CovarianceRequest* request =
@@ -325,6 +456,13 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
       const SolverSummary s = Solve(update_options, &builder.graph(), request, &workspace);
       if (!s.usable()) return Status::Error("update at t = " + FormatSeconds(m.t) + " failed: " + s.message);
       iterations += s.iterations;
+      std::set<std::string> consistent;
+      if (!held.empty() && ReadmitConsistentAbsolute(*config.gate_probability, held, &builder, &consistent) > 0) {
+        for (const std::string& name : consistent) after_gap.erase(name);
+        const CovarianceRequest before = leaving;
+        iterations += Solve(update_options, &builder.graph(), request, &workspace).iterations;
+        if (request != nullptr && !leaving.computed && before.computed) leaving = before;
+      }
       if (config.gate_probability) {
         // Without a gated measurement the window may not factor (a gated odometer factor leaves the newest pose's
         // position free until the next samples attach), and the Schur complement EmitOldest would fall back to runs

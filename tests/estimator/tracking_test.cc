@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -439,6 +440,64 @@ TEST(TrackingTest, LeavesOutExactlyTheOutlyingCumulativeWheelReadings) {
   EXPECT_EQ(result.value().counts.at("mocap").rejected, 0);
   for (std::size_t i = 0; i < result.value().position_covariance.size(); ++i)
     ASSERT_TRUE(result.value().position_covariance[i].allFinite()) << "pose " << i;
+}
+
+// Tracking a differential drive under motion capture whose clock steps 0.5 s ahead halfway (its later poses stamped
+// late: 50 mm and 0.25 rad off the truth at their stamps, 500 and 250 times its noise). The wheels' noise leaves the
+// dead-reckoned pose millimetres uncertain within a second; a late pose solved with the window pulls it onto itself and
+// then fits there (without the innovation test none is rejected). The jump shows as a gap of the stream; tested on
+// its innovation at the estimate without it, every late pose must be rejected, and every tracked position lie within
+// the 99.7 % quantile of its reported covariance.
+TEST(TrackingTest, RejectsEveryMotionCapturePoseStampedLateAfterItsClockJumps) {
+  recording::Recording rec = testing::DiffDriveArcWithMotionCapture(120, 0.3, Eigen::Vector2d(1.0, -2.0));
+  const Time truth_end = rec.streams[0].t.back();
+  recording::Stream& mocap = rec.streams[1];
+  mocap.info.rate_hz = 1.0 / testing::kArcDt_s;  // (the jump then shows as a gap of the stream)
+  constexpr int kJumpRow = 60;
+  const std::int64_t jump_ns = Time::FromSeconds(0.5).nanoseconds();
+  int late_in_span = 0;
+  for (std::size_t k = 0; k < mocap.t.size(); ++k) {
+    // Each motion-capture pose 1 us before its wheel reading, so that it has joined the newest pose at the update.
+    mocap.t[k] = Time::FromNanoseconds(mocap.t[k].nanoseconds() - 1000 + (k >= kJumpRow ? jump_ns : 0));
+    late_in_span += k >= kJumpRow && mocap.t[k] <= truth_end;
+  }
+  const Eigen::Index kept = static_cast<Eigen::Index>(kJumpRow + late_in_span);
+  mocap.t.resize(static_cast<std::size_t>(kept));
+  mocap.values.conservativeResize(kept, Eigen::NoChange);
+  const auto config = ParseEstimatorConfig(R"(
+master: wheels
+tracking: {window: 20, max_iterations: 5, improvement_threshold: 1.0e-3, time_budget_s: 1.0e9, initialization_s: 0.5}
+gating: {probability: 0.99999}
+parameters:
+  wheels.radius: {value: [0.04]}
+  wheels.baseline: {value: [0.2]}
+streams:
+  wheels:
+    model: differential_drive
+    source: wheels
+    noise: {wheel_radps: 0.5, lateral_mps: 0.002, vertical_mps: 0.002, tilt_radps: 0.02}
+    parameters: {radius_left: wheels.radius, radius_right: wheels.radius, baseline: wheels.baseline}
+  mocap:
+    model: absolute_pose
+    source: mocap
+    noise: {position_m: 0.0001, orientation_rad: 0.001}
+)",
+                                           "test config");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  const recording::Recording truth = testing::DiffDriveArcWithMotionCapture(120, 0.3, Eigen::Vector2d(1.0, -2.0));
+  auto result = Track(config.value(), rec, {});
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_EQ(result.value().counts.at("mocap").rejected, late_in_span);
+  EXPECT_EQ(result.value().counts.at("wheels").rejected, 0);
+  const double gate = ChiSquareQuantile(0.997, 3);
+  const TrackingResult& r = result.value();
+  for (std::size_t i = 0; i < r.trajectory.size(); ++i) {
+    const Eigen::Matrix3d& cov = r.position_covariance[i];
+    ASSERT_TRUE(cov.allFinite()) << "pose " << i;
+    const Eigen::Index row = static_cast<Eigen::Index>(std::llround(r.trajectory[i].t.seconds() / testing::kArcDt_s));
+    const Eigen::Vector3d error = r.trajectory[i].p_world_body - truth.streams[1].values.row(row).head<3>().transpose();
+    EXPECT_LE(error.dot(cov.ldlt().solve(error)), gate) << "pose " << i << " at " << r.trajectory[i].t.seconds() << " s";
+  }
 }
 
 TEST(TrackingTest, CalibrationPriorOfTheWrongSizeIsAnError) {
