@@ -209,7 +209,7 @@ Result<TwinEffect> Diagnoser::Fit(const TwinCandidate& c, const State& state, do
   runs_ += evaluator.runs();
   if (!fit.ok()) return fit.status();
   TwinEffect e;
-  e.effect = fit.value().effect;
+  e.applied = fit.value().effects;
   e.chi2_before = state.chi2;
   e.chi2_after = fit.value().chi2;
   e.iterations = fit.value().iterations;
@@ -264,7 +264,7 @@ Result<bool> Diagnoser::Round(int round, const std::vector<TwinCandidate>& pool,
       continue;
     }
     std::vector<sim::EffectOptions> effects = state->effects;
-    effects.push_back(e.effect);
+    effects.insert(effects.end(), e.applied.begin(), e.applied.end());
     auto twins = RunWhole(effects);
     if (!twins.ok()) {
       x.decision = "the patched twin of the whole recording failed: " + twins.status().message();
@@ -309,7 +309,7 @@ void Diagnoser::FitJointly(const State& state, const std::vector<TwinCandidate>&
     const auto c = std::find_if(library.begin(), library.end(),
                                 [&](const TwinCandidate& x) { return x.label == e.estimate.name; });
     if (c == library.end() || c->time_shift) {
-      base.effects.push_back(e.effect);
+      base.effects.insert(base.effects.end(), e.applied.begin(), e.applied.end());
       out_.joint.held.push_back(e.estimate.name);
       continue;
     }
@@ -347,7 +347,7 @@ void Diagnoser::FitJointly(const State& state, const std::vector<TwinCandidate>&
   Eigen::Index k = 0;  // the parameter's index in the joint covariance
   for (std::size_t i = 0; i < parts.size(); ++i) {
     TwinEffect e;
-    e.effect = fit.value().effects[i];
+    e.applied = fit.value().effects[i];
     e.estimate.name = parts[i].label;
     const Eigen::Index size = static_cast<Eigen::Index>(parts[i].free.size());
     e.estimate.parameters = Values(parts[i], fit.value().theta.segment(k, size));
@@ -374,7 +374,7 @@ void Diagnoser::FitJointly(const State& state, const std::vector<TwinCandidate>&
 void Diagnoser::Finish(const State& state) {
   out_.heldout_after = state.heldout.front();
   for (std::size_t i = 1; i < state.heldout.size(); ++i) out_.training_runs[i - 1].heldout_after = state.heldout[i];
-  for (const TwinEffect& e : out_.effects) out_.patch.push_back(e.effect);
+  for (const TwinEffect& e : out_.effects) out_.patch.insert(out_.patch.end(), e.applied.begin(), e.applied.end());
   const RunSpan& span = spans_.front();
   const Layout heldout = internal::MakeLayout(real_, span.train_end, span.last);
   const auto statistics = ComponentStatistics(
@@ -428,15 +428,21 @@ Result<TwinDiagnosis> Diagnoser::Run() {
     auto kept = Round(round, pool, step_s, &state, &scored);
     if (!kept.ok()) return kept.status();
     if (round == 0) out_.candidates = scored;
+    out_.rounds.push_back(scored);
     if (!kept.value()) break;
-    // The next round: the candidates that passed the likelihood-ratio test in the first, other than the kept effects.
+    // The next round: the candidates that passed the likelihood-ratio test in the first, other than those that set a
+    // simulator effect kept already (a composite's parts, or the composite of a kept part).
     std::set<std::string> passed, kept_effects;
     for (const TwinEffect& e : out_.candidates)
       if (e.estimate.lr_pvalue < options_.alpha) passed.insert(e.estimate.name);
-    for (const TwinEffect& e : out_.effects) kept_effects.insert(e.effect.name);
+    for (const sim::EffectOptions& e : state.effects) kept_effects.insert(e.name);
     std::vector<TwinCandidate> next;
-    for (const TwinCandidate& c : pool)
-      if (passed.count(c.label) && !kept_effects.count(c.effect)) next.push_back(c);
+    for (const TwinCandidate& c : pool) {
+      const std::vector<std::string> sets = internal::SimulatorEffects(c);
+      if (passed.count(c.label) &&
+          std::none_of(sets.begin(), sets.end(), [&](const std::string& x) { return kept_effects.count(x) > 0; }))
+        next.push_back(c);
+    }
     pool = next;
   }
   if (InterruptRequested()) return InterruptedError();

@@ -159,10 +159,11 @@ struct TwinEffect {
   // parameter's range), held at their neutral values in estimate.parameters and the effect, without a std and not
   // counted in estimate.dof.
   std::vector<std::string> not_informed;
-  std::map<std::string, int> hac_lags;  // per series: the HAC lag (samples)
-  sim::EffectOptions effect;            // as the simulator applies it (time shifts in whole physics steps)
-  double chi2_before = 0.0;             // training part: with the effects kept before it
-  double chi2_after = 0.0;              // with it
+  std::map<std::string, int> hac_lags;      // per series: the HAC lag (samples)
+  std::vector<sim::EffectOptions> applied;  // as the simulator applies it (time shifts in whole physics steps): one
+                                            // effect, or a composite candidate's parts
+  double chi2_before = 0.0;                 // training part: with the effects kept before it
+  double chi2_after = 0.0;                  // with it
   int iterations = 0;
   int runs = 0;  // twin runs spent on the fit
 };
@@ -215,10 +216,12 @@ struct TwinDiagnosis {
   double train_end_s = 0.0;
   std::vector<LocatedComponent> located;  // the nominal twin, whole run
   std::vector<TwinEffect> candidates;     // the first round, best Delta BIC first
-  std::vector<TwinEffect> effects;        // kept, in order
-  TwinJointFit joint;                     // empty unless more than one effect is kept and refitted
-  std::vector<std::string> unexplained;   // "stream/component" inconsistent on the held-out part with the patch
-  TwinComparison whole_run;               // the nominal twin
+  // Every round's candidates (the first is `candidates`), best Delta BIC first, each with its decision.
+  std::vector<std::vector<TwinEffect>> rounds;
+  std::vector<TwinEffect> effects;       // kept, in order
+  TwinJointFit joint;                    // empty unless more than one effect is kept and refitted
+  std::vector<std::string> unexplained;  // "stream/component" inconsistent on the held-out part with the patch
+  TwinComparison whole_run;              // the nominal twin
   TwinComparison heldout_before, heldout_after;
   std::vector<sim::EffectOptions> patch;           // the kept effects as the simulator takes them
   std::vector<TwinHeldOutRun> heldout_runs;        // ShowOnHeldOut's, filled by the caller
@@ -271,7 +274,8 @@ Result<TwinHeldOutRun> ShowOnHeldOut(const sim::Scenario& nominal, const std::ve
 // Per stream: {"window_s", "windows", "mean_position_m", "max_position_m"[, "mean_heading_rad", "max_heading_rad"]}.
 nlohmann::json TwinDriftJson(const std::map<std::string, TwinDrift>& drift);
 
-// {"replayed", "verdict", "std_method", "train_end_s", "located", "candidates", "effects", "joint" (null, or
+// {"replayed", "verdict", "std_method", "train_end_s", "located", "candidates", "rounds" (every round's candidates,
+// the first's as "candidates"), "effects" (each with "effect": the simulator's effects it sets), "joint" (null, or
 // {"effects", "held", "failed", "chi2_before", "chi2_after", "iterations", "runs"}), "unexplained",
 // "heldout": {"before", "after"}, "whole_run", "patch",
 // "heldout_runs": [{"recording", "replayed", "before", "after"}], "runs", "seconds"}, and with further training runs
