@@ -60,6 +60,12 @@ void SetStd(const std::string& name, const TwinCovariance& covariance, Eigen::In
   e->estimate.std[name] = hac ? std::max(e->std_white[name], e->std_hac[name]) : e->std_white[name];
 }
 
+// Whether `c` is among the candidates tried by default on `runs` training runs: a composite only on several. On one
+// run, of one kind of motion, its parameters trade against each other (on a square's in-place turns the track against
+// the scale and the ratio), and the combination that fits that run carries over to other motions worse than one effect
+// does; it is tried there when named.
+bool DefaultCandidate(const TwinCandidate& c, std::size_t runs) { return c.parts.empty() || runs > 1; }
+
 // What one round judges the candidates against: the effects kept so far.
 struct State {
   std::vector<sim::EffectOptions> effects;  // kept
@@ -420,8 +426,9 @@ Result<TwinDiagnosis> Diagnoser::Run() {
   const std::vector<TwinCandidate> library = internal::TwinCandidates(nominal_, options_.max_shift_s);
   std::vector<TwinCandidate> pool;
   for (const TwinCandidate& c : library)
-    if (options_.candidates.empty() ||
-        std::find(options_.candidates.begin(), options_.candidates.end(), c.label) != options_.candidates.end())
+    if (options_.candidates.empty()
+            ? DefaultCandidate(c, runs_in_.size())
+            : std::find(options_.candidates.begin(), options_.candidates.end(), c.label) != options_.candidates.end())
       pool.push_back(c);
   for (int round = 0; round < options_.max_effects && !pool.empty(); ++round) {
     std::vector<TwinEffect> scored;

@@ -10,7 +10,8 @@
 //      noise (level 1), with the conditions computed from the real recording's own streams: the poses of a pose
 //      stream (motion capture) when there is one, else the wheel encoders' dead reckoning with the nominal geometry
 //      (eval/velocity.h), else none;
-//   3. fit: each candidate effect the scenario supports (TwinCandidateNames) is fitted on the training part (the
+//   3. fit: each candidate effect the scenario supports (TwinCandidateNames; options.candidates) is fitted on the
+//   training part (the
 //      first train_fraction of the recording) with the effects kept so far applied: Levenberg-Marquardt over its
 //      parameters on cost = the sum of squared whitened residuals, the Jacobian by finite differences of perturbed
 //      twin runs executed in parallel (central when 2k runs fit in the threads, else forward), over the parameters the
@@ -244,7 +245,9 @@ struct TwinDiagnoseOptions {
   // The std reported: white, hac (the larger of std_white and std_hac, as the estimator's calibration reports), or
   // auto (hac on an imported recording, white on a simulated one).
   estimator::CalibrationOptions::StdMethod std_method = estimator::CalibrationOptions::StdMethod::kAuto;
-  std::vector<std::string> candidates;  // empty: every one the scenario supports
+  // Empty: every one the scenario supports, diff_drive_geometry (the radius scale, right/left ratio and track fitted
+  // together) only with several training runs.
+  std::vector<std::string> candidates;
   std::function<void(const std::string&)> progress;
 };
 
