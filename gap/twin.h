@@ -10,11 +10,11 @@
 //      noise (level 1), with the conditions computed from the real recording's own streams: the poses of a pose
 //      stream (motion capture) when there is one, else the wheel encoders' dead reckoning with the nominal geometry
 //      (eval/velocity.h), else none;
-//   3. fit: each candidate effect the scenario supports (TwinCandidateNames; options.candidates) is fitted on the
-//   training part (the
-//      first train_fraction of the recording) with the effects kept so far applied: Levenberg-Marquardt over its
-//      parameters on cost = the sum of squared whitened residuals, the Jacobian by finite differences of perturbed
-//      twin runs executed in parallel (central when 2k runs fit in the threads, else forward), over the parameters the
+//   3. fit: each candidate effect the scenario supports (TwinCandidateNames; TwinDiagnoseOptions::candidates) is
+//      fitted on the training part (the first train_fraction of the recording) with the effects kept so far applied:
+//      Levenberg-Marquardt over its parameters on cost = the sum of squared whitened residuals, the Jacobian by finite
+//      differences of perturbed twin runs executed in parallel (central when 2k runs fit in the threads or for
+//      diff_drive_geometry, the radius scale, ratio and track as one candidate; else forward), over the parameters the
 //      data informs (a parameter whose conditional white std at the neutral values exceeds 5 % of its range is held at
 //      its neutral value and listed in TwinEffect::not_informed; internal/twin_fit.h FitCandidate). Time shifts
 //      (gps_latency latency_s, imu_time_offset offset_s, pose_time_offset offset_s: the motion capture's pose stamped
@@ -30,9 +30,10 @@
 //      p = 1 - F_chi2(k)(LR) and Delta BIC = -LR + k ln n (gap/internal/decide.h, Score); in order of Delta BIC the
 //      first with p < alpha, Delta BIC < max_delta_bic and a held-out chi-square drop (the twin run over the whole
 //      recording, compared on the rest) above min_heldout_improvement is kept (a candidate whose twin fails is dropped
-//      with the reason); then the candidates that passed p in the first round are tried again on top of the kept
-//      ones, each fitted only when a score test passes alpha (internal/twin_fit.h PredictedDrop: the Gauss-Newton
-//      step's predicted drop from its neutral values, one Jacobian), up to max_effects;
+//      with the reason); then the candidates that passed p in the first round, other than those that set a simulator
+//      effect kept already, are tried again on top of the kept ones, each fitted only when a score test passes alpha
+//      (internal/twin_fit.h PredictedDrop: the Gauss-Newton step's predicted drop from its neutral values, one
+//      Jacobian), up to max_effects; every round's candidates and decisions are kept (TwinDiagnosis::rounds);
 //   5. joint refit: with more than one effect kept, each was fitted on top of the ones before it, held at their values,
 //      so its std is conditional on them; the kept effects' parameters (time shifts held at their values) are fitted
 //      again together, Levenberg-Marquardt from the kept values (internal/twin_fit.h FitJointly), and their joint

@@ -28,7 +28,8 @@ struct TwinParameter {
 struct TwinCandidate {
   std::string label;   // the effect's name, with the wheel for axle_misalignment ("axle_misalignment wheel 1")
   std::string effect;  // the simulator's effect (a composite: its label)
-  std::map<std::string, double> fixed;  // labels, not fitted (axle_misalignment's wheel); a composite's: its parts'
+  std::map<std::string, double> fixed;  // labels, not fitted (axle_misalignment's wheel); a composite's: its held
+                                        // parameters, for the report (its parts hold them)
   std::vector<TwinParameter> free;
   bool time_shift = false;             // one parameter on the physics step grid, searched
   std::vector<TwinCandidate> parts{};  // a composite's effects; empty for a single effect
