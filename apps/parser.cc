@@ -301,7 +301,8 @@ void AddTwinOptions(CLI::App* dia, DiagnoseArgs* args) {
   dia->add_option("--max-effects", args->max_effects, "With --twin: the twin's effects kept at most (default 2)");
   dia->add_option("--twin-candidates", args->twin_candidates,
                   "With --twin: the candidate effects the twin diagnosis tries, as twin.json names them (e.g. "
-                  "wheel_radius_scale, 'axle_misalignment wheel 0'; default every one the scenario supports)");
+                  "wheel_radius_scale, 'axle_misalignment wheel 0'; default every one the scenario supports, "
+                  "diff_drive_geometry only with --train-with)");
 }
 
 void AddDiagnose(CLI::App* app, Commands* commands) {

@@ -60,6 +60,12 @@ void SetStd(const std::string& name, const TwinCovariance& covariance, Eigen::In
   e->estimate.std[name] = hac ? std::max(e->std_white[name], e->std_hac[name]) : e->std_white[name];
 }
 
+// Whether `c` is among the candidates tried by default on `runs` training runs: a composite only on several. On one
+// run, of one kind of motion, its parameters trade against each other (on a square's in-place turns the track against
+// the scale and the ratio), and the combination that fits that run carries over to other motions worse than one effect
+// does; it is tried there when named.
+bool DefaultCandidate(const TwinCandidate& c, std::size_t runs) { return c.parts.empty() || runs > 1; }
+
 // What one round judges the candidates against: the effects kept so far.
 struct State {
   std::vector<sim::EffectOptions> effects;  // kept
@@ -209,7 +215,7 @@ Result<TwinEffect> Diagnoser::Fit(const TwinCandidate& c, const State& state, do
   runs_ += evaluator.runs();
   if (!fit.ok()) return fit.status();
   TwinEffect e;
-  e.effect = fit.value().effect;
+  e.applied = fit.value().effects;
   e.chi2_before = state.chi2;
   e.chi2_after = fit.value().chi2;
   e.iterations = fit.value().iterations;
@@ -264,7 +270,7 @@ Result<bool> Diagnoser::Round(int round, const std::vector<TwinCandidate>& pool,
       continue;
     }
     std::vector<sim::EffectOptions> effects = state->effects;
-    effects.push_back(e.effect);
+    effects.insert(effects.end(), e.applied.begin(), e.applied.end());
     auto twins = RunWhole(effects);
     if (!twins.ok()) {
       x.decision = "the patched twin of the whole recording failed: " + twins.status().message();
@@ -309,7 +315,7 @@ void Diagnoser::FitJointly(const State& state, const std::vector<TwinCandidate>&
     const auto c = std::find_if(library.begin(), library.end(),
                                 [&](const TwinCandidate& x) { return x.label == e.estimate.name; });
     if (c == library.end() || c->time_shift) {
-      base.effects.push_back(e.effect);
+      base.effects.insert(base.effects.end(), e.applied.begin(), e.applied.end());
       out_.joint.held.push_back(e.estimate.name);
       continue;
     }
@@ -347,7 +353,7 @@ void Diagnoser::FitJointly(const State& state, const std::vector<TwinCandidate>&
   Eigen::Index k = 0;  // the parameter's index in the joint covariance
   for (std::size_t i = 0; i < parts.size(); ++i) {
     TwinEffect e;
-    e.effect = fit.value().effects[i];
+    e.applied = fit.value().effects[i];
     e.estimate.name = parts[i].label;
     const Eigen::Index size = static_cast<Eigen::Index>(parts[i].free.size());
     e.estimate.parameters = Values(parts[i], fit.value().theta.segment(k, size));
@@ -374,7 +380,7 @@ void Diagnoser::FitJointly(const State& state, const std::vector<TwinCandidate>&
 void Diagnoser::Finish(const State& state) {
   out_.heldout_after = state.heldout.front();
   for (std::size_t i = 1; i < state.heldout.size(); ++i) out_.training_runs[i - 1].heldout_after = state.heldout[i];
-  for (const TwinEffect& e : out_.effects) out_.patch.push_back(e.effect);
+  for (const TwinEffect& e : out_.effects) out_.patch.insert(out_.patch.end(), e.applied.begin(), e.applied.end());
   const RunSpan& span = spans_.front();
   const Layout heldout = internal::MakeLayout(real_, span.train_end, span.last);
   const auto statistics = ComponentStatistics(
@@ -420,23 +426,30 @@ Result<TwinDiagnosis> Diagnoser::Run() {
   const std::vector<TwinCandidate> library = internal::TwinCandidates(nominal_, options_.max_shift_s);
   std::vector<TwinCandidate> pool;
   for (const TwinCandidate& c : library)
-    if (options_.candidates.empty() ||
-        std::find(options_.candidates.begin(), options_.candidates.end(), c.label) != options_.candidates.end())
+    if (options_.candidates.empty()
+            ? DefaultCandidate(c, runs_in_.size())
+            : std::find(options_.candidates.begin(), options_.candidates.end(), c.label) != options_.candidates.end())
       pool.push_back(c);
   for (int round = 0; round < options_.max_effects && !pool.empty(); ++round) {
     std::vector<TwinEffect> scored;
     auto kept = Round(round, pool, step_s, &state, &scored);
     if (!kept.ok()) return kept.status();
     if (round == 0) out_.candidates = scored;
+    out_.rounds.push_back(scored);
     if (!kept.value()) break;
-    // The next round: the candidates that passed the likelihood-ratio test in the first, other than the kept effects.
+    // The next round: the candidates that passed the likelihood-ratio test in the first, other than those that set a
+    // simulator effect kept already (a composite's parts, or the composite of a kept part).
     std::set<std::string> passed, kept_effects;
     for (const TwinEffect& e : out_.candidates)
       if (e.estimate.lr_pvalue < options_.alpha) passed.insert(e.estimate.name);
-    for (const TwinEffect& e : out_.effects) kept_effects.insert(e.effect.name);
+    for (const sim::EffectOptions& e : state.effects) kept_effects.insert(e.name);
     std::vector<TwinCandidate> next;
-    for (const TwinCandidate& c : pool)
-      if (passed.count(c.label) && !kept_effects.count(c.effect)) next.push_back(c);
+    for (const TwinCandidate& c : pool) {
+      const std::vector<std::string> sets = internal::SimulatorEffects(c);
+      if (passed.count(c.label) &&
+          std::none_of(sets.begin(), sets.end(), [&](const std::string& x) { return kept_effects.count(x) > 0; }))
+        next.push_back(c);
+    }
     pool = next;
   }
   if (InterruptRequested()) return InterruptedError();

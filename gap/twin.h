@@ -10,10 +10,11 @@
 //      noise (level 1), with the conditions computed from the real recording's own streams: the poses of a pose
 //      stream (motion capture) when there is one, else the wheel encoders' dead reckoning with the nominal geometry
 //      (eval/velocity.h), else none;
-//   3. fit: each candidate effect the scenario supports (TwinCandidateNames) is fitted on the training part (the
-//      first train_fraction of the recording) with the effects kept so far applied: Levenberg-Marquardt over its
-//      parameters on cost = the sum of squared whitened residuals, the Jacobian by finite differences of perturbed
-//      twin runs executed in parallel (central when 2k runs fit in the threads, else forward), over the parameters the
+//   3. fit: each candidate effect the scenario supports (TwinCandidateNames; TwinDiagnoseOptions::candidates) is
+//      fitted on the training part (the first train_fraction of the recording) with the effects kept so far applied:
+//      Levenberg-Marquardt over its parameters on cost = the sum of squared whitened residuals, the Jacobian by finite
+//      differences of perturbed twin runs executed in parallel (central when 2k runs fit in the threads or for
+//      diff_drive_geometry, the radius scale, ratio and track as one candidate; else forward), over the parameters the
 //      data informs (a parameter whose conditional white std at the neutral values exceeds 5 % of its range is held at
 //      its neutral value and listed in TwinEffect::not_informed; internal/twin_fit.h FitCandidate). Time shifts
 //      (gps_latency latency_s, imu_time_offset offset_s, pose_time_offset offset_s: the motion capture's pose stamped
@@ -29,9 +30,10 @@
 //      p = 1 - F_chi2(k)(LR) and Delta BIC = -LR + k ln n (gap/internal/decide.h, Score); in order of Delta BIC the
 //      first with p < alpha, Delta BIC < max_delta_bic and a held-out chi-square drop (the twin run over the whole
 //      recording, compared on the rest) above min_heldout_improvement is kept (a candidate whose twin fails is dropped
-//      with the reason); then the candidates that passed p in the first round are tried again on top of the kept
-//      ones, each fitted only when a score test passes alpha (internal/twin_fit.h PredictedDrop: the Gauss-Newton
-//      step's predicted drop from its neutral values, one Jacobian), up to max_effects;
+//      with the reason); then the candidates that passed p in the first round, other than those that set a simulator
+//      effect kept already, are tried again on top of the kept ones, each fitted only when a score test passes alpha
+//      (internal/twin_fit.h PredictedDrop: the Gauss-Newton step's predicted drop from its neutral values, one
+//      Jacobian), up to max_effects; every round's candidates and decisions are kept (TwinDiagnosis::rounds);
 //   5. joint refit: with more than one effect kept, each was fitted on top of the ones before it, held at their values,
 //      so its std is conditional on them; the kept effects' parameters (time shifts held at their values) are fitted
 //      again together, Levenberg-Marquardt from the kept values (internal/twin_fit.h FitJointly), and their joint
@@ -159,10 +161,11 @@ struct TwinEffect {
   // parameter's range), held at their neutral values in estimate.parameters and the effect, without a std and not
   // counted in estimate.dof.
   std::vector<std::string> not_informed;
-  std::map<std::string, int> hac_lags;  // per series: the HAC lag (samples)
-  sim::EffectOptions effect;            // as the simulator applies it (time shifts in whole physics steps)
-  double chi2_before = 0.0;             // training part: with the effects kept before it
-  double chi2_after = 0.0;              // with it
+  std::map<std::string, int> hac_lags;      // per series: the HAC lag (samples)
+  std::vector<sim::EffectOptions> applied;  // as the simulator applies it (time shifts in whole physics steps): one
+                                            // effect, or a composite candidate's parts
+  double chi2_before = 0.0;                 // training part: with the effects kept before it
+  double chi2_after = 0.0;                  // with it
   int iterations = 0;
   int runs = 0;  // twin runs spent on the fit
 };
@@ -215,10 +218,12 @@ struct TwinDiagnosis {
   double train_end_s = 0.0;
   std::vector<LocatedComponent> located;  // the nominal twin, whole run
   std::vector<TwinEffect> candidates;     // the first round, best Delta BIC first
-  std::vector<TwinEffect> effects;        // kept, in order
-  TwinJointFit joint;                     // empty unless more than one effect is kept and refitted
-  std::vector<std::string> unexplained;   // "stream/component" inconsistent on the held-out part with the patch
-  TwinComparison whole_run;               // the nominal twin
+  // Every round's candidates (the first is `candidates`), best Delta BIC first, each with its decision.
+  std::vector<std::vector<TwinEffect>> rounds;
+  std::vector<TwinEffect> effects;       // kept, in order
+  TwinJointFit joint;                    // empty unless more than one effect is kept and refitted
+  std::vector<std::string> unexplained;  // "stream/component" inconsistent on the held-out part with the patch
+  TwinComparison whole_run;              // the nominal twin
   TwinComparison heldout_before, heldout_after;
   std::vector<sim::EffectOptions> patch;           // the kept effects as the simulator takes them
   std::vector<TwinHeldOutRun> heldout_runs;        // ShowOnHeldOut's, filled by the caller
@@ -241,7 +246,9 @@ struct TwinDiagnoseOptions {
   // The std reported: white, hac (the larger of std_white and std_hac, as the estimator's calibration reports), or
   // auto (hac on an imported recording, white on a simulated one).
   estimator::CalibrationOptions::StdMethod std_method = estimator::CalibrationOptions::StdMethod::kAuto;
-  std::vector<std::string> candidates;  // empty: every one the scenario supports
+  // Empty: every one the scenario supports, diff_drive_geometry (the radius scale, right/left ratio and track fitted
+  // together) only with several training runs.
+  std::vector<std::string> candidates;
   std::function<void(const std::string&)> progress;
 };
 
@@ -271,7 +278,8 @@ Result<TwinHeldOutRun> ShowOnHeldOut(const sim::Scenario& nominal, const std::ve
 // Per stream: {"window_s", "windows", "mean_position_m", "max_position_m"[, "mean_heading_rad", "max_heading_rad"]}.
 nlohmann::json TwinDriftJson(const std::map<std::string, TwinDrift>& drift);
 
-// {"replayed", "verdict", "std_method", "train_end_s", "located", "candidates", "effects", "joint" (null, or
+// {"replayed", "verdict", "std_method", "train_end_s", "located", "candidates", "rounds" (every round's candidates,
+// the first's as "candidates"), "effects" (each with "effect": the simulator's effects it sets), "joint" (null, or
 // {"effects", "held", "failed", "chi2_before", "chi2_after", "iterations", "runs"}), "unexplained",
 // "heldout": {"before", "after"}, "whole_run", "patch",
 // "heldout_runs": [{"recording", "replayed", "before", "after"}], "runs", "seconds"}, and with further training runs

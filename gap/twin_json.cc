@@ -27,16 +27,17 @@ nlohmann::json ComparisonJson(const TwinComparison& c) {
 
 nlohmann::json EffectJson(const TwinEffect& e) {
   const EffectEstimate& x = e.estimate;
-  nlohmann::json parameters = nlohmann::json::object(), applied = nlohmann::json::object();
+  nlohmann::json parameters = nlohmann::json::object(), applied = nlohmann::json::array();
   for (const auto& [name, value] : x.parameters) parameters[name] = Number(value);
   const auto numbers = [](const std::map<std::string, double>& values) {
     nlohmann::json out = nlohmann::json::object();
     for (const auto& [name, value] : values) out[name] = Number(value);
     return out;
   };
-  for (const auto& [name, value] : e.effect.parameters) applied[name] = Number(value);
+  for (const sim::EffectOptions& effect : e.applied)
+    applied.push_back({{"name", effect.name}, {"parameters", numbers(effect.parameters)}});
   return {{"name", x.name},
-          {"effect", {{"name", e.effect.name}, {"parameters", applied}}},
+          {"effect", applied},
           {"dof", x.dof},
           {"parameters", parameters},
           {"std", numbers(x.std)},
@@ -112,6 +113,11 @@ nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d) {
   nlohmann::json candidates = nlohmann::json::array(), effects = nlohmann::json::array(),
                  patch = nlohmann::json::array();
   for (const TwinEffect& e : d.candidates) candidates.push_back(EffectJson(e));
+  nlohmann::json rounds = nlohmann::json::array();
+  for (const std::vector<TwinEffect>& round : d.rounds) {
+    rounds.push_back(nlohmann::json::array());
+    for (const TwinEffect& e : round) rounds.back().push_back(EffectJson(e));
+  }
   for (const TwinEffect& e : d.effects) effects.push_back(EffectJson(e));
   for (const sim::EffectOptions& e : d.patch) patch.push_back({{"name", e.name}, {"parameters", e.parameters}});
   nlohmann::json heldout_runs = nlohmann::json::array();
@@ -127,6 +133,7 @@ nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d) {
       {"train_end_s", d.train_end_s},
       {"located", located},
       {"candidates", candidates},
+      {"rounds", rounds},
       {"effects", effects},
       {"joint", JointJson(d.joint)},
       {"unexplained", d.unexplained},

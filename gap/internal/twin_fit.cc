@@ -34,6 +34,18 @@ std::vector<TwinCandidate> Library(const sim::Scenario& nominal, double max_shif
   all.push_back({"wheel_radius_asymmetry", "wheel_radius_asymmetry", {}, {P("ratio_right_left", 1, 0.01, 0.8, 1.2)}});
   all.push_back({"wheel_radius_scale", "wheel_radius_scale", {}, {P("scale", 1, 0.01, 0.8, 1.2)}});
   all.push_back({"track_width_error", "track_width_error", {}, {P("track_error_m", 0, 0.01, -0.1, 0.1)}});
+  // A differential drive's geometry as one effect: the common radius scale, the right/left ratio and the track fitted
+  // together. Each alone, or one on top of another, absorbs what the others explain of the runs at hand (a turn is
+  // both the ratio's and the track's, a line both the scale's and the ratio's); on runs of different drives together
+  // the three are told apart.
+  if (nominal.robot.kind == "differential_drive") {
+    TwinCandidate geometry{"diff_drive_geometry", "diff_drive_geometry", {}, {}};
+    geometry.parts = {all[0], all[1], all[2]};
+    geometry.central = true;
+    for (const TwinCandidate& part : geometry.parts)
+      geometry.free.insert(geometry.free.end(), part.free.begin(), part.free.end());
+    all.push_back(geometry);
+  }
   all.push_back({"odometry_scale_error", "odometry_scale_error", {}, {P("scale", 1, 0.01, 0.5, 1.5)}});
   if (nominal.robot.kind == "skid_steer")
     all.push_back({"skid_steer_track", "skid_steer_track", {}, {P("track_ratio", 1, 0.05, 0.7, 1.5)}});
@@ -116,21 +128,29 @@ struct Parts {
   std::vector<TwinCandidate> candidates;
   std::string label;  // the candidates' labels joined by " + "
   std::vector<TwinParameter> free;
+  bool central = false;  // some candidate asks for central differences
 
   explicit Parts(std::vector<TwinCandidate> parts) : candidates(std::move(parts)) {
     for (const TwinCandidate& c : candidates) {
+      central = central || c.central;
       label += (label.empty() ? "" : " + ") + c.label;
       free.insert(free.end(), c.free.begin(), c.free.end());
     }
   }
-  Patch At(const Eigen::VectorXd& theta) const {
-    Patch out;
+  // Per candidate, its effects at theta.
+  std::vector<Patch> PerCandidate(const Eigen::VectorXd& theta) const {
+    std::vector<Patch> out;
     Eigen::Index offset = 0;
     for (const TwinCandidate& c : candidates) {
       const Eigen::Index k = static_cast<Eigen::Index>(c.free.size());
-      out.push_back(EffectAt(c, theta.segment(offset, k)));
+      out.push_back(EffectsAt(c, theta.segment(offset, k)));
       offset += k;
     }
+    return out;
+  }
+  Patch At(const Eigen::VectorXd& theta) const {
+    Patch out;
+    for (const Patch& p : PerCandidate(theta)) out.insert(out.end(), p.begin(), p.end());
     return out;
   }
 };
@@ -144,11 +164,12 @@ Eigen::VectorXd Clamp(const Parts& parts, Eigen::VectorXd theta) {
 }
 
 // The Jacobian of the residuals by the parameters at `theta` (residuals `center`): central differences when 2k runs
-// fit in the threads, else forward (backward at the upper bound; one-sided at either bound).
+// fit in the threads or a candidate asks for them (TwinCandidate::central), else forward (backward at the upper bound;
+// one-sided at either bound).
 Result<Eigen::MatrixXd> Jacobian(const Parts& parts, const Eigen::VectorXd& theta, const Eigen::VectorXd& center,
                                  int threads, TwinEvaluator* evaluator) {
   const int k = static_cast<int>(parts.free.size());
-  const bool central = 2 * k <= std::max(2, threads);
+  const bool central = parts.central || 2 * k <= std::max(2, threads);
   std::vector<Patch> runs;
   std::vector<std::pair<double, double>> deltas;  // per parameter: the + and - steps taken (0: none)
   for (int j = 0; j < k; ++j) {
@@ -301,7 +322,7 @@ Result<CandidateOutcome> SearchTimeShift(const TwinCandidate& c, const Eigen::Ve
     for (long s : shifts)
       if (s >= lo && s <= hi && !r.count(s) && std::find(todo.begin(), todo.end(), s) == todo.end()) todo.push_back(s);
     std::vector<Patch> runs;
-    for (long s : todo) runs.push_back({EffectAt(c, Eigen::VectorXd::Constant(1, static_cast<double>(s) * step))});
+    for (long s : todo) runs.push_back(EffectsAt(c, Eigen::VectorXd::Constant(1, static_cast<double>(s) * step)));
     const auto out = evaluator->Run(runs);
     for (std::size_t i = 0; i < todo.size(); ++i) {
       if (!out[i].ok()) return Status::Error(c.label + ": a shifted twin: " + out[i].status().message());
@@ -329,7 +350,7 @@ Result<CandidateOutcome> SearchTimeShift(const TwinCandidate& c, const Eigen::Ve
   out.iterations = rounds;
   out.residuals = r[b];
   out.chi2 = chi2[b];
-  out.effect = EffectAt(c, Eigen::VectorXd::Constant(1, static_cast<double>(b) * step));
+  out.effects = EffectsAt(c, Eigen::VectorXd::Constant(1, static_cast<double>(b) * step));
   double vertex = 0.0;
   if (r.count(b - 1) && r.count(b + 1)) {
     const double curvature = chi2[b - 1] - 2.0 * chi2[b] + chi2[b + 1];
@@ -352,6 +373,13 @@ Result<CandidateOutcome> SearchTimeShift(const TwinCandidate& c, const Eigen::Ve
 TwinCandidate Reduced(const TwinCandidate& c, const std::vector<bool>& informed) {
   TwinCandidate out = c;
   out.free.clear();
+  out.parts.clear();
+  auto next = informed.begin();
+  for (const TwinCandidate& part : c.parts) {
+    const auto end = next + static_cast<std::ptrdiff_t>(part.free.size());
+    out.parts.push_back(Reduced(part, std::vector<bool>(next, end)));
+    next = end;
+  }
   for (std::size_t j = 0; j < c.free.size(); ++j) {
     if (informed[j])
       out.free.push_back(c.free[j]);
@@ -369,18 +397,28 @@ std::vector<TwinCandidate> TwinCandidates(const sim::Scenario& nominal, double m
     Eigen::VectorXd theta(static_cast<Eigen::Index>(c.free.size()));
     for (std::size_t j = 0; j < c.free.size(); ++j)
       theta[static_cast<Eigen::Index>(j)] = std::clamp(c.free[j].neutral + 0.01, c.free[j].lo, c.free[j].hi);
-    trial.effects.push_back(EffectAt(c, theta));
+    trial.effects = EffectsAt(c, theta);
     if (!trial.Validate()) out.push_back(c);
   }
   return out;
 }
 
-sim::EffectOptions EffectAt(const TwinCandidate& c, const Eigen::VectorXd& theta) {
-  sim::EffectOptions e;
-  e.name = c.effect;
-  e.parameters = c.fixed;
-  for (std::size_t j = 0; j < c.free.size(); ++j) e.parameters[c.free[j].name] = theta[static_cast<Eigen::Index>(j)];
-  return e;
+Patch EffectsAt(const TwinCandidate& c, const Eigen::VectorXd& theta) {
+  if (c.parts.empty()) {
+    sim::EffectOptions e;
+    e.name = c.effect;
+    e.parameters = c.fixed;
+    for (std::size_t j = 0; j < c.free.size(); ++j) e.parameters[c.free[j].name] = theta[static_cast<Eigen::Index>(j)];
+    return {e};
+  }
+  return Parts(c.parts).At(theta);
+}
+
+std::vector<std::string> SimulatorEffects(const TwinCandidate& c) {
+  if (c.parts.empty()) return {c.effect};
+  std::vector<std::string> out;
+  for (const TwinCandidate& part : c.parts) out.push_back(part.effect);
+  return out;
 }
 
 void ParallelFor(int n, int threads, const std::function<void(int)>& fn) {
@@ -475,7 +513,7 @@ Result<ScoreTest> PredictedDrop(const TwinCandidate& c, const Eigen::VectorXd& b
   if (c.time_shift) {
     const double shift_s = c.free.front().hi > 0.0 ? settings.physics_step_s : -settings.physics_step_s;
     theta[0] = shift_s;
-    auto r = evaluator->Run({Patch{EffectAt(c, theta)}});
+    auto r = evaluator->Run({EffectsAt(c, theta)});
     if (!r[0].ok()) return Status::Error(c.label + ": a shifted twin: " + r[0].status().message());
     const Eigen::VectorXd d = (Masked(r[0].value(), base) - Masked(base, base)) / shift_s;
     const Eigen::VectorXd b = Masked(base, base);
@@ -525,7 +563,7 @@ Result<CandidateOutcome> FitCandidate(const TwinCandidate& c, const Eigen::Vecto
     out.residuals = fit.value().residuals;
     out.iterations = fit.value().iterations;
   }
-  out.effect = EffectAt(c, out.theta);
+  out.effects = EffectsAt(c, out.theta);
   out.informed = informed;
   return out;
 }
@@ -544,7 +582,7 @@ Result<JointOutcome> FitJointly(const std::vector<TwinCandidate>& parts, const E
   JointOutcome out;
   out.theta = fit.value().theta;
   out.covariance = fit.value().covariance;
-  out.effects = joint.At(out.theta);
+  out.effects = joint.PerCandidate(out.theta);
   out.chi2 = fit.value().chi2;
   out.iterations = fit.value().iterations;
   return out;

@@ -23,22 +23,33 @@ struct TwinParameter {
   double lo = 0.0, hi = 0.0;
 };
 
+// One candidate: a simulator effect, or a composite of several fitted together (`parts`, each a single effect's
+// candidate; its `free` the parts' free parameters concatenated in order, their names distinct).
 struct TwinCandidate {
   std::string label;   // the effect's name, with the wheel for axle_misalignment ("axle_misalignment wheel 1")
-  std::string effect;  // the simulator's effect
-  std::map<std::string, double> fixed;  // labels, not fitted (axle_misalignment's wheel)
+  std::string effect;  // the simulator's effect (a composite: its label)
+  std::map<std::string, double> fixed;  // labels, not fitted (axle_misalignment's wheel); a composite's: its held
+                                        // parameters, for the report (its parts hold them)
   std::vector<TwinParameter> free;
-  bool time_shift = false;  // one parameter on the physics step grid, searched
+  bool time_shift = false;             // one parameter on the physics step grid, searched
+  std::vector<TwinCandidate> parts{};  // a composite's effects; empty for a single effect
+  // The Jacobian by central differences however many threads: a forward difference's slope is the secant over a step,
+  // off by half the step times the curvature, and where the parameters trade against each other that bias moves the
+  // fit's minimum by a good part of a step.
+  bool central = false;
 };
 
 // The candidates `nominal` supports (its sensors and robot kind; the scenario validates with each).
 std::vector<TwinCandidate> TwinCandidates(const sim::Scenario& nominal, double max_shift_s);
 
-// The effect of `c` at parameter values `theta` (in c.free's order).
-sim::EffectOptions EffectAt(const TwinCandidate& c, const Eigen::VectorXd& theta);
-
 // The effects one twin run adds to the evaluator's base scenario.
 using Patch = std::vector<sim::EffectOptions>;
+
+// The effects of `c` at parameter values `theta` (in c.free's order): one, or a composite's parts' in order.
+Patch EffectsAt(const TwinCandidate& c, const Eigen::VectorXd& theta);
+
+// The simulator's effects `c` sets (a composite's parts').
+std::vector<std::string> SimulatorEffects(const TwinCandidate& c);
 
 // One recording the fit runs the twin of: its real recording, the twin's runner, the layout of its training part and
 // the twin's duration (s after the recording's first stamp).
@@ -81,9 +92,9 @@ struct CandidateOutcome {
   Eigen::VectorXd theta;       // fitted (time shifts: the parabola's vertex, sub-step); the uninformed at neutral
   std::vector<bool> informed;  // per parameter (c.free's order): fitted; the others are held at their neutral values
   TwinCovariance covariance;   // of the informed parameters of theta, in order, white and HAC (gap/twin.h)
-  sim::EffectOptions effect;   // as applied (time shifts in whole steps)
-  double chi2 = 0.0;           // training part, at `effect`
-  Eigen::VectorXd residuals;   // training part, at `effect`
+  Patch effects;               // as applied (time shifts in whole steps)
+  double chi2 = 0.0;           // training part, at `effects`
+  Eigen::VectorXd residuals;   // training part, at `effects`
   int iterations = 0;
 };
 
@@ -108,16 +119,17 @@ Result<CandidateOutcome> FitCandidate(const TwinCandidate& c, const Eigen::Vecto
 // the parts. Its covariance is the joint one, so each parameter's std is marginal over the others (a part fitted on
 // top of another frozen one reports a std conditional on it). Time-shift parts are refused.
 struct JointOutcome {
-  Eigen::VectorXd theta;      // concatenated as the parts' free parameters
-  TwinCovariance covariance;  // of theta
-  Patch effects;              // one per part, as applied
-  double chi2 = 0.0;          // training part, at `effects`
+  Eigen::VectorXd theta;       // concatenated as the parts' free parameters
+  TwinCovariance covariance;   // of theta
+  std::vector<Patch> effects;  // one per part, as applied
+  double chi2 = 0.0;           // training part, at `effects`
   int iterations = 0;
 };
 Result<JointOutcome> FitJointly(const std::vector<TwinCandidate>& parts, const Eigen::VectorXd& start,
                                 const Eigen::VectorXd& at_start, TwinEvaluator* evaluator, const FitSettings& settings);
 
-// `c` with the parameters not `informed` (c.free's order) held at their neutral values (moved to c.fixed).
+// `c` with the parameters not `informed` (c.free's order) held at their neutral values (moved to c.fixed; a composite's
+// to its parts' fixed, and to its own for the report).
 TwinCandidate Reduced(const TwinCandidate& c, const std::vector<bool>& informed);
 
 // The score test's chi-square drop: the Gauss-Newton step's predicted decrease from the neutral values, g^T H^+ g

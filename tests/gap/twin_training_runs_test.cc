@@ -1,7 +1,7 @@
 // The twin's patch fitted on several training runs (gap/twin.h DiagnoseTwin with TwinTrainingRun): a hidden wheel
-// radius asymmetry in two seeded 30 s recordings of the OptiOdom differential drive (wheel encoders, motion capture)
-// of different drives, the scenario's own (its twin the plain simulation) and one turning the other way at twice the
-// rate (its twin the replay of its drive).
+// radius asymmetry, and a hidden geometry (radius scale and track), in two seeded 30 s recordings of the OptiOdom
+// differential drive (wheel encoders, motion capture) of different drives, the scenario's own (its twin the plain
+// simulation) and one turning the other way at twice the rate (its twin the replay of its drive).
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -26,10 +26,18 @@ sim::Scenario Nominal() {
   return scenario;
 }
 
-// `drive` with the hidden asymmetry, simulated with noise seed `seed`.
-recording::Recording Real(sim::Scenario drive, std::uint64_t seed) {
-  drive.effects = {{"wheel_radius_asymmetry", {{"ratio_right_left", kRatio}}}};
+// `drive` with the hidden `effects` (default: the asymmetry), simulated with noise seed `seed`.
+recording::Recording Real(sim::Scenario drive, std::uint64_t seed,
+                          std::vector<sim::EffectOptions> effects = {
+                              {"wheel_radius_asymmetry", {{"ratio_right_left", kRatio}}}}) {
+  drive.effects = std::move(effects);
   return testing::SimulatedWithSeed(drive, seed).recording;
+}
+
+// The scenario's drive turning the other way at twice the rate.
+sim::Scenario Turned(sim::Scenario drive) {
+  for (sim::ProfileTerm& term : drive.driver.angular_radps.terms) term.amplitude = -0.3;
+  return drive;
 }
 
 // The fitted ratio and its std; fails the test when the asymmetry is not the kept effect.
@@ -56,9 +64,7 @@ double Drift(const TwinComparison& c) {
 // held-out drift shrinks with the patch.
 TEST(TwinTrainingRunsTest, AnEffectFittedOnTwoRunsOfDifferentDrivesUsesBoth) {
   const sim::Scenario nominal = Nominal();
-  sim::Scenario other = nominal;
-  for (sim::ProfileTerm& term : other.driver.angular_radps.terms) term.amplitude = -0.3;
-  const recording::Recording own = Real(nominal, 41), turned = Real(other, 42);
+  const recording::Recording own = Real(nominal, 41), turned = Real(Turned(nominal), 42);
   TwinDiagnoseOptions options;
   options.candidates = {"wheel_radius_asymmetry", "wheel_radius_scale"};
   options.max_effects = 1;
@@ -92,6 +98,53 @@ TEST(TwinTrainingRunsTest, AnEffectFittedOnTwoRunsOfDifferentDrivesUsesBoth) {
   std::printf("turned drive, held-out 10 s drift %.4f m -> %.4f m\n", before, after);
   EXPECT_LT(after, 0.5 * before);
   EXPECT_LT(t.heldout_after.chi2, t.heldout_before.chi2);
+}
+
+// The twin of a recording of `drive`'s own drive: the patched scenario with that drive, simulated without noise.
+TwinRunner PlainSimulationOf(const sim::Scenario& drive) {
+  const TwinRunner plain = PlainSimulationRunner();
+  return [plain, driver = drive.driver](const sim::Scenario& patched) {
+    sim::Scenario s = patched;
+    s.driver = driver;
+    return plain(s);
+  };
+}
+
+// A hidden geometry with both the radius scale and the track off, on the same two drives, each run's twin the plain
+// simulation of its own drive: the joint geometry is kept over each of its parameters alone (its two extra parameters
+// penalized by Delta BIC), its patch sets the three simulator effects, and each parameter is within three of its std
+// of the hidden value (the ratio of the neutral 1).
+TEST(TwinTrainingRunsTest, AJointGeometryIsRecoveredOnTwoRunsOfDifferentDrives) {
+  constexpr double kScale = 0.985, kTrackErrorM = 0.008;
+  const std::vector<sim::EffectOptions> hidden = {{"wheel_radius_scale", {{"scale", kScale}}},
+                                                  {"track_width_error", {{"track_error_m", kTrackErrorM}}}};
+  const sim::Scenario nominal = Nominal(), other = Turned(nominal);
+  const recording::Recording own = Real(nominal, 43, hidden), turned = Real(other, 44, hidden);
+  TwinDiagnoseOptions options;
+  options.candidates = {"wheel_radius_asymmetry", "wheel_radius_scale", "track_width_error", "diff_drive_geometry"};
+  options.max_effects = 1;
+  const std::vector<TwinTrainingRun> runs = {{"own", &own, PlainSimulationRunner(), false},
+                                             {"turned", &turned, PlainSimulationOf(other), false}};
+  auto d = DiagnoseTwin(nominal, runs, options);
+  ASSERT_TRUE(d.ok()) << d.status().message();
+  ASSERT_EQ(d.value().effects.size(), 1u);
+  const TwinEffect& kept = d.value().effects.front();
+  ASSERT_EQ(kept.estimate.name, "diff_drive_geometry");
+  ASSERT_EQ(kept.applied.size(), 3u);
+  EXPECT_EQ(d.value().patch.size(), 3u);
+  ASSERT_EQ(d.value().rounds.size(), 1u);
+  EXPECT_EQ(d.value().rounds.front().size(), options.candidates.size());
+  std::printf("  iterations %d, chi2 %.6g -> %.6g, runs %d\n", kept.iterations, kept.chi2_before, kept.chi2_after,
+              kept.runs);
+  const std::map<std::string, double> truth = {
+      {"scale", kScale}, {"ratio_right_left", 1.0}, {"track_error_m", kTrackErrorM}};
+  for (const auto& [name, value] : truth) {
+    ASSERT_TRUE(kept.estimate.std.count(name)) << name << " not fitted";
+    const double fitted = kept.estimate.parameters.at(name), std = kept.estimate.std.at(name);
+    std::printf("  %s %.6f +- %.3g (hidden %.6f)\n", name.c_str(), fitted, std, value);
+    EXPECT_GT(std, 0.0) << name;
+    EXPECT_NEAR(fitted, value, 3.0 * std) << name;
+  }
 }
 
 // A training run that is missing or has nothing to compare is an error naming it.
