@@ -9,7 +9,8 @@ Each mutant is one operator applied to one seed file; the command runs with a ti
 
   clean      exit 2, one line on stderr (warnings aside) that names the mutated file
   unclean    refused, but with exit 1 for clearly bad data, several lines, or a line that does not name the file
-  failure    exit 1 with one line after a neutral mutation: a run-time failure (the solver diverged), not bad input
+  failure    exit 1 with at most one line after a neutral mutation: a run-time failure (the solver diverged, a
+             regression check that a changed bound fails), not bad input
   accepted   exit 0 after a neutral mutation (a change the data may legitimately carry)
   silent     exit 0 after a mutation that makes the data clearly bad (duplicate key, truncated row, NaN, absurd
              magnitude, undeclared name, ...): a silent acceptance
@@ -424,8 +425,8 @@ class Seeds:
             "    config: %s\n"
             "    checks:\n"
             "      - {metric: metrics.ate_m, bound: \"<= 10\"}\n"
-            "      - {metric: metrics.parameters.gps.lever_arm.error.norm, bound: \"<= 2 * metrics.ate_m + 0.5\"}\n"
-            "      - {metric: calibration.measurements.gps.rejected, bound: \"<= 5\", open: \"a reason\"}\n")
+            "      - {metric: metrics.rpe_trans_m, bound: \"<= 2 * metrics.ate_m + 10\"}\n"
+            "      - {metric: calibration.measurements.gps.rejected, bound: \">= 100000\", open: \"a reason\"}\n")
             % (self.rec, self.estimator))
 
     def write(self, name, text):
@@ -451,10 +452,11 @@ def classify(code, err, names, bad):
     if code == 0:
         return "silent" if bad else "accepted"
     lines = [l for l in err.splitlines() if l.strip() and ": warning: " not in l and not l.startswith("\r")]
-    lines = [l for l in lines if not re.match(r"^(calibrate|simulate|track): ", l)]  # progress lines
+    lines = [l for l in lines if not re.match(r"^(calibrate|simulate|track): |^regress \[", l)]  # progress lines
     if code == 2 and len(lines) == 1 and any(n in lines[0] for n in names):
         return "clean"
-    if code == 1 and len(lines) == 1 and not bad:
+    # regress reports a failed check in its table on standard output, with no line on standard error.
+    if code == 1 and len(lines) <= 1 and not bad:
         return "failure"
     return "unclean"
 
