@@ -261,6 +261,10 @@ std::string AddMessage(const RosMessage& m, Time receive, TopicWork* w) {
       Skip(w, b, "no fix");
       return "";
     }
+    if (!(std::abs(fix->latitude_deg) <= 90.0 && std::abs(fix->longitude_deg) <= 180.0)) {
+      Skip(w, b, "latitude or longitude outside the Earth's range");
+      return "";
+    }
     const auto& c = fix->position_covariance;
     Eigen::VectorXd row(9);
     row << fix->latitude_deg, fix->longitude_deg, fix->altitude_m, c[0], c[1], c[2], c[4], c[5], c[8];

@@ -5,7 +5,8 @@
 //                               is not imported; noise gyro_sigma_radps / accel_sigma_mps2 = median square root of
 //                               the covariances' first diagonal entry, when positive
 //   sensor_msgs/NavSatFix    -> gps: latitude, longitude, altitude and the 6 ENU covariance columns; a fix with status
-//                               -1 (no fix) is skipped and counted; origin = the first kept fix of the first gps stream
+//                               -1 (no fix), or a latitude beyond +-90 deg or longitude beyond +-180 deg, is skipped and
+//                               counted; origin = the first kept fix of the first gps stream
 //   sensor_msgs/MagneticField-> magnetometer, units uT (the message's tesla times 1e6)
 //   sensor_msgs/JointState   -> wheel_encoders: one column per joint (RosbagImportOptions::joints, else the joints of
 //                               the topic's first message), positions [rad] or velocities [rad/s]

@@ -162,6 +162,24 @@ TEST(ImportRosbagChecksTest, ClockOffsetIsReportedWithItsSign) {
       Contains("/imu/data (imu_data): 1 header stamps jump back from the previous message's (sorted by stamp)"));
 }
 
+// A fix whose latitude or longitude is not an angle on the Earth (a corrupted message) is skipped and counted; the
+// others are kept and the origin is the first valid one.
+TEST(ImportRosbagChecksTest, FixOutsideTheEarthsAnglesIsSkippedAndCounted) {
+  TempDir dir;
+  std::string chunk = Connection(0, "/fix", "sensor_msgs/NavSatFix");
+  chunk += MessageRecord(0, 100, 0, testing::FixMessage(kRos1, 100, 0, 0, 400.0));
+  chunk += MessageRecord(0, 100, 100000000, testing::FixMessage(kRos1, 100, 100000000, 0, 48.1));
+  chunk += MessageRecord(0, 100, 200000000, testing::FixMessage(kRos1, 100, 200000000, 0, -90.5));
+  chunk += MessageRecord(0, 100, 300000000, testing::FixMessage(kRos1, 100, 300000000, 0, 48.2));
+  Imported in = Import(BagOf(chunk, "none"), dir);
+  ASSERT_TRUE(in.rec.ok()) << in.rec.status().message();
+  EXPECT_EQ(in.report.Find("/fix")->skipped.at("latitude or longitude outside the Earth's range"), 2);
+  const Stream* gps = in.rec.value().Find("fix");
+  ASSERT_NE(gps, nullptr);
+  ASSERT_EQ(gps->t.size(), 2u);
+  EXPECT_DOUBLE_EQ(gps->values(0, 0), 48.1);
+}
+
 // Progress: the fraction of the selected topics' messages decoded, every kProgressMessages messages and at the end;
 // here 2500 IMU messages (the /rosout log is not a selected topic) and one odometry message.
 TEST(ImportRosbagProgressTest, ReportsTheFractionOfMessagesDecoded) {
