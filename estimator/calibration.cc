@@ -15,7 +15,9 @@
 
 #include "common/chi_square.h"
 #include "estimator/geometry.h"
+#include "estimator/internal/after_gap.h"
 #include "estimator/internal/linearization.h"
+#include "estimator/internal/normal_equations.h"
 
 namespace roamlab::estimator {
 
@@ -407,6 +409,78 @@ Status BuildGraph(const CalibrationOptions& options, ProblemBuilder* builder_ptr
   return Status::Ok();
 }
 
+// Rounds of admission of the absolute rows held out after a gap (AdmitConsistentRows), each followed by a re-solve.
+constexpr int kMaxAdmissionRounds = 5;
+
+// The measurement factors of the absolute streams (a motion-capture pose, a GPS fix) stamped at or after their
+// stream's first resumption after a gap (internal::GapResumes; within a millisecond, the stamps' rounding). After a
+// clock jump every later row is stamped late, and a row a second late bends the first solve until the good wheel and
+// IMU rows of its poses fail with it; after an outage the rows resume consistent. Each is held out (counted as
+// rejected) and admitted on its own innovation (AdmitConsistentRows), not with the stream's later rows once one passes
+// as in tracking: in one batch, a late row far into a long dead-reckoned stretch can pass where the estimate's
+// uncertainty has grown to cover its lateness, and it would take every row after it in with it.
+std::vector<FactorId> HoldOutAbsoluteRowsAfterGaps(const EstimatorConfig& config, const recording::Recording& recording,
+                                                   ProblemBuilder* builder) {
+  constexpr std::int64_t kSlackNs = 1000000;
+  const std::map<std::string, std::vector<Time>> resumes = internal::GapResumes(config, recording, true);
+  std::vector<FactorId> held;
+  for (const auto& [id, entry] : builder->graph().factors()) {
+    const auto resume = resumes.find(entry.stream);
+    if (resume == resumes.end() || builder->StreamOfFactor(id) < 0 || !entry.active) continue;
+    if (entry.stamp.nanoseconds() >= resume->second.front().nanoseconds() - kSlackNs) held.push_back(id);
+  }
+  for (const FactorId id : held) {
+    builder->graph().mutable_factor(id).active = false;
+    ++builder->mutable_counts(builder->graph().factor(id).stream).rejected;
+  }
+  return held;
+}
+
+// Admits each factor of `held` (held out, HoldOutAbsoluteRowsAfterGaps) whose innovation at the current estimate
+// passes the chi-square quantile `probability` of its dimension (internal::InnovationWithin, with the joint marginal
+// covariance of its free variables from one factorization of the whole problem); `held` keeps the others. Where that
+// covariance cannot be had (the problem is singular), a row is admitted untested, to be tested by the gate. Returns
+// how many it admitted.
+int AdmitConsistentRows(double probability, std::vector<FactorId>* held, ProblemBuilder* builder) {
+  Graph& graph = builder->graph();
+  internal::NormalEquations system(graph, FreeVariableOrder(graph));
+  const bool linearized = system.Linearize(graph);
+  std::vector<FactorId> still_held;
+  std::vector<const double*> values;
+  std::vector<VariableId> free_variables;
+  std::vector<int> free;
+  internal::WhitenedFactor wf;
+  Eigen::MatrixXd covariance;
+  int admitted = 0;
+  for (const FactorId id : *held) {
+    FactorEntry& entry = graph.mutable_factor(id);
+    values.clear();
+    free_variables.clear();
+    free.clear();
+    std::uint64_t free_mask = 0;
+    for (std::size_t i = 0; i < entry.variables.size(); ++i) {
+      const Variable& v = graph.variable(entry.variables[i]);
+      values.push_back(v.value.data());
+      if (v.fixed) continue;
+      free_variables.push_back(entry.variables[i]);
+      free.push_back(static_cast<int>(i));
+      free_mask |= std::uint64_t{1} << i;
+    }
+    const bool tested = linearized && system.Covariance(free_variables, &covariance);
+    const bool passes = !tested || (internal::LinearizeFactorAt(entry, values.data(), free_mask, &wf) &&
+                                    internal::InnovationWithin(probability, wf, free, covariance));
+    if (!passes) {
+      still_held.push_back(id);
+      continue;
+    }
+    entry.active = true;
+    --builder->mutable_counts(entry.stream).rejected;
+    ++admitted;
+  }
+  held->swap(still_held);
+  return admitted;
+}
+
 // The scale of the robust start's Huber loss: the chi-square 95 % quantile of a factor's dimension, in whitened units.
 // Errors within it (19 in 20 good ones) count as in least squares; a gross one pulls with the force of one at the scale.
 constexpr double kRobustStartProbability = 0.95;
@@ -430,14 +504,16 @@ bool UseRobustStartLoss(const EstimatorConfig& config, bool robust, ProblemBuild
   return any && robust;
 }
 
-// One stage (stage index s of `stage_count`, its parameters free): a solve, then gating rounds with their re-solves.
+// One stage (stage index s of `stage_count`, its parameters free): a solve, the admission of the `held` rows (held
+// out after a gap; those never admitted are left in it), then gating rounds with their re-solves.
 // `lambda` carries Levenberg-Marquardt's damping from solve to solve: the first stage starts from the configured one,
 // as its parameters and the dead-reckoned poses may be far from the minimum; every later solve starts where the last
 // one ended, as a restart from the configured damping holds the steps back along weakly observed directions (lever
 // arm against height, magnetometer b against A) for many iterations while the damping comes down again.
 Result<StageSummary> SolveStage(const EstimatorConfig& config, const CalibrationOptions& options,
                                 const std::vector<std::string>& free, std::size_t s, std::size_t stage_count,
-                                ProblemBuilder* builder_ptr, SolverWorkspace* workspace, double* lambda) {
+                                ProblemBuilder* builder_ptr, SolverWorkspace* workspace, double* lambda,
+                                std::vector<FactorId>* held) {
   ProblemBuilder& builder = *builder_ptr;
   const bool lm = config.solver.method == SolverOptions::Method::kLevenbergMarquardt;
   SetFree({free.begin(), free.end()}, &builder);
@@ -474,6 +550,15 @@ Result<StageSummary> SolveStage(const EstimatorConfig& config, const Calibration
     stage.solver.seconds += again.seconds;
     return Status::Ok();
   };
+  // The absolute rows held out after a gap: admitted on their innovation at the estimate solved without them, then
+  // re-solved with them, until a round admits none (the rows left out count as rejected; the gate tests them again).
+  for (int admission = 0; config.gate_probability && admission < kMaxAdmissionRounds && !held->empty(); ++admission) {
+    const int admitted = AdmitConsistentRows(*config.gate_probability, held, &builder);
+    if (admitted == 0) break;
+    const Status solved = resolve(std::to_string(admitted) + " rows after a gap admitted, " +
+                                  std::to_string(held->size()) + " held out, re-solved");
+    if (!solved.ok()) return solved;
+  }
   // Passes that bridge wheel readings reject nothing else (GateOptions::defer_when_bridging) and are not counted as
   // rounds, up to kMaxGatingRounds of them: the rounds, burst margin first, start at the estimate re-solved without
   // the readings they left out.
@@ -669,9 +754,13 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
   // them).
   auto workspace = std::make_unique<SolverWorkspace>();
   workspace->set_keep_linearizations(false);
+  // The absolute rows after a gap wait out the first stage's first solve; the later stages gate them as any other.
+  std::vector<FactorId> held;
+  if (config.gate_probability) held = HoldOutAbsoluteRowsAfterGaps(config, recording, &builder);
   for (std::size_t s = 0; s < stages.size(); ++s) {
     Result<StageSummary> stage =
-        SolveStage(config, options, stages[s], s, stages.size(), &builder, workspace.get(), &lambda);
+        SolveStage(config, options, stages[s], s, stages.size(), &builder, workspace.get(), &lambda, &held);
+    held.clear();
     if (!stage.ok()) return stage.status();
     result.iterations += stage.value().solver.iterations;
     result.termination = TerminationName(stage.value().solver.termination);

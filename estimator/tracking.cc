@@ -16,16 +16,15 @@
 #include <Eigen/Eigenvalues>
 
 #include "common/check.h"
-#include "common/chi_square.h"
 #include "common/interrupt.h"
 #include "estimator/calibration.h"
 #include "estimator/covariance.h"
 #include "estimator/geometry.h"
+#include "estimator/internal/after_gap.h"
 #include "estimator/internal/linearization.h"
 #include "estimator/internal/normal_equations.h"
 #include "estimator/marginalization.h"
 #include "estimator/solver.h"
-#include "recording/stream_health.h"
 
 namespace roamlab::estimator {
 namespace {
@@ -110,21 +109,6 @@ std::vector<FactorId> NewAbsoluteFactors(const ProblemBuilder& builder, FactorId
   return out;
 }
 
-// Per configured stream with a single recording source, the stamps at which that source's rows resume after a gap (an
-// outage, or its clock jumped forward: recording::CheckStreamHealth).
-std::map<std::string, std::vector<Time>> GapResumes(const EstimatorConfig& config, const recording::Recording& rec) {
-  std::map<std::string, std::vector<Time>> out;
-  for (const auto& [name, stream] : config.streams) {
-    if (stream.sources.size() != 1) continue;
-    for (const recording::Stream& source : rec.streams) {
-      if (source.info.name != stream.sources.begin()->second) continue;
-      for (const recording::StreamGap& gap : recording::CheckStreamHealth(source).gaps)
-        out[name].push_back(Time::FromNanoseconds(gap.after.nanoseconds() + std::llround(gap.length_s * 1e9)));
-    }
-  }
-  return out;
-}
-
 // Adds to `unconfirmed` the streams whose rows resume after a gap within a millisecond of the newest pose or before it
 // (a row is attached at the master sample at or after its stamp); `resumes` loses each gap so passed.
 void MarkStreamsAfterGaps(Time newest, std::map<std::string, std::vector<Time>>* resumes,
@@ -147,13 +131,13 @@ void HoldOut(const std::vector<FactorId>& factors, ProblemBuilder* builder) {
   }
 }
 
-// Whether the absolute factor `entry` (its one free variable the pose `pose`) fails the innovation test described at
-// ReadmitConsistentAbsolute. A pose whose marginal covariance cannot be had (nothing else holds it) has nothing to
-// test the factor against: it does not fail.
+// Whether the absolute factor `entry` (its one free variable the pose `pose`) fails the innovation test
+// (internal::InnovationWithin) against the pose's marginal covariance in the window. A pose whose marginal covariance
+// cannot be had (nothing else holds it) has nothing to test the factor against: it does not fail.
 bool InnovationFails(double probability, const FactorEntry& entry, VariableId pose,
                      const std::vector<const double*>& values, const Graph& graph, internal::WhitenedFactor* wf) {
-  const std::size_t column = static_cast<std::size_t>(
-      std::find(entry.variables.begin(), entry.variables.end(), pose) - entry.variables.begin());
+  const int column =
+      static_cast<int>(std::find(entry.variables.begin(), entry.variables.end(), pose) - entry.variables.begin());
   if (!internal::LinearizeFactorAt(entry, values.data(), std::uint64_t{1} << column, wf)) return false;
   const auto info = ComputeMarginalInformation(graph, {pose});
   if (!info.ok()) return false;
@@ -161,22 +145,14 @@ bool InnovationFails(double probability, const FactorEntry& entry, VariableId po
   if (information.info() != Eigen::Success || !information.isPositive() ||
       information.vectorD().minCoeff() <= 0.0)
     return false;
-  // (A robust loss scales the whitened error and Jacobian alike: the test takes them before it.)
-  const double unweight = wf->residual.norm() > 0.0 ? std::sqrt(wf->squared_norm) / wf->residual.norm() : 1.0;
-  const Eigen::VectorXd r = unweight * wf->residual;
-  const Eigen::MatrixXd J = unweight * wf->jacobians[column];
-  const Eigen::MatrixXd innovation =
-      Eigen::MatrixXd::Identity(J.rows(), J.rows()) + J * information.solve(J.transpose());
-  return !(r.dot(innovation.ldlt().solve(r)) <= ChiSquareQuantile(probability, entry.factor->residual_dim()));
+  const Eigen::MatrixXd covariance =
+      information.solve(Eigen::MatrixXd::Identity(information.rows(), information.cols()));
+  return !internal::InnovationWithin(probability, *wf, {column}, covariance);
 }
 
-// Re-admits each held-out absolute factor whose innovation passes the chi-square quantile `probability` of its
-// dimension: its whitened error r at the estimate solved without it, against I + J P J^T (J its whitened Jacobian in
-// its pose, P the pose's marginal covariance in the window). Tested after a solve that includes it, the error of an
-// absolute measurement shrinks by the window's uncertainty against its noise: where dead reckoning has left the pose
-// centimetres uncertain, a millimetre measurement pulls the window onto itself and then fits, whatever it says (a
-// motion-capture pose stamped a second late). Adds the streams of those it re-admitted to *consistent; returns how
-// many it re-admitted.
+// Re-admits each held-out absolute factor whose innovation at the estimate solved without it passes the chi-square
+// quantile `probability` of its dimension (InnovationFails). Adds the streams of those it re-admitted to *consistent;
+// returns how many it re-admitted.
 int ReadmitConsistentAbsolute(double probability, const std::vector<FactorId>& held, ProblemBuilder* builder,
                               std::set<std::string>* consistent) {
   Graph& graph = builder->graph();
@@ -403,7 +379,7 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
   leaving.leading_dims = kPositionDims;
   std::vector<double> update_times;
   SolverWorkspace workspace;  // the window's pattern repeats from one update to the next
-  std::map<std::string, std::vector<Time>> gap_resumes = GapResumes(config, recording);
+  std::map<std::string, std::vector<Time>> gap_resumes = internal::GapResumes(config, recording, false);
   std::set<std::string> after_gap;  // absolute streams past a gap, none of their rows since found consistent
   for (std::size_t i = 0; i < measurements.size(); ++i) {
     const MeasurementRef& m = measurements[i];

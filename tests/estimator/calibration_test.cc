@@ -558,5 +558,96 @@ TEST(GateOutliersTest, APassReadmitsTheRowsThatFitAndRejectsAGrossOutlier) {
   EXPECT_GE(mixed.readmitted, off_too - 1);  // (the outlier's pull may keep a neighbour out)
 }
 
+// DiffDriveArcWithMotionCapture's 6 s arc with its motion-capture stream changed by `edit`, the stream's rate set so
+// that a gap in it is found.
+template <typename Edit>
+recording::Recording ArcWithMotionCaptureEdited(const Edit& edit) {
+  recording::Recording rec = testing::DiffDriveArcWithMotionCapture(120, 0.3, Eigen::Vector2d(1.0, -2.0));
+  recording::Stream& mocap = rec.streams[1];
+  mocap.info.rate_hz = 1.0 / testing::kArcDt_s;
+  edit(&mocap);
+  return rec;
+}
+
+// Calibrates the arc's radius and baseline (free, gated), with every pose's position covariance.
+Result<CalibrationResult> CalibrateArc(const recording::Recording& rec) {
+  auto config = ParseEstimatorConfig(testing::ArcConfigYaml({}, "gating: {probability: 0.99999}\n"), "test config");
+  if (!config.ok()) return config.status();
+  for (const char* name : {"wheels.radius", "wheels.baseline"}) config.value().parameters[name].free = true;
+  CalibrationOptions options;
+  options.pose_covariance_every = 1;
+  return Calibrate(config.value(), rec, options);
+}
+
+// Motion capture whose clock steps 1 s ahead halfway through the arc: its later poses are stamped late (10 cm and
+// 0.5 rad off the truth at their stamps, 1000 and 500 times its noise), and as a whole they are the arc a second
+// behind, which the wheels fit as well as the truth but at the jump. In the first solve they bend the trajectory onto
+// themselves; the gate then finds the wheels failing at the jump, not them. The jump shows as a gap of the stream:
+// held out of the first solve and tested on their innovation there, every late pose must be rejected, no wheel span,
+// the radius and the baseline lie within 3 reported standard deviations of the truth and every position within the
+// 99.7 % quantile of its reported covariance (without the hold-out no late pose is rejected, wheel spans are, and the
+// positions after the jump are about 1e6 in squared error against their covariance).
+TEST(CalibrationTest, RejectsEveryMotionCapturePoseStampedLateAfterItsClockJumps) {
+  constexpr int kJumpRow = 60;
+  int late_in_span = 0;
+  const recording::Recording rec = ArcWithMotionCaptureEdited([&](recording::Stream* mocap) {
+    const Time truth_end = mocap->t.back();
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < mocap->t.size(); ++k) {
+      mocap->t[k] = Time::FromNanoseconds(mocap->t[k].nanoseconds() + (k >= kJumpRow ? 1000000000 : 0));
+      if (mocap->t[k] > truth_end) continue;
+      late_in_span += k >= kJumpRow;
+      ++kept;
+    }
+    mocap->t.resize(kept);
+    mocap->values.conservativeResize(static_cast<Eigen::Index>(kept), Eigen::NoChange);
+  });
+  ASSERT_GT(late_in_span, 30);
+  const auto result = CalibrateArc(rec);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  const CalibrationResult& r = result.value();
+  EXPECT_EQ(r.counts.at("mocap").gaps, 1);
+  EXPECT_EQ(r.counts.at("mocap").rejected, late_in_span);
+  EXPECT_EQ(r.counts.at("wheels").rejected, 0);
+  const ParameterEstimate& radius = Find(r, "wheels.radius");
+  const ParameterEstimate& baseline = Find(r, "wheels.baseline");
+  ASSERT_EQ(radius.estimate.size(), 1);
+  ASSERT_EQ(baseline.estimate.size(), 1);
+  EXPECT_LT(std::abs(radius.estimate[0] - testing::kArcRadius_m), 3.0 * radius.std[0]);
+  EXPECT_LT(std::abs(baseline.estimate[0] - testing::kArcTrack_m), 3.0 * baseline.std[0]);
+  const recording::Recording truth = testing::DiffDriveArcWithMotionCapture(120, 0.3, Eigen::Vector2d(1.0, -2.0));
+  ASSERT_EQ(r.pose_covariances.size(), r.trajectory.size());
+  const double gate = ChiSquareQuantile(0.997, 3);
+  for (const PoseCovariance& c : r.pose_covariances) {
+    const StampedPose& pose = r.trajectory[c.pose];
+    const Eigen::Index row = static_cast<Eigen::Index>(std::llround(pose.t.seconds() / testing::kArcDt_s));
+    const Eigen::Vector3d error = pose.p_world_body - truth.streams[1].values.row(row).head<3>().transpose();
+    EXPECT_LE(error.dot(c.covariance.ldlt().solve(error)), gate) << "pose at " << pose.t.seconds() << " s";
+  }
+}
+
+// The same arc with the motion capture out for 2 s from 2 s on: its rows after the gap resume consistent, pass their
+// innovation test, and every one of them is back in the estimate.
+TEST(CalibrationTest, MotionCaptureRowsAfterAnOutageComeBackIn) {
+  const recording::Recording rec = ArcWithMotionCaptureEdited([](recording::Stream* mocap) {
+    constexpr int kFirst = 40, kRows = 40;
+    const auto out = [&](std::size_t k) { return k >= kFirst && k < kFirst + kRows; };
+    std::vector<Time> t;
+    Eigen::MatrixXd values(mocap->values.rows() - kRows, mocap->values.cols());
+    for (std::size_t k = 0; k < mocap->t.size(); ++k) {
+      if (out(k)) continue;
+      values.row(static_cast<Eigen::Index>(t.size())) = mocap->values.row(static_cast<Eigen::Index>(k));
+      t.push_back(mocap->t[k]);
+    }
+    mocap->t = t;
+    mocap->values = values;
+  });
+  const auto result = CalibrateArc(rec);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_EQ(result.value().counts.at("mocap").gaps, 1);
+  EXPECT_EQ(result.value().counts.at("mocap").rejected, 0);
+  EXPECT_EQ(result.value().counts.at("wheels").rejected, 0);
+}
+
 }  // namespace
 }  // namespace roamlab::estimator
