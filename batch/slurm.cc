@@ -377,8 +377,9 @@ int AggregateSlurm(const std::string& out, std::ostream& out_stream, std::ostrea
   if (!missing.empty()) {
     // The submissions of the runs ready now: none when earlier runs' results have just made them ready.
     const int ready = work->Ready();
+    const int runs = work->runs();  // a structured binding cannot be captured in C++17 (clang refuses it)
     const auto submissions = std::count_if(batch["submissions"].begin(), batch["submissions"].end(),
-                                           [&](const json& s) { return s.value("ready", work->runs()) == ready; });
+                                           [&](const json& s) { return s.value("ready", runs) == ready; });
     if (submissions <= batch["slurm"]["retries"].get<int>()) {
       const Status s = SubmitAttempt(&batch, out, work->kind(), missing, ready);
       if (s.ok()) {
