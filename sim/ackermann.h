@@ -11,7 +11,7 @@
 // which inverts the first pair exactly and does not depend on L or w. If the two wheels point to opposite sides (only
 // possible near zero), it falls back to the mean angle.
 //
-// Drive. A PI controller on the rear-wheel speed (mean rear spin rate times the rolling radius, what the vehicle's
+// Drive. A PI controller on the rear-wheel speed (mean rear spin rate times the tire radius, what the vehicle's
 // own speed sensor sees) outputs one torque that goes to both rear wheels: an open differential, so the rear wheels
 // may turn at different rates in curves. The integral is frozen while the torque saturates (anti-windup). The same
 // torque brakes when negative. The steering servos are MuJoCo position actuators on the steering hinges.
@@ -62,7 +62,7 @@ class AckermannVehicle {
   double wheelbase_m() const { return wheelbase_m_; }  // rear to front wheel centres along x of O
   double front_track_m() const { return front_track_m_; }
   double rear_track_m() const { return rear_track_m_; }
-  double wheel_radius_m() const { return wheel_radius_m_; }        // true rolling radius of the rear tires
+  double wheel_radius_m() const { return wheel_radius_m_; }        // the rear tires' geometric radius
   double mass_kg() const { return mass_kg_; }                      // the whole vehicle (the root body's subtree)
   double max_handlebar_rad() const { return max_handlebar_rad_; }  // the inner wheel reaches the servo limit
   int odom_site() const { return odom_site_; }

@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
 #include "sim/mujoco_model.h"
+#include "sim/terrain.h"
 
 namespace roamlab::sim {
 namespace {
@@ -24,6 +26,18 @@ ModelPtr FloorOnlyCopy(const mjModel* model) {
     if (copy->geom_bodyid[g] != 0 || g == ground) continue;
     copy->geom_contype[g] = 0;
     copy->geom_conaffinity[g] = 0;
+  }
+  return copy;
+}
+
+// FloorOnlyCopy with its ground level at z = 0: a heightfield's samples and geom height set to 0 (a plane stays).
+ModelPtr LevelGroundCopy(const mjModel* model) {
+  ModelPtr copy = FloorOnlyCopy(model);
+  const int hfield = IdOf(copy.get(), mjOBJ_HFIELD, "terrain");
+  if (hfield >= 0) {
+    float* samples = copy->hfield_data + copy->hfield_adr[hfield];
+    std::fill(samples, samples + copy->hfield_nrow[hfield] * copy->hfield_ncol[hfield], 0.0f);
+    copy->geom_pos[3 * IdOf(copy.get(), mjOBJ_GEOM, "terrain") + 2] = 0.0;
   }
   return copy;
 }
@@ -75,10 +89,13 @@ Eigen::Vector3d HubWorld(const mjModel* model, const mjData* data, int joint) {
   return Eigen::Vector3d(data->xpos + 3 * model->jnt_bodyid[joint]);
 }
 
+// Sets the robot's actuators for a body velocity set-point v (in O) before a physics step.
+using ApplySetPoint = std::function<void(const Eigen::Vector2d& v, mjData* data)>;
+
 class Drive {
  public:
-  Drive(const mjModel* model, mjData* data, const WheeledRobot& robot, const std::string& what)
-      : model_(model), data_(data), robot_(robot), what_(what) {}
+  Drive(const mjModel* model, mjData* data, ApplySetPoint apply, const std::string& what)
+      : model_(model), data_(data), apply_(std::move(apply)), what_(what) {}
 
   // Steps for duration_s with the body velocity set-point ramping from `from` to `to` (in O).
   Status Run(double duration_s, const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
@@ -129,7 +146,7 @@ class Drive {
 
   // One physics step at the set-point v (in O), then the positions for the new state.
   Status Step(const Eigen::Vector2d& v) {
-    robot_.Apply(v.x(), v.y(), 0.0, data_);
+    apply_(v, data_);
     mj_step(model_, data_);
     if (data_->warning[mjWARN_BADQACC].number > 0)
       return Status::Error(what_ +
@@ -140,7 +157,7 @@ class Drive {
 
   const mjModel* model_;
   mjData* data_;
-  const WheeledRobot& robot_;
+  ApplySetPoint apply_;
   const std::string& what_;
 };
 
@@ -153,7 +170,8 @@ Result<std::vector<double>> MeasureRollingRadii(const mjModel* model, const Whee
   const mjModel* m = floor_only.get();
   DataPtr data = MakeData(m);
   robot.Place(m, data.get(), x, y, yaw_rad, kPlacementClearanceM);
-  Drive driver(m, data.get(), robot, what);
+  Drive driver(
+      m, data.get(), [&robot](const Eigen::Vector2d& v, mjData* d) { robot.Apply(v.x(), v.y(), 0.0, d); }, what);
   const Eigen::Vector2d rest = Eigen::Vector2d::Zero();
   if (Status s = driver.Run(drive.settle_s, rest, rest); !s.ok()) return s;
 
@@ -178,6 +196,35 @@ Result<std::vector<double>> MeasureRollingRadii(const mjModel* model, const Whee
     for (std::size_t k = 0; k < group.size(); ++k) radii[static_cast<std::size_t>(group[k])] = travels[k].radius_m;
   }
   return radii;
+}
+
+Result<double> MeasureRearRollingRadius(const mjModel* model, const AckermannVehicle& vehicle,
+                                        const SpeedControllerOptions& controller, const std::string& what,
+                                        const RearRollingDrive& drive) {
+  const ModelPtr level = LevelGroundCopy(model);
+  const mjModel* m = level.get();
+  DataPtr data = MakeData(m);
+  TerrainOptions flat;
+  flat.type = TerrainOptions::Type::kFlat;
+  vehicle.Place(m, data.get(), Terrain::Make(flat, Eigen::Vector2d::Zero()), 0.0, 0.0, 0.0, kPlacementClearanceM);
+  SpeedController speed(controller);
+  const double dt_s = m->opt.timestep;
+  const ApplySetPoint apply = [&](const Eigen::Vector2d& v, mjData* d) {
+    vehicle.Apply(0.0, speed.Update(v.x(), vehicle.RearWheelRate(d) * vehicle.wheel_radius_m(), dt_s), d);
+  };
+  Drive driver(m, data.get(), apply, what);
+  const Eigen::Vector2d rest = Eigen::Vector2d::Zero();
+  const Eigen::Vector2d v(drive.speed_mps, 0.0);
+  if (Status s = driver.Run(drive.settle_s, rest, rest); !s.ok()) return s;
+  if (Status s = driver.Run(drive.ramp_s, rest, v); !s.ok()) return s;
+  if (Status s = driver.Run(drive.hold_s, v, v); !s.ok()) return s;
+  std::vector<WheelTravel> travels(2);
+  travels[0].joint = IdOf(m, mjOBJ_JOINT, "wheel_rear_left");
+  travels[1].joint = IdOf(m, mjOBJ_JOINT, "wheel_rear_right");
+  for (WheelTravel& w : travels) w.window_rad = drive.revolutions * kTwoPi;
+  const double window_s = drive.revolutions * kTwoPi * vehicle.wheel_radius_m() / drive.speed_mps;
+  if (Status s = driver.Measure(v, kWindowTimeLimit * window_s, &travels); !s.ok()) return s;
+  return 0.5 * (travels[0].radius_m + travels[1].radius_m);
 }
 
 }  // namespace roamlab::sim

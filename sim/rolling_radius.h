@@ -15,6 +15,16 @@
 // radian differ between wheels by a tenth of a millimetre).
 // Driven along its own rolling direction, a wheel's rollers do not turn and nothing asks it to slip. Deterministic:
 // the same model and start give the same radii.
+//
+// The Ackermann vehicle's rear tires (spheres of the geometric radius r) roll below r too: the soft contact lets a tire
+// sink into the ground under the vehicle's weight, MuJoCo puts the contact point midway through the penetration, and
+// on a heightfield a tire over a triangle's edge rests on two contacts. MeasureRearRollingRadius drives a copy of the
+// bound model on its own ground made level (a heightfield's samples and geom set to z = 0, so that the tires meet the
+// same triangles; a plane as it is; every other world geom out of contact): placed at rest at the origin heading
+// along x, settled, then straight (handlebar 0) under the speed controller, ramped up to a slow speed and held; over
+// whole revolutions of the rear wheels, each rear hub's travel along its rolling direction over its rotation, the
+// mean of the two. On level ground at constant speed the tires carry only the rolling resistance: the free-rolling
+// travel per radian, which does not depend on the speed or the heading. Deterministic.
 #pragma once
 
 #include <string>
@@ -23,6 +33,7 @@
 #include <mujoco/mujoco.h>
 
 #include "common/status.h"
+#include "sim/ackermann.h"
 #include "sim/wheeled_robot.h"
 
 namespace roamlab::sim {
@@ -40,5 +51,19 @@ struct RollingRadiusDrive {
 Result<std::vector<double>> MeasureRollingRadii(const mjModel* model, const WheeledRobot& robot, double x, double y,
                                                 double yaw_rad, const std::string& what,
                                                 const RollingRadiusDrive& drive = {});
+
+struct RearRollingDrive {
+  double speed_mps = 1.0;  // the speed controller's set-point
+  double settle_s = 1.0;   // at rest after placing
+  double ramp_s = 1.0;     // speed ramp
+  double hold_s = 2.0;     // at constant speed before the measurement
+  int revolutions = 4;     // of the rear wheels, measured over
+};
+
+// The free-rolling travel per radian [m] of the rear tires of `vehicle` (bound to `model`), driven by `controller`.
+// Errors name `what` (a wheel that does not turn its window within the time the drive allows, a diverged simulation).
+Result<double> MeasureRearRollingRadius(const mjModel* model, const AckermannVehicle& vehicle,
+                                        const SpeedControllerOptions& controller, const std::string& what,
+                                        const RearRollingDrive& drive = {});
 
 }  // namespace roamlab::sim

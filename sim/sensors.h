@@ -12,8 +12,9 @@
 //                  it shares the IMU's frame; h_world is the Earth field in ENU (unit magnitude by default)
 //   gps            p_antenna = p_world_body + q_world_body S_GPS (then ENU -> latitude, longitude, altitude)  (eq. 9)
 //   rear wheel     z_v = omega_rear r / k_v,  k_v = kv_over_L L                                 (seed eq. 15)
-//                  omega_rear = mean spin rate of the two rear wheels relative to the chassis [rad/s], r the true
-//                  rolling radius [m]: without slip, k_v z_v is the forward speed of O
+//                  omega_rear = mean spin rate of the two rear wheels relative to the chassis [rad/s], r the tires'
+//                  geometric radius [m]; the ground passes at omega_rear times their travel per radian, below r by
+//                  the contact's sink (rolling_radius.h), which truth.yaml's kv_over_L takes in
 //   handlebar      z_theta = (delta - k_gamma) / k_theta                                         (seed eq. 15)
 //                  delta = the bicycle-equivalent steering angle of the two front wheels (ackermann.h)
 //
@@ -58,7 +59,7 @@ Eigen::Vector3d MagnetometerReading(const FrameKinematics& body, const Eigen::Qu
                                     const MagnetometerCalibration& magnetometer);
 Eigen::Vector3d GpsAntennaWorld(const FrameKinematics& body, const Eigen::Vector3d& lever_arm_m);  // ENU [m]
 
-// Eq. 15 readings. rear_wheel_rate_radps: mean rear-wheel spin rate; wheel_radius_m: true rolling radius.
+// Eq. 15 readings. rear_wheel_rate_radps: mean rear-wheel spin rate; wheel_radius_m: the tires' geometric radius.
 double SpeedReading(double rear_wheel_rate_radps, double wheel_radius_m, double kv_over_L, double wheelbase_m);
 double SteeringReading(double delta_rad, double k_theta, double k_gamma);
 

@@ -171,6 +171,10 @@ class Simulator::Impl {
         const double scale = EffectParameter(scenario_.effects, "lateral_slip", "contact_time_scale", 1.0);
         if (Status st = vehicle_.SoftenTires(model_.get(), scale, model_where_); !st.ok()) return st;
       }
+      // The rear tires' free-rolling travel per radian on the changed model: the speed reading's true gain.
+      auto rolling = MeasureRearRollingRadius(model_.get(), vehicle_, scenario_.robot.speed_controller, model_where_);
+      if (!rolling.ok()) return rolling.status();
+      rear_rolling_radius_m_ = rolling.value();
       controller_.emplace(scenario_.robot.speed_controller);
       odom_site_ = vehicle_.odom_site();
     } else {
@@ -873,6 +877,7 @@ class Simulator::Impl {
     // True calibration.
     internal::TrueSensorFrames frames{imu_, magnetometer_, {}, laser_mounting_, std::nullopt};
     if (sensors.wheel_encoders) frames.wheels = wheeled_.TrueOdometerCalibration();
+    if (ackermann_) frames.rear_rolling_over_radius = rear_rolling_radius_m_ / vehicle_.wheel_radius_m();
     if (camera_ != nullptr) frames.camera = camera_mounting_;
     out_.truth.calibration = internal::TrueCalibration(sensors, frames);
     out_.stats.terrain_relief_m = terrain_.Relief();
@@ -890,6 +895,7 @@ class Simulator::Impl {
   ModelPtr model_;
   DataPtr data_;
   AckermannVehicle vehicle_;
+  double rear_rolling_radius_m_ = 0.0;  // the rear tires' free-rolling travel per radian (sim/rolling_radius.h)
   WheeledRobot wheeled_;
   int odom_site_ = -1;
   frontend::ScanGeometry scan_geometry_;

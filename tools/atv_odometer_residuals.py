@@ -3,17 +3,20 @@
 
     python3 tools/atv_odometer_residuals.py [--roamlab build/apps/roamlab] [--scenario scenarios/atv_hills.yaml]
                                               [--drive NAME]
-                                              [--seed 1] [--height 0.28] [--lever 0.625]
+                                              [--seed 1] [--height 0.28] [--lever 0.625] [--t0 2] [--rolling-kv]
 
 Simulates the scenario (with --drive, its variant of tools/atv_calibration_information.py's DRIVES, e.g. `sines`,
 the drive of atv_hills_sines.yaml) with every sensor noise set to zero, then takes the velocities between consecutive
-ground-truth poses of O (eq. 7 inverted, as the estimator does) and the true calibration, and prints, for the rows of
-estimator/models/ackermann_velocity.h: their RMS, 1/e correlation time and white-noise equivalent (the per-sample
-sigma of white noise with the same low-frequency power, sqrt of the summed autocovariance over +-3 s), at O and at the
+ground-truth poses of O (eq. 7 inverted, as the estimator does) and the true calibration, the speed read through the
+geometric kv/L (truth.yaml's kv_over_L_geometric, as the configurations' noise was fitted; with --rolling-kv through
+its kv_over_L, the tires' rolling value, whose smaller offset the calibrated kv/L would absorb), and prints, for the
+rows of estimator/models/ackermann_velocity.h: their RMS, 1/e correlation time and white-noise equivalent (the
+per-sample sigma of white noise with the same low-frequency power, sqrt of the summed autocovariance over +-3 s), at O and at the
 rear ground contact (--height below O, vertical chord lever --lever), and least-squares slopes on the body rates and
 the lateral acceleration, and each row's split into a first-order Gauss-Markov part (stationary sigma, correlation
 time tau) and a white part, with the fit's white equivalent (the Bartlett-weighted sum above, over +-3 s, falls short
-of it for correlation times of a second or more). Last, the IMU's rows against the same poses: their model error
+of it for correlation times of a second or more). Then the speed gain kv/L the speed row alone fits to the drive.
+Last, the IMU's rows against the same poses: their model error
 (the readings are instantaneous samples, the estimator's rates and accelerations come from the poses). Standard
 library only.
 """
@@ -141,6 +144,8 @@ def main():
     ap.add_argument("--height", type=float, default=0.28, help="contact below O [m]")
     ap.add_argument("--lever", type=float, default=0.625, help="vertical row's pitch-rate lever [m]")
     ap.add_argument("--t0", type=float, default=2.0, help="skip the first seconds [s]")
+    ap.add_argument("--rolling-kv", action="store_true",
+                    help="read the speed through truth.yaml's kv_over_L (the tires' rolling value), not the geometric")
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         scenario = args.scenario
@@ -153,7 +158,9 @@ def main():
             open(scenario, "w").write(information.variant(args.scenario, information.DRIVES[args.drive][1], True))
         rec = simulate_noiseless(args.roamlab, scenario, args.seed, tmp)
         truth = open(os.path.join(rec, "truth.yaml")).read()
-        kv_over_l = float(re.search(r"odometer.kv_over_L: *([0-9.eE+-]+)", truth).group(1))
+        kv_rolling = float(re.search(r"odometer.kv_over_L: *([0-9.eE+-]+)", truth).group(1))
+        kv_geometric = float(re.search(r"odometer.kv_over_L_geometric: *([0-9.eE+-]+)", truth).group(1))
+        kv_over_l = kv_rolling if args.rolling_kv else kv_geometric
         k_theta = float(re.search(r"odometer.k_theta: *([0-9.eE+-]+)", truth).group(1))
         k_gamma = float(re.search(r"odometer.k_gamma: *([0-9.eE+-]+)", truth).group(1))
         wheelbase = float(re.search(r"wheelbase_m: *([0-9.eE+-]+)", open(os.path.join(rec, "recording.yaml")).read())
@@ -173,6 +180,7 @@ def main():
         imu = {round(float(r[0]) * 1e3): [float(x) for x in r[1:7]]
                for r in list(csv.reader(open(os.path.join(rec, "imu.csv"))))[1:]}
     samples = []
+    rolls = []  # sin of O's roll at the middle of each sample's interval: e_z^T R_mid e_y
     for (t0, p0, q0), (t1, p1, q1) in zip(poses, poses[1:]):
         key = round(t0 * 1e3)
         if t0 < args.t0 or key not in speed:
@@ -184,6 +192,7 @@ def main():
         if v[0] < 0.5:
             continue
         samples.append((v, w, speed[key] * kv_over_l * wheelbase, k_theta * steering[key] + k_gamma))
+        rolls.append(rotate(qmul(q0, qexp([c / 2 for c in phi])), [0.0, 1.0, 0.0])[2])
     dt = poses[1][0] - poses[0][0]
     lags = int(round(3.0 / dt))
     a_y = [s[0][0] * s[1][2] for s in samples]
@@ -243,7 +252,29 @@ def main():
                 print("  %-32s %8.4f %8.2f %8.4f %10.4f" % (name, sigma, tau, white,
                                                            math.sqrt(sigma ** 2 * (1 + rho) / (1 - rho) + white ** 2)))
 
+    speed_gains(samples, rolls, kv_over_l, kv_rolling, kv_geometric, args.height)
     imu_rows(poses, imu, misalignment, args.t0)
+
+
+def speed_gains(samples, rolls, kv_over_l, kv_rolling, kv_geometric, h):
+    """The speed gain kv/L the speed row alone fits to the drive (least squares of the row's speed on the reading, as
+    a calibration of kv/L alone does), relative to truth.yaml's geometric kv/L: with the row at O, at the contact h
+    below O, and at the contact with the yaw rate a rolled chassis shows about its y axis (omega_z sin(roll)) taken
+    out of the pitch rate (on level ground, where the roll is the suspension's); beside it truth.yaml's kv/L, the
+    tires' free-rolling value; and the roll's slope on the lateral acceleration."""
+    wheel = [s[2] * kv_geometric / kv_over_l for s in samples]  # the reading times the geometric k_v: omega r
+    print("speed gain the speed row fits, relative to the geometric kv/L %.4f (truth.yaml's kv/L: %+.3f %%)" %
+          (kv_geometric, 100 * (kv_rolling / kv_geometric - 1)))
+    for label, rows in (
+            ("at O", [v[0] for v, _, _, _ in samples]),
+            ("at the contact", [v[0] - h * w[1] for v, w, _, _ in samples]),
+            ("at the contact, yaw-in-roll out of omega_y",
+             [v[0] - h * (w[1] - w[2] * r) for (v, w, _, _), r in zip(samples, rolls)])):
+        gain = sum(c * c for c in rows) / sum(c * z for c, z in zip(rows, wheel))
+        print("  %-44s %+.3f %%" % (label, 100 * (gain - 1)))
+    b, r = least_squares(rolls, [[v[0] * w[2] for v, w, _, _ in samples]])
+    print("  sin(roll) %+.4f rad s^2/m on a_y, residual rms %.4f (on level ground: the roll on the suspension)" %
+          (b[1], r))
 
 
 def block_equivalent(a, n):

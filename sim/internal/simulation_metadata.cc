@@ -60,7 +60,10 @@ std::map<std::string, std::vector<double>> TrueCalibration(const SensorOptions& 
   if (sensors.laser) AddMounting("scan_matching", frames.laser, &cal);
   if (frames.camera) AddMounting("visual_odometry", *frames.camera, &cal);
   if (sensors.odometer) {
-    cal["odometer.kv_over_L"] = {sensors.odometer->kv_over_L};
+    // The reading z_v = omega r / k_v takes the tires' geometric radius r; the ground passes at omega times their
+    // travel per radian, so the true gain is the scenario's times that over r, which is stated beside it.
+    cal["odometer.kv_over_L"] = {sensors.odometer->kv_over_L * frames.rear_rolling_over_radius};
+    cal["odometer.kv_over_L_geometric"] = {sensors.odometer->kv_over_L};
     cal["odometer.k_theta"] = {sensors.odometer->k_theta};
     cal["odometer.k_gamma"] = {sensors.odometer->k_gamma};
   }

@@ -26,6 +26,7 @@ struct TrueSensorFrames {
   std::map<std::string, std::vector<double>> wheels;  // the wheeled robot's true odometer geometry
   recording::Mounting laser;                          // the laser site in O
   std::optional<recording::Mounting> camera;          // the camera in O, when it ran
+  double rear_rolling_over_radius = 1.0;  // the Ackermann rear tires' travel per radian over their geometric radius
 };
 
 // The true calibration, named as calibration.json names the estimated parameters; quaternions w first, matrices

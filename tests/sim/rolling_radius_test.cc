@@ -1,5 +1,6 @@
 // The effective rolling radius of roller wheels (sim/rolling_radius.h): below the rollers' envelope by the axle's dip
-// between two rollers, deterministic, and the truth of the simulated recordings' wheel radii.
+// between two rollers, deterministic, and the truth of the simulated recordings' wheel radii. The ATV's rear tires:
+// below their radius by half the contact's penetration, and the truth of its speed gain kv/L.
 #include "sim/rolling_radius.h"
 
 #include <cmath>
@@ -7,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "sim/ackermann.h"
 #include "sim/mujoco_model.h"
 #include "sim/scenario.h"
 #include "sim/simulator.h"
@@ -23,7 +25,8 @@ struct FlatWorld {
   WheeledRobot robot;
 };
 
-FlatWorld Compile(const std::string& file, const std::string& kind) {
+// The model in `file` on the flat floor (friction 0.6; a tire's own friction rules when higher).
+ModelPtr CompileOnFloor(const std::string& file) {
   TerrainOptions floor;
   floor.type = TerrainOptions::Type::kFlat;
   floor.friction = 0.6;
@@ -33,7 +36,11 @@ FlatWorld Compile(const std::string& file, const std::string& kind) {
       {"world.xml", "<mujoco model=\"world\">\n<include file=\"robot.xml\"/>\n" + terrain.Mjcf() + "</mujoco>\n"}};
   auto model = LoadModelFromFiles("world.xml", files, file);
   EXPECT_TRUE(model.ok()) << model.status().message();
-  FlatWorld world{std::move(model).value(), {}};
+  return std::move(model).value();
+}
+
+FlatWorld Compile(const std::string& file, const std::string& kind) {
+  FlatWorld world{CompileOnFloor(file), {}};
   auto robot = WheeledRobot::Bind(world.model.get(), kind, file);
   EXPECT_TRUE(robot.ok()) << robot.status().message();
   world.robot = robot.value();
@@ -138,6 +145,92 @@ TEST(RollingRadiusTest, TheTruthIsTheRollingRadiusAndKeepsTheEnvelope) {
       EXPECT_GT(truth.at("odometer.radius_" + index)[0], rigid_m - kContactSinkM) << scenario << " wheel " << i;
     }
   }
+}
+
+// The ATV on the flat floor (a plane).
+struct AtvWorld {
+  ModelPtr model;
+  AckermannVehicle vehicle;
+};
+
+AtvWorld CompileAtv() {
+  AtvWorld world{CompileOnFloor("models/atv.xml"), {}};
+  auto vehicle = AckermannVehicle::Bind(world.model.get(), "atv.xml");
+  EXPECT_TRUE(vehicle.ok()) << vehicle.status().message();
+  world.vehicle = vehicle.value();
+  return world;
+}
+
+// Free rolling on level ground: the travel per radian is the same at 1 and 3 m/s to 1 % of the 0.36 mm sink (the
+// faster roll carries more of the wheels' hinge damping), and the same on every call.
+TEST(RollingRadiusTest, TheAtvsRearTiresRollAtOneRadiusWhateverTheSpeed) {
+  const AtvWorld world = CompileAtv();
+  RearRollingDrive fast;
+  fast.speed_mps = 3.0;
+  auto slow_m = MeasureRearRollingRadius(world.model.get(), world.vehicle, {}, "atv");
+  auto fast_m = MeasureRearRollingRadius(world.model.get(), world.vehicle, {}, "atv", fast);
+  auto again_m = MeasureRearRollingRadius(world.model.get(), world.vehicle, {}, "atv");
+  ASSERT_TRUE(slow_m.ok() && fast_m.ok() && again_m.ok()) << slow_m.status().message();
+  EXPECT_EQ(again_m.value(), slow_m.value());
+  EXPECT_NEAR(fast_m.value(), slow_m.value(), 0.01 * 3.6e-4);
+  EXPECT_LT(slow_m.value(), world.vehicle.wheel_radius_m());
+  std::printf("ATV rear tires on a plane: %.6f m per rad at 1 m/s, %.6f at 3 m/s (radius %.3f m)\n", slow_m.value(),
+              fast_m.value(), world.vehicle.wheel_radius_m());
+}
+
+// A short straight roll of the scenario on a flat floor, simulated: O's travel over the rear wheels' rotation is the
+// travel per radian truth.yaml's kv/L states (over its geometric value, times the tire radius), and it lies below the
+// tire's radius by half the rear tires' penetration (MuJoCo's contact point is midway through it).
+TEST(RollingRadiusTest, TheAtvsKvOverLTruthIsTheRearTiresTravelPerRadian) {
+  Scenario s = testing::AtvHills(6.0);
+  s.terrain.type = TerrainOptions::Type::kFlat;
+  s.driver.speed_mps = Profile::Constant(2.0);
+  s.driver.handlebar_rad = Profile::Constant(0.0);
+  constexpr double kFromS = 2.0;  // the speed controller has settled
+  struct Roll {
+    Eigen::Vector3d first_m = Eigen::Vector3d::Zero(), last_m = Eigen::Vector3d::Zero();
+    double first_rad = 0.0, last_rad = 0.0, penetration_m = 0.0;
+    int contacts = 0;
+    bool started = false;
+  } roll;
+  SimulateOptions options;
+  options.noise = false;
+  options.observer = [&roll](Time t, const mjModel* m, const mjData* d) {
+    if (t.seconds() < kFromS) return;
+    const Eigen::Vector3d p(d->site_xpos + 3 * IdOf(m, mjOBJ_SITE, "odom"));
+    const double angle_rad = 0.5 * (d->qpos[m->jnt_qposadr[IdOf(m, mjOBJ_JOINT, "wheel_rear_left")]] +
+                                    d->qpos[m->jnt_qposadr[IdOf(m, mjOBJ_JOINT, "wheel_rear_right")]]);
+    if (!roll.started) {
+      roll.first_m = p;
+      roll.first_rad = angle_rad;
+      roll.started = true;
+    }
+    roll.last_m = p;
+    roll.last_rad = angle_rad;
+    const int left = IdOf(m, mjOBJ_GEOM, "tire_rear_left"), right = IdOf(m, mjOBJ_GEOM, "tire_rear_right");
+    for (int i = 0; i < d->ncon; ++i) {
+      const mjContact& c = d->contact[i];
+      if (c.geom1 != left && c.geom2 != left && c.geom1 != right && c.geom2 != right) continue;
+      roll.penetration_m -= c.dist;
+      ++roll.contacts;
+    }
+  };
+  auto sim = Simulate(s, options);
+  ASSERT_TRUE(sim.ok()) << sim.status().message();
+  const double travel_per_rad_m = (roll.last_m - roll.first_m).norm() / (roll.last_rad - roll.first_rad);
+  const double penetration_m = roll.penetration_m / roll.contacts;
+
+  const auto& truth = sim.value().truth.calibration;
+  ASSERT_TRUE(truth.count("odometer.kv_over_L") && truth.count("odometer.kv_over_L_geometric"));
+  EXPECT_EQ(truth.at("odometer.kv_over_L_geometric")[0], s.sensors.odometer->kv_over_L);
+  const double radius_m = 0.28;  // models/atv.xml's tires
+  const double stated_m = radius_m * truth.at("odometer.kv_over_L")[0] / truth.at("odometer.kv_over_L_geometric")[0];
+  // Both measure the same roll, over windows a few revolutions long: a micrometre apart against a 0.35 mm sink.
+  EXPECT_NEAR(stated_m, travel_per_rad_m, 2e-6);
+  EXPECT_NEAR(radius_m - stated_m, 0.5 * penetration_m, 1e-5);
+  EXPECT_GT(penetration_m, 5e-4);  // solimp's 1 mm width under 1.8 kN per rear tire
+  std::printf("ATV: stated %.6f m per rad, rolled %.6f, sink %.3f mm, rear tires' penetration %.3f mm\n", stated_m,
+              travel_per_rad_m, 1e3 * (radius_m - stated_m), 1e3 * penetration_m);
 }
 
 }  // namespace
