@@ -300,7 +300,9 @@ void SchurComplementOntoBlanket(const Eigen::MatrixXd& H, const Eigen::VectorXd&
   const int nb = n - nm;
   Eigen::MatrixXd Hbb = H.bottomRightCorner(nb, nb);
   Eigen::VectorXd gb = g.tail(nb);
-  if (nm > 0) {
+  // Without a blanket (nb = 0) there is nothing to condition, and a solve on W's zero columns would offset a null
+  // pointer.
+  if (nm > 0 && nb > 0) {
     // Hmb^T Hmm^-1 Hmb = W^T W with W = L^-1 Hmb (Hmm + 1e-12 I = L L^T): half the arithmetic of solving for
     // Hmm^-1 Hmb and multiplying, in coefficient-wise products (a blanket of a few dozen coordinates, on which a
     // blocked product's packing costs more than the arithmetic). LDLT where the Cholesky factorization fails.

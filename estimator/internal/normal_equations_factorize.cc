@@ -321,7 +321,8 @@ bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, doubl
         std::copy_n(kept_envelope_.data() + kept_envelope_start_[kb] + t * kept_height + skip, height,
                     envelope_.data() + envelope_start_[b] + t * height);
     }
-    border_.topRows(reused_rows) = kept_border_.middleRows(row_shift, reused_rows);
+    // Without border columns the border has no storage: a block of it would offset a null pointer.
+    if (border_.cols() > 0) border_.topRows(reused_rows) = kept_border_.middleRows(row_shift, reused_rows);
   }
   reused_blocks_ += reused;
 
