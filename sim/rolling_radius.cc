@@ -76,7 +76,8 @@ struct WheelTravel {
   double start_angle_rad = 0.0;
   Eigen::Vector3d last_hub_world = Eigen::Vector3d::Zero();
   double travel_m = 0.0;
-  double radius_m = 0.0;  // set when the window closes
+  double radius_m = 0.0;    // set when the window closes
+  double duration_s = 0.0;  // set when the window closes
 };
 
 // The rolling direction in the world, d = a x e_z (a: the hinge axis), of the wheel on `joint`.
@@ -91,11 +92,13 @@ Eigen::Vector3d HubWorld(const mjModel* model, const mjData* data, int joint) {
 
 // Sets the robot's actuators for a body velocity set-point v (in O) before a physics step.
 using ApplySetPoint = std::function<void(const Eigen::Vector2d& v, mjData* data)>;
+// Sees the state after each physics step of a measurement while a window is open.
+using ObserveStep = std::function<void(const mjData* data)>;
 
 class Drive {
  public:
-  Drive(const mjModel* model, mjData* data, ApplySetPoint apply, const std::string& what)
-      : model_(model), data_(data), apply_(std::move(apply)), what_(what) {}
+  Drive(const mjModel* model, mjData* data, ApplySetPoint apply, const std::string& what, ObserveStep observe = {})
+      : model_(model), data_(data), apply_(std::move(apply)), what_(what), observe_(std::move(observe)) {}
 
   // Steps for duration_s with the body velocity set-point ramping from `from` to `to` (in O).
   Status Run(double duration_s, const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
@@ -118,6 +121,7 @@ class Drive {
       std::vector<double> turned_before;
       for (const WheelTravel& w : *travels) turned_before.push_back(Turned(w));
       if (Status s = Step(v); !s.ok()) return s;
+      if (observe_) observe_(data_);
       bool open = false;
       for (std::size_t i = 0; i < travels->size(); ++i) {
         WheelTravel& w = (*travels)[i];
@@ -134,6 +138,7 @@ class Drive {
         // The window closes within this step: its share of the step's travel, linear in the rotation.
         const double share = (w.window_rad - turned_before[i]) / (turned - turned_before[i]);
         w.radius_m = (w.travel_m + share * step_m) / w.window_rad;
+        w.duration_s = (static_cast<double>(k) + share) * model_->opt.timestep;
       }
       if (!open) return Status::Ok();
     }
@@ -159,7 +164,41 @@ class Drive {
   mjData* data_;
   ApplySetPoint apply_;
   const std::string& what_;
+  ObserveStep observe_;
 };
+
+// A copy of LevelGroundCopy(model) whose gravity is turned by atan(grade) about y: the force balance of a drive along
+// +x up a slope of that grade (unchanged at grade 0).
+ModelPtr GradedGroundCopy(const mjModel* model, double grade) {
+  ModelPtr copy = LevelGroundCopy(model);
+  if (grade == 0.0) return copy;
+  const double g_mps2 = Eigen::Vector3d(copy->opt.gravity).norm();
+  const double slope_rad = std::atan(grade);
+  copy->opt.gravity[0] = -g_mps2 * std::sin(slope_rad);
+  copy->opt.gravity[1] = 0.0;
+  copy->opt.gravity[2] = -g_mps2 * std::cos(slope_rad);
+  return copy;
+}
+
+// The ground's force [N] on the geoms `tires` along the world direction `along`, summed over their contacts.
+double ContactForceAlong(const mjModel* model, const mjData* data, const std::vector<int>& tires,
+                         const Eigen::Vector3d& along) {
+  double force_n = 0.0;
+  for (int i = 0; i < data->ncon; ++i) {
+    const mjContact& c = data->contact[i];
+    const bool on_first = std::find(tires.begin(), tires.end(), c.geom1) != tires.end();
+    const bool on_second = std::find(tires.begin(), tires.end(), c.geom2) != tires.end();
+    if (on_first == on_second) continue;
+    mjtNum f_contact[6];
+    mj_contactForce(model, data, i, f_contact);
+    // The contact frame's rows are the normal (from geom1 to geom2) and the two tangents; the force acts on geom2.
+    Eigen::Vector3d f_world = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) f_world += f_contact[k] * Eigen::Vector3d(c.frame + 3 * k);
+    force_n += (on_second ? 1.0 : -1.0) * f_world.dot(along);
+  }
+  return force_n;
+}
+
 
 }  // namespace
 
@@ -198,11 +237,29 @@ Result<std::vector<double>> MeasureRollingRadii(const mjModel* model, const Whee
   return radii;
 }
 
+std::string RearRollingDrive::Validate() const {
+  if (!(speed_mps > 0.0)) return "speed_mps: must be positive";
+  if (!(settle_s >= 0.0) || !(ramp_s >= 0.0) || !(hold_s >= 0.0)) return "settle_s, ramp_s, hold_s: must be >= 0";
+  if (revolutions < 1) return "revolutions: must be at least 1";
+  if (!(std::abs(grade) < 1.0)) return "grade: must be within (-1, 1)";
+  return "";
+}
+
 Result<double> MeasureRearRollingRadius(const mjModel* model, const AckermannVehicle& vehicle,
                                         const SpeedControllerOptions& controller, const std::string& what,
                                         const RearRollingDrive& drive) {
-  const ModelPtr level = LevelGroundCopy(model);
-  const mjModel* m = level.get();
+  auto roll = MeasureRearRoll(model, vehicle, controller, what, drive);
+  if (!roll.ok()) return roll.status();
+  return roll.value().travel_per_rad_m;
+}
+
+Result<RearRoll> MeasureRearRoll(const mjModel* model, const AckermannVehicle& vehicle,
+                                 const SpeedControllerOptions& controller, const std::string& what,
+                                 const RearRollingDrive& drive) {
+  if (const std::string problem = drive.Validate(); !problem.empty())
+    return Status::Error(what + ": measuring the rear rolling: " + problem);
+  const ModelPtr graded = GradedGroundCopy(model, drive.grade);
+  const mjModel* m = graded.get();
   DataPtr data = MakeData(m);
   TerrainOptions flat;
   flat.type = TerrainOptions::Type::kFlat;
@@ -212,19 +269,35 @@ Result<double> MeasureRearRollingRadius(const mjModel* model, const AckermannVeh
   const ApplySetPoint apply = [&](const Eigen::Vector2d& v, mjData* d) {
     vehicle.Apply(0.0, speed.Update(v.x(), vehicle.RearWheelRate(d) * vehicle.wheel_radius_m(), dt_s), d);
   };
-  Drive driver(m, data.get(), apply, what);
+  // The traction on the rear tires along their mean rolling direction, summed over the measurement's steps.
+  const std::vector<int> rear_tires{IdOf(m, mjOBJ_GEOM, "tire_rear_left"), IdOf(m, mjOBJ_GEOM, "tire_rear_right")};
+  const int rear_left = IdOf(m, mjOBJ_JOINT, "wheel_rear_left"), rear_right = IdOf(m, mjOBJ_JOINT, "wheel_rear_right");
+  double traction_sum_n = 0.0;
+  long traction_steps = 0;
+  const ObserveStep observe = [&](const mjData* d) {
+    const Eigen::Vector3d along =
+        (RollingDirectionWorld(d, rear_left) + RollingDirectionWorld(d, rear_right)).normalized();
+    traction_sum_n += ContactForceAlong(m, d, rear_tires, along);
+    ++traction_steps;
+  };
+  Drive driver(m, data.get(), apply, what, observe);
   const Eigen::Vector2d rest = Eigen::Vector2d::Zero();
   const Eigen::Vector2d v(drive.speed_mps, 0.0);
   if (Status s = driver.Run(drive.settle_s, rest, rest); !s.ok()) return s;
   if (Status s = driver.Run(drive.ramp_s, rest, v); !s.ok()) return s;
   if (Status s = driver.Run(drive.hold_s, v, v); !s.ok()) return s;
   std::vector<WheelTravel> travels(2);
-  travels[0].joint = IdOf(m, mjOBJ_JOINT, "wheel_rear_left");
-  travels[1].joint = IdOf(m, mjOBJ_JOINT, "wheel_rear_right");
+  travels[0].joint = rear_left;
+  travels[1].joint = rear_right;
   for (WheelTravel& w : travels) w.window_rad = drive.revolutions * kTwoPi;
   const double window_s = drive.revolutions * kTwoPi * vehicle.wheel_radius_m() / drive.speed_mps;
   if (Status s = driver.Measure(v, kWindowTimeLimit * window_s, &travels); !s.ok()) return s;
-  return 0.5 * (travels[0].radius_m + travels[1].radius_m);
+  RearRoll roll;
+  roll.travel_per_rad_m = 0.5 * (travels[0].radius_m + travels[1].radius_m);
+  roll.wheel_rate_radps =
+      0.5 * (travels[0].window_rad / travels[0].duration_s + travels[1].window_rad / travels[1].duration_s);
+  roll.traction_n = traction_sum_n / static_cast<double>(traction_steps);
+  return roll;
 }
 
 }  // namespace roamlab::sim

@@ -25,6 +25,14 @@
 // whole revolutions of the rear wheels, each rear hub's travel along its rolling direction over its rotation, the
 // mean of the two. On level ground at constant speed the tires carry only the rolling resistance: the free-rolling
 // travel per radian, which does not depend on the speed or the heading. Deterministic.
+//
+// Driven, a tire slips: MuJoCo's soft friction passes a tangential force through a slip velocity that grows with it,
+// so the wheel turns faster than its hub advances. The drive's `grade` puts the force balance of a slope on the same
+// level ground: gravity turned by atan(grade) about the lateral axis, so that the rear tires carry the weight's
+// component along the slope, m g sin(atan(grade)), on top of the rolling resistance, at the same contact geometry (the
+// level ground's triangles). MeasureRearRoll reports the window's travel per radian with the traction the ground puts
+// on the rear tires and their spin rate, from which a slip-versus-traction curve follows unconfounded by the terrain's
+// shape.
 #pragma once
 
 #include <string>
@@ -58,12 +66,30 @@ struct RearRollingDrive {
   double ramp_s = 1.0;     // speed ramp
   double hold_s = 2.0;     // at constant speed before the measurement
   int revolutions = 4;     // of the rear wheels, measured over
+  double grade = 0.0;      // rise per run of the slope driven up (negative: down), |grade| < 1
+
+  // Empty when usable; otherwise "<field>: <problem>".
+  std::string Validate() const;
 };
 
-// The free-rolling travel per radian [m] of the rear tires of `vehicle` (bound to `model`), driven by `controller`.
-// Errors name `what` (a wheel that does not turn its window within the time the drive allows, a diverged simulation).
+// What one straight drive of the rear wheels measures over its window.
+struct RearRoll {
+  double travel_per_rad_m = 0.0;  // the rear hubs' travel along their rolling direction over their rotation (mean)
+  double wheel_rate_radps = 0.0;  // the rear wheels' mean spin rate over the window
+  double traction_n = 0.0;        // the ground's force on both rear tires along their rolling direction (mean)
+};
+
+// The free-rolling travel per radian [m] of the rear tires of `vehicle` (bound to `model`), driven by `controller`
+// (drive.grade 0: level ground). Errors name `what` (a wheel that does not turn its window within the time the drive
+// allows, a diverged simulation, an unusable drive).
 Result<double> MeasureRearRollingRadius(const mjModel* model, const AckermannVehicle& vehicle,
                                         const SpeedControllerOptions& controller, const std::string& what,
                                         const RearRollingDrive& drive = {});
+
+// The same drive's window in full: travel per radian, spin rate and traction. The slip velocity against a reference
+// travel per radian r_ref (e.g. the level drive's) is wheel_rate_radps (r_ref - travel_per_rad_m).
+Result<RearRoll> MeasureRearRoll(const mjModel* model, const AckermannVehicle& vehicle,
+                                 const SpeedControllerOptions& controller, const std::string& what,
+                                 const RearRollingDrive& drive = {});
 
 }  // namespace roamlab::sim
