@@ -199,7 +199,6 @@ double ContactForceAlong(const mjModel* model, const mjData* data, const std::ve
   return force_n;
 }
 
-
 }  // namespace
 
 Result<std::vector<double>> MeasureRollingRadii(const mjModel* model, const WheeledRobot& robot, double x, double y,

@@ -260,8 +260,8 @@ TEST(RollingRadiusTest, TheAtvsRearTiresSlipAtAVelocityProportionalToTheTraction
     ASSERT_TRUE(roll.ok()) << roll.status().message();
     traction_mps2.push_back(roll.value().traction_n / mass_kg);
     slips_mps.push_back(slip_mps(roll.value()));
-    std::printf("grade %+.2f: f_x/m %+.4f m/s^2, travel per rad %.6f m, slip %+.6f m/s\n", grade,
-                traction_mps2.back(), roll.value().travel_per_rad_m, slips_mps.back());
+    std::printf("grade %+.2f: f_x/m %+.4f m/s^2, travel per rad %.6f m, slip %+.6f m/s\n", grade, traction_mps2.back(),
+                roll.value().travel_per_rad_m, slips_mps.back());
   }
   const LineFit fit = FitLine(traction_mps2, slips_mps);
   std::printf("slip = %+.6f m/s + %.6f s * f_x/m (+- %.6f s), residual std %.2e m/s, R^2 %.5f\n", fit.intercept,
