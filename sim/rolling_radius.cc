@@ -252,6 +252,15 @@ Result<double> MeasureRearRollingRadius(const mjModel* model, const AckermannVeh
   return roll.value().travel_per_rad_m;
 }
 
+double RearTractionN(const mjModel* model, const mjData* data) {
+  const std::vector<int> rear_tires{IdOf(model, mjOBJ_GEOM, "tire_rear_left"),
+                                    IdOf(model, mjOBJ_GEOM, "tire_rear_right")};
+  const Eigen::Vector3d along = (RollingDirectionWorld(data, IdOf(model, mjOBJ_JOINT, "wheel_rear_left")) +
+                                 RollingDirectionWorld(data, IdOf(model, mjOBJ_JOINT, "wheel_rear_right")))
+                                    .normalized();
+  return ContactForceAlong(model, data, rear_tires, along);
+}
+
 Result<RearRoll> MeasureRearRoll(const mjModel* model, const AckermannVehicle& vehicle,
                                  const SpeedControllerOptions& controller, const std::string& what,
                                  const RearRollingDrive& drive) {
@@ -268,15 +277,11 @@ Result<RearRoll> MeasureRearRoll(const mjModel* model, const AckermannVehicle& v
   const ApplySetPoint apply = [&](const Eigen::Vector2d& v, mjData* d) {
     vehicle.Apply(0.0, speed.Update(v.x(), vehicle.RearWheelRate(d) * vehicle.wheel_radius_m(), dt_s), d);
   };
-  // The traction on the rear tires along their mean rolling direction, summed over the measurement's steps.
-  const std::vector<int> rear_tires{IdOf(m, mjOBJ_GEOM, "tire_rear_left"), IdOf(m, mjOBJ_GEOM, "tire_rear_right")};
-  const int rear_left = IdOf(m, mjOBJ_JOINT, "wheel_rear_left"), rear_right = IdOf(m, mjOBJ_JOINT, "wheel_rear_right");
+  // The traction on the rear tires, summed over the measurement's steps.
   double traction_sum_n = 0.0;
   long traction_steps = 0;
   const ObserveStep observe = [&](const mjData* d) {
-    const Eigen::Vector3d along =
-        (RollingDirectionWorld(d, rear_left) + RollingDirectionWorld(d, rear_right)).normalized();
-    traction_sum_n += ContactForceAlong(m, d, rear_tires, along);
+    traction_sum_n += RearTractionN(m, d);
     ++traction_steps;
   };
   Drive driver(m, data.get(), apply, what, observe);
@@ -286,8 +291,8 @@ Result<RearRoll> MeasureRearRoll(const mjModel* model, const AckermannVehicle& v
   if (Status s = driver.Run(drive.ramp_s, rest, v); !s.ok()) return s;
   if (Status s = driver.Run(drive.hold_s, v, v); !s.ok()) return s;
   std::vector<WheelTravel> travels(2);
-  travels[0].joint = rear_left;
-  travels[1].joint = rear_right;
+  travels[0].joint = IdOf(m, mjOBJ_JOINT, "wheel_rear_left");
+  travels[1].joint = IdOf(m, mjOBJ_JOINT, "wheel_rear_right");
   for (WheelTravel& w : travels) w.window_rad = drive.revolutions * kTwoPi;
   const double window_s = drive.revolutions * kTwoPi * vehicle.wheel_radius_m() / drive.speed_mps;
   if (Status s = driver.Measure(v, kWindowTimeLimit * window_s, &travels); !s.ok()) return s;

@@ -86,6 +86,11 @@ Result<double> MeasureRearRollingRadius(const mjModel* model, const AckermannVeh
                                         const SpeedControllerOptions& controller, const std::string& what,
                                         const RearRollingDrive& drive = {});
 
+// The ground's force [N] on the rear tires of the Ackermann model `model` (models/atv.xml's names) along their mean
+// rolling direction (the rear hinges' axes crossed with the world's z), summed over their contacts in `data`, whose
+// constraint forces must be current (after mj_forward or a step). Positive: pushing the vehicle forward.
+double RearTractionN(const mjModel* model, const mjData* data);
+
 // The same drive's window in full: travel per radian, spin rate and traction. The slip velocity against a reference
 // travel per radian r_ref (e.g. the level drive's) is wheel_rate_radps (r_ref - travel_per_rad_m).
 Result<RearRoll> MeasureRearRoll(const mjModel* model, const AckermannVehicle& vehicle,

@@ -281,6 +281,54 @@ TEST(RollingRadiusTest, TheAtvsRearTiresSlipAtAVelocityProportionalToTheTraction
   EXPECT_NEAR(slip_mps(fast.value()), predicted_mps, 3.0 * fit.residual_std);
 }
 
+// The slip's regressor on a drive. Beyond the level drive's traction (which truth.yaml's kv/L includes), the rear
+// tires carry m times O's forward specific force f_x = a_x + g sin(pitch) (what an IMU reads and the estimator's
+// slip_per_mps2 regresses on) plus the steered front tires' drag in turns, about the front axle's share (0.44 of the
+// ATV's weight, models/atv.xml) of m a_y tan(delta). Over the noise-free weave of atv_hills.yaml, the speed-weighted
+// traction per unit mass that the speed row's gain sees, <v (F - F_level) / m>, lies between the two (f_x alone and
+// with the drag estimate), which bracket the slip's effect on kv/L in tools/atv_slip_kv.py.
+TEST(RollingRadiusTest, TheWeavesRearTractionLiesBetweenTheSpecificForceAndItsFrontDragEstimate) {
+  constexpr double kFrontShare = 0.44;
+  const Scenario s = testing::AtvHills(30.0);
+  double level_n = 0.0, mass_kg = 0.0;
+  double vv = 0.0, v_traction = 0.0, v_specific = 0.0, v_drag = 0.0;  // sums over the samples
+  long samples = 0;
+  Status measured = Status::Ok();
+  SimulateOptions options;
+  options.noise = false;
+  options.observer = [&](Time, const mjModel* m, const mjData* d) {
+    auto vehicle = AckermannVehicle::Bind(m, "atv");
+    if (!vehicle.ok()) return;
+    if (mass_kg == 0.0) {
+      auto level = MeasureRearRoll(m, vehicle.value(), s.robot.speed_controller, "atv");
+      if (!level.ok()) measured = level.status();
+      level_n = level.ok() ? level.value().traction_n : 0.0;
+      mass_kg = vehicle.value().mass_kg();
+    }
+    // O's velocity and specific force in O ([angular, linear]; mj_rnePostConstraint has run for the sensors).
+    mjtNum velocity[6], acceleration[6];
+    mj_objectVelocity(m, d, mjOBJ_SITE, vehicle.value().odom_site(), velocity, 1);
+    mj_objectAcceleration(m, d, mjOBJ_SITE, vehicle.value().odom_site(), acceleration, 1);
+    const double v_mps = velocity[3], a_y_mps2 = velocity[3] * velocity[2];
+    vv += v_mps * v_mps;
+    v_traction += v_mps * (RearTractionN(m, d) - level_n) / mass_kg;
+    v_specific += v_mps * acceleration[3];
+    v_drag += v_mps * kFrontShare * a_y_mps2 * std::tan(vehicle.value().SteeringAngle(d));
+    ++samples;
+  };
+  auto sim = Simulate(s, options);
+  ASSERT_TRUE(sim.ok()) << sim.status().message();
+  ASSERT_TRUE(measured.ok()) << measured.message();
+  ASSERT_GT(mass_kg, 0.0);
+  EXPECT_GT(v_traction, v_specific);
+  EXPECT_LT(v_traction, v_specific + v_drag);
+  const double n = static_cast<double>(samples);
+  std::printf(
+      "weave, %ld samples: <v^2> %.3f m^2/s^2; <v (F - F_level)/m> %+.4f, <v f_x> %+.4f, "
+      "<v (f_x + %.2f a_y tan(delta))> %+.4f m^2/s^3 (F_level %.1f N, m %.1f kg)\n",
+      samples, vv / n, v_traction / n, v_specific / n, kFrontShare, (v_specific + v_drag) / n, level_n, mass_kg);
+}
+
 // A short straight roll of the scenario on a flat floor, simulated: O's travel over the rear wheels' rotation is the
 // travel per radian truth.yaml's kv/L states (over its geometric value, times the tire radius), and it lies below the
 // tire's radius by half the rear tires' penetration (MuJoCo's contact point is midway through it).
