@@ -14,7 +14,9 @@ f_x = a_x + g sin(pitch), the estimator's own slip regressor (the resistance's c
 the rear tires also push against the steered front tires' side force, whose component along O's x is about the front
 axle's share of m a_y times tan(delta); --front-drag-share S adds S a_y tan(delta) to f_x (a_y = v_x omega_z, delta
 the true bicycle angle from the noise-free steering reading and truth.yaml's k_theta and k_gamma) as a rough estimate
-of it (0.44: the static share of the ATV's weight on the front axle).
+of it (0.44: the static share of the ATV's weight on the front axle). The contacts' own traction lies between the two
+(RollingRadiusTest.TheWeavesRearTractionLiesBetweenTheSpecificForceAndItsFrontDragEstimate prints its speed-weighted
+mean beside theirs).
 
 Simulates the scenario with every sensor noise set to zero (tools/atv_odometer_residuals.py's way), takes f_x from the
 ground-truth poses of O (the second difference of the positions at each rear-wheel reading's interval, plus gravity,
