@@ -3,7 +3,7 @@
 estimator never does).
 
     python3 tools/atv_slip_kv.py [--roamlab build/apps/roamlab] [--scenario scenarios/atv_hills.yaml]
-                                 [--config configs/atv_calibration.yaml] [--seed 1] [--slip-s 0.0017]
+                                 [--config configs/atv_calibration.yaml] [--seed 1] [--slip-s 0.00167]
                                  [--front-drag-share 0]
 
 A driven tire turns faster than the ground passes by a slip velocity s = c f_x / m that grows with its traction f_x
@@ -82,7 +82,7 @@ def main():
     ap.add_argument("--scenario", default="scenarios/atv_hills.yaml")
     ap.add_argument("--config", default="configs/atv_calibration.yaml")
     ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--slip-s", type=float, default=0.0017, help="slip velocity per m/s^2 of traction per mass [s]")
+    ap.add_argument("--slip-s", type=float, default=0.00167, help="slip velocity per m/s^2 of traction per mass [s]")
     ap.add_argument("--front-drag-share", type=float, default=0.0,
                     help="add this share of m a_y tan(delta) to the traction (the front tires' drag in turns)")
     args = ap.parse_args()
