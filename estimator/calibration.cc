@@ -717,10 +717,10 @@ Result<StageSummary> SolveStage(const EstimatorConfig& config, const Calibration
   for (const auto& [stream, c] : builder.counts()) stage.rejected += c.rejected;
   Say(options, "stage " + std::to_string(s + 1) + "/" + std::to_string(stage_count) + ": " +
                    std::to_string(stage.rejected) + " measurements rejected, " + std::to_string(stage.readmitted) +
-                   " re-admitted on their innovation; cost " +
-                   std::to_string(stage.solver.initial_cost) + " -> " + std::to_string(stage.solver.final_cost) +
-                   " in " + std::to_string(stage.solver.iterations) + " iterations (" +
-                   TerminationName(stage.solver.termination) + "), " + std::to_string(stage.solver.seconds) + " s");
+                   " re-admitted on their innovation; cost " + std::to_string(stage.solver.initial_cost) + " -> " +
+                   std::to_string(stage.solver.final_cost) + " in " + std::to_string(stage.solver.iterations) +
+                   " iterations (" + TerminationName(stage.solver.termination) + "), " +
+                   std::to_string(stage.solver.seconds) + " s");
   return stage;
 }
 
@@ -883,8 +883,8 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
   if (config.gate_probability) held = HoldOutAbsoluteRowsAfterGaps(config, recording, &builder);
   const std::vector<FactorId> after_gap = held;
   for (std::size_t s = 0; s < stages.size(); ++s) {
-    Result<StageSummary> stage = SolveStage(config, options, stages[s], s, stages.size(), &builder, workspace.get(),
-                                            &lambda, &held, after_gap);
+    Result<StageSummary> stage =
+        SolveStage(config, options, stages[s], s, stages.size(), &builder, workspace.get(), &lambda, &held, after_gap);
     held.clear();
     if (!stage.ok()) return stage.status();
     result.iterations += stage.value().solver.iterations;

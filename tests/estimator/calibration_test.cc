@@ -653,11 +653,10 @@ TEST(CalibrationTest, MotionCaptureRowsAfterAnOutageComeBackIn) {
   EXPECT_EQ(result.value().counts.at("wheels").rejected, 0);
 }
 
-
 // Three consecutive motion-capture poses of a differential drive 5 cm (50 sigma) sideways, least squares from the
 // start: the first gate, tested at the estimate they bent, rejects them with good rows of the same poses and their
 // neighbours (wheel spans, motion-capture poses). Re-solved without them, those poses are held by nothing, and the good
-// rows still fail the gate's own test, which passes after pass leave out. On their innovation, which counts the
+// rows still fail the gate's own test: the passes after it leave them out. On their innovation, which counts the
 // estimate's uncertainty of those poses, every good row comes back (the outliers too: nothing holds their poses); a
 // re-solve and passes that reject only the worst failing row at a pose then leave exactly the three outliers out.
 TEST(GateOutliersTest, RowsOfPosesNothingHoldsComeBackOnTheirInnovation) {

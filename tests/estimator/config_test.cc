@@ -35,7 +35,8 @@ TEST(ConfigTest, ParsesTheAtvConfiguration) {
 // The calibration's gate starts under Huber's loss unless the configuration turns it off.
 TEST(ConfigTest, GatingRobustStartIsOnUnlessTurnedOff) {
   const std::string good = testing::AtvConfigYaml({});
-  const auto by_default = ParseEstimatorConfig(Replace(good, "master: odometer", "master: odometer\ngating: {probability: 0.999}"), "est.yaml");
+  const auto by_default = ParseEstimatorConfig(
+      Replace(good, "master: odometer", "master: odometer\ngating: {probability: 0.999}"), "est.yaml");
   ASSERT_TRUE(by_default.ok()) << by_default.status().message();
   EXPECT_TRUE(by_default.value().gate_robust_start);
   const auto off = ParseEstimatorConfig(
