@@ -14,10 +14,12 @@
 #include <utility>
 
 #include "common/chi_square.h"
+#include "estimator/factor.h"
 #include "estimator/geometry.h"
 #include "estimator/internal/after_gap.h"
 #include "estimator/internal/linearization.h"
 #include "estimator/internal/normal_equations.h"
+#include "estimator/models/prior.h"
 
 namespace roamlab::estimator {
 
@@ -350,6 +352,96 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
 
 namespace {
 
+// The weak prior of every free pose in ReadmitOnInnovation's covariance when the active problem is singular: wide
+// enough that a pose which anything holds keeps the uncertainty its rows give it (millimetres to centimetres), finite
+// for a pose that nothing holds, whose innovation then passes whatever its rows say (the gate re-tests them once the
+// re-solve has placed the pose).
+constexpr double kWeakPriorPosition_m = 100.0;
+constexpr double kWeakPriorRotation_rad = 10.0;
+
+// Adds the weak prior (kWeakPriorPosition_m, kWeakPriorRotation_rad) on every free pose at its current value; returns
+// the factors added.
+std::vector<FactorId> AddWeakPosePriors(ProblemBuilder* builder) {
+  Eigen::Matrix<double, 6, 1> variance;
+  variance << Eigen::Vector3d::Constant(kWeakPriorPosition_m * kWeakPriorPosition_m),
+      Eigen::Vector3d::Constant(kWeakPriorRotation_rad * kWeakPriorRotation_rad);
+  Graph& graph = builder->graph();
+  std::vector<FactorId> priors;
+  for (const PoseNode& node : builder->poses()) {
+    const Variable& pose = graph.variable(node.id);
+    if (pose.fixed) continue;
+    priors.push_back(graph.AddFactor(MakeFactor(PriorError<PoseBlock>(pose.value)), {node.id},
+                                     Eigen::MatrixXd(variance.asDiagonal()), Loss::Trivial(), "weak pose prior",
+                                     node.t));
+  }
+  return priors;
+}
+
+}  // namespace
+
+int ReadmitOnInnovation(double probability, ProblemBuilder* builder, const std::set<FactorId>& excluded) {
+  Graph& graph = builder->graph();
+  // The rejected measurement factors, but the bridges, the spans they replace and the excluded ones.
+  const std::map<FactorId, ProblemBuilder::CumulativeSpan>& spans = builder->cumulative_spans();
+  std::vector<FactorId> candidates;
+  for (const auto& [id, stream] : builder->factor_streams()) {
+    if (excluded.count(id) > 0 || graph.factors().count(id) == 0 || graph.factor(id).active) continue;
+    if (const auto span = spans.find(id); span != spans.end() && (span->second.bridge || span->second.replaced))
+      continue;
+    candidates.push_back(id);
+  }
+  if (candidates.empty()) return 0;
+  // One factorization of the active problem; when it is singular, one with the weak pose priors.
+  internal::NormalEquations system(graph, FreeVariableOrder(graph));
+  Eigen::VectorXd unused;
+  bool factored = system.Linearize(graph) && system.Solve(0.0, &unused);
+  std::vector<FactorId> priors;
+  if (!factored) {
+    priors = AddWeakPosePriors(builder);
+    system.Reset(graph, FreeVariableOrder(graph));
+    factored = system.Linearize(graph) && system.Solve(0.0, &unused);
+  }
+  // Each candidate's innovation at the current estimate, all against the same factorization.
+  std::vector<FactorId> passing;
+  std::vector<const double*> values;
+  std::vector<VariableId> free_variables;
+  std::vector<int> free;
+  internal::WhitenedFactor wf;
+  Eigen::MatrixXd covariance;
+  for (const FactorId id : candidates) {
+    if (!factored) break;
+    const FactorEntry& entry = graph.factor(id);
+    values.clear();
+    free_variables.clear();
+    free.clear();
+    std::uint64_t free_mask = 0;
+    for (std::size_t i = 0; i < entry.variables.size(); ++i) {
+      const Variable& v = graph.variable(entry.variables[i]);
+      values.push_back(v.value.data());
+      if (v.fixed || system.OffsetOf(entry.variables[i]) < 0) continue;
+      free_variables.push_back(entry.variables[i]);
+      free.push_back(static_cast<int>(i));
+      free_mask |= std::uint64_t{1} << i;
+    }
+    if (free_variables.empty())
+      covariance.resize(0, 0);
+    else if (!system.Covariance(free_variables, &covariance))
+      continue;
+    if (internal::LinearizeFactorAt(entry, values.data(), free_mask, &wf) &&
+        internal::InnovationWithin(probability, wf, free, covariance))
+      passing.push_back(id);
+  }
+  for (const FactorId id : priors) graph.RemoveFactor(id);
+  for (const FactorId id : passing) {
+    FactorEntry& entry = graph.mutable_factor(id);
+    entry.active = true;
+    --builder->mutable_counts(entry.stream).rejected;
+  }
+  return static_cast<int>(passing.size());
+}
+
+namespace {
+
 // Gating in calibration: a burst's neighbours within 1.5 times its length are rejected for one round
 // (GateOptions::burst_margin), so that the rounds do not peel a skid's edges a few rows at a time.
 constexpr double kBurstMargin = 1.5;
@@ -504,8 +596,12 @@ bool UseRobustStartLoss(const EstimatorConfig& config, bool robust, ProblemBuild
   return any && robust;
 }
 
+// Rounds of re-admission on the innovation (ReadmitOnInnovation) per stage, each followed by a re-solve and a gate.
+constexpr int kMaxReadmissionRounds = 3;
+
 // One stage (stage index s of `stage_count`, its parameters free): a solve, the admission of the `held` rows (held
-// out after a gap; those never admitted are left in it), then gating rounds with their re-solves.
+// out after a gap; those never admitted are left in it), then gating rounds with their re-solves, then the rounds
+// that re-admit rejected rows on their innovation (all but the `after_gap` rows: every row held out after a gap).
 // `lambda` carries Levenberg-Marquardt's damping from solve to solve: the first stage starts from the configured one,
 // as its parameters and the dead-reckoned poses may be far from the minimum; every later solve starts where the last
 // one ended, as a restart from the configured damping holds the steps back along weakly observed directions (lever
@@ -513,7 +609,7 @@ bool UseRobustStartLoss(const EstimatorConfig& config, bool robust, ProblemBuild
 Result<StageSummary> SolveStage(const EstimatorConfig& config, const CalibrationOptions& options,
                                 const std::vector<std::string>& free, std::size_t s, std::size_t stage_count,
                                 ProblemBuilder* builder_ptr, SolverWorkspace* workspace, double* lambda,
-                                std::vector<FactorId>* held) {
+                                std::vector<FactorId>* held, const std::vector<FactorId>& after_gap) {
   ProblemBuilder& builder = *builder_ptr;
   const bool lm = config.solver.method == SolverOptions::Method::kLevenbergMarquardt;
   SetFree({free.begin(), free.end()}, &builder);
@@ -592,11 +688,39 @@ Result<StageSummary> SolveStage(const EstimatorConfig& config, const Calibration
     const Status solved = resolve("rounds ended under Huber's loss: least squares");
     if (!solved.ok()) return solved;
   }
+  // The rejected rows that fit on their innovation come back (ReadmitOnInnovation: a good row of a pose that an
+  // outlier bent, rejected with it, fails the gate's own test at an estimate that nothing holds there), each round
+  // re-solved and gated once more, rejecting only the worst failing row at a pose (GateOptions::worst_per_pose): rows
+  // of a pose that nothing held all pass their innovation, an outlier among them too. A row comes back once a stage.
+  std::set<FactorId> not_readmitted(after_gap.begin(), after_gap.end());
+  for (int round = 0; config.gate_probability && round < kMaxReadmissionRounds; ++round) {
+    std::set<FactorId> rejected_now;
+    for (const auto& [id, stream] : builder.factor_streams())
+      if (builder.graph().factors().count(id) > 0 && !builder.graph().factor(id).active) rejected_now.insert(id);
+    const int readmitted = ReadmitOnInnovation(*config.gate_probability, &builder, not_readmitted);
+    if (readmitted == 0) break;
+    stage.readmitted += readmitted;
+    for (const FactorId id : rejected_now)
+      if (builder.graph().factor(id).active) not_readmitted.insert(id);
+    Status solved = resolve(std::to_string(readmitted) + " rejected rows re-admitted on their innovation, re-solved");
+    if (!solved.ok()) return solved;
+    GateOptions gate;
+    gate.ignore_chance_changes = true;
+    gate.worst_per_pose = true;
+    gate.defer_when_bridging = true;
+    const GateSwitches changed = GateOutliers(*config.gate_probability, &builder, 0, nullptr, gate);
+    if (changed.switched() == 0) break;
+    solved = resolve("gated after the re-admission: " + std::to_string(changed.rejected) + " measurements rejected, " +
+                     std::to_string(changed.readmitted) + " re-admitted, re-solved");
+    if (!solved.ok()) return solved;
+  }
   for (const auto& [stream, c] : builder.counts()) stage.rejected += c.rejected;
-  Say(options, "stage " + std::to_string(s + 1) + "/" + std::to_string(stage_count) + ": cost " +
-                   std::to_string(stage.solver.initial_cost) + " -> " + std::to_string(stage.solver.final_cost) +
-                   " in " + std::to_string(stage.solver.iterations) + " iterations (" +
-                   TerminationName(stage.solver.termination) + "), " + std::to_string(stage.solver.seconds) + " s");
+  Say(options, "stage " + std::to_string(s + 1) + "/" + std::to_string(stage_count) + ": " +
+                   std::to_string(stage.rejected) + " measurements rejected, " + std::to_string(stage.readmitted) +
+                   " re-admitted on their innovation; cost " + std::to_string(stage.solver.initial_cost) + " -> " +
+                   std::to_string(stage.solver.final_cost) + " in " + std::to_string(stage.solver.iterations) +
+                   " iterations (" + TerminationName(stage.solver.termination) + "), " +
+                   std::to_string(stage.solver.seconds) + " s");
   return stage;
 }
 
@@ -757,9 +881,10 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
   // The absolute rows after a gap wait out the first stage's first solve; the later stages gate them as any other.
   std::vector<FactorId> held;
   if (config.gate_probability) held = HoldOutAbsoluteRowsAfterGaps(config, recording, &builder);
+  const std::vector<FactorId> after_gap = held;
   for (std::size_t s = 0; s < stages.size(); ++s) {
     Result<StageSummary> stage =
-        SolveStage(config, options, stages[s], s, stages.size(), &builder, workspace.get(), &lambda, &held);
+        SolveStage(config, options, stages[s], s, stages.size(), &builder, workspace.get(), &lambda, &held, after_gap);
     held.clear();
     if (!stage.ok()) return stage.status();
     result.iterations += stage.value().solver.iterations;

@@ -17,6 +17,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -50,7 +51,8 @@ struct Correlation {
 struct StageSummary {
   std::vector<std::string> free_parameters;
   SolverSummary solver;
-  int rejected = 0;  // measurements gated out after this stage
+  int rejected = 0;    // measurements gated out after this stage
+  int readmitted = 0;  // rejected measurements this stage re-admitted on their innovation (ReadmitOnInnovation)
 };
 
 // The whitened error of one measurement at the final estimate (L^-1 e, eq. 1's covariance, before any robust loss):
@@ -169,5 +171,17 @@ struct GateSwitches {
 // linearization's error instead of being evaluated again.
 GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId first = 0,
                           const SolverWorkspace* last_solve = nullptr, const GateOptions& options = {});
+
+// Re-tests every measurement factor the gate has rejected on its innovation at the current estimate: its whitened
+// error r against I + J P J^T, J its whitened Jacobians and P the joint marginal covariance of its free variables from
+// one factorization of the active problem (the innovation test of the rows held out after a gap). Tested at an
+// estimate solved without it, a good row of a pose whose other rows were rejected with it (or that an outlier bent)
+// can fail the gate's own test by far, as nothing holds that pose where the row would put it; its innovation counts
+// the pose's uncertainty. Where the active problem is singular (a pose that nothing holds at all), every free pose
+// takes a weak prior (100 m, 10 rad) for this covariance alone. A factor whose r^T (I + J P J^T)^-1 r is within the
+// chi-square quantile `probability` of its dimension is re-admitted. Left as they are: the bridges over cumulative
+// wheel readings and the spans they replace, and the factors in `excluded` (the rows held out after a gap, which have
+// their own admission). Keeps the per-stream rejected counts up to date; returns how many factors it re-admitted.
+int ReadmitOnInnovation(double probability, ProblemBuilder* builder, const std::set<FactorId>& excluded = {});
 
 }  // namespace roamlab::estimator

@@ -50,6 +50,7 @@ json SolverJson(const CalibrationResult& r) {
                       {"termination", TerminationName(s.solver.termination)},
                       {"cost_history", s.solver.cost_history},
                       {"rejected", s.rejected},
+                      {"readmitted", s.readmitted},
                       {"seconds", s.solver.seconds}});
   return {{"iterations", r.iterations},   {"initial_cost", r.initial_cost}, {"final_cost", r.final_cost},
           {"termination", r.termination}, {"seconds", r.seconds},           {"stages", stages}};

@@ -136,8 +136,9 @@ struct EstimatorConfig {
   SolverOptions solver;
   std::optional<double> gate_probability;
   // Calibration with the gate on: each stage's solves take Huber's loss (gating.robust_start) until the gate has
-  // settled, then least squares on the measurements it kept (calibration.h, Calibrate).
-  bool gate_robust_start = false;
+  // settled, then least squares on the measurements it kept (calibration.h, Calibrate). On by default: least squares
+  // with gross outliers in bends the first solve, and the gate's decisions taken there reject good rows with them.
+  bool gate_robust_start = true;
   TrackingConfig tracking;
   std::map<std::string, ParameterConfig> parameters;
   std::map<std::string, StreamConfig> streams;  // by stream name (ordered: deterministic)

@@ -74,6 +74,7 @@ json CalibrationSchema() {
                                      {"initial_cost", "number"},
                                      {"final_cost", "number"},
                                      {"rejected", "number"},
+                                     {"readmitted", "number"},
                                      {"seconds", "timing"}}})}}},
           {"measurements", CountsSchema()}};
 }

@@ -32,6 +32,22 @@ TEST(ConfigTest, ParsesTheAtvConfiguration) {
   EXPECT_DOUBLE_EQ(config.value().streams.at("gps").noise.at("sigma_m"), 0.33);
 }
 
+// The calibration's gate starts under Huber's loss unless the configuration turns it off.
+TEST(ConfigTest, GatingRobustStartIsOnUnlessTurnedOff) {
+  const std::string good = testing::AtvConfigYaml({});
+  const auto by_default = ParseEstimatorConfig(
+      Replace(good, "master: odometer", "master: odometer\ngating: {probability: 0.999}"), "est.yaml");
+  ASSERT_TRUE(by_default.ok()) << by_default.status().message();
+  EXPECT_TRUE(by_default.value().gate_robust_start);
+  const auto off = ParseEstimatorConfig(
+      Replace(good, "master: odometer", "master: odometer\ngating: {probability: 0.999, robust_start: false}"),
+      "est.yaml");
+  ASSERT_TRUE(off.ok()) << off.status().message();
+  EXPECT_FALSE(off.value().gate_robust_start);
+  ExpectError(Replace(good, "master: odometer", "master: odometer\ngating: {probability: 0.999, robust_start: 3}"),
+              "gating.robust_start");
+}
+
 TEST(ConfigTest, RejectsUnknownKeysModelsAndMissingNoise) {
   const std::string good = testing::AtvConfigYaml({});
   ExpectError(Replace(good, "master: odometer", "master: odometer\nwindow: 3"), "unknown key 'window'");
