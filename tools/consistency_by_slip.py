@@ -9,7 +9,9 @@ run drives its own terrain). Each run's file OUT/calibrations/NNNNNN.json holds 
 slip of a driven wheel's rim over the ground during the drive; OUT/consistency.json holds every block's NEES per run
 (`per_run`, in the order of `calibrated_runs`). Printed: how many runs slipped more than MPS (default 0.3 m/s), then per
 parameter the mean NEES over every run, over the runs that slipped more and over the others, the share of the NEES sum
-the slipping runs hold, and the Spearman rank correlation between a run's slip and its NEES. Standard library only.
+the slipping runs hold, the Spearman rank correlation between a run's slip and its NEES, the median NEES, and the 95 %
+band of the others' mean NEES (chi-square of n d degrees of freedom over n, by the Wilson-Hilferty approximation).
+Standard library only.
 """
 import argparse
 import json
@@ -54,6 +56,13 @@ def spearman(x, y):
     return sxy / math.sqrt(sxx * syy) if sxx > 0 and syy > 0 else float("nan")
 
 
+def average_nees_band(n, d):
+    """95 % band of the mean of n NEES of d degrees of freedom (Wilson-Hilferty, within 1 % of the exact quantiles)."""
+    k = n * d
+    h = 2.0 / (9.0 * k)
+    return tuple(d * (1.0 - h + z * math.sqrt(h)) ** 3 for z in (-1.959964, 1.959964))
+
+
 def mean(values):
     return sum(values) / len(values) if values else float("nan")
 
@@ -70,8 +79,8 @@ def main():
     print("%d calibrated runs (%d failed); %d slipped more than %.2f m/s (max wheel slip: median %.3f, max %.3f m/s)"
           % (len(runs), len(failed), sum(slipping), args.slip, sorted(slip.values())[len(slip) // 2],
              max(slip.values())))
-    print("%-20s %5s %10s %10s %10s %12s %9s" % ("parameter", "dim", "NEES all", "slipping", "others",
-                                                   "share [%]", "Spearman"))
+    print("%-20s %5s %10s %10s %10s %16s %10s %9s %8s" % ("parameter", "dim", "NEES all", "slipping", "others",
+                                                          "others' band", "share [%]", "Spearman", "median"))
     for block in summary["parameters"]:
         nees = block["nees"]["per_run"]
         pairs = [(s, n, slip[i]) for s, n, i in zip(slipping, nees, runs) if n is not None]
@@ -80,9 +89,12 @@ def main():
         total = sum(n for _, n, _ in pairs)
         share = 100.0 * sum(high) / total if total > 0 else float("nan")
         rho = spearman([x for _, _, x in pairs], [n for _, n, _ in pairs])
-        print("%-20s %5d %10.2f %10.2f %10.2f %12.0f %9.2f" % (block["name"], block["dimension"],
-                                                               mean([n for _, n, _ in pairs]), mean(high), mean(low),
-                                                               share, rho))
+        band = average_nees_band(len(low), block["dimension"]) if low else (float("nan"), float("nan"))
+        values = sorted(n for _, n, _ in pairs)
+        median = values[len(values) // 2] if len(values) % 2 else 0.5 * sum(values[len(values) // 2 - 1:][:2])
+        print("%-20s %5d %10.2f %10.2f %10.2f   [%5.2f, %5.2f] %10.0f %9.2f %8.2f"
+              % (block["name"], block["dimension"], mean([n for _, n, _ in pairs]), mean(high), mean(low), band[0],
+                 band[1], share, rho, median))
 
 
 if __name__ == "__main__":
