@@ -47,8 +47,9 @@ std::string Headline(const MonteCarloArgs& args, const experiment::ConsistencySu
   const int failed = static_cast<int>(summary.failed_runs.size());
   char line[320];
   std::snprintf(line, sizeof line,
-                "%d runs (%d calibrated, %d failed): 2-sigma coverage consistent with 95.4 %% for %d of %d components, mean std within 20 %% of "
-                "the Cramer-Rao std for %d, block NEES in band for %d of %zu parameters; wrote ",
+                "%d runs (%d calibrated, %d failed): 2-sigma coverage consistent with 95.4 %% for %d of %d "
+                "components, mean std within 20 %% of the Cramer-Rao std for %d, block NEES in band for %d of %zu "
+                "parameters; wrote ",
                 args.runs, args.runs - failed, failed, covered, components, efficient, in_band, summary.blocks.size());
   return line + args.out + "/consistency.json" + summary.plot_note;
 }

@@ -159,8 +159,8 @@ Outcome RunOne(const MonteCarloOptions& options, const Shared& shared, int i) {
     return written.ok() ? Outcome::Ok() : Outcome::Failed(written);
   }
   if (!calibrated.ok())
-    return Outcome::Failed(
-        Status::Error("run " + std::to_string(i) + ", seed " + std::to_string(seed) + ": " + calibrated.status().message()));
+    return Outcome::Failed(Status::Error("run " + std::to_string(i) + ", seed " + std::to_string(seed) + ": " +
+                                         calibrated.status().message()));
   auto compared = CompareWithTruth(calibrated.value(), truth);
   if (!compared.ok()) return Outcome::BadInput(compared.status());
   nlohmann::json parameters = nlohmann::json::object();
@@ -238,8 +238,8 @@ Result<RunFiles> ReadRuns(const MonteCarloOptions& options, const std::vector<st
     Result<std::string> text = ReadWholeFile(path);
     if (!text.ok()) return Status::Error(path + ": missing: run " + std::to_string(i) + " has no result");
     const nlohmann::json run = nlohmann::json::parse(text.value(), nullptr, false);
-    const std::string other = path + ": not the result of run " + std::to_string(i) + " (seed " +
-                              std::to_string(options.seed_base + i) + ")";
+    const std::string other =
+        path + ": not the result of run " + std::to_string(i) + " (seed " + std::to_string(options.seed_base + i) + ")";
     const std::string again = " (malformed or of another call; delete it to run it again)";
     if (!IsRunOf(run, options, i)) return Status::Error(other + again);
     if (run.contains("failed")) {
@@ -294,9 +294,9 @@ std::string WriteOutputs(const MonteCarloOptions& options, const std::vector<eva
   *written = WriteFileAtomic(options.out + "/consistency.json", j.dump(2) + "\n");
   if (!written->ok()) return "";
   if (!eval::GnuplotAvailable()) return " (gnuplot not found: no consistency.png)";
-  auto plot = eval::WriteConsistencyPlot(
-      options.out, "Calibration errors over " + std::to_string(runs.calibrated.size()) + " runs",
-      PlotData(blocks, runs.draws));
+  auto plot = eval::WriteConsistencyPlot(options.out,
+                                         "Calibration errors over " + std::to_string(runs.calibrated.size()) + " runs",
+                                         PlotData(blocks, runs.draws));
   const Status drawn = plot.ok() ? eval::RunGnuplot(options.out, plot.value().script) : plot.status();
   return drawn.ok() ? "" : " (plot failed: " + drawn.message() + ")";
 }
@@ -338,7 +338,8 @@ Outcome Aggregate(const MonteCarloOptions& options, const Shared& shared, Consis
   if (runs.value().calibrated.empty()) {
     const FailedRun& first = runs.value().failed.front();
     return Outcome::Failed(Status::Error("every run failed, the first: run " + std::to_string(first.run) +
-                                         " (terrain seed " + std::to_string(first.terrain_seed) + "): " + first.reason));
+                                         " (terrain seed " + std::to_string(first.terrain_seed) +
+                                         "): " + first.reason));
   }
   std::vector<eval::BlockConsistency> blocks;
   for (std::size_t k = 0; k < names.size(); ++k) {

@@ -51,9 +51,9 @@ std::string ConsistencyRunFile(const std::string& out, int i);
 // simulation or calibration): counted and named, never dropped silently.
 struct FailedRun {
   int run = 0;
-  std::uint64_t seed = 0;          // noise
+  std::uint64_t seed = 0;  // noise
   std::uint64_t terrain_seed = 0;
-  std::string reason;              // "simulation: ..." or "calibration: ...", one line
+  std::string reason;  // "simulation: ..." or "calibration: ...", one line
 };
 
 struct ConsistencySummary {

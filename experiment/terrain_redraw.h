@@ -1,7 +1,7 @@
 // A terrain of its own for every run of a Monte-Carlo experiment (`roamlab montecarlo --calibration-consistency
 // --redraw-terrain`): run i drives the scenario's hills drawn by the terrain generator (sim/terrain.h) with seed
-// terrain_seed_base + i, everything else (relief, wavelengths, size, friction, drive, sensors) the scenario's. The noise
-// seed stays apart (experiment/montecarlo.h), so the two draws are independent.
+// terrain_seed_base + i, everything else (relief, wavelengths, size, friction, drive, sensors) the scenario's. The
+// noise seed stays apart (experiment/montecarlo.h), so the two draws are independent.
 #pragma once
 
 #include <cstdint>

@@ -174,8 +174,8 @@ TEST_F(ConsistencyCliTest, StatisticsAreThoseOfTheRuns) {
 }
 
 TEST_F(ConsistencyCliTest, RefusesWhatItDoesNotSupportWithOneLine) {
-  for (const std::string extra : {" --backend slurm", " --calibration x.json", " --calibrate-each-run",
-                                  " --terrain-base 5"}) {
+  for (const std::string extra :
+       {" --backend slurm", " --calibration x.json", " --calibrate-each-run", " --terrain-base 5"}) {
     const CommandRun r = Roamlab(Command(1, "bad") + extra, dir_);
     EXPECT_EQ(r.exit_code, 2) << extra << ": " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
@@ -228,8 +228,8 @@ TEST_F(ConsistencyCliTest, RedrawnTerrainsDifferAndTheNoiseAloneDoesNotChangeThe
   for (const nlohmann::json& block : j["parameters"]) ExpectStatisticsOfTheRuns(block, redrawn_runs);
 
   // A resumed call with other terrains does not take these files for its own.
-  const CommandRun other = Roamlab(base + (dir_ / "redrawn").string() + " --redraw-terrain --terrain-base 41 --resume",
-                                   dir_);
+  const CommandRun other =
+      Roamlab(base + (dir_ / "redrawn").string() + " --redraw-terrain --terrain-base 41 --resume", dir_);
   EXPECT_EQ(other.exit_code, 1) << other.err;
   EXPECT_NE(other.err.find("000000.json: not the result of run 0"), std::string::npos) << other.err;
 }
@@ -262,8 +262,8 @@ TEST_F(ConsistencyCliTest, ARunThatFailsOnItsTerrainIsCountedAndNamed) {
     EXPECT_EQ(reason.rfind("simulation: ", 0), 0u) << reason;
     // Its result file says the same, and the table names it.
     EXPECT_EQ(ReadJson(dir_ / "steep" / "calibrations" / ("00000" + std::to_string(i) + ".json"))["failed"], reason);
-    EXPECT_NE(r.out.find("  run " + std::to_string(i) + " (noise seed " + std::to_string(1000 + i) +
-                         ", terrain seed " + std::to_string(f["terrain_seed"].get<int>()) + "): " + reason),
+    EXPECT_NE(r.out.find("  run " + std::to_string(i) + " (noise seed " + std::to_string(1000 + i) + ", terrain seed " +
+                         std::to_string(f["terrain_seed"].get<int>()) + "): " + reason),
               std::string::npos)
         << r.out;
   }
