@@ -35,6 +35,11 @@ int RunLocally(const MonteCarloArgs& args, batch::Work& work) {
 }  // namespace
 
 int RunMonteCarlo(const MonteCarloArgs& given) {
+  if (given.terrain_base && !given.redraw_terrain)
+    return BadInput(given.err, "montecarlo", "--terrain-base is for --redraw-terrain");
+  if (given.redraw_terrain && !given.calibration_consistency)
+    return BadInput(given.err, "montecarlo",
+                    "--redraw-terrain is for --calibration-consistency (tracking runs keep the scenario's terrain)");
   if (given.calibration_consistency) return RunCalibrationConsistency(given);
   // An external command runs where roamlab was started, wherever the runs execute (a Slurm task's directory).
   MonteCarloArgs args = given;

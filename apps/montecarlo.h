@@ -2,6 +2,7 @@
 #pragma once
 
 #include <iosfwd>
+#include <optional>
 
 #include "apps/batch.h"
 #include "experiment/montecarlo.h"
@@ -11,6 +12,10 @@ namespace roamlab::apps {
 // The runner's options (without log and progress, which the command sets).
 struct MonteCarloArgs : experiment::MonteCarloOptions {
   BackendArgs backend;
+  // --redraw-terrain [--terrain-base N]: with --calibration-consistency, terrain_seed_base is set to N (default
+  // experiment::kDefaultTerrainSeedBase); --terrain-base alone is bad input.
+  bool redraw_terrain = false;
+  std::optional<unsigned long long> terrain_base;
   bool quiet = false;           // no progress bar and no summary
   std::ostream* err = nullptr;  // receives the one-line error; nullptr: stderr
 };

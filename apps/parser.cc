@@ -23,6 +23,7 @@
 #include "apps/simulate.h"
 #include "apps/sweep.h"
 #include "apps/version.h"
+#include "experiment/terrain_redraw.h"
 
 namespace roamlab::apps {
 namespace {
@@ -183,6 +184,13 @@ void AddMonteCarlo(CLI::App* app, Commands* commands) {
     mc->add_flag("--calibration-consistency", args->calibration_consistency,
                  "Calibrate each run with --config instead of tracking it: the calibration's std against its errors "
                  "(consistency.json, consistency.png)");
+    mc->add_flag("--redraw-terrain", args->redraw_terrain,
+                 "With --calibration-consistency: run i also drives its own terrain, the scenario's hills drawn with "
+                 "terrain seed TERRAIN_BASE + i; a run that fails on its terrain is counted and named (failed_runs)");
+    mc->add_option_function<unsigned long long>(
+        "--terrain-base", [args](const unsigned long long& base) { args->terrain_base = base; },
+        "With --redraw-terrain: run i draws terrain seed TERRAIN_BASE + i (default " +
+            std::to_string(experiment::kDefaultTerrainSeedBase) + ")");
     mc->add_flag("--no-time-budget", args->no_time_budget,
                  "Ignore tracking.time_budget_s: results that do not depend on the machine's speed or load");
     mc->add_flag("--resume", args->resume, "Run only the runs whose result file OUT/runs/NNNNNN.json is missing");

@@ -16,6 +16,7 @@
 #include "estimator/calibration.h"
 #include "eval/parameters.h"
 #include "eval/plots.h"
+#include "experiment/terrain_redraw.h"
 #include "recording/stream_health.h"
 #include "sim/simulator.h"
 
@@ -25,6 +26,8 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr char kCramerRaoMethod[] =
     "the std calibrate reports on the scenario simulated with every noise source off (the recording at the truth)";
+constexpr char kCramerRaoOnRedrawnTerrain[] =
+    ", on the scenario's own terrain (each redrawn terrain has a bound of its own; this one is a reference)";
 
 // What every run shares.
 struct Shared {
@@ -94,20 +97,33 @@ Result<std::vector<RunParameter>> CompareWithTruth(const estimator::CalibrationR
   return out;
 }
 
-// Simulates the scenario (noise off when !noise), calibrates it; `truth` receives the simulation's truth.
+// Simulates the scenario (noise off when !noise), calibrates it; `truth` receives the simulation's truth and `stats`
+// (optional) its statistics. An error says which step failed: "simulation: ..." or "calibration: ...".
 Result<estimator::CalibrationResult> SimulateAndCalibrate(const sim::Scenario& scenario,
                                                           const estimator::EstimatorConfig& config, std::uint64_t seed,
-                                                          bool noise, recording::Truth* truth) {
+                                                          bool noise, recording::Truth* truth,
+                                                          sim::SimulationStats* stats = nullptr) {
   sim::SimulateOptions sim_options;
   sim_options.seed = seed;
   sim_options.noise = noise;
   auto simulation = sim::Simulate(scenario, sim_options);
-  if (!simulation.ok()) return Status::Error("seed " + std::to_string(seed) + ": " + simulation.status().message());
+  if (!simulation.ok()) return Status::Error("simulation: " + simulation.status().message());
   recording::DropDuplicateRows(&simulation.value().recording);  // as the reader does (a duplicates fault)
   auto calibrated = estimator::Calibrate(config, simulation.value().recording);
-  if (!calibrated.ok()) return Status::Error("seed " + std::to_string(seed) + ": " + calibrated.status().message());
+  if (!calibrated.ok()) return Status::Error("calibration: " + calibrated.status().message());
   *truth = std::move(simulation.value().truth);
+  if (stats) *stats = simulation.value().stats;
   return calibrated;
+}
+
+// What the drive did, from the simulation (evaluation only: the calibration never sees it).
+nlohmann::json DriveJson(const sim::SimulationStats& stats) {
+  return {{"distance_m", stats.distance_m},
+          {"path_height_range_m", stats.path_height_range_m},
+          {"max_abs_roll_rad", stats.max_abs_roll_rad},
+          {"max_abs_pitch_rad", stats.max_abs_pitch_rad},
+          {"max_lateral_speed_mps", stats.max_lateral_speed_mps},
+          {"max_wheel_slip_mps", stats.max_wheel_slip_mps}};
 }
 
 nlohmann::json MatrixJson(const Eigen::MatrixXd& m) {
@@ -119,12 +135,32 @@ nlohmann::json MatrixJson(const Eigen::MatrixXd& m) {
   return rows;
 }
 
-// Run i: simulate with its seed, calibrate, compare with the truth, write its result file.
+// The head of run i's result file: its index, noise seed and, when the terrain is redrawn, its terrain seed.
+nlohmann::json RunHead(const MonteCarloOptions& options, int i) {
+  nlohmann::json j = {{"run", i}, {"seed", options.seed_base + static_cast<std::uint64_t>(i)}};
+  if (options.terrain_seed_base) j["terrain_seed"] = RunTerrainSeed(*options.terrain_seed_base, i);
+  return j;
+}
+
+// Run i: simulate with its seed (and its terrain), calibrate, compare with the truth, write its result file. With the
+// terrain redrawn, a terrain the drive fails on is a result: its file says why ("failed").
 Outcome RunOne(const MonteCarloOptions& options, const Shared& shared, int i) {
   const std::uint64_t seed = options.seed_base + static_cast<std::uint64_t>(i);
+  nlohmann::json j = RunHead(options, i);
+  const sim::Scenario scenario = options.terrain_seed_base
+                                     ? WithTerrainSeed(shared.scenario, RunTerrainSeed(*options.terrain_seed_base, i))
+                                     : shared.scenario;
   recording::Truth truth;
-  auto calibrated = SimulateAndCalibrate(shared.scenario, shared.config, seed, true, &truth);
-  if (!calibrated.ok()) return Outcome::Failed(Status::Error("run " + std::to_string(i) + ", " + calibrated.status().message()));
+  sim::SimulationStats stats;
+  auto calibrated = SimulateAndCalibrate(scenario, shared.config, seed, true, &truth, &stats);
+  if (!calibrated.ok() && options.terrain_seed_base && !InterruptRequested()) {
+    j["failed"] = calibrated.status().message();
+    const Status written = WriteFileAtomic(ConsistencyRunFile(options.out, i), j.dump() + "\n");
+    return written.ok() ? Outcome::Ok() : Outcome::Failed(written);
+  }
+  if (!calibrated.ok())
+    return Outcome::Failed(Status::Error("run " + std::to_string(i) + ", seed " + std::to_string(seed) + ": " +
+                                         calibrated.status().message()));
   auto compared = CompareWithTruth(calibrated.value(), truth);
   if (!compared.ok()) return Outcome::BadInput(compared.status());
   nlohmann::json parameters = nlohmann::json::object();
@@ -135,8 +171,9 @@ Outcome RunOne(const MonteCarloOptions& options, const Shared& shared, int i) {
                           {"error", NumberArray(p.draw.error)},
                           {"std", NumberArray(p.draw.std)},
                           {"covariance", MatrixJson(p.draw.covariance)}};
-  const nlohmann::json j = {
-      {"run", i}, {"seed", seed}, {"seconds", calibrated.value().seconds}, {"parameters", parameters}};
+  j["seconds"] = calibrated.value().seconds;
+  j["drive"] = DriveJson(stats);
+  j["parameters"] = parameters;
   const Status written = WriteFileAtomic(ConsistencyRunFile(options.out, i), j.dump() + "\n");
   return written.ok() ? Outcome::Ok() : Outcome::Failed(written);
 }
@@ -173,27 +210,51 @@ bool ReadDraw(const nlohmann::json& run, const std::string& name, eval::Paramete
   return true;
 }
 
-// Every run's draws per parameter (in the order of `names`); an error names the file that is missing or malformed.
-Result<std::vector<std::vector<eval::ParameterDraw>>> ReadDraws(const MonteCarloOptions& options,
-                                                                const std::vector<std::string>& names) {
-  std::vector<std::vector<eval::ParameterDraw>> draws(names.size());
+// What the run files hold: the draws of the calibrated runs per parameter (in the order of `names`), which runs those
+// are, and the runs that failed.
+struct RunFiles {
+  std::vector<std::vector<eval::ParameterDraw>> draws;
+  std::vector<int> calibrated;
+  std::vector<FailedRun> failed;
+};
+
+// Whether `run` is the file of run i of this call: its noise seed and, when the terrain is redrawn, its terrain seed.
+bool IsRunOf(const nlohmann::json& run, const MonteCarloOptions& options, int i) {
+  if (!run.is_object()) return false;
+  const nlohmann::json head = RunHead(options, i);
+  for (const char* key : {"seed", "terrain_seed"}) {
+    if (head.contains(key) != run.contains(key)) return false;
+    if (head.contains(key) && !(run[key].is_number_unsigned() && run[key] == head[key])) return false;
+  }
+  return true;
+}
+
+// Every run's file; an error names the file that is missing or malformed.
+Result<RunFiles> ReadRuns(const MonteCarloOptions& options, const std::vector<std::string>& names) {
+  RunFiles out;
+  out.draws.resize(names.size());
   for (int i = 0; i < options.runs; ++i) {
     const std::string path = ConsistencyRunFile(options.out, i);
     Result<std::string> text = ReadWholeFile(path);
     if (!text.ok()) return Status::Error(path + ": missing: run " + std::to_string(i) + " has no result");
     const nlohmann::json run = nlohmann::json::parse(text.value(), nullptr, false);
-    const bool same = run.is_object() && run.contains("seed") && run["seed"].is_number_unsigned() &&
-                      run["seed"].get<std::uint64_t>() == options.seed_base + static_cast<std::uint64_t>(i);
-    for (std::size_t k = 0; k < names.size(); ++k) {
-      eval::ParameterDraw draw;
-      if (!same || !ReadDraw(run, names[k], &draw))
-        return Status::Error(path + ": not the result of run " + std::to_string(i) + " (seed " +
-                             std::to_string(options.seed_base + i) + ") with " + names[k] +
-                             " (malformed or of another call; delete it to run it again)");
-      draws[k].push_back(std::move(draw));
+    const std::string other =
+        path + ": not the result of run " + std::to_string(i) + " (seed " + std::to_string(options.seed_base + i) + ")";
+    const std::string again = " (malformed or of another call; delete it to run it again)";
+    if (!IsRunOf(run, options, i)) return Status::Error(other + again);
+    if (run.contains("failed")) {
+      if (!run["failed"].is_string() || !options.terrain_seed_base) return Status::Error(other + again);
+      out.failed.push_back({i, run["seed"].get<std::uint64_t>(), run["terrain_seed"].get<std::uint64_t>(),
+                            run["failed"].get<std::string>()});
+      continue;
     }
+    std::vector<eval::ParameterDraw> draws(names.size());
+    for (std::size_t k = 0; k < names.size(); ++k)
+      if (!ReadDraw(run, names[k], &draws[k])) return Status::Error(other + " with " + names[k] + again);
+    for (std::size_t k = 0; k < names.size(); ++k) out.draws[k].push_back(std::move(draws[k]));
+    out.calibrated.push_back(i);
   }
-  return draws;
+  return out;
 }
 
 // The normalized errors error / std of every run and the coverage per component, for the figure.
@@ -213,18 +274,29 @@ std::vector<eval::NormalizedErrors> PlotData(const std::vector<eval::BlockConsis
 
 // OUT/consistency.json and OUT/consistency.png; returns the plot note.
 std::string WriteOutputs(const MonteCarloOptions& options, const std::vector<eval::BlockConsistency>& blocks,
-                         const std::vector<std::vector<eval::ParameterDraw>>& draws, Status* written) {
-  const nlohmann::json j = {{"scenario", options.scenario},
-                            {"config", options.config},
-                            {"runs", options.runs},
-                            {"seed_base", options.seed_base},
-                            {"cramer_rao", kCramerRaoMethod},
-                            {"parameters", eval::ConsistencyJson(blocks)}};
+                         const RunFiles& runs, Status* written) {
+  nlohmann::json failed = nlohmann::json::array();
+  for (const FailedRun& f : runs.failed)
+    failed.push_back({{"run", f.run}, {"seed", f.seed}, {"terrain_seed", f.terrain_seed}, {"reason", f.reason}});
+  nlohmann::json j = {{"scenario", options.scenario},
+                      {"config", options.config},
+                      {"runs", options.runs},
+                      {"seed_base", options.seed_base},
+                      {"terrain_seed_base", nullptr},
+                      {"cramer_rao", kCramerRaoMethod},
+                      {"calibrated_runs", runs.calibrated},
+                      {"failed_runs", failed},
+                      {"parameters", eval::ConsistencyJson(blocks)}};
+  if (options.terrain_seed_base) {
+    j["terrain_seed_base"] = *options.terrain_seed_base;
+    j["cramer_rao"] = std::string(kCramerRaoMethod) + kCramerRaoOnRedrawnTerrain;
+  }
   *written = WriteFileAtomic(options.out + "/consistency.json", j.dump(2) + "\n");
   if (!written->ok()) return "";
   if (!eval::GnuplotAvailable()) return " (gnuplot not found: no consistency.png)";
-  auto plot = eval::WriteConsistencyPlot(
-      options.out, "Calibration errors over " + std::to_string(options.runs) + " runs", PlotData(blocks, draws));
+  auto plot = eval::WriteConsistencyPlot(options.out,
+                                         "Calibration errors over " + std::to_string(runs.calibrated.size()) + " runs",
+                                         PlotData(blocks, runs.draws));
   const Status drawn = plot.ok() ? eval::RunGnuplot(options.out, plot.value().script) : plot.status();
   return drawn.ok() ? "" : " (plot failed: " + drawn.message() + ")";
 }
@@ -236,6 +308,9 @@ Outcome Prepare(const MonteCarloOptions& options, Shared* shared) {
   auto scenario = sim::LoadScenario(options.scenario);
   if (!scenario.ok()) return Outcome::BadInput(scenario.status());
   shared->scenario = std::move(scenario).value();
+  if (options.terrain_seed_base)
+    if (const std::string problem = TerrainRedrawProblem(shared->scenario); !problem.empty())
+      return Outcome::BadInput(Status::Error(options.scenario + ": " + problem + " (--redraw-terrain)"));
   auto config = estimator::LoadEstimatorConfig(options.config);
   if (!config.ok()) return Outcome::BadInput(config.status());
   shared->config = std::move(config).value();
@@ -257,21 +332,28 @@ Outcome Prepare(const MonteCarloOptions& options, Shared* shared) {
 Outcome Aggregate(const MonteCarloOptions& options, const Shared& shared, ConsistencySummary* summary) {
   std::vector<std::string> names;
   for (const auto& [name, std] : shared.cramer_rao_std) names.push_back(name);
-  auto draws = ReadDraws(options, names);
-  if (!draws.ok()) return Outcome::Failed(draws.status());
+  auto runs = ReadRuns(options, names);
+  if (!runs.ok()) return Outcome::Failed(runs.status());
+  const std::vector<std::vector<eval::ParameterDraw>>& draws = runs.value().draws;
+  if (runs.value().calibrated.empty()) {
+    const FailedRun& first = runs.value().failed.front();
+    return Outcome::Failed(Status::Error("every run failed, the first: run " + std::to_string(first.run) +
+                                         " (terrain seed " + std::to_string(first.terrain_seed) +
+                                         "): " + first.reason));
+  }
   std::vector<eval::BlockConsistency> blocks;
   for (std::size_t k = 0; k < names.size(); ++k) {
     const Eigen::VectorXd& crb = shared.cramer_rao_std.at(names[k]);
-    if (crb.size() != draws.value()[k].front().error.size())
+    if (crb.size() != draws[k].front().error.size())
       return Outcome::Failed(Status::Error(names[k] + ": the Cramer-Rao std has another size than the runs' errors"));
-    blocks.push_back(eval::BlockStatistics(names[k], draws.value()[k], crb));
+    blocks.push_back(eval::BlockStatistics(names[k], draws[k], crb));
     const Eigen::VectorXd& noise_free = shared.noise_free_error.at(names[k]);
     for (Eigen::Index i = 0; i < noise_free.size(); ++i) blocks.back().components[i].noise_free_error = noise_free[i];
   }
   Status written = Status::Ok();
-  const std::string note = WriteOutputs(options, blocks, draws.value(), &written);
+  const std::string note = WriteOutputs(options, blocks, runs.value(), &written);
   if (!written.ok()) return Outcome::Failed(written);
-  if (summary) *summary = {std::move(blocks), note};
+  if (summary) *summary = {std::move(blocks), std::move(runs.value().failed), note};
   return Outcome::Ok();
 }
 

@@ -482,6 +482,8 @@ std::string WriteOutputs(const MonteCarloOptions& options, const eval::MonteCarl
 std::string MonteCarloOptions::Validate() const {
   if (runs < 1) return "--runs must be at least 1";
   if (jobs < 0) return "--jobs must be >= 0";
+  if (terrain_seed_base && !calibration_consistency)
+    return "--redraw-terrain is for --calibration-consistency (tracking runs keep the scenario's terrain)";
   if (config.empty() == command.command.empty())
     return "give the estimator either as --config (roamlab's) or as --command (an external one)";
   if (!external()) return "";

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,9 @@ struct MonteCarloOptions {
   // Calibrate each run's recording with `config` (a calibration configuration) instead of tracking it, and test the
   // calibration's reported std against its errors (experiment/consistency.h, RunCalibrationConsistency).
   bool calibration_consistency = false;
+  // With calibration_consistency: run i also drives a terrain of its own, the scenario's hills drawn with terrain seed
+  // terrain_seed_base + i (experiment/terrain_redraw.h); unset: every run drives the scenario's terrain.
+  std::optional<unsigned long long> terrain_seed_base;
   std::function<void(const std::string& line)> log;      // optional: what is being done, one line at a time
   std::function<void(int finished, int runs)> progress;  // optional: once with 0 before the runs, then after each run
 

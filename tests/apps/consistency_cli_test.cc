@@ -1,5 +1,6 @@
 // `roamlab montecarlo --calibration-consistency` end to end on a short ATV drive: consistency.json's statistics are
-// those of the runs' own result files, and what it does not support is refused with one line.
+// those of the runs' own result files, --redraw-terrain gives each run its own terrain and names the runs that fail on
+// theirs, and what it does not support is refused with one line.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -61,6 +62,17 @@ class ConsistencyCliTest : public ::testing::Test {
   std::string Command(int jobs, const std::string& out) const {
     return "montecarlo " + scenario_ + " --config " + config_ + " --calibration-consistency --runs 3 --seed-base 500" +
            " --jobs " + std::to_string(jobs) + " --out " + (dir_ / out).string();
+  }
+
+  // A copy of the short scenario with `from` replaced by `to`, written to NAME.yaml.
+  std::string Variant(const std::string& name, const std::string& from, const std::string& to) const {
+    std::ifstream in(scenario_);
+    std::string scenario((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(scenario.find(from), std::string::npos) << from;
+    if (scenario.find(from) != std::string::npos) scenario.replace(scenario.find(from), from.size(), to);
+    const std::string path = (dir_ / (name + ".yaml")).string();
+    std::ofstream(path) << scenario;
+    return path;
   }
 
   testing::TempDir temp_;
@@ -162,7 +174,8 @@ TEST_F(ConsistencyCliTest, StatisticsAreThoseOfTheRuns) {
 }
 
 TEST_F(ConsistencyCliTest, RefusesWhatItDoesNotSupportWithOneLine) {
-  for (const std::string extra : {" --backend slurm", " --calibration x.json", " --calibrate-each-run"}) {
+  for (const std::string extra :
+       {" --backend slurm", " --calibration x.json", " --calibrate-each-run", " --terrain-base 5"}) {
     const CommandRun r = Roamlab(Command(1, "bad") + extra, dir_);
     EXPECT_EQ(r.exit_code, 2) << extra << ": " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
@@ -173,6 +186,110 @@ TEST_F(ConsistencyCliTest, RefusesWhatItDoesNotSupportWithOneLine) {
       dir_);
   EXPECT_EQ(missing.exit_code, 2) << missing.err;
   EXPECT_NE(missing.err.find("none.yaml"), std::string::npos) << missing.err;
+}
+
+// The drive of run i as the simulation measured it (its terrain shows in the height range, the roll and the slip).
+std::vector<double> Drive(const nlohmann::json& run) {
+  std::vector<double> out;
+  for (const char* key : {"distance_m", "path_height_range_m", "max_abs_roll_rad", "max_wheel_slip_mps"})
+    out.push_back(Value(run["drive"][key]));
+  return out;
+}
+
+TEST_F(ConsistencyCliTest, RedrawnTerrainsDifferAndTheNoiseAloneDoesNotChangeTheDrive) {
+  const std::string base = "montecarlo " + scenario_ + " --config " + config_ +
+                           " --calibration-consistency --runs 2 --seed-base 500 --jobs 2 --quiet --out ";
+  const CommandRun same = Roamlab(base + (dir_ / "same").string(), dir_);
+  ASSERT_EQ(same.exit_code, 0) << same.err;
+  const CommandRun redrawn = Roamlab(base + (dir_ / "redrawn").string() + " --redraw-terrain --terrain-base 40", dir_);
+  ASSERT_EQ(redrawn.exit_code, 0) << redrawn.err;
+
+  std::vector<nlohmann::json> same_runs, redrawn_runs;
+  for (int i = 0; i < 2; ++i) {
+    const std::string file = "00000" + std::to_string(i) + ".json";
+    same_runs.push_back(ReadJson(dir_ / "same" / "calibrations" / file));
+    redrawn_runs.push_back(ReadJson(dir_ / "redrawn" / "calibrations" / file));
+    EXPECT_FALSE(same_runs.back().contains("terrain_seed"));
+    EXPECT_EQ(redrawn_runs.back()["terrain_seed"], 40 + i);
+    EXPECT_EQ(redrawn_runs.back()["seed"], 500 + i);
+    ASSERT_TRUE(redrawn_runs.back().contains("parameters")) << redrawn_runs.back();
+  }
+  // The noise seeds alone leave the physics as it was; the terrains change it.
+  EXPECT_EQ(Drive(same_runs[0]), Drive(same_runs[1]));
+  EXPECT_NE(Drive(redrawn_runs[0]), Drive(redrawn_runs[1]));
+  EXPECT_NE(Drive(redrawn_runs[0])[1], Drive(redrawn_runs[1])[1]) << "the path's height range";
+  EXPECT_NE(Drive(redrawn_runs[1]), Drive(same_runs[1]));
+
+  const nlohmann::json j = ReadJson(dir_ / "redrawn" / "consistency.json");
+  EXPECT_EQ(j["terrain_seed_base"], 40);
+  EXPECT_EQ(j["calibrated_runs"], nlohmann::json({0, 1}));
+  EXPECT_EQ(j["failed_runs"], nlohmann::json::array());
+  EXPECT_TRUE(ReadJson(dir_ / "same" / "consistency.json")["terrain_seed_base"].is_null());
+  for (const nlohmann::json& block : j["parameters"]) ExpectStatisticsOfTheRuns(block, redrawn_runs);
+
+  // A resumed call with other terrains does not take these files for its own.
+  const CommandRun other =
+      Roamlab(base + (dir_ / "redrawn").string() + " --redraw-terrain --terrain-base 41 --resume", dir_);
+  EXPECT_EQ(other.exit_code, 1) << other.err;
+  EXPECT_NE(other.err.find("000000.json: not the result of run 0"), std::string::npos) << other.err;
+}
+
+// Hills steep enough that the short drive rolls over on terrain seed 1 and not on seeds 2 and 3 (found by simulating
+// them: `roamlab simulate` of the short scenario with this relief and each seed).
+constexpr char kSteepReliefM[] = "40.0";
+constexpr char kSteepTerrainBase[] = "1";
+
+TEST_F(ConsistencyCliTest, ARunThatFailsOnItsTerrainIsCountedAndNamed) {
+  // Steep hills: the drive rolls over or leaves the ground on some of these terrains and not on others.
+  const std::string steep = Variant("steep", "relief_m: 4.0", "relief_m: " + std::string(kSteepReliefM));
+  const CommandRun r = Roamlab("montecarlo " + steep + " --config " + config_ +
+                                   " --calibration-consistency --runs 3 --jobs 2 --redraw-terrain --terrain-base " +
+                                   std::string(kSteepTerrainBase) + " --out " + (dir_ / "steep").string(),
+                               dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = ReadJson(dir_ / "steep" / "consistency.json");
+  ASSERT_TRUE(j["failed_runs"].is_array());
+  ASSERT_GE(j["failed_runs"].size(), 1u) << j["failed_runs"];
+  const std::size_t calibrated = j["calibrated_runs"].size();
+  EXPECT_GE(calibrated, 1u);
+  EXPECT_EQ(calibrated + j["failed_runs"].size(), 3u) << "every run is either calibrated or named as failed";
+  for (const nlohmann::json& block : j["parameters"]) EXPECT_EQ(block["runs"], calibrated);
+  for (const nlohmann::json& f : j["failed_runs"]) {
+    const int i = f["run"];
+    EXPECT_EQ(f["terrain_seed"], std::stoull(kSteepTerrainBase) + i);
+    EXPECT_EQ(f["seed"], 1000 + i);
+    const std::string reason = f["reason"];
+    EXPECT_EQ(reason.rfind("simulation: ", 0), 0u) << reason;
+    // Its result file says the same, and the table names it.
+    EXPECT_EQ(ReadJson(dir_ / "steep" / "calibrations" / ("00000" + std::to_string(i) + ".json"))["failed"], reason);
+    EXPECT_NE(r.out.find("  run " + std::to_string(i) + " (noise seed " + std::to_string(1000 + i) + ", terrain seed " +
+                         std::to_string(f["terrain_seed"].get<int>()) + "): " + reason),
+              std::string::npos)
+        << r.out;
+  }
+  EXPECT_NE(r.out.find("3 runs (" + std::to_string(calibrated) + " calibrated, " +
+                       std::to_string(j["failed_runs"].size()) + " failed)"),
+            std::string::npos)
+      << r.out;
+}
+
+TEST_F(ConsistencyCliTest, RefusesToRedrawWhatItCannot) {
+  const std::string hills =
+      "type: hills\n    seed: 7\n    size_m: [300.0, 300.0]\n    resolution_m: 1.0\n    relief_m: 4.0\n"
+      "    wavelength_m: [20.0, 60.0]\n    waves: 16\n";
+  const std::string flat = Variant("flat", hills, "type: flat\n");
+  const std::vector<std::string> bad = {
+      // The terrain of tracking runs is not redrawn.
+      "montecarlo " + scenario_ + " --config " + config_ + " --runs 2 --redraw-terrain --out " + (dir_ / "t").string(),
+      // A flat floor has no seed.
+      "montecarlo " + flat + " --config " + config_ + " --calibration-consistency --runs 2 --redraw-terrain --out " +
+          (dir_ / "f").string()};
+  for (const std::string& command : bad) {
+    const CommandRun r = Roamlab(command, dir_);
+    EXPECT_EQ(r.exit_code, 2) << command << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find("terrain"), std::string::npos) << r.err;
+  }
 }
 
 }  // namespace
