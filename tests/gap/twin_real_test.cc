@@ -60,7 +60,10 @@ TEST(TwinRealTest, SquareRunPatchLowersTheCircularRunsDrift) {
     for (const auto& [k, v] : e.estimate.parameters) std::cout << " " << k << " = " << v;
     std::cout << "\n";
   }
-  auto shown = ShowOnHeldOut(nominal.value(), d.value().patch, held.value(), ReplayRunner(held.value()));
+  const TwinResidualOptions held_residuals =
+      ReplayedResidualOptions(nominal.value(), held.value(), options.increment_window_s);
+  auto shown = ShowOnHeldOut(nominal.value(), d.value().patch, held.value(), ReplayRunner(held.value()), {}, 2,
+                             held_residuals);
   ASSERT_TRUE(shown.ok()) << shown.status().message();
   ASSERT_TRUE(shown.value().before.drift.count("mocap"));
   ASSERT_TRUE(shown.value().after.drift.count("mocap"));
@@ -98,7 +101,8 @@ TEST(TwinRealTest, SquareRunPatchLowersTheCircularRunsDrift) {
               << " m, patch and clock " << c.heldout_after.drift.at("mocap").mean_position_m << " m\n";
   std::vector<sim::EffectOptions> with_clock = patch;
   with_clock.insert(with_clock.end(), c.patch.begin(), c.patch.end());
-  auto clocked = ShowOnHeldOut(nominal.value(), with_clock, held.value(), ReplayRunner(held.value()));
+  auto clocked =
+      ShowOnHeldOut(nominal.value(), with_clock, held.value(), ReplayRunner(held.value()), {}, 2, held_residuals);
   ASSERT_TRUE(clocked.ok()) << clocked.status().message();
   if (clocked.value().after.drift.count("mocap"))
     std::cout << "circular run 01, 10 s drift with the patch and the clock: "
