@@ -127,8 +127,8 @@ class Diagnoser {
   const recording::Recording& real_;  // the diagnosed recording, the first run
   const TwinDiagnoseOptions& options_;
   TwinDiagnosis out_;
-  std::vector<RunSpan> spans_;              // per run
-  std::vector<internal::FitRun> fit_runs_;  // per run, its training part
+  std::vector<RunSpan> spans_;                  // per run
+  std::vector<internal::FitRun> fit_runs_;      // per run, its training part
   std::vector<TwinResidualOptions> residuals_;  // per run: its fit's and held-out comparison's
   int measurements_ = 0;
   int runs_ = 0;

@@ -318,9 +318,9 @@ nlohmann::json TwinDriftJson(const std::map<std::string, TwinDrift>& drift);
 // the first's as "candidates"), "effects" (each with "effect": the simulator's effects it sets), "joint" (null, or
 // {"effects", "held", "failed", "chi2_before", "chi2_after", "iterations", "runs"}), "unexplained",
 // "heldout": {"before", "after"}, "whole_run", "patch",
-// "heldout_runs": [{"recording", "replayed", "before", "after"}], "increment_window_s", "runs", "seconds"}, and with further training runs
-// "training_runs": [{"recording", "replayed", "train_end_s", "heldout": {"before", "after"}}]: gap.json's "simulation"
-// section.
+// "heldout_runs": [{"recording", "replayed", "before", "after"}], "increment_window_s", "runs", "seconds"}, and with
+// further training runs "training_runs": [{"recording", "replayed", "train_end_s", "heldout": {"before", "after"}}]:
+// gap.json's "simulation" section.
 nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d);
 
 }  // namespace roamlab::gap

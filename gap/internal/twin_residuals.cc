@@ -153,10 +153,8 @@ void WhitenedIncrements(const Series& series, const Stream& real, const Stream& 
       (*out)[k + 1] = delta.dot(across) / std::sqrt(sigma2 + heading2);
       continue;
     }
-    const Eigen::Vector3d delta =
-        (position(real, b) - position(real, a)) - (position(twin, *tb) - position(twin, *ta));
-    for (int c = 0; c < n; ++c)
-      (*out)[k + c] = delta[c] / (std::sqrt(2.0) * series.sigma[static_cast<std::size_t>(c)]);
+    const Eigen::Vector3d delta = (position(real, b) - position(real, a)) - (position(twin, *tb) - position(twin, *ta));
+    for (int c = 0; c < n; ++c) (*out)[k + c] = delta[c] / (std::sqrt(2.0) * series.sigma[static_cast<std::size_t>(c)]);
   }
 }
 

@@ -158,8 +158,7 @@ TEST(TwinCompareTest, TheWindowedIncrementIsWhitenedByTheTwoPosesNoise) {
     const Eigen::Vector2d delta = Eigen::Rotation2Dd(-start_rad) * Eigen::Vector2d(-0.1, 0.0);
     const Eigen::Vector2d along(std::cos(1.0), std::sin(1.0)), across(-std::sin(1.0), std::cos(1.0));
     expected += std::pow(delta.dot(along), 2) / (2.0 * kSigmaM * kSigmaM) +
-                std::pow(delta.dot(across), 2) /
-                    (2.0 * kSigmaM * kSigmaM + std::pow(kHeadingSigmaRad * chord_m, 2));
+                std::pow(delta.dot(across), 2) / (2.0 * kSigmaM * kSigmaM + std::pow(kHeadingSigmaRad * chord_m, 2));
   }
   EXPECT_NEAR(c.chi2, expected, 1e-6 * expected);
   EXPECT_LT(c.chi2, 100.0);  // the across components weigh less than with the position noise alone

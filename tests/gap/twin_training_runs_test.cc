@@ -182,9 +182,9 @@ TEST(TwinTrainingRunsTest, AJointGeometryIsRecoveredFromReplaysOfTwoDrives) {
   }
   // The encoder stream that drives each replay is left out of its comparisons, with the reason.
   const std::vector<std::string>& left_out = d.value().heldout_before.left_out;
-  EXPECT_TRUE(std::any_of(left_out.begin(), left_out.end(),
-                          [](const std::string& s) { return s.rfind("wheel_encoders: drives the replay", 0) == 0; }))
-      << left_out.size();
+  EXPECT_TRUE(std::any_of(left_out.begin(), left_out.end(), [](const std::string& s) {
+    return s.rfind("wheel_encoders: drives the replay", 0) == 0;
+  })) << left_out.size();
 }
 
 // A training run that is missing or has nothing to compare is an error naming it.
