@@ -5,7 +5,9 @@
 //
 //   1. compare: per stream and component the residual real - twin matched by stamp and whitened by the recording's
 //      stated noise (gap/internal/twin_residuals.h); RMS per stream and component; for an absolute stream (gps,
-//      position, pose) the drift over fixed windows (TwinDrift);
+//      position, pose) the drift over fixed windows (TwinDrift). A replayed run's fit and held-out comparison compare
+//      its absolute streams by windowed increments and leave out the encoders that drive the replay
+//      (TwinDiagnoseOptions::increment_window_s, ReplayedResidualOptions);
 //   2. locate: Locate (gap/locate.h) on the nominal twin's whitened residuals of the whole run, against the stated
 //      noise (level 1), with the conditions computed from the real recording's own streams: the poses of a pose
 //      stream (motion capture) when there is one, else the wheel encoders' dead reckoning with the nominal geometry
