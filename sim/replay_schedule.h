@@ -41,11 +41,12 @@ struct DriveInputs {
   Eigen::MatrixXd values;      // one row per t
   bool hold = false;           // true: each row holds until the next (recorded commands); false: linear between rows
   std::string source;          // what the inputs were taken from (stream names), for messages and truth.yaml
-  std::vector<std::string> streams;  // the recorded streams they were taken from
   Eigen::MatrixXd angles_rad;  // kWheelRates from cumulative angles: per row the angle [rad] of each model wheel;
                                // empty otherwise
   Eigen::VectorXd travel_m;    // kAckermann from measured speeds: per row the rear wheels' travel since the first
                                // row [m] (the speeds integrated); empty otherwise
+  // The recorded streams the inputs were taken from (DriveInputsFrom).
+  std::vector<std::string> streams;
 
   // The inputs at recording time `t`: the first row before the first stamp, the last after the last.
   Eigen::VectorXd At(Time t) const;
