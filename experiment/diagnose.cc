@@ -189,7 +189,11 @@ Outcome DiagnoseTwinToFile(const DiagnoseRequest& request, const Inputs& in, con
   if (!diagnosed.ok()) return Outcome::Failed(Status::Error("twin: " + diagnosed.status().message()));
   gap::TwinDiagnosis& d = diagnosed.value();
   for (const HeldOut& h : held_out) {
-    auto shown = gap::ShowOnHeldOut(*in.scenario, d.patch, h.recording, h.runner, options.drift, options.threads);
+    const gap::TwinResidualOptions residuals =
+        h.replayed ? gap::ReplayedResidualOptions(*in.scenario, h.recording, options.increment_window_s)
+                   : gap::TwinResidualOptions{};
+    auto shown =
+        gap::ShowOnHeldOut(*in.scenario, d.patch, h.recording, h.runner, options.drift, options.threads, residuals);
     if (!shown.ok())
       return Outcome::Failed(Status::Error("twin, held out " + h.path + ": " + shown.status().message()));
     shown.value().recording = h.path;

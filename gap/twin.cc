@@ -66,6 +66,12 @@ void SetStd(const std::string& name, const TwinCovariance& covariance, Eigen::In
 // does; it is tried there when named.
 bool DefaultCandidate(const TwinCandidate& c, std::size_t runs) { return c.parts.empty() || runs > 1; }
 
+// `options` comparing the absolute values (the located components and the unexplained ones are judged per sample).
+TwinResidualOptions Absolute(TwinResidualOptions options) {
+  options.increment_window_s = 0.0;
+  return options;
+}
+
 // What one round judges the candidates against: the effects kept so far.
 struct State {
   std::vector<sim::EffectOptions> effects;  // kept
@@ -121,8 +127,9 @@ class Diagnoser {
   const recording::Recording& real_;  // the diagnosed recording, the first run
   const TwinDiagnoseOptions& options_;
   TwinDiagnosis out_;
-  std::vector<RunSpan> spans_;              // per run
-  std::vector<internal::FitRun> fit_runs_;  // per run, its training part
+  std::vector<RunSpan> spans_;                  // per run
+  std::vector<internal::FitRun> fit_runs_;      // per run, its training part
+  std::vector<TwinResidualOptions> residuals_;  // per run: its fit's and held-out comparison's
   int measurements_ = 0;
   int runs_ = 0;
   bool hac_ = false;  // the std reported is the HAC one
@@ -146,8 +153,10 @@ Status Diagnoser::Span() {
     span.train_end = Time::FromSeconds(span.first.seconds() + options_.train_fraction * seconds);
     span.whole_s = std::max(seconds, 1.0);
     span.train_s = std::min(span.whole_s, SecondsBetween(span.first, span.train_end) + 0.05);
+    residuals_.push_back(run.replayed ? ReplayedResidualOptions(nominal_, *run.real, options_.increment_window_s)
+                                      : TwinResidualOptions{});
     internal::FitRun fit{run.recording, run.real, &run.runner,
-                         internal::MakeLayout(*run.real, span.first, span.train_end), span.train_s};
+                         internal::MakeLayout(*run.real, span.first, span.train_end, residuals_.back()), span.train_s};
     if (fit.layout.size == 0) return Status::Error(name + "the recording has no stream with a stated noise to compare");
     spans_.push_back(span);
     fit_runs_.push_back(std::move(fit));
@@ -183,7 +192,7 @@ std::vector<TwinComparison> Diagnoser::HeldOut(const std::vector<recording::Reco
   std::vector<TwinComparison> out;
   for (std::size_t i = 0; i < twins.size(); ++i)
     out.push_back(CompareTwin(*runs_in_[i].real, twins[i], spans_[i].train_end.seconds(), spans_[i].last.seconds(),
-                              options_.drift));
+                              options_.drift, residuals_[i]));
   return out;
 }
 
@@ -382,7 +391,7 @@ void Diagnoser::Finish(const State& state) {
   for (std::size_t i = 1; i < state.heldout.size(); ++i) out_.training_runs[i - 1].heldout_after = state.heldout[i];
   for (const TwinEffect& e : out_.effects) out_.patch.insert(out_.patch.end(), e.applied.begin(), e.applied.end());
   const RunSpan& span = spans_.front();
-  const Layout heldout = internal::MakeLayout(real_, span.train_end, span.last);
+  const Layout heldout = internal::MakeLayout(real_, span.train_end, span.last, Absolute(residuals_.front()));
   const auto statistics = ComponentStatistics(
       internal::MeasurementResiduals(heldout, internal::WhitenedResiduals(heldout, real_, state.twins.front())));
   for (const auto& [key, level] : statistics)
@@ -396,6 +405,8 @@ Result<TwinDiagnosis> Diagnoser::Run() {
   const auto start = std::chrono::steady_clock::now();
   if (Status s = Span(); !s.ok()) return s;
   out_.replayed = options_.replayed;
+  if (std::any_of(runs_in_.begin(), runs_in_.end(), [](const TwinTrainingRun& r) { return r.replayed; }))
+    out_.increment_window_s = options_.increment_window_s;
   hac_ = estimator::UsesHac(options_.std_method, real_);
   out_.std_method = hac_ ? "hac" : "white";
   State state;
@@ -410,13 +421,14 @@ Result<TwinDiagnosis> Diagnoser::Run() {
   if (!twins.ok()) return Status::Error("the nominal twin: " + twins.status().message());
   state.twins = std::move(twins).value();
   const RunSpan& span = spans_.front();
-  out_.whole_run = CompareTwin(real_, state.twins.front(), span.first.seconds(), span.last.seconds(), options_.drift);
+  out_.whole_run = CompareTwin(real_, state.twins.front(), span.first.seconds(), span.last.seconds(), options_.drift,
+                               Absolute(residuals_.front()));
   state.heldout = HeldOut(state.twins);
   out_.heldout_before = state.heldout.front();
   for (std::size_t i = 1; i < runs_in_.size(); ++i)
     out_.training_runs.push_back(
         {runs_in_[i].recording, runs_in_[i].replayed, spans_[i].train_end.seconds(), state.heldout[i], {}});
-  const Layout whole = internal::MakeLayout(real_, span.first, span.last);
+  const Layout whole = internal::MakeLayout(real_, span.first, span.last, Absolute(residuals_.front()));
   out_.located =
       Locate(internal::MeasurementResiduals(whole, internal::WhitenedResiduals(whole, real_, state.twins.front())),
              RealConditions(real_), {});
@@ -470,7 +482,7 @@ std::vector<std::string> TwinCandidateNames(const sim::Scenario& nominal) {
 
 Result<TwinHeldOutRun> ShowOnHeldOut(const sim::Scenario& nominal, const std::vector<sim::EffectOptions>& patch,
                                      const recording::Recording& held, const TwinRunner& runner,
-                                     const DriftOptions& drift, int threads) {
+                                     const DriftOptions& drift, int threads, const TwinResidualOptions& residuals) {
   Time first = Time::FromNanoseconds(std::numeric_limits<std::int64_t>::max());
   Time last = Time::FromNanoseconds(std::numeric_limits<std::int64_t>::min());
   for (const recording::Stream& s : held.streams) {
@@ -496,8 +508,8 @@ Result<TwinHeldOutRun> ShowOnHeldOut(const sim::Scenario& nominal, const std::ve
       return Status::Error(std::string(i == 0 ? "the nominal" : "the patched") +
                            " twin: " + twins[i].status().message());
   TwinHeldOutRun out;
-  out.before = CompareTwin(held, twins[0].value(), first.seconds(), last.seconds(), drift);
-  out.after = CompareTwin(held, twins[1].value(), first.seconds(), last.seconds(), drift);
+  out.before = CompareTwin(held, twins[0].value(), first.seconds(), last.seconds(), drift, residuals);
+  out.after = CompareTwin(held, twins[1].value(), first.seconds(), last.seconds(), drift, residuals);
   return out;
 }
 

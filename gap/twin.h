@@ -5,7 +5,9 @@
 //
 //   1. compare: per stream and component the residual real - twin matched by stamp and whitened by the recording's
 //      stated noise (gap/internal/twin_residuals.h); RMS per stream and component; for an absolute stream (gps,
-//      position, pose) the drift over fixed windows (TwinDrift);
+//      position, pose) the drift over fixed windows (TwinDrift). A replayed run's fit and held-out comparison compare
+//      its absolute streams by windowed increments and leave out the encoders that drive the replay
+//      (TwinDiagnoseOptions::increment_window_s, ReplayedResidualOptions);
 //   2. locate: Locate (gap/locate.h) on the nominal twin's whitened residuals of the whole run, against the stated
 //      noise (level 1), with the conditions computed from the real recording's own streams: the poses of a pose
 //      stream (motion capture) when there is one, else the wheel encoders' dead reckoning with the nominal geometry
@@ -72,7 +74,13 @@ using TwinRunner = std::function<Result<recording::Recording>(const sim::Scenari
 TwinRunner PlainSimulationRunner();
 // Replays `patched` with the drive inputs of `real` (sim/replay.h) up to patched.duration_s after the recording's first
 // stamp (stamps may be absolute, e.g. Unix time): the twin of any recording with drive inputs. Keeps its own copy of
-// the recording, and the replay's start (sim::ReplayStartOf) found at its first call, so that every run starts alike.
+// the recording, and the replay's start (sim::ReplayStartOf) found at its first call. With a pose stream (motion
+// capture) each run then replays its first sim::kStartAlignS from that start with its own scenario, and the start is
+// moved by the planar rigid motion (yaw and translation) that best fits that replay's pose track onto the recorded one
+// over that span, positions and headings weighted by their stated noise (as TwinDrift's alignment), before the run
+// is replayed from the aligned start: a single pose's heading noise (5 mrad in motion capture), and a recording that
+// starts in motion, which the twin takes a few steps to follow, would otherwise turn the whole run by some mrad and
+// bias the geometry fitted to it.
 TwinRunner ReplayRunner(const recording::Recording& real);
 
 // How far `twin` is from following the drive of `real`: for each wheel stream in both (wheel_encoders, steering),
@@ -118,8 +126,30 @@ struct DriftOptions {
   double align_s = 2.0;   // the span of the window's start the alignment fits
 };
 
+// How the twin's residuals compare a recording's streams (gap/internal/twin_residuals.h).
+//   increment_window_s > 0: the absolute streams (pose, gps, position) compared by their increments over consecutive
+//     windows [t0, t0 + W] (each ending at the last sample within W of its start, the next starting there; a window
+//     shorter than 0.9 W is not compared): the recorded and the twin's displacement from t0, each expressed in its own
+//     frame at t0 (a pose stream: x y rotated by -yaw(t0), compared along and across the recorded displacement d; a
+//     gps fix or position stream: the increment in ENU, per axis), whitened by the noise of the two recorded samples:
+//     sqrt(2) sigma per axis, and across a pose's displacement sqrt(2 sigma^2 + sigma_yaw^2 |d|^2) (its stated
+//     orientation_rad turns d). What the twin's 10 s drift measures, without the start's error carried along the
+//     whole track. 0: sample by sample, the absolute values.
+//   left_out: streams not compared, by name, with the reason (the layout's left_out as "stream: reason").
+struct TwinResidualOptions {
+  double increment_window_s = 0.0;
+  std::map<std::string, std::string> left_out;
+};
+// The residual options of a replayed run of `real` (ReplayRunner): windowed increments of increment_window_s, and the
+// wheel_encoders stream that drives the replay (sim::DriveInputsFrom) left out: the twin's encoders track the recorded
+// angles through the wheels' velocity servos, a tick or two behind (both in whole ticks), a systematic residual of
+// several sigma that the effects fitted would otherwise chase.
+TwinResidualOptions ReplayedResidualOptions(const sim::Scenario& nominal, const recording::Recording& real,
+                                            double increment_window_s);
+
 // The twin against the real recording over [from_s, to_s].
 struct TwinComparison {
+  double increment_window_s = 0.0;  // the residuals' (TwinResidualOptions)
   double from_s = 0.0, to_s = 0.0;
   std::map<std::string, SimulatedStreamFit> streams;  // an imu as "gyroscope" and "accelerometer"
   std::map<std::string, TwinDrift> drift;             // absolute streams with a window inside the span
@@ -128,7 +158,7 @@ struct TwinComparison {
   int residuals = 0;                                  // scalar residuals compared
 };
 TwinComparison CompareTwin(const recording::Recording& real, const recording::Recording& twin, double from_s,
-                           double to_s, const DriftOptions& drift = {});
+                           double to_s, const DriftOptions& drift = {}, const TwinResidualOptions& residuals = {});
 
 // The rows of a fit at its solution: the whitened residuals (finite entries only) and their derivatives by the
 // parameters (one column each, in the fitted units), with each row's stamp and series (stream name), the rows of one
@@ -228,6 +258,7 @@ struct TwinDiagnosis {
   std::vector<sim::EffectOptions> patch;           // the kept effects as the simulator takes them
   std::vector<TwinHeldOutRun> heldout_runs;        // ShowOnHeldOut's, filled by the caller
   std::vector<TwinTrainingFigures> training_runs;  // the training runs after the diagnosed one
+  double increment_window_s = 0.0;                 // the replayed runs' residuals (TwinDiagnoseOptions)
   int runs = 0;
   double seconds = 0.0;
 };
@@ -243,6 +274,11 @@ struct TwinDiagnoseOptions {
   int max_iterations = 8;    // Levenberg-Marquardt
   bool replayed = false;     // the runner replays the recorded drive (written with the results)
   DriftOptions drift;
+  // A replayed run's fit and held-out comparison (TwinTrainingRun::replayed): its absolute streams compared by their
+  // increments over windows of this length, and its driving encoders left out (ReplayedResidualOptions); 0: the
+  // absolute values, the driving encoders still left out. The other runs, and the located components, compare the
+  // absolute values.
+  double increment_window_s = 10.0;
   // The std reported: white, hac (the larger of std_white and std_hac, as the estimator's calibration reports), or
   // auto (hac on an imported recording, white on a simulated one).
   estimator::CalibrationOptions::StdMethod std_method = estimator::CalibrationOptions::StdMethod::kAuto;
@@ -270,10 +306,12 @@ Result<TwinDiagnosis> DiagnoseTwin(const sim::Scenario& nominal, const std::vect
 
 // The patch shown on a held-out recording: its twin with `runner` (the twin of `held`) for the nominal scenario (its
 // effects removed) and for the nominal one with `patch`, both up to held's last stamp, run in parallel on `threads`,
-// each compared with `held` over its span. Errors: a twin fails, or `held` has no span of samples.
+// each compared with `held` over its span (`residuals`: ReplayedResidualOptions for a replayed twin, as the fit's).
+// Errors: a twin fails, or `held` has no span of samples.
 Result<TwinHeldOutRun> ShowOnHeldOut(const sim::Scenario& nominal, const std::vector<sim::EffectOptions>& patch,
                                      const recording::Recording& held, const TwinRunner& runner,
-                                     const DriftOptions& drift = {}, int threads = 2);
+                                     const DriftOptions& drift = {}, int threads = 2,
+                                     const TwinResidualOptions& residuals = {});
 
 // Per stream: {"window_s", "windows", "mean_position_m", "max_position_m"[, "mean_heading_rad", "max_heading_rad"]}.
 nlohmann::json TwinDriftJson(const std::map<std::string, TwinDrift>& drift);
@@ -282,9 +320,9 @@ nlohmann::json TwinDriftJson(const std::map<std::string, TwinDrift>& drift);
 // the first's as "candidates"), "effects" (each with "effect": the simulator's effects it sets), "joint" (null, or
 // {"effects", "held", "failed", "chi2_before", "chi2_after", "iterations", "runs"}), "unexplained",
 // "heldout": {"before", "after"}, "whole_run", "patch",
-// "heldout_runs": [{"recording", "replayed", "before", "after"}], "runs", "seconds"}, and with further training runs
-// "training_runs": [{"recording", "replayed", "train_end_s", "heldout": {"before", "after"}}]: gap.json's "simulation"
-// section.
+// "heldout_runs": [{"recording", "replayed", "before", "after"}], "increment_window_s", "runs", "seconds"}, and with
+// further training runs "training_runs": [{"recording", "replayed", "train_end_s", "heldout": {"before", "after"}}]:
+// gap.json's "simulation" section.
 nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d);
 
 }  // namespace roamlab::gap

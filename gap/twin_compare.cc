@@ -13,6 +13,7 @@
 #include "estimator/models/enu.h"
 #include "gap/internal/twin_residuals.h"
 #include "gap/twin.h"
+#include "recording/odometry_pose.h"
 #include "sim/replay.h"
 #include "sim/simulator.h"
 
@@ -152,13 +153,29 @@ std::optional<TwinDrift> Drift(const Stream& r, const Stream& s, Time from, Time
 
 }  // namespace
 
+TwinResidualOptions ReplayedResidualOptions(const sim::Scenario& nominal, const recording::Recording& real,
+                                            double increment_window_s) {
+  TwinResidualOptions out;
+  out.increment_window_s = increment_window_s;
+  auto drive = sim::DriveInputsFrom(real, nominal);
+  if (!drive.ok()) return out;
+  for (const std::string& name : drive.value().streams) {
+    const Stream* s = real.Find(name);
+    if (s && s->info.type == StreamType::kWheelEncoders)
+      out.left_out[name] =
+          "drives the replay (the twin's encoders track it through the wheel servos, a tick or two behind)";
+  }
+  return out;
+}
+
 TwinComparison CompareTwin(const recording::Recording& real, const recording::Recording& twin, double from_s,
-                           double to_s, const DriftOptions& drift) {
+                           double to_s, const DriftOptions& drift, const TwinResidualOptions& residuals) {
   TwinComparison out;
   out.from_s = from_s;
   out.to_s = to_s;
+  out.increment_window_s = residuals.increment_window_s;
   const Time from = Time::FromSeconds(from_s), to = Time::FromSeconds(to_s);
-  const internal::Layout layout = internal::MakeLayout(real, from, to);
+  const internal::Layout layout = internal::MakeLayout(real, from, to, residuals);
   std::vector<std::string> missing;
   const Eigen::VectorXd whitened = internal::WhitenedResiduals(layout, real, twin, &missing);
   out.streams = internal::SeriesFits(layout, whitened);
@@ -319,6 +336,34 @@ TwinRunner PlainSimulationRunner() {
   };
 }
 
+namespace {
+
+// `start` moved by the planar rigid motion (PlanarAlignment, noise-weighted positions and headings) that best fits the
+// pose track of `head` (a replay's first span from `start`) onto the recorded one; unchanged when the replay has no
+// pose stream with 3 samples matched by stamp.
+sim::ReplayStart PoseAlignedStart(const recording::Recording& real, const recording::Recording& head,
+                                  sim::ReplayStart start) {
+  for (const Stream& twin : head.streams) {
+    const Stream* recorded = real.Find(twin.info.name);
+    if (twin.info.type != StreamType::kPose || !recorded || recorded->info.type != StreamType::kPose ||
+        recorded->values.cols() < 7 || twin.values.cols() < 7)
+      continue;
+    const Time from = Time::FromNanoseconds(std::numeric_limits<std::int64_t>::min());
+    const Time to = Time::FromNanoseconds(std::numeric_limits<std::int64_t>::max());
+    const Track k = Matched(*recorded, twin, from, to, real.origin);
+    if (k.t_s.size() < 3) return start;
+    const auto [R, p] = PlanarAlignment(k, 0, k.t_s.size() - 1);
+    const Eigen::Vector3d moved = R * Eigen::Vector3d(start.p_m.x(), start.p_m.y(), 0.0) + p;
+    start.p_m = moved.head<2>();
+    start.yaw_rad += std::atan2(R(1, 0), R(0, 0));
+    start.source += ", aligned by its pose track's first " + std::to_string(static_cast<int>(sim::kStartAlignS)) + " s";
+    return start;
+  }
+  return start;
+}
+
+}  // namespace
+
 TwinRunner ReplayRunner(const recording::Recording& real) {
   auto recorded = std::make_shared<const recording::Recording>(real);
   std::optional<Time> first;
@@ -336,6 +381,18 @@ TwinRunner ReplayRunner(const recording::Recording& real) {
     if (!start->found->ok()) return start->found->status();
     sim::ReplayOptions options;
     options.start = start->found->value();
+    // With a pose stream: this scenario's replay of the first kStartAlignS, fitted onto the recorded poses, moves the
+    // start (one pose's heading noise, and a start in motion that the twin takes a few steps to follow, would turn
+    // the whole run by some mrad).
+    if (std::any_of(recorded->streams.begin(), recorded->streams.end(), [&](const Stream& s) {
+          return s.info.type == StreamType::kPose && !recording::PosedOdometry(*recorded, s);
+        })) {
+      sim::ReplayOptions head = options;
+      head.to_s = first_s + std::min(sim::kStartAlignS, patched.duration_s);
+      auto replayed = sim::Replay(patched, *recorded, head);
+      if (!replayed.ok()) return Status::Error("the replay that aligns the start: " + replayed.status().message());
+      options.start = PoseAlignedStart(*recorded, replayed.value().recording, *options.start);
+    }
     options.to_s = first_s + patched.duration_s;
     auto replayed = sim::Replay(patched, *recorded, options);
     if (!replayed.ok()) return replayed.status();

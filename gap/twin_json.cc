@@ -18,6 +18,7 @@ nlohmann::json StreamsJson(const std::map<std::string, SimulatedStreamFit>& stre
 nlohmann::json ComparisonJson(const TwinComparison& c) {
   return {{"from_s", c.from_s},
           {"to_s", c.to_s},
+          {"increment_window_s", c.increment_window_s},
           {"chi2", Number(c.chi2)},
           {"residuals", c.residuals},
           {"streams", StreamsJson(c.streams)},
@@ -141,6 +142,7 @@ nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d) {
       {"whole_run", ComparisonJson(d.whole_run)},
       {"patch", patch},
       {"heldout_runs", heldout_runs},
+      {"increment_window_s", d.increment_window_s},
       {"runs", d.runs},
       {"seconds", d.seconds}};
   if (d.training_runs.empty()) return out;

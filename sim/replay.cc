@@ -119,6 +119,7 @@ Found FromInputsStream(const Recording& real, bool ackermann, std::string* note)
     in.t = s.t;
     in.hold = true;
     in.source = "inputs stream '" + s.info.name + "'";
+    in.streams = {s.info.name};
     in.values = Eigen::MatrixXd::Zero(s.values.rows(), static_cast<Eigen::Index>(needed.size()));
     for (std::size_t j = 0; j < needed.size(); ++j)
       if (columns[j] >= 0) in.values.col(static_cast<Eigen::Index>(j)) = s.values.col(columns[j]);
@@ -149,6 +150,7 @@ Found FromWheelEncoders(const Recording& real, const RobotOptions& robot) {
     in.kind = DriveInputs::Kind::kWheelRates;
     in.t = s.t;
     in.source = "wheel_encoders stream '" + s.info.name + "'" + (IsAngleEncoder(s) ? " (differentiated)" : "");
+    in.streams = {s.info.name};
     in.values.resize(rates.rows(), static_cast<Eigen::Index>(model.size()));
     if (IsAngleEncoder(s)) in.angles_rad.resize(rates.rows(), static_cast<Eigen::Index>(model.size()));
     for (std::size_t i = 0; i < model.size(); ++i) {
@@ -171,6 +173,7 @@ Found FromOdometry(const Recording& real) {
     in.kind = DriveInputs::Kind::kBodyVelocity;
     in.t = s.t;
     in.source = "odometry stream '" + s.info.name + "'";
+    in.streams = {s.info.name};
     in.values.resize(s.values.rows(), 3);
     for (Eigen::Index k = 0; k < s.values.rows(); ++k) {
       const Eigen::Vector3d omega = R * s.values.row(k).segment<3>(3).transpose();
@@ -203,6 +206,7 @@ Found FromAckermannOdometer(const Recording& real, const Scenario& nominal) {
   in.kind = DriveInputs::Kind::kAckermann;
   in.t = speed->t;
   in.source = "rear-wheel speed '" + speed->info.name + "' and steering '" + steering->info.name + "'";
+  in.streams = {speed->info.name, steering->info.name};
   in.values.resize(v.size(), 2);
   in.values.col(0) = v;
   // The steering angle at the speed's stamps (linear between its own rows).

@@ -45,6 +45,8 @@ struct DriveInputs {
                                // empty otherwise
   Eigen::VectorXd travel_m;    // kAckermann from measured speeds: per row the rear wheels' travel since the first
                                // row [m] (the speeds integrated); empty otherwise
+  // The recorded streams the inputs were taken from (DriveInputsFrom).
+  std::vector<std::string> streams;
 
   // The inputs at recording time `t`: the first row before the first stamp, the last after the last.
   Eigen::VectorXd At(Time t) const;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/Geometry>
+
 #include "estimator/models/enu.h"
 #include "gap/locate.h"
 
@@ -77,6 +79,85 @@ void AddSeries(const Stream& s, const std::vector<double>& sigma, Time from, Tim
   }
 }
 
+bool Absolute(StreamType type) {
+  return type == StreamType::kPose || type == StreamType::kGps || type == StreamType::kPosition;
+}
+
+// The windowed increments' series of an absolute stream over [from, to] (gap/twin.h TwinResidualOptions): windows
+// from a sample to the last sample within window_s of it, the next from there, each at least 0.9 window_s long.
+void AddIncrementSeries(const Stream& s, const std::vector<double>& sigma, Time from, Time to, double window_s,
+                        Layout* layout) {
+  Series series;
+  series.name = s.info.name;
+  series.stream = s.info.name;
+  series.type = s.info.type;
+  series.sigma = sigma;
+  if (s.info.type == StreamType::kPose) series.heading_sigma = Noise(s.info, "orientation_rad");
+  std::size_t a = static_cast<std::size_t>(std::lower_bound(s.t.begin(), s.t.end(), from) - s.t.begin());
+  while (a < s.t.size() && s.t[a] <= to) {
+    std::size_t b = a;
+    while (b + 1 < s.t.size() && s.t[b + 1] <= to && SecondsBetween(s.t[a], s.t[b + 1]) <= window_s + 1e-9) ++b;
+    if (b == a || SecondsBetween(s.t[a], s.t[b]) < 0.9 * window_s) break;
+    series.starts.push_back(a);
+    series.rows.push_back(b);
+    series.t.push_back(s.t[b]);
+    a = b;
+  }
+  series.offset = layout->size;
+  layout->size += series.size();
+  layout->series.push_back(std::move(series));
+}
+
+double Yaw(const Eigen::Quaterniond& q) {
+  const Eigen::Vector3d x = q * Eigen::Vector3d::UnitX();
+  return std::atan2(x.y(), x.x());
+}
+
+// A pose's planar increment from row a to row b in its frame at a: R(-yaw_a) (p_b - p_a).
+Eigen::Vector2d PoseIncrement(const Stream& s, std::size_t a, std::size_t b) {
+  const auto row = [&](std::size_t i) { return s.values.row(static_cast<Eigen::Index>(i)); };
+  const Eigen::Quaterniond q_a(row(a)[6], row(a)[3], row(a)[4], row(a)[5]);
+  const Eigen::Vector2d d(row(b)[0] - row(a)[0], row(b)[1] - row(a)[1]);
+  return Eigen::Rotation2Dd(-Yaw(q_a.normalized())) * d;
+}
+
+// The whitened increments of one series: per window the recorded increment less the twin's (rows of `twin` matched
+// by stamp, NaN where it lacks either), a pose's along and across the recorded displacement d, over sqrt(2) sigma and
+// sqrt(2 sigma^2 + heading_sigma^2 |d|^2); a gps fix's or position's per ENU axis over sqrt(2) sigma.
+void WhitenedIncrements(const Series& series, const Stream& real, const Stream& twin,
+                        const std::optional<estimator::EnuConverter>& enu, Eigen::VectorXd* out) {
+  const auto twin_row = [&](Time t) -> std::optional<std::size_t> {
+    const auto it = std::lower_bound(twin.t.begin(), twin.t.end(), t);
+    if (it == twin.t.end() || *it != t) return std::nullopt;
+    return static_cast<std::size_t>(it - twin.t.begin());
+  };
+  const auto position = [&](const Stream& x, std::size_t row) {
+    const Eigen::Vector3d p = x.values.row(static_cast<Eigen::Index>(row)).head(3).transpose();
+    return series.type == StreamType::kGps ? Eigen::Vector3d(enu->ToEnu(p[0], p[1], p[2])) : p;
+  };
+  const int n = series.components();
+  if (series.type == StreamType::kPose && (real.values.cols() < 7 || twin.values.cols() < 7)) return;
+  for (std::size_t i = 0; i < series.rows.size(); ++i) {
+    const std::size_t a = series.starts[i], b = series.rows[i];
+    const auto ta = twin_row(real.t[a]), tb = twin_row(real.t[b]);
+    if (!ta || !tb) continue;
+    const Eigen::Index k = series.offset + static_cast<Eigen::Index>(i) * n;
+    if (series.type == StreamType::kPose) {
+      const Eigen::Vector2d d = PoseIncrement(real, a, b);
+      const Eigen::Vector2d delta = d - PoseIncrement(twin, *ta, *tb);
+      const Eigen::Vector2d along = d.norm() > 0.0 ? Eigen::Vector2d(d.normalized()) : Eigen::Vector2d::UnitX();
+      const Eigen::Vector2d across(-along.y(), along.x());
+      const double sigma2 = 2.0 * series.sigma[0] * series.sigma[0];
+      const double heading2 = series.heading_sigma * series.heading_sigma * d.squaredNorm();
+      (*out)[k] = delta.dot(along) / std::sqrt(sigma2);
+      (*out)[k + 1] = delta.dot(across) / std::sqrt(sigma2 + heading2);
+      continue;
+    }
+    const Eigen::Vector3d delta = (position(real, b) - position(real, a)) - (position(twin, *tb) - position(twin, *ta));
+    for (int c = 0; c < n; ++c) (*out)[k + c] = delta[c] / (std::sqrt(2.0) * series.sigma[static_cast<std::size_t>(c)]);
+  }
+}
+
 }  // namespace
 
 std::vector<double> ColumnSigmas(const recording::StreamInfo& info) {
@@ -123,10 +204,14 @@ std::vector<double> ColumnSigmas(const recording::StreamInfo& info) {
   }
 }
 
-Layout MakeLayout(const recording::Recording& real, Time from, Time to) {
+Layout MakeLayout(const recording::Recording& real, Time from, Time to, const TwinResidualOptions& options) {
   Layout layout;
   layout.origin = real.origin;
   for (const Stream& s : real.streams) {
+    if (const auto it = options.left_out.find(s.info.name); it != options.left_out.end()) {
+      layout.left_out.push_back(s.info.name + ": " + it->second);
+      continue;
+    }
     const std::vector<double> sigma = ColumnSigmas(s.info);
     const bool stated = !sigma.empty() && std::all_of(sigma.begin(), sigma.end(), [](double x) { return x > 0.0; });
     std::string why;
@@ -140,7 +225,10 @@ Layout MakeLayout(const recording::Recording& real, Time from, Time to) {
       layout.left_out.push_back(s.info.name + ": " + why);
       continue;
     }
-    AddSeries(s, sigma, from, to, &layout);
+    if (options.increment_window_s > 0.0 && Absolute(s.info.type))
+      AddIncrementSeries(s, sigma, from, to, options.increment_window_s, &layout);
+    else
+      AddSeries(s, sigma, from, to, &layout);
   }
   return layout;
 }
@@ -156,6 +244,10 @@ Eigen::VectorXd WhitenedResiduals(const Layout& layout, const recording::Recordi
     const int n = series.components();
     if (!r || !s || s->info.type != series.type || s->values.cols() < series.first_column + n) {
       if (missing) missing->push_back(series.name + ": not in the twin");
+      continue;
+    }
+    if (!series.starts.empty()) {
+      WhitenedIncrements(series, *r, *s, enu, &out);
       continue;
     }
     const auto value = [&](const Stream& stream, std::size_t row) {

@@ -8,6 +8,9 @@
 // ticks_per_revolution) or its one stated sigma, and the one stated sigma of the other single-noise streams (gyroscope,
 // accelerometer, magnetometer, steering). A gps fix is compared in the real recording's ENU frame (its origin). A
 // sample of the real recording is matched by its exact stamp; a twin without that stamp leaves the entry NaN.
+// With TwinResidualOptions::increment_window_s (gap/twin.h), the pose, gps and position streams are compared by their
+// increments over consecutive windows instead, whitened by the two recorded samples' noise; streams named in its
+// left_out are not compared.
 #pragma once
 
 #include <map>
@@ -20,6 +23,7 @@
 #include "common/time.h"
 #include "estimator/calibration.h"
 #include "gap/resimulate.h"
+#include "gap/twin.h"
 #include "recording/recording.h"
 
 namespace roamlab::gap::internal {
@@ -37,18 +41,24 @@ struct Series {
   std::vector<std::size_t> rows;  // the real recording's rows compared
   std::vector<Time> t;            // their stamps
   Eigen::Index offset = 0;        // first entry in the residual vector
+  // Windowed increments: entry i compares the increment from the real recording's row starts[i] to rows[i] (t[i]
+  // its stamp); a pose's two components along and across the recorded displacement, the across one whitened with
+  // heading_sigma too (gap/twin.h TwinResidualOptions). Empty: sample by sample.
+  std::vector<std::size_t> starts;
+  double heading_sigma = 0.0;  // rad: a pose stream's stated orientation_rad
   int components() const { return static_cast<int>(sigma.size()); }
   Eigen::Index size() const { return static_cast<Eigen::Index>(rows.size()) * components(); }
 };
 
-// The series of `real` over [from, to] (stamps inclusive), in stream order, and the entries they take.
+// The series of `real` over [from, to] (stamps inclusive), in stream order, and the entries they take; the absolute
+// streams as windowed increments when options.increment_window_s > 0, the streams in options.left_out left out.
 struct Layout {
   std::vector<Series> series;
   std::vector<std::string> left_out;  // "stream: reason" for the streams not compared
   std::optional<recording::GeodeticOrigin> origin;
   Eigen::Index size = 0;
 };
-Layout MakeLayout(const recording::Recording& real, Time from, Time to);
+Layout MakeLayout(const recording::Recording& real, Time from, Time to, const TwinResidualOptions& options = {});
 
 // Whitened real - twin at the layout's samples: entry offset + i * components + c for sample i, component c of a
 // series; NaN where the twin has no sample at the stamp (or lacks the stream). `missing` (may be null) gets

@@ -112,6 +112,58 @@ TEST(TwinCompareTest, TheAlignmentOverTheWindowsStartKeepsTheHeadingNoiseOut) {
   EXPECT_NEAR(c.drift.at("mocap").mean_heading_rad, kHeadingSigmaRad * std::sqrt(2.0 / M_PI), 0.0015);
 }
 
+// Compared by 10 s increments, each in its own frame at the window's start: a pose track moved rigidly (yaw and
+// translation) leaves no residual in the three windows of 30 s, where the absolute values are far apart; a position
+// track (no heading) leaves none when translated, and some when turned.
+TEST(TwinCompareTest, ARigidlyMovedTwinHasNoWindowedIncrementResidual) {
+  TwinResidualOptions increments;
+  increments.increment_window_s = 10.0;
+  for (const StreamType type : {StreamType::kPose, StreamType::kPosition}) {
+    const recording::Recording real = With(Track(type, 0.0, Eigen::Vector3d::Zero(), 0.0));
+    const Eigen::Vector3d offset(3.0, -2.0, 0.5);
+    const recording::Recording moved = With(Track(type, type == StreamType::kPose ? 0.7 : 0.0, offset, 0.0));
+    const TwinComparison c = CompareTwin(real, moved, 0.0, kDurationS, {}, increments);
+    EXPECT_EQ(c.increment_window_s, 10.0);
+    EXPECT_EQ(c.residuals, 3 * (type == StreamType::kPose ? 2 : 3));
+    EXPECT_LT(c.chi2, 1e-12);
+    EXPECT_GT(CompareTwin(real, moved, 0.0, kDurationS).chi2, 1e4);
+    if (type == StreamType::kPose) continue;
+    const recording::Recording turned = With(Track(type, 0.7, offset, 0.0));
+    EXPECT_GT(CompareTwin(real, turned, 0.0, kDurationS, {}, increments).chi2, 1e4);
+  }
+}
+
+// A twin 0.01 m/s faster along x is 0.1 m off in each 10 s increment. Whitened by two samples' noise (sqrt(2) sigma,
+// sigma 1 cm) that is chi2 = 3 x 0.1^2 / (2 sigma^2) = 150 over the three windows, for a pose and a position stream.
+// With a pose's heading noise stated, the component across the recorded displacement d (the 8.4 m chord of each
+// window's arc, at 1 rad from the start's heading) is whitened by sqrt(2 sigma^2 + sigma_yaw^2 |d|^2).
+TEST(TwinCompareTest, TheWindowedIncrementIsWhitenedByTheTwoPosesNoise) {
+  constexpr double kSigmaM = 0.01, kHeadingSigmaRad = 0.005;
+  TwinResidualOptions increments;
+  increments.increment_window_s = 10.0;
+  for (const StreamType type : {StreamType::kPose, StreamType::kPosition}) {
+    const recording::Recording real = With(Track(type, 0.0, Eigen::Vector3d::Zero(), 0.0));
+    const recording::Recording faster = With(Track(type, 0.0, Eigen::Vector3d::Zero(), 0.01));
+    const TwinComparison c = CompareTwin(real, faster, 0.0, kDurationS, {}, increments);
+    EXPECT_NEAR(c.chi2, 3.0 * 0.01 / (2.0 * kSigmaM * kSigmaM), 1e-6) << static_cast<int>(type);
+  }
+  Stream real = Track(StreamType::kPose, 0.0, Eigen::Vector3d::Zero(), 0.0);
+  Stream faster = Track(StreamType::kPose, 0.0, Eigen::Vector3d::Zero(), 0.01);
+  real.info.noise["orientation_rad"] = faster.info.noise["orientation_rad"] = kHeadingSigmaRad;
+  const TwinComparison c = CompareTwin(With(real), With(faster), 0.0, kDurationS, {}, increments);
+  double expected = 0.0;
+  const double chord_m = 2.0 * 5.0 * std::sin(1.0);
+  for (const double start_rad : {0.0, 2.0, 4.0}) {
+    // Real minus twin in the frame at the start: (-0.1, 0) turned by -start; d at 1 rad in that frame.
+    const Eigen::Vector2d delta = Eigen::Rotation2Dd(-start_rad) * Eigen::Vector2d(-0.1, 0.0);
+    const Eigen::Vector2d along(std::cos(1.0), std::sin(1.0)), across(-std::sin(1.0), std::cos(1.0));
+    expected += std::pow(delta.dot(along), 2) / (2.0 * kSigmaM * kSigmaM) +
+                std::pow(delta.dot(across), 2) / (2.0 * kSigmaM * kSigmaM + std::pow(kHeadingSigmaRad * chord_m, 2));
+  }
+  EXPECT_NEAR(c.chi2, expected, 1e-6 * expected);
+  EXPECT_LT(c.chi2, 100.0);  // the across components weigh less than with the position noise alone
+}
+
 TEST(TwinCompareTest, TheWhiteNoiseCovarianceIsTheInverseCurvature) {
   TwinFitRows rows;
   rows.jacobian = Eigen::MatrixXd::Zero(4, 2);
