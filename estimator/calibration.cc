@@ -3,12 +3,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdint>
 #include <cstddef>
+#include <cstdint>
 #include <deque>
 #include <functional>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <utility>
@@ -377,6 +378,31 @@ std::vector<FactorId> AddWeakPosePriors(ProblemBuilder* builder) {
   return priors;
 }
 
+// Whether factor `id`'s innovation at the current estimate passes the chi-square quantile `probability` of its
+// dimension (internal::InnovationWithin), with the joint marginal covariance of its free variables from `system`'s
+// factorization; nullopt where that covariance cannot be had.
+std::optional<bool> InnovationPasses(double probability, const Graph& graph, internal::NormalEquations& system,
+                                     FactorId id) {
+  const FactorEntry& entry = graph.factor(id);
+  std::vector<const double*> values;
+  std::vector<VariableId> free_variables;
+  std::vector<int> free;
+  std::uint64_t free_mask = 0;
+  for (std::size_t i = 0; i < entry.variables.size(); ++i) {
+    const Variable& v = graph.variable(entry.variables[i]);
+    values.push_back(v.value.data());
+    if (v.fixed || system.OffsetOf(entry.variables[i]) < 0) continue;
+    free_variables.push_back(entry.variables[i]);
+    free.push_back(static_cast<int>(i));
+    free_mask |= std::uint64_t{1} << i;
+  }
+  Eigen::MatrixXd covariance;
+  if (!free_variables.empty() && !system.Covariance(free_variables, &covariance)) return std::nullopt;
+  internal::WhitenedFactor wf;
+  return internal::LinearizeFactorAt(entry, values.data(), free_mask, &wf) &&
+         internal::InnovationWithin(probability, wf, free, covariance);
+}
+
 }  // namespace
 
 int ReadmitOnInnovation(double probability, ProblemBuilder* builder, const std::set<FactorId>& excluded) {
@@ -403,33 +429,9 @@ int ReadmitOnInnovation(double probability, ProblemBuilder* builder, const std::
   }
   // Each candidate's innovation at the current estimate, all against the same factorization.
   std::vector<FactorId> passing;
-  std::vector<const double*> values;
-  std::vector<VariableId> free_variables;
-  std::vector<int> free;
-  internal::WhitenedFactor wf;
-  Eigen::MatrixXd covariance;
   for (const FactorId id : candidates) {
     if (!factored) break;
-    const FactorEntry& entry = graph.factor(id);
-    values.clear();
-    free_variables.clear();
-    free.clear();
-    std::uint64_t free_mask = 0;
-    for (std::size_t i = 0; i < entry.variables.size(); ++i) {
-      const Variable& v = graph.variable(entry.variables[i]);
-      values.push_back(v.value.data());
-      if (v.fixed || system.OffsetOf(entry.variables[i]) < 0) continue;
-      free_variables.push_back(entry.variables[i]);
-      free.push_back(static_cast<int>(i));
-      free_mask |= std::uint64_t{1} << i;
-    }
-    if (free_variables.empty())
-      covariance.resize(0, 0);
-    else if (!system.Covariance(free_variables, &covariance))
-      continue;
-    if (internal::LinearizeFactorAt(entry, values.data(), free_mask, &wf) &&
-        internal::InnovationWithin(probability, wf, free, covariance))
-      passing.push_back(id);
+    if (InnovationPasses(probability, graph, system, id).value_or(false)) passing.push_back(id);
   }
   for (const FactorId id : priors) graph.RemoveFactor(id);
   for (const FactorId id : passing) {
@@ -538,33 +540,14 @@ int AdmitConsistentRows(double probability, std::vector<FactorId>* held, Problem
   internal::NormalEquations system(graph, FreeVariableOrder(graph));
   const bool linearized = system.Linearize(graph);
   std::vector<FactorId> still_held;
-  std::vector<const double*> values;
-  std::vector<VariableId> free_variables;
-  std::vector<int> free;
-  internal::WhitenedFactor wf;
-  Eigen::MatrixXd covariance;
   int admitted = 0;
   for (const FactorId id : *held) {
-    FactorEntry& entry = graph.mutable_factor(id);
-    values.clear();
-    free_variables.clear();
-    free.clear();
-    std::uint64_t free_mask = 0;
-    for (std::size_t i = 0; i < entry.variables.size(); ++i) {
-      const Variable& v = graph.variable(entry.variables[i]);
-      values.push_back(v.value.data());
-      if (v.fixed) continue;
-      free_variables.push_back(entry.variables[i]);
-      free.push_back(static_cast<int>(i));
-      free_mask |= std::uint64_t{1} << i;
-    }
-    const bool tested = linearized && system.Covariance(free_variables, &covariance);
-    const bool passes = !tested || (internal::LinearizeFactorAt(entry, values.data(), free_mask, &wf) &&
-                                    internal::InnovationWithin(probability, wf, free, covariance));
+    const bool passes = !linearized || InnovationPasses(probability, graph, system, id).value_or(true);
     if (!passes) {
       still_held.push_back(id);
       continue;
     }
+    FactorEntry& entry = graph.mutable_factor(id);
     entry.active = true;
     --builder->mutable_counts(entry.stream).rejected;
     ++admitted;
@@ -574,7 +557,8 @@ int AdmitConsistentRows(double probability, std::vector<FactorId>* held, Problem
 }
 
 // The scale of the robust start's Huber loss: the chi-square 95 % quantile of a factor's dimension, in whitened units.
-// Errors within it (19 in 20 good ones) count as in least squares; a gross one pulls with the force of one at the scale.
+// Errors within it (19 in 20 good ones) count as in least squares; a gross one pulls with the force of one at the
+// scale.
 constexpr double kRobustStartProbability = 0.95;
 
 // Gives every measurement factor of a stream configured with the trivial loss Huber's loss at the
@@ -675,12 +659,11 @@ Result<StageSummary> SolveStage(const EstimatorConfig& config, const Calibration
       if (!solved.ok()) return solved;
       continue;
     }
-    const Status solved =
-        resolve("gating round " + std::to_string(pass + 1) + ": " + std::to_string(changed.rejected) +
-                " measurements rejected, " + std::to_string(changed.readmitted) + " re-admitted" +
-                (changed.bridged > 0 ? ", " + std::to_string(changed.bridged) + " wheel readings bridged" : "") +
-                (changed.ignored > 0 ? ", " + std::to_string(changed.ignored) + " failing by chance" : "") +
-                ", re-solved");
+    const Status solved = resolve(
+        "gating round " + std::to_string(pass + 1) + ": " + std::to_string(changed.rejected) +
+        " measurements rejected, " + std::to_string(changed.readmitted) + " re-admitted" +
+        (changed.bridged > 0 ? ", " + std::to_string(changed.bridged) + " wheel readings bridged" : "") +
+        (changed.ignored > 0 ? ", " + std::to_string(changed.ignored) + " failing by chance" : "") + ", re-solved");
     if (!solved.ok()) return solved;
   }
   if (robust) {

@@ -60,6 +60,19 @@ double Drift(const TwinComparison& c) {
   return c.drift.count("mocap") ? c.drift.at("mocap").mean_position_m : 0.0;
 }
 
+// The fitted drive geometry of `kept`: each parameter has a positive std and lies within three of it of `hidden`.
+void ExpectGeometryWithinThreeStd(const TwinEffect& kept, const std::map<std::string, double>& hidden) {
+  std::printf("  iterations %d, chi2 %.6g -> %.6g, runs %d\n", kept.iterations, kept.chi2_before, kept.chi2_after,
+              kept.runs);
+  for (const auto& [name, value] : hidden) {
+    ASSERT_TRUE(kept.estimate.std.count(name)) << name << " not fitted";
+    const double fitted = kept.estimate.parameters.at(name), std = kept.estimate.std.at(name);
+    std::printf("  %s %.6f +- %.3g (hidden %.6f)\n", name.c_str(), fitted, std, value);
+    EXPECT_GT(std, 0.0) << name;
+    EXPECT_NEAR(fitted, value, 3.0 * std) << name;
+  }
+}
+
 // The ratio fitted on both runs is named and within three of its std of the hidden one, with a smaller std than
 // fitted on the first run alone; each run's series enter the HAC covariance as series of their own; the second run's
 // held-out drift shrinks with the patch.
@@ -135,17 +148,7 @@ TEST(TwinTrainingRunsTest, AJointGeometryIsRecoveredOnTwoRunsOfDifferentDrives) 
   EXPECT_EQ(d.value().patch.size(), 3u);
   ASSERT_EQ(d.value().rounds.size(), 1u);
   EXPECT_EQ(d.value().rounds.front().size(), options.candidates.size());
-  std::printf("  iterations %d, chi2 %.6g -> %.6g, runs %d\n", kept.iterations, kept.chi2_before, kept.chi2_after,
-              kept.runs);
-  const std::map<std::string, double> truth = {
-      {"scale", kScale}, {"ratio_right_left", 1.0}, {"track_error_m", kTrackErrorM}};
-  for (const auto& [name, value] : truth) {
-    ASSERT_TRUE(kept.estimate.std.count(name)) << name << " not fitted";
-    const double fitted = kept.estimate.parameters.at(name), std = kept.estimate.std.at(name);
-    std::printf("  %s %.6f +- %.3g (hidden %.6f)\n", name.c_str(), fitted, std, value);
-    EXPECT_GT(std, 0.0) << name;
-    EXPECT_NEAR(fitted, value, 3.0 * std) << name;
-  }
+  ExpectGeometryWithinThreeStd(kept, {{"scale", kScale}, {"ratio_right_left", 1.0}, {"track_error_m", kTrackErrorM}});
 }
 
 // The same hidden geometry with each run's twin the replay of its recorded drive (wheel encoders in whole ticks,
@@ -169,17 +172,7 @@ TEST(TwinTrainingRunsTest, AJointGeometryIsRecoveredFromReplaysOfTwoDrives) {
   ASSERT_TRUE(d.ok()) << d.status().message();
   ASSERT_EQ(d.value().effects.size(), 1u);
   const TwinEffect& kept = d.value().effects.front();
-  std::printf("  iterations %d, chi2 %.6g -> %.6g, runs %d\n", kept.iterations, kept.chi2_before, kept.chi2_after,
-              kept.runs);
-  const std::map<std::string, double> truth = {
-      {"scale", kScale}, {"ratio_right_left", 1.0}, {"track_error_m", kTrackErrorM}};
-  for (const auto& [name, value] : truth) {
-    ASSERT_TRUE(kept.estimate.std.count(name)) << name << " not fitted";
-    const double fitted = kept.estimate.parameters.at(name), std = kept.estimate.std.at(name);
-    std::printf("  %s %.6f +- %.3g (hidden %.6f)\n", name.c_str(), fitted, std, value);
-    EXPECT_GT(std, 0.0) << name;
-    EXPECT_NEAR(fitted, value, 3.0 * std) << name;
-  }
+  ExpectGeometryWithinThreeStd(kept, {{"scale", kScale}, {"ratio_right_left", 1.0}, {"track_error_m", kTrackErrorM}});
   // The encoder stream that drives each replay is left out of its comparisons, with the reason.
   const std::vector<std::string>& left_out = d.value().heldout_before.left_out;
   EXPECT_TRUE(std::any_of(left_out.begin(), left_out.end(), [](const std::string& s) {
