@@ -60,6 +60,14 @@ double Drift(const TwinComparison& c) {
   return c.drift.count("mocap") ? c.drift.at("mocap").mean_position_m : 0.0;
 }
 
+// The hidden geometry of the joint-geometry tests: every wheel's radius scaled by kHiddenScale, the track
+// kHiddenTrackErrorM [m] wider.
+constexpr double kHiddenScale = 0.985, kHiddenTrackErrorM = 0.008;
+std::vector<sim::EffectOptions> HiddenGeometry() {
+  return {{"wheel_radius_scale", {{"scale", kHiddenScale}}},
+          {"track_width_error", {{"track_error_m", kHiddenTrackErrorM}}}};
+}
+
 // The fitted drive geometry of `kept`: each parameter has a positive std and lies within three of it of `hidden`.
 void ExpectGeometryWithinThreeStd(const TwinEffect& kept, const std::map<std::string, double>& hidden) {
   std::printf("  iterations %d, chi2 %.6g -> %.6g, runs %d\n", kept.iterations, kept.chi2_before, kept.chi2_after,
@@ -129,11 +137,8 @@ TwinRunner PlainSimulationOf(const sim::Scenario& drive) {
 // penalized by Delta BIC), its patch sets the three simulator effects, and each parameter is within three of its std
 // of the hidden value (the ratio of the neutral 1).
 TEST(TwinTrainingRunsTest, AJointGeometryIsRecoveredOnTwoRunsOfDifferentDrives) {
-  constexpr double kScale = 0.985, kTrackErrorM = 0.008;
-  const std::vector<sim::EffectOptions> hidden = {{"wheel_radius_scale", {{"scale", kScale}}},
-                                                  {"track_width_error", {{"track_error_m", kTrackErrorM}}}};
   const sim::Scenario nominal = Nominal(), other = Turned(nominal);
-  const recording::Recording own = Real(nominal, 43, hidden), turned = Real(other, 44, hidden);
+  const recording::Recording own = Real(nominal, 43, HiddenGeometry()), turned = Real(other, 44, HiddenGeometry());
   TwinDiagnoseOptions options;
   options.candidates = {"wheel_radius_asymmetry", "wheel_radius_scale", "track_width_error", "diff_drive_geometry"};
   options.max_effects = 1;
@@ -148,7 +153,8 @@ TEST(TwinTrainingRunsTest, AJointGeometryIsRecoveredOnTwoRunsOfDifferentDrives) 
   EXPECT_EQ(d.value().patch.size(), 3u);
   ASSERT_EQ(d.value().rounds.size(), 1u);
   EXPECT_EQ(d.value().rounds.front().size(), options.candidates.size());
-  ExpectGeometryWithinThreeStd(kept, {{"scale", kScale}, {"ratio_right_left", 1.0}, {"track_error_m", kTrackErrorM}});
+  ExpectGeometryWithinThreeStd(
+      kept, {{"scale", kHiddenScale}, {"ratio_right_left", 1.0}, {"track_error_m", kHiddenTrackErrorM}});
 }
 
 // The same hidden geometry with each run's twin the replay of its recorded drive (wheel encoders in whole ticks,
@@ -156,11 +162,8 @@ TEST(TwinTrainingRunsTest, AJointGeometryIsRecoveredOnTwoRunsOfDifferentDrives) 
 // starts where its first 10 s fit the recorded track (not at one noisy pose), and the encoder stream that drives it is
 // not compared (its twin tracks it through the servo, a tick or two behind), so neither biases the geometry.
 TEST(TwinTrainingRunsTest, AJointGeometryIsRecoveredFromReplaysOfTwoDrives) {
-  constexpr double kScale = 0.985, kTrackErrorM = 0.008;
-  const std::vector<sim::EffectOptions> hidden = {{"wheel_radius_scale", {{"scale", kScale}}},
-                                                  {"track_width_error", {{"track_error_m", kTrackErrorM}}}};
   const sim::Scenario nominal = Nominal(), other = Turned(nominal);
-  const recording::Recording own = Real(nominal, 43, hidden), turned = Real(other, 44, hidden);
+  const recording::Recording own = Real(nominal, 43, HiddenGeometry()), turned = Real(other, 44, HiddenGeometry());
   TwinDiagnoseOptions options;
   options.candidates = {"diff_drive_geometry"};
   options.max_effects = 1;
@@ -172,7 +175,8 @@ TEST(TwinTrainingRunsTest, AJointGeometryIsRecoveredFromReplaysOfTwoDrives) {
   ASSERT_TRUE(d.ok()) << d.status().message();
   ASSERT_EQ(d.value().effects.size(), 1u);
   const TwinEffect& kept = d.value().effects.front();
-  ExpectGeometryWithinThreeStd(kept, {{"scale", kScale}, {"ratio_right_left", 1.0}, {"track_error_m", kTrackErrorM}});
+  ExpectGeometryWithinThreeStd(
+      kept, {{"scale", kHiddenScale}, {"ratio_right_left", 1.0}, {"track_error_m", kHiddenTrackErrorM}});
   // The encoder stream that drives each replay is left out of its comparisons, with the reason.
   const std::vector<std::string>& left_out = d.value().heldout_before.left_out;
   EXPECT_TRUE(std::any_of(left_out.begin(), left_out.end(), [](const std::string& s) {
