@@ -6,8 +6,8 @@
 //   1. compare: per stream and component the residual real - twin matched by stamp and whitened by the recording's
 //      stated noise (gap/internal/twin_residuals.h); RMS per stream and component; for an absolute stream (gps,
 //      position, pose) the drift over fixed windows (TwinDrift). A replayed run's fit and held-out comparison compare
-//      its absolute streams by windowed increments and leave out the encoders that drive the replay
-//      (TwinDiagnoseOptions::increment_window_s, ReplayedResidualOptions);
+//      its absolute streams over windows (a pose stream as its drift is measured) and leave out the encoders that
+//      drive the replay (TwinDiagnoseOptions::increment_window_s, ReplayedResidualOptions);
 //   2. locate: Locate (gap/locate.h) on the nominal twin's whitened residuals of the whole run, against the stated
 //      noise (level 1), with the conditions computed from the real recording's own streams: the poses of a pose
 //      stream (motion capture) when there is one, else the wheel encoders' dead reckoning with the nominal geometry
@@ -149,7 +149,7 @@ struct TwinResidualOptions {
   double align_s = 2.0;             // a pose stream's window alignment (DriftOptions::align_s)
   std::map<std::string, std::string> left_out;
 };
-// The residual options of a replayed run of `real` (ReplayRunner): windowed increments of increment_window_s, and the
+// The residual options of a replayed run of `real` (ReplayRunner): windows of increment_window_s, and the
 // wheel_encoders stream that drives the replay (sim::DriveInputsFrom) left out: the twin's encoders track the recorded
 // angles through the wheels' velocity servos, a tick or two behind (both in whole ticks), a systematic residual of
 // several sigma that the effects fitted would otherwise chase.
@@ -283,8 +283,8 @@ struct TwinDiagnoseOptions {
   int max_iterations = 8;    // Levenberg-Marquardt
   bool replayed = false;     // the runner replays the recorded drive (written with the results)
   DriftOptions drift;
-  // A replayed run's fit and held-out comparison (TwinTrainingRun::replayed): its absolute streams compared by their
-  // increments over windows of this length, and its driving encoders left out (ReplayedResidualOptions); 0: the
+  // A replayed run's fit and held-out comparison (TwinTrainingRun::replayed): its absolute streams compared over
+  // windows of this length (TwinResidualOptions), and its driving encoders left out (ReplayedResidualOptions); 0: the
   // absolute values, the driving encoders still left out. The other runs, and the located components, compare the
   // absolute values.
   double increment_window_s = 10.0;
