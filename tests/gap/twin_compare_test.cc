@@ -155,7 +155,7 @@ TEST(TwinCompareTest, TheWindowedResidualIsTheDriftWhitenedByTheRecordedNoise) {
 }
 
 // The recorded poses carry their stated noise (1 mm, 5 mrad), the twin none: the pose windows' whitened residuals have
-// unit variance (over 40 draws; without the alignment yaw's share, l^2 / I, the across component's would be about 9:
+// unit variance (over 40 draws; without the alignment yaw's share, l^2 / I, the across component's would be about 7:
 // a lever of 7-8 m turned by about 0.4 mrad against 1 mm).
 TEST(TwinCompareTest, ThePoseWindowsResidualIsWhitenedByTheAlignmentsNoise) {
   constexpr double kSigmaM = 0.001, kHeadingSigmaRad = 0.005;
