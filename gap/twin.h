@@ -6,8 +6,8 @@
 //   1. compare: per stream and component the residual real - twin matched by stamp and whitened by the recording's
 //      stated noise (gap/internal/twin_residuals.h); RMS per stream and component; for an absolute stream (gps,
 //      position, pose) the drift over fixed windows (TwinDrift). A replayed run's fit and held-out comparison compare
-//      its absolute streams by windowed increments and leave out the encoders that drive the replay
-//      (TwinDiagnoseOptions::increment_window_s, ReplayedResidualOptions);
+//      its absolute streams over windows (a pose stream as its drift is measured) and leave out the encoders that
+//      drive the replay (TwinDiagnoseOptions::increment_window_s, ReplayedResidualOptions);
 //   2. locate: Locate (gap/locate.h) on the nominal twin's whitened residuals of the whole run, against the stated
 //      noise (level 1), with the conditions computed from the real recording's own streams: the poses of a pose
 //      stream (motion capture) when there is one, else the wheel encoders' dead reckoning with the nominal geometry
@@ -127,20 +127,29 @@ struct DriftOptions {
 };
 
 // How the twin's residuals compare a recording's streams (gap/internal/twin_residuals.h).
-//   increment_window_s > 0: the absolute streams (pose, gps, position) compared by their increments over consecutive
-//     windows [t0, t0 + W] (each ending at the last sample within W of its start, the next starting there; a window
-//     shorter than 0.9 W is not compared): the recorded and the twin's displacement from t0, each expressed in its own
-//     frame at t0 (a pose stream: x y rotated by -yaw(t0), compared along and across the recorded displacement d; a
-//     gps fix or position stream: the increment in ENU, per axis), whitened by the noise of the two recorded samples:
-//     sqrt(2) sigma per axis, and across a pose's displacement sqrt(2 sigma^2 + sigma_yaw^2 |d|^2) (its stated
-//     orientation_rad turns d). What the twin's 10 s drift measures, without the start's error carried along the
-//     whole track. 0: sample by sample, the absolute values.
+//   increment_window_s > 0: the absolute streams (pose, gps, position) compared over windows of this length instead of
+//     sample by sample:
+//     - a pose stream as TwinDrift measures the twin's drift: a window starting every increment_stride_s (the drift's
+//       stride_s; the windows overlap), the twin aligned onto the recorded poses of its first align_s (the drift's
+//       planar alignment, positions and headings weighted by their stated noise), the recorded position at its last
+//       sample less the aligned twin's, along and across the lever from the aligned samples' recorded centroid,
+//       whitened by the recorded samples' noise: sigma^2 (1 + 1/n) each way (the end sample and the centroid of n
+//       samples) and l^2 / I more across (the lever l turned by the alignment's yaw, of information I). Each entry is
+//       scaled by sqrt(increment_stride_s / increment_window_s), so that the overlapping windows of a span weigh in
+//       the chi-square as the consecutive windows it holds would (their correlation is the HAC's, TwinCovariance);
+//     - a gps fix or position stream by its increments over consecutive windows [t0, t0 + W] (each ending at the last
+//       sample within W of its start, the next starting there; a window shorter than 0.9 W is not compared) in ENU,
+//       per axis, whitened by the noise of the two recorded samples, sqrt(2) sigma.
+//     What the twin's 10 s drift measures, without the start's error carried along the whole track. 0: sample by
+//     sample, the absolute values.
 //   left_out: streams not compared, by name, with the reason (the layout's left_out as "stream: reason").
 struct TwinResidualOptions {
   double increment_window_s = 0.0;
+  double increment_stride_s = 1.0;  // a pose stream's window starts (DriftOptions::stride_s)
+  double align_s = 2.0;             // a pose stream's window alignment (DriftOptions::align_s)
   std::map<std::string, std::string> left_out;
 };
-// The residual options of a replayed run of `real` (ReplayRunner): windowed increments of increment_window_s, and the
+// The residual options of a replayed run of `real` (ReplayRunner): windows of increment_window_s, and the
 // wheel_encoders stream that drives the replay (sim::DriveInputsFrom) left out: the twin's encoders track the recorded
 // angles through the wheels' velocity servos, a tick or two behind (both in whole ticks), a systematic residual of
 // several sigma that the effects fitted would otherwise chase.
@@ -274,8 +283,8 @@ struct TwinDiagnoseOptions {
   int max_iterations = 8;    // Levenberg-Marquardt
   bool replayed = false;     // the runner replays the recorded drive (written with the results)
   DriftOptions drift;
-  // A replayed run's fit and held-out comparison (TwinTrainingRun::replayed): its absolute streams compared by their
-  // increments over windows of this length, and its driving encoders left out (ReplayedResidualOptions); 0: the
+  // A replayed run's fit and held-out comparison (TwinTrainingRun::replayed): its absolute streams compared over
+  // windows of this length (TwinResidualOptions), and its driving encoders left out (ReplayedResidualOptions); 0: the
   // absolute values, the driving encoders still left out. The other runs, and the located components, compare the
   // absolute values.
   double increment_window_s = 10.0;

@@ -23,103 +23,9 @@ namespace {
 using recording::Stream;
 using recording::StreamType;
 
-// An absolute stream's samples matched by stamp in both recordings.
-struct Track {
-  std::vector<double> t_s;
-  std::vector<Eigen::Vector3d> real, twin;
-  std::vector<Eigen::Quaterniond> q_real, q_twin;  // pose streams only
-  // The alignment's weights, 1 / sigma^2 of the stated noise: a pose stream's headings weigh 0 when it states none.
-  double position_weight = 1.0, heading_weight = 0.0;
-};
-
-double StatedNoise(const Stream& s, const char* key) {
-  const auto it = s.info.noise.find(key);
-  return it != s.info.noise.end() && it->second > 0.0 ? it->second : 0.0;
-}
-
-Track Matched(const Stream& r, const Stream& s, Time from, Time to, const std::optional<recording::GeodeticOrigin>& o) {
-  Track track;
-  std::optional<estimator::EnuConverter> enu;
-  if (o) enu.emplace(*o);
-  const auto position = [&](const Stream& x, std::size_t row) {
-    const Eigen::Vector3d v = x.values.row(static_cast<Eigen::Index>(row)).head(3).transpose();
-    return x.info.type == StreamType::kGps ? Eigen::Vector3d(enu->ToEnu(v[0], v[1], v[2])) : v;
-  };
-  const auto attitude = [](const Stream& x, std::size_t row) {
-    const auto v = x.values.row(static_cast<Eigen::Index>(row));
-    return Eigen::Quaterniond(v[6], v[3], v[4], v[5]).normalized();
-  };
-  const bool pose = r.info.type == StreamType::kPose;
-  if (pose) {
-    const double sigma_m = std::max(StatedNoise(r, "position_m"), StatedNoise(r, "sigma_m"));
-    const double sigma_rad = StatedNoise(r, "orientation_rad");
-    if (sigma_rad > 0.0) track.heading_weight = 1.0 / (sigma_rad * sigma_rad);
-    track.position_weight = sigma_m > 0.0 ? 1.0 / (sigma_m * sigma_m) : sigma_rad > 0.0 ? 0.0 : 1.0;
-  }
-  std::size_t j = 0;
-  for (std::size_t i = 0; i < r.t.size(); ++i) {
-    if (r.t[i] < from || to < r.t[i]) continue;
-    while (j < s.t.size() && s.t[j] < r.t[i]) ++j;
-    if (j == s.t.size()) break;
-    if (s.t[j] != r.t[i]) continue;
-    track.t_s.push_back(r.t[i].seconds());
-    track.real.push_back(position(r, i));
-    track.twin.push_back(position(s, j));
-    if (pose) {
-      track.q_real.push_back(attitude(r, i));
-      track.q_twin.push_back(attitude(s, j));
-    }
-  }
-  return track;
-}
-
-double Yaw(const Eigen::Quaterniond& q) {
-  const Eigen::Vector3d x = q * Eigen::Vector3d::UnitX();
-  return std::atan2(x.y(), x.x());
-}
-
-// The planar rigid transform (yaw about the vertical, then translation) of the twin onto the real track that best fits
-// samples [a, b] in least squares: positions weighted by position_weight, a pose stream's headings by heading_weight,
-//   cost(yaw, p) = w_p sum |R t_i + p - r_i|^2 + w_h sum (yaw + psi_twin_i - psi_real_i)^2.
-// For the best p (the centroids matched) the positions' cost is w_p rho (yaw - yaw_p)^2 to second order about their
-// own best yaw yaw_p (rho the size of the centred tracks' cross-covariance), the headings' w_h n (yaw - d)^2 about the
-// mean heading difference d: the yaw is their weighted mean. Without heading weight, a real track that moves less
-// than 0.1 m there gives no yaw: the translation at `a` alone.
-std::pair<Eigen::Matrix3d, Eigen::Vector3d> PlanarAlignment(const Track& k, std::size_t a, std::size_t b) {
-  const double n = static_cast<double>(b - a + 1);
-  Eigen::Vector3d cr = Eigen::Vector3d::Zero(), ct = Eigen::Vector3d::Zero();
-  double heading_sin = 0.0, heading_cos = 0.0;
-  for (std::size_t i = a; i <= b; ++i) {
-    cr += k.real[i];
-    ct += k.twin[i];
-    if (k.heading_weight <= 0.0) continue;
-    const double d = Yaw(k.q_real[i]) - Yaw(k.q_twin[i]);
-    heading_sin += std::sin(d);
-    heading_cos += std::cos(d);
-  }
-  cr /= n;
-  ct /= n;
-  double extent = 0.0, sxx = 0.0, sxy = 0.0;
-  for (std::size_t i = a; i <= b; ++i) {
-    const Eigen::Vector2d r = (k.real[i] - cr).head<2>(), t = (k.twin[i] - ct).head<2>();
-    extent = std::max(extent, r.norm());
-    sxx += t.dot(r);
-    sxy += t.x() * r.y() - t.y() * r.x();
-  }
-  if (k.heading_weight <= 0.0 && extent < 0.1) return {Eigen::Matrix3d::Identity(), k.real[a] - k.twin[a]};
-  double yaw = std::atan2(sxy, sxx);
-  if (k.heading_weight > 0.0) {
-    const double d = std::atan2(heading_sin, heading_cos);
-    const double positions = k.position_weight * std::hypot(sxx, sxy), headings = k.heading_weight * n;
-    yaw = d + positions / (positions + headings) * std::remainder(yaw - d, 2.0 * M_PI);
-  }
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  return {R, cr - R * ct};
-}
-
 std::optional<TwinDrift> Drift(const Stream& r, const Stream& s, Time from, Time to,
                                const std::optional<recording::GeodeticOrigin>& origin, const DriftOptions& options) {
-  const Track k = Matched(r, s, from, to, origin);
+  const internal::Track k = internal::Matched(r, s, from, to, origin);
   TwinDrift d;
   d.stream = r.info.name;
   d.window_s = options.window_s;
@@ -133,11 +39,13 @@ std::optional<TwinDrift> Drift(const Stream& r, const Stream& s, Time from, Time
     if (b <= a || k.t_s[b] - k.t_s[a] < 0.9 * options.window_s) continue;
     std::size_t e = a;
     while (e + 1 < b && k.t_s[e + 1] <= k.t_s[a] + options.align_s + 1e-9) ++e;
-    const auto [R, p] = PlanarAlignment(k, a, e);
-    const double position = (R * k.twin[b] + p - k.real[b]).norm();
+    const internal::PlanarFit fit = internal::PlanarAlignment(k, a, e);
+    const Eigen::Matrix3d& R = fit.R;
+    const double position = (R * k.twin[b] + fit.p - k.real[b]).norm();
     const double heading =
         d.heading_measured
-            ? std::abs(std::remainder(Yaw(Eigen::Quaterniond(R) * k.q_twin[b]) - Yaw(k.q_real[b]), 2.0 * M_PI))
+            ? std::abs(std::remainder(internal::Yaw(Eigen::Quaterniond(R) * k.q_twin[b]) - internal::Yaw(k.q_real[b]),
+                                      2.0 * M_PI))
             : 0.0;
     ++d.windows;
     d.mean_position_m += position;
@@ -350,12 +258,12 @@ sim::ReplayStart PoseAlignedStart(const recording::Recording& real, const record
       continue;
     const Time from = Time::FromNanoseconds(std::numeric_limits<std::int64_t>::min());
     const Time to = Time::FromNanoseconds(std::numeric_limits<std::int64_t>::max());
-    const Track k = Matched(*recorded, twin, from, to, real.origin);
+    const internal::Track k = internal::Matched(*recorded, twin, from, to, real.origin);
     if (k.t_s.size() < 3) return start;
-    const auto [R, p] = PlanarAlignment(k, 0, k.t_s.size() - 1);
-    const Eigen::Vector3d moved = R * Eigen::Vector3d(start.p_m.x(), start.p_m.y(), 0.0) + p;
+    const internal::PlanarFit fit = internal::PlanarAlignment(k, 0, k.t_s.size() - 1);
+    const Eigen::Vector3d moved = fit.R * Eigen::Vector3d(start.p_m.x(), start.p_m.y(), 0.0) + fit.p;
     start.p_m = moved.head<2>();
-    start.yaw_rad += std::atan2(R(1, 0), R(0, 0));
+    start.yaw_rad += std::atan2(fit.R(1, 0), fit.R(0, 0));
     start.source += ", aligned by its pose track's first " + std::to_string(static_cast<int>(sim::kStartAlignS)) + " s";
     return start;
   }

@@ -83,8 +83,9 @@ bool Absolute(StreamType type) {
   return type == StreamType::kPose || type == StreamType::kGps || type == StreamType::kPosition;
 }
 
-// The windowed increments' series of an absolute stream over [from, to] (gap/twin.h TwinResidualOptions): windows
-// from a sample to the last sample within window_s of it, the next from there, each at least 0.9 window_s long.
+// The windowed increments' series of a gps or position stream over [from, to] (gap/twin.h TwinResidualOptions):
+// windows from a sample to the last sample within window_s of it, the next from there, each at least 0.9 window_s
+// long.
 void AddIncrementSeries(const Stream& s, const std::vector<double>& sigma, Time from, Time to, double window_s,
                         Layout* layout) {
   Series series;
@@ -92,7 +93,6 @@ void AddIncrementSeries(const Stream& s, const std::vector<double>& sigma, Time 
   series.stream = s.info.name;
   series.type = s.info.type;
   series.sigma = sigma;
-  if (s.info.type == StreamType::kPose) series.heading_sigma = Noise(s.info, "orientation_rad");
   std::size_t a = static_cast<std::size_t>(std::lower_bound(s.t.begin(), s.t.end(), from) - s.t.begin());
   while (a < s.t.size() && s.t[a] <= to) {
     std::size_t b = a;
@@ -108,22 +108,69 @@ void AddIncrementSeries(const Stream& s, const std::vector<double>& sigma, Time 
   layout->series.push_back(std::move(series));
 }
 
-double Yaw(const Eigen::Quaterniond& q) {
-  const Eigen::Vector3d x = q * Eigen::Vector3d::UnitX();
-  return std::atan2(x.y(), x.x());
+// A pose stream's windows over [from, to] as TwinDrift takes them (gap/twin.h TwinResidualOptions): one starting
+// every stride_s from the first sample (at the first sample at or after that time), ending at the last sample within
+// window_s of it (at least 0.9 window_s long), the alignment over its samples within align_s of its start (before its
+// end); each entry weighted sqrt(stride_s / window_s) when the windows overlap.
+void AddPoseWindowSeries(const Stream& s, const std::vector<double>& sigma, Time from, Time to,
+                         const TwinResidualOptions& options, Layout* layout) {
+  Series series;
+  series.name = s.info.name;
+  series.stream = s.info.name;
+  series.type = s.info.type;
+  series.sigma = sigma;
+  const double window_s = options.increment_window_s;
+  const double stride_s = options.increment_stride_s > 0.0 ? options.increment_stride_s : window_s;
+  series.weight = std::sqrt(std::min(1.0, stride_s / window_s));
+  const std::size_t first = static_cast<std::size_t>(std::lower_bound(s.t.begin(), s.t.end(), from) - s.t.begin());
+  std::size_t last = first;
+  while (last + 1 < s.t.size() && s.t[last + 1] <= to) ++last;
+  std::size_t a = first;
+  for (double w0 = 0.0;
+       first < s.t.size() && s.t[first] <= to && w0 + window_s <= SecondsBetween(s.t[first], s.t[last]) + 1e-9;
+       w0 += stride_s) {
+    while (a < last && SecondsBetween(s.t[first], s.t[a]) < w0 - 1e-9) ++a;
+    std::size_t b = a;
+    while (b < last && SecondsBetween(s.t[first], s.t[b + 1]) <= w0 + window_s + 1e-9) ++b;
+    if (b <= a || SecondsBetween(s.t[a], s.t[b]) < 0.9 * window_s) continue;
+    std::size_t e = a;
+    while (e + 1 < b && SecondsBetween(s.t[a], s.t[e + 1]) <= options.align_s + 1e-9) ++e;
+    series.starts.push_back(a);
+    series.align_ends.push_back(e);
+    series.rows.push_back(b);
+    series.t.push_back(s.t[b]);
+  }
+  series.offset = layout->size;
+  layout->size += series.size();
+  layout->series.push_back(std::move(series));
 }
 
-// A pose's planar increment from row a to row b in its frame at a: R(-yaw_a) (p_b - p_a).
-Eigen::Vector2d PoseIncrement(const Stream& s, std::size_t a, std::size_t b) {
-  const auto row = [&](std::size_t i) { return s.values.row(static_cast<Eigen::Index>(i)); };
-  const Eigen::Quaterniond q_a(row(a)[6], row(a)[3], row(a)[4], row(a)[5]);
-  const Eigen::Vector2d d(row(b)[0] - row(a)[0], row(b)[1] - row(a)[1]);
-  return Eigen::Rotation2Dd(-Yaw(q_a.normalized())) * d;
+// A pose window's whitened end error (gap/twin.h TwinResidualOptions): the twin aligned onto the recorded poses of
+// rows a..e (PlanarAlignment), the recorded position at row b less the aligned twin's, along and across the lever
+// l = p_b - c (c the recorded centroid of a..e, about which the alignment turns the twin), over the noise of the
+// recorded samples: sigma^2 (1 + 1/n) each way (p_b and the centroid of n samples), plus l^2 / I across (I the
+// alignment yaw's information). NaN when the twin lacks the sample of row a or b.
+Eigen::Vector2d WhitenedPoseWindow(const Series& series, const Stream& real, const Stream& twin, std::size_t i) {
+  const Eigen::Vector2d missing = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  const Time ta = real.t[series.starts[i]], te = real.t[series.align_ends[i]], tb = real.t[series.rows[i]];
+  const Track head = Matched(real, twin, ta, te, std::nullopt);
+  const Track end = Matched(real, twin, tb, tb, std::nullopt);
+  if (head.t_s.empty() || head.t_s.front() != ta.seconds() || end.t_s.empty()) return missing;
+  const PlanarFit fit = PlanarAlignment(head, 0, head.t_s.size() - 1);
+  const Eigen::Vector2d error = (end.real[0] - (fit.R * end.twin[0] + fit.p)).head<2>();
+  const Eigen::Vector2d lever = (end.real[0] - fit.real_centroid).head<2>();
+  const Eigen::Vector2d along = lever.norm() > 0.0 ? Eigen::Vector2d(lever.normalized()) : Eigen::Vector2d::UnitX();
+  const Eigen::Vector2d across(-along.y(), along.x());
+  const double n = static_cast<double>(head.t_s.size());
+  const double point2 = series.sigma[0] * series.sigma[0] * (1.0 + 1.0 / n);
+  const double turn2 = fit.yaw_information > 0.0 ? lever.squaredNorm() / fit.yaw_information : 0.0;
+  return series.weight *
+         Eigen::Vector2d(error.dot(along) / std::sqrt(point2), error.dot(across) / std::sqrt(point2 + turn2));
 }
 
 // The whitened increments of one series: per window the recorded increment less the twin's (rows of `twin` matched
-// by stamp, NaN where it lacks either), a pose's along and across the recorded displacement d, over sqrt(2) sigma and
-// sqrt(2 sigma^2 + heading_sigma^2 |d|^2); a gps fix's or position's per ENU axis over sqrt(2) sigma.
+// by stamp, NaN where it lacks either); a gps fix's or position's per ENU axis over sqrt(2) sigma; a pose's as
+// WhitenedPoseWindow.
 void WhitenedIncrements(const Series& series, const Stream& real, const Stream& twin,
                         const std::optional<estimator::EnuConverter>& enu, Eigen::VectorXd* out) {
   const auto twin_row = [&](Time t) -> std::optional<std::size_t> {
@@ -138,27 +185,101 @@ void WhitenedIncrements(const Series& series, const Stream& real, const Stream& 
   const int n = series.components();
   if (series.type == StreamType::kPose && (real.values.cols() < 7 || twin.values.cols() < 7)) return;
   for (std::size_t i = 0; i < series.rows.size(); ++i) {
+    const Eigen::Index k = series.offset + static_cast<Eigen::Index>(i) * n;
+    if (series.type == StreamType::kPose) {
+      out->segment<2>(k) = WhitenedPoseWindow(series, real, twin, i);
+      continue;
+    }
     const std::size_t a = series.starts[i], b = series.rows[i];
     const auto ta = twin_row(real.t[a]), tb = twin_row(real.t[b]);
     if (!ta || !tb) continue;
-    const Eigen::Index k = series.offset + static_cast<Eigen::Index>(i) * n;
-    if (series.type == StreamType::kPose) {
-      const Eigen::Vector2d d = PoseIncrement(real, a, b);
-      const Eigen::Vector2d delta = d - PoseIncrement(twin, *ta, *tb);
-      const Eigen::Vector2d along = d.norm() > 0.0 ? Eigen::Vector2d(d.normalized()) : Eigen::Vector2d::UnitX();
-      const Eigen::Vector2d across(-along.y(), along.x());
-      const double sigma2 = 2.0 * series.sigma[0] * series.sigma[0];
-      const double heading2 = series.heading_sigma * series.heading_sigma * d.squaredNorm();
-      (*out)[k] = delta.dot(along) / std::sqrt(sigma2);
-      (*out)[k + 1] = delta.dot(across) / std::sqrt(sigma2 + heading2);
-      continue;
-    }
     const Eigen::Vector3d delta = (position(real, b) - position(real, a)) - (position(twin, *tb) - position(twin, *ta));
     for (int c = 0; c < n; ++c) (*out)[k + c] = delta[c] / (std::sqrt(2.0) * series.sigma[static_cast<std::size_t>(c)]);
   }
 }
 
 }  // namespace
+
+double Yaw(const Eigen::Quaterniond& q) {
+  const Eigen::Vector3d x = q * Eigen::Vector3d::UnitX();
+  return std::atan2(x.y(), x.x());
+}
+
+Track Matched(const Stream& r, const Stream& s, Time from, Time to,
+              const std::optional<recording::GeodeticOrigin>& origin) {
+  Track track;
+  std::optional<estimator::EnuConverter> enu;
+  if (origin) enu.emplace(*origin);
+  const auto position = [&](const Stream& x, std::size_t row) {
+    const Eigen::Vector3d v = x.values.row(static_cast<Eigen::Index>(row)).head(3).transpose();
+    return x.info.type == StreamType::kGps ? Eigen::Vector3d(enu->ToEnu(v[0], v[1], v[2])) : v;
+  };
+  const auto attitude = [](const Stream& x, std::size_t row) {
+    const auto v = x.values.row(static_cast<Eigen::Index>(row));
+    return Eigen::Quaterniond(v[6], v[3], v[4], v[5]).normalized();
+  };
+  const bool pose = r.info.type == StreamType::kPose;
+  if (pose) {
+    const double sigma_m = std::max(Noise(r.info, "position_m"), Noise(r.info, "sigma_m"));
+    const double sigma_rad = Noise(r.info, "orientation_rad");
+    if (sigma_rad > 0.0) track.heading_weight = 1.0 / (sigma_rad * sigma_rad);
+    track.position_weight = sigma_m > 0.0 ? 1.0 / (sigma_m * sigma_m) : sigma_rad > 0.0 ? 0.0 : 1.0;
+  }
+  std::size_t j = 0;
+  for (std::size_t i = 0; i < r.t.size(); ++i) {
+    if (r.t[i] < from || to < r.t[i]) continue;
+    while (j < s.t.size() && s.t[j] < r.t[i]) ++j;
+    if (j == s.t.size()) break;
+    if (s.t[j] != r.t[i]) continue;
+    track.t_s.push_back(r.t[i].seconds());
+    track.real.push_back(position(r, i));
+    track.twin.push_back(position(s, j));
+    if (pose) {
+      track.q_real.push_back(attitude(r, i));
+      track.q_twin.push_back(attitude(s, j));
+    }
+  }
+  return track;
+}
+
+PlanarFit PlanarAlignment(const Track& k, std::size_t a, std::size_t b) {
+  const double n = static_cast<double>(b - a + 1);
+  Eigen::Vector3d cr = Eigen::Vector3d::Zero(), ct = Eigen::Vector3d::Zero();
+  double heading_sin = 0.0, heading_cos = 0.0;
+  for (std::size_t i = a; i <= b; ++i) {
+    cr += k.real[i];
+    ct += k.twin[i];
+    if (k.heading_weight <= 0.0) continue;
+    const double d = Yaw(k.q_real[i]) - Yaw(k.q_twin[i]);
+    heading_sin += std::sin(d);
+    heading_cos += std::cos(d);
+  }
+  cr /= n;
+  ct /= n;
+  double extent = 0.0, sxx = 0.0, sxy = 0.0;
+  for (std::size_t i = a; i <= b; ++i) {
+    const Eigen::Vector2d r = (k.real[i] - cr).head<2>(), t = (k.twin[i] - ct).head<2>();
+    extent = std::max(extent, r.norm());
+    sxx += t.dot(r);
+    sxy += t.x() * r.y() - t.y() * r.x();
+  }
+  PlanarFit fit;
+  fit.real_centroid = cr;
+  if (k.heading_weight <= 0.0 && extent < 0.1) {
+    fit.p = k.real[a] - k.twin[a];
+    return fit;
+  }
+  double yaw = std::atan2(sxy, sxx);
+  const double positions = k.position_weight * std::hypot(sxx, sxy), headings = k.heading_weight * n;
+  if (k.heading_weight > 0.0) {
+    const double d = std::atan2(heading_sin, heading_cos);
+    yaw = d + positions / (positions + headings) * std::remainder(yaw - d, 2.0 * M_PI);
+  }
+  fit.yaw_information = positions + headings;
+  fit.R = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  fit.p = cr - fit.R * ct;
+  return fit;
+}
 
 std::vector<double> ColumnSigmas(const recording::StreamInfo& info) {
   const auto repeat = [](double sigma, int n) { return std::vector<double>(static_cast<std::size_t>(n), sigma); };
@@ -225,7 +346,9 @@ Layout MakeLayout(const recording::Recording& real, Time from, Time to, const Tw
       layout.left_out.push_back(s.info.name + ": " + why);
       continue;
     }
-    if (options.increment_window_s > 0.0 && Absolute(s.info.type))
+    if (options.increment_window_s > 0.0 && s.info.type == StreamType::kPose)
+      AddPoseWindowSeries(s, sigma, from, to, options, &layout);
+    else if (options.increment_window_s > 0.0 && Absolute(s.info.type))
       AddIncrementSeries(s, sigma, from, to, options.increment_window_s, &layout);
     else
       AddSeries(s, sigma, from, to, &layout);

@@ -9,8 +9,8 @@
 // accelerometer, magnetometer, steering). A gps fix is compared in the real recording's ENU frame (its origin). A
 // sample of the real recording is matched by its exact stamp; a twin without that stamp leaves the entry NaN.
 // With TwinResidualOptions::increment_window_s (gap/twin.h), the pose, gps and position streams are compared by their
-// increments over consecutive windows instead, whitened by the two recorded samples' noise; streams named in its
-// left_out are not compared.
+// increments over windows instead (a pose's as the drift measures it, the twin aligned over each window's start),
+// whitened by the recorded samples' noise; streams named in its left_out are not compared.
 #pragma once
 
 #include <map>
@@ -19,6 +19,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "common/time.h"
 #include "estimator/calibration.h"
@@ -27,6 +28,36 @@
 #include "recording/recording.h"
 
 namespace roamlab::gap::internal {
+
+// An absolute stream's samples matched by stamp in the real recording and the twin (a gps fix in the real recording's
+// ENU frame through `origin`).
+struct Track {
+  std::vector<double> t_s;
+  std::vector<Eigen::Vector3d> real, twin;
+  std::vector<Eigen::Quaterniond> q_real, q_twin;  // pose streams only
+  // The alignment's weights, 1 / sigma^2 of the stated noise: a pose stream's headings weigh 0 when it states none.
+  double position_weight = 1.0, heading_weight = 0.0;
+};
+Track Matched(const recording::Stream& r, const recording::Stream& s, Time from, Time to,
+              const std::optional<recording::GeodeticOrigin>& origin);
+
+double Yaw(const Eigen::Quaterniond& q);
+
+// The planar rigid transform (yaw about the vertical, then translation) of the twin onto the real track that best fits
+// samples [a, b] in least squares: positions weighted by position_weight, a pose stream's headings by heading_weight,
+//   cost(yaw, p) = w_p sum |R t_i + p - r_i|^2 + w_h sum (yaw + psi_twin_i - psi_real_i)^2.
+// For the best p (the centroids matched) the positions' cost is w_p rho (yaw - yaw_p)^2 to second order about their
+// own best yaw yaw_p (rho the size of the centred tracks' cross-covariance), the headings' w_h n (yaw - d)^2 about the
+// mean heading difference d: the yaw is their weighted mean, and w_p rho + w_h n is its information (1 / variance,
+// from a pose stream's stated noise). Without heading weight, a real track that moves less than 0.1 m there gives no
+// yaw: the translation at `a` alone (information 0).
+struct PlanarFit {
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  Eigen::Vector3d real_centroid = Eigen::Vector3d::Zero();  // of the real samples fitted
+  double yaw_information = 0.0;                             // rad^-2
+};
+PlanarFit PlanarAlignment(const Track& k, std::size_t a, std::size_t b);
 
 // The stated noise of each compared column (positive), or empty when the stream states none.
 std::vector<double> ColumnSigmas(const recording::StreamInfo& info);
@@ -42,10 +73,11 @@ struct Series {
   std::vector<Time> t;            // their stamps
   Eigen::Index offset = 0;        // first entry in the residual vector
   // Windowed increments: entry i compares the increment from the real recording's row starts[i] to rows[i] (t[i]
-  // its stamp); a pose's two components along and across the recorded displacement, the across one whitened with
-  // heading_sigma too (gap/twin.h TwinResidualOptions). Empty: sample by sample.
-  std::vector<std::size_t> starts;
-  double heading_sigma = 0.0;  // rad: a pose stream's stated orientation_rad
+  // its stamp). A gps fix's or position's per ENU axis, the windows consecutive. A pose's as the drift measures it
+  // (gap/twin.h TwinResidualOptions): the windows overlapping, the twin aligned over rows starts[i]..align_ends[i],
+  // each entry scaled by `weight`. Empty: sample by sample.
+  std::vector<std::size_t> starts, align_ends;
+  double weight = 1.0;
   int components() const { return static_cast<int>(sigma.size()); }
   Eigen::Index size() const { return static_cast<Eigen::Index>(rows.size()) * components(); }
 };

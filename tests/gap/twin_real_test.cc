@@ -1,11 +1,11 @@
 // The diagnosis against the replayed twin on real OptiOdom recordings (tests/support/real_data.h, skipped when
 // absent), held out across runs: the patch fitted on a Dec-2020 square, circular and Ivanjko run of the differential
-// drive together (each on the replay of its own drive, compared by 10 s windowed increments) is shown on another
-// circular run of the same day (the twin's 10 s motion-capture drift, nominal against patched). The claims asserted
-// are the ones the data supports (docs/results.md): the drift falls by at least a fifth, not to half on every circular
-// run (0.48-0.60 over the day's six, 0.52 on this one), and the motion capture's clock named among the effects is
-// negative, the encoders behind the motion capture. Fitted on the square run alone, 10 s increments of its first
-// two thirds (4 windows) name no effect.
+// drive together (each on the replay of its own drive, its motion capture compared over 10 s windows as the drift
+// measures it) is shown on another circular run of the same day (the twin's 10 s motion-capture drift, nominal against
+// patched). The claims asserted are the ones the data supports (docs/results.md): the joint geometry is named first,
+// its radius scale below 1, and the drift falls to at most half (0.37-0.45 over the day's six circular runs, 0.40 on
+// this one). And the kinematic stand-in's geometry, put into the twin, carries over to the straight-line runs as it
+// does in the stand-in.
 #include <filesystem>
 #include <iostream>
 #include <string>
@@ -38,7 +38,7 @@ Result<recording::Recording> ImportRun(const std::string& set_path, const std::s
   return recording::ReadRecording(path, read);
 }
 
-TEST(TwinRealTest, AMixedSetsPatchLowersAnotherCircularRunsDrift) {
+TEST(TwinRealTest, AMixedSetsPatchHalvesAnotherCircularRunsDrift) {
   const std::vector<std::string> training = {kDiff + "square/231220200029/231220200029",
                                              kDiff + "circular/231220200121/231220200121",
                                              kDiff + "ivanjko/231220200057/231220200057"};
@@ -63,16 +63,18 @@ TEST(TwinRealTest, AMixedSetsPatchLowersAnotherCircularRunsDrift) {
   for (std::size_t i = 0; i < runs.size(); ++i) set.push_back({training[i], &runs[i], ReplayRunner(runs[i]), true});
   auto d = DiagnoseTwin(nominal.value(), set, options);
   ASSERT_TRUE(d.ok()) << d.status().message();
-  ASSERT_FALSE(d.value().patch.empty()) << "no effect named on the mixed set";
-  const TwinEffect* clock = nullptr;
+  ASSERT_FALSE(d.value().effects.empty()) << "no effect named on the mixed set";
   for (const TwinEffect& e : d.value().effects) {
     std::cout << e.estimate.name;
     for (const auto& [k, v] : e.estimate.parameters)
       std::cout << " " << k << " = " << v
                 << (e.estimate.std.count(k) ? " +- " + std::to_string(e.estimate.std.at(k)) : "");
     std::cout << "\n";
-    if (e.estimate.name == "pose_time_offset") clock = &e;
   }
+  // The wheels roll less far than the nominal radius says (the straight stretches' distance ratio 0.990-0.997).
+  const TwinEffect& geometry = d.value().effects.front();
+  ASSERT_EQ(geometry.estimate.name, "diff_drive_geometry");
+  EXPECT_LT(geometry.estimate.parameters.at("scale"), 1.0);
   const TwinResidualOptions held_residuals =
       ReplayedResidualOptions(nominal.value(), held.value(), options.increment_window_s);
   auto shown =
@@ -83,15 +85,38 @@ TEST(TwinRealTest, AMixedSetsPatchLowersAnotherCircularRunsDrift) {
   const double before = shown.value().before.drift.at("mocap").mean_position_m;
   const double after = shown.value().after.drift.at("mocap").mean_position_m;
   std::cout << "circular run 0134, 10 s drift: nominal twin " << before << " m, patched " << after << " m ("
-            << after / before << "x); chi2 of its increments " << shown.value().before.chi2 << " -> "
+            << after / before << "x); chi2 of its windows " << shown.value().before.chi2 << " -> "
             << shown.value().after.chi2 << "\n";
-  EXPECT_LT(after, 0.8 * before);
+  EXPECT_LT(after, 0.5 * before);
   EXPECT_LT(shown.value().after.chi2, shown.value().before.chi2);
+}
 
-  // The motion capture's clock (pose_time_offset) is named on top of the geometry: negative, the encoders (the drive
-  // the twin replays) behind the motion capture.
-  ASSERT_NE(clock, nullptr) << "pose_time_offset not named";
-  EXPECT_LT(clock->estimate.parameters.at("offset_s"), 0.0);
+// The twin's physics follows the kinematics: the geometry that the kinematic stand-in (tools/optiodom_drift_floor.py,
+// dead reckoning of the encoders) fits on the same Dec set (scale 0.9940, R/L 1.0014, track +2.0 mm), put into the
+// twin, lowers the twin's drift on the held-out straight-line runs as it lowers the stand-in's (0.25-0.39x there;
+// measured in the twin: 0.27, 0.41, 0.34). What kept the twin's own patch from it was its fit, not its physics.
+TEST(TwinRealTest, TheKinematicStandInsGeometryCarriesOverInTheTwin) {
+  const std::vector<std::string> lines = {kDiff + "ivanjko/231220200102/231220200102",
+                                          kDiff + "ivanjko/231220200104/231220200104",
+                                          kDiff + "ivanjko/231220200107/231220200107"};
+  for (const std::string& set : lines)
+    if (!std::filesystem::exists(set + "_metadata.csv")) GTEST_SKIP() << "real data absent: " << set;
+  auto nominal = sim::LoadScenario(roamlab::testing::SourceDir() + "/scenarios/real/optiodom_diff.yaml");
+  ASSERT_TRUE(nominal.ok()) << nominal.status().message();
+  const std::vector<sim::EffectOptions> stand_in = {{"wheel_radius_scale", {{"scale", 0.9940}}},
+                                                    {"wheel_radius_asymmetry", {{"ratio_right_left", 1.0014}}},
+                                                    {"track_width_error", {{"track_error_m", 0.0020}}}};
+  ::roamlab::testing::TempDir dir;
+  for (const std::string& set : lines) {
+    auto run = ImportRun(set, "01", dir);
+    ASSERT_TRUE(run.ok()) << run.status().message();
+    auto shown = ShowOnHeldOut(nominal.value(), stand_in, run.value(), ReplayRunner(run.value()));
+    ASSERT_TRUE(shown.ok()) << shown.status().message();
+    const double before = shown.value().before.drift.at("mocap").mean_position_m;
+    const double after = shown.value().after.drift.at("mocap").mean_position_m;
+    std::cout << set << ": 10 s drift " << before << " -> " << after << " m (" << after / before << "x)\n";
+    EXPECT_LT(after, 0.5 * before) << set;
+  }
 }
 
 }  // namespace
