@@ -268,6 +268,8 @@ struct TwinDiagnosis {
   std::vector<TwinHeldOutRun> heldout_runs;        // ShowOnHeldOut's, filled by the caller
   std::vector<TwinTrainingFigures> training_runs;  // the training runs after the diagnosed one
   double increment_window_s = 0.0;                 // the replayed runs' residuals (TwinDiagnoseOptions)
+  std::string train_weight = "windows";            // TwinDiagnoseOptions::train_weight: "windows" or "runs"
+  std::vector<double> run_weights;                 // per training run (the diagnosed first): its chi-square weight
   int runs = 0;
   double seconds = 0.0;
 };
@@ -288,6 +290,14 @@ struct TwinDiagnoseOptions {
   // absolute values, the driving encoders still left out. The other runs, and the located components, compare the
   // absolute values.
   double increment_window_s = 10.0;
+  // How the training runs weigh in the fit (with several runs):
+  //   kWindows: each residual as its series weighs it, so that a run weighs by its training part's length;
+  //   kRuns: each run's whitened residuals scaled by sqrt(w_r), w_r = S / (R S_r), S_r the run's summed chi-square
+  //     weight (its layout's entries, each its series' weight squared), S the runs' total, R their number: every run
+  //     weighs S / R, the total S unchanged (internal::EqualRunScales). The held-out test weighs each run's held-out
+  //     chi-square by the same w_r. With one run the two are the same.
+  enum class TrainWeight { kWindows, kRuns };
+  TrainWeight train_weight = TrainWeight::kWindows;
   // The std reported: white, hac (the larger of std_white and std_hac, as the estimator's calibration reports), or
   // auto (hac on an imported recording, white on a simulated one).
   estimator::CalibrationOptions::StdMethod std_method = estimator::CalibrationOptions::StdMethod::kAuto;
@@ -329,7 +339,8 @@ nlohmann::json TwinDriftJson(const std::map<std::string, TwinDrift>& drift);
 // the first's as "candidates"), "effects" (each with "effect": the simulator's effects it sets), "joint" (null, or
 // {"effects", "held", "failed", "chi2_before", "chi2_after", "iterations", "runs"}), "unexplained",
 // "heldout": {"before", "after"}, "whole_run", "patch",
-// "heldout_runs": [{"recording", "replayed", "before", "after"}], "increment_window_s", "runs", "seconds"}, and with
+// "heldout_runs": [{"recording", "replayed", "before", "after"}], "increment_window_s", "train_weight", "run_weights",
+// "runs", "seconds"}, and with
 // further training runs "training_runs": [{"recording", "replayed", "train_end_s", "heldout": {"before", "after"}}]:
 // gap.json's "simulation" section.
 nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d);

@@ -432,6 +432,21 @@ void ParallelFor(int n, int threads, const std::function<void(int)>& fn) {
   for (std::thread& t : pool) t.join();
 }
 
+double SummedWeight(const Layout& layout) {
+  double sum = 0.0;
+  for (const Series& s : layout.series) sum += s.weight * s.weight * static_cast<double>(s.size());
+  return sum;
+}
+
+std::vector<double> EqualRunScales(const std::vector<double>& summed_weights) {
+  double total = 0.0;
+  for (double s : summed_weights) total += s;
+  const double each = total / static_cast<double>(summed_weights.size());
+  std::vector<double> out;
+  for (double s : summed_weights) out.push_back(std::sqrt(each / s));
+  return out;
+}
+
 Layout CombinedLayout(const std::vector<FitRun>& runs) {
   if (runs.size() == 1) return runs.front().layout;
   Layout out;
@@ -469,7 +484,7 @@ Eigen::VectorXd Concatenated(const std::vector<FitRun>& runs, const std::vector<
 Eigen::VectorXd CombinedResiduals(const std::vector<FitRun>& runs, const std::vector<recording::Recording>& twins) {
   std::vector<Eigen::VectorXd> per_run;
   for (std::size_t i = 0; i < runs.size(); ++i)
-    per_run.push_back(WhitenedResiduals(runs[i].layout, *runs[i].real, twins[i]));
+    per_run.push_back(runs[i].scale * WhitenedResiduals(runs[i].layout, *runs[i].real, twins[i]));
   return Concatenated(runs, per_run);
 }
 
@@ -485,7 +500,8 @@ std::vector<Result<Eigen::VectorXd>> TwinEvaluator::Run(const std::vector<Patch>
     Result<Eigen::VectorXd>& out = each[static_cast<std::size_t>(i)];
     try {
       auto twin = (*run.runner)(patched);
-      out = twin.ok() ? Result<Eigen::VectorXd>(WhitenedResiduals(run.layout, *run.real, twin.value())) : twin.status();
+      out = twin.ok() ? Result<Eigen::VectorXd>(run.scale * WhitenedResiduals(run.layout, *run.real, twin.value()))
+                      : twin.status();
     } catch (const std::exception& e) {
       out = Status::Error(std::string("the twin runner failed: ") + e.what());
     }
