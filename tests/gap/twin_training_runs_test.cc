@@ -194,7 +194,8 @@ TEST(TwinTrainingRunsTest, WeighingTheRunsAlikeMakesAShortRunCountAsMuchAsALongO
   sim::Scenario nominal = Nominal(), long_drive = Nominal(), short_drive = Nominal();
   long_drive.duration_s = 60.0;
   short_drive.duration_s = 20.0;
-  const recording::Recording long_run = Real(long_drive, 45, {{"wheel_radius_asymmetry", {{"ratio_right_left", 1.01}}}});
+  const recording::Recording long_run =
+      Real(long_drive, 45, {{"wheel_radius_asymmetry", {{"ratio_right_left", 1.01}}}});
   const recording::Recording short_run =
       Real(short_drive, 46, {{"wheel_radius_asymmetry", {{"ratio_right_left", 1.03}}}});
   TwinDiagnoseOptions options;
