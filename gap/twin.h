@@ -177,10 +177,16 @@ struct TwinFitRows {
   Eigen::VectorXd residuals;
   std::vector<Time> t;
   std::vector<std::string> series;
+  // Per row: its chi-square weight w, the square of the factor its whitened residual and Jacobian row were scaled by
+  // (TwinDiagnoseOptions::train_weight); empty: every one 1.
+  std::vector<double> weight;
 };
 // The parameters' covariances from the rows:
-//   white: (J^T J)^-1, pseudo-inverse over the directions the rows see: independent unit-variance residuals;
-//   hac:   the Newey-West sandwich white M white with the estimator's weights and bandwidth (estimator/covariance.h):
+//   white: (J^T J)^-1, pseudo-inverse over the directions the rows see: independent unit-variance residuals; with
+//          row weights other than 1, the weighted fit's (J^T J)^-1 J^T W J (J^T J)^-1 (a row scaled by sqrt(w) has
+//          variance w);
+//   hac:   the Newey-West sandwich B M B, B = (J^T J)^-1, with the estimator's weights and bandwidth
+//   (estimator/covariance.h):
 //          the rows of one series and stamp form one residual vector r_t and one score g_t = J_t^T r_t, and M sums
 //          within each series the Bartlett-weighted products g_t g_{t+l}^T up to the series' lag L_s
 //          (AnalyzeAutocorrelation of its residual vectors), the scores prewhitened by an AR(1) per parameter and

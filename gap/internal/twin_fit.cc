@@ -101,8 +101,9 @@ Eigen::VectorXd Masked(const Eigen::VectorXd& r, const Eigen::VectorXd& center) 
   return out;
 }
 
-// The fit's rows: the finite entries of `center` and the Jacobian's rows there.
-TwinFitRows Rows(const Layout& layout, const Eigen::VectorXd& center, const Eigen::MatrixXd& jacobian) {
+// The fit's rows: the finite entries of `center` and the Jacobian's rows there, with their weights (per entry).
+TwinFitRows Rows(const Layout& layout, const Eigen::VectorXd& center, const Eigen::MatrixXd& jacobian,
+                 const std::vector<double>& weights) {
   TwinFitRows rows;
   std::vector<Eigen::Index> keep;
   for (const Series& s : layout.series)
@@ -111,6 +112,7 @@ TwinFitRows Rows(const Layout& layout, const Eigen::VectorXd& center, const Eige
         const Eigen::Index k = s.offset + static_cast<Eigen::Index>(i) * s.components() + c;
         if (!std::isfinite(center[k])) continue;
         keep.push_back(k);
+        rows.weight.push_back(weights[static_cast<std::size_t>(k)]);
         rows.t.push_back(s.t[i]);
         rows.series.push_back(s.name);
       }
@@ -299,7 +301,7 @@ Result<LeastSquares> FitLeastSquares(const Parts& parts, const Eigen::VectorXd& 
     }
     if (decrease < enough) break;
   }
-  out.covariance = ComputeTwinCovariance(Rows(evaluator->layout(), out.residuals, J));
+  out.covariance = ComputeTwinCovariance(Rows(evaluator->layout(), out.residuals, J, evaluator->entry_weights()));
   return out;
 }
 
@@ -364,7 +366,7 @@ Result<CandidateOutcome> SearchTimeShift(const TwinCandidate& c, const Eigen::Ve
           ? Eigen::VectorXd((Masked(r[up], r[b]) - Masked(r[down], r[b])) / (static_cast<double>(up - down) * step))
           : Eigen::VectorXd::Zero(base.size());
   const Eigen::VectorXd at_vertex = r[b] + J.col(0) * (vertex * step);
-  out.covariance = ComputeTwinCovariance(Rows(evaluator->layout(), at_vertex, J));
+  out.covariance = ComputeTwinCovariance(Rows(evaluator->layout(), at_vertex, J, evaluator->entry_weights()));
   return out;
 }
 

@@ -84,15 +84,21 @@ Eigen::VectorXd CombinedResiduals(const std::vector<FitRun>& runs, const std::ve
 class TwinEvaluator {
  public:
   TwinEvaluator(const sim::Scenario& base, const std::vector<FitRun>& runs, int threads)
-      : base_(base), runs_of_(runs), layout_(CombinedLayout(runs)), threads_(threads) {}
+      : base_(base), runs_of_(runs), layout_(CombinedLayout(runs)), threads_(threads) {
+    for (const FitRun& run : runs)
+      entry_weights_.insert(entry_weights_.end(), static_cast<std::size_t>(run.layout.size), run.scale * run.scale);
+  }
   std::vector<Result<Eigen::VectorXd>> Run(const std::vector<Patch>& patches);
   int runs() const { return runs_; }
   const Layout& layout() const { return layout_; }
+  // Per entry of the layout: its run's chi-square weight (FitRun::scale squared).
+  const std::vector<double>& entry_weights() const { return entry_weights_; }
 
  private:
   const sim::Scenario& base_;
   const std::vector<FitRun>& runs_of_;
   Layout layout_;
+  std::vector<double> entry_weights_;
   int threads_;
   int runs_ = 0;
 };
