@@ -306,6 +306,10 @@ void AddTwinOptions(CLI::App* dia, DiagnoseArgs* args) {
                   "With --twin: other recordings of the same robot the twin's patch is fitted on as well, each on its "
                   "own twin, its first 2/3 in the fit and its last 1/3 in the held-out test (twin.json "
                   "training_runs)");
+  dia->add_option("--train-weight", args->train_weight,
+                  "With --train-with: how the training runs weigh in the twin's fit: windows (default; each residual "
+                  "as its stream weighs it, a longer run more) or runs (each run's residuals scaled so that every run "
+                  "weighs the same, their total unchanged; twin.json run_weights)");
   dia->add_option("--max-effects", args->max_effects, "With --twin: the twin's effects kept at most (default 2)");
   dia->add_option("--twin-candidates", args->twin_candidates,
                   "With --twin: the candidate effects the twin diagnosis tries, as twin.json names them (e.g. "

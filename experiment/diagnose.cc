@@ -182,6 +182,7 @@ Outcome DiagnoseTwinToFile(const DiagnoseRequest& request, const Inputs& in, con
   options.progress = [&](const std::string& line) { say("  " + line); };
   if (request.max_shift_s) options.max_shift_s = *request.max_shift_s;
   if (request.max_effects) options.max_effects = *request.max_effects;
+  if (request.train_weight == "runs") options.train_weight = gap::TwinDiagnoseOptions::TrainWeight::kRuns;
   options.candidates = request.twin_candidates;
   std::vector<gap::TwinTrainingRun> runs = {{request.recording, &in.recording, runner, replayed}};
   for (const HeldOut& t : training) runs.push_back({t.path, &t.recording, t.runner, t.replayed});
@@ -253,6 +254,8 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
     return Outcome::BadInput(Status::Error("--held-out needs --twin (or --replay)"));
   if (!request.train_with.empty() && !request.twin)
     return Outcome::BadInput(Status::Error("--train-with needs --twin (or --replay)"));
+  if (request.train_weight != "windows" && request.train_weight != "runs")
+    return Outcome::BadInput(Status::Error("--train-weight " + request.train_weight + ": must be windows or runs"));
   if (request.max_effects && !(*request.max_effects >= 1))
     return Outcome::BadInput(
         Status::Error("--max-effects " + std::to_string(*request.max_effects) + ": must be 1 or more"));

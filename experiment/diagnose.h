@@ -58,6 +58,9 @@ struct DiagnoseRequest {
   // and checked as `held_out` (gap::DiagnoseTwin's training runs; twin.json's training_runs).
   std::vector<std::string> train_with;
   std::optional<int> max_effects;  // the twin's effects kept at most (default gap::TwinDiagnoseOptions')
+  // How the training runs weigh in the twin's fit (gap::TwinDiagnoseOptions::train_weight): "windows" (default) or
+  // "runs"; another value is bad input.
+  std::string train_weight = "windows";
   // The twin's candidate effects (gap::TwinCandidateNames' labels; empty: every one the scenario supports). A label the
   // scenario does not support is bad input.
   std::vector<std::string> twin_candidates;

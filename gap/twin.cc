@@ -81,10 +81,10 @@ struct State {
   std::vector<recording::Recording> twins;  // per run, the whole recording's twin
 };
 
-// The runs' held-out chi-square.
-double Chi2(const std::vector<TwinComparison>& heldout) {
+// The runs' held-out chi-square, each run's weighted as its training residuals (FitRun::scale squared).
+double Chi2(const std::vector<TwinComparison>& heldout, const std::vector<internal::FitRun>& runs) {
   double sum = 0.0;
-  for (const TwinComparison& c : heldout) sum += c.chi2;
+  for (std::size_t i = 0; i < heldout.size(); ++i) sum += runs[i].scale * runs[i].scale * heldout[i].chi2;
   return sum;
 }
 
@@ -161,6 +161,14 @@ Status Diagnoser::Span() {
     spans_.push_back(span);
     fit_runs_.push_back(std::move(fit));
   }
+  if (options_.train_weight == TwinDiagnoseOptions::TrainWeight::kRuns) {
+    std::vector<double> summed;
+    for (const internal::FitRun& run : fit_runs_) summed.push_back(internal::SummedWeight(run.layout));
+    const std::vector<double> scales = internal::EqualRunScales(summed);
+    for (std::size_t i = 0; i < fit_runs_.size(); ++i) fit_runs_[i].scale = scales[i];
+    out_.train_weight = "runs";
+  }
+  for (const internal::FitRun& run : fit_runs_) out_.run_weights.push_back(run.scale * run.scale);
   out_.train_end_s = spans_.front().train_end.seconds();
   return Status::Ok();
 }
@@ -287,7 +295,8 @@ Result<bool> Diagnoser::Round(int round, const std::vector<TwinCandidate>& pool,
     }
     std::vector<TwinComparison> heldout = HeldOut(twins.value());
     x.evaluated_heldout = true;
-    x.heldout_improvement = Chi2(state->heldout) > 0.0 ? 1.0 - Chi2(heldout) / Chi2(state->heldout) : 0.0;
+    const double before = Chi2(state->heldout, fit_runs_);
+    x.heldout_improvement = before > 0.0 ? 1.0 - Chi2(heldout, fit_runs_) / before : 0.0;
     if (!(x.heldout_improvement > options_.min_heldout_improvement)) {
       x.decision = "the held-out chi-square does not drop";
       continue;

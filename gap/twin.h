@@ -177,10 +177,16 @@ struct TwinFitRows {
   Eigen::VectorXd residuals;
   std::vector<Time> t;
   std::vector<std::string> series;
+  // Per row: its chi-square weight w, the square of the factor its whitened residual and Jacobian row were scaled by
+  // (TwinDiagnoseOptions::train_weight); empty: every one 1.
+  std::vector<double> weight;
 };
 // The parameters' covariances from the rows:
-//   white: (J^T J)^-1, pseudo-inverse over the directions the rows see: independent unit-variance residuals;
-//   hac:   the Newey-West sandwich white M white with the estimator's weights and bandwidth (estimator/covariance.h):
+//   white: (J^T J)^-1, pseudo-inverse over the directions the rows see: independent unit-variance residuals; with
+//          row weights other than 1, the weighted fit's (J^T J)^-1 J^T W J (J^T J)^-1 (a row scaled by sqrt(w) has
+//          variance w);
+//   hac:   the Newey-West sandwich B M B, B = (J^T J)^-1, with the estimator's weights and bandwidth
+//   (estimator/covariance.h):
 //          the rows of one series and stamp form one residual vector r_t and one score g_t = J_t^T r_t, and M sums
 //          within each series the Bartlett-weighted products g_t g_{t+l}^T up to the series' lag L_s
 //          (AnalyzeAutocorrelation of its residual vectors), the scores prewhitened by an AR(1) per parameter and
@@ -268,6 +274,8 @@ struct TwinDiagnosis {
   std::vector<TwinHeldOutRun> heldout_runs;        // ShowOnHeldOut's, filled by the caller
   std::vector<TwinTrainingFigures> training_runs;  // the training runs after the diagnosed one
   double increment_window_s = 0.0;                 // the replayed runs' residuals (TwinDiagnoseOptions)
+  std::string train_weight = "windows";            // TwinDiagnoseOptions::train_weight: "windows" or "runs"
+  std::vector<double> run_weights;                 // per training run (the diagnosed first): its chi-square weight
   int runs = 0;
   double seconds = 0.0;
 };
@@ -288,6 +296,14 @@ struct TwinDiagnoseOptions {
   // absolute values, the driving encoders still left out. The other runs, and the located components, compare the
   // absolute values.
   double increment_window_s = 10.0;
+  // How the training runs weigh in the fit (with several runs):
+  //   kWindows: each residual as its series weighs it, so that a run weighs by its training part's length;
+  //   kRuns: each run's whitened residuals scaled by sqrt(w_r), w_r = S / (R S_r), S_r the run's summed chi-square
+  //     weight (its layout's entries, each its series' weight squared), S the runs' total, R their number: every run
+  //     weighs S / R, the total S unchanged (internal::EqualRunScales). The held-out test weighs each run's held-out
+  //     chi-square by the same w_r. With one run the two are the same.
+  enum class TrainWeight { kWindows, kRuns };
+  TrainWeight train_weight = TrainWeight::kWindows;
   // The std reported: white, hac (the larger of std_white and std_hac, as the estimator's calibration reports), or
   // auto (hac on an imported recording, white on a simulated one).
   estimator::CalibrationOptions::StdMethod std_method = estimator::CalibrationOptions::StdMethod::kAuto;
@@ -329,7 +345,8 @@ nlohmann::json TwinDriftJson(const std::map<std::string, TwinDrift>& drift);
 // the first's as "candidates"), "effects" (each with "effect": the simulator's effects it sets), "joint" (null, or
 // {"effects", "held", "failed", "chi2_before", "chi2_after", "iterations", "runs"}), "unexplained",
 // "heldout": {"before", "after"}, "whole_run", "patch",
-// "heldout_runs": [{"recording", "replayed", "before", "after"}], "increment_window_s", "runs", "seconds"}, and with
+// "heldout_runs": [{"recording", "replayed", "before", "after"}], "increment_window_s", "train_weight", "run_weights",
+// "runs", "seconds"}, and with
 // further training runs "training_runs": [{"recording", "replayed", "train_end_s", "heldout": {"before", "after"}}]:
 // gap.json's "simulation" section.
 nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d);

@@ -200,7 +200,13 @@ std::string DriveMismatch(const recording::Recording& real, const recording::Rec
 TwinCovariance ComputeTwinCovariance(const TwinFitRows& rows) {
   TwinCovariance out;
   const Eigen::Index k = rows.jacobian.cols();
-  out.white = (rows.jacobian.transpose() * rows.jacobian).completeOrthogonalDecomposition().pseudoInverse();
+  const Eigen::MatrixXd bread =
+      (rows.jacobian.transpose() * rows.jacobian).completeOrthogonalDecomposition().pseudoInverse();
+  out.white = bread;
+  if (std::any_of(rows.weight.begin(), rows.weight.end(), [](double w) { return w != 1.0; })) {
+    const Eigen::Map<const Eigen::VectorXd> w(rows.weight.data(), static_cast<Eigen::Index>(rows.weight.size()));
+    out.white = bread * (rows.jacobian.transpose() * w.asDiagonal() * rows.jacobian) * bread;
+  }
   Eigen::MatrixXd M = Eigen::MatrixXd::Zero(k, k);
   // Per series (its rows in time order, those of one stamp together): residual vectors and scores per stamp.
   for (std::size_t begin = 0; begin < rows.series.size();) {
@@ -229,7 +235,7 @@ TwinCovariance ComputeTwinCovariance(const TwinFitRows& rows) {
     M += estimator::PrewhitenedBartlettSum(g, lag);
     begin = end;
   }
-  out.hac = out.white * M * out.white;
+  out.hac = bread * M * bread;
   out.hac = 0.5 * (out.hac + out.hac.transpose()).eval();
   return out;
 }

@@ -143,6 +143,8 @@ nlohmann::json TwinDiagnosisJson(const TwinDiagnosis& d) {
       {"patch", patch},
       {"heldout_runs", heldout_runs},
       {"increment_window_s", d.increment_window_s},
+      {"train_weight", d.train_weight},
+      {"run_weights", d.run_weights},
       {"runs", d.runs},
       {"seconds", d.seconds}};
   if (d.training_runs.empty()) return out;

@@ -101,8 +101,9 @@ Eigen::VectorXd Masked(const Eigen::VectorXd& r, const Eigen::VectorXd& center) 
   return out;
 }
 
-// The fit's rows: the finite entries of `center` and the Jacobian's rows there.
-TwinFitRows Rows(const Layout& layout, const Eigen::VectorXd& center, const Eigen::MatrixXd& jacobian) {
+// The fit's rows: the finite entries of `center` and the Jacobian's rows there, with their weights (per entry).
+TwinFitRows Rows(const Layout& layout, const Eigen::VectorXd& center, const Eigen::MatrixXd& jacobian,
+                 const std::vector<double>& weights) {
   TwinFitRows rows;
   std::vector<Eigen::Index> keep;
   for (const Series& s : layout.series)
@@ -111,6 +112,7 @@ TwinFitRows Rows(const Layout& layout, const Eigen::VectorXd& center, const Eige
         const Eigen::Index k = s.offset + static_cast<Eigen::Index>(i) * s.components() + c;
         if (!std::isfinite(center[k])) continue;
         keep.push_back(k);
+        rows.weight.push_back(weights[static_cast<std::size_t>(k)]);
         rows.t.push_back(s.t[i]);
         rows.series.push_back(s.name);
       }
@@ -299,7 +301,7 @@ Result<LeastSquares> FitLeastSquares(const Parts& parts, const Eigen::VectorXd& 
     }
     if (decrease < enough) break;
   }
-  out.covariance = ComputeTwinCovariance(Rows(evaluator->layout(), out.residuals, J));
+  out.covariance = ComputeTwinCovariance(Rows(evaluator->layout(), out.residuals, J, evaluator->entry_weights()));
   return out;
 }
 
@@ -364,7 +366,7 @@ Result<CandidateOutcome> SearchTimeShift(const TwinCandidate& c, const Eigen::Ve
           ? Eigen::VectorXd((Masked(r[up], r[b]) - Masked(r[down], r[b])) / (static_cast<double>(up - down) * step))
           : Eigen::VectorXd::Zero(base.size());
   const Eigen::VectorXd at_vertex = r[b] + J.col(0) * (vertex * step);
-  out.covariance = ComputeTwinCovariance(Rows(evaluator->layout(), at_vertex, J));
+  out.covariance = ComputeTwinCovariance(Rows(evaluator->layout(), at_vertex, J, evaluator->entry_weights()));
   return out;
 }
 
@@ -432,6 +434,21 @@ void ParallelFor(int n, int threads, const std::function<void(int)>& fn) {
   for (std::thread& t : pool) t.join();
 }
 
+double SummedWeight(const Layout& layout) {
+  double sum = 0.0;
+  for (const Series& s : layout.series) sum += s.weight * s.weight * static_cast<double>(s.size());
+  return sum;
+}
+
+std::vector<double> EqualRunScales(const std::vector<double>& summed_weights) {
+  double total = 0.0;
+  for (double s : summed_weights) total += s;
+  const double each = total / static_cast<double>(summed_weights.size());
+  std::vector<double> out;
+  for (double s : summed_weights) out.push_back(std::sqrt(each / s));
+  return out;
+}
+
 Layout CombinedLayout(const std::vector<FitRun>& runs) {
   if (runs.size() == 1) return runs.front().layout;
   Layout out;
@@ -469,7 +486,7 @@ Eigen::VectorXd Concatenated(const std::vector<FitRun>& runs, const std::vector<
 Eigen::VectorXd CombinedResiduals(const std::vector<FitRun>& runs, const std::vector<recording::Recording>& twins) {
   std::vector<Eigen::VectorXd> per_run;
   for (std::size_t i = 0; i < runs.size(); ++i)
-    per_run.push_back(WhitenedResiduals(runs[i].layout, *runs[i].real, twins[i]));
+    per_run.push_back(runs[i].scale * WhitenedResiduals(runs[i].layout, *runs[i].real, twins[i]));
   return Concatenated(runs, per_run);
 }
 
@@ -485,7 +502,8 @@ std::vector<Result<Eigen::VectorXd>> TwinEvaluator::Run(const std::vector<Patch>
     Result<Eigen::VectorXd>& out = each[static_cast<std::size_t>(i)];
     try {
       auto twin = (*run.runner)(patched);
-      out = twin.ok() ? Result<Eigen::VectorXd>(WhitenedResiduals(run.layout, *run.real, twin.value())) : twin.status();
+      out = twin.ok() ? Result<Eigen::VectorXd>(run.scale * WhitenedResiduals(run.layout, *run.real, twin.value()))
+                      : twin.status();
     } catch (const std::exception& e) {
       out = Status::Error(std::string("the twin runner failed: ") + e.what());
     }

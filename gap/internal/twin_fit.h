@@ -59,31 +59,46 @@ struct FitRun {
   const TwinRunner* runner = nullptr;
   Layout layout;
   double duration_s = 0.0;
+  double scale = 1.0;  // its whitened residuals' factor in the fit (gap/twin.h TwinDiagnoseOptions::train_weight)
 };
+
+// A layout's summed chi-square weight: its entries, each its series' weight squared.
+double SummedWeight(const Layout& layout);
+
+// Per run (summed weights S_r > 0, in order) the residuals' factor sqrt(S / (R S_r)) that makes every run's summed
+// weight S / R, S the total and R the runs' number.
+std::vector<double> EqualRunScales(const std::vector<double>& summed_weights);
 
 // The runs' layouts as one residual vector: the series concatenated in the runs' order, their offsets moved, and with
 // more than one run each series' name prefixed "NAME: " so that the HAC covariance (ComputeTwinCovariance) treats
 // each run's series as independent of the others'.
 Layout CombinedLayout(const std::vector<FitRun>& runs);
 
-// The runs' whitened training residuals, concatenated as CombinedLayout, for their twins (one per run, in order).
+// The runs' whitened training residuals, each run's times its scale, concatenated as CombinedLayout, for their twins
+// (one per run, in order).
 Eigen::VectorXd CombinedResiduals(const std::vector<FitRun>& runs, const std::vector<recording::Recording>& twins);
 
 // Runs the twin of patched scenarios (the base with a patch's effects each) for every run, the runs x patches in
-// parallel, and returns the whitened training residuals of each patch (CombinedLayout's entries; NaN where a twin has
-// no sample). A patch fails when any run's twin fails.
+// parallel, and returns the whitened training residuals of each patch (CombinedLayout's entries, each run's times its
+// scale; NaN where a twin has no sample). A patch fails when any run's twin fails.
 class TwinEvaluator {
  public:
   TwinEvaluator(const sim::Scenario& base, const std::vector<FitRun>& runs, int threads)
-      : base_(base), runs_of_(runs), layout_(CombinedLayout(runs)), threads_(threads) {}
+      : base_(base), runs_of_(runs), layout_(CombinedLayout(runs)), threads_(threads) {
+    for (const FitRun& run : runs)
+      entry_weights_.insert(entry_weights_.end(), static_cast<std::size_t>(run.layout.size), run.scale * run.scale);
+  }
   std::vector<Result<Eigen::VectorXd>> Run(const std::vector<Patch>& patches);
   int runs() const { return runs_; }
   const Layout& layout() const { return layout_; }
+  // Per entry of the layout: its run's chi-square weight (FitRun::scale squared).
+  const std::vector<double>& entry_weights() const { return entry_weights_; }
 
  private:
   const sim::Scenario& base_;
   const std::vector<FitRun>& runs_of_;
   Layout layout_;
+  std::vector<double> entry_weights_;
   int threads_;
   int runs_ = 0;
 };

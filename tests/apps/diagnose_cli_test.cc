@@ -239,6 +239,10 @@ TEST(DiagnoseCliTest, HeldOutShowsTheTwinsPatchOnARecordingOfAnotherDrive) {
   const CommandRun no_twin = Roamlab(common + "--out " + dir.File("bad") + " --train-with " + dir.File("held"), dir);
   EXPECT_EQ(no_twin.exit_code, 2);
   EXPECT_NE(no_twin.err.find("--train-with needs --twin"), std::string::npos) << no_twin.err;
+  const CommandRun bad_weight = Roamlab(
+      common + "--out " + dir.File("bad") + " --twin --train-with " + dir.File("held") + " --train-weight equal", dir);
+  EXPECT_EQ(bad_weight.exit_code, 2);
+  EXPECT_NE(bad_weight.err.find("--train-weight equal: must be windows or runs"), std::string::npos) << bad_weight.err;
   const CommandRun unknown = Roamlab(
       common + "--out " + dir.File("bad") + " --twin --twin-candidates wheel_radius_scale gyro_scale_error", dir);
   EXPECT_EQ(unknown.exit_code, 2);

@@ -204,6 +204,23 @@ TEST(TwinCompareTest, TheWhiteNoiseCovarianceIsTheInverseCurvature) {
   EXPECT_NEAR(cov(1, 1), 0.0, 1e-12);  // unseen: no information, and no variance claimed either
 }
 
+// Rows scaled by sqrt(w) (a run's residuals weighted in the fit, TwinDiagnoseOptions::train_weight): three unit rows
+// and one scaled by 2 (w = 4) of the first parameter give the weighted fit's variance (J^T J)^-1 J^T W J (J^T J)^-1 =
+// (3 + 4 * 4) / 7^2, not the 1/7 of unit-variance rows.
+TEST(TwinCompareTest, TheWhiteCovarianceOfWeightedRowsIsTheWeightedFits) {
+  TwinFitRows rows;
+  rows.jacobian = Eigen::MatrixXd::Zero(4, 1);
+  rows.jacobian.col(0) << 1, 1, 1, 2;
+  rows.residuals = Eigen::VectorXd::Zero(4);
+  for (int i = 0; i < 4; ++i) {
+    rows.t.push_back(Time::FromSeconds(i));
+    rows.series.push_back("s");
+  }
+  EXPECT_NEAR(ComputeTwinCovariance(rows).white(0, 0), 1.0 / 7.0, 1e-12);
+  rows.weight = {1.0, 1.0, 1.0, 4.0};
+  EXPECT_NEAR(ComputeTwinCovariance(rows).white(0, 0), 19.0 / 49.0, 1e-12);
+}
+
 // The mean of a first-order Gauss-Markov series e(k+1) = a e(k) + sqrt(1 - a^2) n fitted as one parameter (the
 // residuals at the fit: the series less its mean; two components per stamp, one series): the HAC variance over the
 // white one is the long-run factor (1 + a) / (1 - a) (the scores prewhitened by their AR(1) and recoloured, so without

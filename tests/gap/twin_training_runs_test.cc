@@ -1,7 +1,8 @@
 // The twin's patch fitted on several training runs (gap/twin.h DiagnoseTwin with TwinTrainingRun): a hidden wheel
 // radius asymmetry, and a hidden geometry (radius scale and track), in two seeded 30 s recordings of the OptiOdom
 // differential drive (wheel encoders, motion capture) of different drives, the scenario's own (its twin the plain
-// simulation) and one turning the other way at twice the rate (its twin the replay of its drive).
+// simulation) and one turning the other way at twice the rate (its twin the replay of its drive); and two runs of one
+// drive of very different lengths, weighed by their windows or alike (TwinDiagnoseOptions::train_weight).
 #include <algorithm>
 #include <cstdio>
 #include <string>
@@ -182,6 +183,57 @@ TEST(TwinTrainingRunsTest, AJointGeometryIsRecoveredFromReplaysOfTwoDrives) {
   EXPECT_TRUE(std::any_of(left_out.begin(), left_out.end(), [](const std::string& s) {
     return s.rfind("wheel_encoders: drives the replay", 0) == 0;
   })) << left_out.size();
+}
+
+// Two runs of the same drive of very different lengths (60 s and 20 s), with different hidden asymmetries (1.01 and
+// 1.03), each replayed and compared by the drift's 10 s windows: weighted by their windows the long run's 31 training
+// windows outweigh the short run's 4 and the fit lands near its ratio; with each run weighing the same
+// (TrainWeight::kRuns) the short run's chi-square weight is its windows' ratio above the long run's (their total
+// unchanged), and the fitted ratio moves to the two's middle.
+TEST(TwinTrainingRunsTest, WeighingTheRunsAlikeMakesAShortRunCountAsMuchAsALongOne) {
+  sim::Scenario nominal = Nominal(), long_drive = Nominal(), short_drive = Nominal();
+  long_drive.duration_s = 60.0;
+  short_drive.duration_s = 20.0;
+  const recording::Recording long_run =
+      Real(long_drive, 45, {{"wheel_radius_asymmetry", {{"ratio_right_left", 1.01}}}});
+  const recording::Recording short_run =
+      Real(short_drive, 46, {{"wheel_radius_asymmetry", {{"ratio_right_left", 1.03}}}});
+  TwinDiagnoseOptions options;
+  options.candidates = {"wheel_radius_asymmetry"};
+  options.max_effects = 1;
+  options.replayed = true;
+  const std::vector<TwinTrainingRun> runs = {{"long", &long_run, ReplayRunner(long_run), true},
+                                             {"short", &short_run, ReplayRunner(short_run), true}};
+  auto by_windows = DiagnoseTwin(nominal, runs, options);
+  ASSERT_TRUE(by_windows.ok()) << by_windows.status().message();
+  options.train_weight = TwinDiagnoseOptions::TrainWeight::kRuns;
+  auto by_runs = DiagnoseTwin(nominal, runs, options);
+  ASSERT_TRUE(by_runs.ok()) << by_runs.status().message();
+
+  EXPECT_EQ(by_windows.value().train_weight, "windows");
+  EXPECT_EQ(by_windows.value().run_weights, (std::vector<double>{1.0, 1.0}));
+  EXPECT_EQ(by_runs.value().train_weight, "runs");
+  const std::vector<double>& w = by_runs.value().run_weights;
+  ASSERT_EQ(w.size(), 2u);
+  std::printf("chi-square weights: long %.4f, short %.4f\n", w[0], w[1]);
+  EXPECT_LT(w[0], 1.0);
+  EXPECT_NEAR(w[1] / w[0], 31.0 / 4.0, 0.5);
+
+  // The first round's fit (the held-out test, on the long run's last third alone, then rejects the compromise).
+  const auto fitted = [](const TwinDiagnosis& d) {
+    EXPECT_EQ(d.candidates.size(), 1u);
+    if (d.candidates.empty()) return 0.0;
+    const EffectEstimate& e = d.candidates.front().estimate;
+    std::printf("  ratio_right_left %.6f, LR %.4g: %s\n", e.parameters.at("ratio_right_left"), e.lr_raw,
+                e.decision.c_str());
+    return e.parameters.at("ratio_right_left");
+  };
+  std::printf("weighted by windows:\n");
+  const double ratio_windows = fitted(by_windows.value());
+  std::printf("each run weighing the same:\n");
+  const double ratio_runs = fitted(by_runs.value());
+  EXPECT_NEAR(ratio_windows, 1.01, 0.004);
+  EXPECT_NEAR(ratio_runs, 1.02, 0.003);
 }
 
 // A training run that is missing or has nothing to compare is an error naming it.
