@@ -451,23 +451,34 @@ Result<TwinDiagnosis> Diagnoser::Run() {
             ? DefaultCandidate(c, runs_in_.size())
             : std::find(options_.candidates.begin(), options_.candidates.end(), c.label) != options_.candidates.end())
       pool.push_back(c);
+  // A round after a kept time shift re-screens: it tries every candidate not yet kept (a clock error hides what the
+  // others explain); the rounds after a non-clock effect try the significant candidates of the last screening round.
+  const std::vector<TwinCandidate> screened = pool;
+  std::set<std::string> passed;
+  bool screening = true;
   for (int round = 0; round < options_.max_effects && !pool.empty(); ++round) {
     std::vector<TwinEffect> scored;
     auto kept = Round(round, pool, step_s, &state, &scored);
     if (!kept.ok()) return kept.status();
     if (round == 0) out_.candidates = scored;
     out_.rounds.push_back(scored);
+    if (screening) {
+      passed.clear();
+      for (const TwinEffect& e : scored)
+        if (e.estimate.lr_pvalue < options_.alpha) passed.insert(e.estimate.name);
+    }
     if (!kept.value()) break;
-    // The next round: the candidates that passed the likelihood-ratio test in the first, other than those that set a
-    // simulator effect kept already (a composite's parts, or the composite of a kept part).
-    std::set<std::string> passed, kept_effects;
-    for (const TwinEffect& e : out_.candidates)
-      if (e.estimate.lr_pvalue < options_.alpha) passed.insert(e.estimate.name);
+    const std::string& label = out_.effects.back().estimate.name;
+    screening = std::any_of(screened.begin(), screened.end(),
+                            [&](const TwinCandidate& c) { return c.label == label && c.time_shift; });
+    // The next round: those candidates, other than the ones that set a simulator effect kept already (a composite's
+    // parts, or the composite of a kept part).
+    std::set<std::string> kept_effects;
     for (const sim::EffectOptions& e : state.effects) kept_effects.insert(e.name);
     std::vector<TwinCandidate> next;
-    for (const TwinCandidate& c : pool) {
+    for (const TwinCandidate& c : screened) {
       const std::vector<std::string> sets = internal::SimulatorEffects(c);
-      if (passed.count(c.label) &&
+      if ((screening || passed.count(c.label)) &&
           std::none_of(sets.begin(), sets.end(), [&](const std::string& x) { return kept_effects.count(x) > 0; }))
         next.push_back(c);
     }

@@ -314,7 +314,8 @@ std::optional<P> EffectsProblem(const Scenario& s) {
       return P{k + ".parameters.latency_s", "must be in [0, 1]"};
     if (e.name == "imu_time_offset" && !(std::abs(EffectParameter(s.effects, e.name, "offset_s", 0.0)) <= 0.5))
       return P{k + ".parameters.offset_s", "must be in [-0.5, 0.5]"};
-    if (e.name == "pose_time_offset" && !(std::abs(EffectParameter(s.effects, e.name, "offset_s", 0.0)) <= 0.5))
+    if ((e.name == "pose_time_offset" || e.name == "drive_time_offset") &&
+        !(std::abs(EffectParameter(s.effects, e.name, "offset_s", 0.0)) <= 0.5))
       return P{k + ".parameters.offset_s", "must be in [-0.5, 0.5]"};
     if (e.name == "gps_latency" && !s.sensors.gps) return P{k + ".name", "gps_latency needs sensors.gps"};
     if (e.name == "pose_time_offset" && !s.sensors.mocap) return P{k + ".name", "pose_time_offset needs sensors.mocap"};

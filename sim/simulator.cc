@@ -455,11 +455,15 @@ class Simulator::Impl {
     return {ramp * first.Evaluate(0.0), ramp * second.Evaluate(0.0), ramp * third.Evaluate(0.0)};
   }
 
+  // The recording time whose drive inputs hold at simulation time t_ns >= 0: t0 + t_ns, plus drive_time_offset's
+  // shift (inputs stamped late are read that much later).
+  Time DriveStamp(std::int64_t t_ns) const { return Time::FromNanoseconds(origin_ns_ + t_ns + drive_shift_ns_); }
+
   // A replay's drive inputs at t_ns: the recording's from t = 0, rest before (sim/replay_schedule.h).
   Eigen::VectorXd ReplayInputs(std::int64_t t_ns) const {
     const DriveInputs& drive = options_.replay->drive;
     if (t_ns < 0) return Eigen::VectorXd::Zero(drive.values.cols());
-    return drive.At(Time::FromNanoseconds(origin_ns_ + t_ns));
+    return drive.At(DriveStamp(t_ns));
   }
 
   // A replay's wheel-rate targets at t_ns: the measured rates, plus the tracking of the measured angles.
@@ -472,10 +476,9 @@ class Simulator::Impl {
     for (Eigen::Index i = 0; i < wheels; ++i) twin_angles[i] = wheeled_.WheelAngle(data_.get(), static_cast<int>(i));
     if (replay_angles_at_start_.size() == 0) {
       replay_angles_at_start_ = twin_angles;
-      measured_angles_at_start_ = drive.AnglesAt(Time::FromNanoseconds(origin_ns_));
+      measured_angles_at_start_ = drive.AnglesAt(DriveStamp(0));
     }
-    const Eigen::VectorXd measured =
-        drive.AnglesAt(Time::FromNanoseconds(origin_ns_ + t_ns)) - measured_angles_at_start_;
+    const Eigen::VectorXd measured = drive.AnglesAt(DriveStamp(t_ns)) - measured_angles_at_start_;
     return rates + (measured - (twin_angles - replay_angles_at_start_)) / kAngleTrackingS;
   }
 
@@ -484,8 +487,7 @@ class Simulator::Impl {
   double ReplayTravelCorrection(double rear_speed_mps, double dt_s) {
     if (!options_.replay || options_.replay->drive.travel_m.size() == 0 || t_ns_ < 0) return 0.0;
     const DriveInputs& drive = options_.replay->drive;
-    const double measured_m =
-        drive.TravelAt(Time::FromNanoseconds(origin_ns_ + t_ns_)) - drive.TravelAt(Time::FromNanoseconds(origin_ns_));
+    const double measured_m = drive.TravelAt(DriveStamp(t_ns_)) - drive.TravelAt(DriveStamp(0));
     const double correction = (measured_m - replay_travel_m_) / kAngleTrackingS;
     replay_travel_m_ += rear_speed_mps * dt_s;
     return correction;
@@ -533,6 +535,11 @@ class Simulator::Impl {
         !s.ok())
       return s;
     mag_clock_.shift_ns = imu_clock_.shift_ns;  // the magnetometer shares the IMU's clock
+    const double drive_shift_s = EffectParameter(effects, "drive_time_offset", "offset_s", 0.0);
+    if (drive_shift_s != 0.0 && !options_.replay)
+      return Status::Error(where_ + ": drive_time_offset shifts a replay's recorded drive inputs; this run drives the "
+                                    "scenario's own schedule");
+    drive_shift_ns_ = std::llround(drive_shift_s * 1e9);
     // A sample taken after the end of the drive (negative shift) extends the physics past it.
     loop_end_ns_ = end_ns_ + std::max<std::int64_t>(
                                  0, -std::min({imu_clock_.shift_ns, gps_clock_.shift_ns, mocap_clock_.shift_ns}));
@@ -934,6 +941,7 @@ class Simulator::Impl {
   std::int64_t loop_end_ns_ = 0;  // end_ns_, or later when a sample is taken after the recording's end
   std::int64_t t_ns_ = 0;         // the current time, for messages
   std::int64_t origin_ns_ = 0;    // the recording time of t = 0 (a replay's t0)
+  std::int64_t drive_shift_ns_ = 0;  // drive_time_offset: a replay reads its drive inputs this much later
   Eigen::VectorXd replay_angles_at_start_, measured_angles_at_start_;  // a replay's wheel angles at t = 0
   double replay_travel_m_ = 0.0;                                       // a replay's Ackermann travel since t = 0
   Time origin() const { return Time::FromNanoseconds(origin_ns_); }

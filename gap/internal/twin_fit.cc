@@ -84,6 +84,12 @@ std::vector<TwinCandidate> Library(const sim::Scenario& nominal, double max_shif
   TwinCandidate pose{"pose_time_offset", "pose_time_offset", {}, {P("offset_s", 0, 0, -imu_range, imu_range)}};
   pose.time_shift = true;
   all.push_back(pose);
+  // The recorded drive inputs against the other sensors (sim/scenario.h drive_time_offset): the whole twin shifted.
+  // A candidate with an IMU, whose rates time the drive; with one absolute stream and no IMU that stream's own clock
+  // (pose_time_offset, gps_latency) says the same.
+  TwinCandidate drive{"drive_time_offset", "drive_time_offset", {}, {P("offset_s", 0, 0, -imu_range, imu_range)}};
+  drive.time_shift = true;
+  if (nominal.sensors.imu) all.push_back(drive);
   return all;
 }
 

@@ -186,6 +186,39 @@ TEST(ReplayTest, InputsNotTheScheduleDriveTheTwin) {
   EXPECT_GT(schedule.max_position_m, 10.0 * follows.max_position_m);
 }
 
+// drive_time_offset: the encoder rows stamped 0.2 s early (offset -0.2 s). A replay patched with the offset reads at
+// t the inputs stamped t - 0.2 s and reproduces the truth as a replay of the right stamps does; the nominal replay
+// runs the drive 0.2 s ahead. (Early, not late: the replay starts at the first encoder row, and inputs stamped late
+// would start the twin 0.2 s into the drive with a step of the wheel rates, on this slippery floor a spin.) A
+// simulation of the scenario's own drive refuses the effect.
+TEST(ReplayTest, ADriveTimeOffsetReadsTheInputsThatMuchLater) {
+  constexpr double kOffsetS = -0.2;
+  const Scenario nominal = GentleDiffDrive(12.0);
+  const Simulation real = SimulateOk(nominal);
+  Recording early = real.recording;
+  for (Stream& s : early.streams)
+    if (s.info.name == "wheel_encoders")
+      for (Time& t : s.t) t = Time::FromNanoseconds(t.nanoseconds() + std::llround(kOffsetS * 1e9));
+  Scenario patched = nominal;
+  patched.effects = {{"drive_time_offset", {{"offset_s", kOffsetS}}}};
+  const Simulation shifted = ReplayOk(patched, early);
+  const Simulation ahead = ReplayOk(nominal, early);
+  const TrackError a = Compare(*shifted.recording.ground_truth, *real.recording.ground_truth);
+  const TrackError b = Compare(*ahead.recording.ground_truth, *real.recording.ground_truth);
+  std::printf("encoders 0.2 s early: replay with the offset <= %.4f m, %.4f rad; without %.4f m, %.4f rad\n",
+              a.max_position_m, a.max_heading_rad, b.max_position_m, b.max_heading_rad);
+  const Bound bound = EncoderBound(real.recording, Extent(*real.recording.ground_truth));
+  // The shifted twin starts at rest 0.2 s before the recorded drive: its wheels may settle a tick further from the
+  // recorded angles, twice the heading bound of the right stamps' replay.
+  EXPECT_LT(a.max_heading_rad, 2.0 * bound.heading_rad);
+  EXPECT_LT(a.max_position_m, bound.position_m);
+  EXPECT_GT(b.max_position_m, 5.0 * a.max_position_m);
+  EXPECT_GT(b.max_heading_rad, 5.0 * a.max_heading_rad);
+  auto refused = Simulate(patched);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_THAT(refused.status().message(), HasSubstr("drive_time_offset"));
+}
+
 // odometry_scale_error: the encoders read 3 % more than the wheels turn (the motion is the same). A replay of the
 // patched scenario takes the encoders' drive over the scale and drives the true motion, its encoders reading what was
 // recorded; the nominal one drives 3 % too far.
