@@ -337,7 +337,8 @@ void AddDiagnose(CLI::App* app, Commands* commands) {
                   "Do not simulate the nominal scenario to learn its levels (compare with chi2/dof 1)");
     dia->add_option("--baseline-seed", args->baseline_seed, "Noise seed of the nominal simulation (default 900001)");
     dia->add_option("--max-shift", args->max_shift_s,
-                    "Time-shift search range [s] of gps_latency, imu_time_offset and pose_time_offset (default 0.5; "
+                    "Time-shift search range [s] of gps_latency, imu_time_offset, pose_time_offset and drive_time_offset "
+                    "(default 0.5; "
                     "below 1/12 of the recording's span)");
     dia->add_option("--std", args->std_method,
                     "The effects' standard deviations, also the twin's with --replay: white, hac (autocorrelated "

@@ -66,6 +66,12 @@ void SetStd(const std::string& name, const TwinCovariance& covariance, Eigen::In
 // does; it is tried there when named.
 bool DefaultCandidate(const TwinCandidate& c, std::size_t runs) { return c.parts.empty() || runs > 1; }
 
+// A drive's clock shifts the recorded inputs of a replay; a plain simulation drives the scenario's own schedule.
+bool Applies(const TwinCandidate& c, const std::vector<TwinTrainingRun>& runs) {
+  return c.effect != "drive_time_offset" ||
+         std::all_of(runs.begin(), runs.end(), [](const TwinTrainingRun& r) { return r.replayed; });
+}
+
 // `options` comparing the absolute values (the located components and the unexplained ones are judged per sample).
 TwinResidualOptions Absolute(TwinResidualOptions options) {
   options.increment_window_s = 0.0;
@@ -447,9 +453,10 @@ Result<TwinDiagnosis> Diagnoser::Run() {
   const std::vector<TwinCandidate> library = internal::TwinCandidates(nominal_, options_.max_shift_s);
   std::vector<TwinCandidate> pool;
   for (const TwinCandidate& c : library)
-    if (options_.candidates.empty()
-            ? DefaultCandidate(c, runs_in_.size())
-            : std::find(options_.candidates.begin(), options_.candidates.end(), c.label) != options_.candidates.end())
+    if (Applies(c, runs_in_) &&
+        (options_.candidates.empty()
+             ? DefaultCandidate(c, runs_in_.size())
+             : std::find(options_.candidates.begin(), options_.candidates.end(), c.label) != options_.candidates.end()))
       pool.push_back(c);
   // A round after a kept time shift re-screens: it tries every candidate not yet kept (a clock error hides what the
   // others explain); the rounds after a non-clock effect try the significant candidates of the last screening round.
