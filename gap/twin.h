@@ -190,13 +190,19 @@ struct TwinFitRows {
 //          the rows of one series and stamp form one residual vector r_t and one score g_t = J_t^T r_t, and M sums
 //          within each series the Bartlett-weighted products g_t g_{t+l}^T up to the series' lag L_s
 //          (AnalyzeAutocorrelation of its residual vectors), the scores prewhitened by an AR(1) per parameter and
-//          recoloured (PrewhitenedBartlettSum); series independent of each other. With white residuals it is the
-//          white covariance rescaled by the residuals' actual spread.
+//          recoloured (PrewhitenedBartlettSum), each series' sum times FixedBFactor(b_s)^2, b_s = (L_s + 1) / n_s
+//          of its n_s stamps; series independent of each other. With white residuals (L_s = 0) it is the white
+//          covariance rescaled by the residuals' actual spread.
 struct TwinCovariance {
   Eigen::MatrixXd white, hac;
   std::map<std::string, int> lags;  // per series: L_s (samples)
 };
 TwinCovariance ComputeTwinCovariance(const TwinFitRows& rows);
+// A HAC std's widening at the bandwidth share b = (L + 1) / n of its series: Kiefer and Vogelsang's fixed-b critical
+// value of the Bartlett kernel (two-sided 5 %), cv(b) = 1.96 + 2.9694 b + 0.4160 b^2 - 0.5324 b^3, over the normal's
+// 1.96. With the lag a fixed share of the series the HAC long-run sum stays random and low (its mean 1 - b + b^2 / 3
+// of the true one), and +-2 of the widened std covers as +-2 normal std would; 1 at b = 0.
+double FixedBFactor(double b);
 
 struct TwinEffect {
   EffectEstimate estimate;  // name (the candidate's label), dof, parameters, std, lr, p, Delta BIC, held-out drop

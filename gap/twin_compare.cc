@@ -197,6 +197,11 @@ std::string DriveMismatch(const recording::Recording& real, const recording::Rec
          " of its size";
 }
 
+double FixedBFactor(double b) {
+  b = std::clamp(b, 0.0, 1.0);
+  return (1.96 + b * (2.9694 + b * (0.4160 - 0.5324 * b))) / 1.96;
+}
+
 TwinCovariance ComputeTwinCovariance(const TwinFitRows& rows) {
   TwinCovariance out;
   const Eigen::Index k = rows.jacobian.cols();
@@ -232,7 +237,8 @@ TwinCovariance ComputeTwinCovariance(const TwinFitRows& rows) {
                     residuals.end());
     const int lag = estimator::AnalyzeAutocorrelation(residuals).lag;
     out.lags[rows.series[begin]] = lag;
-    M += estimator::PrewhitenedBartlettSum(g, lag);
+    const double widening = FixedBFactor(static_cast<double>(lag + 1) / static_cast<double>(g.cols()));
+    M += widening * widening * estimator::PrewhitenedBartlettSum(g, lag);
     begin = end;
   }
   out.hac = bread * M * bread;

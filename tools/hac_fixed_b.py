@@ -14,6 +14,12 @@ fit x_t - mean, summing to zero as a fit's scores do), with the twin's estimator
 
     python3 tools/hac_fixed_b.py [N] [REPLICATIONS]   (defaults 925, the stamps of a Dec square run's training part,
                                                        and 2000; seed fixed)
+
+With --grid it prints, for lags L = b n over a grid of b, the 95 % quantile of |t| for phi 0, 0.5 and 0.9 beside
+Kiefer and Vogelsang's fixed-b critical value of the Bartlett kernel, cv(b) = 1.96 + 2.9694 b + 0.4160 b^2 -
+0.5324 b^3 (two-sided 5 %), whose ratio to 1.96 the twin's HAC std is widened by (gap/twin_compare.cc FixedBFactor).
+
+    python3 tools/hac_fixed_b.py --grid [N] [REPLICATIONS]
 """
 import math
 import random
@@ -60,6 +66,31 @@ def quantile(values, q):
     return ordered[min(len(ordered) - 1, int(q * len(ordered)))]
 
 
+def t_quantile(n, lag, phi, replications, rng):
+    """The 95 % quantile of |mean| / HAC std over replications of an AR(1) series of n samples."""
+    abs_t = []
+    for _ in range(replications):
+        x = [rng.gauss(0.0, 1.0) / math.sqrt(1.0 - phi * phi)]
+        for _ in range(n - 1):
+            x.append(phi * x[-1] + rng.gauss(0.0, 1.0))
+        mean = sum(x) / n
+        abs_t.append(abs(n * mean / math.sqrt(prewhitened_bartlett_sum([v - mean for v in x], lag))))
+    return quantile(abs_t, 0.95)
+
+
+def grid(n, replications):
+    rng = random.Random(7)
+    print(f"n {n}, {replications} replications")
+    print("| b | L | abs(t) q95, phi 0 | phi 0.5 | phi 0.9 | cv(b) |")
+    print("|---|---|---|---|---|---|")
+    for b in (0.02, 0.05, 0.1, 0.15, 0.2, 0.25):
+        lag = max(1, round(b * n))
+        q = [t_quantile(n, lag, phi, replications, rng) for phi in (0.0, 0.5, 0.9)]
+        cv = 1.96 + 2.9694 * b + 0.4160 * b * b - 0.5324 * b ** 3
+        print(f"| {b:.2f} | {lag} | {q[0]:.2f} | {q[1]:.2f} | {q[2]:.2f} | {cv:.2f} |", flush=True)
+    return 0
+
+
 def main(n, replications):
     lag = n // 4
     rng = random.Random(7)
@@ -90,6 +121,10 @@ if __name__ == "__main__":
     if len(sys.argv) > 1 and sys.argv[1] in ("-h", "--help"):
         print(__doc__)
         sys.exit(0)
+    mode = main
+    if len(sys.argv) > 1 and sys.argv[1] == "--grid":
+        mode = grid
+        del sys.argv[1]
     try:
         args = [int(a) for a in sys.argv[1:3]]
     except ValueError:
@@ -98,4 +133,4 @@ if __name__ == "__main__":
     if len(sys.argv) > 3 or any(a < 8 for a in args):
         print(__doc__, file=sys.stderr)
         sys.exit(2)
-    sys.exit(main(*(args + [925, 2000][len(args):])))
+    sys.exit(mode(*(args + [925, 2000][len(args):])))
