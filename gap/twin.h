@@ -21,16 +21,15 @@
 //      its neutral value and listed in TwinEffect::not_informed; internal/twin_fit.h FitCandidate). Time shifts
 //      (gps_latency latency_s, imu_time_offset offset_s, pose_time_offset offset_s: the motion capture's pose stamped
 //      t is O's pose at t - offset_s, so negative is wheel encoders that read behind it; drive_time_offset offset_s, a
-//      replay's drive inputs stamped t were the robot's at t - offset_s, with an IMU and replayed runs only) are
-//      whole physics steps in
-//      the simulator: a 1-D search on the step grid, coarse to fine, then a parabola through the best step and its
-//      neighbours for the value.
+//      replay's drive inputs stamped t were the robot's at t - offset_s, with an IMU and replayed runs only) are whole
+//      physics steps in the simulator: a 1-D search on the step grid, coarse to fine, then a parabola through the best
+//      step and its neighbours for the value.
 //      The parameters' covariance comes from the residuals' Jacobian at the fit (TwinFitRows, TwinCovariance): the
 //      white-noise curvature (J^T J)^-1, which assumes independent residuals and understates the spread of
 //      autocorrelated ones (real recordings, coloured sensor noise), and the HAC (Newey-West) sandwich around it,
-//      which does not (each series' sum widened by its fixed-b factor, FixedBFactor);
-//      TwinDiagnoseOptions::std_method chooses the one reported as the std (auto: HAC on an imported
-//      recording, white on a simulated one, as the estimator's calibration chooses; estimator/calibration.h UsesHac);
+//      which does not (each series' sum widened by its fixed-b factor, FixedBFactor); TwinDiagnoseOptions::std_method
+//      chooses the one reported as the std (auto: HAC on an imported recording, white on a simulated one, as the
+//      estimator's calibration chooses; estimator/calibration.h UsesHac);
 //   4. name: each candidate is scored by its chi-square drop LR on the training part (~ chi2(k) under "no effect"),
 //      p = 1 - F_chi2(k)(LR) and Delta BIC = -LR + k ln n (gap/internal/decide.h, Score); in order of Delta BIC the
 //      first with p < alpha, Delta BIC < max_delta_bic and a held-out chi-square drop (the twin run over the whole

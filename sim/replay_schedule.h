@@ -2,7 +2,7 @@
 // taken from a recording and the recording's own sample stamps. The simulator keeps one loop; with a schedule
 // (SimulateOptions::replay) its simulation time 0 is the recording time `t0`:
 //   - Drive. During the lead-in the robot settles at rest on the ground; from t = 0 on the set-points are the inputs
-//     at t0 + t (DriveInputs::At). A recording that starts in motion therefore starts the twin with a step. Measured
+//     at t0 + t (DriveInputs::At; at t0 + t + offset_s with the effect drive_time_offset). A recording that starts in motion therefore starts the twin with a step. Measured
 //     wheel angles (DriveInputs::angles_rad) are tracked: each wheel's servo target is its measured rate plus
 //     (measured - twin angle increment since t = 0) / kAngleTrackingS, which removes the velocity servo's
 //     steady-state error (the load torque over its gain: the twin's wheel would otherwise lag the recorded one, which
