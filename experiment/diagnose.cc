@@ -167,6 +167,18 @@ Status CheckTwinCandidates(const std::vector<std::string>& names, const sim::Sce
   return Status::Ok();
 }
 
+// A drive's clock (drive_time_offset) shifts a replay's recorded inputs: named as a candidate, every training run must
+// be replayed. The first run twinned by the plain simulation of its own drive, or "".
+std::string NotReplayedForTheDriveClock(const DiagnoseRequest& request, const gap::TwinChoice& twin,
+                                        const std::vector<HeldOut>& training) {
+  const auto& names = request.twin_candidates;
+  if (std::find(names.begin(), names.end(), "drive_time_offset") == names.end()) return "";
+  if (!twin.replayed) return request.recording;
+  for (const HeldOut& t : training)
+    if (!t.replayed) return t.path;
+  return "";
+}
+
 std::string Millimetres(double m) { return Fixed(1e3 * m, 3) + " mm"; }
 
 // The diagnosis against the scenario's twin (runner: ChooseTwin's), fitted on the recording and the training runs,
@@ -275,6 +287,10 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
     auto trained = LoadOtherRuns(request, request.train_with, *in.scenario, say);
     if (!trained.ok()) return Outcome::BadInput(trained.status());
     training = std::move(trained).value();
+    if (const std::string run = NotReplayedForTheDriveClock(request, *twin, training); !run.empty())
+      return Outcome::BadInput(Status::Error("--twin-candidates: 'drive_time_offset' shifts a replay's recorded drive "
+                                             "inputs, and " + run +
+                                             " is twinned by the plain simulation of its own drive (--replay replays it)"));
   }
   if (Status s = RemoveEarlierOutputs(given, request.out); !s.ok()) return Outcome::Failed(s);
   IncompleteMarker marker(request.out);

@@ -184,6 +184,31 @@ TEST(DiagnoseCliTest, TheTwinOfARecordingOfAnotherDriveIsItsReplay) {
   }
 }
 
+// The drive's clock named as a twin candidate of a recording of the scenario's own drive, whose twin is the plain
+// simulation: one line naming the recording, exit 2, before any diagnosis; with --replay it is accepted.
+TEST(DiagnoseCliTest, TheDriveClockNeedsAReplayedTwin) {
+  testing::TempDir dir;
+  const std::string nominal = DiffDrive(dir, "0.6", "nominal.yaml", "9.0");
+  ASSERT_EQ(Roamlab("simulate " + nominal + " --out " + dir.File("rec") + " --quiet", dir).exit_code, 0);
+  const std::string common = "diagnose --real " + dir.File("rec") + " --scenario " + nominal +
+                             " --no-baseline --quiet --twin --twin-candidates drive_time_offset ";
+  const CommandRun refused = Roamlab(common + "--out " + dir.File("bad"), dir);
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_NE(refused.err.find("'drive_time_offset' shifts a replay's recorded drive inputs, and " + dir.File("rec") +
+                             " is twinned by the plain simulation of its own drive"),
+            std::string::npos)
+      << refused.err;
+  EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1);
+  EXPECT_FALSE(std::filesystem::exists(dir.File("bad/twin.json")));
+  const CommandRun replayed = Roamlab(common + "--replay --no-plots --out " + dir.File("out"), dir);
+  ASSERT_EQ(replayed.exit_code, 0) << replayed.err;
+  std::ifstream in(dir.File("out/twin.json"));
+  ASSERT_TRUE(in.good());
+  const nlohmann::json twin = nlohmann::json::parse(in);
+  ASSERT_EQ(twin.at("candidates").size(), 1u);
+  EXPECT_EQ(twin.at("candidates")[0].at("name"), "drive_time_offset");
+}
+
 // scenarios/real/optiodom_diff.yaml (motion capture: the twin's drift is measured) shortened to `duration_s`, with its
 // turn-rate amplitude `turn_radps` and `effects`, written to `name`.
 std::string OptiOdomDiff(const testing::TempDir& dir, const std::string& turn_radps, const std::string& effects,
