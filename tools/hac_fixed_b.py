@@ -81,7 +81,7 @@ def t_quantile(n, lag, phi, replications, rng):
 def grid(n, replications):
     rng = random.Random(7)
     print(f"n {n}, {replications} replications")
-    print("| b | L | abs(t) q95, phi 0 | phi 0.5 | phi 0.9 | cv(b) |")
+    print("| b | L | 95 % quantile of abs(t), AR(1) coefficient 0 | coefficient 0.5 | coefficient 0.9 | cv(b) |")
     print("|---|---|---|---|---|---|")
     for b in (0.02, 0.05, 0.1, 0.15, 0.2, 0.25):
         lag = max(1, round(b * n))
