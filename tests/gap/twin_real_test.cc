@@ -123,8 +123,8 @@ TEST(TwinRealTest, TheKinematicStandInsGeometryCarriesOverInTheTwin) {
 
 // Within a day the reported std covers the spread between runs of one kind of motion: two Dec square runs, each
 // diagnosed alone against its replayed twin, fit every first-round candidate within 2 of each other in units of the
-// two reported (HAC) stds, |a - b| / sqrt(sa^2 + sb^2) (measured over the day's four square runs: at most 1.90, the
-// motion capture's clock; 1.44 on this pair).
+// two reported (HAC) stds, |a - b| / sqrt(sa^2 + sb^2) (docs/results.md gives the day's four square runs; the motion
+// capture's clock spreads most).
 TEST(TwinRealTest, TwoSquareRunsOfADayFitEveryCandidateWithinTheirStd) {
   const std::vector<std::string> squares = {kDiff + "square/231220200029/231220200029",
                                             kDiff + "square/231220200040/231220200040"};

@@ -171,12 +171,11 @@ TEST(TwinTest, AHiddenImuTimeOffsetIsRecoveredOnTheStepGrid) {
 }
 
 // The wheel encoders stamped 0.1 s early against the IMU and the motion capture (each encoder row's stamp moved by
-// -0.1 s), a
-// recording of a drive that starts from rest (so that the replay, which starts at the first encoder row, starts at
-// rest: ReplayTest) whose twin is replayed from those encoders, diagnosed with the two clocks that could explain it:
-// the drive's offset is named first, ahead of the IMU's clock alone (which leaves the poses shifted), and the
-// patched twin follows the held-out motion capture more closely. The replay of the right stamps reads an offset of its
-// own (its wheels follow the quantized angles through velocity servos, and start from rest): the hidden offset is
+// -0.1 s), a recording of a drive that starts from rest (so that the replay, which starts at the first encoder row,
+// starts at rest: ReplayTest) whose twin is replayed from those encoders, diagnosed with the two clocks that could
+// explain it: the drive's offset is named first, ahead of the IMU's clock alone (which leaves the poses shifted), and
+// the patched twin follows the held-out motion capture more closely. The replay of the right stamps reads an offset of
+// its own (its wheels follow the quantized angles through velocity servos, and start from rest): the hidden offset is
 // recovered within that own offset plus 3 of the fit's standard deviations.
 TEST(TwinTest, AHiddenDriveTimeOffsetIsNamedFromTheReplayedEncoders) {
   constexpr double kOffsetS = -0.1;
