@@ -52,12 +52,15 @@ std::map<std::string, double> Values(const TwinCandidate& c, const Eigen::Vector
   return out;
 }
 
-// e's std of parameter `name` from the covariances' diagonal entry k; the reported one is the larger of the white and
-// the HAC std when `hac`, else the white.
+// e's std of parameter `name` from the covariances' diagonal entry k; the reported one is the largest of the white,
+// the HAC and (a time shift's) the batch-means std when `hac`, else the white.
 void SetStd(const std::string& name, const TwinCovariance& covariance, Eigen::Index k, bool hac, TwinEffect* e) {
   e->std_white[name] = std::sqrt(std::max(0.0, covariance.white(k, k)));
   e->std_hac[name] = std::sqrt(std::max(0.0, covariance.hac(k, k)));
   e->estimate.std[name] = hac ? std::max(e->std_white[name], e->std_hac[name]) : e->std_white[name];
+  if (covariance.batch.size() == 0) return;
+  e->std_batch[name] = std::sqrt(std::max(0.0, covariance.batch(k, k)));
+  if (hac) e->estimate.std[name] = std::max(e->estimate.std[name], e->std_batch[name]);
 }
 
 // Whether `c` is among the candidates tried by default on `runs` training runs: a composite only on several. On one

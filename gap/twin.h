@@ -199,6 +199,9 @@ struct TwinFitRows {
 struct TwinCovariance {
   Eigen::MatrixXd white, hac;
   std::map<std::string, int> lags;  // per series: L_s (samples)
+  // A time shift's: the batch-means variance of its spread along the run (internal/twin_fit.h BatchShiftStd), 1 x 1;
+  // empty for other fits.
+  Eigen::MatrixXd batch;
 };
 TwinCovariance ComputeTwinCovariance(const TwinFitRows& rows);
 // A HAC std's widening at the bandwidth share b = (L + 1) / n of its series: Kiefer and Vogelsang's fixed-b critical
@@ -209,8 +212,9 @@ double FixedBFactor(double b);
 
 struct TwinEffect {
   EffectEstimate estimate;  // name (the candidate's label), dof, parameters, std, lr, p, Delta BIC, held-out drop
-  // Per fitted parameter; estimate.std is the chosen one (std_method).
+  // Per fitted parameter; estimate.std is the chosen one (std_method): with HAC the largest of the three.
   std::map<std::string, double> std_white, std_hac;
+  std::map<std::string, double> std_batch;  // a time shift's batch-means std; empty for other fits
   // Parameters the data does not inform (internal/twin_fit.h FitCandidate: a conditional white std above 5 % of the
   // parameter's range), held at their neutral values in estimate.parameters and the effect, without a std and not
   // counted in estimate.dof.

@@ -44,6 +44,7 @@ nlohmann::json EffectJson(const TwinEffect& e) {
           {"std", numbers(x.std)},
           {"std_white", numbers(e.std_white)},
           {"std_hac", numbers(e.std_hac)},
+          {"std_batch", numbers(e.std_batch)},
           {"not_informed", e.not_informed},
           {"hac_lags", e.hac_lags},
           {"chi2_before", Number(e.chi2_before)},
