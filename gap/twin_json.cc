@@ -59,13 +59,14 @@ nlohmann::json EffectJson(const TwinEffect& e) {
           {"runs", e.runs}};
 }
 
-// Null when no joint fit was made; each effect as EffectJson without the naming's scores, with std_white_conditional.
+// Null when no joint fit was made; each effect as EffectJson without the naming's scores and std_batch (time shifts
+// are not refitted jointly), with std_white_conditional.
 nlohmann::json JointJson(const TwinJointFit& j) {
   if (j.effects.empty() && j.failed.empty()) return nullptr;
   nlohmann::json effects = nlohmann::json::array();
   for (std::size_t i = 0; i < j.effects.size(); ++i) {
     nlohmann::json x = EffectJson(j.effects[i]);
-    for (const char* key : {"lr", "p", "delta_bic", "heldout_improvement", "accepted"}) x.erase(key);
+    for (const char* key : {"lr", "p", "delta_bic", "heldout_improvement", "accepted", "std_batch"}) x.erase(key);
     x["std_white_conditional"] = nlohmann::json::object();
     if (i < j.std_white_conditional.size())
       for (const auto& [name, value] : j.std_white_conditional[i]) x["std_white_conditional"][name] = Number(value);

@@ -398,15 +398,17 @@ double ParabolaVertex(double x0, double y0, double x1, double y1, double x2, dou
   return std::clamp(x1 - 0.5 * ((x1 - x0) * a - (x1 - x2) * b) / denominator, x0, x2);
 }
 
-}  // namespace
-
-double BatchShiftStd(const Layout& layout, const std::map<long, Eigen::VectorXd>& residuals_at_step, double step_s,
+// Per span of each series' stamps (BatchShiftStd): its chi-square at each evaluated shift (in the map's order) and its
+// information, over the entries finite at every shift.
+struct Spans {
+  std::vector<std::vector<double>> chi2;
+  std::vector<double> information;
+};
+Spans SpanChiSquares(const Layout& layout, const std::map<long, Eigen::VectorXd>& residuals_at_step,
                      const Eigen::VectorXd& jacobian, int batches) {
-  if (residuals_at_step.size() < 3 || batches < 2) return 0.0;
-  // chi2[k][j]: span k's chi-square at the j-th evaluated shift, over the entries finite at every shift.
-  std::vector<std::vector<double>> chi2(static_cast<std::size_t>(batches),
-                                        std::vector<double>(residuals_at_step.size(), 0.0));
-  std::vector<double> information(static_cast<std::size_t>(batches), 0.0);
+  Spans out;
+  out.chi2.assign(static_cast<std::size_t>(batches), std::vector<double>(residuals_at_step.size(), 0.0));
+  out.information.assign(static_cast<std::size_t>(batches), 0.0);
   for (const Series& series : layout.series) {
     if (series.t.empty()) continue;
     const double span_s = SecondsBetween(series.t.front(), series.t.back());
@@ -419,23 +421,17 @@ double BatchShiftStd(const Layout& layout, const std::map<long, Eigen::VectorXd>
                          [&](const auto& at) { return std::isfinite(at.second[e]); }))
           continue;
         std::size_t j = 0;
-        for (const auto& at : residuals_at_step) chi2[k][j++] += at.second[e] * at.second[e];
-        information[k] += jacobian[e] * jacobian[e];
+        for (const auto& at : residuals_at_step) out.chi2[k][j++] += at.second[e] * at.second[e];
+        out.information[k] += jacobian[e] * jacobian[e];
       }
     }
   }
-  std::vector<double> shifts_s;
-  for (const auto& at : residuals_at_step) shifts_s.push_back(static_cast<double>(at.first) * step_s);
-  std::vector<double> theta, weight;
-  for (int k = 0; k < batches; ++k) {
-    const auto& c = chi2[static_cast<std::size_t>(k)];
-    if (!(information[static_cast<std::size_t>(k)] > 0.0)) continue;
-    const auto j = static_cast<std::size_t>(std::min_element(c.begin(), c.end()) - c.begin());
-    theta.push_back(j == 0 || j + 1 == c.size()
-                        ? shifts_s[j]
-                        : ParabolaVertex(shifts_s[j - 1], c[j - 1], shifts_s[j], c[j], shifts_s[j + 1], c[j + 1]));
-    weight.push_back(information[static_cast<std::size_t>(k)]);
-  }
+  return out;
+}
+
+// The std of the weighted mean of `theta` (weights `weight`, positive) from their scatter (BatchShiftStd's formula);
+// 0 below 3 effective spans.
+double WeightedBatchStd(const std::vector<double>& theta, std::vector<double> weight) {
   const double total = std::accumulate(weight.begin(), weight.end(), 0.0);
   double mean = 0.0, sum_w2 = 0.0;
   for (std::size_t k = 0; k < theta.size(); ++k) {
@@ -448,6 +444,27 @@ double BatchShiftStd(const Layout& layout, const std::map<long, Eigen::VectorXd>
   double sum = 0.0;
   for (std::size_t k = 0; k < theta.size(); ++k) sum += weight[k] * weight[k] * (theta[k] - mean) * (theta[k] - mean);
   return std::sqrt(sum / (1.0 - sum_w2)) * StudentT975(effective - 1.0) / 1.959964;
+}
+
+}  // namespace
+
+double BatchShiftStd(const Layout& layout, const std::map<long, Eigen::VectorXd>& residuals_at_step, double step_s,
+                     const Eigen::VectorXd& jacobian, int batches) {
+  if (residuals_at_step.size() < 3 || batches < 2) return 0.0;
+  const Spans spans = SpanChiSquares(layout, residuals_at_step, jacobian, batches);
+  std::vector<double> shifts_s;
+  for (const auto& at : residuals_at_step) shifts_s.push_back(static_cast<double>(at.first) * step_s);
+  std::vector<double> theta, weight;
+  for (std::size_t k = 0; k < spans.chi2.size(); ++k) {
+    if (!(spans.information[k] > 0.0)) continue;
+    const std::vector<double>& c = spans.chi2[k];
+    const auto j = static_cast<std::size_t>(std::min_element(c.begin(), c.end()) - c.begin());
+    theta.push_back(j == 0 || j + 1 == c.size()
+                        ? shifts_s[j]
+                        : ParabolaVertex(shifts_s[j - 1], c[j - 1], shifts_s[j], c[j], shifts_s[j + 1], c[j + 1]));
+    weight.push_back(spans.information[k]);
+  }
+  return WeightedBatchStd(theta, weight);
 }
 
 TwinCandidate Reduced(const TwinCandidate& c, const std::vector<bool>& informed) {
