@@ -163,11 +163,10 @@ Result<ScoreTest> PredictedDrop(const TwinCandidate& c, const Eigen::VectorXd& b
 // evaluated shift on each side) and its information h_k (the sum of `jacobian`'s squares over the span's entries);
 // with w_k = h_k / sum h over the spans with h_k > 0, theta_bar = sum w_k theta_k and K_eff = 1 / sum w_k^2,
 //   var = K_eff / (K_eff - 1) sum_k w_k^2 (theta_k - theta_bar)^2
-// (unbiased when span k's best shift varies as 1 / h_k; K / (K - 1) for K equal spans), widened by
-// t_0.975(K_eff - 1) / 1.96. Where the chi-square is
-// not smooth at the step's scale (a twin's contact chatter in its accelerometer), the step-wide curvature and the HAC
-// sandwich around it pin the shift far tighter than the spans' own best shifts agree. Returns the std [s]; 0 with
-// K_eff below 3 (too few informed spans to say).
+// (unbiased when span k's best shift has variance proportional to 1 / h_k; K / (K - 1) for K equal spans), widened by
+// t_0.975(K_eff - 1) / 1.96. Where the chi-square is not smooth at the step's scale (a twin's contact chatter in its
+// accelerometer), the step-wide curvature and the HAC sandwich around it pin the shift far tighter than the spans' own
+// best shifts agree. Returns the std [s]; 0 with K_eff below 3 (too few informed spans to say).
 double BatchShiftStd(const Layout& layout, const std::map<long, Eigen::VectorXd>& residuals_at_step, double step_s,
                      const Eigen::VectorXd& jacobian, int batches);
 
