@@ -15,6 +15,7 @@
 #include <utility>
 
 #include "common/chi_square.h"
+#include "common/interrupt.h"
 #include "estimator/factor.h"
 #include "estimator/geometry.h"
 #include "estimator/internal/after_gap.h"
@@ -473,8 +474,14 @@ void Say(const CalibrationOptions& options, const std::string& line) {
 // (the nearest pose in time) or aligned to the absolute fixes and the IMU misalignment to the motion.
 Status BuildGraph(const CalibrationOptions& options, ProblemBuilder* builder_ptr) {
   ProblemBuilder& builder = *builder_ptr;
-  for (const MeasurementRef& m : builder.Measurements()) builder.Add(m);
+  // (A long recording's graph takes seconds to build on a loaded machine: an interruption is checked along the way.)
+  std::size_t added = 0;
+  for (const MeasurementRef& m : builder.Measurements()) {
+    if (++added % 4096 == 0 && InterruptRequested()) return InterruptedError();
+    builder.Add(m);
+  }
   builder.Finish();
+  if (InterruptRequested()) return InterruptedError();
   if (builder.poses().size() < 3) return Status::Error("the recording gives fewer than 3 poses on the master stream");
   if (options.initial_trajectory && !options.initial_trajectory->empty()) {
     const Trajectory& initial = *options.initial_trajectory;
@@ -599,6 +606,12 @@ Result<StageSummary> SolveStage(const EstimatorConfig& config, const Calibration
   SetFree({free.begin(), free.end()}, &builder);
   StageSummary stage;
   stage.free_parameters = free;
+  // Checked before each gating, admission and re-admission pass (each tests every measurement, and the re-admission
+  // factorizes); the solves check their own iterations.
+  const auto interrupted = [s]() -> std::optional<Status> {
+    if (!InterruptRequested()) return std::nullopt;
+    return Status::Error("stage " + std::to_string(s + 1) + ": " + InterruptedError().message());
+  };
   SolverOptions stage_options = config.solver;
   if (lm) stage_options.initial_lambda = std::max(*lambda, std::numeric_limits<double>::epsilon());
   bool robust = config.gate_probability && config.gate_robust_start && UseRobustStartLoss(config, true, &builder);
@@ -633,6 +646,7 @@ Result<StageSummary> SolveStage(const EstimatorConfig& config, const Calibration
   // The absolute rows held out after a gap: admitted on their innovation at the estimate solved without them, then
   // re-solved with them, until a round admits none (the rows left out count as rejected; the gate tests them again).
   for (int admission = 0; config.gate_probability && admission < kMaxAdmissionRounds && !held->empty(); ++admission) {
+    if (auto stop = interrupted()) return *stop;
     const int admitted = AdmitConsistentRows(*config.gate_probability, held, &builder);
     if (admitted == 0) break;
     const Status solved = resolve(std::to_string(admitted) + " rows after a gap admitted, " +
@@ -644,6 +658,7 @@ Result<StageSummary> SolveStage(const EstimatorConfig& config, const Calibration
   // the readings they left out.
   int round = 0;
   for (int pass = 0; config.gate_probability && round < kMaxGatingRounds; ++pass) {
+    if (auto stop = interrupted()) return *stop;
     // (Not handed the workspace: Levenberg-Marquardt's last point had its cost evaluated, not its linearization.)
     GateOptions gate;
     gate.burst_margin = round == 0 ? kBurstMargin : 0.0;
@@ -677,6 +692,7 @@ Result<StageSummary> SolveStage(const EstimatorConfig& config, const Calibration
   // of a pose that nothing held all pass their innovation, an outlier among them too. A row comes back once a stage.
   std::set<FactorId> not_readmitted(after_gap.begin(), after_gap.end());
   for (int round = 0; config.gate_probability && round < kMaxReadmissionRounds; ++round) {
+    if (auto stop = interrupted()) return *stop;
     std::set<FactorId> rejected_now;
     for (const auto& [id, stream] : builder.factor_streams())
       if (builder.graph().factors().count(id) > 0 && !builder.graph().factor(id).active) rejected_now.insert(id);
@@ -877,11 +893,14 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
   result.initial_cost = result.stages.front().solver.initial_cost;
   result.final_cost = result.stages.back().solver.final_cost;
 
+  // The estimate's covariances factorize the whole problem again.
+  if (InterruptRequested()) return InterruptedError();
   const bool hac = UsesHac(options.std_method, recording);
   result.std_method = hac ? "hac" : "white";
   const Status estimated = EstimateParameters(options, stages, hac, &builder, workspace.get(), &result);
   if (!estimated.ok()) return estimated;
   if (options.pose_covariance_every > 0) {
+    if (InterruptRequested()) return InterruptedError();
     const Status poses = EstimatePoseCovariances(options.pose_covariance_every, hac, builder, &result);
     if (!poses.ok()) return poses;
   }

@@ -11,6 +11,7 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/Eigenvalues>
 
+#include "common/interrupt.h"
 #include "estimator/internal/linearization.h"
 #include "estimator/internal/normal_equations.h"
 #include "estimator/internal/sparse_solve.h"
@@ -53,7 +54,10 @@ Status LinearizeWithVariablesLast(const Graph& graph, const std::vector<Variable
   system->Reset(graph, std::move(order));
   system->ForgetLinearizations();  // (a workspace's may have been carried to first order)
   std::string failed;
-  if (!system->Linearize(graph, &failed)) return Status::Error("a factor from '" + failed + "' cannot be evaluated");
+  if (!system->Linearize(graph, &failed)) {
+    if (InterruptRequested()) return InterruptedError();  // (the linearization stops on one)
+    return Status::Error("a factor from '" + failed + "' cannot be evaluated");
+  }
   return Status::Ok();
 }
 

@@ -191,6 +191,16 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
     summary.message = "invalid solver options: " + invalid;
     return summary;
   }
+  // An interruption ends the solve where it is noticed: before the first linearization, within a linearization (which
+  // then fails: NormalEquations looks every 4096 factors), at the top of an iteration and after its factorization. On a
+  // slow or loaded machine one iteration over a whole drive takes seconds. The values are those of an unfinished solve.
+  const auto interrupted = [&summary](int iteration) {
+    if (!InterruptRequested()) return false;
+    summary.termination = Termination::kFailure;
+    summary.message = InterruptedError().message() + " at iteration " + std::to_string(iteration);
+    return true;
+  };
+  if (interrupted(0)) return summary;
 
   SolverWorkspace local;
   local.set_keep_linearizations(false);  // (nobody can read them)
@@ -204,6 +214,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
   summary.factors = static_cast<int>(system.factor_ids().size());
   std::string failed_stream;
   if (!system.Linearize(*graph, &failed_stream)) {
+    if (interrupted(0)) return summary;
     summary.message = "a factor from stream '" + failed_stream + "' could not be evaluated at the initial values";
     return summary;
   }
@@ -225,11 +236,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
   double nu = 2.0;
   summary.termination = Termination::kMaxIterations;
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
-    if (InterruptRequested()) {
-      summary.termination = Termination::kFailure;  // not usable: the values are those of an unfinished solve
-      summary.message = InterruptedError().message() + " at iteration " + std::to_string(iteration);
-      break;
-    }
+    if (interrupted(iteration)) break;
     if (elapsed() > options.time_budget_s) {
       summary.termination = Termination::kTimeBudget;
       break;
@@ -242,6 +249,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
       break;
     }
     ++summary.iterations;
+    if (interrupted(iteration)) break;
 
     // Try the step, keeping a copy of the free variables' values.
     SaveValues(free_variables, &ws.saved_);
@@ -274,6 +282,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
     }
 
     if (!accept) {
+      if (interrupted(iteration)) break;
       if (!lm) {
         summary.termination = Termination::kFailure;
         summary.message = "Gauss-Newton step could not be evaluated";
@@ -319,6 +328,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
       break;
     }
     if (!system.Linearize(*graph, &failed_stream)) {
+      if (interrupted(iteration + 1)) break;
       summary.termination = Termination::kFailure;
       summary.message = "a factor from stream '" + failed_stream + "' could not be evaluated";
       break;

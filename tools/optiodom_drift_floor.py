@@ -13,7 +13,13 @@ encoders' on straight 1 s stretches, its heading change over the encoders' on ar
 forward, their angles differing by more than 5 %, turning by more than 0.05 rad) and on in-place turns (0.5 s stretches with the wheels turning
 opposite ways), all with the nominal geometry.
 
+With --best-common: the one geometry, and the one geometry with one clock shift, that minimize the largest drift
+ratio (patched / nominal) over every run named, fitted on those runs themselves (Nelder-Mead from three starts): what
+the best constant patch of this form can do on them, whatever it was trained on; and each run's motion-capture
+scatter (the white noise of its positions and heading, from their third differences).
+
     python3 tools/optiodom_drift_floor.py DATA_DIR TRAINING_SET[,TRAINING_SET...] OTHER_SET...
+    python3 tools/optiodom_drift_floor.py --best-common DATA_DIR SET...
       (DATA_DIR: the dataset's data/diff folder; a set as shape/name, e.g. square/231220200029)
 """
 import bisect
@@ -172,7 +178,42 @@ def motion_ratios(run):
     return ratio(moved, rolled), ratio(arc_turned, arc_wheels), ratio(turned, wheels)
 
 
+def scatter(values):
+    """The white noise of a smooth series: the robust spread of its third differences over sqrt(20)."""
+    third = sorted(abs(values[i + 3] - 3 * values[i + 2] + 3 * values[i + 1] - values[i])
+                   for i in range(len(values) - 3))
+    return 1.4826 * third[len(third) // 2] / math.sqrt(20)
+
+
+def best_common(runs):
+    """Prints, for the geometry alone and with a clock shift, the patch minimizing the largest drift ratio."""
+    for name, run in runs.items():
+        print(f"{name}: motion capture's scatter x {1000 * scatter(run['x']):.2f} mm, y {1000 * scatter(run['y']):.2f} "
+              f"mm, heading {1000 * scatter(run['th']):.1f} mrad")
+    nominal = {name: drift(run, (1.0, 1.0, 0.0)) for name, run in runs.items()}
+    ratios = lambda p: {name: drift(run, p) / nominal[name] for name, run in runs.items()}  # noqa: E731
+    worst = lambda p: max(ratios(p).values())  # noqa: E731
+    for label, starts, steps in (
+            ("geometry", [(1.0, 1.0, 0.0), (0.995, 1.0, 0.002), (0.993, 1.002, 0.004)], (0.01, 0.003, 0.003)),
+            ("geometry and clock", [(1.0, 1.0, 0.0, 0.0), (0.995, 1.0, 0.002, 0.02), (0.993, 1.002, 0.004, -0.02)],
+             (0.01, 0.003, 0.003, 0.03))):
+        fits = []
+        for start in starts:
+            p, _ = nelder_mead(worst, start, steps, iterations=200)
+            fits.append(nelder_mead(worst, p, tuple(s / 3 for s in steps), iterations=200))
+        p, value = min(fits, key=lambda fit: fit[1])
+        clock = f", clock {1000 * p[3]:+.0f} ms" if len(p) > 3 else ""
+        print(f"best common {label}: scale {p[0]:.4f}, R/L {p[1]:.4f}, track {1000 * p[2]:+.1f} mm{clock}: "
+              f"largest ratio {value:.2f}")
+        print("  " + ", ".join(f"{name} {r:.2f}" for name, r in ratios(p).items()))
+
+
 def main(argv):
+    if len(argv) > 1 and argv[1] == "--best-common":
+        argv = argv[1:]
+        common = True
+    else:
+        common = False
     if len(argv) < 3 or argv[1] in ("-h", "--help"):
         print(__doc__, file=sys.stderr if len(argv) < 3 else sys.stdout)
         return 0 if len(argv) > 1 and argv[1] in ("-h", "--help") else 2
@@ -185,6 +226,9 @@ def main(argv):
             print(f"optiodom_drift_floor.py: {path}: no such run", file=sys.stderr)
             return 2
         runs[name] = load(path)
+    if common:
+        best_common(runs)
+        return 0
     nominal = (1.0, 1.0, 0.0)
     oracles = {name: nelder_mead(lambda p, run=run: drift(run, p), nominal, (0.01, 0.003, 0.003))
                for name, run in runs.items()}

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/check.h"
+#include "common/interrupt.h"
 #include "estimator/internal/normal_equations_shared.h"
 
 namespace roamlab::estimator::internal {
@@ -175,6 +176,10 @@ void AddGradient(const Eigen::MatrixXd& j, const Eigen::VectorXd& r, double* g) 
   if (!fixed) Eigen::Map<Eigen::VectorXd>(g, j.cols()).noalias() += j.transpose() * r;
 }
 
+// Whether an interruption arrived, looked at every 4096th factor: a whole drive's linearization takes seconds on a
+// loaded machine, and the solver stops when it notices one (estimator/solver.cc).
+bool Interrupted(std::size_t k) { return k % 4096 == 4095 && InterruptRequested(); }
+
 }  // namespace
 
 void NormalEquations::PrefetchAhead(std::size_t k) const {
@@ -223,6 +228,10 @@ __attribute__((flatten)) bool NormalEquations::Linearize(const Graph& /*graph*/,
   int free[64];  // positions of a factor's free variables
   const bool keep = keep_linearizations_ || !summed_in_pass;
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
+    if (Interrupted(k)) {
+      if (failed_stream != nullptr) failed_stream->clear();
+      return false;
+    }
     PrefetchAhead(k);
     const WhitenedFactor* linearized = &linearized_[k].whitened;
     if (!keep && !Current(k)) {
@@ -347,6 +356,7 @@ bool NormalEquations::CostWithLastWhitening(const Graph& /*graph*/, double* cost
 bool NormalEquations::LinearizeForCost(double* cost) {
   *cost = 0.0;
   for (std::size_t k = 0; k < factor_ids_.size(); ++k) {
+    if (Interrupted(k)) return false;
     double c = 0.0;
     if (CarryToFirstOrder(k))
       c = linearized_[k].whitened.cost;

@@ -1,11 +1,13 @@
 #include "estimator/internal/normal_equations.h"
 
 #include <algorithm>
+#include <csignal>
 #include <cmath>
 #include <cstdint>
 #include <deque>
 #include <map>
 #include <random>
+#include <string>
 #include <utility>
 
 #include <gtest/gtest.h>
@@ -13,6 +15,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/SparseCholesky>
 
+#include "common/interrupt.h"
 #include "estimator/covariance.h"
 #include "estimator/internal/linearization.h"
 #include "estimator/marginalization.h"
@@ -97,6 +100,32 @@ class SlidingWindowWithInstances {
 // (which skips a pose: fill inside the envelope), and a free constant parameter tied to two poses (the dense border),
 // by linear priors with random Jacobians. The envelope factorization must give the step and the covariances of a dense
 // Cholesky of the same H: a few columns by forward substitution, many by the full solve.
+// An interruption stops a linearization part way (it fails, naming no stream), and a solve before its first
+// iteration; both run whole again once it is cleared.
+TEST(NormalEquationsTest, AnInterruptionStopsALinearizationPartWay) {
+  std::mt19937 rng(7);
+  Graph graph;
+  const auto [poses, lever] = AddPosesAndLever(10000, &rng, &graph);
+  for (const VariableId pose : poses) TieWithRandomPrior({pose, lever}, &rng, &graph);
+  internal::NormalEquations system(graph, FreeVariableOrder(graph));
+  RequestInterrupt(SIGTERM);
+  std::string failed = "not cleared";
+  const bool interrupted_linearization = system.Linearize(graph, &failed);
+  const long evaluated = system.evaluations();
+  const SolverSummary interrupted_solve = Solve(SolverOptions(), &graph);
+  ClearInterrupt();
+  EXPECT_FALSE(interrupted_linearization);
+  EXPECT_EQ(failed, "");
+  EXPECT_GT(evaluated, 0);
+  EXPECT_LT(evaluated, 10000);
+  EXPECT_FALSE(interrupted_solve.usable());
+  EXPECT_EQ(interrupted_solve.iterations, 0);
+  EXPECT_EQ(interrupted_solve.message, "interrupted by SIGTERM at iteration 0");
+
+  EXPECT_TRUE(system.Linearize(graph, &failed));
+  EXPECT_TRUE(Solve(SolverOptions(), &graph).usable());
+}
+
 TEST(NormalEquationsTest, EnvelopeFactorizationOfABandWithABorderMatchesADenseCholesky) {
   std::mt19937 rng(11);
   Graph graph;
