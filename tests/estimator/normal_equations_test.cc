@@ -1,8 +1,8 @@
 #include "estimator/internal/normal_equations.h"
 
 #include <algorithm>
-#include <csignal>
 #include <cmath>
+#include <csignal>
 #include <cstdint>
 #include <deque>
 #include <map>
@@ -96,10 +96,6 @@ class SlidingWindowWithInstances {
   int stamp_ = 0;
 };
 
-// A tracking window in the solver's natural order: poses in time order, each tied to the next and to the one after
-// (which skips a pose: fill inside the envelope), and a free constant parameter tied to two poses (the dense border),
-// by linear priors with random Jacobians. The envelope factorization must give the step and the covariances of a dense
-// Cholesky of the same H: a few columns by forward substitution, many by the full solve.
 // An interruption stops a linearization part way (it fails, naming no stream), and a solve before its first
 // iteration; both run whole again once it is cleared.
 TEST(NormalEquationsTest, AnInterruptionStopsALinearizationPartWay) {
@@ -126,6 +122,10 @@ TEST(NormalEquationsTest, AnInterruptionStopsALinearizationPartWay) {
   EXPECT_TRUE(Solve(SolverOptions(), &graph).usable());
 }
 
+// A tracking window in the solver's natural order: poses in time order, each tied to the next and to the one after
+// (which skips a pose: fill inside the envelope), and a free constant parameter tied to two poses (the dense border),
+// by linear priors with random Jacobians. The envelope factorization must give the step and the covariances of a dense
+// Cholesky of the same H: a few columns by forward substitution, many by the full solve.
 TEST(NormalEquationsTest, EnvelopeFactorizationOfABandWithABorderMatchesADenseCholesky) {
   std::mt19937 rng(11);
   Graph graph;
