@@ -165,6 +165,30 @@ std::optional<Termination> ToleranceMet(const SolverOptions& options, double old
   return std::nullopt;
 }
 
+// An interruption ends a solve where it is noticed: before the first linearization, within a linearization (which
+// then fails: NormalEquations looks every 4096 factors), at the top of an iteration and after its factorization. On a
+// slow or loaded machine one iteration over a whole drive takes seconds. The values are those of an unfinished solve.
+// Returns whether one arrived, then with the summary marked failed at `iteration`.
+bool StopOnInterrupt(int iteration, SolverSummary* summary) {
+  if (!InterruptRequested()) return false;
+  summary->termination = Termination::kFailure;
+  summary->message = InterruptedError().message() + " at iteration " + std::to_string(iteration);
+  return true;
+}
+
+// Levenberg-Marquardt's damping after an accepted step: raised as after a rejection when the step was shortened (the
+// model overestimated the decrease), otherwise scaled by the gain ratio actual / predicted (Nielsen's rule).
+void AdaptDampingAfterStep(bool shortened, double actual, double predicted, double* lambda, double* nu) {
+  if (shortened) {
+    *lambda *= *nu;
+    *nu *= 2.0;
+    return;
+  }
+  const double rho = actual / predicted;
+  *lambda *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
+  *nu = 2.0;
+}
+
 }  // namespace
 
 SolverWorkspace::SolverWorkspace() : system_(std::make_unique<internal::NormalEquations>()) {}
@@ -191,15 +215,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
     summary.message = "invalid solver options: " + invalid;
     return summary;
   }
-  // An interruption ends the solve where it is noticed: before the first linearization, within a linearization (which
-  // then fails: NormalEquations looks every 4096 factors), at the top of an iteration and after its factorization. On a
-  // slow or loaded machine one iteration over a whole drive takes seconds. The values are those of an unfinished solve.
-  const auto interrupted = [&summary](int iteration) {
-    if (!InterruptRequested()) return false;
-    summary.termination = Termination::kFailure;
-    summary.message = InterruptedError().message() + " at iteration " + std::to_string(iteration);
-    return true;
-  };
+  const auto interrupted = [&summary](int iteration) { return StopOnInterrupt(iteration, &summary); };
   if (interrupted(0)) return summary;
 
   SolverWorkspace local;
@@ -305,14 +321,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
       }
       continue;
     }
-    if (lm && shortened) {
-      lambda *= nu;
-      nu *= 2.0;
-    } else if (lm) {
-      const double rho = actual / predicted;
-      lambda *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
-      nu = 2.0;
-    }
+    if (lm) AdaptDampingAfterStep(shortened, actual, predicted, &lambda, &nu);
 
     // Stop here when converged or out of iterations or time; otherwise relinearize at the new point (which also
     // re-evaluates every error covariance, eq. 1).
