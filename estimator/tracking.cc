@@ -11,6 +11,8 @@
 #include <memory>
 #include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -343,6 +345,116 @@ Status EmitFinalWindow(const EstimatorConfig& config, FactorId first_ungated, co
   return Status::Ok();
 }
 
+// The first stretch, buffered until the tracking's initialization time: aligned to the absolute fixes, solved in one
+// batch and gated.
+Status InitializeWindow(const EstimatorConfig& config, ProblemBuilder* builder) {
+  builder->AlignToAbsoluteFixes();
+  if (config.gate_probability) HoldOutNewestSpans(builder);
+  const SolverSummary s = Solve(config.solver, &builder->graph());
+  if (!s.usable()) return Status::Error("initialization failed: " + s.message);
+  if (config.gate_probability)
+    GateAndResolve(*config.gate_probability, 0, std::numeric_limits<FactorId>::max(), nullptr, builder,
+                   [&] { return Solve(config.solver, &builder->graph()).iterations; });
+  return Status::Ok();
+}
+
+// What the window's updates carry from one to the next.
+struct WindowState {
+  // The factors attached since the last update start at first_new_factor; those attached before it and not gated yet
+  // at first_ungated. An update gates the latter (UpdateWindow).
+  FactorId first_new_factor = 0;
+  FactorId first_ungated = 0;
+  CovarianceRequest leaving;  // the covariance of the pose about to leave the window
+  SolverWorkspace workspace;  // the window's pattern repeats from one update to the next
+  std::map<std::string, std::vector<Time>> gap_resumes;
+  std::set<std::string> after_gap;  // absolute streams past a gap, none of their rows since found consistent
+};
+
+// One update: Gauss-Newton on the window, gating of the measurements attached at the last update, and a re-solve after
+// each gating pass that switched any. The solve also gives the covariance of the pose about to leave the window. A
+// measurement is gated one update after it is attached, once the next master sample's measurements join its newest
+// pose: until then the master row that predicted the new pose and the IMU rows that tie it to the poses before are the
+// only measurements of its motion since the last pose, the solve splits a conflict between them, and which of them
+// fails worst is chance. Rejecting the IMU's row there leaves the pose to an outlying master row, and the velocity it
+// gives the pose is carried on to the next poses, failing their good rows. The next sample's rows side with the good
+// ones. A cumulative wheel master (its readings bridged, GateOutliers) is gated at attachment, with the newest pose's
+// spans held out of the first solve (HoldOutNewestSpans): its bridges test a reading on both spans it joins. Returns
+// the solver's iterations.
+Result<int> UpdateWindow(const EstimatorConfig& config, const SolverOptions& update_options, Time t,
+                         ProblemBuilder* builder, WindowState* state) {
+  const bool delayed = builder->cumulative_spans().empty();
+  if (config.gate_probability) HoldOutNewestSpans(builder);
+  // After a gap in an absolute stream (an outage, or its clock jumped: every later row stamped late), its rows attached
+  // now are held out of the first solve and tested on their innovation there (ReadmitConsistentAbsolute) until one
+  // passes; those that pass go back in for a re-solve, and the gate below tests them again.
+  MarkStreamsAfterGaps(builder->poses().back().t, &state->gap_resumes, &state->after_gap);
+  const std::vector<FactorId> held =
+      config.gate_probability && !state->after_gap.empty()
+          ? NewAbsoluteFactors(*builder, state->first_new_factor, config.master, state->after_gap)
+          : std::vector<FactorId>();
+  HoldOut(held, builder);
+  CovarianceRequest& leaving = state->leaving;
+  leaving.variables.assign(1, builder->poses().front().id);
+  leaving.computed = false;
+  CovarianceRequest* request =
+      static_cast<int>(builder->poses().size()) > config.tracking.window ? &leaving : nullptr;
+  const SolverSummary s = Solve(update_options, &builder->graph(), request, &state->workspace);
+  if (!s.usable()) return Status::Error("update at t = " + FormatSeconds(t) + " failed: " + s.message);
+  int iterations = s.iterations;
+  std::set<std::string> consistent;
+  if (!held.empty() && ReadmitConsistentAbsolute(*config.gate_probability, held, builder, &consistent) > 0) {
+    for (const std::string& name : consistent) state->after_gap.erase(name);
+    const CovarianceRequest before = leaving;
+    iterations += Solve(update_options, &builder->graph(), request, &state->workspace).iterations;
+    if (request != nullptr && !leaving.computed && before.computed) leaving = before;
+  }
+  if (config.gate_probability) {
+    // Without a gated measurement the window may not factor (a gated odometer factor leaves the newest pose's position
+    // free until the next samples attach), and the Schur complement EmitOldest would fall back to runs through that
+    // singular block: keep the leaving pose's covariance from before the gate then.
+    iterations += GateAndResolve(*config.gate_probability, delayed ? state->first_ungated : state->first_new_factor,
+                                 delayed ? state->first_new_factor : std::numeric_limits<FactorId>::max(),
+                                 &state->workspace, builder, [&] {
+      const CovarianceRequest before_gate = leaving;
+      const int resolve_iterations =
+          Solve(update_options, &builder->graph(), request, &state->workspace).iterations;
+      if (request != nullptr && !leaving.computed && before_gate.computed) leaving = before_gate;
+      return resolve_iterations;
+    });
+  }
+  return iterations;
+}
+
+// Poses beyond the window leave it: after an update the one whose covariance the solve computed, after the initial
+// batch every pose beyond the window, their covariances from one factorization.
+Status EmitPosesBeyondWindow(const EstimatorConfig& config, const TrackingOptions& options, ProblemBuilder* builder,
+                             WindowState* state, TrackingResult* out) {
+  const int excess = static_cast<int>(builder->poses().size()) - config.tracking.window;
+  const std::vector<CovarianceRequest> batch =
+      excess > 1 ? OldestPoseCovariances(*builder, excess) : std::vector<CovarianceRequest>();
+  for (int k = 0; k < excess; ++k) {
+    // After an update, the leaving pose's factors were linearized at the solve's final point (Gauss-Newton).
+    const Status st = EmitAndMarginalizeOldest(builder, excess > 1 ? &batch[k] : &state->leaving,
+                                               excess > 1 ? nullptr : &state->workspace, options, out);
+    if (!st.ok()) return st;
+  }
+  state->leaving.computed = false;
+  return Status::Ok();
+}
+
+// The update times' mean and 99th percentile, the mean iterations per update.
+void SetUpdateStatistics(std::vector<double> update_times, int iterations, TrackingResult* out) {
+  double total_s = 0.0;
+  for (const double dt : update_times) total_s += dt;
+  out->mean_update_s = out->updates > 0 ? total_s / out->updates : 0.0;
+  if (!update_times.empty()) {
+    const std::size_t k = std::min(update_times.size() - 1, (update_times.size() * 99) / 100);
+    std::nth_element(update_times.begin(), update_times.begin() + k, update_times.end());
+    out->p99_update_s = update_times[k];
+  }
+  out->mean_iterations = out->updates > 0 ? static_cast<double>(iterations) / out->updates : 0.0;
+}
+
 }  // namespace
 
 Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::Recording& recording,
@@ -363,131 +475,55 @@ Result<TrackingResult> Track(const EstimatorConfig& config_in, const recording::
   }
 
   const SolverOptions update_options = UpdateOptions(config);
-
   TrackingResult out;
   const std::vector<MeasurementRef> measurements = builder.Measurements();
-  const std::string& master = config.master;
   bool initialized = false;
   std::size_t poses_before = 0;
-  double update_seconds = 0.0;
   int iterations = 0;
-  // The factors attached since the last update start at first_new_factor; those attached before it and not gated yet
-  // at first_ungated. An update gates the latter (below).
-  FactorId first_new_factor = 0;
-  FactorId first_ungated = 0;
-  CovarianceRequest leaving;
-  leaving.leading_dims = kPositionDims;
   std::vector<double> update_times;
-  SolverWorkspace workspace;  // the window's pattern repeats from one update to the next
-  std::map<std::string, std::vector<Time>> gap_resumes = internal::GapResumes(config, recording, false);
-  std::set<std::string> after_gap;  // absolute streams past a gap, none of their rows since found consistent
+  WindowState state;
+  state.leaving.leading_dims = kPositionDims;
+  state.gap_resumes = internal::GapResumes(config, recording, false);
   for (std::size_t i = 0; i < measurements.size(); ++i) {
     const MeasurementRef& m = measurements[i];
     builder.Add(m);
-    if (builder.stream_names()[m.stream] != master || builder.poses().size() == poses_before) continue;
+    if (builder.stream_names()[m.stream] != config.master || builder.poses().size() == poses_before) continue;
     poses_before = builder.poses().size();
     if (InterruptRequested()) return InterruptedError();
     if (options.progress && i % 1000 == 0) options.progress(static_cast<double>(i) / measurements.size());
-
-    // Initialization: buffer, then align and solve the first stretch in one batch.
     if (!initialized) {
+      // Buffer the first stretch, then solve it in one batch.
       if (builder.poses().size() < 3 ||
           SecondsBetween(builder.poses().front().t, m.t) < config.tracking.initialization_s)
         continue;
-      builder.AlignToAbsoluteFixes();
-      if (config.gate_probability) HoldOutNewestSpans(&builder);
-      const SolverSummary s = Solve(config.solver, &builder.graph());
-      if (!s.usable()) return Status::Error("initialization failed: " + s.message);
-      if (config.gate_probability)
-        GateAndResolve(*config.gate_probability, 0, std::numeric_limits<FactorId>::max(), nullptr, &builder,
-                       [&] { return Solve(config.solver, &builder.graph()).iterations; });
-      first_new_factor = NextFactorId(builder.graph());
+      const Status st = InitializeWindow(config, &builder);
+      if (!st.ok()) return st;
+      state.first_new_factor = NextFactorId(builder.graph());
       initialized = true;
     } else {
-      // One update: Gauss-Newton on the window, gating of the measurements attached at the last update, and a re-solve
-      // after each gating pass that switched any. The solve also gives the covariance of the pose about to leave the
-      // window. A measurement is gated one update after it is attached, once the next master sample's measurements
-      // join its newest pose: until then the master row that predicted the new pose and the IMU rows that tie it to
-      // the poses before are the only measurements of its motion since the last pose, the solve splits a conflict
-      // between them, and which of them fails worst is chance. Rejecting the IMU's row there leaves the pose to an
-      // outlying master row, and the velocity it gives the pose is carried on to the next poses, failing their good
-      // rows. The next sample's rows side with the good ones. A cumulative wheel master (its readings bridged,
-      // GateOutliers) is gated at attachment, with the newest pose's spans held out of the first solve
-      // (HoldOutNewestSpans): its bridges test a reading on both spans it joins.
-      const bool delayed = builder.cumulative_spans().empty();
       const auto t0 = Clock::now();
-      if (config.gate_probability) HoldOutNewestSpans(&builder);
-      // After a gap in an absolute stream (an outage, or its clock jumped: every later row stamped late), its rows
-      // attached now are held out of the first solve and tested on their innovation there (ReadmitConsistentAbsolute)
-      // until one passes; those that pass go back in for a re-solve, and the gate below tests them again.
-      MarkStreamsAfterGaps(builder.poses().back().t, &gap_resumes, &after_gap);
-      const std::vector<FactorId> held = config.gate_probability && !after_gap.empty()
-                                             ? NewAbsoluteFactors(builder, first_new_factor, master, after_gap)
-                                             : std::vector<FactorId>();
-      HoldOut(held, &builder);
-      leaving.variables.assign(1, builder.poses().front().id);
-      leaving.computed = false;
-      CovarianceRequest* request =
-          static_cast<int>(builder.poses().size()) > config.tracking.window ? &leaving : nullptr;
-      const SolverSummary s = Solve(update_options, &builder.graph(), request, &workspace);
-      if (!s.usable()) return Status::Error("update at t = " + FormatSeconds(m.t) + " failed: " + s.message);
-      iterations += s.iterations;
-      std::set<std::string> consistent;
-      if (!held.empty() && ReadmitConsistentAbsolute(*config.gate_probability, held, &builder, &consistent) > 0) {
-        for (const std::string& name : consistent) after_gap.erase(name);
-        const CovarianceRequest before = leaving;
-        iterations += Solve(update_options, &builder.graph(), request, &workspace).iterations;
-        if (request != nullptr && !leaving.computed && before.computed) leaving = before;
-      }
-      if (config.gate_probability) {
-        // Without a gated measurement the window may not factor (a gated odometer factor leaves the newest pose's
-        // position free until the next samples attach), and the Schur complement EmitOldest would fall back to runs
-        // through that singular block: keep the leaving pose's covariance from before the gate then.
-        iterations += GateAndResolve(*config.gate_probability, delayed ? first_ungated : first_new_factor,
-                                     delayed ? first_new_factor : std::numeric_limits<FactorId>::max(), &workspace,
-                                     &builder, [&] {
-          const CovarianceRequest before_gate = leaving;
-          const int resolve_iterations = Solve(update_options, &builder.graph(), request, &workspace).iterations;
-          if (request != nullptr && !leaving.computed && before_gate.computed) leaving = before_gate;
-          return resolve_iterations;
-        });
-      }
+      const Result<int> update = UpdateWindow(config, update_options, m.t, &builder, &state);
+      if (!update.ok()) return update.status();
+      iterations += update.value();
       const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
       ++out.updates;
-      update_seconds += dt;
       update_times.push_back(dt);
       out.max_update_s = std::max(out.max_update_s, dt);
     }
-    first_ungated = first_new_factor;
-    first_new_factor = NextFactorId(builder.graph());
-    // Poses beyond the window leave it: after an update the one whose covariance the solve computed, after the
-    // initial batch every pose beyond the window, their covariances from one factorization.
-    const int excess = static_cast<int>(builder.poses().size()) - config.tracking.window;
-    const std::vector<CovarianceRequest> batch =
-        excess > 1 ? OldestPoseCovariances(builder, excess) : std::vector<CovarianceRequest>();
-    for (int k = 0; k < excess; ++k) {
-      // After an update, the leaving pose's factors were linearized at the solve's final point (Gauss-Newton).
-      const Status st = EmitAndMarginalizeOldest(&builder, excess > 1 ? &batch[k] : &leaving,
-                                                 excess > 1 ? nullptr : &workspace, options, &out);
-      if (!st.ok()) return st;
-    }
-    leaving.computed = false;
+    state.first_ungated = state.first_new_factor;
+    state.first_new_factor = NextFactorId(builder.graph());
+    const Status emitted = EmitPosesBeyondWindow(config, options, &builder, &state, &out);
+    if (!emitted.ok()) return emitted;
     poses_before = builder.poses().size();
   }
   builder.Finish();
 
-  const FactorId first_final = builder.cumulative_spans().empty() ? first_ungated : first_new_factor;
+  const FactorId first_final = builder.cumulative_spans().empty() ? state.first_ungated : state.first_new_factor;
   const Status final_window = EmitFinalWindow(config, first_final, options, &builder, &out);
   if (!final_window.ok()) return final_window;
-  out.mean_update_s = out.updates > 0 ? update_seconds / out.updates : 0.0;
-  if (!update_times.empty()) {
-    const std::size_t k = std::min(update_times.size() - 1, (update_times.size() * 99) / 100);
-    std::nth_element(update_times.begin(), update_times.begin() + k, update_times.end());
-    out.p99_update_s = update_times[k];
-  }
-  out.mean_iterations = out.updates > 0 ? static_cast<double>(iterations) / out.updates : 0.0;
-  out.factor_evaluations = workspace.evaluations();
-  out.factor_carries = workspace.carries();
+  SetUpdateStatistics(std::move(update_times), iterations, &out);
+  out.factor_evaluations = state.workspace.evaluations();
+  out.factor_carries = state.workspace.carries();
   out.counts = builder.counts();
   out.total_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return out;
