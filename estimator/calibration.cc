@@ -212,36 +212,23 @@ std::vector<VariableId> UnbendBridgedPoses(const std::vector<FactorId>& run, Gra
   return inside;
 }
 
-}  // namespace
-
-GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId first,
-                          const SolverWorkspace* last_solve, const GateOptions& options) {
-  Graph& graph = builder->graph();
-  // Quantiles per (probability, dimension), kept across calls: online tracking gates at every update.
-  thread_local std::map<std::pair<double, int>, double> quantiles;
-  const auto threshold = [&](int dim) {
-    const auto key = std::make_pair(probability, dim);
-    const auto it = quantiles.find(key);
-    return it != quantiles.end() ? it->second : (quantiles[key] = ChiSquareQuantile(probability, dim));
-  };
-  // One walk over the measurement factors and the graph's factors in id order (a whole recording's 10^5-10^6).
-  std::vector<FactorId> switched;
-  GateSwitches result;
+// Every measurement factor with an id in [first, end) but the spans bridges replaced, tested against the
+// gate at the current estimate: with the last solve's linearization where it has the factor, else evaluated here.
+// One walk over the measurement factors and the graph's factors in id order (a whole recording's 10^5-10^6).
+std::vector<TestedFactor> TestMeasurementFactors(const std::function<double(int)>& threshold,
+                                                 const ProblemBuilder& builder, FactorId first,
+                                                 const SolverWorkspace* last_solve, FactorId end) {
+  const Graph& graph = builder.graph();
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
-  std::vector<std::pair<double, int>> failing;  // (ignore_chance_changes) squared norm and dimension of each active
-                                                // factor that fails
-  std::vector<FailingFactor> failing_factors;   // (worst_per_pose)
-  const bool bursts = options.burst_margin > 0.0;
-  std::vector<std::vector<GateRow>> rows(bursts ? builder->stream_names().size() : 0);  // per stream, in time order
+  const std::map<FactorId, ProblemBuilder::CumulativeSpan>& spans = builder.cumulative_spans();
   std::vector<const double*> values;
   internal::WhitenedFactor wf;  // reused: its buffers keep their size
-  std::vector<TestedFactor> tested_factors;
-  const std::map<FactorId, ProblemBuilder::CumulativeSpan>& spans = builder->cumulative_spans();
+  std::vector<TestedFactor> tested;
   auto factor = graph.factors().lower_bound(first);
-  for (auto stream = builder->factor_streams().lower_bound(first); stream != builder->factor_streams().end();
+  for (auto stream = builder.factor_streams().lower_bound(first); stream != builder.factor_streams().end();
        ++stream) {
     const FactorId id = stream->first;
-    if (id >= options.end) break;
+    if (id >= end) break;
     while (factor != graph.factors().end() && factor->first < id) ++factor;
     if (factor == graph.factors().end()) break;
     if (factor->first != id) continue;  // (no longer in the graph)
@@ -263,15 +250,21 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
       ok = internal::LinearizeFactorAt(entry, values.data(), 0, &wf);
       linearized = &wf;
     }
-    tested_factors.push_back({id, stream->second, entry.active, ok && linearized->squared_norm <= threshold(dim),
-                              ok ? linearized->squared_norm : kInfinity, dim});
+    tested.push_back({id, stream->second, entry.active, ok && linearized->squared_norm <= threshold(dim),
+                      ok ? linearized->squared_norm : kInfinity, dim});
   }
-  const int tested = static_cast<int>(tested_factors.size());
-  // A reading of a cumulative wheel stream that fails both spans it joins is left out, not both spans.
-  std::vector<std::vector<FactorId>> runs;
-  const std::set<FactorId> bridged = BridgeFailingRuns(tested_factors, threshold, builder, &result.bridged, &runs);
-  // The poses of the readings left out go back between their neighbours, and their measurements rejected before (as
-  // that reading bent them) are re-admitted where they fit there.
+  return tested;
+}
+
+// The poses of the readings the bridges of `runs` left out go back between their neighbours (UnbendBridgedPoses), and
+// their measurements rejected before (as that reading bent them) that fit there now. Returns those measurements.
+std::set<FactorId> RefitAroundBridges(const std::vector<std::vector<FactorId>>& runs,
+                                      const std::set<FactorId>& bridged,
+                                      const std::function<double(int)>& threshold, ProblemBuilder* builder) {
+  Graph& graph = builder->graph();
+  const std::map<FactorId, ProblemBuilder::CumulativeSpan>& spans = builder->cumulative_spans();
+  std::vector<const double*> values;
+  internal::WhitenedFactor wf;
   std::set<FactorId> refit;
   for (const std::vector<FactorId>& run : runs)
     for (const VariableId pose : UnbendBridgedPoses(run, &graph))
@@ -285,6 +278,58 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
             wf.squared_norm <= threshold(entry.factor->residual_dim()))
           refit.insert(id);
       }
+  return refit;
+}
+
+// Switches the factors of `switched` (rejects the active ones, re-admits the others) and counts them into *result,
+// unless the changes are by chance (GateOptions::ignore_chance_changes): no more newly failing factors than the
+// test's false alarms among the `tested` factors, and none of `failing` (squared norm, dimension) beyond the quantile
+// that all of them pass with the test's probability (1 - (1 - p) / N each): a gross outlier is rejected however few
+// there are. The factors that fit again are re-admitted, unless they and the failing ones together are no more than
+// the false alarms either.
+void ApplySwitches(const std::vector<FactorId>& switched, const std::vector<std::pair<double, int>>& failing,
+                   int tested, double probability, bool ignore_chance_changes, ProblemBuilder* builder,
+                   GateSwitches* result) {
+  Graph& graph = builder->graph();
+  for (FactorId id : switched) (graph.factor(id).active ? result->rejected : result->readmitted) += 1;
+  const double false_alarms = static_cast<double>(tested) * (1.0 - probability);
+  const bool by_chance =
+      ignore_chance_changes && static_cast<double>(result->rejected) <= false_alarms &&
+      std::none_of(failing.begin(), failing.end(), [&](const std::pair<double, int>& f) {
+        return f.first > ChiSquareQuantile(1.0 - (1.0 - probability) / static_cast<double>(tested), f.second);
+      });
+  if (by_chance) {
+    std::swap(result->ignored, result->rejected);
+    if (static_cast<double>(switched.size()) <= false_alarms) result->readmitted = 0;
+  }
+  for (FactorId id : switched) {
+    FactorEntry& entry = graph.mutable_factor(id);
+    if (by_chance && (entry.active || result->readmitted == 0)) continue;
+    entry.active = !entry.active;
+    builder->mutable_counts(entry.stream).rejected += entry.active ? -1 : 1;
+  }
+}
+
+}  // namespace
+
+GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId first,
+                          const SolverWorkspace* last_solve, const GateOptions& options) {
+  Graph& graph = builder->graph();
+  // Quantiles per (probability, dimension), kept across calls: online tracking gates at every update.
+  thread_local std::map<std::pair<double, int>, double> quantiles;
+  const auto threshold = [&](int dim) {
+    const auto key = std::make_pair(probability, dim);
+    const auto it = quantiles.find(key);
+    return it != quantiles.end() ? it->second : (quantiles[key] = ChiSquareQuantile(probability, dim));
+  };
+  const std::vector<TestedFactor> tested_factors =
+      TestMeasurementFactors(threshold, *builder, first, last_solve, options.end);
+  const int tested = static_cast<int>(tested_factors.size());
+  GateSwitches result;
+  // A reading of a cumulative wheel stream that fails both spans it joins is left out, not both spans.
+  std::vector<std::vector<FactorId>> runs;
+  const std::set<FactorId> bridged = BridgeFailingRuns(tested_factors, threshold, builder, &result.bridged, &runs);
+  const std::set<FactorId> refit = RefitAroundBridges(runs, bridged, threshold, builder);
   // The other measurements of the poses a bridged reading bent wait for the re-solve without it: failing there now,
   // they would be rejected with it and leave those poses held by nothing, where they stay bent.
   std::set<VariableId> bent_poses;
@@ -298,6 +343,12 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
     const std::vector<VariableId>& vars = graph.factor(id).variables;
     return std::any_of(vars.begin(), vars.end(), [&](VariableId v) { return bent_poses.count(v) > 0; });
   };
+  std::vector<FactorId> switched;
+  std::vector<std::pair<double, int>> failing;  // (ignore_chance_changes) squared norm and dimension of each active
+                                                // factor that fails
+  std::vector<FailingFactor> failing_factors;   // (worst_per_pose)
+  const bool bursts = options.burst_margin > 0.0;
+  std::vector<std::vector<GateRow>> rows(bursts ? builder->stream_names().size() : 0);  // per stream, in time order
   for (const TestedFactor& t : tested_factors) {
     if (refit.count(t.id) > 0) continue;
     if (bridged.count(t.id) > 0 || (!t.pass && !bent_poses.empty() && waits_for_resolve(t.id))) continue;
@@ -328,27 +379,7 @@ GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId 
     switched.insert(switched.end(), worst.begin(), worst.end());
     std::sort(switched.begin(), switched.end());
   }
-  // By chance: no more newly failing factors than the test's false alarms among the tested factors, and none beyond
-  // the quantile that all of them pass with the test's probability (1 - (1 - p) / N each): a gross outlier is rejected
-  // however few there are. The factors that fit again are re-admitted, unless they and the failing ones together are
-  // no more than the false alarms either.
-  for (FactorId id : switched) (graph.factor(id).active ? result.rejected : result.readmitted) += 1;
-  const double false_alarms = static_cast<double>(tested) * (1.0 - probability);
-  const bool by_chance =
-      options.ignore_chance_changes && static_cast<double>(result.rejected) <= false_alarms &&
-      std::none_of(failing.begin(), failing.end(), [&](const std::pair<double, int>& f) {
-        return f.first > ChiSquareQuantile(1.0 - (1.0 - probability) / static_cast<double>(tested), f.second);
-      });
-  if (by_chance) {
-    std::swap(result.ignored, result.rejected);
-    if (static_cast<double>(switched.size()) <= false_alarms) result.readmitted = 0;
-  }
-  for (FactorId id : switched) {
-    FactorEntry& entry = graph.mutable_factor(id);
-    if (by_chance && (entry.active || result.readmitted == 0)) continue;
-    entry.active = !entry.active;
-    builder->mutable_counts(entry.stream).rejected += entry.active ? -1 : 1;
-  }
+  ApplySwitches(switched, failing, tested, probability, options.ignore_chance_changes, builder, &result);
   return result;
 }
 
