@@ -392,6 +392,15 @@ Result<EstimatorConfig> ParseEstimatorConfig(const std::string& yaml_text, const
   }
 }
 
+std::set<std::string> StreamsRead(const EstimatorConfig& config) {
+  std::set<std::string> read;
+  for (const auto& [name, stream] : config.streams) {
+    for (const auto& [role, source] : stream.sources) read.insert(source);
+    for (const auto& [role, source] : stream.inputs) read.insert(source);
+  }
+  return read;
+}
+
 Result<EstimatorConfig> LoadEstimatorConfig(const std::string& path) {
   std::ifstream in(path);
   if (!in) return Status::Error(path + ": cannot open the estimator configuration");

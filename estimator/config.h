@@ -51,6 +51,7 @@
 
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -162,6 +163,9 @@ struct ModelSpec {
 };
 // The spec of a registered model (model_registry.h); nullptr for an unknown name.
 const ModelSpec* FindModelSpec(const std::string& model);
+
+// The recording streams a configuration reads: its streams' sources and inputs.
+std::set<std::string> StreamsRead(const EstimatorConfig& config);
 
 Result<EstimatorConfig> LoadEstimatorConfig(const std::string& path);
 Result<EstimatorConfig> ParseEstimatorConfig(const std::string& yaml_text, const std::string& source_name);

@@ -314,6 +314,8 @@ Outcome Prepare(const MonteCarloOptions& options, Shared* shared) {
   auto config = estimator::LoadEstimatorConfig(options.config);
   if (!config.ok()) return Outcome::BadInput(config.status());
   shared->config = std::move(config).value();
+  // Only the calibration reads the runs' recordings: the laser and camera it does not read are not simulated.
+  shared->scenario.DropUnreadCostlySensors(estimator::StreamsRead(shared->config));
   const auto& parameters = shared->config.parameters;
   if (std::none_of(parameters.begin(), parameters.end(), [](const auto& p) { return p.second.free; }))
     return Outcome::BadInput(Status::Error(options.config + ": no free parameter to calibrate"));

@@ -143,7 +143,9 @@ Result<DesignCandidate> Evaluate(const Problem& p, const DriveDesign& drive, con
   c.objective = kInfinity;
   sim::SimulateOptions options;
   options.noise = false;
-  auto simulation = sim::Simulate(WithDrive(*p.family, p.scenario, drive), options);
+  sim::Scenario simulated = WithDrive(*p.family, p.scenario, drive);
+  simulated.DropUnreadCostlySensors(estimator::StreamsRead(p.config));
+  auto simulation = sim::Simulate(simulated, options);
   auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count(); };
   if (!simulation.ok()) {
     c.infeasible = simulation.status().message();

@@ -156,7 +156,9 @@ Outcome InformationToDirectory(const InformationRequest& request, InformationRun
     return Outcome::BadInput(Status::Error("--window: " + problem));
   if (Status dir = MakeOutputDirectory(request.out); !dir.ok()) return Outcome::BadInput(dir);
 
-  // The drive without sensor noise; the configuration against its recording.
+  // The drive without sensor noise (without the laser and camera the configuration does not read); the configuration
+  // against its recording.
+  scenario.value().DropUnreadCostlySensors(estimator::StreamsRead(config.value()));
   sim::SimulateOptions simulate;
   simulate.noise = false;
   simulate.progress = request.progress;

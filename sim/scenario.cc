@@ -542,6 +542,17 @@ std::vector<std::string> Scenario::StreamNames() const {
   return names;
 }
 
+void Scenario::DropUnreadCostlySensors(const std::set<std::string>& read) {
+  std::set<std::string> faulted;
+  for (const FaultOptions& fault : faults) faulted.insert(fault.stream);
+  const auto unread = [&](const std::vector<std::string>& streams) {
+    return std::none_of(streams.begin(), streams.end(),
+                        [&](const std::string& s) { return read.count(s) > 0 || faulted.count(s) > 0; });
+  };
+  if (sensors.laser && unread({"scan_matching", "laser_scan"})) sensors.laser.reset();
+  if (sensors.camera && unread({"visual_odometry", "visual_odometry_images"})) sensors.camera.reset();
+}
+
 const std::map<std::string, std::map<std::string, double>>& KnownEffects() {
   static const std::map<std::string, std::map<std::string, double>> known = {
       {"gps_latency", {{"latency_s", 0.0}}},

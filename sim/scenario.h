@@ -265,6 +265,7 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -420,6 +421,12 @@ struct Scenario {
 
   // The names of the streams the scenario's sensors write (the `stream` a fault may name).
   std::vector<std::string> StreamNames() const;
+
+  // Drops the sensors that cost most to simulate, the ray-cast laser and the rendered camera, when none of the streams
+  // they write is in `read` and no fault names one: for runs whose recording only an estimator reads. The other
+  // streams keep their noise (each sensor draws from a generator of its own); the physics can differ in its last
+  // digits, as a camera frame's step solves the forward dynamics once more.
+  void DropUnreadCostlySensors(const std::set<std::string>& read);
 
   // The first problem, if any: the key path as written in the YAML (e.g. "sensors.gps.rate_hz") and what is wrong.
   // Checks values only; files are checked by LoadScenario and the model by the simulator.

@@ -1,6 +1,7 @@
 #include "estimator/config.h"
 
 #include <algorithm>
+#include <set>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -30,6 +31,13 @@ TEST(ConfigTest, ParsesTheAtvConfiguration) {
   EXPECT_EQ(config.value().streams.size(), 5u);
   EXPECT_TRUE(config.value().parameters.at("gps.lever_arm").free);
   EXPECT_DOUBLE_EQ(config.value().streams.at("gps").noise.at("sigma_m"), 0.33);
+}
+
+TEST(ConfigTest, StreamsReadAreTheStreamsSources) {
+  const auto config = ParseEstimatorConfig(testing::AtvConfigYaml({"gps.lever_arm"}), "est.yaml");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  const std::set<std::string> read = StreamsRead(config.value());
+  EXPECT_EQ(read, (std::set<std::string>{"gps", "imu", "magnetometer", "rear_wheel", "steering"}));
 }
 
 // The calibration's gate starts under Huber's loss unless the configuration turns it off.

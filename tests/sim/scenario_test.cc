@@ -103,6 +103,28 @@ class ScenarioErrorTest : public ::testing::Test {
   std::string text_;
 };
 
+// The laser and the camera are left out of a run whose estimator reads neither of their streams, unless a fault
+// names one; every other sensor stays.
+TEST(ScenarioTest, UnreadLaserAndCameraAreDropped) {
+  auto loaded = LoadScenario(testing::SourcePath("scenarios/indoor_omni_slip.yaml"));
+  ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+  ASSERT_TRUE(loaded.value().sensors.laser && loaded.value().sensors.camera && loaded.value().sensors.imu);
+  Scenario wheels_only = loaded.value();
+  wheels_only.DropUnreadCostlySensors({"imu", "wheel_encoders"});
+  EXPECT_FALSE(wheels_only.sensors.laser);
+  EXPECT_FALSE(wheels_only.sensors.camera);
+  EXPECT_TRUE(wheels_only.sensors.imu && wheels_only.sensors.wheel_encoders);
+  Scenario laser_read = loaded.value();
+  laser_read.DropUnreadCostlySensors({"imu", "scan_matching"});
+  EXPECT_TRUE(laser_read.sensors.laser);
+  EXPECT_FALSE(laser_read.sensors.camera);
+  Scenario camera_faulted = loaded.value();
+  camera_faulted.faults.push_back({"outliers", "visual_odometry", 0.1, 0.05});
+  camera_faulted.DropUnreadCostlySensors({"imu"});
+  EXPECT_TRUE(camera_faulted.sensors.camera);
+  EXPECT_FALSE(camera_faulted.sensors.laser);
+}
+
 TEST_F(ScenarioErrorTest, FaultsAreReadAndChecked) {
   EXPECT_EQ(LoadWith("effects: []",
                      "effects: []\nfaults:\n  - {type: outage, stream: gps, start_s: 5, duration_s: 20}\n"
