@@ -881,6 +881,18 @@ void KeepResiduals(const ProblemBuilder& builder, CalibrationResult* result) {
 
 }  // namespace
 
+std::vector<std::string> HeavilyGatedStreams(const CalibrationResult& result, double share) {
+  std::vector<std::string> lines;
+  for (const auto& [stream, c] : result.counts) {
+    if (c.attached <= 0 || c.rejected <= share * c.attached) continue;
+    const long percent = std::lround(100.0 * c.rejected / c.attached);
+    lines.push_back("stream '" + stream + "': the gate rejected " + std::to_string(c.rejected) + " of " +
+                    std::to_string(c.attached) + " measurements (" + std::to_string(percent) +
+                    " %); the estimate rests on the other streams, and the calibration may have failed");
+  }
+  return lines;
+}
+
 bool UsesHac(CalibrationOptions::StdMethod method, const recording::Recording& recording) {
   return method == CalibrationOptions::StdMethod::kHac ||
          (method == CalibrationOptions::StdMethod::kAuto && recording.provenance.source == "imported");

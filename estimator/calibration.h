@@ -121,6 +121,11 @@ Result<CalibrationResult> Calibrate(const EstimatorConfig& config, const recordi
 // Whether `method` resolves to the HAC standard deviation for `recording` (kAuto: when it is imported).
 bool UsesHac(CalibrationOptions::StdMethod method, const recording::Recording& recording);
 
+// One line for each stream whose measurements the gate rejected in more than `share` of those attached: the estimate
+// then rests on the other streams, and a calibration that rejects most of a stream has often failed (a slipping
+// drive's wheel stream, gated at a solve that stopped short). Empty when none.
+std::vector<std::string> HeavilyGatedStreams(const CalibrationResult& result, double share = 0.5);
+
 // Options of one gating pass (GateOutliers) beyond testing each factor alone.
 struct GateOptions {
   // > 0: a burst in a stream (at least 3 of its rows failing, at most 10 rows apart, one of them active until now) also

@@ -230,6 +230,8 @@ Outcome CalibrateToDirectory(const CalibrateRequest& request, estimator::Calibra
   auto calibrated = estimator::Calibrate(inputs.value().config, inputs.value().recording, options);
   if (!calibrated.ok()) return Failed(calibrated.status(), &marker);
   const estimator::CalibrationResult& r = calibrated.value();
+  if (request.warning)
+    for (const std::string& line : estimator::HeavilyGatedStreams(r)) request.warning(request.recording + ": " + line);
   Status st = estimator::WriteCalibrationFile(r, request.recording, request.config, request.out + "/calibration.json");
   if (st.ok()) st = WriteTum(r.trajectory, request.out + "/trajectory.tum");
   if (st.ok()) st = marker.Complete();

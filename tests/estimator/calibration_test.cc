@@ -66,6 +66,22 @@ TEST(CalibrationTest, RecoversLeverArmAndSteeringGainsWithinReportedUncertainty)
                                            {"gps.lever_arm", "odometer.k_theta", "odometer.k_gamma"});
 }
 
+// A stream the gate rejected more than half of is named with its counts; the others are not.
+TEST(CalibrationTest, HeavilyGatedStreamsAreNamed) {
+  CalibrationResult result;
+  result.counts["odometer"].attached = 3000;
+  result.counts["odometer"].rejected = 2517;
+  result.counts["mocap"].attached = 601;
+  result.counts["mocap"].rejected = 281;
+  result.counts["empty"].attached = 0;
+  const std::vector<std::string> lines = HeavilyGatedStreams(result);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NE(lines[0].find("'odometer'"), std::string::npos) << lines[0];
+  EXPECT_NE(lines[0].find("2517 of 3000"), std::string::npos) << lines[0];
+  EXPECT_NE(lines[0].find("84 %"), std::string::npos) << lines[0];
+  EXPECT_EQ(HeavilyGatedStreams(result, 0.4).size(), 2u);
+}
+
 TEST(CalibrationTest, RecoversSpeedGainWithinReportedUncertainty) {
   ExpectRecoveredWithinReportedUncertainty(kLeverArmAndGains, {"odometer.kv_over_L"});
 }
