@@ -4,8 +4,9 @@
 Usage: python3 tools/husky_gps_yaw_scale.py REC [--window S] [--odometry-lag S]
 
 REC is an imported recording with `odometry` (body twist: vx, wz), `imu` and `gps` streams, the Husky's as
-docs/results.md imports it. Each heading source's yaw rate (the odometry's wz, and the gyroscope's axis that the
-mounting turns to the body's vertical) is multiplied by a scale k and integrated with the odometry's forward speed
+docs/results.md imports it. Each heading source's yaw rate [rad/s] (the odometry's wz in the body frame, and the
+gyroscope's y axis: the Husky's IMU is mounted a quarter turn about x, so its y axis is the body's vertical; another
+mounting needs another column) is multiplied by a scale k and integrated with the odometry's forward speed
 times s into a planar track; over consecutive windows of S seconds that track is fitted to the GPS fixes (east,
 north) by a rigid planar motion, and the residual's mean square summed over the windows. Printed per source: the
 best k (s profiled out), the profile of the residual RMS over k, and a bootstrap over the windows (resampled with
