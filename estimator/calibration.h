@@ -165,15 +165,22 @@ struct GateSwitches {
   int switched() const { return rejected + readmitted + bridged; }
 };
 
-// Re-tests the measurement factors with `first` <= id < options.end (factor ids grow as factors are added, so `first`
-// selects the newest ones): active exactly when the whitened squared error is within the chi-square quantile
-// `probability` of its dimension, but for what `options` add. A run of failing intervals of a cumulative wheel master
-// stream is first bridged where a bridge over its readings passes (ProblemBuilder::BridgeCumulativeRun; the readings
-// left out count as rejected), the poses of the left-out readings are set between the bridge's ends, their rejected
-// measurements that fit there re-admitted, and the other failing measurements of the bridged poses left as they are
-// until the next pass. Keeps the per-stream rejected counts up to date. `last_solve` (optional): the workspace of the
-// solve that left the graph at its current values; a factor it linearized at exactly these values is tested on that
-// linearization's error instead of being evaluated again.
+// Whether the gate tests (and may reject or hold out) measurement factor `entry`: every one but those under Cauchy's
+// loss. Cauchy's loss is the stream's model of a heavy tail (a slipping wheel's rows: a third of them beyond the gate
+// at the truth on a square-wave omni drive), and it already gives a gross error almost no weight; the gate's
+// chi-square test, which assumes Gaussian noise, would reject the tail the loss is there to keep, and with it most of
+// the stream once the estimate moves.
+bool Gated(const FactorEntry& entry);
+
+// Re-tests the gated measurement factors (Gated) with `first` <= id < options.end (factor ids grow as factors are
+// added, so `first` selects the newest ones): active exactly when the whitened squared error is within the chi-square
+// quantile `probability` of its dimension, but for what `options` add. A run of failing intervals of a cumulative wheel
+// master stream is first bridged where a bridge over its readings passes (ProblemBuilder::BridgeCumulativeRun; the
+// readings left out count as rejected), the poses of the left-out readings are set between the bridge's ends, their
+// rejected measurements that fit there re-admitted, and the other failing measurements of the bridged poses left as
+// they are until the next pass. Keeps the per-stream rejected counts up to date. `last_solve` (optional): the workspace
+// of the solve that left the graph at its current values; a factor it linearized at exactly these values is tested on
+// that linearization's error instead of being evaluated again.
 GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId first = 0,
                           const SolverWorkspace* last_solve = nullptr, const GateOptions& options = {});
 
