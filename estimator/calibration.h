@@ -123,7 +123,7 @@ bool UsesHac(CalibrationOptions::StdMethod method, const recording::Recording& r
 
 // One line for each stream whose measurements the gate rejected in more than `share` of those attached: the estimate
 // then rests on the other streams, and a calibration that rejects most of a stream has often failed (a slipping
-// drive's wheel stream, gated at a solve that stopped short). Empty when none.
+// drive's wheel stream under the Gaussian gate instead of Cauchy's loss, Gated). Empty when none.
 std::vector<std::string> HeavilyGatedStreams(const CalibrationResult& result, double share = 0.5);
 
 // Options of one gating pass (GateOutliers) beyond testing each factor alone.
@@ -166,8 +166,8 @@ struct GateSwitches {
 };
 
 // Whether the gate tests (and may reject or hold out) measurement factor `entry`: every one but those under Cauchy's
-// loss. Cauchy's loss is the stream's model of a heavy tail (a slipping wheel's rows: a third of them beyond the gate
-// at the truth on a square-wave omni drive), and it already gives a gross error almost no weight; the gate's
+// loss. Cauchy's loss is the stream's model of a heavy tail (a slipping wheel's rows: many beyond the gate even at the
+// truth on a square-wave omni drive), and it already gives a gross error almost no weight; the gate's
 // chi-square test, which assumes Gaussian noise, would reject the tail the loss is there to keep, and with it most of
 // the stream once the estimate moves.
 bool Gated(const FactorEntry& entry);

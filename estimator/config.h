@@ -7,7 +7,8 @@
 //                                          # or a gyroscope stream (IMU master, below)
 //   poses: {rate_hz: 20, position_sigma_m: 1.0}   # IMU master only (PosesConfig)
 //   solver: {method: levenberg_marquardt, max_iterations: 50, function_tolerance: 1.0e-8, step_tolerance: 1.0e-10}
-//   gating: {probability: 0.99999}         # chi-square gate on whitened errors; omit to disable
+//   gating: {probability: 0.99999}         # chi-square gate on whitened errors (not of a stream under Cauchy's
+//                                          # loss); omit to disable
 //   tracking: {window: 40, max_iterations: 10, improvement_threshold: 1.0e-3, time_budget_s: 0.05,
 //              initialization_s: 2.0, relinearize_threshold: 0.0}
 //   parameters:                            # any parameter not listed here keeps its model default and is fixed
