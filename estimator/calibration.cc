@@ -234,7 +234,7 @@ std::vector<TestedFactor> TestMeasurementFactors(const std::function<double(int)
     if (factor->first != id) continue;  // (no longer in the graph)
     if (const auto span = spans.find(id); span != spans.end() && span->second.replaced) continue;
     const FactorEntry& entry = factor->second;
-    if (!Gated(entry)) continue;
+    if (!builder.StreamGated(stream->second)) continue;
     const int dim = entry.factor->residual_dim();
     // The solve's linearization (of an active factor, with the Jacobians of its free variables), else the error.
     const internal::WhitenedFactor* linearized = nullptr;
@@ -312,8 +312,6 @@ void ApplySwitches(const std::vector<FactorId>& switched, const std::vector<std:
 }
 
 }  // namespace
-
-bool Gated(const FactorEntry& entry) { return entry.loss.type != Loss::Type::kCauchy; }
 
 GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId first,
                           const SolverWorkspace* last_solve, const GateOptions& options) {
@@ -561,7 +559,8 @@ std::vector<FactorId> HoldOutAbsoluteRowsAfterGaps(const EstimatorConfig& config
   std::vector<FactorId> held;
   for (const auto& [id, entry] : builder->graph().factors()) {
     const auto resume = resumes.find(entry.stream);
-    if (resume == resumes.end() || builder->StreamOfFactor(id) < 0 || !entry.active || !Gated(entry)) continue;
+    const int stream = builder->StreamOfFactor(id);
+    if (resume == resumes.end() || stream < 0 || !builder->StreamGated(stream) || !entry.active) continue;
     if (entry.stamp.nanoseconds() >= resume->second.front().nanoseconds() - kSlackNs) held.push_back(id);
   }
   for (const FactorId id : held) {

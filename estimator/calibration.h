@@ -123,7 +123,8 @@ bool UsesHac(CalibrationOptions::StdMethod method, const recording::Recording& r
 
 // One line for each stream whose measurements the gate rejected in more than `share` of those attached: the estimate
 // then rests on the other streams, and a calibration that rejects most of a stream has often failed (a slipping
-// drive's wheel stream under the Gaussian gate instead of Cauchy's loss, Gated). Empty when none.
+// drive's wheel stream under the Gaussian gate; `gate: false` in its configuration leaves it to its loss). Empty when
+// none.
 std::vector<std::string> HeavilyGatedStreams(const CalibrationResult& result, double share = 0.5);
 
 // Options of one gating pass (GateOutliers) beyond testing each factor alone.
@@ -165,14 +166,7 @@ struct GateSwitches {
   int switched() const { return rejected + readmitted + bridged; }
 };
 
-// Whether the gate tests (and may reject or hold out) measurement factor `entry`: every one but those under Cauchy's
-// loss. Cauchy's loss is the stream's model of a heavy tail (a slipping wheel's rows: many beyond the gate even at the
-// truth on a square-wave omni drive), and it already gives a gross error almost no weight; the gate's
-// chi-square test, which assumes Gaussian noise, would reject the tail the loss is there to keep, and with it most of
-// the stream once the estimate moves.
-bool Gated(const FactorEntry& entry);
-
-// Re-tests the gated measurement factors (Gated) with `first` <= id < options.end (factor ids grow as factors are
+// Re-tests the gated measurement factors (ProblemBuilder::StreamGated) with `first` <= id < options.end (factor ids grow as factors are
 // added, so `first` selects the newest ones): active exactly when the whitened squared error is within the chi-square
 // quantile `probability` of its dimension, but for what `options` add. A run of failing intervals of a cumulative wheel
 // master stream is first bridged where a bridge over its readings passes (ProblemBuilder::BridgeCumulativeRun; the

@@ -211,7 +211,7 @@ class Parser {
 
   StreamConfig ParseStream(const std::string& name, const YAML::Node& n) const {
     const std::string where = "stream '" + name + "'";
-    CheckKeys(n, {"model", "source", "noise", "parameters", "options", "inputs", "loss"}, where);
+    CheckKeys(n, {"model", "source", "noise", "parameters", "options", "inputs", "loss", "gate"}, where);
     StreamConfig s;
     if (!n["model"]) Fail(n, where + ": missing key 'model'");
     s.model = String(n["model"], where + ".model");
@@ -273,6 +273,7 @@ class Parser {
         Fail(l, where + ": loss type must be none, huber or cauchy, not '" + type + "'");
       }
     }
+    if (n["gate"]) s.gated = Bool(n["gate"], where + ".gate");
     return s;
   }
 

@@ -7,8 +7,7 @@
 //                                          # or a gyroscope stream (IMU master, below)
 //   poses: {rate_hz: 20, position_sigma_m: 1.0}   # IMU master only (PosesConfig)
 //   solver: {method: levenberg_marquardt, max_iterations: 50, function_tolerance: 1.0e-8, step_tolerance: 1.0e-10}
-//   gating: {probability: 0.99999}         # chi-square gate on whitened errors (not of a stream under Cauchy's
-//                                          # loss); omit to disable
+//   gating: {probability: 0.99999}         # chi-square gate on whitened errors; omit to disable
 //   tracking: {window: 40, max_iterations: 10, improvement_threshold: 1.0e-3, time_budget_s: 0.05,
 //              initialization_s: 2.0, relinearize_threshold: 0.0}
 //   parameters:                            # any parameter not listed here keeps its model default and is fixed
@@ -29,6 +28,7 @@
 //       parameters: {kv_over_L: odometer.kv_over_L}    # slot -> parameter name; default "<stream>.<slot>"
 //       options: {wheelbase_m: 1.25}
 //       loss: {type: huber, scale: 3.0}
+//       gate: false                        # the gate leaves this stream's rows alone (default true)
 //     gps: {model: gps, source: gps, noise: {sigma_m: 0.33}}
 //     scan_matching:                       # a velocity measured over an interval (scan matcher, visual odometry)
 //       model: relative_motion             # eqs. 5-8 between the poses nearest the interval's ends (problem.h)
@@ -98,6 +98,9 @@ struct StreamConfig {
   std::map<std::string, std::vector<double>> options;
   std::map<std::string, std::string> inputs;  // role -> recording stream read as an extra input (optional)
   Loss loss;
+  // `gate: false`: the outlier gate neither tests nor holds out this stream's rows; its loss alone handles its
+  // outliers (a slipping wheel's rows under Cauchy's loss, whose heavy tail a Gaussian gate would reject wholesale).
+  bool gated = true;
 };
 
 struct TrackingConfig {

@@ -120,6 +120,9 @@ class ProblemBuilder {
   const IdTable<int>& factor_streams() const { return stream_of_factor_; }
   // Chi-square dimension of a stream's factors.
   int ResidualDim(const std::string& stream) const;
+  // Whether the outlier gate tests and may reject or hold out the factors of stream index `stream`
+  // (StreamConfig::gated; false for -1, the process and prior factors).
+  bool StreamGated(int stream) const { return stream >= 0 && gated_streams_[static_cast<std::size_t>(stream)] != 0; }
 
   // A factor of a cumulative wheel master stream (differential, tricycle, omni and mecanum drives), whose readings
   // are wheel angles summed since the start: the factor joining the poses of rows row_begin < row_end holds the mean
@@ -196,6 +199,7 @@ class ProblemBuilder {
   Graph graph_;
   std::deque<PoseNode> poses_;
   std::vector<std::string> stream_names_;
+  std::vector<char> gated_streams_;  // by stream index (StreamGated)
   std::map<std::string, StreamCounts> counts_;
   std::map<std::string, VariableId> parameters_;
   std::vector<std::pair<VariableId, Eigen::Vector3d>> absolute_fixes_;

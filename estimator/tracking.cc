@@ -82,7 +82,7 @@ void HoldOutNewestSpans(ProblemBuilder* builder) {
   if (motion_rows < graph.variable(newest).manifold.tangent_dim()) return;
   for (const FactorId id : graph.FactorsOf(newest)) {
     FactorEntry& entry = graph.mutable_factor(id);
-    if (spans.count(id) == 0 || !entry.active || !Gated(entry)) continue;
+    if (spans.count(id) == 0 || !entry.active || !builder->StreamGated(builder->StreamOfFactor(id))) continue;
     entry.active = false;
     ++builder->mutable_counts(entry.stream).rejected;
   }
@@ -97,7 +97,7 @@ std::vector<FactorId> NewAbsoluteFactors(const ProblemBuilder& builder, FactorId
   for (auto it = graph.factors().lower_bound(first); it != graph.factors().end(); ++it) {
     const FactorEntry& entry = it->second;
     const int stream = builder.StreamOfFactor(it->first);
-    if (stream < 0 || builder.stream_names()[stream] == master || !entry.active || !Gated(entry) ||
+    if (stream < 0 || builder.stream_names()[stream] == master || !builder.StreamGated(stream) || !entry.active ||
         streams.count(entry.stream) == 0)
       continue;
     int free_poses = 0, free_other = 0;

@@ -314,19 +314,25 @@ recording::Recording AtvWithGrossGpsOutliers() {
   return synthetic.recording;
 }
 
-// A stream under Cauchy's loss is not gated (Gated): the loss gives the gross outliers almost no weight, and they stay
-// attached.
-TEST(CalibrationTest, AStreamUnderCauchysLossIsNotGated) {
+TEST(CalibrationTest, GatingRejectsGrossGpsOutliers) {
   const recording::Recording recording = AtvWithGrossGpsOutliers();
+  // A robust loss keeps the outliers from bending the first solution; the gate then switches them off.
   EstimatorConfig config = testing::AtvConfig({"gps.lever_arm"});
   config.streams["gps"].loss = Loss::Cauchy(3.0);
   config.gate_probability = 0.99999;
   auto result = Calibrate(config, recording);
   ASSERT_TRUE(result.ok()) << result.status().message();
-  EXPECT_EQ(result.value().counts.at("gps").rejected, 0);
-  EXPECT_GT(result.value().counts.at("gps").attached, 0);
+  EXPECT_EQ(result.value().counts.at("gps").rejected, 3);
   const ParameterEstimate& lever = Find(result.value(), "gps.lever_arm");
   EXPECT_LT(std::abs(lever.estimate[0] - 0.57), 3.5 * lever.std[0]);
+
+  // `gate: false` on the GPS stream: its rows stay attached, the outliers with almost no weight under Cauchy's loss.
+  config.streams["gps"].gated = false;
+  auto ungated = Calibrate(config, recording);
+  ASSERT_TRUE(ungated.ok()) << ungated.status().message();
+  EXPECT_EQ(ungated.value().counts.at("gps").rejected, 0);
+  const ParameterEstimate& kept = Find(ungated.value(), "gps.lever_arm");
+  EXPECT_LT(std::abs(kept.estimate[0] - 0.57), 3.5 * kept.std[0]);
 }
 
 // The rear wheel skids for a second (its reading up to 8 % low, as a sine) and one more row is off alone. Tested one by

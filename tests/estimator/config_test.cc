@@ -56,6 +56,20 @@ TEST(ConfigTest, GatingRobustStartIsOnUnlessTurnedOff) {
               "gating.robust_start");
 }
 
+// A stream is gated unless its configuration says `gate: false`.
+TEST(ConfigTest, AStreamIsGatedUnlessItSaysGateFalse) {
+  const std::string good = testing::AtvConfigYaml({});
+  const auto by_default = ParseEstimatorConfig(good, "est.yaml");
+  ASSERT_TRUE(by_default.ok()) << by_default.status().message();
+  EXPECT_TRUE(by_default.value().streams.at("gps").gated);
+  const std::string fixes = "noise: {sigma_m: 0.33}";
+  const auto off = ParseEstimatorConfig(Replace(good, fixes, fixes + ", gate: false"), "est.yaml");
+  ASSERT_TRUE(off.ok()) << off.status().message();
+  EXPECT_FALSE(off.value().streams.at("gps").gated);
+  EXPECT_TRUE(off.value().streams.at("odometer").gated);
+  ExpectError(Replace(good, fixes, fixes + ", gate: sometimes"), "stream 'gps'.gate");
+}
+
 TEST(ConfigTest, RejectsUnknownKeysModelsAndMissingNoise) {
   const std::string good = testing::AtvConfigYaml({});
   ExpectError(Replace(good, "master: odometer", "master: odometer\nwindow: 3"), "unknown key 'window'");
