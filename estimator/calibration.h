@@ -166,15 +166,15 @@ struct GateSwitches {
   int switched() const { return rejected + readmitted + bridged; }
 };
 
-// Re-tests the gated measurement factors (ProblemBuilder::StreamGated) with `first` <= id < options.end (factor ids grow as factors are
-// added, so `first` selects the newest ones): active exactly when the whitened squared error is within the chi-square
-// quantile `probability` of its dimension, but for what `options` add. A run of failing intervals of a cumulative wheel
-// master stream is first bridged where a bridge over its readings passes (ProblemBuilder::BridgeCumulativeRun; the
-// readings left out count as rejected), the poses of the left-out readings are set between the bridge's ends, their
-// rejected measurements that fit there re-admitted, and the other failing measurements of the bridged poses left as
-// they are until the next pass. Keeps the per-stream rejected counts up to date. `last_solve` (optional): the workspace
-// of the solve that left the graph at its current values; a factor it linearized at exactly these values is tested on
-// that linearization's error instead of being evaluated again.
+// Re-tests the gated measurement factors (ProblemBuilder::StreamGated) with `first` <= id < options.end (factor ids
+// grow as factors are added, so `first` selects the newest ones): active exactly when the whitened squared error is
+// within the chi-square quantile `probability` of its dimension, but for what `options` add. A run of failing intervals
+// of a cumulative wheel master stream is first bridged where a bridge over its readings passes
+// (ProblemBuilder::BridgeCumulativeRun; the readings left out count as rejected), the poses of the left-out readings
+// are set between the bridge's ends, their rejected measurements that fit there re-admitted, and the other failing
+// measurements of the bridged poses left as they are until the next pass. Keeps the per-stream rejected counts up to
+// date. `last_solve` (optional): the workspace of the solve that left the graph at its current values; a factor it
+// linearized at exactly these values is tested on that linearization's error instead of being evaluated again.
 GateSwitches GateOutliers(double probability, ProblemBuilder* builder, FactorId first = 0,
                           const SolverWorkspace* last_solve = nullptr, const GateOptions& options = {});
 
