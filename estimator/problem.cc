@@ -93,6 +93,10 @@ int ProblemBuilder::StreamOfFactor(FactorId id) const {
   return stream == nullptr ? -1 : *stream;
 }
 
+bool ProblemBuilder::StreamGated(int stream) const {
+  return stream >= 0 && impl_->streams[static_cast<std::size_t>(stream)].config.gated;
+}
+
 int ProblemBuilder::ResidualDim(const std::string& stream) const {
   for (const StreamBinding& s : impl_->streams)
     if (s.name == stream) return s.definition->residual_dim;

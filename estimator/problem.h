@@ -122,7 +122,7 @@ class ProblemBuilder {
   int ResidualDim(const std::string& stream) const;
   // Whether the outlier gate tests and may reject or hold out the factors of stream index `stream`
   // (StreamConfig::gated; false for -1, the process and prior factors).
-  bool StreamGated(int stream) const { return stream >= 0 && gated_streams_[static_cast<std::size_t>(stream)] != 0; }
+  bool StreamGated(int stream) const;
 
   // A factor of a cumulative wheel master stream (differential, tricycle, omni and mecanum drives), whose readings
   // are wheel angles summed since the start: the factor joining the poses of rows row_begin < row_end holds the mean
@@ -199,7 +199,6 @@ class ProblemBuilder {
   Graph graph_;
   std::deque<PoseNode> poses_;
   std::vector<std::string> stream_names_;
-  std::vector<char> gated_streams_;  // by stream index (StreamGated)
   std::map<std::string, StreamCounts> counts_;
   std::map<std::string, VariableId> parameters_;
   std::vector<std::pair<VariableId, Eigen::Vector3d>> absolute_fixes_;

@@ -388,7 +388,6 @@ Result<std::unique_ptr<ProblemBuilder>> ProblemBuilder::Create(const EstimatorCo
   Impl& im = *builder->impl_;
   for (std::size_t i = 0; i < im.streams.size(); ++i) {
     builder->stream_names_.push_back(im.streams[i].name);
-    builder->gated_streams_.push_back(im.streams[i].config.gated ? 1 : 0);
     StreamCounts& counts = builder->counts_[im.streams[i].name];
     const recording::Stream& primary = *im.streams[i].primary;
     const recording::StreamHealth health = recording::CheckStreamHealth(primary);
