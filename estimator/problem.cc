@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <set>
 #include <vector>
 
@@ -784,6 +785,31 @@ std::size_t NearestRow(const recording::Stream& stream, Time t) {
   return SecondsBetween(t, *it) < SecondsBetween(stream.t[i - 1], t) ? i : i - 1;
 }
 
+// Half the span of the poses whose motion each pair of AlignImuToMotion compares with the IMU's readings. Over one
+// master interval the dead-reckoned acceleration is the encoders' quantization and the wheels' slip at reversals
+// (an omni robot's square-wave drive: tens of m/s^2 against the IMU's few, in no fixed direction), and it dominates
+// the fit; over 0.2 s either side both average out, and the body turns little enough (0.3 rad at 1.5 rad/s) that
+// its rotation within the span leaves the direction of the mean unbiased.
+constexpr double kAlignmentHalfSpan_s = 0.2;
+
+// Weighted mean of the rows of `stream` (columns [column, column + 3)) with t_a < t < t_c: weight 1 with `tent`
+// false, else the kernel of a second difference over poses at t_a, t_b, t_c (rising linearly from t_a to t_b,
+// falling to t_c), whose mean acceleration it is. nullopt when no row lies there.
+std::optional<Eigen::Vector3d> MeanReading(const recording::Stream& stream, int column, Time t_a, Time t_b, Time t_c,
+                                           bool tent) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double weight = 0.0;
+  for (auto it = std::upper_bound(stream.t.begin(), stream.t.end(), t_a); it != stream.t.end() && *it < t_c; ++it) {
+    const double w = !tent ? 1.0
+                     : *it <= t_b ? SecondsBetween(t_a, *it) / SecondsBetween(t_a, t_b)
+                                  : SecondsBetween(*it, t_c) / SecondsBetween(t_b, t_c);
+    sum += w * stream.values.row(it - stream.t.begin()).segment<3>(column).transpose();
+    weight += w;
+  }
+  if (weight <= 0.0) return std::nullopt;
+  return sum / weight;
+}
+
 }  // namespace
 
 // The dead-reckoned poses know the body's motion in the plane: from three consecutive poses, the body-frame angular
@@ -813,22 +839,30 @@ std::optional<Eigen::Quaterniond> ProblemBuilder::AlignImuToMotion() {
   const double gyro_weight = 1.0 / gyro->noise_covariance(0, 0);
   const double accel_weight = 1.0 / accel->noise_covariance(0, 0);
   const Eigen::Vector3d g_world(0.0, 0.0, kStandardGravity);
-  // Pairs of body-frame vectors from the poses and the IMU's readings at each inner pose.
+  // Pairs of body-frame vectors at each pose b with poses a and c about kAlignmentHalfSpan_s before and after it: the
+  // poses' mean rate and (second difference) mean acceleration over [t_a, t_c], the IMU's readings averaged with the
+  // same kernels; the readings nearest to b where the master's poses are sparser than the IMU's span.
   std::vector<Eigen::Vector3d> omega_body, omega_imu, f_body, f_imu;
+  std::size_t i_a = 0, i_c = 0;
   for (std::size_t k = 1; k + 1 < poses_.size(); ++k) {
-    const Pose<double> a = PoseFromArray(graph_.variable(poses_[k - 1].id).value.data());
+    const Time t_b = poses_[k].t;
+    while (i_a + 1 < k && SecondsBetween(poses_[i_a + 1].t, t_b) >= kAlignmentHalfSpan_s) ++i_a;
+    i_c = std::max(i_c, k + 1);
+    while (i_c + 1 < poses_.size() && SecondsBetween(t_b, poses_[i_c].t) < kAlignmentHalfSpan_s) ++i_c;
+    const Pose<double> a = PoseFromArray(graph_.variable(poses_[i_a].id).value.data());
     const Pose<double> b = PoseFromArray(graph_.variable(poses_[k].id).value.data());
-    const Pose<double> c = PoseFromArray(graph_.variable(poses_[k + 1].id).value.data());
-    const double dt_ab = SecondsBetween(poses_[k - 1].t, poses_[k].t);
-    const double dt_bc = SecondsBetween(poses_[k].t, poses_[k + 1].t);
+    const Pose<double> c = PoseFromArray(graph_.variable(poses_[i_c].id).value.data());
+    const Time t_a = poses_[i_a].t, t_c = poses_[i_c].t;
+    const double dt_ab = SecondsBetween(t_a, t_b), dt_bc = SecondsBetween(t_b, t_c);
     const Eigen::Vector3d accel_world =
         2.0 * ((c.p_world_body - b.p_world_body) / dt_bc - (b.p_world_body - a.p_world_body) / dt_ab) / (dt_ab + dt_bc);
     f_body.push_back(b.q_world_body.conjugate() * (accel_world + g_world));
     omega_body.push_back(QuaternionLog<double>(a.q_world_body.conjugate() * c.q_world_body) / (dt_ab + dt_bc));
-    const Eigen::RowVectorXd w_row = gyro->primary->values.row(NearestRow(*gyro->primary, poses_[k].t));
-    const Eigen::RowVectorXd f_row = accel->primary->values.row(NearestRow(*accel->primary, poses_[k].t));
-    omega_imu.push_back(w_row.segment<3>(gyro->column).transpose());
-    f_imu.push_back(f_row.segment<3>(accel->column).transpose());
+    const auto nearest = [&](const StreamBinding& s) -> Eigen::Vector3d {
+      return s.primary->values.row(NearestRow(*s.primary, t_b)).segment<3>(s.column).transpose();
+    };
+    omega_imu.push_back(MeanReading(*gyro->primary, gyro->column, t_a, t_b, t_c, false).value_or(nearest(*gyro)));
+    f_imu.push_back(MeanReading(*accel->primary, accel->column, t_a, t_b, t_c, true).value_or(nearest(*accel)));
   }
   // A rotation keeps a vector's length: a pair whose lengths disagree far beyond the spread of the others holds an
   // outlier (a master reading off by a few ticks puts a spike of tens of m/s^2 into the dead-reckoned acceleration

@@ -106,12 +106,46 @@ double TangentNorm(const std::vector<Variable*>& variables) {
   return std::sqrt(sq);
 }
 
+// Which variables Levenberg-Marquardt's next step damps. The constant parameters only (the poses and other
+// time-stamped states undamped) after a full step the model predicted well; every variable after a shortened or
+// rejected step, and for the rest of the solve once the states alone were not positive definite (a pose no row
+// constrains in some direction).
+//
+// Why: Marquardt's lambda diag(H) acts on every pose alike, and a chain of poses tied only by relative rows (a
+// stretch dead-reckoned on wheels and IMU between absolute fixes) has curvatures along its long-wavelength modes (the
+// chain bending as a whole, carrying the wheel parameters with it) of order (pi / N)^2 of its diagonal over N poses:
+// a damping of 1e-2 shortens the step along them thousands of times, and the solve crawls for hundreds of iterations
+// to a minimum Gauss-Newton reaches in tens. The states' rows tie each pose to its neighbours and to the parameters,
+// so with the parameters' step held back the states' step is the Gauss-Newton one given it. After a step the model
+// overestimated the damping must reach the states too: raised on the parameters alone it would shorten nothing
+// where the states' own step is what overshoots (the damping then climbs to its limit).
+class DampingScope {
+ public:
+  using Damping = internal::NormalEquations::Damping;
+  Damping next() const { return next_; }
+  void AfterStep(bool full_step_accepted) {
+    next_ = full_step_accepted && !states_singular_ ? Damping::kConstantsOnly : Damping::kAll;
+  }
+  void StatesNotPositiveDefinite() {
+    states_singular_ = true;
+    next_ = Damping::kAll;
+  }
+
+ private:
+  Damping next_ = Damping::kConstantsOnly;
+  bool states_singular_ = false;
+};
+
 // Solves the damped system, raising the damping up to ten times while the matrix is not positive definite.
-bool SolveWithDamping(internal::NormalEquations* system, double* lambda, Eigen::VectorXd* dx) {
-  bool solved = system->Solve(*lambda, dx);
+bool SolveWithDamping(internal::NormalEquations* system, double* lambda, DampingScope* scope, Eigen::VectorXd* dx) {
+  bool solved = system->Solve(*lambda, dx, scope->next());
+  if (!solved && *lambda > 0.0 && scope->next() == DampingScope::Damping::kConstantsOnly) {
+    scope->StatesNotPositiveDefinite();
+    solved = system->Solve(*lambda, dx, scope->next());
+  }
   for (int retry = 0; !solved && retry < 10; ++retry) {
     *lambda = std::max(*lambda * 10.0, 1e-9);
-    solved = system->Solve(*lambda, dx);
+    solved = system->Solve(*lambda, dx, scope->next());
   }
   return solved;
 }
@@ -250,6 +284,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
   const bool lm = options.method == SolverOptions::Method::kLevenbergMarquardt;
   double lambda = lm ? options.initial_lambda : 0.0;
   double nu = 2.0;
+  DampingScope damping;
   summary.termination = Termination::kMaxIterations;
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
     if (interrupted(iteration)) break;
@@ -259,7 +294,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
     }
     // Solve the damped system; raise the damping if the matrix is not positive definite.
     Eigen::VectorXd dx;
-    if (!SolveWithDamping(&system, &lambda, &dx)) {
+    if (!SolveWithDamping(&system, &lambda, &damping, &dx)) {
       summary.termination = Termination::kFailure;
       summary.message = "normal equations are not positive definite even with damping";
       break;
@@ -314,6 +349,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
       }
       lambda *= nu;
       nu *= 2.0;
+      damping.AfterStep(/*full_step_accepted=*/false);
       if (lambda > 1e16) {
         summary.termination = Termination::kFailure;
         summary.message = "Levenberg-Marquardt damping exceeded 1e16 without a successful step";
@@ -322,6 +358,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
       continue;
     }
     if (lm) AdaptDampingAfterStep(shortened, actual, predicted, &lambda, &nu);
+    damping.AfterStep(/*full_step_accepted=*/!shortened);
 
     // Stop here when converged or out of iterations or time; otherwise relinearize at the new point (which also
     // re-evaluates every error covariance, eq. 1).

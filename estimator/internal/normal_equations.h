@@ -93,8 +93,13 @@ class NormalEquations {
   // factorization under a relinearization threshold: see FactorEnvelope).
   long reused_blocks() const { return reused_blocks_; }
 
-  // Solves (H + lambda diag(H)) dx = -g. Returns false if the matrix is not positive definite.
-  bool Solve(double lambda, Eigen::VectorXd* dx);
+  // Which variables Levenberg-Marquardt's damping lambda diag(H) reaches: every one, or the constant parameters only
+  // (no time stamp), the states left undamped (Solve).
+  enum class Damping { kAll, kConstantsOnly };
+
+  // Solves (H + lambda D diag(H)) dx = -g, D selecting the damped variables. Returns false if the matrix is not
+  // positive definite.
+  bool Solve(double lambda, Eigen::VectorXd* dx, Damping damping = Damping::kAll);
 
   // The decrease of the quadratic model of the last Linearize along dx, -g.dx - dx.H.dx / 2. When H lacks the blocks
   // that the factorization took over (Linearize), dx must be the step of the last Solve, which was undamped: then
@@ -177,6 +182,7 @@ class NormalEquations {
   std::vector<VariableSlot> variable_table_;  // every variable of the graph, sorted by id
   std::vector<int> dims_;                     // per block
   std::vector<char> full_column_;             // per block: its column holds every row block before it
+  std::vector<char> damped_;                  // per dimension: lambda diag(H) added there (Solve)
   std::vector<int> block_offset_;             // per block: first column
   int dimension_ = 0;
 

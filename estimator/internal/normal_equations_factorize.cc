@@ -42,15 +42,20 @@ void NormalEquations::Analyze() {
   ++analyses_;
 }
 
-bool NormalEquations::Solve(double lambda, Eigen::VectorXd* dx) {
+bool NormalEquations::Solve(double lambda, Eigen::VectorXd* dx, Damping damping) {
   Cholmod& c = *cholmod_;
   undamped_step_ = false;
+  damped_.assign(dimension_, 1);
+  if (damping == Damping::kConstantsOnly)
+    for (std::size_t b = 0; b < order_.size(); ++b)
+      std::fill_n(damped_.begin() + block_offset_[b], dims_[b], static_cast<char>(full_column_[b]));
   const Eigen::SparseMatrix<double>* A = &H_;
   if (lambda > 0.0 && !natural_order_) {  // (the envelope takes H_ and adds the damping as it copies it)
     CompleteHessian();
     c.damped = H_;
     double* v = c.damped.valuePtr();
-    for (int i = 0; i < dimension_; ++i) v[diagonal_index_[i]] += lambda * std::max(v[diagonal_index_[i]], 1e-12);
+    for (int i = 0; i < dimension_; ++i)
+      if (damped_[i]) v[diagonal_index_[i]] += lambda * std::max(v[diagonal_index_[i]], 1e-12);
     A = &c.damped;
   }
   if (natural_order_ && factor_kept_) {
@@ -352,7 +357,7 @@ bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, doubl
       double* column = envelope_.data() + envelope_start_[b] + t * height - row0;
       for (int p = outer[j]; p < outer[j + 1]; ++p)
         if (inner[p] <= j) column[inner[p]] = value[p];
-      if (!undamped) column[j] += lambda * std::max(column[j], 1e-12);
+      if (!undamped && damped_[j]) column[j] += lambda * std::max(column[j], 1e-12);
     }
     const int end_row = block_offset_[b] + dims_[b];
     for (int c = 0; c < border_columns; ++c) {
@@ -380,7 +385,7 @@ bool NormalEquations::FactorEnvelope(const Eigen::SparseMatrix<double>& A, doubl
     for (int p = next[c]; p < outer[j + 1]; ++p)
       if (inner[p] <= j) corner_(inner[p] - na, c) = value[p];
     double& diagonal = corner_(c, c);
-    if (!undamped) diagonal += lambda * std::max(diagonal, 1e-12);
+    if (!undamped && damped_[j]) diagonal += lambda * std::max(diagonal, 1e-12);
   }
   if (factored && dimension_ > na) {
     corner_.selfadjointView<Eigen::Upper>().rankUpdate(border_.transpose(), -1.0);

@@ -219,6 +219,8 @@ TEST(NormalEquationsTest, EnvelopeFactorizationThatFailsPartwayIsFollowedByAGood
   ASSERT_TRUE(system.factored_in_envelope());
   Eigen::VectorXd dx;
   EXPECT_FALSE(system.Solve(0.0, &dx));
+  // Damping the constant parameter alone leaves the pose's block singular.
+  EXPECT_FALSE(system.Solve(0.3, &dx, internal::NormalEquations::Damping::kConstantsOnly));
   const Eigen::MatrixXd H = Eigen::SparseMatrix<double>(system.hessian_upper().selfadjointView<Eigen::Upper>());
   const double lambda = 0.3;
   Eigen::MatrixXd damped = H;
@@ -257,15 +259,19 @@ TEST(NormalEquationsTest, LargeBandIsFactoredInItsEnvelopeUnlessManyPosesFarApar
     ASSERT_EQ(system.dimension(), 2403);
     EXPECT_EQ(system.factored_in_envelope(), !loop);
     const Eigen::SparseMatrix<double> H = system.hessian_upper().selfadjointView<Eigen::Upper>();
-    for (const double lambda : {0.0, 0.3}) {
+    // Undamped, damped, and damped on the constant parameter only (its 3 trailing rows; the poses undamped).
+    using Damping = internal::NormalEquations::Damping;
+    for (const auto& [lambda, damping] : {std::pair(0.0, Damping::kAll), std::pair(0.3, Damping::kAll),
+                                          std::pair(0.3, Damping::kConstantsOnly)}) {
+      const int first_damped = damping == Damping::kAll ? 0 : system.dimension() - 3;
       Eigen::SparseMatrix<double> A = H;
-      for (int i = 0; i < A.rows(); ++i) A.coeffRef(i, i) += lambda * std::max(H.coeff(i, i), 1e-12);
+      for (int i = first_damped; i < A.rows(); ++i) A.coeffRef(i, i) += lambda * std::max(H.coeff(i, i), 1e-12);
       const Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> reference(A);
       ASSERT_EQ(reference.info(), Eigen::Success);
       const Eigen::VectorXd expected = reference.solve(-system.gradient());
       Eigen::VectorXd dx;
-      ASSERT_TRUE(system.Solve(lambda, &dx));
-      EXPECT_LT((dx - expected).norm(), 1e-9 * expected.norm()) << "lambda " << lambda;
+      ASSERT_TRUE(system.Solve(lambda, &dx, damping));
+      EXPECT_LT((dx - expected).norm(), 1e-9 * expected.norm()) << "lambda " << lambda << ", from " << first_damped;
     }
 
     // The parameter's information with the poses marginalized out, Hpp - Hxp^T Hxx^-1 Hxp: from the envelope

@@ -4,7 +4,9 @@
 #include <cstdint>
 #include <deque>
 #include <random>
+#include <string>
 #include <tuple>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -177,6 +179,47 @@ TEST(SolverTest, LevenbergMarquardtShortensARejectedStepToTheMinimumAlongIt) {
   EXPECT_EQ(summary.cost_history.size(), static_cast<std::size_t>(summary.iterations) + 1);  // all accepted
   EXPECT_LT(std::abs(summary.cost_history[1] - 0.5 * std::pow(std::sin(-0.02), 2)), 2e-3);
   EXPECT_LT(std::abs(graph.variable(x).value[0]), 1e-6);
+}
+
+// A stretch dead-reckoned between two absolute fixes: N stamped states tied by x_{k+1} - x_k = c (c a constant
+// parameter, such as a wheel radius), the first and the last pinned by priors, started from the chain integrated with
+// a wrong c. The error is a ramp, the chain's longest mode, whose curvature is about (pi / N)^2 of the diagonal: a
+// damping of 1e-2 on the states would shorten the step along it a thousand times. Damping only c (the states
+// undamped), the problem being linear, the first step takes the chain to its minimum given c.
+TEST(SolverTest, LevenbergMarquardtDampsTheConstantParametersNotTheStates) {
+  constexpr int kStates = 1000;
+  constexpr double kStep = 0.01, kStartStep = 0.012;
+  Graph graph;
+  const VariableId c =
+      graph.AddVariable({"c", Manifold::Euclidean(1), Eigen::VectorXd::Constant(1, kStartStep), false, std::nullopt});
+  std::vector<VariableId> x;
+  for (int k = 0; k < kStates; ++k)
+    x.push_back(graph.AddVariable({"x" + std::to_string(k), Manifold::Euclidean(1),
+                                   Eigen::VectorXd::Constant(1, k * kStartStep), false, Time::FromSeconds(0.01 * k)}));
+  const std::vector<Manifold> one(1, Manifold::Euclidean(1)), three(3, Manifold::Euclidean(1));
+  const Eigen::MatrixXd unit = Eigen::MatrixXd::Identity(1, 1);
+  const auto zeros = [](int n) { return std::vector<Eigen::VectorXd>(n, Eigen::VectorXd::Zero(1)); };
+  // e = (x_{k+1} - x_k - c) / 0.01 and e = (x - fix) / 0.001, linear in the values (linearized at zero).
+  for (int k = 0; k + 1 < kStates; ++k)
+    graph.AddFactor(std::make_unique<LinearPriorFactor>(three, zeros(3), Eigen::RowVector3d(-100.0, 100.0, -100.0),
+                                                        Eigen::VectorXd::Zero(1)),
+                    {x[k], x[k + 1], c}, unit, Loss::Trivial(), "chain", Time::FromSeconds(0.01 * k));
+  for (const int k : {0, kStates - 1})
+    graph.AddFactor(std::make_unique<LinearPriorFactor>(one, zeros(1), Eigen::MatrixXd::Constant(1, 1, 1000.0),
+                                                        Eigen::VectorXd::Constant(1, -1000.0 * k * kStep)),
+                    {x[k]}, unit, Loss::Trivial(), "fix", Time::FromSeconds(0.01 * k));
+  SolverOptions options;
+  options.initial_lambda = 1e-2;
+  options.max_iterations = 2;
+  const SolverSummary summary = Solve(options, &graph);
+  ASSERT_TRUE(summary.usable()) << summary.message;
+  // c's step is held back by its damping, 1e-2 of its curvature: 1 % of its error left. The middle of the chain,
+  // 1 m off at the start, moves to the minimum given c (damping the states too, it stays 1 m off after two steps).
+  const double c_error = kStartStep - kStep;
+  EXPECT_LT(std::abs(graph.variable(c).value[0] - kStep), 0.02 * c_error);
+  const int middle = kStates / 2;
+  EXPECT_LT(std::abs(graph.variable(x[middle]).value[0] - middle * kStep), 1e-6);
+  EXPECT_LT(summary.final_cost, 1e-8 * summary.initial_cost);
 }
 
 // The solver's order: poses in time; each time-varying instance after the last pose it serves (just before the pose
