@@ -101,7 +101,8 @@ class Parser {
 
   void ParseSolver(const YAML::Node& n, SolverOptions* s) const {
     CheckKeys(n,
-              {"method", "max_iterations", "function_tolerance", "step_tolerance", "time_budget_s", "initial_lambda"},
+              {"method", "max_iterations", "function_tolerance", "step_tolerance", "time_budget_s", "initial_lambda",
+               "damping"},
               "solver");
     if (n["method"]) {
       const std::string m = String(n["method"], "solver.method");
@@ -118,6 +119,16 @@ class Parser {
     if (n["step_tolerance"]) s->step_tolerance = Number(n["step_tolerance"], "step_tolerance");
     if (n["time_budget_s"]) s->time_budget_s = Number(n["time_budget_s"], "time_budget_s");
     if (n["initial_lambda"]) s->initial_lambda = Number(n["initial_lambda"], "initial_lambda");
+    if (n["damping"]) {
+      const std::string d = String(n["damping"], "solver.damping");
+      if (d == "all") {
+        s->damping = SolverOptions::Damping::kAll;
+      } else if (d == "parameters") {
+        s->damping = SolverOptions::Damping::kParameters;
+      } else {
+        Fail(n["damping"], "solver.damping must be all or parameters, not '" + d + "'");
+      }
+    }
     const std::string problem = s->Validate();
     if (!problem.empty()) Fail(n, "solver: " + problem);
   }

@@ -106,10 +106,10 @@ double TangentNorm(const std::vector<Variable*>& variables) {
   return std::sqrt(sq);
 }
 
-// Which variables Levenberg-Marquardt's next step damps. The constant parameters only (the poses and other
-// time-stamped states undamped) after a full step the model predicted well; every variable after a shortened or
-// rejected step, and for the rest of the solve once the states alone were not positive definite (a pose no row
-// constrains in some direction).
+// Which variables Levenberg-Marquardt's next step damps (SolverOptions::damping). With kParameters: the constant
+// parameters only (the poses and other time-stamped states undamped) after a full step the model predicted well;
+// every variable after a shortened or rejected step, and for the rest of the solve once the states alone were not
+// positive definite (a pose no row constrains in some direction). With kAll: every variable, always.
 //
 // Why: Marquardt's lambda diag(H) acts on every pose alike, and a chain of poses tied only by relative rows (a
 // stretch dead-reckoned on wheels and IMU between absolute fixes) has curvatures along its long-wavelength modes (the
@@ -122,18 +122,19 @@ double TangentNorm(const std::vector<Variable*>& variables) {
 class DampingScope {
  public:
   using Damping = internal::NormalEquations::Damping;
+  explicit DampingScope(SolverOptions::Damping option) : every_variable_(option == SolverOptions::Damping::kAll) {}
   Damping next() const { return next_; }
   void AfterStep(bool full_step_accepted) {
-    next_ = full_step_accepted && !states_singular_ ? Damping::kConstantsOnly : Damping::kAll;
+    next_ = full_step_accepted && !every_variable_ ? Damping::kConstantsOnly : Damping::kAll;
   }
   void StatesNotPositiveDefinite() {
-    states_singular_ = true;
+    every_variable_ = true;
     next_ = Damping::kAll;
   }
 
  private:
-  Damping next_ = Damping::kConstantsOnly;
-  bool states_singular_ = false;
+  bool every_variable_;
+  Damping next_ = every_variable_ ? Damping::kAll : Damping::kConstantsOnly;
 };
 
 // Solves the damped system, raising the damping up to ten times while the matrix is not positive definite.
@@ -284,7 +285,7 @@ SolverSummary Solve(const SolverOptions& options, Graph* graph, CovarianceReques
   const bool lm = options.method == SolverOptions::Method::kLevenbergMarquardt;
   double lambda = lm ? options.initial_lambda : 0.0;
   double nu = 2.0;
-  DampingScope damping;
+  DampingScope damping(options.damping);
   summary.termination = Termination::kMaxIterations;
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
     if (interrupted(iteration)) break;

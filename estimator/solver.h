@@ -34,6 +34,11 @@ struct SolverOptions {
   double time_budget_s = std::numeric_limits<double>::infinity();
   // Initial Levenberg-Marquardt damping, relative to diag(H).
   double initial_lambda = 1e-4;
+  // Which variables Levenberg-Marquardt's damping reaches: every one, or after a step its model predicted only the
+  // constant parameters, the poses and other time-stamped states undamped (solver.cc, DampingScope: for a stretch
+  // dead-reckoned between absolute fixes, whose long modes the damping of every pose holds back).
+  enum class Damping { kAll, kParameters };
+  Damping damping = Damping::kAll;
   // Gauss-Newton only: relinearization threshold (iSAM2's; internal::NormalEquations::set_relinearize_threshold). A
   // factor (trivial loss) whose free variables all moved by at most this much in every tangent component since its
   // Jacobians were computed keeps them, and its error is carried to the new values to first order; its part of the

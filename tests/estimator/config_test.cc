@@ -70,6 +70,18 @@ TEST(ConfigTest, AStreamIsGatedUnlessItSaysGateFalse) {
   ExpectError(Replace(good, fixes, fixes + ", gate: sometimes"), "stream 'gps'.gate");
 }
 
+TEST(ConfigTest, SolverDampsEveryVariableUnlessItSaysParameters) {
+  const std::string good = testing::AtvConfigYaml({});
+  const auto by_default = ParseEstimatorConfig(good, "est.yaml");
+  ASSERT_TRUE(by_default.ok()) << by_default.status().message();
+  EXPECT_EQ(by_default.value().solver.damping, SolverOptions::Damping::kAll);
+  const std::string method = "method: levenberg_marquardt";
+  const auto parameters = ParseEstimatorConfig(Replace(good, method, method + ", damping: parameters"), "est.yaml");
+  ASSERT_TRUE(parameters.ok()) << parameters.status().message();
+  EXPECT_EQ(parameters.value().solver.damping, SolverOptions::Damping::kParameters);
+  ExpectError(Replace(good, method, method + ", damping: poses"), "solver.damping must be all or parameters");
+}
+
 TEST(ConfigTest, RejectsUnknownKeysModelsAndMissingNoise) {
   const std::string good = testing::AtvConfigYaml({});
   ExpectError(Replace(good, "master: odometer", "master: odometer\nwindow: 3"), "unknown key 'window'");
