@@ -36,7 +36,9 @@ struct SolverOptions {
   double initial_lambda = 1e-4;
   // Which variables Levenberg-Marquardt's damping reaches: every one, or after a step its model predicted only the
   // constant parameters, the poses and other time-stamped states undamped (solver.cc, DampingScope: for a stretch
-  // dead-reckoned between absolute fixes, whose long modes the damping of every pose holds back).
+  // dead-reckoned between absolute fixes, whose long modes the damping of every pose holds back). Not the default:
+  // where weak directions leave several minima (an IMU-master calibration with unobservable misalignment components)
+  // the longer steps can lead to another one.
   enum class Damping { kAll, kParameters };
   Damping damping = Damping::kAll;
   // Gauss-Newton only: relinearization threshold (iSAM2's; internal::NormalEquations::set_relinearize_threshold). A
