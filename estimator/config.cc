@@ -7,6 +7,9 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
 
@@ -67,6 +70,19 @@ class Parser {
     return node.as<std::string>();
   }
 
+  // The value of `node` among `choices` (name, value); anything else fails naming them.
+  template <typename T>
+  T Choice(const YAML::Node& node, const std::string& what,
+           const std::vector<std::pair<std::string, T>>& choices) const {
+    const std::string given = String(node, what);
+    std::string names;
+    for (std::size_t i = 0; i < choices.size(); ++i) {
+      if (choices[i].first == given) return choices[i].second;
+      names += (i == 0 ? "" : i + 1 == choices.size() ? " or " : ", ") + choices[i].first;
+    }
+    Fail(node, what + " must be " + names + ", not '" + given + "'");
+  }
+
   std::vector<double> Numbers(const YAML::Node& node, const std::string& what, bool allow_inf = false) const {
     std::vector<double> out;
     if (node.IsScalar()) return {Number(node, what, allow_inf)};
@@ -104,31 +120,20 @@ class Parser {
               {"method", "max_iterations", "function_tolerance", "step_tolerance", "time_budget_s", "initial_lambda",
                "damping"},
               "solver");
-    if (n["method"]) {
-      const std::string m = String(n["method"], "solver.method");
-      if (m == "gauss_newton") {
-        s->method = SolverOptions::Method::kGaussNewton;
-      } else if (m == "levenberg_marquardt") {
-        s->method = SolverOptions::Method::kLevenbergMarquardt;
-      } else {
-        Fail(n["method"], "solver.method must be gauss_newton or levenberg_marquardt, not '" + m + "'");
-      }
-    }
+    using Method = SolverOptions::Method;
+    if (n["method"])
+      s->method = Choice<Method>(n["method"], "solver.method",
+                                 {{"gauss_newton", Method::kGaussNewton},
+                                  {"levenberg_marquardt", Method::kLevenbergMarquardt}});
     if (n["max_iterations"]) s->max_iterations = static_cast<int>(Number(n["max_iterations"], "max_iterations"));
     if (n["function_tolerance"]) s->function_tolerance = Number(n["function_tolerance"], "function_tolerance");
     if (n["step_tolerance"]) s->step_tolerance = Number(n["step_tolerance"], "step_tolerance");
     if (n["time_budget_s"]) s->time_budget_s = Number(n["time_budget_s"], "time_budget_s");
     if (n["initial_lambda"]) s->initial_lambda = Number(n["initial_lambda"], "initial_lambda");
-    if (n["damping"]) {
-      const std::string d = String(n["damping"], "solver.damping");
-      if (d == "all") {
-        s->damping = SolverOptions::Damping::kAll;
-      } else if (d == "parameters") {
-        s->damping = SolverOptions::Damping::kParameters;
-      } else {
-        Fail(n["damping"], "solver.damping must be all or parameters, not '" + d + "'");
-      }
-    }
+    using Damping = SolverOptions::Damping;
+    if (n["damping"])
+      s->damping = Choice<Damping>(n["damping"], "solver.damping",
+                                   {{"all", Damping::kAll}, {"parameters", Damping::kParameters}});
     const std::string problem = s->Validate();
     if (!problem.empty()) Fail(n, "solver: " + problem);
   }

@@ -135,6 +135,11 @@ std::optional<Eigen::Quaterniond> InitialImuMisalignment(const EstimatorConfig& 
   return builder.AlignImuToMotion();
 }
 
+Eigen::Quaterniond TrueImuMisalignment(const roamlab::testing::SyntheticRecording& synthetic) {
+  const std::vector<double>& truth = synthetic.truth.calibration.at("imu.misalignment");
+  return Eigen::Quaterniond(truth[0], truth[1], truth[2], truth[3]);
+}
+
 TEST(CalibrationTest, ImuMountedUpsideDownIsFoundFromTheMotion) {
   // Starting from the identity, Gauss-Newton cannot turn a misalignment 180 degrees away (from the MuJoCo ATV it ended
   // 72 degrees off after 1800 iterations). The Wahba initialization (ProblemBuilder::AlignImuToMotion) starts it
@@ -146,8 +151,7 @@ TEST(CalibrationTest, ImuMountedUpsideDownIsFoundFromTheMotion) {
   options.q_body_imu = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY())) *
                        Eigen::Quaterniond(0.938, 0.104, 0.313, 0.104).normalized();
   const auto synthetic = roamlab::testing::MakeAtvRecording(options);
-  const std::vector<double>& truth = synthetic.truth.calibration.at("imu.misalignment");
-  const Eigen::Quaterniond q_true(truth[0], truth[1], truth[2], truth[3]);
+  const Eigen::Quaterniond q_true = TrueImuMisalignment(synthetic);
   const EstimatorConfig config = testing::AtvConfig({"imu.misalignment", "gps.lever_arm"});
 
   const auto q_initial = InitialImuMisalignment(config, synthetic.recording);
@@ -175,12 +179,10 @@ TEST(CalibrationTest, WahbaPairsTheMotionWithTheImuOverASpanNotOneInterval) {
   options.sigma_speed_mps = 3.0;
   options.hilly = false;
   const auto synthetic = roamlab::testing::MakeAtvRecording(options);
-  const std::vector<double>& truth = synthetic.truth.calibration.at("imu.misalignment");
-  const Eigen::Quaterniond q_true(truth[0], truth[1], truth[2], truth[3]);
-  const EstimatorConfig config = testing::AtvConfig({"imu.misalignment", "gps.lever_arm"});
-  const auto q_initial = InitialImuMisalignment(config, synthetic.recording);
+  const auto q_initial =
+      InitialImuMisalignment(testing::AtvConfig({"imu.misalignment", "gps.lever_arm"}), synthetic.recording);
   ASSERT_TRUE(q_initial.has_value());
-  EXPECT_LT(q_initial->angularDistance(q_true), 6.0 * M_PI / 180.0);
+  EXPECT_LT(q_initial->angularDistance(TrueImuMisalignment(synthetic)), 6.0 * M_PI / 180.0);
 }
 
 TEST(CalibrationTest, ResidualsAreTheWhitenedErrorsOfTheCostAndAWarmStartLandsOnTheSameEstimate) {
