@@ -813,8 +813,9 @@ std::optional<Eigen::Vector3d> MeanReading(const recording::Stream& stream, int 
 }  // namespace
 
 // The dead-reckoned poses know the body's motion in the plane: from three poses kAlignmentHalfSpan_s apart, the
-// body-frame mean angular velocity omega^(O) and specific force f^(O) = R^T (a + g e_z) (eqs. 13-14 without lever arm; the poses are level,
-// so hills show up as unexplained gravity components, averaging out over a drive). The IMU reads the same vectors in
+// body-frame mean angular velocity omega^(O) [rad/s] and specific force f^(O) = R^T (a + g e_z) [m/s^2] (eqs. 13-14
+// without lever arm; the poses are level, so hills show up as unexplained gravity components, averaging out over a
+// drive). The IMU reads the same vectors in
 // its own frame: omega^(S) = R_OS^T omega^(O), f^(S) = R_OS^T f^(O). Wahba's problem, max over R of
 // sum_i w_i u_i^(O) . R u_i^(S), is solved by the SVD of B = sum_i w_i u_i^(O) u_i^(S)T: R = U diag(1, 1, d) V^T.
 // Gravity fixes the body's z axis in the IMU frame; forward acceleration and the centripetal acceleration of turns

@@ -115,10 +115,10 @@ double TangentNorm(const std::vector<Variable*>& variables) {
 // stretch dead-reckoned on wheels and IMU between absolute fixes) has curvatures along its long-wavelength modes (the
 // chain bending as a whole, carrying the wheel parameters with it) of order (pi / N)^2 of its diagonal over N poses:
 // a damping of 1e-2 shortens the step along them thousands of times, and the solve crawls for hundreds of iterations
-// to a minimum the undamped states reach in tens. The states' rows tie each pose to its neighbours and to the parameters,
-// so with the parameters' step held back the states' step is the Gauss-Newton one given it. After a step the model
-// overestimated the damping must reach the states too: raised on the parameters alone it would shorten nothing
-// where the states' own step is what overshoots (the damping then climbs to its limit).
+// to a minimum the undamped states reach in tens. The states' rows tie each pose to its neighbours and to the
+// parameters, so with the parameters' step held back the states' step is the Gauss-Newton one given it. After a step
+// the model overestimated the damping must reach the states too: raised on the parameters alone it would shorten
+// nothing where the states' own step is what overshoots (the damping then climbs to its limit).
 class DampingScope {
  public:
   using Damping = internal::NormalEquations::Damping;
