@@ -103,6 +103,51 @@ struct TestedFactor {
 // consecutive ones three spans.
 constexpr std::size_t kMaxBridgedReadings = 3;
 
+// Bridges over the spikes at the ends of the failing spans (not bridges) of cumulative wheel streams
+// (ProblemBuilder::IsCumulativeSpike, read up to each stream's newest span): groups of up to kMaxBridgedReadings
+// consecutive spiking readings, each left out by a bridge whether or not it passes the test at the current estimate.
+// Where two outlying readings lie a row or two apart the estimate can follow them (the reading between them bent
+// instead), so that at that estimate the bridges over the outliers fail and those over their good neighbours pass;
+// the readings alone tell them apart.
+// Removes the spans bridged from *by_row and adds them to *bridged, the readings left out to *readings and each
+// bridged run to *runs.
+void BridgeSpikes(const std::map<FactorId, bool>& failing_now, const std::function<double(int)>& threshold,
+                  const std::map<int, FactorId>& newest, ProblemBuilder* builder,
+                  std::map<std::pair<int, int>, FactorId>* by_row, std::set<FactorId>* bridged, int* readings,
+                  std::vector<std::vector<FactorId>>* runs) {
+  const std::map<FactorId, ProblemBuilder::CumulativeSpan>& spans = builder->cumulative_spans();
+  std::set<std::pair<int, int>> spikes;  // (stream, row)
+  for (const auto& [id, fails] : failing_now) {
+    const auto span = spans.find(id);
+    if (!fails || span == spans.end() || span->second.replaced || span->second.bridge) continue;
+    const int stream = span->second.stream;
+    const auto stream_newest = newest.find(stream);
+    if (stream_newest == newest.end()) continue;
+    const int last_row = spans.at(stream_newest->second).row_end;
+    for (const int row : {span->second.row_begin, span->second.row_end})
+      if (spikes.count({stream, row}) == 0 && builder->IsCumulativeSpike(stream, row, last_row, threshold))
+        spikes.insert({stream, row});
+  }
+  for (auto it = spikes.begin(); it != spikes.end();) {
+    auto end = std::next(it);
+    while (end != spikes.end() && end->first == it->first && end->second == std::prev(end)->second + 1) ++end;
+    const int stream = it->first, first = it->second, count = static_cast<int>(std::distance(it, end));
+    it = end;
+    if (count > static_cast<int>(kMaxBridgedReadings)) continue;
+    std::vector<FactorId> run;
+    for (int row = first - 1; row < first + count; ++row) {
+      const auto span = by_row->find({stream, row});
+      if (span == by_row->end()) break;
+      run.push_back(span->second);
+    }
+    if (static_cast<int>(run.size()) != count + 1 || !builder->BridgeCumulativeRun(run)) continue;
+    for (int row = first - 1; row < first + count; ++row) by_row->erase({stream, row});
+    bridged->insert(run.begin(), run.end());
+    runs->push_back(run);
+    *readings += count;
+  }
+}
+
 // Bridges (ProblemBuilder::BridgeCumulativeRun) over outlying readings of cumulative wheel streams. A reading off by
 // delta makes the span before it delta / dt too fast and the one after it delta / dt too slow; tested alone, each
 // span fails and is rejected, and the poses around the reading lose both. In each run of consecutive failing spans
@@ -160,12 +205,13 @@ std::set<FactorId> BridgeFailingRuns(const std::vector<TestedFactor>& tested,
       }
     }
   };
-  int last_stream = -1, last_end = -1;
-  std::vector<FactorId> run;
-  bool tested_in_run = false;
   // The last span of each stream.
   std::map<int, FactorId> newest;
   for (const auto& [key, id] : by_row) newest[key.first] = id;
+  BridgeSpikes(failing_now, threshold, newest, builder, &by_row, &bridged, readings, runs);
+  int last_stream = -1, last_end = -1;
+  std::vector<FactorId> run;
+  bool tested_in_run = false;
   const auto close_run = [&] {
     const bool open = !run.empty() && newest[last_stream] == run.back();
     if (run.size() >= 2 && tested_in_run) bridge_run(run, open);

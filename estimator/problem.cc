@@ -1,10 +1,12 @@
 #include "estimator/problem.h"
 
 #include <algorithm>
+#include <bitset>
 #include <cmath>
 #include <cstddef>
 #include <functional>
 #include <limits>
+#include <numeric>
 #include <optional>
 #include <set>
 #include <vector>
@@ -590,6 +592,79 @@ std::optional<FactorEntry> ProblemBuilder::CumulativeBridge(const std::vector<Fa
   bridge.stream = first.stream;
   bridge.stamp = first.stamp;
   return bridge;
+}
+
+namespace {
+
+// A spike's neighbours (ProblemBuilder::IsCumulativeSpike): up to 5 rows either side, at most 4 of them left out.
+constexpr int kSpikeHalfWindow = 5;
+constexpr int kSpikeMaxLeftOut = 4;
+
+// Row j's readings' whitened squared distance from the quadratic `coeffs` in time about t0 (QuadraticFitDistances).
+double WhitenedFromQuadratic(const recording::Stream& r, int j, Time t0, double rate_sigma,
+                             const Eigen::MatrixXd& coeffs) {
+  const double tau = SecondsBetween(t0, r.t[j]);
+  const int a = std::max(j - 1, 0), b = std::min(j + 1, static_cast<int>(r.t.size()) - 1);
+  const double sigma = rate_sigma * SecondsBetween(r.t[a], r.t[b]) / (b - a) / std::sqrt(2.0);
+  const Eigen::RowVectorXd fit = coeffs.row(0) + tau * coeffs.row(1) + tau * tau * coeffs.row(2);
+  return (r.values.row(j) - fit).squaredNorm() / (sigma * sigma);
+}
+
+// The readings of rows `rows` of a cumulative stream against the quadratic in time about `t0` fitted to them: each
+// row's whitened squared distance, its reading's noise that of a span's wheel rate `rate_sigma` times the local
+// sample interval over sqrt(2). Also the fit's coefficients (constant, slope, curvature; a column per wheel).
+std::vector<double> QuadraticFitDistances(const recording::Stream& r, const std::vector<int>& rows, Time t0,
+                                          double rate_sigma, Eigen::MatrixXd* coeffs) {
+  Eigen::MatrixXd design(static_cast<Eigen::Index>(rows.size()), 3);
+  Eigen::MatrixXd readings(static_cast<Eigen::Index>(rows.size()), r.values.cols());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const double tau = SecondsBetween(t0, r.t[rows[i]]);
+    design.row(static_cast<Eigen::Index>(i)) << 1.0, tau, tau * tau;
+    readings.row(static_cast<Eigen::Index>(i)) = r.values.row(rows[i]);
+  }
+  *coeffs = design.colPivHouseholderQr().solve(readings);
+  std::vector<double> distances;
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    distances.push_back(WhitenedFromQuadratic(r, rows[i], t0, rate_sigma, *coeffs));
+  return distances;
+}
+
+}  // namespace
+
+bool ProblemBuilder::IsCumulativeSpike(int stream, int row, int last_row,
+                                       const std::function<double(int)>& threshold) const {
+  const StreamBinding& s = impl_->streams[static_cast<std::size_t>(stream)];
+  const recording::Stream& r = *s.primary;
+  last_row = std::min(last_row, static_cast<int>(r.t.size()) - 1);
+  if (row - 2 < 0 || row + 2 > last_row) return false;
+  const double rate_sigma = std::sqrt(s.noise_covariance(0, 0));
+  const double bound = threshold(static_cast<int>(r.values.cols()));
+  std::vector<int> neighbours;
+  for (int j = std::max(0, row - kSpikeHalfWindow); j <= std::min(last_row, row + kSpikeHalfWindow); ++j)
+    if (j != row) neighbours.push_back(j);
+  const int n = static_cast<int>(neighbours.size());
+  // The fewest neighbours left out for the rest to fit within the bound (the best such fit), then the reading.
+  for (int left_out = 0; left_out <= kSpikeMaxLeftOut; ++left_out) {
+    double best_total = std::numeric_limits<double>::infinity(), best_reading = 0.0;
+    for (unsigned mask = 0; mask < (1u << n); ++mask) {
+      if (static_cast<int>(std::bitset<32>(mask).count()) != left_out) continue;
+      std::vector<int> kept;
+      for (int i = 0; i < n; ++i)
+        if ((mask & (1u << i)) == 0) kept.push_back(neighbours[static_cast<std::size_t>(i)]);
+      const auto before = std::count_if(kept.begin(), kept.end(), [&](int j) { return j < row; });
+      if (before < 2 || static_cast<std::ptrdiff_t>(kept.size()) - before < 2) continue;
+      Eigen::MatrixXd coeffs;
+      const std::vector<double> d = QuadraticFitDistances(r, kept, r.t[row], rate_sigma, &coeffs);
+      if (*std::max_element(d.begin(), d.end()) > bound) continue;
+      const double total = std::accumulate(d.begin(), d.end(), 0.0);
+      if (total < best_total) {
+        best_total = total;
+        best_reading = WhitenedFromQuadratic(r, row, r.t[row], rate_sigma, coeffs);
+      }
+    }
+    if (best_total < std::numeric_limits<double>::infinity()) return best_reading > bound;
+  }
+  return false;
 }
 
 std::optional<FactorId> ProblemBuilder::BridgeCumulativeRun(const std::vector<FactorId>& run) {

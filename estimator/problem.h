@@ -40,6 +40,7 @@
 #pragma once
 
 #include <deque>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -144,6 +145,12 @@ class ProblemBuilder {
   std::optional<FactorId> BridgeCumulativeRun(const std::vector<FactorId>& run);
   // The factor that BridgeCumulativeRun would add, not added (to test it first).
   std::optional<FactorEntry> CumulativeBridge(const std::vector<FactorId>& run) const;
+  // Whether the reading of row `row` of cumulative stream `stream` is a spike, told from the readings alone: its
+  // whitened squared distance from a quadratic in time through its neighbours exceeds `threshold(wheels)`, while the
+  // neighbours kept fit within it. The neighbours: up to 5 rows either side (none after `last_row`), the fewest of them
+  // left out (at most 4) for the rest to fit; each wheel's reading noise is the stream's wheel-rate noise times the
+  // sample interval over sqrt(2). False where fewer than two neighbours either side remain.
+  bool IsCumulativeSpike(int stream, int row, int last_row, const std::function<double(int)>& threshold) const;
 
   // Absolute position fixes (GPS, absolute pose) as (pose, measured position in W), for initial alignment.
   const std::vector<std::pair<VariableId, Eigen::Vector3d>>& absolute_fixes() const { return absolute_fixes_; }
