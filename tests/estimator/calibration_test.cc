@@ -555,15 +555,20 @@ std::set<int> BridgedRows(const ProblemBuilder& builder) {
   return rows;
 }
 
-// A spike is told from the readings alone: rows 30 and 32 off by 0.5 rad, the good row 31 between them is not; nor is
-// a row with fewer than two readable neighbours after it.
-TEST(ProblemBuilderTest, ASpikeIsToldFromTheNeighbouringReadings) {
+// The bridging tests' arc (60 samples) with the wheels' cumulative angles of rows 30 and 32 both off by 0.5 rad.
+recording::Recording ArcWithReadingsOffAt30And32() {
   recording::Recording rec = testing::DiffDriveArcWithMotionCapture(60, 0.3, Eigen::Vector2d(1.0, -2.0));
   rec.streams[0].values.row(30) += Eigen::RowVector2d(0.5, 0.5);
   rec.streams[0].values.row(32) += Eigen::RowVector2d(0.5, 0.5);
+  return rec;
+}
+
+// A spike is told from the readings alone: rows 30 and 32 off by 0.5 rad, the good row 31 between them is not; nor is
+// a row with fewer than two readable neighbours after it.
+TEST(ProblemBuilderTest, ASpikeIsToldFromTheNeighbouringReadings) {
   const auto config = BridgingConfig();
   ASSERT_TRUE(config.ok()) << config.status().message();
-  auto built = ProblemBuilder::Create(config.value(), rec);
+  auto built = ProblemBuilder::Create(config.value(), ArcWithReadingsOffAt30And32());
   ASSERT_TRUE(built.ok()) << built.status().message();
   const std::vector<std::string>& names = built.value()->stream_names();
   const int wheels = static_cast<int>(std::find(names.begin(), names.end(), "wheels") - names.begin());
@@ -580,12 +585,9 @@ TEST(ProblemBuilderTest, ASpikeIsToldFromTheNeighbouringReadings) {
 // between them. (Where the estimate follows such a pair, bridges tested at it can leave the good reading out instead:
 // `indoor_fault_outliers` of regression/faults.yaml.)
 TEST(GateOutliersTest, OutlyingReadingsTwoRowsApartAreBridgedNotTheGoodReadingBetween) {
-  recording::Recording rec = testing::DiffDriveArcWithMotionCapture(60, 0.3, Eigen::Vector2d(1.0, -2.0));
-  rec.streams[0].values.row(30) += Eigen::RowVector2d(0.5, 0.5);
-  rec.streams[0].values.row(32) += Eigen::RowVector2d(0.5, 0.5);
   const auto config = BridgingConfig();
   ASSERT_TRUE(config.ok()) << config.status().message();
-  const std::unique_ptr<ProblemBuilder> builder = SolvedProblem(config.value(), rec);
+  const std::unique_ptr<ProblemBuilder> builder = SolvedProblem(config.value(), ArcWithReadingsOffAt30And32());
   const GateSwitches first = GateOutliers(0.99999, builder.get());
   EXPECT_EQ(first.bridged, 2);
   EXPECT_EQ(BridgedRows(*builder), (std::set<int>{30, 32}));
