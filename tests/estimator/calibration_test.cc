@@ -568,7 +568,8 @@ recording::Recording ArcWithReadingsOffAt30And32() {
 TEST(ProblemBuilderTest, ASpikeIsToldFromTheNeighbouringReadings) {
   const auto config = BridgingConfig();
   ASSERT_TRUE(config.ok()) << config.status().message();
-  auto built = ProblemBuilder::Create(config.value(), ArcWithReadingsOffAt30And32());
+  const recording::Recording rec = ArcWithReadingsOffAt30And32();  // the builder reads it: kept alive
+  auto built = ProblemBuilder::Create(config.value(), rec);
   ASSERT_TRUE(built.ok()) << built.status().message();
   const std::vector<std::string>& names = built.value()->stream_names();
   const int wheels = static_cast<int>(std::find(names.begin(), names.end(), "wheels") - names.begin());
@@ -587,7 +588,8 @@ TEST(ProblemBuilderTest, ASpikeIsToldFromTheNeighbouringReadings) {
 TEST(GateOutliersTest, OutlyingReadingsTwoRowsApartAreBridgedNotTheGoodReadingBetween) {
   const auto config = BridgingConfig();
   ASSERT_TRUE(config.ok()) << config.status().message();
-  const std::unique_ptr<ProblemBuilder> builder = SolvedProblem(config.value(), ArcWithReadingsOffAt30And32());
+  const recording::Recording rec = ArcWithReadingsOffAt30And32();  // the builder reads it: kept alive
+  const std::unique_ptr<ProblemBuilder> builder = SolvedProblem(config.value(), rec);
   const GateSwitches first = GateOutliers(0.99999, builder.get());
   EXPECT_EQ(first.bridged, 2);
   EXPECT_EQ(BridgedRows(*builder), (std::set<int>{30, 32}));
