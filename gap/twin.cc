@@ -63,11 +63,12 @@ void SetStd(const std::string& name, const TwinCovariance& covariance, Eigen::In
   if (hac) e->estimate.std[name] = std::max(e->estimate.std[name], e->std_batch[name]);
 }
 
-// Whether `c` is among the candidates tried by default on `runs` training runs: a composite only on several. On one
-// run, of one kind of motion, its parameters trade against each other (on a square's in-place turns the track against
-// the scale and the ratio), and the combination that fits that run carries over to other motions worse than one effect
-// does; it is tried there when named.
-bool DefaultCandidate(const TwinCandidate& c, std::size_t runs) { return c.parts.empty() || runs > 1; }
+// Whether `c` is among the candidates tried by default on `runs` training runs: the geometry composite and the drive's
+// clock drift only on several. On one run, of one kind of motion, their parameters trade against each other (on a
+// square's in-place turns the track against the scale and the ratio; on a straight line the clock's rate against the
+// scale), and the combination that fits that run carries over to other motions worse than one effect does; they are
+// tried there when named.
+bool DefaultCandidate(const TwinCandidate& c, std::size_t runs) { return !c.several_runs || runs > 1; }
 
 // A drive's clock shifts the recorded inputs of a replay; a plain simulation drives the scenario's own schedule.
 bool Applies(const TwinCandidate& c, const std::vector<TwinTrainingRun>& runs) {

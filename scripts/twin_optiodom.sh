@@ -7,14 +7,16 @@
 # dataset has no other runs of 23 Jun), diff_jun25 (25 Jun: circular runs train, another circular and an Ivanjko run
 # held out), omni3 (22 Dec 2020: square runs train, circular runs held out), diffset_dec (23 Dec: the patch fitted on a
 # square, a circular and an Ivanjko run together, --train-with, with at most 2 and 3 effects; the other circular,
-# Ivanjko and square runs of the day held out).
+# Ivanjko and square runs of the day held out), squareset_dec and squareset_jun (three square runs of 23 Dec or of
+# 23 Jun fitted together, at most 3 effects; the day's fourth square and the circular and Ivanjko runs of 23 Dec or
+# 25 Jun held out).
 #   bash scripts/twin_optiodom.sh [DATA_DIR] [OUT_DIR]   (DATA_DIR: the OptiOdom dataset's data/ folder, default
 #                                                          $ROAMLAB_DATA_DIR/optiodom/data, else ../shared/data's;
 #                                                          OUT_DIR: out/twin_optiodom)
 # Needs build/apps/roamlab and python3. Ten diagnoses of about 40-70 s of CPU each and two (diffset_dec) of about
 # 110-160 s, on two threads; JOBS (default 1) of them at a time (OUT/<day>_<set>.time: each one's wall and CPU time).
 # ONLY (a regular expression) runs only the days whose names match (diff_dec, diff_jun, diff_jun25, omni3,
-# diffset_dec).
+# diffset_dec, squareset_dec, squareset_jun).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 data=${1:-${ROAMLAB_DATA_DIR:-$here/../shared/data}/optiodom/data}
@@ -89,6 +91,17 @@ for n in 2 3; do
   while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do reap; done
   diagnose_set "${set_runs[@]}" &
 done
+square_set() {  # day, three training squares, held-out shape/set...
+  local day=$1 training=$2
+  shift 2
+  while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do reap; done
+  diagnose_set "$day" diff 3 "$training" "$@" &
+}
+square_set squareset_dec "square/231220200029 square/231220200040 square/231220200045" square/231220200048 \
+  circular/2312202001{21,34,41,46,50,54,57} ivanjko/231220200057 ivanjko/2312202001{02,04,07}
+square_set squareset_jun "square/230620202042 square/230620202144 square/230620202258" square/230620202317 \
+  circular/2506202021{04,19} circular/2506202022{36,51} circular/2506202023{17,45} ivanjko/2506202016{18,36,55} \
+  ivanjko/250620201738
 while [ "$(jobs -rp | wc -l)" -gt 0 ]; do reap; done
 python3 "$here/tools/twin_table.py" "$out"
 for f in "$out"/*.time; do echo "$(basename "$f" .time): $(tail -1 "$f")"; done

@@ -2,16 +2,17 @@
 // taken from a recording and the recording's own sample stamps. The simulator keeps one loop; with a schedule
 // (SimulateOptions::replay) its simulation time 0 is the recording time `t0`:
 //   - Drive. During the lead-in the robot settles at rest on the ground; from t = 0 on the set-points are the inputs
-//     at t0 + t (DriveInputs::At; at t0 + t + offset_s with the effect drive_time_offset). A recording that starts in motion therefore starts the twin with a step. Measured
-//     wheel angles (DriveInputs::angles_rad) are tracked: each wheel's servo target is its measured rate plus
-//     (measured - twin angle increment since t = 0) / kAngleTrackingS, which removes the velocity servo's
+//     at t0 + t (DriveInputs::At; at t0 + t + offset_s + drift_ppm 1e-6 t with the effect drive_time_offset, its
+//     rates then scaled by 1 + drift_ppm 1e-6). A recording that starts in motion therefore starts the twin with a
+//     step. Measured wheel angles (DriveInputs::angles_rad) are tracked: each wheel's servo target is its measured rate
+//     plus (measured - twin angle increment since t = 0) / kAngleTrackingS, which removes the velocity servo's
 //     steady-state error (the load torque over its gain: the twin's wheel would otherwise lag the recorded one, which
 //     had already lagged its own command by as much). Likewise an Ackermann vehicle's measured travel
 //     (DriveInputs::travel_m): the speed set-point is the measured speed plus (measured - twin travel since t = 0) /
 //     kAngleTrackingS, the twin's travel being its rear-wheel speed integrated. Both are in the speed sensor's terms:
 //     with longitudinal_slip or slope_slip the twin's rear-wheel speed is read as the sensor would, times the slip
-//     factor at the last odometer sample (1 + s_f f_x + s_p g sin(pitch) of that state), and the controller's target
-//     is divided by it, so that the twin's speed readings follow the recorded ones.
+//     factor at the last odometer sample (1 + s_f f_x + s_p g sin(pitch) of that state), and the controller's target is
+//     divided by it, so that the twin's speed readings follow the recorded ones.
 //   - Samples. A scheduled stream's sample stamped s is taken at the physics step nearest s - t0 (half a step at most
 //     away: 1 ms on models/diffdrive.xml, 0.5 ms on models/atv.xml), minus the time shift of an effect
 //     (gps_latency, imu_time_offset, pose_time_offset); two stamps nearest the same step read the same state. The

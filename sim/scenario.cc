@@ -558,7 +558,7 @@ const std::map<std::string, std::map<std::string, double>>& KnownEffects() {
       {"gps_latency", {{"latency_s", 0.0}}},
       {"imu_time_offset", {{"offset_s", 0.0}}},
       {"pose_time_offset", {{"offset_s", 0.0}}},
-      {"drive_time_offset", {{"offset_s", 0.0}}},
+      {"drive_time_offset", {{"offset_s", 0.0}, {"drift_ppm", 0.0}}},
       {"steering_offset", {{"offset_rad", 0.0}}},
       {"gyro_scale_error", {{"scale_x", 1.0}, {"scale_y", 1.0}, {"scale_z", 1.0}}},
       {"gyro_bias_drift", {{"initial_x", 0.0}, {"initial_y", 0.0}, {"initial_z", 0.0}, {"random_walk", 0.0}}},

@@ -67,11 +67,14 @@
 //                                          encoders read |offset_s| behind it. |offset_s| <= 0.5, whole physics
 //                                          steps; needs sensors.mocap (the estimator's time shift of the same name,
 //                                          gap/diagnose.h, means the same: stamps moved to t - offset_s)
-//   drive_time_offset {offset_s: 0}        a replay's recorded drive inputs (sim/replay.h) stamped t were the
-//                                          robot's at t - offset_s: positive, the drive readings are stamped late
+//   drive_time_offset {offset_s: 0, drift_ppm: 0}   a replay's recorded drive inputs (sim/replay.h) stamped t were
+//                                          the robot's at t - offset_s: positive, the drive readings are stamped late
 //                                          against the other sensors (an odometry that lags the IMU), and the twin
-//                                          takes at recording time t the inputs stamped t + offset_s. |offset_s| <=
-//                                          0.5; a simulation of the scenario's own drive refuses a non-zero value
+//                                          takes at recording time t0 + t the inputs stamped t0 + t + offset_s +
+//                                          drift_ppm 1e-6 t (t0 the replay's start): the drive's clock runs drift_ppm
+//                                          parts per million faster than the others', its rates read per unit of it.
+//                                          |offset_s| <= 0.5, |drift_ppm| <= 10000; a simulation of the scenario's own
+//                                          drive refuses non-zero values
 //   steering_offset {offset_rad: 0}        the front wheels' angle when the handlebar sensor reads zero: eq. 15's
 //                                          k_gamma becomes k_gamma + offset_rad
 //   gyro_scale_error {scale_x: 1, scale_y: 1, scale_z: 1}   per-axis gain of the gyroscope in its own frame

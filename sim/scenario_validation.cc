@@ -206,6 +206,8 @@ std::optional<P> WheelChangesProblem(const Scenario& s) {
 
 // A sensor noise's Gauss-Markov correlation time [s]: 0 (white) or up to an hour.
 bool CorrelationTime(double seconds) { return seconds >= 0.0 && seconds <= 3600.0; }
+// drive_time_offset's drift: 1 % (a clock that far off is not a drift but a wrong rate setting).
+constexpr double kMaxDriveDriftPpm = 1e4;
 constexpr const char* kCorrelationRange = "must be in [0, 3600] s (0: white noise)";
 
 // The IMU, magnetometer and GPS.
@@ -317,6 +319,9 @@ std::optional<P> EffectsProblem(const Scenario& s) {
     if ((e.name == "pose_time_offset" || e.name == "drive_time_offset") &&
         !(std::abs(EffectParameter(s.effects, e.name, "offset_s", 0.0)) <= 0.5))
       return P{k + ".parameters.offset_s", "must be in [-0.5, 0.5]"};
+    if (e.name == "drive_time_offset" &&
+        !(std::abs(EffectParameter(s.effects, e.name, "drift_ppm", 0.0)) <= kMaxDriveDriftPpm))
+      return P{k + ".parameters.drift_ppm", "must be in [-10000, 10000]"};
     if (e.name == "gps_latency" && !s.sensors.gps) return P{k + ".name", "gps_latency needs sensors.gps"};
     if (e.name == "pose_time_offset" && !s.sensors.mocap) return P{k + ".name", "pose_time_offset needs sensors.mocap"};
     if (e.name == "gyro_bias_drift") {

@@ -456,14 +456,25 @@ class Simulator::Impl {
   }
 
   // The recording time whose drive inputs hold at simulation time t_ns >= 0: t0 + t_ns, plus drive_time_offset's
-  // shift (inputs stamped late are read that much later).
-  Time DriveStamp(std::int64_t t_ns) const { return Time::FromNanoseconds(origin_ns_ + t_ns + drive_shift_ns_); }
+  // shift (inputs stamped late are read that much later) and its drift (the drive's clock running drift_ppm faster
+  // than the others since t = 0).
+  Time DriveStamp(std::int64_t t_ns) const {
+    const auto drift_ns = std::llround(drive_drift_ * static_cast<double>(t_ns));
+    return Time::FromNanoseconds(origin_ns_ + t_ns + drive_shift_ns_ + drift_ns);
+  }
 
-  // A replay's drive inputs at t_ns: the recording's from t = 0, rest before (sim/replay_schedule.h).
+  // A replay's drive inputs at t_ns: the recording's from t = 0, rest before (sim/replay_schedule.h). The rates and
+  // speeds among them are per unit of the drive's clock, so a drifting clock scales them by 1 + drift; the handlebar
+  // angle is not a rate.
   Eigen::VectorXd ReplayInputs(std::int64_t t_ns) const {
     const DriveInputs& drive = options_.replay->drive;
     if (t_ns < 0) return Eigen::VectorXd::Zero(drive.values.cols());
-    return drive.At(DriveStamp(t_ns));
+    Eigen::VectorXd u = drive.At(DriveStamp(t_ns));
+    if (drive.kind == DriveInputs::Kind::kAckermann)
+      u[0] *= 1.0 + drive_drift_;
+    else
+      u *= 1.0 + drive_drift_;
+    return u;
   }
 
   // A replay's wheel-rate targets at t_ns: the measured rates, plus the tracking of the measured angles.
@@ -540,6 +551,10 @@ class Simulator::Impl {
       return Status::Error(where_ + ": drive_time_offset shifts a replay's recorded drive inputs; this run drives the "
                                     "scenario's own schedule");
     drive_shift_ns_ = std::llround(drive_shift_s * 1e9);
+    drive_drift_ = EffectParameter(effects, "drive_time_offset", "drift_ppm", 0.0) * 1e-6;
+    if (drive_drift_ != 0.0 && !options_.replay)
+      return Status::Error(where_ + ": drive_time_offset's drift moves a replay's recorded drive inputs; this run "
+                                    "drives the scenario's own schedule");
     // A sample taken after the end of the drive (negative shift) extends the physics past it.
     loop_end_ns_ = end_ns_ + std::max<std::int64_t>(
                                  0, -std::min({imu_clock_.shift_ns, gps_clock_.shift_ns, mocap_clock_.shift_ns}));
@@ -942,6 +957,7 @@ class Simulator::Impl {
   std::int64_t t_ns_ = 0;         // the current time, for messages
   std::int64_t origin_ns_ = 0;    // the recording time of t = 0 (a replay's t0)
   std::int64_t drive_shift_ns_ = 0;  // drive_time_offset: a replay reads its drive inputs this much later
+  double drive_drift_ = 0.0;         // drive_time_offset's drift_ppm * 1e-6: and later still by this times t
   Eigen::VectorXd replay_angles_at_start_, measured_angles_at_start_;  // a replay's wheel angles at t = 0
   double replay_travel_m_ = 0.0;                                       // a replay's Ackermann travel since t = 0
   Time origin() const { return Time::FromNanoseconds(origin_ns_); }

@@ -18,8 +18,13 @@ ratio (patched / nominal) over every run named, fitted on those runs themselves 
 the best constant patch of this form can do on them, whatever it was trained on; and each run's motion-capture
 scatter (the white noise of its positions and heading, from their third differences).
 
+With --local-clock SCALE,RATIO,TRACK_ERROR_M: per run, the encoders' clock shift that best fits each 15 s stretch
+(every 7.5 s; 5 s windows aligned over 1 s, the shift searched from -60 to +160 ms in 10 ms steps) with that one
+geometry: whether a run's clock shift is constant or drifts.
+
     python3 tools/optiodom_drift_floor.py DATA_DIR TRAINING_SET[,TRAINING_SET...] OTHER_SET...
     python3 tools/optiodom_drift_floor.py --best-common DATA_DIR SET...
+    python3 tools/optiodom_drift_floor.py --local-clock SCALE,RATIO,TRACK_ERROR_M DATA_DIR SET...
       (DATA_DIR: the dataset's data/diff folder; a set as shape/name, e.g. square/231220200029)
 """
 import bisect
@@ -208,7 +213,32 @@ def best_common(runs):
         print("  " + ", ".join(f"{name} {r:.2f}" for name, r in ratios(p).items()))
 
 
+def local_clock(runs, p, stretch_s=15.0, step_s=7.5):
+    """Prints, per run, the best clock shift [ms] of each stretch, at its start [s]."""
+    for name, run in runs.items():
+        t, shifts = run["t"], []
+        start = t[0]
+        while start + stretch_s <= t[-1]:
+            a, b = bisect.bisect_left(t, start), bisect.bisect_right(t, start + stretch_s)
+            part = {k: v[a:b] for k, v in run.items()}
+            best = min(range(-60, 161, 10),
+                       key=lambda ms: drift(part, (*p, ms / 1000), window_s=5.0, align_s=1.0))
+            shifts.append(f"{start - t[0]:.0f} s: {best:+d}")
+            start += step_s
+        print(f"{name}: clock shift [ms] by stretch: {', '.join(shifts)}")
+
+
 def main(argv):
+    clock_geometry = None
+    if len(argv) > 2 and argv[1] == "--local-clock":
+        try:
+            clock_geometry = tuple(float(v) for v in argv[2].split(","))
+        except ValueError:
+            clock_geometry = ()
+        if len(clock_geometry) != 3:
+            print(f"optiodom_drift_floor.py: --local-clock {argv[2]}: needs SCALE,RATIO,TRACK_ERROR_M", file=sys.stderr)
+            return 2
+        argv = argv[2:]
     if len(argv) > 1 and argv[1] == "--best-common":
         argv = argv[1:]
         common = True
@@ -228,6 +258,9 @@ def main(argv):
         runs[name] = load(path)
     if common:
         best_common(runs)
+        return 0
+    if clock_geometry:
+        local_clock(runs, clock_geometry)
         return 0
     nominal = (1.0, 1.0, 0.0)
     oracles = {name: nelder_mead(lambda p, run=run: drift(run, p), nominal, (0.01, 0.003, 0.003))

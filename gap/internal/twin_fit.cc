@@ -45,6 +45,7 @@ std::vector<TwinCandidate> Library(const sim::Scenario& nominal, double max_shif
     TwinCandidate geometry{"diff_drive_geometry", "diff_drive_geometry", {}, {}};
     geometry.parts = {all[0], all[1], all[2]};
     geometry.central = true;
+    geometry.several_runs = true;
     for (const TwinCandidate& part : geometry.parts)
       geometry.free.insert(geometry.free.end(), part.free.begin(), part.free.end());
     all.push_back(geometry);
@@ -93,6 +94,18 @@ std::vector<TwinCandidate> Library(const sim::Scenario& nominal, double max_shif
   TwinCandidate drive{"drive_time_offset", "drive_time_offset", {}, {P("offset_s", 0, 0, -imu_range, imu_range)}};
   drive.time_shift = true;
   if (nominal.sensors.imu) all.push_back(drive);
+  // The recorded drive's clock against the others' as an offset at the replay's start and a rate (drive_time_offset
+  // with drift_ppm): two free-running clocks part linearly, and a constant shift fitted on the first part of a run is
+  // wrong on the last. Fitted by Levenberg-Marquardt: the replay reads its inputs between their rows, so the residuals
+  // are smooth in both. At a constant speed the rate trades with the wheels' scale; stops, turns and runs of other
+  // drives tell them apart.
+  TwinCandidate clock{"drive_clock_drift",
+                      "drive_time_offset",
+                      {},
+                      {P("offset_s", 0, 0.02, -imu_range, imu_range), P("drift_ppm", 0, 2000, -1e4, 1e4)}};
+  clock.central = true;
+  clock.several_runs = true;
+  all.push_back(clock);
   return all;
 }
 

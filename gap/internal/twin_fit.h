@@ -37,6 +37,9 @@ struct TwinCandidate {
   // off by half the step times the curvature, and where the parameters trade against each other that bias moves the
   // fit's minimum by a good part of a step.
   bool central = false;
+  // Tried by default only on several training runs: on one run, of one kind of motion, its parameters trade against
+  // each other or against another candidate's (gap/twin.cc DefaultCandidate).
+  bool several_runs = false;
 };
 
 // The candidates `nominal` supports (its sensors and robot kind; the scenario validates with each).

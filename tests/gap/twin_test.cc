@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <string>
 #include <utility>
@@ -147,10 +148,10 @@ TEST(TwinTest, NoHiddenEffectNamesNone) {
   // Every candidate the diff drive with IMU and GPS supports was fitted and scored.
   const std::vector<std::string> names = TwinCandidateNames(Nominal());
   // wheel ratio, radius scale, track, the three as one geometry, odometry scale, two axles, gyro scale and bias, IMU
-  // offset, GPS latency, the drive's offset; on one run the joint geometry is tried only when named, and the drive's
-  // offset only in a replay (this twin is the plain simulation).
-  EXPECT_EQ(names.size(), 12u);
-  ASSERT_EQ(d.candidates.size(), names.size() - 2);
+  // offset, GPS latency, the drive's offset, the drive's clock drift; on one run the joint geometry and the clock drift
+  // are tried only when named, and the drive's offset and drift only in a replay (this twin is the plain simulation).
+  EXPECT_EQ(names.size(), 13u);
+  ASSERT_EQ(d.candidates.size(), names.size() - 3);
   for (const TwinEffect& e : d.candidates) {
     EXPECT_NE(std::find(names.begin(), names.end(), e.estimate.name), names.end()) << e.estimate.name;
     EXPECT_FALSE(e.estimate.decision.empty()) << e.estimate.name;
@@ -170,15 +171,9 @@ TEST(TwinTest, AHiddenImuTimeOffsetIsRecoveredOnTheStepGrid) {
   EXPECT_NEAR(d.effects.front().applied.front().parameters.at("offset_s"), kOffsetS, 1e-9);  // in whole steps
 }
 
-// The wheel encoders stamped 0.1 s early against the IMU and the motion capture (each encoder row's stamp moved by
-// -0.1 s), a recording of a drive that starts from rest (so that the replay, which starts at the first encoder row,
-// starts at rest: ReplayTest) whose twin is replayed from those encoders, diagnosed with the two clocks that could
-// explain it: the drive's offset is named first, ahead of the IMU's clock alone (which leaves the poses shifted), and
-// the patched twin follows the held-out motion capture more closely. The replay of the right stamps reads an offset of
-// its own (its wheels follow the quantized angles through velocity servos, and start from rest): the hidden offset is
-// recovered within that own offset plus 3 of the fit's standard deviations.
-TEST(TwinTest, AHiddenDriveTimeOffsetIsNamedFromTheReplayedEncoders) {
-  constexpr double kOffsetS = -0.1;
+// A drive that starts from rest (so that the replay, which starts at the first encoder row, starts at rest:
+// ReplayTest), with motion capture (each replayed run aligns its start to it: ReplayRunner).
+sim::Scenario FromRestWithMotionCapture() {
   sim::Scenario nominal = Nominal();
   nominal.duration_s = 30.0;
   sim::ProfileTerm from_rest;  // the constant 0.15 m/s reached over the first second, not during the lead-in
@@ -187,44 +182,108 @@ TEST(TwinTest, AHiddenDriveTimeOffsetIsNamedFromTheReplayedEncoders) {
   from_rest.to = 0.15;
   nominal.driver.linear_mps.terms.front() = from_rest;
   nominal.sensors.gps.reset();
-  nominal.sensors.mocap = sim::MocapOptions{};  // each replayed run aligns its start to it (ReplayRunner)
+  nominal.sensors.mocap = sim::MocapOptions{};
+  return nominal;
+}
+
+// `own` with its wheel encoders' stamps t moved to restamp(t), diagnosed by its replayed twin with `candidates`, one
+// effect kept at most; every candidate's fit printed.
+TwinDiagnosis DiagnosedRestamped(const sim::Scenario& nominal, const recording::Recording& own,
+                                 const std::function<Time(Time)>& restamp, const std::vector<std::string>& candidates,
+                                 const char* what) {
+  recording::Recording real = own;
+  for (recording::Stream& s : real.streams)
+    if (s.info.name == nominal.sensors.wheel_encoders->name)
+      for (Time& t : s.t) t = restamp(t);
+  TwinDiagnoseOptions options;
+  options.candidates = candidates;
+  options.max_effects = 1;
+  options.replayed = true;
+  options.increment_window_s = 5.0;
+  auto d = DiagnoseTwin(nominal, real, ReplayRunner(real), options);
+  EXPECT_TRUE(d.ok()) << d.status().message();
+  if (!d.ok()) return TwinDiagnosis{};
+  std::printf("%s:\n", what);
+  for (const TwinEffect& e : d.value().candidates)
+    for (const auto& [name, value] : e.estimate.parameters)
+      std::printf("  %s %s = %.5g +- %.2g, chi2 drop %.1f, %d iterations: %s\n", e.estimate.name.c_str(),
+                  name.c_str(), value, e.estimate.std.count(name) ? e.estimate.std.at(name) : 0.0, e.estimate.lr_raw,
+                  e.iterations, e.estimate.decision.c_str());
+  return d.value();
+}
+
+const EffectEstimate* CandidateFit(const TwinDiagnosis& d, const std::string& name) {
+  const auto it = std::find_if(d.candidates.begin(), d.candidates.end(),
+                               [&](const TwinEffect& c) { return c.estimate.name == name; });
+  return it == d.candidates.end() ? nullptr : &it->estimate;
+}
+
+// The wheel encoders stamped 0.1 s early against the IMU and the motion capture (each encoder row's stamp moved by
+// -0.1 s), diagnosed with the two clocks that could explain it: the drive's offset is named first, ahead of the IMU's
+// clock alone (which leaves the poses shifted), and the patched twin follows the held-out motion capture more closely.
+// The replay of the right stamps reads an offset of its own (its wheels follow the quantized angles through velocity
+// servos, and start from rest): the hidden offset is recovered within that own offset plus 3 of the fit's standard
+// deviations.
+TEST(TwinTest, AHiddenDriveTimeOffsetIsNamedFromTheReplayedEncoders) {
+  constexpr double kOffsetS = -0.1;
+  const sim::Scenario nominal = FromRestWithMotionCapture();
   const recording::Recording own = testing::SimulatedWithSeed(nominal, 16).recording;
-  const auto diagnosed = [&](double shift_s) {
-    recording::Recording real = own;
-    for (recording::Stream& s : real.streams)
-      if (s.info.name == nominal.sensors.wheel_encoders->name)
-        for (Time& t : s.t) t = Time::FromNanoseconds(t.nanoseconds() + std::llround(shift_s * 1e9));
-    TwinDiagnoseOptions options;
-    options.candidates = {"drive_time_offset", "imu_time_offset"};
-    options.max_effects = 1;
-    options.replayed = true;
-    options.increment_window_s = 5.0;
-    auto d = DiagnoseTwin(nominal, real, ReplayRunner(real), options);
-    EXPECT_TRUE(d.ok()) << d.status().message();
-    if (!d.ok()) return TwinDiagnosis{};
-    std::printf("encoders shifted by %.3f s:\n", shift_s);
-    for (const TwinEffect& e : d.value().candidates)
-      for (const auto& [name, value] : e.estimate.parameters)
-        std::printf("  %s %s = %.5g +- %.2g, chi2 drop %.1f: %s\n", e.estimate.name.c_str(), name.c_str(), value,
-                    e.estimate.std.count(name) ? e.estimate.std.at(name) : 0.0, e.estimate.lr_raw,
-                    e.estimate.decision.c_str());
-    return d.value();
-  };
-  const TwinDiagnosis right = diagnosed(0.0), early = diagnosed(kOffsetS);
+  const std::vector<std::string> candidates = {"drive_time_offset", "imu_time_offset"};
+  const TwinDiagnosis right = DiagnosedRestamped(nominal, own, [](Time t) { return t; }, candidates, "right stamps");
+  const TwinDiagnosis early = DiagnosedRestamped(
+      nominal, own, [&](Time t) { return Time::FromNanoseconds(t.nanoseconds() + std::llround(kOffsetS * 1e9)); },
+      candidates, "encoders 0.1 s early");
   ASSERT_FALSE(early.effects.empty());
   const EffectEstimate& e = early.effects.front().estimate;
   EXPECT_EQ(e.name, "drive_time_offset");
-  const auto own_offset = std::find_if(right.candidates.begin(), right.candidates.end(),
-                                       [](const TwinEffect& c) { return c.estimate.name == "drive_time_offset"; });
-  ASSERT_NE(own_offset, right.candidates.end());
-  ASSERT_TRUE(e.std.count("offset_s") && own_offset->estimate.std.count("offset_s"));
-  const double fitted = e.parameters.at("offset_s"), own_s = own_offset->estimate.parameters.at("offset_s");
+  const EffectEstimate* own_offset = CandidateFit(right, "drive_time_offset");
+  ASSERT_NE(own_offset, nullptr);
+  ASSERT_TRUE(e.std.count("offset_s") && own_offset->std.count("offset_s"));
+  const double fitted = e.parameters.at("offset_s"), own_s = own_offset->parameters.at("offset_s");
   std::printf("  fitted %.5f +- %.2g s (hidden %.3f); the right stamps' own %.5f s\n", fitted, e.std.at("offset_s"),
               kOffsetS, own_s);
   EXPECT_LT(fitted, 0.0);
   EXPECT_NEAR(fitted, kOffsetS, std::abs(own_s) + 3.0 * e.std.at("offset_s"));
   const double before = early.heldout_before.drift.at("mocap").mean_position_m;
   const double after = early.heldout_after.drift.at("mocap").mean_position_m;
+  std::printf("  held-out 10 s drift %.4f m -> %.4f m\n", before, after);
+  EXPECT_LT(after, before);
+}
+
+// The wheel encoders' clock running 3000 ppm fast against the motion capture's (each encoder row stamped
+// t0 + 1.003 (t - t0), t0 the first row's: 108 ms ahead at the end of the 36 s drive), without an IMU, diagnosed with
+// the drive's clock drift alone: named, the rate recovered within the right stamps' own reading plus 3 of its standard
+// deviations, and the patched twin follows the held-out motion capture more closely.
+TEST(TwinTest, AHiddenDriveClockDriftIsRecoveredFromTheReplayedEncoders) {
+  constexpr double kDriftPpm = 3000.0;
+  sim::Scenario nominal = FromRestWithMotionCapture();
+  nominal.sensors.imu.reset();  // the motion capture times the drive, as on the OptiOdom robots
+  nominal.duration_s = 36.0;    // a held-out third that holds a 10 s drift window
+  const recording::Recording own = testing::SimulatedWithSeed(nominal, 16).recording;
+  const recording::Stream* encoders = own.Find(nominal.sensors.wheel_encoders->name);
+  ASSERT_NE(encoders, nullptr);
+  const std::int64_t t0_ns = encoders->t.front().nanoseconds();
+  const std::vector<std::string> candidates = {"drive_clock_drift"};
+  const TwinDiagnosis right = DiagnosedRestamped(nominal, own, [](Time t) { return t; }, candidates, "right stamps");
+  const TwinDiagnosis fast = DiagnosedRestamped(
+      nominal, own,
+      [&](Time t) {
+        const auto since_ns = static_cast<double>(t.nanoseconds() - t0_ns);
+        return Time::FromNanoseconds(t0_ns + std::llround(since_ns * (1.0 + kDriftPpm * 1e-6)));
+      },
+      candidates, "encoders' clock 3000 ppm fast");
+  ASSERT_FALSE(fast.effects.empty());
+  const EffectEstimate& e = fast.effects.front().estimate;
+  EXPECT_EQ(e.name, "drive_clock_drift");
+  const EffectEstimate* own_fit = CandidateFit(right, "drive_clock_drift");
+  ASSERT_NE(own_fit, nullptr);
+  ASSERT_TRUE(e.std.count("drift_ppm") && own_fit->parameters.count("drift_ppm"));
+  const double fitted = e.parameters.at("drift_ppm"), own_ppm = own_fit->parameters.at("drift_ppm");
+  std::printf("  fitted %.0f +- %.0f ppm, offset %.4f s (hidden %.0f ppm); the right stamps' own %.0f ppm\n", fitted,
+              e.std.at("drift_ppm"), e.parameters.at("offset_s"), kDriftPpm, own_ppm);
+  EXPECT_NEAR(fitted, kDriftPpm, std::abs(own_ppm) + 3.0 * e.std.at("drift_ppm"));
+  const double before = fast.heldout_before.drift.at("mocap").mean_position_m;
+  const double after = fast.heldout_after.drift.at("mocap").mean_position_m;
   std::printf("  held-out 10 s drift %.4f m -> %.4f m\n", before, after);
   EXPECT_LT(after, before);
 }

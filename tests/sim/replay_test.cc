@@ -219,6 +219,38 @@ TEST(ReplayTest, ADriveTimeOffsetReadsTheInputsThatMuchLater) {
   EXPECT_THAT(refused.status().message(), HasSubstr("drive_time_offset"));
 }
 
+// drive_time_offset's drift: the encoders' clock running 5000 ppm fast (each encoder row stamped t0 + 1.005 (t - t0),
+// t0 the first row's; 60 ms ahead at the end of the 12 s drive). A replay patched with the drift reads at t0 + t the
+// inputs stamped t0 + 1.005 t, at 1.005 times their rates, and reproduces the truth as a replay of the right stamps
+// does; the nominal replay falls behind. A simulation of the scenario's own drive refuses the drift.
+TEST(ReplayTest, ADriveClockDriftReadsTheInputsOnTheDriftingClock) {
+  constexpr double kDrift = 5e-3;
+  const Scenario nominal = GentleDiffDrive(12.0);
+  const Simulation real = SimulateOk(nominal);
+  Recording fast = real.recording;
+  for (Stream& s : fast.streams) {
+    if (s.info.name != "wheel_encoders") continue;
+    const std::int64_t t0_ns = s.t.front().nanoseconds();
+    for (Time& t : s.t)
+      t = Time::FromNanoseconds(t0_ns + std::llround(static_cast<double>(t.nanoseconds() - t0_ns) * (1.0 + kDrift)));
+  }
+  Scenario patched = nominal;
+  patched.effects = {{"drive_time_offset", {{"drift_ppm", kDrift * 1e6}}}};
+  const Simulation drifting = ReplayOk(patched, fast);
+  const Simulation behind = ReplayOk(nominal, fast);
+  const TrackError a = Compare(*drifting.recording.ground_truth, *real.recording.ground_truth);
+  const TrackError b = Compare(*behind.recording.ground_truth, *real.recording.ground_truth);
+  std::printf("encoders' clock 5000 ppm fast: replay with the drift <= %.4f m, %.4f rad; without %.4f m, %.4f rad\n",
+              a.max_position_m, a.max_heading_rad, b.max_position_m, b.max_heading_rad);
+  const Bound bound = EncoderBound(real.recording, Extent(*real.recording.ground_truth));
+  EXPECT_LT(a.max_heading_rad, bound.heading_rad);
+  EXPECT_LT(a.max_position_m, bound.position_m);
+  EXPECT_GT(b.max_position_m, 5.0 * a.max_position_m);
+  auto refused = Simulate(patched);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_THAT(refused.status().message(), HasSubstr("drive_time_offset's drift"));
+}
+
 // odometry_scale_error: the encoders read 3 % more than the wheels turn (the motion is the same). A replay of the
 // patched scenario takes the encoders' drive over the scale and drives the true motion, its encoders reading what was
 // recorded; the nominal one drives 3 % too far.

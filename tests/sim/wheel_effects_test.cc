@@ -310,6 +310,10 @@ TEST(WheelEffectsValidation, OneLineErrors) {
   EXPECT_EQ(ProblemOf(WithMocap({{"pose_time_offset", {{"offset_s", -0.03}}}})), "");
   EXPECT_EQ(ProblemOf(WithMocap({{"pose_time_offset", {{"offset_s", 0.6}}}})),
             "effects[0].parameters.offset_s: must be in [-0.5, 0.5]");
+  s.effects = {{"drive_time_offset", {{"offset_s", 0.01}, {"drift_ppm", -1200}}}};
+  EXPECT_EQ(ProblemOf(s), "");
+  s.effects = {{"drive_time_offset", {{"drift_ppm", 20000}}}};
+  EXPECT_EQ(ProblemOf(s), "effects[0].parameters.drift_ppm: must be in [-10000, 10000]");
 
   Scenario omni = s;
   omni.robot.kind = "omni3";
