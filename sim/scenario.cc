@@ -383,10 +383,11 @@ void ReadSensors(YamlReader& r, const YAML::Node& node, Scenario* s) {
     MocapOptions& mocap = s->sensors.mocap.emplace();
     const YAML::Node n = node["mocap"];
     const std::string k = "sensors.mocap";
-    if (section(n, k, {"rate_hz", "position_sigma_m", "orientation_sigma_rad"})) {
+    if (section(n, k, {"rate_hz", "position_sigma_m", "orientation_sigma_rad", "noise_correlation_s"})) {
       r.Number(n, k, "rate_hz", &mocap.rate_hz);
       r.Number(n, k, "position_sigma_m", &mocap.position_sigma_m);
       r.Number(n, k, "orientation_sigma_rad", &mocap.orientation_sigma_rad);
+      r.Number(n, k, "noise_correlation_s", &mocap.noise_correlation_s);
     }
   }
   if (node["odometer"]) {

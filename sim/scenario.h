@@ -48,8 +48,8 @@
 //                                           # ...} (sim/faults.h: outliers, outage, clock_jump, duplicates, freeze);
 //                                           # the ground truth and truth.yaml are untouched; not applied by replay
 //
-// Coloured sensor noise: `noise_correlation_s` [s] in imu (gyro and accel), magnetometer, gps and odometer (both
-// readings), in [0, 3600], default 0 (white), makes that sensor's noise a first-order Gauss-Markov process per axis
+// Coloured sensor noise: `noise_correlation_s` [s] in imu (gyro and accel), magnetometer, gps, odometer (both
+// readings) and mocap (position and orientation), in [0, 3600], default 0 (white), makes that sensor's noise a first-order Gauss-Markov process per axis
 // with the same stationary sigma: e(k+1) = a e(k) + sigma sqrt(1 - a^2) n, a = exp(-period / noise_correlation_s),
 // e(0) ~ N(0, sigma^2) (sim/noise.h GaussMarkovNoise). At 0 the sensor draws exactly the white noise it draws without
 // the key.
@@ -349,6 +349,7 @@ struct MocapOptions {
   double rate_hz = 20.0;
   double position_sigma_m = 0.001;
   double orientation_sigma_rad = 0.005;
+  double noise_correlation_s = 0.0;  // Gauss-Markov correlation time of the position and orientation noise; 0: white
 };
 
 struct OdometerOptions {

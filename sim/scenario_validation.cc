@@ -237,6 +237,8 @@ std::optional<P> InertialAndGpsProblem(const Scenario& s) {
     if (!Positive(mocap->rate_hz)) return P{"sensors.mocap.rate_hz", "must be > 0"};
     if (!NonNegative(mocap->position_sigma_m)) return P{"sensors.mocap.position_sigma_m", "must be >= 0"};
     if (!NonNegative(mocap->orientation_sigma_rad)) return P{"sensors.mocap.orientation_sigma_rad", "must be >= 0"};
+    if (!CorrelationTime(mocap->noise_correlation_s))
+      return P{"sensors.mocap.noise_correlation_s", kCorrelationRange};
   }
   if (const auto& gps = s.sensors.gps) {
     if (!Positive(gps->rate_hz)) return P{"sensors.gps.rate_hz", "must be > 0"};

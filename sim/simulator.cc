@@ -302,6 +302,9 @@ class Simulator::Impl {
     }
     if (sensors.mocap) {
       if (Status s = clock(sensors.mocap->rate_hz, "sensors.mocap.rate_hz", &mocap_clock_); !s.ok()) return s;
+      const double period_s = 1e-9 * static_cast<double>(mocap_clock_.period_ns);
+      mocap_position_noise_.SetCorrelation(sensors.mocap->noise_correlation_s, period_s);
+      mocap_orientation_noise_.SetCorrelation(sensors.mocap->noise_correlation_s, period_s);
     }
     if (sensors.odometer) {
       if (Status s = clock(sensors.odometer->rate_hz, "sensors.odometer.rate_hz", &odometer_clock_); !s.ok()) return s;
@@ -972,8 +975,8 @@ class Simulator::Impl {
   GaussMarkovNoise speed_noise_{seed_, NoiseSource::kSpeed, options_.noise};
   GaussMarkovNoise steering_noise_{seed_, NoiseSource::kSteering, options_.noise};
   NoiseStream laser_noise_{seed_, NoiseSource::kLaserRange, options_.noise};
-  NoiseStream mocap_position_noise_{seed_, NoiseSource::kMocapPosition, options_.noise};
-  NoiseStream mocap_orientation_noise_{seed_, NoiseSource::kMocapOrientation, options_.noise};
+  GaussMarkovNoise mocap_position_noise_{seed_, NoiseSource::kMocapPosition, options_.noise};
+  GaussMarkovNoise mocap_orientation_noise_{seed_, NoiseSource::kMocapOrientation, options_.noise};
   NoiseStream gyro_bias_noise_{seed_, NoiseSource::kGyroBiasWalk};  // an effect, not sensor noise: always on
   NoiseStream multipath_noise_{seed_, NoiseSource::kGpsMultipath};  // likewise
 
