@@ -178,6 +178,17 @@ TEST_F(ScenarioErrorTest, BadValues) {
               "sensors.gps.noise_correlation_s", "must be in [0, 3600] s");
 }
 
+TEST_F(ScenarioErrorTest, MotionCaptureNoiseCorrelationIsParsedAndChecked) {
+  const std::string sensors = "sensors:\n";
+  EXPECT_EQ(LoadIndoorWith(sensors, sensors + "  mocap: {rate_hz: 20, noise_correlation_s: 0.2}\n"), "");
+  auto loaded = LoadScenario(path_);
+  ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+  ASSERT_TRUE(loaded.value().sensors.mocap.has_value());
+  EXPECT_EQ(loaded.value().sensors.mocap->noise_correlation_s, 0.2);
+  ExpectError(LoadIndoorWith(sensors, sensors + "  mocap: {rate_hz: 20, noise_correlation_s: -1}\n"),
+              "noise_correlation_s: -1", "sensors.mocap.noise_correlation_s", "must be in [0, 3600] s");
+}
+
 TEST_F(ScenarioErrorTest, WheelOffsetIsParsedAndChecked) {
   const std::string kind = "kind: differential_drive\n";
   EXPECT_EQ(LoadIndoorWith(kind, kind + "  wheel_offset: [{wheel: 1, offset_m: [-0.03, 0.01]}]\n"), "");
