@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <map>
 #include <string>
 #include <utility>
@@ -218,6 +219,38 @@ const EffectEstimate* CandidateFit(const TwinDiagnosis& d, const std::string& na
   return it == d.candidates.end() ? nullptr : &it->estimate;
 }
 
+// `shifted` (the restamped recording's diagnosis) names `name` first, its `parameter` within the right stamps' own fit
+// of it (`right`) plus 3 of its standard deviations of `hidden`, and the patched twin follows the held-out motion
+// capture more closely. Returns the fitted value (NaN when not named).
+double ExpectNamedAndRecovered(const TwinDiagnosis& right, const TwinDiagnosis& shifted, const std::string& name,
+                               const std::string& parameter, double hidden) {
+  constexpr double kNotNamed = std::numeric_limits<double>::quiet_NaN();
+  if (shifted.effects.empty()) {
+    ADD_FAILURE() << "nothing named";
+    return kNotNamed;
+  }
+  const EffectEstimate& e = shifted.effects.front().estimate;
+  EXPECT_EQ(e.name, name);
+  const EffectEstimate* own = CandidateFit(right, name);
+  if (!own || !e.std.count(parameter) || !own->parameters.count(parameter)) {
+    ADD_FAILURE() << name << "." << parameter << " not fitted";
+    return kNotNamed;
+  }
+  const double fitted = e.parameters.at(parameter), own_value = own->parameters.at(parameter);
+  std::printf("  fitted %s %.5g +- %.2g (hidden %.5g); the right stamps' own %.5g\n", parameter.c_str(), fitted,
+              e.std.at(parameter), hidden, own_value);
+  EXPECT_NEAR(fitted, hidden, std::abs(own_value) + 3.0 * e.std.at(parameter));
+  if (!shifted.heldout_before.drift.count("mocap") || !shifted.heldout_after.drift.count("mocap")) {
+    ADD_FAILURE() << "no 10 s drift window in the held-out part";
+    return fitted;
+  }
+  const double before = shifted.heldout_before.drift.at("mocap").mean_position_m;
+  const double after = shifted.heldout_after.drift.at("mocap").mean_position_m;
+  std::printf("  held-out 10 s drift %.4f m -> %.4f m\n", before, after);
+  EXPECT_LT(after, before);
+  return fitted;
+}
+
 // The wheel encoders stamped 0.1 s early against the IMU and the motion capture (each encoder row's stamp moved by
 // -0.1 s), diagnosed with the two clocks that could explain it: the drive's offset is named first, ahead of the IMU's
 // clock alone (which leaves the poses shifted), and the patched twin follows the held-out motion capture more closely.
@@ -233,21 +266,7 @@ TEST(TwinTest, AHiddenDriveTimeOffsetIsNamedFromTheReplayedEncoders) {
   const TwinDiagnosis early = DiagnosedRestamped(
       nominal, own, [&](Time t) { return Time::FromNanoseconds(t.nanoseconds() + std::llround(kOffsetS * 1e9)); },
       candidates, "encoders 0.1 s early");
-  ASSERT_FALSE(early.effects.empty());
-  const EffectEstimate& e = early.effects.front().estimate;
-  EXPECT_EQ(e.name, "drive_time_offset");
-  const EffectEstimate* own_offset = CandidateFit(right, "drive_time_offset");
-  ASSERT_NE(own_offset, nullptr);
-  ASSERT_TRUE(e.std.count("offset_s") && own_offset->std.count("offset_s"));
-  const double fitted = e.parameters.at("offset_s"), own_s = own_offset->parameters.at("offset_s");
-  std::printf("  fitted %.5f +- %.2g s (hidden %.3f); the right stamps' own %.5f s\n", fitted, e.std.at("offset_s"),
-              kOffsetS, own_s);
-  EXPECT_LT(fitted, 0.0);
-  EXPECT_NEAR(fitted, kOffsetS, std::abs(own_s) + 3.0 * e.std.at("offset_s"));
-  const double before = early.heldout_before.drift.at("mocap").mean_position_m;
-  const double after = early.heldout_after.drift.at("mocap").mean_position_m;
-  std::printf("  held-out 10 s drift %.4f m -> %.4f m\n", before, after);
-  EXPECT_LT(after, before);
+  EXPECT_LT(ExpectNamedAndRecovered(right, early, "drive_time_offset", "offset_s", kOffsetS), 0.0);
 }
 
 // The wheel encoders' clock running 3000 ppm fast against the motion capture's (each encoder row stamped
@@ -272,20 +291,7 @@ TEST(TwinTest, AHiddenDriveClockDriftIsRecoveredFromTheReplayedEncoders) {
         return Time::FromNanoseconds(t0_ns + std::llround(since_ns * (1.0 + kDriftPpm * 1e-6)));
       },
       candidates, "encoders' clock 3000 ppm fast");
-  ASSERT_FALSE(fast.effects.empty());
-  const EffectEstimate& e = fast.effects.front().estimate;
-  EXPECT_EQ(e.name, "drive_clock_drift");
-  const EffectEstimate* own_fit = CandidateFit(right, "drive_clock_drift");
-  ASSERT_NE(own_fit, nullptr);
-  ASSERT_TRUE(e.std.count("drift_ppm") && own_fit->parameters.count("drift_ppm"));
-  const double fitted = e.parameters.at("drift_ppm"), own_ppm = own_fit->parameters.at("drift_ppm");
-  std::printf("  fitted %.0f +- %.0f ppm, offset %.4f s (hidden %.0f ppm); the right stamps' own %.0f ppm\n", fitted,
-              e.std.at("drift_ppm"), e.parameters.at("offset_s"), kDriftPpm, own_ppm);
-  EXPECT_NEAR(fitted, kDriftPpm, std::abs(own_ppm) + 3.0 * e.std.at("drift_ppm"));
-  const double before = fast.heldout_before.drift.at("mocap").mean_position_m;
-  const double after = fast.heldout_after.drift.at("mocap").mean_position_m;
-  std::printf("  held-out 10 s drift %.4f m -> %.4f m\n", before, after);
-  EXPECT_LT(after, before);
+  ExpectNamedAndRecovered(right, fast, "drive_clock_drift", "drift_ppm", kDriftPpm);
 }
 
 // A drive-scale error: the wheel encoders read 3 % more than the wheels turn, on a short 15 s case of the scenario's

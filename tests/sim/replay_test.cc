@@ -186,6 +186,25 @@ TEST(ReplayTest, InputsNotTheScheduleDriveTheTwin) {
   EXPECT_GT(schedule.max_position_m, 10.0 * follows.max_position_m);
 }
 
+// The replays of `restamped` (real's recording with its encoders' stamps moved) by `patched` and by `nominal`, each
+// against real's ground truth, printed after `what`; and the bound of a replay of the right stamps.
+struct RestampedReplays {
+  TrackError patched, nominal;
+  Bound bound;
+};
+
+RestampedReplays ReplayRestamped(const Scenario& nominal, const Scenario& patched, const Simulation& real,
+                                 const Recording& restamped, const char* what) {
+  RestampedReplays out;
+  out.patched = Compare(*ReplayOk(patched, restamped).recording.ground_truth, *real.recording.ground_truth);
+  out.nominal = Compare(*ReplayOk(nominal, restamped).recording.ground_truth, *real.recording.ground_truth);
+  std::printf("%s: replay with the effect <= %.4f m, %.4f rad; without %.4f m, %.4f rad\n", what,
+              out.patched.max_position_m, out.patched.max_heading_rad, out.nominal.max_position_m,
+              out.nominal.max_heading_rad);
+  out.bound = EncoderBound(real.recording, Extent(*real.recording.ground_truth));
+  return out;
+}
+
 // drive_time_offset: the encoder rows stamped 0.2 s early (offset -0.2 s). A replay patched with the offset reads at
 // t the inputs stamped t - 0.2 s and reproduces the truth as a replay of the right stamps does; the nominal replay
 // runs the drive 0.2 s ahead. (Early, not late: the replay starts at the first encoder row, and inputs stamped late
@@ -201,19 +220,13 @@ TEST(ReplayTest, ADriveTimeOffsetReadsTheInputsThatMuchLater) {
       for (Time& t : s.t) t = Time::FromNanoseconds(t.nanoseconds() + std::llround(kOffsetS * 1e9));
   Scenario patched = nominal;
   patched.effects = {{"drive_time_offset", {{"offset_s", kOffsetS}}}};
-  const Simulation shifted = ReplayOk(patched, early);
-  const Simulation ahead = ReplayOk(nominal, early);
-  const TrackError a = Compare(*shifted.recording.ground_truth, *real.recording.ground_truth);
-  const TrackError b = Compare(*ahead.recording.ground_truth, *real.recording.ground_truth);
-  std::printf("encoders 0.2 s early: replay with the offset <= %.4f m, %.4f rad; without %.4f m, %.4f rad\n",
-              a.max_position_m, a.max_heading_rad, b.max_position_m, b.max_heading_rad);
-  const Bound bound = EncoderBound(real.recording, Extent(*real.recording.ground_truth));
+  const RestampedReplays r = ReplayRestamped(nominal, patched, real, early, "encoders 0.2 s early");
   // The shifted twin starts at rest 0.2 s before the recorded drive: its wheels may settle a tick further from the
   // recorded angles, twice the heading bound of the right stamps' replay.
-  EXPECT_LT(a.max_heading_rad, 2.0 * bound.heading_rad);
-  EXPECT_LT(a.max_position_m, bound.position_m);
-  EXPECT_GT(b.max_position_m, 5.0 * a.max_position_m);
-  EXPECT_GT(b.max_heading_rad, 5.0 * a.max_heading_rad);
+  EXPECT_LT(r.patched.max_heading_rad, 2.0 * r.bound.heading_rad);
+  EXPECT_LT(r.patched.max_position_m, r.bound.position_m);
+  EXPECT_GT(r.nominal.max_position_m, 5.0 * r.patched.max_position_m);
+  EXPECT_GT(r.nominal.max_heading_rad, 5.0 * r.patched.max_heading_rad);
   auto refused = Simulate(patched);
   ASSERT_FALSE(refused.ok());
   EXPECT_THAT(refused.status().message(), HasSubstr("drive_time_offset"));
@@ -236,16 +249,10 @@ TEST(ReplayTest, ADriveClockDriftReadsTheInputsOnTheDriftingClock) {
   }
   Scenario patched = nominal;
   patched.effects = {{"drive_time_offset", {{"drift_ppm", kDrift * 1e6}}}};
-  const Simulation drifting = ReplayOk(patched, fast);
-  const Simulation behind = ReplayOk(nominal, fast);
-  const TrackError a = Compare(*drifting.recording.ground_truth, *real.recording.ground_truth);
-  const TrackError b = Compare(*behind.recording.ground_truth, *real.recording.ground_truth);
-  std::printf("encoders' clock 5000 ppm fast: replay with the drift <= %.4f m, %.4f rad; without %.4f m, %.4f rad\n",
-              a.max_position_m, a.max_heading_rad, b.max_position_m, b.max_heading_rad);
-  const Bound bound = EncoderBound(real.recording, Extent(*real.recording.ground_truth));
-  EXPECT_LT(a.max_heading_rad, bound.heading_rad);
-  EXPECT_LT(a.max_position_m, bound.position_m);
-  EXPECT_GT(b.max_position_m, 5.0 * a.max_position_m);
+  const RestampedReplays r = ReplayRestamped(nominal, patched, real, fast, "encoders' clock 5000 ppm fast");
+  EXPECT_LT(r.patched.max_heading_rad, r.bound.heading_rad);
+  EXPECT_LT(r.patched.max_position_m, r.bound.position_m);
+  EXPECT_GT(r.nominal.max_position_m, 5.0 * r.patched.max_position_m);
   auto refused = Simulate(patched);
   ASSERT_FALSE(refused.ok());
   EXPECT_THAT(refused.status().message(), HasSubstr("drive_time_offset's drift"));
