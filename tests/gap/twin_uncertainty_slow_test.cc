@@ -5,7 +5,8 @@
 // GPS latency (a time shift, on the GPS fixes only) and a gyroscope z scale (a scale, on the gyroscope only), whose
 // candidates each see only their own stream, so that each is fitted alone against the nominal twin; and one with a
 // hidden wheel radius ratio (a scale of the drive itself). The twin is the plain noise-free simulation (the recordings
-// are of the scenario's own drive). The hidden values are drawn here and used only to score the fits.
+// are of the scenario's own drive). A second test does the same for the drive's clock drift, a replay's effect, under
+// coloured motion-capture noise. The hidden values are drawn here and used only to score the fits.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
