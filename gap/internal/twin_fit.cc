@@ -99,8 +99,7 @@ std::vector<TwinCandidate> Library(const sim::Scenario& nominal, double max_shif
   // wrong on the last. Fitted by Levenberg-Marquardt: the replay reads its inputs between their rows, so the pose and
   // position windows' residuals are smooth in both. At a constant speed the rate trades with the wheels' scale; stops,
   // turns and runs of other drives tell them apart. Not with an IMU: its per-sample rates and forces time the drive so
-  // sharply that the residuals are far from quadratic over the difference steps, and the fit stops near its start (a
-  // simulated 3000 ppm read as 28 +- 0.8 ppm).
+  // sharply that the residuals are far from quadratic over the difference steps, and the fit stops near its start.
   TwinCandidate clock{"drive_clock_drift",
                       "drive_time_offset",
                       {},
