@@ -70,6 +70,14 @@ Result<Inputs> LoadInputs(const DiagnoseRequest& request) {
     auto loaded = sim::LoadScenario(request.scenario);
     if (!loaded.ok()) return loaded.status();
     in.scenario = std::move(loaded).value();
+    // The diagnosis names what the nominal model leaves out; a scenario with effects (one patched with a diagnosis's
+    // scenario_patch.yaml, say) is not the nominal one, and its effects would not be in the model compared with.
+    if (!in.scenario->effects.empty()) {
+      std::string names;
+      for (const sim::EffectOptions& e : in.scenario->effects) names += (names.empty() ? "" : ", ") + e.name;
+      return Status::Error(request.scenario + ": has effects (" + names +
+                           "); diagnose compares the recording with the nominal model: give the scenario without them");
+    }
   }
   recording::ReadOptions read;
   read.load_ground_truth = false;

@@ -13,10 +13,14 @@ encoders' on straight 1 s stretches, its heading change over the encoders' on ar
 forward, their angles differing by more than 5 %, turning by more than 0.05 rad) and on in-place turns (0.5 s stretches with the wheels turning
 opposite ways), all with the nominal geometry.
 
-With --best-common: the one geometry, and the one geometry with one clock shift, that minimize the largest drift
-ratio (patched / nominal) over every run named, fitted on those runs themselves (Nelder-Mead from three starts): what
-the best constant patch of this form can do on them, whatever it was trained on; and each run's motion-capture
-scatter (the white noise of its positions and heading, from their third differences).
+With --best-common: the one geometry, the one geometry with one clock shift, and the one geometry with one clock
+shift at the run's start drifting at one rate (the twin's drive_clock_drift), that minimize the largest drift ratio
+(patched / nominal) over every run named, fitted on those runs themselves (Nelder-Mead from three starts): what the
+best patch of each form can do on them, whatever it was trained on; and each run's motion-capture scatter (the white
+noise of its positions and heading, from their third differences).
+
+With --patch SCALE,RATIO,TRACK_ERROR_M[,SHIFT_S[,DRIFT_PPM]]: each run's drift with that one patch (a twin's fitted
+patch, say) over its nominal drift.
 
 With --local-clock SCALE,RATIO,TRACK_ERROR_M: per run, the encoders' clock shift that best fits each 15 s stretch
 (every 7.5 s; 5 s windows aligned over 1 s, the shift searched from -60 to +160 ms in 10 ms steps) with that one
@@ -25,6 +29,7 @@ geometry: whether a run's clock shift is constant or drifts.
     python3 tools/optiodom_drift_floor.py DATA_DIR TRAINING_SET[,TRAINING_SET...] OTHER_SET...
     python3 tools/optiodom_drift_floor.py --best-common DATA_DIR SET...
     python3 tools/optiodom_drift_floor.py --local-clock SCALE,RATIO,TRACK_ERROR_M DATA_DIR SET...
+    python3 tools/optiodom_drift_floor.py --patch SCALE,RATIO,TRACK_ERROR_M[,SHIFT_S[,DRIFT_PPM]] DATA_DIR SET...
       (DATA_DIR: the dataset's data/diff folder; a set as shape/name, e.g. square/231220200029)
 """
 import bisect
@@ -58,11 +63,11 @@ def geometry(p):
     return RADIUS_M * scale * math.sqrt(ratio), RADIUS_M * scale / math.sqrt(ratio), TRACK_M + track_error
 
 
-def shifted(t, values, shift_s):
-    """values (at stamps t) read at t + shift_s, linearly interpolated, held at the ends."""
+def shifted(t, values, shift_s, drift=0.0):
+    """values (at stamps t) read at t + shift_s + drift (t - t[0]), linearly interpolated, held at the ends."""
     out = []
     for q in t:
-        q += shift_s
+        q += shift_s + drift * (q - t[0])
         i = min(max(bisect.bisect_right(t, q), 1), len(t) - 1)
         a = min(max((q - t[i - 1]) / (t[i] - t[i - 1]), 0.0), 1.0)
         out.append(values[i - 1] + a * (values[i] - values[i - 1]))
@@ -70,7 +75,8 @@ def shifted(t, values, shift_s):
 
 
 def dead_reckon(run, p):
-    """The pose from the encoder angles with geometry p[:3], the encoders read p[3] s later when given."""
+    """The pose from the encoder angles with geometry p[:3], the encoders read p[3] s later when given, and p[4] ppm of
+    the time since the run's start later still when given (their clock's drift)."""
     r_right, r_left, track = geometry(p[:3])
     x, y, th = [0.0], [0.0], [0.0]
     for i in range(1, len(run["t"])):
@@ -82,7 +88,8 @@ def dead_reckon(run, p):
         y.append(y[-1] + ds * math.sin(mid))
         th.append(th[-1] + dth)
     if len(p) > 3:
-        return tuple(shifted(run["t"], v, p[3]) for v in (x, y, th))
+        drift = 1e-6 * p[4] if len(p) > 4 else 0.0
+        return tuple(shifted(run["t"], v, p[3], drift) for v in (x, y, th))
     return x, y, th
 
 
@@ -191,7 +198,8 @@ def scatter(values):
 
 
 def best_common(runs):
-    """Prints, for the geometry alone and with a clock shift, the patch minimizing the largest drift ratio."""
+    """Prints, for the geometry alone, with a clock shift and with a drifting clock, the patch minimizing the largest
+    drift ratio."""
     for name, run in runs.items():
         print(f"{name}: motion capture's scatter x {1000 * scatter(run['x']):.2f} mm, y {1000 * scatter(run['y']):.2f} "
               f"mm, heading {1000 * scatter(run['th']):.1f} mrad")
@@ -201,13 +209,16 @@ def best_common(runs):
     for label, starts, steps in (
             ("geometry", [(1.0, 1.0, 0.0), (0.995, 1.0, 0.002), (0.993, 1.002, 0.004)], (0.01, 0.003, 0.003)),
             ("geometry and clock", [(1.0, 1.0, 0.0, 0.0), (0.995, 1.0, 0.002, 0.02), (0.993, 1.002, 0.004, -0.02)],
-             (0.01, 0.003, 0.003, 0.03))):
+             (0.01, 0.003, 0.003, 0.03)),
+            ("geometry and drifting clock", [(1.0, 1.0, 0.0, 0.0, 0.0), (0.995, 1.0, 0.002, 0.05, -1000.0),
+                                             (0.993, 1.002, 0.004, 0.02, 1000.0)], (0.01, 0.003, 0.003, 0.03, 1000.0))):
         fits = []
         for start in starts:
             p, _ = nelder_mead(worst, start, steps, iterations=200)
             fits.append(nelder_mead(worst, p, tuple(s / 3 for s in steps), iterations=200))
         p, value = min(fits, key=lambda fit: fit[1])
         clock = f", clock {1000 * p[3]:+.0f} ms" if len(p) > 3 else ""
+        clock += f" drifting {p[4]:+.0f} ppm" if len(p) > 4 else ""
         print(f"best common {label}: scale {p[0]:.4f}, R/L {p[1]:.4f}, track {1000 * p[2]:+.1f} mm{clock}: "
               f"largest ratio {value:.2f}")
         print("  " + ", ".join(f"{name} {r:.2f}" for name, r in ratios(p).items()))
@@ -228,16 +239,29 @@ def local_clock(runs, p, stretch_s=15.0, step_s=7.5):
         print(f"{name}: clock shift [ms] by stretch: {', '.join(shifts)}")
 
 
+def show_patch(runs, p):
+    """Prints each run's drift with patch p over its nominal drift."""
+    for name, run in runs.items():
+        d0, d = drift(run, (1.0, 1.0, 0.0)), drift(run, p)
+        print(f"{name}: {1000 * d0:.1f} -> {1000 * d:.1f} mm ({d / d0:.2f})")
+
+
 def main(argv):
-    clock_geometry = None
-    if len(argv) > 2 and argv[1] == "--local-clock":
+    clock_geometry = patch = None
+    if len(argv) > 2 and argv[1] in ("--local-clock", "--patch"):
         try:
-            clock_geometry = tuple(float(v) for v in argv[2].split(","))
+            values = tuple(float(v) for v in argv[2].split(","))
         except ValueError:
-            clock_geometry = ()
-        if len(clock_geometry) != 3:
-            print(f"optiodom_drift_floor.py: --local-clock {argv[2]}: needs SCALE,RATIO,TRACK_ERROR_M", file=sys.stderr)
+            values = ()
+        sizes, form = ((3,), "SCALE,RATIO,TRACK_ERROR_M") if argv[1] == "--local-clock" else \
+            ((3, 4, 5), "SCALE,RATIO,TRACK_ERROR_M[,SHIFT_S[,DRIFT_PPM]]")
+        if len(values) not in sizes:
+            print(f"optiodom_drift_floor.py: {argv[1]} {argv[2]}: needs {form}", file=sys.stderr)
             return 2
+        if argv[1] == "--local-clock":
+            clock_geometry = values
+        else:
+            patch = values
         argv = argv[2:]
     if len(argv) > 1 and argv[1] == "--best-common":
         argv = argv[1:]
@@ -261,6 +285,9 @@ def main(argv):
         return 0
     if clock_geometry:
         local_clock(runs, clock_geometry)
+        return 0
+    if patch:
+        show_patch(runs, patch)
         return 0
     nominal = (1.0, 1.0, 0.0)
     oracles = {name: nelder_mead(lambda p, run=run: drift(run, p), nominal, (0.01, 0.003, 0.003))

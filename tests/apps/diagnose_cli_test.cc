@@ -120,6 +120,23 @@ TEST(DiagnoseCliTest, RefusesARecordingOfAnotherRobotKind) {
   EXPECT_FALSE(std::ifstream(dir.File("out/gap.json")).good());
 }
 
+// A scenario with effects (one patched with a diagnosis's scenario_patch.yaml) is not the nominal model: refused, not
+// run without them.
+TEST(DiagnoseCliTest, RefusesAScenarioWithEffects) {
+  testing::TempDir dir;
+  ASSERT_EQ(Roamlab("simulate " + Scenario(dir, 1.0, "[]") + " --out " + dir.File("rec") + " --quiet", dir).exit_code,
+            0);
+  const std::string patched = Scenario(dir, 1.0, "[{name: steering_offset, parameters: {offset_rad: 0.03}}]");
+  const CommandRun run =
+      Roamlab("diagnose --real " + dir.File("rec") + " --scenario " + patched + " --out " + dir.File("out"), dir);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("roamlab diagnose: " + patched + ": has effects (steering_offset); diagnose compares"),
+            std::string::npos)
+      << run.err;
+  EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1);
+  EXPECT_FALSE(std::ifstream(dir.File("out/gap.json")).good());
+}
+
 TEST(DiagnoseCliTest, RefusesAShiftRangeTheRecordingCannotHold) {
   testing::TempDir dir;
   const std::string scenario = Scenario(dir, 1.5, "[]");
