@@ -5,7 +5,8 @@ the twin, gap/twin.h TwinDrift: 10 s windows every 1 s, each aligned by the nois
 first 2 s, the position error at its end).
 
 Per run (run-01 of each set named): the nominal geometry's drift; the drift with the geometry fitted to that run's own
-windows (an oracle: common radius scale, right/left radius ratio and track, Nelder-Mead on the mean drift), the same
+windows (an oracle: radius scale, right/left radius ratio and track error, as the twin's wheel_radius_scale,
+wheel_radius_asymmetry and track_width_error set them; Nelder-Mead on the mean drift), the same
 with a clock shift of the encoders against the motion capture fitted too, and the geometry fitted on a training run
 (the first run named; several, comma-separated, fitted together on the mean over them of drift / nominal drift)
 carried over; the motion capture's distance over the
@@ -58,9 +59,10 @@ def load(path):
 
 
 def geometry(p):
-    """(scale, right/left ratio, track error [m]) -> right and left radius, track [m]."""
+    """(scale, right/left ratio, track error [m]) -> right and left radius, track [m], as the twin's effects set them
+    (wheel_radius_scale both radii, wheel_radius_asymmetry the right one): a patch reads the same in both."""
     scale, ratio, track_error = p
-    return RADIUS_M * scale * math.sqrt(ratio), RADIUS_M * scale / math.sqrt(ratio), TRACK_M + track_error
+    return RADIUS_M * scale * ratio, RADIUS_M * scale, TRACK_M + track_error
 
 
 def shifted(t, values, shift_s, drift=0.0):

@@ -129,10 +129,10 @@ TEST(TwinRealTest, ThreeSquaresNameTheEncodersClockDriftAndHalveTheFourthSquares
   EXPECT_LT(HeldDrift(out.held.after), 0.5 * HeldDrift(out.held.before));
 }
 
-// The twin's physics follows the kinematics: the geometry that the kinematic stand-in (tools/optiodom_drift_floor.py,
-// dead reckoning of the encoders) fits on the same Dec set (scale 0.9940, R/L 1.0014, track +2.0 mm), put into the
-// twin, lowers the twin's drift on the held-out straight-line runs as it lowers the stand-in's (0.25-0.39x there;
-// measured in the twin: 0.27, 0.41, 0.34). What kept the twin's own patch from it was its fit, not its physics.
+// The twin's physics follows the kinematics: a geometry near the one the kinematic stand-in
+// (tools/optiodom_drift_floor.py, dead reckoning of the encoders) fits on the same Dec set, put into the twin, lowers
+// the twin's drift on the held-out straight-line runs as it lowers the stand-in's (docs/results.md gives both). What
+// kept the twin's own patch from it was its fit, not its physics.
 TEST(TwinRealTest, TheKinematicStandInsGeometryCarriesOverInTheTwin) {
   const std::vector<std::string> lines = {kDiff + "ivanjko/231220200102/231220200102",
                                           kDiff + "ivanjko/231220200104/231220200104",
