@@ -5,6 +5,7 @@
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <map>
 #include <set>
 
 #include "common/chi_square.h"
@@ -127,6 +128,9 @@ class Diagnoser {
   std::vector<TwinComparison> HeldOut(const std::vector<recording::Recording>& twins) const;
   // screen: fitted only when the score test (PredictedDrop) passes alpha.
   Result<TwinEffect> Fit(const TwinCandidate& c, const State& state, double step_s, bool screen);
+  // The kept effects other than time shifts refitted together with `c` (its informed parameters, from its own fit
+  // `e`); on success e takes the joint values and std and the refit is recorded for Round. Returns whether it was.
+  bool RefitWithKept(const TwinCandidate& c, double step_s, TwinEffect* e);
   Result<bool> Round(int round, const std::vector<TwinCandidate>& pool, double step_s, State* state,
                      std::vector<TwinEffect>* scored);
   void FitJointly(const State& state, const std::vector<TwinCandidate>& library, double step_s);
@@ -143,6 +147,14 @@ class Diagnoser {
   int measurements_ = 0;
   int runs_ = 0;
   bool hac_ = false;  // the std reported is the HAC one
+  const std::vector<TwinCandidate>* library_ = nullptr;
+  // Per candidate of the current round refitted with the kept effects: the whole patch with it, and the kept effects'
+  // refitted records (index into out_.effects, record).
+  struct Refit {
+    std::vector<sim::EffectOptions> patch;
+    std::vector<std::pair<std::size_t, TwinEffect>> kept;
+  };
+  std::map<std::string, Refit> refits_;
 };
 
 Status Diagnoser::Span() {
@@ -261,16 +273,86 @@ Result<TwinEffect> Diagnoser::Fit(const TwinCandidate& c, const State& state, do
   }
   e.estimate.dof = static_cast<int>(k);
   e.hac_lags = covariance.lags;
-  e.estimate.lr_raw = state.chi2 - fit.value().chi2;
+  if (k > 0 && !c.time_shift) {
+    std::vector<bool> informed = fit.value().informed;
+    RefitWithKept(internal::Reduced(c, informed), step_s, &e);
+  }
+  e.estimate.lr_raw = state.chi2 - e.chi2_after;
   internal::Score(nullptr, measurements_, &e.estimate);
   if (k == 0) e.estimate.decision = "not fitted: the data informs none of its parameters";
   return e;
+}
+
+// Forward selection with refit: the candidate is judged as the nested model "kept effects + candidate, all free"
+// against "kept effects", so that an effect whose signature overlaps a kept one's (a clock's rate and a wheel scale on
+// straight runs) is not judged against a kept one that has already absorbed part of it. Time shifts, searched on the
+// step grid, stay at their kept values.
+bool Diagnoser::RefitWithKept(const TwinCandidate& c, double step_s, TwinEffect* e) {
+  sim::Scenario base = Base({});
+  std::vector<TwinCandidate> parts;
+  std::vector<std::size_t> kept;
+  std::vector<double> start;
+  for (std::size_t i = 0; i < out_.effects.size(); ++i) {
+    const TwinEffect& x = out_.effects[i];
+    const auto l = std::find_if(library_->begin(), library_->end(),
+                                [&](const TwinCandidate& y) { return y.label == x.estimate.name; });
+    if (l == library_->end() || l->time_shift) {
+      base.effects.insert(base.effects.end(), x.applied.begin(), x.applied.end());
+      continue;
+    }
+    std::vector<bool> informed;
+    for (const internal::TwinParameter& p : l->free)
+      informed.push_back(std::find(x.not_informed.begin(), x.not_informed.end(), p.name) == x.not_informed.end());
+    parts.push_back(internal::Reduced(*l, informed));
+    for (const internal::TwinParameter& p : parts.back().free) start.push_back(x.estimate.parameters.at(p.name));
+    kept.push_back(i);
+  }
+  if (parts.empty()) return false;
+  parts.push_back(c);
+  for (const internal::TwinParameter& p : c.free) start.push_back(e->estimate.parameters.at(p.name));
+  // The start's residuals: the candidate's own fit is on top of the kept effects at their values.
+  internal::Patch at_start;
+  for (std::size_t i : kept) at_start.insert(at_start.end(), out_.effects[i].applied.begin(), out_.effects[i].applied.end());
+  at_start.insert(at_start.end(), e->applied.begin(), e->applied.end());
+  internal::TwinEvaluator evaluator(base, fit_runs_, options_.threads);
+  auto residuals = evaluator.Run({at_start});
+  internal::FitSettings settings;
+  settings.max_iterations = options_.max_iterations;
+  settings.physics_step_s = step_s;
+  settings.threads = options_.threads;
+  const Eigen::VectorXd theta0 =
+      Eigen::Map<const Eigen::VectorXd>(start.data(), static_cast<Eigen::Index>(start.size()));
+  Result<internal::JointOutcome> fit = residuals.front().ok()
+                                           ? internal::FitJointly(parts, theta0, residuals.front().value(),
+                                                                  &evaluator, settings)
+                                           : Result<internal::JointOutcome>(residuals.front().status());
+  runs_ += evaluator.runs();
+  e->runs += evaluator.runs();
+  if (!fit.ok() || !(fit.value().chi2 <= e->chi2_after)) return false;
+  Refit refit{base.effects, {}};
+  Eigen::Index k = 0;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const Eigen::Index size = static_cast<Eigen::Index>(parts[i].free.size());
+    const internal::Patch& applied = fit.value().effects[i];
+    refit.patch.insert(refit.patch.end(), applied.begin(), applied.end());
+    TwinEffect& t = i + 1 < parts.size() ? refit.kept.emplace_back(kept[i], out_.effects[kept[i]]).second : *e;
+    t.applied = applied;
+    t.estimate.parameters = Values(parts[i], fit.value().theta.segment(k, size));
+    for (const internal::TwinParameter& p : parts[i].free) SetStd(p.name, fit.value().covariance, k++, hac_, &t);
+    t.hac_lags = fit.value().covariance.lags;
+  }
+  e->chi2_after = fit.value().chi2;
+  e->iterations += fit.value().iterations;
+  e->refitted = true;
+  refits_[c.label] = std::move(refit);
+  return true;
 }
 
 // Fits the pool on top of `state`, scores them and keeps the first that passes (its held-out run becomes the new
 // state). A candidate whose twin fails is dropped with the reason. Returns whether one was kept.
 Result<bool> Diagnoser::Round(int round, const std::vector<TwinCandidate>& pool, double step_s, State* state,
                               std::vector<TwinEffect>* scored) {
+  refits_.clear();
   for (const TwinCandidate& c : pool) {
     if (InterruptRequested()) return InterruptedError();
     Progress("round " + std::to_string(round + 1) + ": fitting " + c.label);
@@ -296,8 +378,10 @@ Result<bool> Diagnoser::Round(int round, const std::vector<TwinCandidate>& pool,
       x.decision = x.lr_pvalue < options_.alpha ? "Delta BIC not below the threshold" : "p not below alpha";
       continue;
     }
+    const auto refit = refits_.find(x.name);
     std::vector<sim::EffectOptions> effects = state->effects;
     effects.insert(effects.end(), e.applied.begin(), e.applied.end());
+    if (refit != refits_.end()) effects = refit->second.patch;
     auto twins = RunWhole(effects);
     if (!twins.ok()) {
       x.decision = "the patched twin of the whole recording failed: " + twins.status().message();
@@ -318,6 +402,11 @@ Result<bool> Diagnoser::Round(int round, const std::vector<TwinCandidate>& pool,
     state->heldout = std::move(heldout);
     state->twins = std::move(twins).value();
     state->residuals = internal::CombinedResiduals(fit_runs_, state->twins);
+    if (refit != refits_.end())
+      for (auto& [i, t] : refit->second.kept) {
+        t.estimate.decision = "accepted; refitted with " + x.name;
+        out_.effects[i] = t;
+      }
     out_.effects.push_back(e);
     for (TwinEffect& other : *scored) {
       EffectEstimate& y = other.estimate;
@@ -455,6 +544,7 @@ Result<TwinDiagnosis> Diagnoser::Run() {
   state.chi2 = internal::SumOfSquares(state.residuals, &measurements_);
 
   const std::vector<TwinCandidate> library = internal::TwinCandidates(nominal_, options_.max_shift_s);
+  library_ = &library;
   std::vector<TwinCandidate> pool;
   for (const TwinCandidate& c : library)
     if (Applies(c, runs_in_) &&

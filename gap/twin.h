@@ -38,12 +38,18 @@
 //      candidate, and later the ones that passed p in that round), other than those that set a simulator effect kept
 //      already, are tried again on top of the kept ones, each fitted only when a score test passes alpha
 //      (internal/twin_fit.h PredictedDrop: the Gauss-Newton step's predicted drop from its neutral values, one
-//      Jacobian), up to max_effects; every round's candidates and decisions are kept (TwinDiagnosis::rounds);
-//   5. joint refit: with more than one effect kept, each was fitted on top of the ones before it, held at their values,
-//      so its std is conditional on them; the kept effects' parameters (time shifts held at their values) are fitted
-//      again together, Levenberg-Marquardt from the kept values (internal/twin_fit.h FitJointly), and their joint
-//      values with the marginal std (white and HAC, from the joint covariance) are reported beside the rounds'
-//      (TwinJointFit). It names nothing and leaves the patch and the held-out figures as the rounds kept them;
+//      Jacobian), up to max_effects; every round's candidates and decisions are kept (TwinDiagnosis::rounds).
+//      Forward selection with refit: a candidate other than a time shift, once fitted on top of the kept effects, is
+//      fitted again together with the kept ones that are not time shifts (internal/twin_fit.h FitJointly, from the kept
+//      values and its own), and its LR is the drop of that nested model, "kept + candidate, all free" against "kept"
+//      (TwinEffect::refitted); when it is kept, the kept effects take their refitted values and the patch with them.
+//      Without it an effect whose signature overlaps a kept one's (a drive clock's rate and the wheels' scale on
+//      straight runs) would be judged against a kept effect that has already absorbed part of it;
+//   5. joint refit: the kept effects' parameters (time shifts held at their values) are fitted again together,
+//      Levenberg-Marquardt from the kept values (internal/twin_fit.h FitJointly), and their joint values with the
+//      marginal std (white and HAC, from the joint covariance) and the std conditional on the others are reported
+//      beside the rounds' (TwinJointFit). After a round's refit it starts at the joint optimum unless a time shift was
+//      kept later; it names nothing and leaves the patch and the held-out figures as the rounds kept them;
 //   6. show: on the held-out part, the nominal twin's and the patched twin's residual RMS per stream and drift.
 // Verdict: "named" (some effect kept), "unknown" (no effect kept, and some component inconsistent with the stated
 // noise), "none". `unexplained` lists the components still inconsistent on the held-out part with the patch.
@@ -223,7 +229,10 @@ struct TwinEffect {
   std::vector<sim::EffectOptions> applied;  // as the simulator applies it (time shifts in whole physics steps): one
                                             // effect, or a composite candidate's parts
   double chi2_before = 0.0;                 // training part: with the effects kept before it
-  double chi2_after = 0.0;                  // with it
+  double chi2_after = 0.0;                  // with it (refitted: with it and the kept effects refitted)
+  // Fitted together with the kept effects other than time shifts (step 3): its values and std are the joint fit's,
+  // marginal over theirs.
+  bool refitted = false;
   int iterations = 0;
   int runs = 0;  // twin runs spent on the fit
 };

@@ -49,6 +49,7 @@ nlohmann::json EffectJson(const TwinEffect& e) {
           {"hac_lags", e.hac_lags},
           {"chi2_before", Number(e.chi2_before)},
           {"chi2_after", Number(e.chi2_after)},
+          {"refitted_with_kept", e.refitted},
           {"lr", Number(x.lr)},
           {"p", Number(x.lr_pvalue)},
           {"delta_bic", Number(x.delta_bic)},
@@ -66,7 +67,8 @@ nlohmann::json JointJson(const TwinJointFit& j) {
   nlohmann::json effects = nlohmann::json::array();
   for (std::size_t i = 0; i < j.effects.size(); ++i) {
     nlohmann::json x = EffectJson(j.effects[i]);
-    for (const char* key : {"lr", "p", "delta_bic", "heldout_improvement", "accepted", "std_batch"}) x.erase(key);
+    for (const char* key :
+         {"lr", "p", "delta_bic", "heldout_improvement", "accepted", "std_batch", "refitted_with_kept"}) x.erase(key);
     x["std_white_conditional"] = nlohmann::json::object();
     if (i < j.std_white_conditional.size())
       for (const auto& [name, value] : j.std_white_conditional[i]) x["std_white_conditional"][name] = Number(value);
