@@ -131,9 +131,26 @@ class Diagnoser {
   // The kept effects other than time shifts refitted together with `c` (its informed parameters, from its own fit
   // `e`); on success e takes the joint values and std and the refit is recorded for Round. Returns whether it was.
   bool RefitWithKept(const TwinCandidate& c, double step_s, TwinEffect* e);
+  // The kept effects split for a joint fit: time shifts into the base scenario, the others as candidates over the
+  // parameters their rounds fitted, with their kept values.
+  struct KeptParts {
+    sim::Scenario base;
+    std::vector<TwinCandidate> parts;
+    std::vector<std::size_t> kept;  // per part, its index in out_.effects
+    std::vector<double> start;      // the parts' free parameters at their kept values, concatenated
+    std::vector<std::string> held;  // the time shifts' names
+  };
+  KeptParts Kept() const;
+  internal::FitSettings Settings(double step_s) const {
+    internal::FitSettings settings;
+    settings.max_iterations = options_.max_iterations;
+    settings.physics_step_s = step_s;
+    settings.threads = options_.threads;
+    return settings;
+  }
   Result<bool> Round(int round, const std::vector<TwinCandidate>& pool, double step_s, State* state,
                      std::vector<TwinEffect>* scored);
-  void FitJointly(const State& state, const std::vector<TwinCandidate>& library, double step_s);
+  void FitJointly(const State& state, double step_s);
   void Finish(const State& state);
 
   const sim::Scenario& nominal_;
@@ -147,7 +164,7 @@ class Diagnoser {
   int measurements_ = 0;
   int runs_ = 0;
   bool hac_ = false;  // the std reported is the HAC one
-  const std::vector<TwinCandidate>* library_ = nullptr;
+  std::vector<TwinCandidate> library_;  // every candidate the nominal scenario supports
   // Per candidate of the current round refitted with the kept effects: the whole patch with it, and the kept effects'
   // refitted records (index into out_.effects, record).
   struct Refit {
@@ -229,10 +246,7 @@ std::vector<TwinComparison> Diagnoser::HeldOut(const std::vector<recording::Reco
 Result<TwinEffect> Diagnoser::Fit(const TwinCandidate& c, const State& state, double step_s, bool screen) {
   const sim::Scenario base = Base(state.effects);
   internal::TwinEvaluator evaluator(base, fit_runs_, options_.threads);
-  internal::FitSettings settings;
-  settings.max_iterations = options_.max_iterations;
-  settings.physics_step_s = step_s;
-  settings.threads = options_.threads;
+  const internal::FitSettings settings = Settings(step_s);
   if (screen) {
     auto drop = internal::PredictedDrop(c, state.residuals, &evaluator, settings);
     runs_ += evaluator.runs();
@@ -273,10 +287,7 @@ Result<TwinEffect> Diagnoser::Fit(const TwinCandidate& c, const State& state, do
   }
   e.estimate.dof = static_cast<int>(k);
   e.hac_lags = covariance.lags;
-  if (k > 0 && !c.time_shift) {
-    std::vector<bool> informed = fit.value().informed;
-    RefitWithKept(internal::Reduced(c, informed), step_s, &e);
-  }
+  if (k > 0 && !c.time_shift) RefitWithKept(internal::Reduced(c, fit.value().informed), step_s, &e);
   e.estimate.lr_raw = state.chi2 - e.chi2_after;
   internal::Score(nullptr, measurements_, &e.estimate);
   if (k == 0) e.estimate.decision = "not fitted: the data informs none of its parameters";
@@ -287,26 +298,29 @@ Result<TwinEffect> Diagnoser::Fit(const TwinCandidate& c, const State& state, do
 // against "kept effects", so that an effect whose signature overlaps a kept one's (a clock's rate and a wheel scale on
 // straight runs) is not judged against a kept one that has already absorbed part of it. Time shifts, searched on the
 // step grid, stay at their kept values.
-bool Diagnoser::RefitWithKept(const TwinCandidate& c, double step_s, TwinEffect* e) {
-  sim::Scenario base = Base({});
-  std::vector<TwinCandidate> parts;
-  std::vector<std::size_t> kept;
-  std::vector<double> start;
+Diagnoser::KeptParts Diagnoser::Kept() const {
+  KeptParts out{Base({}), {}, {}, {}, {}};
   for (std::size_t i = 0; i < out_.effects.size(); ++i) {
     const TwinEffect& x = out_.effects[i];
-    const auto l = std::find_if(library_->begin(), library_->end(),
+    const auto c = std::find_if(library_.begin(), library_.end(),
                                 [&](const TwinCandidate& y) { return y.label == x.estimate.name; });
-    if (l == library_->end() || l->time_shift) {
-      base.effects.insert(base.effects.end(), x.applied.begin(), x.applied.end());
+    if (c == library_.end() || c->time_shift) {
+      out.base.effects.insert(out.base.effects.end(), x.applied.begin(), x.applied.end());
+      out.held.push_back(x.estimate.name);
       continue;
     }
     std::vector<bool> informed;
-    for (const internal::TwinParameter& p : l->free)
+    for (const internal::TwinParameter& p : c->free)
       informed.push_back(std::find(x.not_informed.begin(), x.not_informed.end(), p.name) == x.not_informed.end());
-    parts.push_back(internal::Reduced(*l, informed));
-    for (const internal::TwinParameter& p : parts.back().free) start.push_back(x.estimate.parameters.at(p.name));
-    kept.push_back(i);
+    out.parts.push_back(internal::Reduced(*c, informed));
+    for (const internal::TwinParameter& p : out.parts.back().free) out.start.push_back(x.estimate.parameters.at(p.name));
+    out.kept.push_back(i);
   }
+  return out;
+}
+
+bool Diagnoser::RefitWithKept(const TwinCandidate& c, double step_s, TwinEffect* e) {
+  auto [base, parts, kept, start, held] = Kept();
   if (parts.empty()) return false;
   parts.push_back(c);
   for (const internal::TwinParameter& p : c.free) start.push_back(e->estimate.parameters.at(p.name));
@@ -316,15 +330,11 @@ bool Diagnoser::RefitWithKept(const TwinCandidate& c, double step_s, TwinEffect*
   at_start.insert(at_start.end(), e->applied.begin(), e->applied.end());
   internal::TwinEvaluator evaluator(base, fit_runs_, options_.threads);
   auto residuals = evaluator.Run({at_start});
-  internal::FitSettings settings;
-  settings.max_iterations = options_.max_iterations;
-  settings.physics_step_s = step_s;
-  settings.threads = options_.threads;
   const Eigen::VectorXd theta0 =
       Eigen::Map<const Eigen::VectorXd>(start.data(), static_cast<Eigen::Index>(start.size()));
   Result<internal::JointOutcome> fit = residuals.front().ok()
                                            ? internal::FitJointly(parts, theta0, residuals.front().value(),
-                                                                  &evaluator, settings)
+                                                                  &evaluator, Settings(step_s))
                                            : Result<internal::JointOutcome>(residuals.front().status());
   runs_ += evaluator.runs();
   e->runs += evaluator.runs();
@@ -423,39 +433,18 @@ Result<bool> Diagnoser::Round(int round, const std::vector<TwinCandidate>& pool,
 // Step 5 (gap/twin.h): the kept effects other than time shifts, each over the parameters its round fitted, refitted
 // together from their kept values on the training part, the time shifts held in the base. A joint fit whose twin fails
 // leaves the rounds' figures alone and says why.
-void Diagnoser::FitJointly(const State& state, const std::vector<TwinCandidate>& library, double step_s) {
-  sim::Scenario base = Base({});
-  std::vector<TwinCandidate> parts;
-  std::vector<const TwinEffect*> kept;
-  std::vector<double> start;
-  for (const TwinEffect& e : out_.effects) {
-    const auto c = std::find_if(library.begin(), library.end(),
-                                [&](const TwinCandidate& x) { return x.label == e.estimate.name; });
-    if (c == library.end() || c->time_shift) {
-      base.effects.insert(base.effects.end(), e.applied.begin(), e.applied.end());
-      out_.joint.held.push_back(e.estimate.name);
-      continue;
-    }
-    std::vector<bool> informed;
-    for (const internal::TwinParameter& p : c->free)
-      informed.push_back(std::find(e.not_informed.begin(), e.not_informed.end(), p.name) == e.not_informed.end());
-    parts.push_back(internal::Reduced(*c, informed));
-    for (const internal::TwinParameter& p : parts.back().free) start.push_back(e.estimate.parameters.at(p.name));
-    kept.push_back(&e);
-  }
+void Diagnoser::FitJointly(const State& state, double step_s) {
+  auto [base, parts, kept, start, held] = Kept();
+  out_.joint.held = held;
   if (parts.size() < 2) {
     out_.joint = {};
     return;
   }
   Progress("joint refit of the kept effects");
   internal::TwinEvaluator evaluator(base, fit_runs_, options_.threads);
-  internal::FitSettings settings;
-  settings.max_iterations = options_.max_iterations;
-  settings.physics_step_s = step_s;
-  settings.threads = options_.threads;
   const Eigen::VectorXd theta0 =
       Eigen::Map<const Eigen::VectorXd>(start.data(), static_cast<Eigen::Index>(start.size()));
-  auto fit = internal::FitJointly(parts, theta0, state.residuals, &evaluator, settings);
+  auto fit = internal::FitJointly(parts, theta0, state.residuals, &evaluator, Settings(step_s));
   runs_ += evaluator.runs();
   out_.joint.runs = evaluator.runs();
   out_.joint.chi2_before = state.chi2;
@@ -483,7 +472,7 @@ void Diagnoser::FitJointly(const State& state, const std::vector<TwinCandidate>&
       conditional_std[parts[i].free[static_cast<std::size_t>(j)].name] = std::sqrt(std::max(0.0, conditional(j, j)));
     out_.joint.std_white_conditional.push_back(conditional_std);
     for (const internal::TwinParameter& p : parts[i].free) SetStd(p.name, covariance, k++, hac_, &e);
-    e.not_informed = kept[i]->not_informed;
+    e.not_informed = out_.effects[kept[i]].not_informed;
     e.hac_lags = covariance.lags;
     e.chi2_before = out_.joint.chi2_before;
     e.chi2_after = out_.joint.chi2_after;
@@ -543,10 +532,9 @@ Result<TwinDiagnosis> Diagnoser::Run() {
   state.residuals = internal::CombinedResiduals(fit_runs_, state.twins);
   state.chi2 = internal::SumOfSquares(state.residuals, &measurements_);
 
-  const std::vector<TwinCandidate> library = internal::TwinCandidates(nominal_, options_.max_shift_s);
-  library_ = &library;
+  library_ = internal::TwinCandidates(nominal_, options_.max_shift_s);
   std::vector<TwinCandidate> pool;
-  for (const TwinCandidate& c : library)
+  for (const TwinCandidate& c : library_)
     if (Applies(c, runs_in_) &&
         (options_.candidates.empty()
              ? DefaultCandidate(c, runs_in_.size())
@@ -586,7 +574,7 @@ Result<TwinDiagnosis> Diagnoser::Run() {
     pool = next;
   }
   if (InterruptRequested()) return InterruptedError();
-  FitJointly(state, library, step_s);
+  FitJointly(state, step_s);
   Finish(state);
   out_.runs = runs_;
   out_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
