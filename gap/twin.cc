@@ -350,10 +350,10 @@ bool Diagnoser::RefitWithKept(const TwinCandidate& c, double step_s, TwinEffect*
     t.estimate.parameters = Values(parts[i], fit.value().theta.segment(k, size));
     for (const internal::TwinParameter& p : parts[i].free) SetStd(p.name, fit.value().covariance, k++, hac_, &t);
     t.hac_lags = fit.value().covariance.lags;
+    t.refitted = true;
   }
   e->chi2_after = fit.value().chi2;
   e->iterations += fit.value().iterations;
-  e->refitted = true;
   refits_[c.label] = std::move(refit);
   return true;
 }

@@ -230,8 +230,9 @@ struct TwinEffect {
                                             // effect, or a composite candidate's parts
   double chi2_before = 0.0;                 // training part: with the effects kept before it
   double chi2_after = 0.0;                  // with it (refitted: with it and the kept effects refitted)
-  // Fitted together with the kept effects other than time shifts (step 3): its values and std are the joint fit's,
-  // marginal over theirs.
+  // Its values and std come from a fit together with the other kept effects but time shifts (step 3): a later
+  // round's candidate refitted with the kept ones, or a kept one refitted with a later round's; the std is marginal
+  // over theirs.
   bool refitted = false;
   int iterations = 0;
   int runs = 0;  // twin runs spent on the fit

@@ -364,7 +364,7 @@ TEST(TwinTest, TwoKeptEffectsAreRefittedJointlyWithTheirMarginalStd) {
                 0.1 * joint.std_white.at(parameter))
         << kept.estimate.name;
   }
-  EXPECT_TRUE(d.effects[1].refitted);
+  EXPECT_TRUE(d.effects[0].refitted && d.effects[1].refitted);
   EXPECT_NE(d.effects[0].estimate.decision.find("refitted with " + d.effects[1].estimate.name), std::string::npos)
       << d.effects[0].estimate.decision;
   const nlohmann::json json = TwinDiagnosisJson(d);
