@@ -163,7 +163,7 @@ class Diagnoser {
   std::vector<TwinResidualOptions> residuals_;  // per run: its fit's and held-out comparison's
   int measurements_ = 0;
   int runs_ = 0;
-  bool hac_ = false;  // the std reported is the HAC one
+  bool hac_ = false;                    // the std reported is the HAC one
   std::vector<TwinCandidate> library_;  // every candidate the nominal scenario supports
   // Per candidate of the current round refitted with the kept effects: the whole patch with it, and the kept effects'
   // refitted records (index into out_.effects, record).
@@ -294,10 +294,6 @@ Result<TwinEffect> Diagnoser::Fit(const TwinCandidate& c, const State& state, do
   return e;
 }
 
-// Forward selection with refit: the candidate is judged as the nested model "kept effects + candidate, all free"
-// against "kept effects", so that an effect whose signature overlaps a kept one's (a clock's rate and a wheel scale on
-// straight runs) is not judged against a kept one that has already absorbed part of it. Time shifts, searched on the
-// step grid, stay at their kept values.
 Diagnoser::KeptParts Diagnoser::Kept() const {
   KeptParts out{Base({}), {}, {}, {}, {}};
   for (std::size_t i = 0; i < out_.effects.size(); ++i) {
@@ -313,12 +309,17 @@ Diagnoser::KeptParts Diagnoser::Kept() const {
     for (const internal::TwinParameter& p : c->free)
       informed.push_back(std::find(x.not_informed.begin(), x.not_informed.end(), p.name) == x.not_informed.end());
     out.parts.push_back(internal::Reduced(*c, informed));
-    for (const internal::TwinParameter& p : out.parts.back().free) out.start.push_back(x.estimate.parameters.at(p.name));
+    for (const internal::TwinParameter& p : out.parts.back().free)
+      out.start.push_back(x.estimate.parameters.at(p.name));
     out.kept.push_back(i);
   }
   return out;
 }
 
+// Forward selection with refit: the candidate is judged as the nested model "kept effects + candidate, all free"
+// against "kept effects", so that an effect whose signature overlaps a kept one's (a clock's rate and a wheel scale on
+// straight runs) is not judged against a kept one that has already absorbed part of it. Time shifts, searched on the
+// step grid, stay at their kept values.
 bool Diagnoser::RefitWithKept(const TwinCandidate& c, double step_s, TwinEffect* e) {
   auto [base, parts, kept, start, held] = Kept();
   if (parts.empty()) return false;
@@ -326,16 +327,17 @@ bool Diagnoser::RefitWithKept(const TwinCandidate& c, double step_s, TwinEffect*
   for (const internal::TwinParameter& p : c.free) start.push_back(e->estimate.parameters.at(p.name));
   // The start's residuals: the candidate's own fit is on top of the kept effects at their values.
   internal::Patch at_start;
-  for (std::size_t i : kept) at_start.insert(at_start.end(), out_.effects[i].applied.begin(), out_.effects[i].applied.end());
+  for (std::size_t i : kept)
+    at_start.insert(at_start.end(), out_.effects[i].applied.begin(), out_.effects[i].applied.end());
   at_start.insert(at_start.end(), e->applied.begin(), e->applied.end());
   internal::TwinEvaluator evaluator(base, fit_runs_, options_.threads);
   auto residuals = evaluator.Run({at_start});
   const Eigen::VectorXd theta0 =
       Eigen::Map<const Eigen::VectorXd>(start.data(), static_cast<Eigen::Index>(start.size()));
-  Result<internal::JointOutcome> fit = residuals.front().ok()
-                                           ? internal::FitJointly(parts, theta0, residuals.front().value(),
-                                                                  &evaluator, Settings(step_s))
-                                           : Result<internal::JointOutcome>(residuals.front().status());
+  Result<internal::JointOutcome> fit =
+      residuals.front().ok()
+          ? internal::FitJointly(parts, theta0, residuals.front().value(), &evaluator, Settings(step_s))
+          : Result<internal::JointOutcome>(residuals.front().status());
   runs_ += evaluator.runs();
   e->runs += evaluator.runs();
   if (!fit.ok() || !(fit.value().chi2 <= e->chi2_after)) return false;

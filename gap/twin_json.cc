@@ -68,7 +68,8 @@ nlohmann::json JointJson(const TwinJointFit& j) {
   for (std::size_t i = 0; i < j.effects.size(); ++i) {
     nlohmann::json x = EffectJson(j.effects[i]);
     for (const char* key :
-         {"lr", "p", "delta_bic", "heldout_improvement", "accepted", "std_batch", "refitted_with_kept"}) x.erase(key);
+         {"lr", "p", "delta_bic", "heldout_improvement", "accepted", "std_batch", "refitted_with_kept"})
+      x.erase(key);
     x["std_white_conditional"] = nlohmann::json::object();
     if (i < j.std_white_conditional.size())
       for (const auto& [name, value] : j.std_white_conditional[i]) x["std_white_conditional"][name] = Number(value);

@@ -230,7 +230,7 @@ std::vector<std::string> TwinVerdictLines(const TwinDiagnosis& d) {
                                     std::to_string(d.runs) + " twin runs in " + Fixed(d.seconds, 3) + " s)."};
   for (const TwinEffect& e : d.effects)
     lines.push_back(EffectLine(e) + " (training chi2 " + Fixed(e.chi2_before, 5) + " -> " + Fixed(e.chi2_after, 5) +
-                    (e.refitted             ? "; refitted with the other kept effects: std marginal over them)"
+                    (e.refitted                ? "; refitted with the other kept effects: std marginal over them)"
                      : d.joint.effects.empty() ? ")"
                                                : "; std conditional on the effects kept before it)"));
   if (!d.joint.failed.empty()) lines.push_back("The kept effects' joint refit failed: " + d.joint.failed + ".");
