@@ -251,7 +251,7 @@ Status RemoveEarlierOutputs(const DiagnoseRequest& given, const std::string& out
 
 }  // namespace
 
-Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagnosis) {
+Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagnosis, gap::TwinDiagnosis* twin_out) {
   const auto say = [&](const std::string& line) {
     if (given.progress) given.progress(line);
   };
@@ -296,9 +296,10 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
     if (!trained.ok()) return Outcome::BadInput(trained.status());
     training = std::move(trained).value();
     if (const std::string run = NotReplayedForTheDriveClock(request, *twin, training); !run.empty())
-      return Outcome::BadInput(Status::Error("--twin-candidates: 'drive_time_offset' shifts a replay's recorded drive "
-                                             "inputs, and " + run +
-                                             " is twinned by the plain simulation of its own drive (--replay replays it)"));
+      return Outcome::BadInput(
+          Status::Error("--twin-candidates: 'drive_time_offset' shifts a replay's recorded drive "
+                        "inputs, and " +
+                        run + " is twinned by the plain simulation of its own drive (--replay replays it)"));
   }
   if (Status s = RemoveEarlierOutputs(given, request.out); !s.ok()) return Outcome::Failed(s);
   IncompleteMarker marker(request.out);
@@ -364,6 +365,7 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
   (void)marker.AddDone("gap.json, the patches and the report");
   if (Status s = marker.Complete(); !s.ok()) return Outcome::Failed(s);
   if (diagnosis) *diagnosis = std::move(diagnosed).value();
+  if (twin_out && twin_diagnosis) *twin_out = std::move(*twin_diagnosis);
   return Outcome::Ok();
 }
 

@@ -24,6 +24,7 @@
 #include "gap/diagnose.h"
 #include "gap/learn_baseline.h"
 #include "gap/resimulate.h"
+#include "gap/twin.h"
 
 namespace roamlab::experiment {
 
@@ -69,7 +70,9 @@ struct DiagnoseRequest {
 
 // Diagnoses the recording and writes the outputs. Inputs that do not load or do not fit each other (a stream the
 // nominal model reads missing, the platform kind not the scenario's robot) are bad input; a fit or a simulation that
-// fails, or a file that cannot be written, is a failure. `diagnosis` (optional) receives the result.
-Outcome DiagnoseToDirectory(const DiagnoseRequest& request, gap::Diagnosis* diagnosis = nullptr);
+// fails, or a file that cannot be written, is a failure. `diagnosis` (optional) receives the result, and `twin`
+// (optional) the diagnosis against the twin when `request.twin` (else it is left as it is).
+Outcome DiagnoseToDirectory(const DiagnoseRequest& request, gap::Diagnosis* diagnosis = nullptr,
+                            gap::TwinDiagnosis* twin = nullptr);
 
 }  // namespace roamlab::experiment

@@ -178,7 +178,7 @@ std::string MarkdownTable(const html::Table& table) {
 // The re-simulation (gap/resimulate.h) against the recording's held-out part.
 const char kSimulationText[] =
     "The scenario's twin of the recording run again without noise, as believed and with the accepted effects applied "
-    "(scenario_patch.yaml; with --twin the twin diagnosis's patch, twin.json), compared sample by sample with the "
+    "(scenario_patch.yaml: with --twin the twin diagnosis's patch), compared sample by sample with the "
     "recording: RMS of recorded minus twin in units of each stream's stated noise (1 = noise only), and of its 1 s "
     "means (the systematic part); then the drift of its absolute streams over 10 s windows, each window's twin aligned "
     "to the recording at its start.";
@@ -282,7 +282,8 @@ html::Table HeldoutTable(const Diagnosis& d) {
 const char kHeldoutText[] =
     "Whitened residuals: RMS per sample, RMS of their 1 s means (the systematic part) and chi2/dof.";
 
-// The twin's section: which twin and why, the held-out RMS and drift before and after, the twin diagnosis.
+// The twin's section: which twin and why, the held-out RMS and drift before and after, the twin diagnosis's held-out
+// runs.
 struct TwinSection {
   std::string title;
   std::vector<std::string> lines;  // paragraphs before the tables
@@ -301,20 +302,36 @@ TwinSection MakeTwinSection(const ReportInputs& in) {
   }
   out.notes = SimulationNotes(c);
   if (in.twin) {
-    const std::vector<std::string> verdict = internal::TwinVerdictLines(*in.twin);
-    out.lines.insert(out.lines.end(), verdict.begin(), verdict.end());
-    out.lines.push_back("The twin diagnosis in full: twin.json.");
+    out.lines.push_back("The twin diagnosis (its verdict above) in full: twin.json.");
     if (!in.twin->heldout_runs.empty()) out.tables.push_back(internal::HeldOutRunsTable(*in.twin));
   }
   return out;
+}
+
+// The verdicts, first the one whose values are accepted: with a twin diagnosis the twin's, then the estimator-side
+// diagnosis's (its first guess).
+struct Verdict {
+  std::string title, verdict;
+  std::vector<std::string> lines;
+  std::size_t plain = 0;  // the lines before the items
+};
+std::vector<Verdict> Verdicts(const Diagnosis& d, const ReportInputs& in) {
+  Verdict estimator{in.twin ? "Estimator-side verdict (the first guess; estimator_patch.yaml)" : "Verdict", d.verdict,
+                    VerdictLines(d, in.baseline != nullptr), d.verdict == "named" ? 0u : 1u};
+  if (!in.twin) return {estimator};
+  std::vector<std::string> lines = internal::TwinVerdictLines(*in.twin);
+  lines.push_back("Its patch: scenario_patch.yaml.");
+  return {{"Verdict against the twin", in.twin->verdict, lines, 1}, estimator};
 }
 
 // report.html: the verdict first, the tables, then the figures embedded.
 Status WriteReportHtml(const Diagnosis& d, const ReportInputs& in, const ReportFigures& figures,
                        const std::string& dir) {
   html::Page page("Reality-gap diagnosis");
-  page.Paragraph("Verdict: " + d.verdict, d.verdict == "none" ? "verdict-pass" : "verdict-fail");
-  for (const std::string& line : VerdictLines(d, in.baseline != nullptr)) page.Paragraph(line, "headline");
+  for (const Verdict& v : Verdicts(d, in)) {
+    page.Paragraph(v.title + ": " + v.verdict, v.verdict == "none" ? "verdict-pass" : "verdict-fail");
+    for (const std::string& line : v.lines) page.Paragraph(line, "headline");
+  }
   page.Paragraph("Recording " + in.recording + " against the nominal scenario " + in.model + "; " +
                  std::to_string(d.fits) + " calibrations in " + Fixed(d.seconds, 3) + " s.");
   page.Heading(2, "Fit on the held-out part (after t = " + Fixed(d.train_end_s, 4) + " s), before and after");
@@ -346,10 +363,12 @@ Status WriteReportHtml(const Diagnosis& d, const ReportInputs& in, const ReportF
 std::string ReportMarkdown(const Diagnosis& d, const ReportInputs& in, const ReportFigures& figures) {
   std::ostringstream r;
   r << "# Reality-gap diagnosis\n\nRecording `" << in.recording << "` against the nominal scenario `" << in.model
-    << "`.\n\n## Verdict: **" << d.verdict << "**\n\n";
-  const std::vector<std::string> verdict = VerdictLines(d, in.baseline != nullptr);
-  for (std::size_t i = 0; i < verdict.size(); ++i)
-    r << (d.verdict == "named" || (d.verdict == "unknown" && i > 0) ? "- " : "") << verdict[i] << "\n";
+    << "`.\n";
+  for (const Verdict& v : Verdicts(d, in)) {
+    r << "\n## " << v.title << ": **" << v.verdict << "**\n\n";
+    for (std::size_t i = 0; i < v.lines.size(); ++i)
+      r << (i >= v.plain ? "- " : "") << v.lines[i] << "\n";
+  }
   r << "\n## Where (whole run, nominal self-calibration)\n\n" << MarkdownTable(LocatedTable(d));
   r << "\n## Candidates (fitted on the first part, up to t = " << Fixed(d.train_end_s, 4) << " s)\n\n"
     << MarkdownTable(CandidatesTable(d));
@@ -370,7 +389,35 @@ std::string ReportMarkdown(const Diagnosis& d, const ReportInputs& in, const Rep
   return r.str();
 }
 
-std::string ScenarioPatch(const Diagnosis& d, const SimulationComparison* simulation) {
+namespace {
+
+// The twin diagnosis's patch: each kept effect's parts as the simulator applies them, with the std of the kept
+// effect's parameter of the same name.
+std::string TwinScenarioPatch(const TwinDiagnosis& twin) {
+  std::ostringstream y;
+  y << "# Accepted effects of `roamlab diagnose --twin` (twin.json \"patch\"), in the form of a scenario's `effects:`\n"
+    << "# section (sim/scenario.h). Standard deviations (" << twin.std_method << ") are comments.\neffects:\n";
+  if (twin.patch.empty()) y << "  []\n";
+  for (const TwinEffect& e : twin.effects)
+    for (const sim::EffectOptions& part : e.applied) {
+      y << "  - name: " << part.name << "\n    parameters:" << (part.parameters.empty() ? " {}" : "") << "\n";
+      for (const auto& [k, v] : part.parameters) {
+        y << "      " << k << ": " << std::setprecision(10) << v;
+        const auto s = e.estimate.std.find(k);
+        if (s != e.estimate.std.end() && std::isfinite(s->second))
+          y << "   # +- " << std::setprecision(3) << s->second;
+        else if (std::find(e.not_informed.begin(), e.not_informed.end(), k) != e.not_informed.end())
+          y << "   # not informed, held";
+        y << "\n";
+      }
+    }
+  return y.str();
+}
+
+}  // namespace
+
+std::string ScenarioPatch(const Diagnosis& d, const SimulationComparison* simulation, const TwinDiagnosis* twin) {
+  if (twin) return TwinScenarioPatch(*twin);
   std::ostringstream y;
   y << "# Accepted effects of `roamlab diagnose`, in the form of a scenario's `effects:` section (sim/scenario.h).\n"
     << "# Standard deviations are comments.\neffects:\n";
@@ -454,7 +501,8 @@ Status WriteReport(const Diagnosis& d, const ReportInputs& in, const std::string
   json gap_json = DiagnosisJson(d, in.baseline, in.baseline_seed, in.simulation, in.real);
   if (in.simulation) gap_json["simulation"]["twin_diagnosis"] = in.twin ? json("twin.json") : json(nullptr);
   if (Status s = WriteFileAtomic(dir + "/gap.json", gap_json.dump(2) + "\n"); !s.ok()) return s;
-  if (Status s = WriteFileAtomic(dir + "/scenario_patch.yaml", ScenarioPatch(d, in.simulation)); !s.ok()) return s;
+  if (Status s = WriteFileAtomic(dir + "/scenario_patch.yaml", ScenarioPatch(d, in.simulation, in.twin)); !s.ok())
+    return s;
   if (Status s = WriteFileAtomic(dir + "/estimator_patch.yaml", EstimatorPatch(d)); !s.ok()) return s;
   ReportFigures figures;
   if (in.plots) {

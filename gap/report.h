@@ -1,8 +1,9 @@
 // What `roamlab diagnose` writes about a diagnosis (gap/diagnose.h): DIR/gap.json (docs/commands.md, `roamlab
 // diagnose`), DIR/report.md, DIR/report.html (the same, self-contained: verdict first, then the held-out fit before and
 // after, the candidates, where, the re-simulation, and the figures embedded), DIR/scenario_patch.yaml (the accepted
-// effects in a scenario's `effects:` form), DIR/estimator_patch.yaml (the same as estimator parameters and stream time
-// shifts) and PNG figures with their gnuplot scripts.
+// effects in a scenario's `effects:` form; with a twin diagnosis, its patch), DIR/estimator_patch.yaml (the
+// estimator-side diagnosis's effects as estimator parameters and stream time shifts) and PNG figures with their
+// gnuplot scripts.
 #pragma once
 
 #include <cstdint>
@@ -25,11 +26,14 @@ namespace roamlab::gap {
 nlohmann::json DiagnosisJson(const Diagnosis& d, const Baseline* baseline, std::uint64_t baseline_seed,
                              const SimulationComparison* simulation, const recording::Recording* real = nullptr);
 
-// The accepted effects as the simulator takes them: as simulated when the scenario was simulated again (time shifts
-// in whole physics steps), otherwise converted without the step.
-std::string ScenarioPatch(const Diagnosis& d, const SimulationComparison* simulation);
+// The accepted effects as the simulator takes them. With `twin` (not null) the twin diagnosis's patch (twin.json
+// "patch": its values are the accepted ones, the estimator-side diagnosis only its first guess), std as its rounds
+// report them; otherwise the diagnosis's effects, as simulated when the scenario was simulated again (time shifts in
+// whole physics steps), else converted without the step.
+std::string ScenarioPatch(const Diagnosis& d, const SimulationComparison* simulation,
+                          const TwinDiagnosis* twin = nullptr);
 
-// The accepted effects as estimator settings: parameter values and stream time shifts.
+// The estimator-side diagnosis's accepted effects as estimator settings: parameter values and stream time shifts.
 std::string EstimatorPatch(const Diagnosis& d);
 
 struct ReportInputs {
@@ -39,8 +43,8 @@ struct ReportInputs {
   std::uint64_t baseline_seed = 0;
   const SimulationComparison* simulation = nullptr;  // null: no re-simulation
   const recording::Recording* real = nullptr;        // the recording (the twins' drift and figures); null: none
-  // The diagnosis against the twin, written to twin.json by the caller (gap.json's "simulation" names the file and
-  // the report shows its verdict and held-out runs); null: none.
+  // The diagnosis against the twin, written to twin.json by the caller (gap.json's "simulation" names the file, the
+  // report leads with its verdict and shows its held-out runs, scenario_patch.yaml is its patch); null: none.
   const TwinDiagnosis* twin = nullptr;
   bool plots = true;                                 // write the figures (when gnuplot is installed)
   std::function<void(const std::string&)> progress;  // receives a note when no figure can be drawn
@@ -52,9 +56,10 @@ struct ReportFigures {
   std::vector<std::string> notes;
 };
 
-// report.md: the verdict, where the recording departs from the model, the candidates, the held-out fit before and
-// after, the twin against the recording (when re-simulated: which twin and why, the held-out RMS and drift before and
-// after, the twin diagnosis's verdict and held-out runs) and the figures.
+// report.md: the verdict (with a twin diagnosis the twin's first, then the estimator-side one), where the recording
+// departs from the model, the candidates, the held-out fit before and after, the twin against the recording (when
+// re-simulated: which twin and why, the held-out RMS and drift before and after, the twin diagnosis's held-out runs)
+// and the figures.
 std::string ReportMarkdown(const Diagnosis& d, const ReportInputs& in, const ReportFigures& figures);
 
 // Writes gap.json, scenario_patch.yaml, estimator_patch.yaml, the figures, report.md and report.html into `dir` (which

@@ -317,6 +317,30 @@ TEST(DiagnoseCliTest, HeldOutShowsTheTwinsPatchOnARecordingOfAnotherDrive) {
   EXPECT_EQ(gap.at("simulation").at("twin_diagnosis"), "twin.json");
   EXPECT_FALSE(gap.at("simulation").at("replayed").get<bool>());
   EXPECT_EQ(gap.at("simulation").at("effects"), twin.at("patch"));
+
+  // The twin's values are the accepted ones: the summary and the report lead with its verdict, and scenario_patch.yaml
+  // is its patch, which a scenario takes as its effects as it is.
+  EXPECT_EQ(run.out.rfind("twin verdict: named; wheel_radius_scale scale = "),
+            run.out.rfind("\n", run.out.size() - 2) + 1)
+      << run.out;
+  const std::string report = testing::ReadFile(dir.File("out/report.md"));
+  EXPECT_LT(report.find("## Verdict against the twin: **named**"), report.find("## Estimator-side verdict"));
+  const std::string patch = testing::ReadFile(dir.File("out/scenario_patch.yaml"));
+  const std::string entry = "  - name: wheel_radius_scale\n    parameters:\n      scale: ";
+  ASSERT_NE(patch.find(entry), std::string::npos) << patch;
+  EXPECT_NEAR(std::stod(patch.substr(patch.find(entry) + entry.size())),
+              twin.at("patch")[0].at("parameters").at("scale").get<double>(), 1e-9)
+      << patch;
+  std::string patched = testing::ReadFile(nominal);
+  const std::size_t at = patched.find("effects: []");
+  ASSERT_NE(at, std::string::npos);
+  patched.replace(at, std::string("effects: []").size(), patch.substr(patch.find("\neffects:") + 1));
+  testing::WriteFile(dir.File("patched.yaml"), patched);
+  const CommandRun simulated =
+      Roamlab("simulate " + dir.File("patched.yaml") + " --out " + dir.File("patched") + " --quiet", dir);
+  EXPECT_EQ(simulated.exit_code, 0) << simulated.err;
+  const std::string truth = testing::ReadFile(dir.File("patched/truth.yaml"));
+  EXPECT_NE(truth.find("wheel_radius_scale"), std::string::npos) << truth;
 }
 
 // A recording of another drive of the OptiOdom differential drive (motion capture): detected and replayed, gap.json's
