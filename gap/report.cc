@@ -1,6 +1,7 @@
 #include "gap/report.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -183,6 +184,12 @@ const char kSimulationText[] =
     "means (the systematic part); then the drift of its absolute streams over 10 s windows, each window's twin aligned "
     "to the recording at its start.";
 
+// What a replayed twin's sample-by-sample figures measure.
+const char kReplayedText[] =
+    "The replay is dead-reckoned from the recording's start: its RMS over the held-out part carries the error it "
+    "accumulated before, which a small heading error grows, and its wheel encoders follow the recorded angles that "
+    "drive it. The 10 s drift is what the twin's fit compares (twin.json).";
+
 html::Table SimulationTable(const SimulationComparison& c) {
   html::Table t{{"stream", "RMS as believed", "RMS with the effects", "change", "1 s RMS as believed",
                  "1 s RMS with the effects"},
@@ -282,29 +289,70 @@ html::Table HeldoutTable(const Diagnosis& d) {
 const char kHeldoutText[] =
     "Whitened residuals: RMS per sample, RMS of their 1 s means (the systematic part) and chi2/dof.";
 
-// The twin's section: which twin and why, the held-out RMS and drift before and after, the twin diagnosis's held-out
-// runs.
-struct TwinSection {
+// A section of the report: its title, paragraphs, tables, notes and figures (file names in the output directory).
+struct Section {
   std::string title;
   std::vector<std::string> lines;  // paragraphs before the tables
   std::vector<html::Table> tables;
   std::vector<std::string> notes;
+  std::vector<std::string> images;
 };
-TwinSection MakeTwinSection(const ReportInputs& in) {
+
+// The twin against the recording: which twin and why, the held-out RMS and drift before and after.
+Section TwinSection(const ReportInputs& in, const ReportFigures& figures) {
   const SimulationComparison& c = *in.simulation;
-  TwinSection out;
+  Section out;
   out.title = "The twin against the recording (held-out part, after t = " + Fixed(c.from_s, 4) + " s)";
   out.lines = {internal::TwinChoiceText(c.twin), kSimulationText};
+  if (c.twin.replayed) out.lines.push_back(kReplayedText);
   out.tables.push_back(SimulationTable(c));
   if (in.real) {
     const internal::HeldOutDrift drift = internal::TwinHeldOutDrift(c, *in.real);
     if (!drift.before.empty()) out.tables.push_back(internal::DriftTable(drift));
   }
   out.notes = SimulationNotes(c);
-  if (in.twin) {
-    out.lines.push_back("The twin diagnosis (its verdict above) in full: twin.json.");
-    if (!in.twin->heldout_runs.empty()) out.tables.push_back(internal::HeldOutRunsTable(*in.twin));
-  }
+  out.images = figures.twin_images;
+  return out;
+}
+
+// The twin diagnosis (its verdict is the report's first): its candidates round by round and its held-out runs.
+Section TwinDiagnosisSection(const TwinDiagnosis& twin) {
+  Section out{
+      "The twin diagnosis",
+      {"Its candidates round by round, each fitted on the training part (up to t = " + Fixed(twin.train_end_s, 4) +
+       " s) by running the twin, then its patch on the held-out runs; in full: "
+       "twin.json."},
+      {internal::TwinCandidatesTable(twin)},
+      {},
+      {}};
+  if (!twin.heldout_runs.empty()) out.tables.push_back(internal::HeldOutRunsTable(twin));
+  return out;
+}
+
+// The sections after the verdicts. With a twin diagnosis its sections come first, its values being the accepted
+// ones, and the estimator side's follow, titled so; otherwise the estimator side's, then the re-simulation.
+std::vector<Section> Sections(const Diagnosis& d, const ReportInputs& in, const ReportFigures& figures) {
+  const auto title = [&](const std::string& estimator) {
+    return in.twin ? "Estimator side: " + std::string(1, static_cast<char>(std::tolower(estimator[0]))) +
+                         estimator.substr(1)
+                   : estimator;
+  };
+  std::vector<Section> out = {
+      {title("Fit on the held-out part (after t = " + Fixed(d.train_end_s, 4) + " s), before and after"),
+       {kHeldoutText},
+       {HeldoutTable(d)},
+       {},
+       {}},
+      {title("Candidates (fitted on the first part)"), {}, {CandidatesTable(d)}, {}, {}},
+      {title("Where (whole run, nominal self-calibration)"), {}, {LocatedTable(d)}, {}, {}}};
+  std::vector<Section> twin;
+  if (in.twin) twin.push_back(TwinDiagnosisSection(*in.twin));
+  if (in.simulation) twin.push_back(TwinSection(in, figures));
+  out.insert(in.twin ? out.begin() : out.end(), twin.begin(), twin.end());
+  Section plots{"Figures", {}, {}, {}, figures.images};
+  if (figures.images.empty() && figures.twin_images.empty())
+    plots.notes = {figures.notes.empty() ? "No figures were drawn." : figures.notes.front()};
+  out.push_back(plots);
   return out;
 }
 
@@ -324,7 +372,7 @@ std::vector<Verdict> Verdicts(const Diagnosis& d, const ReportInputs& in) {
   return {{"Verdict against the twin", in.twin->verdict, lines, 1}, estimator};
 }
 
-// report.html: the verdict first, the tables, then the figures embedded.
+// report.html: the verdicts first, the sections, their figures embedded.
 Status WriteReportHtml(const Diagnosis& d, const ReportInputs& in, const ReportFigures& figures,
                        const std::string& dir) {
   html::Page page("Reality-gap diagnosis");
@@ -334,27 +382,14 @@ Status WriteReportHtml(const Diagnosis& d, const ReportInputs& in, const ReportF
   }
   page.Paragraph("Recording " + in.recording + " against the nominal scenario " + in.model + "; " +
                  std::to_string(d.fits) + " calibrations in " + Fixed(d.seconds, 3) + " s.");
-  page.Heading(2, "Fit on the held-out part (after t = " + Fixed(d.train_end_s, 4) + " s), before and after");
-  page.Paragraph(kHeldoutText);
-  page.AddTable(HeldoutTable(d));
-  page.Heading(2, "Candidates (fitted on the first part)");
-  page.AddTable(CandidatesTable(d));
-  page.Heading(2, "Where (whole run, nominal self-calibration)");
-  page.AddTable(LocatedTable(d));
-  if (in.simulation) {
-    const TwinSection twin = MakeTwinSection(in);
-    page.Heading(2, twin.title);
-    for (const std::string& line : twin.lines) page.Paragraph(line);
-    for (const html::Table& table : twin.tables) page.AddTable(table);
-    for (const std::string& line : twin.notes) page.Paragraph(line, "note");
-    for (const std::string& image : figures.twin_images)
+  for (const Section& section : Sections(d, in, figures)) {
+    page.Heading(2, section.title);
+    for (const std::string& line : section.lines) page.Paragraph(line);
+    for (const html::Table& table : section.tables) page.AddTable(table);
+    for (const std::string& line : section.notes) page.Paragraph(line, "note");
+    for (const std::string& image : section.images)
       if (Status s = page.AddImage(dir + "/" + image, image); !s.ok()) return s;
   }
-  page.Heading(2, "Figures");
-  if (figures.images.empty() && figures.twin_images.empty())
-    page.Paragraph(figures.notes.empty() ? "No figures were drawn." : figures.notes.front(), "note");
-  for (const std::string& image : figures.images)
-    if (Status s = page.AddImage(dir + "/" + image, image); !s.ok()) return s;
   return page.Write(dir + "/report.html");
 }
 
@@ -366,25 +401,15 @@ std::string ReportMarkdown(const Diagnosis& d, const ReportInputs& in, const Rep
     << "`.\n";
   for (const Verdict& v : Verdicts(d, in)) {
     r << "\n## " << v.title << ": **" << v.verdict << "**\n\n";
-    for (std::size_t i = 0; i < v.lines.size(); ++i)
-      r << (i >= v.plain ? "- " : "") << v.lines[i] << "\n";
+    for (std::size_t i = 0; i < v.lines.size(); ++i) r << (i >= v.plain ? "- " : "") << v.lines[i] << "\n";
   }
-  r << "\n## Where (whole run, nominal self-calibration)\n\n" << MarkdownTable(LocatedTable(d));
-  r << "\n## Candidates (fitted on the first part, up to t = " << Fixed(d.train_end_s, 4) << " s)\n\n"
-    << MarkdownTable(CandidatesTable(d));
-  r << "\n## Fit on the held-out part (parameters fixed at the training values)\n\n"
-    << kHeldoutText << "\n\n"
-    << MarkdownTable(HeldoutTable(d));
-  if (in.simulation) {
-    const TwinSection twin = MakeTwinSection(in);
-    r << "\n## " << twin.title << "\n\n";
-    for (const std::string& line : twin.lines) r << line << "\n\n";
-    for (const html::Table& table : twin.tables) r << MarkdownTable(table) << "\n";
-    for (const std::string& note : twin.notes) r << note << "\n";
-    for (const std::string& image : figures.twin_images) r << "![" << image << "](" << image << ")\n\n";
+  for (const Section& section : Sections(d, in, figures)) {
+    r << "\n## " << section.title << "\n\n";
+    for (const std::string& line : section.lines) r << line << "\n\n";
+    for (const html::Table& table : section.tables) r << MarkdownTable(table) << "\n";
+    for (const std::string& note : section.notes) r << note << "\n\n";
+    for (const std::string& image : section.images) r << "![" << image << "](" << image << ")\n\n";
   }
-  r << "\n";
-  for (const std::string& image : figures.images) r << "![" << image << "](" << image << ")\n\n";
   r << d.fits << " calibrations in " << Fixed(d.seconds, 3) << " s.\n";
   return r.str();
 }

@@ -243,6 +243,20 @@ std::vector<std::string> TwinVerdictLines(const TwinDiagnosis& d) {
   return lines;
 }
 
+html::Table TwinCandidatesTable(const TwinDiagnosis& d) {
+  html::Table t{{"round", "effect", "parameters", "LR", "p", "Delta BIC", "held-out chi2 drop", "decision"}, {}};
+  for (std::size_t round = 0; round < d.rounds.size(); ++round)
+    for (const TwinEffect& e : d.rounds[round]) {
+      std::string parameters = EffectLine(e);
+      parameters = parameters.substr(std::min(parameters.size(), e.estimate.name.size() + 2));
+      const EffectEstimate& x = e.estimate;
+      t.rows.push_back(
+          {std::to_string(round + 1), x.name, parameters, Fixed(x.lr, 4), Fixed(x.lr_pvalue, 3), Fixed(x.delta_bic, 4),
+           x.evaluated_heldout ? Fixed(100.0 * x.heldout_improvement, 3) + " %" : std::string("-"), x.decision});
+    }
+  return t;
+}
+
 html::Table HeldOutRunsTable(const TwinDiagnosis& d) {
   html::Table t{{"recording", "twin", "stream", "mean drift before [m]", "after [m]", "chi2 before", "chi2 after"}, {}};
   for (const TwinHeldOutRun& h : d.heldout_runs) {

@@ -34,6 +34,9 @@ html::Table DriftTable(const HeldOutDrift& drift);
 
 // The twin diagnosis (gap/twin.h): its verdict and kept effects with their stds, in lines.
 std::vector<std::string> TwinVerdictLines(const TwinDiagnosis& d);
+// Its candidates, round by round: each one's values with their std, LR, p, Delta BIC, held-out chi-square drop and
+// decision.
+html::Table TwinCandidatesTable(const TwinDiagnosis& d);
 // Its held-out runs: per run and absolute stream, the drift and the chi-square before and after the patch.
 html::Table HeldOutRunsTable(const TwinDiagnosis& d);
 

@@ -325,6 +325,9 @@ TEST(DiagnoseCliTest, HeldOutShowsTheTwinsPatchOnARecordingOfAnotherDrive) {
       << run.out;
   const std::string report = testing::ReadFile(dir.File("out/report.md"));
   EXPECT_LT(report.find("## Verdict against the twin: **named**"), report.find("## Estimator-side verdict"));
+  // Its candidates, round by round, come before the estimator side's.
+  EXPECT_NE(report.find("| 1 | wheel_radius_scale | scale = "), std::string::npos) << report;
+  EXPECT_LT(report.find("## The twin diagnosis"), report.find("## Estimator side: candidates"));
   const std::string patch = testing::ReadFile(dir.File("out/scenario_patch.yaml"));
   const std::string entry = "  - name: wheel_radius_scale\n    parameters:\n      scale: ";
   ASSERT_NE(patch.find(entry), std::string::npos) << patch;
