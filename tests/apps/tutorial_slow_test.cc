@@ -20,7 +20,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The tutorial's commands: the indented lines of README.md's "A ten-minute tutorial" section, comments removed.
+// The tutorial's commands: the indented lines of README.md's "A ten-minute tutorial" section, comments removed and
+// lines ending in a backslash joined with the next.
 std::vector<std::string> TutorialCommands() {
   const std::string readme = testing::ReadFile(roamlab::testing::SourceDir() + "/README.md");
   const std::size_t begin = readme.find("\n## A ten-minute tutorial\n");
@@ -30,7 +31,13 @@ std::vector<std::string> TutorialCommands() {
   for (std::string line; std::getline(section, line);) {
     if (line.rfind("    ", 0) != 0) continue;
     line = std::regex_replace(line.substr(4), std::regex("\\s*#.*$"), "");
-    if (!line.empty()) commands.push_back(line);
+    // A line ending in a backslash continues on the next.
+    if (!commands.empty() && !commands.back().empty() && commands.back().back() == '\\') {
+      commands.back().pop_back();
+      commands.back() += std::regex_replace(line, std::regex("^\\s+"), "");
+    } else if (!line.empty()) {
+      commands.push_back(line);
+    }
   }
   return commands;
 }
@@ -62,9 +69,8 @@ TEST(Tutorial, EveryCommandRuns) {
       continue;
     }
     command = std::regex_replace(command, std::regex("--runs [0-9]+"), "--runs 2");
-    const testing::CommandRun run =
-        testing::RunCommand("cd " + dir.path() + " && export PATH=" + bin + ":$PATH DATA=" + data + " && " + command,
-                            dir.path());
+    const testing::CommandRun run = testing::RunCommand(
+        "cd " + dir.path() + " && export PATH=" + bin + ":$PATH DATA=" + data + " && " + command, dir.path());
     EXPECT_EQ(run.exit_code, 0) << command << "\n" << run.err;
     if (run.exit_code != 0) break;
     ++ran;
@@ -75,7 +81,8 @@ TEST(Tutorial, EveryCommandRuns) {
                            "tut/report_trk/report.html", "tut/report_trk/metrics.json", "tut/mc/nees.json"})
     EXPECT_TRUE(fs::exists(fs::path(dir.path()) / file)) << file;
   if (!have_data) return;
-  for (const char* file : {"tut/odo/table.json", "tut/gap/report.md"})
+  for (const char* file :
+       {"tut/odo/table.json", "tut/gap/report.md", "tut/twin/twin.json", "tut/twin/scenario_patch.yaml"})
     EXPECT_TRUE(fs::exists(fs::path(dir.path()) / file)) << file;
 }
 
