@@ -240,11 +240,11 @@ std::vector<std::string> VerdictLines(const Diagnosis& d, bool baseline) {
   return lines;
 }
 
-html::Table LocatedTable(const Diagnosis& d) {
+html::Table LocatedTable(const std::vector<LocatedComponent>& located) {
   html::Table t{{"stream[component]", "chi2/dof", "nominal level", "inconsistent", "intervals [s]",
                  "strongest condition (rho, lag)"},
                 {}};
-  for (const LocatedComponent& lc : d.located) {
+  for (const LocatedComponent& lc : located) {
     std::string intervals;
     for (std::size_t i = 0; i < lc.intervals.size() && i < 3; ++i)
       intervals += (i ? ", " : "") + Fixed(lc.intervals[i].first, 3) + "-" + Fixed(lc.intervals[i].second, 3);
@@ -315,16 +315,18 @@ Section TwinSection(const ReportInputs& in, const ReportFigures& figures) {
   return out;
 }
 
-// The twin diagnosis (its verdict is the report's first): its candidates round by round and its held-out runs.
+// The twin diagnosis (its verdict is the report's first): where the nominal twin departs, its candidates round by
+// round, its fit of the held-out part before and after the patch, and its held-out runs.
 Section TwinDiagnosisSection(const TwinDiagnosis& twin) {
-  Section out{
-      "The twin diagnosis",
-      {"Its candidates round by round, each fitted on the training part (up to t = " + Fixed(twin.train_end_s, 4) +
-       " s) by running the twin, then its patch on the held-out runs; in full: "
-       "twin.json."},
-      {internal::TwinCandidatesTable(twin)},
-      {},
-      {}};
+  Section out{"The twin diagnosis",
+              {"Where the nominal twin departs from the recording (whole run, whitened by the stated noise); its "
+               "candidates round by round, each fitted on the training part (up to t = " +
+               Fixed(twin.train_end_s, 4) +
+               " s) by running the twin; the held-out part per stream with the nominal twin and with the patch; "
+               "the patch on the held-out runs. In full: twin.json."},
+              {LocatedTable(twin.located), internal::TwinCandidatesTable(twin), internal::TwinHeldOutTable(twin)},
+              {},
+              {}};
   if (!twin.heldout_runs.empty()) out.tables.push_back(internal::HeldOutRunsTable(twin));
   return out;
 }
@@ -344,7 +346,7 @@ std::vector<Section> Sections(const Diagnosis& d, const ReportInputs& in, const 
        {},
        {}},
       {title("Candidates (fitted on the first part)"), {}, {CandidatesTable(d)}, {}, {}},
-      {title("Where (whole run, nominal self-calibration)"), {}, {LocatedTable(d)}, {}, {}}};
+      {title("Where (whole run, nominal self-calibration)"), {}, {LocatedTable(d.located)}, {}, {}}};
   std::vector<Section> twin;
   if (in.twin) twin.push_back(TwinDiagnosisSection(*in.twin));
   if (in.simulation) twin.push_back(TwinSection(in, figures));

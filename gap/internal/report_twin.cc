@@ -257,6 +257,18 @@ html::Table TwinCandidatesTable(const TwinDiagnosis& d) {
   return t;
 }
 
+html::Table TwinHeldOutTable(const TwinDiagnosis& d) {
+  html::Table t{
+      {"stream", "RMS with the nominal twin", "with the patch", "1 s RMS with the nominal twin", "with the patch"}, {}};
+  for (const auto& [name, b] : d.heldout_before.streams) {
+    const auto a = d.heldout_after.streams.find(name);
+    const bool patched = a != d.heldout_after.streams.end();
+    t.rows.push_back({name, Fixed(b.rms, 4), patched ? Fixed(a->second.rms, 4) : "-", Fixed(b.rms_1s, 4),
+                      patched ? Fixed(a->second.rms_1s, 4) : "-"});
+  }
+  return t;
+}
+
 html::Table HeldOutRunsTable(const TwinDiagnosis& d) {
   html::Table t{{"recording", "twin", "stream", "mean drift before [m]", "after [m]", "chi2 before", "chi2 after"}, {}};
   for (const TwinHeldOutRun& h : d.heldout_runs) {

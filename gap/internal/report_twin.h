@@ -37,6 +37,9 @@ std::vector<std::string> TwinVerdictLines(const TwinDiagnosis& d);
 // Its candidates, round by round: each one's values with their std, LR, p, Delta BIC, held-out chi-square drop and
 // decision.
 html::Table TwinCandidatesTable(const TwinDiagnosis& d);
+// Its held-out part: per stream, the whitened RMS (a replayed twin's over its windows, as fitted) with the nominal
+// twin and with the patch.
+html::Table TwinHeldOutTable(const TwinDiagnosis& d);
 // Its held-out runs: per run and absolute stream, the drift and the chi-square before and after the patch.
 html::Table HeldOutRunsTable(const TwinDiagnosis& d);
 
