@@ -1,8 +1,7 @@
 // What `roamlab diagnose` writes about a diagnosis (gap/diagnose.h): DIR/gap.json (docs/commands.md, `roamlab
-// diagnose`), DIR/report.md, DIR/report.html (the same, self-contained: verdict first, then the held-out fit before and
-// after, the candidates, where, the re-simulation, and the figures embedded), DIR/scenario_patch.yaml (the accepted
-// effects in a scenario's `effects:` form; with a twin diagnosis, its patch), DIR/estimator_patch.yaml (the
-// estimator-side diagnosis's effects as estimator parameters and stream time shifts) and PNG figures with their
+// diagnose`), DIR/report.md, DIR/report.html (the same, self-contained, the figures embedded), DIR/scenario_patch.yaml
+// (the accepted effects in a scenario's `effects:` form; with a twin diagnosis, its patch), DIR/estimator_patch.yaml
+// (the estimator-side diagnosis's effects as estimator parameters and stream time shifts) and PNG figures with their
 // gnuplot scripts.
 #pragma once
 
@@ -56,10 +55,11 @@ struct ReportFigures {
   std::vector<std::string> notes;
 };
 
-// report.md: the verdict (with a twin diagnosis the twin's first, then the estimator-side one), where the recording
-// departs from the model, the candidates, the held-out fit before and after, the twin against the recording (when
-// re-simulated: which twin and why, the held-out RMS and drift before and after, the twin diagnosis's held-out runs)
-// and the figures.
+// report.md: the verdict, the held-out fit before and after, the candidates, where the recording departs from the
+// model, the twin against the recording (when re-simulated: which twin and why, the held-out RMS and drift before and
+// after) and the figures. With a twin diagnosis its verdict comes first, then the estimator side's, and its section
+// (where the nominal twin departs, its candidates, its held-out part and runs) and the twin's come before the estimator
+// side's.
 std::string ReportMarkdown(const Diagnosis& d, const ReportInputs& in, const ReportFigures& figures);
 
 // Writes gap.json, scenario_patch.yaml, estimator_patch.yaml, the figures, report.md and report.html into `dir` (which
