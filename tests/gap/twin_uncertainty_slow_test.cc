@@ -156,6 +156,17 @@ sim::Scenario DriftNominal() {
   return s;
 }
 
+// The wheel encoders' rows of `real` restamped t0 + (1 + d) (t - t0), d = `drift_ppm` 1e-6, t0 their first row.
+void RestampWheelEncoders(const sim::Scenario& nominal, double drift_ppm, recording::Recording* real) {
+  for (recording::Stream& stream : real->streams) {
+    if (stream.info.name != nominal.sensors.wheel_encoders->name) continue;
+    const std::int64_t t0_ns = stream.t.front().nanoseconds();
+    for (Time& t : stream.t)
+      t = Time::FromNanoseconds(t0_ns +
+                                std::llround(static_cast<double>(t.nanoseconds() - t0_ns) * (1.0 + drift_ppm * 1e-6)));
+  }
+}
+
 TEST(TwinUncertaintySlowTest, HacIntervalsCoverAHiddenDriveClockDriftUnderColouredNoise) {
   const auto start = std::chrono::steady_clock::now();
   const sim::Scenario nominal = DriftNominal();
@@ -166,13 +177,7 @@ TEST(TwinUncertaintySlowTest, HacIntervalsCoverAHiddenDriveClockDriftUnderColour
     const double true_ppm = drift_ppm(draws);
     std::printf("case %d\n", k);
     recording::Recording real = testing::SimulatedWithSeed(nominal, 500 + static_cast<std::uint64_t>(k)).recording;
-    for (recording::Stream& stream : real.streams) {
-      if (stream.info.name != nominal.sensors.wheel_encoders->name) continue;
-      const std::int64_t t0_ns = stream.t.front().nanoseconds();
-      for (Time& t : stream.t)
-        t = Time::FromNanoseconds(t0_ns +
-                                  std::llround(static_cast<double>(t.nanoseconds() - t0_ns) * (1.0 + true_ppm * 1e-6)));
-    }
+    RestampWheelEncoders(nominal, true_ppm, &real);
     TwinDiagnoseOptions options;
     options.candidates = {"drive_clock_drift"};
     options.max_effects = 1;
@@ -216,13 +221,7 @@ TEST(TwinUncertaintySlowTest, RefittedIntervalsCoverAHiddenScaleAndClockDriftUnd
     sim::Scenario hidden = nominal;
     hidden.effects = {{"wheel_radius_scale", {{"scale", true_scale}}}};
     recording::Recording real = testing::SimulatedWithSeed(hidden, 600 + static_cast<std::uint64_t>(k)).recording;
-    for (recording::Stream& stream : real.streams) {
-      if (stream.info.name != nominal.sensors.wheel_encoders->name) continue;
-      const std::int64_t t0_ns = stream.t.front().nanoseconds();
-      for (Time& t : stream.t)
-        t = Time::FromNanoseconds(t0_ns +
-                                  std::llround(static_cast<double>(t.nanoseconds() - t0_ns) * (1.0 + true_ppm * 1e-6)));
-    }
+    RestampWheelEncoders(nominal, true_ppm, &real);
     TwinDiagnoseOptions options;
     options.candidates = {"wheel_radius_scale", "drive_clock_drift"};
     options.max_effects = 2;
