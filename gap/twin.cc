@@ -189,11 +189,17 @@ Status Diagnoser::Span() {
     }
     if (span.last <= span.first) return Status::Error(name + "the recording has no span of samples to compare");
     const double seconds = SecondsBetween(span.first, span.last);
-    span.train_end = Time::FromSeconds(span.first.seconds() + options_.train_fraction * seconds);
-    span.whole_s = std::max(seconds, 1.0);
-    span.train_s = std::min(span.whole_s, SecondsBetween(span.first, span.train_end) + 0.05);
     residuals_.push_back(run.replayed ? ReplayedResidualOptions(nominal_, *run.real, options_.increment_window_s)
                                       : TwinResidualOptions{});
+    span.train_end = Time::FromSeconds(span.first.seconds() + options_.train_fraction * seconds);
+    // A further training run whose last part is too short to hold one of its windows gives the held-out test nothing:
+    // it trains whole.
+    const double window_s = residuals_.back().increment_window_s;
+    if (!spans_.empty() && window_s > 0.0 &&
+        (1.0 - options_.train_fraction) * seconds < internal::kShortestWindowShare * window_s)
+      span.train_end = span.last;
+    span.whole_s = std::max(seconds, 1.0);
+    span.train_s = std::min(span.whole_s, SecondsBetween(span.first, span.train_end) + 0.05);
     internal::FitRun fit{run.recording, run.real, &run.runner,
                          internal::MakeLayout(*run.real, span.first, span.train_end, residuals_.back()), span.train_s};
     if (fit.layout.size == 0) return Status::Error(name + "the recording has no stream with a stated noise to compare");

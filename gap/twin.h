@@ -270,8 +270,8 @@ struct TwinTrainingRun {
   bool replayed = false;  // the runner replays its drive
 };
 
-// A further training run's figures: its training part's end and its held-out part (the last 1 - train_fraction) with
-// the nominal twin and the patched one.
+// A further training run's figures: its training part's end and its held-out part (the last 1 - train_fraction; none
+// when the run trains whole, DiagnoseTwin's runs) with the nominal twin and the patched one.
 struct TwinTrainingFigures {
   std::string recording;
   bool replayed = false;
@@ -345,10 +345,12 @@ Result<TwinDiagnosis> DiagnoseTwin(const sim::Scenario& nominal, const recording
                                    const TwinRunner& runner, const TwinDiagnoseOptions& options = {});
 // The diagnosis with the patch fitted on several runs of the same robot, the diagnosed recording first: each run's
 // twin with its own runner; each contributes its first train_fraction to the fit and its last part to the held-out
-// test. The fit's residuals and chi-square, the score test, LR and Delta BIC (n: the runs' training residuals) and the
-// held-out chi-square drop are over the runs together; the HAC covariance treats each run's series as independent
-// series. Locate, whole_run, heldout_before/after and unexplained are the diagnosed recording's; training_runs holds
-// the others' held-out figures. With one run it is the diagnosis above. Errors: as above, naming the run.
+// test, except a further run whose last part is too short to hold one of its comparison's windows (a replayed run's
+// increment_window_s, internal::kShortestWindowShare of it): that one trains whole. The fit's residuals and chi-square,
+// the score test, LR and Delta BIC (n: the runs' training residuals) and the held-out chi-square drop are over the runs
+// together; the HAC covariance treats each run's series as independent series. Locate, whole_run, heldout_before/after
+// and unexplained are the diagnosed recording's; training_runs holds the others' held-out figures. With one run it is
+// the diagnosis above. Errors: as above, naming the run.
 Result<TwinDiagnosis> DiagnoseTwin(const sim::Scenario& nominal, const std::vector<TwinTrainingRun>& runs,
                                    const TwinDiagnoseOptions& options = {});
 

@@ -97,7 +97,7 @@ void AddIncrementSeries(const Stream& s, const std::vector<double>& sigma, Time 
   while (a < s.t.size() && s.t[a] <= to) {
     std::size_t b = a;
     while (b + 1 < s.t.size() && s.t[b + 1] <= to && SecondsBetween(s.t[a], s.t[b + 1]) <= window_s + 1e-9) ++b;
-    if (b == a || SecondsBetween(s.t[a], s.t[b]) < 0.9 * window_s) break;
+    if (b == a || SecondsBetween(s.t[a], s.t[b]) < kShortestWindowShare * window_s) break;
     series.starts.push_back(a);
     series.rows.push_back(b);
     series.t.push_back(s.t[b]);
@@ -132,7 +132,7 @@ void AddPoseWindowSeries(const Stream& s, const std::vector<double>& sigma, Time
     while (a < last && SecondsBetween(s.t[first], s.t[a]) < w0 - 1e-9) ++a;
     std::size_t b = a;
     while (b < last && SecondsBetween(s.t[first], s.t[b + 1]) <= w0 + window_s + 1e-9) ++b;
-    if (b <= a || SecondsBetween(s.t[a], s.t[b]) < 0.9 * window_s) continue;
+    if (b <= a || SecondsBetween(s.t[a], s.t[b]) < kShortestWindowShare * window_s) continue;
     std::size_t e = a;
     while (e + 1 < b && SecondsBetween(s.t[a], s.t[e + 1]) <= options.align_s + 1e-9) ++e;
     series.starts.push_back(a);

@@ -62,6 +62,9 @@ PlanarFit PlanarAlignment(const Track& k, std::size_t a, std::size_t b);
 // The stated noise of each compared column (positive), or empty when the stream states none.
 std::vector<double> ColumnSigmas(const recording::StreamInfo& info);
 
+// A windowed increment is compared only when its samples span at least this share of the window.
+constexpr double kShortestWindowShare = 0.9;
+
 // One compared series: some columns of one stream of the real recording, over its samples in a time span.
 struct Series {
   std::string name;    // the stream's name, or "gyroscope" / "accelerometer" for an imu's columns

@@ -186,10 +186,11 @@ TEST(TwinTrainingRunsTest, AJointGeometryIsRecoveredFromReplaysOfTwoDrives) {
 }
 
 // Two runs of the same drive of very different lengths (60 s and 20 s), with different hidden asymmetries (1.01 and
-// 1.03), each replayed and compared by the drift's 10 s windows: weighted by their windows the long run's 31 training
-// windows outweigh the short run's 4 and the fit lands near its ratio; with each run weighing the same
-// (TrainWeight::kRuns) the short run's chi-square weight is its windows' ratio above the long run's (their total
-// unchanged), and the fitted ratio moves to the two's middle.
+// 1.03), each replayed and compared by the drift's 10 s windows. The short run trains whole (its last third, 6.7 s,
+// cannot hold a window): 11 windows against the long run's 31 in its first 40 s. Weighted by their windows the fit
+// lands at the windows' mean of the two ratios; with each run weighing the same (TrainWeight::kRuns) the short run's
+// chi-square weight is its windows' ratio above the long run's (their total unchanged), and the fitted ratio moves
+// to the two's middle.
 TEST(TwinTrainingRunsTest, WeighingTheRunsAlikeMakesAShortRunCountAsMuchAsALongOne) {
   sim::Scenario nominal = Nominal(), long_drive = Nominal(), short_drive = Nominal();
   long_drive.duration_s = 60.0;
@@ -217,7 +218,13 @@ TEST(TwinTrainingRunsTest, WeighingTheRunsAlikeMakesAShortRunCountAsMuchAsALongO
   ASSERT_EQ(w.size(), 2u);
   std::printf("chi-square weights: long %.4f, short %.4f\n", w[0], w[1]);
   EXPECT_LT(w[0], 1.0);
-  EXPECT_NEAR(w[1] / w[0], 31.0 / 4.0, 0.5);
+  EXPECT_NEAR(w[1] / w[0], 31.0 / 11.0, 0.3);
+  // The long run is cut at 2/3, the short one trains whole and holds nothing out.
+  const TwinDiagnosis& d = by_windows.value();
+  EXPECT_NEAR(d.train_end_s - long_run.streams.front().t.front().seconds(), 40.0, 0.1);
+  ASSERT_EQ(d.training_runs.size(), 1u);
+  EXPECT_NEAR(d.training_runs.front().train_end_s - short_run.streams.front().t.front().seconds(), 20.0, 0.1);
+  EXPECT_EQ(d.training_runs.front().heldout_before.residuals, 0);
 
   // The first round's fit (the held-out test, on the long run's last third alone, then rejects the compromise).
   const auto fitted = [](const TwinDiagnosis& d) {
@@ -232,7 +239,7 @@ TEST(TwinTrainingRunsTest, WeighingTheRunsAlikeMakesAShortRunCountAsMuchAsALongO
   const double ratio_windows = fitted(by_windows.value());
   std::printf("each run weighing the same:\n");
   const double ratio_runs = fitted(by_runs.value());
-  EXPECT_NEAR(ratio_windows, 1.01, 0.004);
+  EXPECT_NEAR(ratio_windows, (31.0 * 1.01 + 11.0 * 1.03) / 42.0, 0.003);
   EXPECT_NEAR(ratio_runs, 1.02, 0.003);
 }
 
