@@ -14,7 +14,7 @@
 #                                                          $ROAMLAB_DATA_DIR/optiodom/data, else ../shared/data's;
 #                                                          OUT_DIR: out/twin_optiodom)
 # Needs build/apps/roamlab and python3. Ten diagnoses of about 40-70 s of CPU each and two (diffset_dec) of about
-# 110-160 s, on two threads; JOBS (default 1) of them at a time (OUT/<day>_<set>.time: each one's wall and CPU time).
+# 190-200 s, on two threads; JOBS (default 1) of them at a time (OUT/<day>_<set>.time: each one's wall and CPU time).
 # ONLY (a regular expression) runs only the days whose names match (diff_dec, diff_jun, diff_jun25, omni3,
 # diffset_dec, squareset_dec, squareset_jun).
 set -euo pipefail

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Which objective the OptiOdom twin's geometry fit needs, on the kinematic stand-in (tools/optiodom_drift_floor.py:
 dead reckoning of the recorded encoder angles). A constant geometry (radius scale, right/left ratio, track error) is
-fitted on the training runs' first two thirds by Nelder-Mead on each of:
+fitted on the training runs' first two thirds (a further run too short to hold a window in its last third whole, as the
+twin fits them) by Nelder-Mead on each of:
   increments: the chi-square of consecutive 10 s increments, each in the frame of the recorded heading at its start,
               along and across the recorded displacement d over sqrt(2) sigma and sqrt(2 sigma^2 + sigma_yaw^2 |d|^2);
   windows:    the chi-square of the drift's windows (gap/twin.h TwinResidualOptions): a 10 s window every second, the
@@ -9,7 +10,7 @@ fitted on the training runs' first two thirds by Nelder-Mead on each of:
               aligned samples' centroid and with the alignment yaw's share across, each weighted sqrt(1 / 10);
   per run:    the same, each run's chi-square over its window count (every run weighs the same);
   drift:      the mean over the runs of each run's 10 s drift over its nominal drift (optiodom_drift_floor.py's fit, on
-              the first two thirds);
+              the training parts);
 and carried to the other runs named: each one's 10 s drift with the fitted geometry over its nominal drift.
 
     python3 tools/optiodom_fit_objectives.py DATA_DIR TRAINING_SET[,TRAINING_SET...] OTHER_SET...
@@ -26,8 +27,13 @@ WINDOW_S, STRIDE_S, ALIGN_S, TRAIN_FRACTION = 10.0, 1.0, 2.0, 2.0 / 3.0
 SIGMA_M, SIGMA_YAW = floor.POSITION_SIGMA_M, floor.HEADING_SIGMA_RAD
 
 
-def training_part(run):
-    n = max(2, int(TRAIN_FRACTION * len(run["t"])))
+def training_part(run, first):
+    """The first two thirds, as the twin fits a run; a further run (not `first`) whose last third is too short for one
+    window trains whole, as in the twin."""
+    t = run["t"]
+    if not first and (1.0 - TRAIN_FRACTION) * (t[-1] - t[0]) < 0.9 * WINDOW_S:
+        return run
+    n = max(2, int(TRAIN_FRACTION * len(t)))
     return {k: v[:n] for k, v in run.items()}
 
 
@@ -94,7 +100,7 @@ def main(argv):
     data = pathlib.Path(argv[1])
     training, others = argv[2].split(","), argv[3:]
     runs = {name: floor.load(data / name / f"{pathlib.Path(name).name}_run-01.csv") for name in training + others}
-    parts = [training_part(runs[name]) for name in training]
+    parts = [training_part(runs[name], i == 0) for i, name in enumerate(training)]
     nominal = (1.0, 1.0, 0.0)
     nominal_drift = [floor.drift(part, nominal) for part in parts]
     objectives = {
