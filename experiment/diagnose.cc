@@ -297,9 +297,8 @@ Outcome DiagnoseToDirectory(const DiagnoseRequest& given, gap::Diagnosis* diagno
     training = std::move(trained).value();
     if (const std::string run = NotReplayedForTheDriveClock(request, *twin, training); !run.empty())
       return Outcome::BadInput(
-          Status::Error("--twin-candidates: 'drive_time_offset' shifts a replay's recorded drive "
-                        "inputs, and " +
-                        run + " is twinned by the plain simulation of its own drive (--replay replays it)"));
+          Status::Error("--twin-candidates: 'drive_time_offset' shifts a replay's recorded drive inputs, and " + run +
+                        " is twinned by the plain simulation of its own drive (--replay replays it)"));
   }
   if (Status s = RemoveEarlierOutputs(given, request.out); !s.ok()) return Outcome::Failed(s);
   IncompleteMarker marker(request.out);
