@@ -168,8 +168,9 @@ std::string ResidualVsCondition(const SimulationComparison& c, const recording::
 }
 
 // "name: parameter = value +- std ..." of a fitted effect.
-std::string EffectLine(const TwinEffect& e) {
-  std::string line = e.estimate.name + ":";
+// Its parameters as " name = value +- std" each.
+std::string ParametersText(const TwinEffect& e) {
+  std::string line;
   for (const auto& [k, v] : e.estimate.parameters) {
     line += " " + k + " = " + Fixed(v, 5);
     if (const auto s = e.estimate.std.find(k); s != e.estimate.std.end()) line += " +- " + Fixed(s->second, 2);
@@ -178,6 +179,8 @@ std::string EffectLine(const TwinEffect& e) {
   }
   return line;
 }
+
+std::string EffectLine(const TwinEffect& e) { return e.estimate.name + ":" + ParametersText(e); }
 
 }  // namespace
 
@@ -247,8 +250,7 @@ html::Table TwinCandidatesTable(const TwinDiagnosis& d) {
   html::Table t{{"round", "effect", "parameters", "LR", "p", "Delta BIC", "held-out chi2 drop", "decision"}, {}};
   for (std::size_t round = 0; round < d.rounds.size(); ++round)
     for (const TwinEffect& e : d.rounds[round]) {
-      std::string parameters = EffectLine(e);
-      parameters = parameters.substr(std::min(parameters.size(), e.estimate.name.size() + 2));
+      const std::string parameters = ParametersText(e).substr(e.estimate.parameters.empty() ? 0 : 1);
       const EffectEstimate& x = e.estimate;
       t.rows.push_back(
           {std::to_string(round + 1), x.name, parameters, Fixed(x.lr, 4), Fixed(x.lr_pvalue, 3), Fixed(x.delta_bic, 4),
